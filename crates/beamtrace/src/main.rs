@@ -1,1 +1,30 @@
-fn main() {}
+//! The `beamtrace` command line: argument parsing and output only; the algorithms live in the
+//! library crates.
+
+mod args;
+mod output;
+mod trace;
+
+use clap::Parser;
+use std::process::ExitCode;
+
+fn main() -> ExitCode {
+    let cli = args::Cli::parse();
+    match run(cli) {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(2)
+        }
+    }
+}
+
+fn run(cli: args::Cli) -> anyhow::Result<ExitCode> {
+    match cli.command {
+        args::Command::Trace(a) => trace::run(&a),
+        args::Command::Demo(a) => trace::run(&a.into_trace()),
+        args::Command::Scene {
+            command: args::SceneCommand::Check(a),
+        } => trace::check(&a),
+    }
+}

@@ -1,1 +1,20 @@
-//! placeholder
+//! Geometry kernel of beamtrace: the scalar type, named tolerances, planes, bounded planar
+//! polygons, segment tests and a bounding-volume hierarchy for occlusion queries.
+//!
+//! Frames and units: right-handed world frame, z up, metres. See `docs/conventions.md`.
+
+pub mod bvh;
+pub mod plane;
+pub mod polygon;
+pub mod tol;
+
+pub use bvh::{Bvh, Occluder};
+pub use plane::{Plane, Side};
+pub use polygon::{Polygon, PolygonError};
+
+/// The one scalar type of the project (metres, seconds, radians unless a name says otherwise).
+pub type Real = f64;
+/// A point or vector in the world frame (metres, z up).
+pub type Vec3 = glam::DVec3;
+/// A point or vector in a polygon's 2-D in-plane frame (metres).
+pub type Vec2 = glam::DVec2;

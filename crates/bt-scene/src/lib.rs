@@ -1,1 +1,20 @@
-//! placeholder
+//! The scene: bounded planar reflectors, blockers, the transmitter (TX), the receiver (RX) and
+//! the carrier frequency, validated once at the boundary.
+//!
+//! Units and frames: metres, z up, Hz; see `docs/conventions.md`. Only [`io`] reads files.
+
+mod builtin;
+mod description;
+pub mod io;
+mod material;
+mod model;
+mod validate;
+
+pub use builtin::{builtin_json, builtin_names, builtin_scene};
+pub use description::{BoxDesc, MaterialDesc, SceneDescription, SurfaceDesc};
+pub use material::{DEFAULT_MATERIAL, Material, default_materials};
+pub use model::{Scene, Surface, SurfaceId, SurfaceKind};
+pub use validate::{DEFAULT_FREQUENCY_HZ, Problem, SceneError, Terminals};
+
+/// Re-exported so users of the scene need not depend on the geometry crate for the basics.
+pub use bt_geom::{Polygon, Real, Vec3};

@@ -1,1 +1,219 @@
-//! placeholder
+//! Solvers for candidate paths and validation of what they find.
+//!
+//! - [`image`]: the image method, exact geometric optics, the reference;
+//! - [`ipc`]: iterative path convergence (the paper's Algorithms 1-2), Gauss-Seidel or Jacobi;
+//! - [`validate`]: the geometric checks every found path must pass.
+//!
+//! [`trace`] runs a solver over a [`CandidateSet`] and returns the valid paths plus a count
+//! of every outcome; one bad candidate never aborts the batch.
+
+pub mod image;
+pub mod ipc;
+pub mod validate;
+
+use bt_geom::{Real, Vec3};
+use bt_paths::CandidateSet;
+use bt_scene::{Scene, SurfaceId};
+use rayon::prelude::*;
+use serde::Serialize;
+
+pub use ipc::{DegenerateKind, IpcOptions, IpcOutcome, UpdateOrder};
+pub use validate::Validity;
+
+/// Which solver computes the interaction points.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(tag = "solver", rename_all = "kebab-case")]
+pub enum Solver {
+    /// The image method.
+    Image,
+    /// Iterative path convergence.
+    Ipc(IpcOptions),
+}
+
+/// A valid specular path found by a solver.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FoundPath {
+    /// Reflecting surfaces, TX side first (empty: line of sight).
+    pub surfaces: Vec<SurfaceId>,
+    /// Interaction points, TX side first, metres (TX and RX excluded).
+    pub points: Vec<Vec3>,
+    /// IPC rounds used (IPC only).
+    pub iterations: Option<u32>,
+    /// Mean displacement of IPC's last round, metres (IPC only).
+    pub residual: Option<Real>,
+}
+
+/// What happened to one candidate.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub enum CandidateOutcome {
+    /// The solver produced points, judged by validation.
+    Solved {
+        /// Geometric verdict.
+        validity: Validity,
+        /// IPC outcome when IPC ran.
+        ipc: Option<IpcOutcome>,
+    },
+    /// The image method found a line parallel to a plane.
+    ImageDegenerate(image::ImageFailure),
+    /// IPC did not converge within the round cap.
+    NotConverged(IpcOutcome),
+    /// IPC degenerated (m + n = 0, opposite sides).
+    Degenerate(IpcOutcome),
+}
+
+/// Counts of candidate outcomes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+pub struct OutcomeCounts {
+    /// Valid paths.
+    pub valid: u64,
+    /// Rejected: a point outside its polygon.
+    pub outside_polygon: u64,
+    /// Rejected: neighbours on opposite sides of a surface.
+    pub opposite_sides: u64,
+    /// Rejected: a neighbour on the plane (grazing).
+    pub grazing: u64,
+    /// Rejected: a segment blocked.
+    pub blocked: u64,
+    /// IPC: round cap reached.
+    pub not_converged: u64,
+    /// IPC or image method: degenerate geometry.
+    pub degenerate: u64,
+}
+
+impl OutcomeCounts {
+    fn add(&mut self, outcome: &CandidateOutcome) {
+        match outcome {
+            CandidateOutcome::Solved { validity, .. } => match validity {
+                Validity::Valid => self.valid += 1,
+                Validity::OutsidePolygon { .. } => self.outside_polygon += 1,
+                Validity::OppositeSides { .. } => self.opposite_sides += 1,
+                Validity::Grazing { .. } => self.grazing += 1,
+                Validity::Blocked { .. } => self.blocked += 1,
+                Validity::NonFinite => self.degenerate += 1,
+            },
+            CandidateOutcome::ImageDegenerate(_) | CandidateOutcome::Degenerate(_) => {
+                self.degenerate += 1
+            }
+            CandidateOutcome::NotConverged(_) => self.not_converged += 1,
+        }
+    }
+}
+
+/// Result of a trace.
+#[derive(Debug, Clone, Default, Serialize)]
+pub struct TraceResult {
+    /// Valid paths, in candidate order.
+    pub paths: Vec<FoundPath>,
+    /// Outcome counts over all candidates.
+    pub counts: OutcomeCounts,
+}
+
+/// Solve and validate one candidate. `points` and `scratch` must have the sequence's length;
+/// on return `points` holds the solver's points (meaningful when `Solved`).
+pub fn solve_candidate(
+    scene: &Scene,
+    seq: &[SurfaceId],
+    solver: &Solver,
+    points: &mut [Vec3],
+    scratch: &mut [Vec3],
+) -> CandidateOutcome {
+    let (tx, rx) = (scene.tx(), scene.rx());
+    let ipc = match solver {
+        Solver::Image => {
+            if let Err(e) = image::solve(scene, seq, tx, rx, points) {
+                return CandidateOutcome::ImageDegenerate(e);
+            }
+            None
+        }
+        Solver::Ipc(options) => {
+            for (p, id) in points.iter_mut().zip(seq) {
+                *p = scene.surface(*id).polygon.centroid();
+            }
+            let outcome = ipc::solve(scene, seq, tx, rx, options, points, scratch);
+            match outcome {
+                IpcOutcome::Converged { .. } => Some(outcome),
+                IpcOutcome::NotConverged { .. } => return CandidateOutcome::NotConverged(outcome),
+                IpcOutcome::Degenerate { .. } => return CandidateOutcome::Degenerate(outcome),
+            }
+        }
+    };
+    CandidateOutcome::Solved {
+        validity: validate::validate(scene, seq, tx, rx, points),
+        ipc,
+    }
+}
+
+/// Maximum order handled with stack buffers; longer sequences use heap buffers.
+const STACK_ORDER: usize = 8;
+
+/// Run `solver` on every candidate. `parallel` spreads candidates over rayon's pool; the
+/// output is identical either way (order-preserving).
+pub fn trace(
+    scene: &Scene,
+    candidates: &CandidateSet,
+    solver: &Solver,
+    parallel: bool,
+) -> TraceResult {
+    let run = |range: std::ops::Range<usize>| {
+        let mut out = TraceResult::default();
+        let mut stack_points = [Vec3::ZERO; STACK_ORDER];
+        let mut stack_scratch = [Vec3::ZERO; STACK_ORDER];
+        let mut heap_points = Vec::new();
+        let mut heap_scratch = Vec::new();
+        for i in range {
+            let seq = candidates.get(i);
+            let n = seq.len();
+            let (points, scratch) = if n <= STACK_ORDER {
+                (&mut stack_points[..n], &mut stack_scratch[..n])
+            } else {
+                heap_points.resize(n, Vec3::ZERO);
+                heap_scratch.resize(n, Vec3::ZERO);
+                (&mut heap_points[..], &mut heap_scratch[..])
+            };
+            let outcome = solve_candidate(scene, seq, solver, points, scratch);
+            out.counts.add(&outcome);
+            if let CandidateOutcome::Solved {
+                validity: Validity::Valid,
+                ipc,
+            } = outcome
+            {
+                let (iterations, residual) = match ipc {
+                    Some(IpcOutcome::Converged {
+                        iterations,
+                        residual,
+                    }) => (Some(iterations), Some(residual)),
+                    _ => (None, None),
+                };
+                out.paths.push(FoundPath {
+                    surfaces: seq.to_vec(),
+                    points: points.to_vec(),
+                    iterations,
+                    residual,
+                });
+            }
+        }
+        out
+    };
+    let total = candidates.len();
+    if !parallel || total < 256 {
+        return run(0..total);
+    }
+    const CHUNK: usize = 128;
+    let parts: Vec<TraceResult> = (0..total.div_ceil(CHUNK))
+        .into_par_iter()
+        .map(|c| run(c * CHUNK..((c + 1) * CHUNK).min(total)))
+        .collect();
+    let mut out = TraceResult::default();
+    for part in parts {
+        out.paths.extend(part.paths);
+        let c = part.counts;
+        out.counts.valid += c.valid;
+        out.counts.outside_polygon += c.outside_polygon;
+        out.counts.opposite_sides += c.opposite_sides;
+        out.counts.grazing += c.grazing;
+        out.counts.blocked += c.blocked;
+        out.counts.not_converged += c.not_converged;
+        out.counts.degenerate += c.degenerate;
+    }
+    out
+}

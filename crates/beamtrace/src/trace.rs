@@ -1,0 +1,137 @@
+//! `beamtrace trace`, `demo` and `scene check`.
+
+use crate::args::{IpcOrderArg, SceneArgs, SolverArg, TraceArgs};
+use crate::output::{self, TraceDocument};
+use anyhow::{Context, bail};
+use bt_paths::AllVisible;
+use bt_scene::io::{LoadOptions, Loaded};
+use bt_scene::{Scene, SceneError, Terminals};
+use bt_solve::{IpcOptions, Solver, UpdateOrder};
+use std::path::Path;
+use std::process::ExitCode;
+use std::time::Instant;
+
+/// Load the scene named on the command line (a file or `builtin:NAME`).
+pub fn load_scene(args: &SceneArgs) -> Result<Loaded, SceneError> {
+    let terminals = Terminals {
+        tx: args.tx,
+        rx: args.rx,
+    };
+    if let Some(name) = args.scene.strip_prefix("builtin:") {
+        return match bt_scene::builtin_scene(name, terminals) {
+            Some(scene) => scene.map(|scene| Loaded {
+                scene,
+                warnings: Vec::new(),
+            }),
+            None => Err(SceneError::UnsupportedFormat {
+                path: format!(
+                    "{} (built-in scenes: {})",
+                    args.scene,
+                    bt_scene::builtin_names().join(", ")
+                ),
+            }),
+        };
+    }
+    let options = LoadOptions {
+        terminals,
+        merge: bt_mesh::MergeOptions {
+            angle_tol_deg: args.merge_angle_deg,
+            dist_tol_m: args.merge_distance,
+            ..bt_mesh::MergeOptions::default()
+        },
+        min_reflector_area_m2: args.min_reflector_area,
+        ..LoadOptions::default()
+    };
+    bt_scene::io::load(Path::new(&args.scene), &options)
+}
+
+/// The solver the arguments select, with defaults scaled to the scene.
+pub fn solver_for(args: &TraceArgs, scene: &Scene) -> anyhow::Result<Solver> {
+    Ok(match args.solver {
+        SolverArg::Image => Solver::Image,
+        SolverArg::Ipc => {
+            let order = match args.ipc_order {
+                IpcOrderArg::GaussSeidel => UpdateOrder::GaussSeidel,
+                IpcOrderArg::Jacobi => UpdateOrder::Jacobi,
+            };
+            let mut options = IpcOptions::for_scene(scene, order);
+            if let Some(t) = args.ipc_threshold {
+                if !(t.is_finite() && t > 0.0) {
+                    bail!("--ipc-threshold must be a positive number of metres, got {t}");
+                }
+                options.threshold = t;
+            }
+            if args.ipc_max_iterations == 0 {
+                bail!("--ipc-max-iterations must be at least 1");
+            }
+            options.max_iterations = args.ipc_max_iterations;
+            Solver::Ipc(options)
+        }
+    })
+}
+
+pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
+    let t0 = Instant::now();
+    let loaded = load_scene(&args.scene)?;
+    for w in &loaded.warnings {
+        eprintln!("warning: {w}");
+    }
+    let scene = loaded.scene;
+    let solver = solver_for(args, &scene)?;
+    let t1 = Instant::now();
+    let candidates = bt_paths::enumerate(&scene, args.max_order, &AllVisible);
+    let t2 = Instant::now();
+    let result = bt_solve::trace(&scene, &candidates, &solver, !args.single_thread);
+    let t3 = Instant::now();
+    let paths = bt_beams::report(&scene, &result.paths);
+    let t4 = Instant::now();
+    let doc = TraceDocument::new(
+        &scene,
+        &solver,
+        args.max_order,
+        paths,
+        candidates.stats,
+        result.counts,
+        [t1 - t0, t2 - t1, t3 - t2, t4 - t3],
+    );
+    let json = serde_json::to_string_pretty(&doc).context("serialising the trace")?;
+    if let Some(path) = &args.out {
+        std::fs::write(path, format!("{json}\n"))
+            .with_context(|| format!("writing {}", path.display()))?;
+    }
+    if args.json {
+        println!("{json}");
+    } else {
+        output::print_table(&doc);
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+pub fn check(args: &SceneArgs) -> anyhow::Result<ExitCode> {
+    match load_scene(args) {
+        Ok(loaded) => {
+            let scene = &loaded.scene;
+            for w in &loaded.warnings {
+                println!("warning: {w}");
+            }
+            let reflectors = scene.reflectors().count();
+            println!(
+                "{}: ok: {} surfaces ({} reflectors, {} blockers), extent {:.2} m, tx {:?}, rx {:?}, {:.3} GHz",
+                args.scene,
+                scene.surfaces().len(),
+                reflectors,
+                scene.surfaces().len() - reflectors,
+                scene.extent(),
+                scene.tx().to_array(),
+                scene.rx().to_array(),
+                scene.frequency_hz() / 1e9
+            );
+            Ok(ExitCode::SUCCESS)
+        }
+        Err(e @ SceneError::Invalid { .. }) => {
+            println!("{e}");
+            Ok(ExitCode::from(1))
+        }
+        Err(e) => Err(e.into()),
+    }
+}

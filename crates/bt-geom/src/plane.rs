@@ -1,0 +1,117 @@
+//! Infinite planes `normal · x = offset` (unit normal, offset in metres).
+
+use crate::{Real, Vec3};
+use serde::{Deserialize, Serialize};
+
+/// An oriented infinite plane: the points `x` with `normal · x = offset`.
+/// `normal` is a unit vector; `offset` is the signed distance of the plane from the origin (m).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Plane {
+    /// Unit normal (world frame).
+    pub normal: Vec3,
+    /// Signed distance from the origin along `normal`, metres.
+    pub offset: Real,
+}
+
+/// Which side of a plane a point lies on, decided with a tolerance band.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+pub enum Side {
+    /// `normal · x - offset > tol`.
+    Front,
+    /// `normal · x - offset < -tol`.
+    Back,
+    /// Within the tolerance band: on the plane.
+    On,
+}
+
+impl Plane {
+    /// Plane through `point` with unit normal `normal` (normalised here; must be non-zero).
+    pub fn from_point_normal(point: Vec3, normal: Vec3) -> Self {
+        let normal = normal.normalize();
+        Self {
+            normal,
+            offset: normal.dot(point),
+        }
+    }
+
+    /// Signed distance of `p` from the plane (m), positive on the normal's side.
+    /// Uses a fused multiply-add chain so the sign is as exact as f64 allows.
+    #[inline]
+    pub fn signed_distance(&self, p: Vec3) -> Real {
+        self.normal.x.mul_add(
+            p.x,
+            self.normal
+                .y
+                .mul_add(p.y, self.normal.z.mul_add(p.z, -self.offset)),
+        )
+    }
+
+    /// Side of `p` with a tolerance band of `tol` metres.
+    #[inline]
+    pub fn side(&self, p: Vec3, tol: Real) -> Side {
+        let d = self.signed_distance(p);
+        if d > tol {
+            Side::Front
+        } else if d < -tol {
+            Side::Back
+        } else {
+            Side::On
+        }
+    }
+
+    /// Orthogonal projection of `p` onto the plane.
+    #[inline]
+    pub fn project(&self, p: Vec3) -> Vec3 {
+        p - self.signed_distance(p) * self.normal
+    }
+
+    /// Mirror image of `p` through the plane (the image source of the image method).
+    #[inline]
+    pub fn mirror(&self, p: Vec3) -> Vec3 {
+        p - 2.0 * self.signed_distance(p) * self.normal
+    }
+
+    /// Parameter `t` where the line `a + t (b - a)` crosses the plane, or `None` when the line
+    /// is parallel to it (|n · (b - a)| below `f64::EPSILON` times the segment length).
+    #[inline]
+    pub fn line_parameter(&self, a: Vec3, b: Vec3) -> Option<Real> {
+        let da = self.signed_distance(a);
+        let db = self.signed_distance(b);
+        let denom = da - db;
+        if denom.abs() <= Real::EPSILON * (b - a).length() {
+            None
+        } else {
+            Some(da / denom)
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn mirror_and_projection_of_a_tilted_plane() {
+        let plane = Plane::from_point_normal(Vec3::new(0.0, 0.0, 1.0), Vec3::new(0.0, 1.0, 1.0));
+        let p = Vec3::new(3.0, -2.0, -1.0);
+        let image = plane.mirror(p);
+        assert!((plane.signed_distance(image) + plane.signed_distance(p)).abs() < 1e-12);
+        let mid = 0.5 * (p + image);
+        assert!(plane.signed_distance(mid).abs() < 1e-12);
+        assert!(plane.signed_distance(plane.project(p)).abs() < 1e-12);
+        assert_eq!(plane.side(p, 1e-9), Side::Back);
+    }
+
+    #[test]
+    fn line_parameter_is_none_for_parallel_lines() {
+        let plane = Plane::from_point_normal(Vec3::ZERO, Vec3::Z);
+        assert_eq!(
+            plane.line_parameter(Vec3::new(0., 0., 1.), Vec3::new(5., 0., 1.)),
+            None
+        );
+        let t = plane
+            .line_parameter(Vec3::new(0., 0., 1.), Vec3::new(0., 0., -3.))
+            .unwrap();
+        assert!((t - 0.25).abs() < 1e-15);
+    }
+}

@@ -1,0 +1,392 @@
+//! Bounded planar polygons: the shape of every reflecting surface and blocker.
+//!
+//! A [`Polygon`] is validated at construction (finite, at least three distinct vertices,
+//! planar, non-zero area, simple) and carries a precomputed in-plane 2-D frame so that the
+//! hot inside test is a handful of multiply-adds.
+
+use crate::plane::Plane;
+use crate::{Real, Vec2, Vec3, tol};
+use serde::Serialize;
+use thiserror::Error;
+
+/// Why a vertex list is not a valid bounded planar polygon.
+#[derive(Debug, Clone, PartialEq, Error, Serialize)]
+pub enum PolygonError {
+    /// Fewer than three vertices.
+    #[error("polygon has {0} vertices, at least 3 are needed")]
+    TooFewVertices(usize),
+    /// A coordinate is NaN or infinite.
+    #[error("vertex {index} has a non-finite coordinate")]
+    NonFinite {
+        /// Vertex index (0-based).
+        index: usize,
+    },
+    /// Two consecutive vertices coincide (the closing vertex must not repeat the first).
+    #[error("vertices {first} and {second} are repeated (same position)")]
+    RepeatedVertex {
+        /// Index of the first of the pair.
+        first: usize,
+        /// Index of the second of the pair.
+        second: usize,
+    },
+    /// The polygon encloses (numerically) no area.
+    #[error("polygon has zero area (collinear or coincident vertices)")]
+    ZeroArea,
+    /// A vertex lies too far from the polygon's plane.
+    #[error(
+        "polygon is not planar: vertex {index} is {distance_m:.3e} m off its plane (tolerance {tolerance_m:.1e} m)"
+    )]
+    NonPlanar {
+        /// Index of the worst vertex.
+        index: usize,
+        /// Its distance from the best-fit plane, metres.
+        distance_m: Real,
+        /// The tolerance it exceeded, metres.
+        tolerance_m: Real,
+    },
+    /// Two non-adjacent edges cross.
+    #[error("polygon is self-intersecting: edges {0} and {1} cross")]
+    SelfIntersecting(usize, usize),
+}
+
+/// A validated simple planar polygon in 3-D.
+///
+/// The normal follows the right-hand rule of the vertex order (counter-clockwise seen from the
+/// side the normal points to). Surfaces reflect from both sides, so the orientation only fixes
+/// the sign convention of [`Plane::signed_distance`].
+#[derive(Debug, Clone, PartialEq)]
+pub struct Polygon {
+    vertices: Vec<Vec3>,
+    plane: Plane,
+    origin: Vec3,
+    u: Vec3,
+    v: Vec3,
+    local: Vec<Vec2>,
+    area: Real,
+    centroid: Vec3,
+    extent: Real,
+    min: Vec3,
+    max: Vec3,
+}
+
+impl Polygon {
+    /// Validate `vertices` (metres, world frame) and build the polygon.
+    pub fn new(vertices: Vec<Vec3>) -> Result<Self, PolygonError> {
+        let n = vertices.len();
+        if n < 3 {
+            return Err(PolygonError::TooFewVertices(n));
+        }
+        if let Some(index) = vertices.iter().position(|p| !p.is_finite()) {
+            return Err(PolygonError::NonFinite { index });
+        }
+        let (min, max) = bounds(&vertices);
+        let extent = (max - min).length();
+        let merge = tol::scaled(tol::REL_VERTEX_MERGE, extent);
+        for i in 0..n {
+            let j = (i + 1) % n;
+            if vertices[i].distance(vertices[j]) <= merge {
+                let (first, second) = if j == 0 { (0, i) } else { (i, j) };
+                return Err(PolygonError::RepeatedVertex { first, second });
+            }
+        }
+        // Newell's method: robust normal and twice the area vector for any simple polygon.
+        let c0 = vertices.iter().copied().sum::<Vec3>() / n as Real;
+        let mut newell = Vec3::ZERO;
+        for i in 0..n {
+            let a = vertices[i] - c0;
+            let b = vertices[(i + 1) % n] - c0;
+            newell += a.cross(b);
+        }
+        let area = 0.5 * newell.length();
+        if area <= tol::REL_AREA * extent * extent || !area.is_normal() {
+            return Err(PolygonError::ZeroArea);
+        }
+        let normal = newell / (2.0 * area);
+        let plane = Plane {
+            normal,
+            offset: normal.dot(c0),
+        };
+        let planarity = tol::REL_PLANARITY * extent;
+        let (index, distance_m) = vertices
+            .iter()
+            .enumerate()
+            .map(|(i, p)| (i, plane.signed_distance(*p).abs()))
+            .fold(
+                (0, 0.0),
+                |best, cur| if cur.1 > best.1 { cur } else { best },
+            );
+        if distance_m > planarity {
+            return Err(PolygonError::NonPlanar {
+                index,
+                distance_m,
+                tolerance_m: planarity,
+            });
+        }
+        let (u, v) = normal.any_orthonormal_pair();
+        let origin = plane.project(c0);
+        let local: Vec<Vec2> = vertices
+            .iter()
+            .map(|p| {
+                let d = *p - origin;
+                Vec2::new(d.dot(u), d.dot(v))
+            })
+            .collect();
+        if let Some((i, j)) = first_crossing(&local) {
+            return Err(PolygonError::SelfIntersecting(i, j));
+        }
+        let centroid = area_centroid(&local, origin, u, v);
+        Ok(Self {
+            vertices,
+            plane,
+            origin,
+            u,
+            v,
+            local,
+            area,
+            centroid,
+            extent,
+            min,
+            max,
+        })
+    }
+
+    /// Vertices in the order given, metres.
+    pub fn vertices(&self) -> &[Vec3] {
+        &self.vertices
+    }
+
+    /// Supporting plane; its normal follows the vertex order (right-hand rule).
+    pub fn plane(&self) -> &Plane {
+        &self.plane
+    }
+
+    /// Area, square metres.
+    pub fn area(&self) -> Real {
+        self.area
+    }
+
+    /// Area centroid (lies in the plane, not necessarily inside a concave polygon), metres.
+    pub fn centroid(&self) -> Vec3 {
+        self.centroid
+    }
+
+    /// Length of the bounding-box diagonal, metres.
+    pub fn extent(&self) -> Real {
+        self.extent
+    }
+
+    /// Axis-aligned bounding box `(min, max)`, metres.
+    pub fn bounds(&self) -> (Vec3, Vec3) {
+        (self.min, self.max)
+    }
+
+    /// Coordinates of `p` (assumed on or near the plane) in the polygon's 2-D frame.
+    #[inline]
+    pub fn to_local(&self, p: Vec3) -> Vec2 {
+        let d = p - self.origin;
+        Vec2::new(d.dot(self.u), d.dot(self.v))
+    }
+
+    /// Signed distance (m) of the projection of `p` from the polygon boundary, measured in the
+    /// plane: positive inside, negative outside, zero on an edge.
+    pub fn signed_boundary_distance(&self, p: Vec3) -> Real {
+        let q = self.to_local(p);
+        let n = self.local.len();
+        let mut inside = false;
+        let mut best = Real::INFINITY;
+        let mut j = n - 1;
+        for i in 0..n {
+            let a = self.local[j];
+            let b = self.local[i];
+            if (b.y > q.y) != (a.y > q.y) {
+                let x = b.x + (q.y - b.y) * (a.x - b.x) / (a.y - b.y);
+                if q.x < x {
+                    inside = !inside;
+                }
+            }
+            best = best.min(segment_distance_sq(q, a, b));
+            j = i;
+        }
+        let d = best.sqrt();
+        if inside { d } else { -d }
+    }
+
+    /// Whether the projection of `p` onto the plane lies inside the polygon or within `tol`
+    /// metres of its boundary (inclusive test, used for interaction points).
+    #[inline]
+    pub fn contains(&self, p: Vec3, tol: Real) -> bool {
+        self.signed_boundary_distance(p) >= -tol
+    }
+
+    /// Whether the open segment `a -> b` passes through the polygon: it crosses the plane at a
+    /// parameter `t` in `[t_min, 1 - t_min]` at a point inside the polygon or within `tol` of
+    /// its boundary (grazing an edge counts as blocked: the conservative choice for occlusion).
+    pub fn blocks_segment(&self, a: Vec3, b: Vec3, t_min: Real, tol: Real) -> bool {
+        let da = self.plane.signed_distance(a);
+        let db = self.plane.signed_distance(b);
+        if (da > tol && db > tol) || (da < -tol && db < -tol) {
+            return false;
+        }
+        match self.plane.line_parameter(a, b) {
+            Some(t) if t >= t_min && t <= 1.0 - t_min => self.contains(a + t * (b - a), tol),
+            _ => false,
+        }
+    }
+}
+
+fn bounds(points: &[Vec3]) -> (Vec3, Vec3) {
+    points
+        .iter()
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| {
+            (lo.min(*p), hi.max(*p))
+        })
+}
+
+fn segment_distance_sq(q: Vec2, a: Vec2, b: Vec2) -> Real {
+    let ab = b - a;
+    let t = ((q - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0);
+    (a + t * ab - q).length_squared()
+}
+
+fn area_centroid(local: &[Vec2], origin: Vec3, u: Vec3, v: Vec3) -> Vec3 {
+    let n = local.len();
+    let (mut a2, mut cx, mut cy) = (0.0, 0.0, 0.0);
+    for i in 0..n {
+        let p = local[i];
+        let q = local[(i + 1) % n];
+        let cross = p.perp_dot(q);
+        a2 += cross;
+        cx += (p.x + q.x) * cross;
+        cy += (p.y + q.y) * cross;
+    }
+    let c = Vec2::new(cx, cy) / (3.0 * a2);
+    origin + c.x * u + c.y * v
+}
+
+/// First pair of non-adjacent edges that intersect, if any (O(n²); polygons are small).
+fn first_crossing(local: &[Vec2]) -> Option<(usize, usize)> {
+    let n = local.len();
+    for i in 0..n {
+        let (a, b) = (local[i], local[(i + 1) % n]);
+        for j in i + 1..n {
+            if j == i + 1 || (i == 0 && j == n - 1) {
+                continue;
+            }
+            let (c, d) = (local[j], local[(j + 1) % n]);
+            if segments_intersect(a, b, c, d) {
+                return Some((i, j));
+            }
+        }
+    }
+    None
+}
+
+fn segments_intersect(a: Vec2, b: Vec2, c: Vec2, d: Vec2) -> bool {
+    let o1 = (b - a).perp_dot(c - a);
+    let o2 = (b - a).perp_dot(d - a);
+    let o3 = (d - c).perp_dot(a - c);
+    let o4 = (d - c).perp_dot(b - c);
+    if o1 * o2 < 0.0 && o3 * o4 < 0.0 {
+        return true;
+    }
+    let on = |p: Vec2, q: Vec2, r: Vec2, o: Real| {
+        o == 0.0
+            && r.x >= p.x.min(q.x)
+            && r.x <= p.x.max(q.x)
+            && r.y >= p.y.min(q.y)
+            && r.y <= p.y.max(q.y)
+    };
+    on(a, b, c, o1) || on(a, b, d, o2) || on(c, d, a, o3) || on(c, d, b, o4)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn square(z: Real) -> Vec<Vec3> {
+        vec![
+            Vec3::new(0., 0., z),
+            Vec3::new(2., 0., z),
+            Vec3::new(2., 2., z),
+            Vec3::new(0., 2., z),
+        ]
+    }
+
+    #[test]
+    fn square_area_normal_centroid() {
+        let p = Polygon::new(square(1.0)).unwrap();
+        assert!((p.area() - 4.0).abs() < 1e-12);
+        assert!((p.plane().normal - Vec3::Z).length() < 1e-12);
+        assert!((p.centroid() - Vec3::new(1., 1., 1.)).length() < 1e-12);
+        assert!(p.contains(Vec3::new(1.0, 1.0, 5.0), 1e-9));
+        assert!(p.contains(Vec3::new(2.0, 1.0, 1.0), 1e-9));
+        assert!(!p.contains(Vec3::new(2.1, 1.0, 1.0), 1e-9));
+        assert!((p.signed_boundary_distance(Vec3::new(0.5, 1.0, 1.0)) - 0.5).abs() < 1e-12);
+    }
+
+    #[test]
+    fn concave_polygon_inside_test() {
+        // An L: the notch at (1.5, 1.5) is outside.
+        let l = Polygon::new(vec![
+            Vec3::new(0., 0., 0.),
+            Vec3::new(2., 0., 0.),
+            Vec3::new(2., 1., 0.),
+            Vec3::new(1., 1., 0.),
+            Vec3::new(1., 2., 0.),
+            Vec3::new(0., 2., 0.),
+        ])
+        .unwrap();
+        assert!((l.area() - 3.0).abs() < 1e-12);
+        assert!(l.contains(Vec3::new(0.5, 1.5, 0.), 1e-9));
+        assert!(!l.contains(Vec3::new(1.5, 1.5, 0.), 1e-9));
+    }
+
+    #[test]
+    fn invalid_polygons_are_reported() {
+        assert_eq!(
+            Polygon::new(square(0.0)[..2].to_vec()),
+            Err(PolygonError::TooFewVertices(2))
+        );
+        let mut nan = square(0.0);
+        nan[2].y = Real::NAN;
+        assert_eq!(Polygon::new(nan), Err(PolygonError::NonFinite { index: 2 }));
+        let mut rep = square(0.0);
+        rep.push(rep[0]);
+        assert_eq!(
+            Polygon::new(rep),
+            Err(PolygonError::RepeatedVertex {
+                first: 0,
+                second: 4
+            })
+        );
+        let line = vec![Vec3::ZERO, Vec3::X, Vec3::new(2., 0., 0.)];
+        assert_eq!(Polygon::new(line), Err(PolygonError::ZeroArea));
+        let mut bent = square(0.0);
+        bent[2].z = 0.1;
+        assert!(matches!(
+            Polygon::new(bent),
+            Err(PolygonError::NonPlanar { .. })
+        ));
+        let bow = vec![
+            Vec3::new(0., 0., 0.),
+            Vec3::new(4., 0., 0.),
+            Vec3::new(4., 2., 0.),
+            Vec3::new(1., -1., 0.),
+        ];
+        assert!(matches!(
+            Polygon::new(bow),
+            Err(PolygonError::SelfIntersecting(..))
+        ));
+    }
+
+    #[test]
+    fn segment_blocking() {
+        let p = Polygon::new(square(1.0)).unwrap();
+        let tol = 1e-9;
+        assert!(p.blocks_segment(Vec3::new(1., 1., 0.), Vec3::new(1., 1., 2.), 1e-9, tol));
+        assert!(!p.blocks_segment(Vec3::new(3., 1., 0.), Vec3::new(3., 1., 2.), 1e-9, tol));
+        assert!(!p.blocks_segment(Vec3::new(1., 1., 0.), Vec3::new(1., 1., 0.5), 1e-9, tol));
+        // A segment ending on the polygon does not count as crossing it.
+        assert!(!p.blocks_segment(Vec3::new(1., 1., 0.), Vec3::new(1., 1., 1.), 1e-9, tol));
+    }
+}

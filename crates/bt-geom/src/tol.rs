@@ -1,0 +1,30 @@
+//! Named tolerances. Every length tolerance is in metres and is meant for scenes of room to
+//! building size (extent 0.1 m .. 1 km); `scaled` adapts a relative tolerance to a scene.
+
+use crate::Real;
+
+/// Relative tolerance of geometric decisions (inside/outside, side of plane) with respect to
+/// the scene extent. 1e-9 of a 10 m room is 10 nm: far below any physical meaning, far above
+/// f64 round-off (~1e-15 relative) accumulated over a few operations.
+pub const REL_GEOMETRY: Real = 1e-9;
+
+/// Maximum distance of a polygon vertex from the best-fit plane, relative to the polygon's
+/// extent, before the polygon counts as non-planar (1e-6: 10 µm on a 10 m wall; meshes exported
+/// in single precision are planar to ~1e-7).
+pub const REL_PLANARITY: Real = 1e-6;
+
+/// Minimum polygon area relative to the square of its extent (1e-12); below it the polygon is
+/// degenerate (zero area).
+pub const REL_AREA: Real = 1e-12;
+
+/// Vertices closer than this relative distance (to the polygon extent) are repeated vertices.
+pub const REL_VERTEX_MERGE: Real = 1e-9;
+
+/// Angle tolerance in radians for the reflection law check of found paths (1e-9 rad).
+pub const ANGLE_REFLECTION_LAW: Real = 1e-9;
+
+/// A length tolerance in metres for a scene whose bounding box diagonal is `extent` metres.
+#[inline]
+pub fn scaled(relative: Real, extent: Real) -> Real {
+    relative * extent.max(1.0)
+}

@@ -1,0 +1,29 @@
+//! Built-in scenes, shipped inside the binary (their JSON lives in `crates/bt-scene/scenes/`).
+
+use crate::Scene;
+use crate::io::parse_json;
+use crate::validate::{SceneError, Terminals};
+
+const LIVING_ROOM: &str = include_str!("../scenes/living-room.json");
+
+/// Names accepted by [`builtin_scene`].
+pub fn builtin_names() -> &'static [&'static str] {
+    &["living-room"]
+}
+
+/// The JSON text of a built-in scene, as a documented example of the scene format.
+pub fn builtin_json(name: &str) -> Option<&'static str> {
+    match name {
+        "living-room" => Some(LIVING_ROOM),
+        _ => None,
+    }
+}
+
+/// A built-in scene by name: `living-room` is a furnished 6 × 4.5 × 2.7 m living room with 25
+/// reflecting surfaces, a lamp shade and a standing person as blockers, TX at router height
+/// (2.2 m) and RX at laptop height (0.72 m).
+pub fn builtin_scene(name: &str, terminals: Terminals) -> Option<Result<Scene, SceneError>> {
+    let json = builtin_json(name)?;
+    let source = format!("builtin:{name}");
+    Some(parse_json(json, &source).and_then(|d| Scene::from_description(&d, &source, terminals)))
+}

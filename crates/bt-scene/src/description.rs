@@ -1,0 +1,91 @@
+//! The scene file format (JSON or TOML), as parsed, before validation.
+//! Documented in `docs/scene-format.md`; unknown fields are errors.
+
+use crate::model::SurfaceKind;
+use bt_geom::Real;
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// A scene file as written by a user. Validate it with [`crate::Scene::from_description`].
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct SceneDescription {
+    /// Scene name (optional; the file stem is used otherwise).
+    #[serde(default)]
+    pub name: Option<String>,
+    /// Carrier frequency, Hz (default 28 GHz).
+    #[serde(default)]
+    pub frequency_hz: Option<Real>,
+    /// Transmitter position `[x, y, z]`, metres.
+    #[serde(default)]
+    pub tx: Option<[Real; 3]>,
+    /// Receiver position `[x, y, z]`, metres.
+    #[serde(default)]
+    pub rx: Option<[Real; 3]>,
+    /// Extra or overriding materials by name (the built-ins are always available).
+    #[serde(default)]
+    pub materials: BTreeMap<String, MaterialDesc>,
+    /// Planar polygons.
+    #[serde(default)]
+    pub surfaces: Vec<SurfaceDesc>,
+    /// Axis-aligned boxes, expanded into their faces (`<name>.top`, `.bottom`, `.west`,
+    /// `.east`, `.south`, `.north` for the -z/+z/-x/+x/-y/+y faces... see the format doc).
+    #[serde(default)]
+    pub boxes: Vec<BoxDesc>,
+}
+
+/// A material entry.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct MaterialDesc {
+    /// Loss per reflection, dB (>= 0).
+    pub reflection_loss_db: Real,
+}
+
+/// One planar polygon.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct SurfaceDesc {
+    /// Unique name.
+    pub name: String,
+    /// Material name (default `"default"`).
+    #[serde(default)]
+    pub material: Option<String>,
+    /// `reflector` (default) or `blocker`.
+    #[serde(default)]
+    pub kind: Option<SurfaceKind>,
+    /// Vertices `[[x, y, z], ...]` in order around the polygon (either winding), metres.
+    pub vertices: Vec<[Real; 3]>,
+}
+
+/// An axis-aligned box, expanded into up to six rectangular faces.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct BoxDesc {
+    /// Name prefix of the faces.
+    pub name: String,
+    /// Material name (default `"default"`).
+    #[serde(default)]
+    pub material: Option<String>,
+    /// `reflector` (default) or `blocker`.
+    #[serde(default)]
+    pub kind: Option<SurfaceKind>,
+    /// Minimum corner, metres.
+    pub min: [Real; 3],
+    /// Maximum corner, metres.
+    pub max: [Real; 3],
+    /// Faces to leave out, from `top`, `bottom`, `west`, `east`, `south`, `north`
+    /// (e.g. the bottom of furniture standing on the floor).
+    #[serde(default)]
+    pub omit: Vec<String>,
+}
+
+/// Face names of a box in output order, with the axis and whether it is the max side.
+pub(crate) const BOX_FACES: [(&str, usize, bool); 6] = [
+    ("top", 2, true),
+    ("bottom", 2, false),
+    ("west", 0, false),
+    ("east", 0, true),
+    ("south", 1, false),
+    ("north", 1, true),
+];

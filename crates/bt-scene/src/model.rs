@@ -1,0 +1,147 @@
+//! The validated scene model.
+
+use crate::material::Material;
+use bt_geom::{Bvh, Polygon, Real, Vec3, tol};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// Index of a surface in [`Scene::surfaces`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
+pub struct SurfaceId(pub u32);
+
+impl SurfaceId {
+    /// The index as `usize`.
+    #[inline]
+    pub fn index(self) -> usize {
+        self.0 as usize
+    }
+}
+
+/// What a surface does to a ray.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum SurfaceKind {
+    /// Reflects specularly from both sides, and occludes.
+    Reflector,
+    /// Only occludes (small objects, people).
+    Blocker,
+}
+
+/// A named bounded planar surface.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Surface {
+    /// Unique name (from the scene file, or generated for meshes).
+    pub name: String,
+    /// Material name, a key of [`Scene::materials`].
+    pub material: String,
+    /// Reflector or blocker.
+    pub kind: SurfaceKind,
+    /// The validated polygon (metres, world frame).
+    pub polygon: Polygon,
+}
+
+/// A validated scene. Construct it with [`crate::io`] loaders or [`Scene::from_description`];
+/// every surface is a valid planar polygon, TX and RX are finite, distinct and off every surface.
+#[derive(Debug, Clone)]
+pub struct Scene {
+    pub(crate) name: String,
+    pub(crate) surfaces: Vec<Surface>,
+    pub(crate) tx: Vec3,
+    pub(crate) rx: Vec3,
+    pub(crate) frequency_hz: Real,
+    pub(crate) materials: BTreeMap<String, Material>,
+    pub(crate) extent: Real,
+    pub(crate) bvh: Bvh,
+}
+
+impl Scene {
+    /// Scene name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+    /// All surfaces, reflectors and blockers; indexed by [`SurfaceId`].
+    pub fn surfaces(&self) -> &[Surface] {
+        &self.surfaces
+    }
+    /// The surface with id `id`.
+    #[inline]
+    pub fn surface(&self, id: SurfaceId) -> &Surface {
+        &self.surfaces[id.index()]
+    }
+    /// Ids of the reflecting surfaces, in scene order.
+    pub fn reflectors(&self) -> impl Iterator<Item = SurfaceId> + '_ {
+        self.surfaces
+            .iter()
+            .enumerate()
+            .filter(|(_, s)| s.kind == SurfaceKind::Reflector)
+            .map(|(i, _)| SurfaceId(i as u32))
+    }
+    /// Transmitter position, metres.
+    pub fn tx(&self) -> Vec3 {
+        self.tx
+    }
+    /// Receiver position, metres.
+    pub fn rx(&self) -> Vec3 {
+        self.rx
+    }
+    /// Carrier frequency, Hz.
+    pub fn frequency_hz(&self) -> Real {
+        self.frequency_hz
+    }
+    /// Materials by name.
+    pub fn materials(&self) -> &BTreeMap<String, Material> {
+        &self.materials
+    }
+    /// The material of a surface.
+    pub fn material_of(&self, id: SurfaceId) -> &Material {
+        &self.materials[&self.surface(id).material]
+    }
+    /// Bounding-box diagonal of all surfaces, TX and RX, metres (scales length tolerances).
+    pub fn extent(&self) -> Real {
+        self.extent
+    }
+    /// Length tolerance of geometric decisions for this scene, metres.
+    pub fn length_tolerance(&self) -> Real {
+        tol::scaled(tol::REL_GEOMETRY, self.extent)
+    }
+    /// BVH over all surfaces (for occlusion tests).
+    pub fn bvh(&self) -> &Bvh {
+        &self.bvh
+    }
+    /// Look a surface up by name.
+    pub fn find(&self, name: &str) -> Option<SurfaceId> {
+        self.surfaces
+            .iter()
+            .position(|s| s.name == name)
+            .map(|i| SurfaceId(i as u32))
+    }
+
+    /// A copy with other TX/RX positions, validated like the originals.
+    pub fn with_terminals(&self, tx: Vec3, rx: Vec3) -> Result<Scene, crate::SceneError> {
+        crate::validate::check_terminals(&self.surfaces, tx, rx, self.extent_with(tx, rx))
+            .map_err(|problems| crate::SceneError::Invalid {
+                source_name: self.name.clone(),
+                problems,
+            })?;
+        let mut scene = self.clone();
+        scene.tx = tx;
+        scene.rx = rx;
+        scene.extent = self.extent_with(tx, rx);
+        Ok(scene)
+    }
+
+    fn extent_with(&self, tx: Vec3, rx: Vec3) -> Real {
+        scene_extent(&self.surfaces, tx, rx)
+    }
+}
+
+/// Bounding-box diagonal of surfaces and terminals, metres.
+pub(crate) fn scene_extent(surfaces: &[Surface], tx: Vec3, rx: Vec3) -> Real {
+    let (mut lo, mut hi) = (tx.min(rx), tx.max(rx));
+    for s in surfaces {
+        let (a, b) = s.polygon.bounds();
+        lo = lo.min(a);
+        hi = hi.max(b);
+    }
+    (hi - lo).length()
+}

@@ -1,0 +1,358 @@
+//! Validation of a [`SceneDescription`] into a [`Scene`], collecting every problem at once.
+
+use crate::description::{BOX_FACES, SceneDescription};
+use crate::material::{DEFAULT_MATERIAL, Material, default_materials};
+use crate::model::{Scene, Surface, SurfaceKind, scene_extent};
+use bt_geom::{Bvh, Polygon, Real, Vec3, tol};
+use serde::Serialize;
+use std::collections::BTreeSet;
+use std::fmt;
+use thiserror::Error;
+
+/// Default carrier frequency when a scene names none: 28 GHz (FR2 mmWave).
+pub const DEFAULT_FREQUENCY_HZ: Real = 28e9;
+
+/// One problem found in a scene, located by field path (e.g. `surfaces[3] "sofa.top"`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Problem {
+    /// Where: a field path into the scene description.
+    pub location: String,
+    /// What is wrong, lowercase.
+    pub message: String,
+}
+
+impl fmt::Display for Problem {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}: {}", self.location, self.message)
+    }
+}
+
+/// Errors of scene loading and validation.
+#[derive(Debug, Error)]
+pub enum SceneError {
+    /// The file could not be read.
+    #[error("{path}: {source}")]
+    Io {
+        /// File path.
+        path: String,
+        /// Underlying error.
+        source: std::io::Error,
+    },
+    /// The file is not valid JSON/TOML of the scene format.
+    #[error("{path}: {message}")]
+    Parse {
+        /// File path.
+        path: String,
+        /// Parser message with line and column.
+        message: String,
+    },
+    /// A mesh file could not be imported.
+    #[error(transparent)]
+    Mesh(#[from] bt_mesh::MeshError),
+    /// The extension is not one of the supported formats.
+    #[error("{path}: unsupported scene format (expected .json, .toml, .obj or .ply)")]
+    UnsupportedFormat {
+        /// File path.
+        path: String,
+    },
+    /// The scene has one or more problems; all are listed.
+    #[error("{source_name}: {} problem(s):\n{}", problems.len(), problems.iter().map(|p| format!("  - {p}")).collect::<Vec<_>>().join("\n"))]
+    Invalid {
+        /// File or scene name.
+        source_name: String,
+        /// Every problem found.
+        problems: Vec<Problem>,
+    },
+}
+
+struct Collector(Vec<Problem>);
+
+impl Collector {
+    fn push(&mut self, location: impl Into<String>, message: impl Into<String>) {
+        self.0.push(Problem {
+            location: location.into(),
+            message: message.into(),
+        });
+    }
+}
+
+/// Terminal positions given outside the description (CLI `--tx/--rx`, mesh import).
+#[derive(Debug, Clone, Copy, Default)]
+pub struct Terminals {
+    /// Overrides the description's TX when set, metres.
+    pub tx: Option<Vec3>,
+    /// Overrides the description's RX when set, metres.
+    pub rx: Option<Vec3>,
+}
+
+impl Scene {
+    /// Validate a description. `source_name` names the file in messages; `terminals` override
+    /// the file's TX/RX. Every problem is reported, not just the first.
+    pub fn from_description(
+        desc: &SceneDescription,
+        source_name: &str,
+        terminals: Terminals,
+    ) -> Result<Scene, SceneError> {
+        let mut problems = Collector(Vec::new());
+        let mut materials = default_materials();
+        for (name, m) in &desc.materials {
+            if !m.reflection_loss_db.is_finite() || m.reflection_loss_db < 0.0 {
+                problems.push(
+                    format!("materials.{name}.reflection_loss_db"),
+                    "must be a finite number >= 0",
+                );
+            }
+            materials.insert(
+                name.clone(),
+                Material {
+                    reflection_loss_db: m.reflection_loss_db,
+                },
+            );
+        }
+        let frequency_hz = desc.frequency_hz.unwrap_or(DEFAULT_FREQUENCY_HZ);
+        if !(frequency_hz.is_finite() && frequency_hz > 0.0) {
+            problems.push(
+                "frequency_hz",
+                format!("must be a positive finite number, got {frequency_hz}"),
+            );
+        }
+
+        let mut raw: Vec<RawSurface> = Vec::new();
+        for (i, s) in desc.surfaces.iter().enumerate() {
+            raw.push(RawSurface {
+                location: format!("surfaces[{i}] \"{}\"", s.name),
+                name: s.name.clone(),
+                material: s.material.clone(),
+                kind: s.kind.unwrap_or(SurfaceKind::Reflector),
+                vertices: s.vertices.iter().map(|v| Vec3::from_array(*v)).collect(),
+            });
+        }
+        for (i, b) in desc.boxes.iter().enumerate() {
+            let location = format!("boxes[{i}] \"{}\"", b.name);
+            for o in &b.omit {
+                if !BOX_FACES.iter().any(|(f, _, _)| f == o) {
+                    problems.push(format!("{location}.omit"), format!("unknown face \"{o}\" (expected top, bottom, west, east, south or north)"));
+                }
+            }
+            let (lo, hi) = (Vec3::from_array(b.min), Vec3::from_array(b.max));
+            if !(lo.is_finite() && hi.is_finite()) || lo.cmpge(hi).any() {
+                problems.push(
+                    location,
+                    "min must be finite and strictly below max on every axis",
+                );
+                continue;
+            }
+            for (face, axis, is_max) in BOX_FACES {
+                if b.omit.iter().any(|o| o == face) {
+                    continue;
+                }
+                raw.push(RawSurface {
+                    location: format!("{location}.{face}"),
+                    name: format!("{}.{face}", b.name),
+                    material: b.material.clone(),
+                    kind: b.kind.unwrap_or(SurfaceKind::Reflector),
+                    vertices: box_face(lo, hi, axis, is_max),
+                });
+            }
+        }
+        let surfaces = build_surfaces(raw, &materials, &mut problems);
+
+        let tx = terminal(
+            "tx",
+            terminals.tx.or(desc.tx.map(Vec3::from_array)),
+            &mut problems,
+        );
+        let rx = terminal(
+            "rx",
+            terminals.rx.or(desc.rx.map(Vec3::from_array)),
+            &mut problems,
+        );
+        let (Some(tx), Some(rx)) = (tx, rx) else {
+            return Err(SceneError::Invalid {
+                source_name: source_name.to_string(),
+                problems: problems.0,
+            });
+        };
+        let extent = scene_extent(&surfaces, tx, rx);
+        if let Err(p) = check_terminals(&surfaces, tx, rx, extent) {
+            problems.0.extend(p);
+        }
+        if !problems.0.is_empty() {
+            return Err(SceneError::Invalid {
+                source_name: source_name.to_string(),
+                problems: problems.0,
+            });
+        }
+        let name = desc.name.clone().unwrap_or_else(|| source_name.to_string());
+        Ok(Scene::assemble(
+            name,
+            surfaces,
+            tx,
+            rx,
+            frequency_hz,
+            materials,
+        ))
+    }
+}
+
+impl Scene {
+    /// Assemble an already validated scene (internal: loaders use it after their checks).
+    pub(crate) fn assemble(
+        name: String,
+        surfaces: Vec<Surface>,
+        tx: Vec3,
+        rx: Vec3,
+        frequency_hz: Real,
+        materials: std::collections::BTreeMap<String, Material>,
+    ) -> Scene {
+        let extent = scene_extent(&surfaces, tx, rx);
+        let polygons: Vec<Polygon> = surfaces.iter().map(|s| s.polygon.clone()).collect();
+        let bvh = Bvh::build(&polygons);
+        Scene {
+            name,
+            surfaces,
+            tx,
+            rx,
+            frequency_hz,
+            materials,
+            extent,
+            bvh,
+        }
+    }
+}
+
+pub(crate) struct RawSurface {
+    pub location: String,
+    pub name: String,
+    pub material: Option<String>,
+    pub kind: SurfaceKind,
+    pub vertices: Vec<Vec3>,
+}
+
+pub(crate) fn build_surfaces(
+    raw: Vec<RawSurface>,
+    materials: &std::collections::BTreeMap<String, Material>,
+    problems: &mut impl ProblemSink,
+) -> Vec<Surface> {
+    let mut names = BTreeSet::new();
+    let mut surfaces = Vec::with_capacity(raw.len());
+    for r in raw {
+        if r.name.is_empty() {
+            problems.report(&r.location, "name is empty");
+        } else if !names.insert(r.name.clone()) {
+            problems.report(
+                &r.location,
+                format!("duplicate surface name \"{}\"", r.name),
+            );
+        }
+        let material = r.material.unwrap_or_else(|| DEFAULT_MATERIAL.to_string());
+        if !materials.contains_key(&material) {
+            problems.report(
+                &r.location,
+                format!("unknown material \"{material}\" (add it under \"materials\")"),
+            );
+        }
+        match Polygon::new(r.vertices) {
+            Ok(polygon) => surfaces.push(Surface {
+                name: r.name,
+                material,
+                kind: r.kind,
+                polygon,
+            }),
+            Err(e) => problems.report(&format!("{}.vertices", r.location), e.to_string()),
+        }
+    }
+    surfaces
+}
+
+/// Where validation problems go.
+pub(crate) trait ProblemSink {
+    fn report(&mut self, location: &str, message: impl Into<String>);
+}
+
+impl ProblemSink for Collector {
+    fn report(&mut self, location: &str, message: impl Into<String>) {
+        self.push(location, message);
+    }
+}
+
+impl ProblemSink for Vec<Problem> {
+    fn report(&mut self, location: &str, message: impl Into<String>) {
+        self.push(Problem {
+            location: location.to_string(),
+            message: message.into(),
+        });
+    }
+}
+
+fn terminal(field: &str, value: Option<Vec3>, problems: &mut Collector) -> Option<Vec3> {
+    match value {
+        None => {
+            problems.push(
+                field,
+                format!("missing: give \"{field}\": [x, y, z] in the scene or --{field} X,Y,Z"),
+            );
+            None
+        }
+        Some(p) if !p.is_finite() => {
+            problems.push(field, "coordinates must be finite numbers");
+            None
+        }
+        Some(p) => Some(p),
+    }
+}
+
+/// TX and RX must be distinct and must not lie on any surface.
+pub(crate) fn check_terminals(
+    surfaces: &[Surface],
+    tx: Vec3,
+    rx: Vec3,
+    extent: Real,
+) -> Result<(), Vec<Problem>> {
+    let mut problems = Vec::new();
+    let eps = tol::scaled(tol::REL_GEOMETRY, extent);
+    if !tx.is_finite() {
+        problems.report("tx", "coordinates must be finite numbers");
+    }
+    if !rx.is_finite() {
+        problems.report("rx", "coordinates must be finite numbers");
+    }
+    if tx.distance(rx) <= eps {
+        problems.report("tx", "tx and rx are at the same position");
+    }
+    for (field, p) in [("tx", tx), ("rx", rx)] {
+        for s in surfaces {
+            if s.polygon.plane().signed_distance(p).abs() <= eps && s.polygon.contains(p, eps) {
+                problems.report(field, format!("lies on surface \"{}\"", s.name));
+            }
+        }
+    }
+    if problems.is_empty() {
+        Ok(())
+    } else {
+        Err(problems)
+    }
+}
+
+/// Rectangle of a box face, counter-clockwise seen from outside the box.
+fn box_face(lo: Vec3, hi: Vec3, axis: usize, is_max: bool) -> Vec<Vec3> {
+    let (a, b) = ((axis + 1) % 3, (axis + 2) % 3);
+    let c = if is_max { hi[axis] } else { lo[axis] };
+    let corner = |u: Real, v: Real| {
+        let mut p = Vec3::ZERO;
+        p[axis] = c;
+        p[a] = u;
+        p[b] = v;
+        p
+    };
+    let mut face = vec![
+        corner(lo[a], lo[b]),
+        corner(hi[a], lo[b]),
+        corner(hi[a], hi[b]),
+        corner(lo[a], hi[b]),
+    ];
+    if !is_max {
+        face.reverse();
+    }
+    face
+}
