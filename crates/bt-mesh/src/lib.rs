@@ -1,1 +1,169 @@
-//! placeholder
+//! Mesh files (Wavefront OBJ, PLY) to bounded planar polygon surfaces.
+//!
+//! A room exported from a 3-D tool is a soup of triangles and polygons. [`read_obj`] and
+//! [`read_ply`] parse one from bytes, weld duplicated vertices, merge edge-connected coplanar
+//! faces into groups and trace each group's boundary into one polygon: a [`MeshSurface`].
+//! [`read_mesh_path`] reads a file and picks the reader by extension.
+//!
+//! Units and frame: coordinates are taken as metres in the file's own frame (beamtrace uses
+//! z up; no axis swap is applied). Areas are m², angles in the options are degrees.
+//!
+//! Decisions and limits:
+//! - Faces merge only with faces of the same object/group name and the same material.
+//! - A group's boundary loops are split by orientation seen from the group normal: every
+//!   counter-clockwise loop becomes a surface (`<name>_<k>`, in discovery order); clockwise
+//!   loops are holes. Holes are not supported yet: the outer loop is kept (the hole is filled,
+//!   `area_m2` includes it) and a warning names the surface.
+//! - Non-manifold edges (used by more than two faces) do not merge across unless the faces
+//!   are coplanar; boundary chains that do not close are skipped with a warning.
+//! - Degenerate faces (fewer than three distinct welded vertices, or height under the weld
+//!   tolerance) are dropped and counted in a warning. Polygon faces that are not planar within
+//!   `dist_tol_m` are split into fan triangles with a warning.
+//! - Output polygon vertices are projected onto the group's plane (moving them at most
+//!   `dist_tol_m`), so every surface is exactly planar up to rounding.
+
+#![warn(missing_docs)]
+
+mod error;
+mod io;
+mod merge;
+mod obj;
+mod ply;
+mod raw;
+
+use glam::DVec3;
+use serde::{Deserialize, Serialize};
+
+pub use error::{MeshError, Position};
+pub use io::read_mesh_path;
+
+/// Default maximum angle between the normals of faces merged into one surface, in degrees.
+pub const DEFAULT_ANGLE_TOL_DEG: f64 = 1.0;
+/// Default maximum distance of a merged face's vertices from the surface plane, in metres
+/// (1 mm: well below a wavelength at 60 GHz, 5 mm, and above export rounding).
+pub const DEFAULT_DIST_TOL_M: f64 = 1e-3;
+/// Default distance under which vertices are welded into one, in metres (0.1 mm: OBJ exporters
+/// write 6 decimals, single-precision PLY keeps ~0.06 mm at 1 km).
+pub const DEFAULT_WELD_TOL_M: f64 = 1e-4;
+
+/// Tolerances of the coplanar merge.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct MergeOptions {
+    /// Maximum angle between a face normal and its group's normal, in degrees, in `[0, 90)`.
+    pub angle_tol_deg: f64,
+    /// Maximum distance of a face's vertices from its group's plane, in metres, `>= 0`. Also
+    /// the planarity limit above which a polygon face is split into triangles.
+    pub dist_tol_m: f64,
+    /// Vertices closer than this, in metres, are welded into one, `>= 0` (0: exact duplicates
+    /// only). Also the length under which boundary vertices count as collinear or repeated.
+    pub weld_tol_m: f64,
+}
+
+impl Default for MergeOptions {
+    fn default() -> Self {
+        MergeOptions {
+            angle_tol_deg: DEFAULT_ANGLE_TOL_DEG,
+            dist_tol_m: DEFAULT_DIST_TOL_M,
+            weld_tol_m: DEFAULT_WELD_TOL_M,
+        }
+    }
+}
+
+impl MergeOptions {
+    /// Checks that every tolerance is finite and in range.
+    pub fn validate(&self) -> Result<(), MeshError> {
+        let bad = |detail: String| Err(MeshError::InvalidOptions { detail });
+        if !(self.angle_tol_deg >= 0.0 && self.angle_tol_deg < 90.0) {
+            return bad(format!(
+                "angle_tol_deg {} must be in [0, 90)",
+                self.angle_tol_deg
+            ));
+        }
+        if !(self.dist_tol_m >= 0.0 && self.dist_tol_m.is_finite()) {
+            return bad(format!(
+                "dist_tol_m {} must be finite and >= 0",
+                self.dist_tol_m
+            ));
+        }
+        if !(self.weld_tol_m >= 0.0 && self.weld_tol_m.is_finite()) {
+            return bad(format!(
+                "weld_tol_m {} must be finite and >= 0",
+                self.weld_tol_m
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// One bounded planar polygon made of coplanar, edge-connected mesh faces.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MeshSurface {
+    /// `<object>_<k>` with the OBJ object/group name (`face_<k>` when the face has none, as in
+    /// every PLY file); `k` counts surfaces of that name from 0 in output order.
+    pub name: String,
+    /// The OBJ `usemtl` material in effect for the faces, if any (no `.mtl` file is read).
+    pub material: Option<String>,
+    /// Outer boundary in metres, counter-clockwise seen from `normal` (right-hand rule gives
+    /// `normal`), no repeated or collinear vertices, at least three, all on one plane.
+    pub vertices: Vec<DVec3>,
+    /// Unit normal: the area-weighted average of the merged faces' normals, following the
+    /// faces' winding (usually pointing into the room for exported interiors — whatever the
+    /// file says).
+    pub normal: DVec3,
+    /// Area of the polygon `vertices` in m² (holes, if any, are included).
+    pub area_m2: f64,
+    /// Number of faces of the file merged into this surface.
+    pub source_faces: usize,
+}
+
+/// What a mesh file yielded.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct MeshImport {
+    /// Surfaces in the order of their first face in the file.
+    pub surfaces: Vec<MeshSurface>,
+    /// Human-readable notes about skipped or altered input (dropped faces, filled holes,
+    /// ignored statements), each starting with the file name.
+    pub warnings: Vec<String>,
+    /// Number of faces in the file, before any was dropped or merged.
+    pub faces_read: usize,
+}
+
+/// The file name used in messages when none is given.
+const UNNAMED: &str = "<input>";
+
+/// Reads a Wavefront OBJ mesh from bytes and merges its faces into planar surfaces.
+/// `file` names the source in errors and warnings. `.mtl` libraries are not read; `usemtl`
+/// names are kept as [`MeshSurface::material`].
+pub fn read_obj(
+    bytes: &[u8],
+    file: Option<&str>,
+    opts: &MergeOptions,
+) -> Result<MeshImport, MeshError> {
+    opts.validate()?;
+    let file = file.unwrap_or(UNNAMED);
+    finish(obj::parse(bytes, file)?, opts, file)
+}
+
+/// Reads a PLY mesh (ASCII, binary little or big endian) from bytes and merges its faces into
+/// planar surfaces. `file` names the source in errors and warnings.
+pub fn read_ply(
+    bytes: &[u8],
+    file: Option<&str>,
+    opts: &MergeOptions,
+) -> Result<MeshImport, MeshError> {
+    opts.validate()?;
+    let file = file.unwrap_or(UNNAMED);
+    finish(ply::parse(bytes, file)?, opts, file)
+}
+
+fn finish(raw: raw::RawMesh, opts: &MergeOptions, file: &str) -> Result<MeshImport, MeshError> {
+    let merged = merge::merge(&raw, opts, file);
+    let faces_read = raw.face_count();
+    let mut warnings = raw.warnings;
+    warnings.extend(merged.warnings);
+    Ok(MeshImport {
+        surfaces: merged.surfaces,
+        warnings,
+        faces_read,
+    })
+}
