@@ -1,1 +1,135 @@
-//! placeholder
+//! PE scheduling for the IPC accelerator (paper section V, eq. 14, Fig. 12).
+//!
+//! CONTRACT (written before the implementation; `bt-hls` codes against these types):
+//! A *job* is one evaluation of Algorithm 2 for one point of one candidate path in one IPC
+//! round. It runs on a processing element (PE) instance of the plane that point lies on and
+//! takes exactly one *slot*. Jacobi order: every job of round `r` of a path must be in a slot
+//! strictly after every job of round `r - 1` of the same path.
+//!
+//! # Entry points
+//! - [`Problem::validate`] checks the input at the boundary (every problem reported at once).
+//! - [`schedule_list`] is the baseline: paths in index order, every job at its earliest free
+//!   slot, no duplicates.
+//! - [`schedule_ga`] is the paper's three-pass procedure: (1) a genetic algorithm over path
+//!   priorities, (2) duplication of the busiest PEs within a [`Budget`], (3) ASAP fill.
+//! - [`Schedule::check`] proves a schedule legal; [`Schedule::stats`] measures it (makespan,
+//!   latency factor of eq. 14, utilisation).
+//!
+//! The latency factor of eq. 14 is summed over paths **and rounds** here (the paper sums over
+//! paths): see [`ScheduleStats::latency_factor`].
+//!
+//! Time is counted in *slots* (one PE evaluation each); a schedule's makespan is its number of
+//! slots. Everything here is deterministic: the GA draws from a ChaCha RNG seeded by
+//! [`GaParams::seed`], and parallel fitness evaluation preserves order.
+#![warn(missing_docs)]
+
+mod asap;
+mod check;
+mod decode;
+mod error;
+mod ga;
+mod list;
+mod occupancy;
+mod problem;
+pub mod synthetic;
+
+pub use check::ScheduleStats;
+pub use error::{ProblemIssue, REPORT_LIMIT, Report, ScheduleError, ScheduleViolation};
+pub use ga::{GaParams, schedule_ga};
+pub use list::schedule_list;
+
+/// One candidate path as the scheduler sees it.
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct PathJob {
+    /// Plane index of each interaction point, TX side first (length = reflection order).
+    pub planes: Vec<u32>,
+    /// IPC rounds this path needs (from the fixed-point model; early stopping frees the PEs).
+    pub rounds: u32,
+}
+
+/// The whole scheduling problem of one time step.
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct Problem {
+    /// Number of planes (PEs before duplication); every `PathJob::planes` entry is below it.
+    pub num_planes: u32,
+    /// Candidate paths; their index is the path id used in [`Job::path`].
+    pub paths: Vec<PathJob>,
+}
+
+/// One job placed in the schedule.
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize,
+)]
+pub struct Job {
+    /// Index into [`Problem::paths`].
+    pub path: u32,
+    /// IPC round, 0-based.
+    pub round: u32,
+    /// Point index within the path, 0-based from the TX side.
+    pub point: u32,
+}
+
+/// A physical PE: a copy of the PE of one plane.
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize, serde::Deserialize,
+)]
+pub struct PeInstance {
+    /// Plane whose PE this is (index below [`Problem::num_planes`]).
+    pub plane: u32,
+    /// 0 for the original, 1.. for duplicates.
+    pub copy: u32,
+}
+
+/// A complete schedule: `slots[t][i]` is the job PE instance `instances[i]` runs in slot `t`.
+///
+/// Serialised as is (`schedule.json`): `instances` as `{plane, copy}` objects and `slots` as
+/// one array per slot holding `null` or `{path, round, point}` per instance. Schedules built by
+/// this crate list `instances` sorted by `(plane, copy)`, give only used planes a PE, and have
+/// no trailing empty slot.
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct Schedule {
+    /// The PE instances (columns of `slots`).
+    pub instances: Vec<PeInstance>,
+    /// One row per slot, `instances.len()` entries per row; `None` = the PE idles.
+    pub slots: Vec<Vec<Option<Job>>>,
+}
+
+/// How many PE instances a schedule may use in total (originals plus duplicates).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct Budget {
+    /// Total PE instances allowed; must be at least the number of distinct planes used by the
+    /// problem's paths (one original PE each).
+    pub max_instances: u32,
+}
+
+impl Budget {
+    /// The smallest budget for `problem`: one PE per plane used, no duplicate.
+    pub fn originals_only(problem: &Problem) -> Budget {
+        let used = problem::used_planes(problem);
+        Budget {
+            max_instances: u32::try_from(used.len()).unwrap_or(u32::MAX),
+        }
+    }
+}
+
+impl Schedule {
+    /// Makespan in slots: index of the last slot with a job, plus one (0 for no job).
+    pub fn makespan(&self) -> u32 {
+        let last = self
+            .slots
+            .iter()
+            .rposition(|row| row.iter().any(Option::is_some));
+        last.map_or(0, |t| u32::try_from(t + 1).unwrap_or(u32::MAX))
+    }
+
+    /// Number of jobs placed (non-empty cells).
+    pub fn job_count(&self) -> u64 {
+        self.slots
+            .iter()
+            .map(|row| row.iter().filter(|c| c.is_some()).count() as u64)
+            .sum()
+    }
+}
+
+#[cfg(test)]
+mod tests;

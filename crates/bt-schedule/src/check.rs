@@ -1,0 +1,253 @@
+//! Legality check and measurements of a [`Schedule`].
+
+use std::collections::BTreeSet;
+
+use crate::error::{Report, ScheduleError, ScheduleViolation};
+use crate::occupancy::NONE;
+use crate::problem::Prepared;
+use crate::{Job, Problem, Schedule};
+
+/// Measurements of a schedule (serialised next to `schedule.json`).
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct ScheduleStats {
+    /// Slots up to and including the last one holding a job.
+    pub makespan: u32,
+    /// Latency factor after eq. 14, in slots: the sum over paths **and rounds** of (latest
+    /// slot - earliest slot) of that round's jobs. The paper sums over paths only; a path spans
+    /// all its rounds, so we take each round on its own, which is 0 exactly when every round
+    /// runs all its PEs in one slot (the paper's goal).
+    pub latency_factor: u64,
+    /// Busy cells / (instances x makespan), in [0, 1]; 0 for an empty schedule.
+    pub utilisation: f64,
+    /// PE instances (columns), originals and duplicates.
+    pub instances: u32,
+    /// Duplicates: instances minus distinct planes among them.
+    pub duplicates: u32,
+    /// Jobs placed (cells holding a job).
+    pub jobs: u64,
+    /// A lower bound on the makespan with these instances, in slots: the larger of the
+    /// busiest plane's jobs per copy and, over paths, rounds x slots one round needs.
+    pub makespan_lower_bound: u32,
+}
+
+impl Schedule {
+    /// Verifies the schedule is legal for `problem` and reports every violation at once:
+    /// each job `(path, round < rounds, point)` appears exactly once; it runs on an instance of
+    /// the plane of its point; instances are distinct and of existing planes; every slot row
+    /// has one entry per instance (so an instance runs at most one job per slot); and Jacobi
+    /// order: every job of round `r` of a path is in a slot strictly later than every job of
+    /// round `r - 1` of that path.
+    pub fn check(&self, problem: &Problem) -> Result<(), ScheduleError> {
+        let prep = Prepared::new(problem)?;
+        let mut report = Report::new();
+        let mut seen = BTreeSet::new();
+        for (i, inst) in self.instances.iter().enumerate() {
+            if !seen.insert(*inst) {
+                report.push(ScheduleViolation::DuplicateInstance {
+                    plane: inst.plane,
+                    copy: inst.copy,
+                });
+            }
+            if inst.plane >= problem.num_planes {
+                report.push(ScheduleViolation::InstancePlaneOutOfRange {
+                    instance: to_u32(i),
+                    plane: inst.plane,
+                    num_planes: problem.num_planes,
+                });
+            }
+        }
+
+        let mut at = vec![NONE; prep.total_jobs()];
+        for (t, row) in self.slots.iter().enumerate() {
+            let slot = to_u32(t);
+            if row.len() != self.instances.len() {
+                report.push(ScheduleViolation::RowLength {
+                    slot,
+                    len: to_u32(row.len()),
+                    expected: to_u32(self.instances.len()),
+                });
+            }
+            for (i, cell) in row.iter().enumerate().take(self.instances.len()) {
+                let Some(job) = *cell else { continue };
+                let instance = to_u32(i);
+                let Some(index) = job_index(&prep, job) else {
+                    report.push(ScheduleViolation::UnknownJob {
+                        slot,
+                        instance,
+                        job,
+                    });
+                    continue;
+                };
+                let expected = problem.paths[job.path as usize].planes[job.point as usize];
+                let plane = self.instances[i].plane;
+                if plane != expected {
+                    report.push(ScheduleViolation::WrongPlane {
+                        job,
+                        instance,
+                        plane,
+                        expected,
+                    });
+                }
+                if at[index] == NONE {
+                    at[index] = slot;
+                } else {
+                    report.push(ScheduleViolation::DuplicateJob {
+                        job,
+                        first: at[index],
+                        slot,
+                    });
+                }
+            }
+        }
+
+        for (p, path) in problem.paths.iter().enumerate() {
+            let k = path.planes.len();
+            let base = prep.job_offset[p] as usize;
+            let mut previous_end = None;
+            for round in 0..path.rounds {
+                let first = base + round as usize * k;
+                let (mut start, mut end) = (None::<u32>, None::<u32>);
+                for (point, &slot) in at[first..first + k].iter().enumerate() {
+                    if slot == NONE {
+                        report.push(ScheduleViolation::MissingJob {
+                            job: Job {
+                                path: p as u32,
+                                round,
+                                point: point as u32,
+                            },
+                        });
+                    } else {
+                        start = Some(start.map_or(slot, |s| s.min(slot)));
+                        end = Some(end.map_or(slot, |e| e.max(slot)));
+                    }
+                }
+                if let (Some(start), Some(previous_end)) = (start, previous_end) {
+                    if start <= previous_end {
+                        report.push(ScheduleViolation::Dependency {
+                            path: p as u32,
+                            round,
+                            start,
+                            previous_end,
+                        });
+                    }
+                }
+                previous_end = end.or(previous_end);
+            }
+        }
+
+        if report.is_empty() {
+            Ok(())
+        } else {
+            Err(ScheduleError::IllegalSchedule(report))
+        }
+    }
+
+    /// Measures the schedule. Meant for schedules that pass [`Schedule::check`]; on others it
+    /// is best effort (jobs that are not part of `problem` are ignored for the latency factor).
+    pub fn stats(&self, problem: &Problem) -> ScheduleStats {
+        let makespan = self.makespan();
+        let instances = to_u32(self.instances.len());
+        let planes: BTreeSet<u32> = self.instances.iter().map(|i| i.plane).collect();
+        let jobs = self.job_count();
+        let cells = u64::from(instances) * u64::from(makespan);
+        let utilisation = if cells == 0 {
+            0.0
+        } else {
+            jobs as f64 / cells as f64
+        };
+
+        // First path-round index of each path; out-of-range jobs are skipped.
+        let mut round_offset = Vec::with_capacity(problem.paths.len() + 1);
+        let mut total = 0usize;
+        for path in &problem.paths {
+            round_offset.push(total);
+            total += path.rounds as usize;
+        }
+        let mut span = vec![(u32::MAX, 0u32); total];
+        for (t, row) in self.slots.iter().enumerate() {
+            for job in row.iter().flatten() {
+                let Some(path) = problem.paths.get(job.path as usize) else {
+                    continue;
+                };
+                if job.round < path.rounds {
+                    let s = &mut span[round_offset[job.path as usize] + job.round as usize];
+                    s.0 = s.0.min(to_u32(t));
+                    s.1 = s.1.max(to_u32(t));
+                }
+            }
+        }
+        let latency_factor = span
+            .iter()
+            .filter(|s| s.0 != u32::MAX)
+            .map(|&(a, b)| u64::from(b - a))
+            .sum();
+
+        let mut copies = vec![0u32; problem.num_planes as usize];
+        for inst in &self.instances {
+            if let Some(c) = copies.get_mut(inst.plane as usize) {
+                *c += 1;
+            }
+        }
+        ScheduleStats {
+            makespan,
+            latency_factor,
+            utilisation,
+            instances,
+            duplicates: instances - to_u32(planes.len()),
+            jobs,
+            makespan_lower_bound: lower_bound(problem, &copies),
+        }
+    }
+}
+
+/// Makespan lower bound in slots with `copies[plane]` PEs per plane (a plane without PE is
+/// counted as having one, so the bound stays finite).
+pub(crate) fn lower_bound(problem: &Problem, copies: &[u32]) -> u32 {
+    let per_copy = |jobs: u64, plane: u32| {
+        let c = u64::from(copies.get(plane as usize).copied().unwrap_or(0).max(1));
+        jobs.div_ceil(c)
+    };
+    let mut load = vec![0u64; problem.num_planes as usize];
+    let mut chain = 0u64;
+    let mut counts: Vec<(u32, u64)> = Vec::new();
+    for path in &problem.paths {
+        counts.clear();
+        for &plane in &path.planes {
+            if let Some(l) = load.get_mut(plane as usize) {
+                *l += u64::from(path.rounds);
+            }
+            match counts.iter_mut().find(|(q, _)| *q == plane) {
+                Some((_, n)) => *n += 1,
+                None => counts.push((plane, 1)),
+            }
+        }
+        let per_round = counts
+            .iter()
+            .map(|&(q, n)| per_copy(n, q))
+            .max()
+            .unwrap_or(0);
+        chain = chain.max(per_round * u64::from(path.rounds));
+    }
+    let load_bound = (0..problem.num_planes)
+        .map(|q| per_copy(load[q as usize], q))
+        .max()
+        .unwrap_or(0);
+    u32::try_from(load_bound.max(chain)).unwrap_or(u32::MAX)
+}
+
+/// Job index of a job of the problem, `None` if out of range.
+fn job_index(prep: &Prepared<'_>, job: Job) -> Option<usize> {
+    let path = prep.problem.paths.get(job.path as usize)?;
+    if job.round >= path.rounds || job.point as usize >= path.planes.len() {
+        return None;
+    }
+    Some(
+        prep.job_offset[job.path as usize] as usize
+            + job.round as usize * path.planes.len()
+            + job.point as usize,
+    )
+}
+
+fn to_u32(n: usize) -> u32 {
+    u32::try_from(n).unwrap_or(u32::MAX)
+}

@@ -1,0 +1,376 @@
+//! Hand problems with known optimal makespan.
+
+use crate::error::{ProblemIssue, ScheduleError, ScheduleViolation};
+use crate::{
+    Budget, GaParams, Job, PathJob, PeInstance, Problem, Schedule, schedule_ga, schedule_list,
+};
+
+fn path(planes: &[u32], rounds: u32) -> PathJob {
+    PathJob {
+        planes: planes.to_vec(),
+        rounds,
+    }
+}
+
+fn small_ga() -> GaParams {
+    GaParams {
+        population: 6,
+        generations: 4,
+        ..GaParams::default()
+    }
+}
+
+fn job(path: u32, round: u32, point: u32) -> Job {
+    Job { path, round, point }
+}
+
+#[test]
+fn disjoint_paths_run_in_parallel() {
+    let problem = Problem {
+        num_planes: 4,
+        paths: vec![path(&[0, 1], 3), path(&[2, 3], 3)],
+    };
+    let budget = Budget::originals_only(&problem);
+    assert_eq!(budget.max_instances, 4);
+    for schedule in [
+        schedule_list(&problem, &budget).unwrap(),
+        schedule_ga(&problem, &budget, &small_ga()).unwrap(),
+    ] {
+        schedule.check(&problem).unwrap();
+        let stats = schedule.stats(&problem);
+        assert_eq!(stats.makespan, 3);
+        assert_eq!(stats.latency_factor, 0);
+        assert_eq!(stats.instances, 4);
+        assert_eq!(stats.duplicates, 0);
+        assert_eq!(stats.jobs, 12);
+        assert_eq!(stats.utilisation, 1.0);
+        assert_eq!(stats.makespan_lower_bound, 3);
+    }
+}
+
+#[test]
+fn a_b_a_needs_two_slots_per_round_without_duplicate() {
+    let problem = Problem {
+        num_planes: 2,
+        paths: vec![path(&[0, 1, 0], 3)],
+    };
+    let budget = Budget::originals_only(&problem);
+    for schedule in [
+        schedule_list(&problem, &budget).unwrap(),
+        schedule_ga(&problem, &budget, &small_ga()).unwrap(),
+    ] {
+        schedule.check(&problem).unwrap();
+        let stats = schedule.stats(&problem);
+        assert_eq!(stats.makespan, 6);
+        assert_eq!(stats.latency_factor, 3);
+        assert_eq!(stats.makespan_lower_bound, 6);
+    }
+}
+
+#[test]
+fn a_b_a_takes_one_slot_per_round_with_a_duplicate_of_a() {
+    let problem = Problem {
+        num_planes: 2,
+        paths: vec![path(&[0, 1, 0], 3)],
+    };
+    let schedule = schedule_ga(&problem, &Budget { max_instances: 3 }, &small_ga()).unwrap();
+    schedule.check(&problem).unwrap();
+    let stats = schedule.stats(&problem);
+    assert_eq!(stats.makespan, 3);
+    assert_eq!(stats.latency_factor, 0);
+    assert_eq!(stats.duplicates, 1);
+    assert_eq!(
+        schedule.instances,
+        vec![
+            PeInstance { plane: 0, copy: 0 },
+            PeInstance { plane: 0, copy: 1 },
+            PeInstance { plane: 1, copy: 0 },
+        ]
+    );
+    // A larger budget changes nothing: duplicates that do not help are not kept.
+    let more = schedule_ga(&problem, &Budget { max_instances: 9 }, &small_ga()).unwrap();
+    assert_eq!(more, schedule);
+}
+
+#[test]
+fn shared_plane_is_the_bottleneck_and_a_duplicate_halves_it() {
+    // Plane 0 carries 2 x 4 jobs; plane 1 and 2 four each.
+    let problem = Problem {
+        num_planes: 3,
+        paths: vec![path(&[0, 1], 4), path(&[0, 2], 4)],
+    };
+    let list = schedule_list(&problem, &Budget::originals_only(&problem)).unwrap();
+    list.check(&problem).unwrap();
+    assert_eq!(list.stats(&problem).makespan, 8);
+    let ga = schedule_ga(&problem, &Budget::originals_only(&problem), &small_ga()).unwrap();
+    ga.check(&problem).unwrap();
+    assert_eq!(ga.stats(&problem).makespan, 8);
+    assert_eq!(ga.stats(&problem).latency_factor, 0);
+    let dup = schedule_ga(&problem, &Budget { max_instances: 4 }, &small_ga()).unwrap();
+    dup.check(&problem).unwrap();
+    let stats = dup.stats(&problem);
+    assert_eq!(
+        (stats.makespan, stats.latency_factor, stats.duplicates),
+        (4, 0, 1)
+    );
+}
+
+#[test]
+fn ga_aligns_rounds_where_the_list_scheduler_spreads_them() {
+    // List order puts path 0 on plane 0 first, so path 1's plane-0 job of each round lags
+    // behind its plane-1 job; the GA finds an order with the same makespan and less spread.
+    let problem = Problem {
+        num_planes: 3,
+        paths: vec![path(&[0], 4), path(&[1, 0], 4), path(&[2], 8)],
+    };
+    let budget = Budget::originals_only(&problem);
+    let list = schedule_list(&problem, &budget).unwrap();
+    let ga = schedule_ga(&problem, &budget, &small_ga()).unwrap();
+    list.check(&problem).unwrap();
+    ga.check(&problem).unwrap();
+    let (l, g) = (list.stats(&problem), ga.stats(&problem));
+    assert!(l.latency_factor > 0);
+    assert_eq!(g.makespan, 8);
+    assert!(g.makespan <= l.makespan);
+    assert!(g.latency_factor < l.latency_factor, "{g:?} vs {l:?}");
+}
+
+#[test]
+fn empty_problem_gives_empty_schedule() {
+    let problem = Problem {
+        num_planes: 5,
+        paths: vec![],
+    };
+    let budget = Budget::originals_only(&problem);
+    assert_eq!(budget.max_instances, 0);
+    for schedule in [
+        schedule_list(&problem, &budget).unwrap(),
+        schedule_ga(&problem, &budget, &GaParams::default()).unwrap(),
+    ] {
+        schedule.check(&problem).unwrap();
+        assert!(schedule.instances.is_empty() && schedule.slots.is_empty());
+        let stats = schedule.stats(&problem);
+        assert_eq!((stats.makespan, stats.jobs), (0, 0));
+        assert_eq!(stats.utilisation, 0.0);
+    }
+}
+
+#[test]
+fn validate_reports_every_issue_at_once() {
+    let problem = Problem {
+        num_planes: 2,
+        paths: vec![
+            path(&[], 3),
+            path(&[0, 5], 2),
+            path(&[1, 1], 0),
+            path(&[0, 1, 0], 1),
+        ],
+    };
+    let Err(ScheduleError::InvalidProblem(report)) = problem.validate() else {
+        panic!("problem should be invalid");
+    };
+    assert_eq!(report.count, 4);
+    assert_eq!(
+        report.items,
+        vec![
+            ProblemIssue::EmptyPath { path: 0 },
+            ProblemIssue::PlaneOutOfRange {
+                path: 1,
+                point: 1,
+                plane: 5,
+                num_planes: 2
+            },
+            ProblemIssue::ZeroRounds { path: 2 },
+            ProblemIssue::RepeatedPlane {
+                path: 2,
+                point: 1,
+                plane: 1
+            },
+        ]
+    );
+    let message = ScheduleError::InvalidProblem(report).to_string();
+    assert!(
+        message.contains("path 1 point 1 lies on plane 5"),
+        "{message}"
+    );
+    assert!(schedule_list(&problem, &Budget { max_instances: 9 }).is_err());
+}
+
+#[test]
+fn budget_and_parameters_are_checked() {
+    let problem = Problem {
+        num_planes: 3,
+        paths: vec![path(&[0, 2], 1)],
+    };
+    assert_eq!(
+        schedule_list(&problem, &Budget { max_instances: 1 }),
+        Err(ScheduleError::BudgetTooSmall {
+            max_instances: 1,
+            needed: 2
+        })
+    );
+    let budget = Budget { max_instances: 2 };
+    for params in [
+        GaParams {
+            population: 0,
+            ..GaParams::default()
+        },
+        GaParams {
+            mutation_rate: f64::NAN,
+            ..GaParams::default()
+        },
+        GaParams {
+            elite: 20,
+            ..GaParams::default()
+        },
+    ] {
+        assert!(matches!(
+            schedule_ga(&problem, &budget, &params),
+            Err(ScheduleError::InvalidGaParams { .. })
+        ));
+    }
+}
+
+/// Path 0 = [0, 1] x 2 rounds, path 1 = [1] x 1 round, on instances (0,0), (1,0).
+fn tiny() -> (Problem, Schedule) {
+    let problem = Problem {
+        num_planes: 2,
+        paths: vec![path(&[0, 1], 2), path(&[1], 1)],
+    };
+    let schedule = Schedule {
+        instances: vec![
+            PeInstance { plane: 0, copy: 0 },
+            PeInstance { plane: 1, copy: 0 },
+        ],
+        slots: vec![
+            vec![Some(job(0, 0, 0)), Some(job(0, 0, 1))],
+            vec![None, Some(job(1, 0, 0))],
+            vec![Some(job(0, 1, 0)), Some(job(0, 1, 1))],
+        ],
+    };
+    (problem, schedule)
+}
+
+fn violations(problem: &Problem, schedule: &Schedule) -> Vec<ScheduleViolation> {
+    match schedule.check(problem) {
+        Err(ScheduleError::IllegalSchedule(report)) => report.items,
+        other => panic!("expected an illegal schedule, got {other:?}"),
+    }
+}
+
+#[test]
+fn check_accepts_the_hand_schedule_and_stats_measure_it() {
+    let (problem, schedule) = tiny();
+    schedule.check(&problem).unwrap();
+    let stats = schedule.stats(&problem);
+    assert_eq!(stats.makespan, 3);
+    assert_eq!(stats.latency_factor, 0);
+    assert_eq!(stats.jobs, 5);
+    assert!((stats.utilisation - 5.0 / 6.0).abs() < 1e-12);
+    assert_eq!(stats.makespan_lower_bound, 3);
+}
+
+#[test]
+fn check_rejects_a_dependency_violation() {
+    let (problem, mut schedule) = tiny();
+    // Plane 0 runs round 1 of path 0 before round 0.
+    schedule.slots[0][0] = Some(job(0, 1, 0));
+    schedule.slots[2][0] = Some(job(0, 0, 0));
+    let v = violations(&problem, &schedule);
+    assert_eq!(
+        v,
+        vec![ScheduleViolation::Dependency {
+            path: 0,
+            round: 1,
+            start: 0,
+            previous_end: 2
+        }]
+    );
+}
+
+#[test]
+fn check_rejects_same_slot_rounds() {
+    let (problem, mut schedule) = tiny();
+    // Round 1's plane-0 job moved up next to round 0's jobs: same slot is not "strictly later".
+    schedule.slots[2][0] = None;
+    schedule.slots[1][0] = Some(job(0, 1, 0));
+    schedule.slots[0][0] = Some(job(0, 0, 0));
+    schedule.slots[1][1] = Some(job(0, 0, 1));
+    schedule.slots[0][1] = Some(job(1, 0, 0));
+    let v = violations(&problem, &schedule);
+    assert_eq!(
+        v,
+        vec![ScheduleViolation::Dependency {
+            path: 0,
+            round: 1,
+            start: 1,
+            previous_end: 1
+        }]
+    );
+}
+
+#[test]
+fn check_rejects_missing_duplicate_unknown_and_misplaced_jobs() {
+    let (problem, mut schedule) = tiny();
+    schedule.slots[1][1] = None;
+    let v = violations(&problem, &schedule);
+    assert_eq!(v, vec![ScheduleViolation::MissingJob { job: job(1, 0, 0) }]);
+
+    let (problem, mut schedule) = tiny();
+    schedule.slots[1][0] = Some(job(0, 0, 0));
+    assert_eq!(
+        violations(&problem, &schedule),
+        vec![ScheduleViolation::DuplicateJob {
+            job: job(0, 0, 0),
+            first: 0,
+            slot: 1
+        }]
+    );
+
+    let (problem, mut schedule) = tiny();
+    schedule.slots[1][0] = Some(job(1, 1, 0));
+    assert_eq!(
+        violations(&problem, &schedule),
+        vec![ScheduleViolation::UnknownJob {
+            slot: 1,
+            instance: 0,
+            job: job(1, 1, 0)
+        }]
+    );
+
+    let (problem, mut schedule) = tiny();
+    schedule.slots[1][1] = None;
+    schedule.slots[1][0] = Some(job(1, 0, 0));
+    assert_eq!(
+        violations(&problem, &schedule),
+        vec![ScheduleViolation::WrongPlane {
+            job: job(1, 0, 0),
+            instance: 0,
+            plane: 0,
+            expected: 1
+        }]
+    );
+
+    let (problem, mut schedule) = tiny();
+    schedule.slots[1].pop();
+    schedule.instances.push(PeInstance { plane: 0, copy: 0 });
+    let v = violations(&problem, &schedule);
+    assert!(v.contains(&ScheduleViolation::DuplicateInstance { plane: 0, copy: 0 }));
+    assert!(v.contains(&ScheduleViolation::RowLength {
+        slot: 1,
+        len: 1,
+        expected: 3
+    }));
+}
+
+#[test]
+fn schedule_round_trips_through_json() {
+    let (_, schedule) = tiny();
+    let text = serde_json::to_string(&schedule).unwrap();
+    assert!(
+        text.starts_with(r#"{"instances":[{"plane":0,"copy":0}"#),
+        "{text}"
+    );
+    let back: Schedule = serde_json::from_str(&text).unwrap();
+    assert_eq!(back, schedule);
+}
