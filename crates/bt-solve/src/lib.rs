@@ -2,13 +2,15 @@
 //!
 //! - [`image`]: the image method, exact geometric optics, the reference;
 //! - [`ipc`]: iterative path convergence (the paper's Algorithms 1-2), Gauss-Seidel or Jacobi;
-//! - [`validate`]: the geometric checks every found path must pass.
+//! - [`validate`]: the geometric checks every found path must pass;
+//! - [`sbr`]: shooting and bouncing rays, the baseline (whole-scene, not per candidate).
 //!
 //! [`trace`] runs a solver over a [`CandidateSet`] and returns the valid paths plus a count
 //! of every outcome; one bad candidate never aborts the batch.
 
 pub mod image;
 pub mod ipc;
+pub mod sbr;
 pub mod validate;
 
 use bt_geom::{Real, Vec3};
@@ -18,6 +20,7 @@ use rayon::prelude::*;
 use serde::Serialize;
 
 pub use ipc::{DegenerateKind, IpcOptions, IpcOutcome, UpdateOrder};
+pub use sbr::{SbrLaunch, SbrOptions};
 pub use validate::Validity;
 
 /// Which solver computes the interaction points.
@@ -28,6 +31,10 @@ pub enum Solver {
     Image,
     /// Iterative path convergence.
     Ipc(IpcOptions),
+    /// Shooting and bouncing rays: [`trace`] runs [`sbr::trace`] up to the longest candidate's
+    /// order (the candidates themselves are not used); [`solve_candidate`] runs
+    /// [`sbr::solve_sequence`].
+    Sbr(SbrOptions),
 }
 
 /// A valid specular path found by a solver.
@@ -59,6 +66,8 @@ pub enum CandidateOutcome {
     NotConverged(IpcOutcome),
     /// IPC degenerated (m + n = 0, opposite sides).
     Degenerate(IpcOutcome),
+    /// SBR: no launched ray reached RX through this sequence.
+    Missed,
 }
 
 /// Counts of candidate outcomes.
@@ -78,6 +87,8 @@ pub struct OutcomeCounts {
     pub not_converged: u64,
     /// IPC or image method: degenerate geometry.
     pub degenerate: u64,
+    /// SBR per candidate: no ray reached RX through the sequence.
+    pub missed: u64,
 }
 
 impl OutcomeCounts {
@@ -95,6 +106,7 @@ impl OutcomeCounts {
                 self.degenerate += 1
             }
             CandidateOutcome::NotConverged(_) => self.not_converged += 1,
+            CandidateOutcome::Missed => self.missed += 1,
         }
     }
 }
@@ -136,6 +148,13 @@ pub fn solve_candidate(
                 IpcOutcome::Degenerate { .. } => return CandidateOutcome::Degenerate(outcome),
             }
         }
+        Solver::Sbr(options) => match sbr::solve_sequence(scene, seq, options) {
+            Some(path) => {
+                points.copy_from_slice(&path.points);
+                None
+            }
+            None => return CandidateOutcome::Missed,
+        },
     };
     CandidateOutcome::Solved {
         validity: validate::validate(scene, seq, tx, rx, points),
@@ -154,6 +173,10 @@ pub fn trace(
     solver: &Solver,
     parallel: bool,
 ) -> TraceResult {
+    if let Solver::Sbr(options) = solver {
+        let max_order = candidates.iter().map(<[SurfaceId]>::len).max().unwrap_or(0);
+        return sbr::to_trace_result(&sbr::trace_detailed(scene, options, max_order, parallel));
+    }
     let run = |range: std::ops::Range<usize>| {
         let mut out = TraceResult::default();
         let mut stack_points = [Vec3::ZERO; STACK_ORDER];
@@ -214,6 +237,7 @@ pub fn trace(
         out.counts.blocked += c.blocked;
         out.counts.not_converged += c.not_converged;
         out.counts.degenerate += c.degenerate;
+        out.counts.missed += c.missed;
     }
     out
 }
