@@ -1,0 +1,202 @@
+//! Integration tests of the `beamtrace` binary: the README's commands, every input format, bad
+//! input (clear errors, never a panic) and the golden JSON of the built-in scene.
+
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn testdata(name: &str) -> String {
+    repo().join("testdata/scenes").join(name).display().to_string()
+}
+
+fn beamtrace(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_beamtrace")).args(args).output().expect("binary runs")
+}
+
+fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// Runs and parses `--json` output, asserting success.
+fn trace_json(args: &[&str]) -> Value {
+    let mut all = vec!["trace"];
+    all.extend_from_slice(args);
+    all.push("--json");
+    let o = beamtrace(&all);
+    assert!(o.status.success(), "{:?} failed: {}", all, stderr(&o));
+    serde_json::from_slice(&o.stdout).expect("valid JSON")
+}
+
+/// A failing command: non-zero exit, not a panic (101), and stderr mentions every needle.
+fn assert_clear_error(args: &[&str], needles: &[&str]) {
+    let o = beamtrace(args);
+    let code = o.status.code();
+    assert!(code.is_some() && code != Some(0) && code != Some(101), "{args:?}: exit {code:?}");
+    let text = format!("{}{}", stdout(&o), stderr(&o));
+    assert!(!text.contains("panicked"), "{args:?} panicked: {text}");
+    for n in needles {
+        assert!(text.contains(n), "{args:?}: message lacks {n:?}:\n{text}");
+    }
+}
+
+fn without_timings(mut v: Value) -> Value {
+    v["stats"].as_object_mut().unwrap().remove("time_s");
+    v
+}
+
+#[test]
+fn demo_prints_a_table_of_paths() {
+    let o = beamtrace(&["demo"]);
+    assert!(o.status.success(), "{}", stderr(&o));
+    let out = stdout(&o);
+    assert!(out.contains("(line of sight)"));
+    assert!(out.contains("valid paths from"));
+}
+
+#[test]
+fn golden_json_of_the_builtin_scene() {
+    let doc = without_timings(trace_json(&["builtin:living-room"]));
+    let text = serde_json::to_string_pretty(&doc).unwrap() + "\n";
+    let golden = repo().join("testdata/golden/living-room-image.json");
+    if std::env::var_os("UPDATE_GOLDEN").is_some() {
+        std::fs::write(&golden, &text).unwrap();
+    }
+    let expected = std::fs::read_to_string(&golden).expect("golden file exists (UPDATE_GOLDEN=1 writes it)");
+    assert_eq!(text, expected, "output differs from {}; rerun with UPDATE_GOLDEN=1 if intended", golden.display());
+}
+
+#[test]
+fn json_document_has_the_documented_fields() {
+    let doc = trace_json(&["builtin:living-room", "--max-order", "2"]);
+    let paths = doc["paths"].as_array().unwrap();
+    assert!(!paths.is_empty());
+    for p in paths {
+        for field in ["order", "surfaces", "points", "length_m", "delay_s", "aod_deg", "aoa_deg", "loss_db"] {
+            assert!(p.get(field).is_some(), "path lacks {field}");
+        }
+        assert_eq!(p["points"].as_array().unwrap().len(), p["order"].as_u64().unwrap() as usize);
+        assert!(p["aod_deg"]["azimuth"].is_f64() && p["aoa_deg"]["elevation"].is_f64());
+    }
+    let stats = &doc["stats"];
+    assert_eq!(stats["valid_paths"].as_u64().unwrap() as usize, paths.len());
+    assert!(stats["candidates"]["generated"].as_u64().unwrap() >= stats["candidates"]["candidates"].as_u64().unwrap());
+    assert!(stats["time_s"]["solve"].is_f64());
+}
+
+#[test]
+fn ipc_orders_agree_with_the_image_method_through_the_cli() {
+    let image = trace_json(&["builtin:living-room"]);
+    for order in ["gauss-seidel", "jacobi"] {
+        let ipc = trace_json(&["builtin:living-room", "--solver", "ipc", "--ipc-order", order]);
+        let (a, b) = (image["paths"].as_array().unwrap(), ipc["paths"].as_array().unwrap());
+        assert_eq!(a.len(), b.len(), "{order}");
+        for (p, q) in a.iter().zip(b) {
+            assert_eq!(p["surfaces"], q["surfaces"]);
+            for (x, y) in p["points"].as_array().unwrap().iter().zip(q["points"].as_array().unwrap()) {
+                for i in 0..3 {
+                    let d = (x[i].as_f64().unwrap() - y[i].as_f64().unwrap()).abs();
+                    assert!(d < 1e-9, "{order}: {d}");
+                }
+            }
+            assert!(q["iterations"].as_u64().unwrap() >= 1);
+        }
+    }
+}
+
+#[test]
+fn negative_coordinates_work_in_both_spellings() {
+    let scene = testdata("one-wall.json");
+    let a = trace_json(&[&scene, "--tx", "-1.5,0.5,2", "--rx=-0.5,3,1"]);
+    let b = trace_json(&[&scene, "--tx=-1.5,0.5,2", "--rx", "-0.5,3,1"]);
+    assert_eq!(a["tx"], serde_json::json!([-1.5, 0.5, 2.0]));
+    assert_eq!(without_timings(a), without_timings(b));
+}
+
+#[test]
+fn single_wall_reflection_point_is_analytic() {
+    // TX (-1.5, 1, 2), RX (2, 2, 1): image of TX is (-1.5, -1, 2); the line to RX meets y = 0
+    // at a third of the way: (-1.5 + 3.5/3, 0, 2 - 1/3).
+    let doc = trace_json(&[&testdata("one-wall.json")]);
+    let p = &doc["paths"][1]["points"][0];
+    let expected = [-1.5 + 3.5 / 3.0, 0.0, 2.0 - 1.0 / 3.0];
+    for i in 0..3 {
+        assert!((p[i].as_f64().unwrap() - expected[i]).abs() < 1e-12);
+    }
+}
+
+#[test]
+fn meshes_import_and_trace_like_the_equivalent_scene() {
+    let rx = "3.6,2.9,0.8";
+    let tx = "1.1,0.7,2.1";
+    let obj = trace_json(&[&testdata("box-room.obj"), "--tx", tx, "--rx", rx]);
+    let ascii = trace_json(&[&testdata("box-room-ascii.ply"), "--tx", tx, "--rx", rx]);
+    let binary = trace_json(&[&testdata("box-room-binary.ply"), "--tx", tx, "--rx", rx]);
+    // The box as 12 triangles is 6 surfaces: 1 + 6 + 18 + 38 image sources up to order 3.
+    assert_eq!(obj["paths"].as_array().unwrap().len(), 63);
+    let (a, b) = (without_timings(ascii), without_timings(binary));
+    assert_eq!(a["paths"], b["paths"]);
+    let lengths = |v: &Value| v["paths"].as_array().unwrap().iter().map(|p| p["length_m"].as_f64().unwrap()).collect::<Vec<_>>();
+    for (x, y) in lengths(&obj).iter().zip(lengths(&a)) {
+        assert!((x - y).abs() < 1e-9);
+    }
+}
+
+#[test]
+fn scene_check_reports_every_problem() {
+    let o = beamtrace(&["scene", "check", &testdata("bad-scene.toml")]);
+    assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
+    let out = stdout(&o);
+    for needle in ["bent-quad", "not planar", "zero area", "duplicate surface name", "unknown material", "tx: missing", "rx: coordinates must be finite"] {
+        assert!(out.contains(needle), "report lacks {needle:?}:\n{out}");
+    }
+}
+
+#[test]
+fn scene_check_accepts_the_builtin_scene() {
+    let o = beamtrace(&["scene", "check", "builtin:living-room"]);
+    assert!(o.status.success());
+    assert!(stdout(&o).contains("25 reflectors"), "{}", stdout(&o));
+}
+
+#[test]
+fn bad_inputs_give_clear_errors() {
+    let dir = std::env::temp_dir().join(format!("beamtrace-cli-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let write = |name: &str, text: &str| {
+        let p = dir.join(name);
+        std::fs::write(&p, text).unwrap();
+        p.display().to_string()
+    };
+    let malformed = write("malformed.json", "{ \"tx\": [0, 0, 1],\n  \"surfaces\": [ }");
+    assert_clear_error(&["trace", &malformed], &["malformed.json", "line 2"]);
+    let unknown = write("unknown.json", r#"{ "tx": [0,0,1], "rx": [1,0,1], "surfacez": [] }"#);
+    assert_clear_error(&["trace", &unknown], &["unknown field `surfacez`"]);
+    let no_tx = write("no-tx.json", r#"{ "rx": [1,0,1] }"#);
+    assert_clear_error(&["trace", &no_tx], &["tx: missing"]);
+    let same = write("same.json", r#"{ "tx": [1,0,1], "rx": [1,0,1] }"#);
+    assert_clear_error(&["trace", &same], &["same position"]);
+    let on_wall = write(
+        "on-wall.json",
+        r#"{ "tx": [0,0,1], "rx": [0,1,1], "surfaces": [ { "name": "w", "vertices": [[-1,0,0],[1,0,0],[1,0,2],[-1,0,2]] } ] }"#,
+    );
+    assert_clear_error(&["trace", &on_wall], &["tx: lies on surface \"w\""]);
+    let bad_obj = write("bad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 7\n");
+    assert_clear_error(&["trace", &bad_obj, "--tx", "0,0,1", "--rx", "1,1,1"], &["bad.obj", "line 4"]);
+    let garbage = write("garbage.obj", "v 0 0 zero\n");
+    assert_clear_error(&["trace", &garbage, "--tx", "0,0,1", "--rx", "1,1,1"], &["garbage.obj", "line 1"]);
+    assert_clear_error(&["trace", &testdata("huge-claim.ply"), "--tx", "0,0,1", "--rx", "1,1,1"], &["huge-claim.ply", "3000000000"]);
+    assert_clear_error(&["trace", &testdata("box-room.obj")], &["--tx"]);
+    assert_clear_error(&["trace", "builtin:living-room", "--tx", "1,2"], &["X,Y,Z"]);
+    assert_clear_error(&["trace", "builtin:living-room", "--tx", "1,nan,2"], &["not finite"]);
+    assert_clear_error(&["trace", "no/such/file.json"], &["no/such/file.json"]);
+    assert_clear_error(&["trace", "scene.xyz"], &["unsupported scene format"]);
+    std::fs::remove_dir_all(&dir).ok();
+}
