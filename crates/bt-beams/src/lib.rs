@@ -100,7 +100,7 @@ pub fn describe(scene: &Scene, path: &FoundPath) -> PathReport {
     vertices.push(tx);
     vertices.extend_from_slice(&path.points);
     vertices.push(rx);
-    let length_m: Real = vertices.windows(2).map(|w| w[0].distance(w[1])).sum();
+    let length_m: Real = vertices.windows(2).map(|w| w[0].distance(w[1])).fold(0.0, |a, b| a + b);
     let incidence_deg = path
         .surfaces
         .iter()
@@ -111,11 +111,12 @@ pub fn describe(scene: &Scene, path: &FoundPath) -> PathReport {
             incoming.dot(normal).abs().min(1.0).acos().to_degrees()
         })
         .collect();
+    // Fold from +0.0: an empty f64 sum is -0.0, which would print as -0.0 for line of sight.
     let reflection_loss_db = path
         .surfaces
         .iter()
         .map(|id| scene.material_of(*id).reflection_loss_db)
-        .sum();
+        .fold(0.0, |a, b| a + b);
     let free_space_loss_db = free_space_loss_db(length_m, scene.frequency_hz());
     let n = vertices.len();
     PathReport {
