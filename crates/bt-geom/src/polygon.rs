@@ -213,9 +213,33 @@ impl Polygon {
 
     /// Whether the projection of `p` onto the plane lies inside the polygon or within `tol`
     /// metres of its boundary (inclusive test, used for interaction points).
+    /// Same answer as `signed_boundary_distance(p) >= -tol`, without square roots, and without
+    /// any distance computation for points strictly inside.
     #[inline]
     pub fn contains(&self, p: Vec3, tol: Real) -> bool {
-        self.signed_boundary_distance(p) >= -tol
+        let q = self.to_local(p);
+        let n = self.local.len();
+        let mut inside = false;
+        let mut j = n - 1;
+        for i in 0..n {
+            let (a, b) = (self.local[j], self.local[i]);
+            if (b.y > q.y) != (a.y > q.y) && q.x < b.x + (q.y - b.y) * (a.x - b.x) / (a.y - b.y) {
+                inside = !inside;
+            }
+            j = i;
+        }
+        if inside {
+            return true;
+        }
+        let tol2 = tol * tol;
+        let mut j = n - 1;
+        for i in 0..n {
+            if segment_distance_sq(q, self.local[j], self.local[i]) <= tol2 {
+                return true;
+            }
+            j = i;
+        }
+        false
     }
 
     /// Whether the open segment `a -> b` passes through the polygon: it crosses the plane at a
@@ -388,5 +412,25 @@ mod tests {
         assert!(!p.blocks_segment(Vec3::new(1., 1., 0.), Vec3::new(1., 1., 0.5), 1e-9, tol));
         // A segment ending on the polygon does not count as crossing it.
         assert!(!p.blocks_segment(Vec3::new(1., 1., 0.), Vec3::new(1., 1., 1.), 1e-9, tol));
+    }
+}
+
+#[cfg(test)]
+mod contains_props {
+    use super::*;
+    use proptest::prelude::*;
+
+    proptest! {
+        #![proptest_config(ProptestConfig { rng_seed: proptest::test_runner::RngSeed::Fixed(7), ..ProptestConfig::default() })]
+        /// The fast inside test agrees with the signed boundary distance everywhere.
+        #[test]
+        fn contains_matches_signed_distance(x in -0.5f64..2.5, y in -0.5f64..2.5, tol in prop_oneof![Just(0.0), Just(1e-9), Just(0.1)]) {
+            let l = Polygon::new(vec![
+                Vec3::new(0., 0., 0.), Vec3::new(2., 0., 0.), Vec3::new(2., 1., 0.),
+                Vec3::new(1., 1., 0.), Vec3::new(1., 2., 0.), Vec3::new(0., 2., 0.),
+            ]).unwrap();
+            let p = Vec3::new(x, y, 0.3);
+            prop_assert_eq!(l.contains(p, tol), l.signed_boundary_distance(p) >= -tol);
+        }
     }
 }
