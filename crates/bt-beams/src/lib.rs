@@ -100,7 +100,10 @@ pub fn describe(scene: &Scene, path: &FoundPath) -> PathReport {
     vertices.push(tx);
     vertices.extend_from_slice(&path.points);
     vertices.push(rx);
-    let length_m: Real = vertices.windows(2).map(|w| w[0].distance(w[1])).fold(0.0, |a, b| a + b);
+    let length_m: Real = vertices
+        .windows(2)
+        .map(|w| w[0].distance(w[1]))
+        .fold(0.0, |a, b| a + b);
     let incidence_deg = path
         .surfaces
         .iter()

@@ -167,7 +167,11 @@ pub fn solve(
                     let next = if k + 1 == n { rx } else { points[k + 1] };
                     let plane = scene.surface(seq[k]).polygon.plane();
                     let Some(p) = intersection_point(plane, prev, next, min_sum) else {
-                        return IpcOutcome::Degenerate { kind: DegenerateKind::NeighboursOnPlane, index: k, iterations };
+                        return IpcOutcome::Degenerate {
+                            kind: DegenerateKind::NeighboursOnPlane,
+                            index: k,
+                            iterations,
+                        };
                     };
                     moved += p.distance(points[k]);
                     points[k] = p;
@@ -180,7 +184,11 @@ pub fn solve(
                     let next = if k + 1 == n { rx } else { scratch[k + 1] };
                     let plane = scene.surface(seq[k]).polygon.plane();
                     let Some(p) = intersection_point(plane, prev, next, min_sum) else {
-                        return IpcOutcome::Degenerate { kind: DegenerateKind::NeighboursOnPlane, index: k, iterations };
+                        return IpcOutcome::Degenerate {
+                            kind: DegenerateKind::NeighboursOnPlane,
+                            index: k,
+                            iterations,
+                        };
                     };
                     moved += p.distance(scratch[k]);
                     points[k] = p;
@@ -209,9 +217,16 @@ pub fn solve(
                 || moved * rate / (1.0 - rate) <= limit * ERROR_GUARD_FACTOR;
             if settled {
                 if let Some(index) = opposite_sides(scene, seq, tx, rx, points) {
-                    return IpcOutcome::Degenerate { kind: DegenerateKind::OppositeSides, index, iterations };
+                    return IpcOutcome::Degenerate {
+                        kind: DegenerateKind::OppositeSides,
+                        index,
+                        iterations,
+                    };
                 }
-                return IpcOutcome::Converged { iterations, residual: moved / n as Real };
+                return IpcOutcome::Converged {
+                    iterations,
+                    residual: moved / n as Real,
+                };
             }
         }
         // Give up early when the rate measured over the last window cannot reach the
@@ -221,7 +236,11 @@ pub fn solve(
             if iterations > STALL_WINDOW {
                 let rate = (moved / window_start).powf(1.0 / STALL_WINDOW as Real);
                 let remaining = (options.max_iterations - iterations) as Real;
-                let needed = if rate < 1.0 { (limit / moved).ln() / rate.ln() } else { Real::INFINITY };
+                let needed = if rate < 1.0 {
+                    (limit / moved).ln() / rate.ln()
+                } else {
+                    Real::INFINITY
+                };
                 if needed > 4.0 * remaining {
                     break;
                 }
@@ -234,11 +253,25 @@ pub fn solve(
     let residual = last / n as Real;
     if rule_met && residual.is_finite() {
         if let Some(index) = opposite_sides(scene, seq, tx, rx, points) {
-            return IpcOutcome::Degenerate { kind: DegenerateKind::OppositeSides, index, iterations };
+            return IpcOutcome::Degenerate {
+                kind: DegenerateKind::OppositeSides,
+                index,
+                iterations,
+            };
         }
-        return IpcOutcome::Converged { iterations, residual };
+        return IpcOutcome::Converged {
+            iterations,
+            residual,
+        };
     }
-    IpcOutcome::NotConverged { iterations, residual: if residual.is_finite() { residual } else { Real::MAX } }
+    IpcOutcome::NotConverged {
+        iterations,
+        residual: if residual.is_finite() {
+            residual
+        } else {
+            Real::MAX
+        },
+    }
 }
 
 fn opposite_sides(

@@ -8,13 +8,23 @@ use common::*;
 /// Lengths of all paths of order <= `max` in an empty box: image sources form a lattice; the
 /// image with a_x, a_y, a_z reflections per axis is reached by exactly one valid sequence.
 fn lattice_lengths(size: Vec3, tx: Vec3, rx: Vec3, max: i32) -> Vec<Real> {
-    let image = |a: i32, l: Real, t: Real| if a % 2 == 0 { a as Real * l + t } else { (a + 1) as Real * l - t };
+    let image = |a: i32, l: Real, t: Real| {
+        if a % 2 == 0 {
+            a as Real * l + t
+        } else {
+            (a + 1) as Real * l - t
+        }
+    };
     let mut lengths = Vec::new();
     for a in -max..=max {
         for b in -max..=max {
             for c in -max..=max {
                 if a.abs() + b.abs() + c.abs() <= max {
-                    let img = Vec3::new(image(a, size.x, tx.x), image(b, size.y, tx.y), image(c, size.z, tx.z));
+                    let img = Vec3::new(
+                        image(a, size.x, tx.x),
+                        image(b, size.y, tx.y),
+                        image(c, size.z, tx.z),
+                    );
                     lengths.push(img.distance(rx));
                 }
             }
@@ -45,12 +55,19 @@ fn box_room_matches_the_image_source_lattice_up_to_third_order() {
     let scene = box_room(size, tx, rx);
     let expected = lattice_lengths(size, tx, rx, 3);
     assert_eq!(expected.len(), 1 + 6 + 18 + 38);
-    for solver in [Solver::Image, ipc(&scene, UpdateOrder::GaussSeidel), ipc(&scene, UpdateOrder::Jacobi)] {
+    for solver in [
+        Solver::Image,
+        ipc(&scene, UpdateOrder::GaussSeidel),
+        ipc(&scene, UpdateOrder::Jacobi),
+    ] {
         let paths = run(&scene, 3, solver);
         let got = path_lengths(&scene, &paths);
         assert_eq!(got.len(), expected.len(), "{solver:?}");
         for (g, e) in got.iter().zip(&expected) {
-            assert!((g - e).abs() < 1e-9, "{solver:?}: length {g} vs lattice {e}");
+            assert!(
+                (g - e).abs() < 1e-9,
+                "{solver:?}: length {g} vs lattice {e}"
+            );
         }
         for p in &paths {
             assert!(reflection_law_error(&scene, p) < 1e-9);

@@ -27,7 +27,11 @@ pub fn box_room(size: Vec3, tx: Vec3, rx: Vec3) -> Scene {
 /// orientation and position, some reflectors, some blockers) and random TX/RX.
 pub fn random_scene(seed: u64, n: usize) -> Scene {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let size = Vec3::new(rng.random_range(3.0..8.0), rng.random_range(3.0..8.0), rng.random_range(2.2..3.5));
+    let size = Vec3::new(
+        rng.random_range(3.0..8.0),
+        rng.random_range(3.0..8.0),
+        rng.random_range(2.2..3.5),
+    );
     let mut surfaces = Vec::new();
     for i in 0..n {
         let centre = Vec3::new(
@@ -35,8 +39,12 @@ pub fn random_scene(seed: u64, n: usize) -> Scene {
             rng.random_range(0.2..size.y - 0.2),
             rng.random_range(0.2..size.z - 0.2),
         );
-        let normal = Vec3::new(rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0), rng.random_range(-1.0..1.0))
-            .normalize_or(Vec3::Z);
+        let normal = Vec3::new(
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+            rng.random_range(-1.0..1.0),
+        )
+        .normalize_or(Vec3::Z);
         let (u, v) = normal.any_orthonormal_pair();
         let (a, b) = (rng.random_range(0.2..1.2), rng.random_range(0.2..1.2));
         let verts: Vec<[Real; 3]> = [(-a, -b), (a, -b), (a, b), (-a, b)]
@@ -44,11 +52,17 @@ pub fn random_scene(seed: u64, n: usize) -> Scene {
             .map(|(x, y)| (centre + *x * u + *y * v).to_array())
             .collect();
         let kind = if i % 3 == 2 { "blocker" } else { "reflector" };
-        surfaces.push(format!(r#"{{ "name": "s{i}", "kind": "{kind}", "vertices": {verts:?} }}"#));
+        surfaces.push(format!(
+            r#"{{ "name": "s{i}", "kind": "{kind}", "vertices": {verts:?} }}"#
+        ));
     }
     // TX/RX: retry until valid (not on a surface); the chance of failure is negligible.
     let pick = |rng: &mut ChaCha8Rng| {
-        [rng.random_range(0.1..size.x - 0.1), rng.random_range(0.1..size.y - 0.1), rng.random_range(0.1..size.z - 0.1)]
+        [
+            rng.random_range(0.1..size.x - 0.1),
+            rng.random_range(0.1..size.y - 0.1),
+            rng.random_range(0.1..size.z - 0.1),
+        ]
     };
     let (tx, rx) = (pick(&mut rng), pick(&mut rng));
     let json = format!(

@@ -43,7 +43,9 @@ proptest! {
 
 #[test]
 fn builtin_living_room_ipc_equals_image_method() {
-    let scene = bt_scene::builtin_scene("living-room", Default::default()).unwrap().unwrap();
+    let scene = bt_scene::builtin_scene("living-room", Default::default())
+        .unwrap()
+        .unwrap();
     let reference = run(&scene, 3, Solver::Image);
     assert!(reference.len() > 20);
     for order in [UpdateOrder::GaussSeidel, UpdateOrder::Jacobi] {
