@@ -20,11 +20,53 @@ pub enum Command {
     Trace(TraceArgs),
     /// Trace the built-in furnished living room.
     Demo(DemoArgs),
+    /// Build the weak visibility relationship network (WVRN) of a scene and export it as a
+    /// table, JSON or Graphviz DOT.
+    Wvrn(WvrnArgs),
     /// Scene utilities.
     Scene {
         #[command(subcommand)]
         command: SceneCommand,
     },
+    /// The paper's validation studies.
+    Study {
+        #[command(subcommand)]
+        command: StudyCommand,
+    },
+}
+
+#[derive(Debug, Subcommand)]
+pub enum StudyCommand {
+    /// Section III: generated 2-D rooms with a moving vertex, image method vs IPC vs SBR
+    /// (writes results.csv, summary.md and Figs. 5-7 as SVG and PNG into --out).
+    #[command(name = "2d")]
+    TwoD(Study2dArgs),
+}
+
+#[derive(Debug, Args, Clone)]
+pub struct Study2dArgs {
+    /// Number of rooms (shapes cycle L, T, U, convex: 100 gives 25 of each, as Table I).
+    #[arg(long, default_value_t = 100)]
+    pub rooms: usize,
+    /// Time steps per room (the moving vertex advances once per step).
+    #[arg(long, default_value_t = 10)]
+    pub steps: usize,
+    /// Seed of the room generator (echoed into the outputs).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Output directory (created if missing).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// SBR angular step, degrees (the paper: 1).
+    #[arg(long, default_value_t = 1.0)]
+    pub sbr_step_deg: f64,
+    /// Launch SBR rays over the whole sphere (azimuth × elevation grid) instead of only in the
+    /// plane of the room.
+    #[arg(long)]
+    pub sbr_sphere: bool,
+    /// Highest reflection order.
+    #[arg(long, default_value_t = 3)]
+    pub max_order: usize,
 }
 
 #[derive(Debug, Subcommand)]
@@ -61,6 +103,8 @@ pub enum SolverArg {
     Image,
     /// Iterative path convergence (the paper's algorithm).
     Ipc,
+    /// Shooting and bouncing rays (the baseline; approximate paths).
+    Sbr,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -91,6 +135,15 @@ pub struct TraceArgs {
     /// IPC round cap.
     #[arg(long, default_value_t = bt_solve::ipc::DEFAULT_MAX_ITERATIONS)]
     pub ipc_max_iterations: u32,
+    /// SBR: azimuth × elevation grid step, degrees (default 1, i.e. 360 × 180 rays).
+    #[arg(long, conflicts_with = "sbr_rays")]
+    pub sbr_step_deg: Option<f64>,
+    /// SBR: launch this many rays on a Fibonacci sphere instead of a grid.
+    #[arg(long)]
+    pub sbr_rays: Option<u32>,
+    /// SBR: launch only in the horizontal plane through TX (2-D scenes of vertical walls).
+    #[arg(long)]
+    pub sbr_planar: bool,
     /// Use one thread (benchmarking); the output is identical either way.
     #[arg(long)]
     pub single_thread: bool,
@@ -100,6 +153,49 @@ pub struct TraceArgs {
     /// Write the JSON document to this file (the table still goes to stdout unless --json).
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Route candidates over the WVRN (the default; it provably loses no path).
+    #[arg(long, overrides_with = "no_wvrn")]
+    pub wvrn: bool,
+    /// Enumerate candidates exhaustively instead of over the WVRN.
+    #[arg(long, overrides_with = "wvrn")]
+    pub no_wvrn: bool,
+    /// Trace every time step of a dynamic scene (static scenes have one step).
+    #[arg(long)]
+    pub steps: bool,
+    /// With --steps: print one JSON object per step and line.
+    #[arg(long, requires = "steps")]
+    pub jsonl: bool,
+    /// With --steps: trace each step from scratch instead of updating the previous one.
+    #[arg(long, requires = "steps")]
+    pub from_scratch: bool,
+}
+
+impl TraceArgs {
+    /// Whether candidates are routed over the WVRN.
+    pub fn use_wvrn(&self) -> bool {
+        !self.no_wvrn
+    }
+}
+
+#[derive(Debug, Args, Clone)]
+pub struct WvrnArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// Print JSON (nodes, edges, pruned pairs with reasons, candidate reduction).
+    #[arg(long, conflicts_with = "dot")]
+    pub json: bool,
+    /// Print Graphviz DOT (dynamic scenes: red edges change with the motion, green are static).
+    #[arg(long)]
+    pub dot: bool,
+    /// Write the output to this file instead of stdout.
+    #[arg(short = 'o', long)]
+    pub out: Option<PathBuf>,
+    /// Dynamic scenes: the time step to export (0-based).
+    #[arg(long, default_value_t = 0)]
+    pub step: usize,
+    /// Highest reflection order for the candidate reduction figures.
+    #[arg(long, default_value_t = 3)]
+    pub max_order: usize,
 }
 
 #[derive(Debug, Args, Clone)]
@@ -131,9 +227,17 @@ impl DemoArgs {
             ipc_order: IpcOrderArg::GaussSeidel,
             ipc_threshold: None,
             ipc_max_iterations: bt_solve::ipc::DEFAULT_MAX_ITERATIONS,
+            sbr_step_deg: None,
+            sbr_rays: None,
+            sbr_planar: false,
             single_thread: false,
             json: self.json,
             out: None,
+            wvrn: false,
+            no_wvrn: false,
+            steps: false,
+            jsonl: false,
+            from_scratch: false,
         }
     }
 }

@@ -3,7 +3,10 @@
 
 mod args;
 mod output;
+mod study;
+mod steps;
 mod trace;
+mod wvrn;
 
 use clap::Parser;
 use std::process::ExitCode;
@@ -23,8 +26,12 @@ fn run(cli: args::Cli) -> anyhow::Result<ExitCode> {
     match cli.command {
         args::Command::Trace(a) => trace::run(&a),
         args::Command::Demo(a) => trace::run(&a.into_trace()),
+        args::Command::Wvrn(a) => wvrn::run(&a),
         args::Command::Scene {
             command: args::SceneCommand::Check(a),
         } => trace::check(&a),
+        args::Command::Study {
+            command: args::StudyCommand::TwoD(a),
+        } => study::run_2d(&a),
     }
 }

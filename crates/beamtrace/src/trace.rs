@@ -6,7 +6,7 @@ use anyhow::{Context, bail};
 use bt_paths::AllVisible;
 use bt_scene::io::{LoadOptions, Loaded};
 use bt_scene::{Scene, SceneError, Terminals};
-use bt_solve::{IpcOptions, Solver, UpdateOrder};
+use bt_solve::{IpcOptions, SbrOptions, Solver, UpdateOrder};
 use std::path::Path;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -67,10 +67,27 @@ pub fn solver_for(args: &TraceArgs, scene: &Scene) -> anyhow::Result<Solver> {
             options.max_iterations = args.ipc_max_iterations;
             Solver::Ipc(options)
         }
+        SolverArg::Sbr => {
+            let options = match (args.sbr_rays, args.sbr_step_deg) {
+                (Some(rays), _) => SbrOptions::fibonacci(rays),
+                (None, step) => SbrOptions::grid(step.unwrap_or(1.0)),
+            };
+            let options = SbrOptions {
+                planar: args.sbr_planar,
+                ..options
+            };
+            if let Some(problem) = options.problem() {
+                bail!("{problem}");
+            }
+            Solver::Sbr(options)
+        }
     })
 }
 
 pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
+    if args.steps {
+        return crate::steps::run(args);
+    }
     let t0 = Instant::now();
     let loaded = load_scene(&args.scene)?;
     for w in &loaded.warnings {
@@ -79,7 +96,12 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
     let scene = loaded.scene;
     let solver = solver_for(args, &scene)?;
     let t1 = Instant::now();
-    let candidates = bt_paths::enumerate(&scene, args.max_order, &AllVisible);
+    let candidates = if args.use_wvrn() {
+        let wvrn = bt_paths::wvrn::Wvrn::build(&scene);
+        bt_paths::enumerate(&scene, args.max_order, &wvrn)
+    } else {
+        bt_paths::enumerate(&scene, args.max_order, &AllVisible)
+    };
     let t2 = Instant::now();
     let result = bt_solve::trace(&scene, &candidates, &solver, !args.single_thread);
     let t3 = Instant::now();

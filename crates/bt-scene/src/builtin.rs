@@ -5,16 +5,20 @@ use crate::io::parse_json;
 use crate::validate::{SceneError, Terminals};
 
 const LIVING_ROOM: &str = include_str!("../scenes/living-room.json");
+const LIVING_ROOM_DYNAMIC: &str = include_str!("../scenes/living-room-dynamic.json");
 
 /// Names accepted by [`builtin_scene`].
 pub fn builtin_names() -> &'static [&'static str] {
-    &["living-room"]
+    &["living-room", "living-room-dynamic"]
 }
 
 /// The JSON text of a built-in scene, as a documented example of the scene format.
 pub fn builtin_json(name: &str) -> Option<&'static str> {
     match name {
         "living-room" => Some(LIVING_ROOM),
+        // Load it with `dynamic::builtin_dynamic_scene` for all 10 steps; as a static scene
+        // it is step 0 (person at its start, door closed).
+        "living-room-dynamic" => Some(LIVING_ROOM_DYNAMIC),
         _ => None,
     }
 }

@@ -32,6 +32,18 @@ pub struct SceneDescription {
     /// `.east`, `.south`, `.north` for the -z/+z/-x/+x/-y/+y faces... see the format doc).
     #[serde(default)]
     pub boxes: Vec<BoxDesc>,
+    /// Dynamic scenes: number of time steps (default 1). See `docs/dynamic-scenes.md`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub steps: Option<u32>,
+    /// Dynamic scenes: moving objects by name (members and motion).
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
+    pub objects: BTreeMap<String, crate::dynamic::ObjectDesc>,
+    /// Dynamic scenes: TX position per step `[[x, y, z], ...]` (one per step), metres.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tx_steps: Option<Vec<[Real; 3]>>,
+    /// Dynamic scenes: RX position per step `[[x, y, z], ...]` (one per step), metres.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rx_steps: Option<Vec<[Real; 3]>>,
 }
 
 /// A material entry.
@@ -43,7 +55,7 @@ pub struct MaterialDesc {
 }
 
 /// One planar polygon.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct SurfaceDesc {
     /// Unique name.
@@ -56,10 +68,13 @@ pub struct SurfaceDesc {
     pub kind: Option<SurfaceKind>,
     /// Vertices `[[x, y, z], ...]` in order around the polygon (either winding), metres.
     pub vertices: Vec<[Real; 3]>,
+    /// Dynamic scenes: the moving object this surface belongs to (a key of `objects`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub object: Option<String>,
 }
 
 /// An axis-aligned box, expanded into up to six rectangular faces.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct BoxDesc {
     /// Name prefix of the faces.
@@ -78,6 +93,9 @@ pub struct BoxDesc {
     /// (e.g. the bottom of furniture standing on the floor).
     #[serde(default)]
     pub omit: Vec<String>,
+    /// Dynamic scenes: the moving object this box belongs to (a key of `objects`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub object: Option<String>,
 }
 
 /// Face names of a box in output order, with the axis and whether it is the max side.

@@ -5,6 +5,7 @@
 
 mod builtin;
 mod description;
+pub mod dynamic;
 pub mod io;
 mod material;
 mod model;

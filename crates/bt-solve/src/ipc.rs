@@ -44,12 +44,24 @@ pub struct IpcOptions {
     /// remaining error Δ·ρ/(1−ρ) to be at most `threshold × ERROR_GUARD_FACTOR`, with the
     /// contraction rate ρ measured over the last two rounds. Off = the paper's rule alone.
     pub error_guard: bool,
+    /// Early stopping of paths that clearly tend to be invalid (the paper, section VI): stop
+    /// a run when a point lies outside its polygon by more than [`EARLY_REJECT_MARGIN`] times
+    /// the distance it can still move at the measured contraction rate. The run ends as
+    /// [`IpcOutcome::LeftPolygon`]; such a path could not have become valid.
+    pub early_reject: bool,
 }
+
+/// Safety factor of early rejection over the estimated remaining movement Δ·ρ/(1−ρ) (the
+/// estimate can be optimistic where convergence is sublinear, near corners).
+pub const EARLY_REJECT_MARGIN: Real = 100.0;
 
 /// The error guard accepts an estimated remaining error of up to this many thresholds
 /// (1e-13 × extent × 10 = 1e-12 × extent: 0.01 nm in a 10 m room, leaving two orders of
 /// magnitude for the inaccuracy of the rate estimate below the 1e-9 m promise).
 pub const ERROR_GUARD_FACTOR: Real = 10.0;
+
+/// Early rejection starts after this many rounds (the rate needs a history of 16 rounds).
+pub const EARLY_REJECT_FROM: usize = 24;
 
 /// Rounds over which the error guard measures the contraction rate (even, for Jacobi).
 pub const RATE_WINDOW: usize = 256;
@@ -73,6 +85,7 @@ impl IpcOptions {
             threshold: DEFAULT_REL_THRESHOLD * scene.extent().max(1.0),
             max_iterations: DEFAULT_MAX_ITERATIONS,
             error_guard: true,
+            early_reject: true,
         }
     }
 }
@@ -95,6 +108,14 @@ pub enum IpcOutcome {
         iterations: u32,
         /// Mean displacement of the last round, metres.
         residual: Real,
+    },
+    /// Early stopping: point `index` lies outside its polygon by far more than it can still
+    /// move, so the converged path would be invalid.
+    LeftPolygon {
+        /// Index of the interaction point (0-based from TX).
+        index: usize,
+        /// Rounds run.
+        iterations: u32,
     },
     /// The update is undefined or meaningless for this candidate.
     Degenerate {
@@ -246,6 +267,16 @@ pub fn solve(
                 }
             }
             window_start = moved;
+        }
+        if options.early_reject && iterations as usize >= EARLY_REJECT_FROM && iterations % 8 == 0 {
+            let base = recent[(iterations as usize - 16) % RATE_WINDOW];
+            let rate = (moved / base).powf(1.0 / 16.0);
+            if rate < 1.0 {
+                let reach = EARLY_REJECT_MARGIN * moved * rate / (1.0 - rate) + scene.length_tolerance();
+                if let Some(index) = (0..n).find(|&k| !scene.surface(seq[k]).polygon.contains(points[k], reach)) {
+                    return IpcOutcome::LeftPolygon { index, iterations };
+                }
+            }
         }
         recent[slot] = moved;
         last = moved;

@@ -66,6 +66,8 @@ pub enum CandidateOutcome {
     NotConverged(IpcOutcome),
     /// IPC degenerated (m + n = 0, opposite sides).
     Degenerate(IpcOutcome),
+    /// IPC stopped early: a point was leaving its polygon for good.
+    LeftPolygon(IpcOutcome),
     /// SBR: no launched ray reached RX through this sequence.
     Missed,
 }
@@ -106,6 +108,7 @@ impl OutcomeCounts {
                 self.degenerate += 1
             }
             CandidateOutcome::NotConverged(_) => self.not_converged += 1,
+            CandidateOutcome::LeftPolygon(_) => self.outside_polygon += 1,
             CandidateOutcome::Missed => self.missed += 1,
         }
     }
@@ -146,6 +149,7 @@ pub fn solve_candidate(
                 IpcOutcome::Converged { .. } => Some(outcome),
                 IpcOutcome::NotConverged { .. } => return CandidateOutcome::NotConverged(outcome),
                 IpcOutcome::Degenerate { .. } => return CandidateOutcome::Degenerate(outcome),
+                IpcOutcome::LeftPolygon { .. } => return CandidateOutcome::LeftPolygon(outcome),
             }
         }
         Solver::Sbr(options) => match sbr::solve_sequence(scene, seq, options) {

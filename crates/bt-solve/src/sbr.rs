@@ -287,9 +287,7 @@ pub fn trace_detailed(
         merged.merge(part);
     }
     let mut paths = merged.paths;
-    paths.sort_by(|a, b| {
-        (a.surfaces.len(), &a.surfaces).cmp(&(b.surfaces.len(), &b.surfaces))
-    });
+    paths.sort_by(|a, b| (a.surfaces.len(), &a.surfaces).cmp(&(b.surfaces.len(), &b.surfaces)));
     SbrResult {
         paths,
         rays: total as u64,
@@ -300,11 +298,7 @@ pub fn trace_detailed(
 /// SBR for one surface sequence: shoot the whole pattern but follow a ray only while it hits
 /// the surfaces of `seq` in order; the closest ray caught after the whole sequence wins.
 /// Returns it, or `None` when no ray reached RX that way.
-pub fn solve_sequence(
-    scene: &Scene,
-    seq: &[SurfaceId],
-    options: &SbrOptions,
-) -> Option<SbrPath> {
+pub fn solve_sequence(scene: &Scene, seq: &[SurfaceId], options: &SbrOptions) -> Option<SbrPath> {
     let tracer = Tracer::new(scene, options, seq.len(), Some(seq));
     tracer.run(0..options.ray_count()).paths.into_iter().next()
 }
@@ -461,10 +455,8 @@ impl<'a> Tracer<'a> {
             if surface.kind == SurfaceKind::Blocker {
                 break;
             }
-            if let Some(target) = self.target {
-                if target.get(order) != Some(&id) {
-                    break;
-                }
+            if self.target.is_some_and(|t| t.get(order) != Some(&id)) {
+                break;
             }
             let p = origin + t * dir;
             let n = surface.polygon.plane().normal;

@@ -1,0 +1,572 @@
+//! Tracing dynamic scenes step by step, incrementally: between two time steps only what the
+//! moving objects can have changed is recomputed, and the result equals a from-scratch trace.
+//!
+//! One step of [`IncrementalTracer::step`]:
+//! 1. *Moved surfaces*: vertex lists compared exactly with the previous step
+//!    ([`bt_scene::dynamic::moved_surfaces`]); TX/RX compared too.
+//! 2. *WVRN*: [`Wvrn::update`] recomputes the pairs touching moved nodes and re-tests the other
+//!    links against the moved occluders only (the paper's red vs green edges).
+//! 3. *Candidates*: the candidate set depends only on the links and the side masks of reflectors
+//!    and terminals, so it is reused when no reflector or terminal moved and no link changed;
+//!    otherwise the enumeration runs again (a DFS far cheaper than solving, see the benchmark).
+//! 4. *Paths*: a candidate's outcome is reused when it existed in the previous step, none of its
+//!    surfaces moved, the terminals and the length tolerance are unchanged, and its outcome does
+//!    not depend on other surfaces, or no moved surface's bounding box (before or after the
+//!    move, padded by 4 × the length tolerance) meets the bounding box of one of its previous
+//!    segments. Why that is exact: the solvers use only the candidate's own planes and the
+//!    terminals, so its points are the same; validation then differs only in occlusion, and a
+//!    surface can block a segment (within the validation's tolerance band) only if its box,
+//!    padded by the tolerance, meets the segment's box. Everything else is solved again, IPC
+//!    warm-started from the previous step's points.
+//!
+//! For the image method the incremental result is bit-identical to [`trace_scratch`]; for IPC
+//! reused and warm-started points agree with a cold start to the IPC threshold.
+
+use bt_geom::{Real, Vec3};
+use bt_paths::wvrn::{Wvrn, WvrnStats};
+use bt_paths::{AllVisible, CandidateSet, CandidateStats};
+use bt_scene::dynamic::{DynamicScene, moved_surfaces};
+use bt_scene::{Scene, SurfaceId};
+use bt_solve::{
+    CandidateOutcome, FoundPath, IpcOutcome, OutcomeCounts, Solver, TraceResult, Validity,
+};
+use rayon::prelude::*;
+use serde::Serialize;
+use std::cmp::Ordering;
+
+/// What to trace at every step.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct StepOptions {
+    /// Highest reflection order.
+    pub max_order: usize,
+    /// Path solver (IPC options are used as given; scale them to the scene yourself).
+    pub solver: Solver,
+    /// Route candidates over the WVRN (true) or enumerate exhaustively.
+    pub wvrn: bool,
+    /// Spread solving over rayon's pool (output identical either way).
+    pub parallel: bool,
+}
+
+/// What an incremental step recomputed.
+#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+pub struct UpdateStats {
+    /// Computed from scratch (first step, or the scene is not the next step of the previous).
+    pub full: bool,
+    /// Surfaces whose geometry changed since the previous step.
+    pub moved_surfaces: usize,
+    /// TX or RX moved (every candidate is then solved again).
+    pub terminals_moved: bool,
+    /// WVRN pairs with a moved node, recomputed ("red" pairs).
+    pub wvrn_recomputed_pairs: usize,
+    /// WVRN links re-tested against the moved occluders only.
+    pub wvrn_retested_pairs: usize,
+    /// WVRN pairs whose linked-ness changed.
+    pub wvrn_links_changed: usize,
+    /// The candidate enumeration ran again (else the previous set was reused).
+    pub candidates_rederived: bool,
+    /// Candidates solved and validated this step.
+    pub solved: usize,
+    /// Of those, IPC runs warm-started from the previous step's points.
+    pub warm_started: usize,
+    /// Candidates whose previous outcome was reused.
+    pub reused: usize,
+}
+
+/// The result of one time step.
+#[derive(Debug, Clone, Serialize)]
+pub struct StepTrace {
+    /// Time step, 0-based.
+    pub step: usize,
+    /// Valid paths (candidate order) and outcome counts.
+    pub trace: TraceResult,
+    /// Candidate enumeration counts.
+    pub candidates: CandidateStats,
+    /// WVRN counts when the WVRN is used.
+    pub wvrn: Option<WvrnStats>,
+    /// What the incremental update did (all zeros but `full` for a from-scratch trace).
+    pub update: UpdateStats,
+}
+
+/// Trace one scene from scratch: WVRN (when enabled), enumeration, [`bt_solve::trace`].
+/// The reference the incremental tracer must reproduce.
+pub fn trace_scratch(scene: &Scene, step: usize, options: &StepOptions) -> StepTrace {
+    let wvrn = options.wvrn.then(|| Wvrn::build(scene));
+    let candidates = match &wvrn {
+        Some(w) => bt_paths::enumerate(scene, options.max_order, w),
+        None => bt_paths::enumerate(scene, options.max_order, &AllVisible),
+    };
+    let trace = bt_solve::trace(scene, &candidates, &options.solver, options.parallel);
+    StepTrace {
+        step,
+        trace,
+        candidates: candidates.stats,
+        wvrn: wvrn.map(|w| w.stats()),
+        update: UpdateStats {
+            full: true,
+            solved: candidates.len(),
+            ..UpdateStats::default()
+        },
+    }
+}
+
+/// Trace every step of a dynamic scene, incrementally or each from scratch.
+pub fn trace_steps(
+    dynamic: &DynamicScene,
+    options: &StepOptions,
+    incremental: bool,
+) -> Vec<StepTrace> {
+    if incremental {
+        let mut tracer = IncrementalTracer::new(*options);
+        dynamic.scenes().iter().map(|s| tracer.step(s)).collect()
+    } else {
+        dynamic
+            .scenes()
+            .iter()
+            .enumerate()
+            .map(|(k, s)| trace_scratch(s, k, options))
+            .collect()
+    }
+}
+
+/// One candidate's outcome and the points its solver produced (meaningful when solved).
+#[derive(Debug, Clone)]
+struct Record {
+    outcome: CandidateOutcome,
+    /// Offset of its points in `State::points`.
+    start: u32,
+}
+
+#[derive(Clone)]
+struct State {
+    scene: Scene,
+    wvrn: Option<Wvrn>,
+    candidates: CandidateSet,
+    records: Vec<Record>,
+    points: Vec<Vec3>,
+    step: usize,
+}
+
+/// Traces the steps of a dynamic scene one after the other, reusing the previous step's WVRN,
+/// candidates and outcomes where the motion provably changed nothing. Cloning keeps the state
+/// (to branch, or to time one step).
+#[derive(Clone)]
+pub struct IncrementalTracer {
+    options: StepOptions,
+    state: Option<State>,
+}
+
+impl IncrementalTracer {
+    /// A tracer with no previous step.
+    pub fn new(options: StepOptions) -> Self {
+        Self {
+            options,
+            state: None,
+        }
+    }
+
+    /// Trace the next step. Scenes that are not a next step of the previous one (other
+    /// surfaces) are traced from scratch.
+    pub fn step(&mut self, scene: &Scene) -> StepTrace {
+        let options = self.options;
+        let prev = self.state.take();
+        let step = prev.as_ref().map_or(0, |p| p.step + 1);
+        if matches!(options.solver, Solver::Sbr(_)) {
+            // SBR traces the whole scene at once, not per candidate: nothing to reuse.
+            let result = trace_scratch(scene, step, &options);
+            self.state = Some(State {
+                scene: scene.clone(),
+                wvrn: None,
+                candidates: CandidateSet::default(),
+                records: Vec::new(),
+                points: Vec::new(),
+                step,
+            });
+            return result;
+        }
+        let moved = prev.as_ref().and_then(|p| moved_surfaces(&p.scene, scene));
+        let (Some(prev), Some(moved)) = (prev, moved) else {
+            return self.full(scene, step);
+        };
+        let mut update = UpdateStats {
+            moved_surfaces: moved.len(),
+            terminals_moved: prev.scene.tx() != scene.tx() || prev.scene.rx() != scene.rx(),
+            ..UpdateStats::default()
+        };
+        let tol = scene.length_tolerance();
+        let everything = update.terminals_moved || tol != prev.scene.length_tolerance();
+
+        let mut wvrn = prev.wvrn;
+        let mut links_changed = false;
+        if let Some(w) = &mut wvrn {
+            let delta = w.update(scene, &moved);
+            update.wvrn_recomputed_pairs = delta.recomputed_pairs;
+            update.wvrn_retested_pairs = delta.retested_pairs;
+            update.wvrn_links_changed = delta.changed.len();
+            links_changed = delta.rebuilt || !delta.changed.is_empty();
+        }
+        let reflector_moved = moved
+            .iter()
+            .any(|id| scene.surface(*id).kind == bt_scene::SurfaceKind::Reflector);
+        let candidates = if everything || reflector_moved || links_changed {
+            update.candidates_rederived = true;
+            match &wvrn {
+                Some(w) => bt_paths::enumerate(scene, options.max_order, w),
+                None => bt_paths::enumerate(scene, options.max_order, &AllVisible),
+            }
+        } else {
+            prev.candidates.clone()
+        };
+
+        // Moved surfaces' boxes before and after, padded by the validation's tolerance band.
+        let pad = Vec3::splat(4.0 * tol.max(prev.scene.length_tolerance()));
+        let mut is_moved = vec![false; scene.surfaces().len()];
+        let mut boxes: Vec<(Vec3, Vec3)> = Vec::with_capacity(2 * moved.len());
+        for id in &moved {
+            is_moved[id.index()] = true;
+            for s in [&prev.scene, scene] {
+                let (lo, hi) = s.surface(*id).polygon.bounds();
+                boxes.push((lo - pad, hi + pad));
+            }
+        }
+        let union = boxes
+            .iter()
+            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), (a, b)| {
+                (lo.min(*a), hi.max(*b))
+            });
+        let (tx, rx) = (scene.tx(), scene.rx());
+
+        // Walk both candidate sets in their common order (by length, then by ids).
+        enum Plan {
+            Reuse(usize),
+            Solve(Option<usize>),
+        }
+        let mut plans = Vec::with_capacity(candidates.len());
+        let mut j = 0;
+        for seq in candidates.iter() {
+            while j < prev.candidates.len()
+                && canonical(prev.candidates.get(j), seq) == Ordering::Less
+            {
+                j += 1;
+            }
+            let old = (j < prev.candidates.len() && prev.candidates.get(j) == seq).then_some(j);
+            let plan = match old {
+                None => Plan::Solve(None),
+                Some(_) if everything || seq.iter().any(|id| is_moved[id.index()]) => {
+                    Plan::Solve(old)
+                }
+                Some(o) => {
+                    let record = &prev.records[o];
+                    let pts =
+                        &prev.points[record.start as usize..record.start as usize + seq.len()];
+                    if depends_on_others(&record.outcome) && touches(&boxes, union, tx, rx, pts) {
+                        Plan::Solve(old)
+                    } else {
+                        Plan::Reuse(o)
+                    }
+                }
+            };
+            plans.push(plan);
+        }
+
+        // Solve the affected candidates (in parallel, order preserved).
+        let todo: Vec<usize> = plans
+            .iter()
+            .enumerate()
+            .filter_map(|(i, p)| matches!(p, Plan::Solve(_)).then_some(i))
+            .collect();
+        // Each chunk returns its outcomes and the points of its candidates, concatenated.
+        let solve_range = |range: &[usize]| -> (Vec<(CandidateOutcome, bool)>, Vec<Vec3>) {
+            let mut scratch = Vec::new();
+            let mut all_points = Vec::new();
+            let outcomes = range
+                .iter()
+                .map(|&i| {
+                    let seq = candidates.get(i);
+                    let start = all_points.len();
+                    all_points.resize(start + seq.len(), Vec3::ZERO);
+                    scratch.resize(seq.len(), Vec3::ZERO);
+                    let Plan::Solve(old) = plans[i] else {
+                        unreachable!()
+                    };
+                    let warm = old.and_then(|o| {
+                        let r = &prev.records[o];
+                        let pts = &prev.points[r.start as usize..r.start as usize + seq.len()];
+                        warm_start(&r.outcome, pts)
+                    });
+                    let points = &mut all_points[start..];
+                    let outcome =
+                        solve_one(scene, seq, &options.solver, warm, points, &mut scratch);
+                    (
+                        outcome,
+                        warm.is_some() && matches!(options.solver, Solver::Ipc(_)),
+                    )
+                })
+                .collect();
+            (outcomes, all_points)
+        };
+        const CHUNK: usize = 64;
+        let (solved, solved_points) = if options.parallel && todo.len() >= 256 {
+            let parts: Vec<_> = todo.par_chunks(CHUNK).map(solve_range).collect();
+            let mut out = (Vec::with_capacity(todo.len()), Vec::new());
+            for (o, p) in parts {
+                out.0.extend(o);
+                out.1.extend(p);
+            }
+            out
+        } else {
+            solve_range(&todo)
+        };
+        update.solved = solved.len();
+        update.warm_started = solved.iter().filter(|s| s.1).count();
+        update.reused = candidates.len() - solved.len();
+
+        let mut records = Vec::with_capacity(candidates.len());
+        let mut points = Vec::with_capacity(prev.points.len());
+        let mut fresh = solved.into_iter();
+        let mut fresh_points = 0;
+        for (i, plan) in plans.iter().enumerate() {
+            let n = candidates.get(i).len();
+            let start = points.len() as u32;
+            match plan {
+                Plan::Reuse(o) => {
+                    let r = &prev.records[*o];
+                    points.extend_from_slice(&prev.points[r.start as usize..r.start as usize + n]);
+                    records.push(Record {
+                        outcome: r.outcome,
+                        start,
+                    });
+                }
+                Plan::Solve(_) => {
+                    let (outcome, _) = fresh.next().expect("one result per planned solve");
+                    points.extend_from_slice(&solved_points[fresh_points..fresh_points + n]);
+                    fresh_points += n;
+                    records.push(Record { outcome, start });
+                }
+            }
+        }
+        let state = State {
+            scene: scene.clone(),
+            wvrn,
+            candidates,
+            records,
+            points,
+            step,
+        };
+        let result = state.result(update);
+        self.state = Some(state);
+        result
+    }
+
+    fn full(&mut self, scene: &Scene, step: usize) -> StepTrace {
+        let options = self.options;
+        let wvrn = options.wvrn.then(|| Wvrn::build(scene));
+        let candidates = match &wvrn {
+            Some(w) => bt_paths::enumerate(scene, options.max_order, w),
+            None => bt_paths::enumerate(scene, options.max_order, &AllVisible),
+        };
+        let idx: Vec<usize> = (0..candidates.len()).collect();
+        let solve = |range: &[usize]| -> Vec<(CandidateOutcome, Vec<Vec3>)> {
+            let mut scratch = Vec::new();
+            range
+                .iter()
+                .map(|&i| {
+                    let seq = candidates.get(i);
+                    let mut points = vec![Vec3::ZERO; seq.len()];
+                    scratch.resize(seq.len(), Vec3::ZERO);
+                    let o = solve_one(scene, seq, &options.solver, None, &mut points, &mut scratch);
+                    (o, points)
+                })
+                .collect()
+        };
+        let solved: Vec<(CandidateOutcome, Vec<Vec3>)> = if options.parallel && idx.len() >= 256 {
+            idx.par_chunks(64)
+                .map(solve)
+                .collect::<Vec<_>>()
+                .into_iter()
+                .flatten()
+                .collect()
+        } else {
+            solve(&idx)
+        };
+        let mut records = Vec::with_capacity(solved.len());
+        let mut points = Vec::new();
+        for (outcome, pts) in solved {
+            records.push(Record {
+                outcome,
+                start: points.len() as u32,
+            });
+            points.extend(pts);
+        }
+        let update = UpdateStats {
+            full: true,
+            solved: records.len(),
+            candidates_rederived: true,
+            ..UpdateStats::default()
+        };
+        let state = State {
+            scene: scene.clone(),
+            wvrn,
+            candidates,
+            records,
+            points,
+            step,
+        };
+        let result = state.result(update);
+        self.state = Some(state);
+        result
+    }
+}
+
+impl State {
+    fn result(&self, update: UpdateStats) -> StepTrace {
+        let mut trace = TraceResult::default();
+        for (i, r) in self.records.iter().enumerate() {
+            let seq = self.candidates.get(i);
+            add(&mut trace.counts, &r.outcome);
+            if let CandidateOutcome::Solved {
+                validity: Validity::Valid,
+                ipc,
+            } = r.outcome
+            {
+                let (iterations, residual) = match ipc {
+                    Some(IpcOutcome::Converged {
+                        iterations,
+                        residual,
+                    }) => (Some(iterations), Some(residual)),
+                    _ => (None, None),
+                };
+                trace.paths.push(FoundPath {
+                    surfaces: seq.to_vec(),
+                    points: self.points[r.start as usize..r.start as usize + seq.len()].to_vec(),
+                    iterations,
+                    residual,
+                });
+            }
+        }
+        StepTrace {
+            step: self.step,
+            trace,
+            candidates: self.candidates.stats,
+            wvrn: self.wvrn.as_ref().map(Wvrn::stats),
+            update,
+        }
+    }
+}
+
+/// The order of [`bt_paths::enumerate`]'s output: by length, then lexicographically by id
+/// (reflectors are enumerated in scene order, so by increasing id).
+fn canonical(a: &[SurfaceId], b: &[SurfaceId]) -> Ordering {
+    a.len().cmp(&b.len()).then_with(|| a.cmp(b))
+}
+
+/// Whether an outcome can change when surfaces other than the candidate's own move: only
+/// occlusion looks at other surfaces, and validation reaches it only for paths that passed
+/// the inside and side checks, i.e. verdicts `Valid` and `Blocked`.
+fn depends_on_others(outcome: &CandidateOutcome) -> bool {
+    matches!(
+        outcome,
+        CandidateOutcome::Solved {
+            validity: Validity::Valid | Validity::Blocked { .. },
+            ..
+        }
+    )
+}
+
+/// Whether any box meets the bounding box of a segment of the path `tx -> points -> rx`;
+/// `union` bounds all the boxes (a quick rejection).
+fn touches(
+    boxes: &[(Vec3, Vec3)],
+    union: (Vec3, Vec3),
+    tx: Vec3,
+    rx: Vec3,
+    points: &[Vec3],
+) -> bool {
+    let meets = |(blo, bhi): (Vec3, Vec3), lo: Vec3, hi: Vec3| {
+        !(bhi.cmplt(lo).any() || blo.cmpgt(hi).any())
+    };
+    let n = points.len();
+    (0..=n).any(|k| {
+        let a = if k == 0 { tx } else { points[k - 1] };
+        let b = if k == n { rx } else { points[k] };
+        let (lo, hi) = (a.min(b), a.max(b));
+        meets(union, lo, hi) && boxes.iter().any(|bx| meets(*bx, lo, hi))
+    })
+}
+
+/// Previous points usable as an IPC warm start: those of a converged run.
+fn warm_start<'a>(outcome: &CandidateOutcome, points: &'a [Vec3]) -> Option<&'a [Vec3]> {
+    match outcome {
+        CandidateOutcome::Solved {
+            ipc: Some(IpcOutcome::Converged { .. }),
+            ..
+        } if points.iter().all(|p| p.is_finite()) => Some(points),
+        _ => None,
+    }
+}
+
+/// [`bt_solve::solve_candidate`], with IPC starting from `warm` when given.
+fn solve_one(
+    scene: &Scene,
+    seq: &[SurfaceId],
+    solver: &Solver,
+    warm: Option<&[Vec3]>,
+    points: &mut [Vec3],
+    scratch: &mut [Vec3],
+) -> CandidateOutcome {
+    match (solver, warm) {
+        (Solver::Ipc(options), Some(warm)) => {
+            points.copy_from_slice(warm);
+            let (tx, rx) = (scene.tx(), scene.rx());
+            let outcome = bt_solve::ipc::solve(scene, seq, tx, rx, options, points, scratch);
+            match outcome {
+                IpcOutcome::Converged { .. } => CandidateOutcome::Solved {
+                    validity: bt_solve::validate::validate(scene, seq, tx, rx, points),
+                    ipc: Some(outcome),
+                },
+                IpcOutcome::NotConverged { .. } => CandidateOutcome::NotConverged(outcome),
+                IpcOutcome::Degenerate { .. } => CandidateOutcome::Degenerate(outcome),
+                IpcOutcome::LeftPolygon { .. } => CandidateOutcome::LeftPolygon(outcome),
+            }
+        }
+        _ => bt_solve::solve_candidate(scene, seq, solver, points, scratch),
+    }
+}
+
+/// Count an outcome the way [`bt_solve::trace`] does (a copy of bt-solve's private
+/// `OutcomeCounts::add`; the equality tests catch any drift).
+fn add(counts: &mut OutcomeCounts, outcome: &CandidateOutcome) {
+    match outcome {
+        CandidateOutcome::Solved { validity, .. } => match validity {
+            Validity::Valid => counts.valid += 1,
+            Validity::OutsidePolygon { .. } => counts.outside_polygon += 1,
+            Validity::OppositeSides { .. } => counts.opposite_sides += 1,
+            Validity::Grazing { .. } => counts.grazing += 1,
+            Validity::Blocked { .. } => counts.blocked += 1,
+            Validity::NonFinite => counts.degenerate += 1,
+        },
+        CandidateOutcome::ImageDegenerate(_) | CandidateOutcome::Degenerate(_) => {
+            counts.degenerate += 1
+        }
+        CandidateOutcome::NotConverged(_) => counts.not_converged += 1,
+        CandidateOutcome::Missed => counts.missed += 1,
+        CandidateOutcome::LeftPolygon(_) => counts.outside_polygon += 1,
+    }
+}
+
+/// Largest distance between corresponding points of two path lists with the same surface
+/// sequences, metres; `None` when the sequences differ. For comparing steps in tests and tools.
+pub fn max_point_distance(a: &[FoundPath], b: &[FoundPath]) -> Option<Real> {
+    if a.len() != b.len() {
+        return None;
+    }
+    let mut worst: Real = 0.0;
+    for (p, q) in a.iter().zip(b) {
+        if p.surfaces != q.surfaces {
+            return None;
+        }
+        for (x, y) in p.points.iter().zip(&q.points) {
+            worst = worst.max(x.distance(*y));
+        }
+    }
+    Some(worst)
+}

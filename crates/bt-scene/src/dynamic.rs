@@ -1,0 +1,657 @@
+//! Dynamic scenes: a scene over discrete time steps, with named objects (groups of surfaces and
+//! boxes) that translate and rotate, as in the paper's Figs. 2, 11 and 14-15 (a person walking,
+//! a door opening). Format documented in `docs/dynamic-scenes.md`.
+//!
+//! The pose of an object at step `k` is a rotation by `angle_k` (degrees, right-hand rule) about
+//! `axis` through `pivot`, followed by a translation `offset_k` (metres):
+//! `x' = pivot + R(axis, angle_k) (x - pivot) + offset_k`. Poses come either from a constant
+//! per-step motion (`offset_k = k · translate`, `angle_k = k · rotate_deg`) or from keyframes
+//! (linear interpolation between keyframes, held constant before the first and after the last).
+//!
+//! Every step is validated like a static scene when the [`DynamicScene`] is built, and every
+//! problem of every step is reported at once. Surfaces keep their names and [`SurfaceId`]s
+//! across steps; TX and RX are fixed unless the file gives `tx_steps` / `rx_steps`.
+
+use crate::description::{BOX_FACES, SceneDescription};
+use crate::model::{Scene, Surface, SurfaceId};
+use crate::validate::{Problem, SceneError, Terminals, check_terminals};
+use crate::{builtin_json, io::parse_json};
+use bt_geom::{Polygon, Real, Vec3};
+use serde::{Deserialize, Serialize};
+use std::collections::BTreeMap;
+
+/// A moving object as written in a scene file (an entry of `objects`).
+///
+/// Give either a constant per-step motion (`translate` and/or `rotate_deg`) or `keyframes`.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct ObjectDesc {
+    /// Names of surfaces or boxes that belong to the object, in addition to those whose
+    /// `object` field names it (a box name covers all its faces).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub members: Vec<String>,
+    /// Translation per step `[dx, dy, dz]`, metres.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub translate: Option<[Real; 3]>,
+    /// Rotation per step about `axis` through `pivot`, degrees (right-hand rule).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rotate_deg: Option<Real>,
+    /// Point on the rotation axis (a door's hinge), metres. Required when the object rotates.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pivot: Option<[Real; 3]>,
+    /// Rotation axis direction (any length > 0; default `[0, 0, 1]`, z up).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub axis: Option<[Real; 3]>,
+    /// Poses at given steps, linearly interpolated in between.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub keyframes: Vec<KeyframeDesc>,
+}
+
+/// The pose of an object at one step.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct KeyframeDesc {
+    /// Time step (0-based, below `steps`; keyframes strictly increasing).
+    pub step: u32,
+    /// Translation from the file's geometry `[dx, dy, dz]`, metres (default zero).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub offset: Option<[Real; 3]>,
+    /// Rotation about the object's axis through its pivot, degrees (default 0).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub angle_deg: Option<Real>,
+}
+
+/// Pose of an object at one step: rotation about an axis through a pivot, then translation.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Pose {
+    /// Translation applied after the rotation, metres.
+    pub offset: Vec3,
+    /// Rotation angle, degrees (right-hand rule about `axis`).
+    pub angle_deg: Real,
+    /// Point on the rotation axis, metres.
+    pub pivot: Vec3,
+    /// Unit rotation axis.
+    pub axis: Vec3,
+}
+
+impl Pose {
+    /// The identity pose.
+    pub const IDENTITY: Pose = Pose {
+        offset: Vec3::ZERO,
+        angle_deg: 0.0,
+        pivot: Vec3::ZERO,
+        axis: Vec3::Z,
+    };
+
+    /// Whether the pose leaves every point where it is (exactly).
+    pub fn is_identity(&self) -> bool {
+        self.offset == Vec3::ZERO && self.angle_deg == 0.0
+    }
+
+    /// Image of the point `p` (metres).
+    pub fn apply(&self, p: Vec3) -> Vec3 {
+        if self.angle_deg == 0.0 {
+            return p + self.offset;
+        }
+        let q = glam::DQuat::from_axis_angle(self.axis, self.angle_deg.to_radians());
+        self.pivot + q * (p - self.pivot) + self.offset
+    }
+}
+
+/// An object of a validated dynamic scene.
+#[derive(Debug, Clone, PartialEq)]
+pub struct DynamicObject {
+    /// Object name (a key of the file's `objects`).
+    pub name: String,
+    /// Its surfaces, ids valid in every step's [`Scene`].
+    pub surfaces: Vec<SurfaceId>,
+    /// Its pose at each step.
+    pub poses: Vec<Pose>,
+}
+
+/// A validated scene over time steps: one [`Scene`] per step, same surfaces (names, ids,
+/// kinds, materials) in each, only the geometry of moving objects and the terminals differ.
+#[derive(Debug, Clone)]
+pub struct DynamicScene {
+    scenes: Vec<Scene>,
+    objects: Vec<DynamicObject>,
+}
+
+impl DynamicScene {
+    /// A static scene as a one-step dynamic scene.
+    pub fn from_static(scene: Scene) -> Self {
+        Self {
+            scenes: vec![scene],
+            objects: Vec::new(),
+        }
+    }
+
+    /// Validate a description with `steps`, `objects` and optional `tx_steps` / `rx_steps`.
+    /// `terminals` (CLI `--tx/--rx`) override the file's terminals at every step. A description
+    /// without dynamic fields gives a one-step scene equal to [`Scene::from_description`].
+    pub fn from_description(
+        desc: &SceneDescription,
+        source_name: &str,
+        terminals: Terminals,
+    ) -> Result<Self, SceneError> {
+        let mut problems: Vec<Problem> = Vec::new();
+        let mut push =
+            |location: String, message: String| problems.push(Problem { location, message });
+        let steps = desc.steps.unwrap_or(1);
+        if steps == 0 {
+            push("steps".into(), "must be at least 1".into());
+        }
+        let steps = steps.max(1) as usize;
+        let mut terminal_steps = |field: &str, values: &Option<Vec<[Real; 3]>>| {
+            let v: Option<Vec<Vec3>> = values
+                .as_ref()
+                .map(|v| v.iter().map(|p| Vec3::from_array(*p)).collect());
+            if let Some(v) = &v {
+                if v.len() != steps {
+                    push(
+                        field.into(),
+                        format!("has {} positions, expected one per step ({steps})", v.len()),
+                    );
+                }
+                if let Some(i) = v.iter().position(|p| !p.is_finite()) {
+                    push(
+                        format!("{field}[{i}]"),
+                        "coordinates must be finite numbers".into(),
+                    );
+                }
+            }
+            v
+        };
+        let tx_steps = terminal_steps("tx_steps", &desc.tx_steps);
+        let rx_steps = terminal_steps("rx_steps", &desc.rx_steps);
+
+        // Step 0 terminals decide the base scene; validation of the file's geometry happens
+        // there (every static problem reported by the static validator).
+        let base_terminals = Terminals {
+            tx: terminals
+                .tx
+                .or_else(|| tx_steps.as_ref().and_then(|v| v.first().copied())),
+            rx: terminals
+                .rx
+                .or_else(|| rx_steps.as_ref().and_then(|v| v.first().copied())),
+        };
+        let base = Scene::from_description(desc, source_name, base_terminals);
+
+        let mut motions: Vec<(String, Vec<Pose>)> = Vec::new();
+        for (name, object) in &desc.objects {
+            match poses(object, steps) {
+                Ok(p) => motions.push((name.clone(), p)),
+                Err(list) => {
+                    for (field, message) in list {
+                        push(format!("objects.{name}{field}"), message);
+                    }
+                }
+            }
+        }
+        let base = match base {
+            Ok(base) => base,
+            Err(SceneError::Invalid {
+                problems: mut base_problems,
+                ..
+            }) => {
+                base_problems.extend(problems);
+                return Err(SceneError::Invalid {
+                    source_name: source_name.to_string(),
+                    problems: base_problems,
+                });
+            }
+            Err(e) => return Err(e),
+        };
+
+        let members = members(desc, &base, &mut problems);
+        if !problems.is_empty() {
+            return Err(SceneError::Invalid {
+                source_name: source_name.to_string(),
+                problems,
+            });
+        }
+        let objects: Vec<DynamicObject> = motions
+            .into_iter()
+            .map(|(name, poses)| DynamicObject {
+                surfaces: members.get(&name).cloned().unwrap_or_default(),
+                name,
+                poses,
+            })
+            .collect();
+
+        let mut scenes = Vec::with_capacity(steps);
+        for k in 0..steps {
+            let mut surfaces: Vec<Surface> = base.surfaces().to_vec();
+            for object in &objects {
+                let pose = object.poses[k];
+                if pose.is_identity() {
+                    continue;
+                }
+                for id in &object.surfaces {
+                    let s = &mut surfaces[id.index()];
+                    let moved = s
+                        .polygon
+                        .vertices()
+                        .iter()
+                        .map(|p| pose.apply(*p))
+                        .collect();
+                    match Polygon::new(moved) {
+                        Ok(p) => s.polygon = p,
+                        Err(e) => problems.push(Problem {
+                            location: format!(
+                                "steps[{k}] object \"{}\" surface \"{}\"",
+                                object.name, s.name
+                            ),
+                            message: e.to_string(),
+                        }),
+                    }
+                }
+            }
+            let tx = terminals
+                .tx
+                .or_else(|| tx_steps.as_ref().and_then(|v| v.get(k).copied()))
+                .unwrap_or(base.tx());
+            let rx = terminals
+                .rx
+                .or_else(|| rx_steps.as_ref().and_then(|v| v.get(k).copied()))
+                .unwrap_or(base.rx());
+            let extent = crate::model::scene_extent(&surfaces, tx, rx);
+            if let Err(list) = check_terminals(&surfaces, tx, rx, extent) {
+                problems.extend(list.into_iter().map(|p| Problem {
+                    location: format!("steps[{k}] {}", p.location),
+                    message: p.message,
+                }));
+            }
+            scenes.push(Scene::assemble(
+                base.name().to_string(),
+                surfaces,
+                tx,
+                rx,
+                base.frequency_hz(),
+                base.materials().clone(),
+            ));
+        }
+        if !problems.is_empty() {
+            return Err(SceneError::Invalid {
+                source_name: source_name.to_string(),
+                problems,
+            });
+        }
+        Ok(Self { scenes, objects })
+    }
+
+    /// Number of time steps (at least 1).
+    pub fn len(&self) -> usize {
+        self.scenes.len()
+    }
+
+    /// Always false: a dynamic scene has at least one step.
+    pub fn is_empty(&self) -> bool {
+        self.scenes.is_empty()
+    }
+
+    /// The validated scene of step `k` (0-based). Panics when `k >= len()`.
+    pub fn step(&self, k: usize) -> &Scene {
+        &self.scenes[k]
+    }
+
+    /// The scenes of all steps, in order.
+    pub fn scenes(&self) -> &[Scene] {
+        &self.scenes
+    }
+
+    /// The moving objects, by name order.
+    pub fn objects(&self) -> &[DynamicObject] {
+        &self.objects
+    }
+}
+
+/// Surfaces whose geometry differs between two steps of the same dynamic scene (vertex lists
+/// compared exactly), in id order. `None` when the two scenes do not have the same surfaces
+/// (count, names, kinds), i.e. are not steps of one dynamic scene.
+pub fn moved_surfaces(prev: &Scene, next: &Scene) -> Option<Vec<SurfaceId>> {
+    let (a, b) = (prev.surfaces(), next.surfaces());
+    if a.len() != b.len() {
+        return None;
+    }
+    let mut moved = Vec::new();
+    for (i, (s, t)) in a.iter().zip(b).enumerate() {
+        if s.name != t.name || s.kind != t.kind || s.material != t.material {
+            return None;
+        }
+        if s.polygon.vertices() != t.polygon.vertices() {
+            moved.push(SurfaceId(i as u32));
+        }
+    }
+    Some(moved)
+}
+
+/// Names accepted by [`builtin_dynamic_scene`].
+pub fn builtin_dynamic_names() -> &'static [&'static str] {
+    &["living-room-dynamic"]
+}
+
+/// A built-in dynamic scene by name: `living-room-dynamic` is the built-in living room over 10
+/// steps with a person (0.4 × 0.3 × 1.75 m blocker) walking across the room through the
+/// line of sight, and the door swinging open about its hinge from 0° to 90° (10° per step).
+/// Static built-in scenes are returned as one-step dynamic scenes.
+pub fn builtin_dynamic_scene(
+    name: &str,
+    terminals: Terminals,
+) -> Option<Result<DynamicScene, SceneError>> {
+    let json = builtin_json(name)?;
+    let source = format!("builtin:{name}");
+    Some(
+        parse_json(json, &source)
+            .and_then(|d| DynamicScene::from_description(&d, &source, terminals)),
+    )
+}
+
+type FieldProblems = Vec<(String, String)>;
+
+/// Poses of one object at steps `0..steps`.
+fn poses(object: &ObjectDesc, steps: usize) -> Result<Vec<Pose>, FieldProblems> {
+    let mut problems: FieldProblems = Vec::new();
+    let finite3 = |v: &[Real; 3]| v.iter().all(|x| x.is_finite());
+    let axis = object.axis.unwrap_or([0.0, 0.0, 1.0]);
+    let axis_v = Vec3::from_array(axis);
+    if !finite3(&axis) || axis_v.length() == 0.0 || !axis_v.length().is_normal() {
+        problems.push((".axis".into(), "must be a finite non-zero vector".into()));
+    }
+    if object.pivot.as_ref().is_some_and(|p| !finite3(p)) {
+        problems.push((".pivot".into(), "coordinates must be finite numbers".into()));
+    }
+    if object.translate.as_ref().is_some_and(|t| !finite3(t)) {
+        problems.push((
+            ".translate".into(),
+            "must be three finite numbers (metres per step)".into(),
+        ));
+    }
+    if object.rotate_deg.is_some_and(|r| !r.is_finite()) {
+        problems.push((
+            ".rotate_deg".into(),
+            "must be a finite number of degrees".into(),
+        ));
+    }
+    let per_step = object.translate.is_some() || object.rotate_deg.is_some();
+    if per_step && !object.keyframes.is_empty() {
+        problems.push((
+            String::new(),
+            "give either a per-step motion (translate, rotate_deg) or keyframes, not both".into(),
+        ));
+    }
+    let mut rotates = object.rotate_deg.is_some_and(|r| r != 0.0);
+    for (i, k) in object.keyframes.iter().enumerate() {
+        if k.step as usize >= steps {
+            problems.push((
+                format!(".keyframes[{i}].step"),
+                format!("is {}, must be below steps ({steps})", k.step),
+            ));
+        }
+        if i > 0 && k.step <= object.keyframes[i - 1].step {
+            problems.push((
+                format!(".keyframes[{i}].step"),
+                "keyframe steps must be strictly increasing".into(),
+            ));
+        }
+        if k.offset.is_some_and(|o| !finite3(&o)) {
+            problems.push((
+                format!(".keyframes[{i}].offset"),
+                "must be three finite numbers".into(),
+            ));
+        }
+        if k.angle_deg.is_some_and(|a| !a.is_finite()) {
+            problems.push((
+                format!(".keyframes[{i}].angle_deg"),
+                "must be a finite number".into(),
+            ));
+        }
+        rotates |= k.angle_deg.is_some_and(|a| a != 0.0);
+    }
+    if rotates && object.pivot.is_none() {
+        problems.push((
+            ".pivot".into(),
+            "missing: a rotating object needs a pivot [x, y, z]".into(),
+        ));
+    }
+    if !problems.is_empty() {
+        return Err(problems);
+    }
+    let pivot = Vec3::from_array(object.pivot.unwrap_or([0.0; 3]));
+    let axis = axis_v.normalize();
+    let pose = |offset: Vec3, angle_deg: Real| Pose {
+        offset,
+        angle_deg,
+        pivot,
+        axis,
+    };
+    let keys: Vec<(Real, Vec3, Real)> = object
+        .keyframes
+        .iter()
+        .map(|k| {
+            (
+                k.step as Real,
+                Vec3::from_array(k.offset.unwrap_or([0.0; 3])),
+                k.angle_deg.unwrap_or(0.0),
+            )
+        })
+        .collect();
+    Ok((0..steps)
+        .map(|k| {
+            let t = k as Real;
+            if keys.is_empty() {
+                let offset = Vec3::from_array(object.translate.unwrap_or([0.0; 3])) * t;
+                return pose(offset, object.rotate_deg.unwrap_or(0.0) * t);
+            }
+            let (first, last) = (keys[0], keys[keys.len() - 1]);
+            if t <= first.0 {
+                return pose(first.1, first.2);
+            }
+            if t >= last.0 {
+                return pose(last.1, last.2);
+            }
+            let i = keys.iter().rposition(|key| key.0 <= t).unwrap_or(0);
+            let (a, b) = (keys[i], keys[i + 1]);
+            if t == a.0 {
+                return pose(a.1, a.2);
+            }
+            let f = (t - a.0) / (b.0 - a.0);
+            pose(a.1 + (b.1 - a.1) * f, a.2 + (b.2 - a.2) * f)
+        })
+        .collect())
+}
+
+/// Surfaces of each object: from `object` fields of surfaces and boxes, and from `members`.
+fn members(
+    desc: &SceneDescription,
+    base: &Scene,
+    problems: &mut Vec<Problem>,
+) -> BTreeMap<String, Vec<SurfaceId>> {
+    let mut owner: BTreeMap<SurfaceId, String> = BTreeMap::new();
+    let mut assign =
+        |object: &str, location: String, ids: Vec<SurfaceId>, problems: &mut Vec<Problem>| {
+            if !desc.objects.contains_key(object) {
+                problems.push(Problem {
+                    location,
+                    message: format!("unknown object \"{object}\" (define it under \"objects\")"),
+                });
+                return;
+            }
+            for id in ids {
+                match owner.get(&id) {
+                    Some(other) if other != object => problems.push(Problem {
+                        location: location.clone(),
+                        message: format!(
+                            "surface \"{}\" is already a member of object \"{other}\"",
+                            base.surface(id).name
+                        ),
+                    }),
+                    _ => {
+                        owner.insert(id, object.to_string());
+                    }
+                }
+            }
+        };
+    let box_faces = |name: &str| -> Vec<SurfaceId> {
+        BOX_FACES
+            .iter()
+            .filter_map(|(face, _, _)| base.find(&format!("{name}.{face}")))
+            .collect()
+    };
+    for (i, s) in desc.surfaces.iter().enumerate() {
+        if let Some(object) = &s.object {
+            let ids = base.find(&s.name).into_iter().collect();
+            assign(
+                object,
+                format!("surfaces[{i}] \"{}\".object", s.name),
+                ids,
+                problems,
+            );
+        }
+    }
+    for (i, b) in desc.boxes.iter().enumerate() {
+        if let Some(object) = &b.object {
+            assign(
+                object,
+                format!("boxes[{i}] \"{}\".object", b.name),
+                box_faces(&b.name),
+                problems,
+            );
+        }
+    }
+    for (name, object) in &desc.objects {
+        for (i, member) in object.members.iter().enumerate() {
+            let location = format!("objects.{name}.members[{i}]");
+            let ids: Vec<SurfaceId> = if let Some(id) = base.find(member) {
+                vec![id]
+            } else if desc.boxes.iter().any(|b| &b.name == member) {
+                box_faces(member)
+            } else {
+                problems.push(Problem {
+                    location,
+                    message: format!("no surface or box named \"{member}\""),
+                });
+                continue;
+            };
+            assign(name, location, ids, problems);
+        }
+    }
+    let mut by_object: BTreeMap<String, Vec<SurfaceId>> = BTreeMap::new();
+    for (id, object) in owner {
+        by_object.entry(object).or_default().push(id);
+    }
+    for name in desc.objects.keys() {
+        if !by_object.contains_key(name) {
+            problems.push(Problem {
+                location: format!("objects.{name}"),
+                message: "has no members (give \"object\": \"NAME\" on surfaces or boxes, or \"members\")".into(),
+            });
+        }
+    }
+    by_object
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn door_scene(extra: &str) -> SceneDescription {
+        let json = format!(
+            r#"{{ "tx": [1, 1, 1], "rx": [3, 2, 1.5], "steps": 4,
+            "boxes": [ {{ "name": "room", "min": [0, 0, 0], "max": [4, 3, 2.5] }},
+                       {{ "name": "crate", "kind": "blocker", "min": [2, 0.2, 0], "max": [2.5, 0.6, 0.5], "object": "crate" }} ],
+            "surfaces": [ {{ "name": "door", "object": "door", "vertices": [[3.9, 1, 0], [3.9, 1.8, 0], [3.9, 1.8, 2], [3.9, 1, 2]] }} ],
+            "objects": {{
+               "door": {{ "pivot": [3.9, 1, 0], "keyframes": [ {{ "step": 0 }}, {{ "step": 3, "angle_deg": 90 }} ] }},
+               "crate": {{ "translate": [0.1, 0.2, 0] }} {extra} }} }}"#
+        );
+        serde_json::from_str(&json).unwrap()
+    }
+
+    #[test]
+    fn door_rotates_about_its_hinge_and_crate_translates() {
+        let d = DynamicScene::from_description(&door_scene(""), "t", Terminals::default()).unwrap();
+        assert_eq!(d.len(), 4);
+        let door = d.step(0).find("door").unwrap();
+        let last = d.step(3).surface(door).polygon.vertices();
+        // 90° about +z through the hinge (3.9, 1): the free edge (3.9, 1.8) goes to (3.1, 1).
+        assert!(
+            (last[1] - Vec3::new(3.1, 1.0, 0.0)).length() < 1e-12,
+            "{last:?}"
+        );
+        assert!((last[0] - Vec3::new(3.9, 1.0, 0.0)).length() < 1e-12);
+        let mid = d.step(1).surface(door).polygon.vertices()[1];
+        let a = 30f64.to_radians();
+        assert!((mid - Vec3::new(3.9 - 0.8 * a.sin(), 1.0 + 0.8 * a.cos(), 0.0)).length() < 1e-12);
+        let top = d.step(0).find("crate.top").unwrap();
+        let c2 =
+            d.step(2).surface(top).polygon.centroid() - d.step(0).surface(top).polygon.centroid();
+        assert!((c2 - Vec3::new(0.2, 0.4, 0.0)).length() < 1e-12);
+        // Names and ids stay; moved surfaces are the door and the crate's five faces.
+        let moved = moved_surfaces(d.step(0), d.step(1)).unwrap();
+        assert_eq!(moved.len(), 1 + 6);
+        for k in 1..4 {
+            assert_eq!(d.step(k).surfaces().len(), d.step(0).surfaces().len());
+        }
+    }
+
+    #[test]
+    fn static_description_gives_one_step_equal_to_the_static_scene() {
+        let json = builtin_json("living-room").unwrap();
+        let desc = parse_json(json, "x").unwrap();
+        let d = DynamicScene::from_description(&desc, "x", Terminals::default()).unwrap();
+        let s = Scene::from_description(&desc, "x", Terminals::default()).unwrap();
+        assert_eq!(d.len(), 1);
+        assert_eq!(moved_surfaces(d.step(0), &s), Some(vec![]));
+    }
+
+    #[test]
+    fn problems_are_all_reported() {
+        let mut desc = door_scene(
+            r#", "ghost": { "translate": [1, 0, 0] }, "spin": { "rotate_deg": 5, "members": ["nothing"] }"#,
+        );
+        desc.objects.get_mut("door").unwrap().keyframes[1].step = 7;
+        desc.tx_steps = Some(vec![[1.0, 1.0, 1.0]]);
+        let err = DynamicScene::from_description(&desc, "t", Terminals::default()).unwrap_err();
+        let SceneError::Invalid { problems, .. } = err else {
+            panic!()
+        };
+        let text: Vec<String> = problems.iter().map(|p| p.to_string()).collect();
+        let has = |s: &str| text.iter().any(|t| t.contains(s));
+        assert!(has("tx_steps: has 1 positions"), "{text:#?}");
+        assert!(has("objects.door.keyframes[1].step: is 7"), "{text:#?}");
+        assert!(has("objects.spin.pivot: missing"), "{text:#?}");
+        // Motion errors stop before membership checks; fix them and see the rest.
+        desc.objects.get_mut("door").unwrap().keyframes[1].step = 3;
+        desc.objects.get_mut("spin").unwrap().pivot = Some([0.0; 3]);
+        desc.tx_steps = None;
+        let err = DynamicScene::from_description(&desc, "t", Terminals::default()).unwrap_err();
+        let SceneError::Invalid { problems, .. } = err else {
+            panic!()
+        };
+        let text: Vec<String> = problems.iter().map(|p| p.to_string()).collect();
+        let has = |s: &str| text.iter().any(|t| t.contains(s));
+        assert!(has("objects.ghost: has no members"), "{text:#?}");
+        assert!(
+            has("objects.spin.members[0]: no surface or box named \"nothing\""),
+            "{text:#?}"
+        );
+    }
+
+    #[test]
+    fn terminal_on_a_moved_surface_is_reported_with_its_step() {
+        let mut desc = door_scene("");
+        // RX where the crate's west face will be at step 2 (x = 2.2).
+        desc.rx = Some([2.2, 0.8, 0.25]);
+        let err = DynamicScene::from_description(&desc, "t", Terminals::default()).unwrap_err();
+        let SceneError::Invalid { problems, .. } = err else {
+            panic!()
+        };
+        assert!(
+            problems
+                .iter()
+                .any(|p| p.location == "steps[2] rx" && p.message.contains("crate.west")),
+            "{problems:#?}"
+        );
+    }
+}

@@ -1,0 +1,79 @@
+//! The only module of the study that touches the filesystem: writes `results.csv`,
+//! `summary.md` and the figures as SVG and PNG into an output directory.
+
+use crate::run::StudyResults;
+use crate::{StudyError, plot, report};
+use plotters::prelude::*;
+use std::path::{Path, PathBuf};
+
+/// Pixel size of Fig. 5 per drawn room and time step.
+const ROOM_CELL: u32 = 300;
+
+fn write(path: &Path, text: &str) -> Result<PathBuf, StudyError> {
+    std::fs::write(path, text).map_err(|source| StudyError::Io {
+        path: path.display().to_string(),
+        source,
+    })?;
+    Ok(path.to_path_buf())
+}
+
+/// Draw one figure with `$draw(&root, $data)` to `$dir/$stem.svg` and `$dir/$stem.png`.
+macro_rules! figure {
+    ($out:expr, $dir:expr, $stem:expr, $size:expr, $draw:path, $data:expr) => {{
+        for ext in ["svg", "png"] {
+            let path = $dir.join(format!("{}.{ext}", $stem));
+            let plot_error = |message: String| StudyError::Plot {
+                path: path.display().to_string(),
+                message,
+            };
+            if ext == "svg" {
+                let root = SVGBackend::new(&path, $size).into_drawing_area();
+                $draw(&root, $data).map_err(plot_error)?;
+                root.present().map_err(|e| plot_error(e.to_string()))?;
+            } else {
+                let root = BitMapBackend::new(&path, $size).into_drawing_area();
+                $draw(&root, $data).map_err(plot_error)?;
+                root.present().map_err(|e| plot_error(e.to_string()))?;
+            }
+            $out.push(path);
+        }
+    }};
+}
+
+/// Write every output of a study into `dir` (created if missing); returns the files written.
+pub fn write_outputs(dir: &Path, results: &StudyResults) -> Result<Vec<PathBuf>, StudyError> {
+    std::fs::create_dir_all(dir).map_err(|source| StudyError::Io {
+        path: dir.display().to_string(),
+        source,
+    })?;
+    let mut out = vec![
+        write(&dir.join("results.csv"), &report::csv(results))?,
+        write(&dir.join("summary.md"), &report::summary(results))?,
+    ];
+    figure!(
+        out,
+        dir,
+        "fig6-angular-error",
+        (1200, 900),
+        plot::angular_error,
+        results
+    );
+    figure!(
+        out,
+        dir,
+        "fig7-elapsed-time",
+        (1200, 480),
+        plot::elapsed_time,
+        results
+    );
+    let drawings = &results.drawings;
+    let cols = drawings
+        .iter()
+        .map(|d| d.steps.len())
+        .max()
+        .unwrap_or(1)
+        .max(1) as u32;
+    let size = (ROOM_CELL * cols, ROOM_CELL * drawings.len().max(1) as u32);
+    figure!(out, dir, "fig5-rooms", size, plot::rooms, drawings);
+    Ok(out)
+}

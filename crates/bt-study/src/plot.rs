@@ -1,0 +1,314 @@
+//! The figures, drawn on any plotters backend (the SVG and PNG files are made by
+//! [`crate::io`]): Fig. 5 (rooms, terminals and exact paths over time), Fig. 6 (angular error
+//! against time step and number of edges) and Fig. 7 (elapsed time, same axes). Log y axes
+//! with a floor: IPC errors are ~1e-12° and some are exactly 0.
+//!
+//! Text needs a font: DejaVu Sans (Bitstream Vera licence, `assets/DejaVuSans-LICENSE.txt`)
+//! is compiled in and registered as `sans-serif` by [`register_font`].
+
+use crate::report::{GroupBy, Quantity, mean_by};
+use crate::run::{RoomDrawing, StudyResults, StudySolver};
+use bt_geom::Real;
+use plotters::coord::Shift;
+use plotters::prelude::*;
+use std::sync::OnceLock;
+
+/// Errors below this are drawn at it on the log axes, degrees.
+pub const ERROR_FLOOR_DEG: Real = 1e-15;
+/// Times below this are drawn at it on the log axes, seconds.
+pub const TIME_FLOOR_S: Real = 1e-7;
+
+const FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
+const FAMILY: &str = "sans-serif";
+
+/// Register the shipped font as `sans-serif` (idempotent). Must run before drawing text.
+pub fn register_font() -> Result<(), String> {
+    static DONE: OnceLock<Result<(), String>> = OnceLock::new();
+    DONE.get_or_init(|| {
+        plotters::style::register_font(FAMILY, FontStyle::Normal, FONT)
+            .map_err(|_| "the shipped font DejaVuSans.ttf is not a valid font".to_string())
+    })
+    .clone()
+}
+
+fn fail<E: std::fmt::Display>(e: E) -> String {
+    e.to_string()
+}
+
+/// Colour of a solver in every figure.
+pub fn colour(solver: StudySolver) -> RGBColor {
+    match solver {
+        StudySolver::Image => RGBColor(40, 40, 40),
+        StudySolver::IpcGaussSeidel => RGBColor(31, 119, 180),
+        StudySolver::IpcJacobi => RGBColor(44, 160, 44),
+        StudySolver::Sbr => RGBColor(214, 39, 40),
+    }
+}
+
+/// One panel: a line per series on a log y axis; `floor` clamps values (and zeros) from below.
+fn panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    title: &str,
+    x_desc: &str,
+    y_desc: &str,
+    series: &[(StudySolver, Vec<(usize, Real)>)],
+    floor: Real,
+    legend: SeriesLabelPosition,
+) -> Result<(), String> {
+    let xs = series.iter().flat_map(|(_, p)| p.iter().map(|q| q.0));
+    let (x_lo, x_hi) = xs.fold((usize::MAX, 0), |(lo, hi), x| (lo.min(x), hi.max(x)));
+    let (x_lo, x_hi) = if x_lo > x_hi { (0, 1) } else { (x_lo, x_hi) };
+    let ys = series
+        .iter()
+        .flat_map(|(_, p)| p.iter().map(|q| q.1.max(floor)));
+    let (y_lo, y_hi) = ys.fold((Real::INFINITY, floor), |(lo, hi), y| {
+        (lo.min(y), hi.max(y))
+    });
+    let y_lo = if y_lo.is_finite() { y_lo / 3.0 } else { floor };
+    // Headroom above the data for the legend.
+    let y_hi = (y_hi * 30.0).max(y_lo * 10.0);
+    let mut chart = ChartBuilder::on(area)
+        .caption(title, (FAMILY, 18))
+        .margin(10)
+        .x_label_area_size(40)
+        .y_label_area_size(70)
+        .build_cartesian_2d(
+            (x_lo as Real - 0.5)..(x_hi as Real + 0.5),
+            (y_lo..y_hi).log_scale(),
+        )
+        .map_err(fail)?;
+    chart
+        .configure_mesh()
+        .x_desc(x_desc)
+        .y_desc(y_desc)
+        .x_labels((x_hi - x_lo + 1).min(12))
+        .x_label_formatter(&|x| format!("{x:.0}"))
+        .y_label_formatter(&|y| format!("{y:.0e}"))
+        .label_style((FAMILY, 12))
+        .axis_desc_style((FAMILY, 14))
+        .draw()
+        .map_err(fail)?;
+    for (solver, points) in series {
+        let c = colour(*solver);
+        let line: Vec<(Real, Real)> = points
+            .iter()
+            .map(|&(x, y)| (x as Real, y.max(floor)))
+            .collect();
+        chart
+            .draw_series(LineSeries::new(line, c.stroke_width(2)).point_size(3))
+            .map_err(fail)?
+            .label(solver.name())
+            .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
+    }
+    chart
+        .configure_series_labels()
+        .position(legend)
+        .label_font((FAMILY, 12))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(fail)?;
+    Ok(())
+}
+
+fn selected(
+    results: &StudyResults,
+    group: GroupBy,
+    quantity: Quantity,
+    solvers: &[StudySolver],
+) -> Vec<(StudySolver, Vec<(usize, Real)>)> {
+    let mut by = mean_by(&results.rows, group, quantity);
+    solvers
+        .iter()
+        .filter_map(|s| by.remove(s).map(|p| (*s, p)))
+        .collect()
+}
+
+/// Fig. 6: mean angular error at TX and RX against the time step (top) and the number of
+/// edges (bottom), for IPC and SBR (the image method is the zero reference).
+pub fn angular_error<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    results: &StudyResults,
+) -> Result<(), String> {
+    register_font()?;
+    root.fill(&WHITE).map_err(fail)?;
+    let solvers = [
+        StudySolver::IpcGaussSeidel,
+        StudySolver::IpcJacobi,
+        StudySolver::Sbr,
+    ];
+    let panels = root.split_evenly((2, 2));
+    let specs = [
+        (
+            GroupBy::Step,
+            Quantity::ErrorTx,
+            "(a) TX side vs dynamics",
+            "time step",
+        ),
+        (
+            GroupBy::Step,
+            Quantity::ErrorRx,
+            "(a) RX side vs dynamics",
+            "time step",
+        ),
+        (
+            GroupBy::Edges,
+            Quantity::ErrorTx,
+            "(b) TX side vs complexity",
+            "number of edges",
+        ),
+        (
+            GroupBy::Edges,
+            Quantity::ErrorRx,
+            "(b) RX side vs complexity",
+            "number of edges",
+        ),
+    ];
+    for (area, (group, quantity, title, x_desc)) in panels.iter().zip(specs) {
+        let series = selected(results, group, quantity, &solvers);
+        let legend = SeriesLabelPosition::MiddleRight;
+        panel(
+            area,
+            title,
+            x_desc,
+            "mean angular error (deg)",
+            &series,
+            ERROR_FLOOR_DEG,
+            legend,
+        )?;
+    }
+    Ok(())
+}
+
+/// Fig. 7: mean single-threaded elapsed time per room and step, against the time step and the
+/// number of edges, for every solver.
+pub fn elapsed_time<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    results: &StudyResults,
+) -> Result<(), String> {
+    register_font()?;
+    root.fill(&WHITE).map_err(fail)?;
+    let panels = root.split_evenly((1, 2));
+    let specs = [
+        (GroupBy::Step, "(a) elapsed time vs dynamics", "time step"),
+        (
+            GroupBy::Edges,
+            "(b) elapsed time vs complexity",
+            "number of edges",
+        ),
+    ];
+    for (area, (group, title, x_desc)) in panels.iter().zip(specs) {
+        let series = selected(results, group, Quantity::Time, &StudySolver::ALL);
+        let legend = SeriesLabelPosition::UpperLeft;
+        panel(
+            area,
+            title,
+            x_desc,
+            "mean elapsed time (s)",
+            &series,
+            TIME_FLOOR_S,
+            legend,
+        )?;
+    }
+    Ok(())
+}
+
+/// Colour of a path of the given reflection order in Fig. 5.
+fn order_colour(order: usize) -> RGBAColor {
+    match order {
+        0 => RGBColor(0, 0, 0).mix(0.9),
+        1 => RGBColor(31, 119, 180).mix(0.8),
+        2 => RGBColor(44, 160, 44).mix(0.5),
+        _ => RGBColor(255, 127, 14).mix(0.3),
+    }
+}
+
+/// Fig. 5: one row per drawn room, one column per drawn time step: walls (the step-0 contour
+/// in grey underneath), the moving vertex, TX (red triangle), RX (blue dot) and every exact
+/// path coloured by order (black LOS, blue 1st, green 2nd, orange 3rd).
+pub fn rooms<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    drawings: &[RoomDrawing],
+) -> Result<(), String> {
+    register_font()?;
+    root.fill(&WHITE).map_err(fail)?;
+    let cols = drawings
+        .iter()
+        .map(|d| d.steps.len())
+        .max()
+        .unwrap_or(1)
+        .max(1);
+    let cells = root.split_evenly((drawings.len().max(1), cols));
+    for (r, drawing) in drawings.iter().enumerate() {
+        let room = &drawing.room;
+        for (c, (&step, paths)) in drawing.steps.iter().zip(&drawing.paths).enumerate() {
+            let area = &cells[r * cols + c];
+            let title = format!(
+                "room {} ({}, {} edges), step {step}",
+                room.index,
+                room.shape.name(),
+                room.edges
+            );
+            let mut chart = ChartBuilder::on(area)
+                .caption(title, (FAMILY, 14))
+                .margin(6)
+                .x_label_area_size(20)
+                .y_label_area_size(24)
+                .build_cartesian_2d(0.0..crate::room::SQUARE, 0.0..crate::room::SQUARE)
+                .map_err(fail)?;
+            chart
+                .configure_mesh()
+                .disable_mesh()
+                .x_labels(3)
+                .y_labels(3)
+                .label_style((FAMILY, 10))
+                .draw()
+                .map_err(fail)?;
+            let closed = |contour: &[bt_geom::Vec2]| {
+                let mut line: Vec<(Real, Real)> = contour.iter().map(|p| (p.x, p.y)).collect();
+                line.push(line[0]);
+                line
+            };
+            if step > 0 {
+                chart
+                    .draw_series(std::iter::once(PathElement::new(
+                        closed(&room.contours[0]),
+                        RGBColor(180, 180, 180).stroke_width(1),
+                    )))
+                    .map_err(fail)?;
+            }
+            let mut ordered: Vec<&(usize, Vec<bt_geom::Vec2>)> = paths.iter().collect();
+            ordered.sort_by_key(|(order, _)| std::cmp::Reverse(*order));
+            chart
+                .draw_series(ordered.into_iter().map(|(order, line)| {
+                    PathElement::new(
+                        line.iter().map(|p| (p.x, p.y)).collect::<Vec<_>>(),
+                        order_colour(*order).stroke_width(1),
+                    )
+                }))
+                .map_err(fail)?;
+            let contour = &room.contours[step];
+            chart
+                .draw_series(std::iter::once(PathElement::new(
+                    closed(contour),
+                    BLACK.stroke_width(2),
+                )))
+                .map_err(fail)?;
+            let m = contour[room.moving_vertex];
+            chart
+                .draw_series([
+                    Circle::new((m.x, m.y), 4, MAGENTA.stroke_width(2)),
+                    Circle::new((room.rx.x, room.rx.y), 4, BLUE.filled()),
+                ])
+                .map_err(fail)?;
+            chart
+                .draw_series(std::iter::once(TriangleMarker::new(
+                    (room.tx.x, room.tx.y),
+                    6,
+                    RED.filled(),
+                )))
+                .map_err(fail)?;
+        }
+    }
+    Ok(())
+}

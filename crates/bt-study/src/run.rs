@@ -1,0 +1,358 @@
+//! Running the study: every room and time step traced by every solver, matched against the
+//! image method by surface sequence.
+
+use crate::room::{self, Room, Shape};
+use crate::{StudyError, embed};
+use bt_geom::{Real, Vec2, Vec3};
+use bt_paths::{AllVisible, enumerate};
+use bt_scene::{Scene, SurfaceId};
+use bt_solve::{IpcOptions, SbrOptions, Solver, UpdateOrder, sbr, trace};
+use serde::Serialize;
+use std::collections::BTreeMap;
+use std::time::Instant;
+
+/// Settings of a study.
+#[derive(Debug, Clone, Serialize)]
+pub struct StudyConfig {
+    /// Number of rooms (shapes cycle L, T, U, convex).
+    pub rooms: usize,
+    /// Time steps per room (at least 1).
+    pub steps: usize,
+    /// Seed of the room generator (echoed into every output).
+    pub seed: u64,
+    /// Highest reflection order (the paper: 3).
+    pub max_order: usize,
+    /// SBR grid step, degrees (the paper: 1).
+    pub sbr_step_deg: Real,
+    /// Launch SBR rays over the whole sphere instead of the horizontal plane only.
+    pub sbr_sphere: bool,
+}
+
+impl Default for StudyConfig {
+    /// The paper's study: 100 rooms, 10 steps, third order, 1° SBR in the plane.
+    fn default() -> Self {
+        Self {
+            rooms: 100,
+            steps: 10,
+            seed: 1,
+            max_order: 3,
+            sbr_step_deg: 1.0,
+            sbr_sphere: false,
+        }
+    }
+}
+
+impl StudyConfig {
+    /// The SBR options of this study.
+    pub fn sbr_options(&self) -> SbrOptions {
+        let grid = SbrOptions::grid(self.sbr_step_deg);
+        if self.sbr_sphere { grid } else { grid.planar() }
+    }
+
+    /// Every problem with the settings, lowercase.
+    pub fn problems(&self) -> Vec<String> {
+        let mut p = Vec::new();
+        if self.rooms == 0 {
+            p.push("rooms must be at least 1".to_string());
+        }
+        if self.steps == 0 {
+            p.push("steps must be at least 1".to_string());
+        }
+        if self.max_order > 6 {
+            p.push(format!(
+                "max order {} is too high for a study (at most 6)",
+                self.max_order
+            ));
+        }
+        if let Some(m) = self.sbr_options().problem() {
+            p.push(m);
+        }
+        p
+    }
+}
+
+/// The solvers compared.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
+pub enum StudySolver {
+    /// The image method: the reference.
+    Image,
+    /// IPC, Gauss-Seidel rounds, default options for the scene.
+    IpcGaussSeidel,
+    /// IPC, Jacobi rounds, default options for the scene.
+    IpcJacobi,
+    /// Shooting and bouncing rays.
+    Sbr,
+}
+
+impl StudySolver {
+    /// All solvers, in output order.
+    pub const ALL: [StudySolver; 4] = [
+        StudySolver::Image,
+        StudySolver::IpcGaussSeidel,
+        StudySolver::IpcJacobi,
+        StudySolver::Sbr,
+    ];
+
+    /// Name in outputs.
+    pub fn name(self) -> &'static str {
+        match self {
+            StudySolver::Image => "image",
+            StudySolver::IpcGaussSeidel => "ipc-gauss-seidel",
+            StudySolver::IpcJacobi => "ipc-jacobi",
+            StudySolver::Sbr => "sbr",
+        }
+    }
+}
+
+/// One room, time step and solver.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Row {
+    /// Room index.
+    pub room: usize,
+    /// Room shape.
+    pub shape: Shape,
+    /// Number of walls.
+    pub edges: usize,
+    /// Time step, from 0.
+    pub step: usize,
+    /// Solver.
+    pub solver: StudySolver,
+    /// Paths the solver found.
+    pub paths: usize,
+    /// Of those, paths whose surface sequence the image method also found.
+    pub matched: usize,
+    /// Image-method paths the solver did not find.
+    pub missed: usize,
+    /// Solver paths the image method does not have.
+    pub spurious: usize,
+    /// Mean angle between the solver's and the exact departure direction over matched paths,
+    /// degrees (0 when nothing matched).
+    pub mean_err_tx_deg: Real,
+    /// Largest such angle, degrees.
+    pub max_err_tx_deg: Real,
+    /// Mean angle between the solver's and the exact arrival direction, degrees.
+    pub mean_err_rx_deg: Real,
+    /// Largest such angle, degrees.
+    pub max_err_rx_deg: Real,
+    /// Single-threaded wall-clock time from scene to paths (candidate enumeration included for
+    /// the image method and IPC), seconds.
+    pub time_s: Real,
+}
+
+/// A room drawn in Fig. 5: its contour, terminals and image-method paths at a few steps.
+#[derive(Debug, Clone, Serialize)]
+pub struct RoomDrawing {
+    /// The room.
+    pub room: Room,
+    /// Drawn time steps.
+    pub steps: Vec<usize>,
+    /// Per drawn step, every exact path as a polyline TX → points → RX in the plan, metres,
+    /// with its order.
+    pub paths: Vec<Vec<(usize, Vec<Vec2>)>>,
+}
+
+/// Everything a study produced.
+#[derive(Debug, Clone, Serialize)]
+pub struct StudyResults {
+    /// The settings.
+    pub config: StudyConfig,
+    /// One row per room, step and solver, in that order.
+    pub rows: Vec<Row>,
+    /// The rooms drawn in Fig. 5 (the first room of each shape).
+    pub drawings: Vec<RoomDrawing>,
+}
+
+/// A path reduced to what the comparison needs: unit departure and arrival directions.
+struct Directions {
+    departure: Vec3,
+    arrival: Vec3,
+}
+
+fn exact_directions(scene: &Scene, points: &[Vec3]) -> Directions {
+    let (tx, rx) = (scene.tx(), scene.rx());
+    let first = points.first().copied().unwrap_or(rx);
+    let last = points.last().copied().unwrap_or(tx);
+    Directions {
+        departure: (first - tx).normalize(),
+        arrival: (last - rx).normalize(),
+    }
+}
+
+/// Angle between two vectors, degrees; `atan2(|a × b|, a · b)` keeps tiny angles accurate
+/// (`acos` of a dot product cannot resolve angles below ~1e-8 rad).
+pub fn angle_deg(a: Vec3, b: Vec3) -> Real {
+    a.cross(b).length().atan2(a.dot(b)).to_degrees()
+}
+
+type PathMap = BTreeMap<Vec<SurfaceId>, Directions>;
+
+/// Trace one scene with one solver, timed; paths keyed by surface sequence.
+fn run_solver(scene: &Scene, solver: StudySolver, config: &StudyConfig) -> (PathMap, Real) {
+    let start = Instant::now();
+    if solver == StudySolver::Sbr {
+        let result = sbr::trace_detailed(scene, &config.sbr_options(), config.max_order, false);
+        let elapsed = start.elapsed().as_secs_f64();
+        let map = result
+            .paths
+            .into_iter()
+            .map(|p| {
+                let d = Directions {
+                    departure: p.departure,
+                    arrival: p.arrival,
+                };
+                (p.surfaces, d)
+            })
+            .collect();
+        return (map, elapsed);
+    }
+    let s = match solver {
+        StudySolver::IpcGaussSeidel => {
+            Solver::Ipc(IpcOptions::for_scene(scene, UpdateOrder::GaussSeidel))
+        }
+        StudySolver::IpcJacobi => Solver::Ipc(IpcOptions::for_scene(scene, UpdateOrder::Jacobi)),
+        _ => Solver::Image,
+    };
+    let candidates = enumerate(scene, config.max_order, &AllVisible);
+    let result = trace(scene, &candidates, &s, false);
+    let elapsed = start.elapsed().as_secs_f64();
+    let map = result
+        .paths
+        .into_iter()
+        .map(|p| {
+            let d = exact_directions(scene, &p.points);
+            (p.surfaces, d)
+        })
+        .collect();
+    (map, elapsed)
+}
+
+fn compare(reference: &PathMap, found: &PathMap) -> (usize, usize, usize, [Real; 4]) {
+    let mut tx = Vec::new();
+    let mut rx = Vec::new();
+    for (seq, d) in found {
+        if let Some(e) = reference.get(seq) {
+            tx.push(angle_deg(d.departure, e.departure));
+            rx.push(angle_deg(d.arrival, e.arrival));
+        }
+    }
+    let matched = tx.len();
+    let missed = reference.keys().filter(|k| !found.contains_key(*k)).count();
+    let spurious = found.len() - matched;
+    let mean = |v: &[Real]| {
+        if v.is_empty() {
+            0.0
+        } else {
+            v.iter().sum::<Real>() / v.len() as Real
+        }
+    };
+    let max = |v: &[Real]| v.iter().copied().fold(0.0, Real::max);
+    (
+        matched,
+        missed,
+        spurious,
+        [mean(&tx), max(&tx), mean(&rx), max(&rx)],
+    )
+}
+
+/// The time steps drawn in Fig. 5: all when there are at most four, else four spread evenly.
+pub fn drawn_steps(steps: usize) -> Vec<usize> {
+    if steps <= 4 {
+        (0..steps).collect()
+    } else {
+        (0..4).map(|k| k * (steps - 1) / 3).collect()
+    }
+}
+
+/// Run the study. `progress(done, total)` is called after every room and time step.
+/// Rooms and steps run one after the other and every solver single-threaded, so the times
+/// compare fairly; all results but the times are deterministic for a seed.
+pub fn run(
+    config: &StudyConfig,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<StudyResults, StudyError> {
+    let problems = config.problems();
+    if !problems.is_empty() {
+        return Err(StudyError::Config(problems.join("; ")));
+    }
+    let total = config.rooms * config.steps;
+    let mut rows = Vec::with_capacity(total * StudySolver::ALL.len());
+    let mut drawings = Vec::new();
+    for index in 0..config.rooms {
+        let room = room::generate(config.seed, index, config.steps)?;
+        let draw = index < Shape::ALL.len();
+        let mut drawing = RoomDrawing {
+            room: room.clone(),
+            steps: drawn_steps(config.steps),
+            paths: Vec::new(),
+        };
+        for (step, contour) in room.contours.iter().enumerate() {
+            let name = format!("room-{index}-step-{step}");
+            let scene = embed::scene(&name, contour, room.tx, room.rx)?;
+            let mut reference = PathMap::new();
+            for solver in StudySolver::ALL {
+                let (found, time_s) = run_solver(&scene, solver, config);
+                if solver == StudySolver::Image {
+                    reference = found;
+                    rows.push(row(&room, step, solver, &reference, &reference, time_s));
+                } else {
+                    rows.push(row(&room, step, solver, &reference, &found, time_s));
+                }
+            }
+            if draw && drawing.steps.contains(&step) {
+                drawing
+                    .paths
+                    .push(exact_polylines(&scene, config.max_order));
+            }
+            progress(index * config.steps + step + 1, total);
+        }
+        if draw {
+            drawings.push(drawing);
+        }
+    }
+    Ok(StudyResults {
+        config: config.clone(),
+        rows,
+        drawings,
+    })
+}
+
+fn row(
+    room: &Room,
+    step: usize,
+    solver: StudySolver,
+    reference: &PathMap,
+    found: &PathMap,
+    time_s: Real,
+) -> Row {
+    let (matched, missed, spurious, [mean_tx, max_tx, mean_rx, max_rx]) = compare(reference, found);
+    Row {
+        room: room.index,
+        shape: room.shape,
+        edges: room.edges,
+        step,
+        solver,
+        paths: found.len(),
+        matched,
+        missed,
+        spurious,
+        mean_err_tx_deg: mean_tx,
+        max_err_tx_deg: max_tx,
+        mean_err_rx_deg: mean_rx,
+        max_err_rx_deg: max_rx,
+        time_s,
+    }
+}
+
+fn exact_polylines(scene: &Scene, max_order: usize) -> Vec<(usize, Vec<Vec2>)> {
+    let candidates = enumerate(scene, max_order, &AllVisible);
+    trace(scene, &candidates, &Solver::Image, false)
+        .paths
+        .iter()
+        .map(|p| {
+            let mut line = vec![scene.tx().truncate()];
+            line.extend(p.points.iter().map(|q| q.truncate()));
+            line.push(scene.rx().truncate());
+            (p.surfaces.len(), line)
+        })
+        .collect()
+}
