@@ -12,6 +12,7 @@ use clap::Parser;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
+    restore_default_sigpipe();
     let cli = args::Cli::parse();
     match run(cli) {
         Ok(code) => code,
@@ -33,5 +34,15 @@ fn run(cli: args::Cli) -> anyhow::Result<ExitCode> {
         args::Command::Study {
             command: args::StudyCommand::TwoD(a),
         } => study::run_2d(&a),
+    }
+}
+
+/// Rust ignores SIGPIPE, so `beamtrace ... | head` would panic on the closed pipe; restore the
+/// default action (end quietly), as every Unix filter does.
+fn restore_default_sigpipe() {
+    #[cfg(unix)]
+    // SAFETY: called first thing in main, before any thread exists; SIG_DFL is a valid action.
+    unsafe {
+        libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
 }
