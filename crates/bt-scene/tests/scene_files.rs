@@ -1,0 +1,118 @@
+//! Scene files: boxes expand into outward faces, TOML equals JSON, validation reports every
+//! problem with its location, the built-in scene is what the docs promise.
+
+use bt_scene::io::{parse_json, parse_toml};
+use bt_scene::{Scene, SceneError, SurfaceKind, Terminals, Vec3};
+
+fn scene(json: &str) -> Result<Scene, SceneError> {
+    let d = parse_json(json, "test.json")?;
+    Scene::from_description(&d, "test.json", Terminals::default())
+}
+
+#[test]
+fn a_box_becomes_six_outward_faces() {
+    let s = scene(r#"{ "tx": [-1, 0.5, 0.5], "rx": [-2, 0.5, 0.5], "boxes": [ { "name": "b", "min": [0, 0, 0], "max": [2, 1, 1] } ] }"#).unwrap();
+    assert_eq!(s.surfaces().len(), 6);
+    let centre = Vec3::new(1.0, 0.5, 0.5);
+    let area: f64 = s.surfaces().iter().map(|f| f.polygon.area()).sum();
+    assert!((area - 2.0 * (2.0 + 2.0 + 1.0)).abs() < 1e-12);
+    for f in s.surfaces() {
+        // Outward: the centre of the box is behind every face.
+        assert!(
+            f.polygon.plane().signed_distance(centre) < 0.0,
+            "{}",
+            f.name
+        );
+    }
+    assert!(s.find("b.top").is_some() && s.find("b.west").is_some());
+}
+
+#[test]
+fn omitted_faces_and_blockers() {
+    let s = scene(r#"{ "tx": [-1, 0.5, 0.5], "rx": [-2, 0.5, 0.5],
+        "boxes": [ { "name": "p", "kind": "blocker", "material": "human", "min": [0, 0, 0], "max": [0.4, 0.3, 1.8], "omit": ["bottom"] } ] }"#)
+    .unwrap();
+    assert_eq!(s.surfaces().len(), 5);
+    assert!(s.surfaces().iter().all(|f| f.kind == SurfaceKind::Blocker));
+    assert_eq!(s.reflectors().count(), 0);
+    assert_eq!(
+        s.material_of(bt_scene::SurfaceId(0)).reflection_loss_db,
+        20.0
+    );
+}
+
+#[test]
+fn toml_and_json_describe_the_same_scene() {
+    let json = parse_json(r#"{ "tx": [0, 1, 1], "rx": [4, 2, 1], "frequency_hz": 60e9,
+        "surfaces": [ { "name": "wall", "vertices": [[-5, 0, 0], [5, 0, 0], [5, 0, 3], [-5, 0, 3]] } ] }"#, "a.json").unwrap();
+    let toml = parse_toml(
+        "tx = [0.0, 1.0, 1.0]\nrx = [4.0, 2.0, 1.0]\nfrequency_hz = 60e9\n[[surfaces]]\nname = \"wall\"\nvertices = [[-5.0, 0.0, 0.0], [5.0, 0.0, 0.0], [5.0, 0.0, 3.0], [-5.0, 0.0, 3.0]]\n",
+        "a.toml",
+    )
+    .unwrap();
+    assert_eq!(json, toml);
+}
+
+#[test]
+fn every_problem_is_reported_with_its_location() {
+    let err = scene(
+        r#"{ "rx": [0, 0, 0], "frequency_hz": -1,
+        "materials": { "bad": { "reflection_loss_db": -3 } },
+        "surfaces": [
+          { "name": "floor", "vertices": [[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]] },
+          { "name": "floor", "vertices": [[0, 0, 1], [1, 0, 1], [1, 0, 1]] } ],
+        "boxes": [ { "name": "b", "min": [0, 0, 0], "max": [0, 1, 1] } ] }"#,
+    )
+    .unwrap_err();
+    let SceneError::Invalid { problems, .. } = &err else {
+        panic!("{err}")
+    };
+    let text = err.to_string();
+    for needle in [
+        "materials.bad.reflection_loss_db",
+        "frequency_hz",
+        "surfaces[1] \"floor\": duplicate surface name",
+        "surfaces[1] \"floor\".vertices: vertices 1 and 2 are repeated",
+        "boxes[0] \"b\": min must be finite and strictly below max",
+        "tx: missing",
+    ] {
+        assert!(text.contains(needle), "lacks {needle:?}:\n{text}");
+    }
+    assert!(problems.len() >= 6);
+}
+
+#[test]
+fn rx_on_a_surface_is_rejected_and_overrides_apply() {
+    let json = r#"{ "tx": [0, 0, 1], "rx": [0.5, 0.5, 0],
+        "surfaces": [ { "name": "floor", "vertices": [[-1, -1, 0], [1, -1, 0], [1, 1, 0], [-1, 1, 0]] } ] }"#;
+    let err = scene(json).unwrap_err().to_string();
+    assert!(err.contains("rx: lies on surface \"floor\""), "{err}");
+    let d = parse_json(json, "t.json").unwrap();
+    let ok = Scene::from_description(
+        &d,
+        "t.json",
+        Terminals {
+            tx: None,
+            rx: Some(Vec3::new(0.5, 0.5, 0.2)),
+        },
+    )
+    .unwrap();
+    assert_eq!(ok.rx(), Vec3::new(0.5, 0.5, 0.2));
+    // Beside the polygon in its plane is fine.
+    assert!(ok.with_terminals(ok.tx(), Vec3::new(3.0, 0.0, 0.0)).is_ok());
+}
+
+#[test]
+fn builtin_living_room_matches_its_description() {
+    let s = bt_scene::builtin_scene("living-room", Terminals::default())
+        .unwrap()
+        .unwrap();
+    assert_eq!(s.reflectors().count(), 25);
+    assert!(
+        s.surfaces()
+            .iter()
+            .any(|f| f.name.starts_with("person") && f.kind == SurfaceKind::Blocker)
+    );
+    assert!((s.tx().z - 2.2).abs() < 1e-12 && (s.rx().z - 0.72).abs() < 1e-12);
+    assert!(bt_scene::builtin_scene("no-such-room", Terminals::default()).is_none());
+}
