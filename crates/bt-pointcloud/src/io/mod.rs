@@ -1,0 +1,280 @@
+//! Reading and writing point clouds: PLY (ASCII, binary little- and big-endian) and PCD
+//! (ASCII, binary). This is the only module that touches the filesystem, and only through
+//! the thin `*_path` helpers; the parsers work on byte slices.
+//!
+//! Robustness contract: malformed input never panics, and allocation is bounded by the
+//! input length, never by a count claimed in the header. A claim that needs more than
+//! twice the bytes present (plus 4 KiB) is rejected up front with
+//! [`PointCloudError::CountExceedsData`] (a header claiming three billion points in a 1 KB
+//! file); a smaller shortfall is read up to the point where data runs out and reported as
+//! [`PointCloudError::Truncated`] with the point index, which is what a cut-off download
+//! looks like.
+//!
+//! Non-finite points (NaN or infinite x, y or z; common in organised PCD files where a
+//! pixel had no return) are skipped and counted by default ([`NonFinitePolicy::Skip`]),
+//! because that is what downstream plane extraction wants; choose
+//! [`NonFinitePolicy::Reject`] to get a [`PointCloudError::NonFinite`] error instead.
+//! A non-finite *normal* on a finite point is replaced by the zero vector (normals are only
+//! a hint for orienting extracted planes).
+
+mod pcd;
+mod ply;
+
+use std::io::{Read, Write};
+use std::path::Path;
+
+use glam::DVec3;
+
+pub use pcd::{PcdData, parse_pcd, read_pcd, write_pcd};
+pub use ply::{PlyFormat, parse_ply, read_ply, write_ply};
+
+use crate::cloud::PointCloud;
+use crate::error::{DataPos, Origin, PointCloudError};
+
+/// What to do with points whose coordinates are NaN or infinite.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub enum NonFinitePolicy {
+    /// Leave the point out and count it in [`LoadedCloud::skipped_non_finite`].
+    #[default]
+    Skip,
+    /// Fail with [`PointCloudError::NonFinite`] at the first such point.
+    Reject,
+}
+
+/// Options for the readers.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+pub struct ReadOptions {
+    /// Policy for NaN / infinite coordinates.
+    pub non_finite: NonFinitePolicy,
+}
+
+/// A cloud read from a file together with what the reader had to leave out.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LoadedCloud {
+    /// The finite points (metres, the file's frame) and normals if the file has all of
+    /// nx, ny, nz (PLY) or normal_x, normal_y, normal_z (PCD).
+    pub cloud: PointCloud,
+    /// Number of points left out because a coordinate was NaN or infinite.
+    pub skipped_non_finite: u64,
+}
+
+/// File formats understood by [`read_path`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum CloudFormat {
+    /// Stanford PLY.
+    Ply,
+    /// Point Cloud Library PCD.
+    Pcd,
+}
+
+/// Guess the format from the extension (`.ply` / `.pcd`, any case), else from the first
+/// bytes (`ply` magic; PCD's `# .PCD` comment or `VERSION` line).
+pub fn detect_format(path: Option<&Path>, head: &[u8]) -> Option<CloudFormat> {
+    if let Some(ext) = path.and_then(|p| p.extension()).and_then(|e| e.to_str()) {
+        if ext.eq_ignore_ascii_case("ply") {
+            return Some(CloudFormat::Ply);
+        }
+        if ext.eq_ignore_ascii_case("pcd") {
+            return Some(CloudFormat::Pcd);
+        }
+    }
+    if head.starts_with(b"ply") {
+        Some(CloudFormat::Ply)
+    } else if head.starts_with(b"# .PCD")
+        || head.starts_with(b"VERSION")
+        || head.starts_with(b"FIELDS")
+    {
+        Some(CloudFormat::Pcd)
+    } else {
+        None
+    }
+}
+
+/// Parse a PLY or PCD file held in memory, detecting the format from its first bytes.
+pub fn parse_any(bytes: &[u8], opts: &ReadOptions) -> Result<LoadedCloud, PointCloudError> {
+    match detect_format(None, bytes) {
+        Some(CloudFormat::Ply) => parse_ply(bytes, opts),
+        Some(CloudFormat::Pcd) => parse_pcd(bytes, opts),
+        None => Err(PointCloudError::UnknownFormat {
+            origin: Origin(None),
+        }),
+    }
+}
+
+/// Read a `.ply` or `.pcd` file. Errors carry the path.
+pub fn read_path(path: &Path, opts: &ReadOptions) -> Result<LoadedCloud, PointCloudError> {
+    let bytes = std::fs::read(path).map_err(|source| PointCloudError::Io {
+        origin: Origin(Some(path.to_path_buf())),
+        source,
+    })?;
+    let result = match detect_format(Some(path), &bytes) {
+        Some(CloudFormat::Ply) => parse_ply(&bytes, opts),
+        Some(CloudFormat::Pcd) => parse_pcd(&bytes, opts),
+        None => Err(PointCloudError::UnknownFormat {
+            origin: Origin(None),
+        }),
+    };
+    result.map_err(|e| e.with_path(path))
+}
+
+/// Write `cloud` to `path`, choosing the format from the extension: `.ply` as binary
+/// little-endian PLY, `.pcd` as ASCII PCD.
+pub fn write_path(cloud: &PointCloud, path: &Path) -> Result<(), PointCloudError> {
+    let origin = || Origin(Some(path.to_path_buf()));
+    let format = detect_format(Some(path), b"")
+        .ok_or_else(|| PointCloudError::UnknownFormat { origin: origin() })?;
+    let file = std::fs::File::create(path).map_err(|source| PointCloudError::Io {
+        origin: origin(),
+        source,
+    })?;
+    let mut w = std::io::BufWriter::new(file);
+    match format {
+        CloudFormat::Ply => write_ply(cloud, &mut w, PlyFormat::BinaryLittleEndian),
+        CloudFormat::Pcd => write_pcd(cloud, &mut w, PcdData::Ascii),
+    }
+    .and_then(|()| w.flush().map_err(io_err))
+    .map_err(|e| e.with_path(path))
+}
+
+/// Whether a header's claim of at least `min_bytes` of data is absurd given `available`
+/// bytes (rather than a file cut short).
+pub(crate) fn is_absurd(min_bytes: u128, available: usize) -> bool {
+    min_bytes > 2 * available as u128 + 4096
+}
+
+pub(crate) fn io_err(source: std::io::Error) -> PointCloudError {
+    PointCloudError::Io {
+        origin: Origin(None),
+        source,
+    }
+}
+
+pub(crate) fn read_all<R: Read>(mut r: R) -> Result<Vec<u8>, PointCloudError> {
+    let mut buf = Vec::new();
+    r.read_to_end(&mut buf).map_err(io_err)?;
+    Ok(buf)
+}
+
+/// Numeric scalar types shared by PLY and PCD.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Scalar {
+    I8,
+    U8,
+    I16,
+    U16,
+    I32,
+    U32,
+    I64,
+    U64,
+    F32,
+    F64,
+}
+
+impl Scalar {
+    pub(crate) fn size(self) -> usize {
+        match self {
+            Scalar::I8 | Scalar::U8 => 1,
+            Scalar::I16 | Scalar::U16 => 2,
+            Scalar::I32 | Scalar::U32 | Scalar::F32 => 4,
+            Scalar::I64 | Scalar::U64 | Scalar::F64 => 8,
+        }
+    }
+
+    /// Decode one value from exactly `self.size()` bytes.
+    pub(crate) fn decode(self, b: &[u8], big_endian: bool) -> f64 {
+        macro_rules! get {
+            ($t:ty, $n:expr) => {{
+                let mut a = [0u8; $n];
+                a.copy_from_slice(&b[..$n]);
+                if big_endian {
+                    <$t>::from_be_bytes(a)
+                } else {
+                    <$t>::from_le_bytes(a)
+                }
+            }};
+        }
+        match self {
+            Scalar::I8 => b[0] as i8 as f64,
+            Scalar::U8 => b[0] as f64,
+            Scalar::I16 => get!(i16, 2) as f64,
+            Scalar::U16 => get!(u16, 2) as f64,
+            Scalar::I32 => get!(i32, 4) as f64,
+            Scalar::U32 => get!(u32, 4) as f64,
+            Scalar::I64 => get!(i64, 8) as f64,
+            Scalar::U64 => get!(u64, 8) as f64,
+            Scalar::F32 => get!(f32, 4) as f64,
+            Scalar::F64 => get!(f64, 8),
+        }
+    }
+}
+
+/// Collects decoded points, applying the non-finite policy.
+pub(crate) struct PointSink {
+    points: Vec<DVec3>,
+    normals: Option<Vec<DVec3>>,
+    skipped: u64,
+    policy: NonFinitePolicy,
+}
+
+impl PointSink {
+    /// `capacity` must already be bounded by the input length.
+    pub(crate) fn new(capacity: usize, with_normals: bool, policy: NonFinitePolicy) -> Self {
+        Self {
+            points: Vec::with_capacity(capacity),
+            normals: with_normals.then(|| Vec::with_capacity(capacity)),
+            skipped: 0,
+            policy,
+        }
+    }
+
+    pub(crate) fn push(&mut self, p: DVec3, n: DVec3, at: DataPos) -> Result<(), PointCloudError> {
+        if !p.is_finite() {
+            return match self.policy {
+                NonFinitePolicy::Skip => {
+                    self.skipped += 1;
+                    Ok(())
+                }
+                NonFinitePolicy::Reject => Err(PointCloudError::NonFinite {
+                    origin: Origin(None),
+                    at,
+                }),
+            };
+        }
+        self.points.push(p);
+        if let Some(ns) = &mut self.normals {
+            ns.push(if n.is_finite() { n } else { DVec3::ZERO });
+        }
+        Ok(())
+    }
+
+    pub(crate) fn finish(self) -> LoadedCloud {
+        LoadedCloud {
+            cloud: PointCloud::from_parts_unchecked(self.points, self.normals),
+            skipped_non_finite: self.skipped,
+        }
+    }
+}
+
+/// Split off the next line (without `\n` / `\r\n`) starting at `*pos`; `None` at the end.
+pub(crate) fn next_line<'a>(bytes: &'a [u8], pos: &mut usize) -> Option<&'a [u8]> {
+    if *pos >= bytes.len() {
+        return None;
+    }
+    let rest = &bytes[*pos..];
+    let (line, adv) = match rest.iter().position(|&b| b == b'\n') {
+        Some(i) => (&rest[..i], i + 1),
+        None => (rest, rest.len()),
+    };
+    *pos += adv;
+    Some(line.strip_suffix(b"\r").unwrap_or(line))
+}
+
+/// Parse a number token the way both formats spell them (`nan`, `inf` accepted). A value
+/// declared as 32-bit float is rounded to `f32` first, so ASCII and binary files of the
+/// same declared type give identical points.
+pub(crate) fn parse_number(tok: &str, ty: Scalar) -> Option<f64> {
+    match ty {
+        Scalar::F32 => tok.parse::<f32>().ok().map(f64::from),
+        _ => tok.parse::<f64>().ok(),
+    }
+}

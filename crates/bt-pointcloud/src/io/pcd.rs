@@ -1,0 +1,390 @@
+//! PCD (Point Cloud Library) reader and writer: `DATA ascii` and `DATA binary`
+//! (little-endian, as PCL writes on every platform it supports). `binary_compressed` is
+//! reported as [`PointCloudError::Unsupported`].
+
+use std::io::{Read, Write};
+
+use glam::DVec3;
+
+use super::{
+    LoadedCloud, PointSink, ReadOptions, Scalar, io_err, next_line, parse_number, read_all,
+};
+use crate::cloud::PointCloud;
+use crate::error::{DataPos, Origin, PointCloudError};
+
+/// PCD data encodings this crate writes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum PcdData {
+    /// `DATA ascii`: one point per line.
+    Ascii,
+    /// `DATA binary`: packed little-endian records.
+    Binary,
+}
+
+struct Field {
+    name: String,
+    size: usize,
+    count: usize,
+    scalar: Scalar,
+}
+
+fn header_err(line: usize, reason: impl Into<String>) -> PointCloudError {
+    PointCloudError::Header {
+        origin: Origin(None),
+        line,
+        reason: reason.into(),
+    }
+}
+
+/// Parse a PCD file held in memory. Reads `x y z` (any numeric type, count 1) and, when all
+/// three are present, `normal_x normal_y normal_z`; other fields are skipped using their
+/// SIZE, TYPE and COUNT.
+pub fn parse_pcd(bytes: &[u8], opts: &ReadOptions) -> Result<LoadedCloud, PointCloudError> {
+    let mut pos = 0;
+    let mut line_no = 0;
+    let mut names: Option<Vec<String>> = None;
+    let mut sizes: Option<Vec<usize>> = None;
+    let mut types: Option<Vec<u8>> = None;
+    let mut counts: Option<Vec<usize>> = None;
+    let mut width: Option<u64> = None;
+    let mut height: Option<u64> = None;
+    let mut points: Option<u64> = None;
+    let binary;
+    loop {
+        let Some(raw) = next_line(bytes, &mut pos) else {
+            return Err(header_err(line_no.max(1), "header has no 'DATA' line"));
+        };
+        line_no += 1;
+        let line =
+            std::str::from_utf8(raw).map_err(|_| header_err(line_no, "header line is not text"))?;
+        let line = line.split('#').next().unwrap_or("");
+        let mut tok = line.split_ascii_whitespace();
+        let Some(key) = tok.next() else { continue };
+        let rest: Vec<&str> = tok.collect();
+        let ints = |what: &str| -> Result<Vec<u64>, PointCloudError> {
+            rest.iter()
+                .map(|t| {
+                    t.parse::<u64>().map_err(|_| {
+                        header_err(
+                            line_no,
+                            format!("{what}: '{t}' is not a non-negative integer"),
+                        )
+                    })
+                })
+                .collect()
+        };
+        let one = |what: &str| -> Result<u64, PointCloudError> {
+            match ints(what)?.as_slice() {
+                [v] => Ok(*v),
+                _ => Err(header_err(
+                    line_no,
+                    format!("{what} takes exactly one value"),
+                )),
+            }
+        };
+        match key.to_ascii_uppercase().as_str() {
+            "VERSION" | "VIEWPOINT" => {}
+            "FIELDS" => names = Some(rest.iter().map(|s| s.to_string()).collect()),
+            "SIZE" => sizes = Some(ints("SIZE")?.into_iter().map(|v| v as usize).collect()),
+            "COUNT" => {
+                let c = ints("COUNT")?;
+                if c.iter().any(|&v| v == 0 || v > 1 << 20) {
+                    return Err(header_err(
+                        line_no,
+                        "COUNT values must be between 1 and 2^20",
+                    ));
+                }
+                counts = Some(c.into_iter().map(|v| v as usize).collect());
+            }
+            "TYPE" => {
+                let mut t = Vec::new();
+                for s in &rest {
+                    match *s {
+                        "F" | "I" | "U" => t.push(s.as_bytes()[0]),
+                        _ => {
+                            return Err(header_err(
+                                line_no,
+                                format!("TYPE '{s}' is not F, I or U"),
+                            ));
+                        }
+                    }
+                }
+                types = Some(t);
+            }
+            "WIDTH" => width = Some(one("WIDTH")?),
+            "HEIGHT" => height = Some(one("HEIGHT")?),
+            "POINTS" => points = Some(one("POINTS")?),
+            "DATA" => {
+                binary = match rest.as_slice() {
+                    ["ascii"] => false,
+                    ["binary"] => true,
+                    ["binary_compressed"] => {
+                        return Err(PointCloudError::Unsupported {
+                            origin: Origin(None),
+                            line: line_no,
+                            what: "DATA binary_compressed (decompress with pcl_convert_pcd_ascii_binary)".into(),
+                        });
+                    }
+                    _ => {
+                        return Err(header_err(
+                            line_no,
+                            format!("unknown DATA encoding '{}'", rest.join(" ")),
+                        ));
+                    }
+                };
+                break;
+            }
+            other => return Err(header_err(line_no, format!("unknown keyword '{other}'"))),
+        }
+    }
+    let data_line = line_no;
+    let names = names.ok_or_else(|| header_err(data_line, "no FIELDS line"))?;
+    let n = names.len();
+    let sizes = sizes.ok_or_else(|| header_err(data_line, "no SIZE line"))?;
+    let types = types.ok_or_else(|| header_err(data_line, "no TYPE line"))?;
+    let counts = counts.unwrap_or_else(|| vec![1; n]);
+    if sizes.len() != n || types.len() != n || counts.len() != n {
+        return Err(header_err(
+            data_line,
+            format!(
+                "{n} FIELDS but {} SIZE, {} TYPE and {} COUNT values",
+                sizes.len(),
+                types.len(),
+                counts.len()
+            ),
+        ));
+    }
+    let mut fields = Vec::with_capacity(n);
+    for i in 0..n {
+        let scalar = match (types[i], sizes[i]) {
+            (b'F', 4) => Scalar::F32,
+            (b'F', 8) => Scalar::F64,
+            (b'I', 1) => Scalar::I8,
+            (b'I', 2) => Scalar::I16,
+            (b'I', 4) => Scalar::I32,
+            (b'I', 8) => Scalar::I64,
+            (b'U', 1) => Scalar::U8,
+            (b'U', 2) => Scalar::U16,
+            (b'U', 4) => Scalar::U32,
+            (b'U', 8) => Scalar::U64,
+            (t, s) => {
+                return Err(header_err(
+                    data_line,
+                    format!(
+                        "field '{}': TYPE {} with SIZE {s} is not valid",
+                        names[i], t as char
+                    ),
+                ));
+            }
+        };
+        fields.push(Field {
+            name: names[i].clone(),
+            size: sizes[i],
+            count: counts[i],
+            scalar,
+        });
+    }
+    let count = match (points, width, height) {
+        (Some(p), Some(w), Some(h)) if w.checked_mul(h) != Some(p) => {
+            return Err(header_err(
+                data_line,
+                format!("POINTS {p} differs from WIDTH {w} x HEIGHT {h}"),
+            ));
+        }
+        (Some(p), _, _) => p,
+        (None, Some(w), Some(h)) => w
+            .checked_mul(h)
+            .ok_or_else(|| header_err(data_line, "WIDTH x HEIGHT overflows"))?,
+        (None, Some(w), None) => w,
+        _ => return Err(header_err(data_line, "neither POINTS nor WIDTH is given")),
+    };
+
+    // Column (value index) and byte offset of each wanted field.
+    let mut col = Vec::with_capacity(n);
+    let mut offset = Vec::with_capacity(n);
+    let (mut c, mut o) = (0usize, 0usize);
+    for f in &fields {
+        col.push(c);
+        offset.push(o);
+        c += f.count;
+        o += f.size * f.count;
+    }
+    let (values_per_point, stride) = (c, o);
+    let find = |name: &str| -> Result<Option<usize>, PointCloudError> {
+        match fields.iter().position(|f| f.name == name) {
+            Some(i) if fields[i].count != 1 => Err(header_err(
+                data_line,
+                format!("field '{name}' has COUNT {}, expected 1", fields[i].count),
+            )),
+            other => Ok(other),
+        }
+    };
+    let mut xyz = [0usize; 3];
+    for (k, name) in ["x", "y", "z"].into_iter().enumerate() {
+        xyz[k] = find(name)?.ok_or_else(|| PointCloudError::MissingField {
+            origin: Origin(None),
+            field: name.into(),
+        })?;
+    }
+    let normal = match (find("normal_x")?, find("normal_y")?, find("normal_z")?) {
+        (Some(a), Some(b), Some(c)) => Some([a, b, c]),
+        _ => None,
+    };
+
+    let available = bytes.len() - pos;
+    let min_per_point = if binary {
+        stride as u128
+    } else {
+        2 * values_per_point as u128
+    };
+    let min_bytes = count as u128 * min_per_point;
+    if super::is_absurd(min_bytes, available) || (min_per_point == 0 && count > 0) {
+        return Err(PointCloudError::CountExceedsData {
+            origin: Origin(None),
+            claimed: count,
+            min_bytes,
+            available,
+        });
+    }
+    let capacity = count.min((available as u128 / min_per_point.max(1)) as u64) as usize;
+    let mut sink = PointSink::new(capacity, normal.is_some(), opts.non_finite);
+    if binary {
+        let get = |rec: &[u8], i: usize| -> f64 {
+            let f = &fields[i];
+            f.scalar.decode(&rec[offset[i]..offset[i] + f.size], false)
+        };
+        for k in 0..count {
+            let at = DataPos {
+                element: k,
+                line: None,
+            };
+            let Some(rec) = bytes.get(pos..pos + stride) else {
+                return Err(PointCloudError::Truncated {
+                    origin: Origin(None),
+                    at,
+                    expected: count,
+                });
+            };
+            pos += stride;
+            let p = DVec3::new(get(rec, xyz[0]), get(rec, xyz[1]), get(rec, xyz[2]));
+            let nrm = normal.map_or(DVec3::ZERO, |[a, b, c]| {
+                DVec3::new(get(rec, a), get(rec, b), get(rec, c))
+            });
+            sink.push(p, nrm, at)?;
+        }
+    } else {
+        let mut line = data_line;
+        let mut wanted: Vec<(usize, usize)> = xyz.iter().map(|&i| (col[i], i)).collect();
+        if let Some(nr) = normal {
+            wanted.extend(nr.iter().map(|&i| (col[i], i)));
+        }
+        let mut vals = [0.0f64; 6];
+        for k in 0..count {
+            let text = loop {
+                let Some(raw) = next_line(bytes, &mut pos) else {
+                    return Err(PointCloudError::Truncated {
+                        origin: Origin(None),
+                        at: DataPos {
+                            element: k,
+                            line: Some(line + 1),
+                        },
+                        expected: count,
+                    });
+                };
+                line += 1;
+                if !raw.iter().all(u8::is_ascii_whitespace) {
+                    break raw;
+                }
+            };
+            let at = DataPos {
+                element: k,
+                line: Some(line),
+            };
+            let bad = |reason: String| PointCloudError::BadValue {
+                origin: Origin(None),
+                at,
+                reason,
+            };
+            let text = std::str::from_utf8(text).map_err(|_| bad("line is not text".into()))?;
+            let toks: Vec<&str> = text.split_ascii_whitespace().collect();
+            if toks.len() != values_per_point {
+                return Err(bad(format!(
+                    "expected {values_per_point} values, found {}",
+                    toks.len()
+                )));
+            }
+            for (slot, &(c, fi)) in wanted.iter().enumerate() {
+                vals[slot] = parse_number(toks[c], fields[fi].scalar).ok_or_else(|| {
+                    bad(format!(
+                        "'{}' is not a number ('{}')",
+                        toks[c], fields[fi].name
+                    ))
+                })?;
+            }
+            let p = DVec3::new(vals[0], vals[1], vals[2]);
+            let nrm = if normal.is_some() {
+                DVec3::new(vals[3], vals[4], vals[5])
+            } else {
+                DVec3::ZERO
+            };
+            sink.push(p, nrm, at)?;
+        }
+    }
+    Ok(sink.finish())
+}
+
+/// Read a PCD file from a stream (read to the end first, so counts can be checked against
+/// the real length).
+pub fn read_pcd<R: Read>(reader: R, opts: &ReadOptions) -> Result<LoadedCloud, PointCloudError> {
+    parse_pcd(&read_all(reader)?, opts)
+}
+
+/// Write `cloud` as PCD v0.7 with `F 8` fields `x y z` (and `normal_x normal_y normal_z`
+/// when present), as an unorganised cloud (`HEIGHT 1`). ASCII values use the shortest
+/// round-trip representation.
+pub fn write_pcd<W: Write>(
+    cloud: &PointCloud,
+    mut w: W,
+    data: PcdData,
+) -> Result<(), PointCloudError> {
+    let has_n = cloud.normals().is_some();
+    let k = if has_n { 6 } else { 3 };
+    let head = format!(
+        "# .PCD v0.7 - Point Cloud Data file format (written by beamtrace, metres, z up)\nVERSION 0.7\n\
+         FIELDS x y z{}\nSIZE{}\nTYPE{}\nCOUNT{}\nWIDTH {n}\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {n}\nDATA {}\n",
+        if has_n {
+            " normal_x normal_y normal_z"
+        } else {
+            ""
+        },
+        " 8".repeat(k),
+        " F".repeat(k),
+        " 1".repeat(k),
+        match data {
+            PcdData::Ascii => "ascii",
+            PcdData::Binary => "binary",
+        },
+        n = cloud.len(),
+    );
+    w.write_all(head.as_bytes()).map_err(io_err)?;
+    let mut buf = Vec::with_capacity(64);
+    for (i, p) in cloud.points().iter().enumerate() {
+        buf.clear();
+        let mut vals = vec![p.x, p.y, p.z];
+        if let Some(ns) = cloud.normals() {
+            vals.extend([ns[i].x, ns[i].y, ns[i].z]);
+        }
+        match data {
+            PcdData::Ascii => {
+                let s: Vec<String> = vals.iter().map(|v| format!("{v:?}")).collect();
+                buf.extend_from_slice(s.join(" ").as_bytes());
+                buf.push(b'\n');
+            }
+            PcdData::Binary => vals
+                .iter()
+                .for_each(|v| buf.extend_from_slice(&v.to_le_bytes())),
+        }
+        w.write_all(&buf).map_err(io_err)?;
+    }
+    Ok(())
+}

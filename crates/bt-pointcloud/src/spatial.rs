@@ -1,0 +1,103 @@
+//! Uniform voxel hash over a point set, for fixed-radius neighbour queries without O(n²).
+
+use std::collections::HashMap;
+use std::hash::{BuildHasherDefault, Hasher};
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+/// Points bucketed into cubic voxels of edge `cell` (metres). Queries with a radius up to
+/// `cell` visit the 27 surrounding voxels. Only lookups go through the hash map; nothing
+/// iterates it, so results do not depend on hash order.
+pub(crate) struct VoxelIndex {
+    cell: f64,
+    order: Vec<u32>,
+    ranges: HashMap<[i64; 3], (u32, u32), BuildHasherDefault<KeyHasher>>,
+}
+
+/// Multiply-rotate hasher for voxel keys: lookups dominate neighbour queries and the
+/// default SipHash is several times slower. Keys come from coordinates, not from an
+/// adversary choosing collisions, and iteration order is never used.
+#[derive(Default)]
+pub(crate) struct KeyHasher(u64);
+
+impl Hasher for KeyHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+    fn write(&mut self, bytes: &[u8]) {
+        for &b in bytes {
+            self.write_u64(u64::from(b));
+        }
+    }
+    fn write_i64(&mut self, v: i64) {
+        self.write_u64(v as u64);
+    }
+    fn write_u64(&mut self, v: u64) {
+        self.0 = (self.0.rotate_left(5) ^ v).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
+    }
+    fn write_usize(&mut self, v: usize) {
+        self.write_u64(v as u64);
+    }
+}
+
+pub(crate) fn voxel_key(p: DVec3, cell: f64) -> [i64; 3] {
+    // `as` saturates, so absurd coordinates land in the outermost voxel instead of wrapping.
+    let k = (p / cell).floor();
+    [k.x as i64, k.y as i64, k.z as i64]
+}
+
+impl VoxelIndex {
+    pub(crate) fn build(points: &[DVec3], cell: f64) -> Self {
+        let mut keyed: Vec<([i64; 3], u32)> = points
+            .par_iter()
+            .enumerate()
+            .map(|(i, p)| (voxel_key(*p, cell), i as u32))
+            .collect();
+        keyed.par_sort_unstable();
+        let mut ranges = HashMap::default();
+        let mut start = 0;
+        for i in 1..=keyed.len() {
+            if i == keyed.len() || keyed[i].0 != keyed[start].0 {
+                ranges.insert(keyed[start].0, (start as u32, i as u32));
+                start = i;
+            }
+        }
+        Self {
+            cell,
+            order: keyed.into_iter().map(|(_, i)| i).collect(),
+            ranges,
+        }
+    }
+
+    /// Call `f` with the index of every point within `radius` (≤ cell) of `p`.
+    pub(crate) fn for_each_near(
+        &self,
+        points: &[DVec3],
+        p: DVec3,
+        radius: f64,
+        mut f: impl FnMut(u32),
+    ) {
+        debug_assert!(radius <= self.cell * (1.0 + 1e-9));
+        let k = voxel_key(p, self.cell);
+        let r2 = radius * radius;
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    let key = [
+                        k[0].saturating_add(dx),
+                        k[1].saturating_add(dy),
+                        k[2].saturating_add(dz),
+                    ];
+                    if let Some(&(s, e)) = self.ranges.get(&key) {
+                        for &j in &self.order[s as usize..e as usize] {
+                            if points[j as usize].distance_squared(p) <= r2 {
+                                f(j);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+}

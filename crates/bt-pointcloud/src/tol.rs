@@ -1,0 +1,50 @@
+//! Named numerical tolerances of this crate, each with its unit and reason. Length
+//! tolerances that depend on the scan (noise, density) are parameters in
+//! [`ExtractParams`](crate::ExtractParams), not constants.
+
+/// Smallest eigenvalue gap (relative to the trace, dimensionless) below which a covariance is
+/// treated as isotropic. Jacobi sweeps stop when off-diagonal mass falls below this times
+/// the trace.
+pub const EIGEN_REL: f64 = 1e-15;
+
+/// Sine of the smallest angle between two 2-D lines for their intersection to be used as a
+/// polygon corner (dimensionless). Below it the lines are treated as parallel (≈ 3°).
+pub const PARALLEL_SIN: f64 = 0.05;
+
+/// Relative area (dimensionless, fraction of the polygon area) below which a polygon counts
+/// as degenerate.
+pub const AREA_REL: f64 = 1e-9;
+
+/// Cosine of the largest angle between two plane normals for their intersection line to be
+/// used as a shared edge (planes closer to parallel than ≈ 30° are not snapped together).
+pub const SNAP_MAX_COS: f64 = 0.866;
+
+/// Sine of the largest angle (≈ 10°) between a polygon edge and a neighbouring plane's
+/// intersection line for the edge to be snapped onto that line.
+pub const SNAP_EDGE_SIN: f64 = 0.174;
+
+/// Sine of the largest turn (≈ 8°) at a boundary vertex that is merged away as collinear
+/// after edge refinement.
+pub const MERGE_TURN_SIN: f64 = 0.14;
+
+/// Cosine of the largest angle (≈ 30°) between a point's estimated normal and its patch
+/// normal for the point to enter the final least-squares refit. Points near a crease have
+/// blended normals; leaving them out keeps a patch's plane from tilting towards its
+/// neighbour, while they still count for the boundary.
+pub const REFIT_GATE_COS: f64 = 0.866;
+
+/// Ratio of the middle to the largest covariance eigenvalue (dimensionless) below which a
+/// neighbourhood is treated as a line, with no normal.
+pub const LINEAR_NEIGHBOURHOOD: f64 = 1e-3;
+
+/// Cosine of the largest angle (≈ 5°) between a connected component's own least-squares
+/// normal and its RANSAC plane for the component to belong to that plane.
+pub const COMPONENT_COS: f64 = 0.9962;
+
+/// Sine of the largest turn (≈ 27°) merged away on the raw simplified raster boundary,
+/// where a one-cell step over two cells is sampling noise, not shape.
+pub const RASTER_MERGE_TURN_SIN: f64 = 0.45;
+
+/// Sine of the largest angle (≈ 15°) between a simplified boundary edge and an axis of its
+/// patch's minimum-area rectangle for the axis to be the edge's prior direction.
+pub const AXIS_PRIOR_SIN: f64 = 0.26;
