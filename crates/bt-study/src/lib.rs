@@ -5,7 +5,7 @@
 //!
 //! - [`room`]: the seeded room generator and its contour invariants;
 //! - [`embed`]: a 2-D room as a 3-D scene of vertical walls (the same solvers serve 2-D);
-//! - [`run`]: the study itself, one [`run::Row`] per room, step and solver;
+//! - [`mod@run`]: the study itself, one [`run::Row`] per room, step and solver;
 //! - [`report`]: `results.csv`, `summary.md` and the aggregates behind the plots;
 //! - [`plot`]: Figs. 5-7 on any plotters backend; [`io`] writes them as SVG and PNG.
 //!
