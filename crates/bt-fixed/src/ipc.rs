@@ -1,0 +1,285 @@
+//! The IPC loop (Algorithm 1) in fixed point, with the accelerator's Jacobi update.
+
+use crate::{
+    FineCoord, FinePoint, FixedError, FixedPlane, FixedPoint, dequantize_fine_point,
+    displacement_linf, intersection_point, quantize_fine_point, quantize_point,
+};
+
+/// A plane at the boundary, in metres: `normal · x = offset_m`, `normal` unit.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct PlaneInput {
+    /// Unit normal (unitless).
+    pub normal: [f64; 3],
+    /// Offset along the normal, metres.
+    pub offset_m: f64,
+}
+
+/// Why a path was frozen as degenerate.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum DegenerateKind {
+    /// Both neighbours of some point lay on its plane (`m + n = 0`, Algorithm 3 returned the
+    /// midpoint). Reported when only this flag is set.
+    ZeroDistanceSum,
+    /// Some coordinate left the 32-bit range and was saturated (takes precedence).
+    CoordinateOverflow,
+}
+
+/// Outcome of one path, mirroring the hardware status word of `bt-hls`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum FixedOutcome {
+    /// The displacement of round `rounds` was ≤ the threshold.
+    Converged {
+        /// Rounds run (≥ 1).
+        rounds: u32,
+    },
+    /// The round budget ran out.
+    NotConverged {
+        /// Rounds run (= budget).
+        rounds: u32,
+        /// Displacement of the last round (L∞, fine LSB); 0 if no round ran.
+        displacement_lsb: u64,
+    },
+    /// A degenerate flag was raised in round `rounds`; the path was frozen after it.
+    Degenerate {
+        /// Which flag (overflow takes precedence).
+        kind: DegenerateKind,
+        /// Rounds run including the flagged one.
+        rounds: u32,
+    },
+}
+
+/// Result of one path.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct PathResult {
+    /// Intersection points, fine words (mm × 2^8), TX side first.
+    pub points: Vec<FinePoint>,
+    /// The same points in metres.
+    pub points_m: Vec<[f64; 3]>,
+    /// Rounds run.
+    pub rounds: u32,
+    /// L∞ displacement of the last round, fine LSB (0 if no round ran).
+    pub displacement_lsb: u64,
+    /// Convergence reached (displacement ≤ threshold, no degenerate flag).
+    pub converged: bool,
+    /// Sticky `m + n = 0` flag.
+    pub zero_sum: bool,
+    /// Sticky saturation flag.
+    pub overflow: bool,
+}
+
+impl PathResult {
+    /// The outcome as a value.
+    pub fn outcome(&self) -> FixedOutcome {
+        if self.overflow {
+            FixedOutcome::Degenerate {
+                kind: DegenerateKind::CoordinateOverflow,
+                rounds: self.rounds,
+            }
+        } else if self.zero_sum {
+            FixedOutcome::Degenerate {
+                kind: DegenerateKind::ZeroDistanceSum,
+                rounds: self.rounds,
+            }
+        } else if self.converged {
+            FixedOutcome::Converged {
+                rounds: self.rounds,
+            }
+        } else {
+            FixedOutcome::NotConverged {
+                rounds: self.rounds,
+                displacement_lsb: self.displacement_lsb,
+            }
+        }
+    }
+}
+
+#[derive(Debug, Clone, PartialEq)]
+struct FixedPath {
+    planes: Vec<u32>,
+    init: Vec<FinePoint>,
+}
+
+/// The fixed-point IPC model: validated, quantised scene plus candidate paths.
+///
+/// Semantics (identical in `bt_top`): each round is a Jacobi update, every point of a path
+/// computed by [`intersection_point`] from the previous round's values (TX and RX fixed);
+/// the round's displacement is the maximum over the path's points of the L∞ norm of the
+/// point's move, in fine LSB (1/256 mm). After committing round `r`: if a degenerate flag was raised the path
+/// freezes as degenerate, else if displacement ≤ `threshold_lsb` it freezes as converged; a
+/// path never runs more than its round budget.
+#[derive(Debug, Clone, PartialEq)]
+pub struct FixedIpc {
+    planes: Vec<FixedPlane>,
+    paths: Vec<FixedPath>,
+    threshold_lsb: u32,
+    max_rounds: u32,
+}
+
+impl FixedIpc {
+    /// Validates and quantises. `init_points[p][i]` (metres) is the starting point of point `i`
+    /// of path `p` (e.g. its polygon's centroid); `threshold_lsb` is in fine LSB (1/256 mm).
+    /// Every problem is reported at once.
+    pub fn new(
+        planes: &[PlaneInput],
+        paths: &[Vec<u32>],
+        init_points: &[Vec<[f64; 3]>],
+        threshold_lsb: u32,
+        max_rounds: u32,
+    ) -> Result<FixedIpc, FixedError> {
+        let mut problems = Vec::new();
+        let mut fixed_planes = Vec::with_capacity(planes.len());
+        for (i, p) in planes.iter().enumerate() {
+            match FixedPlane::quantize(p.normal, p.offset_m) {
+                Ok(fp) => fixed_planes.push(fp),
+                Err(e) => problems.push(format!("plane {i}: {e}")),
+            }
+        }
+        if init_points.len() != paths.len() {
+            problems.push(format!(
+                "{} paths but {} initial-point lists",
+                paths.len(),
+                init_points.len()
+            ));
+        }
+        let mut fixed_paths = Vec::with_capacity(paths.len());
+        for (p, planes_of_path) in paths.iter().enumerate() {
+            if planes_of_path.is_empty() {
+                problems.push(format!("path {p}: has no reflection point"));
+            }
+            for &pl in planes_of_path {
+                if pl as usize >= planes.len() {
+                    problems.push(format!("path {p}: plane index {pl} out of range"));
+                }
+            }
+            let mut init = Vec::new();
+            if let Some(pts) = init_points.get(p) {
+                if pts.len() != planes_of_path.len() {
+                    problems.push(format!(
+                        "path {p}: {} initial points for {} planes",
+                        pts.len(),
+                        planes_of_path.len()
+                    ));
+                }
+                for (i, &pt) in pts.iter().enumerate() {
+                    match quantize_fine_point(pt) {
+                        Ok(q) => init.push(q),
+                        Err(e) => problems.push(format!("path {p} initial point {i}: {e}")),
+                    }
+                }
+            }
+            fixed_paths.push(FixedPath {
+                planes: planes_of_path.clone(),
+                init,
+            });
+        }
+        if !problems.is_empty() {
+            return Err(FixedError::InvalidInput { problems });
+        }
+        Ok(FixedIpc {
+            planes: fixed_planes,
+            paths: fixed_paths,
+            threshold_lsb,
+            max_rounds,
+        })
+    }
+
+    /// The quantised planes.
+    pub fn planes(&self) -> &[FixedPlane] {
+        &self.planes
+    }
+
+    /// Number of candidate paths.
+    pub fn num_paths(&self) -> usize {
+        self.paths.len()
+    }
+
+    /// Plane indices of path `p`, TX side first.
+    pub fn path_planes(&self, p: usize) -> &[u32] {
+        &self.paths[p].planes
+    }
+
+    /// Quantised initial points of path `p`.
+    pub fn init_points(&self, p: usize) -> &[FinePoint] {
+        &self.paths[p].init
+    }
+
+    /// Convergence threshold on the round displacement, fine LSB (1/256 mm).
+    pub fn threshold_lsb(&self) -> u32 {
+        self.threshold_lsb
+    }
+
+    /// Default round budget per path.
+    pub fn max_rounds(&self) -> u32 {
+        self.max_rounds
+    }
+
+    /// Runs every path with TX/RX in metres and the default budget.
+    pub fn run(&self, tx_m: [f64; 3], rx_m: [f64; 3]) -> Result<Vec<PathResult>, FixedError> {
+        let tx = quantize_point(tx_m)?;
+        let rx = quantize_point(rx_m)?;
+        Ok(self.run_fixed(tx, rx, None))
+    }
+
+    /// Runs every path with TX/RX as millimetre bus words; `budgets[p]` overrides the round budget of path
+    /// `p` (the accelerator's budget is the number of rounds its schedule holds for `p`).
+    pub fn run_fixed(
+        &self,
+        tx: FixedPoint,
+        rx: FixedPoint,
+        budgets: Option<&[u32]>,
+    ) -> Vec<PathResult> {
+        (0..self.paths.len())
+            .map(|p| {
+                let budget = budgets
+                    .and_then(|b| b.get(p).copied())
+                    .unwrap_or(self.max_rounds);
+                self.run_path(p, tx, rx, budget)
+            })
+            .collect()
+    }
+
+    /// Runs path `p` for at most `budget` rounds.
+    pub fn run_path(&self, p: usize, tx: FixedPoint, rx: FixedPoint, budget: u32) -> PathResult {
+        let path = &self.paths[p];
+        let tx = tx.map(FineCoord::from_coord);
+        let rx = rx.map(FineCoord::from_coord);
+        let mut points = path.init.clone();
+        let n = points.len();
+        let mut result = PathResult {
+            points: Vec::new(),
+            points_m: Vec::new(),
+            rounds: 0,
+            displacement_lsb: 0,
+            converged: false,
+            zero_sum: false,
+            overflow: false,
+        };
+        for _ in 0..budget {
+            let mut next = Vec::with_capacity(n);
+            let mut disp = 0;
+            for i in 0..n {
+                let prev = if i == 0 { tx } else { points[i - 1] };
+                let follow = if i + 1 == n { rx } else { points[i + 1] };
+                let plane = &self.planes[path.planes[i] as usize];
+                let trace = intersection_point(plane, prev, follow);
+                result.zero_sum |= trace.proportion.zero_sum;
+                result.overflow |= trace.overflow;
+                disp = disp.max(displacement_linf(trace.point, points[i]));
+                next.push(trace.point);
+            }
+            points = next;
+            result.rounds += 1;
+            result.displacement_lsb = disp;
+            if result.zero_sum || result.overflow {
+                break;
+            }
+            if disp <= u64::from(self.threshold_lsb) {
+                result.converged = true;
+                break;
+            }
+        }
+        result.points_m = points.iter().map(|&q| dequantize_fine_point(q)).collect();
+        result.points = points;
+        result
+    }
+}

@@ -1,0 +1,255 @@
+//! The arithmetic of one processing element (Algorithm 2 with Algorithm 3 inside).
+
+use crate::{FineCoord, FinePoint, FixedPlane, NORMAL_FRAC, round_shift};
+
+/// Guard (fraction) bits carried by the four registers of Algorithm 3 below the millimetre LSB.
+///
+/// Floor halving of `L_p` loses < 1 guard LSB per iteration, so the accumulated truncation
+/// error of `B_p` stays below `PROPORTION_ITERATIONS / 2^GUARD_BITS` = 0.0005 LSB; the decision
+/// error term `|l|·2i/((m+n)·2^G)` of [`halving_proportion`] is 0.02 LSB for |l| = 20 m,
+/// m + n = 1 m. (All Algorithm 3 quantities are in fine LSB = 1/256 mm.)
+pub const GUARD_BITS: u32 = 16;
+
+/// Maximal number of halving iterations of Algorithm 3 (the hardware always spends this many
+/// cycles; iterations after `L` reaches 0 are frozen, as the paper's `while L > 0`). The
+/// ratio resolution is then `2^-(PROPORTION_ITERATIONS+1)` ≈ 1.2e-10 when `m + n` is large.
+pub const PROPORTION_ITERATIONS: u32 = 32;
+
+/// Bit widths of every intermediate, shared with the RTL generator (`bt-hls` declares its wires
+/// with exactly these widths). `tests/widths.rs` proves, over the whole input domain (any 32-bit
+/// coordinates, any unit normal, any 32-bit offset), that no value leaves its width.
+pub mod width {
+    use super::GUARD_BITS;
+    /// Fine coordinate word (signed, mm × 2^8): |s| ≤ 2^39.
+    pub const COORD: u32 = crate::FineCoord::BITS;
+    /// Accumulator `Σ n_k s_k − offset·2^30 + 2^29` (signed): |·| < 2^70.45.
+    pub const DOT_ACC: u32 = 72;
+    /// Signed distance `d`, fine units (signed): |d| < 2^40.45.
+    pub const DISTANCE: u32 = 42;
+    /// Accumulator `d · n_k + 2^29` (signed): |·| < 2^70.45.
+    pub const PROJ_ACC: u32 = 72;
+    /// Projection `t_k`, fine units (signed): |t| < 2^40.9.
+    pub const PROJECTION: u32 = 42;
+    /// `t_next − t_prev`, fine units (signed).
+    pub const DELTA: u32 = 43;
+    /// `m = |d_prev|`, `n = |d_next|` (unsigned).
+    pub const ABS_DISTANCE: u32 = 41;
+    /// `m + n` (unsigned).
+    pub const DISTANCE_SUM: u32 = 42;
+    /// Register `L` of Algorithm 3 (unsigned, guard bits included).
+    pub const HALF_SUM: u32 = DISTANCE_SUM + GUARD_BITS - 1;
+    /// Register `B` and the compared `m · 2^G` (unsigned): B ∈ [0, 2·L₀].
+    pub const SEARCH: u32 = DISTANCE_SUM + GUARD_BITS;
+    /// Register `L_p` (signed, guard bits included).
+    pub const HALF_DELTA: u32 = DELTA + GUARD_BITS - 1;
+    /// Register `B_p` (signed): |B_p| ≤ 2|L_p₀| + iterations, plus rounding headroom.
+    pub const ACC_DELTA: u32 = DELTA + GUARD_BITS + 1;
+    /// Rounded proportion `round(B_p / 2^G)`, fine units (signed).
+    pub const OFFSET: u32 = DELTA + 1;
+    /// `t_prev + offset` before saturation (signed).
+    pub const SUM_POINT: u32 = 44;
+    /// Per-round displacement `|s_new − s_old|` per component (unsigned).
+    pub const DISPLACEMENT: u32 = COORD;
+    /// Iteration counter of Algorithm 3 (unsigned).
+    pub const ITERATION: u32 = 6;
+
+    /// `v` fits a two's-complement word of `bits` bits (`1 ≤ bits ≤ 127`).
+    pub fn fits_signed(v: i128, bits: u32) -> bool {
+        let half = 1i128 << (bits - 1);
+        (-half..half).contains(&v)
+    }
+
+    /// `v` fits an unsigned word of `bits` bits (`bits ≤ 127`).
+    pub fn fits_unsigned(v: i128, bits: u32) -> bool {
+        (0..1i128 << bits).contains(&v)
+    }
+}
+
+use width::fits_signed;
+
+/// Signed distance of `s` to the plane in fine units (mm × 2^8): `round_half_up((Σ n_k·s_k − offset·2^30) / 2^30)`,
+/// the products by CSD shift-add, accumulated at full precision, one rounding shift.
+/// Positive on the side the normal points to.
+///
+/// Verilog twin: `bt_pe_<i>`: `d_prev_acc` = sum of `±(s_prev_k <<< shift)` terms plus the
+/// folded constant `2^29 − offset·2^30`; `d_prev = d_prev_acc[63:30]` (same for `next`).
+pub fn signed_distance(plane: &FixedPlane, s: FinePoint) -> i64 {
+    let mut acc: i128 = plane
+        .normal
+        .iter()
+        .zip(s)
+        .map(|(n, c)| n.csd().mul(c.0))
+        .sum();
+    acc -= i128::from(plane.offset.0) << NORMAL_FRAC;
+    let d = round_shift(acc, NORMAL_FRAC);
+    debug_assert!(fits_signed(acc + (1 << (NORMAL_FRAC - 1)), width::DOT_ACC));
+    debug_assert!(fits_signed(d, width::DISTANCE));
+    d as i64
+}
+
+/// Orthogonal projection onto the plane in fine units, per component
+/// `t_k = s_k − round_half_up(d · n_k / 2^30)`, `d` from [`signed_distance`].
+///
+/// Verilog twin: `bt_pe_<i>`: `t_prev_k = s_prev_k − p_prev_k_acc[63:30]` where
+/// `p_prev_k_acc` is the CSD network of `n_k` applied to `d_prev` plus `2^29`.
+pub fn project(plane: &FixedPlane, s: FinePoint, d: i64) -> [i64; 3] {
+    std::array::from_fn(|k| {
+        let acc = plane.normal[k].csd().mul(d);
+        debug_assert!(fits_signed(acc + (1 << (NORMAL_FRAC - 1)), width::PROJ_ACC));
+        let t = s[k].0 - round_shift(acc, NORMAL_FRAC) as i64;
+        debug_assert!(fits_signed(i128::from(t), width::PROJECTION));
+        t
+    })
+}
+
+/// Result of Algorithm 3 on the three components of `l = t_next − t_prev`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct Proportion {
+    /// `≈ l_k · m / (m + n)` per component, fine LSB (rounded half up from the guard bits).
+    pub offset: [i64; 3],
+    /// `m + n == 0`: no halving happened and the result is `l / 2` (midpoint).
+    pub zero_sum: bool,
+    /// Halving iterations that changed the registers (≤ [`PROPORTION_ITERATIONS`]).
+    pub iterations: u32,
+}
+
+/// Algorithm 3 (halving comparison), exactly as the paper writes it, on `G = GUARD_BITS`
+/// guard bits, the three components sharing one decision sequence:
+///
+/// ```text
+/// L ← (m+n)/2; B ← L; L_p ← l/2; B_p ← L_p          (all scaled by 2^G: exact)
+/// repeat PROPORTION_ITERATIONS times, frozen once L = 0 (the paper's `while L > 0`):
+///     L ← ⌊L/2⌋; L_p ← ⌊L_p/2⌋                          (arithmetic shift: floor)
+///     if B < m·2^G: B ← B + L; B_p ← B_p + L_p  else: B ← B − L; B_p ← B_p − L_p
+/// return round_half_up(B_p / 2^G)
+/// ```
+///
+/// Rounding and bias: iterated floor halving equals `⌊L_p₀ / 2^i⌋`, so each step is low by
+/// < 1 guard LSB; `B_p` carries at most `i` guard LSBs of truncation error (bias towards −∞)
+/// after `i` iterations, then one round-half-up. `B` carries the same kind of error, so the
+/// decision sequence is a binary search on `m/(m+n)` perturbed by ≤ `i / ((m+n)·2^G)`. The
+/// proved bound (`tests/algorithm3.rs`), with `i` = iterations run and `L_i` the final `L`:
+///
+/// `|out − l·m/(m+n)| ≤ 1/2 + i/2^G + |l|·(L_i/((m+n)·2^G) + 2i/((m+n)·2^G))`
+///
+/// where `L_i/((m+n)·2^G) ≤ 2^-(i+1)`, and `L_i = 0` when the search stopped on `L = 0` (its
+/// resolution then being set by `m + n`, 65536 times finer than the LSB quantisation of `m, n`).
+/// Degenerate inputs are values: `m = 0` gives `≈ 0` (the point stays at `t_prev`), `n = 0`
+/// gives `≈ l`, `m + n = 0` gives `l/2` with `zero_sum` set. `m + n` cannot overflow: both are
+/// below 2^32.45, the sum register is [`width::DISTANCE_SUM`] = 34 bits.
+///
+/// Verilog twin: the `bt_pe_<i>` registers `hc_l`, `hc_b`, `hc_m`, `hc_lp_{x,y,z}`,
+/// `hc_bp_{x,y,z}` and the iteration counter `hc_iter` (one iteration per clock).
+pub fn halving_proportion(m: u64, n: u64, l: [i64; 3]) -> Proportion {
+    let sum = u128::from(m) + u128::from(n);
+    let mut big_l: u128 = sum << (GUARD_BITS - 1);
+    let mut b = big_l;
+    let target = u128::from(m) << GUARD_BITS;
+    let mut lp: [i128; 3] = l.map(|x| i128::from(x) << (GUARD_BITS - 1));
+    let mut bp = lp;
+    let mut iterations = 0;
+    for _ in 0..PROPORTION_ITERATIONS {
+        if big_l == 0 {
+            break;
+        }
+        iterations += 1;
+        big_l >>= 1;
+        let up = b < target;
+        for k in 0..3 {
+            lp[k] >>= 1;
+            if up {
+                bp[k] += lp[k];
+            } else {
+                bp[k] -= lp[k];
+            }
+        }
+        if up {
+            b += big_l;
+        } else {
+            b -= big_l;
+        }
+        debug_assert!(b >> width::SEARCH == 0);
+    }
+    debug_assert!(
+        bp.iter()
+            .all(|&v| fits_signed(v + (1 << (GUARD_BITS - 1)), width::ACC_DELTA))
+    );
+    Proportion {
+        offset: bp.map(|v| round_shift(v, GUARD_BITS) as i64),
+        zero_sum: sum == 0,
+        iterations,
+    }
+}
+
+/// Every intermediate of one PE evaluation (Algorithm 2), for tests and debugging.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct PeTrace {
+    /// Signed distance of the leading point, fine LSB.
+    pub d_prev: i64,
+    /// Signed distance of the following point, fine LSB.
+    pub d_next: i64,
+    /// Projection of the leading point, fine LSB.
+    pub t_prev: [i64; 3],
+    /// Projection of the following point, fine LSB.
+    pub t_next: [i64; 3],
+    /// `m = |d_prev|`, fine LSB.
+    pub m: u64,
+    /// `n = |d_next|`, fine LSB.
+    pub n: u64,
+    /// `t_next − t_prev`, fine LSB.
+    pub delta: [i64; 3],
+    /// Algorithm 3 output.
+    pub proportion: Proportion,
+    /// `t_prev + offset` before saturation, fine LSB.
+    pub unsaturated: [i64; 3],
+    /// The new intersection point (saturated to 40 bits).
+    pub point: FinePoint,
+    /// Some component did not fit 40 bits and was saturated.
+    pub overflow: bool,
+}
+
+/// Algorithm 2 in fixed point: the new intersection point on `plane` from the leading point
+/// `prev` and following point `next`, with the proportion applied component-wise
+/// (`s = t_prev + (m/(m+n))·(t_next − t_prev)`: no norm, no square root).
+///
+/// Verilog twin: one `bt_pe_<i>` evaluation (`start` → `s_out`, `zero_sum`, `overflow`).
+pub fn intersection_point(plane: &FixedPlane, prev: FinePoint, next: FinePoint) -> PeTrace {
+    let d_prev = signed_distance(plane, prev);
+    let d_next = signed_distance(plane, next);
+    let t_prev = project(plane, prev, d_prev);
+    let t_next = project(plane, next, d_next);
+    let m = d_prev.unsigned_abs();
+    let n = d_next.unsigned_abs();
+    let delta: [i64; 3] = std::array::from_fn(|k| t_next[k] - t_prev[k]);
+    let proportion = halving_proportion(m, n, delta);
+    let unsaturated: [i64; 3] = std::array::from_fn(|k| t_prev[k] + proportion.offset[k]);
+    let mut overflow = false;
+    let point = unsaturated.map(|v| {
+        let clamped = v.clamp(FineCoord::MIN.0, FineCoord::MAX.0);
+        overflow |= clamped != v;
+        FineCoord(clamped)
+    });
+    PeTrace {
+        d_prev,
+        d_next,
+        t_prev,
+        t_next,
+        m,
+        n,
+        delta,
+        proportion,
+        unsaturated,
+        point,
+        overflow,
+    }
+}
+
+/// Per-round displacement of one point: L∞ norm `max_k |a_k − b_k|` in fine LSB (1/256 mm).
+///
+/// Verilog twin: `bt_top`'s write-back stage (`wb_disp`), compared against the threshold.
+pub fn displacement_linf(a: FinePoint, b: FinePoint) -> u64 {
+    (0..3)
+        .map(|k| (a[k].0 - b[k].0).unsigned_abs())
+        .max()
+        .unwrap_or(0)
+}

@@ -1,0 +1,59 @@
+// Shared proptest strategies (included with `mod common;`).
+#![allow(dead_code)]
+
+use bt_fixed::{FineCoord, FinePoint, FixedPlane};
+use proptest::prelude::*;
+
+/// Any unit normal: random directions plus the axis-aligned and diagonal special cases.
+pub fn unit_normal() -> impl Strategy<Value = [f64; 3]> {
+    prop_oneof![
+        (-1.0f64..1.0, -1.0f64..1.0, -1.0f64..1.0)
+            .prop_filter("non-zero", |(x, y, z)| x * x + y * y + z * z > 1e-6)
+            .prop_map(|(x, y, z)| {
+                let len = (x * x + y * y + z * z).sqrt();
+                [x / len, y / len, z / len]
+            }),
+        prop::sample::select(vec![
+            [1.0, 0.0, 0.0],
+            [-1.0, 0.0, 0.0],
+            [0.0, 1.0, 0.0],
+            [0.0, 0.0, -1.0],
+            [0.6, 0.8, 0.0],
+            [1.0 / 3f64.sqrt(), 1.0 / 3f64.sqrt(), -1.0 / 3f64.sqrt()],
+            [-1.0 / 3f64.sqrt(), -1.0 / 3f64.sqrt(), -1.0 / 3f64.sqrt()],
+        ]),
+    ]
+}
+
+/// Any plane: unit normal and any 40-bit offset word.
+pub fn any_plane() -> impl Strategy<Value = FixedPlane> {
+    (unit_normal(), any_coord()).prop_map(|(n, off)| {
+        let mut p = FixedPlane::quantize(n, 0.0).unwrap();
+        p.offset = off;
+        p
+    })
+}
+
+/// Any 40-bit fine coordinate word, biased towards the extremes and indoor scale.
+pub fn any_coord() -> impl Strategy<Value = FineCoord> {
+    let (min, max) = (FineCoord::MIN.0, FineCoord::MAX.0);
+    prop_oneof![
+        (min..=max).prop_map(FineCoord),
+        prop::sample::select(vec![min, min + 1, -1, 0, 1, max - 1, max]).prop_map(FineCoord),
+        (-5_120_000i64..5_120_000).prop_map(FineCoord),
+    ]
+}
+
+/// Any point of 40-bit words.
+pub fn any_point() -> impl Strategy<Value = FinePoint> {
+    [any_coord(), any_coord(), any_coord()]
+}
+
+/// `round_half_up(num / 2^shift)` computed by exact Euclidean division (the oracle).
+pub fn oracle_round(num: i128, shift: u32) -> i128 {
+    if shift == 0 {
+        return num;
+    }
+    // floor((2·num + 2^shift) / 2^(shift+1))
+    (2 * num + (1i128 << shift)).div_euclid(1i128 << (shift + 1))
+}

@@ -1,0 +1,116 @@
+//! `FixedIpc` outcomes and validation.
+
+use bt_fixed::{Coord, DegenerateKind, FixedError, FixedIpc, FixedOutcome, PlaneInput};
+
+fn floor() -> PlaneInput {
+    PlaneInput {
+        normal: [0.0, 0.0, 1.0],
+        offset_m: 0.0,
+    }
+}
+
+#[test]
+fn single_floor_bounce_converges_to_the_mirror_point() {
+    let ipc = FixedIpc::new(&[floor()], &[vec![0]], &[vec![[0.5, 0.5, 0.0]]], 16, 50).unwrap();
+    let r = &ipc.run([0.0, 0.0, 1.0], [3.0, 0.0, 2.0]).unwrap()[0];
+    assert!(
+        matches!(r.outcome(), FixedOutcome::Converged { rounds: 1 | 2 }),
+        "{r:?}"
+    );
+    // Mirror point: x = 3 · 1/(1+2) = 1 m.
+    assert!((r.points_m[0][0] - 1.0).abs() < 1e-5, "{r:?}");
+    assert_eq!(r.points[0][2].0, 0);
+}
+
+#[test]
+fn zero_budget_returns_the_initial_points() {
+    let ipc = FixedIpc::new(&[floor()], &[vec![0]], &[vec![[0.5, 0.5, 0.0]]], 16, 0).unwrap();
+    let r = &ipc.run([0.0, 0.0, 1.0], [3.0, 0.0, 2.0]).unwrap()[0];
+    assert_eq!(
+        r.outcome(),
+        FixedOutcome::NotConverged {
+            rounds: 0,
+            displacement_lsb: 0
+        }
+    );
+    assert_eq!(r.points_m[0], [0.5, 0.5, 0.0]);
+}
+
+#[test]
+fn terminals_on_the_plane_are_degenerate_not_a_panic() {
+    let ipc = FixedIpc::new(&[floor()], &[vec![0]], &[vec![[0.5, 0.5, 0.0]]], 16, 50).unwrap();
+    let r = &ipc.run([0.0, 0.0, 0.0], [1.0, 0.0, 0.0]).unwrap()[0];
+    assert_eq!(
+        r.outcome(),
+        FixedOutcome::Degenerate {
+            kind: DegenerateKind::ZeroDistanceSum,
+            rounds: 1
+        }
+    );
+    assert_eq!(r.points_m[0], [0.5, 0.0, 0.0]); // midpoint
+}
+
+#[test]
+fn leaving_the_range_is_degenerate_overflow() {
+    let r3 = 1.0 / 3f64.sqrt();
+    let plane = PlaneInput {
+        normal: [r3, r3, r3],
+        offset_m: 0.0,
+    };
+    let ipc = FixedIpc::new(&[plane], &[vec![0]], &[vec![[0.0, 0.0, 0.0]]], 16, 50).unwrap();
+    let corner = [Coord(i32::MAX), Coord(i32::MAX), Coord(i32::MIN)];
+    let r = &ipc.run_fixed(corner, corner, None)[0];
+    assert_eq!(
+        r.outcome(),
+        FixedOutcome::Degenerate {
+            kind: DegenerateKind::CoordinateOverflow,
+            rounds: 1
+        }
+    );
+}
+
+#[test]
+fn per_path_budgets_override_the_default() {
+    let ipc = FixedIpc::new(
+        &[floor()],
+        &[vec![0], vec![0]],
+        &[vec![[9.0, 9.0, 0.0]], vec![[9.0, 9.0, 0.0]]],
+        0,
+        50,
+    )
+    .unwrap();
+    let tx = [Coord(0), Coord(0), Coord(1000)];
+    let rx = [Coord(3000), Coord(0), Coord(2000)];
+    let r = ipc.run_fixed(tx, rx, Some(&[1, 3]));
+    assert_eq!(r[0].rounds, 1);
+    assert!(r[1].rounds >= 2);
+}
+
+#[test]
+fn validation_reports_every_problem() {
+    let bad_plane = PlaneInput {
+        normal: [0.0, 0.0, 2.0],
+        offset_m: 0.0,
+    };
+    let err = FixedIpc::new(
+        &[floor(), bad_plane],
+        &[vec![], vec![7], vec![0, 0]],
+        &[vec![], vec![[f64::NAN, 0.0, 0.0]]],
+        16,
+        10,
+    )
+    .unwrap_err();
+    let FixedError::InvalidInput { problems } = err else {
+        panic!("{err:?}")
+    };
+    let text = problems.join("\n");
+    for needle in [
+        "plane 1",
+        "path 0: has no",
+        "plane index 7",
+        "path 1 initial point 0",
+        "3 paths but 2",
+    ] {
+        assert!(text.contains(needle), "missing {needle:?} in\n{text}");
+    }
+}

@@ -1,0 +1,337 @@
+//! Driving the external tools: Verilator (lint), Icarus Verilog (co-simulation), Yosys
+//! (synthesis). A missing tool is [`HlsError::ToolMissing`], never a panic.
+
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::process::{Command, Output};
+
+use crate::error::io_err;
+use crate::{HlsError, bus_cycles_formula, recompute, rtl_files};
+
+/// Runs `tool args` in `dir`; maps "not found" to [`HlsError::ToolMissing`].
+fn run(tool: &str, package: &str, args: &[String], dir: &Path) -> Result<Output, HlsError> {
+    Command::new(tool)
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .map_err(|e| {
+            if e.kind() == std::io::ErrorKind::NotFound {
+                HlsError::ToolMissing {
+                    tool: tool.into(),
+                    package: package.into(),
+                }
+            } else {
+                HlsError::ToolFailed {
+                    tool: tool.into(),
+                    message: e.to_string(),
+                }
+            }
+        })
+}
+
+fn failure(tool: &str, out: &Output) -> HlsError {
+    let mut message = String::from_utf8_lossy(&out.stderr).into_owned();
+    let stdout = String::from_utf8_lossy(&out.stdout);
+    let tail: Vec<&str> = stdout.lines().rev().take(30).collect();
+    message.push_str(&tail.into_iter().rev().collect::<Vec<_>>().join("\n"));
+    HlsError::ToolFailed {
+        tool: tool.into(),
+        message,
+    }
+}
+
+fn rel_rtl(out_dir: &Path) -> Result<Vec<String>, HlsError> {
+    Ok(rtl_files(out_dir)?
+        .iter()
+        .map(|p| {
+            format!(
+                "rtl/{}",
+                p.file_name().unwrap_or_default().to_string_lossy()
+            )
+        })
+        .collect())
+}
+
+/// Result of [`lint`].
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct LintReport {
+    /// Modules linted as top (every generated module, then the testbench).
+    pub modules: Vec<String>,
+    /// Every `%Warning`/`%Error` line Verilator printed (empty = clean).
+    pub warnings: Vec<String>,
+}
+
+/// Runs `verilator --lint-only -Wall` with each generated module as top (all RTL files given,
+/// so instances resolve), and the testbench with `--timing`.
+pub fn lint(out_dir: &Path) -> Result<LintReport, HlsError> {
+    let files = rel_rtl(out_dir)?;
+    let mut report = LintReport {
+        modules: Vec::new(),
+        warnings: Vec::new(),
+    };
+    let mut tops: Vec<(String, Vec<String>)> = files
+        .iter()
+        .map(|f| {
+            let name = Path::new(f)
+                .file_stem()
+                .unwrap_or_default()
+                .to_string_lossy()
+                .into_owned();
+            (name, vec![])
+        })
+        .collect();
+    tops.push(("bt_tb".into(), vec!["--timing".into(), "tb/bt_tb.v".into()]));
+    for (top, extra) in tops {
+        let mut args: Vec<String> = vec![
+            "--lint-only".into(),
+            "-Wall".into(),
+            "--top-module".into(),
+            top.clone(),
+        ];
+        args.extend(files.iter().cloned());
+        args.extend(extra);
+        let out = run("verilator", "verilator", &args, out_dir)?;
+        let text = String::from_utf8_lossy(&out.stderr);
+        report.warnings.extend(
+            text.lines()
+                .filter(|l| l.starts_with("%Warning") || l.starts_with("%Error"))
+                .map(|l| format!("{top}: {l}")),
+        );
+        if !out.status.success() && report.warnings.is_empty() {
+            return Err(failure("verilator", &out));
+        }
+        report.modules.push(top);
+    }
+    Ok(report)
+}
+
+/// Result of [`simulate`].
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct SimReport {
+    /// `CYCLES` register read back after the design vector's run.
+    pub cycles: u64,
+    /// The exact prediction `points + makespan · cycles_per_slot`.
+    pub predicted_cycles: u64,
+    /// Testbench-measured edges from start to `ins_irq`, per vector.
+    pub irq_cycles: Vec<u64>,
+    /// Testbench edges of the whole bus program.
+    pub tb_cycles: u64,
+    /// Predicted testbench edges ([`bus_cycles_formula`] summed over vectors).
+    pub predicted_tb_cycles: u64,
+    /// Words that differ from the `bt-fixed` model (plus protocol errors).
+    pub mismatches: usize,
+    /// The first 50 mismatches, described.
+    pub mismatch_details: Vec<String>,
+    /// Words read and compared.
+    pub words_compared: usize,
+    /// Test vectors run.
+    pub vectors: usize,
+}
+
+/// Compiles and runs the testbench with Icarus Verilog (`iverilog -g2005`, `vvp`), then
+/// compares every word read with the `bt-fixed` model recomputed from `hls_input.json` and
+/// `schedule.json`, and the cycle counts with their exact formulas.
+pub fn simulate(out_dir: &Path) -> Result<SimReport, HlsError> {
+    let (d, vectors) = recompute(out_dir)?;
+    let mut args: Vec<String> = vec![
+        "-g2005".into(),
+        "-o".into(),
+        "tb/sim.vvp".into(),
+        "-s".into(),
+        "bt_tb".into(),
+    ];
+    args.extend(rel_rtl(out_dir)?);
+    args.push("tb/bt_tb.v".into());
+    let out = run("iverilog", "iverilog", &args, out_dir)?;
+    if !out.status.success() {
+        return Err(failure("iverilog", &out));
+    }
+    let tb = out_dir.join("tb");
+    let result = tb.join("sim_out.txt");
+    let _ = std::fs::remove_file(&result);
+    let out = run("vvp", "iverilog", &["-n".into(), "sim.vvp".into()], &tb)?;
+    if !out.status.success() {
+        return Err(failure("vvp", &out));
+    }
+    let text = std::fs::read_to_string(&result).map_err(io_err(&result))?;
+    let expected: Vec<(u32, u32)> = vectors
+        .iter()
+        .flat_map(|v| v.reads.iter().copied())
+        .collect();
+    let predicted_cycles = d.predicted_cycles();
+    let predicted_tb_cycles = vectors.len() as u64
+        * bus_cycles_formula(predicted_cycles, d.num_paths.into(), d.num_points.into());
+    let mut report = SimReport {
+        cycles: 0,
+        predicted_cycles,
+        irq_cycles: Vec::new(),
+        tb_cycles: 0,
+        predicted_tb_cycles,
+        mismatches: 0,
+        mismatch_details: Vec::new(),
+        words_compared: 0,
+        vectors: vectors.len(),
+    };
+    let note = |r: &mut SimReport, s: String| {
+        r.mismatches += 1;
+        if r.mismatch_details.len() < 50 {
+            r.mismatch_details.push(s);
+        }
+    };
+    let parse = |s: Option<&str>, radix: u32| -> Result<u64, HlsError> {
+        s.and_then(|v| u64::from_str_radix(v, radix).ok())
+            .ok_or_else(|| HlsError::Parse {
+                what: "sim_out.txt".into(),
+                message: format!("bad field {s:?}"),
+            })
+    };
+    let mut reads = 0usize;
+    for line in text.lines() {
+        let mut f = line.split_whitespace();
+        match f.next() {
+            Some("R") => {
+                let (addr, data) = (parse(f.next(), 16)? as u32, parse(f.next(), 16)? as u32);
+                match expected.get(reads) {
+                    Some(&(ea, ed)) if ea == addr => {
+                        if ed != data {
+                            let v = reads / (expected.len() / vectors.len()).max(1);
+                            note(
+                                &mut report,
+                                format!(
+                                    "vector {v} addr 0x{addr:04x}: rtl 0x{data:08x}, model 0x{ed:08x}"
+                                ),
+                            );
+                        }
+                        if reads == 0 {
+                            report.cycles = data.into();
+                        }
+                    }
+                    other => note(
+                        &mut report,
+                        format!("read #{reads} at 0x{addr:04x}, expected {other:?}"),
+                    ),
+                }
+                reads += 1;
+            }
+            Some("C") => report.irq_cycles.push(parse(f.next(), 10)?),
+            Some("T") => report.tb_cycles = parse(f.next(), 10)?,
+            Some("E") => note(&mut report, format!("testbench: {line}")),
+            _ => {}
+        }
+    }
+    report.words_compared = reads;
+    if reads != expected.len() {
+        note(
+            &mut report,
+            format!("{reads} words read, {} expected", expected.len()),
+        );
+    }
+    Ok(report)
+}
+
+/// Result of [`synthesize`].
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct SynthReport {
+    /// `cycloneive_lcell_comb` cells (4-input LUTs, one per logic element).
+    pub logic_cells: u64,
+    /// `dffeas` cells (logic-element registers).
+    pub registers: u64,
+    /// Bits in M9K block RAM cells (0 with `-nobram`, see [`synthesize`]).
+    pub memory_bits: u64,
+    /// Logic elements estimate `max(logic_cells, registers)` (each LE holds one LUT and one
+    /// register; Quartus packing can only add to this) as a percentage of the EP4CE115's 114,480.
+    pub percent_of_ep4ce115: f64,
+    /// Every cell type and count of the final `stat`.
+    pub cells: BTreeMap<String, u64>,
+}
+
+/// Logic elements of the EP4CE115 (paper's Cyclone IV E device).
+pub const EP4CE115_LES: u64 = 114_480;
+
+/// Runs `yosys synth_intel -family cycloneive -nobram -top bt_top` (the EP4CE115 is a
+/// Cyclone IV E) on `rtl/*.v`, logging to `synth/yosys.log`, and parses the final cell counts.
+///
+/// `-nobram`: Yosys 0.23's M9K mapping aborts on our point memory ("Can't find object for
+/// defparam `INIT`"), so the point memory is built from registers and counted in
+/// `registers`/`logic_cells` (a pessimistic figure: Quartus would put it in M9K blocks).
+/// Synthesis of the 6-plane test scene takes about 4 minutes on one core.
+pub fn synthesize(out_dir: &Path) -> Result<SynthReport, HlsError> {
+    let files = rel_rtl(out_dir)?;
+    let synth = out_dir.join("synth");
+    std::fs::create_dir_all(&synth).map_err(io_err(&synth))?;
+    let script = format!(
+        "read_verilog {}; synth_intel -family cycloneive -nobram -top bt_top; tee -o synth/stat.txt stat",
+        files.join(" ")
+    );
+    let out = run(
+        "yosys",
+        "yosys",
+        &[
+            "-q".into(),
+            "-l".into(),
+            "synth/yosys.log".into(),
+            "-p".into(),
+            script,
+        ],
+        out_dir,
+    )?;
+    if !out.status.success() {
+        return Err(failure("yosys", &out));
+    }
+    let stat_path = synth.join("stat.txt");
+    let stat = std::fs::read_to_string(&stat_path).map_err(io_err(&stat_path))?;
+    let cells = parse_stat(&stat);
+    let count = |suffix: &str| {
+        cells
+            .iter()
+            .filter(|(k, _)| k.ends_with(suffix))
+            .map(|(_, v)| v)
+            .sum::<u64>()
+    };
+    let logic_cells = count("lcell_comb");
+    let registers = count("dffeas");
+    let memory_bits = count("ram_block") * 9216;
+    Ok(SynthReport {
+        logic_cells,
+        registers,
+        memory_bits,
+        percent_of_ep4ce115: 100.0 * logic_cells.max(registers) as f64 / EP4CE115_LES as f64,
+        cells,
+    })
+}
+
+/// Cell lines of a Yosys `stat` ("     <type>   <count>") after "Number of cells".
+fn parse_stat(stat: &str) -> BTreeMap<String, u64> {
+    let mut cells = BTreeMap::new();
+    let mut in_cells = false;
+    for line in stat.lines() {
+        if line.contains("Number of cells") {
+            in_cells = true;
+            continue;
+        }
+        if in_cells {
+            let f: Vec<&str> = line.split_whitespace().collect();
+            match f.as_slice() {
+                [name, n] => {
+                    if let Ok(n) = n.parse::<u64>() {
+                        *cells.entry((*name).to_string()).or_insert(0) += n;
+                    }
+                }
+                [] => {}
+                _ => in_cells = false,
+            }
+        }
+    }
+    cells
+}
+
+#[cfg(test)]
+mod tests {
+    #[test]
+    fn parses_yosys_stat() {
+        let stat = "=== bt_top ===\n\n   Number of wires: 10\n   Number of cells:   7\n     cycloneive_lcell_comb    5\n     dffeas    2\n\n";
+        let c = super::parse_stat(stat);
+        assert_eq!(c["cycloneive_lcell_comb"], 5);
+        assert_eq!(c["dffeas"], 2);
+    }
+}

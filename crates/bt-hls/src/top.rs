@@ -1,0 +1,777 @@
+//! `bt_top`: PE matrix, scheduler ROM, coordinate updater-buffer, convergence flags and the
+//! Avalon-MM slave. Twin of `bt_fixed::FixedIpc::run_fixed` with the schedule's budgets.
+
+use bt_fixed::{FineCoord, width};
+
+use crate::input::{ADDRESS_BITS, Design, PE_LATENCY, bits_for};
+use crate::pe::{POINT_BITS, pe_module_name, port};
+use crate::verilog::{BinaryOp, Direction, Expr, Item, Module, Stmt, UnaryOp};
+
+/// FSM state encodings.
+const S_IDLE: u128 = 0;
+const S_INIT: u128 = 1;
+const S_LOAD: u128 = 2;
+const S_EXEC: u128 = 3;
+const S_WB: u128 = 4;
+const STATE_BITS: u32 = 3;
+
+/// Register-map version reported in `INFO[15:8]`.
+pub const MAP_VERSION: u32 = 1;
+
+fn nb(l: Expr, r: Expr) -> Stmt {
+    Stmt::NonBlocking(l, r)
+}
+fn bl(l: &str, r: Expr) -> Stmt {
+    Stmt::Blocking(Expr::id(l), r)
+}
+fn id(n: &str) -> Expr {
+    Expr::id(n)
+}
+fn lit(w: u32, v: u128) -> Expr {
+    Expr::lit(w, v)
+}
+fn state_is(s: u128) -> Expr {
+    id("state").eq(lit(STATE_BITS, s))
+}
+fn or(a: Expr, b: Expr) -> Expr {
+    Expr::bin(BinaryOp::Or, a, b)
+}
+
+/// Packs a fine point as the 120-bit `{z, y, x}` literal.
+fn point_literal(p: &[FineCoord; 3]) -> Expr {
+    let cw = width::COORD;
+    let mask = (1u128 << cw) - 1;
+    let v = (p[0].0 as u128 & mask)
+        | ((p[1].0 as u128 & mask) << cw)
+        | ((p[2].0 as u128 & mask) << (2 * cw));
+    lit(POINT_BITS, v)
+}
+
+pub(crate) fn top_module(d: &Design) -> Module {
+    let k = d.num_instances;
+    let (pb, ptb, ib, sb) = (d.path_bits, d.point_bits, d.inst_bits, d.slot_bits);
+    let np2 = 1u32 << pb;
+    let depth = 1u32 << (ptb + 1);
+    let cw = width::COORD;
+    let dispw = cw + 1;
+    let cnt_bits = bits_for(u64::from(d.num_points.max(k + 1).max(PE_LATENCY)) + 1);
+    let status_bits = d.status_base.trailing_zeros();
+    let point_bits_addr = d.point_base.trailing_zeros();
+    let mut items = Vec::new();
+    let mut unused: Vec<Expr> = vec![lit(1, 0)];
+
+    items.push(Item::Comment(format!(
+        "{} paths, {} points, {} PE instances, makespan {} slots, {} cycles per slot, threshold {} fine LSB",
+        d.num_paths,
+        d.num_points,
+        k,
+        d.makespan,
+        d.cycles_per_slot(),
+        d.input.threshold_lsb
+    )));
+    for (n, w) in [
+        ("state", STATE_BITS),
+        ("cnt", cnt_bits),
+        ("slot", sb),
+        ("cycles", 32),
+        ("done", 1),
+        ("tx_x", 32),
+        ("tx_y", 32),
+        ("tx_z", 32),
+        ("rx_x", 32),
+        ("rx_y", 32),
+        ("rx_z", 32),
+        ("cur", np2),
+        ("conv", np2),
+        ("dz", np2),
+        ("ov", np2),
+        ("pbig", np2),
+        ("pdz", np2),
+        ("pov", np2),
+        ("rd_a", POINT_BITS),
+        ("rd_b", POINT_BITS),
+        ("ld_q_en", 1),
+        ("ld_q_first", 1),
+        ("ld_q_last", 1),
+        ("ld_q_inst", ib),
+        ("wb_q_en", 1),
+        ("wb_q_end", 1),
+        ("wb_q_path", pb),
+        ("wb_q_point", ptb),
+        ("wb_q_inst", ib),
+        ("rq_valid", 1),
+        ("rq_kind", 2),
+        ("rq_reg", 4),
+        ("rq_word", 2),
+        ("rq_path", pb),
+    ] {
+        items.push(Item::Reg(n.into(), w));
+    }
+    items.push(Item::Memory("rounds".into(), 16, np2));
+    items.push(Item::Memory("point_mem".into(), POINT_BITS, depth));
+    for j in 0..k {
+        items.push(Item::Reg(format!("op_prev_{j}"), POINT_BITS));
+        items.push(Item::Reg(format!("op_next_{j}"), POINT_BITS));
+        items.push(Item::Wire(format!("pe_out_{j}"), POINT_BITS));
+        items.push(Item::Wire(format!("pe_zs_{j}"), 1));
+        items.push(Item::Wire(format!("pe_ov_{j}"), 1));
+    }
+
+    // Scheduler ROM: {slot, instance} -> job.
+    items.push(Item::Comment(
+        "PE scheduler ROM: entry {slot, instance} -> {valid, path, point, first, last, round_end}"
+            .into(),
+    ));
+    for (n, w) in [
+        ("rom_valid", 1),
+        ("rom_path", pb),
+        ("rom_point", ptb),
+        ("rom_first", 1),
+        ("rom_last", 1),
+        ("rom_end", 1),
+    ] {
+        items.push(Item::Reg(n.into(), w));
+    }
+    items.push(Item::Wire("rom_index".into(), sb + ib));
+    items.push(Item::Assign(
+        id("rom_index"),
+        Expr::concat(vec![id("slot"), Expr::slice("cnt", ib - 1, 0)]),
+    ));
+    // Last job of each (path, round) in (slot, instance) order.
+    let mut last_of_round = std::collections::BTreeMap::new();
+    for (t, row) in d.schedule.slots.iter().enumerate() {
+        for (i, job) in row.iter().enumerate() {
+            if let Some(job) = job {
+                last_of_round.insert((job.path, job.round), (t, i));
+            }
+        }
+    }
+    let mut arms = Vec::new();
+    for (t, row) in d.schedule.slots.iter().enumerate() {
+        for (i, job) in row.iter().enumerate() {
+            let Some(job) = job else { continue };
+            let n = d.input.paths[job.path as usize].len() as u32;
+            let point = d.first_point[job.path as usize] + job.point;
+            let index = ((t as u128) << ib) | i as u128;
+            arms.push((
+                lit(sb + ib, index),
+                vec![
+                    bl("rom_valid", lit(1, 1)),
+                    bl("rom_path", lit(pb, job.path.into())),
+                    bl("rom_point", lit(ptb, point.into())),
+                    bl("rom_first", lit(1, u128::from(job.point == 0))),
+                    bl("rom_last", lit(1, u128::from(job.point + 1 == n))),
+                    bl(
+                        "rom_end",
+                        lit(
+                            1,
+                            u128::from(last_of_round[&(job.path, job.round)] == (t, i)),
+                        ),
+                    ),
+                ],
+            ));
+        }
+    }
+    let rom_defaults = vec![
+        bl("rom_valid", lit(1, 0)),
+        bl("rom_path", lit(pb, 0)),
+        bl("rom_point", lit(ptb, 0)),
+        bl("rom_first", lit(1, 0)),
+        bl("rom_last", lit(1, 0)),
+        bl("rom_end", lit(1, 0)),
+    ];
+    let mut rom = rom_defaults.clone();
+    rom.push(Stmt::Case(id("rom_index"), arms, rom_defaults));
+    items.push(Item::AlwaysComb(rom));
+
+    // Initial points ROM and point -> path ROM.
+    items.push(Item::Reg("init_point".into(), POINT_BITS));
+    items.push(Item::Reg("bus_path".into(), pb));
+    items.push(Item::Wire("bus_point".into(), ptb));
+    items.push(Item::Assign(
+        id("bus_point"),
+        Expr::slice("avs_address", ptb + 1, 2),
+    ));
+    let mut init_arms = Vec::new();
+    let mut path_arms = Vec::new();
+    for p in 0..d.num_paths as usize {
+        for (i, pt) in d.model.init_points(p).iter().enumerate() {
+            let g = d.first_point[p] + i as u32;
+            init_arms.push((
+                lit(ptb, g.into()),
+                vec![bl("init_point", point_literal(pt))],
+            ));
+            path_arms.push((lit(ptb, g.into()), vec![bl("bus_path", lit(pb, p as u128))]));
+        }
+    }
+    items.push(Item::AlwaysComb(vec![Stmt::Case(
+        Expr::slice("cnt", ptb - 1, 0),
+        init_arms,
+        vec![bl("init_point", lit(POINT_BITS, 0))],
+    )]));
+    items.push(Item::AlwaysComb(vec![Stmt::Case(
+        id("bus_point"),
+        path_arms,
+        vec![bl("bus_path", lit(pb, 0))],
+    )]));
+
+    // Coordinate updater-buffer: two banks per point, bank = cur[path] holds the last committed round.
+    items.push(Item::Comment(
+        "coordinate updater-buffer: address {point, bank}; cur[path] = bank of the committed round"
+            .into(),
+    ));
+    let rom_bank = Expr::id("cur").at(id("rom_path"));
+    for (n, w) in [
+        ("ra_addr", ptb + 1),
+        ("rb_addr", ptb + 1),
+        ("wr_addr", ptb + 1),
+        ("wr_en", 1),
+    ] {
+        items.push(Item::Reg(n.into(), w));
+    }
+    items.push(Item::Reg("wr_data".into(), POINT_BITS));
+    let one_pt = lit(ptb, 1);
+    items.push(Item::AlwaysComb(vec![
+        bl(
+            "ra_addr",
+            Expr::concat(vec![id("bus_point"), Expr::id("cur").at(id("bus_path"))]),
+        ),
+        Stmt::If(
+            state_is(S_LOAD),
+            vec![bl(
+                "ra_addr",
+                Expr::concat(vec![
+                    id("rom_point").minus(one_pt.clone()),
+                    rom_bank.clone(),
+                ]),
+            )],
+            vec![Stmt::If(
+                state_is(S_WB),
+                vec![bl(
+                    "ra_addr",
+                    Expr::concat(vec![id("rom_point"), rom_bank.clone()]),
+                )],
+                vec![],
+            )],
+        ),
+        bl(
+            "rb_addr",
+            Expr::concat(vec![id("rom_point").plus(one_pt), rom_bank]),
+        ),
+    ]));
+    // Write-back: PE output select, displacement, freeze.
+    items.push(Item::Reg("pe_sel".into(), POINT_BITS));
+    items.push(Item::Reg("pe_sel_zs".into(), 1));
+    items.push(Item::Reg("pe_sel_ov".into(), 1));
+    let sel_arms = (0..k)
+        .map(|j| {
+            (
+                lit(ib, j.into()),
+                vec![
+                    bl("pe_sel", id(&format!("pe_out_{j}"))),
+                    bl("pe_sel_zs", id(&format!("pe_zs_{j}"))),
+                    bl("pe_sel_ov", id(&format!("pe_ov_{j}"))),
+                ],
+            )
+        })
+        .collect();
+    let sel_default = vec![
+        bl("pe_sel", lit(POINT_BITS, 0)),
+        bl("pe_sel_zs", lit(1, 0)),
+        bl("pe_sel_ov", lit(1, 0)),
+    ];
+    items.push(Item::AlwaysComb(vec![Stmt::Case(
+        id("wb_q_inst"),
+        sel_arms,
+        sel_default,
+    )]));
+    let mut big_terms = Vec::new();
+    for (a, axis) in ["x", "y", "z"].iter().enumerate() {
+        let (hi, lo) = (cw * (a as u32 + 1) - 1, cw * a as u32);
+        let (nw, ow) = (format!("new_{axis}"), format!("old_{axis}"));
+        items.push(Item::Wire(nw.clone(), cw));
+        items.push(Item::Assign(id(&nw), Expr::slice("pe_sel", hi, lo)));
+        items.push(Item::Wire(ow.clone(), cw));
+        items.push(Item::Assign(id(&ow), Expr::slice("rd_a", hi, lo)));
+        let diff = format!("diff_{axis}");
+        items.push(Item::Wire(diff.clone(), dispw));
+        items.push(Item::Assign(
+            id(&diff),
+            crate::pe::sext(&nw, cw, dispw).minus(crate::pe::sext(&ow, cw, dispw)),
+        ));
+        let abs = format!("adiff_{axis}");
+        items.push(Item::Wire(abs.clone(), dispw));
+        items.push(Item::Assign(
+            id(&abs),
+            Expr::mux(
+                Expr::bit(&diff, dispw - 1),
+                id(&diff).inv().plus(lit(dispw, 1)),
+                id(&diff),
+            ),
+        ));
+        big_terms.push(Expr::bin(
+            BinaryOp::Gt,
+            id(&abs),
+            lit(dispw, d.input.threshold_lsb.into()),
+        ));
+    }
+    items.push(Item::Comment(
+        "wb_big: L-infinity displacement of the written point exceeds the threshold".into(),
+    ));
+    items.push(Item::Wire("wb_big".into(), 1));
+    items.push(Item::Assign(
+        id("wb_big"),
+        big_terms.into_iter().reduce(or).expect("3 axes"),
+    ));
+    items.push(Item::Wire("wb_frozen".into(), 1));
+    let at_wb = |v: &str| Expr::id(v).at(id("wb_q_path"));
+    items.push(Item::Assign(
+        id("wb_frozen"),
+        or(or(at_wb("conv"), at_wb("dz")), at_wb("ov")),
+    ));
+    items.push(Item::Wire("wb_go".into(), 1));
+    items.push(Item::Assign(
+        id("wb_go"),
+        state_is(S_WB)
+            .and(id("wb_q_en"))
+            .and(id("wb_frozen").lnot()),
+    ));
+    items.push(Item::Wire("any_big".into(), 1));
+    items.push(Item::Assign(id("any_big"), or(at_wb("pbig"), id("wb_big"))));
+    items.push(Item::Wire("any_dz".into(), 1));
+    items.push(Item::Assign(
+        id("any_dz"),
+        or(at_wb("pdz"), id("pe_sel_zs")),
+    ));
+    items.push(Item::Wire("any_ov".into(), 1));
+    items.push(Item::Assign(
+        id("any_ov"),
+        or(at_wb("pov"), id("pe_sel_ov")),
+    ));
+    items.push(Item::AlwaysComb(vec![
+        bl("wr_en", state_is(S_INIT).or(id("wb_go"))),
+        bl(
+            "wr_addr",
+            Expr::concat(vec![Expr::slice("cnt", ptb - 1, 0), lit(1, 0)]),
+        ),
+        bl("wr_data", id("init_point")),
+        Stmt::If(
+            state_is(S_WB),
+            vec![
+                bl(
+                    "wr_addr",
+                    Expr::concat(vec![
+                        id("wb_q_point"),
+                        Expr::id("cur").at(id("wb_q_path")).inv(),
+                    ]),
+                ),
+                bl("wr_data", id("pe_sel")),
+            ],
+            vec![],
+        ),
+    ]));
+    items.push(Item::AlwaysFf(vec![
+        Stmt::If(
+            id("wr_en"),
+            vec![nb(Expr::id("point_mem").at(id("wr_addr")), id("wr_data"))],
+            vec![],
+        ),
+        nb(id("rd_a"), Expr::id("point_mem").at(id("ra_addr"))),
+        nb(id("rd_b"), Expr::id("point_mem").at(id("rb_addr"))),
+    ]));
+
+    // PE matrix.
+    items.push(Item::Wire("pe_start".into(), 1));
+    items.push(Item::Assign(
+        id("pe_start"),
+        state_is(S_EXEC).and(id("cnt").eq(lit(cnt_bits, 0))),
+    ));
+    for (j, inst) in d.schedule.instances.iter().enumerate() {
+        items.push(Item::Instance {
+            module: pe_module_name(inst.plane as usize),
+            name: format!("u_pe_{j}"),
+            ports: vec![
+                ("clk".into(), id("clk")),
+                ("rst_n".into(), id("rst_n")),
+                ("start".into(), id("pe_start")),
+                ("s_prev".into(), id(&format!("op_prev_{j}"))),
+                ("s_next".into(), id(&format!("op_next_{j}"))),
+                ("s_out".into(), id(&format!("pe_out_{j}"))),
+                ("zero_sum".into(), id(&format!("pe_zs_{j}"))),
+                ("overflow".into(), id(&format!("pe_ov_{j}"))),
+            ],
+        });
+    }
+
+    // Operand load (one instance per cycle, memory data one cycle after the address).
+    let fine = |n: &str| Expr::concat(vec![id(n), lit(8, 0)]);
+    let tx_fine = Expr::concat(vec![fine("tx_z"), fine("tx_y"), fine("tx_x")]);
+    let rx_fine = Expr::concat(vec![fine("rx_z"), fine("rx_y"), fine("rx_x")]);
+    let load_arms = (0..k)
+        .map(|j| {
+            (
+                lit(ib, j.into()),
+                vec![
+                    nb(
+                        id(&format!("op_prev_{j}")),
+                        Expr::mux(id("ld_q_first"), tx_fine.clone(), id("rd_a")),
+                    ),
+                    nb(
+                        id(&format!("op_next_{j}")),
+                        Expr::mux(id("ld_q_last"), rx_fine.clone(), id("rd_b")),
+                    ),
+                ],
+            )
+        })
+        .collect();
+    items.push(Item::AlwaysFf(vec![Stmt::If(
+        state_is(S_LOAD).and(id("ld_q_en")),
+        vec![Stmt::Case(id("ld_q_inst"), load_arms, vec![])],
+        vec![],
+    )]));
+
+    // Main FSM.
+    let k_cnt = lit(cnt_bits, k.into());
+    let cnt_inc = id("cnt").plus(lit(cnt_bits, 1));
+    let start_req = id("avs_write")
+        .and(id("avs_address").eq(lit(ADDRESS_BITS, 0)))
+        .and(Expr::bit("avs_writedata", 0))
+        .and(state_is(S_IDLE));
+    let all_zero = lit(np2, 0);
+    let mut on_start = vec![
+        nb(id("state"), lit(STATE_BITS, S_INIT)),
+        nb(id("cnt"), lit(cnt_bits, 0)),
+        nb(id("slot"), lit(sb, 0)),
+        nb(id("cycles"), lit(32, 0)),
+        nb(id("done"), lit(1, 0)),
+    ];
+    for v in ["cur", "conv", "dz", "ov", "pbig", "pdz", "pov"] {
+        on_start.push(nb(id(v), all_zero.clone()));
+    }
+    for p in 0..np2 {
+        on_start.push(nb(Expr::id("rounds").at(lit(pb, p.into())), lit(16, 0)));
+    }
+    let init = vec![
+        nb(id("cnt"), cnt_inc.clone()),
+        Stmt::If(
+            id("cnt").eq(lit(cnt_bits, u128::from(d.num_points - 1))),
+            vec![
+                nb(id("state"), lit(STATE_BITS, S_LOAD)),
+                nb(id("cnt"), lit(cnt_bits, 0)),
+            ],
+            vec![],
+        ),
+    ];
+    let not_last = Expr::bin(BinaryOp::Ne, id("cnt"), k_cnt.clone());
+    let load = vec![
+        nb(id("ld_q_en"), not_last.clone().and(id("rom_valid"))),
+        nb(id("ld_q_first"), id("rom_first")),
+        nb(id("ld_q_last"), id("rom_last")),
+        nb(id("ld_q_inst"), Expr::slice("cnt", ib - 1, 0)),
+        Stmt::If(
+            id("cnt").eq(k_cnt.clone()),
+            vec![
+                nb(id("state"), lit(STATE_BITS, S_EXEC)),
+                nb(id("cnt"), lit(cnt_bits, 0)),
+            ],
+            vec![nb(id("cnt"), cnt_inc.clone())],
+        ),
+    ];
+    let exec = vec![Stmt::If(
+        id("cnt").eq(lit(cnt_bits, u128::from(PE_LATENCY - 1))),
+        vec![
+            nb(id("state"), lit(STATE_BITS, S_WB)),
+            nb(id("cnt"), lit(cnt_bits, 0)),
+        ],
+        vec![nb(id("cnt"), cnt_inc.clone())],
+    )];
+    let wbp = |v: &str| Expr::id(v).at(id("wb_q_path"));
+    let commit = vec![Stmt::If(
+        id("wb_q_end"),
+        vec![
+            nb(wbp("cur"), wbp("cur").inv()),
+            nb(
+                Expr::id("rounds").at(id("wb_q_path")),
+                Expr::id("rounds").at(id("wb_q_path")).plus(lit(16, 1)),
+            ),
+            nb(wbp("dz"), id("any_dz")),
+            nb(wbp("ov"), id("any_ov")),
+            nb(
+                wbp("conv"),
+                id("any_big")
+                    .lnot()
+                    .and(id("any_dz").lnot())
+                    .and(id("any_ov").lnot()),
+            ),
+            nb(wbp("pbig"), lit(1, 0)),
+            nb(wbp("pdz"), lit(1, 0)),
+            nb(wbp("pov"), lit(1, 0)),
+        ],
+        vec![
+            nb(wbp("pbig"), id("any_big")),
+            nb(wbp("pdz"), id("any_dz")),
+            nb(wbp("pov"), id("any_ov")),
+        ],
+    )];
+    let wb = vec![
+        nb(id("wb_q_en"), not_last.and(id("rom_valid"))),
+        nb(id("wb_q_end"), id("rom_end")),
+        nb(id("wb_q_path"), id("rom_path")),
+        nb(id("wb_q_point"), id("rom_point")),
+        nb(id("wb_q_inst"), Expr::slice("cnt", ib - 1, 0)),
+        Stmt::If(id("wb_go"), commit, vec![]),
+        Stmt::If(
+            id("cnt").eq(k_cnt),
+            vec![
+                nb(id("cnt"), lit(cnt_bits, 0)),
+                Stmt::If(
+                    id("slot").eq(lit(sb, u128::from(d.makespan - 1))),
+                    vec![
+                        nb(id("state"), lit(STATE_BITS, S_IDLE)),
+                        nb(id("done"), lit(1, 1)),
+                    ],
+                    vec![
+                        nb(id("state"), lit(STATE_BITS, S_LOAD)),
+                        nb(id("slot"), id("slot").plus(lit(sb, 1))),
+                    ],
+                ),
+            ],
+            vec![nb(id("cnt"), cnt_inc)],
+        ),
+    ];
+    items.push(Item::Comment(format!(
+        "main FSM: IDLE -> INIT ({} cycles) -> per slot LOAD ({}) EXEC ({}) WB ({}) -> IDLE with done",
+        d.num_points,
+        k + 1,
+        PE_LATENCY,
+        k + 1
+    )));
+    items.push(Item::Wire("start_req".into(), 1));
+    items.push(Item::Assign(id("start_req"), start_req));
+    items.push(Item::AlwaysFf(vec![Stmt::If(
+        id("rst_n").lnot(),
+        vec![
+            nb(id("state"), lit(STATE_BITS, S_IDLE)),
+            nb(id("cnt"), lit(cnt_bits, 0)),
+            nb(id("slot"), lit(sb, 0)),
+            nb(id("cycles"), lit(32, 0)),
+            nb(id("done"), lit(1, 0)),
+            nb(id("ld_q_en"), lit(1, 0)),
+            nb(id("wb_q_en"), lit(1, 0)),
+        ],
+        vec![
+            Stmt::If(
+                Expr::bin(BinaryOp::Ne, id("state"), lit(STATE_BITS, S_IDLE)),
+                vec![nb(id("cycles"), id("cycles").plus(lit(32, 1)))],
+                vec![],
+            ),
+            Stmt::Case(
+                id("state"),
+                vec![
+                    (
+                        lit(STATE_BITS, S_IDLE),
+                        vec![Stmt::If(id("start_req"), on_start, vec![])],
+                    ),
+                    (lit(STATE_BITS, S_INIT), init),
+                    (lit(STATE_BITS, S_LOAD), load),
+                    (lit(STATE_BITS, S_EXEC), exec),
+                    (lit(STATE_BITS, S_WB), wb),
+                ],
+                vec![nb(id("state"), lit(STATE_BITS, S_IDLE))],
+            ),
+        ],
+    )]));
+
+    // Avalon-MM slave: writes.
+    let wr = |addr: u32, reg: &str| {
+        Stmt::If(
+            id("avs_address").eq(lit(ADDRESS_BITS, addr.into())),
+            vec![nb(id(reg), id("avs_writedata"))],
+            vec![],
+        )
+    };
+    items.push(Item::AlwaysFf(vec![Stmt::If(
+        id("rst_n").lnot(),
+        vec![
+            nb(id("tx_x"), lit(32, 0)),
+            nb(id("tx_y"), lit(32, 0)),
+            nb(id("tx_z"), lit(32, 0)),
+            nb(id("rx_x"), lit(32, 0)),
+            nb(id("rx_y"), lit(32, 0)),
+            nb(id("rx_z"), lit(32, 0)),
+        ],
+        vec![Stmt::If(
+            id("avs_write"),
+            vec![
+                wr(4, "tx_x"),
+                wr(5, "tx_y"),
+                wr(6, "tx_z"),
+                wr(8, "rx_x"),
+                wr(9, "rx_y"),
+                wr(10, "rx_z"),
+            ],
+            vec![],
+        )],
+    )]));
+    // Avalon-MM slave: pipelined reads, fixed latency 2 (address -> registered select -> readdata).
+    let hi = ADDRESS_BITS - 1;
+    items.push(Item::Wire("is_ctrl".into(), 1));
+    items.push(Item::Assign(
+        id("is_ctrl"),
+        Expr::slice("avs_address", hi, 4).eq(lit(ADDRESS_BITS - 4, 0)),
+    ));
+    items.push(Item::Wire("is_status".into(), 1));
+    items.push(Item::Assign(
+        id("is_status"),
+        Expr::slice("avs_address", hi, status_bits).eq(lit(ADDRESS_BITS - status_bits, 1)),
+    ));
+    items.push(Item::Wire("is_point".into(), 1));
+    items.push(Item::Assign(
+        id("is_point"),
+        Expr::slice("avs_address", hi, point_bits_addr).eq(lit(ADDRESS_BITS - point_bits_addr, 1)),
+    ));
+    items.push(Item::AlwaysFf(vec![Stmt::If(
+        id("rst_n").lnot(),
+        vec![
+            nb(id("rq_valid"), lit(1, 0)),
+            nb(id("avs_readdatavalid"), lit(1, 0)),
+            nb(id("avs_readdata"), lit(32, 0)),
+        ],
+        vec![
+            nb(id("rq_valid"), id("avs_read")),
+            nb(
+                id("rq_kind"),
+                Expr::mux(
+                    id("is_ctrl"),
+                    lit(2, 1),
+                    Expr::mux(
+                        id("is_status"),
+                        lit(2, 2),
+                        Expr::mux(id("is_point"), lit(2, 3), lit(2, 0)),
+                    ),
+                ),
+            ),
+            nb(id("rq_reg"), Expr::slice("avs_address", 3, 0)),
+            nb(id("rq_word"), Expr::slice("avs_address", 1, 0)),
+            nb(id("rq_path"), Expr::slice("avs_address", pb - 1, 0)),
+            nb(id("avs_readdatavalid"), id("rq_valid")),
+            nb(id("avs_readdata"), id("read_mux")),
+        ],
+    )]));
+    let info = (k << 24) | (MAP_VERSION << 16) | (d.num_paths & 0xffff);
+    items.push(Item::Reg("read_mux".into(), 32));
+    let rqp = |v: &str| Expr::id(v).at(id("rq_path"));
+    let ctrl_arms = vec![
+        (
+            lit(4, 0),
+            vec![bl(
+                "read_mux",
+                Expr::concat(vec![
+                    lit(30, 0),
+                    id("done"),
+                    Expr::bin(BinaryOp::Ne, id("state"), lit(STATE_BITS, S_IDLE)),
+                ]),
+            )],
+        ),
+        (lit(4, 1), vec![bl("read_mux", id("cycles"))]),
+        (lit(4, 2), vec![bl("read_mux", lit(32, info.into()))]),
+        (
+            lit(4, 3),
+            vec![bl("read_mux", lit(32, d.input.threshold_lsb.into()))],
+        ),
+        (lit(4, 4), vec![bl("read_mux", id("tx_x"))]),
+        (lit(4, 5), vec![bl("read_mux", id("tx_y"))]),
+        (lit(4, 6), vec![bl("read_mux", id("tx_z"))]),
+        (lit(4, 8), vec![bl("read_mux", id("rx_x"))]),
+        (lit(4, 9), vec![bl("read_mux", id("rx_y"))]),
+        (lit(4, 10), vec![bl("read_mux", id("rx_z"))]),
+    ];
+    let point_arms = vec![
+        (
+            lit(2, 0),
+            vec![bl("read_mux", Expr::slice("rd_a", cw - 1, 8))],
+        ),
+        (
+            lit(2, 1),
+            vec![bl("read_mux", Expr::slice("rd_a", 2 * cw - 1, cw + 8))],
+        ),
+        (
+            lit(2, 2),
+            vec![bl("read_mux", Expr::slice("rd_a", 3 * cw - 1, 2 * cw + 8))],
+        ),
+    ];
+    let frac_word = Expr::concat(vec![
+        lit(8, 0),
+        Expr::slice("rd_a", 2 * cw + 7, 2 * cw),
+        Expr::slice("rd_a", cw + 7, cw),
+        Expr::slice("rd_a", 7, 0),
+    ]);
+    items.push(Item::AlwaysComb(vec![
+        bl("read_mux", lit(32, 0)),
+        Stmt::Case(
+            id("rq_kind"),
+            vec![
+                (
+                    lit(2, 1),
+                    vec![Stmt::Case(
+                        id("rq_reg"),
+                        ctrl_arms,
+                        vec![bl("read_mux", lit(32, 0))],
+                    )],
+                ),
+                (
+                    lit(2, 2),
+                    vec![bl(
+                        "read_mux",
+                        Expr::concat(vec![
+                            Expr::id("rounds").at(id("rq_path")),
+                            lit(13, 0),
+                            rqp("ov"),
+                            rqp("dz"),
+                            rqp("conv"),
+                        ]),
+                    )],
+                ),
+                (
+                    lit(2, 3),
+                    vec![Stmt::Case(
+                        id("rq_word"),
+                        point_arms,
+                        vec![bl("read_mux", frac_word)],
+                    )],
+                ),
+            ],
+            vec![bl("read_mux", lit(32, 0))],
+        ),
+    ]));
+    items.push(Item::Assign(id("ins_irq"), id("done")));
+    unused.push(Expr::slice("avs_writedata", 31, 1));
+    items.push(Item::Wire("bt_unused_ok".into(), 1));
+    items.push(Item::Assign(
+        id("bt_unused_ok"),
+        Expr::Unary(UnaryOp::ReduceAnd, Box::new(Expr::concat(unused))),
+    ));
+
+    Module {
+        name: "bt_top".into(),
+        header: vec![
+            "bt_top: IPC ray-tracing accelerator generated by bt-hls (register map in report.md)."
+                .into(),
+            format!(
+                "Avalon-MM slave, 32-bit words, word address {ADDRESS_BITS} bits, fixed read latency 2, irq = done."
+            ),
+        ],
+        ports: vec![
+            port("clk", Direction::Input, 1),
+            port("rst_n", Direction::Input, 1),
+            port("avs_address", Direction::Input, ADDRESS_BITS),
+            port("avs_read", Direction::Input, 1),
+            port("avs_write", Direction::Input, 1),
+            port("avs_writedata", Direction::Input, 32),
+            port("avs_readdata", Direction::OutputReg, 32),
+            port("avs_readdatavalid", Direction::OutputReg, 1),
+            port("ins_irq", Direction::Output, 1),
+        ],
+        items,
+    }
+}

@@ -1,0 +1,111 @@
+// The small test scene shared by the bt-hls integration tests.
+#![allow(dead_code)]
+
+use std::path::PathBuf;
+use std::sync::OnceLock;
+
+use bt_hls::{HlsInput, PlaneSpec, Report};
+use bt_schedule::{Budget, GaParams, Schedule, schedule_ga};
+
+/// A 5 m x 4 m x 3 m room: four walls (the x = 0 wall tilted by ~5.7 degrees so its PE has a
+/// real CSD network), floor and ceiling; all first-order paths and every second-order path
+/// between two walls or a wall and the floor (orders <= 2).
+pub fn small_scene() -> HlsInput {
+    let tilt = [0.995_037_190_209_989_1, 0.099_503_719_020_998_92, 0.0];
+    let planes = vec![
+        PlaneSpec {
+            name: "wall_west_tilted".into(),
+            normal: tilt,
+            offset_m: tilt[1] * 2.0,
+        },
+        PlaneSpec {
+            name: "wall_east".into(),
+            normal: [-1.0, 0.0, 0.0],
+            offset_m: -5.0,
+        },
+        PlaneSpec {
+            name: "wall_south".into(),
+            normal: [0.0, 1.0, 0.0],
+            offset_m: 0.0,
+        },
+        PlaneSpec {
+            name: "wall_north".into(),
+            normal: [0.0, -1.0, 0.0],
+            offset_m: -4.0,
+        },
+        PlaneSpec {
+            name: "floor".into(),
+            normal: [0.0, 0.0, 1.0],
+            offset_m: 0.0,
+        },
+        PlaneSpec {
+            name: "ceiling".into(),
+            normal: [0.0, 0.0, -1.0],
+            offset_m: -3.0,
+        },
+    ];
+    let centroids = [
+        [0.0, 2.0, 1.5],
+        [5.0, 2.0, 1.5],
+        [2.5, 0.0, 1.5],
+        [2.5, 4.0, 1.5],
+        [2.5, 2.0, 0.0],
+        [2.5, 2.0, 3.0],
+    ];
+    let mut paths: Vec<Vec<u32>> = (0..6).map(|p| vec![p]).collect();
+    for a in 0..5u32 {
+        for b in 0..5u32 {
+            if a != b {
+                paths.push(vec![a, b]);
+            }
+        }
+    }
+    let init_points = paths
+        .iter()
+        .map(|p| p.iter().map(|&i| centroids[i as usize]).collect())
+        .collect();
+    HlsInput {
+        planes,
+        paths,
+        init_points,
+        tx: [1.2, 1.0, 1.5],
+        rx: [3.9, 2.7, 1.1],
+        threshold_lsb: 16,
+        max_rounds: 40,
+        test_vectors: vec![
+            [[0.8, 3.1, 2.2], [4.1, 0.9, 0.6]],
+            [[2.5, 2.0, 1.0], [2.6, 2.1, 2.0]],
+        ],
+    }
+}
+
+/// The schedule: the paper's GA + duplication + ASAP with 2 duplicate PEs, fixed seed.
+pub fn small_schedule(input: &HlsInput) -> Schedule {
+    let problem = input.problem().expect("problem");
+    schedule_ga(&problem, &Budget { max_instances: 8 }, &GaParams::default()).expect("schedule")
+}
+
+pub struct Generated {
+    pub dir: PathBuf,
+    pub report: Report,
+    pub input: HlsInput,
+    pub schedule: Schedule,
+}
+
+/// Generated once per test binary, in the target's temporary directory.
+pub fn generated() -> &'static Generated {
+    static G: OnceLock<Generated> = OnceLock::new();
+    G.get_or_init(|| {
+        let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("bt_hls_small_scene");
+        let _ = std::fs::remove_dir_all(&dir);
+        let input = small_scene();
+        let schedule = small_schedule(&input);
+        let report = bt_hls::generate(&input, &schedule, &dir).expect("generate");
+        Generated {
+            dir,
+            report,
+            input,
+            schedule,
+        }
+    })
+}
