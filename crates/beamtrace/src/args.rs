@@ -18,6 +18,13 @@ pub enum Command {
     /// Trace every specular path between TX and RX in a scene (JSON/TOML scene, OBJ or PLY mesh,
     /// or builtin:living-room).
     Trace(TraceArgs),
+    /// Extract planar surfaces from a point cloud (PLY or PCD) into a scene file.
+    Extract(ExtractArgs),
+    /// Sample a scene's surfaces into a noisy synthetic point cloud (PLY or PCD by extension).
+    Sample(SampleArgs),
+    /// Compile a scene into FPGA RTL (fixed-point model, PE schedule, Verilog), co-simulate,
+    /// synthesise.
+    Hls(HlsArgs),
     /// Trace the built-in furnished living room.
     Demo(DemoArgs),
     /// Build the weak visibility relationship network (WVRN) of a scene and export it as a
@@ -258,4 +265,110 @@ pub fn parse_vec3(s: &str) -> anyhow::Result<Vec3> {
         }
     }
     Ok(Vec3::from_array(v))
+}
+
+#[derive(Debug, Args, Clone)]
+pub struct ExtractArgs {
+    /// Point cloud: .ply (ASCII or binary) or .pcd (ASCII or binary), metres, z up.
+    pub cloud: PathBuf,
+    /// Scene file to write (JSON).
+    #[arg(short = 'o', long = "output")]
+    pub output: PathBuf,
+    /// Also write the extraction report (JSON) here.
+    #[arg(long)]
+    pub report: Option<PathBuf>,
+    /// RANSAC seed.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+    /// RANSAC inlier distance, metres (about 3 σ of the sensor noise).
+    #[arg(long, default_value_t = 0.015)]
+    pub distance_threshold: f64,
+    /// Planes of at least this area (m²) reflect; smaller ones only block (paper: 0.25).
+    #[arg(long, default_value_t = 0.25)]
+    pub min_reflector_area: f64,
+    /// TX X,Y,Z in metres to store in the scene (optional).
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub tx: Option<Vec3>,
+    /// RX X,Y,Z in metres to store in the scene (optional).
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
+    pub rx: Option<Vec3>,
+}
+
+#[derive(Debug, Args, Clone)]
+pub struct SampleArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// Point cloud to write (.ply binary little-endian, or .pcd ASCII).
+    #[arg(short = 'o', long = "output")]
+    pub output: PathBuf,
+    /// Points per square metre of surface.
+    #[arg(long, default_value_t = 2000.0)]
+    pub density: f64,
+    /// Gaussian noise along the surface normal, metres (standard deviation).
+    #[arg(long, default_value_t = 0.005)]
+    pub noise: f64,
+    /// Random seed.
+    #[arg(long, default_value_t = 0)]
+    pub seed: u64,
+}
+
+#[derive(Debug, Args, Clone)]
+#[command(args_conflicts_with_subcommands = true, subcommand_negates_reqs = true)]
+pub struct HlsArgs {
+    #[command(subcommand)]
+    pub command: HlsCommand,
+}
+
+#[derive(Debug, Subcommand, Clone)]
+pub enum HlsCommand {
+    /// Generate the accelerator for a scene into a directory.
+    Gen(HlsGenArgs),
+    /// Co-simulate a generated directory (Icarus Verilog) against the Rust model.
+    Sim {
+        /// Directory written by `hls gen`.
+        dir: PathBuf,
+    },
+    /// Synthesise a generated directory with Yosys for the Cyclone IV E and report resources.
+    Synth {
+        /// Directory written by `hls gen`.
+        dir: PathBuf,
+    },
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum ScheduleArg {
+    /// Genetic algorithm + PE duplication + ASAP fill (the paper's three passes).
+    Ga,
+    /// Simple list scheduler (baseline, no duplication).
+    List,
+}
+
+#[derive(Debug, Args, Clone)]
+pub struct HlsGenArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// Output directory.
+    #[arg(short = 'o', long = "output")]
+    pub output: PathBuf,
+    /// Highest reflection order of the candidate paths.
+    #[arg(long, default_value_t = 3)]
+    pub max_order: usize,
+    /// Scheduler.
+    #[arg(long, value_enum, default_value_t = ScheduleArg::Ga)]
+    pub schedule: ScheduleArg,
+    /// Total PE instances allowed (default: planes + 25 % for duplicates).
+    #[arg(long)]
+    pub pe_budget: Option<u32>,
+    /// GA seed.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Convergence threshold on a round's largest displacement, in 1/256 mm.
+    #[arg(long, default_value_t = 16)]
+    pub threshold_lsb: u32,
+    /// Round cap of the fixed-point IPC.
+    #[arg(long, default_value_t = 256)]
+    pub max_rounds: u32,
+    /// Model and schedule only (cycle counts, errors): skip writing RTL (for large scenes).
+    #[arg(long)]
+    pub plan_only: bool,
 }

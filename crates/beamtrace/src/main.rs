@@ -2,9 +2,11 @@
 //! library crates.
 
 mod args;
+mod cloud;
+mod hls;
 mod output;
-mod study;
 mod steps;
+mod study;
 mod trace;
 mod wvrn;
 
@@ -28,6 +30,9 @@ fn run(cli: args::Cli) -> anyhow::Result<ExitCode> {
         args::Command::Trace(a) => trace::run(&a),
         args::Command::Demo(a) => trace::run(&a.into_trace()),
         args::Command::Wvrn(a) => wvrn::run(&a),
+        args::Command::Extract(a) => cloud::run_extract(&a),
+        args::Command::Hls(a) => hls::run(&a),
+        args::Command::Sample(a) => cloud::run_sample(&a),
         args::Command::Scene {
             command: args::SceneCommand::Check(a),
         } => trace::check(&a),

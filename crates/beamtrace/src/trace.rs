@@ -32,6 +32,26 @@ pub fn load_scene(args: &SceneArgs) -> Result<Loaded, SceneError> {
             }),
         };
     }
+    let path = Path::new(&args.scene);
+    if crate::cloud::is_point_cloud(path) {
+        // A point cloud where a scene is expected: extract its planes with the default
+        // parameters (use `beamtrace extract` to tune them and keep the scene file).
+        let (extraction, _) =
+            crate::cloud::extract_from(path, &bt_pointcloud::ExtractParams::default()).map_err(
+                |e| SceneError::Parse {
+                    path: args.scene.clone(),
+                    message: format!("{e:#}"),
+                },
+            )?;
+        let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("cloud");
+        let desc = crate::cloud::description(&extraction, name, None, None);
+        let scene = bt_scene::Scene::from_description(&desc, &args.scene, terminals)?;
+        let warnings = vec![format!(
+            "{}: point cloud: extracted {} planes ({} reflectors); `beamtrace extract` writes them as a scene file",
+            args.scene, extraction.report.planes_found, extraction.report.reflectors
+        )];
+        return Ok(Loaded { scene, warnings });
+    }
     let options = LoadOptions {
         terminals,
         merge: bt_mesh::MergeOptions {
@@ -42,7 +62,7 @@ pub fn load_scene(args: &SceneArgs) -> Result<Loaded, SceneError> {
         min_reflector_area_m2: args.min_reflector_area,
         ..LoadOptions::default()
     };
-    bt_scene::io::load(Path::new(&args.scene), &options)
+    bt_scene::io::load(path, &options)
 }
 
 /// The solver the arguments select, with defaults scaled to the scene.
