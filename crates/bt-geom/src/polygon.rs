@@ -62,6 +62,10 @@ pub struct Polygon {
     u: Vec3,
     v: Vec3,
     local: Vec<Vec2>,
+    /// Bounding box of `local`: the inside test rejects points beyond it (plus the tolerance)
+    /// before looking at any edge.
+    local_min: Vec2,
+    local_max: Vec2,
     area: Real,
     centroid: Vec3,
     extent: Real,
@@ -135,6 +139,11 @@ impl Polygon {
             return Err(PolygonError::SelfIntersecting(i, j));
         }
         let centroid = area_centroid(&local, origin, u, v);
+        let (local_min, local_max) = local
+            .iter()
+            .fold((Vec2::INFINITY, Vec2::NEG_INFINITY), |(lo, hi), p| {
+                (lo.min(*p), hi.max(*p))
+            });
         Ok(Self {
             vertices,
             plane,
@@ -142,6 +151,8 @@ impl Polygon {
             u,
             v,
             local,
+            local_min,
+            local_max,
             area,
             centroid,
             extent,
@@ -213,11 +224,19 @@ impl Polygon {
 
     /// Whether the projection of `p` onto the plane lies inside the polygon or within `tol`
     /// metres of its boundary (inclusive test, used for interaction points).
-    /// Same answer as `signed_boundary_distance(p) >= -tol`, without square roots, and without
-    /// any distance computation for points strictly inside.
+    /// Same answer as `signed_boundary_distance(p) >= -tol`, without square roots, without any
+    /// distance computation for points strictly inside, and without looking at the edges for
+    /// points beyond the polygon's 2-D bounding box grown by `tol` (most rejected paths).
     #[inline]
     pub fn contains(&self, p: Vec3, tol: Real) -> bool {
         let q = self.to_local(p);
+        if q.x < self.local_min.x - tol
+            || q.x > self.local_max.x + tol
+            || q.y < self.local_min.y - tol
+            || q.y > self.local_max.y + tol
+        {
+            return false;
+        }
         let n = self.local.len();
         let mut inside = false;
         let mut j = n - 1;

@@ -2,7 +2,7 @@
 //! compare as ratios inside one run: `cargo bench -p bt-solve --bench trace`.
 
 use bt_paths::{AllVisible, enumerate};
-use bt_solve::{IpcOptions, Solver, UpdateOrder, trace};
+use bt_solve::{Acceleration, IpcOptions, Solver, UpdateOrder, trace};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
 
@@ -25,6 +25,13 @@ fn living_room(c: &mut Criterion) {
         (
             "ipc-jacobi",
             Solver::Ipc(IpcOptions::for_scene(&scene, UpdateOrder::Jacobi)),
+        ),
+        (
+            "ipc-gauss-seidel-newton",
+            Solver::Ipc(IpcOptions {
+                acceleration: Acceleration::Newton,
+                ..IpcOptions::for_scene(&scene, UpdateOrder::GaussSeidel)
+            }),
         ),
     ];
     for (name, solver) in &solvers {

@@ -20,6 +20,7 @@ pub enum ImageFailure {
 
 /// Fill `points` (length = sequence length) with the interaction points of `seq` from `tx` to
 /// `rx`, metres.
+#[inline(always)]
 pub fn solve(
     scene: &Scene,
     seq: &[SurfaceId],

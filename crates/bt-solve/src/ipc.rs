@@ -31,6 +31,22 @@ pub enum UpdateOrder {
     Jacobi,
 }
 
+/// What follows the paper's rounds once the path has nearly settled.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "kebab-case")]
+pub enum Acceleration {
+    /// Nothing: the paper's rounds until its stopping rule (Algorithms 1-2 alone).
+    #[default]
+    None,
+    /// The paper's rounds until the mean displacement of a round is at most
+    /// [`NEWTON_SWITCH_REL`] × extent (also tried once after [`NEWTON_PATIENCE`] rounds),
+    /// then Newton steps on the stationarity of the path
+    /// length (the reflection law) until a step is at most the threshold ε_N. A Newton step
+    /// that fails (singular system, no decrease of the length) hands the run back to the
+    /// paper's rounds, so the result is never worse than without acceleration.
+    Newton,
+}
+
 /// IPC settings.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct IpcOptions {
@@ -49,6 +65,9 @@ pub struct IpcOptions {
     /// the distance it can still move at the measured contraction rate. The run ends as
     /// [`IpcOutcome::LeftPolygon`]; such a path could not have become valid.
     pub early_reject: bool,
+    /// Acceleration after the paper's rounds (default none: the paper's IPC as it is).
+    #[serde(default)]
+    pub acceleration: Acceleration,
 }
 
 /// Safety factor of early rejection over the estimated remaining movement Δ·ρ/(1−ρ) (the
@@ -74,6 +93,21 @@ pub const STALL_WINDOW: u32 = 64;
 /// rates up to 0.999 per round (error ≈ ε ρ/(1−ρ)).
 pub const DEFAULT_REL_THRESHOLD: Real = 1e-13;
 
+/// Newton acceleration starts once the mean displacement of a round is at most this times
+/// max(scene extent, 1 m): 10 µm in a 10 m room, where Newton's quadratic convergence has
+/// taken over for every non-degenerate path while the rounds have not yet slowed down.
+pub const NEWTON_SWITCH_REL: Real = 1e-6;
+
+/// Newton acceleration also starts after this many rounds when the displacement has not yet
+/// fallen to the switch point: Jacobi rounds oscillate (eigenvalues near −1) on chains that
+/// bounce near a corner, and the damped Newton iteration on the convex path length does not
+/// need a close start. A failed attempt leaves the points as they were.
+pub const NEWTON_PATIENCE: u32 = 64;
+
+/// Newton steps allowed before the run falls back to the paper's rounds (quadratic convergence
+/// from 1e-6 × extent needs 2-4; damped steps from a far start need more).
+pub const NEWTON_MAX_STEPS: u32 = 32;
+
 /// Default round cap (hard third-order cases need thousands of rounds at the default threshold).
 pub const DEFAULT_MAX_ITERATIONS: u32 = 100_000;
 
@@ -86,6 +120,7 @@ impl IpcOptions {
             max_iterations: DEFAULT_MAX_ITERATIONS,
             error_guard: true,
             early_reject: true,
+            acceleration: Acceleration::None,
         }
     }
 }
@@ -154,8 +189,16 @@ pub fn intersection_point(plane: &Plane, prev: Vec3, next: Vec3, min_sum: Real) 
     Some(t_prev + (m / sum) * (t_next - t_prev))
 }
 
+/// Chains up to this order keep a copy of their planes on the stack (longer ones on the heap).
+const LOCAL_PLANES: usize = 8;
+
 /// Run IPC on `seq` between `tx` and `rx`. `points` holds the initial points on entry (one per
-/// surface) and the final ones on return; `scratch` (same length) is used by Jacobi rounds.
+/// surface) and the final ones on return; `scratch` (same length) is kept for API stability
+/// (Jacobi rounds now update in place, remembering each point's previous value).
+///
+/// With [`Acceleration::Newton`], `iterations` in the outcome counts rounds plus Newton steps
+/// and `residual` is the mean displacement of the last update (round or Newton step).
+#[inline(always)]
 pub fn solve(
     scene: &Scene,
     seq: &[SurfaceId],
@@ -167,8 +210,95 @@ pub fn solve(
 ) -> IpcOutcome {
     let n = seq.len();
     debug_assert!(points.len() == n && scratch.len() == n);
+    let _ = scratch;
+    // The planes of this chain, contiguous: the rounds touch nothing else of the scene.
+    if n <= LOCAL_PLANES {
+        let mut planes = [Plane {
+            normal: Vec3::ZERO,
+            offset: 0.0,
+        }; LOCAL_PLANES];
+        for (plane, id) in planes.iter_mut().zip(seq) {
+            *plane = *scene.surface(*id).polygon.plane();
+        }
+        run(scene, seq, &planes[..n], tx, rx, options, points)
+    } else {
+        let planes: Vec<Plane> = seq
+            .iter()
+            .map(|id| *scene.surface(*id).polygon.plane())
+            .collect();
+        run(scene, seq, &planes, tx, rx, options, points)
+    }
+}
+
+/// One Gauss-Seidel round (Algorithm 1, lines 9-14): returns the summed displacement, or the
+/// index of a point whose neighbours both lie on its plane.
+#[inline(always)]
+fn round_gauss_seidel(
+    planes: &[Plane],
+    tx: Vec3,
+    rx: Vec3,
+    points: &mut [Vec3],
+    min_sum: Real,
+) -> Result<Real, usize> {
+    let n = points.len();
+    let mut moved = 0.0;
+    let mut prev = tx;
+    for k in 0..n {
+        let next = if k + 1 == n { rx } else { points[k + 1] };
+        let Some(p) = intersection_point(&planes[k], prev, next, min_sum) else {
+            return Err(k);
+        };
+        moved += p.distance(points[k]);
+        points[k] = p;
+        prev = p;
+    }
+    Ok(moved)
+}
+
+/// One Jacobi round: every point from the previous round's neighbours. In place: the old value
+/// of point k - 1 is kept in a register, point k + 1 is not yet overwritten.
+#[inline(always)]
+fn round_jacobi(
+    planes: &[Plane],
+    tx: Vec3,
+    rx: Vec3,
+    points: &mut [Vec3],
+    min_sum: Real,
+) -> Result<Real, usize> {
+    let n = points.len();
+    let mut moved = 0.0;
+    let mut prev_old = tx;
+    for k in 0..n {
+        let next = if k + 1 == n { rx } else { points[k + 1] };
+        let Some(p) = intersection_point(&planes[k], prev_old, next, min_sum) else {
+            return Err(k);
+        };
+        let old = points[k];
+        moved += p.distance(old);
+        points[k] = p;
+        prev_old = old;
+    }
+    Ok(moved)
+}
+
+#[inline(always)]
+fn run(
+    scene: &Scene,
+    seq: &[SurfaceId],
+    planes: &[Plane],
+    tx: Vec3,
+    rx: Vec3,
+    options: &IpcOptions,
+    points: &mut [Vec3],
+) -> IpcOutcome {
+    let n = seq.len();
     let min_sum = scene.length_tolerance() * 1e-3;
     let limit = options.threshold * n as Real;
+    // Newton is tried at most twice: after NEWTON_PATIENCE rounds and at the switch point.
+    let newton = options.acceleration == Acceleration::Newton;
+    let (mut switch_pending, mut patience_pending) = (newton, newton);
+    let newton_switch = NEWTON_SWITCH_REL * scene.extent().max(1.0) * n as Real;
+    let mut newton_steps = 0;
     // Displacement sums of the last RATE_WINDOW rounds (ring) and of the round STALL_WINDOW
     // rounds ago.
     let mut recent = [Real::INFINITY; RATE_WINDOW];
@@ -177,67 +307,70 @@ pub fn solve(
     // guard (near-corner paths converge sublinearly) still counts as converged, as the paper's
     // algorithm would have stopped there.
     let mut rule_met = false;
-    let mut iterations = 0;
-    while iterations < options.max_iterations {
-        iterations += 1;
-        let mut moved = 0.0;
-        match options.order {
-            UpdateOrder::GaussSeidel => {
-                for k in 0..n {
-                    let prev = if k == 0 { tx } else { points[k - 1] };
-                    let next = if k + 1 == n { rx } else { points[k + 1] };
-                    let plane = scene.surface(seq[k]).polygon.plane();
-                    let Some(p) = intersection_point(plane, prev, next, min_sum) else {
-                        return IpcOutcome::Degenerate {
-                            kind: DegenerateKind::NeighboursOnPlane,
-                            index: k,
-                            iterations,
-                        };
-                    };
-                    moved += p.distance(points[k]);
-                    points[k] = p;
-                }
+    let mut rounds = 0;
+    while rounds < options.max_iterations {
+        rounds += 1;
+        let round = match options.order {
+            UpdateOrder::GaussSeidel => round_gauss_seidel(planes, tx, rx, points, min_sum),
+            UpdateOrder::Jacobi => round_jacobi(planes, tx, rx, points, min_sum),
+        };
+        let moved = match round {
+            Ok(moved) => moved,
+            Err(index) => {
+                return IpcOutcome::Degenerate {
+                    kind: DegenerateKind::NeighboursOnPlane,
+                    index,
+                    iterations: rounds + newton_steps,
+                };
             }
-            UpdateOrder::Jacobi => {
-                scratch.copy_from_slice(points);
-                for k in 0..n {
-                    let prev = if k == 0 { tx } else { scratch[k - 1] };
-                    let next = if k + 1 == n { rx } else { scratch[k + 1] };
-                    let plane = scene.surface(seq[k]).polygon.plane();
-                    let Some(p) = intersection_point(plane, prev, next, min_sum) else {
-                        return IpcOutcome::Degenerate {
-                            kind: DegenerateKind::NeighboursOnPlane,
-                            index: k,
-                            iterations,
-                        };
-                    };
-                    moved += p.distance(scratch[k]);
-                    points[k] = p;
-                }
-            }
-        }
+        };
         if !moved.is_finite() {
             break;
+        }
+        let at_switch = switch_pending && moved <= newton_switch;
+        let at_patience = patience_pending && rounds >= NEWTON_PATIENCE;
+        if at_switch || at_patience {
+            switch_pending &= !at_switch;
+            patience_pending = false;
+            match crate::newton::polish(planes, tx, rx, points, options.threshold) {
+                crate::newton::Polish::Converged { steps, last_step } => {
+                    let iterations = rounds + steps;
+                    if let Some(index) = opposite_sides(scene, planes, tx, rx, points) {
+                        return IpcOutcome::Degenerate {
+                            kind: DegenerateKind::OppositeSides,
+                            index,
+                            iterations,
+                        };
+                    }
+                    return IpcOutcome::Converged {
+                        iterations,
+                        residual: last_step / n as Real,
+                    };
+                }
+                // The points are unchanged; the paper's rounds carry on.
+                crate::newton::Polish::Failed { steps } => newton_steps += steps,
+            }
         }
         // The paper's rule, then the error guard. The rate is measured over RATE_WINDOW
         // (even) rounds so that Jacobi's alternating displacements and round-off noise do not
         // fake a fast rate; a rate >= 1 means the displacement has reached round-off noise,
         // where more rounds cannot help.
-        let slot = iterations as usize % RATE_WINDOW;
+        let slot = rounds as usize % RATE_WINDOW;
         if moved <= limit {
             rule_met = true;
             // Before a full window, measure over the rounds run so far (from the first).
-            let (base, rounds) = if iterations as usize > RATE_WINDOW {
+            let (base, window) = if rounds as usize > RATE_WINDOW {
                 (recent[slot], RATE_WINDOW as Real)
             } else {
-                (recent[1 % RATE_WINDOW], (iterations - 1).max(1) as Real)
+                (recent[1 % RATE_WINDOW], (rounds - 1).max(1) as Real)
             };
-            let rate = (moved / base).powf(1.0 / rounds);
+            let rate = (moved / base).powf(1.0 / window);
             let settled = !options.error_guard
                 || !(rate < 1.0)
                 || moved * rate / (1.0 - rate) <= limit * ERROR_GUARD_FACTOR;
             if settled {
-                if let Some(index) = opposite_sides(scene, seq, tx, rx, points) {
+                let iterations = rounds + newton_steps;
+                if let Some(index) = opposite_sides(scene, planes, tx, rx, points) {
                     return IpcOutcome::Degenerate {
                         kind: DegenerateKind::OppositeSides,
                         index,
@@ -253,10 +386,10 @@ pub fn solve(
         // Give up early when the rate measured over the last window cannot reach the
         // threshold within the remaining rounds (with a factor 4 of slack for rates that
         // improve near the fixed point).
-        if iterations % STALL_WINDOW == 0 {
-            if iterations > STALL_WINDOW {
+        if rounds % STALL_WINDOW == 0 {
+            if rounds > STALL_WINDOW {
                 let rate = (moved / window_start).powf(1.0 / STALL_WINDOW as Real);
-                let remaining = (options.max_iterations - iterations) as Real;
+                let remaining = (options.max_iterations - rounds) as Real;
                 let needed = if rate < 1.0 {
                     (limit / moved).ln() / rate.ln()
                 } else {
@@ -268,22 +401,29 @@ pub fn solve(
             }
             window_start = moved;
         }
-        if options.early_reject && iterations as usize >= EARLY_REJECT_FROM && iterations % 8 == 0 {
-            let base = recent[(iterations as usize - 16) % RATE_WINDOW];
+        if options.early_reject && rounds as usize >= EARLY_REJECT_FROM && rounds % 8 == 0 {
+            let base = recent[(rounds as usize - 16) % RATE_WINDOW];
             let rate = (moved / base).powf(1.0 / 16.0);
             if rate < 1.0 {
-                let reach = EARLY_REJECT_MARGIN * moved * rate / (1.0 - rate) + scene.length_tolerance();
-                if let Some(index) = (0..n).find(|&k| !scene.surface(seq[k]).polygon.contains(points[k], reach)) {
-                    return IpcOutcome::LeftPolygon { index, iterations };
+                let reach =
+                    EARLY_REJECT_MARGIN * moved * rate / (1.0 - rate) + scene.length_tolerance();
+                if let Some(index) =
+                    (0..n).find(|&k| !scene.surface(seq[k]).polygon.contains(points[k], reach))
+                {
+                    return IpcOutcome::LeftPolygon {
+                        index,
+                        iterations: rounds + newton_steps,
+                    };
                 }
             }
         }
         recent[slot] = moved;
         last = moved;
     }
+    let iterations = rounds + newton_steps;
     let residual = last / n as Real;
     if rule_met && residual.is_finite() {
-        if let Some(index) = opposite_sides(scene, seq, tx, rx, points) {
+        if let Some(index) = opposite_sides(scene, planes, tx, rx, points) {
             return IpcOutcome::Degenerate {
                 kind: DegenerateKind::OppositeSides,
                 index,
@@ -307,20 +447,17 @@ pub fn solve(
 
 fn opposite_sides(
     scene: &Scene,
-    seq: &[SurfaceId],
+    planes: &[Plane],
     tx: Vec3,
     rx: Vec3,
     points: &[Vec3],
 ) -> Option<usize> {
     let tol = scene.length_tolerance();
-    (0..seq.len()).find(|&k| {
-        let plane = scene.surface(seq[k]).polygon.plane();
+    let n = planes.len();
+    (0..n).find(|&k| {
+        let plane = &planes[k];
         let prev = if k == 0 { tx } else { points[k - 1] };
-        let next = if k + 1 == seq.len() {
-            rx
-        } else {
-            points[k + 1]
-        };
+        let next = if k + 1 == n { rx } else { points[k + 1] };
         let (a, b) = (plane.signed_distance(prev), plane.signed_distance(next));
         (a > tol && b < -tol) || (a < -tol && b > tol)
     })

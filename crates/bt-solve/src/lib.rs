@@ -1,7 +1,8 @@
 //! Solvers for candidate paths and validation of what they find.
 //!
 //! - [`image`]: the image method, exact geometric optics, the reference;
-//! - [`ipc`]: iterative path convergence (the paper's Algorithms 1-2), Gauss-Seidel or Jacobi;
+//! - [`ipc`]: iterative path convergence (the paper's Algorithms 1-2), Gauss-Seidel or Jacobi,
+//!   optionally finished by Newton steps ([`Acceleration::Newton`]);
 //! - [`validate`]: the geometric checks every found path must pass;
 //! - [`sbr`]: shooting and bouncing rays, the baseline (whole-scene, not per candidate).
 //!
@@ -10,6 +11,7 @@
 
 pub mod image;
 pub mod ipc;
+mod newton;
 pub mod sbr;
 pub mod validate;
 
@@ -19,7 +21,7 @@ use bt_scene::{Scene, SurfaceId};
 use rayon::prelude::*;
 use serde::Serialize;
 
-pub use ipc::{DegenerateKind, IpcOptions, IpcOutcome, UpdateOrder};
+pub use ipc::{Acceleration, DegenerateKind, IpcOptions, IpcOutcome, UpdateOrder};
 pub use sbr::{SbrLaunch, SbrOptions};
 pub use validate::Validity;
 
@@ -125,6 +127,7 @@ pub struct TraceResult {
 
 /// Solve and validate one candidate. `points` and `scratch` must have the sequence's length;
 /// on return `points` holds the solver's points (meaningful when `Solved`).
+#[inline(always)]
 pub fn solve_candidate(
     scene: &Scene,
     seq: &[SurfaceId],
@@ -181,46 +184,7 @@ pub fn trace(
         let max_order = candidates.iter().map(<[SurfaceId]>::len).max().unwrap_or(0);
         return sbr::to_trace_result(&sbr::trace_detailed(scene, options, max_order, parallel));
     }
-    let run = |range: std::ops::Range<usize>| {
-        let mut out = TraceResult::default();
-        let mut stack_points = [Vec3::ZERO; STACK_ORDER];
-        let mut stack_scratch = [Vec3::ZERO; STACK_ORDER];
-        let mut heap_points = Vec::new();
-        let mut heap_scratch = Vec::new();
-        for i in range {
-            let seq = candidates.get(i);
-            let n = seq.len();
-            let (points, scratch) = if n <= STACK_ORDER {
-                (&mut stack_points[..n], &mut stack_scratch[..n])
-            } else {
-                heap_points.resize(n, Vec3::ZERO);
-                heap_scratch.resize(n, Vec3::ZERO);
-                (&mut heap_points[..], &mut heap_scratch[..])
-            };
-            let outcome = solve_candidate(scene, seq, solver, points, scratch);
-            out.counts.add(&outcome);
-            if let CandidateOutcome::Solved {
-                validity: Validity::Valid,
-                ipc,
-            } = outcome
-            {
-                let (iterations, residual) = match ipc {
-                    Some(IpcOutcome::Converged {
-                        iterations,
-                        residual,
-                    }) => (Some(iterations), Some(residual)),
-                    _ => (None, None),
-                };
-                out.paths.push(FoundPath {
-                    surfaces: seq.to_vec(),
-                    points: points.to_vec(),
-                    iterations,
-                    residual,
-                });
-            }
-        }
-        out
-    };
+    let run = |range: std::ops::Range<usize>| run_range(scene, candidates, solver, range);
     let total = candidates.len();
     if !parallel || total < 256 {
         return run(0..total);
@@ -242,6 +206,86 @@ pub fn trace(
         out.counts.not_converged += c.not_converged;
         out.counts.degenerate += c.degenerate;
         out.counts.missed += c.missed;
+    }
+    out
+}
+
+/// The candidate loop of [`trace`] over `range`.
+///
+/// Compiled twice: with the `fma` target feature when the CPU has it (checked at run time),
+/// and without. The solvers use `mul_add` for robust side tests; without the feature every
+/// `mul_add` is a call into the software-dispatched `fma` of compiler-builtins, which also
+/// spills every live float register (a third of the instructions of an IPC round). FMA is
+/// correctly rounded either way, and Rust never contracts a separate multiply and add, so
+/// both versions give bit-identical results.
+fn run_range(
+    scene: &Scene,
+    candidates: &CandidateSet,
+    solver: &Solver,
+    range: std::ops::Range<usize>,
+) -> TraceResult {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("fma") {
+        // SAFETY: the CPU supports FMA (checked just above).
+        return unsafe { run_range_fma(scene, candidates, solver, range) };
+    }
+    run_range_impl(scene, candidates, solver, range)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "fma")]
+fn run_range_fma(
+    scene: &Scene,
+    candidates: &CandidateSet,
+    solver: &Solver,
+    range: std::ops::Range<usize>,
+) -> TraceResult {
+    run_range_impl(scene, candidates, solver, range)
+}
+
+#[inline(always)]
+fn run_range_impl(
+    scene: &Scene,
+    candidates: &CandidateSet,
+    solver: &Solver,
+    range: std::ops::Range<usize>,
+) -> TraceResult {
+    let mut out = TraceResult::default();
+    let mut stack_points = [Vec3::ZERO; STACK_ORDER];
+    let mut stack_scratch = [Vec3::ZERO; STACK_ORDER];
+    let mut heap_points = Vec::new();
+    let mut heap_scratch = Vec::new();
+    for i in range {
+        let seq = candidates.get(i);
+        let n = seq.len();
+        let (points, scratch) = if n <= STACK_ORDER {
+            (&mut stack_points[..n], &mut stack_scratch[..n])
+        } else {
+            heap_points.resize(n, Vec3::ZERO);
+            heap_scratch.resize(n, Vec3::ZERO);
+            (&mut heap_points[..], &mut heap_scratch[..])
+        };
+        let outcome = solve_candidate(scene, seq, solver, points, scratch);
+        out.counts.add(&outcome);
+        if let CandidateOutcome::Solved {
+            validity: Validity::Valid,
+            ipc,
+        } = outcome
+        {
+            let (iterations, residual) = match ipc {
+                Some(IpcOutcome::Converged {
+                    iterations,
+                    residual,
+                }) => (Some(iterations), Some(residual)),
+                _ => (None, None),
+            };
+            out.paths.push(FoundPath {
+                surfaces: seq.to_vec(),
+                points: points.to_vec(),
+                iterations,
+                residual,
+            });
+        }
     }
     out
 }

@@ -38,6 +38,7 @@ pub enum Validity {
 }
 
 /// Validate the path TX -> points -> RX over the surface sequence `seq`.
+#[inline(always)]
 pub fn validate(scene: &Scene, seq: &[SurfaceId], tx: Vec3, rx: Vec3, points: &[Vec3]) -> Validity {
     let tol = scene.length_tolerance();
     let n = seq.len();
@@ -80,6 +81,7 @@ pub fn validate(scene: &Scene, seq: &[SurfaceId], tx: Vec3, rx: Vec3, points: &[
 }
 
 /// The first surface (other than the segment's own end surfaces) crossing the segment `a -> b`.
+#[inline(always)]
 pub fn blocker(
     scene: &Scene,
     a: Vec3,
