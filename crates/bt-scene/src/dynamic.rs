@@ -20,6 +20,16 @@ use bt_geom::{Polygon, Real, Vec3};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
+/// Largest `steps` a scene file may ask for. Every step is a full [`Scene`] (surfaces copied,
+/// BVH built), so without a limit a 100-byte file saying `"steps": 4000000000` asks for
+/// 735 GB up front (`docs/fuzzing.md`); the paper's scenes use tens.
+pub const MAX_STEPS: u32 = 10_000;
+
+/// Largest `steps` × number of surfaces: the surface copies kept for all steps (about 600 bytes
+/// each with the per-step BVH), so a 3 KB file of 70 boxes cannot ask for 10 000 steps of 420
+/// surfaces (2.5 GB); the limit is about 150 MB.
+pub const MAX_SURFACE_STEPS: usize = 250_000;
+
 /// A moving object as written in a scene file (an entry of `objects`).
 ///
 /// Give either a constant per-step motion (`translate` and/or `rotate_deg`) or `keyframes`.
@@ -141,7 +151,11 @@ impl DynamicScene {
         if steps == 0 {
             push("steps".into(), "must be at least 1".into());
         }
-        let steps = steps.max(1) as usize;
+        if steps > MAX_STEPS {
+            push("steps".into(), format!("is {steps}, at most {MAX_STEPS}"));
+        }
+        // Clamped so the per-step poses built before the error is returned stay small.
+        let steps = steps.clamp(1, MAX_STEPS) as usize;
         let mut terminal_steps = |field: &str, values: &Option<Vec<[Real; 3]>>| {
             let v: Option<Vec<Vec3>> = values
                 .as_ref()
@@ -204,6 +218,17 @@ impl DynamicScene {
         };
 
         let members = members(desc, &base, &mut problems);
+        let copies = steps.saturating_mul(base.surfaces().len().max(1));
+        if copies > MAX_SURFACE_STEPS {
+            problems.push(Problem {
+                location: "steps".into(),
+                message: format!(
+                    "{steps} steps of {} surfaces make {copies} surface copies, at most \
+                     {MAX_SURFACE_STEPS} (every step is a full copy of the scene)",
+                    base.surfaces().len()
+                ),
+            });
+        }
         if !problems.is_empty() {
             return Err(SceneError::Invalid {
                 source_name: source_name.to_string(),

@@ -1,0 +1,16 @@
+//! PLY meshes (ASCII and binary): `read_ply` with the default merge, then the mesh-to-scene
+//! step the CLI runs.
+#![no_main]
+
+use libfuzzer_sys::fuzz_target;
+
+#[path = "mesh_common.rs"]
+mod mesh_common;
+
+fuzz_target!(|data: &[u8]| {
+    mesh_common::check(bt_mesh::read_ply(
+        data,
+        None,
+        &bt_mesh::MergeOptions::default(),
+    ));
+});

@@ -1,0 +1,20 @@
+//! Point clouds (PLY and PCD, ASCII and binary) through `parse_any`: an accepted cloud has only
+//! finite points and normals, and allocation stays bounded by the input length.
+#![no_main]
+
+use bt_pointcloud::io::{NonFinitePolicy, ReadOptions, parse_any};
+use libfuzzer_sys::fuzz_target;
+
+fuzz_target!(|data: &[u8]| {
+    for non_finite in [NonFinitePolicy::Skip, NonFinitePolicy::Reject] {
+        let Ok(loaded) = parse_any(data, &ReadOptions { non_finite }) else {
+            continue;
+        };
+        let cloud = &loaded.cloud;
+        assert!(cloud.points().iter().all(|p| p.is_finite()));
+        if let Some(normals) = cloud.normals() {
+            assert_eq!(normals.len(), cloud.len());
+            assert!(normals.iter().all(|n| n.is_finite()));
+        }
+    }
+});
