@@ -70,6 +70,32 @@ impl VoxelIndex {
         }
     }
 
+    /// Call `f` with the index of every point inside the axis-aligned box `[lo, hi]`
+    /// (metres), voxel by voxel in key order.
+    pub(crate) fn for_each_in_box(
+        &self,
+        points: &[DVec3],
+        lo: DVec3,
+        hi: DVec3,
+        mut f: impl FnMut(u32),
+    ) {
+        let (a, b) = (voxel_key(lo, self.cell), voxel_key(hi, self.cell));
+        for x in a[0]..=b[0] {
+            for y in a[1]..=b[1] {
+                for z in a[2]..=b[2] {
+                    if let Some(&(s, e)) = self.ranges.get(&[x, y, z]) {
+                        for &j in &self.order[s as usize..e as usize] {
+                            let p = points[j as usize];
+                            if p.cmpge(lo).all() && p.cmple(hi).all() {
+                                f(j);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+
     /// Call `f` with the index of every point within `radius` (≤ cell) of `p`.
     pub(crate) fn for_each_near(
         &self,

@@ -48,3 +48,34 @@ pub const RASTER_MERGE_TURN_SIN: f64 = 0.45;
 /// Sine of the largest angle (≈ 15°) between a simplified boundary edge and an axis of its
 /// patch's minimum-area rectangle for the axis to be the edge's prior direction.
 pub const AXIS_PRIOR_SIN: f64 = 0.26;
+
+/// Cosine of the largest angle (≈ 3°) between two patches' planes for them to be treated as
+/// parallel layers competing for the same points (a pane in front of a wall).
+pub const LAYER_PARALLEL_COS: f64 = 0.9986;
+
+/// Smallest share (dimensionless) of a point's neighbours that must be nearer a plane for the
+/// point to join that plane when re-assigning points between parallel layers. A layer that
+/// is really there holds about half (overlapping layers) or all (an occluded wall) of the
+/// neighbourhood, even at its edge a quarter; the noise tail of another layer ≈ 2 % at 4 σ.
+pub const LAYER_MIN_SHARE: f64 = 0.1;
+
+/// Smallest share (dimensionless) of a point's neighbours in the other layer for the point
+/// to move there from the patch RANSAC gave it. Inside an overlap a layer holds about half
+/// the neighbourhood (all of it where it occludes the other); just outside its edge a
+/// quarter or less, and noise-tail points there must not join it (they make corner spikes).
+pub const LAYER_JOIN_SHARE: f64 = 0.35;
+
+/// Smallest separation of two parallel layers, in units of their noise σ (dimensionless),
+/// for them to be kept as distinct surfaces after re-assignment. One Gaussian layer cut at
+/// its middle gives two halves ≈ 2.7 σ_half apart; the test room's pane is 4 σ off the wall.
+pub const LAYER_SEPARATION_SIGMAS: f64 = 3.0;
+
+/// Fewest points (dimensionless count) a gap strip between a patch edge and a crease line
+/// must be able to hold, at the patch's density, for its emptiness to be evidence of a real
+/// gap; narrower strips are below the data's resolution and may be snapped shut.
+pub const SNAP_MIN_EXPECTED: f64 = 8.0;
+
+/// Smallest filled fraction (dimensionless) of such a strip, counted against the patch's
+/// density, for the strip to be lost surface (snap) rather than a real gap (keep the edge).
+/// A lost strip is full (≈ 1), a real gap empty (≈ 0).
+pub const SNAP_MIN_FILL: f64 = 0.5;

@@ -19,6 +19,7 @@
 //! iterates a hash map. Same cloud and parameters ⇒ bit-identical output.
 
 mod boundary;
+mod layers;
 mod normals;
 mod snap;
 
@@ -66,7 +67,9 @@ pub struct ExtractParams {
     /// Stop when fewer points remain, or the best plane has fewer inliers.
     pub min_plane_points: usize,
     /// Cell edge for splitting a plane's inliers into connected patches, metres. Patches
-    /// separated by a gap wider than twice this are always split.
+    /// separated by a gap wider than twice this are always split. Also the
+    /// radius of the neighbourhood vote that separates parallel surfaces closer than the
+    /// RANSAC band (a pane in front of a wall).
     pub cluster_eps_m: f64,
     /// Patches with fewer points are dropped.
     pub min_patch_points: usize,
@@ -326,13 +329,13 @@ fn local_hypothesis(
     (n, d)
 }
 
-struct RawPatch {
-    indices: Vec<u32>,
-    ransac_plane: usize,
+pub(super) struct RawPatch {
+    pub(super) indices: Vec<u32>,
+    pub(super) ransac_plane: usize,
 }
 
 /// Unit vectors `(u, v)` with `(u, v, n)` right-handed, chosen deterministically from `n`.
-fn frame(n: DVec3) -> (DVec3, DVec3) {
+pub(super) fn frame(n: DVec3) -> (DVec3, DVec3) {
     let a = if n.x.abs() <= n.y.abs() && n.x.abs() <= n.z.abs() {
         DVec3::X
     } else if n.y.abs() <= n.z.abs() {
@@ -480,6 +483,36 @@ pub fn extract_planes_with_progress(
         progress(prog);
     }
     let leftover_points = remaining.len() + points_without_normal;
+
+    // Parallel surfaces closer than the RANSAC band share their points out competitively;
+    // patches that changed are split into connected parts again.
+    let changed = layers::separate_parallel(
+        pts,
+        &mut raw,
+        params.distance_threshold_m,
+        params.cluster_eps_m,
+        params.min_patch_points,
+    );
+    if !changed.is_empty() {
+        let mut next = Vec::with_capacity(raw.len());
+        for (k, rp) in raw.into_iter().enumerate() {
+            if changed.binary_search(&k).is_err() {
+                next.push(rp);
+                continue;
+            }
+            let Some(fit) = fit_plane(rp.indices.iter().map(|&i| pts[i as usize])) else {
+                next.push(rp);
+                continue;
+            };
+            for indices in split_connected(pts, &rp.indices, fit.normal, params.cluster_eps_m) {
+                next.push(RawPatch {
+                    indices,
+                    ransac_plane: rp.ransac_plane,
+                });
+            }
+        }
+        raw = next;
+    }
     prog.stage = Stage::Boundaries;
     progress(prog);
 
@@ -548,7 +581,9 @@ pub fn extract_planes_with_progress(
                 poly,
                 lo: DVec3::ZERO,
                 hi: DVec3::ZERO,
+                density: 0.0,
             };
+            g.density = rp.indices.len() as f64 / signed_area(&g.poly).max(f64::MIN_POSITIVE);
             g.update_bounds();
             Some((g, rms, rp.ransac_plane))
         })
@@ -569,7 +604,16 @@ pub fn extract_planes_with_progress(
             }
         }
     }
-    let snapped = snap::snap_all(&geoms, params.snap_distance_m, params.boundary_cell_m);
+    let snapped = snap::snap_all(
+        &geoms,
+        params.snap_distance_m,
+        params.boundary_cell_m,
+        &snap::Cloud {
+            pts,
+            index: &coarse,
+            band: params.distance_threshold_m,
+        },
+    );
 
     let mut planes = Vec::new();
     for ((g, poly), (count, rms, plane)) in geoms.iter().zip(snapped).zip(meta) {

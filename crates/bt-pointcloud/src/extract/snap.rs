@@ -12,6 +12,7 @@ use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
 use super::boundary::{Line2, intersect, is_simple, lines_of, polygon_from_lines, signed_area};
+use crate::spatial::VoxelIndex;
 use crate::tol;
 
 /// Points sampled along an edge for the adjacency test (plus one).
@@ -27,6 +28,16 @@ pub(crate) struct PatchGeom {
     pub poly: Vec<DVec2>,
     pub lo: DVec3,
     pub hi: DVec3,
+    /// Points of the patch per m² of its polygon.
+    pub density: f64,
+}
+
+/// The cloud, for checking that a gap between an edge and a crease line is data, not air.
+pub(crate) struct Cloud<'a> {
+    pub pts: &'a [DVec3],
+    pub index: &'a VoxelIndex,
+    /// RANSAC distance threshold, metres: the width of the band a neighbour steals.
+    pub band: f64,
 }
 
 impl PatchGeom {
@@ -76,9 +87,98 @@ fn distance_to_polygon(poly: &[DVec2], p: DVec2) -> f64 {
     if inside { 0.0 } else { best }
 }
 
+/// Whether the strip between edge `a`–`b` of patch `p` and the crease line `line` (both in
+/// `p`'s frame) is surface the extraction lost rather than a real gap.
+///
+/// Near a crease, the neighbour `q` takes every point within the band of its plane, i.e.
+/// within `band / sin θ` of the line in `p`'s plane, and points whose normals blend the two
+/// planes may be left unassigned; those points are still in the cloud, on `p`'s plane. So
+/// the strip from the edge to the stolen band is filled with cloud points on `p`'s plane
+/// when the edge really ends at the crease, and empty when the surface ends short of it (a
+/// cabinet top 5 cm in front of a wall). Only snaps that extend the patch are checked;
+/// trimming an edge that overshoots the line is always allowed. Strips too narrow to hold
+/// [`tol::SNAP_MIN_EXPECTED`] points at `p`'s density cannot tell, and may be snapped.
+fn gap_is_surface(
+    p: &PatchGeom,
+    q: &PatchGeom,
+    a: DVec2,
+    b: DVec2,
+    line: Line2,
+    cell: f64,
+    cloud: &Cloud,
+) -> bool {
+    let sin = p.normal.cross(q.normal).length();
+    let stolen = cloud.band / sin.max(f64::MIN_POSITIVE);
+    // Trimming an edge that overshoots the line (the line runs inside the polygon, which
+    // lies to the left of a counter-clockwise edge) closes no gap: nothing to check.
+    let len = a.distance(b);
+    let e = (b - a) / len;
+    let outward = DVec2::new(e.y, -e.x);
+    let mid = (a + b) * 0.5;
+    let foot = line.p + line.d * (mid - line.p).dot(line.d);
+    if (foot - mid).dot(outward) <= 0.0 {
+        return true;
+    }
+    let side = |x: DVec2| (x - line.p).perp_dot(line.d);
+    let (sa, sb) = (side(a), side(b));
+    if sa * sb < 0.0 {
+        return true; // the edge crosses the line: nothing to measure
+    }
+    let sign = if sa + sb >= 0.0 { 1.0 } else { -1.0 };
+    let (sa, sb) = (sa.abs(), sb.abs());
+    let trim = if len > 4.0 * cell { cell } else { 0.0 };
+    let (t0, t1) = (trim / len, 1.0 - trim / len);
+    // Expected count: density × area of the strip beyond the stolen band (linear in t).
+    let depth = |t: f64| (sa + (sb - sa) * t - stolen).max(0.0);
+    let steps = 16;
+    let strip_area = (0..steps)
+        .map(|k| depth(t0 + (t1 - t0) * (k as f64 + 0.5) / steps as f64))
+        .sum::<f64>()
+        / steps as f64
+        * len
+        * (t1 - t0);
+    let expected = p.density * strip_area;
+    if expected < tol::SNAP_MIN_EXPECTED {
+        return true;
+    }
+    let corners = [
+        p.lift(a + e * trim),
+        p.lift(b - e * trim),
+        p.lift(line.p + line.d * (a + e * trim - line.p).dot(line.d)),
+        p.lift(line.p + line.d * (b - e * trim - line.p).dot(line.d)),
+    ];
+    let pad = DVec3::splat(cloud.band);
+    let lo = corners.iter().fold(DVec3::INFINITY, |m, c| m.min(*c)) - pad;
+    let hi = corners.iter().fold(DVec3::NEG_INFINITY, |m, c| m.max(*c)) + pad;
+    let mut found = 0usize;
+    cloud.index.for_each_in_box(cloud.pts, lo, hi, |j| {
+        let x = cloud.pts[j as usize];
+        if (p.normal.dot(x) - p.offset).abs() > cloud.band {
+            return;
+        }
+        let x2 = p.local(x);
+        let t = (x2 - a).dot(e) / len;
+        if !(t0..=t1).contains(&t) {
+            return;
+        }
+        let s = side(x2) * sign;
+        if s >= stolen && s < sa + (sb - sa) * t {
+            found += 1;
+        }
+    });
+    found as f64 >= tol::SNAP_MIN_FILL * expected
+}
+
 /// Snap edges of every patch onto intersection lines with adjoining patches; returns the
 /// new polygons (unchanged where no snap applies or the snapped polygon would be invalid).
-pub(crate) fn snap_all(patches: &[PatchGeom], snap: f64, cell: f64) -> Vec<Vec<DVec2>> {
+/// An edge is only snapped across a gap the data cannot show to be real (see
+/// [`gap_is_surface`]).
+pub(crate) fn snap_all(
+    patches: &[PatchGeom],
+    snap: f64,
+    cell: f64,
+    cloud: &Cloud,
+) -> Vec<Vec<DVec2>> {
     patches
         .par_iter()
         .enumerate()
@@ -129,7 +229,10 @@ pub(crate) fn snap_all(patches: &[PatchGeom], snap: f64, cell: f64) -> Vec<Vec<D
                         })
                         .count();
                     let adj = 2 * near > ADJ_SAMPLES + 1;
-                    if adj && best.is_none_or(|(w, _)| worst < w) {
+                    if adj
+                        && best.is_none_or(|(w, _)| worst < w)
+                        && gap_is_surface(p, q, a, b, cand, cell, cloud)
+                    {
                         best = Some((worst, cand));
                     }
                 }

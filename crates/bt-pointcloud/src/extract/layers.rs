@@ -1,0 +1,369 @@
+//! Separating parallel surfaces closer than the RANSAC band (a window pane 2 cm in front of
+//! a wall, a picture on a wall, a recessed door).
+//!
+//! Sequential RANSAC hands every point within the distance threshold to the plane found
+//! first. When two parallel surfaces are only a few noise σ apart, the first one takes the
+//! near tail of the second (biasing its offset and thinning it), and the second then takes
+//! the far tail of the first wherever that tail lies next to it, which adds spikes and
+//! islands to its boundary. This step re-assigns the points of such a pair competitively
+//! (k-planes style: each point to the nearer plane, refit, repeat) with one addition that
+//! keeps it local: a point may only go to a plane that is *present around it*, i.e. at
+//! least [`tol::LAYER_MIN_SHARE`] of its neighbours within the vote radius are nearer that
+//! plane. A lone point of the wall's noise tail beside the window (≈ 2 % of wall points are
+//! nearer the window plane) is outvoted by the wall points around it and stays with the
+//! wall; a window point has window points around it and goes to the window, wherever it
+//! lies within the band.
+//!
+//! A pair is only re-assigned when the result is two distinct layers: the planes must be
+//! at least [`tol::LAYER_SEPARATION_SIGMAS`] noise σ apart, σ measured on the outer
+//! (uncontested) side of each layer. Otherwise both patches stay as RANSAC left them.
+
+use std::collections::HashMap;
+
+use glam::{DVec2, DVec3};
+use rayon::prelude::*;
+
+use super::{RawPatch, frame};
+use crate::linalg::fit_plane;
+use crate::tol;
+
+/// Rounds of assignment and refit per pair.
+const ROUNDS: usize = 4;
+
+/// A patch takes part only with at least this many times the minimum patch size: the plane
+/// of a fragment of a few dozen points is too loosely determined (degrees) for the parallel
+/// and distance tests, and pairing it only reshuffles slivers.
+const LAYER_MIN_POINTS_FACTOR: usize = 4;
+
+#[derive(Clone, Copy)]
+struct Layer {
+    normal: DVec3,
+    offset: f64,
+    centroid: DVec3,
+    lo: DVec3,
+    hi: DVec3,
+}
+
+fn layer_of(pts: &[DVec3], idx: &[u32]) -> Option<Layer> {
+    let f = fit_plane(idx.iter().map(|&i| pts[i as usize]))?;
+    let (lo, hi) = idx
+        .iter()
+        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(l, h), &i| {
+            (l.min(pts[i as usize]), h.max(pts[i as usize]))
+        });
+    Some(Layer {
+        normal: f.normal,
+        offset: f.offset,
+        centroid: f.centroid,
+        lo,
+        hi,
+    })
+}
+
+/// Re-assign points between every pair of patches whose planes are parallel (within
+/// [`tol::LAYER_PARALLEL_COS`]), closer than twice the distance threshold `band` and
+/// overlapping in space. `radius` is the vote radius, metres (a few point spacings);
+/// patches with fewer than [`LAYER_MIN_POINTS_FACTOR`] × `min_points` points take no part.
+/// Pairs are visited in index order, so the result is deterministic. Returns the indices of
+/// the patches that changed.
+pub(super) fn separate_parallel(
+    pts: &[DVec3],
+    patches: &mut [RawPatch],
+    band: f64,
+    radius: f64,
+    min_points: usize,
+) -> Vec<usize> {
+    let layers: Vec<Option<Layer>> = patches
+        .par_iter()
+        .map(|p| {
+            if p.indices.len() >= LAYER_MIN_POINTS_FACTOR * min_points {
+                layer_of(pts, &p.indices)
+            } else {
+                None
+            }
+        })
+        .collect();
+    let mut pairs = Vec::new();
+    for i in 0..patches.len() {
+        for j in i + 1..patches.len() {
+            let (Some(a), Some(b)) = (layers[i], layers[j]) else {
+                continue;
+            };
+            if a.normal.dot(b.normal).abs() < tol::LAYER_PARALLEL_COS {
+                continue;
+            }
+            let grow = DVec3::splat(radius + band);
+            if (a.hi + grow).cmplt(b.lo).any() || (b.hi + grow).cmplt(a.lo).any() {
+                continue;
+            }
+            // Each centroid within the other's doubled band (a tilted fragment fails this).
+            let gap_ab = (a.normal.dot(b.centroid) - a.offset).abs();
+            let gap_ba = (b.normal.dot(a.centroid) - b.offset).abs();
+            if gap_ab.max(gap_ba) <= 2.0 * band {
+                pairs.push((i, j));
+            }
+        }
+    }
+    let mut changed = Vec::new();
+    for (i, j) in pairs {
+        if patches[i].indices.len() < 3 || patches[j].indices.len() < 3 {
+            continue;
+        }
+        if let Some((a, b)) = separate_pair(pts, &patches[i].indices, &patches[j].indices, radius)
+            && (a != patches[i].indices || b != patches[j].indices)
+        {
+            patches[i].indices = a;
+            patches[j].indices = b;
+            changed.push(i);
+            changed.push(j);
+        }
+    }
+    changed.sort_unstable();
+    changed.dedup();
+    changed
+}
+
+/// Competitive, locally voted assignment of two parallel patches' points; `None` when the
+/// two do not form distinct layers (then nothing should change).
+fn separate_pair(
+    pts: &[DVec3],
+    pa: &[u32],
+    pb: &[u32],
+    radius: f64,
+) -> Option<(Vec<u32>, Vec<u32>)> {
+    let la = layer_of(pts, pa)?;
+    let lb = layer_of(pts, pb)?;
+    let grow = DVec3::splat(radius);
+    let within = |p: DVec3, l: &Layer| !(p.cmplt(l.lo - grow).any() || p.cmpgt(l.hi + grow).any());
+    // Contested points: each patch's points inside the other's (grown) bounding box.
+    let contested: Vec<u32> = pa
+        .iter()
+        .copied()
+        .filter(|&i| within(pts[i as usize], &lb))
+        .chain(pb.iter().copied().filter(|&i| within(pts[i as usize], &la)))
+        .collect();
+    if contested.is_empty() {
+        return None;
+    }
+    let centre = contested
+        .iter()
+        .fold(DVec3::ZERO, |c, &i| c + pts[i as usize])
+        / contested.len() as f64;
+    let fixed_a: Vec<u32> = pa
+        .iter()
+        .copied()
+        .filter(|&i| !within(pts[i as usize], &lb))
+        .collect();
+    let fixed_b: Vec<u32> = pb
+        .iter()
+        .copied()
+        .filter(|&i| !within(pts[i as usize], &la))
+        .collect();
+
+    // Neighbour lists in the common 2-D frame, computed once (the points do not move, only
+    // their labels change).
+    let (u, v) = frame(la.normal);
+    let flat: Vec<DVec2> = contested
+        .iter()
+        .map(|&i| DVec2::new(pts[i as usize].dot(u), pts[i as usize].dot(v)))
+        .collect();
+    let near = Grid::new(&flat, radius);
+    let adjacency: Vec<Vec<u32>> = (0..contested.len())
+        .into_par_iter()
+        .map(|k| {
+            let mut out = Vec::new();
+            near.visit(&flat, k, |m| out.push(m));
+            out
+        })
+        .collect();
+    drop(near);
+
+    let (mut na, mut da) = (la.normal, la.offset);
+    let (mut nb, mut db) = if lb.normal.dot(la.normal) < 0.0 {
+        (-lb.normal, -lb.offset)
+    } else {
+        (lb.normal, lb.offset)
+    };
+    let orig_b: Vec<bool> = contested
+        .iter()
+        .map(|&i| pb.binary_search(&i).is_ok())
+        .collect();
+    // Start from "nearer plane"; then each round decides by the posterior with the local
+    // prior (share of neighbours currently in each layer) and Gaussian residuals.
+    let mut to_b: Vec<bool> = contested
+        .par_iter()
+        .map(|&i| {
+            let p = pts[i as usize];
+            (nb.dot(p) - db).abs() < (na.dot(p) - da).abs()
+        })
+        .collect();
+    let share = |k: usize, in_b: &[bool]| {
+        let nb_k = &adjacency[k];
+        nb_k.iter().filter(|&&m| in_b[m as usize]).count() as f64 / nb_k.len().max(1) as f64
+    };
+    // Presence over twice the radius: four times the neighbours, so the share is steady
+    // enough to test against a floor even at a layer's corner (a quarter disk).
+    let wide = Grid::new(&flat, 2.0 * radius);
+    let share0_b: Vec<f64> = (0..contested.len())
+        .into_par_iter()
+        .map(|k| {
+            let (mut all, mut b) = (0usize, 0usize);
+            wide.visit(&flat, k, |m| {
+                all += 1;
+                b += usize::from(to_b[m as usize]);
+            });
+            b as f64 / all.max(1) as f64
+        })
+        .collect();
+    drop(wide);
+    let mut sigma = outer_sigma(pts, &contested, &to_b, centre, (na, da), (nb, db))?;
+    for _ in 0..ROUNDS {
+        let inv = 0.5 / (sigma * sigma);
+        let next: Vec<bool> = (0..contested.len())
+            .into_par_iter()
+            .map(|k| {
+                // A layer absent around the point (share of "nearer" neighbours, fixed by the
+                // geometry, not by the labels, so corners do not erode round by round).
+                if share0_b[k] < tol::LAYER_MIN_SHARE {
+                    return false;
+                }
+                if share0_b[k] > 1.0 - tol::LAYER_MIN_SHARE {
+                    return true;
+                }
+                let wb = share(k, &to_b).clamp(tol::LAYER_MIN_SHARE, 1.0 - tol::LAYER_MIN_SHARE);
+                let wa = 1.0 - wb;
+                let p = pts[contested[k] as usize];
+                let (ra, rb) = (na.dot(p) - da, nb.dot(p) - db);
+                let want_b = wb.ln() - rb * rb * inv > wa.ln() - ra * ra * inv;
+                // Leaving the patch RANSAC gave it for the other takes a layer that is
+                // established around the point, not just present nearby.
+                let target = if want_b { wb } else { wa };
+                if want_b != orig_b[k] && target < tol::LAYER_JOIN_SHARE {
+                    orig_b[k]
+                } else {
+                    want_b
+                }
+            })
+            .collect();
+        let side = |want_b: bool| {
+            contested
+                .iter()
+                .zip(&next)
+                .filter(move |(_, b)| **b == want_b)
+                .map(|(&i, _)| pts[i as usize])
+        };
+        let fa = fit_plane(fixed_a.iter().map(|&i| pts[i as usize]).chain(side(false)));
+        let fb = fit_plane(fixed_b.iter().map(|&i| pts[i as usize]).chain(side(true)));
+        let (Some(fa), Some(fb)) = (fa, fb) else {
+            return None;
+        };
+        let done = next == to_b;
+        to_b = next;
+        (na, da) = (fa.normal, fa.offset);
+        (nb, db) = if fb.normal.dot(na) < 0.0 {
+            (-fb.normal, -fb.offset)
+        } else {
+            (fb.normal, fb.offset)
+        };
+        sigma = outer_sigma(pts, &contested, &to_b, centre, (na, da), (nb, db))?;
+        if done {
+            break;
+        }
+    }
+
+    // Distinct layers? Separation measured where the points are.
+    let sep = ((nb.dot(centre) - db) - (na.dot(centre) - da)).abs();
+    if sep < tol::LAYER_SEPARATION_SIGMAS * sigma {
+        return None;
+    }
+    let mut a = fixed_a;
+    let mut b = fixed_b;
+    for (&i, &tb) in contested.iter().zip(&to_b) {
+        if tb { b.push(i) } else { a.push(i) }
+    }
+    a.sort_unstable();
+    b.sort_unstable();
+    Some((a, b))
+}
+
+/// Noise σ of two parallel layers, metres: RMS residual of each layer's points on the side
+/// away from the other plane (those are not contested, so their spread is the plain noise),
+/// the larger of the two. `None` if a side has fewer than three points.
+fn outer_sigma(
+    pts: &[DVec3],
+    contested: &[u32],
+    to_b: &[bool],
+    centre: DVec3,
+    (na, da): (DVec3, f64),
+    (nb, db): (DVec3, f64),
+) -> Option<f64> {
+    // Which side of A the layer B lies on, where the points are (`centre`).
+    let b_above = nb.dot(centre) - db < na.dot(centre) - da;
+    let side = |want_b: bool| -> Option<f64> {
+        let (n, d) = if want_b { (nb, db) } else { (na, da) };
+        let away = if want_b == b_above { 1.0 } else { -1.0 };
+        let (s, c) = contested
+            .iter()
+            .zip(to_b)
+            .filter(|(_, b)| **b == want_b)
+            .map(|(&i, _)| (n.dot(pts[i as usize]) - d) * away)
+            .filter(|&r| r > 0.0)
+            .fold((0.0, 0usize), |(s, c), r| (s + r * r, c + 1));
+        (c >= 3).then(|| (s / c as f64).sqrt())
+    };
+    let sigma = side(false)?.max(side(true)?);
+    (sigma > 0.0).then_some(sigma)
+}
+
+/// 2-D points bucketed into square cells of edge `radius`, for neighbour visits within it.
+struct Grid {
+    radius: f64,
+    keyed: Vec<((i64, i64), u32)>,
+    cells: HashMap<(i64, i64), (usize, usize)>,
+}
+
+impl Grid {
+    fn key(p: DVec2, radius: f64) -> (i64, i64) {
+        ((p.x / radius).floor() as i64, (p.y / radius).floor() as i64)
+    }
+
+    fn new(flat: &[DVec2], radius: f64) -> Self {
+        let mut keyed: Vec<((i64, i64), u32)> = flat
+            .iter()
+            .enumerate()
+            .map(|(k, p)| (Self::key(*p, radius), k as u32))
+            .collect();
+        keyed.sort_unstable();
+        let mut cells = HashMap::new();
+        let mut s = 0;
+        for k in 1..=keyed.len() {
+            if k == keyed.len() || keyed[k].0 != keyed[s].0 {
+                cells.insert(keyed[s].0, (s, k));
+                s = k;
+            }
+        }
+        Self {
+            radius,
+            keyed,
+            cells,
+        }
+    }
+
+    /// Call `f` with every point within the radius of point `k`, `k` itself excluded.
+    fn visit(&self, flat: &[DVec2], k: usize, mut f: impl FnMut(u32)) {
+        let q = flat[k];
+        let (ci, cj) = Self::key(q, self.radius);
+        let r2 = self.radius * self.radius;
+        for di in -1..=1 {
+            for dj in -1..=1 {
+                if let Some(&(s, e)) = self.cells.get(&(ci + di, cj + dj)) {
+                    for &(_, m) in &self.keyed[s..e] {
+                        if m as usize != k && flat[m as usize].distance_squared(q) <= r2 {
+                            f(m);
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
