@@ -50,6 +50,13 @@ pub mod width {
     pub const SUM_POINT: u32 = 44;
     /// Per-round displacement `|s_new − s_old|` per component (unsigned).
     pub const DISPLACEMENT: u32 = COORD;
+    /// The RTL's search register `E = B − m·2^G` (signed), which replaces the pair `B`,
+    /// `m·2^G` and the comparator (`B < m·2^G` ⇔ `E < 0`): `E ∈ (−2^SEARCH, 2^SEARCH)`.
+    pub const SEARCH_DIFF: u32 = SEARCH + 1;
+    /// The RTL's fused output accumulator `t_prev·2^G + 2^(G−1) + B_p` (signed, kept modulo
+    /// 2^POINT_ACC): `acc >> G = t_prev + round_half_up(B_p / 2^G)` = the unsaturated point,
+    /// which fits [`SUM_POINT`] bits, so the wrap-around of intermediate values is harmless.
+    pub const POINT_ACC: u32 = SUM_POINT + GUARD_BITS;
     /// Iteration counter of Algorithm 3 (unsigned).
     pub const ITERATION: u32 = 6;
 
@@ -71,8 +78,10 @@ use width::fits_signed;
 /// the products by CSD shift-add, accumulated at full precision, one rounding shift.
 /// Positive on the side the normal points to.
 ///
-/// Verilog twin: `bt_pe_<i>`: `d_prev_acc` = sum of `±(s_prev_k <<< shift)` terms plus the
-/// folded constant `2^29 − offset·2^30`; `d_prev = d_prev_acc[63:30]` (same for `next`).
+/// Verilog twin: `bt_pe_<i>`: `dot` = the per-component CSD networks `net_k` (sums of
+/// `±(x_k <<< shift)`, shared by all four products of one evaluation) plus the folded constant
+/// `2^29 − offset·2^30`, the constant low bits below the lowest digit dropped; `d` = its slice
+/// from bit 30 up.
 pub fn signed_distance(plane: &FixedPlane, s: FinePoint) -> i64 {
     let mut acc: i128 = plane
         .normal
@@ -90,8 +99,8 @@ pub fn signed_distance(plane: &FixedPlane, s: FinePoint) -> i64 {
 /// Orthogonal projection onto the plane in fine units, per component
 /// `t_k = s_k − round_half_up(d · n_k / 2^30)`, `d` from [`signed_distance`].
 ///
-/// Verilog twin: `bt_pe_<i>`: `t_prev_k = s_prev_k − p_prev_k_acc[63:30]` where
-/// `p_prev_k_acc` is the CSD network of `n_k` applied to `d_prev` plus `2^29`.
+/// Verilog twin: `bt_pe_<i>`: `t_k = a_k − p_round_k[..:30]` where `p_round_k` is the shared
+/// network `net_k` applied to `d_prev` (step 2; `d_next` and `b_k` in step 3) plus `2^29`.
 pub fn project(plane: &FixedPlane, s: FinePoint, d: i64) -> [i64; 3] {
     std::array::from_fn(|k| {
         let acc = plane.normal[k].csd().mul(d);
@@ -138,8 +147,10 @@ pub struct Proportion {
 /// gives `≈ l`, `m + n = 0` gives `l/2` with `zero_sum` set. `m + n` cannot overflow: both are
 /// below 2^32.45, the sum register is [`width::DISTANCE_SUM`] = 34 bits.
 ///
-/// Verilog twin: the `bt_pe_<i>` registers `hc_l`, `hc_b`, `hc_m`, `hc_lp_{x,y,z}`,
-/// `hc_bp_{x,y,z}` and the iteration counter `hc_iter` (one iteration per clock).
+/// Verilog twin: the `bt_pe_<i>` registers `r_l` (`L`), `r_e` (`E = B − m·2^G`, whose sign is
+/// the comparison), `b_{x,y,z}` (`L_p`) and `a_{x,y,z}` (`t_prev·2^G + 2^(G−1) + B_p`, see
+/// [`width::POINT_ACC`]), one iteration per clock; `tests/rtl_form.rs` proves the re-arrangement
+/// exact.
 pub fn halving_proportion(m: u64, n: u64, l: [i64; 3]) -> Proportion {
     let sum = u128::from(m) + u128::from(n);
     let mut big_l: u128 = sum << (GUARD_BITS - 1);
@@ -212,7 +223,8 @@ pub struct PeTrace {
 /// `prev` and following point `next`, with the proportion applied component-wise
 /// (`s = t_prev + (m/(m+n))·(t_next − t_prev)`: no norm, no square root).
 ///
-/// Verilog twin: one `bt_pe_<i>` evaluation (`start` → `s_out`, `zero_sum`, `overflow`).
+/// Verilog twin: one `bt_pe_<i>` evaluation (`load`, `start` → `s_sum`, `zero_sum`) followed by
+/// `bt_top`'s saturation after its PE select (`sat_{x,y,z}`, `pe_sel_ov`).
 pub fn intersection_point(plane: &FixedPlane, prev: FinePoint, next: FinePoint) -> PeTrace {
     let d_prev = signed_distance(plane, prev);
     let d_next = signed_distance(plane, next);

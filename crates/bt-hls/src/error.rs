@@ -10,6 +10,9 @@ pub enum HlsError {
     /// The schedule does not fit the input (see `bt_schedule::Schedule::check`).
     #[error("schedule does not fit the input: {0}")]
     Schedule(String),
+    /// The scheduler rejected the problem or the budget.
+    #[error("scheduling failed: {0}")]
+    Scheduling(#[from] bt_schedule::ScheduleError),
     /// The design exceeds a structural limit of the generator.
     #[error("design too large: {0}")]
     TooLarge(String),

@@ -1,6 +1,8 @@
 //! The generator's input, its validation, and the derived design parameters.
 
-use bt_fixed::{FixedIpc, FixedPoint, PROPORTION_ITERATIONS, PlaneInput, quantize_point};
+use bt_fixed::{
+    FixedIpc, FixedPoint, PROPORTION_ITERATIONS, PathResult, PlaneInput, quantize_point,
+};
 use bt_schedule::{PathJob, Problem, Schedule};
 
 use crate::HlsError;
@@ -62,18 +64,25 @@ impl HlsInput {
     pub fn problem(&self) -> Result<Problem, HlsError> {
         let model = self.model()?;
         let results = model.run(self.tx, self.rx)?;
-        Ok(Problem {
+        Ok(self.problem_for(&results))
+    }
+
+    /// The scheduling problem from model results already computed at the design TX/RX
+    /// (`results[p]` of path `p`, as [`FixedIpc::run`] returns them): saves a second run.
+    pub fn problem_for(&self, results: &[PathResult]) -> Problem {
+        debug_assert_eq!(results.len(), self.paths.len());
+        Problem {
             num_planes: self.planes.len() as u32,
             paths: self
                 .paths
                 .iter()
-                .zip(&results)
+                .zip(results)
                 .map(|(planes, r)| PathJob {
                     planes: planes.clone(),
                     rounds: r.rounds.max(1),
                 })
                 .collect(),
-        })
+        }
     }
 
     /// All (TX, RX) vectors quantised to bus words, the design pair first.
@@ -85,9 +94,11 @@ impl HlsInput {
     }
 }
 
-/// Latency of one PE evaluation in cycles: capture distances, set up Algorithm 3,
-/// [`PROPORTION_ITERATIONS`] halving steps, output.
-pub const PE_LATENCY: u32 = 3 + PROPORTION_ITERATIONS;
+/// Latency of one PE evaluation in cycles, from `start` to a valid `s_sum`: `d_prev`,
+/// `d_next`, `t_prev`, `t_next` through the shared CSD networks (4), Algorithm 3 set-up (1),
+/// [`PROPORTION_ITERATIONS`] halving steps. The result is combinational from the registers,
+/// so no output cycle.
+pub const PE_LATENCY: u32 = 5 + PROPORTION_ITERATIONS;
 
 /// Largest word address the 16-bit Avalon address port can reach.
 pub const ADDRESS_BITS: u32 = 16;
@@ -206,11 +217,11 @@ impl Design {
     /// memory (one point per cycle), then per slot load operands (instances + 1), run the PEs
     /// ([`PE_LATENCY`]) and write back (instances + 1).
     pub fn predicted_cycles(&self) -> u64 {
-        u64::from(self.num_points) + u64::from(self.makespan) * u64::from(self.cycles_per_slot())
+        crate::plan::run_cycles(self.num_points.into(), self.num_instances, self.makespan)
     }
 
     /// Cycles of one schedule slot.
     pub fn cycles_per_slot(&self) -> u32 {
-        2 * (self.num_instances + 1) + PE_LATENCY
+        crate::plan::cycles_per_slot(self.num_instances) as u32
     }
 }

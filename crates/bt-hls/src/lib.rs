@@ -19,6 +19,7 @@
 mod error;
 mod input;
 mod pe;
+mod plan;
 mod tools;
 mod top;
 pub mod verilog;
@@ -31,6 +32,7 @@ use bt_schedule::Schedule;
 pub use error::HlsError;
 pub use input::{ADDRESS_BITS, HlsInput, PE_LATENCY, PlaneSpec};
 pub use pe::{POINT_BITS, pe_module_name};
+pub use plan::{Plan, PlanOptions, ScheduleKind, cycles_per_slot, plan, run_cycles};
 pub use tools::{LintReport, SimReport, SynthReport, lint, simulate, synthesize};
 pub use top::MAP_VERSION;
 

@@ -9,6 +9,9 @@ use crate::verilog::{BinaryOp, Direction, Expr, Item, Module, Port, Stmt, UnaryO
 /// Width of a packed point `{z, y, x}` of fine words.
 pub const POINT_BITS: u32 = 3 * width::COORD;
 
+/// Width of a PE's packed unsaturated result `{z, y, x}` ([`width::SUM_POINT`] bits each).
+pub const SUM_BITS: u32 = 3 * width::SUM_POINT;
+
 const AXES: [&str; 3] = ["x", "y", "z"];
 
 pub(crate) fn port(name: &str, dir: Direction, width: u32) -> Port {
@@ -52,25 +55,51 @@ pub(crate) fn sext(name: &str, w: u32, total: u32) -> Expr {
     }
 }
 
-/// Adder network `constant + Σ ±(input << shift)` for the CSD digits of `coeffs`.
-fn csd_network(
-    inputs: &[(&str, &bt_fixed::Csd)],
+/// `Σ ±(input << (shift − base))` over the CSD digits of one normal component, in `total`
+/// bits (two's complement, modulo 2^total): the product `input · n_k / 2^base`, exact because
+/// every digit's shift is ≥ `base`.
+fn csd_sum(
+    input: &str,
     input_width: u32,
-    constant: i128,
+    csd: &bt_fixed::Csd,
+    base: u32,
     total: u32,
 ) -> Result<Expr, HlsError> {
-    let mut acc = Expr::lit_signed(total, constant);
-    for (name, csd) in inputs {
-        for d in &csd.digits {
-            let term = shifted_term(name, input_width, d.shift, total)?;
-            acc = if d.negative {
-                acc.minus(term)
-            } else {
-                acc.plus(term)
-            };
-        }
+    let mut acc: Option<Expr> = None;
+    for d in &csd.digits {
+        let term = shifted_term(input, input_width, d.shift - base, total)?;
+        acc = Some(match (acc, d.negative) {
+            (None, false) => term,
+            (None, true) => Expr::lit(total, 0).minus(term),
+            (Some(a), false) => a.plus(term),
+            (Some(a), true) => a.minus(term),
+        });
     }
-    Ok(acc)
+    Ok(acc.unwrap_or_else(|| Expr::lit(total, 0)))
+}
+
+/// `sub ? a − b : a + b` as one `w`-bit adder (`{a, 1} + {b ^ sub, sub}`, top `w` bits): the
+/// carry-in rides on an extra LSB so no second adder and no result multiplexer is built.
+/// Declares the `w + 1`-bit wire `name` and returns `name[w:1]`.
+fn add_sub(
+    items: &mut Vec<Item>,
+    unused: &mut Vec<Expr>,
+    name: &str,
+    a: Expr,
+    b: Expr,
+    sub: Expr,
+    w: u32,
+) -> Expr {
+    items.push(Item::Wire(name.into(), w + 1));
+    items.push(Item::Assign(
+        Expr::id(name),
+        Expr::concat(vec![a, Expr::lit(1, 1)]).plus(Expr::concat(vec![
+            Expr::bin(BinaryOp::Xor, b, sub.clone().repeat(w)),
+            sub,
+        ])),
+    ));
+    unused.push(Expr::bit(name, 0));
+    Expr::slice(name, w, 1)
 }
 
 /// Name of the PE module of plane `index`.
@@ -78,30 +107,46 @@ pub fn pe_module_name(index: usize) -> String {
     format!("bt_pe_{index}")
 }
 
-/// Builds `bt_pe_<index>` for `plane`.
+/// First iteration step of Algorithm 3 in the PE's step counter (see [`pe_module`]).
+const FIRST_ITERATION_STEP: u32 = 5;
+
+/// Builds `bt_pe_<index>` for `plane`: a small sequential datapath that time-shares one CSD
+/// network per normal component over the four products of Algorithm 2, folds the operand,
+/// projection and Algorithm 3 registers into each other and fuses the output addition into the
+/// `B_p` accumulator. Bit-exact with `bt_fixed::intersection_point` (before saturation, which
+/// `bt_top` applies once after its PE select):
+///
+/// | step | network input | writes |
+/// |---|---|---|
+/// | idle, `load` | - | `a_k ← s_prev_k`, `b_k ← s_next_k` |
+/// | idle, `start` | `a_k` | `r_e ← d_prev` |
+/// | 1 | `b_k` | `r_l ← d_next` |
+/// | 2 | `r_e` | `a_k ← t_prev_k = a_k − round(d_prev·n_k)` |
+/// | 3 | `r_l` | `b_k ← t_next_k` |
+/// | 4 | - | `b_k ← L_p0 = δ_k·2^15`, `a_k ← (t_prev+t_next)·2^15 + 2^15` (= `t_prev·2^16 + 2^15 + B_p0`), `r_e ← E = (n−m)·2^15`, `r_l ← L = (m+n)·2^15` |
+/// | 5 .. 36 | - | one halving step: `r_l ← L/2`, `b_k ← L_p/2`, `E ± L/2`, `a_k ± L_p/2` (sign of `E` decides) |
+///
+/// `s_sum_k = a_k >> 16 = t_prev_k + round(B_p/2^16)`, valid from [`crate::PE_LATENCY`] cycles
+/// after `start` until the next `load`.
 pub(crate) fn pe_module(
     index: usize,
     plane_name: &str,
     plane: &FixedPlane,
 ) -> Result<Module, HlsError> {
     let cw = width::COORD;
-    let half = 1i128 << (NORMAL_FRAC - 1);
     let g = GUARD_BITS;
-    let (dw, tw, deltaw, sumw) = (
-        width::DISTANCE,
-        width::PROJECTION,
-        width::DELTA,
-        width::DISTANCE_SUM,
-    );
-    let (lw, bw, lpw, bpw) = (
+    let xw = width::DISTANCE; // network input: s (40 bits, sign-extended), d or t (42 bits)
+    debug_assert_eq!(width::PROJECTION, xw);
+    let (deltaw, sumw, accw) = (width::DELTA, width::DISTANCE_SUM, width::DOT_ACC);
+    let (lw, ew, lpw, aw) = (
         width::HALF_SUM,
-        width::SEARCH,
+        width::SEARCH_DIFF,
         width::HALF_DELTA,
-        width::ACC_DELTA,
+        width::POINT_ACC,
     );
-    let (offw, spw) = (width::OFFSET, width::SUM_POINT);
-    debug_assert_eq!(width::DOT_ACC, width::PROJ_ACC);
-    let accw = width::DOT_ACC;
+    let spw = width::SUM_POINT;
+    let last_step = FIRST_ITERATION_STEP + PROPORTION_ITERATIONS - 1;
+    let stepw = 64 - u64::from(last_step).leading_zeros();
     let mut items = Vec::new();
     let csd: Vec<bt_fixed::Csd> = plane.normal.iter().map(|n| n.csd()).collect();
     items.push(Item::Comment(format!(
@@ -119,301 +164,318 @@ pub(crate) fn pe_module(
         csd[2].digits.len()
     )));
     let mut unused = Vec::new();
-    // Stage 0 (combinational from the held operands): signed distances.
-    let dot_const = half - (i128::from(plane.offset.0) << NORMAL_FRAC);
-    for side in ["prev", "next"] {
-        for (k, axis) in AXES.iter().enumerate() {
-            let name = format!("{side}_{axis}");
-            items.push(Item::Wire(name.clone(), cw));
-            items.push(Item::Assign(
-                Expr::id(&name),
-                Expr::slice(format!("s_{side}"), cw * (k as u32 + 1) - 1, cw * k as u32),
-            ));
-        }
-        let names: Vec<String> = AXES.iter().map(|a| format!("{side}_{a}")).collect();
-        let inputs: Vec<(&str, &bt_fixed::Csd)> =
-            names.iter().map(String::as_str).zip(csd.iter()).collect();
-        let acc = format!("d_{side}_acc");
-        items.push(Item::Comment(format!(
-            "d_{side} = round_half_up((n . s_{side} - offset * 2^30) / 2^30)"
-        )));
-        items.push(Item::Wire(acc.clone(), accw));
-        items.push(Item::Assign(
-            Expr::id(&acc),
-            csd_network(&inputs, cw, dot_const, accw)?,
-        ));
-        unused.push(Expr::slice(&acc, NORMAL_FRAC - 1, 0));
-        items.push(Item::Reg(format!("d_{side}"), dw));
-    }
-    // Stage 1: projections, m, n, delta.
-    for side in ["prev", "next"] {
-        for (k, axis) in AXES.iter().enumerate() {
-            let acc = format!("p_{side}_{axis}_acc");
-            let d = format!("d_{side}");
-            items.push(Item::Wire(acc.clone(), accw));
-            items.push(Item::Assign(
-                Expr::id(&acc),
-                csd_network(&[(&d, &csd[k])], dw, half, accw)?,
-            ));
-            unused.push(Expr::slice(&acc, NORMAL_FRAC - 1, 0));
-            let t = format!("t_{side}_{axis}");
-            items.push(Item::Wire(t.clone(), tw));
-            items.push(Item::Assign(
-                Expr::id(&t),
-                sext(&format!("{side}_{axis}"), cw, tw).minus(Expr::slice(
-                    &acc,
-                    accw - 1,
-                    NORMAL_FRAC,
-                )),
-            ));
-        }
-    }
+    items.push(Item::Reg("step".into(), stepw));
+    items.push(Item::Reg("zs".into(), 1));
+    items.push(Item::Reg("r_e".into(), ew));
+    items.push(Item::Reg("r_l".into(), lw));
     for axis in AXES {
-        let delta = format!("delta_{axis}");
-        items.push(Item::Wire(delta.clone(), deltaw));
+        items.push(Item::Reg(format!("a_{axis}"), aw));
+        items.push(Item::Reg(format!("b_{axis}"), lpw));
+    }
+    // Shared networks: input selected by step[1:0] (0 = a, 1 = b, 2 = r_e, 3 = r_l).
+    items.push(Item::Comment(
+        "one CSD network per non-zero normal component, shared by d_prev, d_next, t_prev, t_next"
+            .into(),
+    ));
+    let low = |n: &str| Expr::slice(n, xw - 1, 0);
+    let s1 = Expr::bit("step", 1);
+    let s0 = Expr::bit("step", 0);
+    // Lowest digit shift per component (the network's exact low bits are all zero below it).
+    let base: Vec<Option<u32>> = csd
+        .iter()
+        .map(|c| c.digits.iter().map(|d| d.shift).min())
+        .collect();
+    for (k, axis) in AXES.iter().enumerate() {
+        let Some(bk) = base[k] else { continue };
+        let xin = format!("x_in_{axis}");
+        items.push(Item::Wire(xin.clone(), xw));
         items.push(Item::Assign(
-            Expr::id(&delta),
-            sext(&format!("t_next_{axis}"), tw, deltaw).minus(sext(
-                &format!("t_prev_{axis}"),
-                tw,
-                deltaw,
-            )),
+            Expr::id(&xin),
+            Expr::mux(
+                s1.clone(),
+                Expr::mux(s0.clone(), low("r_l"), low("r_e")),
+                Expr::mux(
+                    s0.clone(),
+                    low(&format!("b_{axis}")),
+                    low(&format!("a_{axis}")),
+                ),
+            ),
+        ));
+        let net = format!("net_{axis}");
+        let nw = accw - bk;
+        items.push(Item::Comment(format!(
+            "net_{axis} = x_in_{axis} * n_{axis} / 2^{bk} ({} digits)",
+            csd[k].digits.len()
+        )));
+        items.push(Item::Wire(net.clone(), nw));
+        items.push(Item::Assign(
+            Expr::id(&net),
+            csd_sum(&xin, xw, &csd[k], bk, nw)?,
         ));
     }
-    for (abs, d) in [("m_dist", "d_prev"), ("n_dist", "d_next")] {
-        items.push(Item::Wire(abs.into(), dw));
+    // Signed distance: round_half_up((Σ n_k x_k − offset·2^30) / 2^30), exact below bit `sd`.
+    let nf = NORMAL_FRAC;
+    let sd = base.iter().flatten().copied().min().unwrap_or(nf).min(nf);
+    let dot_const = (1i128 << (nf - 1)) - (i128::from(plane.offset.0) << nf);
+    let dw = accw - sd;
+    let mut dot = Expr::lit_signed(dw, dot_const >> sd);
+    for (k, axis) in AXES.iter().enumerate() {
+        let Some(bk) = base[k] else { continue };
+        dot = dot.plus(shifted_term(
+            &format!("net_{axis}"),
+            accw - bk,
+            bk - sd,
+            dw,
+        )?);
+    }
+    items.push(Item::Comment(format!(
+        "dot = (n . x_in - offset * 2^30 + 2^29) / 2^{sd}; d = dot >> {}",
+        nf - sd
+    )));
+    items.push(Item::Wire("dot".into(), dw));
+    items.push(Item::Assign(Expr::id("dot"), dot));
+    if nf > sd {
+        unused.push(Expr::slice("dot", nf - sd - 1, 0));
+    }
+    items.push(Item::Wire("d_new".into(), xw));
+    items.push(Item::Assign(
+        Expr::id("d_new"),
+        Expr::slice("dot", dw - 1, nf - sd),
+    ));
+    // Projections: t_k = base_k − round_half_up(d · n_k / 2^30), base = a (step 2) or b (step 3).
+    for (k, axis) in AXES.iter().enumerate() {
+        let pbase = Expr::mux(
+            s0.clone(),
+            low(&format!("b_{axis}")),
+            low(&format!("a_{axis}")),
+        );
+        let t = format!("t_{axis}");
+        items.push(Item::Wire(t.clone(), xw));
+        let Some(bk) = base[k] else {
+            items.push(Item::Assign(Expr::id(&t), pbase));
+            continue;
+        };
+        let net = format!("net_{axis}");
+        let nw = accw - bk;
+        let p = if bk >= nf {
+            // Multiple of 2^30: the rounding half cannot carry.
+            if bk > nf {
+                return Err(HlsError::TooLarge(format!(
+                    "normal component {axis} of plane {index} has a digit above 2^30"
+                )));
+            }
+            Expr::id(&net)
+        } else {
+            let pr = format!("p_round_{axis}");
+            items.push(Item::Wire(pr.clone(), nw));
+            items.push(Item::Assign(
+                Expr::id(&pr),
+                Expr::id(&net).plus(Expr::lit(nw, 1u128 << (nf - 1 - bk))),
+            ));
+            unused.push(Expr::slice(&pr, nf - bk - 1, 0));
+            Expr::slice(&pr, nw - 1, nf - bk)
+        };
+        items.push(Item::Assign(Expr::id(&t), pbase.minus(p)));
+    }
+    // Step 4: m, n, delta, and the Algorithm 3 initial values.
+    for (abs, r) in [("m_dist", "r_e"), ("n_dist", "r_l")] {
+        items.push(Item::Wire(abs.into(), xw));
         items.push(Item::Assign(
             Expr::id(abs),
             Expr::mux(
-                Expr::bit(d, dw - 1),
-                Expr::id(d).inv().plus(Expr::lit(dw, 1)),
-                Expr::id(d),
+                Expr::bit(r, xw - 1),
+                low(r).inv().plus(Expr::lit(xw, 1)),
+                low(r),
             ),
         ));
     }
-    debug_assert_eq!(sumw, dw);
+    debug_assert_eq!(sumw, xw);
     items.push(Item::Wire("dist_sum".into(), sumw));
     items.push(Item::Assign(
         Expr::id("dist_sum"),
         Expr::id("m_dist").plus(Expr::id("n_dist")),
     ));
-    // Algorithm 3 registers and one iteration.
+    items.push(Item::Wire("dist_diff".into(), sumw + 1));
+    items.push(Item::Assign(
+        Expr::id("dist_diff"),
+        Expr::concat(vec![Expr::lit(1, 0), Expr::id("n_dist")])
+            .minus(Expr::concat(vec![Expr::lit(1, 0), Expr::id("m_dist")])),
+    ));
+    for axis in AXES {
+        let (a, b) = (format!("a_{axis}"), format!("b_{axis}"));
+        let delta = format!("delta_{axis}");
+        items.push(Item::Wire(delta.clone(), deltaw));
+        items.push(Item::Assign(
+            Expr::id(&delta),
+            sext_slice(&b, xw - 1, 0, deltaw).minus(sext_slice(&a, xw - 1, 0, deltaw)),
+        ));
+        // t_prev + t_next + 1 as one adder: {b, 1} + {a, 1} = 2·(a + b + 1).
+        let tsum = format!("tsum_{axis}");
+        items.push(Item::Wire(tsum.clone(), deltaw + 1));
+        items.push(Item::Assign(
+            Expr::id(&tsum),
+            Expr::concat(vec![sext_slice(&b, xw - 1, 0, deltaw), Expr::lit(1, 1)]).plus(
+                Expr::concat(vec![sext_slice(&a, xw - 1, 0, deltaw), Expr::lit(1, 1)]),
+            ),
+        ));
+        unused.push(Expr::bit(&tsum, 0));
+    }
+    // One halving step.
     items.push(Item::Comment(format!(
-        "Algorithm 3 on {g} guard bits: L <- (m+n)/2, B <- L, Lp <- l/2, Bp <- Lp; {PROPORTION_ITERATIONS} steps, frozen once L = 0"
+        "Algorithm 3 on {g} guard bits, {PROPORTION_ITERATIONS} steps frozen once L = 0; E = B - m*2^{g} replaces B, m and the comparator"
     )));
-    for (n, w) in [
-        ("hc_l", lw),
-        ("hc_b", bw),
-        ("hc_m", bw),
-        ("hc_iter", width::ITERATION),
-        ("phase", 2),
-    ] {
-        items.push(Item::Reg(n.into(), w));
-    }
-    items.push(Item::Reg("hc_zs".into(), 1));
-    for axis in AXES {
-        items.push(Item::Reg(format!("hc_lp_{axis}"), lpw));
-        items.push(Item::Reg(format!("hc_bp_{axis}"), bpw));
-        items.push(Item::Reg(format!("hc_t_{axis}"), tw));
-    }
-    items.push(Item::Wire("l_half".into(), lw));
-    items.push(Item::Assign(
-        Expr::id("l_half"),
-        Expr::concat(vec![Expr::lit(1, 0), Expr::slice("hc_l", lw - 1, 1)]),
-    ));
     items.push(Item::Wire("go_up".into(), 1));
-    items.push(Item::Assign(
-        Expr::id("go_up"),
-        Expr::bin(BinaryOp::Lt, Expr::id("hc_b"), Expr::id("hc_m")),
-    ));
-    items.push(Item::Wire("b_next".into(), bw));
-    let l_ext = Expr::concat(vec![Expr::lit(1, 0), Expr::id("l_half")]);
-    items.push(Item::Assign(
-        Expr::id("b_next"),
-        Expr::mux(
-            Expr::id("go_up"),
-            Expr::id("hc_b").plus(l_ext.clone()),
-            Expr::id("hc_b").minus(l_ext),
-        ),
-    ));
-    let mut sat_parts = Vec::new();
-    let mut ovf_terms = Vec::new();
+    items.push(Item::Assign(Expr::id("go_up"), Expr::bit("r_e", ew - 1)));
+    let l_half = Expr::concat(vec![
+        Expr::lit(ew - lw + 1, 0),
+        Expr::slice("r_l", lw - 1, 1),
+    ]);
+    let e_next = add_sub(
+        &mut items,
+        &mut unused,
+        "e_next",
+        Expr::id("r_e"),
+        l_half,
+        Expr::id("go_up").lnot(),
+        ew,
+    );
+    let mut a_next = Vec::new();
     for axis in AXES {
-        let lp = format!("hc_lp_{axis}");
-        unused.push(Expr::bit(&lp, 0));
+        let b = format!("b_{axis}");
         let lph = format!("lp_half_{axis}");
         items.push(Item::Wire(lph.clone(), lpw));
         items.push(Item::Assign(
             Expr::id(&lph),
-            Expr::concat(vec![Expr::bit(&lp, lpw - 1), Expr::slice(&lp, lpw - 1, 1)]),
+            Expr::concat(vec![Expr::bit(&b, lpw - 1), Expr::slice(&b, lpw - 1, 1)]),
         ));
-        let bp = format!("hc_bp_{axis}");
-        let bpn = format!("bp_next_{axis}");
-        items.push(Item::Wire(bpn.clone(), bpw));
-        items.push(Item::Assign(
-            Expr::id(&bpn),
-            Expr::mux(
-                Expr::id("go_up"),
-                Expr::id(&bp).plus(sext(&lph, lpw, bpw)),
-                Expr::id(&bp).minus(sext(&lph, lpw, bpw)),
-            ),
+        a_next.push(add_sub(
+            &mut items,
+            &mut unused,
+            &format!("a_next_{axis}"),
+            Expr::id(format!("a_{axis}")),
+            sext(&lph, lpw, aw),
+            Expr::id("go_up").lnot(),
+            aw,
         ));
-        // Output: round_half_up(Bp / 2^G), add to t_prev, saturate to the 40-bit word.
-        let oacc = format!("off_acc_{axis}");
-        items.push(Item::Wire(oacc.clone(), bpw));
-        items.push(Item::Assign(
-            Expr::id(&oacc),
-            Expr::id(&bp).plus(Expr::lit(bpw, 1 << (g - 1))),
-        ));
-        unused.push(Expr::slice(&oacc, g - 1, 0));
-        debug_assert_eq!(bpw - g, offw);
-        let sum = format!("sum_{axis}");
-        items.push(Item::Wire(sum.clone(), spw));
-        items.push(Item::Assign(
-            Expr::id(&sum),
-            sext(&format!("hc_t_{axis}"), tw, spw).plus(sext_slice(&oacc, bpw - 1, g, spw)),
-        ));
-        let ovf = format!("ovf_{axis}");
-        let top = Expr::slice(&sum, spw - 1, cw - 1);
-        let topw = spw - cw + 1;
-        items.push(Item::Wire(ovf.clone(), 1));
-        items.push(Item::Assign(
-            Expr::id(&ovf),
-            Expr::bin(
-                BinaryOp::LogicAnd,
-                Expr::bin(BinaryOp::Ne, top.clone(), Expr::lit(topw, 0)),
-                Expr::bin(BinaryOp::Ne, top, Expr::lit(topw, (1u128 << topw) - 1)),
-            ),
-        ));
-        let sat = format!("sat_{axis}");
-        items.push(Item::Wire(sat.clone(), cw));
-        items.push(Item::Assign(
-            Expr::id(&sat),
-            Expr::mux(
-                Expr::id(&ovf),
-                Expr::mux(
-                    Expr::bit(&sum, spw - 1),
-                    Expr::lit(cw, 1 << (cw - 1)),
-                    Expr::lit(cw, (1 << (cw - 1)) - 1),
-                ),
-                Expr::slice(&sum, cw - 1, 0),
-            ),
-        ));
-        sat_parts.insert(0, Expr::id(&sat));
-        ovf_terms.push(Expr::id(&ovf));
     }
+    // Output: the unsaturated point t_prev + round(B_p / 2^G) = a >> G.
+    let mut sum_parts = Vec::new();
+    for axis in AXES {
+        sum_parts.insert(0, Expr::slice(format!("a_{axis}"), aw - 1, g));
+    }
+    debug_assert_eq!(aw - g, spw);
+    items.push(Item::Assign(Expr::id("s_sum"), Expr::concat(sum_parts)));
+    items.push(Item::Assign(Expr::id("zero_sum"), Expr::id("zs")));
+
     // Sequencer.
     let nb = |l: &str, r: Expr| Stmt::NonBlocking(Expr::id(l), r);
+    let step_is = |v: u32| Expr::id("step").eq(Expr::lit(stepw, v.into()));
+    let mut load = Vec::new();
+    for (k, axis) in AXES.iter().enumerate() {
+        let (hi, lo) = (cw * (k as u32 + 1) - 1, cw * k as u32);
+        load.push(nb(&format!("a_{axis}"), sext_slice("s_prev", hi, lo, aw)));
+        load.push(nb(&format!("b_{axis}"), sext_slice("s_next", hi, lo, lpw)));
+    }
     let idle = vec![Stmt::If(
         Expr::id("start"),
         vec![
-            nb("d_prev", Expr::slice("d_prev_acc", accw - 1, NORMAL_FRAC)),
-            nb("d_next", Expr::slice("d_next_acc", accw - 1, NORMAL_FRAC)),
-            nb("phase", Expr::lit(2, 1)),
+            nb("r_e", sext("d_new", xw, ew)),
+            nb("step", Expr::lit(stepw, 1)),
         ],
-        vec![],
+        vec![Stmt::If(Expr::id("load"), load, vec![])],
     )];
+    let mut proj_prev = Vec::new();
+    let mut proj_next = Vec::new();
     let mut setup = vec![
         nb(
-            "hc_l",
+            "r_e",
+            Expr::concat(vec![
+                Expr::bit("dist_diff", sumw).repeat(ew - (sumw + 1) - (g - 1)),
+                Expr::id("dist_diff"),
+                Expr::lit(1, 0).repeat(g - 1),
+            ]),
+        ),
+        nb(
+            "r_l",
             Expr::concat(vec![Expr::id("dist_sum"), Expr::lit(1, 0).repeat(g - 1)]),
         ),
-        nb(
-            "hc_b",
-            Expr::concat(vec![
-                Expr::lit(1, 0),
-                Expr::id("dist_sum"),
-                Expr::lit(1, 0).repeat(g - 1),
-            ]),
-        ),
-        nb(
-            "hc_m",
-            Expr::concat(vec![Expr::id("m_dist"), Expr::lit(1, 0).repeat(g)]),
-        ),
-        nb("hc_zs", Expr::id("dist_sum").eq(Expr::lit(sumw, 0))),
-        nb("hc_iter", Expr::lit(width::ITERATION, 0)),
-        nb("phase", Expr::lit(2, 2)),
+        nb("zs", Expr::id("dist_sum").eq(Expr::lit(sumw, 0))),
     ];
-    debug_assert_eq!(bw, sumw + g);
-    for axis in AXES {
-        let delta = format!("delta_{axis}");
+    debug_assert_eq!(lw, sumw + g - 1);
+    debug_assert_eq!(lpw, deltaw + g - 1);
+    let mut iterate = vec![
+        nb(
+            "r_l",
+            Expr::concat(vec![Expr::lit(1, 0), Expr::slice("r_l", lw - 1, 1)]),
+        ),
+        nb("r_e", e_next),
+    ];
+    for (k, axis) in AXES.iter().enumerate() {
+        let (a, b, t) = (
+            format!("a_{axis}"),
+            format!("b_{axis}"),
+            format!("t_{axis}"),
+        );
+        proj_prev.push(nb(&a, sext(&t, xw, aw)));
+        proj_next.push(nb(&b, sext(&t, xw, lpw)));
         setup.push(nb(
-            &format!("hc_lp_{axis}"),
-            Expr::concat(vec![Expr::id(&delta), Expr::lit(1, 0).repeat(g - 1)]),
-        ));
-        setup.push(nb(
-            &format!("hc_bp_{axis}"),
+            &b,
             Expr::concat(vec![
-                Expr::bit(&delta, deltaw - 1).repeat(bpw - lpw),
-                Expr::id(&delta),
+                Expr::id(format!("delta_{axis}")),
                 Expr::lit(1, 0).repeat(g - 1),
             ]),
         ));
+        // t_prev·2^G + 2^(G−1) + B_p0 = (t_prev + t_next + 1)·2^(G−1), modulo 2^POINT_ACC.
+        let tsum = format!("tsum_{axis}");
         setup.push(nb(
-            &format!("hc_t_{axis}"),
-            Expr::id(format!("t_prev_{axis}")),
+            &a,
+            Expr::concat(vec![
+                Expr::bit(&tsum, deltaw).repeat(aw - deltaw - (g - 1)),
+                Expr::slice(&tsum, deltaw, 1),
+                Expr::lit(1, 0).repeat(g - 1),
+            ]),
         ));
+        iterate.push(nb(&b, Expr::id(format!("lp_half_{axis}"))));
+        iterate.push(nb(&a, a_next[k].clone()));
     }
-    let mut step = vec![
-        nb("hc_l", Expr::id("l_half")),
-        nb("hc_b", Expr::id("b_next")),
-    ];
-    for axis in AXES {
-        step.push(nb(
-            &format!("hc_lp_{axis}"),
-            Expr::id(format!("lp_half_{axis}")),
-        ));
-        step.push(nb(
-            &format!("hc_bp_{axis}"),
-            Expr::id(format!("bp_next_{axis}")),
-        ));
-    }
+    debug_assert!(aw >= deltaw + g);
+    proj_prev.push(nb("step", Expr::lit(stepw, 3)));
+    proj_next.push(nb("step", Expr::lit(stepw, 4)));
+    setup.push(nb("step", Expr::lit(stepw, FIRST_ITERATION_STEP.into())));
     let iterate = vec![
         Stmt::If(
-            Expr::bin(BinaryOp::Ne, Expr::id("hc_l"), Expr::lit(lw, 0)),
-            step,
+            Expr::bin(BinaryOp::Ne, Expr::id("r_l"), Expr::lit(lw, 0)),
+            iterate,
             vec![],
-        ),
-        nb(
-            "hc_iter",
-            Expr::id("hc_iter").plus(Expr::lit(width::ITERATION, 1)),
         ),
         Stmt::If(
-            Expr::id("hc_iter").eq(Expr::lit(
-                width::ITERATION,
-                u128::from(PROPORTION_ITERATIONS - 1),
-            )),
-            vec![nb("phase", Expr::lit(2, 3))],
-            vec![],
+            step_is(last_step),
+            vec![nb("step", Expr::lit(stepw, 0))],
+            vec![nb("step", Expr::id("step").plus(Expr::lit(stepw, 1)))],
         ),
-    ];
-    let ovf_any = ovf_terms
-        .into_iter()
-        .reduce(|a, b| Expr::bin(BinaryOp::Or, a, b))
-        .expect("three axes");
-    let output = vec![
-        nb("s_out", Expr::concat(sat_parts)),
-        nb("zero_sum", Expr::id("hc_zs")),
-        nb("overflow", ovf_any),
-        nb("phase", Expr::lit(2, 0)),
     ];
     items.push(Item::AlwaysFf(vec![Stmt::If(
         Expr::id("rst_n").lnot(),
-        vec![
-            nb("phase", Expr::lit(2, 0)),
-            nb("s_out", Expr::lit(POINT_BITS, 0)),
-            nb("zero_sum", Expr::lit(1, 0)),
-            nb("overflow", Expr::lit(1, 0)),
-        ],
+        vec![nb("step", Expr::lit(stepw, 0))],
         vec![Stmt::Case(
-            Expr::id("phase"),
+            Expr::id("step"),
             vec![
-                (Expr::lit(2, 0), idle),
-                (Expr::lit(2, 1), setup),
-                (Expr::lit(2, 2), iterate),
-                (Expr::lit(2, 3), output),
+                (Expr::lit(stepw, 0), idle),
+                (
+                    Expr::lit(stepw, 1),
+                    vec![
+                        nb(
+                            "r_l",
+                            Expr::concat(vec![Expr::lit(lw - xw, 0), Expr::id("d_new")]),
+                        ),
+                        nb("step", Expr::lit(stepw, 2)),
+                    ],
+                ),
+                (Expr::lit(stepw, 2), proj_prev),
+                (Expr::lit(stepw, 3), proj_next),
+                (Expr::lit(stepw, 4), setup),
             ],
-            vec![nb("phase", Expr::lit(2, 0))],
+            iterate,
         )],
     )]));
     items.push(Item::Wire("bt_unused_ok".into(), 1));
@@ -429,20 +491,22 @@ pub(crate) fn pe_module(
                 "bt_pe_{index}: IPC processing element of plane {index} ('{plane_name}'), generated by bt-hls."
             ),
             format!(
-                "Latency {} cycles from `start`; twin of bt_fixed::intersection_point.",
+                "`load` latches the operands; `s_sum` valid {} cycles after `start`; twin of bt_fixed::intersection_point before saturation.",
                 crate::PE_LATENCY
             ),
-            "Points are {z, y, x} of 40-bit two's-complement words, mm x 2^8.".into(),
+            format!(
+                "Operands are {{z, y, x}} of 40-bit words, s_sum {{z, y, x}} of {spw}-bit words, mm x 2^8."
+            ),
         ],
         ports: vec![
             port("clk", Direction::Input, 1),
             port("rst_n", Direction::Input, 1),
+            port("load", Direction::Input, 1),
             port("start", Direction::Input, 1),
             port("s_prev", Direction::Input, POINT_BITS),
             port("s_next", Direction::Input, POINT_BITS),
-            port("s_out", Direction::OutputReg, POINT_BITS),
-            port("zero_sum", Direction::OutputReg, 1),
-            port("overflow", Direction::OutputReg, 1),
+            port("s_sum", Direction::Output, SUM_BITS),
+            port("zero_sum", Direction::Output, 1),
         ],
         items,
     })

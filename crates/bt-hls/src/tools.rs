@@ -236,8 +236,10 @@ pub struct SynthReport {
     pub logic_cells: u64,
     /// `dffeas` cells (logic-element registers).
     pub registers: u64,
-    /// Bits in M9K block RAM cells (0 with `-nobram`, see [`synthesize`]).
+    /// Bits of the memories inferred into M9K blocks (width × depth as written in the RTL).
     pub memory_bits: u64,
+    /// M9K blocks (`altsyncram` cells, 9,216 bits each; the EP4CE115 has 432).
+    pub m9k_blocks: u64,
     /// Logic elements estimate `max(logic_cells, registers)` (each LE holds one LUT and one
     /// register; Quartus packing can only add to this) as a percentage of the EP4CE115's 114,480.
     pub percent_of_ep4ce115: f64,
@@ -248,19 +250,33 @@ pub struct SynthReport {
 /// Logic elements of the EP4CE115 (paper's Cyclone IV E device).
 pub const EP4CE115_LES: u64 = 114_480;
 
-/// Runs `yosys synth_intel -family cycloneive -nobram -top bt_top` (the EP4CE115 is a
-/// Cyclone IV E) on `rtl/*.v`, logging to `synth/yosys.log`, and parses the final cell counts.
+/// Runs Yosys `synth_intel -family cycloneive -top bt_top` (the EP4CE115 is a Cyclone IV E)
+/// on `rtl/*.v`, logging to `synth/yosys.log`, and parses the final cell counts.
 ///
-/// `-nobram`: Yosys 0.23's M9K mapping aborts on our point memory ("Can't find object for
-/// defparam `INIT`"), so the point memory is built from registers and counted in
-/// `registers`/`logic_cells` (a pessimistic figure: Quartus would put it in M9K blocks).
-/// Synthesis of the 6-plane test scene takes about 4 minutes on one core.
+/// Block RAM: synth_intel's own M9K mapping aborts in Yosys 0.23 ("Can't find object for
+/// defparam `INIT`": its techmap module declares no `INIT` parameter, so every memory fails, and
+/// it would also tie the write data to the read port). The script therefore runs synth_intel up
+/// to `map_bram`, maps memories with this crate's rules (`bt_m9k.txt`: simple dual-port M9K,
+/// no initial contents) onto `altsyncram` cells, and resumes at `map_ffram`. The point memory
+/// lands in M9K; the `rounds` array (cleared on start) and the ROMs stay in logic.
 pub fn synthesize(out_dir: &Path) -> Result<SynthReport, HlsError> {
     let files = rel_rtl(out_dir)?;
     let synth = out_dir.join("synth");
     std::fs::create_dir_all(&synth).map_err(io_err(&synth))?;
+    for (name, text) in [
+        ("bt_m9k.txt", include_str!("bt_m9k.txt")),
+        ("bt_m9k_map.v", include_str!("bt_m9k_map.v")),
+    ] {
+        let path = synth.join(name);
+        std::fs::write(&path, text).map_err(io_err(&path))?;
+    }
     let script = format!(
-        "read_verilog {}; synth_intel -family cycloneive -nobram -top bt_top; tee -o synth/stat.txt stat",
+        "read_verilog {}; \
+         synth_intel -family cycloneive -top bt_top -run :map_bram; \
+         memory_bram -rules synth/bt_m9k.txt; \
+         techmap -map synth/bt_m9k_map.v; \
+         synth_intel -family cycloneive -top bt_top -run map_ffram:; \
+         tee -o synth/stat.txt stat",
         files.join(" ")
     );
     let out = run(
@@ -281,6 +297,8 @@ pub fn synthesize(out_dir: &Path) -> Result<SynthReport, HlsError> {
     let stat_path = synth.join("stat.txt");
     let stat = std::fs::read_to_string(&stat_path).map_err(io_err(&stat_path))?;
     let cells = parse_stat(&stat);
+    let log_path = synth.join("yosys.log");
+    let log = std::fs::read_to_string(&log_path).map_err(io_err(&log_path))?;
     let count = |suffix: &str| {
         cells
             .iter()
@@ -290,14 +308,47 @@ pub fn synthesize(out_dir: &Path) -> Result<SynthReport, HlsError> {
     };
     let logic_cells = count("lcell_comb");
     let registers = count("dffeas");
-    let memory_bits = count("ram_block") * 9216;
+    let m9k_blocks = count("altsyncram");
+    let memory_bits = parse_bram_bits(&log);
     Ok(SynthReport {
         logic_cells,
         registers,
         memory_bits,
+        m9k_blocks,
         percent_of_ep4ce115: 100.0 * logic_cells.max(registers) as f64 / EP4CE115_LES as f64,
         cells,
     })
+}
+
+/// Bits (`Properties: ... bits=N`) of every memory that `memory_bram` mapped onto
+/// `$__BT_M9K_SDP` cells, from the Yosys log.
+fn parse_bram_bits(log: &str) -> u64 {
+    let mut total = 0;
+    let mut current: Option<u64> = None;
+    let mut mapped = false;
+    let mut flush = |bits: Option<u64>, mapped: bool| {
+        if mapped {
+            total += bits.unwrap_or(0);
+        }
+    };
+    for line in log.lines() {
+        let l = line.trim_start();
+        if l.starts_with("Processing ") && l.ends_with(':') {
+            flush(current.take(), mapped);
+            mapped = false;
+        } else if let Some(rest) = l.strip_prefix("Properties:") {
+            current = rest
+                .split_whitespace()
+                .find_map(|f| f.strip_prefix("bits=")?.parse().ok());
+        } else if l.starts_with("Creating $__BT_M9K_SDP cell") {
+            mapped = true;
+        } else if l.starts_with("Executing") || l.contains(". Executing ") {
+            flush(current.take(), mapped);
+            mapped = false;
+        }
+    }
+    flush(current, mapped);
+    total
 }
 
 /// Cell lines of a Yosys `stat` ("     <type>   <count>") after "Number of cells".
@@ -333,5 +384,11 @@ mod tests {
         let c = super::parse_stat(stat);
         assert_eq!(c["cycloneive_lcell_comb"], 5);
         assert_eq!(c["dffeas"], 2);
+    }
+
+    #[test]
+    fn counts_bits_of_memories_mapped_to_m9k() {
+        let log = "23. Executing MEMORY_BRAM pass.\nProcessing bt_top.rom:\n  Properties: ports=1 bits=160 rports=1\n    rejected\nProcessing bt_top.pm_a:\n  Properties: ports=2 bits=7680 rports=1\n      Creating $__BT_M9K_SDP cell at grid position <0 0 0>: pm_a.0.0.0\n24. Executing TECHMAP pass.\n";
+        assert_eq!(super::parse_bram_bits(log), 7680);
     }
 }

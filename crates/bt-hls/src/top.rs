@@ -4,7 +4,7 @@
 use bt_fixed::{FineCoord, width};
 
 use crate::input::{ADDRESS_BITS, Design, PE_LATENCY, bits_for};
-use crate::pe::{POINT_BITS, pe_module_name, port};
+use crate::pe::{POINT_BITS, SUM_BITS, pe_module_name, port};
 use crate::verilog::{BinaryOp, Direction, Expr, Item, Module, Stmt, UnaryOp};
 
 /// FSM state encodings.
@@ -108,13 +108,14 @@ pub(crate) fn top_module(d: &Design) -> Module {
         items.push(Item::Reg(n.into(), w));
     }
     items.push(Item::Memory("rounds".into(), 16, np2));
-    items.push(Item::Memory("point_mem".into(), POINT_BITS, depth));
+    // Two copies of the point memory (one per read port, both written): each is a plain
+    // 1-write 1-read array with a registered read, which Yosys maps to M9K blocks.
+    items.push(Item::Memory("pm_a".into(), POINT_BITS, depth));
+    items.push(Item::Memory("pm_b".into(), POINT_BITS, depth));
     for j in 0..k {
-        items.push(Item::Reg(format!("op_prev_{j}"), POINT_BITS));
-        items.push(Item::Reg(format!("op_next_{j}"), POINT_BITS));
-        items.push(Item::Wire(format!("pe_out_{j}"), POINT_BITS));
+        items.push(Item::Wire(format!("pe_load_{j}"), 1));
+        items.push(Item::Wire(format!("pe_sum_{j}"), SUM_BITS));
         items.push(Item::Wire(format!("pe_zs_{j}"), 1));
-        items.push(Item::Wire(format!("pe_ov_{j}"), 1));
     }
 
     // Scheduler ROM: {slot, instance} -> job.
@@ -259,32 +260,75 @@ pub(crate) fn top_module(d: &Design) -> Module {
             Expr::concat(vec![id("rom_point").plus(one_pt), rom_bank]),
         ),
     ]));
-    // Write-back: PE output select, displacement, freeze.
-    items.push(Item::Reg("pe_sel".into(), POINT_BITS));
+    // Write-back: PE output select, saturation (once, for all PEs), displacement, freeze.
+    items.push(Item::Reg("pe_sel_sum".into(), SUM_BITS));
     items.push(Item::Reg("pe_sel_zs".into(), 1));
-    items.push(Item::Reg("pe_sel_ov".into(), 1));
     let sel_arms = (0..k)
         .map(|j| {
             (
                 lit(ib, j.into()),
                 vec![
-                    bl("pe_sel", id(&format!("pe_out_{j}"))),
+                    bl("pe_sel_sum", id(&format!("pe_sum_{j}"))),
                     bl("pe_sel_zs", id(&format!("pe_zs_{j}"))),
-                    bl("pe_sel_ov", id(&format!("pe_ov_{j}"))),
                 ],
             )
         })
         .collect();
     let sel_default = vec![
-        bl("pe_sel", lit(POINT_BITS, 0)),
+        bl("pe_sel_sum", lit(SUM_BITS, 0)),
         bl("pe_sel_zs", lit(1, 0)),
-        bl("pe_sel_ov", lit(1, 0)),
     ];
     items.push(Item::AlwaysComb(vec![Stmt::Case(
         id("wb_q_inst"),
         sel_arms,
         sel_default,
     )]));
+    let spw = width::SUM_POINT;
+    let mut sat_parts = Vec::new();
+    let mut ovf_terms = Vec::new();
+    for (a, axis) in ["x", "y", "z"].iter().enumerate() {
+        let sum = format!("sum_{axis}");
+        items.push(Item::Wire(sum.clone(), spw));
+        items.push(Item::Assign(
+            id(&sum),
+            Expr::slice("pe_sel_sum", spw * (a as u32 + 1) - 1, spw * a as u32),
+        ));
+        let ovf = format!("ovf_{axis}");
+        let top = Expr::slice(&sum, spw - 1, cw - 1);
+        let topw = spw - cw + 1;
+        items.push(Item::Wire(ovf.clone(), 1));
+        items.push(Item::Assign(
+            id(&ovf),
+            Expr::bin(
+                BinaryOp::LogicAnd,
+                Expr::bin(BinaryOp::Ne, top.clone(), lit(topw, 0)),
+                Expr::bin(BinaryOp::Ne, top, lit(topw, (1u128 << topw) - 1)),
+            ),
+        ));
+        let sat = format!("sat_{axis}");
+        items.push(Item::Wire(sat.clone(), cw));
+        items.push(Item::Assign(
+            id(&sat),
+            Expr::mux(
+                id(&ovf),
+                Expr::mux(
+                    Expr::bit(&sum, spw - 1),
+                    lit(cw, 1 << (cw - 1)),
+                    lit(cw, (1 << (cw - 1)) - 1),
+                ),
+                Expr::slice(&sum, cw - 1, 0),
+            ),
+        ));
+        sat_parts.insert(0, id(&sat));
+        ovf_terms.push(id(&ovf));
+    }
+    items.push(Item::Wire("pe_sel".into(), POINT_BITS));
+    items.push(Item::Assign(id("pe_sel"), Expr::concat(sat_parts)));
+    items.push(Item::Wire("pe_sel_ov".into(), 1));
+    items.push(Item::Assign(
+        id("pe_sel_ov"),
+        ovf_terms.into_iter().reduce(or).expect("3 axes"),
+    ));
     let mut big_terms = Vec::new();
     for (a, axis) in ["x", "y", "z"].iter().enumerate() {
         let (hi, lo) = (cw * (a as u32 + 1) - 1, cw * a as u32);
@@ -370,15 +414,16 @@ pub(crate) fn top_module(d: &Design) -> Module {
             vec![],
         ),
     ]));
-    items.push(Item::AlwaysFf(vec![
-        Stmt::If(
-            id("wr_en"),
-            vec![nb(Expr::id("point_mem").at(id("wr_addr")), id("wr_data"))],
-            vec![],
-        ),
-        nb(id("rd_a"), Expr::id("point_mem").at(id("ra_addr"))),
-        nb(id("rd_b"), Expr::id("point_mem").at(id("rb_addr"))),
-    ]));
+    for (mem, rd, addr) in [("pm_a", "rd_a", "ra_addr"), ("pm_b", "rd_b", "rb_addr")] {
+        items.push(Item::AlwaysFf(vec![
+            Stmt::If(
+                id("wr_en"),
+                vec![nb(Expr::id(mem).at(id("wr_addr")), id("wr_data"))],
+                vec![],
+            ),
+            nb(id(rd), Expr::id(mem).at(id(addr))),
+        ]));
+    }
 
     // PE matrix.
     items.push(Item::Wire("pe_start".into(), 1));
@@ -393,42 +438,39 @@ pub(crate) fn top_module(d: &Design) -> Module {
             ports: vec![
                 ("clk".into(), id("clk")),
                 ("rst_n".into(), id("rst_n")),
+                ("load".into(), id(&format!("pe_load_{j}"))),
                 ("start".into(), id("pe_start")),
-                ("s_prev".into(), id(&format!("op_prev_{j}"))),
-                ("s_next".into(), id(&format!("op_next_{j}"))),
-                ("s_out".into(), id(&format!("pe_out_{j}"))),
+                ("s_prev".into(), id("opnd_prev")),
+                ("s_next".into(), id("opnd_next")),
+                ("s_sum".into(), id(&format!("pe_sum_{j}"))),
                 ("zero_sum".into(), id(&format!("pe_zs_{j}"))),
-                ("overflow".into(), id(&format!("pe_ov_{j}"))),
             ],
         });
     }
 
-    // Operand load (one instance per cycle, memory data one cycle after the address).
+    // Operand load (one instance per cycle, memory data one cycle after the address): the
+    // operands are broadcast and the addressed PE latches them.
     let fine = |n: &str| Expr::concat(vec![id(n), lit(8, 0)]);
     let tx_fine = Expr::concat(vec![fine("tx_z"), fine("tx_y"), fine("tx_x")]);
     let rx_fine = Expr::concat(vec![fine("rx_z"), fine("rx_y"), fine("rx_x")]);
-    let load_arms = (0..k)
-        .map(|j| {
-            (
-                lit(ib, j.into()),
-                vec![
-                    nb(
-                        id(&format!("op_prev_{j}")),
-                        Expr::mux(id("ld_q_first"), tx_fine.clone(), id("rd_a")),
-                    ),
-                    nb(
-                        id(&format!("op_next_{j}")),
-                        Expr::mux(id("ld_q_last"), rx_fine.clone(), id("rd_b")),
-                    ),
-                ],
-            )
-        })
-        .collect();
-    items.push(Item::AlwaysFf(vec![Stmt::If(
-        state_is(S_LOAD).and(id("ld_q_en")),
-        vec![Stmt::Case(id("ld_q_inst"), load_arms, vec![])],
-        vec![],
-    )]));
+    items.push(Item::Wire("opnd_prev".into(), POINT_BITS));
+    items.push(Item::Assign(
+        id("opnd_prev"),
+        Expr::mux(id("ld_q_first"), tx_fine, id("rd_a")),
+    ));
+    items.push(Item::Wire("opnd_next".into(), POINT_BITS));
+    items.push(Item::Assign(
+        id("opnd_next"),
+        Expr::mux(id("ld_q_last"), rx_fine, id("rd_b")),
+    ));
+    for j in 0..k {
+        items.push(Item::Assign(
+            id(&format!("pe_load_{j}")),
+            state_is(S_LOAD)
+                .and(id("ld_q_en"))
+                .and(id("ld_q_inst").eq(lit(ib, j.into()))),
+        ));
+    }
 
     // Main FSM.
     let k_cnt = lit(cnt_bits, k.into());

@@ -112,4 +112,7 @@ fn synthesis_smoke_test_reports_cell_counts() {
     assert!(synth.logic_cells > 100, "{synth:?}");
     assert!(synth.registers > 100, "{synth:?}");
     assert!(synth.percent_of_ep4ce115 > 0.0 && synth.percent_of_ep4ce115 < 100.0);
+    // The point memory (two copies of 8 x 120 bits) is inferred into M9K, not registers.
+    assert!(synth.m9k_blocks > 0, "{synth:?}");
+    assert_eq!(synth.memory_bits, 2 * 8 * 120, "{synth:?}");
 }

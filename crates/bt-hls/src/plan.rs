@@ -1,0 +1,115 @@
+//! Planning one accelerator run without writing RTL: the PE schedule of a scheduling problem
+//! and the exact cycle count it implies (`hls gen --plan-only`, one time step of a study).
+
+use bt_schedule::{Budget, GaParams, Problem, Schedule, ScheduleStats};
+
+use crate::HlsError;
+use crate::input::PE_LATENCY;
+
+/// Which scheduler places the jobs.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ScheduleKind {
+    /// The paper's three passes: GA, PE duplication, ASAP fill ([`bt_schedule::schedule_ga`]).
+    Ga,
+    /// The list scheduler, one PE per plane, no duplicate ([`bt_schedule::schedule_list`]).
+    List,
+}
+
+impl ScheduleKind {
+    /// Name in outputs (`ga`, `list`).
+    pub fn name(self) -> &'static str {
+        match self {
+            ScheduleKind::Ga => "ga",
+            ScheduleKind::List => "list",
+        }
+    }
+}
+
+/// How to schedule.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct PlanOptions {
+    /// Scheduler.
+    pub schedule: ScheduleKind,
+    /// Total PE instances allowed; `None`: the planes used plus 25 % for duplicates. Never
+    /// below the planes used (one original PE each).
+    pub pe_budget: Option<u32>,
+    /// GA parameters (seed included); ignored by the list scheduler.
+    pub ga: GaParams,
+}
+
+/// A scheduled run: the schedule, its statistics and its cycle count.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Plan {
+    /// The schedule (legal for the problem: checked).
+    pub schedule: Schedule,
+    /// Its statistics.
+    pub stats: ScheduleStats,
+    /// Makespan of the list schedule with one PE per plane, slots (the baseline).
+    pub list_makespan: u32,
+    /// The PE budget applied.
+    pub pe_budget: u32,
+    /// Path points (the point memory initialised before the first slot).
+    pub points: u64,
+    /// Cycles of one schedule slot ([`cycles_per_slot`]).
+    pub cycles_per_slot: u64,
+    /// Cycles from start to done ([`run_cycles`]): what the `CYCLES` register will read.
+    pub predicted_cycles: u64,
+}
+
+/// Cycles of one schedule slot with `instances` PE instances: load operands (instances + 1),
+/// run the PEs ([`PE_LATENCY`]), write back (instances + 1).
+pub fn cycles_per_slot(instances: u32) -> u64 {
+    2 * (u64::from(instances) + 1) + u64::from(PE_LATENCY)
+}
+
+/// Cycles of one accelerator run (the `CYCLES` register): initialise the point memory (one
+/// point per cycle), then `makespan` slots of [`cycles_per_slot`].
+pub fn run_cycles(points: u64, instances: u32, makespan: u32) -> u64 {
+    points + u64::from(makespan) * cycles_per_slot(instances)
+}
+
+/// Schedule `problem` (from [`crate::HlsInput::problem`] or
+/// [`crate::HlsInput::problem_for`]) and predict the run's cycles. Deterministic for the
+/// options (the GA is seeded).
+pub fn plan(problem: &Problem, options: &PlanOptions) -> Result<Plan, HlsError> {
+    let planes_used = {
+        let mut used: Vec<u32> = problem
+            .paths
+            .iter()
+            .flat_map(|p| p.planes.iter().copied())
+            .collect();
+        used.sort_unstable();
+        used.dedup();
+        used.len() as u32
+    };
+    let budget = Budget {
+        max_instances: options
+            .pe_budget
+            .unwrap_or(planes_used + planes_used / 4)
+            .max(planes_used),
+    };
+    let list = bt_schedule::schedule_list(
+        problem,
+        &Budget {
+            max_instances: planes_used,
+        },
+    )?;
+    let list_makespan = list.stats(problem).makespan;
+    let schedule = match options.schedule {
+        ScheduleKind::List => list,
+        ScheduleKind::Ga => bt_schedule::schedule_ga(problem, &budget, &options.ga)?,
+    };
+    schedule.check(problem)?;
+    let stats = schedule.stats(problem);
+    let points: u64 = problem.paths.iter().map(|p| p.planes.len() as u64).sum();
+    Ok(Plan {
+        predicted_cycles: run_cycles(points, stats.instances, stats.makespan),
+        cycles_per_slot: cycles_per_slot(stats.instances),
+        schedule,
+        stats,
+        list_makespan,
+        pe_budget: budget.max_instances,
+        points,
+    })
+}
