@@ -48,6 +48,47 @@ pub enum StudyCommand {
     /// (writes results.csv, summary.md and Figs. 5-7 as SVG and PNG into --out).
     #[command(name = "2d")]
     TwoD(Study2dArgs),
+    /// Section VI: the dynamic living room (a person walks, a door opens) at every time step,
+    /// image method vs IPC vs SBR vs the FPGA's fixed-point IPC with per-step cycle counts
+    /// (writes results.csv, fpga.csv, summary.md and Figs. 17-19 as SVG and PNG into --out).
+    LivingRoom(StudyLivingRoomArgs),
+}
+
+#[derive(Debug, Args, Clone)]
+pub struct StudyLivingRoomArgs {
+    /// Output directory (created if missing).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// The dynamic scene whose time steps are traced (a scene file with steps, or builtin:NAME).
+    #[arg(long, default_value = "builtin:living-room-dynamic")]
+    pub steps_from: String,
+    /// SBR grid step over the whole sphere, degrees (the paper: 1, i.e. 64,800 rays).
+    #[arg(long, default_value_t = 1.0)]
+    pub sbr_step_deg: f64,
+    /// Highest reflection order.
+    #[arg(long, default_value_t = 3)]
+    pub max_order: usize,
+    /// PE scheduler of each step's accelerator.
+    #[arg(long, value_enum, default_value_t = ScheduleArg::Ga)]
+    pub schedule: ScheduleArg,
+    /// GA seed (echoed into the outputs).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// GA chromosomes per generation (hls gen uses 12).
+    #[arg(long, default_value_t = 4)]
+    pub ga_population: u32,
+    /// GA generations after the initial population (hls gen uses 12).
+    #[arg(long, default_value_t = 2)]
+    pub ga_generations: u32,
+    /// Total PE instances per step (default: planes used + 25 % for duplicates).
+    #[arg(long)]
+    pub pe_budget: Option<u32>,
+    /// Fixed-point convergence threshold on a round's largest displacement, in 1/256 mm.
+    #[arg(long, default_value_t = 16)]
+    pub threshold_lsb: u32,
+    /// Round cap of the fixed-point IPC.
+    #[arg(long, default_value_t = 256)]
+    pub max_rounds: u32,
 }
 
 #[derive(Debug, Args, Clone)]
@@ -122,6 +163,14 @@ pub enum IpcOrderArg {
     Jacobi,
 }
 
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum IpcAccelArg {
+    /// The paper's rounds alone.
+    None,
+    /// The paper's rounds until nearly settled, then Newton steps on the reflection law.
+    Newton,
+}
+
 #[derive(Debug, Args, Clone)]
 pub struct TraceArgs {
     #[command(flatten)]
@@ -142,6 +191,9 @@ pub struct TraceArgs {
     /// IPC round cap.
     #[arg(long, default_value_t = bt_solve::ipc::DEFAULT_MAX_ITERATIONS)]
     pub ipc_max_iterations: u32,
+    /// IPC acceleration once the rounds have nearly settled (none = the paper's IPC).
+    #[arg(long, value_enum, default_value_t = IpcAccelArg::None)]
+    pub ipc_accel: IpcAccelArg,
     /// SBR: azimuth × elevation grid step, degrees (default 1, i.e. 360 × 180 rays).
     #[arg(long, conflicts_with = "sbr_rays")]
     pub sbr_step_deg: Option<f64>,
@@ -234,6 +286,7 @@ impl DemoArgs {
             ipc_order: IpcOrderArg::GaussSeidel,
             ipc_threshold: None,
             ipc_max_iterations: bt_solve::ipc::DEFAULT_MAX_ITERATIONS,
+            ipc_accel: IpcAccelArg::None,
             sbr_step_deg: None,
             sbr_rays: None,
             sbr_planar: false,
@@ -343,6 +396,15 @@ pub enum ScheduleArg {
     List,
 }
 
+impl ScheduleArg {
+    pub fn kind(self) -> bt_hls::ScheduleKind {
+        match self {
+            ScheduleArg::Ga => bt_hls::ScheduleKind::Ga,
+            ScheduleArg::List => bt_hls::ScheduleKind::List,
+        }
+    }
+}
+
 #[derive(Debug, Args, Clone)]
 pub struct HlsGenArgs {
     #[command(flatten)]
@@ -371,4 +433,8 @@ pub struct HlsGenArgs {
     /// Model and schedule only (cycle counts, errors): skip writing RTL (for large scenes).
     #[arg(long)]
     pub plan_only: bool,
+    /// Every time step of a dynamic scene: one accelerator (or, with --plan-only, schedule)
+    /// per step into OUTPUT/step-<k>/, per-step cycle counts into OUTPUT/steps.json.
+    #[arg(long)]
+    pub steps: bool,
 }

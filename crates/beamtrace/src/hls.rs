@@ -1,18 +1,18 @@
 //! `beamtrace hls`: scene -> fixed-point model -> PE schedule -> Verilog, and `hls sim` /
 //! `hls synth` on a generated directory.
 
-use crate::args::{HlsArgs, HlsCommand, HlsGenArgs, ScheduleArg};
+use crate::args::{HlsArgs, HlsCommand, HlsGenArgs};
 use anyhow::{Context, bail};
-use bt_hls::{HlsInput, PE_LATENCY, PlaneSpec};
+use bt_hls::{HlsInput, PlanOptions};
 use bt_paths::AllVisible;
 use bt_scene::Scene;
-use bt_schedule::{Budget, GaParams, Problem, Schedule};
+use bt_schedule::{GaParams, Problem};
 use serde::Serialize;
 use std::path::Path;
 use std::process::ExitCode;
 
 /// Clock of the paper's platform (Cyclone IV E at 50 MHz), Hz.
-pub const CLOCK_HZ: f64 = 50e6;
+pub const CLOCK_HZ: f64 = bt_study::living_room::CLOCK_HZ;
 
 pub fn run(args: &HlsArgs) -> anyhow::Result<ExitCode> {
     match &args.command {
@@ -52,7 +52,10 @@ pub fn run(args: &HlsArgs) -> anyhow::Result<ExitCode> {
             );
             println!("  logic cells      {:>10}", r.logic_cells);
             println!("  registers        {:>10}", r.registers);
-            println!("  memory bits      {:>10}", r.memory_bits);
+            println!(
+                "  memory bits      {:>10}   ({} M9K blocks)",
+                r.memory_bits, r.m9k_blocks
+            );
             println!(
                 "  share of EP4CE115 {:>9.2} %   (paper, Table III: IPC 4 %-43 % of LEs)",
                 r.percent_of_ep4ce115
@@ -66,6 +69,9 @@ pub fn run(args: &HlsArgs) -> anyhow::Result<ExitCode> {
 #[derive(Debug, Serialize)]
 pub struct HlsSummary {
     pub scene: String,
+    /// Time step of a dynamic scene (`hls gen --steps`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub step: Option<usize>,
     pub max_order: usize,
     pub planes: usize,
     pub paths: usize,
@@ -91,62 +97,6 @@ pub struct FixedError {
     pub max_angle_error_tx_deg: f64,
     pub max_angle_error_rx_deg: f64,
     pub not_converged: usize,
-}
-
-/// The HLS input of a scene: one plane per reflector (PE `bt_pe_<i>`), every candidate path of
-/// order >= 1 up to `max_order`, initial points at the polygon centroids.
-pub fn hls_input(
-    scene: &Scene,
-    max_order: usize,
-    threshold_lsb: u32,
-    max_rounds: u32,
-) -> (HlsInput, Vec<usize>) {
-    let reflectors: Vec<_> = scene.reflectors().collect();
-    let index_of = |id: bt_scene::SurfaceId| {
-        reflectors
-            .iter()
-            .position(|r| *r == id)
-            .expect("candidates use reflectors") as u32
-    };
-    let candidates = bt_paths::enumerate(scene, max_order, &AllVisible);
-    let mut paths = Vec::new();
-    let mut init_points = Vec::new();
-    let mut candidate_index = Vec::new();
-    for (i, seq) in candidates.iter().enumerate() {
-        if seq.is_empty() {
-            continue;
-        }
-        paths.push(seq.iter().map(|id| index_of(*id)).collect());
-        init_points.push(
-            seq.iter()
-                .map(|id| scene.surface(*id).polygon.centroid().to_array())
-                .collect(),
-        );
-        candidate_index.push(i);
-    }
-    let planes = reflectors
-        .iter()
-        .map(|id| {
-            let s = scene.surface(*id);
-            let p = s.polygon.plane();
-            PlaneSpec {
-                name: s.name.clone(),
-                normal: p.normal.to_array(),
-                offset_m: p.offset,
-            }
-        })
-        .collect();
-    let input = HlsInput {
-        planes,
-        paths,
-        init_points,
-        tx: scene.tx().to_array(),
-        rx: scene.rx().to_array(),
-        threshold_lsb,
-        max_rounds,
-        test_vectors: Vec::new(),
-    };
-    (input, candidate_index)
 }
 
 fn fixed_error(scene: &Scene, input: &HlsInput, max_order: usize) -> anyhow::Result<FixedError> {
@@ -194,97 +144,159 @@ fn fixed_error(scene: &Scene, input: &HlsInput, max_order: usize) -> anyhow::Res
 }
 
 fn generate(args: &HlsGenArgs) -> anyhow::Result<ExitCode> {
-    let loaded = crate::trace::load_scene(&args.scene)?;
-    let scene = loaded.scene;
     if args.max_order == 0 {
         bail!("--max-order must be at least 1 (line of sight needs no accelerator)");
     }
-    let (input, _) = hls_input(&scene, args.max_order, args.threshold_lsb, args.max_rounds);
-    if input.paths.is_empty() {
-        bail!(
-            "{}: no candidate reflection paths up to order {}",
-            args.scene.scene,
-            args.max_order
+    if args.steps {
+        return generate_steps(args);
+    }
+    let loaded = crate::trace::load_scene(&args.scene)?;
+    let summary = generate_one(&loaded.scene, None, args, &args.output)?;
+    print_summary(&summary, &args.output);
+    Ok(ExitCode::SUCCESS)
+}
+
+/// `hls gen --steps`: one accelerator (or schedule) per time step into `DIR/step-<k>/`, and
+/// the per-step cycle counts in `DIR/steps.json`.
+fn generate_steps(args: &HlsGenArgs) -> anyhow::Result<ExitCode> {
+    let dynamic = crate::steps::load_dynamic(&args.scene)?;
+    std::fs::create_dir_all(&args.output)
+        .with_context(|| format!("creating {}", args.output.display()))?;
+    let mut summaries = Vec::with_capacity(dynamic.len());
+    println!(
+        "{:>4} {:>6} {:>7} {:>9} {:>9} {:>12} {:>10}  directory",
+        "step", "paths", "points", "instances", "makespan", "cycles", "ms@50MHz"
+    );
+    for (k, scene) in dynamic.scenes().iter().enumerate() {
+        let dir = args.output.join(format!("step-{k}"));
+        let s = generate_one(scene, Some(k), args, &dir)?;
+        println!(
+            "{:>4} {:>6} {:>7} {:>9} {:>9} {:>12} {:>10.3}  {}",
+            k,
+            s.paths,
+            s.points,
+            s.stats.instances,
+            s.stats.makespan,
+            s.predicted_cycles,
+            s.latency_s_at_50mhz * 1e3,
+            dir.display()
         );
+        summaries.push(s);
+    }
+    let total: u64 = summaries.iter().map(|s| s.predicted_cycles).sum();
+    let doc = StepsSummary {
+        scene: dynamic.step(0).name().to_string(),
+        max_order: args.max_order,
+        schedule: args.schedule.kind().name(),
+        seed: args.seed,
+        clock_hz: CLOCK_HZ,
+        rtl_written: !args.plan_only,
+        cycles: summaries.iter().map(|s| s.predicted_cycles).collect(),
+        steps: summaries,
+    };
+    write(
+        &args.output.join("steps.json"),
+        &serde_json::to_string_pretty(&doc)?,
+    )?;
+    println!(
+        "{} steps: {} cycles in all, mean {:.3} ms per step at 50 MHz; wrote {}/steps.json{}",
+        doc.steps.len(),
+        total,
+        total as f64 / doc.steps.len().max(1) as f64 / CLOCK_HZ * 1e3,
+        args.output.display(),
+        if args.plan_only {
+            " and step-<k>/{schedule,summary}.json (--plan-only: no RTL)"
+        } else {
+            " and step-<k>/ (RTL, testbench, summary.json)"
+        }
+    );
+    Ok(ExitCode::SUCCESS)
+}
+
+/// What `hls gen --steps` writes as `DIR/steps.json`.
+#[derive(Debug, Serialize)]
+pub struct StepsSummary {
+    pub scene: String,
+    pub max_order: usize,
+    pub schedule: &'static str,
+    pub seed: u64,
+    pub clock_hz: f64,
+    pub rtl_written: bool,
+    /// Predicted `CYCLES` per step (Fig. 19 of the paper), step 0 first.
+    pub cycles: Vec<u64>,
+    pub steps: Vec<HlsSummary>,
+}
+
+/// Model, schedule and (unless `--plan-only`) RTL of one scene into `out`.
+fn generate_one(
+    scene: &Scene,
+    step: Option<usize>,
+    args: &HlsGenArgs,
+    out: &Path,
+) -> anyhow::Result<HlsSummary> {
+    let (input, _) =
+        bt_study::fpga::hls_input(scene, args.max_order, args.threshold_lsb, args.max_rounds);
+    if input.paths.is_empty() {
+        match step {
+            Some(k) => bail!(
+                "{} step {k}: no candidate reflection paths up to order {}",
+                args.scene.scene,
+                args.max_order
+            ),
+            None => bail!(
+                "{}: no candidate reflection paths up to order {}",
+                args.scene.scene,
+                args.max_order
+            ),
+        }
     }
     let problem: Problem = input.problem()?;
-    let planes_used = {
-        let mut used: Vec<u32> = problem
-            .paths
-            .iter()
-            .flat_map(|p| p.planes.iter().copied())
-            .collect();
-        used.sort_unstable();
-        used.dedup();
-        used.len() as u32
-    };
-    let budget = Budget {
-        max_instances: args
-            .pe_budget
-            .unwrap_or(planes_used + planes_used / 4)
-            .max(planes_used),
-    };
-    let list = bt_schedule::schedule_list(
+    let plan = bt_hls::plan(
         &problem,
-        &Budget {
-            max_instances: planes_used,
-        },
-    )?;
-    let schedule: Schedule = match args.schedule {
-        ScheduleArg::List => list.clone(),
-        ScheduleArg::Ga => bt_schedule::schedule_ga(
-            &problem,
-            &budget,
-            &GaParams {
+        &PlanOptions {
+            schedule: args.schedule.kind(),
+            pe_budget: args.pe_budget,
+            ga: GaParams {
                 seed: args.seed,
                 ..GaParams::default()
             },
-        )?,
-    };
-    schedule.check(&problem)?;
-    let stats = schedule.stats(&problem);
-    let points: usize = input.paths.iter().map(Vec::len).sum();
-    let cycles_per_slot = 2 * (stats.instances as u64 + 1) + PE_LATENCY as u64;
-    let predicted_cycles = points as u64 + stats.makespan as u64 * cycles_per_slot;
-    let fixed = fixed_error(&scene, &input, args.max_order)?;
-    std::fs::create_dir_all(&args.output)
-        .with_context(|| format!("creating {}", args.output.display()))?;
+        },
+    )?;
+    let fixed = fixed_error(scene, &input, args.max_order)?;
+    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let rtl_written = !args.plan_only;
     if rtl_written {
-        let report = bt_hls::generate(&input, &schedule, &args.output)?;
-        debug_assert_eq!(report.predicted_cycles, predicted_cycles);
+        let report = bt_hls::generate(&input, &plan.schedule, out)?;
+        debug_assert_eq!(report.predicted_cycles, plan.predicted_cycles);
     } else {
         write(
-            &args.output.join("schedule.json"),
-            &serde_json::to_string(&schedule)?,
+            &out.join("schedule.json"),
+            &serde_json::to_string(&plan.schedule)?,
         )?;
     }
     let summary = HlsSummary {
         scene: scene.name().to_string(),
+        step,
         max_order: args.max_order,
         planes: input.planes.len(),
         paths: input.paths.len(),
-        points,
-        schedule: match args.schedule {
-            ScheduleArg::Ga => "ga",
-            ScheduleArg::List => "list",
-        },
+        points: plan.points as usize,
+        schedule: args.schedule.kind().name(),
         seed: args.seed,
-        pe_budget: budget.max_instances,
-        list_makespan: list.stats(&problem).makespan,
-        stats,
-        cycles_per_slot,
-        predicted_cycles,
-        latency_s_at_50mhz: predicted_cycles as f64 / CLOCK_HZ,
+        pe_budget: plan.pe_budget,
+        list_makespan: plan.list_makespan,
+        stats: plan.stats,
+        cycles_per_slot: plan.cycles_per_slot,
+        predicted_cycles: plan.predicted_cycles,
+        latency_s_at_50mhz: plan.predicted_cycles as f64 / CLOCK_HZ,
         fixed_vs_f64: fixed,
         rtl_written,
     };
     write(
-        &args.output.join("summary.json"),
+        &out.join("summary.json"),
         &serde_json::to_string_pretty(&summary)?,
     )?;
-    print_summary(&summary, &args.output);
-    Ok(ExitCode::SUCCESS)
+    Ok(summary)
 }
 
 fn write(path: &Path, text: &str) -> anyhow::Result<()> {

@@ -39,6 +39,9 @@ fn run(cli: args::Cli) -> anyhow::Result<ExitCode> {
         args::Command::Study {
             command: args::StudyCommand::TwoD(a),
         } => study::run_2d(&a),
+        args::Command::Study {
+            command: args::StudyCommand::LivingRoom(a),
+        } => study::run_living_room(&a),
     }
 }
 

@@ -1,8 +1,9 @@
-//! `beamtrace study 2d`: run the 2-D validation study with a progress bar and write its
-//! outputs (the study itself lives in `bt-study`).
+//! `beamtrace study 2d` and `study living-room`: run a study with a progress bar and write
+//! its outputs (the studies themselves live in `bt-study`).
 
-use crate::args::Study2dArgs;
+use crate::args::{SceneArgs, Study2dArgs, StudyLivingRoomArgs};
 use anyhow::Context;
+use bt_study::living_room::{self, LivingRoomConfig};
 use bt_study::{StudyConfig, report};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::io::Write;
@@ -43,6 +44,64 @@ pub fn run_2d(args: &Study2dArgs) -> anyhow::Result<ExitCode> {
         r.sbr_error_deg,
         r.ipc_error_deg,
         r.sbr_over_ipc_error
+    );
+    for f in files {
+        let _ = writeln!(stdout, "wrote {}", f.display());
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+pub fn run_living_room(args: &StudyLivingRoomArgs) -> anyhow::Result<ExitCode> {
+    let config = LivingRoomConfig {
+        scene: args.steps_from.clone(),
+        max_order: args.max_order,
+        sbr_step_deg: args.sbr_step_deg,
+        threshold_lsb: args.threshold_lsb,
+        max_rounds: args.max_rounds,
+        schedule: args.schedule.kind(),
+        seed: args.seed,
+        ga_population: args.ga_population,
+        ga_generations: args.ga_generations,
+        pe_budget: args.pe_budget,
+    };
+    let problems = config.problems();
+    if !problems.is_empty() {
+        anyhow::bail!("{}", problems.join("; "));
+    }
+    let scene = crate::steps::load_dynamic(&SceneArgs {
+        scene: args.steps_from.clone(),
+        tx: None,
+        rx: None,
+        min_reflector_area: 0.25,
+        merge_angle_deg: 1.0,
+        merge_distance: 1e-3,
+    })?;
+    let bar = ProgressBar::new(scene.len() as u64);
+    bar.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} time steps  {elapsed} (eta {eta})")
+            .context("progress bar template")?,
+    );
+    bar.tick();
+    let results = bt_study::living_room::run(&scene, &config, &mut |done, _| {
+        bar.set_position(done as u64)
+    })?;
+    bar.finish_and_clear();
+    let files = bt_study::io::write_living_room(&args.out, &results)?;
+    let h = living_room::report::headline(&results);
+    let mut stdout = std::io::stdout().lock();
+    let _ = writeln!(
+        stdout,
+        "{} × {} steps, order <= {}: FPGA IPC error {:.3e}° / {:.3e}° (TX / RX), SBR {:.3e}° / {:.3e}° (ratio {:.2e}); FPGA {:.3} ms per step at 50 MHz; SBR/IPC CPU time {:.3}",
+        results.scene_name,
+        results.steps,
+        config.max_order,
+        h.fixed_err_deg[0],
+        h.fixed_err_deg[1],
+        h.sbr_err_deg[0],
+        h.sbr_err_deg[1],
+        h.sbr_over_fixed_error,
+        h.fpga_mean_latency_s * 1e3,
+        h.sbr_over_ipc_time
     );
     for f in files {
         let _ = writeln!(stdout, "wrote {}", f.display());

@@ -1,12 +1,12 @@
 //! `beamtrace trace`, `demo` and `scene check`.
 
-use crate::args::{IpcOrderArg, SceneArgs, SolverArg, TraceArgs};
+use crate::args::{IpcAccelArg, IpcOrderArg, SceneArgs, SolverArg, TraceArgs};
 use crate::output::{self, TraceDocument};
 use anyhow::{Context, bail};
 use bt_paths::AllVisible;
 use bt_scene::io::{LoadOptions, Loaded};
 use bt_scene::{Scene, SceneError, Terminals};
-use bt_solve::{IpcOptions, SbrOptions, Solver, UpdateOrder};
+use bt_solve::{Acceleration, IpcOptions, SbrOptions, Solver, UpdateOrder};
 use std::path::Path;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -85,6 +85,10 @@ pub fn solver_for(args: &TraceArgs, scene: &Scene) -> anyhow::Result<Solver> {
                 bail!("--ipc-max-iterations must be at least 1");
             }
             options.max_iterations = args.ipc_max_iterations;
+            options.acceleration = match args.ipc_accel {
+                IpcAccelArg::None => Acceleration::None,
+                IpcAccelArg::Newton => Acceleration::Newton,
+            };
             Solver::Ipc(options)
         }
         SolverArg::Sbr => {

@@ -10,11 +10,18 @@ fn repo() -> PathBuf {
 }
 
 fn testdata(name: &str) -> String {
-    repo().join("testdata/scenes").join(name).display().to_string()
+    repo()
+        .join("testdata/scenes")
+        .join(name)
+        .display()
+        .to_string()
 }
 
 fn beamtrace(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_beamtrace")).args(args).output().expect("binary runs")
+    Command::new(env!("CARGO_BIN_EXE_beamtrace"))
+        .args(args)
+        .output()
+        .expect("binary runs")
 }
 
 fn stdout(o: &Output) -> String {
@@ -39,7 +46,10 @@ fn trace_json(args: &[&str]) -> Value {
 fn assert_clear_error(args: &[&str], needles: &[&str]) {
     let o = beamtrace(args);
     let code = o.status.code();
-    assert!(code.is_some() && code != Some(0) && code != Some(101), "{args:?}: exit {code:?}");
+    assert!(
+        code.is_some() && code != Some(0) && code != Some(101),
+        "{args:?}: exit {code:?}"
+    );
     let text = format!("{}{}", stdout(&o), stderr(&o));
     assert!(!text.contains("panicked"), "{args:?} panicked: {text}");
     for n in needles {
@@ -69,8 +79,14 @@ fn golden_json_of_the_builtin_scene() {
     if std::env::var_os("UPDATE_GOLDEN").is_some() {
         std::fs::write(&golden, &text).unwrap();
     }
-    let expected = std::fs::read_to_string(&golden).expect("golden file exists (UPDATE_GOLDEN=1 writes it)");
-    assert_eq!(text, expected, "output differs from {}; rerun with UPDATE_GOLDEN=1 if intended", golden.display());
+    let expected =
+        std::fs::read_to_string(&golden).expect("golden file exists (UPDATE_GOLDEN=1 writes it)");
+    assert_eq!(
+        text,
+        expected,
+        "output differs from {}; rerun with UPDATE_GOLDEN=1 if intended",
+        golden.display()
+    );
 }
 
 #[test]
@@ -79,15 +95,23 @@ fn json_document_has_the_documented_fields() {
     let paths = doc["paths"].as_array().unwrap();
     assert!(!paths.is_empty());
     for p in paths {
-        for field in ["order", "surfaces", "points", "length_m", "delay_s", "aod_deg", "aoa_deg", "loss_db"] {
+        for field in [
+            "order", "surfaces", "points", "length_m", "delay_s", "aod_deg", "aoa_deg", "loss_db",
+        ] {
             assert!(p.get(field).is_some(), "path lacks {field}");
         }
-        assert_eq!(p["points"].as_array().unwrap().len(), p["order"].as_u64().unwrap() as usize);
+        assert_eq!(
+            p["points"].as_array().unwrap().len(),
+            p["order"].as_u64().unwrap() as usize
+        );
         assert!(p["aod_deg"]["azimuth"].is_f64() && p["aoa_deg"]["elevation"].is_f64());
     }
     let stats = &doc["stats"];
     assert_eq!(stats["valid_paths"].as_u64().unwrap() as usize, paths.len());
-    assert!(stats["candidates"]["generated"].as_u64().unwrap() >= stats["candidates"]["candidates"].as_u64().unwrap());
+    assert!(
+        stats["candidates"]["generated"].as_u64().unwrap()
+            >= stats["candidates"]["candidates"].as_u64().unwrap()
+    );
     assert!(stats["time_s"]["solve"].is_f64());
 }
 
@@ -95,12 +119,26 @@ fn json_document_has_the_documented_fields() {
 fn ipc_orders_agree_with_the_image_method_through_the_cli() {
     let image = trace_json(&["builtin:living-room"]);
     for order in ["gauss-seidel", "jacobi"] {
-        let ipc = trace_json(&["builtin:living-room", "--solver", "ipc", "--ipc-order", order]);
-        let (a, b) = (image["paths"].as_array().unwrap(), ipc["paths"].as_array().unwrap());
+        let ipc = trace_json(&[
+            "builtin:living-room",
+            "--solver",
+            "ipc",
+            "--ipc-order",
+            order,
+        ]);
+        let (a, b) = (
+            image["paths"].as_array().unwrap(),
+            ipc["paths"].as_array().unwrap(),
+        );
         assert_eq!(a.len(), b.len(), "{order}");
         for (p, q) in a.iter().zip(b) {
             assert_eq!(p["surfaces"], q["surfaces"]);
-            for (x, y) in p["points"].as_array().unwrap().iter().zip(q["points"].as_array().unwrap()) {
+            for (x, y) in p["points"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .zip(q["points"].as_array().unwrap())
+            {
                 for i in 0..3 {
                     let d = (x[i].as_f64().unwrap() - y[i].as_f64().unwrap()).abs();
                     assert!(d < 1e-9, "{order}: {d}");
@@ -143,7 +181,14 @@ fn meshes_import_and_trace_like_the_equivalent_scene() {
     assert_eq!(obj["paths"].as_array().unwrap().len(), 63);
     let (a, b) = (without_timings(ascii), without_timings(binary));
     assert_eq!(a["paths"], b["paths"]);
-    let lengths = |v: &Value| v["paths"].as_array().unwrap().iter().map(|p| p["length_m"].as_f64().unwrap()).collect::<Vec<_>>();
+    let lengths = |v: &Value| {
+        v["paths"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|p| p["length_m"].as_f64().unwrap())
+            .collect::<Vec<_>>()
+    };
     for (x, y) in lengths(&obj).iter().zip(lengths(&a)) {
         assert!((x - y).abs() < 1e-9);
     }
@@ -154,7 +199,15 @@ fn scene_check_reports_every_problem() {
     let o = beamtrace(&["scene", "check", &testdata("bad-scene.toml")]);
     assert_eq!(o.status.code(), Some(1), "{}", stderr(&o));
     let out = stdout(&o);
-    for needle in ["bent-quad", "not planar", "zero area", "duplicate surface name", "unknown material", "tx: missing", "rx: coordinates must be finite"] {
+    for needle in [
+        "bent-quad",
+        "not planar",
+        "zero area",
+        "duplicate surface name",
+        "unknown material",
+        "tx: missing",
+        "rx: coordinates must be finite",
+    ] {
         assert!(out.contains(needle), "report lacks {needle:?}:\n{out}");
     }
 }
@@ -175,9 +228,15 @@ fn bad_inputs_give_clear_errors() {
         std::fs::write(&p, text).unwrap();
         p.display().to_string()
     };
-    let malformed = write("malformed.json", "{ \"tx\": [0, 0, 1],\n  \"surfaces\": [ }");
+    let malformed = write(
+        "malformed.json",
+        "{ \"tx\": [0, 0, 1],\n  \"surfaces\": [ }",
+    );
     assert_clear_error(&["trace", &malformed], &["malformed.json", "line 2"]);
-    let unknown = write("unknown.json", r#"{ "tx": [0,0,1], "rx": [1,0,1], "surfacez": [] }"#);
+    let unknown = write(
+        "unknown.json",
+        r#"{ "tx": [0,0,1], "rx": [1,0,1], "surfacez": [] }"#,
+    );
     assert_clear_error(&["trace", &unknown], &["unknown field `surfacez`"]);
     let no_tx = write("no-tx.json", r#"{ "rx": [1,0,1] }"#);
     assert_clear_error(&["trace", &no_tx], &["tx: missing"]);
@@ -189,13 +248,32 @@ fn bad_inputs_give_clear_errors() {
     );
     assert_clear_error(&["trace", &on_wall], &["tx: lies on surface \"w\""]);
     let bad_obj = write("bad.obj", "v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2 7\n");
-    assert_clear_error(&["trace", &bad_obj, "--tx", "0,0,1", "--rx", "1,1,1"], &["bad.obj", "line 4"]);
+    assert_clear_error(
+        &["trace", &bad_obj, "--tx", "0,0,1", "--rx", "1,1,1"],
+        &["bad.obj", "line 4"],
+    );
     let garbage = write("garbage.obj", "v 0 0 zero\n");
-    assert_clear_error(&["trace", &garbage, "--tx", "0,0,1", "--rx", "1,1,1"], &["garbage.obj", "line 1"]);
-    assert_clear_error(&["trace", &testdata("huge-claim.ply"), "--tx", "0,0,1", "--rx", "1,1,1"], &["huge-claim.ply", "3000000000"]);
+    assert_clear_error(
+        &["trace", &garbage, "--tx", "0,0,1", "--rx", "1,1,1"],
+        &["garbage.obj", "line 1"],
+    );
+    assert_clear_error(
+        &[
+            "trace",
+            &testdata("huge-claim.ply"),
+            "--tx",
+            "0,0,1",
+            "--rx",
+            "1,1,1",
+        ],
+        &["huge-claim.ply", "3000000000"],
+    );
     assert_clear_error(&["trace", &testdata("box-room.obj")], &["--tx"]);
     assert_clear_error(&["trace", "builtin:living-room", "--tx", "1,2"], &["X,Y,Z"]);
-    assert_clear_error(&["trace", "builtin:living-room", "--tx", "1,nan,2"], &["not finite"]);
+    assert_clear_error(
+        &["trace", "builtin:living-room", "--tx", "1,nan,2"],
+        &["not finite"],
+    );
     assert_clear_error(&["trace", "no/such/file.json"], &["no/such/file.json"]);
     assert_clear_error(&["trace", "scene.xyz"], &["unsupported scene format"]);
     std::fs::remove_dir_all(&dir).ok();

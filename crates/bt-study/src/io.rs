@@ -1,6 +1,7 @@
-//! The only module of the study that touches the filesystem: writes `results.csv`,
+//! The only module of the studies that touches the filesystem: writes `results.csv`,
 //! `summary.md` and the figures as SVG and PNG into an output directory.
 
+use crate::living_room::{self, LivingRoomResults};
 use crate::run::StudyResults;
 use crate::{StudyError, plot, report};
 use plotters::prelude::*;
@@ -75,5 +76,56 @@ pub fn write_outputs(dir: &Path, results: &StudyResults) -> Result<Vec<PathBuf>,
         .max(1) as u32;
     let size = (ROOM_CELL * cols, ROOM_CELL * drawings.len().max(1) as u32);
     figure!(out, dir, "fig5-rooms", size, plot::rooms, drawings);
+    Ok(out)
+}
+
+/// Write every output of the living-room study into `dir` (created if missing):
+/// `results.csv`, `fpga.csv`, `summary.md`, `fig17-angular-error`, `fig18-ray-directions` and
+/// `fig19-run-time` as SVG and PNG. Returns the files written.
+pub fn write_living_room(
+    dir: &Path,
+    results: &LivingRoomResults,
+) -> Result<Vec<PathBuf>, StudyError> {
+    std::fs::create_dir_all(dir).map_err(|source| StudyError::Io {
+        path: dir.display().to_string(),
+        source,
+    })?;
+    let mut out = vec![
+        write(&dir.join("results.csv"), &living_room::report::csv(results))?,
+        write(
+            &dir.join("fpga.csv"),
+            &living_room::report::fpga_csv(results),
+        )?,
+        write(
+            &dir.join("summary.md"),
+            &living_room::report::summary(results),
+        )?,
+    ];
+    figure!(
+        out,
+        dir,
+        "fig17-angular-error",
+        (1200, 480),
+        living_room::plot::angular_error,
+        results
+    );
+    let rays = &results.rays;
+    let size = (1200, 420 * rays.len().max(1) as u32);
+    figure!(
+        out,
+        dir,
+        "fig18-ray-directions",
+        size,
+        living_room::plot::ray_directions,
+        rays
+    );
+    figure!(
+        out,
+        dir,
+        "fig19-run-time",
+        (1000, 560),
+        living_room::plot::run_time,
+        results
+    );
     Ok(out)
 }

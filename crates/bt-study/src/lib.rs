@@ -13,7 +13,9 @@
 //! `docs/study-2d.md` describes the method and the measured numbers.
 
 pub mod embed;
+pub mod fpga;
 pub mod io;
+pub mod living_room;
 pub mod plot;
 pub mod report;
 pub mod room;
@@ -44,6 +46,14 @@ pub enum StudyError {
         /// Scene name (`room-R-step-S`).
         name: String,
         /// The validation message.
+        message: String,
+    },
+    /// A time step of the living-room study failed (fixed-point model or scheduler).
+    #[error("step {step}: {message}")]
+    Step {
+        /// Time step, from 0.
+        step: usize,
+        /// What failed.
         message: String,
     },
     /// An output file could not be written.

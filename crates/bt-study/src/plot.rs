@@ -19,7 +19,7 @@ pub const ERROR_FLOOR_DEG: Real = 1e-15;
 pub const TIME_FLOOR_S: Real = 1e-7;
 
 const FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
-const FAMILY: &str = "sans-serif";
+pub(crate) const FAMILY: &str = "sans-serif";
 
 /// Register the shipped font as `sans-serif` (idempotent). Must run before drawing text.
 pub fn register_font() -> Result<(), String> {
@@ -31,7 +31,7 @@ pub fn register_font() -> Result<(), String> {
     .clone()
 }
 
-fn fail<E: std::fmt::Display>(e: E) -> String {
+pub(crate) fn fail<E: std::fmt::Display>(e: E) -> String {
     e.to_string()
 }
 
@@ -42,25 +42,48 @@ pub fn colour(solver: StudySolver) -> RGBColor {
         StudySolver::IpcGaussSeidel => RGBColor(31, 119, 180),
         StudySolver::IpcJacobi => RGBColor(44, 160, 44),
         StudySolver::Sbr => RGBColor(214, 39, 40),
+        StudySolver::IpcFixedPoint => RGBColor(148, 103, 189),
+    }
+}
+
+/// One line of a panel.
+pub(crate) struct Series {
+    /// Legend text.
+    pub(crate) label: String,
+    /// Line colour.
+    pub(crate) colour: RGBColor,
+    /// `(x, y)` points, x ascending.
+    pub(crate) points: Vec<(usize, Real)>,
+}
+
+impl Series {
+    /// A solver's series, in its colour and under its name.
+    pub(crate) fn of(solver: StudySolver, points: Vec<(usize, Real)>) -> Series {
+        Series {
+            label: solver.name().to_string(),
+            colour: colour(solver),
+            points,
+        }
     }
 }
 
 /// One panel: a line per series on a log y axis; `floor` clamps values (and zeros) from below.
-fn panel<DB: DrawingBackend>(
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn panel<DB: DrawingBackend>(
     area: &DrawingArea<DB, Shift>,
     title: &str,
     x_desc: &str,
     y_desc: &str,
-    series: &[(StudySolver, Vec<(usize, Real)>)],
+    series: &[Series],
     floor: Real,
     legend: SeriesLabelPosition,
 ) -> Result<(), String> {
-    let xs = series.iter().flat_map(|(_, p)| p.iter().map(|q| q.0));
+    let xs = series.iter().flat_map(|s| s.points.iter().map(|q| q.0));
     let (x_lo, x_hi) = xs.fold((usize::MAX, 0), |(lo, hi), x| (lo.min(x), hi.max(x)));
     let (x_lo, x_hi) = if x_lo > x_hi { (0, 1) } else { (x_lo, x_hi) };
     let ys = series
         .iter()
-        .flat_map(|(_, p)| p.iter().map(|q| q.1.max(floor)));
+        .flat_map(|s| s.points.iter().map(|q| q.1.max(floor)));
     let (y_lo, y_hi) = ys.fold((Real::INFINITY, floor), |(lo, hi), y| {
         (lo.min(y), hi.max(y))
     });
@@ -88,16 +111,17 @@ fn panel<DB: DrawingBackend>(
         .axis_desc_style((FAMILY, 14))
         .draw()
         .map_err(fail)?;
-    for (solver, points) in series {
-        let c = colour(*solver);
-        let line: Vec<(Real, Real)> = points
+    for s in series {
+        let c = s.colour;
+        let line: Vec<(Real, Real)> = s
+            .points
             .iter()
             .map(|&(x, y)| (x as Real, y.max(floor)))
             .collect();
         chart
             .draw_series(LineSeries::new(line, c.stroke_width(2)).point_size(3))
             .map_err(fail)?
-            .label(solver.name())
+            .label(s.label.as_str())
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
     }
     chart
@@ -116,11 +140,11 @@ fn selected(
     group: GroupBy,
     quantity: Quantity,
     solvers: &[StudySolver],
-) -> Vec<(StudySolver, Vec<(usize, Real)>)> {
+) -> Vec<Series> {
     let mut by = mean_by(&results.rows, group, quantity);
     solvers
         .iter()
-        .filter_map(|s| by.remove(s).map(|p| (*s, p)))
+        .filter_map(|s| by.remove(s).map(|p| Series::of(*s, p)))
         .collect()
 }
 

@@ -82,10 +82,13 @@ pub enum StudySolver {
     IpcJacobi,
     /// Shooting and bouncing rays.
     Sbr,
+    /// The accelerator: the bit-exact fixed-point IPC model of `bt-fixed` (Jacobi rounds,
+    /// millimetre words), line of sight checked on the host (living-room study only).
+    IpcFixedPoint,
 }
 
 impl StudySolver {
-    /// All solvers, in output order.
+    /// The solvers of the 2-D study, in output order.
     pub const ALL: [StudySolver; 4] = [
         StudySolver::Image,
         StudySolver::IpcGaussSeidel,
@@ -100,6 +103,7 @@ impl StudySolver {
             StudySolver::IpcGaussSeidel => "ipc-gauss-seidel",
             StudySolver::IpcJacobi => "ipc-jacobi",
             StudySolver::Sbr => "sbr",
+            StudySolver::IpcFixedPoint => "ipc-fixed-point",
         }
     }
 }
@@ -163,12 +167,15 @@ pub struct StudyResults {
 }
 
 /// A path reduced to what the comparison needs: unit departure and arrival directions.
-struct Directions {
-    departure: Vec3,
-    arrival: Vec3,
+pub(crate) struct Directions {
+    /// Unit direction the path leaves TX in.
+    pub(crate) departure: Vec3,
+    /// Unit direction, seen from RX, the path arrives from.
+    pub(crate) arrival: Vec3,
 }
 
-fn exact_directions(scene: &Scene, points: &[Vec3]) -> Directions {
+/// Departure and arrival directions of a path through `points` between the scene's TX and RX.
+pub(crate) fn exact_directions(scene: &Scene, points: &[Vec3]) -> Directions {
     let (tx, rx) = (scene.tx(), scene.rx());
     let first = points.first().copied().unwrap_or(rx);
     let last = points.last().copied().unwrap_or(tx);
@@ -184,10 +191,15 @@ pub fn angle_deg(a: Vec3, b: Vec3) -> Real {
     a.cross(b).length().atan2(a.dot(b)).to_degrees()
 }
 
-type PathMap = BTreeMap<Vec<SurfaceId>, Directions>;
+pub(crate) type PathMap = BTreeMap<Vec<SurfaceId>, Directions>;
 
-/// Trace one scene with one solver, timed; paths keyed by surface sequence.
-fn run_solver(scene: &Scene, solver: StudySolver, config: &StudyConfig) -> (PathMap, Real) {
+/// Trace one scene with one solver (image, IPC or SBR), timed; paths keyed by surface
+/// sequence.
+pub(crate) fn run_solver(
+    scene: &Scene,
+    solver: StudySolver,
+    config: &StudyConfig,
+) -> (PathMap, Real) {
     let start = Instant::now();
     if solver == StudySolver::Sbr {
         let result = sbr::trace_detailed(scene, &config.sbr_options(), config.max_order, false);
@@ -226,7 +238,10 @@ fn run_solver(scene: &Scene, solver: StudySolver, config: &StudyConfig) -> (Path
     (map, elapsed)
 }
 
-fn compare(reference: &PathMap, found: &PathMap) -> (usize, usize, usize, [Real; 4]) {
+/// Matched, missed and spurious paths of `found` against `reference`, and the mean and largest
+/// departure and arrival errors over the matched ones, degrees (`[mean TX, max TX, mean RX,
+/// max RX]`, zeros when nothing matched).
+pub(crate) fn compare(reference: &PathMap, found: &PathMap) -> (usize, usize, usize, [Real; 4]) {
     let mut tx = Vec::new();
     let mut rx = Vec::new();
     for (seq, d) in found {

@@ -1,0 +1,259 @@
+//! `beamtrace study living-room` and `beamtrace hls gen --steps` on a short version of the
+//! built-in dynamic living room (the same room, person and door, fewer steps): the CSV is
+//! consistent and the accuracy ordering of the paper holds (image exact, IPC ~1e-11°, the
+//! fixed-point accelerator < 0.1°, SBR visibly worse), the figures exist, and every step gets
+//! its own schedule with a positive cycle count.
+
+use serde_json::Value;
+use std::collections::BTreeMap;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+fn beamtrace(args: &[&str]) -> (bool, String, String) {
+    let o = Command::new(env!("CARGO_BIN_EXE_beamtrace"))
+        .args(args)
+        .output()
+        .expect("binary runs");
+    (
+        o.status.success(),
+        String::from_utf8_lossy(&o.stdout).into_owned(),
+        String::from_utf8_lossy(&o.stderr).into_owned(),
+    )
+}
+
+fn tmp(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("beamtrace-lr-{}-{name}", std::process::id()));
+    std::fs::create_dir_all(&dir).expect("temp dir");
+    dir
+}
+
+/// The built-in dynamic living room cut to `steps` steps: the person walks as before, the door
+/// opens by 10° per step.
+fn short_living_room(dir: &Path, steps: usize) -> String {
+    let source =
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../bt-scene/scenes/living-room-dynamic.json");
+    let mut scene: Value =
+        serde_json::from_str(&std::fs::read_to_string(source).expect("built-in scene")).unwrap();
+    scene["steps"] = steps.into();
+    scene["objects"]["door"]["keyframes"] = serde_json::json!([
+        { "step": 0, "angle_deg": 0 },
+        { "step": steps - 1, "angle_deg": 10 * (steps - 1) }
+    ]);
+    let path = dir.join(format!("living-room-{steps}-steps.json"));
+    std::fs::write(&path, serde_json::to_string_pretty(&scene).unwrap()).unwrap();
+    path.display().to_string()
+}
+
+#[test]
+fn study_living_room_writes_consistent_csv_and_figures() {
+    let dir = tmp("study");
+    let scene = short_living_room(&dir, 2);
+    let out = dir.join("out");
+    let (ok, stdout, stderr) = beamtrace(&[
+        "study",
+        "living-room",
+        "--out",
+        out.to_str().unwrap(),
+        "--steps-from",
+        &scene,
+        "--sbr-step-deg",
+        "5",
+        "--max-order",
+        "2",
+    ]);
+    assert!(ok, "{stdout}{stderr}");
+    assert!(stdout.contains("FPGA IPC error"), "{stdout}");
+
+    let csv = std::fs::read_to_string(out.join("results.csv")).expect("results.csv");
+    let mut lines = csv.lines();
+    let header: Vec<&str> = lines.next().expect("header").split(',').collect();
+    let col = |name: &str| header.iter().position(|h| *h == name).expect(name);
+    let rows: Vec<Vec<&str>> = lines.map(|l| l.split(',').collect()).collect();
+    assert_eq!(rows.len(), 2 * 5, "{csv}");
+    let mut by_solver: BTreeMap<&str, Vec<&Vec<&str>>> = BTreeMap::new();
+    for r in &rows {
+        assert_eq!(r.len(), header.len(), "{r:?}");
+        by_solver.entry(r[col("solver")]).or_default().push(r);
+    }
+    assert_eq!(
+        by_solver.keys().copied().collect::<Vec<_>>(),
+        [
+            "image",
+            "ipc-fixed-point",
+            "ipc-gauss-seidel",
+            "ipc-jacobi",
+            "sbr"
+        ]
+    );
+    let num = |r: &Vec<&str>, name: &str| -> f64 {
+        let v: f64 = r[col(name)]
+            .parse()
+            .unwrap_or_else(|_| panic!("{name}: {r:?}"));
+        assert!(v.is_finite() && v >= 0.0, "{name}: {r:?}");
+        v
+    };
+    let int = |r: &Vec<&str>, name: &str| -> usize { r[col(name)].parse().expect(name) };
+    for r in &rows {
+        // Every number finite; counts add up.
+        for name in [
+            "mean_err_tx_deg",
+            "max_err_tx_deg",
+            "mean_err_rx_deg",
+            "max_err_rx_deg",
+            "time_s",
+        ] {
+            num(r, name);
+        }
+        assert!(
+            num(r, "mean_err_tx_deg") <= num(r, "max_err_tx_deg"),
+            "{r:?}"
+        );
+        assert_eq!(
+            int(r, "matched") + int(r, "spurious"),
+            int(r, "paths"),
+            "{r:?}"
+        );
+        let step = r[col("step")];
+        let image = by_solver["image"]
+            .iter()
+            .find(|i| i[col("step")] == step)
+            .expect("image row");
+        assert_eq!(
+            int(r, "matched") + int(r, "missed"),
+            int(image, "paths"),
+            "{r:?}"
+        );
+        let has_fpga = !r[col("fpga_cycles")].is_empty();
+        assert_eq!(has_fpga, r[col("solver")] == "ipc-fixed-point", "{r:?}");
+        if has_fpga {
+            assert!(int(r, "fpga_cycles") > 0, "{r:?}");
+            let latency = num(r, "fpga_latency_s");
+            assert!(
+                (latency - int(r, "fpga_cycles") as f64 / 50e6).abs() <= 1e-12,
+                "{r:?}"
+            );
+        }
+    }
+    let max_err = |solver: &str| {
+        by_solver[solver]
+            .iter()
+            .map(|r| num(r, "max_err_tx_deg").max(num(r, "max_err_rx_deg")))
+            .fold(0.0, f64::max)
+    };
+    let mean_err = |solver: &str| {
+        by_solver[solver]
+            .iter()
+            .map(|r| num(r, "mean_err_tx_deg"))
+            .sum::<f64>()
+    };
+    assert_eq!(max_err("image"), 0.0);
+    assert!(max_err("ipc-gauss-seidel") < 1e-6, "{csv}");
+    assert!(max_err("ipc-jacobi") < 1e-6, "{csv}");
+    assert!(max_err("ipc-fixed-point") < 0.1, "{csv}");
+    assert!(mean_err("sbr") > 0.0, "{csv}");
+    assert!(mean_err("sbr") > mean_err("ipc-fixed-point"), "{csv}");
+    for r in &by_solver["image"] {
+        assert!(int(r, "paths") > 10, "{r:?}");
+    }
+
+    let fpga = std::fs::read_to_string(out.join("fpga.csv")).expect("fpga.csv");
+    assert_eq!(fpga.lines().count(), 1 + 2, "{fpga}");
+    let summary = std::fs::read_to_string(out.join("summary.md")).expect("summary.md");
+    assert!(
+        summary.contains("The paper's conclusions, measured"),
+        "{summary}"
+    );
+    for stem in [
+        "fig17-angular-error",
+        "fig18-ray-directions",
+        "fig19-run-time",
+    ] {
+        for ext in ["svg", "png"] {
+            let f = out.join(format!("{stem}.{ext}"));
+            let len = std::fs::metadata(&f).map(|m| m.len()).unwrap_or(0);
+            assert!(len > 1000, "{} missing or empty", f.display());
+        }
+    }
+    // Deterministic except the times: a second run gives the same errors and cycles.
+    let out2 = dir.join("out2");
+    let (ok, stdout, stderr) = beamtrace(&[
+        "study",
+        "living-room",
+        "--out",
+        out2.to_str().unwrap(),
+        "--steps-from",
+        &scene,
+        "--sbr-step-deg",
+        "5",
+        "--max-order",
+        "2",
+    ]);
+    assert!(ok, "{stdout}{stderr}");
+    let strip_times = |text: &str| -> Vec<String> {
+        text.lines()
+            .map(|l| {
+                let mut f: Vec<&str> = l.split(',').collect();
+                if f.len() == header.len() {
+                    f[col("time_s")] = "";
+                }
+                f.join(",")
+            })
+            .collect()
+    };
+    let again = std::fs::read_to_string(out2.join("results.csv")).unwrap();
+    assert_eq!(strip_times(&csv), strip_times(&again));
+    std::fs::remove_dir_all(&dir).ok();
+}
+
+#[test]
+fn hls_gen_steps_plans_every_step() {
+    let dir = tmp("hls");
+    let scene = short_living_room(&dir, 3);
+    let out = dir.join("out");
+    let (ok, stdout, stderr) = beamtrace(&[
+        "hls",
+        "gen",
+        &scene,
+        "--steps",
+        "--plan-only",
+        "--max-order",
+        "2",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert!(ok, "{stdout}{stderr}");
+    let doc: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("steps.json")).unwrap()).unwrap();
+    let steps = doc["steps"].as_array().expect("steps");
+    assert_eq!(steps.len(), 3, "{doc}");
+    assert_eq!(doc["cycles"].as_array().map(Vec::len), Some(3), "{doc}");
+    assert_eq!(doc["rtl_written"], false);
+    for (k, s) in steps.iter().enumerate() {
+        assert_eq!(s["step"], k, "{s}");
+        let cycles = s["predicted_cycles"].as_u64().expect("cycles");
+        assert!(cycles > 0, "{s}");
+        assert_eq!(doc["cycles"][k], cycles);
+        assert!(
+            s["fixed_vs_f64"]["max_angle_error_tx_deg"]
+                .as_f64()
+                .unwrap()
+                < 0.1,
+            "{s}"
+        );
+        let step_dir = out.join(format!("step-{k}"));
+        assert!(
+            step_dir.join("schedule.json").exists(),
+            "{}",
+            step_dir.display()
+        );
+        assert!(!step_dir.join("rtl").exists());
+        let own: Value =
+            serde_json::from_str(&std::fs::read_to_string(step_dir.join("summary.json")).unwrap())
+                .unwrap();
+        assert_eq!(own["predicted_cycles"], cycles);
+        assert!(stdout.contains(&format!(" {cycles} ")), "{stdout}");
+    }
+    // The person and the door move: the candidate sets differ between steps.
+    assert_ne!(steps[0]["paths"], steps[2]["paths"], "{doc}");
+    std::fs::remove_dir_all(&dir).ok();
+}

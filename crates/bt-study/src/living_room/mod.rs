@@ -1,0 +1,543 @@
+//! The paper's 3-D evaluation (Section VI, Figs. 14-20): a furnished living room in which a
+//! person walks and a door opens over time steps, traced at every step by the image method
+//! (geometric optics, the reference), IPC (Gauss-Seidel and Jacobi, f64), SBR (1° grid over
+//! the sphere) and the accelerator's bit-exact fixed-point IPC model, with the accelerator's
+//! cycle count per step from a per-step PE schedule.
+//!
+//! - [`mod@run`] here: the study, one [`Row`] per step and solver, one [`FpgaStep`] per step,
+//!   and the ray directions of Fig. 18 for two steps;
+//! - [`report`]: `results.csv`, `fpga.csv`, `summary.md`;
+//! - [`plot`]: Figs. 17-19 on any plotters backend; [`crate::io::write_living_room`] writes
+//!   them as SVG and PNG.
+//!
+//! Units: metres, seconds; angles in degrees where the name says `_deg`; cycles of the
+//! accelerator's clock, [`CLOCK_HZ`]. `docs/study-living-room.md` has the measured numbers.
+
+pub mod plot;
+pub mod report;
+
+use crate::run::{Directions, PathMap, compare, exact_directions, run_solver};
+use crate::{StudyConfig, StudyError, StudySolver, fpga};
+use bt_geom::{Real, Vec3};
+use bt_hls::{PlanOptions, ScheduleKind};
+use bt_scene::Scene;
+use bt_scene::dynamic::DynamicScene;
+use bt_schedule::{GaParams, Problem};
+use bt_solve::{SbrOptions, Validity, validate::validate};
+use serde::Serialize;
+use std::time::Instant;
+
+/// Clock of the paper's platform (Intel Cyclone IV E at 50 MHz), Hz.
+pub const CLOCK_HZ: Real = 50e6;
+
+/// The solvers of the living-room study, in output order.
+pub const SOLVERS: [StudySolver; 5] = [
+    StudySolver::Image,
+    StudySolver::IpcGaussSeidel,
+    StudySolver::IpcJacobi,
+    StudySolver::Sbr,
+    StudySolver::IpcFixedPoint,
+];
+
+/// Settings of the living-room study.
+#[derive(Debug, Clone, Serialize)]
+pub struct LivingRoomConfig {
+    /// Where the scene came from (`builtin:living-room-dynamic`, a file name), echoed.
+    pub scene: String,
+    /// Highest reflection order (the paper: 3), at least 1.
+    pub max_order: usize,
+    /// SBR grid step over the whole sphere, degrees (the paper: 1, 64 800 rays).
+    pub sbr_step_deg: Real,
+    /// Fixed-point IPC convergence threshold on a round's L∞ displacement, 1/256 mm.
+    pub threshold_lsb: u32,
+    /// Fixed-point IPC round cap.
+    pub max_rounds: u32,
+    /// PE scheduler of each step.
+    pub schedule: ScheduleKind,
+    /// GA seed (echoed into every output).
+    pub seed: u64,
+    /// GA chromosomes per generation.
+    pub ga_population: u32,
+    /// GA generations after the initial population.
+    pub ga_generations: u32,
+    /// Total PE instances per step; `None`: the planes used plus 25 %.
+    pub pe_budget: Option<u32>,
+}
+
+impl Default for LivingRoomConfig {
+    /// The paper's setting: third order, 1° SBR sphere, the `hls gen` defaults (threshold
+    /// 16/256 mm, 256 rounds, GA seed 1) but a smaller GA (population 4, 2 generations instead
+    /// of 12 × 12): on the living room's ~9,600 candidates it reaches the same makespan at
+    /// step 0 in a sixth of the time (the duplication and ASAP passes do most of the work).
+    fn default() -> Self {
+        Self {
+            scene: "builtin:living-room-dynamic".into(),
+            max_order: 3,
+            sbr_step_deg: 1.0,
+            threshold_lsb: 16,
+            max_rounds: 256,
+            schedule: ScheduleKind::Ga,
+            seed: 1,
+            ga_population: 4,
+            ga_generations: 2,
+            pe_budget: None,
+        }
+    }
+}
+
+impl LivingRoomConfig {
+    /// The SBR options: a full-sphere grid.
+    pub fn sbr_options(&self) -> SbrOptions {
+        SbrOptions::grid(self.sbr_step_deg)
+    }
+
+    /// The scheduler options of every step.
+    pub fn plan_options(&self) -> PlanOptions {
+        PlanOptions {
+            schedule: self.schedule,
+            pe_budget: self.pe_budget,
+            ga: GaParams {
+                seed: self.seed,
+                population: self.ga_population,
+                generations: self.ga_generations,
+                elite: GaParams::default().elite.min(self.ga_population),
+                ..GaParams::default()
+            },
+        }
+    }
+
+    /// Every problem with the settings, lowercase.
+    pub fn problems(&self) -> Vec<String> {
+        let mut p = Vec::new();
+        if self.max_order == 0 {
+            p.push("max order must be at least 1 (the accelerator traces reflections)".into());
+        }
+        if self.max_order > 6 {
+            p.push(format!(
+                "max order {} is too high for a study (at most 6)",
+                self.max_order
+            ));
+        }
+        if self.ga_population == 0 {
+            p.push("ga population must be at least 1".into());
+        }
+        if self.max_rounds == 0 {
+            p.push("max rounds must be at least 1".into());
+        }
+        if let Some(m) = self.sbr_options().problem() {
+            p.push(m);
+        }
+        p
+    }
+
+    /// The 2-D study's settings that make its solver runner do this study's job.
+    fn solver_config(&self) -> StudyConfig {
+        StudyConfig {
+            rooms: 1,
+            steps: 1,
+            seed: self.seed,
+            max_order: self.max_order,
+            sbr_step_deg: self.sbr_step_deg,
+            sbr_sphere: true,
+        }
+    }
+}
+
+/// One time step and solver.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Row {
+    /// Time step, from 0.
+    pub step: usize,
+    /// Solver.
+    pub solver: StudySolver,
+    /// Paths the solver found.
+    pub paths: usize,
+    /// Of those, paths whose surface sequence the image method also found.
+    pub matched: usize,
+    /// Image-method paths the solver did not find.
+    pub missed: usize,
+    /// Solver paths the image method does not have.
+    pub spurious: usize,
+    /// Mean angle between the solver's and the exact departure direction at TX over matched
+    /// paths, degrees (0 when nothing matched).
+    pub mean_err_tx_deg: Real,
+    /// Largest such angle, degrees.
+    pub max_err_tx_deg: Real,
+    /// Mean angle between the solver's and the exact arrival direction at RX, degrees.
+    pub mean_err_rx_deg: Real,
+    /// Largest such angle, degrees.
+    pub max_err_rx_deg: Real,
+    /// Single-threaded wall-clock time from scene to paths, seconds (candidate enumeration
+    /// included; for the fixed-point model: building its input and running it in software).
+    pub time_s: Real,
+}
+
+/// The accelerator at one time step: its input, the fixed-point outcomes and the schedule.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FpgaStep {
+    /// Time step, from 0.
+    pub step: usize,
+    /// Candidate paths of order ≥ 1 computed by the accelerator.
+    pub paths: usize,
+    /// Their points.
+    pub points: u64,
+    /// Paths converged in the fixed-point model.
+    pub converged: usize,
+    /// Paths that hit the round cap.
+    pub not_converged: usize,
+    /// Paths frozen as degenerate (overflow or zero distance sum).
+    pub degenerate: usize,
+    /// PE instances of the schedule (originals and duplicates).
+    pub instances: u32,
+    /// Duplicated PEs.
+    pub duplicates: u32,
+    /// The PE budget applied.
+    pub pe_budget: u32,
+    /// Schedule makespan, slots.
+    pub makespan: u32,
+    /// Makespan of the list schedule (one PE per plane), slots.
+    pub list_makespan: u32,
+    /// Latency factor (eq. 14, summed over paths and rounds), slots.
+    pub latency_factor: u64,
+    /// Busy PE cells / all cells.
+    pub utilisation: Real,
+    /// Cycles per schedule slot.
+    pub cycles_per_slot: u64,
+    /// Predicted `CYCLES` of the run (exact; co-simulation checks the formula).
+    pub cycles: u64,
+    /// `cycles / CLOCK_HZ`, seconds.
+    pub latency_s: Real,
+    /// Candidate paths the host accepted (converged in fixed point and valid in f64).
+    pub accepted_paths: usize,
+    /// Cycles of a run computing only the accepted paths, with the same scheduler: the bound
+    /// a perfect early rejection of invalid candidates (the paper's Section VI-C proposal)
+    /// could reach. 0 when no path was accepted.
+    pub accepted_cycles: u64,
+    /// Wall-clock time of the scheduler, seconds (may use every core).
+    pub schedule_time_s: Real,
+}
+
+/// A ray direction at both ends, degrees: azimuth from +x towards +y in (-180, 180],
+/// elevation from the horizontal in [-90, 90].
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct RayAngles {
+    /// Departure azimuth at TX.
+    pub tx_azimuth_deg: Real,
+    /// Departure elevation at TX.
+    pub tx_elevation_deg: Real,
+    /// Arrival azimuth at RX (the direction the path arrives from, seen at RX).
+    pub rx_azimuth_deg: Real,
+    /// Arrival elevation at RX.
+    pub rx_elevation_deg: Real,
+}
+
+/// Fig. 18's data for one step: every path's directions by solver.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StepRays {
+    /// Time step, from 0.
+    pub step: usize,
+    /// Geometric optics (the image method).
+    pub exact: Vec<RayAngles>,
+    /// The fixed-point IPC model (the accelerator).
+    pub fixed_point: Vec<RayAngles>,
+    /// SBR.
+    pub sbr: Vec<RayAngles>,
+}
+
+/// Everything the study produced.
+#[derive(Debug, Clone, Serialize)]
+pub struct LivingRoomResults {
+    /// The settings.
+    pub config: LivingRoomConfig,
+    /// Scene name.
+    pub scene_name: String,
+    /// Time steps.
+    pub steps: usize,
+    /// Reflectors (the accelerator's planes) at step 0.
+    pub reflectors: usize,
+    /// One row per step and solver, in that order ([`SOLVERS`]).
+    pub rows: Vec<Row>,
+    /// One entry per step.
+    pub fpga: Vec<FpgaStep>,
+    /// Ray directions at the [`drawn_steps`].
+    pub rays: Vec<StepRays>,
+}
+
+/// The steps drawn in Fig. 18: the first and the fifth (the paper's time steps 1 and 5),
+/// or the last when there are fewer than five.
+pub fn drawn_steps(steps: usize) -> Vec<usize> {
+    match steps {
+        0 => Vec::new(),
+        1 => vec![0],
+        n => vec![0, (n - 1).min(4)],
+    }
+}
+
+fn angles(d: &Directions) -> RayAngles {
+    let az_el = |v: Vec3| {
+        (
+            v.y.atan2(v.x).to_degrees(),
+            v.z.atan2(v.x.hypot(v.y)).to_degrees(),
+        )
+    };
+    let (tx_az, tx_el) = az_el(d.departure);
+    let (rx_az, rx_el) = az_el(d.arrival);
+    RayAngles {
+        tx_azimuth_deg: tx_az,
+        tx_elevation_deg: tx_el,
+        rx_azimuth_deg: rx_az,
+        rx_elevation_deg: rx_el,
+    }
+}
+
+/// What the fixed-point model produced at one step.
+struct FixedStep {
+    paths: PathMap,
+    time_s: Real,
+    fpga: FpgaStep,
+}
+
+/// The accelerator at one step: build its input, run the bit-exact model (timed, as a
+/// software emulation), keep the converged paths that validate in f64 (the host's check, as
+/// the paper's Raspberry Pi post-processor), add line of sight from the host, then schedule.
+fn fixed_point_step(
+    scene: &Scene,
+    step: usize,
+    config: &LivingRoomConfig,
+) -> Result<FixedStep, StudyError> {
+    let hardware = |e: &dyn std::fmt::Display| StudyError::Step {
+        step,
+        message: e.to_string(),
+    };
+    let (tx, rx) = (scene.tx(), scene.rx());
+    let start = Instant::now();
+    let (input, sequences) = fpga::hls_input(
+        scene,
+        config.max_order,
+        config.threshold_lsb,
+        config.max_rounds,
+    );
+    if input.paths.is_empty() {
+        return Err(StudyError::Step {
+            step,
+            message: format!(
+                "no candidate reflection path up to order {} for the accelerator",
+                config.max_order
+            ),
+        });
+    }
+    let model = input.model().map_err(|e| hardware(&e))?;
+    let results = model.run(input.tx, input.rx).map_err(|e| hardware(&e))?;
+    let mut paths = PathMap::new();
+    if validate(scene, &[], tx, rx, &[]) == Validity::Valid {
+        paths.insert(Vec::new(), exact_directions(scene, &[]));
+    }
+    let mut points = Vec::new();
+    let mut accepted = Vec::new();
+    for (p, (seq, r)) in sequences.iter().zip(&results).enumerate() {
+        if !r.converged {
+            continue;
+        }
+        points.clear();
+        points.extend(r.points_m.iter().map(|p| Vec3::from_array(*p)));
+        if validate(scene, seq, tx, rx, &points) == Validity::Valid {
+            paths.insert(seq.clone(), exact_directions(scene, &points));
+            accepted.push(p);
+        }
+    }
+    let time_s = start.elapsed().as_secs_f64();
+    let problem = input.problem_for(&results);
+    let start = Instant::now();
+    let plan = bt_hls::plan(&problem, &config.plan_options()).map_err(|e| hardware(&e))?;
+    let schedule_time_s = start.elapsed().as_secs_f64();
+    // The oracle bound of the paper's early-stopping strategy: only the accepted paths run.
+    let accepted_cycles = if accepted.is_empty() {
+        0
+    } else {
+        let sub = Problem {
+            num_planes: problem.num_planes,
+            paths: accepted.iter().map(|&p| problem.paths[p].clone()).collect(),
+        };
+        bt_hls::plan(&sub, &config.plan_options())
+            .map_err(|e| hardware(&e))?
+            .predicted_cycles
+    };
+    let converged = results.iter().filter(|r| r.converged).count();
+    let degenerate = results.iter().filter(|r| r.overflow || r.zero_sum).count();
+    let fpga = FpgaStep {
+        step,
+        paths: input.paths.len(),
+        points: plan.points,
+        converged,
+        not_converged: results.len() - converged - degenerate,
+        degenerate,
+        instances: plan.stats.instances,
+        duplicates: plan.stats.duplicates,
+        pe_budget: plan.pe_budget,
+        makespan: plan.stats.makespan,
+        list_makespan: plan.list_makespan,
+        latency_factor: plan.stats.latency_factor,
+        utilisation: plan.stats.utilisation,
+        cycles_per_slot: plan.cycles_per_slot,
+        cycles: plan.predicted_cycles,
+        latency_s: plan.predicted_cycles as Real / CLOCK_HZ,
+        accepted_paths: accepted.len(),
+        accepted_cycles,
+        schedule_time_s,
+    };
+    Ok(FixedStep {
+        paths,
+        time_s,
+        fpga,
+    })
+}
+
+fn row(
+    step: usize,
+    solver: StudySolver,
+    reference: &PathMap,
+    found: &PathMap,
+    time_s: Real,
+) -> Row {
+    let (matched, missed, spurious, [mean_tx, max_tx, mean_rx, max_rx]) = compare(reference, found);
+    Row {
+        step,
+        solver,
+        paths: found.len(),
+        matched,
+        missed,
+        spurious,
+        mean_err_tx_deg: mean_tx,
+        max_err_tx_deg: max_tx,
+        mean_err_rx_deg: mean_rx,
+        max_err_rx_deg: max_rx,
+        time_s,
+    }
+}
+
+/// Run the study over every step of `scene`. `progress(done, total)` is called after every
+/// step. Steps and solvers run one after the other, every solver single-threaded, so the times
+/// compare fairly (only the scheduler, which is not timed as a solver, uses every core). All
+/// results but the times are deterministic.
+pub fn run(
+    scene: &DynamicScene,
+    config: &LivingRoomConfig,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<LivingRoomResults, StudyError> {
+    let problems = config.problems();
+    if !problems.is_empty() {
+        return Err(StudyError::Config(problems.join("; ")));
+    }
+    let solver_config = config.solver_config();
+    let steps = scene.len();
+    let drawn = drawn_steps(steps);
+    let mut rows = Vec::with_capacity(steps * SOLVERS.len());
+    let mut fpga = Vec::with_capacity(steps);
+    let mut rays = Vec::new();
+    for (step, s) in scene.scenes().iter().enumerate() {
+        let (reference, time_s) = run_solver(s, StudySolver::Image, &solver_config);
+        rows.push(row(
+            step,
+            StudySolver::Image,
+            &reference,
+            &reference,
+            time_s,
+        ));
+        let mut sbr_paths = PathMap::new();
+        for solver in [
+            StudySolver::IpcGaussSeidel,
+            StudySolver::IpcJacobi,
+            StudySolver::Sbr,
+        ] {
+            let (found, time_s) = run_solver(s, solver, &solver_config);
+            rows.push(row(step, solver, &reference, &found, time_s));
+            if solver == StudySolver::Sbr {
+                sbr_paths = found;
+            }
+        }
+        let fixed = fixed_point_step(s, step, config)?;
+        rows.push(row(
+            step,
+            StudySolver::IpcFixedPoint,
+            &reference,
+            &fixed.paths,
+            fixed.time_s,
+        ));
+        fpga.push(fixed.fpga);
+        if drawn.contains(&step) {
+            rays.push(StepRays {
+                step,
+                exact: reference.values().map(angles).collect(),
+                fixed_point: fixed.paths.values().map(angles).collect(),
+                sbr: sbr_paths.values().map(angles).collect(),
+            });
+        }
+        progress(step + 1, steps);
+    }
+    let step0 = scene.step(0);
+    Ok(LivingRoomResults {
+        config: config.clone(),
+        scene_name: step0.name().to_string(),
+        steps,
+        reflectors: step0.reflectors().count(),
+        rows,
+        fpga,
+        rays,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use bt_scene::Terminals;
+    use bt_scene::dynamic::builtin_dynamic_scene;
+
+    #[test]
+    fn drawn_steps_are_the_papers_first_and_fifth() {
+        assert_eq!(drawn_steps(10), vec![0, 4]);
+        assert_eq!(drawn_steps(2), vec![0, 1]);
+        assert_eq!(drawn_steps(1), vec![0]);
+    }
+
+    #[test]
+    fn azimuth_and_elevation_follow_the_conventions() {
+        let d = Directions {
+            departure: Vec3::new(0.0, 1.0, 0.0),
+            arrival: Vec3::new(-1.0, 0.0, 1.0).normalize(),
+        };
+        let a = angles(&d);
+        assert!((a.tx_azimuth_deg - 90.0).abs() < 1e-12);
+        assert!(a.tx_elevation_deg.abs() < 1e-12);
+        assert!((a.rx_azimuth_deg - 180.0).abs() < 1e-12);
+        assert!((a.rx_elevation_deg - 45.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn first_order_study_of_the_living_room_matches_the_reference() {
+        let scene = builtin_dynamic_scene("living-room-dynamic", Terminals::default())
+            .expect("built in")
+            .expect("valid");
+        let config = LivingRoomConfig {
+            max_order: 1,
+            sbr_step_deg: 5.0,
+            schedule: ScheduleKind::List,
+            ..LivingRoomConfig::default()
+        };
+        let results = run(&scene, &config, &mut |_, _| {}).expect("study runs");
+        assert_eq!(results.rows.len(), scene.len() * SOLVERS.len());
+        assert_eq!(results.fpga.len(), scene.len());
+        for r in &results.rows {
+            let limit = match r.solver {
+                StudySolver::Image => 0.0,
+                StudySolver::IpcGaussSeidel | StudySolver::IpcJacobi => 1e-6,
+                StudySolver::IpcFixedPoint => 0.1,
+                StudySolver::Sbr => 90.0,
+            };
+            assert!(r.max_err_tx_deg <= limit, "{r:?}");
+            assert!(r.max_err_rx_deg <= limit, "{r:?}");
+        }
+        for f in &results.fpga {
+            assert!(f.cycles > f.points && f.makespan > 0, "{f:?}");
+        }
+    }
+}

@@ -1,0 +1,411 @@
+//! The living-room study's text outputs (`results.csv`, `fpga.csv`, `summary.md`) and the
+//! aggregates behind them. Pure functions of the results: writing files is [`crate::io`]'s job.
+
+use super::{CLOCK_HZ, LivingRoomResults, Row, SOLVERS};
+use crate::StudySolver;
+use bt_geom::Real;
+use std::collections::BTreeMap;
+use std::fmt::Write;
+
+/// Column names of `results.csv`.
+pub const CSV_HEADER: &str = "scene,step,solver,paths,matched,missed,spurious,\
+mean_err_tx_deg,max_err_tx_deg,mean_err_rx_deg,max_err_rx_deg,time_s,fpga_cycles,fpga_latency_s";
+
+/// Column names of `fpga.csv`.
+pub const FPGA_CSV_HEADER: &str = "scene,step,paths,points,converged,not_converged,degenerate,\
+instances,duplicates,pe_budget,makespan,list_makespan,latency_factor,utilisation,\
+cycles_per_slot,cycles,latency_s,accepted_paths,accepted_cycles,schedule_time_s";
+
+/// `results.csv`: one line per step and solver; floats in Rust's shortest round-trip
+/// scientific notation. `fpga_cycles` and `fpga_latency_s` (the accelerator's predicted run,
+/// at 50 MHz) are filled on the `ipc-fixed-point` rows only.
+pub fn csv(results: &LivingRoomResults) -> String {
+    let mut out = String::with_capacity(160 * (results.rows.len() + 1));
+    out.push_str(CSV_HEADER);
+    out.push('\n');
+    for r in &results.rows {
+        let fpga = if r.solver == StudySolver::IpcFixedPoint {
+            results
+                .fpga
+                .iter()
+                .find(|f| f.step == r.step)
+                .map(|f| format!("{},{:e}", f.cycles, f.latency_s))
+                .unwrap_or_else(|| ",".into())
+        } else {
+            ",".into()
+        };
+        let _ = writeln!(
+            out,
+            "{},{},{},{},{},{},{},{:e},{:e},{:e},{:e},{:e},{}",
+            results.scene_name,
+            r.step,
+            r.solver.name(),
+            r.paths,
+            r.matched,
+            r.missed,
+            r.spurious,
+            r.mean_err_tx_deg,
+            r.max_err_tx_deg,
+            r.mean_err_rx_deg,
+            r.max_err_rx_deg,
+            r.time_s,
+            fpga
+        );
+    }
+    out
+}
+
+/// `fpga.csv`: the accelerator of every step (candidate paths, fixed-point outcomes, the PE
+/// schedule and its cycles); `schedule_time_s` is the only varying column.
+pub fn fpga_csv(results: &LivingRoomResults) -> String {
+    let mut out = String::new();
+    out.push_str(FPGA_CSV_HEADER);
+    out.push('\n');
+    for f in &results.fpga {
+        let _ = writeln!(
+            out,
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{:e},{},{},{:e},{},{},{:e}",
+            results.scene_name,
+            f.step,
+            f.paths,
+            f.points,
+            f.converged,
+            f.not_converged,
+            f.degenerate,
+            f.instances,
+            f.duplicates,
+            f.pe_budget,
+            f.makespan,
+            f.list_makespan,
+            f.latency_factor,
+            f.utilisation,
+            f.cycles_per_slot,
+            f.cycles,
+            f.latency_s,
+            f.accepted_paths,
+            f.accepted_cycles,
+            f.schedule_time_s
+        );
+    }
+    out
+}
+
+/// Totals of one solver over all steps.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct Totals {
+    /// Steps.
+    pub steps: usize,
+    /// Paths found.
+    pub paths: usize,
+    /// Image-method paths missed.
+    pub missed: usize,
+    /// Spurious paths.
+    pub spurious: usize,
+    /// Mean angular error at TX over every matched path of every step, degrees.
+    pub mean_err_tx_deg: Real,
+    /// Largest angular error at TX, degrees.
+    pub max_err_tx_deg: Real,
+    /// Mean angular error at RX over every matched path, degrees.
+    pub mean_err_rx_deg: Real,
+    /// Largest angular error at RX, degrees.
+    pub max_err_rx_deg: Real,
+    /// Mean time per step, seconds.
+    pub mean_time_s: Real,
+}
+
+/// Totals per solver. The mean errors weight each step by its matched paths (a mean over
+/// paths, as the paper averages the rays of a step).
+pub fn totals(rows: &[Row]) -> BTreeMap<StudySolver, Totals> {
+    let mut out: BTreeMap<StudySolver, (Totals, usize)> = BTreeMap::new();
+    for r in rows {
+        let (t, matched) = out.entry(r.solver).or_default();
+        t.steps += 1;
+        t.paths += r.paths;
+        t.missed += r.missed;
+        t.spurious += r.spurious;
+        t.mean_err_tx_deg += r.mean_err_tx_deg * r.matched as Real;
+        t.mean_err_rx_deg += r.mean_err_rx_deg * r.matched as Real;
+        t.max_err_tx_deg = t.max_err_tx_deg.max(r.max_err_tx_deg);
+        t.max_err_rx_deg = t.max_err_rx_deg.max(r.max_err_rx_deg);
+        t.mean_time_s += r.time_s;
+        *matched += r.matched;
+    }
+    out.into_iter()
+        .map(|(s, (mut t, matched))| {
+            let m = matched.max(1) as Real;
+            t.mean_err_tx_deg /= m;
+            t.mean_err_rx_deg /= m;
+            t.mean_time_s /= t.steps.max(1) as Real;
+            (s, t)
+        })
+        .collect()
+}
+
+/// Headline numbers of the comparison with the paper.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Headline {
+    /// Mean angular error of the fixed-point model (the FPGA), TX and RX, degrees.
+    pub fixed_err_deg: [Real; 2],
+    /// Largest angular error of the fixed-point model, TX and RX, degrees.
+    pub fixed_max_err_deg: [Real; 2],
+    /// Mean angular error of SBR, TX and RX, degrees.
+    pub sbr_err_deg: [Real; 2],
+    /// Mean angular error of IPC (Gauss-Seidel, f64), TX and RX, degrees.
+    pub ipc_err_deg: [Real; 2],
+    /// SBR error / fixed-point error at TX (the paper: > 100).
+    pub sbr_over_fixed_error: Real,
+    /// Mean accelerator latency per step at 50 MHz, seconds (the paper: ≈ 1 ms).
+    pub fpga_mean_latency_s: Real,
+    /// Smallest and largest accelerator latency over the steps, seconds.
+    pub fpga_latency_range_s: (Real, Real),
+    /// Mean latency of runs computing only the accepted paths (the early-stopping bound),
+    /// seconds.
+    pub fpga_accepted_mean_latency_s: Real,
+    /// Mean SBR time / mean IPC (Gauss-Seidel) time, both single-threaded CPU.
+    pub sbr_over_ipc_time: Real,
+    /// Mean SBR time / mean IPC (Jacobi) time.
+    pub sbr_over_jacobi_time: Real,
+    /// Mean SBR CPU time / mean accelerator latency.
+    pub sbr_cpu_over_fpga: Real,
+    /// Mean IPC (Gauss-Seidel) CPU time / mean accelerator latency.
+    pub ipc_cpu_over_fpga: Real,
+}
+
+/// The headline numbers.
+pub fn headline(results: &LivingRoomResults) -> Headline {
+    let t = totals(&results.rows);
+    let get = |s| t.get(&s).copied().unwrap_or_default();
+    let (gs, jacobi, sbr, fixed) = (
+        get(StudySolver::IpcGaussSeidel),
+        get(StudySolver::IpcJacobi),
+        get(StudySolver::Sbr),
+        get(StudySolver::IpcFixedPoint),
+    );
+    let lat: Vec<Real> = results.fpga.iter().map(|f| f.latency_s).collect();
+    let mean_lat = lat.iter().sum::<Real>() / lat.len().max(1) as Real;
+    let range = lat
+        .iter()
+        .fold((Real::INFINITY, 0.0), |(lo, hi): (Real, Real), &x| {
+            (lo.min(x), hi.max(x))
+        });
+    Headline {
+        fixed_err_deg: [fixed.mean_err_tx_deg, fixed.mean_err_rx_deg],
+        fixed_max_err_deg: [fixed.max_err_tx_deg, fixed.max_err_rx_deg],
+        sbr_err_deg: [sbr.mean_err_tx_deg, sbr.mean_err_rx_deg],
+        ipc_err_deg: [gs.mean_err_tx_deg, gs.mean_err_rx_deg],
+        sbr_over_fixed_error: sbr.mean_err_tx_deg / fixed.mean_err_tx_deg,
+        fpga_mean_latency_s: mean_lat,
+        fpga_latency_range_s: if lat.is_empty() { (0.0, 0.0) } else { range },
+        fpga_accepted_mean_latency_s: results
+            .fpga
+            .iter()
+            .map(|f| f.accepted_cycles as Real / CLOCK_HZ)
+            .sum::<Real>()
+            / results.fpga.len().max(1) as Real,
+        sbr_over_ipc_time: sbr.mean_time_s / gs.mean_time_s,
+        sbr_over_jacobi_time: sbr.mean_time_s / jacobi.mean_time_s,
+        sbr_cpu_over_fpga: sbr.mean_time_s / mean_lat,
+        ipc_cpu_over_fpga: gs.mean_time_s / mean_lat,
+    }
+}
+
+fn find(results: &LivingRoomResults, step: usize, solver: StudySolver) -> Option<&Row> {
+    results
+        .rows
+        .iter()
+        .find(|r| r.step == step && r.solver == solver)
+}
+
+/// `summary.md`: settings, per-solver totals, a per-step table and the paper's conclusions
+/// as measured numbers.
+pub fn summary(results: &LivingRoomResults) -> String {
+    let c = &results.config;
+    let sbr = c.sbr_options();
+    let mut s = String::new();
+    let _ = writeln!(s, "# Living-room study (paper Section VI, Figs. 17-20)\n");
+    let _ = writeln!(
+        s,
+        "Scene `{}` ({}), {} time steps, {} reflectors, reflections up to order {}.\n\
+         SBR: {}° azimuth × elevation grid over the sphere ({} rays), capture radius {:.4} × \
+         unfolded length.\n\
+         Fixed-point IPC: the accelerator's bit-exact model (`bt-fixed`, Jacobi rounds, \
+         millimetre words, 1/256 mm inside), threshold {}/256 mm, at most {} rounds, every \
+         candidate of order 1-{}; converged paths are validated in f64 by the host, which also \
+         checks line of sight. One PE schedule per step: {} (seed {}, GA population {}, {} \
+         generations), PE budget {}; latency = predicted cycles / {} MHz.\n\
+         Every solver runs single-threaded; times are wall clock from the scene to the paths \
+         (candidate enumeration included).\n",
+        results.scene_name,
+        c.scene,
+        results.steps,
+        results.reflectors,
+        c.max_order,
+        c.sbr_step_deg,
+        sbr.ray_count(),
+        sbr.capture_factor(),
+        c.threshold_lsb,
+        c.max_rounds,
+        c.max_order,
+        c.schedule.name(),
+        c.seed,
+        c.ga_population,
+        c.ga_generations,
+        c.pe_budget
+            .map_or_else(|| "planes used + 25 %".to_string(), |b| b.to_string()),
+        CLOCK_HZ / 1e6,
+    );
+    let _ = writeln!(s, "## Per solver, all steps\n");
+    let _ = writeln!(
+        s,
+        "| solver | paths | missed | spurious | mean err TX (°) | max err TX (°) | mean err RX (°) | max err RX (°) | mean time per step (ms) |"
+    );
+    let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|---:|---:|");
+    let t = totals(&results.rows);
+    for solver in SOLVERS {
+        let Some(t) = t.get(&solver) else { continue };
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {:.3e} | {:.3e} | {:.3e} | {:.3e} | {:.3} |",
+            solver.name(),
+            t.paths,
+            t.missed,
+            t.spurious,
+            t.mean_err_tx_deg,
+            t.max_err_tx_deg,
+            t.mean_err_rx_deg,
+            t.max_err_rx_deg,
+            t.mean_time_s * 1e3
+        );
+    }
+    let fpga_mean =
+        results.fpga.iter().map(|f| f.latency_s).sum::<Real>() / results.fpga.len().max(1) as Real;
+    let _ = writeln!(
+        s,
+        "| FPGA (predicted, {} MHz) | | | | | | | | {:.3} |",
+        CLOCK_HZ / 1e6,
+        fpga_mean * 1e3
+    );
+    let _ = writeln!(s, "\n## Per step\n");
+    let _ = writeln!(
+        s,
+        "Errors are means over the step's matched paths, TX / RX, degrees; SBR and fixed-point \
+         missed / spurious paths against the image method; times in ms.\n"
+    );
+    let _ = writeln!(
+        s,
+        "| step | exact paths | candidates | IPC GS err | fixed-point err | SBR err | SBR miss/spur | fixed miss/spur | image | IPC GS | IPC Jacobi | SBR | FPGA cycles | FPGA ms | accepted only: cycles |"
+    );
+    let _ = writeln!(
+        s,
+        "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+    );
+    for f in &results.fpga {
+        let k = f.step;
+        let get = |solver| {
+            find(results, k, solver).cloned().unwrap_or(Row {
+                step: k,
+                solver,
+                paths: 0,
+                matched: 0,
+                missed: 0,
+                spurious: 0,
+                mean_err_tx_deg: 0.0,
+                max_err_tx_deg: 0.0,
+                mean_err_rx_deg: 0.0,
+                max_err_rx_deg: 0.0,
+                time_s: 0.0,
+            })
+        };
+        let (image, gs, jacobi, sbr, fixed) = (
+            get(StudySolver::Image),
+            get(StudySolver::IpcGaussSeidel),
+            get(StudySolver::IpcJacobi),
+            get(StudySolver::Sbr),
+            get(StudySolver::IpcFixedPoint),
+        );
+        let err = |r: &Row| format!("{:.1e} / {:.1e}", r.mean_err_tx_deg, r.mean_err_rx_deg);
+        let _ = writeln!(
+            s,
+            "| {} | {} | {} | {} | {} | {} | {} / {} | {} / {} | {:.2} | {:.2} | {:.2} | {:.2} | {} | {:.3} | {} |",
+            k,
+            image.paths,
+            f.paths,
+            err(&gs),
+            err(&fixed),
+            err(&sbr),
+            sbr.missed,
+            sbr.spurious,
+            fixed.missed,
+            fixed.spurious,
+            image.time_s * 1e3,
+            gs.time_s * 1e3,
+            jacobi.time_s * 1e3,
+            sbr.time_s * 1e3,
+            f.cycles,
+            f.latency_s * 1e3,
+            f.accepted_cycles
+        );
+    }
+    let h = headline(results);
+    let _ = writeln!(s, "\n## The paper's conclusions, measured\n");
+    let _ = writeln!(s, "| quantity | measured | paper |");
+    let _ = writeln!(s, "|---|---:|---:|");
+    let _ = writeln!(
+        s,
+        "| FPGA IPC (fixed-point model) mean angular error, TX / RX (°) | {:.3e} / {:.3e} | < 0.1 (Fig. 17) |",
+        h.fixed_err_deg[0], h.fixed_err_deg[1]
+    );
+    let _ = writeln!(
+        s,
+        "| FPGA IPC largest angular error, TX / RX (°) | {:.3e} / {:.3e} | within the 10° tolerance (Fig. 18) |",
+        h.fixed_max_err_deg[0], h.fixed_max_err_deg[1]
+    );
+    let _ = writeln!(
+        s,
+        "| SBR mean angular error, TX / RX (°) | {:.3e} / {:.3e} | clusters around the GO rays (Fig. 18) |",
+        h.sbr_err_deg[0], h.sbr_err_deg[1]
+    );
+    let _ = writeln!(
+        s,
+        "| SBR error / FPGA IPC error (TX) | {:.3e} | > 100 (Fig. 17) |",
+        h.sbr_over_fixed_error
+    );
+    let _ = writeln!(
+        s,
+        "| IPC f64 (Gauss-Seidel) mean angular error, TX / RX (°) | {:.3e} / {:.3e} | — |",
+        h.ipc_err_deg[0], h.ipc_err_deg[1]
+    );
+    let _ = writeln!(
+        s,
+        "| FPGA IPC time per step (cycles / 50 MHz), mean (min-max) | {:.3} ms ({:.3}-{:.3}) | ≈ 1 ms (Fig. 19) |",
+        h.fpga_mean_latency_s * 1e3,
+        h.fpga_latency_range_s.0 * 1e3,
+        h.fpga_latency_range_s.1 * 1e3
+    );
+    let _ = writeln!(
+        s,
+        "| FPGA IPC time per step, only the paths the host accepts (early-stopping bound), mean | {:.4} ms | — (Section VI-C proposes early stopping) |",
+        h.fpga_accepted_mean_latency_s * 1e3
+    );
+    let _ = writeln!(
+        s,
+        "| SBR time / IPC (Gauss-Seidel) time, one CPU core | {:.3} | > 1 (Fig. 19: IPC faster on the same platform) |",
+        h.sbr_over_ipc_time
+    );
+    let _ = writeln!(
+        s,
+        "| SBR time / IPC (Jacobi) time, one CPU core | {:.3} | — |",
+        h.sbr_over_jacobi_time
+    );
+    let _ = writeln!(
+        s,
+        "| SBR (one CPU core) / FPGA IPC time | {:.3e} | ≈ 9e4 (≈ 500 × the FPGA SBR's 200 ms, vs 1 ms; Figs. 19-20) |",
+        h.sbr_cpu_over_fpga
+    );
+    let _ = writeln!(
+        s,
+        "| IPC Gauss-Seidel (one CPU core) / FPGA IPC time | {:.3e} | — |",
+        h.ipc_cpu_over_fpga
+    );
+    s
+}
