@@ -341,6 +341,8 @@ fn grow_regions(
     let mut group_of: Vec<Option<u32>> = vec![None; faces.len()];
     let mut groups = Vec::new();
     let mut queue = std::collections::VecDeque::new();
+    // skip[i], for i the first index of an edge's run in `edges`: where its ungrouped faces begin.
+    let mut skip = vec![0u32; edges.len()];
     for seed in 0..faces.len() {
         if group_of[seed].is_some() {
             continue;
@@ -358,7 +360,14 @@ fn grow_regions(
             for i in 0..n {
                 let key = edge_key(face.vertices[i], face.vertices[(i + 1) % n]);
                 let start = edges.partition_point(|&(k, _)| k < key);
-                for &(k, other) in &edges[start..] {
+                // Skip the leading run of faces on this edge that already have a group, so
+                // many faces on one edge (duplicated triangles) cost linear, not quadratic, time.
+                let mut first = skip[start].max(start as u32) as usize;
+                while first < edges.len() && edges[first].0 == key && group_of[edges[first].1 as usize].is_some() {
+                    first += 1;
+                }
+                skip[start] = first as u32;
+                for &(k, other) in &edges[first..] {
                     if k != key {
                         break;
                     }
