@@ -363,7 +363,10 @@ fn grow_regions(
                 // Skip the leading run of faces on this edge that already have a group, so
                 // many faces on one edge (duplicated triangles) cost linear, not quadratic, time.
                 let mut first = skip[start].max(start as u32) as usize;
-                while first < edges.len() && edges[first].0 == key && group_of[edges[first].1 as usize].is_some() {
+                while first < edges.len()
+                    && edges[first].0 == key
+                    && group_of[edges[first].1 as usize].is_some()
+                {
                     first += 1;
                 }
                 skip[start] = first as u32;

@@ -69,7 +69,11 @@ fn many_faces_on_one_edge_merge_in_linear_time() {
     for _ in 0..20_000 {
         obj.push_str("f 1 2 3\n");
     }
-    let import = bt_mesh::read_obj(obj.as_bytes(), None, &bt_mesh::MergeOptions::default()).unwrap();
+    let import =
+        bt_mesh::read_obj(obj.as_bytes(), None, &bt_mesh::MergeOptions::default()).unwrap();
     assert_eq!(import.faces_read, 20_000);
-    assert!(import.surfaces.len() <= 1, "identical triangles give at most one surface");
+    assert!(
+        import.surfaces.len() <= 1,
+        "identical triangles give at most one surface"
+    );
 }
