@@ -25,7 +25,7 @@ fn tmp(name: &str) -> PathBuf {
     std::env::temp_dir().join(format!("beamtrace-hls-{}-{name}", std::process::id()))
 }
 
-fn summary(dir: &PathBuf) -> Value {
+fn summary(dir: &std::path::Path) -> Value {
     serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap()
 }
 

@@ -365,6 +365,8 @@ fn run(
                 (recent[1 % RATE_WINDOW], (rounds - 1).max(1) as Real)
             };
             let rate = (moved / base).powf(1.0 / window);
+            // `!(rate < 1.0)` on purpose: a NaN rate (0/0 at exact convergence) counts as settled.
+            #[allow(clippy::neg_cmp_op_on_partial_ord)]
             let settled = !options.error_guard
                 || !(rate < 1.0)
                 || moved * rate / (1.0 - rate) <= limit * ERROR_GUARD_FACTOR;
