@@ -96,7 +96,16 @@ pub struct FixedError {
     pub mean_point_error_mm: f64,
     pub max_angle_error_tx_deg: f64,
     pub max_angle_error_rx_deg: f64,
+    /// Valid paths (in f64) the fixed-point model does not converge on.
     pub not_converged: usize,
+    /// Valid paths the host check rejects (`bt_study::fpga::host_accepts`): lost paths.
+    pub missed: usize,
+    /// Candidates frozen by early stopping.
+    pub left_bounds: usize,
+    /// Converged, f64-valid results rejected by the reflection-law check.
+    pub reflection_rejected: usize,
+    /// Results the host accepts that are no path of the image method (false convergences).
+    pub spurious: usize,
 }
 
 fn fixed_error(scene: &Scene, input: &HlsInput, max_order: usize) -> anyhow::Result<FixedError> {
@@ -105,6 +114,25 @@ fn fixed_error(scene: &Scene, input: &HlsInput, max_order: usize) -> anyhow::Res
     let candidates = bt_paths::enumerate(scene, max_order, &AllVisible);
     let reference = bt_solve::trace(scene, &candidates, &bt_solve::Solver::Image, true);
     let mut err = FixedError::default();
+    // Input paths are the non-empty candidates in order (`bt_study::fpga::hls_input`).
+    let candidates_of: Vec<Vec<bt_scene::SurfaceId>> = candidates
+        .iter()
+        .filter(|seq| !seq.is_empty())
+        .map(|seq| seq.to_vec())
+        .collect();
+    debug_assert_eq!(candidates_of.len(), input.paths.len());
+    err.left_bounds = results.iter().filter(|r| r.left_bounds).count();
+    for (seq, r) in candidates_of.iter().zip(&results) {
+        match bt_study::fpga::host_accepts(scene, seq, r) {
+            Ok(_) => {
+                if !reference.paths.iter().any(|p| p.surfaces == *seq) {
+                    err.spurious += 1;
+                }
+            }
+            Err(bt_study::fpga::HostRejection::ReflectionLaw) => err.reflection_rejected += 1,
+            Err(_) => {}
+        }
+    }
     let mut sum = 0.0;
     let mut count = 0usize;
     for path in &reference.paths {
@@ -119,6 +147,9 @@ fn fixed_error(scene: &Scene, input: &HlsInput, max_order: usize) -> anyhow::Res
         let r = &results[k];
         if !r.converged {
             err.not_converged += 1;
+        }
+        if bt_study::fpga::host_accepts(scene, &candidates_of[k], r).is_err() {
+            err.missed += 1;
         }
         err.valid_paths_compared += 1;
         for (q, p) in r.points_m.iter().zip(&path.points) {

@@ -14,6 +14,73 @@ pub struct PlaneInput {
     pub offset_m: f64,
 }
 
+/// Early stopping (the paper's Section VI proposal): freeze a path once one of its points lies
+/// clearly outside its plane's polygon, so its PE slots go to other paths.
+///
+/// After committing round `r ≥ min_rounds`, the path freezes with `left_bounds` if some point
+/// `p` written in that round lies, on some axis `a`, outside the plane's box widened by
+/// `margin_lsb + (|Δx| + |Δy| + |Δz|) << displacement_shift`, where `Δ` is that point's move in
+/// the round (its L1 norm bounds the L∞ one from above, and needs no comparator). A point that
+/// is still moving gets a proportionally wider margin; a stalled point outside its box by more
+/// than `margin_lsb` is frozen. Verilog twin: `wb_lb` in `bt_top`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct EarlyStop {
+    /// First round after which a path may be frozen (≥ 1).
+    pub min_rounds: u32,
+    /// `K = 2^displacement_shift`, the factor of the point's displacement in the margin (≤ 4).
+    pub displacement_shift: u32,
+    /// Fixed margin, fine LSB (1/256 mm), below 2^32.
+    pub margin_lsb: u32,
+}
+
+impl EarlyStop {
+    /// Largest accepted `displacement_shift` (the RTL's comparison is 48 bits wide).
+    pub const MAX_SHIFT: u32 = 4;
+}
+
+impl Default for EarlyStop {
+    /// 8 rounds, K = 4, 200 mm: no valid path frozen on the living room and 12 seeded
+    /// furnished rooms, order ≤ 3 (`bt-study/tests/early_stop.rs`); 50 mm froze a slowly
+    /// contracting valid path (73 rounds to converge) at round 9.
+    fn default() -> Self {
+        EarlyStop {
+            min_rounds: 8,
+            displacement_shift: 2,
+            margin_lsb: 200 * 256,
+        }
+    }
+}
+
+/// Axis-aligned bounds of a plane's polygon in metres (`min`, `max`), for [`EarlyStop`].
+pub type BoundsM = [[f64; 3]; 2];
+
+/// Quantised early-stopping box of one plane, widened by the fixed margin: a point is outside
+/// on axis `a` when `p + slack < lo[a]` or `p − slack > hi[a]`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct FineBox {
+    /// `floor(min) − 1 − margin`, fine LSB.
+    pub lo: [i64; 3],
+    /// `ceil(max) + 1 + margin`, fine LSB.
+    pub hi: [i64; 3],
+}
+
+impl FineBox {
+    /// A box no 40-bit point can leave (planes without bounds): ±2^41, so the RTL's 48-bit
+    /// comparison cannot overflow.
+    pub const UNBOUNDED: FineBox = FineBox {
+        lo: [-(1 << 41); 3],
+        hi: [1 << 41; 3],
+    };
+
+    /// Whether `point`, which moved by `move_l1` fine LSB (L1) in its round, is outside.
+    ///
+    /// Verilog twin: the `lb_*` wires of `bt_top` (48-bit signed comparisons).
+    pub fn outside(&self, point: FinePoint, move_l1: u64, shift: u32) -> bool {
+        let slack = (move_l1 << shift) as i64;
+        (0..3).any(|a| point[a].0 + slack < self.lo[a] || point[a].0 - slack > self.hi[a])
+    }
+}
+
 /// Why a path was frozen as degenerate.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub enum DegenerateKind {
@@ -38,6 +105,12 @@ pub enum FixedOutcome {
         rounds: u32,
         /// Displacement of the last round (L∞, fine LSB); 0 if no round ran.
         displacement_lsb: u64,
+    },
+    /// Early stopping froze the path after round `rounds`: a point left its plane's box
+    /// ([`EarlyStop`]). Not a path.
+    LeftBounds {
+        /// Rounds run including the flagged one.
+        rounds: u32,
     },
     /// A degenerate flag was raised in round `rounds`; the path was frozen after it.
     Degenerate {
@@ -65,6 +138,9 @@ pub struct PathResult {
     pub zero_sum: bool,
     /// Sticky saturation flag.
     pub overflow: bool,
+    /// Frozen by early stopping ([`EarlyStop`]); never set together with `converged`.
+    #[serde(default)]
+    pub left_bounds: bool,
 }
 
 impl PathResult {
@@ -78,6 +154,10 @@ impl PathResult {
         } else if self.zero_sum {
             FixedOutcome::Degenerate {
                 kind: DegenerateKind::ZeroDistanceSum,
+                rounds: self.rounds,
+            }
+        } else if self.left_bounds {
+            FixedOutcome::LeftBounds {
                 rounds: self.rounds,
             }
         } else if self.converged {
@@ -105,14 +185,16 @@ struct FixedPath {
 /// computed by [`intersection_point`] from the previous round's values (TX and RX fixed);
 /// the round's displacement is the maximum over the path's points of the L∞ norm of the
 /// point's move, in fine LSB (1/256 mm). After committing round `r`: if a degenerate flag was raised the path
-/// freezes as degenerate, else if displacement ≤ `threshold_lsb` it freezes as converged; a
-/// path never runs more than its round budget.
+/// freezes as degenerate, else if early stopping is on, `r ≥ min_rounds` and a point of the
+/// round left its box it freezes with `left_bounds` ([`EarlyStop`]), else if displacement ≤
+/// `threshold_lsb` it freezes as converged; a path never runs more than its round budget.
 #[derive(Debug, Clone, PartialEq)]
 pub struct FixedIpc {
     planes: Vec<FixedPlane>,
     paths: Vec<FixedPath>,
     threshold_lsb: u32,
     max_rounds: u32,
+    early_stop: Option<(EarlyStop, Vec<FineBox>)>,
 }
 
 impl FixedIpc {
@@ -180,7 +262,69 @@ impl FixedIpc {
             paths: fixed_paths,
             threshold_lsb,
             max_rounds,
+            early_stop: None,
         })
+    }
+
+    /// Turns early stopping on: `bounds[i]` is the polygon box of plane `i` in metres (`None`:
+    /// that plane never freezes a path). The box is rounded outwards by one fine LSB more than
+    /// the quantisation, so it is conservative. Every problem is reported at once.
+    pub fn with_early_stop(
+        mut self,
+        stop: EarlyStop,
+        bounds: &[Option<BoundsM>],
+    ) -> Result<FixedIpc, FixedError> {
+        let mut problems = Vec::new();
+        if bounds.len() != self.planes.len() {
+            problems.push(format!(
+                "{} planes but {} early-stopping boxes",
+                self.planes.len(),
+                bounds.len()
+            ));
+        }
+        if stop.min_rounds == 0 {
+            problems.push("early stopping: min_rounds must be at least 1".into());
+        }
+        if stop.displacement_shift > EarlyStop::MAX_SHIFT {
+            problems.push(format!(
+                "early stopping: displacement_shift {} exceeds {}",
+                stop.displacement_shift,
+                EarlyStop::MAX_SHIFT
+            ));
+        }
+        let margin = i64::from(stop.margin_lsb);
+        let mut boxes = Vec::with_capacity(bounds.len());
+        for (i, b) in bounds.iter().enumerate() {
+            let Some([min, max]) = b else {
+                boxes.push(FineBox::UNBOUNDED);
+                continue;
+            };
+            let mut fb = FineBox::UNBOUNDED;
+            for a in 0..3 {
+                if min[a].partial_cmp(&max[a]).is_none_or(|o| o.is_gt()) {
+                    problems.push(format!("plane {i}: box min > max (or NaN) on axis {a}"));
+                    continue;
+                }
+                match (FineCoord::quantize(min[a]), FineCoord::quantize(max[a])) {
+                    (Ok(lo), Ok(hi)) => {
+                        fb.lo[a] = lo.0 - 1 - margin;
+                        fb.hi[a] = hi.0 + 1 + margin;
+                    }
+                    (Err(e), _) | (_, Err(e)) => problems.push(format!("plane {i} box: {e}")),
+                }
+            }
+            boxes.push(fb);
+        }
+        if !problems.is_empty() {
+            return Err(FixedError::InvalidInput { problems });
+        }
+        self.early_stop = Some((stop, boxes));
+        Ok(self)
+    }
+
+    /// Early-stopping settings and the widened box of every plane, if on.
+    pub fn early_stop(&self) -> Option<(&EarlyStop, &[FineBox])> {
+        self.early_stop.as_ref().map(|(s, b)| (s, b.as_slice()))
     }
 
     /// The quantised planes.
@@ -253,10 +397,16 @@ impl FixedIpc {
             converged: false,
             zero_sum: false,
             overflow: false,
+            left_bounds: false,
         };
         for _ in 0..budget {
             let mut next = Vec::with_capacity(n);
             let mut disp = 0;
+            let mut outside = false;
+            let check = self
+                .early_stop
+                .as_ref()
+                .filter(|(s, _)| result.rounds + 1 >= s.min_rounds);
             for i in 0..n {
                 let prev = if i == 0 { tx } else { points[i - 1] };
                 let follow = if i + 1 == n { rx } else { points[i + 1] };
@@ -265,12 +415,26 @@ impl FixedIpc {
                 result.zero_sum |= trace.proportion.zero_sum;
                 result.overflow |= trace.overflow;
                 disp = disp.max(displacement_linf(trace.point, points[i]));
+                if let Some((stop, boxes)) = check {
+                    let l1: u64 = (0..3)
+                        .map(|a| (trace.point[a].0 - points[i][a].0).unsigned_abs())
+                        .sum();
+                    outside |= boxes[path.planes[i] as usize].outside(
+                        trace.point,
+                        l1,
+                        stop.displacement_shift,
+                    );
+                }
                 next.push(trace.point);
             }
             points = next;
             result.rounds += 1;
             result.displacement_lsb = disp;
             if result.zero_sum || result.overflow {
+                break;
+            }
+            if outside {
+                result.left_bounds = true;
                 break;
             }
             if disp <= u64::from(self.threshold_lsb) {

@@ -45,7 +45,9 @@ pub use coord::{
 };
 pub use csd::{Csd, CsdDigit, round_shift};
 pub use error::FixedError;
-pub use ipc::{DegenerateKind, FixedIpc, FixedOutcome, PathResult, PlaneInput};
+pub use ipc::{
+    BoundsM, DegenerateKind, EarlyStop, FineBox, FixedIpc, FixedOutcome, PathResult, PlaneInput,
+};
 pub use normal::{FixedPlane, NORMAL_FRAC, NormalComponent, UNIT_NORMAL_TOLERANCE};
 pub use ops::{
     GUARD_BITS, PROPORTION_ITERATIONS, PeTrace, Proportion, displacement_linf, halving_proportion,

@@ -1,6 +1,6 @@
 //! `FixedIpc` outcomes and validation.
 
-use bt_fixed::{Coord, DegenerateKind, FixedError, FixedIpc, FixedOutcome, PlaneInput};
+use bt_fixed::{Coord, DegenerateKind, EarlyStop, FixedError, FixedIpc, FixedOutcome, PlaneInput};
 
 fn floor() -> PlaneInput {
     PlaneInput {
@@ -113,4 +113,65 @@ fn validation_reports_every_problem() {
     ] {
         assert!(text.contains(needle), "missing {needle:?} in\n{text}");
     }
+}
+
+#[test]
+fn early_stopping_freezes_a_point_outside_its_box_and_nothing_else() {
+    // The mirror point is x = 1 m; a floor patch x in [0, 0.5] m does not hold it.
+    let ipc = || FixedIpc::new(&[floor()], &[vec![0]], &[vec![[0.25, 0.0, 0.0]]], 16, 50).unwrap();
+    let stop = EarlyStop {
+        min_rounds: 1,
+        ..EarlyStop::default()
+    };
+    let (tx, rx) = ([0.0, 0.0, 1.0], [3.0, 0.0, 2.0]);
+    let small = Some([[0.0, -1.0, 0.0], [0.5, 1.0, 0.0]]);
+    let r = &ipc()
+        .with_early_stop(stop, &[small])
+        .unwrap()
+        .run(tx, rx)
+        .unwrap()[0];
+    // Round 1 moves the point by 0.75 m: the margin covers it; round 2 stalls outside.
+    assert_eq!(r.outcome(), FixedOutcome::LeftBounds { rounds: 2 }, "{r:?}");
+    assert!(r.left_bounds && !r.converged);
+    // Converged before min_rounds: untouched.
+    let late = EarlyStop {
+        min_rounds: 3,
+        ..stop
+    };
+    let r = &ipc()
+        .with_early_stop(late, &[small])
+        .unwrap()
+        .run(tx, rx)
+        .unwrap()[0];
+    assert!(
+        matches!(r.outcome(), FixedOutcome::Converged { .. }),
+        "{r:?}"
+    );
+    // A box holding the solution, or none: the same result as without early stopping.
+    let plain = ipc().run(tx, rx).unwrap();
+    for bounds in [Some([[0.0, -1.0, 0.0], [2.0, 1.0, 0.0]]), None] {
+        let r = ipc()
+            .with_early_stop(stop, &[bounds])
+            .unwrap()
+            .run(tx, rx)
+            .unwrap();
+        assert_eq!(r, plain);
+    }
+}
+
+#[test]
+fn early_stopping_settings_are_validated() {
+    let ipc = FixedIpc::new(&[floor()], &[vec![0]], &[vec![[0.5, 0.5, 0.0]]], 16, 50).unwrap();
+    let bad = EarlyStop {
+        min_rounds: 0,
+        displacement_shift: 5,
+        margin_lsb: 0,
+    };
+    let err = ipc
+        .with_early_stop(bad, &[Some([[1.0, 0.0, 0.0], [0.0, 1.0, f64::NAN]])])
+        .unwrap_err();
+    let FixedError::InvalidInput { problems } = err else {
+        panic!("{err:?}")
+    };
+    assert_eq!(problems.len(), 4, "{problems:?}");
 }

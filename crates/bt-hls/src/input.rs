@@ -1,7 +1,8 @@
 //! The generator's input, its validation, and the derived design parameters.
 
 use bt_fixed::{
-    FixedIpc, FixedPoint, PROPORTION_ITERATIONS, PathResult, PlaneInput, quantize_point,
+    BoundsM, EarlyStop, FixedIpc, FixedPoint, PROPORTION_ITERATIONS, PathResult, PlaneInput,
+    quantize_point,
 };
 use bt_schedule::{PathJob, Problem, Schedule};
 
@@ -16,6 +17,10 @@ pub struct PlaneSpec {
     pub normal: [f64; 3],
     /// Offset along the normal, metres.
     pub offset_m: f64,
+    /// Axis-aligned bounds of the plane's polygon, metres (`[min, max]`), for early stopping;
+    /// `None`: this plane never freezes a path.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub bounds_m: Option<BoundsM>,
 }
 
 /// Everything `generate` needs besides the schedule. Plain data, metres outside.
@@ -37,6 +42,9 @@ pub struct HlsInput {
     pub max_rounds: u32,
     /// Further (TX, RX) pairs in metres to co-simulate after the design pair.
     pub test_vectors: Vec<[[f64; 3]; 2]>,
+    /// Early stopping on the planes' `bounds_m` ([`EarlyStop`]); `None`: off.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub early_stop: Option<EarlyStop>,
 }
 
 impl HlsInput {
@@ -50,17 +58,25 @@ impl HlsInput {
                 offset_m: p.offset_m,
             })
             .collect();
-        Ok(FixedIpc::new(
+        let model = FixedIpc::new(
             &planes,
             &self.paths,
             &self.init_points,
             self.threshold_lsb,
             self.max_rounds,
-        )?)
+        )?;
+        Ok(match self.early_stop {
+            Some(stop) => {
+                let bounds: Vec<Option<BoundsM>> = self.planes.iter().map(|p| p.bounds_m).collect();
+                model.with_early_stop(stop, &bounds)?
+            }
+            None => model,
+        })
     }
 
     /// The scheduling problem: each path's round budget is the number of rounds the fixed-point
-    /// model needs at the design TX/RX (at least 1, at most `max_rounds`).
+    /// model needs at the design TX/RX (at least 1, at most `max_rounds`; with early stopping,
+    /// a frozen path's budget ends at the round that froze it).
     pub fn problem(&self) -> Result<Problem, HlsError> {
         let model = self.model()?;
         let results = model.run(self.tx, self.rx)?;

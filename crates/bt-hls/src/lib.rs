@@ -26,9 +26,10 @@ pub mod verilog;
 
 use std::path::{Path, PathBuf};
 
-use bt_fixed::{FixedPoint, PathResult};
+use bt_fixed::FixedPoint;
 use bt_schedule::Schedule;
 
+pub use bt_fixed::{BoundsM, EarlyStop, FixedOutcome, PathResult};
 pub use error::HlsError;
 pub use input::{ADDRESS_BITS, HlsInput, PE_LATENCY, PlaneSpec};
 pub use pe::{POINT_BITS, pe_module_name};
@@ -97,9 +98,11 @@ pub struct VectorExpectation {
     pub paths: Vec<PathResult>,
 }
 
-/// The status word of a path: `{rounds[15:0], 13'b0, overflow, zero_sum, converged}`.
+/// The status word of a path:
+/// `{rounds[15:0], 12'b0, left_bounds, overflow, zero_sum, converged}`.
 pub fn status_word(r: &PathResult) -> u32 {
     (r.rounds.min(0xffff) << 16)
+        | (u32::from(r.left_bounds) << 3)
         | (u32::from(r.overflow) << 2)
         | (u32::from(r.zero_sum) << 1)
         | u32::from(r.converged)
@@ -180,7 +183,7 @@ fn register_map(d: &Design, report_cycles: u64, tb_cycles: u64) -> String {
     s.push_str("| 0x0004-0x0006 | RW | TX_X, TX_Y, TX_Z | transmitter, mm |\n");
     s.push_str("| 0x0008-0x000a | RW | RX_X, RX_Y, RX_Z | receiver, mm |\n");
     s.push_str(&format!(
-        "| 0x{:04x} + p | R | PATH_STATUS[p] | `{{rounds[15:0], 13'b0, overflow, zero_sum, converged}}`, p < {} |\n",
+        "| 0x{:04x} + p | R | PATH_STATUS[p] | `{{rounds[15:0], 12'b0, left_bounds, overflow, zero_sum, converged}}`, p < {} |\n",
         d.status_base, d.num_paths
     ));
     s.push_str(&format!(

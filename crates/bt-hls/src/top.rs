@@ -16,7 +16,11 @@ const S_WB: u128 = 4;
 const STATE_BITS: u32 = 3;
 
 /// Register-map version reported in `INFO[15:8]`.
-pub const MAP_VERSION: u32 = 1;
+pub const MAP_VERSION: u32 = 2;
+
+/// Width of the early-stopping comparisons (`bt_fixed::FineBox::outside`): a 40-bit point
+/// plus or minus `(L1 move) << 4` and the ±2^41 box bounds fit in 48 signed bits.
+const BOX_BITS: u32 = 48;
 
 fn nb(l: Expr, r: Expr) -> Stmt {
     Stmt::NonBlocking(l, r)
@@ -59,6 +63,7 @@ pub(crate) fn top_module(d: &Design) -> Module {
     let point_bits_addr = d.point_base.trailing_zeros();
     let mut items = Vec::new();
     let mut unused: Vec<Expr> = vec![lit(1, 0)];
+    let early = d.model.early_stop().map(|(s, b)| (*s, b.to_vec()));
 
     items.push(Item::Comment(format!(
         "{} paths, {} points, {} PE instances, makespan {} slots, {} cycles per slot, threshold {} fine LSB",
@@ -106,6 +111,10 @@ pub(crate) fn top_module(d: &Design) -> Module {
         ("rq_path", pb),
     ] {
         items.push(Item::Reg(n.into(), w));
+    }
+    if early.is_some() {
+        items.push(Item::Reg("lb".into(), np2));
+        items.push(Item::Reg("plb".into(), np2));
     }
     items.push(Item::Memory("rounds".into(), 16, np2));
     // Two copies of the point memory (one per read port, both written): each is a plain
@@ -367,12 +376,18 @@ pub(crate) fn top_module(d: &Design) -> Module {
         id("wb_big"),
         big_terms.into_iter().reduce(or).expect("3 axes"),
     ));
-    items.push(Item::Wire("wb_frozen".into(), 1));
     let at_wb = |v: &str| Expr::id(v).at(id("wb_q_path"));
-    items.push(Item::Assign(
-        id("wb_frozen"),
-        or(or(at_wb("conv"), at_wb("dz")), at_wb("ov")),
-    ));
+    if let Some((stop, boxes)) = &early {
+        early_stop_logic(d, stop, boxes, &mut items);
+    }
+    items.push(Item::Wire("wb_frozen".into(), 1));
+    let mut frozen = or(or(at_wb("conv"), at_wb("dz")), at_wb("ov"));
+    if early.is_some() {
+        frozen = or(frozen, at_wb("lb"));
+        items.push(Item::Wire("any_lb".into(), 1));
+        items.push(Item::Assign(id("any_lb"), or(at_wb("plb"), id("wb_lb"))));
+    }
+    items.push(Item::Assign(id("wb_frozen"), frozen));
     items.push(Item::Wire("wb_go".into(), 1));
     items.push(Item::Assign(
         id("wb_go"),
@@ -490,6 +505,10 @@ pub(crate) fn top_module(d: &Design) -> Module {
     for v in ["cur", "conv", "dz", "ov", "pbig", "pdz", "pov"] {
         on_start.push(nb(id(v), all_zero.clone()));
     }
+    if early.is_some() {
+        on_start.push(nb(id("lb"), all_zero.clone()));
+        on_start.push(nb(id("plb"), all_zero.clone()));
+    }
     for p in 0..np2 {
         on_start.push(nb(Expr::id("rounds").at(lit(pb, p.into())), lit(16, 0)));
     }
@@ -528,6 +547,23 @@ pub(crate) fn top_module(d: &Design) -> Module {
         vec![nb(id("cnt"), cnt_inc.clone())],
     )];
     let wbp = |v: &str| Expr::id(v).at(id("wb_q_path"));
+    let mut conv_next = id("any_big")
+        .lnot()
+        .and(id("any_dz").lnot())
+        .and(id("any_ov").lnot());
+    let mut at_end = Vec::new();
+    let mut in_round = Vec::new();
+    if early.is_some() {
+        conv_next = conv_next.and(id("any_lb").lnot());
+        at_end.push(nb(
+            wbp("lb"),
+            id("any_lb")
+                .and(id("any_dz").lnot())
+                .and(id("any_ov").lnot()),
+        ));
+        at_end.push(nb(wbp("plb"), lit(1, 0)));
+        in_round.push(nb(wbp("plb"), id("any_lb")));
+    }
     let commit = vec![Stmt::If(
         id("wb_q_end"),
         vec![
@@ -538,22 +574,22 @@ pub(crate) fn top_module(d: &Design) -> Module {
             ),
             nb(wbp("dz"), id("any_dz")),
             nb(wbp("ov"), id("any_ov")),
-            nb(
-                wbp("conv"),
-                id("any_big")
-                    .lnot()
-                    .and(id("any_dz").lnot())
-                    .and(id("any_ov").lnot()),
-            ),
+            nb(wbp("conv"), conv_next),
             nb(wbp("pbig"), lit(1, 0)),
             nb(wbp("pdz"), lit(1, 0)),
             nb(wbp("pov"), lit(1, 0)),
-        ],
+        ]
+        .into_iter()
+        .chain(at_end)
+        .collect(),
         vec![
             nb(wbp("pbig"), id("any_big")),
             nb(wbp("pdz"), id("any_dz")),
             nb(wbp("pov"), id("any_ov")),
-        ],
+        ]
+        .into_iter()
+        .chain(in_round)
+        .collect(),
     )];
     let wb = vec![
         nb(id("wb_q_en"), not_last.and(id("rom_valid"))),
@@ -767,7 +803,12 @@ pub(crate) fn top_module(d: &Design) -> Module {
                         "read_mux",
                         Expr::concat(vec![
                             Expr::id("rounds").at(id("rq_path")),
-                            lit(13, 0),
+                            lit(12, 0),
+                            if early.is_some() {
+                                rqp("lb")
+                            } else {
+                                lit(1, 0)
+                            },
                             rqp("ov"),
                             rqp("dz"),
                             rqp("conv"),
@@ -816,4 +857,108 @@ pub(crate) fn top_module(d: &Design) -> Module {
         ],
         items,
     }
+}
+
+/// Early stopping at write-back (twin of `bt_fixed::FineBox::outside` and the `min_rounds`
+/// rule of `FixedIpc::run_path`): `wb_lb` = the written point lies outside its instance's
+/// widened box by more than `(L1 move) << shift`, in a round ≥ `min_rounds`. Signed 48-bit
+/// comparisons are unsigned ones with the sign bit flipped (the box constants are flipped
+/// when generated).
+fn early_stop_logic(
+    d: &Design,
+    stop: &bt_fixed::EarlyStop,
+    boxes: &[bt_fixed::FineBox],
+    items: &mut Vec<Item>,
+) {
+    let w = BOX_BITS;
+    let bias = 1i128 << (w - 1);
+    let biased = |v: i64| lit(w, ((i128::from(v) + bias) as u128) & ((1u128 << w) - 1));
+    let axes = ["x", "y", "z"];
+    let mut defaults = Vec::new();
+    for axis in axes {
+        for side in ["lo", "hi"] {
+            let n = format!("box_{side}_{axis}");
+            items.push(Item::Reg(n.clone(), w));
+            defaults.push(bl(&n, lit(w, 0)));
+        }
+    }
+    let arms = d
+        .schedule
+        .instances
+        .iter()
+        .enumerate()
+        .map(|(j, inst)| {
+            let b = &boxes[inst.plane as usize];
+            let mut stmts = Vec::new();
+            for (a, axis) in axes.iter().enumerate() {
+                stmts.push(bl(&format!("box_lo_{axis}"), biased(b.lo[a])));
+                stmts.push(bl(&format!("box_hi_{axis}"), biased(b.hi[a])));
+            }
+            (lit(d.inst_bits, j as u128), stmts)
+        })
+        .collect();
+    items.push(Item::Comment(
+        "early stopping: widened polygon box of the written instance's plane (sign bit flipped)"
+            .into(),
+    ));
+    items.push(Item::AlwaysComb(vec![Stmt::Case(
+        id("wb_q_inst"),
+        arms,
+        defaults,
+    )]));
+    let dispw = width::COORD + 1;
+    let mvw = w - bt_fixed::EarlyStop::MAX_SHIFT;
+    let zext = |n: &str| Expr::concat(vec![lit(mvw - dispw, 0), id(n)]);
+    items.push(Item::Wire("mv_l1".into(), mvw));
+    items.push(Item::Assign(
+        id("mv_l1"),
+        zext("adiff_x").plus(zext("adiff_y")).plus(zext("adiff_z")),
+    ));
+    let shift = stop.displacement_shift;
+    items.push(Item::Wire("slack".into(), w));
+    let mut parts = vec![lit(w - mvw - shift, 0), id("mv_l1")];
+    if shift > 0 {
+        parts.push(lit(shift, 0));
+    }
+    items.push(Item::Assign(id("slack"), Expr::concat(parts)));
+    let mut terms = Vec::new();
+    for axis in axes {
+        let pw = format!("bp_{axis}");
+        items.push(Item::Wire(pw.clone(), w));
+        items.push(Item::Assign(
+            id(&pw),
+            crate::pe::sext(&format!("new_{axis}"), width::COORD, w),
+        ));
+        for (side, expr) in [
+            ("lo", id(&pw).plus(id("slack"))),
+            ("hi", id(&pw).minus(id("slack"))),
+        ] {
+            let n = format!("bq_{side}_{axis}");
+            items.push(Item::Wire(n.clone(), w));
+            items.push(Item::Assign(id(&n), expr));
+            let flipped = Expr::concat(vec![Expr::bit(&n, w - 1).inv(), Expr::slice(&n, w - 2, 0)]);
+            let op = if side == "lo" {
+                BinaryOp::Lt
+            } else {
+                BinaryOp::Gt
+            };
+            terms.push(Expr::bin(op, flipped, id(&format!("box_{side}_{axis}"))));
+        }
+    }
+    let outside = terms.into_iter().reduce(or).expect("3 axes");
+    let late = if stop.min_rounds >= 2 {
+        Expr::bin(
+            BinaryOp::Gt,
+            Expr::id("rounds").at(id("wb_q_path")),
+            lit(16, u128::from(stop.min_rounds - 2)),
+        )
+    } else {
+        lit(1, 1)
+    };
+    items.push(Item::Comment(format!(
+        "wb_lb: outside the box by more than (L1 move) << {shift}, in round >= {}",
+        stop.min_rounds
+    )));
+    items.push(Item::Wire("wb_lb".into(), 1));
+    items.push(Item::Assign(id("wb_lb"), late.and(outside)));
 }

@@ -1,14 +1,85 @@
 //! A scene as the accelerator's input: the bridge from `bt-scene` to `bt-hls`, shared by
 //! `beamtrace hls gen` and the living-room study.
 
-use bt_hls::{HlsInput, PlaneSpec};
+use bt_geom::{Real, Vec3};
+use bt_hls::{EarlyStop, HlsInput, PathResult, PlaneSpec};
 use bt_paths::{AllVisible, enumerate};
 use bt_scene::{Scene, SurfaceId};
+use bt_solve::{Validity, validate::validate};
+
+/// Largest reflection-law error the host accepts on a fixed-point path, degrees: the angle
+/// between the mirrored incoming direction and the outgoing one at any bounce. Valid paths of
+/// the living room stay below 0.2° (millimetre points over legs of ≥ 0.3 m); the false
+/// convergences of the fixed-point model (points stalled 0.5-2.6 m from the solution) are off
+/// by degrees (`docs/study-living-room.md`).
+pub const REFLECTION_TOLERANCE_DEG: Real = 0.5;
+
+/// Largest reflection-law error over the bounces of `points` (surfaces `seq`, TX and RX),
+/// degrees; infinite for a zero-length leg.
+pub fn reflection_error_deg(
+    scene: &Scene,
+    seq: &[SurfaceId],
+    tx: Vec3,
+    rx: Vec3,
+    points: &[Vec3],
+) -> Real {
+    let mut worst: Real = 0.0;
+    for (i, (&p, id)) in points.iter().zip(seq).enumerate() {
+        let prev = if i == 0 { tx } else { points[i - 1] };
+        let next = points.get(i + 1).copied().unwrap_or(rx);
+        let (Some(u), Some(v)) = ((p - prev).try_normalize(), (next - p).try_normalize()) else {
+            return Real::INFINITY;
+        };
+        let n = scene.surface(*id).polygon.plane().normal;
+        let mirrored = u - 2.0 * u.dot(n) * n;
+        worst = worst.max(mirrored.angle_between(v).to_degrees());
+    }
+    worst
+}
+
+/// The host's check of one accelerator result (the paper's post-processor): converged, valid
+/// in f64 (inside every polygon, same side, unblocked) and obeying the reflection law within
+/// [`REFLECTION_TOLERANCE_DEG`].
+pub fn host_accepts(
+    scene: &Scene,
+    seq: &[SurfaceId],
+    result: &PathResult,
+) -> Result<Vec<Vec3>, HostRejection> {
+    if !result.converged {
+        return Err(HostRejection::NotConverged);
+    }
+    let points: Vec<Vec3> = result
+        .points_m
+        .iter()
+        .map(|p| Vec3::from_array(*p))
+        .collect();
+    let (tx, rx) = (scene.tx(), scene.rx());
+    if validate(scene, seq, tx, rx, &points) != Validity::Valid {
+        return Err(HostRejection::Invalid);
+    }
+    if reflection_error_deg(scene, seq, tx, rx, &points) > REFLECTION_TOLERANCE_DEG {
+        return Err(HostRejection::ReflectionLaw);
+    }
+    Ok(points)
+}
+
+/// Why the host rejects an accelerator result.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum HostRejection {
+    /// Not converged (round cap, degenerate or early-stopped).
+    NotConverged,
+    /// Fails the f64 validation (outside a polygon, wrong side, blocked).
+    Invalid,
+    /// Converged and valid, but breaks the reflection law by more than the tolerance: a false
+    /// convergence of the fixed-point iteration.
+    ReflectionLaw,
+}
 
 /// The HLS input of a scene: one plane per reflector (PE `bt_pe_<i>` for the `i`-th
 /// reflector), every candidate path of order 1 to `max_order` (exhaustive enumeration with
 /// the side test, as the paper computes *all* paths on the FPGA), starting points at the
-/// polygon centroids; `threshold_lsb` in 1/256 mm, `max_rounds` the round cap. Also returns
+/// polygon centroids; `threshold_lsb` in 1/256 mm, `max_rounds` the round cap; early stopping
+/// ([`EarlyStop::default`]) on every plane's polygon bounding box. Also returns
 /// the surface sequence of every input path (`input.paths[p]` is `sequences[p]`).
 pub fn hls_input(
     scene: &Scene,
@@ -44,10 +115,12 @@ pub fn hls_input(
         .map(|id| {
             let s = scene.surface(*id);
             let p = s.polygon.plane();
+            let (min, max) = s.polygon.bounds();
             PlaneSpec {
                 name: s.name.clone(),
                 normal: p.normal.to_array(),
                 offset_m: p.offset,
+                bounds_m: Some([min.to_array(), max.to_array()]),
             }
         })
         .collect();
@@ -60,6 +133,7 @@ pub fn hls_input(
         threshold_lsb,
         max_rounds,
         test_vectors: Vec::new(),
+        early_stop: Some(EarlyStop::default()),
     };
     (input, sequences)
 }

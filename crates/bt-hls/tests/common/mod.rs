@@ -17,31 +17,37 @@ pub fn small_scene() -> HlsInput {
             name: "wall_west_tilted".into(),
             normal: tilt,
             offset_m: tilt[1] * 2.0,
+            bounds_m: Some([[-0.2, 0.0, 0.0], [0.2, 4.0, 3.0]]),
         },
         PlaneSpec {
             name: "wall_east".into(),
             normal: [-1.0, 0.0, 0.0],
             offset_m: -5.0,
+            bounds_m: Some([[5.0, 0.0, 0.0], [5.0, 4.0, 3.0]]),
         },
         PlaneSpec {
             name: "wall_south".into(),
             normal: [0.0, 1.0, 0.0],
             offset_m: 0.0,
+            bounds_m: Some([[0.0, 0.0, 0.0], [5.0, 0.0, 3.0]]),
         },
         PlaneSpec {
             name: "wall_north".into(),
             normal: [0.0, -1.0, 0.0],
             offset_m: -4.0,
+            bounds_m: Some([[0.0, 4.0, 0.0], [5.0, 4.0, 3.0]]),
         },
         PlaneSpec {
             name: "floor".into(),
             normal: [0.0, 0.0, 1.0],
             offset_m: 0.0,
+            bounds_m: Some([[0.0, 0.0, 0.0], [5.0, 4.0, 0.0]]),
         },
         PlaneSpec {
             name: "ceiling".into(),
             normal: [0.0, 0.0, -1.0],
             offset_m: -3.0,
+            bounds_m: Some([[0.0, 0.0, 3.0], [5.0, 4.0, 3.0]]),
         },
     ];
     let centroids = [
@@ -76,7 +82,18 @@ pub fn small_scene() -> HlsInput {
             [[0.8, 3.1, 2.2], [4.1, 0.9, 0.6]],
             [[2.5, 2.0, 1.0], [2.6, 2.1, 2.0]],
         ],
+        early_stop: None,
     }
+}
+
+/// The small scene with early stopping on (`EarlyStop::default()`), the east wall and the floor
+/// cut down to 1 m patches (as a window and a rug would be) so that some paths leave them.
+pub fn small_scene_early() -> HlsInput {
+    let mut s = small_scene();
+    s.planes[1].bounds_m = Some([[5.0, 0.0, 0.0], [5.0, 1.0, 3.0]]);
+    s.planes[4].bounds_m = Some([[0.0, 0.0, 0.0], [1.0, 4.0, 0.0]]);
+    s.early_stop = Some(bt_fixed::EarlyStop::default());
+    s
 }
 
 /// The schedule: the paper's GA + duplication + ASAP with 2 duplicate PEs, fixed seed.

@@ -187,6 +187,11 @@ pub struct FpgaStep {
     pub not_converged: usize,
     /// Paths frozen as degenerate (overflow or zero distance sum).
     pub degenerate: usize,
+    /// Paths frozen by early stopping (a point left its polygon's box).
+    pub left_bounds: usize,
+    /// Converged, valid paths the host rejected for breaking the reflection law
+    /// ([`fpga::REFLECTION_TOLERANCE_DEG`]): false convergences of the fixed-point model.
+    pub reflection_rejected: usize,
     /// PE instances of the schedule (originals and duplicates).
     pub instances: u32,
     /// Duplicated PEs.
@@ -332,17 +337,16 @@ fn fixed_point_step(
     if validate(scene, &[], tx, rx, &[]) == Validity::Valid {
         paths.insert(Vec::new(), exact_directions(scene, &[]));
     }
-    let mut points = Vec::new();
     let mut accepted = Vec::new();
+    let mut reflection_rejected = 0;
     for (p, (seq, r)) in sequences.iter().zip(&results).enumerate() {
-        if !r.converged {
-            continue;
-        }
-        points.clear();
-        points.extend(r.points_m.iter().map(|p| Vec3::from_array(*p)));
-        if validate(scene, seq, tx, rx, &points) == Validity::Valid {
-            paths.insert(seq.clone(), exact_directions(scene, &points));
-            accepted.push(p);
+        match fpga::host_accepts(scene, seq, r) {
+            Ok(points) => {
+                paths.insert(seq.clone(), exact_directions(scene, &points));
+                accepted.push(p);
+            }
+            Err(fpga::HostRejection::ReflectionLaw) => reflection_rejected += 1,
+            Err(_) => {}
         }
     }
     let time_s = start.elapsed().as_secs_f64();
@@ -364,13 +368,16 @@ fn fixed_point_step(
     };
     let converged = results.iter().filter(|r| r.converged).count();
     let degenerate = results.iter().filter(|r| r.overflow || r.zero_sum).count();
+    let left_bounds = results.iter().filter(|r| r.left_bounds).count();
     let fpga = FpgaStep {
         step,
         paths: input.paths.len(),
         points: plan.points,
         converged,
-        not_converged: results.len() - converged - degenerate,
+        not_converged: results.len() - converged - degenerate - left_bounds,
         degenerate,
+        left_bounds,
+        reflection_rejected,
         instances: plan.stats.instances,
         duplicates: plan.stats.duplicates,
         pe_budget: plan.pe_budget,

@@ -12,7 +12,7 @@ pub const CSV_HEADER: &str = "scene,step,solver,paths,matched,missed,spurious,\
 mean_err_tx_deg,max_err_tx_deg,mean_err_rx_deg,max_err_rx_deg,time_s,fpga_cycles,fpga_latency_s";
 
 /// Column names of `fpga.csv`.
-pub const FPGA_CSV_HEADER: &str = "scene,step,paths,points,converged,not_converged,degenerate,\
+pub const FPGA_CSV_HEADER: &str = "scene,step,paths,points,converged,not_converged,degenerate,left_bounds,reflection_rejected,\
 instances,duplicates,pe_budget,makespan,list_makespan,latency_factor,utilisation,\
 cycles_per_slot,cycles,latency_s,accepted_paths,accepted_cycles,schedule_time_s";
 
@@ -64,7 +64,7 @@ pub fn fpga_csv(results: &LivingRoomResults) -> String {
     for f in &results.fpga {
         let _ = writeln!(
             out,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{:e},{},{},{:e},{},{},{:e}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:e},{},{},{:e},{},{},{:e}",
             results.scene_name,
             f.step,
             f.paths,
@@ -72,6 +72,8 @@ pub fn fpga_csv(results: &LivingRoomResults) -> String {
             f.converged,
             f.not_converged,
             f.degenerate,
+            f.left_bounds,
+            f.reflection_rejected,
             f.instances,
             f.duplicates,
             f.pe_budget,
