@@ -9,7 +9,7 @@
 use crate::report::{GroupBy, Quantity, mean_by};
 use crate::run::{RoomDrawing, StudyResults, StudySolver};
 use bt_geom::Real;
-use plotters::coord::Shift;
+use plotters::coord::{CoordTranslate, Shift};
 use plotters::prelude::*;
 use std::sync::OnceLock;
 
@@ -33,6 +33,29 @@ pub fn register_font() -> Result<(), String> {
 
 pub(crate) fn fail<E: std::fmt::Display>(e: E) -> String {
     e.to_string()
+}
+
+/// Start a figure: register the font and fill the whole area white.
+pub(crate) fn blank<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+    register_font()?;
+    root.fill(&WHITE).map_err(fail)
+}
+
+/// Draw the legend of every figure: `font_size` text in a translucent white box with a black
+/// border at `position`.
+pub(crate) fn legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    position: SeriesLabelPosition,
+    font_size: u32,
+) -> Result<(), String> {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .label_font((FAMILY, font_size))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(fail)
 }
 
 /// Colour of a solver in every figure.
@@ -76,7 +99,7 @@ pub(crate) fn panel<DB: DrawingBackend>(
     y_desc: &str,
     series: &[Series],
     floor: Real,
-    legend: SeriesLabelPosition,
+    legend_position: SeriesLabelPosition,
 ) -> Result<(), String> {
     let xs = series.iter().flat_map(|s| s.points.iter().map(|q| q.0));
     let (x_lo, x_hi) = xs.fold((usize::MAX, 0), |(lo, hi), x| (lo.min(x), hi.max(x)));
@@ -124,15 +147,26 @@ pub(crate) fn panel<DB: DrawingBackend>(
             .label(s.label.as_str())
             .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(2)));
     }
-    chart
-        .configure_series_labels()
-        .position(legend)
-        .label_font((FAMILY, 12))
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .draw()
-        .map_err(fail)?;
-    Ok(())
+    legend(&mut chart, legend_position, 12)
+}
+
+/// An angular-error panel (Figs. 6 and 17): mean error in degrees on a log axis floored at
+/// [`ERROR_FLOOR_DEG`], legend at the middle right.
+pub(crate) fn error_panel<DB: DrawingBackend>(
+    area: &DrawingArea<DB, Shift>,
+    title: &str,
+    x_desc: &str,
+    series: &[Series],
+) -> Result<(), String> {
+    panel(
+        area,
+        title,
+        x_desc,
+        "mean angular error (deg)",
+        series,
+        ERROR_FLOOR_DEG,
+        SeriesLabelPosition::MiddleRight,
+    )
 }
 
 fn selected(
@@ -154,8 +188,7 @@ pub fn angular_error<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     results: &StudyResults,
 ) -> Result<(), String> {
-    register_font()?;
-    root.fill(&WHITE).map_err(fail)?;
+    blank(root)?;
     let solvers = [
         StudySolver::IpcGaussSeidel,
         StudySolver::IpcJacobi,
@@ -190,16 +223,7 @@ pub fn angular_error<DB: DrawingBackend>(
     ];
     for (area, (group, quantity, title, x_desc)) in panels.iter().zip(specs) {
         let series = selected(results, group, quantity, &solvers);
-        let legend = SeriesLabelPosition::MiddleRight;
-        panel(
-            area,
-            title,
-            x_desc,
-            "mean angular error (deg)",
-            &series,
-            ERROR_FLOOR_DEG,
-            legend,
-        )?;
+        error_panel(area, title, x_desc, &series)?;
     }
     Ok(())
 }
@@ -210,8 +234,7 @@ pub fn elapsed_time<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     results: &StudyResults,
 ) -> Result<(), String> {
-    register_font()?;
-    root.fill(&WHITE).map_err(fail)?;
+    blank(root)?;
     let panels = root.split_evenly((1, 2));
     let specs = [
         (GroupBy::Step, "(a) elapsed time vs dynamics", "time step"),
@@ -223,7 +246,6 @@ pub fn elapsed_time<DB: DrawingBackend>(
     ];
     for (area, (group, title, x_desc)) in panels.iter().zip(specs) {
         let series = selected(results, group, Quantity::Time, &StudySolver::ALL);
-        let legend = SeriesLabelPosition::UpperLeft;
         panel(
             area,
             title,
@@ -231,7 +253,7 @@ pub fn elapsed_time<DB: DrawingBackend>(
             "mean elapsed time (s)",
             &series,
             TIME_FLOOR_S,
-            legend,
+            SeriesLabelPosition::UpperLeft,
         )?;
     }
     Ok(())
@@ -254,8 +276,7 @@ pub fn rooms<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     drawings: &[RoomDrawing],
 ) -> Result<(), String> {
-    register_font()?;
-    root.fill(&WHITE).map_err(fail)?;
+    blank(root)?;
     let cols = drawings
         .iter()
         .map(|d| d.steps.len())

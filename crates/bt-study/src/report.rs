@@ -158,6 +158,15 @@ pub fn totals(rows: &[Row], keep: impl Fn(&Row) -> bool) -> BTreeMap<StudySolver
         .collect()
 }
 
+/// The entries of `solvers` in a per-solver map, in that order; the default (zeros) for a
+/// solver the map lacks.
+pub(crate) fn pick<T: Copy + Default, const N: usize>(
+    by_solver: &BTreeMap<StudySolver, T>,
+    solvers: [StudySolver; N],
+) -> [T; N] {
+    solvers.map(|s| by_solver.get(&s).copied().unwrap_or_default())
+}
+
 /// Headline ratios of the comparison (the paper's conclusions).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Ratios {
@@ -178,13 +187,7 @@ pub struct Ratios {
 /// The headline ratios over all rows.
 pub fn ratios(results: &StudyResults) -> Ratios {
     let t = totals(&results.rows, |_| true);
-    let get = |s| t.get(&s).copied().unwrap_or_default();
-    let (image, gs, jacobi, sbr) = (
-        get(StudySolver::Image),
-        get(StudySolver::IpcGaussSeidel),
-        get(StudySolver::IpcJacobi),
-        get(StudySolver::Sbr),
-    );
+    let [image, gs, jacobi, sbr] = pick(&t, StudySolver::ALL);
     Ratios {
         sbr_over_ipc_time: sbr.time_s / gs.time_s,
         sbr_over_jacobi_time: sbr.time_s / jacobi.time_s,
@@ -287,13 +290,7 @@ pub fn summary(results: &StudyResults) -> String {
     let _ = writeln!(s, "|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|");
     for shape in Shape::ALL {
         let t = totals(&results.rows, |r| r.shape == shape);
-        let get = |x| t.get(&x).copied().unwrap_or_default();
-        let (image, gs, jacobi, sbr) = (
-            get(StudySolver::Image),
-            get(StudySolver::IpcGaussSeidel),
-            get(StudySolver::IpcJacobi),
-            get(StudySolver::Sbr),
-        );
+        let [image, gs, jacobi, sbr] = pick(&t, StudySolver::ALL);
         if image.rows == 0 {
             continue;
         }

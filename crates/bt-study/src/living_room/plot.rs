@@ -4,9 +4,7 @@
 
 use super::{LivingRoomResults, RayAngles, StepRays};
 use crate::StudySolver;
-use crate::plot::{
-    ERROR_FLOOR_DEG, FAMILY, Series, TIME_FLOOR_S, colour, fail, panel, register_font,
-};
+use crate::plot::{FAMILY, Series, TIME_FLOOR_S, blank, colour, error_panel, fail, legend, panel};
 use bt_geom::Real;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -37,8 +35,7 @@ pub fn angular_error<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     results: &LivingRoomResults,
 ) -> Result<(), String> {
-    register_font()?;
-    root.fill(&WHITE).map_err(fail)?;
+    blank(root)?;
     let solvers = [
         StudySolver::IpcGaussSeidel,
         StudySolver::IpcJacobi,
@@ -56,15 +53,7 @@ pub fn angular_error<DB: DrawingBackend>(
             .iter()
             .map(|s| per_step(results, *s, value))
             .collect();
-        panel(
-            area,
-            title,
-            "time step",
-            "mean angular error (deg)",
-            &series,
-            ERROR_FLOOR_DEG,
-            SeriesLabelPosition::MiddleRight,
-        )?;
+        error_panel(area, title, "time step", &series)?;
     }
     Ok(())
 }
@@ -77,8 +66,7 @@ pub fn run_time<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     results: &LivingRoomResults,
 ) -> Result<(), String> {
-    register_font()?;
-    root.fill(&WHITE).map_err(fail)?;
+    blank(root)?;
     let mut series: Vec<Series> = [
         StudySolver::Image,
         StudySolver::IpcGaussSeidel,
@@ -124,8 +112,7 @@ pub fn ray_directions<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     rays: &[StepRays],
 ) -> Result<(), String> {
-    register_font()?;
-    root.fill(&WHITE).map_err(fail)?;
+    blank(root)?;
     let cells = root.split_evenly((rays.len().max(1), 2));
     let exact_colour = RGBColor(20, 20, 20);
     let fixed_colour = colour(StudySolver::IpcGaussSeidel);
@@ -192,14 +179,7 @@ pub fn ray_directions<DB: DrawingBackend>(
                 .map_err(fail)?
                 .label(format!("geometric optics ({})", step.exact.len()))
                 .legend(move |(x, y)| Cross::new((x + 10, y), 5, exact_colour.stroke_width(2)));
-            chart
-                .configure_series_labels()
-                .position(SeriesLabelPosition::LowerLeft)
-                .label_font((FAMILY, 11))
-                .background_style(WHITE.mix(0.85))
-                .border_style(BLACK)
-                .draw()
-                .map_err(fail)?;
+            legend(&mut chart, SeriesLabelPosition::LowerLeft, 11)?;
         }
     }
     Ok(())
