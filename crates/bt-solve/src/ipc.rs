@@ -230,10 +230,12 @@ pub fn solve(
     }
 }
 
-/// One Gauss-Seidel round (Algorithm 1, lines 9-14): returns the summed displacement, or the
-/// index of a point whose neighbours both lie on its plane.
+/// One round of Algorithm 1 (lines 9-14): returns the summed displacement, or the index of a
+/// point whose neighbours both lie on its plane. Gauss-Seidel (`JACOBI = false`) feeds each new
+/// point to its successor; Jacobi computes every point from the previous round, in place: the
+/// old value of point k - 1 is kept in a register, point k + 1 is not yet overwritten.
 #[inline(always)]
-fn round_gauss_seidel(
+fn round<const JACOBI: bool>(
     planes: &[Plane],
     tx: Vec3,
     rx: Vec3,
@@ -248,35 +250,10 @@ fn round_gauss_seidel(
         let Some(p) = intersection_point(&planes[k], prev, next, min_sum) else {
             return Err(k);
         };
-        moved += p.distance(points[k]);
-        points[k] = p;
-        prev = p;
-    }
-    Ok(moved)
-}
-
-/// One Jacobi round: every point from the previous round's neighbours. In place: the old value
-/// of point k - 1 is kept in a register, point k + 1 is not yet overwritten.
-#[inline(always)]
-fn round_jacobi(
-    planes: &[Plane],
-    tx: Vec3,
-    rx: Vec3,
-    points: &mut [Vec3],
-    min_sum: Real,
-) -> Result<Real, usize> {
-    let n = points.len();
-    let mut moved = 0.0;
-    let mut prev_old = tx;
-    for k in 0..n {
-        let next = if k + 1 == n { rx } else { points[k + 1] };
-        let Some(p) = intersection_point(&planes[k], prev_old, next, min_sum) else {
-            return Err(k);
-        };
         let old = points[k];
         moved += p.distance(old);
         points[k] = p;
-        prev_old = old;
+        prev = if JACOBI { old } else { p };
     }
     Ok(moved)
 }
@@ -311,8 +288,8 @@ fn run(
     while rounds < options.max_iterations {
         rounds += 1;
         let round = match options.order {
-            UpdateOrder::GaussSeidel => round_gauss_seidel(planes, tx, rx, points, min_sum),
-            UpdateOrder::Jacobi => round_jacobi(planes, tx, rx, points, min_sum),
+            UpdateOrder::GaussSeidel => round::<false>(planes, tx, rx, points, min_sum),
+            UpdateOrder::Jacobi => round::<true>(planes, tx, rx, points, min_sum),
         };
         let moved = match round {
             Ok(moved) => moved,
