@@ -438,3 +438,18 @@ pub struct HlsGenArgs {
     #[arg(long)]
     pub steps: bool,
 }
+
+/// `beamtrace hls SCENE -o DIR ...` is short for `beamtrace hls gen SCENE -o DIR ...` (the
+/// spelling of the HLS issue); every other command line passes through unchanged.
+pub fn with_default_subcommands(
+    args: impl IntoIterator<Item = std::ffi::OsString>,
+) -> Vec<std::ffi::OsString> {
+    let mut args: Vec<std::ffi::OsString> = args.into_iter().collect();
+    if args.get(1).is_some_and(|a| a == "hls") {
+        let known = ["gen", "sim", "synth", "help", "-h", "--help"];
+        if args.get(2).is_some_and(|a| !known.iter().any(|k| a == k)) {
+            args.insert(2, "gen".into());
+        }
+    }
+    args
+}

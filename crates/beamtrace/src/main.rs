@@ -15,7 +15,7 @@ use std::process::ExitCode;
 
 fn main() -> ExitCode {
     restore_default_sigpipe();
-    let cli = args::Cli::parse();
+    let cli = args::Cli::parse_from(args::with_default_subcommands(std::env::args_os()));
     match run(cli) {
         Ok(code) => code,
         Err(e) => {
