@@ -27,9 +27,7 @@ use bt_paths::wvrn::{Wvrn, WvrnStats};
 use bt_paths::{AllVisible, CandidateSet, CandidateStats};
 use bt_scene::dynamic::{DynamicScene, moved_surfaces};
 use bt_scene::{Scene, SurfaceId};
-use bt_solve::{
-    CandidateOutcome, FoundPath, IpcOutcome, OutcomeCounts, Solver, TraceResult, Validity,
-};
+use bt_solve::{CandidateOutcome, FoundPath, IpcOutcome, Solver, TraceResult, Validity};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::cmp::Ordering;
@@ -294,8 +292,14 @@ impl IncrementalTracer {
                         warm_start(&r.outcome, pts)
                     });
                     let points = &mut all_points[start..];
-                    let outcome =
-                        solve_one(scene, seq, &options.solver, warm, points, &mut scratch);
+                    let outcome = bt_solve::solve_candidate_from(
+                        scene,
+                        seq,
+                        &options.solver,
+                        warm,
+                        points,
+                        &mut scratch,
+                    );
                     (
                         outcome,
                         warm.is_some() && matches!(options.solver, Solver::Ipc(_)),
@@ -373,7 +377,13 @@ impl IncrementalTracer {
                     let seq = candidates.get(i);
                     let mut points = vec![Vec3::ZERO; seq.len()];
                     scratch.resize(seq.len(), Vec3::ZERO);
-                    let o = solve_one(scene, seq, &options.solver, None, &mut points, &mut scratch);
+                    let o = bt_solve::solve_candidate(
+                        scene,
+                        seq,
+                        &options.solver,
+                        &mut points,
+                        &mut scratch,
+                    );
                     (o, points)
                 })
                 .collect()
@@ -422,7 +432,7 @@ impl State {
         let mut trace = TraceResult::default();
         for (i, r) in self.records.iter().enumerate() {
             let seq = self.candidates.get(i);
-            add(&mut trace.counts, &r.outcome);
+            trace.counts.add(&r.outcome);
             if let CandidateOutcome::Solved {
                 validity: Validity::Valid,
                 ipc,
@@ -501,55 +511,6 @@ fn warm_start<'a>(outcome: &CandidateOutcome, points: &'a [Vec3]) -> Option<&'a 
             ..
         } if points.iter().all(|p| p.is_finite()) => Some(points),
         _ => None,
-    }
-}
-
-/// [`bt_solve::solve_candidate`], with IPC starting from `warm` when given.
-fn solve_one(
-    scene: &Scene,
-    seq: &[SurfaceId],
-    solver: &Solver,
-    warm: Option<&[Vec3]>,
-    points: &mut [Vec3],
-    scratch: &mut [Vec3],
-) -> CandidateOutcome {
-    match (solver, warm) {
-        (Solver::Ipc(options), Some(warm)) => {
-            points.copy_from_slice(warm);
-            let (tx, rx) = (scene.tx(), scene.rx());
-            let outcome = bt_solve::ipc::solve(scene, seq, tx, rx, options, points, scratch);
-            match outcome {
-                IpcOutcome::Converged { .. } => CandidateOutcome::Solved {
-                    validity: bt_solve::validate::validate(scene, seq, tx, rx, points),
-                    ipc: Some(outcome),
-                },
-                IpcOutcome::NotConverged { .. } => CandidateOutcome::NotConverged(outcome),
-                IpcOutcome::Degenerate { .. } => CandidateOutcome::Degenerate(outcome),
-                IpcOutcome::LeftPolygon { .. } => CandidateOutcome::LeftPolygon(outcome),
-            }
-        }
-        _ => bt_solve::solve_candidate(scene, seq, solver, points, scratch),
-    }
-}
-
-/// Count an outcome the way [`bt_solve::trace`] does (a copy of bt-solve's private
-/// `OutcomeCounts::add`; the equality tests catch any drift).
-fn add(counts: &mut OutcomeCounts, outcome: &CandidateOutcome) {
-    match outcome {
-        CandidateOutcome::Solved { validity, .. } => match validity {
-            Validity::Valid => counts.valid += 1,
-            Validity::OutsidePolygon { .. } => counts.outside_polygon += 1,
-            Validity::OppositeSides { .. } => counts.opposite_sides += 1,
-            Validity::Grazing { .. } => counts.grazing += 1,
-            Validity::Blocked { .. } => counts.blocked += 1,
-            Validity::NonFinite => counts.degenerate += 1,
-        },
-        CandidateOutcome::ImageDegenerate(_) | CandidateOutcome::Degenerate(_) => {
-            counts.degenerate += 1
-        }
-        CandidateOutcome::NotConverged(_) => counts.not_converged += 1,
-        CandidateOutcome::Missed => counts.missed += 1,
-        CandidateOutcome::LeftPolygon(_) => counts.outside_polygon += 1,
     }
 }
 

@@ -96,7 +96,8 @@ pub struct OutcomeCounts {
 }
 
 impl OutcomeCounts {
-    fn add(&mut self, outcome: &CandidateOutcome) {
+    /// Count one candidate's outcome.
+    pub fn add(&mut self, outcome: &CandidateOutcome) {
         match outcome {
             CandidateOutcome::Solved { validity, .. } => match validity {
                 Validity::Valid => self.valid += 1,
@@ -113,6 +114,18 @@ impl OutcomeCounts {
             CandidateOutcome::LeftPolygon(_) => self.outside_polygon += 1,
             CandidateOutcome::Missed => self.missed += 1,
         }
+    }
+
+    /// Add the counts of another batch.
+    pub fn merge(&mut self, other: &OutcomeCounts) {
+        self.valid += other.valid;
+        self.outside_polygon += other.outside_polygon;
+        self.opposite_sides += other.opposite_sides;
+        self.grazing += other.grazing;
+        self.blocked += other.blocked;
+        self.not_converged += other.not_converged;
+        self.degenerate += other.degenerate;
+        self.missed += other.missed;
     }
 }
 
@@ -135,6 +148,20 @@ pub fn solve_candidate(
     points: &mut [Vec3],
     scratch: &mut [Vec3],
 ) -> CandidateOutcome {
+    solve_candidate_from(scene, seq, solver, None, points, scratch)
+}
+
+/// [`solve_candidate`], with IPC starting from `warm` (e.g. the previous time step's points)
+/// instead of the polygon centroids when given; other solvers ignore `warm`.
+#[inline(always)]
+pub fn solve_candidate_from(
+    scene: &Scene,
+    seq: &[SurfaceId],
+    solver: &Solver,
+    warm: Option<&[Vec3]>,
+    points: &mut [Vec3],
+    scratch: &mut [Vec3],
+) -> CandidateOutcome {
     let (tx, rx) = (scene.tx(), scene.rx());
     let ipc = match solver {
         Solver::Image => {
@@ -144,8 +171,13 @@ pub fn solve_candidate(
             None
         }
         Solver::Ipc(options) => {
-            for (p, id) in points.iter_mut().zip(seq) {
-                *p = scene.surface(*id).polygon.centroid();
+            match warm {
+                Some(warm) => points.copy_from_slice(warm),
+                None => {
+                    for (p, id) in points.iter_mut().zip(seq) {
+                        *p = scene.surface(*id).polygon.centroid();
+                    }
+                }
             }
             let outcome = ipc::solve(scene, seq, tx, rx, options, points, scratch);
             match outcome {
@@ -197,15 +229,7 @@ pub fn trace(
     let mut out = TraceResult::default();
     for part in parts {
         out.paths.extend(part.paths);
-        let c = part.counts;
-        out.counts.valid += c.valid;
-        out.counts.outside_polygon += c.outside_polygon;
-        out.counts.opposite_sides += c.opposite_sides;
-        out.counts.grazing += c.grazing;
-        out.counts.blocked += c.blocked;
-        out.counts.not_converged += c.not_converged;
-        out.counts.degenerate += c.degenerate;
-        out.counts.missed += c.missed;
+        out.counts.merge(&part.counts);
     }
     out
 }
