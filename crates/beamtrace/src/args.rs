@@ -212,12 +212,19 @@ pub struct TraceArgs {
     /// Write the JSON document to this file (the table still goes to stdout unless --json).
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Route candidates over the WVRN (the default; it provably loses no path).
-    #[arg(long, overrides_with = "no_wvrn")]
+    /// Candidate generator: the beam tree (default), every sequence over the WVRN, or every
+    /// sequence (exhaustive, for checking). All three give the same paths.
+    #[arg(long, value_enum, default_value_t = CandidatesArg::BeamTree)]
+    pub candidates: CandidatesArg,
+    /// Old spelling of `--candidates wvrn`.
+    #[arg(long, overrides_with = "no_wvrn", hide = true)]
     pub wvrn: bool,
-    /// Enumerate candidates exhaustively instead of over the WVRN.
-    #[arg(long, overrides_with = "wvrn")]
+    /// Old spelling of `--candidates exhaustive`.
+    #[arg(long, overrides_with = "wvrn", hide = true)]
     pub no_wvrn: bool,
+    /// Budget: stop with an error rather than generate more candidates (beam-tree nodes).
+    #[arg(long, default_value_t = bt_solve::pipeline::DEFAULT_MAX_CANDIDATES)]
+    pub max_candidates: u64,
     /// Trace every time step of a dynamic scene (static scenes have one step).
     #[arg(long)]
     pub steps: bool,
@@ -229,10 +236,31 @@ pub struct TraceArgs {
     pub from_scratch: bool,
 }
 
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum CandidatesArg {
+    /// Visibility-driven beam tree: only sequences geometry allows.
+    BeamTree,
+    /// Every sequence over the weak visibility network.
+    Wvrn,
+    /// Every sequence up to the order (side test only).
+    Exhaustive,
+}
+
 impl TraceArgs {
-    /// Whether candidates are routed over the WVRN.
-    pub fn use_wvrn(&self) -> bool {
-        !self.no_wvrn
+    /// The candidate generator the arguments select (the old `--wvrn`/`--no-wvrn` win).
+    pub fn candidate_mode(&self) -> bt_solve::pipeline::CandidateMode {
+        use bt_solve::pipeline::CandidateMode;
+        if self.no_wvrn {
+            return CandidateMode::Exhaustive;
+        }
+        if self.wvrn {
+            return CandidateMode::Wvrn;
+        }
+        match self.candidates {
+            CandidatesArg::BeamTree => CandidateMode::BeamTree,
+            CandidatesArg::Wvrn => CandidateMode::Wvrn,
+            CandidatesArg::Exhaustive => CandidateMode::Exhaustive,
+        }
     }
 }
 
@@ -293,8 +321,10 @@ impl DemoArgs {
             single_thread: false,
             json: self.json,
             out: None,
+            candidates: CandidatesArg::BeamTree,
             wvrn: false,
             no_wvrn: false,
+            max_candidates: bt_solve::pipeline::DEFAULT_MAX_CANDIDATES,
             steps: false,
             jsonl: false,
             from_scratch: false,

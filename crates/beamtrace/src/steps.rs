@@ -98,7 +98,7 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
     let options = StepOptions {
         max_order: args.max_order,
         solver,
-        wvrn: args.use_wvrn(),
+        wvrn: args.candidate_mode() != bt_solve::pipeline::CandidateMode::Exhaustive,
         parallel: !args.single_thread,
     };
     let incremental = !args.from_scratch;

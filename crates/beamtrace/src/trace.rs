@@ -3,7 +3,6 @@
 use crate::args::{IpcAccelArg, IpcOrderArg, SceneArgs, SolverArg, TraceArgs};
 use crate::output::{self, TraceDocument};
 use anyhow::{Context, bail};
-use bt_paths::AllVisible;
 use bt_scene::io::{LoadOptions, Loaded};
 use bt_scene::{Scene, SceneError, Terminals};
 use bt_solve::{Acceleration, IpcOptions, SbrOptions, Solver, UpdateOrder};
@@ -108,6 +107,17 @@ pub fn solver_for(args: &TraceArgs, scene: &Scene) -> anyhow::Result<Solver> {
     })
 }
 
+/// The pipeline options the arguments select.
+pub fn trace_options(args: &TraceArgs, solver: Solver) -> bt_solve::pipeline::TraceOptions {
+    bt_solve::pipeline::TraceOptions {
+        max_order: args.max_order,
+        solver,
+        candidates: args.candidate_mode(),
+        parallel: !args.single_thread,
+        max_candidates: args.max_candidates,
+    }
+}
+
 pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
     if args.steps {
         return crate::steps::run(args);
@@ -120,25 +130,19 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
     let scene = loaded.scene;
     let solver = solver_for(args, &scene)?;
     let t1 = Instant::now();
-    let candidates = if args.use_wvrn() {
-        let wvrn = bt_paths::wvrn::Wvrn::build(&scene);
-        bt_paths::enumerate(&scene, args.max_order, &wvrn)
-    } else {
-        bt_paths::enumerate(&scene, args.max_order, &AllVisible)
-    };
-    let t2 = Instant::now();
-    let result = bt_solve::trace(&scene, &candidates, &solver, !args.single_thread);
+    let options = trace_options(args, solver);
+    let traced = bt_solve::pipeline::trace_scene(&scene, &options)?;
     let t3 = Instant::now();
-    let paths = bt_beams::report(&scene, &result.paths);
+    let paths = bt_beams::report(&scene, &traced.result.paths);
     let t4 = Instant::now();
     let doc = TraceDocument::new(
         &scene,
         &solver,
         args.max_order,
         paths,
-        candidates.stats,
-        result.counts,
-        [t1 - t0, t2 - t1, t3 - t2, t4 - t3],
+        traced.candidates,
+        traced.result.counts,
+        [t1 - t0, traced.time.candidates, traced.time.solve, t4 - t3],
     );
     let json = serde_json::to_string_pretty(&doc).context("serialising the trace")?;
     if let Some(path) = &args.out {

@@ -12,6 +12,7 @@
 pub mod image;
 pub mod ipc;
 mod newton;
+pub mod pipeline;
 pub mod sbr;
 pub mod validate;
 

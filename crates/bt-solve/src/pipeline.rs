@@ -1,0 +1,184 @@
+//! The one entry every consumer calls to trace a scene: candidates → solver → valid paths.
+//!
+//! `trace` (CLI), the coverage sweep, the Python package, the studies and the accelerator's
+//! host all go through [`trace_scene`] (one TX, one RX) or [`trace_receivers`] (one TX, many
+//! RX), so the candidate generator, its budget and the solver dispatch live in one place.
+
+use crate::{Solver, TraceResult};
+use bt_geom::Vec3;
+use bt_paths::{AllVisible, CandidateSet, CandidateStats};
+use bt_scene::{Scene, SceneError};
+use rayon::prelude::*;
+use serde::Serialize;
+use std::time::{Duration, Instant};
+
+/// How candidate surface sequences are generated.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum CandidateMode {
+    /// Visibility-driven generation (the default): only sequences geometry allows.
+    #[default]
+    BeamTree,
+    /// Every sequence over the weak visibility network (paper's WVRN).
+    Wvrn,
+    /// Every sequence up to the order (side test only): the reference for checking.
+    Exhaustive,
+}
+
+/// Default budget on candidate sequences (see [`TraceOptions::max_candidates`]).
+pub const DEFAULT_MAX_CANDIDATES: u64 = 5_000_000;
+
+/// What to trace and how.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct TraceOptions {
+    /// Highest number of reflections.
+    pub max_order: usize,
+    /// Solver for the candidates.
+    pub solver: Solver,
+    /// Candidate generator.
+    pub candidates: CandidateMode,
+    /// Spread the work over rayon's pool (output identical either way).
+    pub parallel: bool,
+    /// Budget: the trace stops with [`TraceError::Budget`] rather than generate more
+    /// candidates (or beam-tree nodes) than this.
+    pub max_candidates: u64,
+}
+
+impl TraceOptions {
+    /// The image method over the default generator, in parallel, default budget.
+    pub fn new(max_order: usize) -> Self {
+        TraceOptions {
+            max_order,
+            solver: Solver::Image,
+            candidates: CandidateMode::default(),
+            parallel: true,
+            max_candidates: DEFAULT_MAX_CANDIDATES,
+        }
+    }
+}
+
+/// Why a trace could not run.
+#[derive(Debug, thiserror::Error)]
+pub enum TraceError {
+    /// The work would exceed the candidate budget.
+    #[error(
+        "candidate budget exceeded: {estimate} candidates at order {max_order} (budget {budget}); \
+         lower the order or raise the budget with --max-candidates"
+    )]
+    Budget {
+        /// Candidates (or tree nodes) counted or estimated.
+        estimate: u64,
+        /// The budget.
+        budget: u64,
+        /// The order asked for.
+        max_order: usize,
+    },
+    /// A receiver (or transmitter) position is not valid in the scene.
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+}
+
+/// Wall time of each stage of one trace.
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize)]
+pub struct StageTimes {
+    /// Candidate generation.
+    pub candidates: Duration,
+    /// Solving and validation.
+    pub solve: Duration,
+}
+
+/// The outcome of one trace: candidate statistics, valid paths and outcome counts.
+#[derive(Debug, Clone, Default)]
+pub struct Traced {
+    /// How many candidates each stage produced.
+    pub candidates: CandidateStats,
+    /// Valid paths (in candidate order) and outcome counts.
+    pub result: TraceResult,
+    /// Stage wall times.
+    pub time: StageTimes,
+}
+
+/// Generate the candidates of `scene` under `options` (with the budget checked).
+pub fn candidates(scene: &Scene, options: &TraceOptions) -> Result<CandidateSet, TraceError> {
+    let reflectors = scene.reflectors().count() as u64;
+    let estimate = exhaustive_count(reflectors, options.max_order);
+    if options.candidates != CandidateMode::BeamTree && estimate > options.max_candidates {
+        return Err(TraceError::Budget {
+            estimate,
+            budget: options.max_candidates,
+            max_order: options.max_order,
+        });
+    }
+    Ok(match options.candidates {
+        CandidateMode::Exhaustive => bt_paths::enumerate(scene, options.max_order, &AllVisible),
+        CandidateMode::Wvrn | CandidateMode::BeamTree => {
+            let wvrn = bt_paths::wvrn::Wvrn::build(scene);
+            bt_paths::enumerate(scene, options.max_order, &wvrn)
+        }
+    })
+}
+
+/// Number of sequences of order `0..=max_order` over `n` reflectors with no surface twice in
+/// a row (saturating): `1 + Σ n (n-1)^(k-1)`.
+pub fn exhaustive_count(n: u64, max_order: usize) -> u64 {
+    let mut total = 1u64;
+    let mut level = n;
+    for _ in 0..max_order {
+        total = total.saturating_add(level);
+        level = level.saturating_mul(n.saturating_sub(1));
+    }
+    total
+}
+
+/// Trace `scene` from its TX to its RX.
+pub fn trace_scene(scene: &Scene, options: &TraceOptions) -> Result<Traced, TraceError> {
+    let t0 = Instant::now();
+    let set = candidates(scene, options)?;
+    let t1 = Instant::now();
+    let result = crate::trace(scene, &set, &options.solver, options.parallel);
+    let t2 = Instant::now();
+    Ok(Traced {
+        candidates: set.stats,
+        result,
+        time: StageTimes {
+            candidates: t1 - t0,
+            solve: t2 - t1,
+        },
+    })
+}
+
+/// Trace `scene`'s TX to each of `receivers` (one result per receiver, in order). Receivers
+/// run in parallel when `options.parallel`; each one's own trace is then single-threaded.
+/// A receiver on a surface or at the TX fails the whole call with that receiver's error.
+pub fn trace_receivers(
+    scene: &Scene,
+    receivers: &[Vec3],
+    options: &TraceOptions,
+) -> Result<Vec<Traced>, TraceError> {
+    let inner = TraceOptions {
+        parallel: false,
+        ..*options
+    };
+    let one = |rx: &Vec3| -> Result<Traced, TraceError> {
+        let moved = scene.with_terminals(scene.tx(), *rx)?;
+        trace_scene(&moved, &inner)
+    };
+    if options.parallel {
+        receivers.par_iter().map(one).collect()
+    } else {
+        receivers.iter().map(one).collect()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn exhaustive_count_matches_the_formula() {
+        // 1 + 6 + 6*5 + 6*5*5 for a box room at order 3
+        assert_eq!(exhaustive_count(6, 3), 1 + 6 + 30 + 150);
+        assert_eq!(exhaustive_count(0, 3), 1);
+        assert_eq!(exhaustive_count(u64::MAX, 3), u64::MAX);
+    }
+}
