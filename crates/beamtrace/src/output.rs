@@ -2,6 +2,7 @@
 
 use bt_beams::PathReport;
 use bt_paths::CandidateStats;
+use bt_paths::beamtree::TreeStats;
 use bt_scene::Scene;
 use bt_solve::{OutcomeCounts, Solver};
 use serde::Serialize;
@@ -26,6 +27,9 @@ pub struct TraceDocument {
 #[derive(Debug, Serialize)]
 pub struct Stats {
     pub candidates: CandidateStats,
+    /// Beam-tree node counts (beam-tree candidates only).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tree: Option<TreeStats>,
     pub outcomes: OutcomeCounts,
     pub valid_paths: usize,
     /// Wall-clock seconds per stage (the only part of the document that varies between runs).
@@ -47,6 +51,7 @@ impl TraceDocument {
         max_order: usize,
         paths: Vec<PathReport>,
         candidates: CandidateStats,
+        tree: Option<TreeStats>,
         outcomes: OutcomeCounts,
         times: [Duration; 4],
     ) -> Self {
@@ -61,6 +66,7 @@ impl TraceDocument {
             solver: *solver,
             stats: Stats {
                 candidates,
+                tree,
                 outcomes,
                 valid_paths: paths.len(),
                 time_s: StageTimes {
@@ -110,11 +116,12 @@ pub fn print_table(doc: &TraceDocument) {
     }
     let s = &doc.stats;
     println!(
-        "{} valid paths from {} candidates ({} generated, {} pruned by side test); solve {:.3} ms",
+        "{} valid paths from {} candidates ({} generated, {} pruned); candidates {:.3} ms, solve {:.3} ms",
         s.valid_paths,
         s.candidates.candidates,
         s.candidates.generated,
-        s.candidates.pruned_side,
+        s.candidates.pruned_side + s.candidates.pruned_visibility,
+        s.time_s.candidates * 1e3,
         s.time_s.solve * 1e3
     );
 }

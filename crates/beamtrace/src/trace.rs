@@ -141,6 +141,7 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
         args.max_order,
         paths,
         traced.candidates,
+        traced.tree,
         traced.result.counts,
         [t1 - t0, traced.time.candidates, traced.time.solve, t4 - t3],
     );

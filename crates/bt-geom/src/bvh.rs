@@ -87,6 +87,59 @@ impl Bvh {
     }
 }
 
+impl Bvh {
+    /// Calls `visit(item)` for every item whose box passes `box_test(min, max)`, descending only
+    /// into nodes whose box passes it. `box_test` must be conservative (a node's box contains its
+    /// items' boxes): answering `false` for a box prunes everything inside it.
+    pub fn visit(&self, mut box_test: impl FnMut(Vec3, Vec3) -> bool, mut visit: impl FnMut(u32)) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        let mut stack = [0u32; 64];
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let index = stack[top];
+            let node = self.nodes[index as usize];
+            if !box_test(node.min, node.max) {
+                continue;
+            }
+            if node.count > 0 {
+                let start = node.start_or_right as usize;
+                for &item in &self.order[start..start + node.count as usize] {
+                    visit(item);
+                }
+            } else if top + 2 <= stack.len() {
+                stack[top] = node.start_or_right;
+                stack[top + 1] = index + 1;
+                top += 2;
+            }
+        }
+    }
+
+    /// Calls `visit(item)` for every item whose box the segment `a -> b` touches.
+    pub fn visit_segment(&self, a: Vec3, b: Vec3, visit: impl FnMut(u32)) {
+        let d = b - a;
+        let inv = Vec3::new(1.0 / d.x, 1.0 / d.y, 1.0 / d.z);
+        self.visit(|min, max| segment_hits_box(a, inv, min, max), visit);
+    }
+}
+
+/// Whether the box `min..max` may reach the convex region `{x : p.signed_distance(x) >= -eps}`
+/// for every plane `p` (false only when the whole box lies beyond one plane).
+#[inline]
+pub fn box_meets_halfspaces(min: Vec3, max: Vec3, planes: &[crate::Plane], eps: Real) -> bool {
+    planes.iter().all(|p| {
+        // the box corner furthest along the normal
+        let far = Vec3::new(
+            if p.normal.x >= 0.0 { max.x } else { min.x },
+            if p.normal.y >= 0.0 { max.y } else { min.y },
+            if p.normal.z >= 0.0 { max.z } else { min.z },
+        );
+        p.signed_distance(far) >= -eps
+    })
+}
+
 fn build_node(
     boxes: &[(Vec3, Vec3)],
     order: &mut [u32],

@@ -4,6 +4,7 @@
 //! Frames and units: right-handed world frame, z up, metres. See `docs/conventions.md`.
 
 pub mod bvh;
+pub mod convex;
 pub mod plane;
 pub mod polygon;
 pub mod tol;

@@ -198,6 +198,17 @@ impl Polygon {
         Vec2::new(d.dot(self.u), d.dot(self.v))
     }
 
+    /// The world point of in-plane coordinates `q` (inverse of [`Polygon::to_local`] on the plane).
+    #[inline]
+    pub fn from_local(&self, q: Vec2) -> Vec3 {
+        self.origin + q.x * self.u + q.y * self.v
+    }
+
+    /// Vertices in the in-plane 2-D frame of [`Polygon::to_local`], metres.
+    pub fn local_vertices(&self) -> &[Vec2] {
+        &self.local
+    }
+
     /// Signed distance (m) of the projection of `p` from the polygon boundary, measured in the
     /// plane: positive inside, negative outside, zero on an edge.
     pub fn signed_boundary_distance(&self, p: Vec3) -> Real {

@@ -10,6 +10,7 @@
 //! - *visibility*: a [`Visibility`] relation (the weak visibility network, WVRN, of the paper,
 //!   or [`AllVisible`]) says whether two nodes can see each other at all.
 
+pub mod beamtree;
 pub mod wvrn;
 
 use bt_geom::{Plane, Polygon, Real, Side};
@@ -62,8 +63,12 @@ pub struct CandidateStats {
 pub struct CandidateSet {
     ids: Vec<SurfaceId>,
     offsets: Vec<u32>,
+    /// Start points for iterative solvers, parallel to `ids` (empty: none).
+    starts: Vec<bt_geom::Vec3>,
     /// Stage counts.
     pub stats: CandidateStats,
+    /// What the beam tree did, when it generated the set.
+    pub tree: Option<beamtree::TreeStats>,
 }
 
 impl CandidateSet {
@@ -80,6 +85,29 @@ impl CandidateSet {
     pub fn get(&self, i: usize) -> &[SurfaceId] {
         &self.ids[self.offsets[i] as usize..self.offsets[i + 1] as usize]
     }
+    /// Start points of the `i`-th candidate's interaction points (one per surface, metres:
+    /// inside the beam tree's windows), when the generator gives them.
+    #[inline]
+    pub fn start(&self, i: usize) -> Option<&[bt_geom::Vec3]> {
+        if self.starts.is_empty() {
+            None
+        } else {
+            Some(&self.starts[self.offsets[i] as usize..self.offsets[i + 1] as usize])
+        }
+    }
+    /// An empty set whose candidates carry start points.
+    pub fn with_starts() -> Self {
+        CandidateSet {
+            offsets: vec![0],
+            ..CandidateSet::default()
+        }
+    }
+    /// Append a candidate with its start points (`starts.len() == seq.len()`).
+    pub fn push_with_starts(&mut self, seq: &[SurfaceId], starts: &[bt_geom::Vec3]) {
+        debug_assert_eq!(seq.len(), starts.len());
+        self.starts.extend_from_slice(starts);
+        self.push(seq);
+    }
     /// All candidates in order.
     pub fn iter(&self) -> impl ExactSizeIterator<Item = &[SurfaceId]> + '_ {
         (0..self.len()).map(|i| self.get(i))
@@ -87,9 +115,8 @@ impl CandidateSet {
     /// Build from explicit sequences (tests, dynamic updates).
     pub fn from_sequences<'a>(seqs: impl IntoIterator<Item = &'a [SurfaceId]>) -> Self {
         let mut set = CandidateSet {
-            ids: Vec::new(),
             offsets: vec![0],
-            stats: CandidateStats::default(),
+            ..CandidateSet::default()
         };
         for s in seqs {
             set.push(s);
@@ -159,9 +186,8 @@ pub fn enumerate(scene: &Scene, max_order: usize, visibility: &dyn Visibility) -
     }
 
     let mut set = CandidateSet {
-        ids: Vec::new(),
         offsets: vec![0],
-        stats: CandidateStats::default(),
+        ..CandidateSet::default()
     };
     set.stats.generated = 1;
     if links[n * stride + n + 1] {

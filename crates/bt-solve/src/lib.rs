@@ -290,7 +290,8 @@ fn run_range_impl(
             heap_scratch.resize(n, Vec3::ZERO);
             (&mut heap_points[..], &mut heap_scratch[..])
         };
-        let outcome = solve_candidate(scene, seq, solver, points, scratch);
+        let outcome =
+            solve_candidate_from(scene, seq, solver, candidates.start(i), points, scratch);
         out.counts.add(&outcome);
         if let CandidateOutcome::Solved {
             validity: Validity::Valid,

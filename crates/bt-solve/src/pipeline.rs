@@ -6,6 +6,7 @@
 
 use crate::{Solver, TraceResult};
 use bt_geom::Vec3;
+use bt_paths::beamtree::{BeamTree, TreeOptions, TreeStats};
 use bt_paths::{AllVisible, CandidateSet, CandidateStats};
 use bt_scene::{Scene, SceneError};
 use rayon::prelude::*;
@@ -73,6 +74,9 @@ pub enum TraceError {
         /// The order asked for.
         max_order: usize,
     },
+    /// The beam tree ran out of its node budget.
+    #[error(transparent)]
+    Tree(#[from] bt_paths::beamtree::TreeError),
     /// A receiver (or transmitter) position is not valid in the scene.
     #[error(transparent)]
     Scene(#[from] SceneError),
@@ -92,6 +96,8 @@ pub struct StageTimes {
 pub struct Traced {
     /// How many candidates each stage produced.
     pub candidates: CandidateStats,
+    /// What the beam tree did (beam-tree mode only).
+    pub tree: Option<TreeStats>,
     /// Valid paths (in candidate order) and outcome counts.
     pub result: TraceResult,
     /// Stage wall times.
@@ -111,11 +117,20 @@ pub fn candidates(scene: &Scene, options: &TraceOptions) -> Result<CandidateSet,
     }
     Ok(match options.candidates {
         CandidateMode::Exhaustive => bt_paths::enumerate(scene, options.max_order, &AllVisible),
-        CandidateMode::Wvrn | CandidateMode::BeamTree => {
+        CandidateMode::BeamTree => bt_paths::beamtree::candidates(scene, tree_options(options))?,
+        CandidateMode::Wvrn => {
             let wvrn = bt_paths::wvrn::Wvrn::build(scene);
             bt_paths::enumerate(scene, options.max_order, &wvrn)
         }
     })
+}
+
+fn tree_options(options: &TraceOptions) -> TreeOptions {
+    TreeOptions {
+        max_order: options.max_order,
+        max_nodes: options.max_candidates,
+        occlusion: true,
+    }
 }
 
 /// Number of sequences of order `0..=max_order` over `n` reflectors with no surface twice in
@@ -135,16 +150,28 @@ pub fn trace_scene(scene: &Scene, options: &TraceOptions) -> Result<Traced, Trac
     let t0 = Instant::now();
     let set = candidates(scene, options)?;
     let t1 = Instant::now();
+    Ok(solve_set(scene, set, options, t1 - t0))
+}
+
+/// Solve a generated candidate set (the second half of [`trace_scene`]).
+fn solve_set(
+    scene: &Scene,
+    set: CandidateSet,
+    options: &TraceOptions,
+    generation: Duration,
+) -> Traced {
+    let t1 = Instant::now();
     let result = crate::trace(scene, &set, &options.solver, options.parallel);
     let t2 = Instant::now();
-    Ok(Traced {
+    Traced {
         candidates: set.stats,
+        tree: set.tree,
         result,
         time: StageTimes {
-            candidates: t1 - t0,
+            candidates: generation,
             solve: t2 - t1,
         },
-    })
+    }
 }
 
 /// Trace `scene`'s TX to each of `receivers` (one result per receiver, in order). Receivers
@@ -159,9 +186,24 @@ pub fn trace_receivers(
         parallel: false,
         ..*options
     };
+    // Fixed TX: one beam tree answers every receiver by a walk.
+    let tree = match options.candidates {
+        CandidateMode::BeamTree if receivers.len() > 1 => {
+            Some(BeamTree::build(scene, tree_options(options))?)
+        }
+        _ => None,
+    };
     let one = |rx: &Vec3| -> Result<Traced, TraceError> {
         let moved = scene.with_terminals(scene.tx(), *rx)?;
-        trace_scene(&moved, &inner)
+        match &tree {
+            // The tree's margins hold for receivers whose scene tolerance is no larger.
+            Some(tree) if moved.length_tolerance() <= tree.tolerance() => {
+                let t0 = Instant::now();
+                let set = tree.candidates(*rx);
+                Ok(solve_set(&moved, set, &inner, t0.elapsed()))
+            }
+            _ => trace_scene(&moved, &inner),
+        }
     };
     if options.parallel {
         receivers.par_iter().map(one).collect()

@@ -1,0 +1,644 @@
+//! The beam tree: visibility-driven candidate generation (docs/beam-tree.md).
+//!
+//! A node is a prefix `s1..sk` of reflecting surfaces with its *image source* `I_k` (TX
+//! mirrored through the planes of `s1..sk`) and its *window* `W_k`: the part of `s_k`'s plane
+//! that specular rays from TX can reach through every earlier window. Its *beam* is the set of
+//! rays from `I_k` through `W_k`, beyond `s_k`'s plane: a convex cone given by one near plane
+//! (the plane of `s_k`) and one side plane per window edge. A child `s` of the node exists only
+//! where `s`'s polygon meets the beam; its window is `s`'s (convex hull, grown by a margin)
+//! clipped by the beam's planes, so an empty clip proves that no specular path has that prefix.
+//!
+//! A sequence `s1..sk` is a candidate for a receiver exactly when RX lies in node `k`'s beam:
+//! that is the condition for the image-method path to cross every window. The geometry is
+//! exact, and every test keeps a margin of a few length tolerances on the inclusive side, so
+//! the tree never drops a path that validation ([`bt_solve`'s `validate`]) would accept.
+//!
+//! *Occlusion culling.* A convex surface `O` between two consecutive windows that covers the
+//! whole new window as seen from the image source (every ray crosses `O` strictly inside,
+//! strictly between the two planes) blocks every path through it: the node is removed. When
+//! `O` covers the window except across one of its edges, the window is clipped to the
+//! uncovered part, which stays convex. Both tests need only the window's vertices, because
+//! central projection maps convex sets to convex sets.
+
+use crate::{CandidateSet, CandidateStats};
+use bt_geom::bvh::box_meets_halfspaces;
+use bt_geom::{Plane, Real, Vec3, convex};
+use bt_scene::{Scene, SurfaceId, SurfaceKind};
+use serde::Serialize;
+
+/// How the tree is built.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct TreeOptions {
+    /// Highest reflection order.
+    pub max_order: usize,
+    /// Budget on materialised nodes: the build stops with [`TreeError::Budget`] beyond it.
+    pub max_nodes: u64,
+    /// Remove or shrink windows covered by convex occluders (exact; on by default).
+    pub occlusion: bool,
+}
+
+impl TreeOptions {
+    /// Order `max_order`, 5 million nodes, occlusion culling on.
+    pub fn new(max_order: usize) -> Self {
+        TreeOptions {
+            max_order,
+            max_nodes: 5_000_000,
+            occlusion: true,
+        }
+    }
+}
+
+/// Why the tree could not be built.
+#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+pub enum TreeError {
+    /// More nodes than the budget.
+    #[error(
+        "beam tree budget exceeded: more than {budget} nodes by depth {depth} of {max_order} \
+         ({nodes} so far); lower the order or raise the budget with --max-candidates"
+    )]
+    Budget {
+        /// Nodes built when the budget ran out.
+        nodes: u64,
+        /// Depth being built.
+        depth: usize,
+        /// The order asked for.
+        max_order: usize,
+        /// The budget.
+        budget: u64,
+    },
+}
+
+/// What the tree did, for `stats.tree` in the JSON output.
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
+pub struct TreeStats {
+    /// Materialised nodes per depth (index 0 = depth 1).
+    pub nodes_per_depth: Vec<u64>,
+    /// Child sequences examined (each a surface meeting a beam's bounding test).
+    pub tested: u64,
+    /// Sequences whose window clipped to nothing (or grazing image sources).
+    pub empty: u64,
+    /// Nodes removed by occlusion culling.
+    pub occluded: u64,
+    /// Windows shrunk by an occluder.
+    pub occluder_clips: u64,
+}
+
+/// One node: a prefix ending on `surface`.
+#[derive(Debug, Clone, Copy)]
+struct Node {
+    surface: u32,
+    parent: u32,
+    image: Vec3,
+    window: (u32, u32),
+    planes: (u32, u32),
+}
+
+const ROOT: u32 = u32::MAX;
+
+/// A beam tree for a fixed TX, materialised to its full order: answers any RX by a walk
+/// ([`BeamTree::candidates`]), the common beam-management case of a moving handset.
+#[derive(Debug, Clone)]
+pub struct BeamTree {
+    max_order: usize,
+    tol: Real,
+    /// Nodes level by level; `levels[d]` = range of depth `d + 1`.
+    nodes: Vec<Node>,
+    levels: Vec<(usize, usize)>,
+    verts: Vec<Vec3>,
+    planes: Vec<Plane>,
+    stats: TreeStats,
+}
+
+/// Margins in units of the scene's length tolerance: windows grow by `GROW` (validation accepts
+/// points within 1 tolerance of a polygon), plane tests keep `EPS`, occluders must cover with
+/// `COVER` to spare.
+const GROW: Real = 4.0;
+const EPS: Real = 1.0;
+const COVER: Real = 4.0;
+
+/// Per-surface data of one build.
+struct Prepared<'a> {
+    scene: &'a Scene,
+    tol: Real,
+    /// Grown convex hull of each reflector (empty for blockers).
+    hulls: Vec<Vec<Vec3>>,
+    /// Whether each surface is convex (only convex surfaces cull).
+    convex: Vec<bool>,
+    reflectors: Vec<u32>,
+    options: TreeOptions,
+}
+
+impl<'a> Prepared<'a> {
+    fn new(scene: &'a Scene, options: TreeOptions) -> Self {
+        let tol = scene.length_tolerance();
+        let surfaces = scene.surfaces();
+        let hulls = surfaces
+            .iter()
+            .map(|s| match s.kind {
+                SurfaceKind::Reflector => convex::grown_hull(&s.polygon, GROW * tol),
+                SurfaceKind::Blocker => Vec::new(),
+            })
+            .collect();
+        let convex = surfaces
+            .iter()
+            .map(|s| convex::is_convex(&s.polygon))
+            .collect();
+        let reflectors = scene.reflectors().map(|id| id.0).collect();
+        Prepared {
+            scene,
+            tol,
+            hulls,
+            convex,
+            reflectors,
+            options,
+        }
+    }
+
+    fn plane(&self, s: u32) -> &Plane {
+        self.scene.surface(SurfaceId(s)).polygon.plane()
+    }
+}
+
+/// Scratch buffers reused across children.
+#[derive(Default)]
+struct Scratch {
+    a: Vec<Vec3>,
+    b: Vec<Vec3>,
+    items: Vec<u32>,
+}
+
+/// A parent's view for generating children: apex, near plane and beam planes.
+struct Parent<'n> {
+    index: u32,
+    surface: Option<u32>,
+    apex: Vec3,
+    /// Beam planes (near plane first); empty at the root.
+    planes: &'n [Plane],
+}
+
+impl BeamTree {
+    /// Build the tree of `scene`'s TX to `options.max_order`.
+    pub fn build(scene: &Scene, options: TreeOptions) -> Result<Self, TreeError> {
+        let prep = Prepared::new(scene, options);
+        let mut tree = BeamTree {
+            max_order: options.max_order,
+            tol: prep.tol,
+            nodes: Vec::new(),
+            levels: Vec::new(),
+            verts: Vec::new(),
+            planes: Vec::new(),
+            stats: TreeStats::default(),
+        };
+        let mut scratch = Scratch::default();
+        for depth in 1..=options.max_order {
+            tree.grow_level(&prep, depth, &mut scratch, None)?;
+        }
+        Ok(tree)
+    }
+
+    /// Statistics of the build.
+    pub fn stats(&self) -> &TreeStats {
+        &self.stats
+    }
+
+    /// The length tolerance (m) the tree's margins were built with: a receiver scene with a
+    /// larger tolerance needs a new tree.
+    pub fn tolerance(&self) -> Real {
+        self.tol
+    }
+
+    /// Number of materialised nodes.
+    pub fn len(&self) -> usize {
+        self.nodes.len()
+    }
+
+    /// Whether the tree has no node.
+    pub fn is_empty(&self) -> bool {
+        self.nodes.is_empty()
+    }
+
+    /// The candidates for a receiver at `rx`: line of sight and every sequence whose beam holds
+    /// `rx`, by order then lexicographically, with IPC start points inside the windows.
+    pub fn candidates(&self, rx: Vec3) -> CandidateSet {
+        let mut set = CandidateSet::with_starts();
+        set.push_with_starts(&[], &[]);
+        let mut seq = Vec::with_capacity(self.max_order);
+        let mut starts = Vec::with_capacity(self.max_order);
+        for &(lo, hi) in &self.levels {
+            for i in lo..hi {
+                if self.holds(i, rx) {
+                    self.prefix(i as u32, &mut seq, &mut starts);
+                    set.push_with_starts(&seq, &starts);
+                }
+            }
+        }
+        set.stats = self.candidate_stats(set.len() as u64);
+        set.tree = Some(self.stats.clone());
+        set
+    }
+
+    fn candidate_stats(&self, candidates: u64) -> CandidateStats {
+        let generated = self.stats.tested + 1;
+        CandidateStats {
+            generated,
+            pruned_visibility: generated.saturating_sub(candidates),
+            pruned_side: 0,
+            candidates,
+        }
+    }
+
+    /// Whether `p` lies in node `i`'s beam (inclusive, with the tree's margin).
+    fn holds(&self, i: usize, p: Vec3) -> bool {
+        let (lo, hi) = self.nodes[i].planes;
+        let eps = EPS * self.tol;
+        self.planes[lo as usize..hi as usize]
+            .iter()
+            .all(|pl| pl.signed_distance(p) >= -eps)
+    }
+
+    /// The surface sequence and window centres of node `i`, TX side first.
+    fn prefix(&self, mut i: u32, seq: &mut Vec<SurfaceId>, starts: &mut Vec<Vec3>) {
+        seq.clear();
+        starts.clear();
+        while i != ROOT {
+            let node = &self.nodes[i as usize];
+            seq.push(SurfaceId(node.surface));
+            let (lo, hi) = node.window;
+            starts.push(convex::vertex_mean(&self.verts[lo as usize..hi as usize]));
+            i = node.parent;
+        }
+        seq.reverse();
+        starts.reverse();
+    }
+
+    /// Build the nodes of `depth` from those of `depth - 1` (the root when `depth == 1`). With
+    /// `leaf_rx`, the level is not materialised: children holding RX are emitted into `out`.
+    fn grow_level(
+        &mut self,
+        prep: &Prepared,
+        depth: usize,
+        scratch: &mut Scratch,
+        mut leaf: Option<(Vec3, &mut CandidateSet)>,
+    ) -> Result<(), TreeError> {
+        let parents = if depth == 1 {
+            (0, 0)
+        } else {
+            self.levels[depth - 2]
+        };
+        let start = self.nodes.len();
+        let parent_ids: Vec<u32> = if depth == 1 {
+            vec![ROOT]
+        } else {
+            (parents.0 as u32..parents.1 as u32).collect()
+        };
+        let mut children = Vec::new();
+        for p in parent_ids {
+            let (apex, surface, planes) = if p == ROOT {
+                (prep.scene.tx(), None, (0u32, 0u32))
+            } else {
+                let n = self.nodes[p as usize];
+                (n.image, Some(n.surface), n.planes)
+            };
+            let plane_copy: Vec<Plane> = self.planes[planes.0 as usize..planes.1 as usize].to_vec();
+            let parent = Parent {
+                index: p,
+                surface,
+                apex,
+                planes: &plane_copy,
+            };
+            self.child_candidates(prep, &parent, &mut children);
+            for &s in &children {
+                self.stats.tested += 1;
+                match leaf.as_mut() {
+                    Some((rx, out)) => self.leaf_child(prep, &parent, s, *rx, out),
+                    None => self.child(prep, &parent, s, scratch),
+                }
+            }
+            if self.nodes.len() as u64 > prep.options.max_nodes {
+                return Err(TreeError::Budget {
+                    nodes: self.nodes.len() as u64,
+                    depth,
+                    max_order: prep.options.max_order,
+                    budget: prep.options.max_nodes,
+                });
+            }
+        }
+        if leaf.is_none() {
+            self.levels.push((start, self.nodes.len()));
+            self.stats
+                .nodes_per_depth
+                .push((self.nodes.len() - start) as u64);
+        }
+        Ok(())
+    }
+
+    /// Reflectors that may meet the parent's beam, in increasing index order.
+    fn child_candidates(&self, prep: &Prepared, parent: &Parent, out: &mut Vec<u32>) {
+        out.clear();
+        if parent.index == ROOT {
+            out.extend_from_slice(&prep.reflectors);
+            return;
+        }
+        let eps = EPS * prep.tol;
+        let scene = prep.scene;
+        scene.bvh().visit(
+            |lo, hi| box_meets_halfspaces(lo, hi, parent.planes, eps),
+            |item| {
+                if Some(item) != parent.surface
+                    && scene.surface(SurfaceId(item)).kind == SurfaceKind::Reflector
+                {
+                    out.push(item);
+                }
+            },
+        );
+        out.sort_unstable();
+    }
+
+    /// Try child `s` of `parent`; push it when its window is not empty and not occluded.
+    fn child(&mut self, prep: &Prepared, parent: &Parent, s: u32, scratch: &mut Scratch) {
+        let plane = *prep.plane(s);
+        if plane.signed_distance(parent.apex).abs() <= prep.tol {
+            // Every ray from the apex to this plane runs in it: all such paths graze.
+            self.stats.empty += 1;
+            return;
+        }
+        let eps = EPS * prep.tol;
+        scratch.a.clear();
+        scratch.a.extend_from_slice(&prep.hulls[s as usize]);
+        for pl in parent.planes {
+            convex::clip(&scratch.a, pl, eps, &mut scratch.b);
+            std::mem::swap(&mut scratch.a, &mut scratch.b);
+            if scratch.a.len() < 3 {
+                break;
+            }
+        }
+        if scratch.a.len() < 3 {
+            self.stats.empty += 1;
+            return;
+        }
+        if prep.options.occlusion && occlude(prep, parent, s, scratch, &mut self.stats) {
+            self.stats.occluded += 1;
+            return;
+        }
+        let image = plane.mirror(parent.apex);
+        let planes = beam_planes(&plane, image, &scratch.a);
+        let window = push_range(&mut self.verts, &scratch.a);
+        let planes = push_range(&mut self.planes, &planes);
+        self.nodes.push(Node {
+            surface: s,
+            parent: parent.index,
+            image,
+            window,
+            planes,
+        });
+    }
+
+    /// The last level of a single-receiver trace: emit child `s` when RX lies in its beam,
+    /// without building its window (the image method's crossing point is tested instead).
+    fn leaf_child(
+        &mut self,
+        prep: &Prepared,
+        parent: &Parent,
+        s: u32,
+        rx: Vec3,
+        out: &mut CandidateSet,
+    ) {
+        let plane = *prep.plane(s);
+        let tol = prep.tol;
+        let eps = EPS * tol;
+        let d_apex = plane.signed_distance(parent.apex);
+        // RX must be on the apex's side of the plane (the reflected side) and off it.
+        if d_apex.abs() <= tol || plane.signed_distance(rx) * d_apex.signum() < -eps {
+            return;
+        }
+        let image = plane.mirror(parent.apex);
+        let Some(t) = plane.line_parameter(image, rx) else {
+            return;
+        };
+        let x = image + t * (rx - image);
+        let polygon = &prep.scene.surface(SurfaceId(s)).polygon;
+        if !polygon.contains(x, GROW * tol)
+            || !parent.planes.iter().all(|p| p.signed_distance(x) >= -eps)
+        {
+            return;
+        }
+        let mut seq = Vec::with_capacity(self.max_order);
+        let mut starts = Vec::with_capacity(self.max_order);
+        self.prefix(parent.index, &mut seq, &mut starts);
+        seq.push(SurfaceId(s));
+        let mut window = prep.hulls[s as usize].clone();
+        let mut tmp = Vec::new();
+        for pl in parent.planes {
+            convex::clip(&window, pl, eps, &mut tmp);
+            std::mem::swap(&mut window, &mut tmp);
+        }
+        starts.push(if window.len() >= 3 {
+            convex::vertex_mean(&window)
+        } else {
+            polygon.centroid()
+        });
+        out.push_with_starts(&seq, &starts);
+    }
+}
+
+fn push_range<T: Copy>(arena: &mut Vec<T>, items: &[T]) -> (u32, u32) {
+    let lo = arena.len() as u32;
+    arena.extend_from_slice(items);
+    (lo, arena.len() as u32)
+}
+
+/// The beam of rays from `apex` through the convex `window` lying in `plane`: the near plane
+/// (oriented away from the apex) and one side plane per edge (oriented inward). Side planes that
+/// degenerate (apex on the edge's line) are left out, which only widens the beam.
+fn beam_planes(plane: &Plane, apex: Vec3, window: &[Vec3]) -> Vec<Plane> {
+    let mut out = Vec::with_capacity(window.len() + 1);
+    let near = if plane.signed_distance(apex) > 0.0 {
+        Plane {
+            normal: -plane.normal,
+            offset: -plane.offset,
+        }
+    } else {
+        *plane
+    };
+    out.push(near);
+    let inner = convex::vertex_mean(window);
+    let n = window.len();
+    for i in 0..n {
+        let (a, b) = (window[i], window[(i + 1) % n]);
+        let normal = (a - apex).cross(b - apex);
+        let len = normal.length();
+        if !(len > 1e-12 * (a - apex).length() * (b - apex).length()) {
+            continue;
+        }
+        let mut side = Plane::from_point_normal(apex, normal / len);
+        if side.signed_distance(inner) < 0.0 {
+            side = Plane {
+                normal: -side.normal,
+                offset: -side.offset,
+            };
+        }
+        out.push(side);
+    }
+    out
+}
+
+/// Occlusion culling of the window in `scratch.a` (child `s` of `parent`): returns true when a
+/// convex surface between the parent's window (or TX) and the new window covers all of it;
+/// shrinks the window when one covers all of it but the part beyond one edge.
+fn occlude(
+    prep: &Prepared,
+    parent: &Parent,
+    s: u32,
+    scratch: &mut Scratch,
+    stats: &mut TreeStats,
+) -> bool {
+    let scene = prep.scene;
+    let start_plane = parent.surface.map(|p| *prep.plane(p));
+    // Start points of the rays through the window's vertices, on the parent's plane (or TX).
+    let starts: Vec<Vec3> = scratch
+        .a
+        .iter()
+        .map(|&q| match &start_plane {
+            None => parent.apex,
+            Some(pl) => match pl.line_parameter(parent.apex, q) {
+                Some(t) => parent.apex + t * (q - parent.apex),
+                None => q,
+            },
+        })
+        .collect();
+    scratch.items.clear();
+    for (a, q) in starts.iter().zip(&scratch.a) {
+        scene
+            .bvh()
+            .visit_segment(*a, *q, |item| scratch.items.push(item));
+    }
+    scratch.items.sort_unstable();
+    scratch.items.dedup();
+    let margin = COVER * prep.tol;
+    let items = std::mem::take(&mut scratch.items);
+    let mut covered = false;
+    for &o in &items {
+        if Some(o) == parent.surface || o == s || !prep.convex[o as usize] {
+            continue;
+        }
+        let polygon = &scene.surface(SurfaceId(o)).polygon;
+        if !between(polygon.plane(), &starts, &scratch.a, margin) {
+            continue;
+        }
+        match shadow(polygon, parent.apex, &scratch.a, margin) {
+            Shadow::Covers => {
+                covered = true;
+                break;
+            }
+            Shadow::AllBut(plane) => {
+                convex::clip(&scratch.a, &plane, EPS * prep.tol, &mut scratch.b);
+                std::mem::swap(&mut scratch.a, &mut scratch.b);
+                stats.occluder_clips += 1;
+                if scratch.a.len() < 3 {
+                    covered = true;
+                    break;
+                }
+            }
+            Shadow::None => {}
+        }
+    }
+    scratch.items = items;
+    covered
+}
+
+/// Whether every segment start lies strictly on one side of `plane` and every window vertex
+/// strictly on the other, by `margin`: then each ray crosses the plane strictly between them.
+fn between(plane: &Plane, starts: &[Vec3], window: &[Vec3], margin: Real) -> bool {
+    let side = |p: &Vec3| plane.signed_distance(*p);
+    let front = starts.iter().all(|p| side(p) > margin) && window.iter().all(|q| side(q) < -margin);
+    let back = starts.iter().all(|p| side(p) < -margin) && window.iter().all(|q| side(q) > margin);
+    front || back
+}
+
+enum Shadow {
+    /// Every ray through the window crosses the occluder at least `margin` inside its edges.
+    Covers,
+    /// Every ray crosses it inside, except across one edge: clip the window to this half-space
+    /// (the uncovered side).
+    AllBut(Plane),
+    None,
+}
+
+/// The shadow of the convex `occluder` from `apex` on the window's vertices. Each occluder edge,
+/// moved inward by `margin` in the occluder's plane, spans a plane with the apex.
+fn shadow(occluder: &bt_geom::Polygon, apex: Vec3, window: &[Vec3], margin: Real) -> Shadow {
+    let v = occluder.vertices();
+    let n = v.len();
+    let normal = occluder.plane().normal;
+    let mut open: Option<Plane> = None;
+    for i in 0..n {
+        let (a, b) = (v[i], v[(i + 1) % n]);
+        let dir = b - a;
+        let mut inward = normal.cross(dir).normalize_or_zero();
+        if (occluder.centroid() - a).dot(inward) < 0.0 {
+            inward = -inward;
+        }
+        let moved = a + margin * inward;
+        let pn = (moved - apex).cross(dir);
+        let len = pn.length();
+        if !(len > 1e-12 * (moved - apex).length() * dir.length()) {
+            return Shadow::None;
+        }
+        let mut plane = Plane::from_point_normal(apex, pn / len);
+        if plane.signed_distance(moved + inward) < 0.0 {
+            plane = Plane {
+                normal: -plane.normal,
+                offset: -plane.offset,
+            };
+        }
+        if window.iter().all(|q| plane.signed_distance(*q) > 0.0) {
+            continue;
+        }
+        if open.is_some() || window.iter().all(|q| plane.signed_distance(*q) <= 0.0) {
+            return Shadow::None;
+        }
+        open = Some(Plane {
+            normal: -plane.normal,
+            offset: -plane.offset,
+        });
+    }
+    match open {
+        None => Shadow::Covers,
+        Some(plane) => Shadow::AllBut(plane),
+    }
+}
+
+/// The candidates of `scene` for its own RX up to `options.max_order`: the tree is built to
+/// order `max_order - 1` and the last level is tested against RX without being materialised.
+pub fn candidates(scene: &Scene, options: TreeOptions) -> Result<CandidateSet, TreeError> {
+    let prep = Prepared::new(scene, options);
+    let mut tree = BeamTree {
+        max_order: options.max_order,
+        tol: prep.tol,
+        nodes: Vec::new(),
+        levels: Vec::new(),
+        verts: Vec::new(),
+        planes: Vec::new(),
+        stats: TreeStats::default(),
+    };
+    let mut scratch = Scratch::default();
+    let rx = scene.rx();
+    let mut last = CandidateSet::with_starts();
+    for depth in 1..=options.max_order {
+        if depth == options.max_order {
+            tree.grow_level(&prep, depth, &mut scratch, Some((rx, &mut last)))?;
+        } else {
+            tree.grow_level(&prep, depth, &mut scratch, None)?;
+        }
+    }
+    let mut set = tree.candidates(rx);
+    let mut seq_starts = Vec::new();
+    for i in 0..last.len() {
+        seq_starts.clear();
+        seq_starts.extend_from_slice(last.start(i).unwrap_or(&[]));
+        set.push_with_starts(last.get(i), &seq_starts);
+    }
+    set.stats = tree.candidate_stats(set.len() as u64);
+    set.tree = Some(tree.stats.clone());
+    Ok(set)
+}
