@@ -9,7 +9,7 @@ const LIVING_ROOM_DYNAMIC: &str = include_str!("../scenes/living-room-dynamic.js
 
 /// Names accepted by [`builtin_scene`].
 pub fn builtin_names() -> &'static [&'static str] {
-    &["living-room", "living-room-dynamic"]
+    &["living-room", "living-room-dynamic", "city"]
 }
 
 /// The JSON text of a built-in scene, as a documented example of the scene format.
@@ -26,8 +26,34 @@ pub fn builtin_json(name: &str) -> Option<&'static str> {
 /// A built-in scene by name: `living-room` is a furnished 6 × 4.5 × 2.7 m living room with 25
 /// reflecting surfaces, a lamp shade and a standing person as blockers, TX at router height
 /// (2.2 m) and RX at laptop height (0.72 m).
+///
+/// `city` is the seeded synthetic city of [`crate::city`] (a triangle mesh through the mesh
+/// pipeline), TX on a 10 m mast in a street, RX at 1.5 m in the next street.
 pub fn builtin_scene(name: &str, terminals: Terminals) -> Option<Result<Scene, SceneError>> {
+    if name == "city" {
+        return Some(city_scene(terminals));
+    }
     let json = builtin_json(name)?;
     let source = format!("builtin:{name}");
     Some(parse_json(json, &source).and_then(|d| Scene::from_description(&d, &source, terminals)))
+}
+
+fn city_scene(terminals: Terminals) -> Result<Scene, SceneError> {
+    let city = crate::city::CityOptions::default();
+    let obj = crate::city::city_obj(&city);
+    let source = "builtin:city";
+    let options = crate::io::LoadOptions {
+        terminals: Terminals {
+            tx: terminals.tx.or(Some(city.street_point(10, 1000.0, 10.0))),
+            rx: terminals.rx.or(Some(city.street_point(11, 1180.0, 1.5))),
+        },
+        ..crate::io::LoadOptions::default()
+    };
+    let import = bt_mesh::read_obj(obj.as_bytes(), Some(source), &options.merge).map_err(|e| {
+        SceneError::Parse {
+            path: source.to_string(),
+            message: e.to_string(),
+        }
+    })?;
+    crate::io::from_mesh(import, "city", source, &options).map(|loaded| loaded.scene)
 }

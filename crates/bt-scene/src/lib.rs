@@ -4,6 +4,7 @@
 //! Units and frames: metres, z up, Hz; see `docs/conventions.md`. Only [`io`] reads files.
 
 mod builtin;
+pub mod city;
 mod description;
 pub mod dynamic;
 pub mod io;
