@@ -506,21 +506,29 @@ fn occlude(
             },
         })
         .collect();
+    // Only a surface that the ray to some window vertex crosses can cover or clip the window
+    // (the covered part of a convex window contains a vertex); nearest first.
     scratch.items.clear();
+    let mut hits: Vec<(Real, u32)> = Vec::new();
     for (a, q) in starts.iter().zip(&scratch.a) {
-        scene
-            .bvh()
-            .visit_segment(*a, *q, |item| scratch.items.push(item));
+        scene.bvh().visit_segment(*a, *q, |item| {
+            if Some(item) == parent.surface || item == s || !prep.convex[item as usize] {
+                return;
+            }
+            let polygon = &scene.surface(SurfaceId(item)).polygon;
+            if polygon.blocks_segment(*a, *q, 0.0, 0.0) {
+                hits.push((polygon.centroid().distance_squared(parent.apex), item));
+            }
+        });
     }
-    scratch.items.sort_unstable();
-    scratch.items.dedup();
+    hits.sort_unstable_by(|x, y| x.1.cmp(&y.1));
+    hits.dedup_by_key(|h| h.1);
+    hits.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+    scratch.items.extend(hits.iter().map(|h| h.1));
     let margin = COVER * prep.tol;
     let items = std::mem::take(&mut scratch.items);
     let mut covered = false;
     for &o in &items {
-        if Some(o) == parent.surface || o == s || !prep.convex[o as usize] {
-            continue;
-        }
         let polygon = &scene.surface(SurfaceId(o)).polygon;
         if !between(polygon.plane(), &starts, &scratch.a, margin) {
             continue;

@@ -1,0 +1,93 @@
+//! Beam-tree benchmarks, single-threaded, figures as ratios inside one run
+//! (`cargo bench -p bt-solve --bench beamtree`; docs/performance.md):
+//! - living room, order <= 3: candidates only, whole traces (candidates + solver + validation +
+//!   report) with the beam tree and with exhaustive enumeration, IPC Gauss-Seidel, a new RX
+//!   answered by a kept tree;
+//! - the built-in city (39,692 triangles): orders 1, 2 and 3.
+
+use bt_paths::beamtree::{BeamTree, TreeOptions};
+use bt_scene::{Scene, Terminals, Vec3};
+use bt_solve::pipeline::{CandidateMode, TraceOptions, trace_scene};
+use bt_solve::{IpcOptions, Solver, UpdateOrder};
+use criterion::{Criterion, criterion_group, criterion_main};
+use std::hint::black_box;
+use std::time::Duration;
+
+fn options(order: usize, mode: CandidateMode, solver: Solver) -> TraceOptions {
+    TraceOptions {
+        solver,
+        candidates: mode,
+        parallel: false,
+        max_candidates: u64::MAX,
+        ..TraceOptions::new(order)
+    }
+}
+
+fn whole_trace(scene: &Scene, options: &TraceOptions) -> usize {
+    let traced = trace_scene(scene, options).expect("trace runs");
+    bt_beams::report(scene, &traced.result.paths).len()
+}
+
+fn living_room(c: &mut Criterion) {
+    let scene = bt_scene::builtin_scene("living-room", Terminals::default())
+        .unwrap()
+        .unwrap();
+    let gs = Solver::Ipc(IpcOptions::for_scene(&scene, UpdateOrder::GaussSeidel));
+    let mut group = c.benchmark_group("living-room-order3");
+    group.bench_function("beam-tree-candidates", |b| {
+        b.iter(|| bt_paths::beamtree::candidates(black_box(&scene), TreeOptions::new(3)))
+    });
+    for (name, mode, solver) in [
+        ("trace-image-beam-tree", CandidateMode::BeamTree, Solver::Image),
+        ("trace-image-exhaustive", CandidateMode::Exhaustive, Solver::Image),
+        ("trace-ipc-gs-beam-tree", CandidateMode::BeamTree, gs),
+        ("trace-ipc-gs-exhaustive", CandidateMode::Exhaustive, gs),
+    ] {
+        let opts = options(3, mode, solver);
+        group.bench_function(name, |b| b.iter(|| whole_trace(black_box(&scene), &opts)));
+    }
+    // Fixed TX, moving RX: the tree is kept; each new RX is a walk plus the image method.
+    let tree = BeamTree::build(&scene, TreeOptions::new(3)).unwrap();
+    let receivers: Vec<Vec3> = (0..16)
+        .map(|i| Vec3::new(0.8 + 0.3 * i as f64, 1.0 + 0.15 * i as f64, 0.72))
+        .collect();
+    let moved: Vec<Scene> = receivers
+        .iter()
+        .map(|rx| scene.with_terminals(scene.tx(), *rx).unwrap())
+        .collect();
+    group.bench_function("new-rx-kept-tree", |b| {
+        let mut k = 0;
+        b.iter(|| {
+            k = (k + 1) % receivers.len();
+            let set = tree.candidates(receivers[k]);
+            bt_solve::trace(&moved[k], &set, &Solver::Image, false).paths.len()
+        })
+    });
+    group.bench_function("new-rx-walk-only", |b| {
+        let mut k = 0;
+        b.iter(|| {
+            k = (k + 1) % receivers.len();
+            tree.candidates(receivers[k]).len()
+        })
+    });
+    group.finish();
+}
+
+fn city(c: &mut Criterion) {
+    let scene = bt_scene::builtin_scene("city", Terminals::default())
+        .unwrap()
+        .unwrap();
+    let mut group = c.benchmark_group("city");
+    group.sample_size(10);
+    group.measurement_time(Duration::from_secs(20));
+    for order in 1..=3 {
+        let opts = options(order, CandidateMode::BeamTree, Solver::Image);
+        group.bench_function(format!("trace-image-order{order}"), |b| {
+            b.iter(|| whole_trace(black_box(&scene), &opts))
+        });
+    }
+    group.finish();
+}
+
+criterion_group!(benches, living_room, city);
+criterion_main!(benches);
