@@ -25,7 +25,7 @@ pub struct StepsDocument {
     pub frequency_hz: f64,
     pub max_order: usize,
     pub solver: Solver,
-    pub wvrn: bool,
+    pub candidates: bt_solve::pipeline::CandidateMode,
     pub incremental: bool,
     pub steps: Vec<StepDocument>,
 }
@@ -98,7 +98,8 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
     let options = StepOptions {
         max_order: args.max_order,
         solver,
-        wvrn: args.candidate_mode() != bt_solve::pipeline::CandidateMode::Exhaustive,
+        candidates: args.candidate_mode(),
+        max_candidates: args.max_candidates,
         parallel: !args.single_thread,
     };
     let incremental = !args.from_scratch;
@@ -107,9 +108,9 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
     for (k, scene) in dynamic.scenes().iter().enumerate() {
         let t0 = Instant::now();
         let result = if incremental {
-            tracer.step(scene)
+            tracer.step(scene)?
         } else {
-            trace_scratch(scene, k, &options)
+            trace_scratch(scene, k, &options)?
         };
         let time_s = t0.elapsed().as_secs_f64();
         let paths = bt_beams::report(scene, &result.trace.paths);
@@ -141,7 +142,7 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
         frequency_hz: scene0.frequency_hz(),
         max_order: args.max_order,
         solver,
-        wvrn: options.wvrn,
+        candidates: options.candidates,
         incremental,
         steps,
     };
@@ -163,11 +164,11 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
 
 fn print_table(doc: &StepsDocument) {
     println!(
-        "scene {}  {} steps  max order {}  wvrn {}  {}",
+        "scene {}  {} steps  max order {}  candidates {:?}  {}",
         doc.scene,
         doc.steps.len(),
         doc.max_order,
-        if doc.wvrn { "on" } else { "off" },
+        doc.candidates,
         if doc.incremental {
             "incremental"
         } else {

@@ -20,7 +20,12 @@ fn options(wvrn: bool) -> StepOptions {
     StepOptions {
         max_order: ORDER,
         solver: Solver::Image,
-        wvrn,
+        candidates: if wvrn {
+            bt_solve::pipeline::CandidateMode::Wvrn
+        } else {
+            bt_solve::pipeline::CandidateMode::Exhaustive
+        },
+        max_candidates: u64::MAX,
         parallel: false,
     }
 }
@@ -86,14 +91,14 @@ fn steps(c: &mut Criterion) {
         let mut before: Vec<IncrementalTracer> = Vec::new();
         for s in dynamic.scenes() {
             before.push(tracer.clone());
-            tracer.step(s);
+            tracer.step(s).unwrap();
         }
         // Quick ratio over steps 1..n (mean of a few rounds), printed for the record.
         let rounds = 20;
         let t0 = Instant::now();
         for _ in 0..rounds {
             for k in 1..n {
-                black_box(trace_scratch(dynamic.step(k), k, &opts));
+                black_box(trace_scratch(dynamic.step(k), k, &opts).unwrap());
             }
         }
         let scratch = t0.elapsed().as_secs_f64() / (rounds * (n - 1)) as f64;
@@ -101,7 +106,7 @@ fn steps(c: &mut Criterion) {
         for _ in 0..rounds {
             for (k, b) in before.iter().enumerate().skip(1) {
                 let mut t = b.clone();
-                black_box(t.step(dynamic.step(k)));
+                black_box(t.step(dynamic.step(k)).unwrap());
             }
         }
         let incremental = t0.elapsed().as_secs_f64() / (rounds * (n - 1)) as f64;
@@ -119,7 +124,13 @@ fn steps(c: &mut Criterion) {
         g.bench_function("scratch/steps-1-9", |b| {
             b.iter(|| {
                 (1..n)
-                    .map(|k| trace_scratch(dynamic.step(k), k, &opts).trace.paths.len())
+                    .map(|k| {
+                        trace_scratch(dynamic.step(k), k, &opts)
+                            .unwrap()
+                            .trace
+                            .paths
+                            .len()
+                    })
                     .sum::<usize>()
             })
         });
@@ -128,7 +139,7 @@ fn steps(c: &mut Criterion) {
                 || before[1].clone(),
                 |mut t| {
                     (1..n)
-                        .map(|k| t.step(dynamic.step(k)).trace.paths.len())
+                        .map(|k| t.step(dynamic.step(k)).unwrap().trace.paths.len())
                         .sum::<usize>()
                 },
                 BatchSize::SmallInput,

@@ -24,9 +24,10 @@
 
 use bt_geom::{Real, Vec3};
 use bt_paths::wvrn::{Wvrn, WvrnStats};
-use bt_paths::{AllVisible, CandidateSet, CandidateStats};
+use bt_paths::{CandidateSet, CandidateStats};
 use bt_scene::dynamic::{DynamicScene, moved_surfaces};
 use bt_scene::{Scene, SurfaceId};
+use bt_solve::pipeline::{CandidateMode, TraceError, TraceOptions};
 use bt_solve::{CandidateOutcome, FoundPath, IpcOutcome, Solver, TraceResult, Validity};
 use rayon::prelude::*;
 use serde::Serialize;
@@ -39,8 +40,11 @@ pub struct StepOptions {
     pub max_order: usize,
     /// Path solver (IPC options are used as given; scale them to the scene yourself).
     pub solver: Solver,
-    /// Route candidates over the WVRN (true) or enumerate exhaustively.
-    pub wvrn: bool,
+    /// Candidate generator (the beam tree by default; the WVRN mode keeps its incremental
+    /// link update).
+    pub candidates: CandidateMode,
+    /// Budget on candidates (beam-tree nodes) per step.
+    pub max_candidates: u64,
     /// Spread solving over rayon's pool (output identical either way).
     pub parallel: bool,
 }
@@ -85,16 +89,45 @@ pub struct StepTrace {
     pub update: UpdateStats,
 }
 
-/// Trace one scene from scratch: WVRN (when enabled), enumeration, [`bt_solve::trace`].
-/// The reference the incremental tracer must reproduce.
-pub fn trace_scratch(scene: &Scene, step: usize, options: &StepOptions) -> StepTrace {
-    let wvrn = options.wvrn.then(|| Wvrn::build(scene));
-    let candidates = match &wvrn {
-        Some(w) => bt_paths::enumerate(scene, options.max_order, w),
-        None => bt_paths::enumerate(scene, options.max_order, &AllVisible),
-    };
+impl StepOptions {
+    fn trace_options(&self) -> TraceOptions {
+        TraceOptions {
+            max_order: self.max_order,
+            solver: self.solver,
+            candidates: self.candidates,
+            parallel: self.parallel,
+            max_candidates: self.max_candidates,
+        }
+    }
+
+    /// The step's candidates: over `wvrn` when given (WVRN mode), else from the pipeline's
+    /// generator (beam tree or exhaustive), under the budget.
+    fn candidates(&self, scene: &Scene, wvrn: Option<&Wvrn>) -> Result<CandidateSet, TraceError> {
+        match wvrn {
+            Some(w) => {
+                bt_solve::pipeline::check_budget(scene, &self.trace_options())?;
+                Ok(bt_paths::enumerate(scene, self.max_order, w))
+            }
+            None => bt_solve::pipeline::candidates(scene, &self.trace_options()),
+        }
+    }
+
+    fn wvrn(&self, scene: &Scene) -> Option<Wvrn> {
+        (self.candidates == CandidateMode::Wvrn).then(|| Wvrn::build(scene))
+    }
+}
+
+/// Trace one scene from scratch: candidates ([`bt_solve::pipeline::candidates`], or the WVRN),
+/// then [`bt_solve::trace`]. The reference the incremental tracer must reproduce.
+pub fn trace_scratch(
+    scene: &Scene,
+    step: usize,
+    options: &StepOptions,
+) -> Result<StepTrace, TraceError> {
+    let wvrn = options.wvrn(scene);
+    let candidates = options.candidates(scene, wvrn.as_ref())?;
     let trace = bt_solve::trace(scene, &candidates, &options.solver, options.parallel);
-    StepTrace {
+    Ok(StepTrace {
         step,
         trace,
         candidates: candidates.stats,
@@ -104,7 +137,7 @@ pub fn trace_scratch(scene: &Scene, step: usize, options: &StepOptions) -> StepT
             solved: candidates.len(),
             ..UpdateStats::default()
         },
-    }
+    })
 }
 
 /// Trace every step of a dynamic scene, incrementally or each from scratch.
@@ -112,7 +145,7 @@ pub fn trace_steps(
     dynamic: &DynamicScene,
     options: &StepOptions,
     incremental: bool,
-) -> Vec<StepTrace> {
+) -> Result<Vec<StepTrace>, TraceError> {
     if incremental {
         let mut tracer = IncrementalTracer::new(*options);
         dynamic.scenes().iter().map(|s| tracer.step(s)).collect()
@@ -164,13 +197,13 @@ impl IncrementalTracer {
 
     /// Trace the next step. Scenes that are not a next step of the previous one (other
     /// surfaces) are traced from scratch.
-    pub fn step(&mut self, scene: &Scene) -> StepTrace {
+    pub fn step(&mut self, scene: &Scene) -> Result<StepTrace, TraceError> {
         let options = self.options;
         let prev = self.state.take();
         let step = prev.as_ref().map_or(0, |p| p.step + 1);
         if matches!(options.solver, Solver::Sbr(_)) {
             // SBR traces the whole scene at once, not per candidate: nothing to reuse.
-            let result = trace_scratch(scene, step, &options);
+            let result = trace_scratch(scene, step, &options)?;
             self.state = Some(State {
                 scene: scene.clone(),
                 wvrn: None,
@@ -179,7 +212,7 @@ impl IncrementalTracer {
                 points: Vec::new(),
                 step,
             });
-            return result;
+            return Ok(result);
         }
         let moved = prev.as_ref().and_then(|p| moved_surfaces(&p.scene, scene));
         let (Some(prev), Some(moved)) = (prev, moved) else {
@@ -205,12 +238,14 @@ impl IncrementalTracer {
         let reflector_moved = moved
             .iter()
             .any(|id| scene.surface(*id).kind == bt_scene::SurfaceKind::Reflector);
-        let candidates = if everything || reflector_moved || links_changed {
+        // The beam tree's occlusion culling uses blockers too: any motion rederives it.
+        let generator_stale = match options.candidates {
+            CandidateMode::BeamTree => !moved.is_empty(),
+            _ => reflector_moved || links_changed,
+        };
+        let candidates = if everything || generator_stale {
             update.candidates_rederived = true;
-            match &wvrn {
-                Some(w) => bt_paths::enumerate(scene, options.max_order, w),
-                None => bt_paths::enumerate(scene, options.max_order, &AllVisible),
-            }
+            options.candidates(scene, wvrn.as_ref())?
         } else {
             prev.candidates.clone()
         };
@@ -291,6 +326,8 @@ impl IncrementalTracer {
                         let pts = &prev.points[r.start as usize..r.start as usize + seq.len()];
                         warm_start(&r.outcome, pts)
                     });
+                    let from_previous = warm.is_some();
+                    let warm = warm.or(candidates.start(i));
                     let points = &mut all_points[start..];
                     let outcome = bt_solve::solve_candidate_from(
                         scene,
@@ -302,7 +339,7 @@ impl IncrementalTracer {
                     );
                     (
                         outcome,
-                        warm.is_some() && matches!(options.solver, Solver::Ipc(_)),
+                        from_previous && matches!(options.solver, Solver::Ipc(_)),
                     )
                 })
                 .collect();
@@ -358,16 +395,13 @@ impl IncrementalTracer {
         };
         let result = state.result(update);
         self.state = Some(state);
-        result
+        Ok(result)
     }
 
-    fn full(&mut self, scene: &Scene, step: usize) -> StepTrace {
+    fn full(&mut self, scene: &Scene, step: usize) -> Result<StepTrace, TraceError> {
         let options = self.options;
-        let wvrn = options.wvrn.then(|| Wvrn::build(scene));
-        let candidates = match &wvrn {
-            Some(w) => bt_paths::enumerate(scene, options.max_order, w),
-            None => bt_paths::enumerate(scene, options.max_order, &AllVisible),
-        };
+        let wvrn = options.wvrn(scene);
+        let candidates = options.candidates(scene, wvrn.as_ref())?;
         let idx: Vec<usize> = (0..candidates.len()).collect();
         let solve = |range: &[usize]| -> Vec<(CandidateOutcome, Vec<Vec3>)> {
             let mut scratch = Vec::new();
@@ -377,10 +411,11 @@ impl IncrementalTracer {
                     let seq = candidates.get(i);
                     let mut points = vec![Vec3::ZERO; seq.len()];
                     scratch.resize(seq.len(), Vec3::ZERO);
-                    let o = bt_solve::solve_candidate(
+                    let o = bt_solve::solve_candidate_from(
                         scene,
                         seq,
                         &options.solver,
+                        candidates.start(i),
                         &mut points,
                         &mut scratch,
                     );
@@ -423,7 +458,7 @@ impl IncrementalTracer {
         };
         let result = state.result(update);
         self.state = Some(state);
-        result
+        Ok(result)
     }
 }
 

@@ -8,6 +8,7 @@ use bt_dynamic::{IncrementalTracer, StepOptions, max_point_distance, trace_scrat
 use bt_paths::wvrn::Wvrn;
 use bt_scene::Terminals;
 use bt_scene::dynamic::{DynamicScene, builtin_dynamic_scene, moved_surfaces};
+use bt_solve::pipeline::CandidateMode;
 use bt_solve::{IpcOptions, Solver, UpdateOrder};
 
 fn living_room() -> DynamicScene {
@@ -20,8 +21,8 @@ fn assert_same_as_scratch(dynamic: &DynamicScene, options: &StepOptions) -> (usi
     let mut tracer = IncrementalTracer::new(*options);
     let (mut solved, mut total) = (0, 0);
     for (k, scene) in dynamic.scenes().iter().enumerate() {
-        let inc = tracer.step(scene);
-        let scratch = trace_scratch(scene, k, options);
+        let inc = tracer.step(scene).unwrap();
+        let scratch = trace_scratch(scene, k, options).unwrap();
         assert_eq!(inc.step, k);
         assert_eq!(
             inc.candidates, scratch.candidates,
@@ -45,16 +46,21 @@ fn assert_same_as_scratch(dynamic: &DynamicScene, options: &StepOptions) -> (usi
 fn dynamic_living_room_matches_scratch_with_and_without_wvrn() {
     let dynamic = living_room();
     assert_eq!(dynamic.len(), 10);
-    for wvrn in [true, false] {
+    for wvrn in [
+        CandidateMode::BeamTree,
+        CandidateMode::Wvrn,
+        CandidateMode::Exhaustive,
+    ] {
         let options = StepOptions {
             max_order: 3,
             solver: Solver::Image,
-            wvrn,
+            candidates: wvrn,
+            max_candidates: u64::MAX,
             parallel: true,
         };
         let (solved, total) = assert_same_as_scratch(&dynamic, &options);
         eprintln!(
-            "living room (wvrn {wvrn}): re-solved {solved} of {total} candidates over steps 1-9"
+            "living room ({wvrn:?}): re-solved {solved} of {total} candidates over steps 1-9"
         );
         assert!(
             solved < total / 2,
@@ -69,7 +75,8 @@ fn person_blocks_the_line_of_sight_at_steps_2_and_3() {
     let options = StepOptions {
         max_order: 1,
         solver: Solver::Image,
-        wvrn: true,
+        candidates: CandidateMode::Wvrn,
+        max_candidates: u64::MAX,
         parallel: false,
     };
     let mut tracer = IncrementalTracer::new(options);
@@ -79,6 +86,7 @@ fn person_blocks_the_line_of_sight_at_steps_2_and_3() {
         .map(|s| {
             tracer
                 .step(s)
+                .unwrap()
                 .trace
                 .paths
                 .iter()
@@ -98,7 +106,8 @@ fn random_motions_match_scratch() {
         let options = StepOptions {
             max_order: 2,
             solver: Solver::Image,
-            wvrn: true,
+            candidates: CandidateMode::Wvrn,
+            max_candidates: u64::MAX,
             parallel: true,
         };
         assert_same_as_scratch(&dynamic, &options);
@@ -141,7 +150,8 @@ fn ipc_warm_start_agrees_with_the_image_method() {
     let options = StepOptions {
         max_order: 2,
         solver: ipc,
-        wvrn: true,
+        candidates: CandidateMode::Wvrn,
+        max_candidates: u64::MAX,
         parallel: true,
     };
     let image = StepOptions {
@@ -151,9 +161,9 @@ fn ipc_warm_start_agrees_with_the_image_method() {
     let mut tracer = IncrementalTracer::new(options);
     let mut warm = 0;
     for (k, scene) in dynamic.scenes().iter().enumerate() {
-        let inc = tracer.step(scene);
+        let inc = tracer.step(scene).unwrap();
         warm += inc.update.warm_started;
-        let reference = trace_scratch(scene, k, &image);
+        let reference = trace_scratch(scene, k, &image).unwrap();
         let worst = max_point_distance(&inc.trace.paths, &reference.trace.paths)
             .unwrap_or_else(|| panic!("step {k}: IPC found other paths than the image method"));
         assert!(

@@ -75,7 +75,10 @@ pub fn city_obj(options: &CityOptions) -> String {
         v += 4;
     };
     let (lo, hi) = (-margin, size + margin);
-    quad(&mut obj, [[lo, lo, 0.], [hi, lo, 0.], [hi, hi, 0.], [lo, hi, 0.]]);
+    quad(
+        &mut obj,
+        [[lo, lo, 0.], [hi, lo, 0.], [hi, hi, 0.], [lo, hi, 0.]],
+    );
     for i in 0..options.lots {
         for j in 0..options.lots {
             let (x0, y0) = options.lot_origin(i, j);

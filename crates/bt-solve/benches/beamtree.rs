@@ -38,8 +38,16 @@ fn living_room(c: &mut Criterion) {
         b.iter(|| bt_paths::beamtree::candidates(black_box(&scene), TreeOptions::new(3)))
     });
     for (name, mode, solver) in [
-        ("trace-image-beam-tree", CandidateMode::BeamTree, Solver::Image),
-        ("trace-image-exhaustive", CandidateMode::Exhaustive, Solver::Image),
+        (
+            "trace-image-beam-tree",
+            CandidateMode::BeamTree,
+            Solver::Image,
+        ),
+        (
+            "trace-image-exhaustive",
+            CandidateMode::Exhaustive,
+            Solver::Image,
+        ),
         ("trace-ipc-gs-beam-tree", CandidateMode::BeamTree, gs),
         ("trace-ipc-gs-exhaustive", CandidateMode::Exhaustive, gs),
     ] {
@@ -60,7 +68,9 @@ fn living_room(c: &mut Criterion) {
         b.iter(|| {
             k = (k + 1) % receivers.len();
             let set = tree.candidates(receivers[k]);
-            bt_solve::trace(&moved[k], &set, &Solver::Image, false).paths.len()
+            bt_solve::trace(&moved[k], &set, &Solver::Image, false)
+                .paths
+                .len()
         })
     });
     group.bench_function("new-rx-walk-only", |b| {

@@ -106,15 +106,7 @@ pub struct Traced {
 
 /// Generate the candidates of `scene` under `options` (with the budget checked).
 pub fn candidates(scene: &Scene, options: &TraceOptions) -> Result<CandidateSet, TraceError> {
-    let reflectors = scene.reflectors().count() as u64;
-    let estimate = exhaustive_count(reflectors, options.max_order);
-    if options.candidates != CandidateMode::BeamTree && estimate > options.max_candidates {
-        return Err(TraceError::Budget {
-            estimate,
-            budget: options.max_candidates,
-            max_order: options.max_order,
-        });
-    }
+    check_budget(scene, options)?;
     Ok(match options.candidates {
         CandidateMode::Exhaustive => bt_paths::enumerate(scene, options.max_order, &AllVisible),
         CandidateMode::BeamTree => bt_paths::beamtree::candidates(scene, tree_options(options))?,
@@ -131,6 +123,22 @@ fn tree_options(options: &TraceOptions) -> TreeOptions {
         max_nodes: options.max_candidates,
         occlusion: true,
     }
+}
+
+/// Check the budget before enumerating: the exhaustive and WVRN generators are refused when
+/// the sequence count [`exhaustive_count`] exceeds it (the beam tree counts its nodes as it
+/// builds them instead).
+pub fn check_budget(scene: &Scene, options: &TraceOptions) -> Result<(), TraceError> {
+    let reflectors = scene.reflectors().count() as u64;
+    let estimate = exhaustive_count(reflectors, options.max_order);
+    if options.candidates != CandidateMode::BeamTree && estimate > options.max_candidates {
+        return Err(TraceError::Budget {
+            estimate,
+            budget: options.max_candidates,
+            max_order: options.max_order,
+        });
+    }
+    Ok(())
 }
 
 /// Number of sequences of order `0..=max_order` over `n` reflectors with no surface twice in

@@ -76,7 +76,11 @@ fn nasty_scene(seed: u64, n: usize, terminals: u8) -> Option<Scene> {
         let (u, v) = (u0 * a, v0 * b);
         match i % 4 {
             0 => {
-                let kind = if rng.random_bool(0.3) { "blocker" } else { "reflector" };
+                let kind = if rng.random_bool(0.3) {
+                    "blocker"
+                } else {
+                    "reflector"
+                };
                 surfaces.push(rect(&format!("r{i}"), kind, c, u, v));
             }
             1 => {
@@ -92,10 +96,11 @@ fn nasty_scene(seed: u64, n: usize, terminals: u8) -> Option<Scene> {
                 surfaces.push(rect(&format!("c{i}b"), "reflector", c + u, u, v));
             }
             _ => {
-                let l: Vec<[Real; 3]> = [(0., 0.), (2., 0.), (2., 1.), (1., 1.), (1., 2.), (0., 2.)]
-                    .iter()
-                    .map(|(x, y)| (c + (*x - 1.0) * u + (*y - 1.0) * v).to_array())
-                    .collect();
+                let l: Vec<[Real; 3]> =
+                    [(0., 0.), (2., 0.), (2., 1.), (1., 1.), (1., 2.), (0., 2.)]
+                        .iter()
+                        .map(|(x, y)| (c + (*x - 1.0) * u + (*y - 1.0) * v).to_array())
+                        .collect();
                 surfaces.push(format!(
                     r#"{{ "name": "l{i}", "kind": "reflector", "vertices": {l:?} }}"#
                 ));
@@ -220,11 +225,23 @@ fn living_room_same_paths_and_few_candidates() {
         .unwrap();
     for order in 1..=4 {
         let reference = paths(&scene, order, CandidateMode::Exhaustive);
-        let traced = trace_scene(&scene, &options(order, CandidateMode::BeamTree, Solver::Image)).unwrap();
-        assert_eq!(sequences(&traced.result.paths), sequences(&reference), "order {order}");
+        let traced = trace_scene(
+            &scene,
+            &options(order, CandidateMode::BeamTree, Solver::Image),
+        )
+        .unwrap();
+        assert_eq!(
+            sequences(&traced.result.paths),
+            sequences(&reference),
+            "order {order}"
+        );
         if order == 3 {
             // the issue's target: at most 200 of the 9,594 exhaustive candidates
-            assert!(traced.candidates.candidates <= 200, "{:?}", traced.candidates);
+            assert!(
+                traced.candidates.candidates <= 200,
+                "{:?}",
+                traced.candidates
+            );
         }
     }
 }
@@ -243,7 +260,8 @@ fn full_tree_walk_equals_the_single_receiver_trace() {
     for s in &a {
         assert!(b.contains(s), "{s:?}");
     }
-    let solved = |set: &bt_paths::CandidateSet| bt_solve::trace(&scene, set, &Solver::Image, false).paths;
+    let solved =
+        |set: &bt_paths::CandidateSet| bt_solve::trace(&scene, set, &Solver::Image, false).paths;
     assert_eq!(sequences(&solved(&walked)), sequences(&solved(&single)));
 }
 
@@ -260,7 +278,11 @@ fn ipc_finds_the_wall_floor_path_that_centroid_starts_missed() {
     let image = paths(&scene, 2, CandidateMode::Exhaustive);
     let ipc = trace_scene(
         &scene,
-        &options(2, CandidateMode::BeamTree, common::ipc(&scene, UpdateOrder::GaussSeidel)),
+        &options(
+            2,
+            CandidateMode::BeamTree,
+            common::ipc(&scene, UpdateOrder::GaussSeidel),
+        ),
     )
     .unwrap()
     .result
@@ -276,5 +298,3 @@ fn ipc_finds_the_wall_floor_path_that_centroid_starts_missed() {
     let length: Real = v.windows(2).map(|w| w[0].distance(w[1])).sum();
     assert!((length - 3.960).abs() < 5e-4, "{length}");
 }
-
-

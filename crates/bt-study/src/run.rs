@@ -4,7 +4,7 @@
 use crate::room::{self, Room, Shape};
 use crate::{StudyError, embed};
 use bt_geom::{Real, Vec2, Vec3};
-use bt_paths::{AllVisible, enumerate};
+use bt_paths::CandidateSet;
 use bt_scene::{Scene, SurfaceId};
 use bt_solve::{IpcOptions, SbrOptions, Solver, UpdateOrder, sbr, trace};
 use serde::Serialize;
@@ -224,7 +224,7 @@ pub(crate) fn run_solver(
         StudySolver::IpcJacobi => Solver::Ipc(IpcOptions::for_scene(scene, UpdateOrder::Jacobi)),
         _ => Solver::Image,
     };
-    let candidates = enumerate(scene, config.max_order, &AllVisible);
+    let candidates = study_candidates(scene, config.max_order);
     let result = trace(scene, &candidates, &s, false);
     let elapsed = start.elapsed().as_secs_f64();
     let map = result
@@ -358,8 +358,20 @@ fn row(
     }
 }
 
+/// The study's candidates: the beam tree (the generator every consumer uses), unbudgeted since
+/// the study caps its order.
+fn study_candidates(scene: &Scene, max_order: usize) -> CandidateSet {
+    let options = bt_solve::pipeline::TraceOptions {
+        parallel: false,
+        max_candidates: u64::MAX,
+        ..bt_solve::pipeline::TraceOptions::new(max_order)
+    };
+    // Without a budget the beam tree has no error to return.
+    bt_solve::pipeline::candidates(scene, &options).expect("an unbudgeted beam tree cannot fail")
+}
+
 fn exact_polylines(scene: &Scene, max_order: usize) -> Vec<(usize, Vec<Vec2>)> {
-    let candidates = enumerate(scene, max_order, &AllVisible);
+    let candidates = study_candidates(scene, max_order);
     trace(scene, &candidates, &Solver::Image, false)
         .paths
         .iter()
