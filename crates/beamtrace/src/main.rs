@@ -7,6 +7,7 @@ mod hls;
 mod output;
 mod steps;
 mod study;
+mod sweep;
 mod trace;
 mod wvrn;
 
@@ -30,6 +31,8 @@ fn run(cli: args::Cli) -> anyhow::Result<ExitCode> {
         args::Command::Trace(a) => trace::run(&a),
         args::Command::Demo(a) => trace::run(&a.into_trace()),
         args::Command::Wvrn(a) => wvrn::run(&a),
+        args::Command::Sweep(a) => sweep::run(&a),
+        args::Command::View(_) => anyhow::bail!("view: not built yet"),
         args::Command::Extract(a) => cloud::run_extract(&a),
         args::Command::Hls(a) => hls::run(&a),
         args::Command::Sample(a) => cloud::run_sample(&a),

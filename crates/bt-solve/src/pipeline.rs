@@ -149,12 +149,26 @@ pub fn trace_scene(scene: &Scene, options: &TraceOptions) -> Result<Traced, Trac
 
 /// Trace `scene`'s TX to each of `receivers` (one result per receiver, in order). Receivers
 /// run in parallel when `options.parallel`; each one's own trace is then single-threaded.
-/// A receiver on a surface or at the TX fails the whole call with that receiver's error.
+/// A receiver on a surface or at the TX fails the whole call with that receiver's error
+/// (see [`trace_each_receiver`] for one result per receiver).
 pub fn trace_receivers(
     scene: &Scene,
     receivers: &[Vec3],
     options: &TraceOptions,
 ) -> Result<Vec<Traced>, TraceError> {
+    trace_each_receiver(scene, receivers, options)
+        .into_iter()
+        .collect()
+}
+
+/// Like [`trace_receivers`], but one outcome per receiver: a receiver on a surface or at the
+/// TX gets its own [`TraceError::Scene`] and the others are still traced (coverage sweeps
+/// mark such grid points instead of failing). A budget error repeats for every receiver.
+pub fn trace_each_receiver(
+    scene: &Scene,
+    receivers: &[Vec3],
+    options: &TraceOptions,
+) -> Vec<Result<Traced, TraceError>> {
     let inner = TraceOptions {
         parallel: false,
         ..*options
