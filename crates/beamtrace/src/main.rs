@@ -9,6 +9,7 @@ mod steps;
 mod study;
 mod sweep;
 mod trace;
+mod view;
 mod wvrn;
 
 use clap::Parser;
@@ -32,7 +33,7 @@ fn run(cli: args::Cli) -> anyhow::Result<ExitCode> {
         args::Command::Demo(a) => trace::run(&a.into_trace()),
         args::Command::Wvrn(a) => wvrn::run(&a),
         args::Command::Sweep(a) => sweep::run(&a),
-        args::Command::View(_) => anyhow::bail!("view: not built yet"),
+        args::Command::View(a) => view::run(&a),
         args::Command::Extract(a) => cloud::run_extract(&a),
         args::Command::Hls(a) => hls::run(&a),
         args::Command::Sample(a) => cloud::run_sample(&a),
