@@ -72,6 +72,21 @@ def test_living_room_draws_one_line_per_path(beamtrace, browser, tmp_path):
     assert page.evaluate("!!document.querySelector('canvas').getContext('webgl2')")
     page.screenshot(path=str(tmp_path / "view.png"))
     assert errors == []
+    # Hovering a path shows its numbers: the middle of the line of sight.
+    doc = json.loads(paths_json.read_text())
+    mid = [(a + b) / 2 for a, b in zip(doc["tx"], doc["rx"])]
+    x, y = page.evaluate("p => window.beamtraceView.project(p)", mid)
+    page.mouse.move(x, y)
+    tip = page.locator("#tip")
+    assert tip.is_visible()
+    lines = tip.text_content().split("\n")
+    lengths = {f"{p['length_m']:.3f}" for p in doc["paths"]}
+    assert lines[1].split()[1] in lengths, lines
+    assert lines[2].startswith("AoD az") and lines[3].startswith("AoA az"), lines
+    # Colour by loss is a switch away.
+    page.select_option("#colour-by", "loss")
+    assert "dB" in page.locator("#legend-paths").text_content()
+    assert errors == []
     # Without --paths the viewer traces the scene itself: the same count.
     traced = tmp_path / "traced.html"
     beamtrace("view", "builtin:living-room", "-o", traced)

@@ -7,6 +7,19 @@
   function orderColour(order) {
     return ORDER_COLOURS[Math.min(order, ORDER_COLOURS.length - 1)];
   }
+  // Colour by loss: viridis from the weakest (dark) to the strongest path (yellow) of the
+  // whole document, so colours compare across time steps.
+  var VIRIDIS = ["#440154", "#46327e", "#365c8d", "#277f8e", "#1fa187", "#4ac16d", "#a0da39", "#fde725"];
+  var losses = [];
+  doc.steps.forEach(function (s) { s.paths.forEach(function (p) { losses.push(p.loss_db); }); });
+  var lossMin = losses.length ? Math.min.apply(null, losses) : 0;
+  var lossMax = losses.length ? Math.max.apply(null, losses) : 1;
+  var colourBy = "order";
+  function pathColour(p) {
+    if (colourBy === "order") return orderColour(p.order);
+    var t = lossMax > lossMin ? (lossMax - p.loss_db) / (lossMax - lossMin) : 1;
+    return VIRIDIS[Math.min(VIRIDIS.length - 1, Math.floor(t * VIRIDIS.length))];
+  }
   function text(el, s) { el.textContent = s; return el; }
   function make(tag, s) { return text(document.createElement(tag), s); }
 
@@ -102,7 +115,7 @@
     step.paths.forEach(function (p) {
       var pts = [step.tx].concat(p.points, [step.rx]);
       var line = new THREE.Line(lineGeometry(pts), new THREE.LineBasicMaterial({
-        color: orderColour(p.order), transparent: true, opacity: p.order === 0 ? 1 : 0.75 }));
+        color: pathColour(p), transparent: true, opacity: p.order === 0 ? 1 : 0.75 }));
       line.userData.path = p;
       stepGroup.add(line);
       pathLines.push(line);
@@ -131,35 +144,35 @@
     controls.update();
   }
 
-  function legend() {
-    var el = document.getElementById("legend");
-    var orders = {};
-    doc.steps.forEach(function (s) { s.paths.forEach(function (p) { orders[p.order] = true; }); });
-    Object.keys(orders).map(Number).sort(function (a, b) { return a - b; }).forEach(function (o) {
-      var row = document.createElement("div");
-      var sw = make("span", "");
-      sw.className = "swatch";
-      sw.style.background = orderColour(o);
-      row.appendChild(sw);
-      row.appendChild(document.createTextNode(o === 0 ? "line of sight" : "order " + o));
-      el.appendChild(row);
-    });
-    doc.materials.forEach(function (m) {
-      var row = document.createElement("div");
-      var sw = make("span", "");
-      sw.className = "box";
-      sw.style.background = m.colour;
-      row.appendChild(sw);
-      row.appendChild(document.createTextNode(m.name));
-      el.appendChild(row);
-    });
+  function swatchRow(colour, cls, label) {
     var row = document.createElement("div");
     var sw = make("span", "");
-    sw.className = "box";
-    sw.style.background = "#e15759";
+    sw.className = cls;
+    sw.style.background = colour;
     row.appendChild(sw);
-    row.appendChild(document.createTextNode("blocker"));
-    el.appendChild(row);
+    row.appendChild(document.createTextNode(label));
+    return row;
+  }
+
+  function legend() {
+    var paths = document.getElementById("legend-paths");
+    paths.replaceChildren();
+    if (colourBy === "order") {
+      var orders = {};
+      doc.steps.forEach(function (s) { s.paths.forEach(function (p) { orders[p.order] = true; }); });
+      Object.keys(orders).map(Number).sort(function (a, b) { return a - b; }).forEach(function (o) {
+        paths.appendChild(swatchRow(orderColour(o), "swatch", o === 0 ? "line of sight" : "order " + o));
+      });
+    } else {
+      paths.appendChild(swatchRow(VIRIDIS[VIRIDIS.length - 1], "swatch", "loss " + lossMin.toFixed(1) + " dB"));
+      paths.appendChild(swatchRow(VIRIDIS[0], "swatch", "loss " + lossMax.toFixed(1) + " dB"));
+    }
+  }
+
+  function surfaceLegend() {
+    var el = document.getElementById("legend-surfaces");
+    doc.materials.forEach(function (m) { el.appendChild(swatchRow(m.colour, "box", m.name)); });
+    el.appendChild(swatchRow("#e15759", "box", "blocker"));
   }
 
   // Hover: the nearest path line under the pointer, its numbers in the tip.
@@ -183,7 +196,7 @@
     raycaster.params.Line.threshold = 0.03 * camera.position.distanceTo(controls.target) / 5;
     raycaster.setFromCamera(pointer, camera);
     var hits = raycaster.intersectObjects(pathLines, false);
-    if (highlighted) { highlighted.material.linewidth = 1; highlighted.material.color.set(orderColour(highlighted.userData.path.order)); }
+    if (highlighted) { highlighted.material.linewidth = 1; highlighted.material.color.set(pathColour(highlighted.userData.path)); }
     highlighted = null;
     if (hits.length) {
       highlighted = hits[0].object;
@@ -206,6 +219,17 @@
 
   text(document.getElementById("title"), doc.scene);
   legend();
+  surfaceLegend();
+  document.getElementById("colour-by").addEventListener("change", function (e) {
+    colourBy = e.target.value;
+    pathLines.forEach(function (l) { l.material.color.set(pathColour(l.userData.path)); });
+    legend();
+  });
+  // Pixel position of a world point (metres), for tests that hover a path.
+  state.project = function (p) {
+    var v = new THREE.Vector3(p[0], p[1], p[2]).project(camera);
+    return [(v.x + 1) / 2 * window.innerWidth, (1 - v.y) / 2 * window.innerHeight];
+  };
   var slider = document.getElementById("step");
   if (doc.steps.length > 1) {
     slider.max = String(doc.steps.length - 1);
