@@ -30,6 +30,12 @@ pub enum Command {
     /// Build the weak visibility relationship network (WVRN) of a scene and export it as a
     /// table, JSON or Graphviz DOT.
     Wvrn(WvrnArgs),
+    /// Coverage sweep: trace the TX to every point of a receiver grid; writes coverage.csv and
+    /// a heat map (coverage.svg, coverage.png) over the floor plan into --out.
+    Sweep(SweepArgs),
+    /// Write one self-contained HTML page showing the scene and its paths in 3-D (three.js
+    /// inlined, no network needed); dynamic scenes get a time-step slider.
+    View(ViewArgs),
     /// Scene utilities.
     Scene {
         #[command(subcommand)]
@@ -175,6 +181,29 @@ pub enum IpcAccelArg {
 pub struct TraceArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
+    #[command(flatten)]
+    pub solve: SolveArgs,
+    /// Print the JSON document instead of a table.
+    #[arg(long)]
+    pub json: bool,
+    /// Write the JSON document to this file (the table still goes to stdout unless --json).
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Trace every time step of a dynamic scene (static scenes have one step).
+    #[arg(long)]
+    pub steps: bool,
+    /// With --steps: print one JSON object per step and line.
+    #[arg(long, requires = "steps")]
+    pub jsonl: bool,
+    /// With --steps: trace each step from scratch instead of updating the previous one.
+    #[arg(long, requires = "steps")]
+    pub from_scratch: bool,
+}
+
+/// How to trace: order, solver and its options, candidate generator, budget, threads (shared
+/// by `trace`, `sweep` and `view`).
+#[derive(Debug, Args, Clone)]
+pub struct SolveArgs {
     /// Highest reflection order.
     #[arg(long, default_value_t = 3)]
     pub max_order: usize,
@@ -206,12 +235,6 @@ pub struct TraceArgs {
     /// Use one thread (benchmarking); the output is identical either way.
     #[arg(long)]
     pub single_thread: bool,
-    /// Print the JSON document instead of a table.
-    #[arg(long)]
-    pub json: bool,
-    /// Write the JSON document to this file (the table still goes to stdout unless --json).
-    #[arg(long)]
-    pub out: Option<PathBuf>,
     /// Candidate generator: the beam tree (default), every sequence over the WVRN, or every
     /// sequence (exhaustive, for checking). All three give the same paths.
     #[arg(long, value_enum, default_value_t = CandidatesArg::BeamTree)]
@@ -225,15 +248,65 @@ pub struct TraceArgs {
     /// Budget: stop with an error rather than generate more candidates (beam-tree nodes).
     #[arg(long, default_value_t = bt_solve::pipeline::DEFAULT_MAX_CANDIDATES)]
     pub max_candidates: u64,
-    /// Trace every time step of a dynamic scene (static scenes have one step).
+}
+
+#[derive(Debug, Args, Clone)]
+pub struct SweepArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    /// Receiver grid x0:x1:dx,y0:y1:dy,z in metres (both ends included), e.g.
+    /// 0.25:5.75:0.25,0.25:4.25:0.25,1.2.
+    #[arg(long, allow_hyphen_values = true, value_parser = parse_grid)]
+    pub grid: bt_coverage::Grid,
+    #[command(flatten)]
+    pub solve: SolveArgs,
+    /// Output directory (created if missing): coverage.csv, coverage.svg, coverage.png.
     #[arg(long)]
-    pub steps: bool,
-    /// With --steps: print one JSON object per step and line.
-    #[arg(long, requires = "steps")]
-    pub jsonl: bool,
-    /// With --steps: trace each step from scratch instead of updating the previous one.
-    #[arg(long, requires = "steps")]
-    pub from_scratch: bool,
+    pub out: PathBuf,
+    /// Budget: refuse grids with more points than this (checked before any work).
+    #[arg(long, default_value_t = bt_coverage::DEFAULT_MAX_POINTS)]
+    pub max_points: u64,
+    /// What the heat map shows.
+    #[arg(long, value_enum, default_value_t = MapArg::Gain)]
+    pub map: MapArg,
+}
+
+fn parse_grid(s: &str) -> Result<bt_coverage::Grid, bt_coverage::GridError> {
+    s.parse()
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum MapArg {
+    /// Gain of the strongest path (dB, the negated loss).
+    Gain,
+    /// Number of paths.
+    Paths,
+    /// Delay of the shortest path (ns).
+    Delay,
+}
+
+impl MapArg {
+    pub fn quantity(self) -> bt_coverage::MapQuantity {
+        match self {
+            MapArg::Gain => bt_coverage::MapQuantity::StrongestGain,
+            MapArg::Paths => bt_coverage::MapQuantity::Paths,
+            MapArg::Delay => bt_coverage::MapQuantity::ShortestDelay,
+        }
+    }
+}
+
+#[derive(Debug, Args, Clone)]
+pub struct ViewArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    #[command(flatten)]
+    pub solve: SolveArgs,
+    /// Show the paths of this `beamtrace trace --json` document instead of tracing the scene.
+    #[arg(long)]
+    pub paths: Option<PathBuf>,
+    /// HTML file to write.
+    #[arg(short = 'o', long = "output")]
+    pub output: PathBuf,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -246,7 +319,7 @@ pub enum CandidatesArg {
     Exhaustive,
 }
 
-impl TraceArgs {
+impl SolveArgs {
     /// The candidate generator the arguments select (the old `--wvrn`/`--no-wvrn` win).
     pub fn candidate_mode(&self) -> bt_solve::pipeline::CandidateMode {
         use bt_solve::pipeline::CandidateMode;
@@ -309,8 +382,22 @@ impl DemoArgs {
                 merge_angle_deg: 1.0,
                 merge_distance: 1e-3,
             },
-            max_order: self.max_order,
-            solver: self.solver,
+            solve: SolveArgs::with(self.max_order, self.solver),
+            json: self.json,
+            out: None,
+            steps: false,
+            jsonl: false,
+            from_scratch: false,
+        }
+    }
+}
+
+impl SolveArgs {
+    /// The defaults of every option but the order and the solver.
+    pub fn with(max_order: usize, solver: SolverArg) -> Self {
+        SolveArgs {
+            max_order,
+            solver,
             ipc_order: IpcOrderArg::GaussSeidel,
             ipc_threshold: None,
             ipc_max_iterations: bt_solve::ipc::DEFAULT_MAX_ITERATIONS,
@@ -319,15 +406,10 @@ impl DemoArgs {
             sbr_rays: None,
             sbr_planar: false,
             single_thread: false,
-            json: self.json,
-            out: None,
             candidates: CandidatesArg::BeamTree,
             wvrn: false,
             no_wvrn: false,
             max_candidates: bt_solve::pipeline::DEFAULT_MAX_CANDIDATES,
-            steps: false,
-            jsonl: false,
-            from_scratch: false,
         }
     }
 }

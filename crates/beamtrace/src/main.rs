@@ -7,7 +7,9 @@ mod hls;
 mod output;
 mod steps;
 mod study;
+mod sweep;
 mod trace;
+mod view;
 mod wvrn;
 
 use clap::Parser;
@@ -30,6 +32,8 @@ fn run(cli: args::Cli) -> anyhow::Result<ExitCode> {
         args::Command::Trace(a) => trace::run(&a),
         args::Command::Demo(a) => trace::run(&a.into_trace()),
         args::Command::Wvrn(a) => wvrn::run(&a),
+        args::Command::Sweep(a) => sweep::run(&a),
+        args::Command::View(a) => view::run(&a),
         args::Command::Extract(a) => cloud::run_extract(&a),
         args::Command::Hls(a) => hls::run(&a),
         args::Command::Sample(a) => cloud::run_sample(&a),

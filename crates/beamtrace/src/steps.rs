@@ -94,13 +94,13 @@ pub fn load_dynamic(args: &SceneArgs) -> anyhow::Result<DynamicScene> {
 pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
     let dynamic = load_dynamic(&args.scene)?;
     let scene0 = dynamic.step(0);
-    let solver = solver_for(args, scene0)?;
+    let solver = solver_for(&args.solve, scene0)?;
     let options = StepOptions {
-        max_order: args.max_order,
+        max_order: args.solve.max_order,
         solver,
-        candidates: args.candidate_mode(),
-        max_candidates: args.max_candidates,
-        parallel: !args.single_thread,
+        candidates: args.solve.candidate_mode(),
+        max_candidates: args.solve.max_candidates,
+        parallel: !args.solve.single_thread,
     };
     let incremental = !args.from_scratch;
     let mut tracer = IncrementalTracer::new(options);
@@ -140,7 +140,7 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
         format_version: FORMAT_VERSION,
         scene: scene0.name().to_string(),
         frequency_hz: scene0.frequency_hz(),
-        max_order: args.max_order,
+        max_order: args.solve.max_order,
         solver,
         candidates: options.candidates,
         incremental,

@@ -1,6 +1,6 @@
 //! `beamtrace trace`, `demo` and `scene check`.
 
-use crate::args::{IpcAccelArg, IpcOrderArg, SceneArgs, SolverArg, TraceArgs};
+use crate::args::{IpcAccelArg, IpcOrderArg, SceneArgs, SolveArgs, SolverArg, TraceArgs};
 use crate::output::{self, TraceDocument};
 use anyhow::{Context, bail};
 use bt_scene::io::{LoadOptions, Loaded};
@@ -65,7 +65,7 @@ pub fn load_scene(args: &SceneArgs) -> Result<Loaded, SceneError> {
 }
 
 /// The solver the arguments select, with defaults scaled to the scene.
-pub fn solver_for(args: &TraceArgs, scene: &Scene) -> anyhow::Result<Solver> {
+pub fn solver_for(args: &SolveArgs, scene: &Scene) -> anyhow::Result<Solver> {
     Ok(match args.solver {
         SolverArg::Image => Solver::Image,
         SolverArg::Ipc => {
@@ -108,7 +108,7 @@ pub fn solver_for(args: &TraceArgs, scene: &Scene) -> anyhow::Result<Solver> {
 }
 
 /// The pipeline options the arguments select.
-pub fn trace_options(args: &TraceArgs, solver: Solver) -> bt_solve::pipeline::TraceOptions {
+pub fn trace_options(args: &SolveArgs, solver: Solver) -> bt_solve::pipeline::TraceOptions {
     bt_solve::pipeline::TraceOptions {
         max_order: args.max_order,
         solver,
@@ -128,9 +128,9 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
         eprintln!("warning: {w}");
     }
     let scene = loaded.scene;
-    let solver = solver_for(args, &scene)?;
+    let solver = solver_for(&args.solve, &scene)?;
     let t1 = Instant::now();
-    let options = trace_options(args, solver);
+    let options = trace_options(&args.solve, solver);
     let traced = bt_solve::pipeline::trace_scene(&scene, &options)?;
     let t3 = Instant::now();
     let paths = bt_beams::report(&scene, &traced.result.paths);
@@ -138,7 +138,7 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
     let doc = TraceDocument::new(
         &scene,
         &solver,
-        args.max_order,
+        args.solve.max_order,
         paths,
         traced.candidates,
         traced.tree,

@@ -184,12 +184,26 @@ fn solve_set(
 
 /// Trace `scene`'s TX to each of `receivers` (one result per receiver, in order). Receivers
 /// run in parallel when `options.parallel`; each one's own trace is then single-threaded.
-/// A receiver on a surface or at the TX fails the whole call with that receiver's error.
+/// A receiver on a surface or at the TX fails the whole call with that receiver's error
+/// (see [`trace_each_receiver`] for one result per receiver).
 pub fn trace_receivers(
     scene: &Scene,
     receivers: &[Vec3],
     options: &TraceOptions,
 ) -> Result<Vec<Traced>, TraceError> {
+    trace_each_receiver(scene, receivers, options)
+        .into_iter()
+        .collect()
+}
+
+/// Like [`trace_receivers`], but one outcome per receiver: a receiver on a surface or at the
+/// TX gets its own [`TraceError::Scene`] and the others are still traced (coverage sweeps
+/// mark such grid points instead of failing). A budget error repeats for every receiver.
+pub fn trace_each_receiver(
+    scene: &Scene,
+    receivers: &[Vec3],
+    options: &TraceOptions,
+) -> Vec<Result<Traced, TraceError>> {
     let inner = TraceOptions {
         parallel: false,
         ..*options
@@ -197,7 +211,10 @@ pub fn trace_receivers(
     // Fixed TX: one beam tree answers every receiver by a walk.
     let tree = match options.candidates {
         CandidateMode::BeamTree if receivers.len() > 1 => {
-            Some(BeamTree::build(scene, tree_options(options))?)
+            match BeamTree::build(scene, tree_options(options)) {
+                Ok(tree) => Some(tree),
+                Err(e) => return receivers.iter().map(|_| Err(e.clone().into())).collect(),
+            }
         }
         _ => None,
     };

@@ -3,60 +3,22 @@
 //! against time step and number of edges) and Fig. 7 (elapsed time, same axes). Log y axes
 //! with a floor: IPC errors are ~1e-12° and some are exactly 0.
 //!
-//! Text needs a font: DejaVu Sans (Bitstream Vera licence, `assets/DejaVuSans-LICENSE.txt`)
-//! is compiled in and registered as `sans-serif` by [`register_font`].
+//! The font, the white canvas and the legend style are shared with every other figure
+//! (`bt-plot`).
 
 use crate::report::{GroupBy, Quantity, mean_by};
 use crate::run::{RoomDrawing, StudyResults, StudySolver};
 use bt_geom::Real;
-use plotters::coord::{CoordTranslate, Shift};
+use plotters::coord::Shift;
 use plotters::prelude::*;
-use std::sync::OnceLock;
 
 /// Errors below this are drawn at it on the log axes, degrees.
 pub const ERROR_FLOOR_DEG: Real = 1e-15;
 /// Times below this are drawn at it on the log axes, seconds.
 pub const TIME_FLOOR_S: Real = 1e-7;
 
-const FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
-pub(crate) const FAMILY: &str = "sans-serif";
-
-/// Register the shipped font as `sans-serif` (idempotent). Must run before drawing text.
-pub fn register_font() -> Result<(), String> {
-    static DONE: OnceLock<Result<(), String>> = OnceLock::new();
-    DONE.get_or_init(|| {
-        plotters::style::register_font(FAMILY, FontStyle::Normal, FONT)
-            .map_err(|_| "the shipped font DejaVuSans.ttf is not a valid font".to_string())
-    })
-    .clone()
-}
-
-pub(crate) fn fail<E: std::fmt::Display>(e: E) -> String {
-    e.to_string()
-}
-
-/// Start a figure: register the font and fill the whole area white.
-pub(crate) fn blank<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>) -> Result<(), String> {
-    register_font()?;
-    root.fill(&WHITE).map_err(fail)
-}
-
-/// Draw the legend of every figure: `font_size` text in a translucent white box with a black
-/// border at `position`.
-pub(crate) fn legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
-    chart: &mut ChartContext<'a, DB, CT>,
-    position: SeriesLabelPosition,
-    font_size: u32,
-) -> Result<(), String> {
-    chart
-        .configure_series_labels()
-        .position(position)
-        .label_font((FAMILY, font_size))
-        .background_style(WHITE.mix(0.85))
-        .border_style(BLACK)
-        .draw()
-        .map_err(fail)
-}
+pub use bt_plot::register_font;
+pub(crate) use bt_plot::{FAMILY, blank, fail, legend};
 
 /// Colour of a solver in every figure.
 pub fn colour(solver: StudySolver) -> RGBColor {

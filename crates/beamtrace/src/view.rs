@@ -1,0 +1,46 @@
+//! `beamtrace view`: one self-contained HTML page of a scene (every time step of a dynamic
+//! scene) and its paths, traced here or read from a `trace --json` document.
+
+use crate::args::ViewArgs;
+use crate::output::write_atomic;
+use crate::steps::load_dynamic;
+use crate::trace::{solver_for, trace_options};
+use anyhow::Context;
+use bt_view::StepPaths;
+use std::process::ExitCode;
+
+pub fn run(args: &ViewArgs) -> anyhow::Result<ExitCode> {
+    let dynamic = load_dynamic(&args.scene)?;
+    let scenes: Vec<&bt_scene::Scene> = dynamic.scenes().iter().collect();
+    let paths = match &args.paths {
+        Some(file) => {
+            let name = file.display().to_string();
+            let text = std::fs::read_to_string(file).with_context(|| format!("reading {name}"))?;
+            let paths = bt_view::read_paths(&text, &name)?;
+            bt_view::check_steps(&paths, scenes.len(), &name)?;
+            paths
+        }
+        None => {
+            let options = trace_options(&args.solve, solver_for(&args.solve, scenes[0])?);
+            let mut steps = Vec::with_capacity(scenes.len());
+            for scene in &scenes {
+                let traced = bt_solve::pipeline::trace_scene(scene, &options)?;
+                let reports = bt_beams::report(scene, &traced.result.paths);
+                steps.push(StepPaths::from_reports(scene, &reports));
+            }
+            steps
+        }
+    };
+    let html = bt_view::page(&scenes, &paths);
+    write_atomic(&args.output, html.as_bytes())?;
+    let total: usize = paths.iter().map(|s| s.paths.len()).sum();
+    println!(
+        "{}: {} time step(s), {} paths -> {} ({} KiB)",
+        scenes[0].name(),
+        scenes.len(),
+        total,
+        args.output.display(),
+        html.len() / 1024
+    );
+    Ok(ExitCode::SUCCESS)
+}

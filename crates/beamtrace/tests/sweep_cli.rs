@@ -1,0 +1,165 @@
+//! `beamtrace sweep`: every grid point against its own `beamtrace trace --rx` run, a golden
+//! CSV of a tiny grid (with a point at the TX, marked skipped), determinism across thread
+//! counts, and bad grids refused with a clear message.
+
+use serde_json::Value;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+fn beamtrace(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_beamtrace"))
+        .args(args)
+        .output()
+        .expect("binary runs")
+}
+
+fn tmp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("bt-sweep-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    dir
+}
+
+fn sweep(grid: &str, extra: &[&str], name: &str) -> (PathBuf, String) {
+    let dir = tmp_dir(name);
+    let d = dir.display().to_string();
+    let mut args = vec!["sweep", "builtin:living-room", "--grid", grid, "--out", &d];
+    args.extend_from_slice(extra);
+    let o = beamtrace(&args);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let csv = std::fs::read_to_string(dir.join("coverage.csv")).unwrap();
+    (dir, csv)
+}
+
+#[test]
+fn every_point_equals_its_own_trace() {
+    let grid = "0.7:5.2:1.5,0.6:3.9:1.1,1.1";
+    let (dir, csv) = sweep(grid, &["--max-order", "2"], "points");
+    for ext in ["svg", "png"] {
+        assert!(
+            std::fs::metadata(dir.join(format!("coverage.{ext}")))
+                .unwrap()
+                .len()
+                > 1000
+        );
+    }
+    let lines: Vec<&str> = csv.lines().skip(1).collect();
+    assert_eq!(lines.len(), 4 * 4);
+    for line in lines {
+        let f: Vec<&str> = line.split(',').collect();
+        assert_eq!(f[3], "ok", "{line}");
+        let rx = format!("{},{},{}", f[0], f[1], f[2]);
+        let o = beamtrace(&[
+            "trace",
+            "builtin:living-room",
+            "--rx",
+            &rx,
+            "--max-order",
+            "2",
+            "--json",
+        ]);
+        assert!(o.status.success());
+        let doc: Value = serde_json::from_slice(&o.stdout).unwrap();
+        let paths = doc["paths"].as_array().unwrap();
+        assert_eq!(f[4].parse::<usize>().unwrap(), paths.len(), "{line}");
+        let delay = paths
+            .iter()
+            .map(|p| p["delay_s"].as_f64().unwrap())
+            .fold(f64::INFINITY, f64::min);
+        assert!(
+            (f[5].parse::<f64>().unwrap() - delay * 1e9).abs() < 1e-6,
+            "{line}"
+        );
+        let best = paths
+            .iter()
+            .min_by(|a, b| {
+                a["loss_db"]
+                    .as_f64()
+                    .unwrap()
+                    .total_cmp(&b["loss_db"].as_f64().unwrap())
+            })
+            .unwrap();
+        assert_eq!(
+            f[6].parse::<u64>().unwrap(),
+            best["order"].as_u64().unwrap(),
+            "{line}"
+        );
+        assert!((f[7].parse::<f64>().unwrap() - best["loss_db"].as_f64().unwrap()).abs() < 1e-4);
+        let names: Vec<&str> = best["surfaces"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|s| s.as_str().unwrap())
+            .collect();
+        assert_eq!(f[9], names.join(" > "), "{line}");
+    }
+    let _ = std::fs::remove_dir_all(dir);
+}
+
+#[test]
+fn tiny_grid_matches_the_golden_csv_and_marks_the_tx() {
+    // (5.6, 0.6, 2.2) is the living room's TX: skipped with empty fields, the rest traced.
+    let (dir, csv) = sweep("5.0:5.6:0.3,0.6:1.2:0.6,2.2", &[], "golden");
+    let golden = repo().join("testdata/golden/sweep-living-room.csv");
+    if std::env::var_os("UPDATE_GOLDEN").is_some() {
+        std::fs::write(&golden, &csv).unwrap();
+    }
+    let expected =
+        std::fs::read_to_string(&golden).expect("golden file (UPDATE_GOLDEN=1 writes it)");
+    assert_eq!(csv, expected, "rerun with UPDATE_GOLDEN=1 if intended");
+    assert!(
+        csv.contains("5.600000,0.600000,2.200000,skipped,,,,,,,tx and rx are at the same position")
+    );
+    let (dir1, single) = sweep(
+        "5.0:5.6:0.3,0.6:1.2:0.6,2.2",
+        &["--single-thread"],
+        "single",
+    );
+    assert_eq!(csv, single, "output depends on the thread count");
+    let _ = std::fs::remove_dir_all(dir);
+    let _ = std::fs::remove_dir_all(dir1);
+}
+
+#[test]
+fn bad_grids_are_refused_with_the_field_named() {
+    let cases = [
+        ("0:1:0.5,0:1:0.5", "2 comma-separated fields, expected 3"),
+        ("0:1:0.5,0:1,1", "y axis \"0:1\" has 2"),
+        ("0:1:x,0:1:0.5,1", "x step \"x\" is not a number"),
+        ("1:0:0.5,0:1:0.5,1", "x stop 0 is below its start 1"),
+        ("0:1:0.5,0:1:-1,1", "y step must be positive"),
+        (
+            "0:100:0.01,0:100:0.01,1",
+            "use a coarser step or raise the budget with --max-points",
+        ),
+    ];
+    for (grid, message) in cases {
+        let dir = tmp_dir("bad");
+        let o = beamtrace(&[
+            "sweep",
+            "builtin:living-room",
+            "--grid",
+            grid,
+            "--out",
+            &dir.display().to_string(),
+        ]);
+        let err = String::from_utf8_lossy(&o.stderr);
+        assert_eq!(o.status.code(), Some(2), "{grid}: {err}");
+        assert!(err.contains(message), "{grid}: {err}");
+        assert!(!dir.exists(), "{grid}: wrote output");
+    }
+    let o = beamtrace(&[
+        "sweep",
+        "builtin:living-room",
+        "--grid",
+        "0:1:1,0:1:1,1",
+        "--rx",
+        "1,1,1",
+        "--out",
+        "x",
+    ]);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("--rx is not used"));
+}

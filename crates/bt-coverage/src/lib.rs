@@ -1,0 +1,221 @@
+//! Coverage sweeps: trace one TX to every point of a receiver grid and summarise each point —
+//! number of paths, the shortest delay, the strongest path (lowest loss) — as rows for a CSV
+//! file and a heat map over the floor plan.
+//!
+//! Tracing goes through `bt_solve::pipeline::trace_each_receiver` (the one many-receiver
+//! entry), in chunks so a caller can show progress. A grid point on a surface or at the TX is
+//! a [`PointStatus::Skipped`] row, not a failure of the sweep; a candidate budget error is.
+
+pub mod grid;
+mod map;
+
+pub use grid::{Axis, DEFAULT_MAX_POINTS, Grid, GridError};
+pub use map::{HeatMap, MapQuantity};
+
+use bt_beams::PathReport;
+use bt_geom::{Real, Vec3};
+use bt_scene::Scene;
+use bt_solve::pipeline::{TraceError, TraceOptions, trace_each_receiver};
+
+/// Why a sweep could not run.
+#[derive(Debug, thiserror::Error)]
+pub enum CoverageError {
+    /// The grid is malformed or too large.
+    #[error(transparent)]
+    Grid(#[from] GridError),
+    /// Tracing failed for a reason that holds for every point (the candidate budget).
+    #[error(transparent)]
+    Trace(#[from] TraceError),
+    /// A figure could not be drawn or written.
+    #[error(transparent)]
+    Plot(#[from] bt_plot::PlotError),
+}
+
+/// The strongest path at a point: the lowest total loss (free space + reflections); among
+/// equal losses the better ranked one (lower order, then shorter).
+#[derive(Debug, Clone, PartialEq)]
+pub struct Strongest {
+    /// Number of reflections.
+    pub order: usize,
+    /// Total loss, dB.
+    pub loss_db: Real,
+    /// Unfolded length, metres.
+    pub length_m: Real,
+    /// Reflecting surfaces, TX side first.
+    pub surfaces: Vec<String>,
+}
+
+/// What was found at one grid point.
+#[derive(Debug, Clone, PartialEq)]
+pub enum PointStatus {
+    /// Traced.
+    Traced {
+        /// Number of valid paths.
+        paths: usize,
+        /// Delay of the shortest path, seconds (`None` without paths).
+        shortest_delay_s: Option<Real>,
+        /// The strongest path (`None` without paths).
+        strongest: Option<Strongest>,
+    },
+    /// Not traced: the point lies on a surface or at the TX (the reason, from the scene's
+    /// validation).
+    Skipped(String),
+}
+
+/// One grid point and its result.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Row {
+    /// Receiver position, metres, world frame.
+    pub rx: Vec3,
+    /// The result.
+    pub status: PointStatus,
+}
+
+/// Receivers traced per chunk between two progress calls (big enough to keep every core busy).
+pub const CHUNK: usize = 256;
+
+/// Trace `scene`'s TX to every one of `points` (in order; rows come back in the same order,
+/// identical whatever the thread count). `progress(done, total)` runs after every chunk.
+pub fn sweep(
+    scene: &Scene,
+    points: &[Vec3],
+    options: &TraceOptions,
+    progress: &mut dyn FnMut(usize, usize),
+) -> Result<Vec<Row>, CoverageError> {
+    let mut rows = Vec::with_capacity(points.len());
+    for chunk in points.chunks(CHUNK) {
+        for (rx, outcome) in chunk.iter().zip(trace_each_receiver(scene, chunk, options)) {
+            let status = match outcome {
+                Ok(traced) => {
+                    let moved = scene
+                        .with_terminals(scene.tx(), *rx)
+                        .map_err(TraceError::from)?;
+                    summarise(&bt_beams::report(&moved, &traced.result.paths))
+                }
+                Err(TraceError::Scene(e)) => PointStatus::Skipped(skip_reason(&e)),
+                Err(e) => return Err(e.into()),
+            };
+            rows.push(Row { rx: *rx, status });
+        }
+        progress(rows.len(), points.len());
+    }
+    Ok(rows)
+}
+
+/// The problems of an invalid receiver, without the scene name.
+fn skip_reason(e: &bt_scene::SceneError) -> String {
+    match e {
+        bt_scene::SceneError::Invalid { problems, .. } => problems
+            .iter()
+            .map(|p| p.message.as_str())
+            .collect::<Vec<_>>()
+            .join("; "),
+        other => other.to_string(),
+    }
+}
+
+/// A point's summary from its ranked path reports.
+pub fn summarise(paths: &[PathReport]) -> PointStatus {
+    let shortest_delay_s = paths.iter().map(|p| p.delay_s).min_by(Real::total_cmp);
+    // Reports come ranked, and min_by keeps the first of equal losses: the better ranked.
+    let strongest = paths
+        .iter()
+        .min_by(|a, b| a.loss_db.total_cmp(&b.loss_db))
+        .map(|p| Strongest {
+            order: p.order,
+            loss_db: p.loss_db,
+            length_m: p.length_m,
+            surfaces: p.surfaces.clone(),
+        });
+    PointStatus::Traced {
+        paths: paths.len(),
+        shortest_delay_s,
+        strongest,
+    }
+}
+
+/// The CSV header of [`csv`].
+pub const CSV_HEADER: &str = "x_m,y_m,z_m,status,paths,shortest_delay_ns,strongest_order,strongest_loss_db,strongest_length_m,strongest_surfaces,note";
+
+/// The rows as CSV (RFC 4180: fields with commas, quotes or line breaks are quoted; surface
+/// names are data). Skipped points have empty result fields and the reason in `note`.
+/// Numbers print with fixed decimals so the bytes are the same on every machine.
+pub fn csv(rows: &[Row]) -> String {
+    let mut out = String::with_capacity(64 * (rows.len() + 1));
+    out.push_str(CSV_HEADER);
+    out.push('\n');
+    for row in rows {
+        let p = row.rx;
+        let coords = format!("{:.6},{:.6},{:.6}", p.x, p.y, p.z);
+        let line = match &row.status {
+            PointStatus::Traced {
+                paths,
+                shortest_delay_s,
+                strongest,
+            } => {
+                let delay = shortest_delay_s
+                    .map(|d| format!("{:.6}", d * 1e9))
+                    .unwrap_or_default();
+                let best = strongest
+                    .as_ref()
+                    .map(|s| {
+                        format!(
+                            "{},{:.4},{:.6},{}",
+                            s.order,
+                            s.loss_db,
+                            s.length_m,
+                            csv_field(&s.surfaces.join(" > "))
+                        )
+                    })
+                    .unwrap_or_else(|| ",,,".to_string());
+                format!("{coords},ok,{paths},{delay},{best},")
+            }
+            PointStatus::Skipped(reason) => {
+                format!("{coords},skipped,,,,,,,{}", csv_field(reason))
+            }
+        };
+        out.push_str(&line);
+        out.push('\n');
+    }
+    out
+}
+
+/// One CSV field, quoted (with doubled quotes) when it holds a comma, quote or line break.
+fn csv_field(s: &str) -> String {
+    if s.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn csv_fields_with_separators_are_quoted() {
+        assert_eq!(csv_field("wall"), "wall");
+        assert_eq!(csv_field("a,b"), "\"a,b\"");
+        assert_eq!(csv_field("say \"hi\""), "\"say \"\"hi\"\"\"");
+        assert_eq!(csv_field("two\nlines"), "\"two\nlines\"");
+    }
+
+    #[test]
+    fn skipped_rows_have_empty_result_fields() {
+        let rows = [Row {
+            rx: Vec3::new(1.0, 2.0, 0.0),
+            status: PointStatus::Skipped("lies on surface \"floor, west\"".into()),
+        }];
+        let text = csv(&rows);
+        let line = text.lines().nth(1).unwrap();
+        assert_eq!(
+            line,
+            "1.000000,2.000000,0.000000,skipped,,,,,,,\"lies on surface \"\"floor, west\"\"\""
+        );
+        assert_eq!(
+            CSV_HEADER.split(',').count(),
+            "1,2,0,skipped,,,,,,,x".split(',').count()
+        );
+    }
+}

@@ -1,0 +1,121 @@
+//! The chart setup every beamtrace figure shares: the shipped font, a white canvas, the legend
+//! style, and writing one figure as SVG and PNG (atomically: temp file + rename).
+//!
+//! Text needs a font and the machines that draw figures may have none: DejaVu Sans (Bitstream
+//! Vera licence, `assets/DejaVuSans-LICENSE.txt`) is compiled in and registered as
+//! `sans-serif` by [`register_font`].
+
+use plotters::coord::{CoordTranslate, Shift};
+use plotters::prelude::*;
+use std::path::{Path, PathBuf};
+use std::sync::OnceLock;
+
+const FONT: &[u8] = include_bytes!("../assets/DejaVuSans.ttf");
+/// The font family of every label (the shipped DejaVu Sans).
+pub const FAMILY: &str = "sans-serif";
+
+/// Register the shipped font as `sans-serif` (idempotent). Must run before drawing text.
+pub fn register_font() -> Result<(), String> {
+    static DONE: OnceLock<Result<(), String>> = OnceLock::new();
+    DONE.get_or_init(|| {
+        plotters::style::register_font(FAMILY, FontStyle::Normal, FONT)
+            .map_err(|_| "the shipped font DejaVuSans.ttf is not a valid font".to_string())
+    })
+    .clone()
+}
+
+/// A plotters error as the message the figure writers report.
+pub fn fail<E: std::fmt::Display>(e: E) -> String {
+    e.to_string()
+}
+
+/// Start a figure: register the font and fill the whole area white.
+pub fn blank<DB: DrawingBackend>(root: &DrawingArea<DB, Shift>) -> Result<(), String> {
+    register_font()?;
+    root.fill(&WHITE).map_err(fail)
+}
+
+/// Draw the legend of a chart: `font_size` text in a translucent white box with a black
+/// border at `position`.
+pub fn legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
+    chart: &mut ChartContext<'a, DB, CT>,
+    position: SeriesLabelPosition,
+    font_size: u32,
+) -> Result<(), String> {
+    chart
+        .configure_series_labels()
+        .position(position)
+        .label_font((FAMILY, font_size))
+        .background_style(WHITE.mix(0.85))
+        .border_style(BLACK)
+        .draw()
+        .map_err(fail)
+}
+
+/// A figure that can draw itself on any plotters backend.
+pub trait Figure {
+    /// Draw on `root` (the caller presents it).
+    fn draw<DB: DrawingBackend>(&self, root: &DrawingArea<DB, Shift>) -> Result<(), String>;
+}
+
+/// Why a figure could not be written.
+#[derive(Debug, thiserror::Error)]
+#[error("{path}: {message}")]
+pub struct PlotError {
+    /// The figure file.
+    pub path: String,
+    /// What went wrong (drawing or writing).
+    pub message: String,
+}
+
+/// Write `figure` as `{stem}.svg` and `{stem}.png` of `size` pixels; each file is drawn into a
+/// temporary file beside it and renamed into place. Returns the two paths.
+pub fn write_svg_png(
+    stem: &Path,
+    size: (u32, u32),
+    figure: &impl Figure,
+) -> Result<[PathBuf; 2], PlotError> {
+    let svg = with_extension(stem, "svg");
+    let png = with_extension(stem, "png");
+    atomically(&svg, |tmp| {
+        let root = SVGBackend::new(tmp, size).into_drawing_area();
+        figure.draw(&root)?;
+        root.present().map_err(fail)
+    })?;
+    atomically(&png, |tmp| {
+        let root = BitMapBackend::new(tmp, size).into_drawing_area();
+        figure.draw(&root)?;
+        root.present().map_err(fail)
+    })?;
+    Ok([svg, png])
+}
+
+fn with_extension(stem: &Path, ext: &str) -> PathBuf {
+    let mut name = stem.as_os_str().to_owned();
+    name.push(".");
+    name.push(ext);
+    PathBuf::from(name)
+}
+
+/// Draw into `.{name}.tmp-{pid}.{ext}` beside `path` (the backends pick the format by
+/// extension), then rename it over `path`; the temporary file is removed on failure.
+fn atomically(
+    path: &Path,
+    draw: impl FnOnce(&Path) -> Result<(), String>,
+) -> Result<(), PlotError> {
+    let error = |message: String| PlotError {
+        path: path.display().to_string(),
+        message,
+    };
+    let name = path.file_name().map(|n| n.to_string_lossy().into_owned());
+    let ext = path.extension().map(|e| e.to_string_lossy().into_owned());
+    let (Some(name), Some(ext)) = (name, ext) else {
+        return Err(error("not a file name".into()));
+    };
+    let tmp = path.with_file_name(format!(".{name}.tmp-{}.{ext}", std::process::id()));
+    let result = draw(&tmp).and_then(|()| std::fs::rename(&tmp, path).map_err(fail));
+    if result.is_err() {
+        let _ = std::fs::remove_file(&tmp);
+    }
+    result.map_err(error)
+}

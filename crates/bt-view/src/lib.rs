@@ -1,0 +1,342 @@
+//! A 3-D viewer of a scene and its paths as ONE self-contained HTML page: three.js (vendored,
+//! `assets/`) and the viewer script are inlined, the data is a JSON document inside
+//! `<script type="application/json">` read with `textContent` — names from the scene are data
+//! and never reach HTML markup (the script writes them with `textContent` only).
+//!
+//! The page exposes `window.beamtraceView = { steps, step, pathLines, paths, surfaces, ready }`
+//! so a browser test can check what was drawn.
+
+use bt_beams::PathReport;
+use bt_geom::Real;
+use bt_scene::{Scene, SurfaceKind};
+use serde::{Deserialize, Serialize};
+
+const THREE: &str = include_str!("../assets/three.bundle.min.js");
+const VIEWER: &str = include_str!("../assets/viewer.js");
+const TEMPLATE: &str = include_str!("../assets/page.html");
+
+/// Version of the embedded document's layout.
+pub const FORMAT_VERSION: u32 = 1;
+
+/// Why a page could not be made.
+#[derive(Debug, thiserror::Error)]
+pub enum ViewError {
+    /// The paths document is not a `beamtrace trace --json` (or `--steps --json`) document.
+    #[error("{path}: not a beamtrace trace --json document: {message}")]
+    PathsDocument {
+        /// The file.
+        path: String,
+        /// What serde said (with line and column).
+        message: String,
+    },
+    /// The paths document has another number of steps than the scene.
+    #[error("{path}: {found} time steps of paths, but the scene has {expected}")]
+    StepCount {
+        /// The file.
+        path: String,
+        /// Steps in the document.
+        found: usize,
+        /// Steps of the scene.
+        expected: usize,
+    },
+}
+
+/// One path as the viewer shows it (the fields of a trace document's path).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct ViewPath {
+    /// Reflections (0 = line of sight).
+    pub order: usize,
+    /// Reflecting surfaces, TX side first.
+    pub surfaces: Vec<String>,
+    /// Interaction points, metres, TX side first.
+    pub points: Vec<[Real; 3]>,
+    /// Unfolded length, metres.
+    pub length_m: Real,
+    /// Delay, seconds.
+    pub delay_s: Real,
+    /// Departure direction (azimuth, elevation), degrees.
+    pub aod_deg: Angles,
+    /// Arrival direction (azimuth, elevation), degrees.
+    pub aoa_deg: Angles,
+    /// Total loss, dB.
+    pub loss_db: Real,
+}
+
+/// Azimuth and elevation, degrees (`docs/conventions.md`).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+pub struct Angles {
+    /// From +x towards +y.
+    pub azimuth: Real,
+    /// From the horizontal plane, positive up.
+    pub elevation: Real,
+}
+
+impl From<&PathReport> for ViewPath {
+    fn from(p: &PathReport) -> Self {
+        ViewPath {
+            order: p.order,
+            surfaces: p.surfaces.clone(),
+            points: p.points.clone(),
+            length_m: p.length_m,
+            delay_s: p.delay_s,
+            aod_deg: Angles {
+                azimuth: p.aod_deg.azimuth,
+                elevation: p.aod_deg.elevation,
+            },
+            aoa_deg: Angles {
+                azimuth: p.aoa_deg.azimuth,
+                elevation: p.aoa_deg.elevation,
+            },
+            loss_db: p.loss_db,
+        }
+    }
+}
+
+/// The paths of one time step with the terminals they were traced for.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+pub struct StepPaths {
+    /// Transmitter, metres.
+    pub tx: [Real; 3],
+    /// Receiver, metres.
+    pub rx: [Real; 3],
+    /// The paths.
+    pub paths: Vec<ViewPath>,
+}
+
+impl StepPaths {
+    /// The ranked reports of a trace of `scene`.
+    pub fn from_reports(scene: &Scene, paths: &[PathReport]) -> Self {
+        StepPaths {
+            tx: scene.tx().to_array(),
+            rx: scene.rx().to_array(),
+            paths: paths.iter().map(ViewPath::from).collect(),
+        }
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(untagged)]
+enum PathsDocument {
+    Steps { steps: Vec<StepPaths> },
+    One(StepPaths),
+}
+
+/// Read the paths of a `beamtrace trace --json` document (one step) or of a
+/// `trace --steps --json` document (every step); `path` names the file in errors.
+pub fn read_paths(text: &str, path: &str) -> Result<Vec<StepPaths>, ViewError> {
+    let doc: PathsDocument = serde_json::from_str(text).map_err(|e| ViewError::PathsDocument {
+        path: path.to_string(),
+        message: e.to_string(),
+    })?;
+    Ok(match doc {
+        PathsDocument::Steps { steps } => steps,
+        PathsDocument::One(step) => vec![step],
+    })
+}
+
+/// Check that `paths` has one entry per scene step.
+pub fn check_steps(paths: &[StepPaths], steps: usize, path: &str) -> Result<(), ViewError> {
+    if paths.len() == steps {
+        Ok(())
+    } else {
+        Err(ViewError::StepCount {
+            path: path.to_string(),
+            found: paths.len(),
+            expected: steps,
+        })
+    }
+}
+
+#[derive(Serialize)]
+struct Document<'a> {
+    format_version: u32,
+    scene: &'a str,
+    materials: Vec<MaterialColour<'a>>,
+    steps: Vec<StepDocument<'a>>,
+}
+
+#[derive(Serialize)]
+struct MaterialColour<'a> {
+    name: &'a str,
+    colour: &'static str,
+}
+
+#[derive(Serialize)]
+struct StepDocument<'a> {
+    surfaces: Vec<SurfaceDocument<'a>>,
+    tx: [Real; 3],
+    rx: [Real; 3],
+    paths: &'a [ViewPath],
+}
+
+#[derive(Serialize)]
+struct SurfaceDocument<'a> {
+    name: &'a str,
+    material: &'a str,
+    kind: SurfaceKind,
+    colour: &'static str,
+    vertices: Vec<[Real; 3]>,
+}
+
+/// Colours of the materials, in the order of the scene's (sorted) material names.
+const PALETTE: [&str; 12] = [
+    "#4e79a7", "#f28e2b", "#59a14f", "#b07aa1", "#76b7b2", "#edc948", "#9c755f", "#bab0ac",
+    "#17becf", "#bcbd22", "#7f7f7f", "#ff9da7",
+];
+/// Colour of every blocker (they only occlude).
+const BLOCKER: &str = "#e15759";
+
+/// The HTML page for the time steps `scenes` (one for a static scene) and their paths
+/// (`paths[k]` belongs to `scenes[k]`; the caller checks the counts, see [`check_steps`]).
+pub fn page(scenes: &[&Scene], paths: &[StepPaths]) -> String {
+    let name = scenes.first().map_or("", |s| s.name());
+    let material_names: Vec<&str> = scenes
+        .first()
+        .map(|s| s.materials().keys().map(String::as_str).collect())
+        .unwrap_or_default();
+    let colour_of = |material: &str| {
+        let i = material_names
+            .iter()
+            .position(|m| *m == material)
+            .unwrap_or(0);
+        PALETTE[i % PALETTE.len()]
+    };
+    let steps = scenes
+        .iter()
+        .zip(paths)
+        .map(|(scene, step)| StepDocument {
+            surfaces: scene
+                .surfaces()
+                .iter()
+                .map(|s| SurfaceDocument {
+                    name: &s.name,
+                    material: &s.material,
+                    kind: s.kind,
+                    colour: match s.kind {
+                        SurfaceKind::Reflector => colour_of(&s.material),
+                        SurfaceKind::Blocker => BLOCKER,
+                    },
+                    vertices: s.polygon.vertices().iter().map(|v| v.to_array()).collect(),
+                })
+                .collect(),
+            tx: step.tx,
+            rx: step.rx,
+            paths: &step.paths,
+        })
+        .collect();
+    let doc = Document {
+        format_version: FORMAT_VERSION,
+        scene: name,
+        materials: material_names
+            .iter()
+            .map(|m| MaterialColour {
+                name: m,
+                colour: colour_of(m),
+            })
+            .collect(),
+        steps,
+    };
+    let json = serde_json::to_string(&doc).expect("the view document serialises");
+    fill(
+        TEMPLATE,
+        &[
+            ("{{TITLE}}", &html_text(&format!("beamtrace view: {name}"))),
+            ("{{DATA}}", &script_safe_json(&json)),
+            ("{{THREE}}", THREE),
+            ("{{VIEWER}}", VIEWER),
+        ],
+    )
+}
+
+/// Replace each placeholder of `template` once, in one pass over the template only: a value
+/// (a scene name, say) that happens to contain a placeholder is never expanded.
+fn fill(template: &str, values: &[(&str, &str)]) -> String {
+    let mut out =
+        String::with_capacity(template.len() + values.iter().map(|v| v.1.len()).sum::<usize>());
+    let mut rest = template;
+    while let Some(i) = rest.find("{{") {
+        out.push_str(&rest[..i]);
+        rest = &rest[i..];
+        match values.iter().find(|(key, _)| rest.starts_with(key)) {
+            Some((key, value)) => {
+                out.push_str(value);
+                rest = &rest[key.len()..];
+            }
+            None => {
+                out.push_str("{{");
+                rest = &rest[2..];
+            }
+        }
+    }
+    out.push_str(rest);
+    out
+}
+
+/// JSON that can sit inside `<script type="application/json">`: `<`, `>` and `&` as `\u` escapes
+/// (so no `</script>` or `<!--` can end or confuse the element; JSON.parse restores them), and
+/// U+2028/U+2029 escaped too.
+pub fn script_safe_json(json: &str) -> String {
+    let mut out = String::with_capacity(json.len());
+    for c in json.chars() {
+        match c {
+            '<' => out.push_str("\\u003c"),
+            '>' => out.push_str("\\u003e"),
+            '&' => out.push_str("\\u0026"),
+            '\u{2028}' => out.push_str("\\u2028"),
+            '\u{2029}' => out.push_str("\\u2029"),
+            c => out.push(c),
+        }
+    }
+    out
+}
+
+/// Text for an HTML text node (the page title).
+fn html_text(s: &str) -> String {
+    s.replace('&', "&amp;")
+        .replace('<', "&lt;")
+        .replace('>', "&gt;")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn script_safe_json_cannot_close_the_element_and_round_trips() {
+        let name = "</script><script>alert(1)</script><!-- & \u{2028}";
+        let json = serde_json::to_string(&name).unwrap();
+        let safe = script_safe_json(&json);
+        assert!(!safe.contains('<') && !safe.contains('>') && !safe.contains('&'));
+        let back: String = serde_json::from_str(&safe).unwrap();
+        assert_eq!(back, name);
+    }
+
+    #[test]
+    fn the_vendored_bundle_can_be_inlined() {
+        assert!(!THREE.contains("</script") && !THREE.contains("<!--"));
+        assert!(!VIEWER.contains("</script") && !VIEWER.contains("<!--"));
+        assert!(
+            !VIEWER.contains("innerHTML"),
+            "names must only reach textContent"
+        );
+    }
+
+    #[test]
+    fn placeholders_inside_values_are_not_expanded() {
+        let page = fill("a{{X}}b{{Y}}c", &[("{{X}}", "{{Y}}"), ("{{Y}}", "y")]);
+        assert_eq!(page, "a{{Y}}byc");
+    }
+
+    #[test]
+    fn bad_paths_documents_name_the_file() {
+        let e = read_paths("{\"paths\": 3}", "p.json")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("p.json: not a beamtrace trace --json document"),
+            "{e}"
+        );
+        let e = check_steps(&[], 2, "p.json").unwrap_err().to_string();
+        assert_eq!(e, "p.json: 0 time steps of paths, but the scene has 2");
+    }
+}
