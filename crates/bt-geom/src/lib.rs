@@ -5,6 +5,7 @@
 
 pub mod bvh;
 pub mod plane;
+pub mod poly2;
 pub mod polygon;
 pub mod tol;
 

@@ -7,10 +7,9 @@
 //! with integer count and index types; other properties skipped) are used; other elements are
 //! read and skipped.
 
-use glam::DVec3;
-
 use crate::error::{MeshError, Position};
 use crate::raw::RawMesh;
+use bt_geom::{Real, Vec3};
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Format {
@@ -173,7 +172,7 @@ pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
         line: header.lines + 1,
         file,
     };
-    let mut values: Vec<f64> = Vec::new();
+    let mut values: Vec<Real> = Vec::new();
     let mut face: Vec<u32> = Vec::new();
     for (e, element) in header.elements.iter().enumerate() {
         for index in 0..element.count {
@@ -205,7 +204,7 @@ pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
                         for _ in 0..n as u64 {
                             let v = reader.read(item, &property.name, &start)?;
                             if collect {
-                                if v < 0.0 || v >= vertex_count as f64 {
+                                if v < 0.0 || v >= vertex_count as Real {
                                     return Err(MeshError::IndexOutOfRange {
                                         file: file.to_owned(),
                                         position: start,
@@ -234,7 +233,7 @@ pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
                     }
                     xyz[k] = value;
                 }
-                mesh.positions.push(DVec3::from_array(xyz));
+                mesh.positions.push(Vec3::from_array(xyz));
             } else if e == face_element {
                 if face.len() < 3 {
                     return Err(MeshError::FaceTooSmall {
@@ -416,7 +415,7 @@ impl Reader<'_> {
     }
 
     /// One scalar of type `ty` as f64 (exact for every PLY integer type).
-    fn read(&mut self, ty: Scalar, property: &str, at: &Position) -> Result<f64, MeshError> {
+    fn read(&mut self, ty: Scalar, property: &str, at: &Position) -> Result<Real, MeshError> {
         let truncated = || MeshError::Truncated {
             file: self.file.to_owned(),
             position: at.clone(),
@@ -438,9 +437,9 @@ impl Reader<'_> {
                 }
                 let token = String::from_utf8_lossy(&self.bytes[start..self.pos]);
                 let value = if ty.is_integer() {
-                    token.parse::<i64>().ok().map(|v| v as f64)
+                    token.parse::<i64>().ok().map(|v| v as Real)
                 } else {
-                    token.parse::<f64>().ok()
+                    token.parse::<Real>().ok()
                 };
                 value.ok_or_else(|| MeshError::Syntax {
                     file: self.file.to_owned(),
@@ -462,14 +461,14 @@ impl Reader<'_> {
                 }
                 // `buf` now holds little-endian bytes.
                 Ok(match ty {
-                    Scalar::I8 => f64::from(buf[0] as i8),
-                    Scalar::U8 => f64::from(buf[0]),
-                    Scalar::I16 => f64::from(i16::from_le_bytes([buf[0], buf[1]])),
-                    Scalar::U16 => f64::from(u16::from_le_bytes([buf[0], buf[1]])),
-                    Scalar::I32 => f64::from(i32::from_le_bytes([buf[0], buf[1], buf[2], buf[3]])),
-                    Scalar::U32 => f64::from(u32::from_le_bytes([buf[0], buf[1], buf[2], buf[3]])),
-                    Scalar::F32 => f64::from(f32::from_le_bytes([buf[0], buf[1], buf[2], buf[3]])),
-                    Scalar::F64 => f64::from_le_bytes(buf),
+                    Scalar::I8 => Real::from(buf[0] as i8),
+                    Scalar::U8 => Real::from(buf[0]),
+                    Scalar::I16 => Real::from(i16::from_le_bytes([buf[0], buf[1]])),
+                    Scalar::U16 => Real::from(u16::from_le_bytes([buf[0], buf[1]])),
+                    Scalar::I32 => Real::from(i32::from_le_bytes([buf[0], buf[1], buf[2], buf[3]])),
+                    Scalar::U32 => Real::from(u32::from_le_bytes([buf[0], buf[1], buf[2], buf[3]])),
+                    Scalar::F32 => Real::from(f32::from_le_bytes([buf[0], buf[1], buf[2], buf[3]])),
+                    Scalar::F64 => Real::from_le_bytes(buf),
                 })
             }
         }

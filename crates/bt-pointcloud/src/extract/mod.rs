@@ -18,12 +18,12 @@
 //! choice, all parallel work is order-preserving `map`/`filter` + `collect`, and nothing
 //! iterates a hash map. Same cloud and parameters ⇒ bit-identical output.
 
+use bt_geom::{Real, Vec2, Vec3};
 mod boundary;
 mod layers;
 mod normals;
 mod snap;
 
-use glam::{DVec2, DVec3};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use rayon::prelude::*;
@@ -44,20 +44,20 @@ pub struct ExtractParams {
     /// Seed of the RANSAC random generator (echoed in the report).
     pub seed: u64,
     /// RANSAC inlier distance to the plane, metres (≈ 3 σ of the range noise).
-    pub distance_threshold_m: f64,
+    pub distance_threshold_m: Real,
     /// Neighbourhood size for normals, metres: PCA over a cube of 1.5 × this edge
     /// (≈ 3–4 point spacings or more).
-    pub normal_radius_m: f64,
+    pub normal_radius_m: Real,
     /// Largest angle between a point's normal and the plane normal for an inlier, degrees.
-    pub normal_angle_deg: f64,
+    pub normal_angle_deg: Real,
     /// Radius of the neighbourhood a hypothesis is refitted on before scoring, metres.
-    pub hypothesis_radius_m: f64,
+    pub hypothesis_radius_m: Real,
     /// Fewest hypotheses per plane.
     pub min_iterations: usize,
     /// Most hypotheses per plane.
     pub max_iterations: usize,
     /// Probability of having drawn a point of the best plane when hypothesising stops.
-    pub confidence: f64,
+    pub confidence: Real,
     /// Size of the random subsample hypotheses are scored on.
     pub score_sample: usize,
     /// Most least-squares refit / re-collect rounds for the winning hypothesis.
@@ -70,21 +70,21 @@ pub struct ExtractParams {
     /// separated by a gap wider than twice this are always split. Also the
     /// radius of the neighbourhood vote that separates parallel surfaces closer than the
     /// RANSAC band (a pane in front of a wall).
-    pub cluster_eps_m: f64,
+    pub cluster_eps_m: Real,
     /// Patches with fewer points are dropped.
     pub min_patch_points: usize,
     /// Patches whose minimum-area bounding rectangle is narrower are dropped, metres
     /// (removes slivers left along creases).
-    pub min_patch_width_m: f64,
+    pub min_patch_width_m: Real,
     /// Raster cell for boundary tracing, metres (≈ 2 point spacings or more).
-    pub boundary_cell_m: f64,
+    pub boundary_cell_m: Real,
     /// Douglas–Peucker tolerance for the traced boundary, metres.
-    pub simplify_tolerance_m: f64,
+    pub simplify_tolerance_m: Real,
     /// Largest distance over which an edge is moved onto the intersection line with an
     /// adjoining plane, metres.
-    pub snap_distance_m: f64,
+    pub snap_distance_m: Real,
     /// Patches of at least this area are reflectors, others blockers, m² (paper: 0.25).
-    pub min_reflector_area_m2: f64,
+    pub min_reflector_area_m2: Real,
 }
 
 impl Default for ExtractParams {
@@ -117,7 +117,7 @@ impl ExtractParams {
     /// Check every parameter; all problems are reported together.
     pub fn validate(&self) -> Result<(), PointCloudError> {
         let mut problems = Vec::new();
-        let mut pos = |name: &str, v: f64| {
+        let mut pos = |name: &str, v: Real| {
             if !(v.is_finite() && v > 0.0) {
                 problems.push(format!("{name} must be finite and positive, got {v}"));
             }
@@ -173,18 +173,18 @@ impl ExtractParams {
 pub struct ExtractedPlane {
     /// Unit normal. Oriented to agree with the input normals when the cloud has them,
     /// otherwise towards the centroid of the whole cloud (for a room scan: into the room).
-    pub normal: DVec3,
+    pub normal: Vec3,
     /// Plane offset: points `x` on the plane satisfy `normal · x = offset`, metres.
-    pub offset: f64,
+    pub offset: Real,
     /// Boundary vertices on the plane, a simple polygon, counter-clockwise seen from the
     /// side the normal points to (looking against the normal), no repeated closing vertex.
-    pub polygon: Vec<DVec3>,
+    pub polygon: Vec<Vec3>,
     /// Area of `polygon`, m².
-    pub area_m2: f64,
+    pub area_m2: Real,
     /// Number of cloud points assigned to this patch.
     pub inliers: usize,
     /// RMS distance of those points to the plane, metres.
-    pub rms_m: f64,
+    pub rms_m: Real,
     /// `area_m2 ≥ min_reflector_area_m2`: takes part in reflection; otherwise it only
     /// blocks rays.
     pub reflector: bool,
@@ -196,15 +196,15 @@ pub struct ExtractedPlane {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PlaneSummary {
     /// Unit normal, world frame.
-    pub normal: [f64; 3],
+    pub normal: [Real; 3],
     /// Offset along the normal, metres.
-    pub offset_m: f64,
+    pub offset_m: Real,
     /// Polygon area, m².
-    pub area_m2: f64,
+    pub area_m2: Real,
     /// Assigned points.
     pub inliers: usize,
     /// RMS point-to-plane distance, metres.
-    pub rms_m: f64,
+    pub rms_m: Real,
     /// Reflector (true) or blocker (false).
     pub reflector: bool,
     /// Polygon vertex count.
@@ -237,9 +237,9 @@ pub struct ExtractionReport {
     /// Points never assigned to any RANSAC plane.
     pub leftover_points: usize,
     /// Inlier-weighted RMS point-to-plane distance over kept patches, metres.
-    pub rms_m: f64,
+    pub rms_m: Real,
     /// Total area of kept patches, m².
-    pub total_area_m2: f64,
+    pub total_area_m2: Real,
     /// Per-patch summaries, in the order of [`Extraction::planes`].
     pub planes: Vec<PlaneSummary>,
     /// Parameters used.
@@ -296,13 +296,13 @@ pub fn extract_planes(
 /// is several centimetres; a tilted hypothesis can collect bands of two parallel surfaces
 /// (a wall and a door recessed 4 cm) and the global refit then settles between them.
 fn local_hypothesis(
-    pts: &[DVec3],
-    normals: &[DVec3],
+    pts: &[Vec3],
+    normals: &[Vec3],
     taken: &[bool],
     coarse: &VoxelIndex,
     i: usize,
     params: &ExtractParams,
-) -> (DVec3, f64) {
+) -> (Vec3, Real) {
     let (p, mut n) = (pts[i], normals[i]);
     let mut d = n.dot(p);
     let cos_gate = params.normal_angle_deg.to_radians().cos();
@@ -335,13 +335,13 @@ pub(super) struct RawPatch {
 }
 
 /// Unit vectors `(u, v)` with `(u, v, n)` right-handed, chosen deterministically from `n`.
-pub(super) fn frame(n: DVec3) -> (DVec3, DVec3) {
+pub(super) fn frame(n: Vec3) -> (Vec3, Vec3) {
     let a = if n.x.abs() <= n.y.abs() && n.x.abs() <= n.z.abs() {
-        DVec3::X
+        Vec3::X
     } else if n.y.abs() <= n.z.abs() {
-        DVec3::Y
+        Vec3::Y
     } else {
-        DVec3::Z
+        Vec3::Z
     };
     let u = n.cross(a).normalize();
     (u, n.cross(u))
@@ -367,13 +367,13 @@ pub fn extract_planes_with_progress(
     let normals = normals::estimate_normals(pts, params.normal_radius_m);
     let coarse = VoxelIndex::build(pts, params.hypothesis_radius_m);
     let mut remaining: Vec<u32> = (0..n as u32)
-        .filter(|&i| normals[i as usize] != DVec3::ZERO)
+        .filter(|&i| normals[i as usize] != Vec3::ZERO)
         .collect();
     let points_without_normal = n - remaining.len();
 
     let t = params.distance_threshold_m;
     let cos_gate = params.normal_angle_deg.to_radians().cos();
-    let is_inlier = |i: u32, nrm: DVec3, d: f64| {
+    let is_inlier = |i: u32, nrm: Vec3, d: Real| {
         let i = i as usize;
         (nrm.dot(pts[i]) - d).abs() <= t && nrm.dot(normals[i]).abs() >= cos_gate
     };
@@ -391,14 +391,14 @@ pub fn extract_planes_with_progress(
                 .map(|_| remaining[rng.random_range(0..remaining.len())])
                 .collect()
         };
-        let mut best: Option<(usize, DVec3, f64)> = None;
+        let mut best: Option<(usize, Vec3, Real)> = None;
         let mut tried = 0;
         let mut needed = params.min_iterations;
         while tried < needed.min(params.max_iterations) {
             let seeds: Vec<usize> = (0..64)
                 .map(|_| remaining[rng.random_range(0..remaining.len())] as usize)
                 .collect();
-            let batch: Vec<(DVec3, f64)> = seeds
+            let batch: Vec<(Vec3, Real)> = seeds
                 .par_iter()
                 .map(|&i| local_hypothesis(pts, &normals, &taken, &coarse, i, params))
                 .collect();
@@ -412,7 +412,7 @@ pub fn extract_planes_with_progress(
                 }
             }
             tried += batch.len();
-            let w = best.map_or(0.0, |b| b.0 as f64 / sample.len() as f64);
+            let w = best.map_or(0.0, |b| b.0 as Real / sample.len() as Real);
             needed = if w >= 1.0 {
                 0
             } else if w <= 0.0 {
@@ -423,7 +423,7 @@ pub fn extract_planes_with_progress(
             .max(params.min_iterations);
         }
         let Some((_, mut nrm, d)) = best else { break };
-        let collect = |nrm: DVec3, d: f64| -> Vec<u32> {
+        let collect = |nrm: Vec3, d: Real| -> Vec<u32> {
             remaining
                 .par_iter()
                 .copied()
@@ -518,12 +518,12 @@ pub fn extract_planes_with_progress(
 
     // Per patch: refit, orient, frame, boundary. Order-preserving parallel map.
     let centroid = if n > 0 {
-        pts.iter().fold(DVec3::ZERO, |a, p| a + *p) / n as f64
+        pts.iter().fold(Vec3::ZERO, |a, p| a + *p) / n as Real
     } else {
-        DVec3::ZERO
+        Vec3::ZERO
     };
     let in_normals = cloud.normals();
-    let built: Vec<Option<(PatchGeom, f64, usize)>> = raw
+    let built: Vec<Option<(PatchGeom, Real, usize)>> = raw
         .par_iter()
         .map(|rp| {
             if rp.indices.len() < params.min_patch_points {
@@ -544,8 +544,8 @@ pub fn extract_planes_with_progress(
                 .indices
                 .iter()
                 .map(|&i| (fit.normal.dot(pts[i as usize]) - fit.offset).powi(2))
-                .sum::<f64>()
-                / rp.indices.len() as f64)
+                .sum::<Real>()
+                / rp.indices.len() as Real)
                 .sqrt();
             let mut normal = fit.normal;
             let flip = match in_normals {
@@ -553,7 +553,7 @@ pub fn extract_planes_with_progress(
                     rp.indices
                         .iter()
                         .map(|&i| normal.dot(ns[i as usize]))
-                        .sum::<f64>()
+                        .sum::<Real>()
                         < 0.0
                 }
                 None => normal.dot(centroid - fit.centroid) < 0.0,
@@ -563,12 +563,12 @@ pub fn extract_planes_with_progress(
             }
             let (u, v) = frame(normal);
             let origin = fit.centroid;
-            let p2: Vec<DVec2> = rp
+            let p2: Vec<Vec2> = rp
                 .indices
                 .iter()
                 .map(|&i| {
                     let r = pts[i as usize] - origin;
-                    DVec2::new(r.dot(u), r.dot(v))
+                    Vec2::new(r.dot(u), r.dot(v))
                 })
                 .collect();
             let poly = patch_boundary(&p2, params.boundary_cell_m, params.simplify_tolerance_m)?;
@@ -579,11 +579,11 @@ pub fn extract_planes_with_progress(
                 u,
                 v,
                 poly,
-                lo: DVec3::ZERO,
-                hi: DVec3::ZERO,
+                lo: Vec3::ZERO,
+                hi: Vec3::ZERO,
                 density: 0.0,
             };
-            g.density = rp.indices.len() as f64 / signed_area(&g.poly).max(f64::MIN_POSITIVE);
+            g.density = rp.indices.len() as Real / signed_area(&g.poly).max(Real::MIN_POSITIVE);
             g.update_bounds();
             Some((g, rms, rp.ransac_plane))
         })
@@ -639,9 +639,9 @@ pub fn extract_planes_with_progress(
     let rms_m = if inliers > 0 {
         (planes
             .iter()
-            .map(|p| p.rms_m * p.rms_m * p.inliers as f64)
-            .sum::<f64>()
-            / inliers as f64)
+            .map(|p| p.rms_m * p.rms_m * p.inliers as Real)
+            .sum::<Real>()
+            / inliers as Real)
             .sqrt()
     } else {
         0.0
@@ -682,7 +682,7 @@ pub fn extract_planes_with_progress(
 /// Split a plane's inliers into connected patches: points are binned into square cells of
 /// `eps` metres in the plane's 2-D frame and cells touching by side or corner are joined.
 /// Patches come out in ascending order of their smallest cell, point indices ascending.
-fn split_connected(pts: &[DVec3], inliers: &[u32], normal: DVec3, eps: f64) -> Vec<Vec<u32>> {
+fn split_connected(pts: &[Vec3], inliers: &[u32], normal: Vec3, eps: Real) -> Vec<Vec<u32>> {
     use std::collections::HashMap;
     let (u, v) = frame(normal);
     let mut keyed: Vec<((i64, i64), u32)> = inliers

@@ -17,13 +17,12 @@
 //! A non-finite *normal* on a finite point is replaced by the zero vector (normals are only
 //! a hint for orienting extracted planes).
 
+use bt_geom::{Real, Vec3};
 mod pcd;
 mod ply;
 
 use std::io::{Read, Write};
 use std::path::Path;
-
-use glam::DVec3;
 
 pub use pcd::{PcdData, parse_pcd, read_pcd, write_pcd};
 pub use ply::{PlyFormat, parse_ply, read_ply, write_ply};
@@ -181,7 +180,7 @@ impl Scalar {
     }
 
     /// Decode one value from exactly `self.size()` bytes.
-    pub(crate) fn decode(self, b: &[u8], big_endian: bool) -> f64 {
+    pub(crate) fn decode(self, b: &[u8], big_endian: bool) -> Real {
         macro_rules! get {
             ($t:ty, $n:expr) => {{
                 let mut a = [0u8; $n];
@@ -194,24 +193,24 @@ impl Scalar {
             }};
         }
         match self {
-            Scalar::I8 => b[0] as i8 as f64,
-            Scalar::U8 => b[0] as f64,
-            Scalar::I16 => get!(i16, 2) as f64,
-            Scalar::U16 => get!(u16, 2) as f64,
-            Scalar::I32 => get!(i32, 4) as f64,
-            Scalar::U32 => get!(u32, 4) as f64,
-            Scalar::I64 => get!(i64, 8) as f64,
-            Scalar::U64 => get!(u64, 8) as f64,
-            Scalar::F32 => get!(f32, 4) as f64,
-            Scalar::F64 => get!(f64, 8),
+            Scalar::I8 => b[0] as i8 as Real,
+            Scalar::U8 => b[0] as Real,
+            Scalar::I16 => get!(i16, 2) as Real,
+            Scalar::U16 => get!(u16, 2) as Real,
+            Scalar::I32 => get!(i32, 4) as Real,
+            Scalar::U32 => get!(u32, 4) as Real,
+            Scalar::I64 => get!(i64, 8) as Real,
+            Scalar::U64 => get!(u64, 8) as Real,
+            Scalar::F32 => get!(f32, 4) as Real,
+            Scalar::F64 => get!(Real, 8),
         }
     }
 }
 
 /// Collects decoded points, applying the non-finite policy.
 pub(crate) struct PointSink {
-    points: Vec<DVec3>,
-    normals: Option<Vec<DVec3>>,
+    points: Vec<Vec3>,
+    normals: Option<Vec<Vec3>>,
     skipped: u64,
     policy: NonFinitePolicy,
 }
@@ -227,7 +226,7 @@ impl PointSink {
         }
     }
 
-    pub(crate) fn push(&mut self, p: DVec3, n: DVec3, at: DataPos) -> Result<(), PointCloudError> {
+    pub(crate) fn push(&mut self, p: Vec3, n: Vec3, at: DataPos) -> Result<(), PointCloudError> {
         if !p.is_finite() {
             return match self.policy {
                 NonFinitePolicy::Skip => {
@@ -242,7 +241,7 @@ impl PointSink {
         }
         self.points.push(p);
         if let Some(ns) = &mut self.normals {
-            ns.push(if n.is_finite() { n } else { DVec3::ZERO });
+            ns.push(if n.is_finite() { n } else { Vec3::ZERO });
         }
         Ok(())
     }
@@ -272,9 +271,9 @@ pub(crate) fn next_line<'a>(bytes: &'a [u8], pos: &mut usize) -> Option<&'a [u8]
 /// Parse a number token the way both formats spell them (`nan`, `inf` accepted). A value
 /// declared as 32-bit float is rounded to `f32` first, so ASCII and binary files of the
 /// same declared type give identical points.
-pub(crate) fn parse_number(tok: &str, ty: Scalar) -> Option<f64> {
+pub(crate) fn parse_number(tok: &str, ty: Scalar) -> Option<Real> {
     match ty {
-        Scalar::F32 => tok.parse::<f32>().ok().map(f64::from),
-        _ => tok.parse::<f64>().ok(),
+        Scalar::F32 => tok.parse::<f32>().ok().map(Real::from),
+        _ => tok.parse::<Real>().ok(),
     }
 }

@@ -2,9 +2,8 @@
 //! (little-endian, as PCL writes on every platform it supports). `binary_compressed` is
 //! reported as [`PointCloudError::Unsupported`].
 
+use bt_geom::{Real, Vec3};
 use std::io::{Read, Write};
-
-use glam::DVec3;
 
 use super::{
     LoadedCloud, PointSink, ReadOptions, Scalar, io_err, next_line, parse_number, read_all,
@@ -249,7 +248,7 @@ pub fn parse_pcd(bytes: &[u8], opts: &ReadOptions) -> Result<LoadedCloud, PointC
     let capacity = count.min((available as u128 / min_per_point.max(1)) as u64) as usize;
     let mut sink = PointSink::new(capacity, normal.is_some(), opts.non_finite);
     if binary {
-        let get = |rec: &[u8], i: usize| -> f64 {
+        let get = |rec: &[u8], i: usize| -> Real {
             let f = &fields[i];
             f.scalar.decode(&rec[offset[i]..offset[i] + f.size], false)
         };
@@ -266,9 +265,9 @@ pub fn parse_pcd(bytes: &[u8], opts: &ReadOptions) -> Result<LoadedCloud, PointC
                 });
             };
             pos += stride;
-            let p = DVec3::new(get(rec, xyz[0]), get(rec, xyz[1]), get(rec, xyz[2]));
-            let nrm = normal.map_or(DVec3::ZERO, |[a, b, c]| {
-                DVec3::new(get(rec, a), get(rec, b), get(rec, c))
+            let p = Vec3::new(get(rec, xyz[0]), get(rec, xyz[1]), get(rec, xyz[2]));
+            let nrm = normal.map_or(Vec3::ZERO, |[a, b, c]| {
+                Vec3::new(get(rec, a), get(rec, b), get(rec, c))
             });
             sink.push(p, nrm, at)?;
         }
@@ -321,11 +320,11 @@ pub fn parse_pcd(bytes: &[u8], opts: &ReadOptions) -> Result<LoadedCloud, PointC
                     ))
                 })?;
             }
-            let p = DVec3::new(vals[0], vals[1], vals[2]);
+            let p = Vec3::new(vals[0], vals[1], vals[2]);
             let nrm = if normal.is_some() {
-                DVec3::new(vals[3], vals[4], vals[5])
+                Vec3::new(vals[3], vals[4], vals[5])
             } else {
-                DVec3::ZERO
+                Vec3::ZERO
             };
             sink.push(p, nrm, at)?;
         }

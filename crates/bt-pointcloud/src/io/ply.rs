@@ -5,9 +5,8 @@
 //! line or point index, and the generic `ply-rs` element maps cost an allocation per point
 //! (too slow for 10⁶-point clouds). `ply-rs` is used in the tests as an independent writer.
 
+use bt_geom::{Real, Vec3};
 use std::io::{Read, Write};
-
-use glam::DVec3;
 
 use super::{
     LoadedCloud, PointSink, ReadOptions, Scalar, io_err, next_line, parse_number, read_all,
@@ -298,10 +297,9 @@ pub fn parse_ply(bytes: &[u8], opts: &ReadOptions) -> Result<LoadedCloud, PointC
                 });
             }
             if is_vertex {
-                let p = DVec3::new(vals[xyz[0]], vals[xyz[1]], vals[xyz[2]]);
-                let n = normal_idx.map_or(DVec3::ZERO, |[a, b, c]| {
-                    DVec3::new(vals[a], vals[b], vals[c])
-                });
+                let p = Vec3::new(vals[xyz[0]], vals[xyz[1]], vals[xyz[2]]);
+                let n =
+                    normal_idx.map_or(Vec3::ZERO, |[a, b, c]| Vec3::new(vals[a], vals[b], vals[c]));
                 sink.push(p, n, at(line))?;
             }
         }
@@ -315,7 +313,7 @@ fn read_binary_element(
     pos: &mut usize,
     e: &Element,
     big_endian: bool,
-    vals: &mut [f64],
+    vals: &mut [Real],
     k: u64,
 ) -> Result<bool, PointCloudError> {
     for (i, p) in e.props.iter().enumerate() {
@@ -362,7 +360,7 @@ fn read_ascii_element(
     pos: &mut usize,
     line: &mut usize,
     e: &Element,
-    vals: &mut [f64],
+    vals: &mut [Real],
     k: u64,
 ) -> Result<bool, PointCloudError> {
     let text = loop {
@@ -419,7 +417,7 @@ pub fn read_ply<R: Read>(reader: R, opts: &ReadOptions) -> Result<LoadedCloud, P
 
 /// Write `cloud` as PLY with `double x y z` (and `double nx ny nz` when the cloud has
 /// normals). ASCII output uses the shortest representation that reads back to the same
-/// `f64`, so ASCII and binary round trips are both exact.
+/// `Real`, so ASCII and binary round trips are both exact.
 pub fn write_ply<W: Write>(
     cloud: &PointCloud,
     mut w: W,
