@@ -2,6 +2,7 @@
 //! polygons, segment tests and a bounding-volume hierarchy for occlusion queries.
 //!
 //! Frames and units: right-handed world frame, z up, metres. See `docs/conventions.md`.
+#![warn(missing_docs)]
 
 pub mod bvh;
 pub mod plane;

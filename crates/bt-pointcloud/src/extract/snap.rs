@@ -105,7 +105,7 @@ fn gap_is_surface(
     b: Vec2,
     line: Line2,
     cell: Real,
-    cloud: &Cloud,
+    cloud: &Cloud<'_>,
 ) -> bool {
     let sin = p.normal.cross(q.normal).length();
     let stolen = cloud.band / sin.max(Real::MIN_POSITIVE);
@@ -177,7 +177,7 @@ pub(crate) fn snap_all(
     patches: &[PatchGeom],
     snap: Real,
     cell: Real,
-    cloud: &Cloud,
+    cloud: &Cloud<'_>,
 ) -> Vec<Vec<Vec2>> {
     patches
         .par_iter()
