@@ -349,6 +349,11 @@ pub(super) fn frame(n: Vec3) -> (Vec3, Vec3) {
 
 /// Like [`extract_planes`], calling `progress` after each stage and each RANSAC plane. The
 /// library never prints; wire the callback to a progress bar in the binary.
+///
+/// Stages, one function each: normals, [`ransac_patches`] (planes and their connected
+/// components), [`separate_layers`] (parallel surfaces share their points), [`build_patch`]
+/// (refit, orient, boundary; in parallel), snapping of shared edges, [`finish_planes`] (area
+/// and width checks) and [`report`].
 pub fn extract_planes_with_progress(
     cloud: &PointCloud,
     params: &ExtractParams,
@@ -366,84 +371,138 @@ pub fn extract_planes_with_progress(
     progress(prog);
     let normals = normals::estimate_normals(pts, params.normal_radius_m);
     let coarse = VoxelIndex::build(pts, params.hypothesis_radius_m);
+    let ransac = ransac_patches(pts, &normals, &coarse, params, &mut prog, progress);
+    let raw = separate_layers(pts, ransac.patches, params);
+    prog.stage = Stage::Boundaries;
+    progress(prog);
+
+    // Per patch: refit, orient, frame, boundary. Order-preserving parallel map.
+    let centroid = if n > 0 {
+        pts.iter().fold(Vec3::ZERO, |a, p| a + *p) / n as Real
+    } else {
+        Vec3::ZERO
+    };
+    let in_normals = cloud.normals();
+    let built: Vec<Option<(PatchGeom, Real, usize)>> = raw
+        .par_iter()
+        .map(|rp| build_patch(rp, pts, &normals, in_normals, centroid, params))
+        .collect();
+    let mut dropped = Dropped::default();
+    let mut geoms = Vec::new();
+    let mut meta = Vec::new();
+    for (rp, b) in raw.iter().zip(built) {
+        match b {
+            Some((g, rms, plane)) => {
+                geoms.push(g);
+                meta.push((rp.indices.len(), rms, plane));
+            }
+            None => dropped.add(rp.indices.len()),
+        }
+    }
+    let snapped = snap::snap_all(
+        &geoms,
+        params.snap_distance_m,
+        params.boundary_cell_m,
+        &snap::Cloud {
+            pts,
+            index: &coarse,
+            band: params.distance_threshold_m,
+        },
+    );
+    let planes = finish_planes(&geoms, snapped, meta, params, &mut dropped);
+    let report = report(&planes, params, n, &ransac.counts, dropped);
+    prog.stage = Stage::Done;
+    progress(prog);
+    Ok(Extraction { planes, report })
+}
+
+/// Point counts of the RANSAC stage for the report.
+struct RansacCounts {
+    /// RANSAC planes accepted.
+    planes: usize,
+    /// Points without an estimated normal (never candidates).
+    without_normal: usize,
+    /// Points with a normal no plane took, plus those without a normal.
+    leftover: usize,
+}
+
+/// The connected patches found by RANSAC, in discovery order, with the counts.
+struct Ransac {
+    patches: Vec<RawPatch>,
+    counts: RansacCounts,
+}
+
+/// Patches and points dropped on the way (too small, no boundary, degenerate after snapping).
+#[derive(Default)]
+struct Dropped {
+    patches: usize,
+    points: usize,
+}
+
+impl Dropped {
+    fn add(&mut self, points: usize) {
+        self.patches += 1;
+        self.points += points;
+    }
+}
+
+/// The inlier test of RANSAC: a point is an inlier of the plane `nrm · x = d` when it lies
+/// within the band `distance_threshold_m` and its normal within the angle gate.
+#[derive(Clone, Copy)]
+struct InlierTest<'a> {
+    pts: &'a [Vec3],
+    normals: &'a [Vec3],
+    band: Real,
+    cos_gate: Real,
+}
+
+impl<'a> InlierTest<'a> {
+    fn new(pts: &'a [Vec3], normals: &'a [Vec3], params: &ExtractParams) -> Self {
+        Self {
+            pts,
+            normals,
+            band: params.distance_threshold_m,
+            cos_gate: params.normal_angle_deg.to_radians().cos(),
+        }
+    }
+
+    #[inline]
+    fn holds(&self, i: u32, nrm: Vec3, d: Real) -> bool {
+        let i = i as usize;
+        (nrm.dot(self.pts[i]) - d).abs() <= self.band
+            && nrm.dot(self.normals[i]).abs() >= self.cos_gate
+    }
+}
+
+/// The RANSAC stage: best plane hypothesis on the remaining points, refit, split into
+/// connected components (tilted components go back to the pool), until `max_planes` or too
+/// few points remain. Reports progress after every plane.
+fn ransac_patches(
+    pts: &[Vec3],
+    normals: &[Vec3],
+    coarse: &VoxelIndex,
+    params: &ExtractParams,
+    prog: &mut Progress,
+    progress: &mut dyn FnMut(Progress),
+) -> Ransac {
+    let n = pts.len();
     let mut remaining: Vec<u32> = (0..n as u32)
         .filter(|&i| normals[i as usize] != Vec3::ZERO)
         .collect();
     let points_without_normal = n - remaining.len();
-
-    let t = params.distance_threshold_m;
-    let cos_gate = params.normal_angle_deg.to_radians().cos();
-    let is_inlier = |i: u32, nrm: Vec3, d: Real| {
-        let i = i as usize;
-        (nrm.dot(pts[i]) - d).abs() <= t && nrm.dot(normals[i]).abs() >= cos_gate
-    };
     let mut rng = ChaCha8Rng::seed_from_u64(params.seed);
     let mut raw: Vec<RawPatch> = Vec::new();
     let mut taken = vec![false; n];
     let mut ransac_planes = 0;
-    let log_fail = (1.0 - params.confidence).ln();
     while ransac_planes < params.max_planes && remaining.len() >= params.min_plane_points {
-        // Score hypotheses on a random subsample of the remaining points.
-        let sample: Vec<u32> = if remaining.len() <= params.score_sample {
-            remaining.clone()
-        } else {
-            (0..params.score_sample)
-                .map(|_| remaining[rng.random_range(0..remaining.len())])
-                .collect()
-        };
-        let mut best: Option<(usize, Vec3, Real)> = None;
-        let mut tried = 0;
-        let mut needed = params.min_iterations;
-        while tried < needed.min(params.max_iterations) {
-            let seeds: Vec<usize> = (0..64)
-                .map(|_| remaining[rng.random_range(0..remaining.len())] as usize)
-                .collect();
-            let batch: Vec<(Vec3, Real)> = seeds
-                .par_iter()
-                .map(|&i| local_hypothesis(pts, &normals, &taken, &coarse, i, params))
-                .collect();
-            let counts: Vec<usize> = batch
-                .par_iter()
-                .map(|&(nrm, d)| sample.iter().filter(|&&i| is_inlier(i, nrm, d)).count())
-                .collect();
-            for (&(nrm, d), &c) in batch.iter().zip(&counts) {
-                if best.is_none_or(|(bc, _, _)| c > bc) {
-                    best = Some((c, nrm, d));
-                }
-            }
-            tried += batch.len();
-            let w = best.map_or(0.0, |b| b.0 as Real / sample.len() as Real);
-            needed = if w >= 1.0 {
-                0
-            } else if w <= 0.0 {
-                params.max_iterations
-            } else {
-                (log_fail / (1.0 - w).ln()).ceil() as usize
-            }
-            .max(params.min_iterations);
-        }
-        let Some((_, mut nrm, d)) = best else { break };
-        let collect = |nrm: Vec3, d: Real| -> Vec<u32> {
-            remaining
-                .par_iter()
-                .copied()
-                .filter(|&i| is_inlier(i, nrm, d))
-                .collect()
-        };
-        let mut inliers = collect(nrm, d);
-        for _ in 0..params.refine_iterations {
-            let Some(fit) = fit_plane(inliers.iter().map(|&i| pts[i as usize])) else {
-                break;
-            };
-            let next = collect(fit.normal, fit.offset);
-            if next.len() < inliers.len() || next == inliers {
-                break;
-            }
-            (nrm, inliers) = (fit.normal, next);
-        }
-        if inliers.len() < params.min_plane_points {
+        let Some((nrm, d)) =
+            best_hypothesis(pts, normals, coarse, &taken, &remaining, params, &mut rng)
+        else {
             break;
-        }
+        };
+        let Some((nrm, inliers)) = refined_inliers(pts, normals, &remaining, params, nrm, d) else {
+            break;
+        };
         // A component whose own least-squares plane is tilted against the RANSAC plane is a
         // band where the infinite plane cuts through another surface (e.g. a 15° sofa back
         // extended into a picture on the wall): its points go back to the pool. If nothing
@@ -474,18 +533,115 @@ pub fn extract_planes_with_progress(
             }
         }
         ransac_planes += 1;
-        prog = Progress {
+        *prog = Progress {
             stage: Stage::Ransac,
             points_assigned: n - remaining.len() - points_without_normal,
             points_total: n,
             ransac_planes,
         };
-        progress(prog);
+        progress(*prog);
     }
-    let leftover_points = remaining.len() + points_without_normal;
+    Ransac {
+        patches: raw,
+        counts: RansacCounts {
+            planes: ransac_planes,
+            without_normal: points_without_normal,
+            leftover: remaining.len() + points_without_normal,
+        },
+    }
+}
 
-    // Parallel surfaces closer than the RANSAC band share their points out competitively;
-    // patches that changed are split into connected parts again.
+/// Scores local plane hypotheses (64 per batch, seeded from random remaining points) on a
+/// random subsample of the remaining points until the adaptive RANSAC count for the requested
+/// confidence is reached; returns the best plane `(normal, offset)`.
+fn best_hypothesis(
+    pts: &[Vec3],
+    normals: &[Vec3],
+    coarse: &VoxelIndex,
+    taken: &[bool],
+    remaining: &[u32],
+    params: &ExtractParams,
+    rng: &mut ChaCha8Rng,
+) -> Option<(Vec3, Real)> {
+    let log_fail = (1.0 - params.confidence).ln();
+    let inlier = InlierTest::new(pts, normals, params);
+    // Score hypotheses on a random subsample of the remaining points.
+    let sample: Vec<u32> = if remaining.len() <= params.score_sample {
+        remaining.to_vec()
+    } else {
+        (0..params.score_sample)
+            .map(|_| remaining[rng.random_range(0..remaining.len())])
+            .collect()
+    };
+    let mut best: Option<(usize, Vec3, Real)> = None;
+    let mut tried = 0;
+    let mut needed = params.min_iterations;
+    while tried < needed.min(params.max_iterations) {
+        let seeds: Vec<usize> = (0..64)
+            .map(|_| remaining[rng.random_range(0..remaining.len())] as usize)
+            .collect();
+        let batch: Vec<(Vec3, Real)> = seeds
+            .par_iter()
+            .map(|&i| local_hypothesis(pts, normals, taken, coarse, i, params))
+            .collect();
+        let counts: Vec<usize> = batch
+            .par_iter()
+            .map(|&(nrm, d)| sample.iter().filter(|&&i| inlier.holds(i, nrm, d)).count())
+            .collect();
+        for (&(nrm, d), &c) in batch.iter().zip(&counts) {
+            if best.is_none_or(|(bc, _, _)| c > bc) {
+                best = Some((c, nrm, d));
+            }
+        }
+        tried += batch.len();
+        let w = best.map_or(0.0, |b| b.0 as Real / sample.len() as Real);
+        needed = if w >= 1.0 {
+            0
+        } else if w <= 0.0 {
+            params.max_iterations
+        } else {
+            (log_fail / (1.0 - w).ln()).ceil() as usize
+        }
+        .max(params.min_iterations);
+    }
+    best.map(|(_, nrm, d)| (nrm, d))
+}
+
+/// The inliers of plane `(nrm, d)` among `remaining`, refit by least squares while the set
+/// grows; `None` when fewer than `min_plane_points` remain. Returns the final normal too.
+fn refined_inliers(
+    pts: &[Vec3],
+    normals: &[Vec3],
+    remaining: &[u32],
+    params: &ExtractParams,
+    mut nrm: Vec3,
+    d: Real,
+) -> Option<(Vec3, Vec<u32>)> {
+    let inlier = InlierTest::new(pts, normals, params);
+    let collect = |nrm: Vec3, d: Real| -> Vec<u32> {
+        remaining
+            .par_iter()
+            .copied()
+            .filter(|&i| inlier.holds(i, nrm, d))
+            .collect()
+    };
+    let mut inliers = collect(nrm, d);
+    for _ in 0..params.refine_iterations {
+        let Some(fit) = fit_plane(inliers.iter().map(|&i| pts[i as usize])) else {
+            break;
+        };
+        let next = collect(fit.normal, fit.offset);
+        if next.len() < inliers.len() || next == inliers {
+            break;
+        }
+        (nrm, inliers) = (fit.normal, next);
+    }
+    (inliers.len() >= params.min_plane_points).then_some((nrm, inliers))
+}
+
+/// Parallel surfaces closer than the RANSAC band share their points out competitively;
+/// patches that changed are split into connected parts again.
+fn separate_layers(pts: &[Vec3], mut raw: Vec<RawPatch>, params: &ExtractParams) -> Vec<RawPatch> {
     let changed = layers::separate_parallel(
         pts,
         &mut raw,
@@ -493,135 +649,118 @@ pub fn extract_planes_with_progress(
         params.cluster_eps_m,
         params.min_patch_points,
     );
-    if !changed.is_empty() {
-        let mut next = Vec::with_capacity(raw.len());
-        for (k, rp) in raw.into_iter().enumerate() {
-            if changed.binary_search(&k).is_err() {
-                next.push(rp);
-                continue;
-            }
-            let Some(fit) = fit_plane(rp.indices.iter().map(|&i| pts[i as usize])) else {
-                next.push(rp);
-                continue;
-            };
-            for indices in split_connected(pts, &rp.indices, fit.normal, params.cluster_eps_m) {
-                next.push(RawPatch {
-                    indices,
-                    ransac_plane: rp.ransac_plane,
-                });
-            }
-        }
-        raw = next;
+    if changed.is_empty() {
+        return raw;
     }
-    prog.stage = Stage::Boundaries;
-    progress(prog);
+    let mut next = Vec::with_capacity(raw.len());
+    for (k, rp) in raw.into_iter().enumerate() {
+        if changed.binary_search(&k).is_err() {
+            next.push(rp);
+            continue;
+        }
+        let Some(fit) = fit_plane(rp.indices.iter().map(|&i| pts[i as usize])) else {
+            next.push(rp);
+            continue;
+        };
+        for indices in split_connected(pts, &rp.indices, fit.normal, params.cluster_eps_m) {
+            next.push(RawPatch {
+                indices,
+                ransac_plane: rp.ransac_plane,
+            });
+        }
+    }
+    next
+}
 
-    // Per patch: refit, orient, frame, boundary. Order-preserving parallel map.
-    let centroid = if n > 0 {
-        pts.iter().fold(Vec3::ZERO, |a, p| a + *p) / n as Real
-    } else {
-        Vec3::ZERO
-    };
-    let in_normals = cloud.normals();
-    let built: Vec<Option<(PatchGeom, Real, usize)>> = raw
-        .par_iter()
-        .map(|rp| {
-            if rp.indices.len() < params.min_patch_points {
-                return None;
-            }
-            let mut fit = fit_plane(rp.indices.iter().map(|&i| pts[i as usize]))?;
-            for _ in 0..2 {
-                let core = rp
-                    .indices
-                    .iter()
-                    .filter(|&&i| normals[i as usize].dot(fit.normal).abs() >= tol::REFIT_GATE_COS);
-                match fit_plane(core.map(|&i| pts[i as usize])) {
-                    Some(f) => fit = f,
-                    None => break,
-                }
-            }
-            let rms = (rp
-                .indices
+/// One patch's geometry: least-squares refit on the points whose normals agree, orientation
+/// (towards the input normals, else away from the cloud's centroid), in-plane frame and
+/// boundary polygon; with the refit's RMS distance (m) and the RANSAC plane index. `None` for
+/// patches too small or without a boundary.
+fn build_patch(
+    rp: &RawPatch,
+    pts: &[Vec3],
+    normals: &[Vec3],
+    in_normals: Option<&[Vec3]>,
+    centroid: Vec3,
+    params: &ExtractParams,
+) -> Option<(PatchGeom, Real, usize)> {
+    if rp.indices.len() < params.min_patch_points {
+        return None;
+    }
+    let mut fit = fit_plane(rp.indices.iter().map(|&i| pts[i as usize]))?;
+    for _ in 0..2 {
+        let core = rp
+            .indices
+            .iter()
+            .filter(|&&i| normals[i as usize].dot(fit.normal).abs() >= tol::REFIT_GATE_COS);
+        match fit_plane(core.map(|&i| pts[i as usize])) {
+            Some(f) => fit = f,
+            None => break,
+        }
+    }
+    let rms = (rp
+        .indices
+        .iter()
+        .map(|&i| (fit.normal.dot(pts[i as usize]) - fit.offset).powi(2))
+        .sum::<Real>()
+        / rp.indices.len() as Real)
+        .sqrt();
+    let mut normal = fit.normal;
+    let flip = match in_normals {
+        Some(ns) => {
+            rp.indices
                 .iter()
-                .map(|&i| (fit.normal.dot(pts[i as usize]) - fit.offset).powi(2))
+                .map(|&i| normal.dot(ns[i as usize]))
                 .sum::<Real>()
-                / rp.indices.len() as Real)
-                .sqrt();
-            let mut normal = fit.normal;
-            let flip = match in_normals {
-                Some(ns) => {
-                    rp.indices
-                        .iter()
-                        .map(|&i| normal.dot(ns[i as usize]))
-                        .sum::<Real>()
-                        < 0.0
-                }
-                None => normal.dot(centroid - fit.centroid) < 0.0,
-            };
-            if flip {
-                normal = -normal;
-            }
-            let (u, v) = frame(normal);
-            let origin = fit.centroid;
-            let p2: Vec<Vec2> = rp
-                .indices
-                .iter()
-                .map(|&i| {
-                    let r = pts[i as usize] - origin;
-                    Vec2::new(r.dot(u), r.dot(v))
-                })
-                .collect();
-            let poly = patch_boundary(&p2, params.boundary_cell_m, params.simplify_tolerance_m)?;
-            let mut g = PatchGeom {
-                normal,
-                offset: normal.dot(origin),
-                origin,
-                u,
-                v,
-                poly,
-                lo: Vec3::ZERO,
-                hi: Vec3::ZERO,
-                density: 0.0,
-            };
-            g.density = rp.indices.len() as Real / signed_area(&g.poly).max(Real::MIN_POSITIVE);
-            g.update_bounds();
-            Some((g, rms, rp.ransac_plane))
+                < 0.0
+        }
+        None => normal.dot(centroid - fit.centroid) < 0.0,
+    };
+    if flip {
+        normal = -normal;
+    }
+    let (u, v) = frame(normal);
+    let origin = fit.centroid;
+    let p2: Vec<Vec2> = rp
+        .indices
+        .iter()
+        .map(|&i| {
+            let r = pts[i as usize] - origin;
+            Vec2::new(r.dot(u), r.dot(v))
         })
         .collect();
-    let mut dropped_patches = 0;
-    let mut dropped_points = 0;
-    let mut geoms = Vec::new();
-    let mut meta = Vec::new();
-    for (rp, b) in raw.iter().zip(built) {
-        match b {
-            Some((g, rms, plane)) => {
-                geoms.push(g);
-                meta.push((rp.indices.len(), rms, plane));
-            }
-            None => {
-                dropped_patches += 1;
-                dropped_points += rp.indices.len();
-            }
-        }
-    }
-    let snapped = snap::snap_all(
-        &geoms,
-        params.snap_distance_m,
-        params.boundary_cell_m,
-        &snap::Cloud {
-            pts,
-            index: &coarse,
-            band: params.distance_threshold_m,
-        },
-    );
+    let poly = patch_boundary(&p2, params.boundary_cell_m, params.simplify_tolerance_m)?;
+    let mut g = PatchGeom {
+        normal,
+        offset: normal.dot(origin),
+        origin,
+        u,
+        v,
+        poly,
+        lo: Vec3::ZERO,
+        hi: Vec3::ZERO,
+        density: 0.0,
+    };
+    g.density = rp.indices.len() as Real / signed_area(&g.poly).max(Real::MIN_POSITIVE);
+    g.update_bounds();
+    Some((g, rms, rp.ransac_plane))
+}
 
+/// The extracted planes from the snapped polygons: patches whose polygon lost its area or is
+/// narrower than `min_patch_width_m` are dropped; reflectors by area.
+fn finish_planes(
+    geoms: &[PatchGeom],
+    snapped: Vec<Vec<Vec2>>,
+    meta: Vec<(usize, Real, usize)>,
+    params: &ExtractParams,
+    dropped: &mut Dropped,
+) -> Vec<ExtractedPlane> {
     let mut planes = Vec::new();
     for ((g, poly), (count, rms, plane)) in geoms.iter().zip(snapped).zip(meta) {
         let area = signed_area(&poly);
         let (_, width, _) = min_area_rect(&convex_hull(&poly));
         if !(area > 0.0 && area.is_finite()) || width < params.min_patch_width_m {
-            dropped_patches += 1;
-            dropped_points += count;
+            dropped.add(count);
             continue;
         }
         planes.push(ExtractedPlane {
@@ -635,6 +774,17 @@ pub fn extract_planes_with_progress(
             ransac_plane: plane,
         });
     }
+    planes
+}
+
+/// The extraction report: counts, inlier-weighted RMS and one summary per plane.
+fn report(
+    planes: &[ExtractedPlane],
+    params: &ExtractParams,
+    input_points: usize,
+    ransac: &RansacCounts,
+    dropped: Dropped,
+) -> ExtractionReport {
     let inliers: usize = planes.iter().map(|p| p.inliers).sum();
     let rms_m = if inliers > 0 {
         (planes
@@ -646,18 +796,18 @@ pub fn extract_planes_with_progress(
     } else {
         0.0
     };
-    let report = ExtractionReport {
+    ExtractionReport {
         seed: params.seed,
-        input_points: n,
-        points_without_normal,
-        ransac_planes,
+        input_points,
+        points_without_normal: ransac.without_normal,
+        ransac_planes: ransac.planes,
         planes_found: planes.len(),
         reflectors: planes.iter().filter(|p| p.reflector).count(),
         blockers: planes.iter().filter(|p| !p.reflector).count(),
         inliers,
-        dropped_patches,
-        dropped_points,
-        leftover_points,
+        dropped_patches: dropped.patches,
+        dropped_points: dropped.points,
+        leftover_points: ransac.leftover,
         rms_m,
         total_area_m2: planes.iter().map(|p| p.area_m2).sum(),
         planes: planes
@@ -673,10 +823,7 @@ pub fn extract_planes_with_progress(
             })
             .collect(),
         params: params.clone(),
-    };
-    prog.stage = Stage::Done;
-    progress(prog);
-    Ok(Extraction { planes, report })
+    }
 }
 
 /// Split a plane's inliers into connected patches: points are binned into square cells of
