@@ -11,53 +11,7 @@ use crate::error::{MeshError, Position};
 use crate::raw::RawMesh;
 use bt_geom::{Real, Vec3};
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Format {
-    Ascii,
-    BinaryLittleEndian,
-    BinaryBigEndian,
-}
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Scalar {
-    I8,
-    U8,
-    I16,
-    U16,
-    I32,
-    U32,
-    F32,
-    F64,
-}
-
-impl Scalar {
-    fn parse(name: &str) -> Option<Scalar> {
-        Some(match name {
-            "char" | "int8" => Scalar::I8,
-            "uchar" | "uint8" => Scalar::U8,
-            "short" | "int16" => Scalar::I16,
-            "ushort" | "uint16" => Scalar::U16,
-            "int" | "int32" => Scalar::I32,
-            "uint" | "uint32" => Scalar::U32,
-            "float" | "float32" => Scalar::F32,
-            "double" | "float64" => Scalar::F64,
-            _ => return None,
-        })
-    }
-
-    fn size(self) -> usize {
-        match self {
-            Scalar::I8 | Scalar::U8 => 1,
-            Scalar::I16 | Scalar::U16 => 2,
-            Scalar::I32 | Scalar::U32 | Scalar::F32 => 4,
-            Scalar::F64 => 8,
-        }
-    }
-
-    fn is_integer(self) -> bool {
-        !matches!(self, Scalar::F32 | Scalar::F64)
-    }
-}
+use bt_formats::{PlyFormat as Format, Scalar};
 
 #[derive(Debug, Clone, Copy)]
 enum Kind {
@@ -293,17 +247,12 @@ fn parse_header(bytes: &[u8], file: &str) -> Result<Header, MeshError> {
                         detail: format!("PLY format version {version}"),
                     });
                 }
-                format = Some(match *kind {
-                    "ascii" => Format::Ascii,
-                    "binary_little_endian" => Format::BinaryLittleEndian,
-                    "binary_big_endian" => Format::BinaryBigEndian,
-                    other => {
-                        return Err(MeshError::Unsupported {
-                            file: file.to_owned(),
-                            detail: format!("PLY format {other:?}"),
-                        });
-                    }
-                });
+                format = Some(
+                    Format::from_name(kind).ok_or_else(|| MeshError::Unsupported {
+                        file: file.to_owned(),
+                        detail: format!("PLY format {kind:?}"),
+                    })?,
+                );
             }
             ["element", name, count] => {
                 let count: u64 = count.parse().map_err(|_| {
@@ -320,7 +269,7 @@ fn parse_header(bytes: &[u8], file: &str) -> Result<Header, MeshError> {
                     .last_mut()
                     .ok_or_else(|| syntax(line_no, "property before any element".into()))?;
                 let scalar = |name: &str| {
-                    Scalar::parse(name)
+                    Scalar::from_ply_name(name)
                         .ok_or_else(|| syntax(line_no, format!("unknown property type {name:?}")))
                 };
                 let property = match rest {
@@ -454,22 +403,7 @@ impl Reader<'_> {
                     .get(self.pos..self.pos + size)
                     .ok_or_else(truncated)?;
                 self.pos += size;
-                let mut buf = [0u8; 8];
-                buf[..size].copy_from_slice(raw);
-                if self.format == Format::BinaryBigEndian {
-                    buf[..size].reverse();
-                }
-                // `buf` now holds little-endian bytes.
-                Ok(match ty {
-                    Scalar::I8 => Real::from(buf[0] as i8),
-                    Scalar::U8 => Real::from(buf[0]),
-                    Scalar::I16 => Real::from(i16::from_le_bytes([buf[0], buf[1]])),
-                    Scalar::U16 => Real::from(u16::from_le_bytes([buf[0], buf[1]])),
-                    Scalar::I32 => Real::from(i32::from_le_bytes([buf[0], buf[1], buf[2], buf[3]])),
-                    Scalar::U32 => Real::from(u32::from_le_bytes([buf[0], buf[1], buf[2], buf[3]])),
-                    Scalar::F32 => Real::from(f32::from_le_bytes([buf[0], buf[1], buf[2], buf[3]])),
-                    Scalar::F64 => Real::from_le_bytes(buf),
-                })
+                Ok(ty.decode(raw, self.format.is_big_endian()))
             }
         }
     }

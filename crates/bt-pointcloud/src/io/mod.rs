@@ -154,58 +154,8 @@ pub(crate) fn read_all<R: Read>(mut r: R) -> Result<Vec<u8>, PointCloudError> {
     Ok(buf)
 }
 
-/// Numeric scalar types shared by PLY and PCD.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Scalar {
-    I8,
-    U8,
-    I16,
-    U16,
-    I32,
-    U32,
-    I64,
-    U64,
-    F32,
-    F64,
-}
-
-impl Scalar {
-    pub(crate) fn size(self) -> usize {
-        match self {
-            Scalar::I8 | Scalar::U8 => 1,
-            Scalar::I16 | Scalar::U16 => 2,
-            Scalar::I32 | Scalar::U32 | Scalar::F32 => 4,
-            Scalar::I64 | Scalar::U64 | Scalar::F64 => 8,
-        }
-    }
-
-    /// Decode one value from exactly `self.size()` bytes.
-    pub(crate) fn decode(self, b: &[u8], big_endian: bool) -> Real {
-        macro_rules! get {
-            ($t:ty, $n:expr) => {{
-                let mut a = [0u8; $n];
-                a.copy_from_slice(&b[..$n]);
-                if big_endian {
-                    <$t>::from_be_bytes(a)
-                } else {
-                    <$t>::from_le_bytes(a)
-                }
-            }};
-        }
-        match self {
-            Scalar::I8 => b[0] as i8 as Real,
-            Scalar::U8 => b[0] as Real,
-            Scalar::I16 => get!(i16, 2) as Real,
-            Scalar::U16 => get!(u16, 2) as Real,
-            Scalar::I32 => get!(i32, 4) as Real,
-            Scalar::U32 => get!(u32, 4) as Real,
-            Scalar::I64 => get!(i64, 8) as Real,
-            Scalar::U64 => get!(u64, 8) as Real,
-            Scalar::F32 => get!(f32, 4) as Real,
-            Scalar::F64 => get!(Real, 8),
-        }
-    }
-}
+/// Numeric scalar types shared by PLY and PCD: the byte-level layer of `bt-formats`.
+pub(crate) use bt_formats::Scalar;
 
 /// Collects decoded points, applying the non-finite policy.
 pub(crate) struct PointSink {

@@ -260,26 +260,14 @@ fn fields(kw: &Keywords) -> Result<Vec<Field>, PointCloudError> {
     }
     let mut fields = Vec::with_capacity(n);
     for i in 0..n {
-        let scalar = match (types[i], sizes[i]) {
-            (b'F', 4) => Scalar::F32,
-            (b'F', 8) => Scalar::F64,
-            (b'I', 1) => Scalar::I8,
-            (b'I', 2) => Scalar::I16,
-            (b'I', 4) => Scalar::I32,
-            (b'I', 8) => Scalar::I64,
-            (b'U', 1) => Scalar::U8,
-            (b'U', 2) => Scalar::U16,
-            (b'U', 4) => Scalar::U32,
-            (b'U', 8) => Scalar::U64,
-            (t, s) => {
-                return Err(header_err(
-                    data_line,
-                    format!(
-                        "field '{}': TYPE {} with SIZE {s} is not valid",
-                        names[i], t as char
-                    ),
-                ));
-            }
+        let Some(scalar) = Scalar::from_pcd(types[i], sizes[i]) else {
+            return Err(header_err(
+                data_line,
+                format!(
+                    "field '{}': TYPE {} with SIZE {} is not valid",
+                    names[i], types[i] as char, sizes[i]
+                ),
+            ));
         };
         fields.push(Field {
             name: names[i].clone(),

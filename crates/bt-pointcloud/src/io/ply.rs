@@ -14,16 +14,8 @@ use super::{
 use crate::cloud::PointCloud;
 use crate::error::{DataPos, Origin, PointCloudError};
 
-/// PLY encodings.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum PlyFormat {
-    /// `format ascii 1.0`.
-    Ascii,
-    /// `format binary_little_endian 1.0`.
-    BinaryLittleEndian,
-    /// `format binary_big_endian 1.0`.
-    BinaryBigEndian,
-}
+/// PLY encodings (the byte-level layer of `bt-formats`).
+pub use bt_formats::PlyFormat;
 
 #[derive(Debug, Clone, Copy)]
 enum PropKind {
@@ -60,20 +52,6 @@ impl Element {
                 .sum(),
         }
     }
-}
-
-fn scalar_from_name(name: &str) -> Option<Scalar> {
-    Some(match name {
-        "char" | "int8" => Scalar::I8,
-        "uchar" | "uint8" => Scalar::U8,
-        "short" | "int16" => Scalar::I16,
-        "ushort" | "uint16" => Scalar::U16,
-        "int" | "int32" => Scalar::I32,
-        "uint" | "uint32" => Scalar::U32,
-        "float" | "float32" => Scalar::F32,
-        "double" | "float64" => Scalar::F64,
-        _ => return None,
-    })
 }
 
 struct Header {
@@ -117,11 +95,11 @@ fn parse_header(bytes: &[u8]) -> Result<Header, PointCloudError> {
         }
         match key {
             "format" => {
-                let f = match tok.next() {
-                    Some("ascii") => PlyFormat::Ascii,
-                    Some("binary_little_endian") => PlyFormat::BinaryLittleEndian,
-                    Some("binary_big_endian") => PlyFormat::BinaryBigEndian,
-                    other => {
+                let name = tok.next();
+                let f = match name.and_then(PlyFormat::from_name) {
+                    Some(f) => f,
+                    None => {
+                        let other = name;
                         return Err(header_err(
                             line_no,
                             format!("unknown format {:?}", other.unwrap_or("")),
@@ -163,7 +141,8 @@ fn parse_header(bytes: &[u8]) -> Result<Header, PointCloudError> {
                 let words: Vec<&str> = tok.collect();
                 let (kind, name) = match words.as_slice() {
                     ["list", c, i, name] => {
-                        let (Some(count), Some(item)) = (scalar_from_name(c), scalar_from_name(i))
+                        let (Some(count), Some(item)) =
+                            (Scalar::from_ply_name(c), Scalar::from_ply_name(i))
                         else {
                             return Err(header_err(
                                 line_no,
@@ -179,7 +158,7 @@ fn parse_header(bytes: &[u8]) -> Result<Header, PointCloudError> {
                         (PropKind::List { count, item }, *name)
                     }
                     [t, name] => {
-                        let s = scalar_from_name(t).ok_or_else(|| {
+                        let s = Scalar::from_ply_name(t).ok_or_else(|| {
                             header_err(line_no, format!("unknown property type '{t}'"))
                         })?;
                         (PropKind::Scalar(s), *name)
@@ -423,11 +402,7 @@ pub fn write_ply<W: Write>(
     mut w: W,
     format: PlyFormat,
 ) -> Result<(), PointCloudError> {
-    let fmt = match format {
-        PlyFormat::Ascii => "ascii",
-        PlyFormat::BinaryLittleEndian => "binary_little_endian",
-        PlyFormat::BinaryBigEndian => "binary_big_endian",
-    };
+    let fmt = format.name();
     let mut head = format!(
         "ply\nformat {fmt} 1.0\ncomment written by beamtrace bt-pointcloud (metres, z up)\nelement vertex {}\n\
          property double x\nproperty double y\nproperty double z\n",

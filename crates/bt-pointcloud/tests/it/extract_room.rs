@@ -2,11 +2,9 @@
 //! 1°, offset within 2 cm, area within 5 %), classified by area, and the output is
 //! deterministic for a seed.
 
-mod common;
-
+use crate::common::room::furnished_room;
 use bt_geom::poly2::newell;
 use bt_pointcloud::{ExtractParams, ExtractedPlane, extract_planes, sample_polygons};
-use common::room::furnished_room;
 use glam::DVec3;
 
 /// Area centroid of a planar polygon (fan triangulation with signed areas).

@@ -4,63 +4,12 @@
 //! reflection-law check; a valid path the host still rejects ran exactly as without early
 //! stopping (a round-cap or quantisation effect, not ours).
 
-use bt_geom::{Real, Vec3};
 use bt_paths::{AllVisible, enumerate};
-use bt_scene::{Scene, SceneDescription, Terminals};
+use bt_scene::{Scene, Terminals};
 use bt_study::fpga::{HostRejection, hls_input, host_accepts};
-use rand::{Rng, SeedableRng};
-use rand_chacha::ChaCha8Rng;
+use bt_testkit::random_scene;
 
 const SEED: u64 = 0x005e_ede5;
-
-/// A box room with `n` random rectangles (every third a blocker) and random TX/RX.
-fn random_scene(seed: u64, n: usize) -> Scene {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let size = Vec3::new(
-        rng.random_range(3.0..8.0),
-        rng.random_range(3.0..8.0),
-        rng.random_range(2.2..3.5),
-    );
-    let mut surfaces = Vec::new();
-    for i in 0..n {
-        let centre = Vec3::new(
-            rng.random_range(0.2..size.x - 0.2),
-            rng.random_range(0.2..size.y - 0.2),
-            rng.random_range(0.2..size.z - 0.2),
-        );
-        let normal = Vec3::new(
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-            rng.random_range(-1.0..1.0),
-        )
-        .normalize_or(Vec3::Z);
-        let (u, v) = normal.any_orthonormal_pair();
-        let (a, b) = (rng.random_range(0.2..1.2), rng.random_range(0.2..1.2));
-        let verts: Vec<[Real; 3]> = [(-a, -b), (a, -b), (a, b), (-a, b)]
-            .iter()
-            .map(|(x, y)| (centre + *x * u + *y * v).to_array())
-            .collect();
-        let kind = if i % 3 == 2 { "blocker" } else { "reflector" };
-        surfaces.push(format!(
-            r#"{{ "name": "s{i}", "kind": "{kind}", "vertices": {verts:?} }}"#
-        ));
-    }
-    let pick = |rng: &mut ChaCha8Rng| {
-        [
-            rng.random_range(0.1..size.x - 0.1),
-            rng.random_range(0.1..size.y - 0.1),
-            rng.random_range(0.1..size.z - 0.1),
-        ]
-    };
-    let (tx, rx) = (pick(&mut rng), pick(&mut rng));
-    let json = format!(
-        r#"{{ "tx": {tx:?}, "rx": {rx:?}, "surfaces": [{}], "boxes": [ {{ "name": "room", "min": [0, 0, 0], "max": {:?} }} ] }}"#,
-        surfaces.join(","),
-        size.to_array()
-    );
-    let d: SceneDescription = serde_json::from_str(&json).unwrap();
-    Scene::from_description(&d, "random", Terminals::default()).expect("random scene is valid")
-}
 
 #[derive(Debug, Default)]
 struct Counts {
