@@ -81,16 +81,7 @@ fn ply_has_no_faces(path: &Path) -> bool {
         return false;
     };
     let n = f.read(&mut head).unwrap_or(0);
-    let text = String::from_utf8_lossy(&head[..n]);
-    let Some(end) = text.find("end_header") else {
-        return false;
-    };
-    !text[..end].lines().any(|l| {
-        let mut w = l.split_whitespace();
-        w.next() == Some("element")
-            && w.next() == Some("face")
-            && w.next().is_some_and(|c| c != "0")
-    })
+    bt_formats::ply_declares_faces(&head[..n]) == Some(false)
 }
 
 pub fn run_extract(args: &ExtractArgs) -> anyhow::Result<ExitCode> {

@@ -84,13 +84,13 @@ pub struct HlsSummary {
     pub cycles_per_slot: u64,
     pub predicted_cycles: u64,
     pub latency_s_at_50mhz: f64,
-    pub fixed_vs_f64: FixedError,
+    pub fixed_vs_f64: FixedDeviation,
     pub rtl_written: bool,
 }
 
 /// Fixed-point model vs the f64 reference on the paths valid in f64 (image method).
 #[derive(Debug, Serialize, Default)]
-pub struct FixedError {
+pub struct FixedDeviation {
     pub valid_paths_compared: usize,
     pub max_point_error_mm: f64,
     pub mean_point_error_mm: f64,
@@ -108,12 +108,16 @@ pub struct FixedError {
     pub spurious: usize,
 }
 
-fn fixed_error(scene: &Scene, input: &HlsInput, max_order: usize) -> anyhow::Result<FixedError> {
+fn fixed_deviation(
+    scene: &Scene,
+    input: &HlsInput,
+    max_order: usize,
+) -> anyhow::Result<FixedDeviation> {
     let model = input.model()?;
     let results = model.run(input.tx, input.rx)?;
     let candidates = bt_paths::enumerate(scene, max_order, &AllVisible);
     let reference = bt_solve::trace(scene, &candidates, &bt_solve::Solver::Image, true);
-    let mut err = FixedError::default();
+    let mut err = FixedDeviation::default();
     // Input paths are the non-empty candidates in order (`bt_study::fpga::hls_input`).
     let candidates_of: Vec<Vec<bt_scene::SurfaceId>> = candidates
         .iter()
@@ -293,7 +297,7 @@ fn generate_one(
             },
         },
     )?;
-    let fixed = fixed_error(scene, &input, args.max_order)?;
+    let fixed = fixed_deviation(scene, &input, args.max_order)?;
     std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let rtl_written = !args.plan_only;
     if rtl_written {

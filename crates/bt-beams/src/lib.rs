@@ -5,6 +5,7 @@
 //! elevation from the horizontal plane, positive up, in [-90°, 90°]. The departure direction is
 //! TX towards the first interaction point (or RX); the arrival direction is RX towards the last
 //! interaction point (or TX), i.e. where the wave comes from, as Sionna RT and MATLAB report it.
+#![warn(missing_docs)]
 
 use bt_geom::{Real, Vec3};
 use bt_scene::{Scene, SurfaceId};

@@ -21,6 +21,7 @@
 //!
 //! For the image method the incremental result is bit-identical to [`trace_scratch`]; for IPC
 //! reused and warm-started points agree with a cold start to the IPC threshold.
+#![warn(missing_docs)]
 
 use bt_geom::{Real, Vec3};
 use bt_paths::wvrn::{Wvrn, WvrnStats};

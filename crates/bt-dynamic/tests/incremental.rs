@@ -2,7 +2,7 @@
 //! with the image method, IPC warm starts agreeing with the image method to 1e-9 m; and the
 //! incrementally updated WVRN equals the one rebuilt at each step.
 
-mod common;
+use bt_testkit::partitioned as common;
 
 use bt_dynamic::{IncrementalTracer, StepOptions, max_point_distance, trace_scratch};
 use bt_paths::wvrn::Wvrn;

@@ -2,7 +2,7 @@
 //! exhaustive enumeration (image method, the reference), on seeded random scenes with
 //! occluders and on the built-in living room; and it removes candidates where occluders are.
 
-mod common;
+use bt_testkit::partitioned as common;
 
 use bt_paths::wvrn::Wvrn;
 use bt_paths::{AllVisible, enumerate};

@@ -2,10 +2,12 @@
 //! polygons, segment tests and a bounding-volume hierarchy for occlusion queries.
 //!
 //! Frames and units: right-handed world frame, z up, metres. See `docs/conventions.md`.
+#![warn(missing_docs)]
 
 pub mod bvh;
 pub mod convex;
 pub mod plane;
+pub mod poly2;
 pub mod polygon;
 pub mod tol;
 

@@ -5,6 +5,7 @@
 //! hot inside test is a handful of multiply-adds.
 
 use crate::plane::Plane;
+use crate::poly2::{self, segment_distance_sq};
 use crate::{Real, Vec2, Vec3, tol};
 use serde::Serialize;
 use thiserror::Error;
@@ -95,12 +96,7 @@ impl Polygon {
         }
         // Newell's method: robust normal and twice the area vector for any simple polygon.
         let c0 = vertices.iter().copied().sum::<Vec3>() / n as Real;
-        let mut newell = Vec3::ZERO;
-        for i in 0..n {
-            let a = vertices[i] - c0;
-            let b = vertices[(i + 1) % n] - c0;
-            newell += a.cross(b);
-        }
+        let newell = poly2::newell(&vertices);
         let area = 0.5 * newell.length();
         if area <= tol::REL_AREA * extent * extent || !area.is_normal() {
             return Err(PolygonError::ZeroArea);
@@ -135,7 +131,7 @@ impl Polygon {
                 Vec2::new(d.dot(u), d.dot(v))
             })
             .collect();
-        if let Some((i, j)) = first_crossing(&local) {
+        if let Some((i, j)) = poly2::first_crossing(&local) {
             return Err(PolygonError::SelfIntersecting(i, j));
         }
         let centroid = area_centroid(&local, origin, u, v);
@@ -214,21 +210,10 @@ impl Polygon {
     pub fn signed_boundary_distance(&self, p: Vec3) -> Real {
         let q = self.to_local(p);
         let n = self.local.len();
-        let mut inside = false;
-        let mut best = Real::INFINITY;
-        let mut j = n - 1;
-        for i in 0..n {
-            let a = self.local[j];
-            let b = self.local[i];
-            if (b.y > q.y) != (a.y > q.y) {
-                let x = b.x + (q.y - b.y) * (a.x - b.x) / (a.y - b.y);
-                if q.x < x {
-                    inside = !inside;
-                }
-            }
-            best = best.min(segment_distance_sq(q, a, b));
-            j = i;
-        }
+        let best = (0..n)
+            .map(|i| segment_distance_sq(q, self.local[(i + n - 1) % n], self.local[i]))
+            .fold(Real::INFINITY, Real::min);
+        let inside = poly2::contains(&self.local, q);
         let d = best.sqrt();
         if inside { d } else { -d }
     }
@@ -248,19 +233,10 @@ impl Polygon {
         {
             return false;
         }
-        let n = self.local.len();
-        let mut inside = false;
-        let mut j = n - 1;
-        for i in 0..n {
-            let (a, b) = (self.local[j], self.local[i]);
-            if (b.y > q.y) != (a.y > q.y) && q.x < b.x + (q.y - b.y) * (a.x - b.x) / (a.y - b.y) {
-                inside = !inside;
-            }
-            j = i;
-        }
-        if inside {
+        if poly2::contains(&self.local, q) {
             return true;
         }
+        let n = self.local.len();
         let tol2 = tol * tol;
         let mut j = n - 1;
         for i in 0..n {
@@ -296,12 +272,6 @@ fn bounds(points: &[Vec3]) -> (Vec3, Vec3) {
         })
 }
 
-fn segment_distance_sq(q: Vec2, a: Vec2, b: Vec2) -> Real {
-    let ab = b - a;
-    let t = ((q - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0);
-    (a + t * ab - q).length_squared()
-}
-
 fn area_centroid(local: &[Vec2], origin: Vec3, u: Vec3, v: Vec3) -> Vec3 {
     let n = local.len();
     let (mut a2, mut cx, mut cy) = (0.0, 0.0, 0.0);
@@ -315,42 +285,6 @@ fn area_centroid(local: &[Vec2], origin: Vec3, u: Vec3, v: Vec3) -> Vec3 {
     }
     let c = Vec2::new(cx, cy) / (3.0 * a2);
     origin + c.x * u + c.y * v
-}
-
-/// First pair of non-adjacent edges that intersect, if any (O(n²); polygons are small).
-fn first_crossing(local: &[Vec2]) -> Option<(usize, usize)> {
-    let n = local.len();
-    for i in 0..n {
-        let (a, b) = (local[i], local[(i + 1) % n]);
-        for j in i + 1..n {
-            if j == i + 1 || (i == 0 && j == n - 1) {
-                continue;
-            }
-            let (c, d) = (local[j], local[(j + 1) % n]);
-            if segments_intersect(a, b, c, d) {
-                return Some((i, j));
-            }
-        }
-    }
-    None
-}
-
-fn segments_intersect(a: Vec2, b: Vec2, c: Vec2, d: Vec2) -> bool {
-    let o1 = (b - a).perp_dot(c - a);
-    let o2 = (b - a).perp_dot(d - a);
-    let o3 = (d - c).perp_dot(a - c);
-    let o4 = (d - c).perp_dot(b - c);
-    if o1 * o2 < 0.0 && o3 * o4 < 0.0 {
-        return true;
-    }
-    let on = |p: Vec2, q: Vec2, r: Vec2, o: Real| {
-        o == 0.0
-            && r.x >= p.x.min(q.x)
-            && r.x <= p.x.max(q.x)
-            && r.y >= p.y.min(q.y)
-            && r.y <= p.y.max(q.y)
-    };
-    on(a, b, c, o1) || on(a, b, d, o2) || on(c, d, a, o3) || on(c, d, b, o4)
 }
 
 #[cfg(test)]

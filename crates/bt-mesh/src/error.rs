@@ -1,5 +1,6 @@
 //! The crate's one error type.
 
+use bt_geom::Real;
 use std::fmt;
 
 /// Where in a mesh file a problem is: a text line, an element of a PLY body, or both.
@@ -108,7 +109,7 @@ pub enum MeshError {
         /// `x`, `y` or `z`.
         axis: char,
         /// The value read.
-        value: f64,
+        value: Real,
     },
     /// A PLY header claims more elements than the body can possibly hold. Checked before any
     /// allocation, so a hostile header cannot exhaust memory.

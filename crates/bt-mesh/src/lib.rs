@@ -24,39 +24,34 @@
 
 #![warn(missing_docs)]
 
+use bt_geom::{Real, Vec3};
+
 mod error;
 mod io;
 mod merge;
 mod obj;
 mod ply;
 mod raw;
+pub mod tol;
 
-use glam::DVec3;
 use serde::{Deserialize, Serialize};
 
 pub use error::{MeshError, Position};
 pub use io::read_mesh_path;
 
-/// Default maximum angle between the normals of faces merged into one surface, in degrees.
-pub const DEFAULT_ANGLE_TOL_DEG: f64 = 1.0;
-/// Default maximum distance of a merged face's vertices from the surface plane, in metres
-/// (1 mm: well below a wavelength at 60 GHz, 5 mm, and above export rounding).
-pub const DEFAULT_DIST_TOL_M: f64 = 1e-3;
-/// Default distance under which vertices are welded into one, in metres (0.1 mm: OBJ exporters
-/// write 6 decimals, single-precision PLY keeps ~0.06 mm at 1 km).
-pub const DEFAULT_WELD_TOL_M: f64 = 1e-4;
+pub use tol::{DEFAULT_ANGLE_TOL_DEG, DEFAULT_DIST_TOL_M, DEFAULT_WELD_TOL_M};
 
 /// Tolerances of the coplanar merge.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct MergeOptions {
     /// Maximum angle between a face normal and its group's normal, in degrees, in `[0, 90)`.
-    pub angle_tol_deg: f64,
+    pub angle_tol_deg: Real,
     /// Maximum distance of a face's vertices from its group's plane, in metres, `>= 0`. Also
     /// the planarity limit above which a polygon face is split into triangles.
-    pub dist_tol_m: f64,
+    pub dist_tol_m: Real,
     /// Vertices closer than this, in metres, are welded into one, `>= 0` (0: exact duplicates
     /// only). Also the length under which boundary vertices count as collinear or repeated.
-    pub weld_tol_m: f64,
+    pub weld_tol_m: Real,
 }
 
 impl Default for MergeOptions {
@@ -105,13 +100,13 @@ pub struct MeshSurface {
     pub material: Option<String>,
     /// Outer boundary in metres, counter-clockwise seen from `normal` (right-hand rule gives
     /// `normal`), no repeated or collinear vertices, at least three, all on one plane.
-    pub vertices: Vec<DVec3>,
+    pub vertices: Vec<Vec3>,
     /// Unit normal: the area-weighted average of the merged faces' normals, following the
     /// faces' winding (usually pointing into the room for exported interiors — whatever the
     /// file says).
-    pub normal: DVec3,
+    pub normal: Vec3,
     /// Area of the polygon `vertices` in m² (holes, if any, are included).
-    pub area_m2: f64,
+    pub area_m2: Real,
     /// Number of faces of the file merged into this surface.
     pub source_faces: usize,
 }

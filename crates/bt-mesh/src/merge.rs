@@ -15,16 +15,13 @@
 //!    clockwise loops (seen from the normal) become surfaces, clockwise loops are holes, which
 //!    are filled with a warning.
 
+use bt_geom::poly2::{self, contains, signed_area};
+use bt_geom::{Real, Vec2, Vec3};
 use std::collections::HashMap;
 
-use glam::{DVec2, DVec3};
-
 use crate::raw::RawMesh;
+use crate::tol;
 use crate::{MergeOptions, MeshSurface};
-
-/// Relative length tolerance (to the mesh's bounding-box diagonal) below which lengths count as
-/// zero even when `weld_tol_m` is 0: a few hundred ulps of f64 coordinates.
-const REL_ZERO_LENGTH: f64 = 1e-12;
 
 /// Result of the merge: surfaces in file order and warnings.
 pub(crate) struct Merged {
@@ -41,17 +38,17 @@ struct Face {
     /// Object/group name and material (interned indices).
     key: (Option<u32>, Option<u32>),
     /// Unit normal (right-hand rule on the vertex order).
-    normal: DVec3,
+    normal: Vec3,
     /// Area in m².
-    area: f64,
+    area: Real,
     /// Vertex average, a point on the face's plane.
-    centroid: DVec3,
+    centroid: Vec3,
 }
 
 /// Runs the whole merge. `opts` must be validated.
 pub(crate) fn merge(mesh: &RawMesh, opts: &MergeOptions, file: &str) -> Merged {
     let extent = bounding_diagonal(&mesh.positions);
-    let zero_length = opts.weld_tol_m.max(REL_ZERO_LENGTH * extent.max(1.0));
+    let zero_length = opts.weld_tol_m.max(tol::REL_ZERO_LENGTH * extent.max(1.0));
     let (weld_map, points) = weld(&mesh.positions, opts.weld_tol_m);
     let mut warnings = Vec::new();
 
@@ -141,7 +138,7 @@ pub(crate) fn merge(mesh: &RawMesh, opts: &MergeOptions, file: &str) -> Merged {
     Merged { surfaces, warnings }
 }
 
-fn bounding_diagonal(points: &[DVec3]) -> f64 {
+fn bounding_diagonal(points: &[Vec3]) -> Real {
     let Some(&first) = points.first() else {
         return 0.0;
     };
@@ -154,14 +151,14 @@ fn bounding_diagonal(points: &[DVec3]) -> f64 {
 /// Maps every position to a welded vertex id; returns the map and the welded positions (the
 /// first position of each cluster). A position joins the nearest earlier welded vertex within
 /// `tol`, found through a hash grid of cell size `tol`; `tol == 0` welds exact duplicates only.
-fn weld(positions: &[DVec3], tol: f64) -> (Vec<u32>, Vec<DVec3>) {
+fn weld(positions: &[Vec3], tol: Real) -> (Vec<u32>, Vec<Vec3>) {
     let mut map = Vec::with_capacity(positions.len());
-    let mut welded: Vec<DVec3> = Vec::new();
+    let mut welded: Vec<Vec3> = Vec::new();
     if tol <= 0.0 {
         let mut exact: HashMap<[u64; 3], u32> = HashMap::new();
         for &p in positions {
             // `+ 0.0` turns -0.0 into 0.0 so both weld.
-            let key = (p + DVec3::ZERO).to_array().map(f64::to_bits);
+            let key = (p + Vec3::ZERO).to_array().map(Real::to_bits);
             let id = *exact.entry(key).or_insert_with(|| {
                 welded.push(p);
                 (welded.len() - 1) as u32
@@ -170,11 +167,11 @@ fn weld(positions: &[DVec3], tol: f64) -> (Vec<u32>, Vec<DVec3>) {
         }
         return (map, welded);
     }
-    let cell_of = |p: DVec3| (p / tol).floor().to_array().map(|c| c as i64);
+    let cell_of = |p: Vec3| (p / tol).floor().to_array().map(|c| c as i64);
     let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
     for &p in positions {
         let cell = cell_of(p);
-        let mut best: Option<(f64, u32)> = None;
+        let mut best: Option<(Real, u32)> = None;
         for dx in -1..=1i64 {
             for dy in -1..=1i64 {
                 for dz in -1..=1i64 {
@@ -206,25 +203,14 @@ fn weld(positions: &[DVec3], tol: f64) -> (Vec<u32>, Vec<DVec3>) {
     (map, welded)
 }
 
-/// Area vector (normal times area, right-hand rule) of a closed polygon, computed relative to
-/// its first vertex to avoid cancellation far from the origin.
-fn area_vector(points: &[DVec3]) -> DVec3 {
-    let p0 = points[0];
-    let mut sum = DVec3::ZERO;
-    for w in points[1..].windows(2) {
-        sum += (w[0] - p0).cross(w[1] - p0);
-    }
-    0.5 * sum
-}
-
 /// Builds the planar faces; returns them with the counts of dropped degenerate faces and of
 /// non-planar faces split into triangles.
 fn planar_faces(
     mesh: &RawMesh,
     weld_map: &[u32],
-    points: &[DVec3],
+    points: &[Vec3],
     opts: &MergeOptions,
-    zero_length: f64,
+    zero_length: Real,
 ) -> (Vec<Face>, usize, usize) {
     let mut faces = Vec::with_capacity(mesh.face_count());
     let mut degenerate = 0usize;
@@ -249,7 +235,7 @@ fn planar_faces(
                     .vertices
                     .iter()
                     .map(|&v| (points[v as usize] - face.centroid).dot(face.normal).abs())
-                    .fold(0.0, f64::max);
+                    .fold(0.0, Real::max);
                 if off_plane <= opts.dist_tol_m {
                     faces.push(face);
                 } else {
@@ -274,22 +260,22 @@ fn make_face(
     ids: &[u32],
     source: usize,
     key: (Option<u32>, Option<u32>),
-    points: &[DVec3],
-    zero_length: f64,
+    points: &[Vec3],
+    zero_length: Real,
 ) -> Option<Face> {
     if ids.len() < 3 {
         return None;
     }
-    let pts: Vec<DVec3> = ids.iter().map(|&i| points[i as usize]).collect();
-    let area_vec = area_vector(&pts);
+    let pts: Vec<Vec3> = ids.iter().map(|&i| points[i as usize]).collect();
+    let area_vec = 0.5 * poly2::newell(&pts);
     let area = area_vec.length();
     let longest = (0..pts.len())
         .map(|i| pts[i].distance(pts[(i + 1) % pts.len()]))
-        .fold(0.0, f64::max);
+        .fold(0.0, Real::max);
     if !area.is_finite() || area <= 0.5 * zero_length * longest {
         return None;
     }
-    let centroid = pts.iter().sum::<DVec3>() / pts.len() as f64;
+    let centroid = pts.iter().sum::<Vec3>() / pts.len() as Real;
     Some(Face {
         vertices: ids.to_vec(),
         source,
@@ -334,7 +320,7 @@ struct Group {
 fn grow_regions(
     faces: &[Face],
     edges: &[(u64, u32)],
-    points: &[DVec3],
+    points: &[Vec3],
     opts: &MergeOptions,
 ) -> Vec<Group> {
     let cos_tol = opts.angle_tol_deg.to_radians().cos();
@@ -415,26 +401,26 @@ fn grow_regions(
 
 /// A closed boundary loop in the group's plane coordinates (metres).
 struct Loop {
-    points: Vec<DVec2>,
+    points: Vec<Vec2>,
     /// Signed area in m²: positive counter-clockwise seen from the group normal.
-    area: f64,
+    area: Real,
 }
 
 /// The traced boundary of one group, with the plane frame its 2-D coordinates live in.
 struct Traced {
-    normal: DVec3,
-    origin: DVec3,
-    u: DVec3,
-    v: DVec3,
+    normal: Vec3,
+    origin: Vec3,
+    u: Vec3,
+    v: Vec3,
     outer: Vec<Loop>,
     holes: Vec<Loop>,
     open_chains: usize,
     zero_loops: usize,
 }
 
-fn trace_group(faces: &[Face], group: &Group, points: &[DVec3], zero_length: f64) -> Traced {
-    let mut normal_sum = DVec3::ZERO;
-    let mut centroid_sum = DVec3::ZERO;
+fn trace_group(faces: &[Face], group: &Group, points: &[Vec3], zero_length: Real) -> Traced {
+    let mut normal_sum = Vec3::ZERO;
+    let mut centroid_sum = Vec3::ZERO;
     let mut area_sum = 0.0;
     for &f in &group.faces {
         normal_sum += faces[f].normal * faces[f].area;
@@ -447,7 +433,7 @@ fn trace_group(faces: &[Face], group: &Group, points: &[DVec3], zero_length: f64
     let v = normal.cross(u);
     let project = |id: u32| {
         let d = points[id as usize] - origin;
-        DVec2::new(d.dot(u), d.dot(v))
+        Vec2::new(d.dot(u), d.dot(v))
     };
 
     // Directed half-edges in face order; boundary = undirected edge used once in the group.
@@ -512,7 +498,7 @@ fn trace_group(faces: &[Face], group: &Group, points: &[DVec3], zero_length: f64
                     let out = project(boundary[h].1) - project(at);
                     (incoming.perp_dot(out).atan2(incoming.dot(out)), h)
                 })
-                .fold(None, |best: Option<(f64, usize)>, (turn, h)| match best {
+                .fold(None, |best: Option<(Real, usize)>, (turn, h)| match best {
                     Some((bt, _)) if bt <= turn => best,
                     _ => Some((turn, h)),
                 });
@@ -533,7 +519,7 @@ fn trace_group(faces: &[Face], group: &Group, points: &[DVec3], zero_length: f64
         }
         let pts = simplify(ids.into_iter().map(project).collect(), zero_length);
         let area = signed_area(&pts);
-        let perimeter: f64 = (0..pts.len())
+        let perimeter: Real = (0..pts.len())
             .map(|i| pts[i].distance(pts[(i + 1) % pts.len()]))
             .sum();
         if pts.len() < 3 || area.abs() <= 0.5 * zero_length * perimeter {
@@ -549,17 +535,17 @@ fn trace_group(faces: &[Face], group: &Group, points: &[DVec3], zero_length: f64
 
 /// Whether `p` is redundant between `a` and `b`: within `eps` of the line through them, or `a`
 /// and `b` coincide (a spike).
-fn redundant(a: DVec2, p: DVec2, b: DVec2, eps: f64) -> bool {
+fn redundant(a: Vec2, p: Vec2, b: Vec2, eps: Real) -> bool {
     let ab = b - a;
     let len = ab.length();
     len <= eps || ab.perp_dot(p - a).abs() <= eps * len
 }
 
 /// Removes repeated, collinear and spike vertices of a closed loop until none is left.
-fn simplify(mut pts: Vec<DVec2>, eps: f64) -> Vec<DVec2> {
+fn simplify(mut pts: Vec<Vec2>, eps: Real) -> Vec<Vec2> {
     loop {
         let before = pts.len();
-        let mut out: Vec<DVec2> = Vec::with_capacity(before);
+        let mut out: Vec<Vec2> = Vec::with_capacity(before);
         for &p in &pts {
             if out.last().is_some_and(|q| q.distance(p) <= eps) {
                 continue;
@@ -595,36 +581,6 @@ fn simplify(mut pts: Vec<DVec2>, eps: f64) -> Vec<DVec2> {
     }
 }
 
-/// Shoelace area, positive counter-clockwise.
-fn signed_area(pts: &[DVec2]) -> f64 {
-    let n = pts.len();
-    if n < 3 {
-        return 0.0;
-    }
-    let p0 = pts[0];
-    let mut sum = 0.0;
-    for i in 1..n - 1 {
-        sum += (pts[i] - p0).perp_dot(pts[i + 1] - p0);
-    }
-    0.5 * sum
-}
-
-/// Even-odd point-in-polygon test.
-fn contains(poly: &[DVec2], p: DVec2) -> bool {
-    let mut inside = false;
-    let n = poly.len();
-    for i in 0..n {
-        let (a, b) = (poly[i], poly[(i + 1) % n]);
-        if (a.y > p.y) != (b.y > p.y) {
-            let x = a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x);
-            if p.x < x {
-                inside = !inside;
-            }
-        }
-    }
-    inside
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -632,16 +588,16 @@ mod tests {
     #[test]
     fn weld_joins_nearby_positions_and_keeps_far_ones() {
         let pts = [
-            DVec3::new(0.0, 0.0, 0.0),
-            DVec3::new(1.0, 0.0, 0.0),
-            DVec3::new(0.00005, 0.0, 0.0),
-            DVec3::new(1.0, 0.0, -0.00009),
-            DVec3::new(0.0, 0.0, 0.001),
+            Vec3::new(0.0, 0.0, 0.0),
+            Vec3::new(1.0, 0.0, 0.0),
+            Vec3::new(0.00005, 0.0, 0.0),
+            Vec3::new(1.0, 0.0, -0.00009),
+            Vec3::new(0.0, 0.0, 0.001),
         ];
         let (map, welded) = weld(&pts, 1e-4);
         assert_eq!(map, [0, 1, 0, 1, 2]);
         assert_eq!(welded.len(), 3);
-        let (map, _) = weld(&[DVec3::ZERO, DVec3::new(-0.0, 0.0, 0.0)], 0.0);
+        let (map, _) = weld(&[Vec3::ZERO, Vec3::new(-0.0, 0.0, 0.0)], 0.0);
         assert_eq!(map, [0, 0]);
     }
 
@@ -657,7 +613,7 @@ mod tests {
             (0.0, 1.0),
             (0.0, 0.5),
         ]
-        .map(|(x, y)| DVec2::new(x, y));
+        .map(|(x, y)| Vec2::new(x, y));
         let out = simplify(square.to_vec(), 1e-9);
         assert_eq!(out.len(), 4, "{out:?}");
         assert!((signed_area(&out) - 1.0).abs() < 1e-12);
@@ -665,9 +621,8 @@ mod tests {
 
     #[test]
     fn point_in_polygon() {
-        let square =
-            [(0.0, 0.0), (2.0, 0.0), (2.0, 2.0), (0.0, 2.0)].map(|(x, y)| DVec2::new(x, y));
-        assert!(contains(&square, DVec2::new(1.0, 1.0)));
-        assert!(!contains(&square, DVec2::new(3.0, 1.0)));
+        let square = [(0.0, 0.0), (2.0, 0.0), (2.0, 2.0), (0.0, 2.0)].map(|(x, y)| Vec2::new(x, y));
+        assert!(contains(&square, Vec2::new(1.0, 1.0)));
+        assert!(!contains(&square, Vec2::new(3.0, 1.0)));
     }
 }

@@ -8,9 +8,8 @@
 //! normals, smoothing groups and `mtllib` are ignored; `l`/`p` elements and unknown statements
 //! are skipped with a warning.
 
+use bt_geom::{Real, Vec3};
 use std::collections::BTreeSet;
-
-use glam::DVec3;
 
 use crate::error::{MeshError, Position};
 use crate::raw::{RawMesh, intern};
@@ -50,7 +49,7 @@ pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
                     let token = tokens.next().ok_or_else(|| {
                         syntax(line_no, format!("vertex has no {axis} coordinate"))
                     })?;
-                    let value: f64 = token.parse().map_err(|_| {
+                    let value: Real = token.parse().map_err(|_| {
                         syntax(
                             line_no,
                             format!("vertex {axis} coordinate {token:?} is not a number"),
@@ -72,7 +71,7 @@ pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
                         detail: format!("more than {} vertices", u32::MAX),
                     });
                 }
-                mesh.positions.push(DVec3::from_array(xyz));
+                mesh.positions.push(Vec3::from_array(xyz));
             }
             "f" => {
                 face.clear();

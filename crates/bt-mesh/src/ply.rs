@@ -7,58 +7,11 @@
 //! with integer count and index types; other properties skipped) are used; other elements are
 //! read and skipped.
 
-use glam::DVec3;
-
 use crate::error::{MeshError, Position};
 use crate::raw::RawMesh;
+use bt_geom::{Real, Vec3};
 
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Format {
-    Ascii,
-    BinaryLittleEndian,
-    BinaryBigEndian,
-}
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-enum Scalar {
-    I8,
-    U8,
-    I16,
-    U16,
-    I32,
-    U32,
-    F32,
-    F64,
-}
-
-impl Scalar {
-    fn parse(name: &str) -> Option<Scalar> {
-        Some(match name {
-            "char" | "int8" => Scalar::I8,
-            "uchar" | "uint8" => Scalar::U8,
-            "short" | "int16" => Scalar::I16,
-            "ushort" | "uint16" => Scalar::U16,
-            "int" | "int32" => Scalar::I32,
-            "uint" | "uint32" => Scalar::U32,
-            "float" | "float32" => Scalar::F32,
-            "double" | "float64" => Scalar::F64,
-            _ => return None,
-        })
-    }
-
-    fn size(self) -> usize {
-        match self {
-            Scalar::I8 | Scalar::U8 => 1,
-            Scalar::I16 | Scalar::U16 => 2,
-            Scalar::I32 | Scalar::U32 | Scalar::F32 => 4,
-            Scalar::F64 => 8,
-        }
-    }
-
-    fn is_integer(self) -> bool {
-        !matches!(self, Scalar::F32 | Scalar::F64)
-    }
-}
+use bt_formats::{PlyFormat as Format, Scalar};
 
 #[derive(Debug, Clone, Copy)]
 enum Kind {
@@ -173,7 +126,7 @@ pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
         line: header.lines + 1,
         file,
     };
-    let mut values: Vec<f64> = Vec::new();
+    let mut values: Vec<Real> = Vec::new();
     let mut face: Vec<u32> = Vec::new();
     for (e, element) in header.elements.iter().enumerate() {
         for index in 0..element.count {
@@ -205,7 +158,7 @@ pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
                         for _ in 0..n as u64 {
                             let v = reader.read(item, &property.name, &start)?;
                             if collect {
-                                if v < 0.0 || v >= vertex_count as f64 {
+                                if v < 0.0 || v >= vertex_count as Real {
                                     return Err(MeshError::IndexOutOfRange {
                                         file: file.to_owned(),
                                         position: start,
@@ -234,7 +187,7 @@ pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
                     }
                     xyz[k] = value;
                 }
-                mesh.positions.push(DVec3::from_array(xyz));
+                mesh.positions.push(Vec3::from_array(xyz));
             } else if e == face_element {
                 if face.len() < 3 {
                     return Err(MeshError::FaceTooSmall {
@@ -294,17 +247,12 @@ fn parse_header(bytes: &[u8], file: &str) -> Result<Header, MeshError> {
                         detail: format!("PLY format version {version}"),
                     });
                 }
-                format = Some(match *kind {
-                    "ascii" => Format::Ascii,
-                    "binary_little_endian" => Format::BinaryLittleEndian,
-                    "binary_big_endian" => Format::BinaryBigEndian,
-                    other => {
-                        return Err(MeshError::Unsupported {
-                            file: file.to_owned(),
-                            detail: format!("PLY format {other:?}"),
-                        });
-                    }
-                });
+                format = Some(
+                    Format::from_name(kind).ok_or_else(|| MeshError::Unsupported {
+                        file: file.to_owned(),
+                        detail: format!("PLY format {kind:?}"),
+                    })?,
+                );
             }
             ["element", name, count] => {
                 let count: u64 = count.parse().map_err(|_| {
@@ -321,7 +269,7 @@ fn parse_header(bytes: &[u8], file: &str) -> Result<Header, MeshError> {
                     .last_mut()
                     .ok_or_else(|| syntax(line_no, "property before any element".into()))?;
                 let scalar = |name: &str| {
-                    Scalar::parse(name)
+                    Scalar::from_ply_name(name)
                         .ok_or_else(|| syntax(line_no, format!("unknown property type {name:?}")))
                 };
                 let property = match rest {
@@ -416,7 +364,7 @@ impl Reader<'_> {
     }
 
     /// One scalar of type `ty` as f64 (exact for every PLY integer type).
-    fn read(&mut self, ty: Scalar, property: &str, at: &Position) -> Result<f64, MeshError> {
+    fn read(&mut self, ty: Scalar, property: &str, at: &Position) -> Result<Real, MeshError> {
         let truncated = || MeshError::Truncated {
             file: self.file.to_owned(),
             position: at.clone(),
@@ -438,9 +386,9 @@ impl Reader<'_> {
                 }
                 let token = String::from_utf8_lossy(&self.bytes[start..self.pos]);
                 let value = if ty.is_integer() {
-                    token.parse::<i64>().ok().map(|v| v as f64)
+                    token.parse::<i64>().ok().map(|v| v as Real)
                 } else {
-                    token.parse::<f64>().ok()
+                    token.parse::<Real>().ok()
                 };
                 value.ok_or_else(|| MeshError::Syntax {
                     file: self.file.to_owned(),
@@ -455,22 +403,7 @@ impl Reader<'_> {
                     .get(self.pos..self.pos + size)
                     .ok_or_else(truncated)?;
                 self.pos += size;
-                let mut buf = [0u8; 8];
-                buf[..size].copy_from_slice(raw);
-                if self.format == Format::BinaryBigEndian {
-                    buf[..size].reverse();
-                }
-                // `buf` now holds little-endian bytes.
-                Ok(match ty {
-                    Scalar::I8 => f64::from(buf[0] as i8),
-                    Scalar::U8 => f64::from(buf[0]),
-                    Scalar::I16 => f64::from(i16::from_le_bytes([buf[0], buf[1]])),
-                    Scalar::U16 => f64::from(u16::from_le_bytes([buf[0], buf[1]])),
-                    Scalar::I32 => f64::from(i32::from_le_bytes([buf[0], buf[1], buf[2], buf[3]])),
-                    Scalar::U32 => f64::from(u32::from_le_bytes([buf[0], buf[1], buf[2], buf[3]])),
-                    Scalar::F32 => f64::from(f32::from_le_bytes([buf[0], buf[1], buf[2], buf[3]])),
-                    Scalar::F64 => f64::from_le_bytes(buf),
-                })
+                Ok(ty.decode(raw, self.format.is_big_endian()))
             }
         }
     }

@@ -1,13 +1,12 @@
 //! The parsed, validated mesh that both readers produce and the merge consumes.
 
-use glam::DVec3;
-
+use bt_geom::Vec3;
 /// A polygon soup as read from a file: finite positions, faces of at least three in-range
 /// vertex indices, and per-face object and material names (interned).
 #[derive(Debug, Default)]
 pub(crate) struct RawMesh {
     /// Vertex positions in metres, all finite.
-    pub positions: Vec<DVec3>,
+    pub positions: Vec<Vec3>,
     /// Concatenated face vertex indices into `positions`.
     pub indices: Vec<u32>,
     /// Face `f` uses `indices[face_start[f]..face_start[f + 1]]`; `len() == faces + 1`.

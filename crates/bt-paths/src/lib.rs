@@ -9,6 +9,7 @@
 //!   plane (coplanar surfaces) and surfaces entirely behind one another.
 //! - *visibility*: a [`Visibility`] relation (the weak visibility network, WVRN, of the paper,
 //!   or [`AllVisible`]) says whether two nodes can see each other at all.
+#![warn(missing_docs)]
 
 pub mod beamtree;
 pub mod wvrn;

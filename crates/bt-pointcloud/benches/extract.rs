@@ -5,7 +5,7 @@ use bt_pointcloud::{ExtractParams, extract_planes, sample_polygons};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::DVec3;
 
-#[path = "../tests/common/room.rs"]
+#[path = "../tests/it/common/room.rs"]
 mod room;
 
 fn area(p: &[DVec3]) -> f64 {

@@ -1,16 +1,16 @@
 //! Uniform voxel hash over a point set, for fixed-radius neighbour queries without O(n²).
 
+use bt_geom::{Real, Vec3};
 use std::collections::HashMap;
 use std::hash::{BuildHasherDefault, Hasher};
 
-use glam::DVec3;
 use rayon::prelude::*;
 
 /// Points bucketed into cubic voxels of edge `cell` (metres). Queries with a radius up to
 /// `cell` visit the 27 surrounding voxels. Only lookups go through the hash map; nothing
 /// iterates it, so results do not depend on hash order.
 pub(crate) struct VoxelIndex {
-    cell: f64,
+    cell: Real,
     order: Vec<u32>,
     ranges: HashMap<[i64; 3], (u32, u32), BuildHasherDefault<KeyHasher>>,
 }
@@ -41,14 +41,14 @@ impl Hasher for KeyHasher {
     }
 }
 
-pub(crate) fn voxel_key(p: DVec3, cell: f64) -> [i64; 3] {
+pub(crate) fn voxel_key(p: Vec3, cell: Real) -> [i64; 3] {
     // `as` saturates, so absurd coordinates land in the outermost voxel instead of wrapping.
     let k = (p / cell).floor();
     [k.x as i64, k.y as i64, k.z as i64]
 }
 
 impl VoxelIndex {
-    pub(crate) fn build(points: &[DVec3], cell: f64) -> Self {
+    pub(crate) fn build(points: &[Vec3], cell: Real) -> Self {
         let mut keyed: Vec<([i64; 3], u32)> = points
             .par_iter()
             .enumerate()
@@ -74,9 +74,9 @@ impl VoxelIndex {
     /// (metres), voxel by voxel in key order.
     pub(crate) fn for_each_in_box(
         &self,
-        points: &[DVec3],
-        lo: DVec3,
-        hi: DVec3,
+        points: &[Vec3],
+        lo: Vec3,
+        hi: Vec3,
         mut f: impl FnMut(u32),
     ) {
         let (a, b) = (voxel_key(lo, self.cell), voxel_key(hi, self.cell));
@@ -99,9 +99,9 @@ impl VoxelIndex {
     /// Call `f` with the index of every point within `radius` (≤ cell) of `p`.
     pub(crate) fn for_each_near(
         &self,
-        points: &[DVec3],
-        p: DVec3,
-        radius: f64,
+        points: &[Vec3],
+        p: Vec3,
+        radius: Real,
         mut f: impl FnMut(u32),
     ) {
         debug_assert!(radius <= self.cell * (1.0 + 1e-9));

@@ -2,6 +2,7 @@
 //! the carrier frequency, validated once at the boundary.
 //!
 //! Units and frames: metres, z up, Hz; see `docs/conventions.md`. Only [`io`] reads files.
+#![warn(missing_docs)]
 
 mod builtin;
 pub mod city;

@@ -79,7 +79,8 @@ pub const EARLY_REJECT_MARGIN: Real = 100.0;
 /// magnitude for the inaccuracy of the rate estimate below the 1e-9 m promise).
 pub const ERROR_GUARD_FACTOR: Real = 10.0;
 
-/// Early rejection starts after this many rounds (the rate needs a history of 16 rounds).
+/// Early rejection starts after this many rounds (the rate needs a history of
+/// [`EARLY_REJECT_SPAN`] rounds).
 pub const EARLY_REJECT_FROM: usize = 24;
 
 /// Rounds over which the error guard measures the contraction rate (even, for Jacobi).
@@ -270,20 +271,12 @@ fn run(
 ) -> IpcOutcome {
     let n = seq.len();
     let min_sum = scene.length_tolerance() * 1e-3;
-    let limit = options.threshold * n as Real;
     // Newton is tried at most twice: after NEWTON_PATIENCE rounds and at the switch point.
     let newton = options.acceleration == Acceleration::Newton;
     let (mut switch_pending, mut patience_pending) = (newton, newton);
     let newton_switch = NEWTON_SWITCH_REL * scene.extent().max(1.0) * n as Real;
     let mut newton_steps = 0;
-    // Displacement sums of the last RATE_WINDOW rounds (ring) and of the round STALL_WINDOW
-    // rounds ago.
-    let mut recent = [Real::INFINITY; RATE_WINDOW];
-    let (mut last, mut window_start) = (Real::INFINITY, Real::INFINITY);
-    // Whether the paper's rule held in some round: a run that then stalls under the error
-    // guard (near-corner paths converge sublinearly) still counts as converged, as the paper's
-    // algorithm would have stopped there.
-    let mut rule_met = false;
+    let mut rule = StoppingRule::new(options, n);
     let mut rounds = 0;
     while rounds < options.max_iterations {
         rounds += 1;
@@ -311,108 +304,46 @@ fn run(
             patience_pending = false;
             match crate::newton::polish(planes, tx, rx, points, options.threshold) {
                 crate::newton::Polish::Converged { steps, last_step } => {
-                    let iterations = rounds + steps;
-                    if let Some(index) = opposite_sides(scene, planes, tx, rx, points) {
-                        return IpcOutcome::Degenerate {
-                            kind: DegenerateKind::OppositeSides,
-                            index,
-                            iterations,
-                        };
-                    }
-                    return IpcOutcome::Converged {
-                        iterations,
-                        residual: last_step / n as Real,
-                    };
+                    let residual = last_step / n as Real;
+                    return converged(scene, planes, tx, rx, points, rounds + steps, residual);
                 }
                 // The points are unchanged; the paper's rounds carry on.
                 crate::newton::Polish::Failed { steps } => newton_steps += steps,
             }
         }
-        // The paper's rule, then the error guard. The rate is measured over RATE_WINDOW
-        // (even) rounds so that Jacobi's alternating displacements and round-off noise do not
-        // fake a fast rate; a rate >= 1 means the displacement has reached round-off noise,
-        // where more rounds cannot help.
-        let slot = rounds as usize % RATE_WINDOW;
-        if moved <= limit {
-            rule_met = true;
-            // Before a full window, measure over the rounds run so far (from the first).
-            let (base, window) = if rounds as usize > RATE_WINDOW {
-                (recent[slot], RATE_WINDOW as Real)
-            } else {
-                (recent[1 % RATE_WINDOW], (rounds - 1).max(1) as Real)
+        if rule.settled(rounds, moved) {
+            let residual = moved / n as Real;
+            return converged(
+                scene,
+                planes,
+                tx,
+                rx,
+                points,
+                rounds + newton_steps,
+                residual,
+            );
+        }
+        if rule.stalled(rounds, moved) {
+            break;
+        }
+        let reach = options
+            .early_reject
+            .then(|| rule.early_reject_reach(rounds, moved, scene.length_tolerance()))
+            .flatten();
+        if let Some(index) = reach.and_then(|reach| {
+            (0..n).find(|&k| !scene.surface(seq[k]).polygon.contains(points[k], reach))
+        }) {
+            return IpcOutcome::LeftPolygon {
+                index,
+                iterations: rounds + newton_steps,
             };
-            let rate = (moved / base).powf(1.0 / window);
-            // `!(rate < 1.0)` on purpose: a NaN rate (0/0 at exact convergence) counts as settled.
-            #[allow(clippy::neg_cmp_op_on_partial_ord)]
-            let settled = !options.error_guard
-                || !(rate < 1.0)
-                || moved * rate / (1.0 - rate) <= limit * ERROR_GUARD_FACTOR;
-            if settled {
-                let iterations = rounds + newton_steps;
-                if let Some(index) = opposite_sides(scene, planes, tx, rx, points) {
-                    return IpcOutcome::Degenerate {
-                        kind: DegenerateKind::OppositeSides,
-                        index,
-                        iterations,
-                    };
-                }
-                return IpcOutcome::Converged {
-                    iterations,
-                    residual: moved / n as Real,
-                };
-            }
         }
-        // Give up early when the rate measured over the last window cannot reach the
-        // threshold within the remaining rounds (with a factor 4 of slack for rates that
-        // improve near the fixed point).
-        if rounds % STALL_WINDOW == 0 {
-            if rounds > STALL_WINDOW {
-                let rate = (moved / window_start).powf(1.0 / STALL_WINDOW as Real);
-                let remaining = (options.max_iterations - rounds) as Real;
-                let needed = if rate < 1.0 {
-                    (limit / moved).ln() / rate.ln()
-                } else {
-                    Real::INFINITY
-                };
-                if needed > 4.0 * remaining {
-                    break;
-                }
-            }
-            window_start = moved;
-        }
-        if options.early_reject && rounds as usize >= EARLY_REJECT_FROM && rounds % 8 == 0 {
-            let base = recent[(rounds as usize - 16) % RATE_WINDOW];
-            let rate = (moved / base).powf(1.0 / 16.0);
-            if rate < 1.0 {
-                let reach =
-                    EARLY_REJECT_MARGIN * moved * rate / (1.0 - rate) + scene.length_tolerance();
-                if let Some(index) =
-                    (0..n).find(|&k| !scene.surface(seq[k]).polygon.contains(points[k], reach))
-                {
-                    return IpcOutcome::LeftPolygon {
-                        index,
-                        iterations: rounds + newton_steps,
-                    };
-                }
-            }
-        }
-        recent[slot] = moved;
-        last = moved;
+        rule.record(rounds, moved);
     }
     let iterations = rounds + newton_steps;
-    let residual = last / n as Real;
-    if rule_met && residual.is_finite() {
-        if let Some(index) = opposite_sides(scene, planes, tx, rx, points) {
-            return IpcOutcome::Degenerate {
-                kind: DegenerateKind::OppositeSides,
-                index,
-                iterations,
-            };
-        }
-        return IpcOutcome::Converged {
-            iterations,
-            residual,
-        };
+    let residual = rule.last / n as Real;
+    if rule.rule_met && residual.is_finite() {
+        return converged(scene, planes, tx, rx, points, iterations, residual);
     }
     IpcOutcome::NotConverged {
         iterations,
@@ -420,6 +351,148 @@ fn run(
             residual
         } else {
             Real::MAX
+        },
+    }
+}
+
+/// Early rejection looks at the points every this many rounds (a divisor of [`RATE_WINDOW`]).
+pub const EARLY_REJECT_EVERY: u32 = 8;
+
+/// Rounds over which early rejection measures the contraction rate; [`EARLY_REJECT_FROM`]
+/// leaves at least this much history.
+pub const EARLY_REJECT_SPAN: usize = 16;
+
+/// The stopping rules of one run and the displacement history they read: the paper's rule
+/// with the error guard ([`StoppingRule::settled`]), the stall check
+/// ([`StoppingRule::stalled`]) and the reach of early rejection
+/// ([`StoppingRule::early_reject_reach`]).
+struct StoppingRule {
+    /// The paper's threshold on the summed displacement of a round: threshold × chain length (m).
+    limit: Real,
+    error_guard: bool,
+    max_iterations: u32,
+    /// Displacement sums of the last RATE_WINDOW rounds (ring, indexed by round).
+    recent: [Real; RATE_WINDOW],
+    /// Displacement of the round that opened the current STALL_WINDOW.
+    window_start: Real,
+    /// Displacement of the last recorded round.
+    last: Real,
+    /// Whether the paper's rule held in some round: a run that then stalls under the error
+    /// guard (near-corner paths converge sublinearly) still counts as converged, as the
+    /// paper's algorithm would have stopped there.
+    rule_met: bool,
+}
+
+impl StoppingRule {
+    fn new(options: &IpcOptions, n: usize) -> Self {
+        Self {
+            limit: options.threshold * n as Real,
+            error_guard: options.error_guard,
+            max_iterations: options.max_iterations,
+            recent: [Real::INFINITY; RATE_WINDOW],
+            window_start: Real::INFINITY,
+            last: Real::INFINITY,
+            rule_met: false,
+        }
+    }
+
+    /// The paper's rule, then the error guard: whether round `rounds` (from 1), which moved
+    /// the points by `moved` in sum, ends the run as converged. The rate is measured over
+    /// RATE_WINDOW (even) rounds so that Jacobi's alternating displacements and round-off
+    /// noise do not fake a fast rate; a rate >= 1 means the displacement has reached
+    /// round-off noise, where more rounds cannot help.
+    #[inline(always)]
+    fn settled(&mut self, rounds: u32, moved: Real) -> bool {
+        if moved > self.limit {
+            return false;
+        }
+        self.rule_met = true;
+        // Before a full window, measure over the rounds run so far (from the first).
+        let (base, window) = if rounds as usize > RATE_WINDOW {
+            (
+                self.recent[rounds as usize % RATE_WINDOW],
+                RATE_WINDOW as Real,
+            )
+        } else {
+            (self.recent[1 % RATE_WINDOW], (rounds - 1).max(1) as Real)
+        };
+        let rate = (moved / base).powf(1.0 / window);
+        // `!(rate < 1.0)` on purpose: a NaN rate (0/0 at exact convergence) counts as settled.
+        #[allow(clippy::neg_cmp_op_on_partial_ord)]
+        let settled = !self.error_guard
+            || !(rate < 1.0)
+            || moved * rate / (1.0 - rate) <= self.limit * ERROR_GUARD_FACTOR;
+        settled
+    }
+
+    /// Whether to give up: every STALL_WINDOW rounds, when the rate measured over the last
+    /// window cannot reach the threshold within the remaining rounds (with a factor 4 of
+    /// slack for rates that improve near the fixed point).
+    #[inline(always)]
+    fn stalled(&mut self, rounds: u32, moved: Real) -> bool {
+        let window_end = rounds.is_multiple_of(STALL_WINDOW);
+        if window_end && rounds > STALL_WINDOW {
+            let rate = (moved / self.window_start).powf(1.0 / STALL_WINDOW as Real);
+            let remaining = (self.max_iterations - rounds) as Real;
+            let needed = if rate < 1.0 {
+                (self.limit / moved).ln() / rate.ln()
+            } else {
+                Real::INFINITY
+            };
+            if needed > 4.0 * remaining {
+                return true;
+            }
+        }
+        if window_end {
+            self.window_start = moved;
+        }
+        false
+    }
+
+    /// On the rounds where early rejection looks, the distance (m) a point may still lie
+    /// outside its polygon: the remaining movement at the rate measured over the last
+    /// EARLY_REJECT_SPAN rounds, times the margin, plus the scene's length tolerance. `None`
+    /// on other rounds and while the displacement is not shrinking.
+    #[inline(always)]
+    fn early_reject_reach(&self, rounds: u32, moved: Real, length_tolerance: Real) -> Option<Real> {
+        let looks =
+            rounds as usize >= EARLY_REJECT_FROM && rounds.is_multiple_of(EARLY_REJECT_EVERY);
+        if !looks {
+            return None;
+        }
+        let base = self.recent[(rounds as usize - EARLY_REJECT_SPAN) % RATE_WINDOW];
+        let rate = (moved / base).powf(1.0 / EARLY_REJECT_SPAN as Real);
+        (rate < 1.0).then(|| EARLY_REJECT_MARGIN * moved * rate / (1.0 - rate) + length_tolerance)
+    }
+
+    /// Remembers the displacement of round `rounds`.
+    #[inline(always)]
+    fn record(&mut self, rounds: u32, moved: Real) {
+        self.recent[rounds as usize % RATE_WINDOW] = moved;
+        self.last = moved;
+    }
+}
+
+/// The outcome of a run whose stopping rule held: converged, unless some point ends with its
+/// neighbours on opposite sides of its plane (a transmission, not a reflection).
+fn converged(
+    scene: &Scene,
+    planes: &[Plane],
+    tx: Vec3,
+    rx: Vec3,
+    points: &[Vec3],
+    iterations: u32,
+    residual: Real,
+) -> IpcOutcome {
+    match opposite_sides(scene, planes, tx, rx, points) {
+        Some(index) => IpcOutcome::Degenerate {
+            kind: DegenerateKind::OppositeSides,
+            index,
+            iterations,
+        },
+        None => IpcOutcome::Converged {
+            iterations,
+            residual,
         },
     }
 }

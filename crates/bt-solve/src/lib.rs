@@ -8,6 +8,7 @@
 //!
 //! [`trace`] runs a solver over a [`CandidateSet`] and returns the valid paths plus a count
 //! of every outcome; one bad candidate never aborts the batch.
+#![warn(missing_docs)]
 
 pub mod image;
 pub mod ipc;

@@ -11,6 +11,7 @@
 //!
 //! Units: metres, seconds; angles in degrees where the name says `_deg`.
 //! `docs/study-2d.md` describes the method and the measured numbers.
+#![warn(missing_docs)]
 
 pub mod embed;
 pub mod fpga;

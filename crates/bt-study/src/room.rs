@@ -16,6 +16,9 @@
 //! TX and RX keep at least [`CLEARANCE`] from every wall at every time step.
 
 use crate::StudyError;
+/// Simplicity and strict (even-odd) containment of a contour: the geometry kernel's predicates.
+pub use bt_geom::poly2::{contains, is_simple};
+use bt_geom::poly2::{segment_distance_sq, signed_area};
 use bt_geom::{Real, Vec2};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
@@ -313,57 +316,6 @@ fn turn(contour: &[Vec2], i: usize) -> Real {
     (b - a).perp_dot(c - b)
 }
 
-/// Twice the signed area (positive: counter-clockwise).
-pub fn signed_area2(contour: &[Vec2]) -> Real {
-    let n = contour.len();
-    (0..n)
-        .map(|i| contour[i].perp_dot(contour[(i + 1) % n]))
-        .sum()
-}
-
-/// Whether the closed contour is simple: no two edges touch except consecutive ones at their
-/// shared vertex (and those do not fold back onto each other).
-pub fn is_simple(contour: &[Vec2]) -> bool {
-    let n = contour.len();
-    if n < 3 {
-        return false;
-    }
-    for i in 0..n {
-        let (a, b) = (contour[i], contour[(i + 1) % n]);
-        for j in i + 1..n {
-            let (c, d) = (contour[j], contour[(j + 1) % n]);
-            let adjacent = j == i + 1 || (i == 0 && j == n - 1);
-            if adjacent {
-                // Consecutive edges share one vertex; they must not overlap along a line.
-                let (shared, p, q) = if j == i + 1 { (b, a, d) } else { (a, b, c) };
-                let (u, w) = (p - shared, q - shared);
-                if u.perp_dot(w) == 0.0 && u.dot(w) > 0.0 {
-                    return false;
-                }
-            } else if segments_touch(a, b, c, d) {
-                return false;
-            }
-        }
-    }
-    true
-}
-
-/// Whether the closed segments `a-b` and `c-d` share a point.
-fn segments_touch(a: Vec2, b: Vec2, c: Vec2, d: Vec2) -> bool {
-    let o1 = (b - a).perp_dot(c - a);
-    let o2 = (b - a).perp_dot(d - a);
-    let o3 = (d - c).perp_dot(a - c);
-    let o4 = (d - c).perp_dot(b - c);
-    let on = |p: Vec2, q: Vec2, r: Vec2| {
-        r.x >= p.x.min(q.x) && r.x <= p.x.max(q.x) && r.y >= p.y.min(q.y) && r.y <= p.y.max(q.y)
-    };
-    (o1 * o2 < 0.0 && o3 * o4 < 0.0)
-        || (o1 == 0.0 && on(a, b, c))
-        || (o2 == 0.0 && on(a, b, d))
-        || (o3 == 0.0 && on(c, d, a))
-        || (o4 == 0.0 && on(c, d, b))
-}
-
 /// All the generator's invariants: counter-clockwise, simple, walls at least [`MIN_EDGE`]
 /// long, corners turning by at least [`MIN_TURN_DEG`], inside the square with a margin.
 pub fn is_valid(contour: &[Vec2]) -> bool {
@@ -374,7 +326,7 @@ pub fn is_valid(contour: &[Vec2]) -> bool {
         && contour.iter().all(|p| p.is_finite())
         && lo.min_element() >= 0.5 * BORDER
         && hi.max_element() <= SQUARE - 0.5 * BORDER
-        && signed_area2(contour) > 0.0
+        && signed_area(contour) > 0.0
         && (0..n).all(|i| contour[i].distance(contour[(i + 1) % n]) >= MIN_EDGE)
         && (0..n).all(|i| {
             let (a, b, c) = (contour[(i + n - 1) % n], contour[i], contour[(i + 1) % n]);
@@ -384,34 +336,11 @@ pub fn is_valid(contour: &[Vec2]) -> bool {
         && is_simple(contour)
 }
 
-/// Whether `p` is strictly inside the contour (crossing number).
-pub fn contains(contour: &[Vec2], p: Vec2) -> bool {
-    let n = contour.len();
-    let mut inside = false;
-    let mut j = n - 1;
-    for i in 0..n {
-        let (a, b) = (contour[j], contour[i]);
-        if (b.y > p.y) != (a.y > p.y) {
-            let x = b.x + (p.y - b.y) * (a.x - b.x) / (a.y - b.y);
-            if p.x < x {
-                inside = !inside;
-            }
-        }
-        j = i;
-    }
-    inside
-}
-
 /// Distance from `p` to the nearest wall, metres.
 pub fn wall_distance(contour: &[Vec2], p: Vec2) -> Real {
     let n = contour.len();
     (0..n)
-        .map(|i| {
-            let (a, b) = (contour[i], contour[(i + 1) % n]);
-            let ab = b - a;
-            let t = ((p - a).dot(ab) / ab.length_squared()).clamp(0.0, 1.0);
-            (a + t * ab).distance(p)
-        })
+        .map(|i| segment_distance_sq(p, contour[i], contour[(i + 1) % n]).sqrt())
         .fold(Real::INFINITY, Real::min)
 }
 

@@ -194,35 +194,41 @@ pub fn angle_deg(a: Vec3, b: Vec3) -> Real {
 pub(crate) type PathMap = BTreeMap<Vec<SurfaceId>, Directions>;
 
 /// Trace one scene with one solver (image, IPC or SBR), timed; paths keyed by surface
-/// sequence.
+/// sequence. The fixed-point model is not a host solver (it runs per step in the living-room
+/// study, with its own quantisation): asking for it here is an error, not a silent fallback.
 pub(crate) fn run_solver(
     scene: &Scene,
     solver: StudySolver,
     config: &StudyConfig,
-) -> (PathMap, Real) {
+) -> Result<(PathMap, Real), StudyError> {
     let start = Instant::now();
-    if solver == StudySolver::Sbr {
-        let result = sbr::trace_detailed(scene, &config.sbr_options(), config.max_order, false);
-        let elapsed = start.elapsed().as_secs_f64();
-        let map = result
-            .paths
-            .into_iter()
-            .map(|p| {
-                let d = Directions {
-                    departure: p.departure,
-                    arrival: p.arrival,
-                };
-                (p.surfaces, d)
-            })
-            .collect();
-        return (map, elapsed);
-    }
     let s = match solver {
+        StudySolver::Image => Solver::Image,
         StudySolver::IpcGaussSeidel => {
             Solver::Ipc(IpcOptions::for_scene(scene, UpdateOrder::GaussSeidel))
         }
         StudySolver::IpcJacobi => Solver::Ipc(IpcOptions::for_scene(scene, UpdateOrder::Jacobi)),
-        _ => Solver::Image,
+        StudySolver::Sbr => {
+            let result = sbr::trace_detailed(scene, &config.sbr_options(), config.max_order, false);
+            let elapsed = start.elapsed().as_secs_f64();
+            let map = result
+                .paths
+                .into_iter()
+                .map(|p| {
+                    let d = Directions {
+                        departure: p.departure,
+                        arrival: p.arrival,
+                    };
+                    (p.surfaces, d)
+                })
+                .collect();
+            return Ok((map, elapsed));
+        }
+        StudySolver::IpcFixedPoint => {
+            return Err(StudyError::Config(
+                "the fixed-point solver runs only in the living-room study".into(),
+            ));
+        }
     };
     let candidates = study_candidates(scene, config.max_order);
     let result = trace(scene, &candidates, &s, false);
@@ -235,7 +241,7 @@ pub(crate) fn run_solver(
             (p.surfaces, d)
         })
         .collect();
-    (map, elapsed)
+    Ok((map, elapsed))
 }
 
 /// Matched, missed and spurious paths of `found` against `reference`, and the mean and largest
@@ -305,7 +311,7 @@ pub fn run(
             let scene = embed::scene(&name, contour, room.tx, room.rx)?;
             let mut reference = PathMap::new();
             for solver in StudySolver::ALL {
-                let (found, time_s) = run_solver(&scene, solver, config);
+                let (found, time_s) = run_solver(&scene, solver, config)?;
                 if solver == StudySolver::Image {
                     reference = found;
                     rows.push(row(&room, step, solver, &reference, &reference, time_s));
@@ -382,4 +388,25 @@ fn exact_polylines(scene: &Scene, max_order: usize) -> Vec<(usize, Vec<Vec2>)> {
             (p.surfaces.len(), line)
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_fixed_point_solver_is_refused_not_replaced_by_the_image_method() {
+        let square = [(1.0, 1.0), (9.0, 1.0), (9.0, 9.0), (1.0, 9.0)].map(|(x, y)| Vec2::new(x, y));
+        let scene = embed::scene("square", &square, Vec2::new(3.0, 3.0), Vec2::new(7.0, 6.0))
+            .expect("valid square room");
+        let config = StudyConfig::default();
+        let Err(err) = run_solver(&scene, StudySolver::IpcFixedPoint, &config) else {
+            panic!("the fixed-point solver must be refused");
+        };
+        assert!(err.to_string().contains("fixed-point"), "{err}");
+        let Ok((image, _)) = run_solver(&scene, StudySolver::Image, &config) else {
+            panic!("the image method must run");
+        };
+        assert!(!image.is_empty());
+    }
 }

@@ -8,52 +8,39 @@
 //! follows the sampled surface rather than the cell raster. Every step that could break
 //! simplicity is checked and falls back to the previous, valid polygon.
 
-use glam::DVec2;
-
 use crate::tol;
+pub(crate) use bt_geom::poly2::{is_simple, signed_area};
+use bt_geom::{Real, Vec2};
 
 /// Largest number of raster cells for one patch; the cell grows beyond it.
-const MAX_CELLS: f64 = 4.0e6;
+const MAX_CELLS: Real = 4.0e6;
 
 /// A directed 2-D line through `p` with unit direction `d`.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Line2 {
-    pub p: DVec2,
-    pub d: DVec2,
-}
-
-fn cross(a: DVec2, b: DVec2) -> f64 {
-    a.x * b.y - a.y * b.x
-}
-
-/// Signed area (positive for counter-clockwise), m².
-pub(crate) fn signed_area(poly: &[DVec2]) -> f64 {
-    let n = poly.len();
-    (0..n)
-        .map(|i| cross(poly[i], poly[(i + 1) % n]))
-        .sum::<f64>()
-        * 0.5
+    pub p: Vec2,
+    pub d: Vec2,
 }
 
 /// Convex hull (Andrew's monotone chain), counter-clockwise, without collinear points.
-pub(crate) fn convex_hull(points: &[DVec2]) -> Vec<DVec2> {
-    let mut p: Vec<DVec2> = points.to_vec();
+pub(crate) fn convex_hull(points: &[Vec2]) -> Vec<Vec2> {
+    let mut p: Vec<Vec2> = points.to_vec();
     p.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
     p.dedup();
     if p.len() < 3 {
         return p;
     }
-    let mut h: Vec<DVec2> = Vec::with_capacity(2 * p.len());
+    let mut h: Vec<Vec2> = Vec::with_capacity(2 * p.len());
     for pass in 0..2 {
         let start = h.len();
-        let iter: Box<dyn Iterator<Item = &DVec2>> = if pass == 0 {
+        let iter: Box<dyn Iterator<Item = &Vec2>> = if pass == 0 {
             Box::new(p.iter())
         } else {
             Box::new(p.iter().rev())
         };
         for &q in iter {
             while h.len() >= start + 2
-                && cross(h[h.len() - 1] - h[h.len() - 2], q - h[h.len() - 2]) <= 0.0
+                && (h[h.len() - 1] - h[h.len() - 2]).perp_dot(q - h[h.len() - 2]) <= 0.0
             {
                 h.pop();
             }
@@ -66,7 +53,7 @@ pub(crate) fn convex_hull(points: &[DVec2]) -> Vec<DVec2> {
 
 /// Minimum-area enclosing rectangle of a convex hull: `(angle_rad, width, length)` where
 /// rotating by `-angle` makes the rectangle axis-aligned and `width ≤ length` (metres).
-pub(crate) fn min_area_rect(hull: &[DVec2]) -> (f64, f64, f64) {
+pub(crate) fn min_area_rect(hull: &[Vec2]) -> (Real, Real, Real) {
     let n = hull.len();
     if n < 3 {
         let len = if n == 2 {
@@ -81,7 +68,7 @@ pub(crate) fn min_area_rect(hull: &[DVec2]) -> (f64, f64, f64) {
         };
         return (ang, 0.0, len);
     }
-    let mut best = (f64::INFINITY, 0.0, 0.0, 0.0);
+    let mut best = (Real::INFINITY, 0.0, 0.0, 0.0);
     for i in 0..n {
         let e = hull[(i + 1) % n] - hull[i];
         let len = e.length();
@@ -91,10 +78,10 @@ pub(crate) fn min_area_rect(hull: &[DVec2]) -> (f64, f64, f64) {
         let d = e / len;
         let o = d.perp();
         let (mut a0, mut a1, mut b0, mut b1) = (
-            f64::INFINITY,
-            f64::NEG_INFINITY,
-            f64::INFINITY,
-            f64::NEG_INFINITY,
+            Real::INFINITY,
+            Real::NEG_INFINITY,
+            Real::INFINITY,
+            Real::NEG_INFINITY,
         );
         for &q in hull {
             let (a, b) = (q.dot(d), q.dot(o));
@@ -112,70 +99,21 @@ pub(crate) fn min_area_rect(hull: &[DVec2]) -> (f64, f64, f64) {
     (ang, w1.min(w2), w1.max(w2))
 }
 
-/// Whether a closed polygon is simple (no two non-adjacent edges touch, no zero-length edge).
-pub(crate) fn is_simple(poly: &[DVec2]) -> bool {
-    let n = poly.len();
-    if n < 3 || poly.iter().any(|p| !p.is_finite()) {
-        return false;
-    }
-    let seg = |i: usize| (poly[i], poly[(i + 1) % n]);
-    for i in 0..n {
-        let (a, b) = seg(i);
-        if a == b {
-            return false;
-        }
-        for j in i + 1..n {
-            if j == i + 1 || (i == 0 && j == n - 1) {
-                continue;
-            }
-            let (c, d) = seg(j);
-            if segments_touch(a, b, c, d) {
-                return false;
-            }
-        }
-    }
-    // Adjacent edges must not fold back onto each other.
-    for i in 0..n {
-        let (a, b, c) = (poly[(i + n - 1) % n], poly[i], poly[(i + 1) % n]);
-        if cross(b - a, c - b) == 0.0 && (b - a).dot(c - b) < 0.0 {
-            return false;
-        }
-    }
-    true
-}
-
-fn segments_touch(a: DVec2, b: DVec2, c: DVec2, d: DVec2) -> bool {
-    let o = |p: DVec2, q: DVec2, r: DVec2| cross(q - p, r - p);
-    let on = |p: DVec2, q: DVec2, r: DVec2| {
-        r.x >= p.x.min(q.x) && r.x <= p.x.max(q.x) && r.y >= p.y.min(q.y) && r.y <= p.y.max(q.y)
-    };
-    let (d1, d2, d3, d4) = (o(c, d, a), o(c, d, b), o(a, b, c), o(a, b, d));
-    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0))
-        && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0))
-    {
-        return true;
-    }
-    (d1 == 0.0 && on(c, d, a))
-        || (d2 == 0.0 && on(c, d, b))
-        || (d3 == 0.0 && on(a, b, c))
-        || (d4 == 0.0 && on(a, b, d))
-}
-
 /// Intersection of two lines, `None` when they are closer to parallel than
 /// [`tol::PARALLEL_SIN`].
-pub(crate) fn intersect(l1: Line2, l2: Line2) -> Option<DVec2> {
-    let den = cross(l1.d, l2.d);
+pub(crate) fn intersect(l1: Line2, l2: Line2) -> Option<Vec2> {
+    let den = l1.d.perp_dot(l2.d);
     if den.abs() < tol::PARALLEL_SIN {
         return None;
     }
-    let t = cross(l2.p - l1.p, l2.d) / den;
+    let t = (l2.p - l1.p).perp_dot(l2.d) / den;
     Some(l1.p + l1.d * t)
 }
 
 /// Rebuild a polygon whose edge `i` lies on `lines[i]` (running from vertex `i` to `i+1`).
 /// Where consecutive lines are nearly parallel the old vertex is projected onto both
 /// lines and averaged.
-pub(crate) fn polygon_from_lines(lines: &[Line2], old: &[DVec2]) -> Vec<DVec2> {
+pub(crate) fn polygon_from_lines(lines: &[Line2], old: &[Vec2]) -> Vec<Vec2> {
     let n = lines.len();
     (0..n)
         .map(|i| {
@@ -189,7 +127,7 @@ pub(crate) fn polygon_from_lines(lines: &[Line2], old: &[DVec2]) -> Vec<DVec2> {
 }
 
 /// Edge lines of a polygon.
-pub(crate) fn lines_of(poly: &[DVec2]) -> Vec<Line2> {
+pub(crate) fn lines_of(poly: &[Vec2]) -> Vec<Line2> {
     let n = poly.len();
     (0..n)
         .map(|i| Line2 {
@@ -201,7 +139,7 @@ pub(crate) fn lines_of(poly: &[DVec2]) -> Vec<Line2> {
 
 /// Accept `new` in place of `old` if it is simple, counter-clockwise, has the same vertex
 /// count and no vertex moved more than `max_move` metres.
-pub(crate) fn acceptable(old: &[DVec2], new: &[DVec2], max_move: f64) -> bool {
+pub(crate) fn acceptable(old: &[Vec2], new: &[Vec2], max_move: Real) -> bool {
     new.len() == old.len()
         && new.iter().zip(old).all(|(a, b)| a.distance(*b) <= max_move)
         && signed_area(new) > tol::AREA_REL * signed_area(old).abs()
@@ -209,14 +147,14 @@ pub(crate) fn acceptable(old: &[DVec2], new: &[DVec2], max_move: f64) -> bool {
 }
 
 /// Drop vertices where the polygon goes straight on (or doubles back exactly).
-fn remove_collinear(poly: &mut Vec<DVec2>) {
+fn remove_collinear(poly: &mut Vec<Vec2>) {
     let mut changed = true;
     while changed && poly.len() > 3 {
         changed = false;
         let n = poly.len();
         for i in 0..n {
             let (a, b, c) = (poly[(i + n - 1) % n], poly[i], poly[(i + 1) % n]);
-            if cross(b - a, c - b) == 0.0 {
+            if (b - a).perp_dot(c - b) == 0.0 {
                 poly.remove(i);
                 changed = true;
                 break;
@@ -226,7 +164,7 @@ fn remove_collinear(poly: &mut Vec<DVec2>) {
 }
 
 /// Douglas–Peucker on a closed ring, anchored at vertex 0 and the vertex farthest from it.
-fn simplify_closed(poly: &[DVec2], tolerance: f64) -> Vec<DVec2> {
+fn simplify_closed(poly: &[Vec2], tolerance: Real) -> Vec<Vec2> {
     let n = poly.len();
     if n <= 4 {
         return poly.to_vec();
@@ -241,7 +179,7 @@ fn simplify_closed(poly: &[DVec2], tolerance: f64) -> Vec<DVec2> {
     let mut keep = vec![false; n];
     keep[0] = true;
     keep[far] = true;
-    let ring: Vec<DVec2> = poly
+    let ring: Vec<Vec2> = poly
         .iter()
         .copied()
         .chain(std::iter::once(poly[0]))
@@ -257,7 +195,7 @@ fn simplify_closed(poly: &[DVec2], tolerance: f64) -> Vec<DVec2> {
         let mut best = (0.0, s);
         for (k, &q) in ring.iter().enumerate().take(e).skip(s + 1) {
             let d = if len > 0.0 {
-                cross(ab, q - a).abs() / len
+                ab.perp_dot(q - a).abs() / len
             } else {
                 q.distance(a)
             };
@@ -280,23 +218,23 @@ fn simplify_closed(poly: &[DVec2], tolerance: f64) -> Vec<DVec2> {
 
 /// Boundary of the points `pts` (patch frame, metres): a simple counter-clockwise polygon,
 /// or `None` if the points do not cover at least one raster cell's worth of area.
-pub(crate) fn patch_boundary(pts: &[DVec2], cell: f64, simplify_tol: f64) -> Option<Vec<DVec2>> {
+pub(crate) fn patch_boundary(pts: &[Vec2], cell: Real, simplify_tol: Real) -> Option<Vec<Vec2>> {
     let hull = convex_hull(pts);
     if hull.len() < 3 {
         return None;
     }
     let (angle, _, _) = min_area_rect(&hull);
-    let rot = DVec2::from_angle(-angle);
-    let back = DVec2::from_angle(angle);
-    let q: Vec<DVec2> = pts.iter().map(|p| rot.rotate(*p)).collect();
+    let rot = Vec2::from_angle(-angle);
+    let back = Vec2::from_angle(angle);
+    let q: Vec<Vec2> = pts.iter().map(|p| rot.rotate(*p)).collect();
     let poly = rect_boundary(&q, cell, simplify_tol)?;
     Some(poly.into_iter().map(|p| back.rotate(p)).collect())
 }
 
-fn rect_boundary(q: &[DVec2], cell0: f64, simplify_tol: f64) -> Option<Vec<DVec2>> {
+fn rect_boundary(q: &[Vec2], cell0: Real, simplify_tol: Real) -> Option<Vec<Vec2>> {
     let (lo, hi) = q
         .iter()
-        .fold((DVec2::INFINITY, DVec2::NEG_INFINITY), |(l, h), p| {
+        .fold((Vec2::INFINITY, Vec2::NEG_INFINITY), |(l, h), p| {
             (l.min(*p), h.max(*p))
         });
     let ext = hi - lo;
@@ -309,7 +247,7 @@ fn rect_boundary(q: &[DVec2], cell0: f64, simplify_tol: f64) -> Option<Vec<DVec2
     let margin = 2usize;
     let w = (ext.x / cell).floor() as usize + 1 + 2 * margin;
     let h = (ext.y / cell).floor() as usize + 1 + 2 * margin;
-    let origin = lo - DVec2::splat(margin as f64 * cell);
+    let origin = lo - Vec2::splat(margin as Real * cell);
     let mut grid = vec![false; w * h];
     for p in q {
         let i = ((p.x - origin.x) / cell).floor() as usize;
@@ -358,20 +296,20 @@ fn rect_boundary(q: &[DVec2], cell0: f64, simplify_tol: f64) -> Option<Vec<DVec2
 /// Remove vertices where the boundary turns by an angle whose sine is below `turn_sin` and
 /// the vertex lies within `tolerance` of the chord of its neighbours, as long as the polygon
 /// stays simple. Returns whether anything was removed.
-fn merge_collinear(poly: &mut Vec<DVec2>, tolerance: f64, turn_sin: f64) -> bool {
+fn merge_collinear(poly: &mut Vec<Vec2>, tolerance: Real, turn_sin: Real) -> bool {
     let mut changed = false;
     loop {
         let n = poly.len();
         if n <= 3 {
             return changed;
         }
-        let mut best: Option<(f64, usize)> = None;
+        let mut best: Option<(Real, usize)> = None;
         for i in 0..n {
             let (a, b, c) = (poly[(i + n - 1) % n], poly[i], poly[(i + 1) % n]);
             let (e1, e2) = ((b - a).normalize_or_zero(), (c - b).normalize_or_zero());
             let chord = c - a;
-            let dev = cross(chord, b - a).abs() / chord.length().max(f64::MIN_POSITIVE);
-            if cross(e1, e2).abs() < turn_sin
+            let dev = chord.perp_dot(b - a).abs() / chord.length().max(Real::MIN_POSITIVE);
+            if e1.perp_dot(e2).abs() < turn_sin
                 && e1.dot(e2) > 0.0
                 && dev <= tolerance
                 && best.is_none_or(|(d, _)| dev < d)
@@ -505,7 +443,7 @@ fn remove_pinches(g: &mut [bool], w: usize, h: usize) -> bool {
 
 /// Trace the outer boundary of a hole-free, pinch-free cell set as a counter-clockwise
 /// polygon in cell units (vertices at cell corners).
-fn trace(g: &[bool], w: usize, h: usize) -> Option<Vec<DVec2>> {
+fn trace(g: &[bool], w: usize, h: usize) -> Option<Vec<Vec2>> {
     let vw = w + 1;
     let mut next = vec![u32::MAX; vw * (h + 1)];
     let vid = |i: usize, j: usize| (j * vw + i) as u32;
@@ -538,9 +476,9 @@ fn trace(g: &[bool], w: usize, h: usize) -> Option<Vec<DVec2>> {
     let mut out = Vec::new();
     let mut v = start;
     loop {
-        out.push(DVec2::new(
-            (v as usize % vw) as f64,
-            (v as usize / vw) as f64,
+        out.push(Vec2::new(
+            (v as usize % vw) as Real,
+            (v as usize / vw) as Real,
         ));
         v = next[v as usize];
         if v == u32::MAX || out.len() > vw * (h + 1) {
@@ -556,16 +494,16 @@ fn trace(g: &[bool], w: usize, h: usize) -> Option<Vec<DVec2>> {
 /// Move every edge onto the outermost sampled points next to it (direction refitted from
 /// per-cell extremes, position from the k-th extreme plus its expected gap), then rebuild
 /// corners as intersections of consecutive edges. `None` if the result is not acceptable.
-fn refine_edges(poly: &[DVec2], pts: &[DVec2], cell: f64) -> Option<Vec<DVec2>> {
+fn refine_edges(poly: &[Vec2], pts: &[Vec2], cell: Real) -> Option<Vec<Vec2>> {
     let n = poly.len();
     let band = 1.5 * cell;
     let mut lines = Vec::with_capacity(n);
-    let mut ts: Vec<(f64, f64)> = Vec::new();
+    let mut ts: Vec<(Real, Real)> = Vec::new();
     for i in 0..n {
         let (a, b) = (poly[i], poly[(i + 1) % n]);
         let len = a.distance(b);
         let d = (b - a) / len;
-        let o = DVec2::new(d.y, -d.x); // outward for a counter-clockwise polygon
+        let o = Vec2::new(d.y, -d.x); // outward for a counter-clockwise polygon
         let trim = cell.min(0.25 * len);
         ts.clear();
         ts.extend(pts.iter().filter_map(|p| {
@@ -584,21 +522,21 @@ fn refine_edges(poly: &[DVec2], pts: &[DVec2], cell: f64) -> Option<Vec<DVec2>> 
         // tilt is statistically significant (beyond three standard errors).
         let (d0, o0) = {
             let axis = if d.x.abs() >= d.y.abs() {
-                DVec2::new(d.x.signum(), 0.0)
+                Vec2::new(d.x.signum(), 0.0)
             } else {
-                DVec2::new(0.0, d.y.signum())
+                Vec2::new(0.0, d.y.signum())
             };
-            let a = if cross(axis, d).abs() < tol::AXIS_PRIOR_SIN {
+            let a = if axis.perp_dot(d).abs() < tol::AXIS_PRIOR_SIN {
                 axis
             } else {
                 d
             };
-            (a, DVec2::new(a.y, -a.x))
+            (a, Vec2::new(a.y, -a.x))
         };
         let mut dir = d0;
         let nb = ((len - 2.0 * trim) / cell).floor() as usize;
         if nb >= 4 {
-            let mut ext = vec![(f64::NAN, f64::NEG_INFINITY); nb];
+            let mut ext = vec![(Real::NAN, Real::NEG_INFINITY); nb];
             for &(t, s) in &ts {
                 let r = d * t + o * s;
                 let (t0, s0) = (r.dot(d0), r.dot(o0));
@@ -607,9 +545,9 @@ fn refine_edges(poly: &[DVec2], pts: &[DVec2], cell: f64) -> Option<Vec<DVec2>> 
                     ext[k] = (t0, s0);
                 }
             }
-            let e: Vec<(f64, f64)> = ext.into_iter().filter(|x| x.0.is_finite()).collect();
+            let e: Vec<(Real, Real)> = ext.into_iter().filter(|x| x.0.is_finite()).collect();
             if e.len() >= 4 {
-                let m = e.len() as f64;
+                let m = e.len() as Real;
                 let (mt, ms) = e
                     .iter()
                     .fold((0.0, 0.0), |(a, b), x| (a + x.0 / m, b + x.1 / m));
@@ -618,7 +556,7 @@ fn refine_edges(poly: &[DVec2], pts: &[DVec2], cell: f64) -> Option<Vec<DVec2>> 
                 });
                 if sxx > 0.0 {
                     let slope = sxy / sxx;
-                    let sse: f64 = e
+                    let sse: Real = e
                         .iter()
                         .map(|x| (x.1 - ms - slope * (x.0 - mt)).powi(2))
                         .sum();
@@ -629,13 +567,13 @@ fn refine_edges(poly: &[DVec2], pts: &[DVec2], cell: f64) -> Option<Vec<DVec2>> 
                 }
             }
         }
-        let o2 = DVec2::new(dir.y, -dir.x);
-        let mut s2: Vec<f64> = ts.iter().map(|&(t, s)| (d * t + o * s).dot(o2)).collect();
+        let o2 = Vec2::new(dir.y, -dir.x);
+        let mut s2: Vec<Real> = ts.iter().map(|&(t, s)| (d * t + o * s).dot(o2)).collect();
         s2.sort_by(|x, y| y.total_cmp(x));
         let k = 3.min(s2.len());
         let depth = s2[0] - s2[s2.len() - 1];
-        let lambda = s2.len() as f64 / depth.max(1e-12);
-        let c = s2[k - 1] + k as f64 / lambda;
+        let lambda = s2.len() as Real / depth.max(tol::MIN_BAND_DEPTH);
+        let c = s2[k - 1] + k as Real / lambda;
         lines.push(Line2 {
             p: a + o2 * c,
             d: dir,
@@ -649,15 +587,18 @@ fn refine_edges(poly: &[DVec2], pts: &[DVec2], cell: f64) -> Option<Vec<DVec2>> 
 mod tests {
     use super::*;
 
-    fn grid_points(w: f64, h: f64, step: f64) -> Vec<DVec2> {
+    fn grid_points(w: Real, h: Real, step: Real) -> Vec<Vec2> {
         let mut v = Vec::new();
         let (nx, ny) = ((w / step) as usize, (h / step) as usize);
         for i in 0..=nx {
             for j in 0..=ny {
                 // Jitter deterministically so points are not on cell borders.
-                let jx = ((i * 7 + j * 13) % 10) as f64 * 0.1 * step;
-                let jy = ((i * 11 + j * 3) % 10) as f64 * 0.1 * step;
-                let p = DVec2::new((i as f64 * step + jx).min(w), (j as f64 * step + jy).min(h));
+                let jx = ((i * 7 + j * 13) % 10) as Real * 0.1 * step;
+                let jy = ((i * 11 + j * 3) % 10) as Real * 0.1 * step;
+                let p = Vec2::new(
+                    (i as Real * step + jx).min(w),
+                    (j as Real * step + jy).min(h),
+                );
                 v.push(p);
             }
         }
@@ -667,11 +608,11 @@ mod tests {
     #[test]
     fn hull_and_rect() {
         let pts = [
-            DVec2::new(0.0, 0.0),
-            DVec2::new(2.0, 0.0),
-            DVec2::new(2.0, 1.0),
-            DVec2::new(0.0, 1.0),
-            DVec2::new(1.0, 0.5),
+            Vec2::new(0.0, 0.0),
+            Vec2::new(2.0, 0.0),
+            Vec2::new(2.0, 1.0),
+            Vec2::new(0.0, 1.0),
+            Vec2::new(1.0, 0.5),
         ];
         let h = convex_hull(&pts);
         assert_eq!(h.len(), 4);
@@ -682,8 +623,8 @@ mod tests {
 
     #[test]
     fn rectangle_boundary_is_accurate() {
-        let rot = DVec2::from_angle(0.3);
-        let pts: Vec<DVec2> = grid_points(1.2, 0.7, 0.02)
+        let rot = Vec2::from_angle(0.3);
+        let pts: Vec<Vec2> = grid_points(1.2, 0.7, 0.02)
             .into_iter()
             .map(|p| rot.rotate(p))
             .collect();
@@ -697,7 +638,7 @@ mod tests {
 
     #[test]
     fn notch_boundary_is_simple_and_concave() {
-        let pts: Vec<DVec2> = grid_points(2.0, 2.0, 0.02)
+        let pts: Vec<Vec2> = grid_points(2.0, 2.0, 0.02)
             .into_iter()
             .filter(|p| !(p.x > 0.6 && p.x < 1.4 && p.y < 1.2))
             .collect();

@@ -18,9 +18,9 @@
 //! at least [`tol::LAYER_SEPARATION_SIGMAS`] noise σ apart, σ measured on the outer
 //! (uncontested) side of each layer. Otherwise both patches stay as RANSAC left them.
 
+use bt_geom::{Real, Vec2, Vec3};
 use std::collections::HashMap;
 
-use glam::{DVec2, DVec3};
 use rayon::prelude::*;
 
 use super::{RawPatch, frame};
@@ -37,18 +37,18 @@ const LAYER_MIN_POINTS_FACTOR: usize = 4;
 
 #[derive(Clone, Copy)]
 struct Layer {
-    normal: DVec3,
-    offset: f64,
-    centroid: DVec3,
-    lo: DVec3,
-    hi: DVec3,
+    normal: Vec3,
+    offset: Real,
+    centroid: Vec3,
+    lo: Vec3,
+    hi: Vec3,
 }
 
-fn layer_of(pts: &[DVec3], idx: &[u32]) -> Option<Layer> {
+fn layer_of(pts: &[Vec3], idx: &[u32]) -> Option<Layer> {
     let f = fit_plane(idx.iter().map(|&i| pts[i as usize]))?;
     let (lo, hi) = idx
         .iter()
-        .fold((DVec3::INFINITY, DVec3::NEG_INFINITY), |(l, h), &i| {
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(l, h), &i| {
             (l.min(pts[i as usize]), h.max(pts[i as usize]))
         });
     Some(Layer {
@@ -67,10 +67,10 @@ fn layer_of(pts: &[DVec3], idx: &[u32]) -> Option<Layer> {
 /// Pairs are visited in index order, so the result is deterministic. Returns the indices of
 /// the patches that changed.
 pub(super) fn separate_parallel(
-    pts: &[DVec3],
+    pts: &[Vec3],
     patches: &mut [RawPatch],
-    band: f64,
-    radius: f64,
+    band: Real,
+    radius: Real,
     min_points: usize,
 ) -> Vec<usize> {
     let layers: Vec<Option<Layer>> = patches
@@ -92,7 +92,7 @@ pub(super) fn separate_parallel(
             if a.normal.dot(b.normal).abs() < tol::LAYER_PARALLEL_COS {
                 continue;
             }
-            let grow = DVec3::splat(radius + band);
+            let grow = Vec3::splat(radius + band);
             if (a.hi + grow).cmplt(b.lo).any() || (b.hi + grow).cmplt(a.lo).any() {
                 continue;
             }
@@ -126,15 +126,15 @@ pub(super) fn separate_parallel(
 /// Competitive, locally voted assignment of two parallel patches' points; `None` when the
 /// two do not form distinct layers (then nothing should change).
 fn separate_pair(
-    pts: &[DVec3],
+    pts: &[Vec3],
     pa: &[u32],
     pb: &[u32],
-    radius: f64,
+    radius: Real,
 ) -> Option<(Vec<u32>, Vec<u32>)> {
     let la = layer_of(pts, pa)?;
     let lb = layer_of(pts, pb)?;
-    let grow = DVec3::splat(radius);
-    let within = |p: DVec3, l: &Layer| !(p.cmplt(l.lo - grow).any() || p.cmpgt(l.hi + grow).any());
+    let grow = Vec3::splat(radius);
+    let within = |p: Vec3, l: &Layer| !(p.cmplt(l.lo - grow).any() || p.cmpgt(l.hi + grow).any());
     // Contested points: each patch's points inside the other's (grown) bounding box.
     let contested: Vec<u32> = pa
         .iter()
@@ -147,8 +147,8 @@ fn separate_pair(
     }
     let centre = contested
         .iter()
-        .fold(DVec3::ZERO, |c, &i| c + pts[i as usize])
-        / contested.len() as f64;
+        .fold(Vec3::ZERO, |c, &i| c + pts[i as usize])
+        / contested.len() as Real;
     let fixed_a: Vec<u32> = pa
         .iter()
         .copied()
@@ -163,9 +163,9 @@ fn separate_pair(
     // Neighbour lists in the common 2-D frame, computed once (the points do not move, only
     // their labels change).
     let (u, v) = frame(la.normal);
-    let flat: Vec<DVec2> = contested
+    let flat: Vec<Vec2> = contested
         .iter()
-        .map(|&i| DVec2::new(pts[i as usize].dot(u), pts[i as usize].dot(v)))
+        .map(|&i| Vec2::new(pts[i as usize].dot(u), pts[i as usize].dot(v)))
         .collect();
     let near = Grid::new(&flat, radius);
     let adjacency: Vec<Vec<u32>> = (0..contested.len())
@@ -199,12 +199,12 @@ fn separate_pair(
         .collect();
     let share = |k: usize, in_b: &[bool]| {
         let nb_k = &adjacency[k];
-        nb_k.iter().filter(|&&m| in_b[m as usize]).count() as f64 / nb_k.len().max(1) as f64
+        nb_k.iter().filter(|&&m| in_b[m as usize]).count() as Real / nb_k.len().max(1) as Real
     };
     // Presence over twice the radius: four times the neighbours, so the share is steady
     // enough to test against a floor even at a layer's corner (a quarter disk).
     let wide = Grid::new(&flat, 2.0 * radius);
-    let share0_b: Vec<f64> = (0..contested.len())
+    let share0_b: Vec<Real> = (0..contested.len())
         .into_par_iter()
         .map(|k| {
             let (mut all, mut b) = (0usize, 0usize);
@@ -212,7 +212,7 @@ fn separate_pair(
                 all += 1;
                 b += usize::from(to_b[m as usize]);
             });
-            b as f64 / all.max(1) as f64
+            b as Real / all.max(1) as Real
         })
         .collect();
     drop(wide);
@@ -290,16 +290,16 @@ fn separate_pair(
 /// away from the other plane (those are not contested, so their spread is the plain noise),
 /// the larger of the two. `None` if a side has fewer than three points.
 fn outer_sigma(
-    pts: &[DVec3],
+    pts: &[Vec3],
     contested: &[u32],
     to_b: &[bool],
-    centre: DVec3,
-    (na, da): (DVec3, f64),
-    (nb, db): (DVec3, f64),
-) -> Option<f64> {
+    centre: Vec3,
+    (na, da): (Vec3, Real),
+    (nb, db): (Vec3, Real),
+) -> Option<Real> {
     // Which side of A the layer B lies on, where the points are (`centre`).
     let b_above = nb.dot(centre) - db < na.dot(centre) - da;
-    let side = |want_b: bool| -> Option<f64> {
+    let side = |want_b: bool| -> Option<Real> {
         let (n, d) = if want_b { (nb, db) } else { (na, da) };
         let away = if want_b == b_above { 1.0 } else { -1.0 };
         let (s, c) = contested
@@ -309,7 +309,7 @@ fn outer_sigma(
             .map(|(&i, _)| (n.dot(pts[i as usize]) - d) * away)
             .filter(|&r| r > 0.0)
             .fold((0.0, 0usize), |(s, c), r| (s + r * r, c + 1));
-        (c >= 3).then(|| (s / c as f64).sqrt())
+        (c >= 3).then(|| (s / c as Real).sqrt())
     };
     let sigma = side(false)?.max(side(true)?);
     (sigma > 0.0).then_some(sigma)
@@ -317,17 +317,17 @@ fn outer_sigma(
 
 /// 2-D points bucketed into square cells of edge `radius`, for neighbour visits within it.
 struct Grid {
-    radius: f64,
+    radius: Real,
     keyed: Vec<((i64, i64), u32)>,
     cells: HashMap<(i64, i64), (usize, usize)>,
 }
 
 impl Grid {
-    fn key(p: DVec2, radius: f64) -> (i64, i64) {
+    fn key(p: Vec2, radius: Real) -> (i64, i64) {
         ((p.x / radius).floor() as i64, (p.y / radius).floor() as i64)
     }
 
-    fn new(flat: &[DVec2], radius: f64) -> Self {
+    fn new(flat: &[Vec2], radius: Real) -> Self {
         let mut keyed: Vec<((i64, i64), u32)> = flat
             .iter()
             .enumerate()
@@ -350,7 +350,7 @@ impl Grid {
     }
 
     /// Call `f` with every point within the radius of point `k`, `k` itself excluded.
-    fn visit(&self, flat: &[DVec2], k: usize, mut f: impl FnMut(u32)) {
+    fn visit(&self, flat: &[Vec2], k: usize, mut f: impl FnMut(u32)) {
         let q = flat[k];
         let (ci, cj) = Self::key(q, self.radius);
         let r2 = self.radius * self.radius;

@@ -1,6 +1,7 @@
 //! Per-point normal estimation by PCA over a fixed-radius neighbourhood.
 
-use glam::{DMat3, DVec3};
+use bt_geom::{Real, Vec3};
+use glam::DMat3;
 use rayon::prelude::*;
 
 use crate::linalg::sym_eigen;
@@ -11,8 +12,8 @@ use crate::tol;
 const MIN_NEIGHBOURS: usize = 5;
 
 /// Unit normal (unoriented) per point from the covariance of the neighbours within `radius`
-/// metres; `DVec3::ZERO` where the neighbourhood is too sparse or degenerate (a line).
-pub(crate) fn estimate_normals(points: &[DVec3], radius: f64) -> Vec<DVec3> {
+/// metres; `Vec3::ZERO` where the neighbourhood is too sparse or degenerate (a line).
+pub(crate) fn estimate_normals(points: &[Vec3], radius: Real) -> Vec<Vec3> {
     let index = VoxelIndex::build(points, radius);
     points
         .par_iter()
@@ -34,19 +35,19 @@ pub(crate) fn estimate_normals(points: &[DVec3], radius: f64) -> Vec<DVec3> {
                 zz += d.z * d.z;
             });
             if n < MIN_NEIGHBOURS {
-                return DVec3::ZERO;
+                return Vec3::ZERO;
             }
-            let k = 1.0 / n as f64;
-            let m = DVec3::new(sx, sy, sz) * k;
+            let k = 1.0 / n as Real;
+            let m = Vec3::new(sx, sy, sz) * k;
             let cov = DMat3::from_cols(
-                DVec3::new(xx * k - m.x * m.x, xy * k - m.x * m.y, xz * k - m.x * m.z),
-                DVec3::new(xy * k - m.x * m.y, yy * k - m.y * m.y, yz * k - m.y * m.z),
-                DVec3::new(xz * k - m.x * m.z, yz * k - m.y * m.z, zz * k - m.z * m.z),
+                Vec3::new(xx * k - m.x * m.x, xy * k - m.x * m.y, xz * k - m.x * m.z),
+                Vec3::new(xy * k - m.x * m.y, yy * k - m.y * m.y, yz * k - m.y * m.z),
+                Vec3::new(xz * k - m.x * m.z, yz * k - m.y * m.z, zz * k - m.z * m.z),
             );
             let (vals, vecs) = sym_eigen(cov);
             // A neighbourhood that is (nearly) a line has no defined plane normal.
             if vals[1] <= tol::LINEAR_NEIGHBOURHOOD * vals[2] || !vecs[0].is_finite() {
-                return DVec3::ZERO;
+                return Vec3::ZERO;
             }
             vecs[0]
         })

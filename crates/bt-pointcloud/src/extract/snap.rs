@@ -8,7 +8,7 @@
 //! line. Both patches then share the crease exactly. All snaps are computed from the
 //! pre-snap polygons, so the result does not depend on patch order.
 
-use glam::{DVec2, DVec3};
+use bt_geom::{Real, Vec2, Vec3};
 use rayon::prelude::*;
 
 use super::boundary::{Line2, intersect, is_simple, lines_of, polygon_from_lines, signed_area};
@@ -20,68 +20,68 @@ const ADJ_SAMPLES: usize = 8;
 
 /// A patch's plane, frame and polygon, as needed for snapping.
 pub(crate) struct PatchGeom {
-    pub normal: DVec3,
-    pub offset: f64,
-    pub origin: DVec3,
-    pub u: DVec3,
-    pub v: DVec3,
-    pub poly: Vec<DVec2>,
-    pub lo: DVec3,
-    pub hi: DVec3,
+    pub normal: Vec3,
+    pub offset: Real,
+    pub origin: Vec3,
+    pub u: Vec3,
+    pub v: Vec3,
+    pub poly: Vec<Vec2>,
+    pub lo: Vec3,
+    pub hi: Vec3,
     /// Points of the patch per m² of its polygon.
-    pub density: f64,
+    pub density: Real,
 }
 
 /// The cloud, for checking that a gap between an edge and a crease line is data, not air.
 pub(crate) struct Cloud<'a> {
-    pub pts: &'a [DVec3],
+    pub pts: &'a [Vec3],
     pub index: &'a VoxelIndex,
     /// RANSAC distance threshold, metres: the width of the band a neighbour steals.
-    pub band: f64,
+    pub band: Real,
 }
 
 impl PatchGeom {
-    pub(crate) fn lift(&self, p: DVec2) -> DVec3 {
+    pub(crate) fn lift(&self, p: Vec2) -> Vec3 {
         self.origin + self.u * p.x + self.v * p.y
     }
 
-    pub(crate) fn local(&self, p: DVec3) -> DVec2 {
+    pub(crate) fn local(&self, p: Vec3) -> Vec2 {
         let r = p - self.origin;
-        DVec2::new(r.dot(self.u), r.dot(self.v))
+        Vec2::new(r.dot(self.u), r.dot(self.v))
     }
 
     pub(crate) fn update_bounds(&mut self) {
-        let pts: Vec<DVec3> = self.poly.iter().map(|p| self.lift(*p)).collect();
-        self.lo = pts.iter().fold(DVec3::INFINITY, |a, p| a.min(*p));
-        self.hi = pts.iter().fold(DVec3::NEG_INFINITY, |a, p| a.max(*p));
+        let pts: Vec<Vec3> = self.poly.iter().map(|p| self.lift(*p)).collect();
+        self.lo = pts.iter().fold(Vec3::INFINITY, |a, p| a.min(*p));
+        self.hi = pts.iter().fold(Vec3::NEG_INFINITY, |a, p| a.max(*p));
     }
 }
 
 /// Distance from `p` to the boundary of a polygon, metres.
-fn distance_to_boundary(poly: &[DVec2], p: DVec2) -> f64 {
+fn distance_to_boundary(poly: &[Vec2], p: Vec2) -> Real {
     let n = poly.len();
     (0..n)
         .map(|i| {
             let (a, b) = (poly[i], poly[(i + 1) % n]);
             let ab = b - a;
-            let t = ((p - a).dot(ab) / ab.length_squared().max(f64::MIN_POSITIVE)).clamp(0.0, 1.0);
+            let t = ((p - a).dot(ab) / ab.length_squared().max(Real::MIN_POSITIVE)).clamp(0.0, 1.0);
             p.distance(a + ab * t)
         })
-        .fold(f64::INFINITY, f64::min)
+        .fold(Real::INFINITY, Real::min)
 }
 
 /// Distance from `p` to a polygon (0 inside), metres.
-fn distance_to_polygon(poly: &[DVec2], p: DVec2) -> f64 {
+fn distance_to_polygon(poly: &[Vec2], p: Vec2) -> Real {
     let n = poly.len();
     let mut inside = false;
-    let mut best = f64::INFINITY;
+    let mut best = Real::INFINITY;
     for i in 0..n {
         let (a, b) = (poly[i], poly[(i + 1) % n]);
         if (a.y > p.y) != (b.y > p.y) && p.x < a.x + (p.y - a.y) / (b.y - a.y) * (b.x - a.x) {
             inside = !inside;
         }
         let ab = b - a;
-        let t = ((p - a).dot(ab) / ab.length_squared().max(f64::MIN_POSITIVE)).clamp(0.0, 1.0);
+        let t = ((p - a).dot(ab) / ab.length_squared().max(Real::MIN_POSITIVE)).clamp(0.0, 1.0);
         best = best.min(p.distance(a + ab * t));
     }
     if inside { 0.0 } else { best }
@@ -101,25 +101,25 @@ fn distance_to_polygon(poly: &[DVec2], p: DVec2) -> f64 {
 fn gap_is_surface(
     p: &PatchGeom,
     q: &PatchGeom,
-    a: DVec2,
-    b: DVec2,
+    a: Vec2,
+    b: Vec2,
     line: Line2,
-    cell: f64,
-    cloud: &Cloud,
+    cell: Real,
+    cloud: &Cloud<'_>,
 ) -> bool {
     let sin = p.normal.cross(q.normal).length();
-    let stolen = cloud.band / sin.max(f64::MIN_POSITIVE);
+    let stolen = cloud.band / sin.max(Real::MIN_POSITIVE);
     // Trimming an edge that overshoots the line (the line runs inside the polygon, which
     // lies to the left of a counter-clockwise edge) closes no gap: nothing to check.
     let len = a.distance(b);
     let e = (b - a) / len;
-    let outward = DVec2::new(e.y, -e.x);
+    let outward = Vec2::new(e.y, -e.x);
     let mid = (a + b) * 0.5;
     let foot = line.p + line.d * (mid - line.p).dot(line.d);
     if (foot - mid).dot(outward) <= 0.0 {
         return true;
     }
-    let side = |x: DVec2| (x - line.p).perp_dot(line.d);
+    let side = |x: Vec2| (x - line.p).perp_dot(line.d);
     let (sa, sb) = (side(a), side(b));
     if sa * sb < 0.0 {
         return true; // the edge crosses the line: nothing to measure
@@ -129,12 +129,12 @@ fn gap_is_surface(
     let trim = if len > 4.0 * cell { cell } else { 0.0 };
     let (t0, t1) = (trim / len, 1.0 - trim / len);
     // Expected count: density × area of the strip beyond the stolen band (linear in t).
-    let depth = |t: f64| (sa + (sb - sa) * t - stolen).max(0.0);
+    let depth = |t: Real| (sa + (sb - sa) * t - stolen).max(0.0);
     let steps = 16;
     let strip_area = (0..steps)
-        .map(|k| depth(t0 + (t1 - t0) * (k as f64 + 0.5) / steps as f64))
-        .sum::<f64>()
-        / steps as f64
+        .map(|k| depth(t0 + (t1 - t0) * (k as Real + 0.5) / steps as Real))
+        .sum::<Real>()
+        / steps as Real
         * len
         * (t1 - t0);
     let expected = p.density * strip_area;
@@ -147,9 +147,9 @@ fn gap_is_surface(
         p.lift(line.p + line.d * (a + e * trim - line.p).dot(line.d)),
         p.lift(line.p + line.d * (b - e * trim - line.p).dot(line.d)),
     ];
-    let pad = DVec3::splat(cloud.band);
-    let lo = corners.iter().fold(DVec3::INFINITY, |m, c| m.min(*c)) - pad;
-    let hi = corners.iter().fold(DVec3::NEG_INFINITY, |m, c| m.max(*c)) + pad;
+    let pad = Vec3::splat(cloud.band);
+    let lo = corners.iter().fold(Vec3::INFINITY, |m, c| m.min(*c)) - pad;
+    let hi = corners.iter().fold(Vec3::NEG_INFINITY, |m, c| m.max(*c)) + pad;
     let mut found = 0usize;
     cloud.index.for_each_in_box(cloud.pts, lo, hi, |j| {
         let x = cloud.pts[j as usize];
@@ -166,7 +166,7 @@ fn gap_is_surface(
             found += 1;
         }
     });
-    found as f64 >= tol::SNAP_MIN_FILL * expected
+    found as Real >= tol::SNAP_MIN_FILL * expected
 }
 
 /// Snap edges of every patch onto intersection lines with adjoining patches; returns the
@@ -175,10 +175,10 @@ fn gap_is_surface(
 /// [`gap_is_surface`]).
 pub(crate) fn snap_all(
     patches: &[PatchGeom],
-    snap: f64,
-    cell: f64,
-    cloud: &Cloud,
-) -> Vec<Vec<DVec2>> {
+    snap: Real,
+    cell: Real,
+    cloud: &Cloud<'_>,
+) -> Vec<Vec<Vec2>> {
     patches
         .par_iter()
         .enumerate()
@@ -192,10 +192,10 @@ pub(crate) fn snap_all(
                 let (a, b) = (p.poly[i], p.poly[(i + 1) % n]);
                 let (a3, b3) = (p.lift(a), p.lift(b));
                 let (elo, ehi) = (
-                    a3.min(b3) - DVec3::splat(snap),
-                    a3.max(b3) + DVec3::splat(snap),
+                    a3.min(b3) - Vec3::splat(snap),
+                    a3.max(b3) + Vec3::splat(snap),
                 );
-                let mut best: Option<(f64, Line2)> = None;
+                let mut best: Option<(Real, Line2)> = None;
                 for (qi, q) in patches.iter().enumerate() {
                     if qi == pi || p.normal.dot(q.normal).abs() > tol::SNAP_MAX_COS {
                         continue;
@@ -207,24 +207,24 @@ pub(crate) fn snap_all(
                     let l2 = l.length_squared();
                     let x0 = (p.offset * q.normal.cross(l) + q.offset * l.cross(p.normal)) / l2;
                     let dir = l / l2.sqrt();
-                    let mut d2 = DVec2::new(dir.dot(p.u), dir.dot(p.v)).normalize_or_zero();
+                    let mut d2 = Vec2::new(dir.dot(p.u), dir.dot(p.v)).normalize_or_zero();
                     let e = (b - a).normalize_or_zero();
                     if d2.dot(e) < 0.0 {
                         d2 = -d2;
                     }
                     let o2 = p.local(x0);
                     let cand = Line2 { p: o2, d: d2 };
-                    let dist = |x: DVec2| (x - o2).perp_dot(d2).abs();
+                    let dist = |x: Vec2| (x - o2).perp_dot(d2).abs();
                     let worst = dist(a).max(dist(b));
                     if worst > snap || e.perp_dot(d2).abs() > tol::SNAP_EDGE_SIN {
                         continue;
                     }
                     // Most of the edge's span, moved onto the line, must lie on or next to Q
                     // (most, not all: a floor edge runs past a doorway in the wall).
-                    let on_line = |x: DVec2| o2 + d2 * (x - o2).dot(d2);
+                    let on_line = |x: Vec2| o2 + d2 * (x - o2).dot(d2);
                     let near = (0..=ADJ_SAMPLES)
                         .filter(|&k| {
-                            let x = a + (b - a) * (k as f64 / ADJ_SAMPLES as f64);
+                            let x = a + (b - a) * (k as Real / ADJ_SAMPLES as Real);
                             distance_to_polygon(&q.poly, q.local(p.lift(on_line(x)))) <= snap
                         })
                         .count();

@@ -17,13 +17,12 @@
 //! A non-finite *normal* on a finite point is replaced by the zero vector (normals are only
 //! a hint for orienting extracted planes).
 
+use bt_geom::{Real, Vec3};
 mod pcd;
 mod ply;
 
 use std::io::{Read, Write};
 use std::path::Path;
-
-use glam::DVec3;
 
 pub use pcd::{PcdData, parse_pcd, read_pcd, write_pcd};
 pub use ply::{PlyFormat, parse_ply, read_ply, write_ply};
@@ -155,63 +154,13 @@ pub(crate) fn read_all<R: Read>(mut r: R) -> Result<Vec<u8>, PointCloudError> {
     Ok(buf)
 }
 
-/// Numeric scalar types shared by PLY and PCD.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(crate) enum Scalar {
-    I8,
-    U8,
-    I16,
-    U16,
-    I32,
-    U32,
-    I64,
-    U64,
-    F32,
-    F64,
-}
-
-impl Scalar {
-    pub(crate) fn size(self) -> usize {
-        match self {
-            Scalar::I8 | Scalar::U8 => 1,
-            Scalar::I16 | Scalar::U16 => 2,
-            Scalar::I32 | Scalar::U32 | Scalar::F32 => 4,
-            Scalar::I64 | Scalar::U64 | Scalar::F64 => 8,
-        }
-    }
-
-    /// Decode one value from exactly `self.size()` bytes.
-    pub(crate) fn decode(self, b: &[u8], big_endian: bool) -> f64 {
-        macro_rules! get {
-            ($t:ty, $n:expr) => {{
-                let mut a = [0u8; $n];
-                a.copy_from_slice(&b[..$n]);
-                if big_endian {
-                    <$t>::from_be_bytes(a)
-                } else {
-                    <$t>::from_le_bytes(a)
-                }
-            }};
-        }
-        match self {
-            Scalar::I8 => b[0] as i8 as f64,
-            Scalar::U8 => b[0] as f64,
-            Scalar::I16 => get!(i16, 2) as f64,
-            Scalar::U16 => get!(u16, 2) as f64,
-            Scalar::I32 => get!(i32, 4) as f64,
-            Scalar::U32 => get!(u32, 4) as f64,
-            Scalar::I64 => get!(i64, 8) as f64,
-            Scalar::U64 => get!(u64, 8) as f64,
-            Scalar::F32 => get!(f32, 4) as f64,
-            Scalar::F64 => get!(f64, 8),
-        }
-    }
-}
+/// Numeric scalar types shared by PLY and PCD: the byte-level layer of `bt-formats`.
+pub(crate) use bt_formats::Scalar;
 
 /// Collects decoded points, applying the non-finite policy.
 pub(crate) struct PointSink {
-    points: Vec<DVec3>,
-    normals: Option<Vec<DVec3>>,
+    points: Vec<Vec3>,
+    normals: Option<Vec<Vec3>>,
     skipped: u64,
     policy: NonFinitePolicy,
 }
@@ -227,7 +176,7 @@ impl PointSink {
         }
     }
 
-    pub(crate) fn push(&mut self, p: DVec3, n: DVec3, at: DataPos) -> Result<(), PointCloudError> {
+    pub(crate) fn push(&mut self, p: Vec3, n: Vec3, at: DataPos) -> Result<(), PointCloudError> {
         if !p.is_finite() {
             return match self.policy {
                 NonFinitePolicy::Skip => {
@@ -242,7 +191,7 @@ impl PointSink {
         }
         self.points.push(p);
         if let Some(ns) = &mut self.normals {
-            ns.push(if n.is_finite() { n } else { DVec3::ZERO });
+            ns.push(if n.is_finite() { n } else { Vec3::ZERO });
         }
         Ok(())
     }
@@ -272,9 +221,9 @@ pub(crate) fn next_line<'a>(bytes: &'a [u8], pos: &mut usize) -> Option<&'a [u8]
 /// Parse a number token the way both formats spell them (`nan`, `inf` accepted). A value
 /// declared as 32-bit float is rounded to `f32` first, so ASCII and binary files of the
 /// same declared type give identical points.
-pub(crate) fn parse_number(tok: &str, ty: Scalar) -> Option<f64> {
+pub(crate) fn parse_number(tok: &str, ty: Scalar) -> Option<Real> {
     match ty {
-        Scalar::F32 => tok.parse::<f32>().ok().map(f64::from),
-        _ => tok.parse::<f64>().ok(),
+        Scalar::F32 => tok.parse::<f32>().ok().map(Real::from),
+        _ => tok.parse::<Real>().ok(),
     }
 }

@@ -2,9 +2,8 @@
 //! (little-endian, as PCL writes on every platform it supports). `binary_compressed` is
 //! reported as [`PointCloudError::Unsupported`].
 
+use bt_geom::{Real, Vec3};
 use std::io::{Read, Write};
-
-use glam::DVec3;
 
 use super::{
     LoadedCloud, PointSink, ReadOptions, Scalar, io_err, next_line, parse_number, read_all,
@@ -36,10 +35,92 @@ fn header_err(line: usize, reason: impl Into<String>) -> PointCloudError {
     }
 }
 
+/// The header lines up to `DATA`, as written.
+struct Keywords {
+    names: Option<Vec<String>>,
+    sizes: Option<Vec<usize>>,
+    types: Option<Vec<u8>>,
+    counts: Option<Vec<usize>>,
+    width: Option<u64>,
+    height: Option<u64>,
+    points: Option<u64>,
+    binary: bool,
+    /// Byte offset of the body.
+    data_start: usize,
+    /// Line number of the `DATA` line.
+    data_line: usize,
+}
+
+/// A checked PCD header: the fields with their scalar types, the point count and the body's
+/// place and encoding.
+struct PcdHeader {
+    fields: Vec<Field>,
+    count: u64,
+    binary: bool,
+    data_start: usize,
+    data_line: usize,
+}
+
+/// Where the values of one point are: per field its column (ASCII value index) and byte
+/// offset (binary record), the values and bytes per point, and the fields read.
+struct Layout {
+    col: Vec<usize>,
+    offset: Vec<usize>,
+    values_per_point: usize,
+    stride: usize,
+    xyz: [usize; 3],
+    normal: Option<[usize; 3]>,
+}
+
 /// Parse a PCD file held in memory. Reads `x y z` (any numeric type, count 1) and, when all
 /// three are present, `normal_x normal_y normal_z`; other fields are skipped using their
 /// SIZE, TYPE and COUNT.
 pub fn parse_pcd(bytes: &[u8], opts: &ReadOptions) -> Result<LoadedCloud, PointCloudError> {
+    let header = parse_header(bytes)?;
+    let layout = layout(&header.fields, header.data_line)?;
+    let count = header.count;
+    let available = bytes.len() - header.data_start;
+    let min_per_point = if header.binary {
+        layout.stride as u128
+    } else {
+        2 * layout.values_per_point as u128
+    };
+    let min_bytes = count as u128 * min_per_point;
+    if super::is_absurd(min_bytes, available) || (min_per_point == 0 && count > 0) {
+        return Err(PointCloudError::CountExceedsData {
+            origin: Origin(None),
+            claimed: count,
+            min_bytes,
+            available,
+        });
+    }
+    let capacity = count.min((available as u128 / min_per_point.max(1)) as u64) as usize;
+    let mut sink = PointSink::new(capacity, layout.normal.is_some(), opts.non_finite);
+    if header.binary {
+        read_binary_body(bytes, &header, &layout, &mut sink)?;
+    } else {
+        read_ascii_body(bytes, &header, &layout, &mut sink)?;
+    }
+    Ok(sink.finish())
+}
+
+/// The header: keywords, then fields and point count checked against each other.
+fn parse_header(bytes: &[u8]) -> Result<PcdHeader, PointCloudError> {
+    let kw = read_keywords(bytes)?;
+    let data_line = kw.data_line;
+    let fields = fields(&kw)?;
+    let count = point_count(&kw)?;
+    Ok(PcdHeader {
+        fields,
+        count,
+        binary: kw.binary,
+        data_start: kw.data_start,
+        data_line,
+    })
+}
+
+/// Reads the header lines up to and including `DATA`.
+fn read_keywords(bytes: &[u8]) -> Result<Keywords, PointCloudError> {
     let mut pos = 0;
     let mut line_no = 0;
     let mut names: Option<Vec<String>> = None;
@@ -49,7 +130,6 @@ pub fn parse_pcd(bytes: &[u8], opts: &ReadOptions) -> Result<LoadedCloud, PointC
     let mut width: Option<u64> = None;
     let mut height: Option<u64> = None;
     let mut points: Option<u64> = None;
-    let binary;
     loop {
         let Some(raw) = next_line(bytes, &mut pos) else {
             return Err(header_err(line_no.max(1), "header has no 'DATA' line"));
@@ -115,7 +195,7 @@ pub fn parse_pcd(bytes: &[u8], opts: &ReadOptions) -> Result<LoadedCloud, PointC
             "HEIGHT" => height = Some(one("HEIGHT")?),
             "POINTS" => points = Some(one("POINTS")?),
             "DATA" => {
-                binary = match rest.as_slice() {
+                let binary = match rest.as_slice() {
                     ["ascii"] => false,
                     ["binary"] => true,
                     ["binary_compressed"] => {
@@ -132,17 +212,41 @@ pub fn parse_pcd(bytes: &[u8], opts: &ReadOptions) -> Result<LoadedCloud, PointC
                         ));
                     }
                 };
-                break;
+                return Ok(Keywords {
+                    names,
+                    sizes,
+                    types,
+                    counts,
+                    width,
+                    height,
+                    points,
+                    binary,
+                    data_start: pos,
+                    data_line: line_no,
+                });
             }
             other => return Err(header_err(line_no, format!("unknown keyword '{other}'"))),
         }
     }
-    let data_line = line_no;
-    let names = names.ok_or_else(|| header_err(data_line, "no FIELDS line"))?;
+}
+
+/// The fields of the header with their scalar types (FIELDS, SIZE, TYPE, COUNT agree).
+fn fields(kw: &Keywords) -> Result<Vec<Field>, PointCloudError> {
+    let data_line = kw.data_line;
+    let names = kw
+        .names
+        .clone()
+        .ok_or_else(|| header_err(data_line, "no FIELDS line"))?;
     let n = names.len();
-    let sizes = sizes.ok_or_else(|| header_err(data_line, "no SIZE line"))?;
-    let types = types.ok_or_else(|| header_err(data_line, "no TYPE line"))?;
-    let counts = counts.unwrap_or_else(|| vec![1; n]);
+    let sizes = kw
+        .sizes
+        .clone()
+        .ok_or_else(|| header_err(data_line, "no SIZE line"))?;
+    let types = kw
+        .types
+        .clone()
+        .ok_or_else(|| header_err(data_line, "no TYPE line"))?;
+    let counts = kw.counts.clone().unwrap_or_else(|| vec![1; n]);
     if sizes.len() != n || types.len() != n || counts.len() != n {
         return Err(header_err(
             data_line,
@@ -156,26 +260,14 @@ pub fn parse_pcd(bytes: &[u8], opts: &ReadOptions) -> Result<LoadedCloud, PointC
     }
     let mut fields = Vec::with_capacity(n);
     for i in 0..n {
-        let scalar = match (types[i], sizes[i]) {
-            (b'F', 4) => Scalar::F32,
-            (b'F', 8) => Scalar::F64,
-            (b'I', 1) => Scalar::I8,
-            (b'I', 2) => Scalar::I16,
-            (b'I', 4) => Scalar::I32,
-            (b'I', 8) => Scalar::I64,
-            (b'U', 1) => Scalar::U8,
-            (b'U', 2) => Scalar::U16,
-            (b'U', 4) => Scalar::U32,
-            (b'U', 8) => Scalar::U64,
-            (t, s) => {
-                return Err(header_err(
-                    data_line,
-                    format!(
-                        "field '{}': TYPE {} with SIZE {s} is not valid",
-                        names[i], t as char
-                    ),
-                ));
-            }
+        let Some(scalar) = Scalar::from_pcd(types[i], sizes[i]) else {
+            return Err(header_err(
+                data_line,
+                format!(
+                    "field '{}': TYPE {} with SIZE {} is not valid",
+                    names[i], types[i] as char, sizes[i]
+                ),
+            ));
         };
         fields.push(Field {
             name: names[i].clone(),
@@ -184,7 +276,13 @@ pub fn parse_pcd(bytes: &[u8], opts: &ReadOptions) -> Result<LoadedCloud, PointC
             scalar,
         });
     }
-    let count = match (points, width, height) {
+    Ok(fields)
+}
+
+/// The number of points: POINTS, or WIDTH x HEIGHT, which must agree when both are given.
+fn point_count(kw: &Keywords) -> Result<u64, PointCloudError> {
+    let data_line = kw.data_line;
+    Ok(match (kw.points, kw.width, kw.height) {
         (Some(p), Some(w), Some(h)) if w.checked_mul(h) != Some(p) => {
             return Err(header_err(
                 data_line,
@@ -197,19 +295,22 @@ pub fn parse_pcd(bytes: &[u8], opts: &ReadOptions) -> Result<LoadedCloud, PointC
             .ok_or_else(|| header_err(data_line, "WIDTH x HEIGHT overflows"))?,
         (None, Some(w), None) => w,
         _ => return Err(header_err(data_line, "neither POINTS nor WIDTH is given")),
-    };
+    })
+}
 
+/// Columns and offsets of the fields and the indices of the fields read.
+fn layout(fields: &[Field], data_line: usize) -> Result<Layout, PointCloudError> {
+    let n = fields.len();
     // Column (value index) and byte offset of each wanted field.
     let mut col = Vec::with_capacity(n);
     let mut offset = Vec::with_capacity(n);
     let (mut c, mut o) = (0usize, 0usize);
-    for f in &fields {
+    for f in fields {
         col.push(c);
         offset.push(o);
         c += f.count;
         o += f.size * f.count;
     }
-    let (values_per_point, stride) = (c, o);
     let find = |name: &str| -> Result<Option<usize>, PointCloudError> {
         match fields.iter().position(|f| f.name == name) {
             Some(i) if fields[i].count != 1 => Err(header_err(
@@ -231,106 +332,125 @@ pub fn parse_pcd(bytes: &[u8], opts: &ReadOptions) -> Result<LoadedCloud, PointC
         _ => None,
     };
 
-    let available = bytes.len() - pos;
-    let min_per_point = if binary {
-        stride as u128
-    } else {
-        2 * values_per_point as u128
+    Ok(Layout {
+        col,
+        offset,
+        values_per_point: c,
+        stride: o,
+        xyz,
+        normal,
+    })
+}
+
+/// Reads `header.count` packed little-endian records.
+fn read_binary_body(
+    bytes: &[u8],
+    header: &PcdHeader,
+    layout: &Layout,
+    sink: &mut PointSink,
+) -> Result<(), PointCloudError> {
+    let (fields, offset, stride, count) =
+        (&header.fields, &layout.offset, layout.stride, header.count);
+    let (xyz, normal) = (layout.xyz, layout.normal);
+    let mut pos = header.data_start;
+    let get = |rec: &[u8], i: usize| -> Real {
+        let f = &fields[i];
+        f.scalar.decode(&rec[offset[i]..offset[i] + f.size], false)
     };
-    let min_bytes = count as u128 * min_per_point;
-    if super::is_absurd(min_bytes, available) || (min_per_point == 0 && count > 0) {
-        return Err(PointCloudError::CountExceedsData {
-            origin: Origin(None),
-            claimed: count,
-            min_bytes,
-            available,
-        });
-    }
-    let capacity = count.min((available as u128 / min_per_point.max(1)) as u64) as usize;
-    let mut sink = PointSink::new(capacity, normal.is_some(), opts.non_finite);
-    if binary {
-        let get = |rec: &[u8], i: usize| -> f64 {
-            let f = &fields[i];
-            f.scalar.decode(&rec[offset[i]..offset[i] + f.size], false)
+    for k in 0..count {
+        let at = DataPos {
+            element: k,
+            line: None,
         };
-        for k in 0..count {
-            let at = DataPos {
-                element: k,
-                line: None,
-            };
-            let Some(rec) = bytes.get(pos..pos + stride) else {
+        let Some(rec) = bytes.get(pos..pos + stride) else {
+            return Err(PointCloudError::Truncated {
+                origin: Origin(None),
+                at,
+                expected: count,
+            });
+        };
+        pos += stride;
+        let p = Vec3::new(get(rec, xyz[0]), get(rec, xyz[1]), get(rec, xyz[2]));
+        let nrm = normal.map_or(Vec3::ZERO, |[a, b, c]| {
+            Vec3::new(get(rec, a), get(rec, b), get(rec, c))
+        });
+        sink.push(p, nrm, at)?;
+    }
+    Ok(())
+}
+
+/// Reads `header.count` points, one a line (blank lines skipped).
+fn read_ascii_body(
+    bytes: &[u8],
+    header: &PcdHeader,
+    layout: &Layout,
+    sink: &mut PointSink,
+) -> Result<(), PointCloudError> {
+    let (fields, col, values_per_point, count) = (
+        &header.fields,
+        &layout.col,
+        layout.values_per_point,
+        header.count,
+    );
+    let (xyz, normal) = (layout.xyz, layout.normal);
+    let (mut pos, data_line) = (header.data_start, header.data_line);
+    let mut line = data_line;
+    let mut wanted: Vec<(usize, usize)> = xyz.iter().map(|&i| (col[i], i)).collect();
+    if let Some(nr) = normal {
+        wanted.extend(nr.iter().map(|&i| (col[i], i)));
+    }
+    let mut vals = [0.0f64; 6];
+    for k in 0..count {
+        let text = loop {
+            let Some(raw) = next_line(bytes, &mut pos) else {
                 return Err(PointCloudError::Truncated {
                     origin: Origin(None),
-                    at,
+                    at: DataPos {
+                        element: k,
+                        line: Some(line + 1),
+                    },
                     expected: count,
                 });
             };
-            pos += stride;
-            let p = DVec3::new(get(rec, xyz[0]), get(rec, xyz[1]), get(rec, xyz[2]));
-            let nrm = normal.map_or(DVec3::ZERO, |[a, b, c]| {
-                DVec3::new(get(rec, a), get(rec, b), get(rec, c))
-            });
-            sink.push(p, nrm, at)?;
-        }
-    } else {
-        let mut line = data_line;
-        let mut wanted: Vec<(usize, usize)> = xyz.iter().map(|&i| (col[i], i)).collect();
-        if let Some(nr) = normal {
-            wanted.extend(nr.iter().map(|&i| (col[i], i)));
-        }
-        let mut vals = [0.0f64; 6];
-        for k in 0..count {
-            let text = loop {
-                let Some(raw) = next_line(bytes, &mut pos) else {
-                    return Err(PointCloudError::Truncated {
-                        origin: Origin(None),
-                        at: DataPos {
-                            element: k,
-                            line: Some(line + 1),
-                        },
-                        expected: count,
-                    });
-                };
-                line += 1;
-                if !raw.iter().all(u8::is_ascii_whitespace) {
-                    break raw;
-                }
-            };
-            let at = DataPos {
-                element: k,
-                line: Some(line),
-            };
-            let bad = |reason: String| PointCloudError::BadValue {
-                origin: Origin(None),
-                at,
-                reason,
-            };
-            let text = std::str::from_utf8(text).map_err(|_| bad("line is not text".into()))?;
-            let toks: Vec<&str> = text.split_ascii_whitespace().collect();
-            if toks.len() != values_per_point {
-                return Err(bad(format!(
-                    "expected {values_per_point} values, found {}",
-                    toks.len()
-                )));
+            line += 1;
+            if !raw.iter().all(u8::is_ascii_whitespace) {
+                break raw;
             }
-            for (slot, &(c, fi)) in wanted.iter().enumerate() {
-                vals[slot] = parse_number(toks[c], fields[fi].scalar).ok_or_else(|| {
-                    bad(format!(
-                        "'{}' is not a number ('{}')",
-                        toks[c], fields[fi].name
-                    ))
-                })?;
-            }
-            let p = DVec3::new(vals[0], vals[1], vals[2]);
-            let nrm = if normal.is_some() {
-                DVec3::new(vals[3], vals[4], vals[5])
-            } else {
-                DVec3::ZERO
-            };
-            sink.push(p, nrm, at)?;
+        };
+        let at = DataPos {
+            element: k,
+            line: Some(line),
+        };
+        let bad = |reason: String| PointCloudError::BadValue {
+            origin: Origin(None),
+            at,
+            reason,
+        };
+        let text = std::str::from_utf8(text).map_err(|_| bad("line is not text".into()))?;
+        let toks: Vec<&str> = text.split_ascii_whitespace().collect();
+        if toks.len() != values_per_point {
+            return Err(bad(format!(
+                "expected {values_per_point} values, found {}",
+                toks.len()
+            )));
         }
+        for (slot, &(c, fi)) in wanted.iter().enumerate() {
+            vals[slot] = parse_number(toks[c], fields[fi].scalar).ok_or_else(|| {
+                bad(format!(
+                    "'{}' is not a number ('{}')",
+                    toks[c], fields[fi].name
+                ))
+            })?;
+        }
+        let p = Vec3::new(vals[0], vals[1], vals[2]);
+        let nrm = if normal.is_some() {
+            Vec3::new(vals[3], vals[4], vals[5])
+        } else {
+            Vec3::ZERO
+        };
+        sink.push(p, nrm, at)?;
     }
-    Ok(sink.finish())
+    Ok(())
 }
 
 /// Read a PCD file from a stream (read to the end first, so counts can be checked against

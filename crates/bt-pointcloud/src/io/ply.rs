@@ -5,9 +5,8 @@
 //! line or point index, and the generic `ply-rs` element maps cost an allocation per point
 //! (too slow for 10⁶-point clouds). `ply-rs` is used in the tests as an independent writer.
 
+use bt_geom::{Real, Vec3};
 use std::io::{Read, Write};
-
-use glam::DVec3;
 
 use super::{
     LoadedCloud, PointSink, ReadOptions, Scalar, io_err, next_line, parse_number, read_all,
@@ -15,16 +14,8 @@ use super::{
 use crate::cloud::PointCloud;
 use crate::error::{DataPos, Origin, PointCloudError};
 
-/// PLY encodings.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum PlyFormat {
-    /// `format ascii 1.0`.
-    Ascii,
-    /// `format binary_little_endian 1.0`.
-    BinaryLittleEndian,
-    /// `format binary_big_endian 1.0`.
-    BinaryBigEndian,
-}
+/// PLY encodings (the byte-level layer of `bt-formats`).
+pub use bt_formats::PlyFormat;
 
 #[derive(Debug, Clone, Copy)]
 enum PropKind {
@@ -61,20 +52,6 @@ impl Element {
                 .sum(),
         }
     }
-}
-
-fn scalar_from_name(name: &str) -> Option<Scalar> {
-    Some(match name {
-        "char" | "int8" => Scalar::I8,
-        "uchar" | "uint8" => Scalar::U8,
-        "short" | "int16" => Scalar::I16,
-        "ushort" | "uint16" => Scalar::U16,
-        "int" | "int32" => Scalar::I32,
-        "uint" | "uint32" => Scalar::U32,
-        "float" | "float32" => Scalar::F32,
-        "double" | "float64" => Scalar::F64,
-        _ => return None,
-    })
 }
 
 struct Header {
@@ -118,11 +95,11 @@ fn parse_header(bytes: &[u8]) -> Result<Header, PointCloudError> {
         }
         match key {
             "format" => {
-                let f = match tok.next() {
-                    Some("ascii") => PlyFormat::Ascii,
-                    Some("binary_little_endian") => PlyFormat::BinaryLittleEndian,
-                    Some("binary_big_endian") => PlyFormat::BinaryBigEndian,
-                    other => {
+                let name = tok.next();
+                let f = match name.and_then(PlyFormat::from_name) {
+                    Some(f) => f,
+                    None => {
+                        let other = name;
                         return Err(header_err(
                             line_no,
                             format!("unknown format {:?}", other.unwrap_or("")),
@@ -164,7 +141,8 @@ fn parse_header(bytes: &[u8]) -> Result<Header, PointCloudError> {
                 let words: Vec<&str> = tok.collect();
                 let (kind, name) = match words.as_slice() {
                     ["list", c, i, name] => {
-                        let (Some(count), Some(item)) = (scalar_from_name(c), scalar_from_name(i))
+                        let (Some(count), Some(item)) =
+                            (Scalar::from_ply_name(c), Scalar::from_ply_name(i))
                         else {
                             return Err(header_err(
                                 line_no,
@@ -180,7 +158,7 @@ fn parse_header(bytes: &[u8]) -> Result<Header, PointCloudError> {
                         (PropKind::List { count, item }, *name)
                     }
                     [t, name] => {
-                        let s = scalar_from_name(t).ok_or_else(|| {
+                        let s = Scalar::from_ply_name(t).ok_or_else(|| {
                             header_err(line_no, format!("unknown property type '{t}'"))
                         })?;
                         (PropKind::Scalar(s), *name)
@@ -298,10 +276,9 @@ pub fn parse_ply(bytes: &[u8], opts: &ReadOptions) -> Result<LoadedCloud, PointC
                 });
             }
             if is_vertex {
-                let p = DVec3::new(vals[xyz[0]], vals[xyz[1]], vals[xyz[2]]);
-                let n = normal_idx.map_or(DVec3::ZERO, |[a, b, c]| {
-                    DVec3::new(vals[a], vals[b], vals[c])
-                });
+                let p = Vec3::new(vals[xyz[0]], vals[xyz[1]], vals[xyz[2]]);
+                let n =
+                    normal_idx.map_or(Vec3::ZERO, |[a, b, c]| Vec3::new(vals[a], vals[b], vals[c]));
                 sink.push(p, n, at(line))?;
             }
         }
@@ -315,7 +292,7 @@ fn read_binary_element(
     pos: &mut usize,
     e: &Element,
     big_endian: bool,
-    vals: &mut [f64],
+    vals: &mut [Real],
     k: u64,
 ) -> Result<bool, PointCloudError> {
     for (i, p) in e.props.iter().enumerate() {
@@ -362,7 +339,7 @@ fn read_ascii_element(
     pos: &mut usize,
     line: &mut usize,
     e: &Element,
-    vals: &mut [f64],
+    vals: &mut [Real],
     k: u64,
 ) -> Result<bool, PointCloudError> {
     let text = loop {
@@ -419,17 +396,13 @@ pub fn read_ply<R: Read>(reader: R, opts: &ReadOptions) -> Result<LoadedCloud, P
 
 /// Write `cloud` as PLY with `double x y z` (and `double nx ny nz` when the cloud has
 /// normals). ASCII output uses the shortest representation that reads back to the same
-/// `f64`, so ASCII and binary round trips are both exact.
+/// `Real`, so ASCII and binary round trips are both exact.
 pub fn write_ply<W: Write>(
     cloud: &PointCloud,
     mut w: W,
     format: PlyFormat,
 ) -> Result<(), PointCloudError> {
-    let fmt = match format {
-        PlyFormat::Ascii => "ascii",
-        PlyFormat::BinaryLittleEndian => "binary_little_endian",
-        PlyFormat::BinaryBigEndian => "binary_big_endian",
-    };
+    let fmt = format.name();
     let mut head = format!(
         "ply\nformat {fmt} 1.0\ncomment written by beamtrace bt-pointcloud (metres, z up)\nelement vertex {}\n\
          property double x\nproperty double y\nproperty double z\n",

@@ -442,7 +442,7 @@ pub fn run(
     let mut fpga = Vec::with_capacity(steps);
     let mut rays = Vec::new();
     for (step, s) in scene.scenes().iter().enumerate() {
-        let (reference, time_s) = run_solver(s, StudySolver::Image, &solver_config);
+        let (reference, time_s) = run_solver(s, StudySolver::Image, &solver_config)?;
         rows.push(row(
             step,
             StudySolver::Image,
@@ -456,7 +456,7 @@ pub fn run(
             StudySolver::IpcJacobi,
             StudySolver::Sbr,
         ] {
-            let (found, time_s) = run_solver(s, solver, &solver_config);
+            let (found, time_s) = run_solver(s, solver, &solver_config)?;
             rows.push(row(step, solver, &reference, &found, time_s));
             if solver == StudySolver::Sbr {
                 sbr_paths = found;

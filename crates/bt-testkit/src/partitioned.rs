@@ -1,12 +1,12 @@
 //! Seeded random scenes: a room split by a partition with a doorway, random boxes and tilted
 //! quads, random terminals; optionally with moving objects.
-#![allow(dead_code)]
 
 use bt_scene::dynamic::{DynamicScene, ObjectDesc};
 use bt_scene::{BoxDesc, SceneDescription, SurfaceDesc, SurfaceKind, Terminals};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
+/// The room: `[0, ROOM]`, metres.
 pub const ROOM: [f64; 3] = [8.0, 6.0, 3.0];
 
 fn quad(c: [f64; 3], u: [f64; 3], v: [f64; 3]) -> Vec<[f64; 3]> {

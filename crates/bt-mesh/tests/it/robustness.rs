@@ -1,9 +1,7 @@
 //! Properties: arbitrary input never panics, and whatever comes out is well formed.
 
-mod common;
-
+use crate::common::*;
 use bt_mesh::{MergeOptions, read_obj, read_ply};
-use common::*;
 use glam::DVec3;
 use proptest::prelude::*;
 

@@ -1,10 +1,8 @@
 //! Property: a rigidly moved box room still gives six surfaces with the moved normals and the
 //! same areas, whatever the file format.
 
-mod common;
-
+use crate::common::*;
 use bt_mesh::{MergeOptions, read_obj, read_ply};
-use common::*;
 use glam::{DQuat, DVec3};
 use proptest::prelude::*;
 

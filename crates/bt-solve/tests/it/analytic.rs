@@ -1,9 +1,8 @@
 //! Analytic cases: the box room (image-source lattice), a single wall, a corner.
 
-mod common;
+use crate::common::*;
 use bt_geom::{Real, Vec3};
 use bt_solve::{Solver, UpdateOrder};
-use common::*;
 
 /// Lengths of all paths of order <= `max` in an empty box: image sources form a lattice; the
 /// image with a_x, a_y, a_z reflections per axis is reached by exactly one valid sequence.

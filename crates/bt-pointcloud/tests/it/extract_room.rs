@@ -2,15 +2,10 @@
 //! 1°, offset within 2 cm, area within 5 %), classified by area, and the output is
 //! deterministic for a seed.
 
-mod common;
-
+use crate::common::room::furnished_room;
+use bt_geom::poly2::newell;
 use bt_pointcloud::{ExtractParams, ExtractedPlane, extract_planes, sample_polygons};
-use common::room::furnished_room;
 use glam::DVec3;
-
-fn newell(p: &[DVec3]) -> DVec3 {
-    (0..p.len()).fold(DVec3::ZERO, |a, i| a + p[i].cross(p[(i + 1) % p.len()]))
-}
 
 /// Area centroid of a planar polygon (fan triangulation with signed areas).
 fn centroid(p: &[DVec3]) -> DVec3 {

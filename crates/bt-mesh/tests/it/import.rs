@@ -1,9 +1,7 @@
 //! Mesh files to surfaces: formats, coplanar merging, concave outlines, bad input.
 
-mod common;
-
+use crate::common::*;
 use bt_mesh::{MergeOptions, MeshError, Position, read_mesh_path, read_obj, read_ply};
-use common::*;
 use glam::{DVec2, DVec3};
 
 const TOL: f64 = 1e-9;

@@ -4,14 +4,14 @@
 //! image method; a kept tree answers new receivers like a fresh trace; IPC started inside the
 //! windows finds what the image method finds.
 
-mod common;
 use bt_geom::{Real, Vec3};
 use bt_paths::beamtree::{BeamTree, TreeOptions};
-use bt_scene::{Scene, SceneDescription, Terminals};
+use bt_scene::{Scene, Terminals};
 use bt_solve::pipeline::{CandidateMode, TraceOptions, trace_receivers, trace_scene};
 use bt_solve::{FoundPath, Solver, UpdateOrder};
-use common::*;
+use crate::common::*;
 use proptest::prelude::*;
+use bt_testkit::nasty_scene;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -29,114 +29,6 @@ fn paths(scene: &Scene, max_order: usize, mode: CandidateMode) -> Vec<FoundPath>
         .expect("trace runs")
         .result
         .paths
-}
-
-fn rect(name: &str, kind: &str, c: Vec3, u: Vec3, v: Vec3) -> String {
-    let verts: Vec<[Real; 3]> = [(-1., -1.), (1., -1.), (1., 1.), (-1., 1.)]
-        .iter()
-        .map(|(x, y)| (c + *x * u + *y * v).to_array())
-        .collect();
-    format!(r#"{{ "name": "{name}", "kind": "{kind}", "vertices": {verts:?} }}"#)
-}
-
-fn random_unit(rng: &mut ChaCha8Rng) -> Vec3 {
-    Vec3::new(
-        rng.random_range(-1.0..1.0),
-        rng.random_range(-1.0..1.0),
-        rng.random_range(-1.0..1.0),
-    )
-    .normalize_or(Vec3::Z)
-}
-
-/// A box room with `n` random pieces of each nasty kind inside: free rectangles (some blockers),
-/// folded pairs sharing an edge, coplanar neighbours sharing an edge, L-shaped (concave) panels.
-/// `terminals` picks how TX and RX are placed (0: random, 1: RX mirrored through an edge
-/// point of a surface, 2: TX in the plane of a surface).
-fn nasty_scene(seed: u64, n: usize, terminals: u8) -> Option<Scene> {
-    let mut rng = ChaCha8Rng::seed_from_u64(seed);
-    let size = Vec3::new(
-        rng.random_range(3.0..7.0),
-        rng.random_range(3.0..7.0),
-        rng.random_range(2.2..3.2),
-    );
-    let inside = |rng: &mut ChaCha8Rng, m: Real| {
-        Vec3::new(
-            rng.random_range(m..size.x - m),
-            rng.random_range(m..size.y - m),
-            rng.random_range(m..size.z - m),
-        )
-    };
-    let mut surfaces = Vec::new();
-    let mut edge_points = Vec::new();
-    for i in 0..n {
-        let c = inside(&mut rng, 0.6);
-        let normal = random_unit(&mut rng);
-        let (u0, v0) = normal.any_orthonormal_pair();
-        let (a, b) = (rng.random_range(0.15..0.6), rng.random_range(0.15..0.6));
-        let (u, v) = (u0 * a, v0 * b);
-        match i % 4 {
-            0 => {
-                let kind = if rng.random_bool(0.3) {
-                    "blocker"
-                } else {
-                    "reflector"
-                };
-                surfaces.push(rect(&format!("r{i}"), kind, c, u, v));
-            }
-            1 => {
-                // folded pair sharing the edge c + v*t: a concave or convex dihedral
-                let fold: Real = rng.random_range(0.3..2.8);
-                let w = (u0 * fold.cos() + normal * fold.sin()) * a;
-                surfaces.push(rect(&format!("f{i}a"), "reflector", c + u, u, v));
-                surfaces.push(rect(&format!("f{i}b"), "reflector", c + w, w, v));
-            }
-            2 => {
-                // coplanar neighbours sharing an edge
-                surfaces.push(rect(&format!("c{i}a"), "reflector", c - u, u, v));
-                surfaces.push(rect(&format!("c{i}b"), "reflector", c + u, u, v));
-            }
-            _ => {
-                let l: Vec<[Real; 3]> =
-                    [(0., 0.), (2., 0.), (2., 1.), (1., 1.), (1., 2.), (0., 2.)]
-                        .iter()
-                        .map(|(x, y)| (c + (*x - 1.0) * u + (*y - 1.0) * v).to_array())
-                        .collect();
-                surfaces.push(format!(
-                    r#"{{ "name": "l{i}", "kind": "reflector", "vertices": {l:?} }}"#
-                ));
-            }
-        }
-        edge_points.push((c + u + v * rng.random_range(-1.0..1.0), normal));
-        edge_points.push((c + u + v, normal));
-    }
-    let tx = inside(&mut rng, 0.1);
-    let (tx, rx) = match terminals {
-        1 => {
-            // RX on the mirror ray of TX through a surface's edge point (or corner): a path
-            // whose reflection point lies exactly on a polygon boundary.
-            let (p, normal) = edge_points[rng.random_range(0..edge_points.len())];
-            let d = p - tx;
-            let r = d - 2.0 * d.dot(normal) * normal;
-            (tx, p + r.normalize() * rng.random_range(0.3..2.0))
-        }
-        2 => {
-            let (p, normal) = edge_points[rng.random_range(0..edge_points.len())];
-            let (u, _) = normal.any_orthonormal_pair();
-            (p + u * rng.random_range(0.2..1.5), inside(&mut rng, 0.1))
-        }
-        _ => (tx, inside(&mut rng, 0.1)),
-    };
-    let json = format!(
-        r#"{{ "tx": {:?}, "rx": {:?}, "surfaces": [{}], "boxes": [ {{ "name": "room", "min": [0, 0, 0], "max": {:?} }} ] }}"#,
-        tx.to_array(),
-        rx.to_array(),
-        surfaces.join(","),
-        size.to_array()
-    );
-    let d: SceneDescription = serde_json::from_str(&json).unwrap();
-    // Random pieces may cross each other or put a terminal outside the room or on a surface:
-    // such draws are skipped (the scene validator says why), not forced.
-    Scene::from_description(&d, "nasty", Terminals::default()).ok()
 }
 
 fn assert_same(a: &[FoundPath], b: &[FoundPath]) -> Result<(), TestCaseError> {
@@ -199,7 +91,7 @@ proptest! {
     fn ipc_from_windows_equals_the_image_method(seed in 0u64..1_000_000, n in 1usize..6) {
         let Some(scene) = nasty_scene(seed, n, 0) else { return Ok(()) };
         let reference = paths(&scene, 3, CandidateMode::Exhaustive);
-        let ipc = trace_scene(&scene, &options(3, CandidateMode::BeamTree, common::ipc(&scene, UpdateOrder::GaussSeidel)))
+        let ipc = trace_scene(&scene, &options(3, CandidateMode::BeamTree, crate::common::ipc(&scene, UpdateOrder::GaussSeidel)))
             .unwrap().result.paths;
         prop_assert_eq!(sequences(&ipc), sequences(&reference));
         // Folded pairs make corner paths, where the paper's rounds converge sublinearly
@@ -281,7 +173,7 @@ fn ipc_finds_the_wall_floor_path_that_centroid_starts_missed() {
         &options(
             2,
             CandidateMode::BeamTree,
-            common::ipc(&scene, UpdateOrder::GaussSeidel),
+            crate::common::ipc(&scene, UpdateOrder::GaussSeidel),
         ),
     )
     .unwrap()

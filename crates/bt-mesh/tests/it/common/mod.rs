@@ -1,7 +1,5 @@
 //! Small mesh builders shared by the integration tests. All lengths in metres.
 
-#![allow(dead_code)]
-
 use bt_mesh::{MeshImport, MeshSurface};
 use glam::DVec3;
 

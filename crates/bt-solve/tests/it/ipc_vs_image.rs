@@ -1,9 +1,8 @@
 //! Property tests: IPC (both update orders) finds exactly the image method's valid paths, to
 //! 1e-9 m, and every reported path obeys the law of reflection and lies inside its polygons.
 
-mod common;
+use crate::common::*;
 use bt_solve::{Solver, UpdateOrder};
-use common::*;
 use proptest::prelude::*;
 
 proptest! {

@@ -1,0 +1,51 @@
+//! Shared helpers of the solver tests: scene builders and path checks.
+
+use bt_geom::{Real, Vec3};
+use bt_paths::{AllVisible, enumerate};
+use bt_scene::{Scene, SurfaceId};
+use bt_solve::{FoundPath, IpcOptions, Solver, UpdateOrder, trace};
+
+pub use bt_testkit::{box_room, random_scene, scene_from_json};
+
+pub fn run(scene: &Scene, max_order: usize, solver: Solver) -> Vec<FoundPath> {
+    let candidates = enumerate(scene, max_order, &AllVisible);
+    trace(scene, &candidates, &solver, true).paths
+}
+
+pub fn ipc(scene: &Scene, order: UpdateOrder) -> Solver {
+    Solver::Ipc(IpcOptions::for_scene(scene, order))
+}
+
+/// Largest deviation from the law of reflection over the path, radians: the outgoing direction
+/// must be the mirror of the incoming one.
+pub fn reflection_law_error(scene: &Scene, path: &FoundPath) -> Real {
+    let mut v = vec![scene.tx()];
+    v.extend_from_slice(&path.points);
+    v.push(scene.rx());
+    let mut worst: Real = 0.0;
+    for (k, id) in path.surfaces.iter().enumerate() {
+        let n = scene.surface(*id).polygon.plane().normal;
+        let d_in = (v[k + 1] - v[k]).normalize();
+        let d_out = (v[k + 2] - v[k + 1]).normalize();
+        let mirrored = d_in - 2.0 * d_in.dot(n) * n;
+        worst = worst.max(angle_between(mirrored, d_out));
+    }
+    worst
+}
+
+/// Angle between two vectors, radians (robust for tiny angles).
+pub fn angle_between(a: Vec3, b: Vec3) -> Real {
+    a.cross(b).length().atan2(a.dot(b))
+}
+
+pub fn sequences(paths: &[FoundPath]) -> Vec<Vec<SurfaceId>> {
+    paths.iter().map(|p| p.surfaces.clone()).collect()
+}
+
+/// Largest point distance between matching paths (same sequences in the same order), metres.
+pub fn max_point_distance(a: &[FoundPath], b: &[FoundPath]) -> Real {
+    a.iter()
+        .zip(b)
+        .flat_map(|(p, q)| p.points.iter().zip(&q.points).map(|(x, y)| x.distance(*y)))
+        .fold(0.0, Real::max)
+}

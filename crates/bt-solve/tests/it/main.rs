@@ -1,0 +1,9 @@
+//! The integration tests of bt-solve, one binary (one link) for all: analytic cases, IPC
+//! against the image method on random scenes, Newton acceleration near corners, the beam tree
+//! against exhaustive enumeration.
+
+mod analytic;
+mod beamtree;
+mod common;
+mod ipc_vs_image;
+mod newton;
