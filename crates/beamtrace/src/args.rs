@@ -126,7 +126,7 @@ pub enum SceneCommand {
 /// Arguments that select and load a scene.
 #[derive(Debug, Args, Clone)]
 pub struct SceneArgs {
-    /// Scene file (.json, .toml, .obj, .ply) or builtin:NAME.
+    /// Scene file (.json, .toml, .obj, .ply mesh, .ply/.pcd point cloud) or builtin:NAME.
     pub scene: String,
     /// Transmitter position X,Y,Z in metres (overrides the scene's).
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]

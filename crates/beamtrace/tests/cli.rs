@@ -276,5 +276,34 @@ fn bad_inputs_give_clear_errors() {
     );
     assert_clear_error(&["trace", "no/such/file.json"], &["no/such/file.json"]);
     assert_clear_error(&["trace", "scene.xyz"], &["unsupported scene format"]);
+    let dir_arg = dir.display().to_string();
+    for command in [
+        &["trace"][..],
+        &["trace", "--steps"],
+        &["wvrn"],
+        &["scene", "check"],
+    ] {
+        let mut args = command.to_vec();
+        args.push(&dir_arg);
+        assert_clear_error(&args, &[&dir_arg, "is a directory"]);
+    }
     std::fs::remove_dir_all(&dir).ok();
+}
+
+/// Every command loads through `bt_scene::load`: an unknown built-in gives the same message
+/// from the static, dynamic and WVRN paths.
+#[test]
+fn unknown_builtin_is_one_error_everywhere() {
+    let expected =
+        "unknown built-in scene \"nowhere\" (built-in scenes: living-room, living-room-dynamic)";
+    for command in [
+        &["trace", "builtin:nowhere"][..],
+        &["trace", "builtin:nowhere", "--steps"],
+        &["wvrn", "builtin:nowhere"],
+        &["scene", "check", "builtin:nowhere"],
+        &["sample", "builtin:nowhere", "-o", "never-written.ply"],
+    ] {
+        assert_clear_error(command, &[expected]);
+    }
+    assert!(!Path::new("never-written.ply").exists());
 }

@@ -49,11 +49,30 @@ pub enum SceneError {
     /// A mesh file could not be imported.
     #[error(transparent)]
     Mesh(#[from] bt_mesh::MeshError),
+    /// A point cloud could not be read, or its planes not extracted.
+    #[error(transparent)]
+    PointCloud(#[from] bt_pointcloud::PointCloudError),
     /// The extension is not one of the supported formats.
-    #[error("{path}: unsupported scene format (expected .json, .toml, .obj or .ply)")]
+    #[error(
+        "{path}: unsupported scene format (expected .json, .toml, .obj, .ply, .pcd or builtin:NAME)"
+    )]
     UnsupportedFormat {
         /// File path.
         path: String,
+    },
+    /// A directory was given where a scene file is expected.
+    #[error("{path}: is a directory, not a scene file")]
+    IsDirectory {
+        /// The directory's path.
+        path: String,
+    },
+    /// `builtin:NAME` names no built-in scene.
+    #[error("unknown built-in scene \"{name}\" (built-in scenes: {known})")]
+    UnknownBuiltin {
+        /// The name after `builtin:`.
+        name: String,
+        /// The known names, comma-separated.
+        known: String,
     },
     /// The scene has one or more problems; all are listed.
     #[error("{source_name}: {} problem(s):\n{}", problems.len(), problems.iter().map(|p| format!("  - {p}")).collect::<Vec<_>>().join("\n"))]

@@ -116,3 +116,67 @@ fn builtin_living_room_matches_its_description() {
     assert!((s.tx().z - 2.2).abs() < 1e-12 && (s.rx().z - 0.72).abs() < 1e-12);
     assert!(bt_scene::builtin_scene("no-such-room", Terminals::default()).is_none());
 }
+
+/// `bt_scene::load` is the one entry for every source: built-ins, scene files, meshes; the
+/// dynamic form gives every step of a dynamic built-in and one step of a static source.
+#[test]
+fn one_loading_entry_for_every_source() {
+    use bt_scene::io::{Format, Source};
+    use bt_scene::{LoadOptions, load, load_dynamic};
+    let testdata = concat!(env!("CARGO_MANIFEST_DIR"), "/../../testdata/scenes");
+    assert_eq!(
+        Source::parse("builtin:living-room"),
+        Source::Builtin("living-room".into())
+    );
+    let options = LoadOptions::default();
+    let builtin = load("builtin:living-room", &options).unwrap().scene;
+    let direct = bt_scene::builtin_scene("living-room", Terminals::default())
+        .unwrap()
+        .unwrap();
+    assert_eq!(builtin.surfaces().len(), direct.surfaces().len());
+    assert_eq!(builtin.name(), direct.name());
+
+    let wall = format!("{testdata}/one-wall.json");
+    assert_eq!(
+        Format::of(std::path::Path::new(&wall)).unwrap(),
+        Format::Json
+    );
+    assert_eq!(load(&wall, &options).unwrap().scene.surfaces().len(), 1);
+    let ply = format!("{testdata}/box-room-ascii.ply");
+    assert_eq!(
+        Format::of(std::path::Path::new(&ply)).unwrap(),
+        Format::PlyMesh
+    );
+    let boxed = LoadOptions {
+        terminals: Terminals {
+            tx: Some(Vec3::new(1.1, 0.7, 2.1)),
+            rx: Some(Vec3::new(3.6, 2.9, 0.8)),
+        },
+        ..LoadOptions::default()
+    };
+    assert_eq!(load(&ply, &boxed).unwrap().scene.surfaces().len(), 6);
+
+    let (steps, _) = load_dynamic("builtin:living-room-dynamic", &options, &mut |_| {}).unwrap();
+    assert_eq!(steps.len(), 10);
+    let (one, _) = load_dynamic(&ply, &boxed, &mut |_| {}).unwrap();
+    assert_eq!(one.len(), 1);
+
+    let unknown = load("builtin:attic", &options).unwrap_err().to_string();
+    assert_eq!(
+        unknown,
+        "unknown built-in scene \"attic\" (built-in scenes: living-room, living-room-dynamic)"
+    );
+    let dynamic_unknown = load_dynamic("builtin:attic", &options, &mut |_| {})
+        .unwrap_err()
+        .to_string();
+    assert_eq!(dynamic_unknown, unknown);
+    let dir = load(testdata, &options).unwrap_err();
+    assert!(
+        matches!(dir, SceneError::IsDirectory { .. }),
+        "{dir}: a directory is not an unsupported format"
+    );
+    assert!(
+        dir.to_string()
+            .ends_with("is a directory, not a scene file")
+    );
+}

@@ -1,5 +1,12 @@
-//! Scene input: the project's JSON/TOML scene files and OBJ/PLY meshes. The only module of the
-//! library crates that touches the filesystem.
+//! Scene input: the project's JSON/TOML scene files, OBJ/PLY meshes and PLY/PCD point clouds,
+//! all behind one entry ([`load`] / [`load_dynamic`], in `source.rs`). The only module of this
+//! crate that touches the filesystem.
+
+mod cloud;
+mod source;
+
+pub use cloud::{cloud_description, is_point_cloud};
+pub use source::{Format, LoadProgress, Source, load, load_dynamic, load_with_progress};
 
 use crate::material::{DEFAULT_MATERIAL, Material, default_materials};
 use crate::model::{Scene, SurfaceKind};
@@ -8,7 +15,6 @@ use crate::validate::{
 };
 use crate::{Problem, SceneDescription};
 use bt_geom::Real;
-use std::path::Path;
 
 pub use crate::validate::Terminals as TerminalOverrides;
 
@@ -21,8 +27,10 @@ pub struct LoadOptions {
     pub merge: bt_mesh::MergeOptions,
     /// Mesh surfaces smaller than this (m²) become blockers (default 0.25 m², as the paper).
     pub min_reflector_area_m2: Real,
-    /// Carrier frequency for meshes, Hz (default 28 GHz).
+    /// Carrier frequency for meshes and point clouds, Hz (default 28 GHz).
     pub frequency_hz: Real,
+    /// Plane-extraction parameters for point clouds (PLY without faces, PCD).
+    pub extract: bt_pointcloud::ExtractParams,
 }
 
 impl Default for LoadOptions {
@@ -32,6 +40,7 @@ impl Default for LoadOptions {
             merge: bt_mesh::MergeOptions::default(),
             min_reflector_area_m2: 0.25,
             frequency_hz: DEFAULT_FREQUENCY_HZ,
+            extract: bt_pointcloud::ExtractParams::default(),
         }
     }
 }
@@ -43,44 +52,6 @@ pub struct Loaded {
     pub scene: Scene,
     /// Warnings for the user.
     pub warnings: Vec<String>,
-}
-
-/// Load a scene from `path`, choosing the format by extension (`.json`, `.toml`, `.obj`, `.ply`).
-pub fn load(path: &Path, options: &LoadOptions) -> Result<Loaded, SceneError> {
-    let display = path.display().to_string();
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .unwrap_or("")
-        .to_ascii_lowercase();
-    match ext.as_str() {
-        "json" | "toml" => {
-            let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
-                path: display.clone(),
-                source,
-            })?;
-            let desc = if ext == "json" {
-                parse_json(&text, &display)?
-            } else {
-                parse_toml(&text, &display)?
-            };
-            let scene = Scene::from_description(&desc, &display, options.terminals)?;
-            Ok(Loaded {
-                scene,
-                warnings: Vec::new(),
-            })
-        }
-        "obj" | "ply" => {
-            let import = bt_mesh::read_mesh_path(path, &options.merge)?;
-            let stem = path
-                .file_stem()
-                .and_then(|s| s.to_str())
-                .unwrap_or("mesh")
-                .to_string();
-            from_mesh(import, &stem, &display, options)
-        }
-        _ => Err(SceneError::UnsupportedFormat { path: display }),
-    }
 }
 
 /// Parse a JSON scene description; errors carry line and column.
