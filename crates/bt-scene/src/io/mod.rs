@@ -5,6 +5,7 @@ use crate::material::{DEFAULT_MATERIAL, Material, default_materials};
 use crate::model::{Scene, SurfaceKind};
 use crate::validate::{
     DEFAULT_FREQUENCY_HZ, RawSurface, SceneError, Terminals, build_surfaces, check_terminals,
+    radio_problems,
 };
 use crate::{Problem, SceneDescription};
 use bt_geom::Real;
@@ -23,6 +24,9 @@ pub struct LoadOptions {
     pub min_reflector_area_m2: Real,
     /// Carrier frequency for meshes, Hz (default 28 GHz).
     pub frequency_hz: Real,
+    /// A radio material for every surface (CLI `--material itu:NAME --thickness M`), replacing
+    /// the radio model of every material of the loaded scene, whatever its format.
+    pub radio: Option<bt_channel::RadioMaterial>,
 }
 
 impl Default for LoadOptions {
@@ -32,6 +36,7 @@ impl Default for LoadOptions {
             merge: bt_mesh::MergeOptions::default(),
             min_reflector_area_m2: 0.25,
             frequency_hz: DEFAULT_FREQUENCY_HZ,
+            radio: None,
         }
     }
 }
@@ -45,8 +50,17 @@ pub struct Loaded {
     pub warnings: Vec<String>,
 }
 
-/// Load a scene from `path`, choosing the format by extension (`.json`, `.toml`, `.obj`, `.ply`).
+/// Load a scene from `path`, choosing the format by extension (`.json`, `.toml`, `.obj`, `.ply`),
+/// and apply `options.radio` to every material.
 pub fn load(path: &Path, options: &LoadOptions) -> Result<Loaded, SceneError> {
+    let mut loaded = load_file(path, options)?;
+    if let Some(radio) = options.radio {
+        loaded.scene = loaded.scene.with_radio_material(radio)?;
+    }
+    Ok(loaded)
+}
+
+fn load_file(path: &Path, options: &LoadOptions) -> Result<Loaded, SceneError> {
     let display = path.display().to_string();
     let ext = path
         .extension()
@@ -100,7 +114,8 @@ pub fn parse_toml(text: &str, path: &str) -> Result<SceneDescription, SceneError
 }
 
 /// Build a scene from imported mesh surfaces: surfaces below the area threshold become blockers,
-/// unknown material names get the default loss (with a warning).
+/// material names of the ITU table (`itu_concrete`, ...) get that material as a half-space,
+/// other unknown names the default loss and radio model (with a warning).
 pub fn from_mesh(
     import: bt_mesh::MeshImport,
     name: &str,
@@ -109,7 +124,7 @@ pub fn from_mesh(
 ) -> Result<Loaded, SceneError> {
     let mut warnings = import.warnings;
     let mut materials = default_materials();
-    let default_loss = materials[DEFAULT_MATERIAL].reflection_loss_db;
+    let default = materials[DEFAULT_MATERIAL].clone();
     let mut raw = Vec::with_capacity(import.surfaces.len());
     for (i, s) in import.surfaces.into_iter().enumerate() {
         let material = s.material.map(|m| {
@@ -118,15 +133,22 @@ pub fn from_mesh(
                 lower
             } else {
                 if !materials.contains_key(&m) {
-                    warnings.push(format!(
-                        "material \"{m}\" is not known: using {default_loss} dB per reflection"
-                    ));
-                    materials.insert(
-                        m.clone(),
-                        Material {
-                            reflection_loss_db: default_loss,
+                    let material = match bt_channel::RadioMaterial::itu(&m, None) {
+                        Ok(radio) => Material {
+                            reflection_loss_db: radio
+                                .normal_loss_db(options.frequency_hz)
+                                .unwrap_or(default.reflection_loss_db),
+                            radio: Some(radio),
                         },
-                    );
+                        Err(_) => {
+                            warnings.push(format!(
+                                "material \"{m}\" is not known: using {} dB per reflection and the radio model of \"{DEFAULT_MATERIAL}\"",
+                                default.reflection_loss_db
+                            ));
+                            default.clone()
+                        }
+                    };
+                    materials.insert(m.clone(), material);
                 }
                 m
             }
@@ -167,6 +189,7 @@ pub fn from_mesh(
     if let Err(p) = check_terminals(&surfaces, tx, rx, extent) {
         problems.extend(p);
     }
+    problems.extend(radio_problems(&surfaces, &materials, options.frequency_hz));
     if !problems.is_empty() {
         return Err(SceneError::Invalid {
             source_name: source.to_string(),
