@@ -5,13 +5,21 @@
 //! Frames and units: world frame of `docs/conventions.md` (metres, z up), Hz, radians inside
 //! the library. Every formula and sign convention: `docs/channel.md`.
 
+pub mod antenna;
+pub mod codebook;
+pub mod gain;
 pub mod material;
+pub mod response;
 
+pub use antenna::{Antenna, Orientation, Pattern, Polarization};
+pub use codebook::{Array, Beam, PathDirections, beam_pairs};
+pub use gain::{Bounce, FreeSpace, SurfaceResponse, free_space, path_gain};
 pub use material::{
     ItuBand, ItuMaterial, RadioMaterial, RadioModel, Reflection, SPEED_OF_LIGHT,
     VACUUM_PERMITTIVITY,
 };
 pub use num_complex::Complex64;
+pub use response::{Tap, frequency_response, subcarriers, total_power};
 
 use bt_geom::Real;
 use thiserror::Error;
