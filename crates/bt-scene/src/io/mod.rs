@@ -12,6 +12,7 @@ use crate::material::{DEFAULT_MATERIAL, Material, default_materials};
 use crate::model::{Scene, SurfaceKind};
 use crate::validate::{
     DEFAULT_FREQUENCY_HZ, RawSurface, SceneError, Terminals, build_surfaces, check_terminals,
+    radio_problems,
 };
 use crate::{Problem, SceneDescription};
 use bt_geom::Real;
@@ -31,6 +32,9 @@ pub struct LoadOptions {
     pub frequency_hz: Real,
     /// Plane-extraction parameters for point clouds (PLY without faces, PCD).
     pub extract: bt_pointcloud::ExtractParams,
+    /// A radio material for every surface (CLI `--material itu:NAME --thickness M`), replacing
+    /// the radio model of every material of the loaded scene, whatever its format.
+    pub radio: Option<bt_channel::RadioMaterial>,
 }
 
 impl Default for LoadOptions {
@@ -41,6 +45,7 @@ impl Default for LoadOptions {
             min_reflector_area_m2: 0.25,
             frequency_hz: DEFAULT_FREQUENCY_HZ,
             extract: bt_pointcloud::ExtractParams::default(),
+            radio: None,
         }
     }
 }
@@ -71,7 +76,8 @@ pub fn parse_toml(text: &str, path: &str) -> Result<SceneDescription, SceneError
 }
 
 /// Build a scene from imported mesh surfaces: surfaces below the area threshold become blockers,
-/// unknown material names get the default loss (with a warning).
+/// material names of the ITU table (`itu_concrete`, ...) get that material as a half-space,
+/// other unknown names the default loss and radio model (with a warning).
 pub fn from_mesh(
     import: bt_mesh::MeshImport,
     name: &str,
@@ -80,7 +86,7 @@ pub fn from_mesh(
 ) -> Result<Loaded, SceneError> {
     let mut warnings = import.warnings;
     let mut materials = default_materials();
-    let default_loss = materials[DEFAULT_MATERIAL].reflection_loss_db;
+    let default = materials[DEFAULT_MATERIAL].clone();
     let mut raw = Vec::with_capacity(import.surfaces.len());
     for (i, s) in import.surfaces.into_iter().enumerate() {
         let material = s.material.map(|m| {
@@ -89,15 +95,22 @@ pub fn from_mesh(
                 lower
             } else {
                 if !materials.contains_key(&m) {
-                    warnings.push(format!(
-                        "material \"{m}\" is not known: using {default_loss} dB per reflection"
-                    ));
-                    materials.insert(
-                        m.clone(),
-                        Material {
-                            reflection_loss_db: default_loss,
+                    let material = match bt_channel::RadioMaterial::itu(&m, None) {
+                        Ok(radio) => Material {
+                            reflection_loss_db: radio
+                                .normal_loss_db(options.frequency_hz)
+                                .unwrap_or(default.reflection_loss_db),
+                            radio: Some(radio),
                         },
-                    );
+                        Err(_) => {
+                            warnings.push(format!(
+                                "material \"{m}\" is not known: using {} dB per reflection and the radio model of \"{DEFAULT_MATERIAL}\"",
+                                default.reflection_loss_db
+                            ));
+                            default.clone()
+                        }
+                    };
+                    materials.insert(m.clone(), material);
                 }
                 m
             }
@@ -138,6 +151,7 @@ pub fn from_mesh(
     if let Err(p) = check_terminals(&surfaces, tx, rx, extent) {
         problems.extend(p);
     }
+    problems.extend(radio_problems(&surfaces, &materials, options.frequency_hz));
     if !problems.is_empty() {
         return Err(SceneError::Invalid {
             source_name: source.to_string(),

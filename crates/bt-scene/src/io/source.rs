@@ -81,7 +81,20 @@ pub fn load(source: &str, options: &LoadOptions) -> Result<Loaded, SceneError> {
 }
 
 /// [`load`], reporting the progress of point-cloud plane extraction to `progress`.
+/// `options.radio`, when set, replaces the radio model of every material, whatever the format.
 pub fn load_with_progress(
+    source: &str,
+    options: &LoadOptions,
+    progress: &mut dyn FnMut(LoadProgress),
+) -> Result<Loaded, SceneError> {
+    let mut loaded = load_any(source, options, progress)?;
+    if let Some(radio) = options.radio {
+        loaded.scene = loaded.scene.with_radio_material(radio)?;
+    }
+    Ok(loaded)
+}
+
+fn load_any(
     source: &str,
     options: &LoadOptions,
     progress: &mut dyn FnMut(LoadProgress),
@@ -132,7 +145,10 @@ pub fn load_dynamic(
     };
     match desc {
         Some(desc) => {
-            let scene = DynamicScene::from_description(&desc, source, options.terminals)?;
+            let mut scene = DynamicScene::from_description(&desc, source, options.terminals)?;
+            if let Some(radio) = options.radio {
+                scene = scene.with_radio_material(radio)?;
+            }
             Ok((scene, Vec::new()))
         }
         None => {
