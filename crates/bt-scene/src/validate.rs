@@ -55,11 +55,23 @@ pub enum SceneError {
     PointCloud(#[from] bt_pointcloud::PointCloudError),
     /// The extension is not one of the supported formats.
     #[error(
-        "{path}: unsupported scene format (expected .json, .toml, .obj, .ply, .pcd or builtin:NAME)"
+        "{path}: unsupported scene format (expected .json, .toml, .xml, .obj, .ply, .pcd or builtin:NAME)"
     )]
     UnsupportedFormat {
         /// File path.
         path: String,
+    },
+    /// A Mitsuba/Sionna XML scene is malformed or uses what beamtrace does not support.
+    #[error("{path}: line {line}, column {column}: {message}")]
+    Xml {
+        /// File path.
+        path: String,
+        /// 1-based line of the offending element.
+        line: u32,
+        /// 1-based column.
+        column: u32,
+        /// What is wrong, naming the element.
+        message: String,
     },
     /// A directory was given where a scene file is expected.
     #[error("{path}: is a directory, not a scene file")]

@@ -179,6 +179,8 @@ fn one_loading_entry_for_every_source() {
         dir.to_string()
             .ends_with("is a directory, not a scene file")
     );
+}
+
 #[test]
 fn radio_materials_from_scene_files() {
     let s = scene(

@@ -1,9 +1,11 @@
-//! Scene input: the project's JSON/TOML scene files, OBJ/PLY meshes and PLY/PCD point clouds,
+//! Scene input: the project's JSON/TOML scene files, OBJ/PLY meshes, PLY/PCD point clouds and
+//! Mitsuba/Sionna XML scenes,
 //! all behind one entry ([`load`] / [`load_dynamic`], in `source.rs`). The only module of this
 //! crate that touches the filesystem.
 
 mod cloud;
 mod source;
+pub mod xml;
 
 pub use cloud::{cloud_description, is_point_cloud};
 pub use source::{Format, LoadProgress, Source, load, load_dynamic, load_with_progress};

@@ -42,6 +42,8 @@ pub enum Format {
     PlyMesh,
     /// A point cloud: `.pcd`, or `.ply` declaring no faces; planes are extracted.
     PointCloud,
+    /// A Mitsuba 3 / Sionna RT scene (`.xml`) with PLY/OBJ shapes and radio bsdfs.
+    Xml,
 }
 
 impl Format {
@@ -62,6 +64,7 @@ impl Format {
             "json" => Format::Json,
             "toml" => Format::Toml,
             "obj" => Format::Obj,
+            "xml" => Format::Xml,
             "pcd" => Format::PointCloud,
             "ply" if super::is_point_cloud(path) => Format::PointCloud,
             "ply" => Format::PlyMesh,
@@ -125,6 +128,7 @@ fn load_any(
             from_mesh(import, &file_stem(&path, "mesh"), &display, options)
         }
         Format::PointCloud => super::cloud::load_cloud(&path, options, progress),
+        Format::Xml => super::xml::load_xml(&path, options),
     }
 }
 
