@@ -10,7 +10,7 @@ use crate::validate::SceneError;
 use bt_geom::Real;
 use glam::DMat4;
 use roxmltree::{Document, Node, ParsingOptions};
-use std::collections::BTreeMap;
+use std::collections::{BTreeMap, BTreeSet};
 
 /// Elements that only matter for rendering images: skipped with one warning each.
 const RENDERING_ONLY: [&str; 6] = [
@@ -37,21 +37,24 @@ const IGNORED_RADIO_PROPERTIES: [&str; 7] = [
 /// Sionna RT's thickness when a radio bsdf names none, metres.
 pub const SIONNA_DEFAULT_THICKNESS_M: Real = 0.1;
 
-/// Parsing context: the document (for line numbers), the file name and the `<default>`s.
+/// Parsing context: the text and its line starts (for positions), the file name, the
+/// `<default>`s and the bsdf ids seen.
 pub(super) struct Ctx<'a> {
-    doc: &'a Document<'a>,
+    text: &'a str,
+    line_starts: Vec<usize>,
     file: &'a str,
     defaults: BTreeMap<String, String>,
+    bsdf_ids: BTreeSet<String>,
 }
 
 impl Ctx<'_> {
-    /// An error at `node`'s start: `file:line:column: message`.
+    /// An error at `node`'s start: `file: line L, column C: message`.
     pub(super) fn error(&self, node: Node, message: impl Into<String>) -> SceneError {
-        let pos = self.doc.text_pos_at(node.range().start);
+        let pos = self.pos(node);
         SceneError::Xml {
             path: self.file.to_string(),
-            line: pos.row,
-            column: pos.col,
+            line: pos.line,
+            column: pos.column,
             message: message.into(),
         }
     }
@@ -61,12 +64,19 @@ impl Ctx<'_> {
         self.pos(node).line
     }
 
-    /// Where `node` starts.
+    /// Where `node` starts, in O(log lines + line length) (roxmltree's own `text_pos_at`
+    /// scans from the start of the text: quadratic over a file of many shapes).
     fn pos(&self, node: Node) -> XmlPos {
-        let p = self.doc.text_pos_at(node.range().start);
+        let offset = node.range().start.min(self.text.len());
+        let line = self.line_starts.partition_point(|&s| s <= offset);
+        let start = self.line_starts[line - 1];
+        let column = self
+            .text
+            .get(start..offset)
+            .map_or(offset - start, |t| t.chars().count());
         XmlPos {
-            line: p.row,
-            column: p.col,
+            line: u32::try_from(line).unwrap_or(u32::MAX),
+            column: u32::try_from(column + 1).unwrap_or(u32::MAX),
         }
     }
 
@@ -161,10 +171,15 @@ pub fn parse_xml(text: &str, file: &str) -> Result<XmlScene, SceneError> {
             message: format!("not well-formed XML: {e}"),
         }
     })?;
+    let line_starts = std::iter::once(0)
+        .chain(text.match_indices('\n').map(|(i, _)| i + 1))
+        .collect();
     let mut ctx = Ctx {
-        doc: &doc,
+        text,
+        line_starts,
         file,
         defaults: BTreeMap::new(),
+        bsdf_ids: BTreeSet::new(),
     };
     let root = doc.root_element();
     if tag(root) != "scene" {
@@ -185,7 +200,7 @@ pub fn parse_xml(text: &str, file: &str) -> Result<XmlScene, SceneError> {
             "default" => {}
             "bsdf" => {
                 let id = ctx.required(node, "id")?;
-                add_bsdf(&ctx, &mut scene, node, id)?;
+                add_bsdf(&mut ctx, &mut scene, node, id)?;
             }
             "shape" => {
                 if scene.shapes.len() >= MAX_XML_SHAPES {
@@ -194,7 +209,7 @@ pub fn parse_xml(text: &str, file: &str) -> Result<XmlScene, SceneError> {
                         format!("more than {MAX_XML_SHAPES} shapes: scene too large"),
                     ));
                 }
-                let shape = parse_shape(&ctx, &mut scene, node)?;
+                let shape = parse_shape(&mut ctx, &mut scene, node)?;
                 scene.shapes.push(shape);
             }
             t if RENDERING_ONLY.contains(&t) => {
@@ -214,14 +229,14 @@ pub fn parse_xml(text: &str, file: &str) -> Result<XmlScene, SceneError> {
     Ok(scene)
 }
 
-fn add_bsdf(ctx: &Ctx, scene: &mut XmlScene, node: Node, id: String) -> Result<(), SceneError> {
+fn add_bsdf(ctx: &mut Ctx, scene: &mut XmlScene, node: Node, id: String) -> Result<(), SceneError> {
     if scene.bsdfs.len() >= MAX_XML_BSDFS {
         return Err(ctx.error(
             node,
             format!("more than {MAX_XML_BSDFS} bsdfs: scene too large"),
         ));
     }
-    if scene.bsdfs.iter().any(|b| b.id == id) {
+    if !ctx.bsdf_ids.insert(id.clone()) {
         return Err(ctx.error(
             node,
             format!("<bsdf id=\"{}\"> is defined twice", id.escape_debug()),
@@ -300,7 +315,7 @@ fn parse_bsdf(ctx: &Ctx, node: Node) -> Result<XmlRadio, SceneError> {
     })
 }
 
-fn parse_shape(ctx: &Ctx, scene: &mut XmlScene, node: Node) -> Result<XmlShape, SceneError> {
+fn parse_shape(ctx: &mut Ctx, scene: &mut XmlScene, node: Node) -> Result<XmlShape, SceneError> {
     let kind = match ctx.required(node, "type")?.as_str() {
         "ply" => MeshKind::Ply,
         "obj" => MeshKind::Obj,
@@ -340,19 +355,12 @@ fn parse_shape(ctx: &Ctx, scene: &mut XmlScene, node: Node) -> Result<XmlShape, 
 }
 
 fn shape_child(
-    ctx: &Ctx,
+    ctx: &mut Ctx,
     scene: &mut XmlScene,
     shape: &mut XmlShape,
     filename: &mut Option<String>,
     child: Node,
 ) -> Result<(), SceneError> {
-    let mut set_bsdf = |id: String, at: Node| {
-        if shape.bsdf.is_some() {
-            return Err(ctx.error(at, "<shape> has more than one bsdf"));
-        }
-        shape.bsdf = Some((id, ctx.pos(at)));
-        Ok(())
-    };
     match tag(child) {
         "string" if ctx.required(child, "name")? == "filename" => {
             *filename = Some(ctx.required(child, "value")?);
@@ -391,7 +399,8 @@ fn shape_child(
                     ),
                 ));
             }
-            set_bsdf(ctx.required(child, "id")?, child)?;
+            let id = ctx.required(child, "id")?;
+            set_bsdf(ctx, shape, id, child)?;
         }
         "bsdf" => {
             let id = match ctx.attr(child, "id")? {
@@ -399,7 +408,7 @@ fn shape_child(
                 None => format!("{}.bsdf", shape.name),
             };
             add_bsdf(ctx, scene, child, id.clone())?;
-            set_bsdf(id, child)?;
+            set_bsdf(ctx, shape, id, child)?;
         }
         "transform" => {
             let name = ctx.required(child, "name")?;
@@ -429,11 +438,20 @@ fn shape_child(
     Ok(())
 }
 
+/// Record the shape's bsdf: one per shape.
+fn set_bsdf(ctx: &Ctx, shape: &mut XmlShape, id: String, at: Node) -> Result<(), SceneError> {
+    if shape.bsdf.is_some() {
+        return Err(ctx.error(at, "<shape> has more than one bsdf"));
+    }
+    shape.bsdf = Some((id, ctx.pos(at)));
+    Ok(())
+}
+
 /// Every shape's bsdf reference names a bsdf of the file.
 fn check_refs(ctx: &Ctx, scene: &XmlScene) -> Result<(), SceneError> {
     for shape in &scene.shapes {
         if let Some((id, at)) = &shape.bsdf
-            && !scene.bsdfs.iter().any(|b| &b.id == id)
+            && !ctx.bsdf_ids.contains(id)
         {
             return Err(SceneError::Xml {
                 path: ctx.file.to_string(),
