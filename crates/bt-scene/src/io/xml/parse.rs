@@ -363,7 +363,11 @@ fn shape_child(
 ) -> Result<(), SceneError> {
     match tag(child) {
         "string" if ctx.required(child, "name")? == "filename" => {
-            *filename = Some(ctx.required(child, "value")?);
+            let value = ctx.required(child, "value")?;
+            if value.is_empty() {
+                return Err(ctx.error(child, "<string name=\"filename\"> is empty"));
+            }
+            *filename = Some(value);
         }
         "boolean" => {
             let name = ctx.required(child, "name")?;
