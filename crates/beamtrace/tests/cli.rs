@@ -57,6 +57,20 @@ fn assert_clear_error(args: &[&str], needles: &[&str]) {
     }
 }
 
+/// A fresh folder for files a test writes.
+fn scratch_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("beamtrace-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+/// Write `text` to `dir/name`; the path as an argument.
+fn write_in(dir: &Path, name: &str, text: &str) -> String {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p.display().to_string()
+}
+
 fn without_timings(mut v: Value) -> Value {
     v["stats"].as_object_mut().unwrap().remove("time_s");
     v
@@ -221,13 +235,8 @@ fn scene_check_accepts_the_builtin_scene() {
 
 #[test]
 fn bad_inputs_give_clear_errors() {
-    let dir = std::env::temp_dir().join(format!("beamtrace-cli-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let write = |name: &str, text: &str| {
-        let p = dir.join(name);
-        std::fs::write(&p, text).unwrap();
-        p.display().to_string()
-    };
+    let dir = scratch_dir("cli");
+    let write = |name: &str, text: &str| write_in(&dir, name, text);
     let malformed = write(
         "malformed.json",
         "{ \"tx\": [0, 0, 1],\n  \"surfaces\": [ }",
@@ -360,13 +369,8 @@ fn xml_scene_traces_like_its_json_twin() {
 
 #[test]
 fn bad_xml_scenes_name_the_element_and_line() {
-    let dir = std::env::temp_dir().join(format!("beamtrace-xml-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    let write = |name: &str, text: &str| {
-        let p = dir.join(name);
-        std::fs::write(&p, text).unwrap();
-        p.display().to_string()
-    };
+    let dir = scratch_dir("xml");
+    let write = |name: &str, text: &str| write_in(&dir, name, text);
     let terminals = ["--tx", "0,0,1", "--rx", "1,1,1"];
     let run = |file: &str, needles: &[&str]| {
         let mut args = vec!["trace", file];
