@@ -15,8 +15,8 @@ pub struct Cli {
 
 #[derive(Debug, Subcommand)]
 pub enum Command {
-    /// Trace every specular path between TX and RX in a scene (JSON/TOML scene, OBJ or PLY mesh,
-    /// or builtin:living-room).
+    /// Trace every specular path between TX and RX in a scene (JSON/TOML scene, Mitsuba/Sionna
+    /// XML scene, OBJ or PLY mesh, point cloud, or builtin:living-room).
     Trace(TraceArgs),
     /// Extract planar surfaces from a point cloud (PLY or PCD) into a scene file.
     Extract(ExtractArgs),
@@ -132,7 +132,8 @@ pub enum SceneCommand {
 /// Arguments that select and load a scene.
 #[derive(Debug, Args, Clone)]
 pub struct SceneArgs {
-    /// Scene file (.json, .toml, .obj, .ply) or builtin:NAME.
+    /// Scene file (.json, .toml, Mitsuba/Sionna .xml, .obj, .ply mesh, .ply/.pcd point cloud)
+    /// or builtin:NAME.
     pub scene: String,
     /// Transmitter position X,Y,Z in metres (overrides the scene's).
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]

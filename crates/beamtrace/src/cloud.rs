@@ -4,84 +4,42 @@
 use crate::args::{ExtractArgs, SampleArgs};
 use anyhow::{Context, bail};
 use bt_pointcloud::io::ReadOptions;
-use bt_pointcloud::{ExtractParams, Extraction, PointCloud};
-use bt_scene::{SceneDescription, SurfaceDesc, SurfaceKind};
-use indicatif::{ProgressBar, ProgressStyle};
+use bt_pointcloud::{ExtractParams, Extraction, PointCloud, Progress};
+use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
 use std::path::Path;
 use std::process::ExitCode;
 
-/// Read a cloud and extract its planes, with a progress bar on stderr.
-pub fn extract_from(path: &Path, params: &ExtractParams) -> anyhow::Result<(Extraction, u64)> {
-    let loaded = bt_pointcloud::io::read_path(path, &ReadOptions::default())?;
-    let bar = ProgressBar::new(loaded.cloud.len() as u64);
+/// A progress bar for plane extraction on stderr, shown from the first report on, and the
+/// callback that feeds it.
+pub fn extraction_progress() -> (ProgressBar, impl FnMut(Progress)) {
+    let bar = ProgressBar::hidden();
     bar.set_style(
         ProgressStyle::with_template(
             "{spinner} extracting planes {bar:30} {pos}/{len} points assigned, {msg}",
         )
         .expect("static template"),
     );
-    let extraction = bt_pointcloud::extract_planes_with_progress(&loaded.cloud, params, &mut |p| {
-        bar.set_position(p.points_assigned as u64);
-        bar.set_message(format!("{} planes", p.ransac_planes));
-    })
-    .with_context(|| format!("extracting planes from {}", path.display()))?;
+    let feed = bar.clone();
+    let callback = move |p: Progress| {
+        if feed.is_hidden() {
+            feed.set_draw_target(ProgressDrawTarget::stderr());
+        }
+        feed.set_length(p.points_total as u64);
+        feed.set_position(p.points_assigned as u64);
+        feed.set_message(format!("{} planes", p.ransac_planes));
+    };
+    (bar, callback)
+}
+
+/// Read a cloud and extract its planes, with a progress bar on stderr.
+fn extract_from(path: &Path, params: &ExtractParams) -> anyhow::Result<(Extraction, u64)> {
+    let loaded = bt_pointcloud::io::read_path(path, &ReadOptions::default())?;
+    let (bar, mut progress) = extraction_progress();
+    let extraction =
+        bt_pointcloud::extract_planes_with_progress(&loaded.cloud, params, &mut progress)
+            .with_context(|| format!("extracting planes from {}", path.display()))?;
     bar.finish_and_clear();
     Ok((extraction, loaded.skipped_non_finite))
-}
-
-/// The scene description of extracted planes: `plane-<k>` surfaces, reflectors or blockers by
-/// area, material `default`; TX/RX as given (or absent: supply them when tracing).
-pub fn description(
-    extraction: &Extraction,
-    name: &str,
-    tx: Option<[f64; 3]>,
-    rx: Option<[f64; 3]>,
-) -> SceneDescription {
-    SceneDescription {
-        name: Some(name.to_string()),
-        tx,
-        rx,
-        surfaces: extraction
-            .planes
-            .iter()
-            .enumerate()
-            .map(|(k, p)| SurfaceDesc {
-                name: format!("plane-{k}"),
-                kind: Some(if p.reflector {
-                    SurfaceKind::Reflector
-                } else {
-                    SurfaceKind::Blocker
-                }),
-                vertices: p.polygon.iter().map(|v| v.to_array()).collect(),
-                ..Default::default()
-            })
-            .collect(),
-        ..Default::default()
-    }
-}
-
-/// Whether `path` should be read as a point cloud: `.pcd`, or a `.ply` without faces.
-pub fn is_point_cloud(path: &Path) -> bool {
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .unwrap_or("")
-        .to_ascii_lowercase();
-    match ext.as_str() {
-        "pcd" => true,
-        "ply" => ply_has_no_faces(path),
-        _ => false,
-    }
-}
-
-fn ply_has_no_faces(path: &Path) -> bool {
-    use std::io::Read;
-    let mut head = vec![0u8; 64 * 1024];
-    let Ok(mut f) = std::fs::File::open(path) else {
-        return false;
-    };
-    let n = f.read(&mut head).unwrap_or(0);
-    bt_formats::ply_declares_faces(&head[..n]) == Some(false)
 }
 
 pub fn run_extract(args: &ExtractArgs) -> anyhow::Result<ExitCode> {
@@ -97,7 +55,7 @@ pub fn run_extract(args: &ExtractArgs) -> anyhow::Result<ExitCode> {
         .file_stem()
         .and_then(|s| s.to_str())
         .unwrap_or("extracted");
-    let desc = description(
+    let desc = bt_scene::io::cloud_description(
         &extraction,
         name,
         args.tx.map(|v| v.to_array()),

@@ -4,17 +4,15 @@
 
 use crate::args::{SceneArgs, TraceArgs};
 use crate::output::FORMAT_VERSION;
-use crate::trace::{load_scene, solver_for};
-use anyhow::{Context, bail};
+use crate::trace::{load_options, solver_for};
+use anyhow::Context;
 use bt_beams::PathReport;
 use bt_dynamic::{IncrementalTracer, StepOptions, UpdateStats, trace_scratch};
 use bt_paths::CandidateStats;
 use bt_paths::wvrn::WvrnStats;
-use bt_scene::dynamic::{DynamicScene, builtin_dynamic_scene};
-use bt_scene::{SceneDescription, Terminals};
+use bt_scene::dynamic::DynamicScene;
 use bt_solve::{OutcomeCounts, Solver};
 use serde::Serialize;
-use std::path::Path;
 use std::process::ExitCode;
 use std::time::Instant;
 
@@ -52,43 +50,16 @@ pub struct StepStats {
 }
 
 /// Load a scene as a dynamic scene: JSON/TOML files and built-ins with their steps; meshes
-/// (and any other static source) as one step.
+/// (and any other static source) as one step. Import warnings go to stderr.
 pub fn load_dynamic(args: &SceneArgs) -> anyhow::Result<DynamicScene> {
-    let terminals = Terminals {
-        tx: args.tx,
-        rx: args.rx,
-    };
-    if let Some(name) = args.scene.strip_prefix("builtin:") {
-        return match builtin_dynamic_scene(name, terminals) {
-            Some(scene) => Ok(scene?),
-            None => bail!(
-                "unknown built-in scene \"{name}\" (built-in scenes: {})",
-                bt_scene::builtin_names().join(", ")
-            ),
-        };
-    }
-    let path = Path::new(&args.scene);
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .unwrap_or("")
-        .to_ascii_lowercase();
-    if ext == "json" || ext == "toml" {
-        let text =
-            std::fs::read_to_string(path).with_context(|| format!("reading {}", path.display()))?;
-        let display = path.display().to_string();
-        let desc: SceneDescription = if ext == "json" {
-            bt_scene::io::parse_json(&text, &display)?
-        } else {
-            bt_scene::io::parse_toml(&text, &display)?
-        };
-        return Ok(DynamicScene::from_description(&desc, &display, terminals)?);
-    }
-    let loaded = load_scene(args)?;
-    for w in &loaded.warnings {
+    let (bar, mut progress) = crate::cloud::extraction_progress();
+    let loaded = bt_scene::load_dynamic(&args.scene, &load_options(args), &mut progress);
+    bar.finish_and_clear();
+    let (scene, warnings) = loaded?;
+    for w in &warnings {
         eprintln!("warning: {w}");
     }
-    Ok(DynamicScene::from_static(loaded.scene))
+    Ok(scene)
 }
 
 pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {

@@ -6,53 +6,16 @@ use anyhow::{Context, bail};
 use bt_scene::io::{LoadOptions, Loaded};
 use bt_scene::{Scene, SceneError, Terminals};
 use bt_solve::{Acceleration, IpcOptions, SbrOptions, Solver, UpdateOrder};
-use std::path::Path;
 use std::process::ExitCode;
 use std::time::Instant;
 
-/// Load the scene named on the command line (a file or `builtin:NAME`).
-pub fn load_scene(args: &SceneArgs) -> Result<Loaded, SceneError> {
-    let terminals = Terminals {
-        tx: args.tx,
-        rx: args.rx,
-    };
-    if let Some(name) = args.scene.strip_prefix("builtin:") {
-        return match bt_scene::builtin_scene(name, terminals) {
-            Some(scene) => scene.map(|scene| Loaded {
-                scene,
-                warnings: Vec::new(),
-            }),
-            None => Err(SceneError::UnsupportedFormat {
-                path: format!(
-                    "{} (built-in scenes: {})",
-                    args.scene,
-                    bt_scene::builtin_names().join(", ")
-                ),
-            }),
-        };
-    }
-    let path = Path::new(&args.scene);
-    if crate::cloud::is_point_cloud(path) {
-        // A point cloud where a scene is expected: extract its planes with the default
-        // parameters (use `beamtrace extract` to tune them and keep the scene file).
-        let (extraction, _) =
-            crate::cloud::extract_from(path, &bt_pointcloud::ExtractParams::default()).map_err(
-                |e| SceneError::Parse {
-                    path: args.scene.clone(),
-                    message: format!("{e:#}"),
-                },
-            )?;
-        let name = path.file_stem().and_then(|s| s.to_str()).unwrap_or("cloud");
-        let desc = crate::cloud::description(&extraction, name, None, None);
-        let scene = bt_scene::Scene::from_description(&desc, &args.scene, terminals)?;
-        let warnings = vec![format!(
-            "{}: point cloud: extracted {} planes ({} reflectors); `beamtrace extract` writes them as a scene file",
-            args.scene, extraction.report.planes_found, extraction.report.reflectors
-        )];
-        return Ok(Loaded { scene, warnings });
-    }
-    let options = LoadOptions {
-        terminals,
+/// The load options the scene arguments select.
+pub fn load_options(args: &SceneArgs) -> LoadOptions {
+    LoadOptions {
+        terminals: Terminals {
+            tx: args.tx,
+            rx: args.rx,
+        },
         merge: bt_mesh::MergeOptions {
             angle_tol_deg: args.merge_angle_deg,
             dist_tol_m: args.merge_distance,
@@ -60,8 +23,16 @@ pub fn load_scene(args: &SceneArgs) -> Result<Loaded, SceneError> {
         },
         min_reflector_area_m2: args.min_reflector_area,
         ..LoadOptions::default()
-    };
-    bt_scene::io::load(path, &options)
+    }
+}
+
+/// Load the scene named on the command line (a file or `builtin:NAME`), with a progress bar
+/// while a point cloud's planes are extracted.
+pub fn load_scene(args: &SceneArgs) -> Result<Loaded, SceneError> {
+    let (bar, mut progress) = crate::cloud::extraction_progress();
+    let loaded = bt_scene::load_with_progress(&args.scene, &load_options(args), &mut progress);
+    bar.finish_and_clear();
+    loaded
 }
 
 /// The solver the arguments select, with defaults scaled to the scene.

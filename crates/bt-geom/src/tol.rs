@@ -23,6 +23,12 @@ pub const REL_VERTEX_MERGE: Real = 1e-9;
 /// Angle tolerance in radians for the reflection law check of found paths (1e-9 rad).
 pub const ANGLE_REFLECTION_LAW: Real = 1e-9;
 
+/// Magnitude below which the denominator of a reflection coefficient counts as zero (1e-12;
+/// dimensionless). It vanishes only where the limit is known: the same medium on both sides
+/// at grazing incidence (no interface: no reflection), or a lossless slab with |r| = 1 (the
+/// slab reflects as its half-space).
+pub const COEFFICIENT_DENOMINATOR: Real = 1e-12;
+
 /// A length tolerance in metres for a scene whose bounding box diagonal is `extent` metres.
 #[inline]
 pub fn scaled(relative: Real, extent: Real) -> Real {

@@ -111,6 +111,15 @@ pub enum MeshError {
         /// The value read.
         value: Real,
     },
+    /// A vertex left the finite numbers when mapped through a caller's transform (a scene
+    /// file's `to_world` with a huge scale).
+    #[error("{file}: vertex {vertex} is not finite after the shape's transform")]
+    NonFiniteTransformed {
+        /// File name as given.
+        file: String,
+        /// Zero-based vertex index in the file.
+        vertex: usize,
+    },
     /// A PLY header claims more elements than the body can possibly hold. Checked before any
     /// allocation, so a hostile header cannot exhaust memory.
     #[error(

@@ -151,6 +151,44 @@ pub fn read_ply(
     finish(ply::parse(bytes, file)?, opts, file)
 }
 
+/// Mesh file formats, for callers that choose the reader themselves.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MeshFormat {
+    /// Wavefront OBJ.
+    Obj,
+    /// PLY (ASCII, binary little or big endian).
+    Ply,
+}
+
+/// Reads a mesh from bytes like [`read_obj`] / [`read_ply`], but first maps every vertex
+/// through `to_world` (metres to metres), so that welding and the coplanar merge run in the
+/// world frame with their tolerances in world metres: the `to_world` transform of a shape in
+/// a Mitsuba scene. A vertex that the transform makes non-finite is an error.
+pub fn read_transformed(
+    bytes: &[u8],
+    format: MeshFormat,
+    file: Option<&str>,
+    opts: &MergeOptions,
+    to_world: &dyn Fn(DVec3) -> DVec3,
+) -> Result<MeshImport, MeshError> {
+    opts.validate()?;
+    let file = file.unwrap_or(UNNAMED);
+    let mut raw = match format {
+        MeshFormat::Obj => obj::parse(bytes, file)?,
+        MeshFormat::Ply => ply::parse(bytes, file)?,
+    };
+    for (vertex, p) in raw.positions.iter_mut().enumerate() {
+        *p = to_world(*p);
+        if !p.is_finite() {
+            return Err(MeshError::NonFiniteTransformed {
+                file: file.to_string(),
+                vertex,
+            });
+        }
+    }
+    finish(raw, opts, file)
+}
+
 fn finish(raw: raw::RawMesh, opts: &MergeOptions, file: &str) -> Result<MeshImport, MeshError> {
     let merged = merge::merge(&raw, opts, file);
     let faces_read = raw.face_count();

@@ -46,12 +46,26 @@ pub struct SceneDescription {
     pub rx_steps: Option<Vec<[Real; 3]>>,
 }
 
-/// A material entry.
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+/// A material entry: a constant loss, a radio model, or both (`docs/scene-format.md`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct MaterialDesc {
-    /// Loss per reflection, dB (>= 0).
-    pub reflection_loss_db: Real,
+    /// Loss per reflection, dB (>= 0). Default with a radio model: its loss at normal
+    /// incidence at the scene's frequency.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub reflection_loss_db: Option<Real>,
+    /// An ITU-R P.2040-3 material name (`concrete`, `itu_glass`, `very_dry_ground`, ...).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub itu: Option<String>,
+    /// Custom relative permittivity εr' (with `conductivity`, instead of `itu`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub relative_permittivity: Option<Real>,
+    /// Custom conductivity σ, S/m (with `relative_permittivity`).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub conductivity: Option<Real>,
+    /// Slab thickness, metres (absent: a half-space).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub thickness: Option<Real>,
 }
 
 /// One planar polygon.

@@ -315,6 +315,22 @@ impl DynamicScene {
         self.scenes.is_empty()
     }
 
+    /// A copy in which every material of every step has the radio model `radio` (CLI
+    /// `--material`), see [`Scene::with_radio_material`].
+    pub fn with_radio_material(
+        &self,
+        radio: bt_channel::RadioMaterial,
+    ) -> Result<Self, SceneError> {
+        Ok(Self {
+            scenes: self
+                .scenes
+                .iter()
+                .map(|s| s.with_radio_material(radio))
+                .collect::<Result<_, _>>()?,
+            objects: self.objects.clone(),
+        })
+    }
+
     /// The validated scene of step `k` (0-based). Panics when `k >= len()`.
     pub fn step(&self, k: usize) -> &Scene {
         &self.scenes[k]

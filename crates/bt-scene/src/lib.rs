@@ -15,6 +15,7 @@ mod validate;
 
 pub use builtin::{builtin_json, builtin_names, builtin_scene};
 pub use description::{BoxDesc, MaterialDesc, SceneDescription, SurfaceDesc};
+pub use io::{LoadOptions, Loaded, Source, load, load_dynamic, load_with_progress};
 pub use material::{DEFAULT_MATERIAL, Material, default_materials};
 pub use model::{Scene, Surface, SurfaceId, SurfaceKind};
 pub use validate::{DEFAULT_FREQUENCY_HZ, Problem, SceneError, Terminals};

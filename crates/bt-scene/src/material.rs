@@ -1,5 +1,8 @@
-//! Materials: for now a constant reflection loss per bounce (Fresnel comes later).
+//! Materials: a constant reflection loss per bounce (the paper's ranking and `loss_db`) and an
+//! optional radio model (ITU-R P.2040 or custom εr', σ; half-space or slab) for complex path
+//! gains (`bt-channel`, `docs/channel.md`).
 
+use bt_channel::{ItuMaterial, RadioMaterial, RadioModel};
 use bt_geom::Real;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -12,28 +15,56 @@ pub const DEFAULT_MATERIAL: &str = "default";
 pub struct Material {
     /// Power lost at each specular reflection, dB (>= 0).
     pub reflection_loss_db: Real,
+    /// Electrical model for complex gains. `None`: the surface reflects both polarisations like
+    /// a perfect conductor scaled by `reflection_loss_db` (R_TE = −a, R_TM = +a with
+    /// a = 10^(−loss/20)); see `docs/channel.md`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub radio: Option<RadioMaterial>,
 }
 
 /// Built-in materials with typical single-bounce losses at mmWave (dB), round numbers from
 /// indoor measurement surveys: metal reflects almost fully, fabric absorbs most. Scene files
 /// may override or add materials.
+///
+/// Their radio models (documented choices, `docs/channel.md`): `default` and `concrete` are ITU
+/// concrete half-spaces, `plasterboard` a 12.5 mm ITU plasterboard slab, `wood` an 18 mm ITU
+/// wood slab (furniture panels, floorboards), `glass` a 6 mm ITU glass pane, `metal` an ITU
+/// metal half-space; `fabric` (upholstery, εr' = 2, σ = 0.1 S/m, 5 mm) and `human` (skin
+/// at mmWave, εr' = 16.5, σ = 25 S/m, half-space) are custom: the ITU table has neither.
 pub fn default_materials() -> BTreeMap<String, Material> {
+    let itu = |m: ItuMaterial, thickness: Option<Real>| RadioMaterial {
+        model: RadioModel::Itu(m),
+        thickness,
+    };
+    let custom =
+        |relative_permittivity: Real, conductivity: Real, thickness: Option<Real>| RadioMaterial {
+            model: RadioModel::Custom {
+                relative_permittivity,
+                conductivity,
+            },
+            thickness,
+        };
     [
-        (DEFAULT_MATERIAL, 6.0),
-        ("concrete", 6.0),
-        ("plasterboard", 8.0),
-        ("wood", 9.0),
-        ("glass", 4.0),
-        ("metal", 0.5),
-        ("fabric", 12.0),
-        ("human", 20.0),
+        (DEFAULT_MATERIAL, 6.0, itu(ItuMaterial::Concrete, None)),
+        ("concrete", 6.0, itu(ItuMaterial::Concrete, None)),
+        (
+            "plasterboard",
+            8.0,
+            itu(ItuMaterial::Plasterboard, Some(0.0125)),
+        ),
+        ("wood", 9.0, itu(ItuMaterial::Wood, Some(0.018))),
+        ("glass", 4.0, itu(ItuMaterial::Glass, Some(0.006))),
+        ("metal", 0.5, itu(ItuMaterial::Metal, None)),
+        ("fabric", 12.0, custom(2.0, 0.1, Some(0.005))),
+        ("human", 20.0, custom(16.5, 25.0, None)),
     ]
     .into_iter()
-    .map(|(name, loss)| {
+    .map(|(name, loss, radio)| {
         (
             name.to_string(),
             Material {
                 reflection_loss_db: loss,
+                radio: Some(radio),
             },
         )
     })

@@ -130,6 +130,51 @@ impl Scene {
         Ok(scene)
     }
 
+    /// A copy at another carrier frequency (Hz), checked against the radio models of the
+    /// materials in use (ITU validity ranges).
+    pub fn with_frequency(&self, frequency_hz: Real) -> Result<Scene, crate::SceneError> {
+        let mut problems = Vec::new();
+        if !(frequency_hz.is_finite() && frequency_hz > 0.0) {
+            problems.push(crate::Problem {
+                location: "frequency_hz".into(),
+                message: format!("must be a positive finite number, got {frequency_hz}"),
+            });
+        } else {
+            problems =
+                crate::validate::radio_problems(&self.surfaces, &self.materials, frequency_hz);
+        }
+        if !problems.is_empty() {
+            return Err(crate::SceneError::Invalid {
+                source_name: self.name.clone(),
+                problems,
+            });
+        }
+        let mut scene = self.clone();
+        scene.frequency_hz = frequency_hz;
+        Ok(scene)
+    }
+
+    /// A copy in which every material has the radio model `radio` (CLI `--material`), checked
+    /// at the scene's frequency. The constant `reflection_loss_db` of each material stays.
+    pub fn with_radio_material(
+        &self,
+        radio: bt_channel::RadioMaterial,
+    ) -> Result<Scene, crate::SceneError> {
+        let mut scene = self.clone();
+        for m in scene.materials.values_mut() {
+            m.radio = Some(radio);
+        }
+        let problems =
+            crate::validate::radio_problems(&scene.surfaces, &scene.materials, scene.frequency_hz);
+        if !problems.is_empty() {
+            return Err(crate::SceneError::Invalid {
+                source_name: self.name.clone(),
+                problems,
+            });
+        }
+        Ok(scene)
+    }
+
     fn extent_with(&self, tx: Vec3, rx: Vec3) -> Real {
         scene_extent(&self.surfaces, tx, rx)
     }

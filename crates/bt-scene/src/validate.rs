@@ -3,6 +3,7 @@
 use crate::description::{BOX_FACES, SceneDescription};
 use crate::material::{DEFAULT_MATERIAL, Material, default_materials};
 use crate::model::{Scene, Surface, SurfaceKind, scene_extent};
+use bt_channel::RadioMaterial;
 use bt_geom::{Bvh, Polygon, Real, Vec3, tol};
 use serde::Serialize;
 use std::collections::BTreeSet;
@@ -49,11 +50,42 @@ pub enum SceneError {
     /// A mesh file could not be imported.
     #[error(transparent)]
     Mesh(#[from] bt_mesh::MeshError),
+    /// A point cloud could not be read, or its planes not extracted.
+    #[error(transparent)]
+    PointCloud(#[from] bt_pointcloud::PointCloudError),
     /// The extension is not one of the supported formats.
-    #[error("{path}: unsupported scene format (expected .json, .toml, .obj or .ply)")]
+    #[error(
+        "{path}: unsupported scene format (expected .json, .toml, .xml, .obj, .ply, .pcd or builtin:NAME)"
+    )]
     UnsupportedFormat {
         /// File path.
         path: String,
+    },
+    /// A Mitsuba/Sionna XML scene is malformed or uses what beamtrace does not support.
+    #[error("{path}: line {line}, column {column}: {message}")]
+    Xml {
+        /// File path.
+        path: String,
+        /// 1-based line of the offending element.
+        line: u32,
+        /// 1-based column.
+        column: u32,
+        /// What is wrong, naming the element.
+        message: String,
+    },
+    /// A directory was given where a scene file is expected.
+    #[error("{path}: is a directory, not a scene file")]
+    IsDirectory {
+        /// The directory's path.
+        path: String,
+    },
+    /// `builtin:NAME` names no built-in scene.
+    #[error("unknown built-in scene \"{name}\" (built-in scenes: {known})")]
+    UnknownBuiltin {
+        /// The name after `builtin:`.
+        name: String,
+        /// The known names, comma-separated.
+        known: String,
     },
     /// The scene has one or more problems; all are listed.
     #[error("{source_name}: {} problem(s):\n{}", problems.len(), problems.iter().map(|p| format!("  - {p}")).collect::<Vec<_>>().join("\n"))]
@@ -94,27 +126,25 @@ impl Scene {
         terminals: Terminals,
     ) -> Result<Scene, SceneError> {
         let mut problems = Collector(Vec::new());
-        let mut materials = default_materials();
-        for (name, m) in &desc.materials {
-            if !m.reflection_loss_db.is_finite() || m.reflection_loss_db < 0.0 {
-                problems.push(
-                    format!("materials.{name}.reflection_loss_db"),
-                    "must be a finite number >= 0",
-                );
-            }
-            materials.insert(
-                name.clone(),
-                Material {
-                    reflection_loss_db: m.reflection_loss_db,
-                },
-            );
-        }
         let frequency_hz = desc.frequency_hz.unwrap_or(DEFAULT_FREQUENCY_HZ);
-        if !(frequency_hz.is_finite() && frequency_hz > 0.0) {
+        let frequency_ok = frequency_hz.is_finite() && frequency_hz > 0.0;
+        if !frequency_ok {
             problems.push(
                 "frequency_hz",
                 format!("must be a positive finite number, got {frequency_hz}"),
             );
+        }
+        let mut materials = default_materials();
+        for (name, m) in &desc.materials {
+            let location = format!("materials.{name}");
+            if let Some(material) = material_from_desc(
+                &location,
+                m,
+                frequency_ok.then_some(frequency_hz),
+                &mut problems,
+            ) {
+                materials.insert(name.clone(), material);
+            }
         }
 
         let mut raw: Vec<RawSurface> = Vec::new();
@@ -156,6 +186,11 @@ impl Scene {
             }
         }
         let surfaces = build_surfaces(raw, &materials, &mut problems);
+        if frequency_ok {
+            problems
+                .0
+                .extend(radio_problems(&surfaces, &materials, frequency_hz));
+        }
 
         let tx = terminal(
             "tx",
@@ -221,6 +256,122 @@ impl Scene {
     }
 }
 
+/// A material entry of a scene file, or `None` with its problems reported under `location`.
+/// `frequency_hz` (when valid) derives a missing `reflection_loss_db` from the radio model.
+fn material_from_desc(
+    location: &str,
+    m: &crate::MaterialDesc,
+    frequency_hz: Option<Real>,
+    problems: &mut impl ProblemSink,
+) -> Option<Material> {
+    let before = problems.count();
+    if let Some(loss) = m.reflection_loss_db
+        && !(loss.is_finite() && loss >= 0.0)
+    {
+        problems.report(
+            &format!("{location}.reflection_loss_db"),
+            "must be a finite number >= 0",
+        );
+    }
+    let radio = match (&m.itu, m.relative_permittivity, m.conductivity) {
+        (None, None, None) => {
+            if m.thickness.is_some() {
+                problems.report(
+                    &format!("{location}.thickness"),
+                    "needs a radio model: \"itu\" or \"relative_permittivity\" and \"conductivity\"",
+                );
+            }
+            None
+        }
+        (Some(name), None, None) => RadioMaterial::itu(name, m.thickness)
+            .map_err(|e| {
+                problems.report(
+                    &format!("{location}.{}", field_of(&e, "itu")),
+                    e.to_string(),
+                )
+            })
+            .ok(),
+        (None, Some(eps), Some(sigma)) => RadioMaterial::custom(eps, sigma, m.thickness)
+            .map_err(|e| {
+                problems.report(
+                    &format!("{location}.{}", field_of(&e, "relative_permittivity")),
+                    e.to_string(),
+                )
+            })
+            .ok(),
+        (Some(_), _, _) => {
+            problems.report(
+                location,
+                "give either \"itu\" or \"relative_permittivity\" with \"conductivity\", not both",
+            );
+            None
+        }
+        (None, eps, _) => {
+            let missing = if eps.is_none() {
+                "relative_permittivity"
+            } else {
+                "conductivity"
+            };
+            problems.report(
+                &format!("{location}.{missing}"),
+                "missing: a custom material needs both \"relative_permittivity\" and \"conductivity\"",
+            );
+            None
+        }
+    };
+    let reflection_loss_db = match (m.reflection_loss_db, &radio, frequency_hz) {
+        (Some(loss), _, _) => loss,
+        (None, Some(r), Some(f)) => match r.normal_loss_db(f) {
+            Ok(loss) => loss,
+            Err(e) => {
+                problems.report(location, e.to_string());
+                0.0
+            }
+        },
+        (None, Some(_), None) => 0.0,
+        (None, None, _) => {
+            if problems.count() == before {
+                problems.report(
+                    location,
+                    "give \"reflection_loss_db\", a radio model (\"itu\" or \"relative_permittivity\" and \"conductivity\"), or both",
+                );
+            }
+            0.0
+        }
+    };
+    (problems.count() == before).then_some(Material {
+        reflection_loss_db,
+        radio,
+    })
+}
+
+/// The field a channel error names, or `default`.
+fn field_of(e: &bt_channel::ChannelError, default: &'static str) -> &'static str {
+    match e {
+        bt_channel::ChannelError::Invalid { field, .. } => field,
+        _ => default,
+    }
+}
+
+/// Problems of the radio models of the materials `surfaces` use at `frequency_hz` (ITU
+/// materials outside their validity range).
+pub(crate) fn radio_problems(
+    surfaces: &[Surface],
+    materials: &std::collections::BTreeMap<String, Material>,
+    frequency_hz: Real,
+) -> Vec<Problem> {
+    let used: BTreeSet<&str> = surfaces.iter().map(|s| s.material.as_str()).collect();
+    let mut problems = Vec::new();
+    for name in used {
+        if let Some(Some(radio)) = materials.get(name).map(|m| m.radio)
+            && let Err(e) = radio.permittivity(frequency_hz)
+        {
+            problems.report(&format!("materials.{name}"), e.to_string());
+        }
+    }
+    problems
+}
+
 pub(crate) struct RawSurface {
     pub location: String,
     pub name: String,
@@ -268,11 +419,16 @@ pub(crate) fn build_surfaces(
 /// Where validation problems go.
 pub(crate) trait ProblemSink {
     fn report(&mut self, location: &str, message: impl Into<String>);
+    /// Problems reported so far.
+    fn count(&self) -> usize;
 }
 
 impl ProblemSink for Collector {
     fn report(&mut self, location: &str, message: impl Into<String>) {
         self.push(location, message);
+    }
+    fn count(&self) -> usize {
+        self.0.len()
     }
 }
 
@@ -282,6 +438,9 @@ impl ProblemSink for Vec<Problem> {
             location: location.to_string(),
             message: message.into(),
         });
+    }
+    fn count(&self) -> usize {
+        self.len()
     }
 }
 

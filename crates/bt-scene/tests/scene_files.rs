@@ -116,3 +116,161 @@ fn builtin_living_room_matches_its_description() {
     assert!((s.tx().z - 2.2).abs() < 1e-12 && (s.rx().z - 0.72).abs() < 1e-12);
     assert!(bt_scene::builtin_scene("no-such-room", Terminals::default()).is_none());
 }
+
+/// `bt_scene::load` is the one entry for every source: built-ins, scene files, meshes; the
+/// dynamic form gives every step of a dynamic built-in and one step of a static source.
+#[test]
+fn one_loading_entry_for_every_source() {
+    use bt_scene::io::{Format, Source};
+    use bt_scene::{LoadOptions, load, load_dynamic};
+    let testdata = concat!(env!("CARGO_MANIFEST_DIR"), "/../../testdata/scenes");
+    assert_eq!(
+        Source::parse("builtin:living-room"),
+        Source::Builtin("living-room".into())
+    );
+    let options = LoadOptions::default();
+    let builtin = load("builtin:living-room", &options).unwrap().scene;
+    let direct = bt_scene::builtin_scene("living-room", Terminals::default())
+        .unwrap()
+        .unwrap();
+    assert_eq!(builtin.surfaces().len(), direct.surfaces().len());
+    assert_eq!(builtin.name(), direct.name());
+
+    let wall = format!("{testdata}/one-wall.json");
+    assert_eq!(
+        Format::of(std::path::Path::new(&wall)).unwrap(),
+        Format::Json
+    );
+    assert_eq!(load(&wall, &options).unwrap().scene.surfaces().len(), 1);
+    let ply = format!("{testdata}/box-room-ascii.ply");
+    assert_eq!(
+        Format::of(std::path::Path::new(&ply)).unwrap(),
+        Format::PlyMesh
+    );
+    let boxed = LoadOptions {
+        terminals: Terminals {
+            tx: Some(Vec3::new(1.1, 0.7, 2.1)),
+            rx: Some(Vec3::new(3.6, 2.9, 0.8)),
+        },
+        ..LoadOptions::default()
+    };
+    assert_eq!(load(&ply, &boxed).unwrap().scene.surfaces().len(), 6);
+
+    let (steps, _) = load_dynamic("builtin:living-room-dynamic", &options, &mut |_| {}).unwrap();
+    assert_eq!(steps.len(), 10);
+    let (one, _) = load_dynamic(&ply, &boxed, &mut |_| {}).unwrap();
+    assert_eq!(one.len(), 1);
+
+    let unknown = load("builtin:attic", &options).unwrap_err().to_string();
+    assert_eq!(
+        unknown,
+        "unknown built-in scene \"attic\" (built-in scenes: living-room, living-room-dynamic)"
+    );
+    let dynamic_unknown = load_dynamic("builtin:attic", &options, &mut |_| {})
+        .unwrap_err()
+        .to_string();
+    assert_eq!(dynamic_unknown, unknown);
+    let dir = load(testdata, &options).unwrap_err();
+    assert!(
+        matches!(dir, SceneError::IsDirectory { .. }),
+        "{dir}: a directory is not an unsupported format"
+    );
+    assert!(
+        dir.to_string()
+            .ends_with("is a directory, not a scene file")
+    );
+}
+
+#[test]
+fn radio_materials_from_scene_files() {
+    let s = scene(
+        r#"{ "tx": [0, 1, 1], "rx": [4, 2, 1], "frequency_hz": 3.5e9,
+        "materials": {
+          "wall": { "itu": "itu_concrete", "thickness": 0.2 },
+          "pane": { "relative_permittivity": 6.0, "conductivity": 0.01, "reflection_loss_db": 2 },
+          "old": { "reflection_loss_db": 7 } },
+        "surfaces": [ { "name": "w", "material": "wall", "vertices": [[-5, 0, 0], [5, 0, 0], [5, 0, 3], [-5, 0, 3]] } ] }"#,
+    )
+    .unwrap();
+    let wall = &s.materials()["wall"];
+    let radio = wall.radio.unwrap();
+    assert_eq!(
+        radio.model,
+        bt_channel::RadioModel::Itu(bt_channel::ItuMaterial::Concrete)
+    );
+    assert_eq!(radio.thickness, Some(0.2));
+    // Without reflection_loss_db: the model's normal-incidence loss at the scene's frequency.
+    let expected = radio.normal_loss_db(3.5e9).unwrap();
+    assert!(wall.reflection_loss_db > 0.0 && wall.reflection_loss_db == expected);
+    assert_eq!(s.materials()["pane"].reflection_loss_db, 2.0);
+    assert!(s.materials()["old"].radio.is_none());
+    // The built-in names carry radio models.
+    assert!(s.materials().values().filter(|m| m.radio.is_none()).count() == 1);
+}
+
+#[test]
+fn radio_material_problems_are_located() {
+    let err = scene(
+        r#"{ "tx": [0, 1, 1], "rx": [4, 2, 1], "frequency_hz": 150e9,
+        "materials": {
+          "a": { "itu": "unobtainium" },
+          "b": { "relative_permittivity": 3.0 },
+          "c": { "itu": "wood", "relative_permittivity": 3.0, "conductivity": 0.1 },
+          "d": { "itu": "brick", "thickness": -1 },
+          "e": { "thickness": 0.1 },
+          "f": { },
+          "g": { "relative_permittivity": -2, "conductivity": 0 } },
+        "surfaces": [ { "name": "w", "material": "glass", "vertices": [[-5, 0, 0], [5, 0, 0], [5, 0, 3], [-5, 0, 3]] } ] }"#,
+    )
+    .unwrap_err()
+    .to_string();
+    for needle in [
+        "materials.a.itu: unknown ITU material \"unobtainium\"",
+        "materials.b.conductivity: missing",
+        "materials.c: give either",
+        "materials.d.thickness: thickness: must be",
+        "materials.e.thickness: needs a radio model",
+        "materials.f: give \"reflection_loss_db\"",
+        "materials.g.relative_permittivity",
+        "materials.glass: ITU material \"glass\" is defined for 0.1–100 GHz or 220–450 GHz, not at 150.0000 GHz",
+    ] {
+        assert!(err.contains(needle), "lacks {needle:?}:\n{err}");
+    }
+}
+
+#[test]
+fn unknown_fields_in_materials_are_rejected() {
+    let err = scene(r#"{ "tx": [0, 1, 1], "rx": [4, 2, 1], "materials": { "a": { "itu": "wood", "permittivity": 2 } } }"#)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("unknown field `permittivity`"), "{err}");
+}
+
+#[test]
+fn frequency_and_material_overrides_are_checked() {
+    let s = bt_scene::builtin_scene("living-room", Terminals::default())
+        .unwrap()
+        .unwrap();
+    assert!(s.materials().values().all(|m| m.radio.is_some()));
+    let at_60 = s.with_frequency(60e9).unwrap();
+    assert_eq!(at_60.frequency_hz(), 60e9);
+    // Glass and plasterboard have no model at 150 GHz.
+    let err = s.with_frequency(150e9).unwrap_err().to_string();
+    assert!(
+        err.contains("materials.glass") && err.contains("150"),
+        "{err}"
+    );
+    assert!(s.with_frequency(-1.0).is_err());
+    let metal = bt_channel::RadioMaterial::itu("metal", None).unwrap();
+    let all_metal = s.with_radio_material(metal).unwrap();
+    assert!(
+        all_metal
+            .materials()
+            .values()
+            .all(|m| m.radio == Some(metal))
+    );
+    // Brick is defined up to 40 GHz only; the living room is at 28 GHz.
+    let brick = bt_channel::RadioMaterial::itu("brick", None).unwrap();
+    assert!(s.with_radio_material(brick).is_ok());
+    assert!(at_60.with_radio_material(brick).is_err());
+}

@@ -1,14 +1,23 @@
-//! Scene input: the project's JSON/TOML scene files and OBJ/PLY meshes. The only module of the
-//! library crates that touches the filesystem.
+//! Scene input: the project's JSON/TOML scene files, OBJ/PLY meshes, PLY/PCD point clouds and
+//! Mitsuba/Sionna XML scenes,
+//! all behind one entry ([`load`] / [`load_dynamic`], in `source.rs`). The only module of this
+//! crate that touches the filesystem.
+
+mod cloud;
+mod source;
+pub mod xml;
+
+pub use cloud::{cloud_description, is_point_cloud};
+pub use source::{Format, LoadProgress, Source, load, load_dynamic, load_with_progress};
 
 use crate::material::{DEFAULT_MATERIAL, Material, default_materials};
 use crate::model::{Scene, SurfaceKind};
 use crate::validate::{
     DEFAULT_FREQUENCY_HZ, RawSurface, SceneError, Terminals, build_surfaces, check_terminals,
+    radio_problems,
 };
 use crate::{Problem, SceneDescription};
 use bt_geom::Real;
-use std::path::Path;
 
 pub use crate::validate::Terminals as TerminalOverrides;
 
@@ -21,8 +30,13 @@ pub struct LoadOptions {
     pub merge: bt_mesh::MergeOptions,
     /// Mesh surfaces smaller than this (m²) become blockers (default 0.25 m², as the paper).
     pub min_reflector_area_m2: Real,
-    /// Carrier frequency for meshes, Hz (default 28 GHz).
+    /// Carrier frequency for meshes and point clouds, Hz (default 28 GHz).
     pub frequency_hz: Real,
+    /// Plane-extraction parameters for point clouds (PLY without faces, PCD).
+    pub extract: bt_pointcloud::ExtractParams,
+    /// A radio material for every surface (CLI `--material itu:NAME --thickness M`), replacing
+    /// the radio model of every material of the loaded scene, whatever its format.
+    pub radio: Option<bt_channel::RadioMaterial>,
 }
 
 impl Default for LoadOptions {
@@ -32,6 +46,8 @@ impl Default for LoadOptions {
             merge: bt_mesh::MergeOptions::default(),
             min_reflector_area_m2: 0.25,
             frequency_hz: DEFAULT_FREQUENCY_HZ,
+            extract: bt_pointcloud::ExtractParams::default(),
+            radio: None,
         }
     }
 }
@@ -43,44 +59,6 @@ pub struct Loaded {
     pub scene: Scene,
     /// Warnings for the user.
     pub warnings: Vec<String>,
-}
-
-/// Load a scene from `path`, choosing the format by extension (`.json`, `.toml`, `.obj`, `.ply`).
-pub fn load(path: &Path, options: &LoadOptions) -> Result<Loaded, SceneError> {
-    let display = path.display().to_string();
-    let ext = path
-        .extension()
-        .and_then(|e| e.to_str())
-        .unwrap_or("")
-        .to_ascii_lowercase();
-    match ext.as_str() {
-        "json" | "toml" => {
-            let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
-                path: display.clone(),
-                source,
-            })?;
-            let desc = if ext == "json" {
-                parse_json(&text, &display)?
-            } else {
-                parse_toml(&text, &display)?
-            };
-            let scene = Scene::from_description(&desc, &display, options.terminals)?;
-            Ok(Loaded {
-                scene,
-                warnings: Vec::new(),
-            })
-        }
-        "obj" | "ply" => {
-            let import = bt_mesh::read_mesh_path(path, &options.merge)?;
-            let stem = path
-                .file_stem()
-                .and_then(|s| s.to_str())
-                .unwrap_or("mesh")
-                .to_string();
-            from_mesh(import, &stem, &display, options)
-        }
-        _ => Err(SceneError::UnsupportedFormat { path: display }),
-    }
 }
 
 /// Parse a JSON scene description; errors carry line and column.
@@ -100,7 +78,8 @@ pub fn parse_toml(text: &str, path: &str) -> Result<SceneDescription, SceneError
 }
 
 /// Build a scene from imported mesh surfaces: surfaces below the area threshold become blockers,
-/// unknown material names get the default loss (with a warning).
+/// material names of the ITU table (`itu_concrete`, ...) get that material as a half-space,
+/// other unknown names the default loss and radio model (with a warning).
 pub fn from_mesh(
     import: bt_mesh::MeshImport,
     name: &str,
@@ -109,7 +88,7 @@ pub fn from_mesh(
 ) -> Result<Loaded, SceneError> {
     let mut warnings = import.warnings;
     let mut materials = default_materials();
-    let default_loss = materials[DEFAULT_MATERIAL].reflection_loss_db;
+    let default = materials[DEFAULT_MATERIAL].clone();
     let mut raw = Vec::with_capacity(import.surfaces.len());
     for (i, s) in import.surfaces.into_iter().enumerate() {
         let material = s.material.map(|m| {
@@ -118,15 +97,22 @@ pub fn from_mesh(
                 lower
             } else {
                 if !materials.contains_key(&m) {
-                    warnings.push(format!(
-                        "material \"{m}\" is not known: using {default_loss} dB per reflection"
-                    ));
-                    materials.insert(
-                        m.clone(),
-                        Material {
-                            reflection_loss_db: default_loss,
+                    let material = match bt_channel::RadioMaterial::itu(&m, None) {
+                        Ok(radio) => Material {
+                            reflection_loss_db: radio
+                                .normal_loss_db(options.frequency_hz)
+                                .unwrap_or(default.reflection_loss_db),
+                            radio: Some(radio),
                         },
-                    );
+                        Err(_) => {
+                            warnings.push(format!(
+                                "material \"{m}\" is not known: using {} dB per reflection and the radio model of \"{DEFAULT_MATERIAL}\"",
+                                default.reflection_loss_db
+                            ));
+                            default.clone()
+                        }
+                    };
+                    materials.insert(m.clone(), material);
                 }
                 m
             }
@@ -167,6 +153,7 @@ pub fn from_mesh(
     if let Err(p) = check_terminals(&surfaces, tx, rx, extent) {
         problems.extend(p);
     }
+    problems.extend(radio_problems(&surfaces, &materials, options.frequency_hz));
     if !problems.is_empty() {
         return Err(SceneError::Invalid {
             source_name: source.to_string(),

@@ -1,0 +1,235 @@
+//! Antennas: a power pattern, a polarisation (slant angle) and an orientation. The far field an
+//! antenna radiates towards (or receives from) a direction is a real vector transverse to it:
+//! √G(θ, φ)·(cos ζ·θ̂ + sin ζ·φ̂) in the antenna's local frame (Sionna RT's polarisation model
+//! 2 and 3GPP TR 38.901 §7.3.2 model 2), rotated into the world frame. `docs/channel.md`.
+
+use crate::ChannelError;
+use bt_geom::{Real, Vec3};
+use serde::Serialize;
+use std::f64::consts::FRAC_PI_4;
+use std::str::FromStr;
+
+/// Power pattern of one element.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Pattern {
+    /// G = 1 (0 dBi) in every direction.
+    Isotropic,
+    /// 3GPP TR 38.901 Table 7.3-1: 8 dBi at boresight (local +x), 65° half-power beamwidth
+    /// in both planes, 30 dB front-to-back ratio and side-lobe limit.
+    Tr38901,
+}
+
+/// Polarisation: the slant angle ζ of the field from θ̂ towards φ̂.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Polarization {
+    /// Vertical, ζ = 0 (field along θ̂).
+    V,
+    /// Horizontal, ζ = 90° (field along φ̂).
+    H,
+    /// Slant +45° (one element of a ±45° cross-polarised pair).
+    Plus45,
+    /// Slant −45° (the other element of the pair).
+    Minus45,
+}
+
+impl Polarization {
+    /// Slant angle ζ, radians.
+    pub fn slant(self) -> Real {
+        match self {
+            Polarization::V => 0.0,
+            Polarization::H => 2.0 * FRAC_PI_4,
+            Polarization::Plus45 => FRAC_PI_4,
+            Polarization::Minus45 => -FRAC_PI_4,
+        }
+    }
+}
+
+/// Orientation of an antenna or array: intrinsic rotations yaw about z, then pitch about the
+/// new y, then roll about the new x (radians); R = Rz(yaw)·Ry(pitch)·Rx(roll) maps local to
+/// world. Zero: boresight along world +x, local z up.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
+pub struct Orientation {
+    /// Rotation about world z, radians.
+    pub yaw: Real,
+    /// Rotation about the yawed y axis, radians.
+    pub pitch: Real,
+    /// Rotation about the resulting x axis, radians.
+    pub roll: Real,
+}
+
+impl Orientation {
+    /// From degrees.
+    pub fn from_degrees(yaw: Real, pitch: Real, roll: Real) -> Orientation {
+        Orientation {
+            yaw: yaw.to_radians(),
+            pitch: pitch.to_radians(),
+            roll: roll.to_radians(),
+        }
+    }
+
+    /// Local → world rotation.
+    pub fn matrix(&self) -> glam::DMat3 {
+        glam::DMat3::from_rotation_z(self.yaw)
+            * glam::DMat3::from_rotation_y(self.pitch)
+            * glam::DMat3::from_rotation_x(self.roll)
+    }
+}
+
+/// An antenna element.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Antenna {
+    /// Power pattern.
+    pub pattern: Pattern,
+    /// Polarisation.
+    pub polarization: Polarization,
+    /// Orientation in the world frame.
+    pub orientation: Orientation,
+}
+
+impl Default for Antenna {
+    /// Isotropic, vertically polarised (the default at both ends).
+    fn default() -> Self {
+        Antenna {
+            pattern: Pattern::Isotropic,
+            polarization: Polarization::V,
+            orientation: Orientation::default(),
+        }
+    }
+}
+
+/// Spherical angles (zenith θ, azimuth φ) of a unit vector, radians.
+fn spherical(v: Vec3) -> (Real, Real) {
+    (v.z.clamp(-1.0, 1.0).acos(), v.y.atan2(v.x))
+}
+
+/// Local spherical unit vectors θ̂ and φ̂ at (θ, φ).
+fn spherical_basis(theta: Real, phi: Real) -> (Vec3, Vec3) {
+    let (st, ct) = theta.sin_cos();
+    let (sp, cp) = phi.sin_cos();
+    (Vec3::new(ct * cp, ct * sp, -st), Vec3::new(-sp, cp, 0.0))
+}
+
+impl Pattern {
+    /// Power gain (linear) towards local zenith θ and azimuth φ (radians).
+    pub fn gain(self, theta: Real, phi: Real) -> Real {
+        match self {
+            Pattern::Isotropic => 1.0,
+            Pattern::Tr38901 => {
+                let (t, p) = (theta.to_degrees(), phi.to_degrees());
+                let vertical = -(12.0 * ((t - 90.0) / 65.0).powi(2)).min(30.0);
+                let horizontal = -(12.0 * (p / 65.0).powi(2)).min(30.0);
+                let a_db = -(-(vertical + horizontal)).min(30.0);
+                10f64.powf((8.0 + a_db) / 10.0)
+            }
+        }
+    }
+}
+
+impl Antenna {
+    /// The field vector (world frame, dimensionless, |·|² = G) towards the world unit direction
+    /// `direction` (departure for a transmitter, the direction the wave comes from for a
+    /// receiver).
+    pub fn field(&self, direction: Vec3) -> Vec3 {
+        let r = self.orientation.matrix();
+        let local = r.transpose() * direction;
+        let (theta, phi) = spherical(local);
+        let (t_hat, p_hat) = spherical_basis(theta, phi);
+        let amplitude = self.pattern.gain(theta, phi).sqrt();
+        let (s, c) = self.polarization.slant().sin_cos();
+        r * (amplitude * (c * t_hat + s * p_hat))
+    }
+}
+
+impl FromStr for Pattern {
+    type Err = ChannelError;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s.to_ascii_lowercase().as_str() {
+            "iso" | "isotropic" => Ok(Pattern::Isotropic),
+            "tr38901" | "38.901" | "3gpp" => Ok(Pattern::Tr38901),
+            _ => Err(ChannelError::Invalid {
+                field: "pattern",
+                message: format!("unknown antenna pattern \"{s}\" (expected iso or tr38901)"),
+            }),
+        }
+    }
+}
+
+impl FromStr for Polarization {
+    type Err = ChannelError;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        match s.to_ascii_lowercase().as_str() {
+            "v" | "vertical" => Ok(Polarization::V),
+            "h" | "horizontal" => Ok(Polarization::H),
+            "+45" | "plus45" => Ok(Polarization::Plus45),
+            "-45" | "minus45" => Ok(Polarization::Minus45),
+            _ => Err(ChannelError::Invalid {
+                field: "polarization",
+                message: format!("unknown polarisation \"{s}\" (expected V, H, +45 or -45)"),
+            }),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn vertical_isotropic_field_is_minus_z_at_the_horizon() {
+        let a = Antenna::default();
+        let f = a.field(Vec3::X);
+        assert!((f - Vec3::new(0.0, 0.0, -1.0)).length() < 1e-15);
+        let h = Antenna {
+            polarization: Polarization::H,
+            ..a
+        };
+        assert!((h.field(Vec3::X) - Vec3::Y).length() < 1e-15);
+        // Transverse to the direction everywhere.
+        let d = Vec3::new(0.3, -0.5, 0.8).normalize();
+        assert!(a.field(d).dot(d).abs() < 1e-15 && h.field(d).dot(d).abs() < 1e-15);
+    }
+
+    #[test]
+    fn tr38901_pattern_values() {
+        let p = Pattern::Tr38901;
+        let db = |t: Real, ph: Real| 10.0 * p.gain(t.to_radians(), ph.to_radians()).log10();
+        assert!((db(90.0, 0.0) - 8.0).abs() < 1e-12);
+        // Half-power at ±32.5° in azimuth: 12 (32.5/65)² = 3 dB.
+        assert!((db(90.0, 32.5) - 5.0).abs() < 1e-12);
+        assert!((db(90.0 + 32.5, 0.0) - 5.0).abs() < 1e-12);
+        // Backwards: limited to 30 dB below the peak.
+        assert!((db(90.0, 180.0) - (8.0 - 30.0)).abs() < 1e-12);
+    }
+
+    #[test]
+    fn orientation_turns_the_boresight() {
+        let a = Antenna {
+            pattern: Pattern::Tr38901,
+            orientation: Orientation::from_degrees(90.0, 0.0, 0.0),
+            ..Antenna::default()
+        };
+        assert!((a.field(Vec3::Y).length_squared() - 10f64.powf(0.8)).abs() < 1e-9);
+        assert!((a.field(-Vec3::Y).length_squared() - 10f64.powf(-2.2)).abs() < 1e-12);
+        // Pitch 90° points the boresight down (-z).
+        let down = Orientation::from_degrees(0.0, 90.0, 0.0).matrix() * Vec3::X;
+        assert!((down - Vec3::new(0.0, 0.0, -1.0)).length() < 1e-15);
+    }
+
+    #[test]
+    fn names_parse() {
+        assert_eq!("ISO".parse::<Pattern>().unwrap(), Pattern::Isotropic);
+        assert_eq!("tr38901".parse::<Pattern>().unwrap(), Pattern::Tr38901);
+        assert_eq!(
+            "-45".parse::<Polarization>().unwrap(),
+            Polarization::Minus45
+        );
+        assert!(
+            "x".parse::<Polarization>()
+                .unwrap_err()
+                .to_string()
+                .contains("polarization")
+        );
+    }
+}

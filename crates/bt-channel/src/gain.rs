@@ -1,0 +1,305 @@
+//! Polarised complex path gains: the transmit antenna's field, one Jones matrix diag(R_TE,
+//! R_TM) per reflection in that bounce's s/p basis, the receive antenna's field, and the
+//! free-space factor λ/(4π·length). No propagation phase: that is the delay (Sionna RT's
+//! convention). Derivation and signs: `docs/channel.md`.
+
+use crate::ChannelError;
+use crate::antenna::Antenna;
+use crate::material::{RadioMaterial, Reflection, SPEED_OF_LIGHT};
+use bt_geom::{Real, Vec3};
+use num_complex::Complex64;
+use std::f64::consts::PI;
+
+/// How a surface reflects.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum SurfaceResponse {
+    /// A radio material: coefficients from its permittivity and thickness.
+    Radio(RadioMaterial),
+    /// Only a constant loss is known: a perfect conductor scaled to it, R_TE = −a, R_TM = +a,
+    /// a = 10^(−loss_db/20), at every angle.
+    ConstantLoss {
+        /// Loss per reflection, dB.
+        loss_db: Real,
+    },
+}
+
+impl SurfaceResponse {
+    /// Reflection coefficients at `frequency_hz` and cos θ = `cos_incidence`.
+    pub fn reflection(
+        &self,
+        frequency_hz: Real,
+        cos_incidence: Real,
+    ) -> Result<Reflection, ChannelError> {
+        match self {
+            SurfaceResponse::Radio(m) => m.reflection(frequency_hz, cos_incidence),
+            SurfaceResponse::ConstantLoss { loss_db } => {
+                let a = 10f64.powf(-loss_db / 20.0);
+                Ok(Reflection {
+                    te: Complex64::new(-a, 0.0),
+                    tm: Complex64::new(a, 0.0),
+                })
+            }
+        }
+    }
+}
+
+/// One reflection of a path: the surface's unit normal (either side) and its response.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Bounce {
+    /// Unit normal of the reflecting plane (its sign does not matter).
+    pub normal: Vec3,
+    /// The surface's reflection.
+    pub response: SurfaceResponse,
+}
+
+/// The free-space amplitude factor of a path and whether it left the far field.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct FreeSpace {
+    /// λ/(4π·max(length, λ/(4π))): never above 1, i.e. never a negative loss.
+    pub amplitude: Real,
+    /// The path is shorter than one wavelength: Friis does not hold there (near field), and
+    /// below λ/(4π) the amplitude is clamped to 1 (0 dB loss).
+    pub near_field: bool,
+}
+
+/// The one home of the Friis factor: amplitude λ/(4π·d) for `length` metres at
+/// `frequency_hz`, clamped so that the loss is never negative (d < λ/(4π)).
+pub fn free_space(length: Real, frequency_hz: Real) -> FreeSpace {
+    let wavelength = SPEED_OF_LIGHT / frequency_hz;
+    let floor = wavelength / (4.0 * PI);
+    FreeSpace {
+        amplitude: floor / length.max(floor),
+        near_field: length < wavelength,
+    }
+}
+
+/// A complex 3-vector (a field transverse to the propagation direction).
+type Field = [Complex64; 3];
+
+fn dot(field: &Field, v: Vec3) -> Complex64 {
+    field[0] * v.x + field[1] * v.y + field[2] * v.z
+}
+
+fn scaled(v: Vec3, c: Complex64) -> Field {
+    [c * v.x, c * v.y, c * v.z]
+}
+
+fn add(a: Field, b: Field) -> Field {
+    [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
+}
+
+/// A unit vector perpendicular to unit `k` (for normal incidence, where the plane of
+/// incidence is undefined and R_TM = −R_TE makes any choice give the same field).
+fn any_perpendicular(k: Vec3) -> Vec3 {
+    let helper = if k.x.abs() < 0.9 { Vec3::X } else { Vec3::Y };
+    k.cross(helper).normalize()
+}
+
+/// Apply one reflection to `field` travelling along unit `k`: returns the reflected field and
+/// direction. s = normalize(k × n), p = s × k before and p' = s × k' after the bounce.
+fn reflect(
+    field: Field,
+    k: Vec3,
+    bounce: &Bounce,
+    frequency_hz: Real,
+) -> Result<(Field, Vec3), ChannelError> {
+    let n = bounce.normal;
+    let cos = k.dot(n).abs().min(1.0);
+    let r = bounce.response.reflection(frequency_hz, cos)?;
+    let k_out = k - 2.0 * k.dot(n) * n;
+    let cross = k.cross(n);
+    let s = if cross.length() > 1e-12 {
+        cross.normalize()
+    } else {
+        any_perpendicular(k)
+    };
+    let (p_in, p_out) = (s.cross(k), s.cross(k_out));
+    let reflected = add(
+        scaled(s, r.te * dot(&field, s)),
+        scaled(p_out, r.tm * dot(&field, p_in)),
+    );
+    Ok((reflected, k_out))
+}
+
+/// Complex gain of the path TX → `points` → RX (world frame, metres) with one [`Bounce`] per
+/// point, at `frequency_hz`: (λ/(4π·length)) · f_RX(−k_last) · Π_bounces · f_TX(k_first).
+/// Without the propagation phase e^{−j2πf·τ}. `length` is clamped as in [`free_space`].
+pub fn path_gain(
+    tx: Vec3,
+    points: &[Vec3],
+    rx: Vec3,
+    bounces: &[Bounce],
+    antennas: (&Antenna, &Antenna),
+    frequency_hz: Real,
+) -> Result<Complex64, ChannelError> {
+    if points.len() != bounces.len() {
+        return Err(ChannelError::Invalid {
+            field: "bounces",
+            message: format!("{} points but {} bounces", points.len(), bounces.len()),
+        });
+    }
+    let mut vertices = Vec::with_capacity(points.len() + 2);
+    vertices.push(tx);
+    vertices.extend_from_slice(points);
+    vertices.push(rx);
+    let length: Real = vertices.windows(2).map(|w| w[0].distance(w[1])).sum();
+    let mut k = (vertices[1] - vertices[0]).normalize();
+    let one = Complex64::new(1.0, 0.0);
+    let mut field = scaled(antennas.0.field(k), one);
+    for bounce in bounces {
+        (field, k) = reflect(field, k, bounce, frequency_hz)?;
+    }
+    let received = dot(&field, antennas.1.field(-k));
+    Ok(received * free_space(length, frequency_hz).amplitude)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::antenna::{Orientation, Pattern, Polarization};
+
+    const F: Real = 28e9;
+
+    fn concrete_slab() -> SurfaceResponse {
+        SurfaceResponse::Radio(RadioMaterial::itu("concrete", Some(0.2)).unwrap())
+    }
+
+    #[test]
+    fn line_of_sight_is_friis_for_vertical_isotropic_antennas() {
+        let a = Antenna::default();
+        let g = path_gain(Vec3::ZERO, &[], Vec3::new(10.0, 0.0, 0.0), &[], (&a, &a), F).unwrap();
+        let lambda = SPEED_OF_LIGHT / F;
+        assert!((g - Complex64::new(lambda / (4.0 * PI * 10.0), 0.0)).norm() < 1e-15);
+        // V transmitted, H received: orthogonal, nothing.
+        let h = Antenna {
+            polarization: Polarization::H,
+            ..a
+        };
+        let g = path_gain(Vec3::ZERO, &[], Vec3::new(10.0, 0.0, 0.0), &[], (&a, &h), F).unwrap();
+        assert!(g.norm() < 1e-18);
+    }
+
+    #[test]
+    fn near_field_never_gains() {
+        let fs = free_space(1e-4, F);
+        assert_eq!(fs.amplitude, 1.0);
+        assert!(fs.near_field);
+        let fs = free_space(1.0, F);
+        assert!(fs.amplitude < 1.0 && !fs.near_field);
+    }
+
+    #[test]
+    fn slanted_antennas_split_the_power() {
+        // +45° into V: cos 45° of the amplitude.
+        let p = Antenna {
+            polarization: Polarization::Plus45,
+            ..Antenna::default()
+        };
+        let v = Antenna::default();
+        let rx = Vec3::new(5.0, 0.0, 0.0);
+        let g45 = path_gain(Vec3::ZERO, &[], rx, &[], (&p, &v), F).unwrap();
+        let gv = path_gain(Vec3::ZERO, &[], rx, &[], (&v, &v), F).unwrap();
+        assert!((g45.norm() / gv.norm() - 0.5f64.sqrt()).abs() < 1e-12);
+    }
+
+    /// A single reflection off the floor z = 0 in the x-z plane: V is TM and H is TE, and
+    /// the reflected/LoS gain ratio is R·r_los/r_refl with the Fresnel coefficient written
+    /// out here by hand.
+    #[test]
+    fn floor_bounce_uses_tm_for_vertical_and_te_for_horizontal() {
+        let (h1, h2, d) = (2.0, 1.0, 6.0);
+        let (tx, rx) = (Vec3::new(0.0, 0.0, h1), Vec3::new(d, 0.0, h2));
+        let x = d * h1 / (h1 + h2);
+        let point = Vec3::new(x, 0.0, 0.0);
+        let material = RadioMaterial::custom(5.0, 0.0, None).unwrap();
+        let bounce = Bounce {
+            normal: Vec3::Z,
+            response: SurfaceResponse::Radio(material),
+        };
+        let (r1, r2) = ((tx - rx).length(), d.hypot(h1 + h2));
+        let cos = (h1 + h2) / r2;
+        let s = (5.0 - (1.0 - cos * cos)).sqrt();
+        let (r_te, r_tm) = ((cos - s) / (cos + s), (5.0 * cos - s) / (5.0 * cos + s));
+        for (pol, coefficient) in [(Polarization::V, r_tm), (Polarization::H, r_te)] {
+            let a = Antenna {
+                polarization: pol,
+                ..Antenna::default()
+            };
+            let los = path_gain(tx, &[], rx, &[], (&a, &a), F).unwrap();
+            let refl = path_gain(tx, &[point], rx, &[bounce], (&a, &a), F).unwrap();
+            let ratio = refl / los;
+            assert!(
+                (ratio - Complex64::new(coefficient * r1 / r2, 0.0)).norm() < 1e-12,
+                "{pol:?}: {ratio}"
+            );
+        }
+    }
+
+    #[test]
+    fn reciprocity_over_two_bounces_with_any_antennas() {
+        let tx = Vec3::new(1.0, 1.0, 1.5);
+        let rx = Vec3::new(4.0, 2.5, 0.8);
+        // Floor z = 0 then wall x = 5: image construction.
+        let rx_img = Vec3::new(10.0 - rx.x, rx.y, rx.z);
+        let tx_img = Vec3::new(tx.x, tx.y, -tx.z);
+        let d = rx_img - tx_img;
+        let t_floor = -tx_img.z / d.z;
+        let p1 = tx_img + t_floor * d;
+        let t_wall = (5.0 - tx_img.x) / d.x;
+        let p2_img = tx_img + t_wall * d;
+        let p2 = Vec3::new(5.0, p2_img.y, p2_img.z);
+        assert!(p1.z.abs() < 1e-12 && t_floor < t_wall);
+        let floor = Bounce {
+            normal: Vec3::Z,
+            response: concrete_slab(),
+        };
+        let wall = Bounce {
+            normal: -Vec3::X,
+            response: SurfaceResponse::Radio(RadioMaterial::itu("glass", Some(0.01)).unwrap()),
+        };
+        let a = Antenna {
+            pattern: Pattern::Tr38901,
+            polarization: Polarization::Plus45,
+            orientation: Orientation::from_degrees(20.0, -10.0, 5.0),
+        };
+        let b = Antenna {
+            pattern: Pattern::Isotropic,
+            polarization: Polarization::H,
+            orientation: Orientation::from_degrees(-150.0, 0.0, 30.0),
+        };
+        let forward = path_gain(tx, &[p1, p2], rx, &[floor, wall], (&a, &b), F).unwrap();
+        let backward = path_gain(rx, &[p2, p1], tx, &[wall, floor], (&b, &a), F).unwrap();
+        assert!(forward.norm() > 1e-6);
+        assert!(
+            (forward - backward).norm() < 1e-15 * forward.norm().max(1.0),
+            "{forward} vs {backward}"
+        );
+    }
+
+    #[test]
+    fn normal_incidence_is_well_defined() {
+        let a = Antenna::default();
+        let bounce = Bounce {
+            normal: Vec3::X,
+            response: concrete_slab(),
+        };
+        let (tx, rx) = (Vec3::new(1.0, 0.0, 0.0), Vec3::new(2.0, 0.0, 0.0));
+        let g = path_gain(tx, &[Vec3::ZERO], rx, &[bounce], (&a, &a), F).unwrap();
+        let r = concrete_slab().reflection(F, 1.0).unwrap();
+        let lambda = SPEED_OF_LIGHT / F;
+        // V stays V (−z at departure along −x and at arrival from −x): R_TE applies.
+        let expected = r.te * (lambda / (4.0 * PI * 3.0));
+        assert!((g - expected).norm() < 1e-15, "{g} vs {expected}");
+    }
+
+    #[test]
+    fn constant_loss_scales_a_conductor() {
+        let r = SurfaceResponse::ConstantLoss { loss_db: 6.0 }
+            .reflection(F, 0.3)
+            .unwrap();
+        assert!(
+            (r.te.re + 10f64.powf(-0.3)).abs() < 1e-15
+                && (r.tm.re - 10f64.powf(-0.3)).abs() < 1e-15
+        );
+    }
+}

@@ -1,0 +1,59 @@
+//! The radio channel of traced paths: ITU-R P.2040-3 materials and their reflection
+//! coefficients, antennas (pattern and polarisation), polarised complex path gains (Jones
+//! calculus), channel impulse and frequency responses, and beam codebooks.
+//!
+//! Frames and units: world frame of `docs/conventions.md` (metres, z up), Hz, radians inside
+//! the library. Every formula and sign convention: `docs/channel.md`.
+
+pub mod antenna;
+pub mod codebook;
+pub mod gain;
+pub mod material;
+pub mod response;
+
+pub use antenna::{Antenna, Orientation, Pattern, Polarization};
+pub use codebook::{Array, Beam, PathDirections, beam_pairs};
+pub use gain::{Bounce, FreeSpace, SurfaceResponse, free_space, path_gain};
+pub use material::{
+    ItuBand, ItuMaterial, RadioMaterial, RadioModel, Reflection, SPEED_OF_LIGHT,
+    VACUUM_PERMITTIVITY,
+};
+pub use num_complex::Complex64;
+pub use response::{Tap, frequency_response, subcarriers, total_power};
+
+use bt_geom::Real;
+use thiserror::Error;
+
+/// Errors of the channel computations.
+#[derive(Debug, Error, Clone, PartialEq)]
+pub enum ChannelError {
+    /// A material name not in ITU-R P.2040-3 Table 3.
+    #[error(
+        "unknown ITU material \"{name}\" (known: vacuum, concrete, brick, plasterboard, wood, glass, ceiling_board, chipboard, plywood, marble, floorboard, metal, very_dry_ground, medium_dry_ground, wet_ground)"
+    )]
+    UnknownMaterial {
+        /// The name given.
+        name: String,
+    },
+    /// The frequency lies outside the material's validity range.
+    #[error(
+        "ITU material \"{material}\" is defined for {valid}, not at {:.4} GHz",
+        frequency_hz / 1e9
+    )]
+    OutOfRange {
+        /// Material name.
+        material: String,
+        /// The frequency asked for, Hz.
+        frequency_hz: Real,
+        /// The validity bands, as text.
+        valid: String,
+    },
+    /// A parameter out of its domain.
+    #[error("{field}: {message}")]
+    Invalid {
+        /// Parameter name.
+        field: &'static str,
+        /// What is wrong.
+        message: String,
+    },
+}

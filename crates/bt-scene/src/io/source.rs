@@ -1,0 +1,192 @@
+//! The one loading entry: a source string (`builtin:NAME` or a file path) to a validated
+//! [`Scene`] or [`DynamicScene`]. Every command of the CLI loads through here, so every
+//! command accepts the same sources and gives the same errors.
+
+use super::{LoadOptions, Loaded, from_mesh, parse_json, parse_toml};
+use crate::SceneDescription;
+use crate::builtin::{builtin_json, builtin_names};
+use crate::dynamic::DynamicScene;
+use crate::model::Scene;
+use crate::validate::SceneError;
+use std::path::{Path, PathBuf};
+
+/// Where a scene comes from, parsed from the command-line spelling by [`Source::parse`].
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Source {
+    /// A scene shipped inside the library (`builtin:NAME`), see [`crate::builtin_names`].
+    Builtin(String),
+    /// A file; its [`Format`] is chosen by extension (and, for `.ply`, by its header).
+    File(PathBuf),
+}
+
+impl Source {
+    /// `builtin:NAME` is a built-in scene, anything else a file path.
+    pub fn parse(text: &str) -> Source {
+        match text.strip_prefix("builtin:") {
+            Some(name) => Source::Builtin(name.to_string()),
+            None => Source::File(PathBuf::from(text)),
+        }
+    }
+}
+
+/// File formats [`load`] understands.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    /// The project's scene file, JSON (`.json`).
+    Json,
+    /// The project's scene file, TOML (`.toml`).
+    Toml,
+    /// A Wavefront OBJ mesh (`.obj`).
+    Obj,
+    /// A PLY mesh (`.ply` declaring faces).
+    PlyMesh,
+    /// A point cloud: `.pcd`, or `.ply` declaring no faces; planes are extracted.
+    PointCloud,
+    /// A Mitsuba 3 / Sionna RT scene (`.xml`) with PLY/OBJ shapes and radio bsdfs.
+    Xml,
+}
+
+impl Format {
+    /// The format of the file at `path`: by extension (any case); a `.ply` is a point cloud
+    /// when its header declares no faces. A directory is an error of its own, not an
+    /// "unsupported format".
+    pub fn of(path: &Path) -> Result<Format, SceneError> {
+        let display = path.display().to_string();
+        if path.is_dir() {
+            return Err(SceneError::IsDirectory { path: display });
+        }
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .unwrap_or("")
+            .to_ascii_lowercase();
+        Ok(match ext.as_str() {
+            "json" => Format::Json,
+            "toml" => Format::Toml,
+            "obj" => Format::Obj,
+            "xml" => Format::Xml,
+            "pcd" => Format::PointCloud,
+            "ply" if super::is_point_cloud(path) => Format::PointCloud,
+            "ply" => Format::PlyMesh,
+            _ => return Err(SceneError::UnsupportedFormat { path: display }),
+        })
+    }
+}
+
+/// Progress of a long load (plane extraction from a point cloud), for a progress bar.
+pub type LoadProgress = bt_pointcloud::Progress;
+
+/// Load the scene named by `source` (`builtin:NAME` or a file path), see [`Source`] and
+/// [`Format`]. A dynamic scene (JSON/TOML with `steps`, or `builtin:living-room-dynamic`)
+/// loads as its step 0; use [`load_dynamic`] for every step.
+pub fn load(source: &str, options: &LoadOptions) -> Result<Loaded, SceneError> {
+    load_with_progress(source, options, &mut |_| {})
+}
+
+/// [`load`], reporting the progress of point-cloud plane extraction to `progress`.
+/// `options.radio`, when set, replaces the radio model of every material, whatever the format.
+pub fn load_with_progress(
+    source: &str,
+    options: &LoadOptions,
+    progress: &mut dyn FnMut(LoadProgress),
+) -> Result<Loaded, SceneError> {
+    let mut loaded = load_any(source, options, progress)?;
+    if let Some(radio) = options.radio {
+        loaded.scene = loaded.scene.with_radio_material(radio)?;
+    }
+    Ok(loaded)
+}
+
+fn load_any(
+    source: &str,
+    options: &LoadOptions,
+    progress: &mut dyn FnMut(LoadProgress),
+) -> Result<Loaded, SceneError> {
+    let path = match Source::parse(source) {
+        Source::Builtin(name) => {
+            let desc = builtin_description(&name)?;
+            let scene = Scene::from_description(&desc, source, options.terminals)?;
+            return Ok(Loaded {
+                scene,
+                warnings: Vec::new(),
+            });
+        }
+        Source::File(path) => path,
+    };
+    let display = path.display().to_string();
+    match Format::of(&path)? {
+        format @ (Format::Json | Format::Toml) => {
+            let desc = read_description(&path, format)?;
+            let scene = Scene::from_description(&desc, &display, options.terminals)?;
+            Ok(Loaded {
+                scene,
+                warnings: Vec::new(),
+            })
+        }
+        Format::Obj | Format::PlyMesh => {
+            let import = bt_mesh::read_mesh_path(&path, &options.merge)?;
+            from_mesh(import, &file_stem(&path, "mesh"), &display, options)
+        }
+        Format::PointCloud => super::cloud::load_cloud(&path, options, progress),
+        Format::Xml => super::xml::load_xml(&path, options),
+    }
+}
+
+/// Load `source` as a scene over time steps: JSON/TOML files and built-ins with their
+/// `steps` and moving objects; every other source (meshes, point clouds) as one step.
+/// Warnings of the import come back beside the scene.
+pub fn load_dynamic(
+    source: &str,
+    options: &LoadOptions,
+    progress: &mut dyn FnMut(LoadProgress),
+) -> Result<(DynamicScene, Vec<String>), SceneError> {
+    let desc = match Source::parse(source) {
+        Source::Builtin(name) => Some(builtin_description(&name)?),
+        Source::File(path) => match Format::of(&path)? {
+            format @ (Format::Json | Format::Toml) => Some(read_description(&path, format)?),
+            _ => None,
+        },
+    };
+    match desc {
+        Some(desc) => {
+            let mut scene = DynamicScene::from_description(&desc, source, options.terminals)?;
+            if let Some(radio) = options.radio {
+                scene = scene.with_radio_material(radio)?;
+            }
+            Ok((scene, Vec::new()))
+        }
+        None => {
+            let loaded = load_with_progress(source, options, progress)?;
+            Ok((DynamicScene::from_static(loaded.scene), loaded.warnings))
+        }
+    }
+}
+
+fn builtin_description(name: &str) -> Result<SceneDescription, SceneError> {
+    let json = builtin_json(name).ok_or_else(|| SceneError::UnknownBuiltin {
+        name: name.to_string(),
+        known: builtin_names().join(", "),
+    })?;
+    parse_json(json, &format!("builtin:{name}"))
+}
+
+fn read_description(path: &Path, format: Format) -> Result<SceneDescription, SceneError> {
+    let display = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+        path: display.clone(),
+        source,
+    })?;
+    if format == Format::Toml {
+        parse_toml(&text, &display)
+    } else {
+        parse_json(&text, &display)
+    }
+}
+
+/// The file name without extension, the scene's name for formats that carry none.
+pub(super) fn file_stem(path: &Path, fallback: &str) -> String {
+    path.file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or(fallback)
+        .to_string()
+}
