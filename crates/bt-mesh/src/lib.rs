@@ -169,7 +169,7 @@ pub fn read_transformed(
     format: MeshFormat,
     file: Option<&str>,
     opts: &MergeOptions,
-    to_world: &dyn Fn(DVec3) -> DVec3,
+    to_world: &dyn Fn(Vec3) -> Vec3,
 ) -> Result<MeshImport, MeshError> {
     opts.validate()?;
     let file = file.unwrap_or(UNNAMED);
