@@ -354,7 +354,7 @@ pub fn parse_vec3(s: &str) -> anyhow::Result<Vec3> {
 pub struct ExtractArgs {
     /// Point cloud: .ply (ASCII or binary) or .pcd (ASCII or binary), metres, z up.
     pub cloud: PathBuf,
-    /// Scene file to write (JSON).
+    /// Scene file to write: .json or .toml (by extension; other extensions are refused).
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,
     /// Also write the extraction report (JSON) here.
@@ -387,6 +387,10 @@ pub struct SampleArgs {
     /// Points per square metre of surface.
     #[arg(long, default_value_t = 2000.0)]
     pub density: f64,
+    /// Budget: stop before sampling rather than generate more points than this (estimated
+    /// as surface area × density).
+    #[arg(long, default_value_t = 20_000_000)]
+    pub max_points: u64,
     /// Gaussian noise along the surface normal, metres (standard deviation).
     #[arg(long, default_value_t = 0.005)]
     pub noise: f64,
@@ -463,6 +467,9 @@ pub struct HlsGenArgs {
     /// Model and schedule only (cycle counts, errors): skip writing RTL (for large scenes).
     #[arg(long)]
     pub plan_only: bool,
+    /// Budget: stop before the work rather than enumerate more candidate paths than this.
+    #[arg(long, default_value_t = bt_solve::pipeline::DEFAULT_MAX_CANDIDATES)]
+    pub max_candidates: u64,
     /// Every time step of a dynamic scene: one accelerator (or, with --plan-only, schedule)
     /// per step into OUTPUT/step-<k>/, per-step cycle counts into OUTPUT/steps.json.
     #[arg(long)]

@@ -179,7 +179,14 @@ pub fn run(args: &WvrnArgs) -> anyhow::Result<ExitCode> {
     };
     match &args.out {
         Some(path) => {
-            std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))?
+            let format: &[&str] = if args.json {
+                &["json"]
+            } else if args.dot {
+                &["dot", "gv"]
+            } else {
+                &["txt"]
+            };
+            crate::files::write(path, text.as_bytes(), &crate::inputs(&args.scene), format)?
         }
         None => print!("{text}"),
     }

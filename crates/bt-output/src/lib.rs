@@ -184,6 +184,7 @@ pub struct OutputDir {
     staging: PathBuf,
     written: BTreeSet<String>,
     protected: Vec<PathBuf>,
+    prefix: String,
     committed: bool,
 }
 
@@ -221,6 +222,7 @@ impl OutputDir {
             staging,
             written: BTreeSet::new(),
             protected: protected.iter().map(|p| p.to_path_buf()).collect(),
+            prefix: String::new(),
             committed: false,
         })
     }
@@ -230,10 +232,23 @@ impl OutputDir {
         &self.dir
     }
 
-    /// Reserve `rel` (a relative path with `/` separators) and return where to write it now,
-    /// inside the staging directory (parents created). For writers that need a path.
+    /// Put every following file under `prefix` (`""`, or a relative directory ending in `/`),
+    /// so a writer of one directory can fill a subdirectory (`step-3/`) of this one.
+    pub fn set_prefix(&mut self, prefix: &str) -> Result<(), OutputError> {
+        if !prefix.is_empty() {
+            check_relative(prefix.trim_end_matches('/'))?;
+        }
+        self.prefix = prefix.to_string();
+        Ok(())
+    }
+
+    /// Reserve `rel` (a relative path with `/` separators, under the current prefix) and
+    /// return where to write it now, inside the staging directory (parents created). For
+    /// writers that need a path.
     pub fn path(&mut self, rel: &str) -> Result<PathBuf, OutputError> {
         check_relative(rel)?;
+        let rel = format!("{}{rel}", self.prefix);
+        let rel = rel.as_str();
         let path = self.staging.join(rel);
         let parent = parent_of(&path);
         std::fs::create_dir_all(parent).map_err(io(parent))?;
@@ -258,8 +273,7 @@ impl OutputDir {
         let finals: Vec<PathBuf> = self.written.iter().map(|r| self.dir.join(r)).collect();
         let manifest = manifest_text(&self.written);
         if !self.dir.exists() {
-            std::fs::write(self.staging.join(MANIFEST), &manifest)
-                .map_err(io(&self.staging))?;
+            std::fs::write(self.staging.join(MANIFEST), &manifest).map_err(io(&self.staging))?;
             std::fs::rename(&self.staging, &self.dir).map_err(io(&self.dir))?;
             self.committed = true;
             return Ok(finals);
@@ -301,7 +315,9 @@ impl Drop for OutputDir {
 }
 
 fn manifest_text(files: &BTreeSet<String>) -> String {
-    let mut s = String::from("# files written by beamtrace into this directory (replaced on the next run; others are left alone)\n");
+    let mut s = String::from(
+        "# files written by beamtrace into this directory (replaced on the next run; others are left alone)\n",
+    );
     for f in files {
         s.push_str(f);
         s.push('\n');
@@ -310,14 +326,19 @@ fn manifest_text(files: &BTreeSet<String>) -> String {
 }
 
 fn read_manifest(dir: &Path) -> BTreeSet<String> {
-    std::fs::read_to_string(dir.join(MANIFEST))
-        .map(|t| {
-            t.lines()
-                .filter(|l| !l.is_empty() && !l.starts_with('#'))
-                .map(str::to_string)
-                .collect()
-        })
-        .unwrap_or_default()
+    manifest_files(dir).unwrap_or_default()
+}
+
+/// The files (relative, sorted) the last committed run wrote into `dir`, or `None` when `dir`
+/// has no manifest.
+pub fn manifest_files(dir: &Path) -> Option<BTreeSet<String>> {
+    let text = std::fs::read_to_string(dir.join(MANIFEST)).ok()?;
+    Some(
+        text.lines()
+            .filter(|l| !l.is_empty() && !l.starts_with('#'))
+            .map(str::to_string)
+            .collect(),
+    )
 }
 
 #[cfg(test)]

@@ -64,6 +64,9 @@ pub enum StudyError {
         /// Underlying error.
         source: std::io::Error,
     },
+    /// An output could not be written safely.
+    #[error(transparent)]
+    Output(#[from] bt_output::OutputError),
     /// A figure could not be drawn.
     #[error("{path}: plotting failed: {message}")]
     Plot {
