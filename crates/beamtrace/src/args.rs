@@ -65,6 +65,12 @@ pub struct StudyLivingRoomArgs {
     /// SBR grid step over the whole sphere, degrees (the paper: 1, i.e. 64,800 rays).
     #[arg(long, default_value_t = 1.0)]
     pub sbr_step_deg: f64,
+    /// Budget: refuse an SBR grid of more rays than this.
+    #[arg(long, default_value_t = bt_solve::sbr::DEFAULT_MAX_RAYS)]
+    pub max_rays: u64,
+    /// Budget: stop before the work rather than enumerate more candidates than this.
+    #[arg(long, default_value_t = bt_solve::pipeline::DEFAULT_MAX_CANDIDATES)]
+    pub max_candidates: u64,
     /// Highest reflection order.
     #[arg(long, default_value_t = 3)]
     pub max_order: usize,
@@ -108,6 +114,12 @@ pub struct Study2dArgs {
     /// SBR angular step, degrees (the paper: 1).
     #[arg(long, default_value_t = 1.0)]
     pub sbr_step_deg: f64,
+    /// Budget: refuse an SBR grid of more rays than this.
+    #[arg(long, default_value_t = bt_solve::sbr::DEFAULT_MAX_RAYS)]
+    pub max_rays: u64,
+    /// Budget: stop before the work rather than enumerate more candidates than this.
+    #[arg(long, default_value_t = bt_solve::pipeline::DEFAULT_MAX_CANDIDATES)]
+    pub max_candidates: u64,
     /// Launch SBR rays over the whole sphere (azimuth × elevation grid) instead of only in the
     /// plane of the room.
     #[arg(long)]
@@ -203,6 +215,9 @@ pub struct TraceArgs {
     /// SBR: launch only in the horizontal plane through TX (2-D scenes of vertical walls).
     #[arg(long)]
     pub sbr_planar: bool,
+    /// Budget: refuse an SBR launch pattern of more rays than this.
+    #[arg(long, default_value_t = bt_solve::sbr::DEFAULT_MAX_RAYS)]
+    pub max_rays: u64,
     /// Use one thread (benchmarking); the output is identical either way.
     #[arg(long)]
     pub single_thread: bool,
@@ -283,6 +298,9 @@ pub struct WvrnArgs {
     /// Highest reflection order for the candidate reduction figures.
     #[arg(long, default_value_t = 3)]
     pub max_order: usize,
+    /// Budget: stop before the work rather than enumerate more candidates than this.
+    #[arg(long, default_value_t = bt_solve::pipeline::DEFAULT_MAX_CANDIDATES)]
+    pub max_candidates: u64,
 }
 
 #[derive(Debug, Args, Clone)]
@@ -318,6 +336,7 @@ impl DemoArgs {
             sbr_step_deg: None,
             sbr_rays: None,
             sbr_planar: false,
+            max_rays: bt_solve::sbr::DEFAULT_MAX_RAYS,
             single_thread: false,
             json: self.json,
             out: None,

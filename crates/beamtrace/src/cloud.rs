@@ -16,7 +16,7 @@ pub fn extract_from(path: &Path, params: &ExtractParams) -> anyhow::Result<(Extr
     let bar = ProgressBar::new(loaded.cloud.len() as u64);
     bar.set_style(
         ProgressStyle::with_template(
-            "{spinner} extracting planes {bar:30} {pos}/{len} points assigned, {msg}",
+            "{spinner} extracting planes {bar:30} {pos}/{len} points assigned, {msg} [{elapsed_precise}, ETA {eta}]",
         )
         .expect("static template"),
     );
@@ -108,11 +108,11 @@ pub fn run_extract(args: &ExtractArgs) -> anyhow::Result<ExitCode> {
     }
     // Refuse a bad output before the (possibly long) extraction.
     let inputs = [args.cloud.as_path()];
-    let format = bt_output::extension_in(&args.output, &["json", "toml"])?;
     bt_output::refuse_input(&args.output, &inputs)?;
+    let format = bt_output::extension_in(&args.output, &["json", "toml"])?;
     if let Some(report) = &args.report {
-        bt_output::extension_in(report, &["json"])?;
         bt_output::refuse_input(report, &inputs)?;
+        bt_output::extension_in(report, &["json"])?;
     }
     let params = ExtractParams {
         seed: args.seed,
@@ -173,8 +173,8 @@ pub fn run_sample(args: &SampleArgs) -> anyhow::Result<ExitCode> {
             args.noise
         );
     }
-    bt_output::extension_in(&args.output, &["ply", "pcd"])?;
     bt_output::refuse_input(&args.output, &crate::inputs(&args.scene))?;
+    bt_output::extension_in(&args.output, &["ply", "pcd"])?;
     let loaded = crate::trace::load_scene(&args.scene)?;
     let polygons: Vec<Vec<glam::DVec3>> = loaded
         .scene

@@ -17,9 +17,9 @@ pub fn inputs(scene: &SceneArgs) -> Vec<&Path> {
 /// Write `bytes` to `path` atomically after checking it is none of `inputs` and its extension
 /// is one of `formats` (lowercase, without dot; empty: any).
 pub fn write(path: &Path, bytes: &[u8], inputs: &[&Path], formats: &[&str]) -> anyhow::Result<()> {
+    bt_output::refuse_input(path, inputs)?;
     if !formats.is_empty() {
         bt_output::extension_in(path, formats)?;
     }
-    bt_output::refuse_input(path, inputs)?;
     bt_output::write_atomic(path, bytes).with_context(|| format!("writing {}", path.display()))
 }

@@ -271,7 +271,7 @@ fn generate_one(
     out: &mut OutputDir,
     prefix: &str,
 ) -> anyhow::Result<HlsSummary> {
-    check_budget(scene, args)?;
+    crate::budget::candidates(scene, args.max_order, args.max_candidates)?;
     let (input, _) =
         bt_study::fpga::hls_input(scene, args.max_order, args.threshold_lsb, args.max_rounds);
     let at = match step {
@@ -345,21 +345,6 @@ fn generate_one(
     Ok(summary)
 }
 
-/// Stop before the work when the candidate enumeration would exceed `--max-candidates`.
-fn check_budget(scene: &Scene, args: &HlsGenArgs) -> anyhow::Result<()> {
-    let reflectors = scene.reflectors().count() as u64;
-    let estimate = bt_solve::pipeline::exhaustive_count(reflectors, args.max_order);
-    if estimate > args.max_candidates {
-        return Err(bt_solve::pipeline::TraceError::Budget {
-            estimate,
-            budget: args.max_candidates,
-            max_order: args.max_order,
-        }
-        .into());
-    }
-    Ok(())
-}
-
 fn write(out: &mut OutputDir, rel: &str, text: &str) -> anyhow::Result<()> {
     out.write(rel, format!("{text}\n").as_bytes())
         .with_context(|| format!("writing {}", out.dir().join(rel).display()))
@@ -368,7 +353,11 @@ fn write(out: &mut OutputDir, rel: &str, text: &str) -> anyhow::Result<()> {
 fn print_summary(s: &HlsSummary, dir: &Path) {
     println!(
         "{}: {} planes, {} candidate paths (order <= {}), {} points",
-        s.scene, s.planes, s.paths, s.max_order, s.points
+        bt_scene::name::escape(&s.scene),
+        s.planes,
+        s.paths,
+        s.max_order,
+        s.points
     );
     println!(
         "schedule {} (seed {}): {} PE instances ({} duplicates, budget {}), makespan {} slots (list scheduler: {}), LF {}, utilisation {:.1} %",

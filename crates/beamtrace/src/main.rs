@@ -2,6 +2,7 @@
 //! library crates.
 
 mod args;
+mod budget;
 mod cloud;
 mod files;
 mod hls;
@@ -24,10 +25,27 @@ fn main() -> ExitCode {
     match run(cli) {
         Ok(code) => code,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", error_chain(&e));
             ExitCode::from(2)
         }
     }
+}
+
+/// The error and its causes joined by `: `, each cause printed once: library errors that show
+/// their source in their own message (`{path}: {source}`) would otherwise repeat the OS error.
+fn error_chain(e: &anyhow::Error) -> String {
+    let mut out = String::new();
+    for cause in e.chain() {
+        let text = cause.to_string();
+        if out.contains(&text) {
+            continue;
+        }
+        if !out.is_empty() {
+            out.push_str(": ");
+        }
+        out.push_str(&text);
+    }
+    out
 }
 
 fn run(cli: args::Cli) -> anyhow::Result<ExitCode> {

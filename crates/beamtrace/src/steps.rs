@@ -94,6 +94,9 @@ pub fn load_dynamic(args: &SceneArgs) -> anyhow::Result<DynamicScene> {
 pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
     let dynamic = load_dynamic(&args.scene)?;
     let scene0 = dynamic.step(0);
+    for scene in dynamic.scenes() {
+        crate::budget::candidates(scene, args.max_order, args.max_candidates)?;
+    }
     let solver = solver_for(args, scene0)?;
     let options = StepOptions {
         max_order: args.max_order,

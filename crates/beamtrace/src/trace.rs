@@ -32,6 +32,15 @@ pub fn load_scene(args: &SceneArgs) -> Result<Loaded, SceneError> {
         };
     }
     let path = Path::new(&args.scene);
+    if path.is_dir() {
+        return Err(SceneError::Io {
+            path: args.scene.clone(),
+            source: std::io::Error::new(
+                std::io::ErrorKind::IsADirectory,
+                "is a directory, not a scene file",
+            ),
+        });
+    }
     if crate::cloud::is_point_cloud(path) {
         // A point cloud where a scene is expected: extract its planes with the default
         // parameters (use `beamtrace extract` to tune them and keep the scene file).
@@ -102,6 +111,9 @@ pub fn solver_for(args: &TraceArgs, scene: &Scene) -> anyhow::Result<Solver> {
             if let Some(problem) = options.problem() {
                 bail!("{problem}");
             }
+            if let Some(problem) = options.over_budget(args.max_rays) {
+                bail!("{problem}");
+            }
             Solver::Sbr(options)
         }
     })
@@ -134,6 +146,17 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
     let traced = bt_solve::pipeline::trace_scene(&scene, &options)?;
     let t3 = Instant::now();
     let paths = bt_beams::report(&scene, &traced.result.paths);
+    if let Some(p) = paths
+        .iter()
+        .find(|p| bt_beams::in_near_field(p.length_m, scene.frequency_hz()))
+    {
+        eprintln!(
+            "warning: a path is {:.3e} m long, shorter than one wavelength ({:.3e} m): Friis does \
+             not hold in the near field; its free-space loss is clamped to the value at one wavelength",
+            p.length_m,
+            bt_beams::near_field_limit_m(scene.frequency_hz())
+        );
+    }
     let t4 = Instant::now();
     let doc = TraceDocument::new(
         &scene,

@@ -259,6 +259,12 @@ fn round<const JACOBI: bool>(
 }
 
 #[inline(always)]
+/// Mean displacement of `n` points that moved `sum` metres in all; 0 for a chain without points
+/// (line of sight), never the NaN of 0/0.
+fn mean_displacement(sum: Real, n: usize) -> Real {
+    if n == 0 { 0.0 } else { sum / n as Real }
+}
+
 fn run(
     scene: &Scene,
     seq: &[SurfaceId],
@@ -321,7 +327,7 @@ fn run(
                     }
                     return IpcOutcome::Converged {
                         iterations,
-                        residual: last_step / n as Real,
+                        residual: mean_displacement(last_step, n),
                     };
                 }
                 // The points are unchanged; the paper's rounds carry on.
@@ -358,7 +364,7 @@ fn run(
                 }
                 return IpcOutcome::Converged {
                     iterations,
-                    residual: moved / n as Real,
+                    residual: mean_displacement(moved, n),
                 };
             }
         }
@@ -400,7 +406,7 @@ fn run(
         last = moved;
     }
     let iterations = rounds + newton_steps;
-    let residual = last / n as Real;
+    let residual = mean_displacement(last, n);
     if rule_met && residual.is_finite() {
         if let Some(index) = opposite_sides(scene, planes, tx, rx, points) {
             return IpcOutcome::Degenerate {
