@@ -140,6 +140,9 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
         eprintln!("warning: {w}");
     }
     let scene = loaded.scene;
+    for w in scene.warnings() {
+        eprintln!("warning: {w}");
+    }
     let solver = solver_for(args, &scene)?;
     let t1 = Instant::now();
     let options = trace_options(args, solver);
@@ -184,7 +187,7 @@ pub fn check(args: &SceneArgs) -> anyhow::Result<ExitCode> {
     match load_scene(args) {
         Ok(loaded) => {
             let scene = &loaded.scene;
-            for w in &loaded.warnings {
+            for w in loaded.warnings.iter().chain(&scene.warnings()) {
                 println!("warning: {w}");
             }
             let reflectors = scene.reflectors().count();

@@ -119,3 +119,31 @@ fn a_directory_as_input_is_named_as_such() {
         text(&r)
     );
 }
+
+#[test]
+fn duplicate_coplanar_faces_with_different_materials_are_warned_about() {
+    let dir = scratch("coplanar");
+    let wall = [[-5, 0, 0], [5, 0, 0], [5, 0, 3], [-5, 0, 3]];
+    let desc = serde_json::json!({
+        "tx": [-1.5, 1, 2], "rx": [2, 2, 1],
+        "surfaces": [
+            { "name": "wall", "material": "concrete", "vertices": wall },
+            { "name": "wall-copy", "material": "glass", "vertices": wall }
+        ]
+    });
+    let scene = scene_with(&dir, "dup.json", &desc.to_string());
+    let r = beamtrace(&["scene", "check", &scene]);
+    assert_ok(&r);
+    assert!(
+        text(&r).contains("\"wall\" (concrete) and \"wall-copy\" (glass) overlap in one plane"),
+        "{}",
+        text(&r)
+    );
+    let r = beamtrace(&["trace", &scene]);
+    assert_ok(&r);
+    assert!(text(&r).contains("found twice"), "{}", text(&r));
+    // The same faces with one material: no warning.
+    let same = desc.to_string().replace("glass", "concrete");
+    let scene = scene_with(&dir, "same.json", &same);
+    assert!(!text(&beamtrace(&["scene", "check", &scene])).contains("overlap"));
+}
