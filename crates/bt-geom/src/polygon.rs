@@ -109,7 +109,7 @@ impl Polygon {
         let extent = (max - min).length();
         let merge = tol::scaled(tol::REL_VERTEX_MERGE, extent);
         let magnitude = min.abs().max(max.abs()).max_element();
-        if !(magnitude * Real::EPSILON < merge) {
+        if magnitude * Real::EPSILON >= merge {
             return Err(PolygonError::Unresolvable {
                 magnitude_m: magnitude,
                 extent_m: extent,

@@ -340,7 +340,7 @@ pub(crate) fn check_terminals(
     }
     for (field, p) in [("tx", tx), ("rx", rx)] {
         let magnitude = p.abs().max_element();
-        if !(magnitude * Real::EPSILON < eps) {
+        if magnitude * Real::EPSILON >= eps {
             problems.report(
                 field,
                 format!(

@@ -148,7 +148,7 @@ impl SbrOptions {
     /// estimate; `None` within the budget.
     pub fn over_budget(&self, max_rays: u64) -> Option<String> {
         let estimate = self.ray_estimate();
-        (!(estimate <= max_rays as f64)).then(|| {
+        (estimate.is_nan() || estimate > max_rays as f64).then(|| {
             format!(
                 "sbr ray budget exceeded: {estimate:.3e} rays (budget {max_rays}); use a coarser \
                  --sbr-step-deg or fewer --sbr-rays, or raise the budget with --max-rays"
