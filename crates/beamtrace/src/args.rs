@@ -71,6 +71,12 @@ pub struct StudyLivingRoomArgs {
     /// SBR grid step over the whole sphere, degrees (the paper: 1, i.e. 64,800 rays).
     #[arg(long, default_value_t = 1.0)]
     pub sbr_step_deg: f64,
+    /// Budget: refuse an SBR grid of more rays than this.
+    #[arg(long, default_value_t = bt_solve::sbr::DEFAULT_MAX_RAYS)]
+    pub max_rays: u64,
+    /// Budget: stop before the work rather than enumerate more candidates than this.
+    #[arg(long, default_value_t = bt_solve::pipeline::DEFAULT_MAX_CANDIDATES)]
+    pub max_candidates: u64,
     /// Highest reflection order.
     #[arg(long, default_value_t = 3)]
     pub max_order: usize,
@@ -114,6 +120,12 @@ pub struct Study2dArgs {
     /// SBR angular step, degrees (the paper: 1).
     #[arg(long, default_value_t = 1.0)]
     pub sbr_step_deg: f64,
+    /// Budget: refuse an SBR grid of more rays than this.
+    #[arg(long, default_value_t = bt_solve::sbr::DEFAULT_MAX_RAYS)]
+    pub max_rays: u64,
+    /// Budget: stop before the work rather than enumerate more candidates than this.
+    #[arg(long, default_value_t = bt_solve::pipeline::DEFAULT_MAX_CANDIDATES)]
+    pub max_candidates: u64,
     /// Launch SBR rays over the whole sphere (azimuth × elevation grid) instead of only in the
     /// plane of the room.
     #[arg(long)]
@@ -233,6 +245,9 @@ pub struct SolveArgs {
     /// SBR: launch only in the horizontal plane through TX (2-D scenes of vertical walls).
     #[arg(long)]
     pub sbr_planar: bool,
+    /// Budget: refuse an SBR launch pattern of more rays than this.
+    #[arg(long, default_value_t = bt_solve::sbr::DEFAULT_MAX_RAYS)]
+    pub max_rays: u64,
     /// Use one thread (benchmarking); the output is identical either way.
     #[arg(long)]
     pub single_thread: bool,
@@ -357,6 +372,9 @@ pub struct WvrnArgs {
     /// Highest reflection order for the candidate reduction figures.
     #[arg(long, default_value_t = 3)]
     pub max_order: usize,
+    /// Budget: stop before the work rather than enumerate more candidates than this.
+    #[arg(long, default_value_t = bt_solve::pipeline::DEFAULT_MAX_CANDIDATES)]
+    pub max_candidates: u64,
 }
 
 #[derive(Debug, Args, Clone)]
@@ -406,6 +424,7 @@ impl SolveArgs {
             sbr_step_deg: None,
             sbr_rays: None,
             sbr_planar: false,
+            max_rays: bt_solve::sbr::DEFAULT_MAX_RAYS,
             single_thread: false,
             candidates: CandidatesArg::BeamTree,
             wvrn: false,
@@ -437,7 +456,7 @@ pub fn parse_vec3(s: &str) -> anyhow::Result<Vec3> {
 pub struct ExtractArgs {
     /// Point cloud: .ply (ASCII or binary) or .pcd (ASCII or binary), metres, z up.
     pub cloud: PathBuf,
-    /// Scene file to write (JSON).
+    /// Scene file to write: .json or .toml (by extension; other extensions are refused).
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,
     /// Also write the extraction report (JSON) here.
@@ -470,6 +489,10 @@ pub struct SampleArgs {
     /// Points per square metre of surface.
     #[arg(long, default_value_t = 2000.0)]
     pub density: f64,
+    /// Budget: stop before sampling rather than generate more points than this (estimated
+    /// as surface area × density).
+    #[arg(long, default_value_t = 20_000_000)]
+    pub max_points: u64,
     /// Gaussian noise along the surface normal, metres (standard deviation).
     #[arg(long, default_value_t = 0.005)]
     pub noise: f64,
@@ -546,6 +569,9 @@ pub struct HlsGenArgs {
     /// Model and schedule only (cycle counts, errors): skip writing RTL (for large scenes).
     #[arg(long)]
     pub plan_only: bool,
+    /// Budget: stop before the work rather than enumerate more candidate paths than this.
+    #[arg(long, default_value_t = bt_solve::pipeline::DEFAULT_MAX_CANDIDATES)]
+    pub max_candidates: u64,
     /// Every time step of a dynamic scene: one accelerator (or, with --plan-only, schedule)
     /// per step into OUTPUT/step-<k>/, per-step cycle counts into OUTPUT/steps.json.
     #[arg(long)]

@@ -15,7 +15,7 @@ pub fn extraction_progress() -> (ProgressBar, impl FnMut(Progress)) {
     let bar = ProgressBar::hidden();
     bar.set_style(
         ProgressStyle::with_template(
-            "{spinner} extracting planes {bar:30} {pos}/{len} points assigned, {msg}",
+            "{spinner} extracting planes {bar:30} {pos}/{len} points assigned, {msg} [{elapsed_precise}, ETA {eta}]",
         )
         .expect("static template"),
     );
@@ -43,6 +43,26 @@ fn extract_from(path: &Path, params: &ExtractParams) -> anyhow::Result<(Extracti
 }
 
 pub fn run_extract(args: &ExtractArgs) -> anyhow::Result<ExitCode> {
+    if !(args.min_reflector_area.is_finite() && args.min_reflector_area >= 0.0) {
+        bail!(
+            "--min-reflector-area must be a finite number of m² >= 0, got {}",
+            args.min_reflector_area
+        );
+    }
+    if !(args.distance_threshold.is_finite() && args.distance_threshold > 0.0) {
+        bail!(
+            "--distance-threshold must be a positive number of metres, got {}",
+            args.distance_threshold
+        );
+    }
+    // Refuse a bad output before the (possibly long) extraction.
+    let inputs = [args.cloud.as_path()];
+    bt_output::refuse_input(&args.output, &inputs)?;
+    let format = bt_output::extension_in(&args.output, &["json", "toml"])?;
+    if let Some(report) = &args.report {
+        bt_output::refuse_input(report, &inputs)?;
+        bt_output::extension_in(report, &["json"])?;
+    }
     let params = ExtractParams {
         seed: args.seed,
         distance_threshold_m: args.distance_threshold,
@@ -61,9 +81,10 @@ pub fn run_extract(args: &ExtractArgs) -> anyhow::Result<ExitCode> {
         args.tx.map(|v| v.to_array()),
         args.rx.map(|v| v.to_array()),
     );
-    let json = serde_json::to_string_pretty(&desc)?;
-    std::fs::write(&args.output, json + "\n")
-        .with_context(|| format!("writing {}", args.output.display()))?;
+    let text = desc
+        .to_text(format)
+        .map_err(|e| anyhow::anyhow!("{}: {e}", args.output.display()))?;
+    crate::files::write(&args.output, text.as_bytes(), &inputs, &[format])?;
     let r = &extraction.report;
     println!(
         "{}: {} points ({} skipped as non-finite) -> {} planes ({} reflectors >= {} m², {} blockers), {} inliers, RMS {:.4} m, {:.2} m² in all, {} leftover points, seed {}",
@@ -82,8 +103,8 @@ pub fn run_extract(args: &ExtractArgs) -> anyhow::Result<ExitCode> {
     );
     println!("wrote {}", args.output.display());
     if let Some(report) = &args.report {
-        std::fs::write(report, serde_json::to_string_pretty(r)? + "\n")
-            .with_context(|| format!("writing {}", report.display()))?;
+        let text = serde_json::to_string_pretty(r)? + "\n";
+        crate::files::write(report, text.as_bytes(), &inputs, &["json"])?;
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -101,6 +122,8 @@ pub fn run_sample(args: &SampleArgs) -> anyhow::Result<ExitCode> {
             args.noise
         );
     }
+    bt_output::refuse_input(&args.output, &crate::inputs(&args.scene))?;
+    bt_output::extension_in(&args.output, &["ply", "pcd"])?;
     let loaded = crate::trace::load_scene(&args.scene)?;
     let polygons: Vec<Vec<glam::DVec3>> = loaded
         .scene
@@ -108,6 +131,22 @@ pub fn run_sample(args: &SampleArgs) -> anyhow::Result<ExitCode> {
         .iter()
         .map(|s| s.polygon.vertices().to_vec())
         .collect();
+    let area: f64 = loaded
+        .scene
+        .surfaces()
+        .iter()
+        .map(|s| s.polygon.area())
+        .sum();
+    let estimate = area * args.density;
+    if estimate > args.max_points as f64 {
+        bail!(
+            "point budget exceeded: {estimate:.3e} points ({area:.1} m² at {} pts/m², about {:.1} GB) \
+             (budget {}); lower --density or raise the budget with --max-points",
+            args.density,
+            estimate * 48.0 / 1e9,
+            args.max_points
+        );
+    }
     let cloud: PointCloud =
         bt_pointcloud::sample_polygons(&polygons, args.density, args.noise, args.seed);
     bt_pointcloud::io::write_path(&cloud, &args.output)

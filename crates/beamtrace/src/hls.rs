@@ -3,6 +3,7 @@
 
 use crate::args::{HlsArgs, HlsCommand, HlsGenArgs};
 use anyhow::{Context, bail};
+use bt_hls::OutputDir;
 use bt_hls::{HlsInput, PlanOptions};
 use bt_paths::AllVisible;
 use bt_scene::Scene;
@@ -186,7 +187,11 @@ fn generate(args: &HlsGenArgs) -> anyhow::Result<ExitCode> {
         return generate_steps(args);
     }
     let loaded = crate::trace::load_scene(&args.scene)?;
-    let summary = generate_one(&loaded.scene, None, args, &args.output)?;
+    let mut out = OutputDir::begin(&args.output, &crate::inputs(&args.scene))
+        .with_context(|| format!("creating {}", args.output.display()))?;
+    let summary = generate_one(&loaded.scene, None, args, &mut out, "")?;
+    out.commit()
+        .with_context(|| format!("writing {}", args.output.display()))?;
     print_summary(&summary, &args.output);
     Ok(ExitCode::SUCCESS)
 }
@@ -195,7 +200,7 @@ fn generate(args: &HlsGenArgs) -> anyhow::Result<ExitCode> {
 /// the per-step cycle counts in `DIR/steps.json`.
 fn generate_steps(args: &HlsGenArgs) -> anyhow::Result<ExitCode> {
     let dynamic = crate::steps::load_dynamic(&args.scene)?;
-    std::fs::create_dir_all(&args.output)
+    let mut top = OutputDir::begin(&args.output, &crate::inputs(&args.scene))
         .with_context(|| format!("creating {}", args.output.display()))?;
     let mut summaries = Vec::with_capacity(dynamic.len());
     println!(
@@ -204,7 +209,7 @@ fn generate_steps(args: &HlsGenArgs) -> anyhow::Result<ExitCode> {
     );
     for (k, scene) in dynamic.scenes().iter().enumerate() {
         let dir = args.output.join(format!("step-{k}"));
-        let s = generate_one(scene, Some(k), args, &dir)?;
+        let s = generate_one(scene, Some(k), args, &mut top, &format!("step-{k}/"))?;
         println!(
             "{:>4} {:>6} {:>7} {:>9} {:>9} {:>12} {:>10.3}  {}",
             k,
@@ -229,10 +234,9 @@ fn generate_steps(args: &HlsGenArgs) -> anyhow::Result<ExitCode> {
         cycles: summaries.iter().map(|s| s.predicted_cycles).collect(),
         steps: summaries,
     };
-    write(
-        &args.output.join("steps.json"),
-        &serde_json::to_string_pretty(&doc)?,
-    )?;
+    write(&mut top, "steps.json", &serde_json::to_string_pretty(&doc)?)?;
+    top.commit()
+        .with_context(|| format!("writing {}", args.output.display()))?;
     println!(
         "{} steps: {} cycles in all, mean {:.3} ms per step at 50 MHz; wrote {}/steps.json{}",
         doc.steps.len(),
@@ -262,30 +266,36 @@ pub struct StepsSummary {
     pub steps: Vec<HlsSummary>,
 }
 
-/// Model, schedule and (unless `--plan-only`) RTL of one scene into `out`.
+/// Model, schedule and (unless `--plan-only`) RTL of one scene into `out` under `prefix`
+/// (`""` or `step-<k>/`).
 fn generate_one(
     scene: &Scene,
     step: Option<usize>,
     args: &HlsGenArgs,
-    out: &Path,
+    out: &mut OutputDir,
+    prefix: &str,
 ) -> anyhow::Result<HlsSummary> {
+    bt_solve::pipeline::exhaustive_budget(scene, args.max_order, args.max_candidates)?;
     let (input, _) =
         bt_study::fpga::hls_input(scene, args.max_order, args.threshold_lsb, args.max_rounds);
+    let at = match step {
+        Some(k) => format!("{} step {k}", args.scene.scene),
+        None => args.scene.scene.clone(),
+    };
     if input.paths.is_empty() {
-        match step {
-            Some(k) => bail!(
-                "{} step {k}: no candidate reflection paths up to order {}",
-                args.scene.scene,
-                args.max_order
-            ),
-            None => bail!(
-                "{}: no candidate reflection paths up to order {}",
-                args.scene.scene,
-                args.max_order
-            ),
-        }
+        bail!(
+            "{at}: no candidate reflection paths up to order {}",
+            args.max_order
+        );
     }
+    let points: u64 = input.paths.iter().map(|p| p.len() as u64).sum();
+    bt_hls::check_capacity(input.paths.len() as u64, points)
+        .with_context(|| format!("{at}: order {}", args.max_order))?;
     let problem: Problem = input.problem()?;
+    let bar = crate::progress::spinner(&format!(
+        "scheduling {} paths, {points} points",
+        input.paths.len()
+    ));
     let plan = bt_hls::plan(
         &problem,
         &PlanOptions {
@@ -297,15 +307,19 @@ fn generate_one(
             },
         },
     )?;
+    bar.finish_and_clear();
     let fixed = fixed_deviation(scene, &input, args.max_order)?;
-    std::fs::create_dir_all(out).with_context(|| format!("creating {}", out.display()))?;
     let rtl_written = !args.plan_only;
     if rtl_written {
-        let report = bt_hls::generate(&input, &plan.schedule, out)?;
+        out.set_prefix(prefix)?;
+        let report = bt_hls::generate_into(&input, &plan.schedule, out);
+        out.set_prefix("")?;
+        let report = report?;
         debug_assert_eq!(report.predicted_cycles, plan.predicted_cycles);
     } else {
         write(
-            &out.join("schedule.json"),
+            out,
+            &format!("{prefix}schedule.json"),
             &serde_json::to_string(&plan.schedule)?,
         )?;
     }
@@ -328,20 +342,26 @@ fn generate_one(
         rtl_written,
     };
     write(
-        &out.join("summary.json"),
+        out,
+        &format!("{prefix}summary.json"),
         &serde_json::to_string_pretty(&summary)?,
     )?;
     Ok(summary)
 }
 
-fn write(path: &Path, text: &str) -> anyhow::Result<()> {
-    std::fs::write(path, format!("{text}\n")).with_context(|| format!("writing {}", path.display()))
+fn write(out: &mut OutputDir, rel: &str, text: &str) -> anyhow::Result<()> {
+    out.write(rel, format!("{text}\n").as_bytes())
+        .with_context(|| format!("writing {}", out.dir().join(rel).display()))
 }
 
 fn print_summary(s: &HlsSummary, dir: &Path) {
     println!(
         "{}: {} planes, {} candidate paths (order <= {}), {} points",
-        s.scene, s.planes, s.paths, s.max_order, s.points
+        bt_scene::name::escape(&s.scene),
+        s.planes,
+        s.paths,
+        s.max_order,
+        s.points
     );
     println!(
         "schedule {} (seed {}): {} PE instances ({} duplicates, budget {}), makespan {} slots (list scheduler: {}), LF {}, utilisation {:.1} %",

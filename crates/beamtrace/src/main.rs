@@ -3,8 +3,10 @@
 
 mod args;
 mod cloud;
+mod files;
 mod hls;
 mod output;
+mod progress;
 mod steps;
 mod study;
 mod sweep;
@@ -15,16 +17,36 @@ mod wvrn;
 use clap::Parser;
 use std::process::ExitCode;
 
+pub use files::inputs;
+
 fn main() -> ExitCode {
     restore_default_sigpipe();
+    exit_cleanly_when_stdout_fails();
     let cli = args::Cli::parse_from(args::with_default_subcommands(std::env::args_os()));
     match run(cli) {
         Ok(code) => code,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", error_chain(&e));
             ExitCode::from(2)
         }
     }
+}
+
+/// The error and its causes joined by `: `, each cause printed once: library errors that show
+/// their source in their own message (`{path}: {source}`) would otherwise repeat the OS error.
+fn error_chain(e: &anyhow::Error) -> String {
+    let mut out = String::new();
+    for cause in e.chain() {
+        let text = cause.to_string();
+        if out.contains(&text) {
+            continue;
+        }
+        if !out.is_empty() {
+            out.push_str(": ");
+        }
+        out.push_str(&text);
+    }
+    out
 }
 
 fn run(cli: args::Cli) -> anyhow::Result<ExitCode> {
@@ -57,4 +79,27 @@ fn restore_default_sigpipe() {
     unsafe {
         libc::signal(libc::SIGPIPE, libc::SIG_DFL);
     }
+}
+
+/// `println!` panics when stdout cannot be written (`beamtrace ... > /dev/full`): report it as
+/// an error with exit code 2 instead of a panic (exit 101). Every other panic keeps the
+/// default report.
+fn exit_cleanly_when_stdout_fails() {
+    let default = std::panic::take_hook();
+    std::panic::set_hook(Box::new(move |info| {
+        let message = info
+            .payload()
+            .downcast_ref::<String>()
+            .map(String::as_str)
+            .or_else(|| info.payload().downcast_ref::<&str>().copied())
+            .unwrap_or("");
+        if message.starts_with("failed printing to stdout") {
+            eprintln!(
+                "error: writing to stdout: {}",
+                message.trim_start_matches("failed printing to stdout: ")
+            );
+            std::process::exit(2);
+        }
+        default(info);
+    }));
 }

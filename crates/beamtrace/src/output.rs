@@ -84,7 +84,7 @@ impl TraceDocument {
 pub fn print_table(doc: &TraceDocument) {
     println!(
         "scene {}  tx {:?}  rx {:?}  {:.2} GHz  max order {}",
-        doc.scene,
+        bt_scene::name::escape(&doc.scene),
         doc.tx,
         doc.rx,
         doc.frequency_hz / 1e9,
@@ -98,7 +98,11 @@ pub fn print_table(doc: &TraceDocument) {
         let names = if p.surfaces.is_empty() {
             "(line of sight)".to_string()
         } else {
-            p.surfaces.join(" > ")
+            p.surfaces
+                .iter()
+                .map(|n| bt_scene::name::escape(n))
+                .collect::<Vec<_>>()
+                .join(" > ")
         };
         println!(
             "{:>4} {:>3} {:>8.3} {:>8.3} {:>8.2} {:>7.2} {:>8.2} {:>7.2} {:>7.2}  {}",

@@ -120,8 +120,8 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
     if args.json || args.out.is_some() {
         let json = serde_json::to_string_pretty(&doc).context("serialising the steps")?;
         if let Some(path) = &args.out {
-            std::fs::write(path, format!("{json}\n"))
-                .with_context(|| format!("writing {}", path.display()))?;
+            let inputs = crate::inputs(&args.scene);
+            crate::files::write(path, format!("{json}\n").as_bytes(), &inputs, &["json"])?;
         }
         if args.json && !args.jsonl {
             println!("{json}");

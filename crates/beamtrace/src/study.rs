@@ -22,6 +22,11 @@ pub fn run_2d(args: &Study2dArgs) -> anyhow::Result<ExitCode> {
     if !problems.is_empty() {
         anyhow::bail!("{}", problems.join("; "));
     }
+    let sbr = bt_solve::SbrOptions::grid(args.sbr_step_deg);
+    let sbr = if args.sbr_sphere { sbr } else { sbr.planar() };
+    if let Some(problem) = sbr.over_budget(args.max_rays) {
+        anyhow::bail!("{problem}");
+    }
     // indicatif draws to stderr and hides itself when stderr is not a terminal.
     let bar = ProgressBar::new((config.rooms * config.steps) as u64);
     bar.set_style(
@@ -76,6 +81,13 @@ pub fn run_living_room(args: &StudyLivingRoomArgs) -> anyhow::Result<ExitCode> {
         merge_angle_deg: 1.0,
         merge_distance: 1e-3,
     })?;
+    if let Some(problem) = bt_solve::SbrOptions::grid(args.sbr_step_deg).over_budget(args.max_rays)
+    {
+        anyhow::bail!("{problem}");
+    }
+    for step in scene.scenes() {
+        bt_solve::pipeline::exhaustive_budget(step, args.max_order, args.max_candidates)?;
+    }
     let bar = ProgressBar::new(scene.len() as u64);
     bar.set_style(
         ProgressStyle::with_template("{bar:40} {pos}/{len} time steps  {elapsed} (eta {eta})")

@@ -73,6 +73,9 @@ pub fn solver_for(args: &SolveArgs, scene: &Scene) -> anyhow::Result<Solver> {
             if let Some(problem) = options.problem() {
                 bail!("{problem}");
             }
+            if let Some(problem) = options.over_budget(args.max_rays) {
+                bail!("{problem}");
+            }
             Solver::Sbr(options)
         }
     })
@@ -99,12 +102,26 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
         eprintln!("warning: {w}");
     }
     let scene = loaded.scene;
+    for w in scene.warnings() {
+        eprintln!("warning: {w}");
+    }
     let solver = solver_for(&args.solve, &scene)?;
     let t1 = Instant::now();
     let options = trace_options(&args.solve, solver);
     let traced = bt_solve::pipeline::trace_scene(&scene, &options)?;
     let t3 = Instant::now();
     let paths = bt_beams::report(&scene, &traced.result.paths);
+    if let Some(p) = paths
+        .iter()
+        .find(|p| bt_beams::in_near_field(p.length_m, scene.frequency_hz()))
+    {
+        eprintln!(
+            "warning: a path is {:.3e} m long, shorter than one wavelength ({:.3e} m): Friis does \
+             not hold in the near field; its free-space loss is clamped to the value at one wavelength",
+            p.length_m,
+            bt_beams::near_field_limit_m(scene.frequency_hz())
+        );
+    }
     let t4 = Instant::now();
     let doc = TraceDocument::new(
         &scene,
@@ -118,8 +135,8 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
     );
     let json = serde_json::to_string_pretty(&doc).context("serialising the trace")?;
     if let Some(path) = &args.out {
-        std::fs::write(path, format!("{json}\n"))
-            .with_context(|| format!("writing {}", path.display()))?;
+        let inputs = crate::inputs(&args.scene);
+        crate::files::write(path, format!("{json}\n").as_bytes(), &inputs, &["json"])?;
     }
     if args.json {
         println!("{json}");
@@ -133,7 +150,7 @@ pub fn check(args: &SceneArgs) -> anyhow::Result<ExitCode> {
     match load_scene(args) {
         Ok(loaded) => {
             let scene = &loaded.scene;
-            for w in &loaded.warnings {
+            for w in loaded.warnings.iter().chain(&scene.warnings()) {
                 println!("warning: {w}");
             }
             let reflectors = scene.reflectors().count();

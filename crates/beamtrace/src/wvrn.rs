@@ -108,6 +108,7 @@ pub fn run(args: &WvrnArgs) -> anyhow::Result<ExitCode> {
         );
     }
     let scene = dynamic.step(args.step);
+    bt_solve::pipeline::exhaustive_budget(scene, args.max_order, args.max_candidates)?;
     let t0 = Instant::now();
     let wvrn = Wvrn::build(scene);
     let build_time_s = t0.elapsed().as_secs_f64();
@@ -179,15 +180,24 @@ pub fn run(args: &WvrnArgs) -> anyhow::Result<ExitCode> {
     };
     match &args.out {
         Some(path) => {
-            std::fs::write(path, text).with_context(|| format!("writing {}", path.display()))?
+            let format: &[&str] = if args.json {
+                &["json"]
+            } else if args.dot {
+                &["dot", "gv"]
+            } else {
+                &["txt"]
+            };
+            crate::files::write(path, text.as_bytes(), &crate::inputs(&args.scene), format)?
         }
         None => print!("{text}"),
     }
     Ok(ExitCode::SUCCESS)
 }
 
+/// A DOT string: the name escaped by the one name rule (quotes, backslashes and control
+/// characters such as NUL, which ends a Graphviz file, become escapes).
 fn quote(s: &str) -> String {
-    format!("\"{}\"", s.replace('\\', "\\\\").replace('"', "\\\""))
+    format!("\"{}\"", bt_scene::name::escape(s))
 }
 
 /// Graphviz DOT: TX/RX as boxes, moving surfaces filled; in a dynamic scene edges whose state
@@ -238,7 +248,7 @@ fn table(doc: &WvrnDocument) -> String {
     let _ = writeln!(
         out,
         "WVRN of {} (step {} of {}): {} nodes, {} of {} pairs linked ({} coplanar, {} occluded), built in {:.3} ms",
-        doc.scene,
+        bt_scene::name::escape(&doc.scene),
         doc.step,
         doc.steps,
         s.nodes,
@@ -258,11 +268,11 @@ fn table(doc: &WvrnDocument) -> String {
         let _ = writeln!(
             out,
             "  {:<20} {:<20} {}{}",
-            doc.nodes[p.a].name,
-            doc.nodes[p.b].name,
+            bt_scene::name::escape(&doc.nodes[p.a].name),
+            bt_scene::name::escape(&doc.nodes[p.b].name),
             p.reason,
             p.by.as_ref()
-                .map(|b| format!(" by {b}"))
+                .map(|b| format!(" by {}", bt_scene::name::escape(b)))
                 .unwrap_or_default()
         );
     }

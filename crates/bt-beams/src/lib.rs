@@ -89,9 +89,24 @@ pub struct PathReport {
     pub residual_m: Option<Real>,
 }
 
-/// Free-space path loss (Friis), dB, for `length` metres at `frequency_hz`.
+/// Free-space path loss (Friis), dB, for `length` metres at `frequency_hz`. Friis holds in the
+/// far field only: below one wavelength it would turn into a gain (−78.6 dB at 100 nm and
+/// 28 GHz), so the length is clamped to [`near_field_limit_m`] and the loss is never below
+/// 20 log10(4π) ≈ 21.98 dB. The one place the clamp lives; [`in_near_field`] tells callers to
+/// warn.
 pub fn free_space_loss_db(length: Real, frequency_hz: Real) -> Real {
+    let length = length.max(near_field_limit_m(frequency_hz));
     20.0 * (4.0 * std::f64::consts::PI * length * frequency_hz / SPEED_OF_LIGHT).log10()
+}
+
+/// The shortest length Friis is used at: one wavelength, metres.
+pub fn near_field_limit_m(frequency_hz: Real) -> Real {
+    SPEED_OF_LIGHT / frequency_hz
+}
+
+/// Whether a path of `length` metres is shorter than [`near_field_limit_m`] (its loss clamped).
+pub fn in_near_field(length: Real, frequency_hz: Real) -> bool {
+    length < near_field_limit_m(frequency_hz)
 }
 
 /// Describe one found path (rank 0 until [`rank`] runs).
@@ -176,6 +191,20 @@ mod tests {
         assert!((d.azimuth - 180.0).abs() < 1e-12 && (d.elevation - 45.0).abs() < 1e-12);
         let v = Vec3::new(0.3, -0.4, 0.2).normalize();
         assert!((Direction::of(v).unit() - v).length() < 1e-12);
+    }
+
+    #[test]
+    fn friis_is_clamped_below_one_wavelength() {
+        let f = 28e9;
+        let lambda = SPEED_OF_LIGHT / f;
+        let floor = 20.0 * (4.0 * std::f64::consts::PI).log10();
+        // Unclamped, 100 nm would give 20 log10(4π · 1e-7 / λ) ≈ -78.6 dB: a gain.
+        for length in [1e-7, 1e-3, lambda * 0.5, lambda] {
+            let l = free_space_loss_db(length, f);
+            assert!((l - floor).abs() < 1e-9, "{length}: {l}");
+            assert_eq!(in_near_field(length, f), length < lambda);
+        }
+        assert!(free_space_loss_db(2.0 * lambda, f) > floor + 6.0);
     }
 
     #[test]

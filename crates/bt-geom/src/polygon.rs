@@ -13,6 +13,21 @@ use thiserror::Error;
 /// Why a vertex list is not a valid bounded planar polygon.
 #[derive(Debug, Clone, PartialEq, Error, Serialize)]
 pub enum PolygonError {
+    /// More vertices than [`MAX_VERTICES`] (the simplicity test is quadratic).
+    #[error("polygon has {0} vertices, more than the {MAX_VERTICES} a surface may have; split it")]
+    TooManyVertices(usize),
+    /// Doubles at the polygon's coordinates are too coarse for its size: one unit in the last
+    /// place exceeds the vertex tolerance, so repeated, collinear and inside would be guesses.
+    #[error(
+        "coordinates of magnitude {magnitude_m:.3e} m cannot resolve a polygon of extent {extent_m:.3e} m \
+         in double precision; move the scene nearer the origin"
+    )]
+    Unresolvable {
+        /// Largest absolute coordinate, metres.
+        magnitude_m: Real,
+        /// The polygon's extent, metres.
+        extent_m: Real,
+    },
     /// Fewer than three vertices.
     #[error("polygon has {0} vertices, at least 3 are needed")]
     TooFewVertices(usize),
@@ -50,6 +65,10 @@ pub enum PolygonError {
     SelfIntersecting(usize, usize),
 }
 
+/// Most vertices a polygon may have: the simplicity test compares every pair of edges, so a
+/// million-vertex polygon would take minutes (a budget, `docs/reliability.md`).
+pub const MAX_VERTICES: usize = 10_000;
+
 /// A validated simple planar polygon in 3-D.
 ///
 /// The normal follows the right-hand rule of the vertex order (counter-clockwise seen from the
@@ -81,12 +100,22 @@ impl Polygon {
         if n < 3 {
             return Err(PolygonError::TooFewVertices(n));
         }
+        if n > MAX_VERTICES {
+            return Err(PolygonError::TooManyVertices(n));
+        }
         if let Some(index) = vertices.iter().position(|p| !p.is_finite()) {
             return Err(PolygonError::NonFinite { index });
         }
         let (min, max) = bounds(&vertices);
         let extent = (max - min).length();
         let merge = tol::scaled(tol::REL_VERTEX_MERGE, extent);
+        let magnitude = min.abs().max(max.abs()).max_element();
+        if magnitude * Real::EPSILON >= merge {
+            return Err(PolygonError::Unresolvable {
+                magnitude_m: magnitude,
+                extent_m: extent,
+            });
+        }
         for i in 0..n {
             let j = (i + 1) % n;
             if vertices[i].distance(vertices[j]) <= merge {

@@ -49,6 +49,9 @@ pub enum HlsError {
         /// What was wrong.
         message: String,
     },
+    /// An output could not be written safely.
+    #[error(transparent)]
+    Output(#[from] bt_output::OutputError),
     /// The fixed-point model rejected the input.
     #[error(transparent)]
     Fixed(#[from] bt_fixed::FixedError),

@@ -119,6 +119,24 @@ pub const PE_LATENCY: u32 = 5 + PROPORTION_ITERATIONS;
 /// Largest word address the 16-bit Avalon address port can reach.
 pub const ADDRESS_BITS: u32 = 16;
 
+/// Whether `num_paths` paths with `num_points` points in all fit the Avalon-MM address space
+/// of [`ADDRESS_BITS`] bits (status words and four words per point). Cheap: callers check it
+/// before scheduling, which can take long on a design that would be refused anyway.
+pub fn check_capacity(num_paths: u64, num_points: u64) -> Result<(), HlsError> {
+    let path_bits = bits_for(num_paths);
+    let point_bits = bits_for(num_points);
+    let status_bits = path_bits.max(4);
+    let point_region_bits = (point_bits + 2).max(status_bits + 1);
+    if point_region_bits + 1 > ADDRESS_BITS {
+        return Err(HlsError::TooLarge(format!(
+            "{num_points} points and {num_paths} paths need more than {ADDRESS_BITS} address bits \
+             (at most {} points): lower --max-order or use fewer reflectors",
+            1u64 << (ADDRESS_BITS - 3)
+        )));
+    }
+    Ok(())
+}
+
 /// `ceil(log2(n))`, at least 1.
 pub(crate) fn bits_for(n: u64) -> u32 {
     (64 - n.saturating_sub(1).leading_zeros()).max(1)
@@ -202,11 +220,7 @@ impl Design {
         let point_bits = bits_for(num_points.into());
         let status_bits = path_bits.max(4);
         let point_region_bits = (point_bits + 2).max(status_bits + 1);
-        if point_region_bits + 1 > ADDRESS_BITS {
-            return Err(HlsError::TooLarge(format!(
-                "{num_points} points and {num_paths} paths need more than {ADDRESS_BITS} address bits"
-            )));
-        }
+        check_capacity(num_paths.into(), num_points.into())?;
         if makespan == 0 {
             return Err(HlsError::Schedule("schedule holds no job".into()));
         }

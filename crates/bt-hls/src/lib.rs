@@ -27,11 +27,12 @@ pub mod verilog;
 use std::path::{Path, PathBuf};
 
 use bt_fixed::FixedPoint;
+pub use bt_output::OutputDir;
 use bt_schedule::Schedule;
 
 pub use bt_fixed::{BoundsM, EarlyStop, FixedOutcome, PathResult};
 pub use error::HlsError;
-pub use input::{ADDRESS_BITS, HlsInput, PE_LATENCY, PlaneSpec};
+pub use input::{ADDRESS_BITS, HlsInput, PE_LATENCY, PlaneSpec, check_capacity};
 pub use pe::{POINT_BITS, pe_module_name};
 pub use plan::{Plan, PlanOptions, ScheduleKind, cycles_per_slot, plan, run_cycles};
 pub use tools::{LintReport, SimReport, SynthReport, lint, simulate, synthesize};
@@ -215,16 +216,12 @@ fn register_map(d: &Design, report_cycles: u64, tb_cycles: u64) -> String {
 }
 
 fn write(
-    out_dir: &Path,
+    out: &mut OutputDir,
     rel: &str,
     contents: &[u8],
     files: &mut Vec<String>,
 ) -> Result<(), HlsError> {
-    let path = out_dir.join(rel);
-    if let Some(parent) = path.parent() {
-        std::fs::create_dir_all(parent).map_err(io_err(parent))?;
-    }
-    std::fs::write(&path, contents).map_err(io_err(&path))?;
+    out.write(rel, contents)?;
     files.push(rel.to_string());
     Ok(())
 }
@@ -256,7 +253,22 @@ fn rtl_of(d: &Design) -> Result<Vec<(String, String)>, HlsError> {
 /// Generates the accelerator for `input` scheduled by `schedule` into `out_dir`:
 /// `rtl/<module>.v`, `tb/bt_tb.v`, `tb/stim.hex`, `vectors/vector_<n>.json`,
 /// `schedule.json`, `hls_input.json`, `report.md`. Deterministic: same inputs, same bytes.
+/// The directory is built aside and swapped in (`bt_output::OutputDir`): files of the user's in
+/// `out_dir` are never touched, files of a previous run are replaced.
 pub fn generate(input: &HlsInput, schedule: &Schedule, out_dir: &Path) -> Result<Report, HlsError> {
+    let mut out = OutputDir::begin(out_dir, &[])?;
+    let report = generate_into(input, schedule, &mut out)?;
+    out.commit()?;
+    Ok(report)
+}
+
+/// [`generate`] into an output directory under construction (the caller adds its own files
+/// and commits).
+pub fn generate_into(
+    input: &HlsInput,
+    schedule: &Schedule,
+    out_dir: &mut OutputDir,
+) -> Result<Report, HlsError> {
     let d = Design::new(input, schedule)?;
     let modules = rtl_of(&d)?;
     let vectors = expectations(&d)?;
@@ -274,10 +286,6 @@ pub fn generate(input: &HlsInput, schedule: &Schedule, out_dir: &Path) -> Result
         .sum();
     let docs = register_map(&d, predicted_cycles, predicted_tb_cycles);
     let mut files = Vec::new();
-    let rtl_dir = out_dir.join("rtl");
-    if rtl_dir.exists() {
-        std::fs::remove_dir_all(&rtl_dir).map_err(io_err(&rtl_dir))?;
-    }
     for (name, text) in &modules {
         write(
             out_dir,
@@ -348,8 +356,17 @@ pub(crate) fn read_json<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T
     })
 }
 
-/// Paths of the generated RTL files in `out_dir`, sorted.
+/// Paths of the generated RTL files in `out_dir`, sorted: the `rtl/*.v` files the generator
+/// listed in the directory's manifest (a user's own files beside them are not ours to
+/// simulate), or every `rtl/*.v` of a directory without a manifest.
 pub fn rtl_files(out_dir: &Path) -> Result<Vec<PathBuf>, HlsError> {
+    if let Some(listed) = bt_output::manifest_files(out_dir) {
+        return Ok(listed
+            .iter()
+            .filter(|f| f.starts_with("rtl/") && f.ends_with(".v"))
+            .map(|f| out_dir.join(f))
+            .collect());
+    }
     let dir = out_dir.join("rtl");
     let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
         .map_err(io_err(&dir))?

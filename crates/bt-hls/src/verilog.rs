@@ -336,11 +336,27 @@ fn print_stmt(out: &mut String, s: &Stmt, indent: usize) {
     }
 }
 
+/// One comment line as it is printed: every control character (a line break, a carriage
+/// return, an escape sequence, a NUL), which could end the comment or reach a terminal, is
+/// written as a Rust-style escape (`\n`, `\u{1b}`). Names from the input reach the RTL only
+/// through here.
+fn comment_line(text: &str) -> String {
+    text.chars()
+        .map(|c| {
+            if c.is_control() || matches!(c, '\u{2028}' | '\u{2029}' | '\u{85}') {
+                c.escape_default().to_string()
+            } else {
+                c.to_string()
+            }
+        })
+        .collect()
+}
+
 /// Prints a module as a complete Verilog-2005 file.
 pub fn print_module(m: &Module) -> String {
     let mut out = String::new();
     for line in &m.header {
-        let _ = writeln!(out, "// {line}");
+        let _ = writeln!(out, "// {}", comment_line(line));
     }
     let _ = writeln!(out, "`timescale 1ns / 1ps");
     let _ = writeln!(out, "`default_nettype none");
@@ -358,8 +374,8 @@ pub fn print_module(m: &Module) -> String {
     for item in &m.items {
         match item {
             Item::Comment(text) => {
-                for line in text.lines() {
-                    let _ = writeln!(out, "  // {line}");
+                for line in text.split('\n') {
+                    let _ = writeln!(out, "  // {}", comment_line(line));
                 }
             }
             Item::LocalParam(n, w, v) => {
@@ -441,5 +457,36 @@ mod tests {
         assert!(text.contains("output reg  [7:0] q"), "{text}");
         assert!(text.contains("q <= (a + 8'd255);"), "{text}");
         assert_eq!(text, print_module(&m));
+    }
+
+    /// The injection of issue 9: a name that closes the comment line and opens a module.
+    const INJECTION: &str =
+        "wall\nmodule pwn; initial $display(\"pwned\"); endmodule\n//\r\u{1b}[31m\0";
+
+    #[test]
+    fn names_in_comments_never_become_code() {
+        let m = Module {
+            name: "bt_demo".into(),
+            header: vec![format!("plane 0 ('{INJECTION}')")],
+            ports: vec![],
+            items: vec![Item::Comment(format!("plane 0 '{INJECTION}'"))],
+        };
+        let text = print_module(&m);
+        let code: Vec<&str> = text
+            .lines()
+            .map(str::trim_start)
+            .filter(|l| !l.starts_with("//"))
+            .collect();
+        assert!(code.iter().all(|l| !l.contains("pwn")), "{text}");
+        assert_eq!(
+            code.iter().filter(|l| l.starts_with("module ")).count(),
+            1,
+            "{text}"
+        );
+        assert!(
+            !text.chars().any(|c| c.is_control() && c != '\n'),
+            "{text:?}"
+        );
+        assert!(text.contains("\\u{1b}[31m"), "{text}");
     }
 }

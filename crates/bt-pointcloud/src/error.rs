@@ -42,6 +42,9 @@ impl fmt::Display for DataPos {
 /// where (line / point index) and what is wrong. Parsers never panic on malformed input.
 #[derive(Debug, thiserror::Error)]
 pub enum PointCloudError {
+    /// An output could not be written safely (atomic write, never over an input).
+    #[error(transparent)]
+    Output(#[from] bt_output::OutputError),
     /// The operating system reported an error while opening, reading or writing.
     #[error("{origin}i/o error: {source}")]
     Io {
@@ -159,7 +162,7 @@ impl PointCloudError {
             | Self::Truncated { origin, .. }
             | Self::BadValue { origin, .. }
             | Self::NonFinite { origin, .. } => *origin = o,
-            Self::InvalidCloud { .. } | Self::InvalidParams { .. } => {}
+            Self::InvalidCloud { .. } | Self::InvalidParams { .. } | Self::Output(_) => {}
         }
         self
     }

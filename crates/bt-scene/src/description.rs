@@ -11,26 +11,26 @@ use std::collections::BTreeMap;
 #[serde(deny_unknown_fields)]
 pub struct SceneDescription {
     /// Scene name (optional; the file stem is used otherwise).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub name: Option<String>,
     /// Carrier frequency, Hz (default 28 GHz).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub frequency_hz: Option<Real>,
     /// Transmitter position `[x, y, z]`, metres.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tx: Option<[Real; 3]>,
     /// Receiver position `[x, y, z]`, metres.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rx: Option<[Real; 3]>,
     /// Extra or overriding materials by name (the built-ins are always available).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub materials: BTreeMap<String, MaterialDesc>,
     /// Planar polygons.
     #[serde(default)]
     pub surfaces: Vec<SurfaceDesc>,
     /// Axis-aligned boxes, expanded into their faces (`<name>.top`, `.bottom`, `.west`,
     /// `.east`, `.south`, `.north` for the -z/+z/-x/+x/-y/+y faces... see the format doc).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub boxes: Vec<BoxDesc>,
     /// Dynamic scenes: number of time steps (default 1). See `docs/dynamic-scenes.md`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
@@ -44,6 +44,20 @@ pub struct SceneDescription {
     /// Dynamic scenes: RX position per step `[[x, y, z], ...]` (one per step), metres.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rx_steps: Option<Vec<[Real; 3]>>,
+}
+
+impl SceneDescription {
+    /// The description as a scene file in `format` (`json` or `toml`, as `io::load` reads
+    /// them); absent optional fields are left out, never written as `null`.
+    pub fn to_text(&self, format: &str) -> Result<String, String> {
+        match format {
+            "json" => serde_json::to_string_pretty(self)
+                .map(|s| s + "\n")
+                .map_err(|e| e.to_string()),
+            "toml" => toml::to_string_pretty(self).map_err(|e| e.to_string()),
+            other => Err(format!("no scene writer for .{other} (use .json or .toml)")),
+        }
+    }
 }
 
 /// A material entry: a constant loss, a radio model, or both (`docs/scene-format.md`).
@@ -75,10 +89,10 @@ pub struct SurfaceDesc {
     /// Unique name.
     pub name: String,
     /// Material name (default `"default"`).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub material: Option<String>,
     /// `reflector` (default) or `blocker`.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub kind: Option<SurfaceKind>,
     /// Vertices `[[x, y, z], ...]` in order around the polygon (either winding), metres.
     pub vertices: Vec<[Real; 3]>,
@@ -94,10 +108,10 @@ pub struct BoxDesc {
     /// Name prefix of the faces.
     pub name: String,
     /// Material name (default `"default"`).
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub material: Option<String>,
     /// `reflector` (default) or `blocker`.
-    #[serde(default)]
+    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub kind: Option<SurfaceKind>,
     /// Minimum corner, metres.
     pub min: [Real; 3],

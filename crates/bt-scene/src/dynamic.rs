@@ -544,7 +544,7 @@ fn members(
             let ids = base.find(&s.name).into_iter().collect();
             assign(
                 object,
-                format!("surfaces[{i}] \"{}\".object", s.name),
+                format!("surfaces[{i}] \"{}\".object", crate::name::escape(&s.name)),
                 ids,
                 problems,
             );

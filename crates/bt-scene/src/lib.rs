@@ -11,6 +11,7 @@ pub mod dynamic;
 pub mod io;
 mod material;
 mod model;
+pub mod name;
 mod validate;
 
 pub use builtin::{builtin_json, builtin_names, builtin_scene};

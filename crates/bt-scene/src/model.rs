@@ -116,6 +116,55 @@ impl Scene {
             .map(|i| SurfaceId(i as u32))
     }
 
+    /// Pairs of surfaces (lower id first) that lie in one plane and overlap (the centroid of
+    /// one inside the other) but name different materials: every path reflecting there is
+    /// found twice, with two losses. A warning, not an error (meshes can hold such faces).
+    /// Pairs are compared only when their bounding boxes meet.
+    pub fn coplanar_conflicts(&self) -> Vec<(SurfaceId, SurfaceId)> {
+        let eps = self.length_tolerance();
+        let boxes: Vec<(Vec3, Vec3)> = self.surfaces.iter().map(|s| s.polygon.bounds()).collect();
+        let mut out = Vec::new();
+        for (i, a) in self.surfaces.iter().enumerate() {
+            for (j, b) in self.surfaces.iter().enumerate().skip(i + 1) {
+                let ((alo, ahi), (blo, bhi)) = (boxes[i], boxes[j]);
+                if a.material == b.material
+                    || (alo - bhi).max_element() > eps
+                    || (blo - ahi).max_element() > eps
+                {
+                    continue;
+                }
+                let (pa, pb) = (&a.polygon, &b.polygon);
+                let same_plane = pa.plane().normal.dot(pb.plane().normal).abs() > 1.0 - 1e-9
+                    && pa.plane().signed_distance(pb.centroid()).abs() <= eps;
+                if same_plane
+                    && (pa.contains(pb.centroid(), eps) || pb.contains(pa.centroid(), eps))
+                {
+                    out.push((SurfaceId(i as u32), SurfaceId(j as u32)));
+                }
+            }
+        }
+        out
+    }
+
+    /// Warnings about a valid scene that likely does not mean what it says (printable: names
+    /// escaped).
+    pub fn warnings(&self) -> Vec<String> {
+        self.coplanar_conflicts()
+            .into_iter()
+            .map(|(a, b)| {
+                let (a, b) = (self.surface(a), self.surface(b));
+                format!(
+                    "surfaces \"{}\" ({}) and \"{}\" ({}) overlap in one plane with different materials: \
+                     paths reflecting there are found twice",
+                    crate::name::escape(&a.name),
+                    crate::name::escape(&a.material),
+                    crate::name::escape(&b.name),
+                    crate::name::escape(&b.material)
+                )
+            })
+            .collect()
+    }
+
     /// A copy with other TX/RX positions, validated like the originals.
     pub fn with_terminals(&self, tx: Vec3, rx: Vec3) -> Result<Scene, crate::SceneError> {
         crate::validate::check_terminals(&self.surfaces, tx, rx, self.extent_with(tx, rx))

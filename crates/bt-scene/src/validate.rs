@@ -13,6 +13,13 @@ use thiserror::Error;
 /// Default carrier frequency when a scene names none: 28 GHz (FR2 mmWave).
 pub const DEFAULT_FREQUENCY_HZ: Real = 28e9;
 
+/// Lowest carrier frequency accepted, Hz (1 kHz).
+pub const MIN_FREQUENCY_HZ: Real = 1e3;
+
+/// Highest carrier frequency accepted, Hz (1 PHz: beyond, Friis' 4π d f / c overflows for
+/// long paths and geometric optics is all that is left anyway).
+pub const MAX_FREQUENCY_HZ: Real = 1e15;
+
 /// One problem found in a scene, located by field path (e.g. `surfaces[3] "sofa.top"`).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Problem {
@@ -126,17 +133,28 @@ impl Scene {
         terminals: Terminals,
     ) -> Result<Scene, SceneError> {
         let mut problems = Collector(Vec::new());
+        if let Some(name) = &desc.name
+            && let Err(e) = crate::name::check(name)
+        {
+            problems.push("name", e);
+        }
         let frequency_hz = desc.frequency_hz.unwrap_or(DEFAULT_FREQUENCY_HZ);
-        let frequency_ok = frequency_hz.is_finite() && frequency_hz > 0.0;
+        let frequency_ok = (MIN_FREQUENCY_HZ..=MAX_FREQUENCY_HZ).contains(&frequency_hz);
         if !frequency_ok {
             problems.push(
                 "frequency_hz",
-                format!("must be a positive finite number, got {frequency_hz}"),
+                format!(
+                    "must be between {MIN_FREQUENCY_HZ:e} and {MAX_FREQUENCY_HZ:e} Hz (radio to optical; \
+                     outside, losses overflow), got {frequency_hz}"
+                ),
             );
         }
         let mut materials = default_materials();
         for (name, m) in &desc.materials {
-            let location = format!("materials.{name}");
+            if let Err(e) = crate::name::check(name) {
+                problems.push("materials", e);
+            }
+            let location = format!("materials.{}", crate::name::escape(name));
             if let Some(material) = material_from_desc(
                 &location,
                 m,
@@ -150,7 +168,7 @@ impl Scene {
         let mut raw: Vec<RawSurface> = Vec::new();
         for (i, s) in desc.surfaces.iter().enumerate() {
             raw.push(RawSurface {
-                location: format!("surfaces[{i}] \"{}\"", s.name),
+                location: format!("surfaces[{i}] \"{}\"", crate::name::escape(&s.name)),
                 name: s.name.clone(),
                 material: s.material.clone(),
                 kind: s.kind.unwrap_or(SurfaceKind::Reflector),
@@ -158,7 +176,7 @@ impl Scene {
             });
         }
         for (i, b) in desc.boxes.iter().enumerate() {
-            let location = format!("boxes[{i}] \"{}\"", b.name);
+            let location = format!("boxes[{i}] \"{}\"", crate::name::escape(&b.name));
             for o in &b.omit {
                 if !BOX_FACES.iter().any(|(f, _, _)| f == o) {
                     problems.push(format!("{location}.omit"), format!("unknown face \"{o}\" (expected top, bottom, west, east, south or north)"));
@@ -388,8 +406,8 @@ pub(crate) fn build_surfaces(
     let mut names = BTreeSet::new();
     let mut surfaces = Vec::with_capacity(raw.len());
     for r in raw {
-        if r.name.is_empty() {
-            problems.report(&r.location, "name is empty");
+        if let Err(e) = crate::name::check(&r.name) {
+            problems.report(&r.location, e);
         } else if !names.insert(r.name.clone()) {
             problems.report(
                 &r.location,
@@ -400,7 +418,10 @@ pub(crate) fn build_surfaces(
         if !materials.contains_key(&material) {
             problems.report(
                 &r.location,
-                format!("unknown material \"{material}\" (add it under \"materials\")"),
+                format!(
+                    "unknown material \"{}\" (add it under \"materials\")",
+                    crate::name::escape(&material)
+                ),
             );
         }
         match Polygon::new(r.vertices) {
@@ -476,13 +497,28 @@ pub(crate) fn check_terminals(
     if !rx.is_finite() {
         problems.report("rx", "coordinates must be finite numbers");
     }
-    if tx.distance(rx) <= eps {
+    for (field, p) in [("tx", tx), ("rx", rx)] {
+        let magnitude = p.abs().max_element();
+        if magnitude * Real::EPSILON >= eps {
+            problems.report(
+                field,
+                format!(
+                    "coordinates of magnitude {magnitude:.3e} m cannot be resolved to the scene's \
+                     tolerance {eps:.1e} m in double precision; move the scene nearer the origin"
+                ),
+            );
+        }
+    }
+    if problems.is_empty() && tx.distance(rx) <= eps {
         problems.report("tx", "tx and rx are at the same position");
     }
     for (field, p) in [("tx", tx), ("rx", rx)] {
         for s in surfaces {
             if s.polygon.plane().signed_distance(p).abs() <= eps && s.polygon.contains(p, eps) {
-                problems.report(field, format!("lies on surface \"{}\"", s.name));
+                problems.report(
+                    field,
+                    format!("lies on surface \"{}\"", crate::name::escape(&s.name)),
+                );
             }
         }
     }

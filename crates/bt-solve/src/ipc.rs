@@ -260,6 +260,12 @@ fn round<const JACOBI: bool>(
 }
 
 #[inline(always)]
+/// Mean displacement of `n` points that moved `sum` metres in all; 0 for a chain without points
+/// (line of sight), never the NaN of 0/0.
+fn mean_displacement(sum: Real, n: usize) -> Real {
+    if n == 0 { 0.0 } else { sum / n as Real }
+}
+
 fn run(
     scene: &Scene,
     seq: &[SurfaceId],
@@ -304,7 +310,7 @@ fn run(
             patience_pending = false;
             match crate::newton::polish(planes, tx, rx, points, options.threshold) {
                 crate::newton::Polish::Converged { steps, last_step } => {
-                    let residual = last_step / n as Real;
+                    let residual = mean_displacement(last_step, n);
                     return converged(scene, planes, tx, rx, points, rounds + steps, residual);
                 }
                 // The points are unchanged; the paper's rounds carry on.
@@ -312,7 +318,7 @@ fn run(
             }
         }
         if rule.settled(rounds, moved) {
-            let residual = moved / n as Real;
+            let residual = mean_displacement(moved, n);
             return converged(
                 scene,
                 planes,
@@ -341,7 +347,7 @@ fn run(
         rule.record(rounds, moved);
     }
     let iterations = rounds + newton_steps;
-    let residual = rule.last / n as Real;
+    let residual = mean_displacement(rule.last, n);
     if rule.rule_met && residual.is_finite() {
         return converged(scene, planes, tx, rx, points, iterations, residual);
     }

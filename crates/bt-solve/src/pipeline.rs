@@ -129,13 +129,23 @@ fn tree_options(options: &TraceOptions) -> TreeOptions {
 /// the sequence count [`exhaustive_count`] exceeds it (the beam tree counts its nodes as it
 /// builds them instead).
 pub fn check_budget(scene: &Scene, options: &TraceOptions) -> Result<(), TraceError> {
+    if options.candidates == CandidateMode::BeamTree {
+        return Ok(());
+    }
+    exhaustive_budget(scene, options.max_order, options.max_candidates)
+}
+
+/// Stop before enumerating every sequence of `scene` up to `max_order` (no surface twice in a
+/// row) when their count [`exhaustive_count`] exceeds `budget` (`--max-candidates`): for
+/// consumers that enumerate exhaustively (the WVRN view, the fixed-point host).
+pub fn exhaustive_budget(scene: &Scene, max_order: usize, budget: u64) -> Result<(), TraceError> {
     let reflectors = scene.reflectors().count() as u64;
-    let estimate = exhaustive_count(reflectors, options.max_order);
-    if options.candidates != CandidateMode::BeamTree && estimate > options.max_candidates {
+    let estimate = exhaustive_count(reflectors, max_order);
+    if estimate > budget {
         return Err(TraceError::Budget {
             estimate,
-            budget: options.max_candidates,
-            max_order: options.max_order,
+            budget,
+            max_order,
         });
     }
     Ok(())

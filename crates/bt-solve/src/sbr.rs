@@ -67,6 +67,10 @@ impl Default for SbrOptions {
     }
 }
 
+/// Default budget on launched rays (`--max-rays`): about 160 MB of ray state; the paper's
+/// 1-degree grid launches 64,800.
+pub const DEFAULT_MAX_RAYS: u64 = 10_000_000;
+
 impl SbrOptions {
     /// A full-sphere grid with step `step_deg` degrees.
     pub fn grid(step_deg: Real) -> Self {
@@ -116,15 +120,40 @@ impl SbrOptions {
         (azimuths, elevations)
     }
 
-    /// Number of rays launched.
+    /// Number of rays launched (saturating; check [`SbrOptions::over_budget`] first).
     pub fn ray_count(&self) -> usize {
         match (self.launch, self.planar) {
             (SbrLaunch::Grid { step_deg }, planar) => {
                 let (az, el) = Self::grid_counts(step_deg);
-                if planar { az } else { az * el }
+                if planar { az } else { az.saturating_mul(el) }
             }
             (SbrLaunch::Fibonacci { rays }, _) => rays as usize,
         }
+    }
+
+    /// Number of rays the pattern asks for, computed without overflow (a step of 1e-20 degrees
+    /// asks for about 6.5e44 rays, which no integer count holds).
+    pub fn ray_estimate(&self) -> f64 {
+        match (self.launch, self.planar) {
+            (SbrLaunch::Grid { step_deg }, planar) => {
+                let az = (360.0 / step_deg).round().max(1.0);
+                let el = (180.0 / step_deg).round().max(1.0);
+                if planar { az } else { az * el }
+            }
+            (SbrLaunch::Fibonacci { rays }, _) => f64::from(rays),
+        }
+    }
+
+    /// A message when the pattern launches more than `max_rays` rays (`--max-rays`), naming the
+    /// estimate; `None` within the budget.
+    pub fn over_budget(&self, max_rays: u64) -> Option<String> {
+        let estimate = self.ray_estimate();
+        (estimate.is_nan() || estimate > max_rays as f64).then(|| {
+            format!(
+                "sbr ray budget exceeded: {estimate:.3e} rays (budget {max_rays}); use a coarser \
+                 --sbr-step-deg or fewer --sbr-rays, or raise the budget with --max-rays"
+            )
+        })
     }
 
     /// Unit direction of ray `index` (`index < ray_count()`), world frame.

@@ -4,25 +4,22 @@
 use crate::living_room::{self, LivingRoomResults};
 use crate::run::StudyResults;
 use crate::{StudyError, plot, report};
+use bt_output::OutputDir;
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 
 /// Pixel size of Fig. 5 per drawn room and time step.
 const ROOM_CELL: u32 = 300;
 
-fn write(path: &Path, text: &str) -> Result<PathBuf, StudyError> {
-    std::fs::write(path, text).map_err(|source| StudyError::Io {
-        path: path.display().to_string(),
-        source,
-    })?;
-    Ok(path.to_path_buf())
+fn write(out: &mut OutputDir, rel: &str, text: &str) -> Result<(), StudyError> {
+    Ok(out.write(rel, text.as_bytes())?)
 }
 
 /// Draw one figure with `$draw(&root, $data)` to `$dir/$stem.svg` and `$dir/$stem.png`.
 macro_rules! figure {
-    ($out:expr, $dir:expr, $stem:expr, $size:expr, $draw:path, $data:expr) => {{
+    ($out:expr, $stem:expr, $size:expr, $draw:path, $data:expr) => {{
         for ext in ["svg", "png"] {
-            let path = $dir.join(format!("{}.{ext}", $stem));
+            let path = $out.path(&format!("{}.{ext}", $stem))?;
             let plot_error = |message: String| StudyError::Plot {
                 path: path.display().to_string(),
                 message,
@@ -36,24 +33,18 @@ macro_rules! figure {
                 $draw(&root, $data).map_err(plot_error)?;
                 root.present().map_err(|e| plot_error(e.to_string()))?;
             }
-            $out.push(path);
         }
     }};
 }
 
-/// Write every output of a study into `dir` (created if missing); returns the files written.
+/// Write every output of a study into `dir` (created if missing; built aside and swapped in,
+/// see `bt_output::OutputDir`); returns the files written.
 pub fn write_outputs(dir: &Path, results: &StudyResults) -> Result<Vec<PathBuf>, StudyError> {
-    std::fs::create_dir_all(dir).map_err(|source| StudyError::Io {
-        path: dir.display().to_string(),
-        source,
-    })?;
-    let mut out = vec![
-        write(&dir.join("results.csv"), &report::csv(results))?,
-        write(&dir.join("summary.md"), &report::summary(results))?,
-    ];
+    let mut out = OutputDir::begin(dir, &[])?;
+    write(&mut out, "results.csv", &report::csv(results))?;
+    write(&mut out, "summary.md", &report::summary(results))?;
     figure!(
         out,
-        dir,
         "fig6-angular-error",
         (1200, 900),
         plot::angular_error,
@@ -61,7 +52,6 @@ pub fn write_outputs(dir: &Path, results: &StudyResults) -> Result<Vec<PathBuf>,
     );
     figure!(
         out,
-        dir,
         "fig7-elapsed-time",
         (1200, 480),
         plot::elapsed_time,
@@ -75,35 +65,32 @@ pub fn write_outputs(dir: &Path, results: &StudyResults) -> Result<Vec<PathBuf>,
         .unwrap_or(1)
         .max(1) as u32;
     let size = (ROOM_CELL * cols, ROOM_CELL * drawings.len().max(1) as u32);
-    figure!(out, dir, "fig5-rooms", size, plot::rooms, drawings);
-    Ok(out)
+    figure!(out, "fig5-rooms", size, plot::rooms, drawings);
+    Ok(out.commit()?)
 }
 
-/// Write every output of the living-room study into `dir` (created if missing):
+/// Write every output of the living-room study into `dir` (created if missing; built aside and
+/// swapped in):
 /// `results.csv`, `fpga.csv`, `summary.md`, `fig17-angular-error`, `fig18-ray-directions` and
 /// `fig19-run-time` as SVG and PNG. Returns the files written.
 pub fn write_living_room(
     dir: &Path,
     results: &LivingRoomResults,
 ) -> Result<Vec<PathBuf>, StudyError> {
-    std::fs::create_dir_all(dir).map_err(|source| StudyError::Io {
-        path: dir.display().to_string(),
-        source,
-    })?;
-    let mut out = vec![
-        write(&dir.join("results.csv"), &living_room::report::csv(results))?,
-        write(
-            &dir.join("fpga.csv"),
-            &living_room::report::fpga_csv(results),
-        )?,
-        write(
-            &dir.join("summary.md"),
-            &living_room::report::summary(results),
-        )?,
-    ];
+    let mut out = OutputDir::begin(dir, &[])?;
+    write(&mut out, "results.csv", &living_room::report::csv(results))?;
+    write(
+        &mut out,
+        "fpga.csv",
+        &living_room::report::fpga_csv(results),
+    )?;
+    write(
+        &mut out,
+        "summary.md",
+        &living_room::report::summary(results),
+    )?;
     figure!(
         out,
-        dir,
         "fig17-angular-error",
         (1200, 480),
         living_room::plot::angular_error,
@@ -113,7 +100,6 @@ pub fn write_living_room(
     let size = (1200, 420 * rays.len().max(1) as u32);
     figure!(
         out,
-        dir,
         "fig18-ray-directions",
         size,
         living_room::plot::ray_directions,
@@ -121,11 +107,10 @@ pub fn write_living_room(
     );
     figure!(
         out,
-        dir,
         "fig19-run-time",
         (1000, 560),
         living_room::plot::run_time,
         results
     );
-    Ok(out)
+    Ok(out.commit()?)
 }

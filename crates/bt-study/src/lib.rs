@@ -57,14 +57,9 @@ pub enum StudyError {
         /// What failed.
         message: String,
     },
-    /// An output file could not be written.
-    #[error("{path}: {source}")]
-    Io {
-        /// File or directory.
-        path: String,
-        /// Underlying error.
-        source: std::io::Error,
-    },
+    /// An output could not be written safely.
+    #[error(transparent)]
+    Output(#[from] bt_output::OutputError),
     /// A figure could not be drawn.
     #[error("{path}: plotting failed: {message}")]
     Plot {

@@ -21,7 +21,7 @@ use bt_geom::{Real, Vec3};
 mod pcd;
 mod ply;
 
-use std::io::{Read, Write};
+use std::io::Read;
 use std::path::Path;
 
 pub use pcd::{PcdData, parse_pcd, read_pcd, write_pcd};
@@ -117,22 +117,19 @@ pub fn read_path(path: &Path, opts: &ReadOptions) -> Result<LoadedCloud, PointCl
 }
 
 /// Write `cloud` to `path`, choosing the format from the extension: `.ply` as binary
-/// little-endian PLY, `.pcd` as ASCII PCD.
+/// little-endian PLY, `.pcd` as ASCII PCD. Atomic (`bt_output::write_atomic_with`): a failed
+/// or killed write leaves the previous file, never a truncated one.
 pub fn write_path(cloud: &PointCloud, path: &Path) -> Result<(), PointCloudError> {
-    let origin = || Origin(Some(path.to_path_buf()));
-    let format = detect_format(Some(path), b"")
-        .ok_or_else(|| PointCloudError::UnknownFormat { origin: origin() })?;
-    let file = std::fs::File::create(path).map_err(|source| PointCloudError::Io {
-        origin: origin(),
-        source,
+    let format = detect_format(Some(path), b"").ok_or_else(|| PointCloudError::UnknownFormat {
+        origin: Origin(Some(path.to_path_buf())),
     })?;
-    let mut w = std::io::BufWriter::new(file);
-    match format {
-        CloudFormat::Ply => write_ply(cloud, &mut w, PlyFormat::BinaryLittleEndian),
-        CloudFormat::Pcd => write_pcd(cloud, &mut w, PcdData::Ascii),
-    }
-    .and_then(|()| w.flush().map_err(io_err))
-    .map_err(|e| e.with_path(path))
+    bt_output::write_atomic_with(path, |w| {
+        match format {
+            CloudFormat::Ply => write_ply(cloud, w, PlyFormat::BinaryLittleEndian),
+            CloudFormat::Pcd => write_pcd(cloud, w, PcdData::Ascii),
+        }
+        .map_err(|e| e.with_path(path))
+    })
 }
 
 /// Whether a header's claim of at least `min_bytes` of data is absurd given `available`

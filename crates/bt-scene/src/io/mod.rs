@@ -123,7 +123,7 @@ pub fn from_mesh(
             SurfaceKind::Blocker
         };
         raw.push(RawSurface {
-            location: format!("surface {i} \"{}\"", s.name),
+            location: format!("surface {i} \"{}\"", crate::name::escape(&s.name)),
             name: s.name,
             material,
             kind,

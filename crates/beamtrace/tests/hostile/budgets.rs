@@ -1,0 +1,125 @@
+//! Every unbounded quantity has a budget, checked before the work, named in the error with the
+//! option that raises it. Runs are held under an address-space limit (`MEMORY_LIMIT_BYTES`):
+//! on main these cases allocated 8 GB to 10 TB.
+
+use crate::*;
+
+#[test]
+fn wvrn_at_order_50_stops_at_the_candidate_budget() {
+    let r = beamtrace(&["wvrn", "builtin:living-room", "--max-order", "50"]);
+    assert_refused(
+        &r,
+        &["candidate budget exceeded", "order 50", "--max-candidates"],
+    );
+}
+
+#[test]
+fn wvrn_at_order_10_is_held_by_the_budget_under_a_memory_limit() {
+    let r = beamtrace(&["wvrn", "builtin:living-room", "--max-order", "10"]);
+    assert_refused(&r, &["candidate budget exceeded", "--max-candidates"]);
+}
+
+#[test]
+fn dynamic_steps_respect_the_candidate_budget() {
+    let r = beamtrace(&[
+        "trace",
+        "builtin:living-room-dynamic",
+        "--steps",
+        "--max-order",
+        "40",
+    ]);
+    assert_refused(&r, &["candidate budget exceeded", "--max-candidates"]);
+}
+
+#[test]
+fn hls_and_study_respect_the_candidate_budget() {
+    let dir = scratch("budget-hls");
+    let out = dir.join("a");
+    let r = beamtrace(&[
+        "hls",
+        "gen",
+        "builtin:living-room",
+        "--max-order",
+        "30",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_refused(&r, &["candidate budget exceeded", "--max-candidates"]);
+    assert!(!out.exists());
+    let r = beamtrace(&[
+        "study",
+        "living-room",
+        "--max-order",
+        "3",
+        "--max-candidates",
+        "100",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_refused(&r, &["candidate budget exceeded", "budget 100"]);
+    assert!(!out.exists());
+}
+
+#[test]
+fn sbr_grids_beyond_the_ray_budget_are_refused_not_answered_with_zero_paths() {
+    for step in ["1e-20", "1e-5"] {
+        let r = beamtrace(&[
+            "trace",
+            &one_wall(),
+            "--solver",
+            "sbr",
+            "--sbr-step-deg",
+            step,
+        ]);
+        assert_refused(&r, &["sbr ray budget exceeded", "--max-rays"]);
+    }
+    let r = beamtrace(&[
+        "trace",
+        &one_wall(),
+        "--solver",
+        "sbr",
+        "--sbr-rays",
+        "1000000000",
+    ]);
+    assert_refused(&r, &["1.000e9 rays", "--max-rays"]);
+    // Within the budget SBR still finds the wall's reflection.
+    let r = beamtrace(&["trace", &one_wall(), "--solver", "sbr", "--json"]);
+    assert_ok(&r);
+    let v: serde_json::Value = serde_json::from_slice(&r.stdout).unwrap();
+    assert!(v["stats"]["valid_paths"].as_u64().unwrap() >= 2, "{v}");
+}
+
+#[test]
+fn sampling_beyond_the_point_budget_is_refused_before_allocating() {
+    let dir = scratch("budget-sample");
+    let out = dir.join("c.ply");
+    let r = beamtrace(&[
+        "sample",
+        "builtin:living-room",
+        "--density",
+        "1e12",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_refused(&r, &["point budget exceeded", "--max-points"]);
+    assert!(!out.exists());
+}
+
+#[test]
+fn a_polygon_with_too_many_vertices_is_refused_not_checked_for_minutes() {
+    let dir = scratch("budget-vertices");
+    let n = 20_001;
+    let vertices: Vec<[f64; 3]> = (0..n)
+        .map(|k| {
+            let a = std::f64::consts::TAU * k as f64 / n as f64;
+            [5.0 * a.cos(), 5.0 * a.sin(), 0.0]
+        })
+        .collect();
+    let desc = serde_json::json!({
+        "tx": [0, 0, 1], "rx": [1, 0, 2],
+        "surfaces": [{ "name": "disc", "vertices": vertices }]
+    });
+    let scene = scene_with(&dir, "disc.json", &desc.to_string());
+    let r = beamtrace(&["scene", "check", &scene]);
+    assert_refused(&r, &["20001 vertices", "10000"]);
+}

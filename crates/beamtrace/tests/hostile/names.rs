@@ -1,0 +1,92 @@
+//! Names are data: checked at load, escaped wherever printed.
+
+use crate::*;
+
+/// The injection: a surface name that ends the Verilog comment and opens a module.
+const INJECTION: &str = "wall\nmodule pwn; initial $display(\"pwned\"); endmodule\n//";
+
+fn scene_named(dir: &std::path::Path, surface: &str, material: &str) -> String {
+    let desc = serde_json::json!({
+        "name": "named",
+        "tx": [-1.5, 1, 2],
+        "rx": [2, 2, 1],
+        "materials": { material: { "reflection_loss_db": 3.0 } },
+        "surfaces": [
+            { "name": surface, "material": material,
+              "vertices": [[-5, 0, 0], [5, 0, 0], [5, 0, 3], [-5, 0, 3]] }
+        ]
+    });
+    scene_with(dir, "named.json", &desc.to_string())
+}
+
+#[test]
+fn the_injection_name_is_refused_at_load_with_the_name_escaped() {
+    let dir = scratch("inject");
+    let scene = scene_named(&dir, INJECTION, "brick");
+    let r = beamtrace(&["scene", "check", &scene]);
+    assert_refused(&r, &["surfaces[0]", "U+000A", "wall\\nmodule pwn"]);
+    assert!(
+        !text(&r).contains("\nmodule pwn"),
+        "raw name reached the terminal"
+    );
+    // Nor does it reach RTL: hls gen refuses the scene before writing anything.
+    let out = dir.join("accel");
+    let r = beamtrace(&[
+        "hls",
+        "gen",
+        &scene,
+        "--max-order",
+        "1",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_refused(&r, &["U+000A"]);
+    assert!(!out.exists());
+}
+
+#[test]
+fn escape_sequences_and_nul_in_names_are_refused() {
+    let dir = scratch("ansi");
+    for (surface, material, code) in [
+        ("wall\u{1b}[2J", "brick", "U+001B"),
+        ("wall", "brick\u{1b}]0;title\u{7}", "U+001B"),
+        ("wall\0", "brick", "U+0000"),
+        ("wall\u{202e}llaw", "brick", "U+202E"),
+    ] {
+        let scene = scene_named(&dir, surface, material);
+        for cmd in [
+            &["scene", "check"][..],
+            &["wvrn", "--dot"][..],
+            &["trace"][..],
+        ] {
+            let mut args = cmd.to_vec();
+            args.push(&scene);
+            let r = beamtrace(&args);
+            assert_refused(&r, &[code]);
+            let t = text(&r);
+            assert!(!t.contains('\u{1b}') && !t.contains('\0'), "{t:?}");
+        }
+    }
+}
+
+#[test]
+fn overlong_names_are_refused() {
+    let dir = scratch("long");
+    let scene = scene_named(&dir, &"w".repeat(5000), "brick");
+    assert_refused(
+        &beamtrace(&["scene", "check", &scene]),
+        &["5000 characters (at most 200)"],
+    );
+}
+
+#[test]
+fn printable_unicode_names_pass_and_print_as_themselves() {
+    let dir = scratch("unicode");
+    let scene = scene_named(&dir, "Wand \"Süd\" 壁", "Ziegel");
+    let r = beamtrace(&["trace", &scene]);
+    assert_ok(&r);
+    assert!(text(&r).contains("Wand \\\"Süd\\\" 壁"), "{}", text(&r));
+    let r = beamtrace(&["wvrn", "--dot", &scene]);
+    assert_ok(&r);
+    assert!(text(&r).contains("\"Wand \\\"Süd\\\" 壁\""), "{}", text(&r));
+}

@@ -1,0 +1,194 @@
+//! Outputs never destroy data.
+
+use crate::*;
+
+#[test]
+fn hls_gen_keeps_the_users_files_and_replaces_its_own() {
+    let dir = scratch("hls-keep");
+    let out = dir.join("accel");
+    std::fs::create_dir_all(out.join("rtl")).unwrap();
+    std::fs::write(
+        out.join("rtl/my_wrapper.v"),
+        "module my_wrapper; endmodule\n",
+    )
+    .unwrap();
+    std::fs::write(out.join("notes.txt"), "mine").unwrap();
+    let o = out.to_str().unwrap();
+    for _ in 0..2 {
+        let r = beamtrace(&[
+            "hls",
+            "gen",
+            "builtin:living-room",
+            "--max-order",
+            "1",
+            "-o",
+            o,
+        ]);
+        assert_ok(&r);
+    }
+    assert_eq!(
+        std::fs::read_to_string(out.join("rtl/my_wrapper.v")).unwrap(),
+        "module my_wrapper; endmodule\n"
+    );
+    assert_eq!(
+        std::fs::read_to_string(out.join("notes.txt")).unwrap(),
+        "mine"
+    );
+    assert!(out.join("rtl/bt_top.v").exists());
+    assert!(out.join("summary.json").exists());
+    let manifest = std::fs::read_to_string(out.join(".beamtrace-manifest")).unwrap();
+    assert!(manifest.contains("rtl/bt_top.v") && manifest.contains("summary.json"));
+    assert!(!manifest.contains("my_wrapper") && !manifest.contains("notes.txt"));
+    // Nothing left beside the directory (no staging directories).
+    let siblings: Vec<_> = std::fs::read_dir(&dir).unwrap().collect();
+    assert_eq!(siblings.len(), 1);
+}
+
+#[test]
+fn hls_gen_that_cannot_fit_fails_fast_and_creates_nothing() {
+    let dir = scratch("hls-fail");
+    let out = dir.join("accel");
+    let r = beamtrace(&[
+        "hls",
+        "gen",
+        "builtin:living-room",
+        "-o",
+        out.to_str().unwrap(),
+    ]);
+    assert_refused(&r, &["address bits", "--max-order"]);
+    assert!(!out.exists(), "a failed run leaves no folder");
+    assert!(tree(&dir).is_empty(), "{:?}", tree(&dir));
+}
+
+fn sampled_cloud(dir: &std::path::Path) -> std::path::PathBuf {
+    let cloud = dir.join("room.ply");
+    let r = beamtrace(&[
+        "sample",
+        &one_wall(),
+        "-o",
+        cloud.to_str().unwrap(),
+        "--density",
+        "2000",
+    ]);
+    assert_ok(&r);
+    cloud
+}
+
+#[test]
+fn extract_refuses_to_overwrite_its_input() {
+    let dir = scratch("extract-same");
+    let cloud = sampled_cloud(&dir);
+    let before = std::fs::read(&cloud).unwrap();
+    let c = cloud.to_str().unwrap();
+    let r = beamtrace(&["extract", c, "-o", c]);
+    assert_refused(&r, &["refusing to write", "it is the input"]);
+    assert_eq!(std::fs::read(&cloud).unwrap(), before);
+    // Another spelling of the same file.
+    let other = dir.join(".").join("room.ply");
+    let r = beamtrace(&[
+        "extract",
+        c,
+        "--report",
+        other.to_str().unwrap(),
+        "-o",
+        dir.join("s.json").to_str().unwrap(),
+    ]);
+    assert_refused(&r, &["it is the input"]);
+    assert_eq!(std::fs::read(&cloud).unwrap(), before);
+}
+
+#[test]
+fn extract_writes_the_format_its_extension_names_or_refuses() {
+    let dir = scratch("extract-ext");
+    let cloud = sampled_cloud(&dir);
+    let c = cloud.to_str().unwrap();
+    let toml = dir.join("room.toml");
+    let r = beamtrace(&["extract", c, "-o", toml.to_str().unwrap()]);
+    assert_ok(&r);
+    let text = std::fs::read_to_string(&toml).unwrap();
+    assert!(text.contains("[[surfaces]]"), "not TOML:\n{text}");
+    // trace reads it back (as TOML, by extension).
+    let r = beamtrace(&[
+        "trace",
+        toml.to_str().unwrap(),
+        "--tx",
+        "-1.5,1,2",
+        "--rx",
+        "2,2,1",
+    ]);
+    assert_ok(&r);
+    let json = dir.join("room.json");
+    assert_ok(&beamtrace(&["extract", c, "-o", json.to_str().unwrap()]));
+    let text = std::fs::read_to_string(&json).unwrap();
+    assert!(
+        !text.contains("null"),
+        "no null where a value is promised:\n{text}"
+    );
+    let yaml = dir.join("room.yaml");
+    let r = beamtrace(&["extract", c, "-o", yaml.to_str().unwrap()]);
+    assert_refused(&r, &["room.yaml", ".json or .toml"]);
+    assert!(!yaml.exists());
+}
+
+#[test]
+fn trace_out_refuses_the_scene_file_and_other_formats() {
+    let dir = scratch("trace-out");
+    let scene = dir.join("scene.json");
+    std::fs::copy(one_wall(), &scene).unwrap();
+    let before = std::fs::read(&scene).unwrap();
+    let s = scene.to_str().unwrap();
+    assert_refused(&beamtrace(&["trace", s, "--out", s]), &["it is the input"]);
+    assert_eq!(std::fs::read(&scene).unwrap(), before);
+    let csv = dir.join("paths.csv");
+    assert_refused(
+        &beamtrace(&["trace", s, "--out", csv.to_str().unwrap()]),
+        &["paths.csv", ".json"],
+    );
+    assert!(!csv.exists());
+    let out = dir.join("paths.json");
+    assert_ok(&beamtrace(&["trace", s, "--out", out.to_str().unwrap()]));
+    assert_eq!(tree(&dir), ["paths.json", "scene.json"]);
+}
+
+#[test]
+fn sample_refuses_to_overwrite_its_input_and_leaves_no_temporary() {
+    let dir = scratch("sample-same");
+    let cloud = sampled_cloud(&dir);
+    let before = std::fs::read(&cloud).unwrap();
+    let c = cloud.to_str().unwrap();
+    assert_refused(&beamtrace(&["sample", c, "-o", c]), &["it is the input"]);
+    assert_eq!(std::fs::read(&cloud).unwrap(), before);
+    assert_eq!(tree(&dir), ["room.ply"]);
+}
+
+#[test]
+fn study_keeps_files_it_did_not_write() {
+    let dir = scratch("study");
+    let out = dir.join("study");
+    std::fs::create_dir_all(&out).unwrap();
+    std::fs::write(out.join("README.txt"), "mine").unwrap();
+    let o = out.to_str().unwrap();
+    let r = beamtrace(&[
+        "study",
+        "2d",
+        "--rooms",
+        "1",
+        "--steps",
+        "1",
+        "--max-order",
+        "1",
+        "--out",
+        o,
+    ]);
+    assert_ok(&r);
+    assert_eq!(
+        std::fs::read_to_string(out.join("README.txt")).unwrap(),
+        "mine"
+    );
+    assert!(out.join("results.csv").exists());
+    assert_eq!(
+        std::fs::read_dir(&dir).unwrap().count(),
+        1,
+        "no staging left"
+    );
+}

@@ -1,0 +1,149 @@
+//! The smaller cases of issue 9.
+
+use crate::*;
+use serde_json::Value;
+
+#[test]
+fn a_full_stdout_is_an_error_not_a_panic() {
+    let Ok(full) = std::fs::OpenOptions::new().write(true).open("/dev/full") else {
+        return; // no /dev/full on this system
+    };
+    let mut cmd = std::process::Command::new(env!("CARGO_BIN_EXE_beamtrace"));
+    let o = cmd
+        .args(["trace", &one_wall(), "--json"])
+        .stdout(full)
+        .output()
+        .unwrap();
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert_eq!(o.status.code(), Some(2), "{err}");
+    assert!(!err.contains("panicked"), "{err}");
+    assert!(err.contains("writing to stdout"), "{err}");
+}
+
+fn trace_json(args: &[&str]) -> Value {
+    let mut all = vec!["trace"];
+    all.extend_from_slice(args);
+    all.push("--json");
+    let r = beamtrace(&all);
+    assert_ok(&r);
+    serde_json::from_slice(&r.stdout).unwrap()
+}
+
+#[test]
+fn ipc_line_of_sight_has_a_numeric_residual() {
+    let v = trace_json(&[&one_wall(), "--solver", "ipc"]);
+    let paths = v["paths"].as_array().unwrap();
+    assert!(paths.iter().any(|p| p["order"] == 0));
+    for p in paths {
+        assert!(p["residual_m"].is_f64(), "{p}");
+    }
+}
+
+#[test]
+fn extreme_frequencies_are_refused_not_given_infinite_loss() {
+    let dir = scratch("freq");
+    for f in ["1e300", "1e-300"] {
+        let text = std::fs::read_to_string(one_wall()).unwrap().replace(
+            "\"name\": \"one-wall\",",
+            &format!("\"name\": \"f\", \"frequency_hz\": {f},"),
+        );
+        let scene = scene_with(&dir, "f.json", &text);
+        assert_refused(&beamtrace(&["trace", &scene]), &["frequency_hz", "between"]);
+    }
+}
+
+#[test]
+fn terminals_closer_than_a_wavelength_get_a_clamped_loss_and_a_warning() {
+    let r = beamtrace(&[
+        "trace",
+        &one_wall(),
+        "--tx",
+        "0,1,1",
+        "--rx",
+        "0,1,1.0000001",
+        "--json",
+    ]);
+    assert_ok(&r);
+    let v: Value = serde_json::from_slice(&r.stdout).unwrap();
+    let floor = 20.0 * (4.0 * std::f64::consts::PI).log10();
+    for p in v["paths"].as_array().unwrap() {
+        let loss = p["free_space_loss_db"].as_f64().unwrap();
+        assert!(loss >= floor - 1e-9, "a loss of {loss} dB is a gain: {p}");
+    }
+    assert!(String::from_utf8_lossy(&r.stderr).contains("near field"));
+}
+
+#[test]
+fn nan_options_are_refused() {
+    let dir = scratch("nan");
+    let r = beamtrace(&[
+        "extract",
+        "whatever.ply",
+        "--min-reflector-area",
+        "nan",
+        "-o",
+        dir.join("x.json").to_str().unwrap(),
+    ]);
+    assert_refused(&r, &["--min-reflector-area", "NaN"]);
+}
+
+#[test]
+fn unresolvable_coordinates_are_refused_with_that_reason() {
+    let dir = scratch("huge");
+    let desc = serde_json::json!({
+        "tx": [1e300, 1, 2], "rx": [1e300, 2, 1],
+        "surfaces": [{ "name": "wall", "vertices":
+            [[1e300, 0, 0], [1e300 + 5.0, 0, 0], [1e300 + 5.0, 0, 3], [1e300, 0, 3]] }]
+    });
+    let scene = scene_with(&dir, "huge.json", &desc.to_string());
+    let r = beamtrace(&["scene", "check", &scene]);
+    assert_refused(&r, &["cannot resolve", "nearer the origin"]);
+    assert!(!text(&r).contains("same position"), "{}", text(&r));
+}
+
+#[test]
+fn os_errors_are_printed_once() {
+    let r = beamtrace(&["trace", "/nonexistent/scene.json"]);
+    assert_refused(&r, &["No such file"]);
+    assert_eq!(text(&r).matches("No such file").count(), 1, "{}", text(&r));
+}
+
+#[test]
+fn a_directory_as_input_is_named_as_such() {
+    let dir = scratch("dir-input");
+    let r = beamtrace(&["trace", dir.to_str().unwrap()]);
+    assert_refused(&r, &["is a directory"]);
+    assert!(
+        !text(&r).contains("unsupported scene format"),
+        "{}",
+        text(&r)
+    );
+}
+
+#[test]
+fn duplicate_coplanar_faces_with_different_materials_are_warned_about() {
+    let dir = scratch("coplanar");
+    let wall = [[-5, 0, 0], [5, 0, 0], [5, 0, 3], [-5, 0, 3]];
+    let desc = serde_json::json!({
+        "tx": [-1.5, 1, 2], "rx": [2, 2, 1],
+        "surfaces": [
+            { "name": "wall", "material": "concrete", "vertices": wall },
+            { "name": "wall-copy", "material": "glass", "vertices": wall }
+        ]
+    });
+    let scene = scene_with(&dir, "dup.json", &desc.to_string());
+    let r = beamtrace(&["scene", "check", &scene]);
+    assert_ok(&r);
+    assert!(
+        text(&r).contains("\"wall\" (concrete) and \"wall-copy\" (glass) overlap in one plane"),
+        "{}",
+        text(&r)
+    );
+    let r = beamtrace(&["trace", &scene]);
+    assert_ok(&r);
+    assert!(text(&r).contains("found twice"), "{}", text(&r));
+    // The same faces with one material: no warning.
+    let same = desc.to_string().replace("glass", "concrete");
+    let scene = scene_with(&dir, "same.json", &same);
+    assert!(!text(&beamtrace(&["scene", "check", &scene])).contains("overlap"));
+}

@@ -1,0 +1,94 @@
+//! The one rule for names from input (surfaces, materials, boxes, scenes): names are data.
+//!
+//! A name is 1 to [`MAX_CHARS`] characters, none of them a control character (line breaks,
+//! escape sequences, NUL, DEL and the C1 range) or a character that breaks or reorders a line
+//! (Unicode line/paragraph separators, bidirectional overrides and isolates). Loaders check it
+//! ([`check`]) and refuse the scene with the name's location; every output that prints a name
+//! still escapes it or derives an identifier (`bt_pe_<index>`), so a name never becomes code.
+
+/// Longest name accepted, in characters.
+pub const MAX_CHARS: usize = 200;
+
+/// Whether `c` may appear in a name.
+fn allowed(c: char) -> bool {
+    !(c.is_control()
+        || matches!(c, '\u{2028}' | '\u{2029}' | '\u{200e}' | '\u{200f}')
+        || ('\u{202a}'..='\u{202e}').contains(&c)
+        || ('\u{2066}'..='\u{2069}').contains(&c))
+}
+
+/// `Ok` when `name` follows the rule; otherwise what is wrong (lowercase, the name escaped).
+pub fn check(name: &str) -> Result<(), String> {
+    if name.is_empty() {
+        return Err("name is empty".into());
+    }
+    let count = name.chars().count();
+    if count > MAX_CHARS {
+        return Err(format!(
+            "name \"{}…\" has {count} characters (at most {MAX_CHARS})",
+            escape(&name.chars().take(40).collect::<String>())
+        ));
+    }
+    if let Some((i, c)) = name.chars().enumerate().find(|(_, c)| !allowed(*c)) {
+        return Err(format!(
+            "name \"{}\" contains the control character U+{:04X} at character {} (names must be printable)",
+            escape(name),
+            c as u32,
+            i + 1
+        ));
+    }
+    Ok(())
+}
+
+/// `name` as it may be printed on a terminal or in a text file: quotes, backslashes and every
+/// character [`check`] refuses written as Rust escapes (`\n`, `\u{1b}`).
+pub fn escape(name: &str) -> String {
+    name.chars()
+        .map(|c| {
+            if c == '"' || c == '\\' || !allowed(c) {
+                c.escape_default().to_string()
+            } else {
+                c.to_string()
+            }
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn printable_names_pass() {
+        for n in ["wall", "sofa.top", "Fenster Süd", "壁-1", "a b (2)"] {
+            assert_eq!(check(n), Ok(()), "{n}");
+        }
+    }
+
+    #[test]
+    fn control_characters_and_long_names_fail() {
+        let injection = "wall\nmodule pwn; initial $display(1); endmodule\n//";
+        let e = check(injection).unwrap_err();
+        assert!(e.contains("U+000A at character 5"), "{e}");
+        assert!(!e.contains('\n'), "{e}");
+        for n in [
+            "a\u{1b}[31m",
+            "nul\0",
+            "del\u{7f}",
+            "bidi\u{202e}",
+            "ls\u{2028}",
+            "",
+        ] {
+            assert!(check(n).is_err(), "{n:?}");
+        }
+        assert!(check(&"x".repeat(MAX_CHARS)).is_ok());
+        assert!(check(&"x".repeat(MAX_CHARS + 1)).is_err());
+    }
+
+    #[test]
+    fn escape_leaves_no_control_character() {
+        let e = escape("a\"b\\c\n\u{1b}\0");
+        assert_eq!(e, "a\\\"b\\\\c\\n\\u{1b}\\u{0}");
+        assert_eq!(escape("sofa.top"), "sofa.top");
+    }
+}
