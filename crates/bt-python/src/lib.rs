@@ -11,6 +11,7 @@ mod options;
 use bt_geom::Vec3;
 use bt_scene::io::LoadOptions;
 use bt_scene::{Scene, SceneError, Terminals};
+use bt_solve::pipeline::TraceError;
 use numpy::PyReadonlyArray2;
 use options::TraceKeywords;
 use pyo3::create_exception;
@@ -59,6 +60,8 @@ fn load_scene(source: &str, options: &LoadOptions) -> Result<bt_scene::io::Loade
 #[pyclass(frozen, module = "beamtrace._native", name = "Scene")]
 struct PyScene {
     scene: Arc<Scene>,
+    /// What `load` was given (file path or `builtin:NAME`): messages name it, as the CLI's do.
+    source: String,
     warnings: Vec<String>,
 }
 
@@ -67,7 +70,23 @@ impl PyScene {
     fn moved(&self, tx: Option<[f64; 3]>, rx: Option<[f64; 3]>) -> PyResult<Scene> {
         let tx = tx.map(vec3).unwrap_or(self.scene.tx());
         let rx = rx.map(vec3).unwrap_or(self.scene.rx());
-        self.scene.with_terminals(tx, rx).map_err(error)
+        self.scene
+            .with_terminals(tx, rx)
+            .map_err(|e| self.error(TraceError::Scene(e)))
+    }
+
+    /// A trace error as the exception, naming the scene's source like the CLI (which
+    /// validates terminals while loading `SOURCE --tx .. --rx ..`).
+    fn error(&self, e: TraceError) -> PyErr {
+        match e {
+            TraceError::Scene(SceneError::Invalid { problems, .. }) => {
+                error(SceneError::Invalid {
+                    source_name: self.source.clone(),
+                    problems,
+                })
+            }
+            e => error(e),
+        }
     }
 }
 
@@ -142,7 +161,7 @@ impl PyScene {
             bt_solve::pipeline::trace_scene(&scene, &options)
                 .map(|traced| bt_beams::report(&scene, &traced.result.paths))
         });
-        columns::to_dict(py, &paths.map_err(error)?)
+        columns::to_dict(py, &paths.map_err(|e| self.error(e))?)
     }
 
     /// Trace one TX to each row of `receivers` (m × 3, metres) in parallel without the GIL;
@@ -185,7 +204,7 @@ impl PyScene {
         let scene = self.moved(tx, Some(first.to_array()))?;
         let options = keywords.trace_options(&scene).map_err(PyValueError::new_err)?;
         let reports = py.detach(|| trace_and_report(&scene, &receivers, &options));
-        let reports = reports.map_err(error)?;
+        let reports = reports.map_err(|e| self.error(e))?;
         let dicts = reports
             .iter()
             .map(|paths| columns::to_dict(py, paths))
@@ -215,13 +234,10 @@ fn trace_and_report(
     scene: &Scene,
     receivers: &[Vec3],
     options: &bt_solve::pipeline::TraceOptions,
-) -> Result<Vec<Vec<bt_beams::PathReport>>, String> {
-    let traced = bt_solve::pipeline::trace_receivers(scene, receivers, options)
-        .map_err(|e| e.to_string())?;
+) -> Result<Vec<Vec<bt_beams::PathReport>>, TraceError> {
+    let traced = bt_solve::pipeline::trace_receivers(scene, receivers, options)?;
     let one = |(rx, t): (&Vec3, &bt_solve::pipeline::Traced)| {
-        let moved = scene
-            .with_terminals(scene.tx(), *rx)
-            .map_err(|e| e.to_string())?;
+        let moved = scene.with_terminals(scene.tx(), *rx)?;
         Ok(bt_beams::report(&moved, &t.result.paths))
     };
     if options.parallel {
@@ -260,6 +276,7 @@ fn load(
     let loaded = py.detach(|| load_scene(&source, &options)).map_err(error)?;
     Ok(PyScene {
         scene: Arc::new(loaded.scene),
+        source,
         warnings: loaded.warnings,
     })
 }

@@ -321,7 +321,7 @@ fn run(
                     }
                     return IpcOutcome::Converged {
                         iterations,
-                        residual: last_step / n as Real,
+                        residual: last_step / n.max(1) as Real,
                     };
                 }
                 // The points are unchanged; the paper's rounds carry on.
@@ -358,7 +358,7 @@ fn run(
                 }
                 return IpcOutcome::Converged {
                     iterations,
-                    residual: moved / n as Real,
+                    residual: moved / n.max(1) as Real,
                 };
             }
         }
@@ -400,7 +400,8 @@ fn run(
         last = moved;
     }
     let iterations = rounds + newton_steps;
-    let residual = last / n as Real;
+    // max(1): line of sight (no points) has nothing to move, residual 0, never 0/0 = NaN.
+    let residual = last / n.max(1) as Real;
     if rule_met && residual.is_finite() {
         if let Some(index) = opposite_sides(scene, planes, tx, rx, points) {
             return IpcOutcome::Degenerate {
