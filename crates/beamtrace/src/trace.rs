@@ -90,20 +90,10 @@ pub fn solver_for(args: &TraceArgs, scene: &Scene) -> anyhow::Result<Solver> {
             };
             Solver::Ipc(options)
         }
-        SolverArg::Sbr => {
-            let options = match (args.sbr_rays, args.sbr_step_deg) {
-                (Some(rays), _) => SbrOptions::fibonacci(rays),
-                (None, step) => SbrOptions::grid(step.unwrap_or(1.0)),
-            };
-            let options = SbrOptions {
-                planar: args.sbr_planar,
-                ..options
-            };
-            if let Some(problem) = options.problem() {
-                bail!("{problem}");
-            }
-            Solver::Sbr(options)
-        }
+        SolverArg::Sbr => Solver::Sbr(
+            SbrOptions::chosen(args.sbr_rays, args.sbr_step_deg, args.sbr_planar)
+                .map_err(anyhow::Error::msg)?,
+        ),
     })
 }
 

@@ -76,8 +76,9 @@ fn column_value<'py>(
 ) -> PyResult<Option<Bound<'py, PyAny>>> {
     let array = |v: Vec<f64>| PyArray1::from_vec(py, v).into_any();
     Ok(Some(match column {
-        Column::Count(f) => PyArray1::from_vec(py, paths.iter().map(|p| f(p) as i64).collect())
-            .into_any(),
+        Column::Count(f) => {
+            PyArray1::from_vec(py, paths.iter().map(|p| f(p) as i64).collect()).into_any()
+        }
         Column::Real(f) => array(paths.iter().map(f).collect()),
         Column::Complex(f) => PyArray1::from_vec(py, paths.iter().map(f).collect()).into_any(),
         Column::Direction(f) => {

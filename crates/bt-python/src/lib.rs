@@ -79,12 +79,10 @@ impl PyScene {
     /// validates terminals while loading `SOURCE --tx .. --rx ..`).
     fn error(&self, e: TraceError) -> PyErr {
         match e {
-            TraceError::Scene(SceneError::Invalid { problems, .. }) => {
-                error(SceneError::Invalid {
-                    source_name: self.source.clone(),
-                    problems,
-                })
-            }
+            TraceError::Scene(SceneError::Invalid { problems, .. }) => error(SceneError::Invalid {
+                source_name: self.source.clone(),
+                problems,
+            }),
             e => error(e),
         }
     }
@@ -115,7 +113,11 @@ impl PyScene {
     /// Names of all surfaces (reflectors and blockers), in scene order.
     #[getter]
     fn surface_names(&self) -> Vec<String> {
-        self.scene.surfaces().iter().map(|s| s.name.clone()).collect()
+        self.scene
+            .surfaces()
+            .iter()
+            .map(|s| s.name.clone())
+            .collect()
     }
     /// Non-fatal notes of the import (merged faces, unknown materials, ...).
     #[getter]
@@ -124,39 +126,17 @@ impl PyScene {
     }
 
     /// Trace one TX → RX; returns the path columns as a dict (see `beamtrace.Paths`).
-    #[pyo3(signature = (tx, rx, *, max_order, solver, candidates, max_candidates, ipc_order,
-                        ipc_accel, sbr_step_deg, sbr_rays, sbr_planar, parallel))]
-    #[allow(clippy::too_many_arguments)] // Python keywords, one per CLI flag
     fn trace<'py>(
         &self,
         py: Python<'py>,
         tx: Option<[f64; 3]>,
         rx: Option<[f64; 3]>,
-        max_order: usize,
-        solver: String,
-        candidates: String,
-        max_candidates: u64,
-        ipc_order: String,
-        ipc_accel: String,
-        sbr_step_deg: Option<f64>,
-        sbr_rays: Option<u32>,
-        sbr_planar: bool,
-        parallel: bool,
+        keywords: TraceKeywords,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let keywords = TraceKeywords {
-            max_order,
-            solver,
-            candidates,
-            max_candidates,
-            ipc_order,
-            ipc_accel,
-            sbr_step_deg,
-            sbr_rays,
-            sbr_planar,
-            parallel,
-        };
         let scene = self.moved(tx, rx)?;
-        let options = keywords.trace_options(&scene).map_err(PyValueError::new_err)?;
+        let options = keywords
+            .trace_options(&scene)
+            .map_err(PyValueError::new_err)?;
         let paths = py.detach(|| {
             bt_solve::pipeline::trace_scene(&scene, &options)
                 .map(|traced| bt_beams::report(&scene, &traced.result.paths))
@@ -166,43 +146,21 @@ impl PyScene {
 
     /// Trace one TX to each row of `receivers` (m × 3, metres) in parallel without the GIL;
     /// returns one column dict per receiver, in order.
-    #[pyo3(signature = (tx, receivers, *, max_order, solver, candidates, max_candidates,
-                        ipc_order, ipc_accel, sbr_step_deg, sbr_rays, sbr_planar, parallel))]
-    #[allow(clippy::too_many_arguments)] // Python keywords, one per CLI flag
     fn trace_many<'py>(
         &self,
         py: Python<'py>,
         tx: Option<[f64; 3]>,
         receivers: PyReadonlyArray2<'py, f64>,
-        max_order: usize,
-        solver: String,
-        candidates: String,
-        max_candidates: u64,
-        ipc_order: String,
-        ipc_accel: String,
-        sbr_step_deg: Option<f64>,
-        sbr_rays: Option<u32>,
-        sbr_planar: bool,
-        parallel: bool,
+        keywords: TraceKeywords,
     ) -> PyResult<Bound<'py, PyList>> {
-        let keywords = TraceKeywords {
-            max_order,
-            solver,
-            candidates,
-            max_candidates,
-            ipc_order,
-            ipc_accel,
-            sbr_step_deg,
-            sbr_rays,
-            sbr_planar,
-            parallel,
-        };
         let receivers = receivers_of(&receivers)?;
         let Some(first) = receivers.first() else {
             return Ok(PyList::empty(py));
         };
         let scene = self.moved(tx, Some(first.to_array()))?;
-        let options = keywords.trace_options(&scene).map_err(PyValueError::new_err)?;
+        let options = keywords
+            .trace_options(&scene)
+            .map_err(PyValueError::new_err)?;
         let reports = py.detach(|| trace_and_report(&scene, &receivers, &options));
         let reports = reports.map_err(|e| self.error(e))?;
         let dicts = reports

@@ -5,8 +5,10 @@ use bt_solve::pipeline::{CandidateMode, TraceOptions};
 use bt_solve::{Acceleration, IpcOptions, SbrOptions, Solver, UpdateOrder};
 
 /// The trace keywords of `Scene.trace` / `Scene.trace_many` (names and values as the CLI's
-/// `beamtrace trace` flags, e.g. `solver="ipc"`, `candidates="beam-tree"`).
-#[derive(Debug, Clone)]
+/// `beamtrace trace` flags, e.g. `solver="ipc"`, `candidates="beam-tree"`), passed from the
+/// Python wrappers as one dict with every key.
+#[derive(Debug, Clone, pyo3::FromPyObject)]
+#[pyo3(from_item_all)]
 pub struct TraceKeywords {
     pub max_order: usize,
     pub solver: String,
@@ -28,17 +30,18 @@ fn choose<T: Copy>(field: &str, value: &str, choices: &[(&str, T)]) -> Result<T,
         .map(|(_, v)| *v)
         .ok_or_else(|| {
             let names: Vec<_> = choices.iter().map(|(n, _)| format!("\"{n}\"")).collect();
-            format!(
-                "{field} must be one of {}, got {value:?}",
-                names.join(", ")
-            )
+            format!("{field} must be one of {}, got {value:?}", names.join(", "))
         })
 }
 
 impl TraceKeywords {
     /// The solver these keywords select, with defaults scaled to `scene` (as the CLI does).
     pub fn solver(&self, scene: &Scene) -> Result<Solver, String> {
-        let kind = choose("solver", &self.solver, &[("image", 0), ("ipc", 1), ("sbr", 2)])?;
+        let kind = choose(
+            "solver",
+            &self.solver,
+            &[("image", 0), ("ipc", 1), ("sbr", 2)],
+        )?;
         Ok(match kind {
             0 => Solver::Image,
             1 => {
@@ -53,7 +56,10 @@ impl TraceKeywords {
                 let acceleration = choose(
                     "ipc_accel",
                     &self.ipc_accel,
-                    &[("none", Acceleration::None), ("newton", Acceleration::Newton)],
+                    &[
+                        ("none", Acceleration::None),
+                        ("newton", Acceleration::Newton),
+                    ],
                 )?;
                 Solver::Ipc(IpcOptions {
                     acceleration,
@@ -64,18 +70,11 @@ impl TraceKeywords {
                 if self.sbr_step_deg.is_some() && self.sbr_rays.is_some() {
                     return Err("give sbr_step_deg or sbr_rays, not both".into());
                 }
-                let options = match (self.sbr_rays, self.sbr_step_deg) {
-                    (Some(rays), _) => SbrOptions::fibonacci(rays),
-                    (None, step) => SbrOptions::grid(step.unwrap_or(1.0)),
-                };
-                let options = SbrOptions {
-                    planar: self.sbr_planar,
-                    ..options
-                };
-                if let Some(problem) = options.problem() {
-                    return Err(problem);
-                }
-                Solver::Sbr(options)
+                Solver::Sbr(SbrOptions::chosen(
+                    self.sbr_rays,
+                    self.sbr_step_deg,
+                    self.sbr_planar,
+                )?)
             }
         })
     }

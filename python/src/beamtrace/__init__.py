@@ -181,7 +181,7 @@ class Scene:
         columns = self._native.trace(
             _point(tx, "tx"),
             _point(rx, "rx"),
-            **_options(locals()),
+            _options(locals()),
         )
         return Paths(columns)
 
@@ -210,7 +210,7 @@ class Scene:
         results = self._native.trace_many(
             _point(tx, "tx"),
             _receivers(rx),
-            **_options(locals()),
+            _options(locals()),
         )
         return [Paths(c) for c in results]
 

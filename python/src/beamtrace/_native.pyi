@@ -25,37 +25,9 @@ class Scene:
     def surface_names(self) -> List[str]: ...
     @property
     def warnings(self) -> List[str]: ...
-    def trace(
-        self,
-        tx: _Point,
-        rx: _Point,
-        *,
-        max_order: int,
-        solver: str,
-        candidates: str,
-        max_candidates: int,
-        ipc_order: str,
-        ipc_accel: str,
-        sbr_step_deg: Optional[float],
-        sbr_rays: Optional[int],
-        sbr_planar: bool,
-        parallel: bool,
-    ) -> Dict[str, Any]: ...
+    def trace(self, tx: _Point, rx: _Point, keywords: Dict[str, Any]) -> Dict[str, Any]: ...
     def trace_many(
-        self,
-        tx: _Point,
-        receivers: npt.NDArray[np.float64],
-        *,
-        max_order: int,
-        solver: str,
-        candidates: str,
-        max_candidates: int,
-        ipc_order: str,
-        ipc_accel: str,
-        sbr_step_deg: Optional[float],
-        sbr_rays: Optional[int],
-        sbr_planar: bool,
-        parallel: bool,
+        self, tx: _Point, receivers: npt.NDArray[np.float64], keywords: Dict[str, Any]
     ) -> List[Dict[str, Any]]: ...
 
 def load(
