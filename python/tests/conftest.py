@@ -14,7 +14,8 @@ TESTDATA = REPO / "testdata" / "scenes"
 
 
 def _cli_path() -> Path:
-    """The release CLI (.ci/run builds it; BEAMTRACE_BIN overrides), built when missing."""
+    """The CLI: BEAMTRACE_BIN (.ci/run passes the one `cargo test` built), else the release
+    build, built when missing."""
     override = os.environ.get("BEAMTRACE_BIN")
     if override:
         return Path(override)
