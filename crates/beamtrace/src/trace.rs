@@ -62,17 +62,8 @@ pub fn solver_for(args: &SolveArgs, scene: &Scene) -> anyhow::Result<Solver> {
             Solver::Ipc(options)
         }
         SolverArg::Sbr => {
-            let options = match (args.sbr_rays, args.sbr_step_deg) {
-                (Some(rays), _) => SbrOptions::fibonacci(rays),
-                (None, step) => SbrOptions::grid(step.unwrap_or(1.0)),
-            };
-            let options = SbrOptions {
-                planar: args.sbr_planar,
-                ..options
-            };
-            if let Some(problem) = options.problem() {
-                bail!("{problem}");
-            }
+            let options = SbrOptions::chosen(args.sbr_rays, args.sbr_step_deg, args.sbr_planar)
+                .map_err(anyhow::Error::msg)?;
             if let Some(problem) = options.over_budget(args.max_rays) {
                 bail!("{problem}");
             }

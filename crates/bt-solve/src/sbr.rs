@@ -96,6 +96,21 @@ impl SbrOptions {
         }
     }
 
+    /// The options a user chose (CLI flags, Python keywords): `rays` on a Fibonacci sphere if
+    /// given, else a grid of `step_deg` (default 1°), optionally `planar`; checked with
+    /// [`SbrOptions::problem`].
+    pub fn chosen(rays: Option<u32>, step_deg: Option<Real>, planar: bool) -> Result<Self, String> {
+        let options = match (rays, step_deg) {
+            (Some(rays), _) => Self::fibonacci(rays),
+            (None, step) => Self::grid(step.unwrap_or(1.0)),
+        };
+        let options = Self { planar, ..options };
+        match options.problem() {
+            Some(problem) => Err(problem),
+            None => Ok(options),
+        }
+    }
+
     /// What is wrong with the options, if anything (a lowercase message naming the field).
     /// Invalid options launch no rays; they never panic.
     pub fn problem(&self) -> Option<String> {

@@ -88,6 +88,8 @@ fn single_wall_gives_line_of_sight_and_one_reflection() {
     assert!((p - Vec3::new(4.0 / 3.0, 0.0, 1.0)).length() < 1e-12, "{p}");
     let ipc_paths = run(&scene, 3, ipc(&scene, UpdateOrder::Jacobi));
     assert!(max_point_distance(&paths, &ipc_paths) < 1e-9);
+    // Line of sight has no point to move: its residual is 0, not 0/0 (a NaN in the JSON).
+    assert_eq!(ipc_paths[0].residual, Some(0.0));
 }
 
 #[test]

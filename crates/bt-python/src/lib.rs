@@ -1,0 +1,260 @@
+//! The native module of the `beamtrace` Python package (`beamtrace._native`).
+//!
+//! Thin by design, like the CLI: Python arguments → library options → one library call
+//! (`bt_scene` loading, `bt_solve::pipeline`, `bt_beams::report`) → NumPy columns. The
+//! Python layer (`python/src/beamtrace`) normalises arrays and wraps the columns in `Paths`.
+//! Tracing releases the GIL; `trace_many` spreads receivers over rayon's pool.
+
+mod columns;
+mod options;
+
+use bt_geom::Vec3;
+use bt_scene::io::LoadOptions;
+use bt_scene::{Scene, SceneError, Terminals};
+use bt_solve::pipeline::TraceError;
+use numpy::PyReadonlyArray2;
+use options::TraceKeywords;
+use pyo3::create_exception;
+use pyo3::exceptions::{PyException, PyValueError};
+use pyo3::prelude::*;
+use pyo3::types::{PyDict, PyList};
+use rayon::prelude::*;
+use std::path::Path;
+use std::sync::Arc;
+
+create_exception!(
+    beamtrace,
+    BeamtraceError,
+    PyException,
+    "A scene that cannot be loaded or a trace that cannot run; the message is the CLI's."
+);
+
+fn error(e: impl std::fmt::Display) -> PyErr {
+    BeamtraceError::new_err(e.to_string())
+}
+
+fn vec3(v: [f64; 3]) -> Vec3 {
+    Vec3::from_array(v)
+}
+
+/// Load a scene file (`.json`, `.toml`, `.obj`, `.ply`) or a built-in scene (`builtin:NAME`).
+fn load_scene(source: &str, options: &LoadOptions) -> Result<bt_scene::io::Loaded, SceneError> {
+    if let Some(name) = source.strip_prefix("builtin:") {
+        return match bt_scene::builtin_scene(name, options.terminals) {
+            Some(scene) => scene.map(|scene| bt_scene::io::Loaded {
+                scene,
+                warnings: Vec::new(),
+            }),
+            None => Err(SceneError::UnsupportedFormat {
+                path: format!(
+                    "{source} (built-in scenes: {})",
+                    bt_scene::builtin_names().join(", ")
+                ),
+            }),
+        };
+    }
+    bt_scene::io::load(Path::new(source), options)
+}
+
+/// A validated scene, ready to trace from any TX to any RX.
+#[pyclass(frozen, module = "beamtrace._native", name = "Scene")]
+struct PyScene {
+    scene: Arc<Scene>,
+    /// What `load` was given (file path or `builtin:NAME`): messages name it, as the CLI's do.
+    source: String,
+    warnings: Vec<String>,
+}
+
+impl PyScene {
+    /// The scene with other terminals (the scene's own where `None`).
+    fn moved(&self, tx: Option<[f64; 3]>, rx: Option<[f64; 3]>) -> PyResult<Scene> {
+        let tx = tx.map(vec3).unwrap_or(self.scene.tx());
+        let rx = rx.map(vec3).unwrap_or(self.scene.rx());
+        self.scene
+            .with_terminals(tx, rx)
+            .map_err(|e| self.error(TraceError::Scene(e)))
+    }
+
+    /// A trace error as the exception, naming the scene's source like the CLI (which
+    /// validates terminals while loading `SOURCE --tx .. --rx ..`).
+    fn error(&self, e: TraceError) -> PyErr {
+        match e {
+            TraceError::Scene(SceneError::Invalid { problems, .. }) => error(SceneError::Invalid {
+                source_name: self.source.clone(),
+                problems,
+            }),
+            e => error(e),
+        }
+    }
+}
+
+#[pymethods]
+impl PyScene {
+    /// Scene name (file stem, or the name inside the scene file).
+    #[getter]
+    fn name(&self) -> &str {
+        self.scene.name()
+    }
+    /// Transmitter position, metres.
+    #[getter]
+    fn tx(&self) -> [f64; 3] {
+        self.scene.tx().to_array()
+    }
+    /// Receiver position, metres.
+    #[getter]
+    fn rx(&self) -> [f64; 3] {
+        self.scene.rx().to_array()
+    }
+    /// Carrier frequency, Hz.
+    #[getter]
+    fn frequency_hz(&self) -> f64 {
+        self.scene.frequency_hz()
+    }
+    /// Names of all surfaces (reflectors and blockers), in scene order.
+    #[getter]
+    fn surface_names(&self) -> Vec<String> {
+        self.scene
+            .surfaces()
+            .iter()
+            .map(|s| s.name.clone())
+            .collect()
+    }
+    /// Non-fatal notes of the import (merged faces, unknown materials, ...).
+    #[getter]
+    fn warnings(&self) -> Vec<String> {
+        self.warnings.clone()
+    }
+
+    /// Trace one TX → RX; returns the path columns as a dict (see `beamtrace.Paths`).
+    fn trace<'py>(
+        &self,
+        py: Python<'py>,
+        tx: Option<[f64; 3]>,
+        rx: Option<[f64; 3]>,
+        keywords: TraceKeywords,
+    ) -> PyResult<Bound<'py, PyDict>> {
+        let scene = self.moved(tx, rx)?;
+        let options = keywords
+            .trace_options(&scene)
+            .map_err(PyValueError::new_err)?;
+        let paths = py.detach(|| {
+            bt_solve::pipeline::trace_scene(&scene, &options)
+                .map(|traced| bt_beams::report(&scene, &traced.result.paths))
+        });
+        columns::to_dict(py, &paths.map_err(|e| self.error(e))?)
+    }
+
+    /// Trace one TX to each row of `receivers` (m × 3, metres) in parallel without the GIL;
+    /// returns one column dict per receiver, in order.
+    fn trace_many<'py>(
+        &self,
+        py: Python<'py>,
+        tx: Option<[f64; 3]>,
+        receivers: PyReadonlyArray2<'py, f64>,
+        keywords: TraceKeywords,
+    ) -> PyResult<Bound<'py, PyList>> {
+        let receivers = receivers_of(&receivers)?;
+        let Some(first) = receivers.first() else {
+            return Ok(PyList::empty(py));
+        };
+        let scene = self.moved(tx, Some(first.to_array()))?;
+        let options = keywords
+            .trace_options(&scene)
+            .map_err(PyValueError::new_err)?;
+        let reports = py.detach(|| trace_and_report(&scene, &receivers, &options));
+        let reports = reports.map_err(|e| self.error(e))?;
+        let dicts = reports
+            .iter()
+            .map(|paths| columns::to_dict(py, paths))
+            .collect::<PyResult<Vec<_>>>()?;
+        PyList::new(py, dicts)
+    }
+}
+
+/// The rows of an (m, 3) array as points.
+fn receivers_of(array: &PyReadonlyArray2<'_, f64>) -> PyResult<Vec<Vec3>> {
+    let view = array.as_array();
+    if view.ncols() != 3 {
+        return Err(PyValueError::new_err(format!(
+            "receivers must have shape (m, 3), got {:?}",
+            view.shape()
+        )));
+    }
+    Ok(view
+        .rows()
+        .into_iter()
+        .map(|r| Vec3::new(r[0], r[1], r[2]))
+        .collect())
+}
+
+/// `bt_solve::pipeline::trace_receivers`, then each receiver's report (in parallel when asked).
+fn trace_and_report(
+    scene: &Scene,
+    receivers: &[Vec3],
+    options: &bt_solve::pipeline::TraceOptions,
+) -> Result<Vec<Vec<bt_beams::PathReport>>, TraceError> {
+    let traced = bt_solve::pipeline::trace_receivers(scene, receivers, options)?;
+    let one = |(rx, t): (&Vec3, &bt_solve::pipeline::Traced)| {
+        let moved = scene.with_terminals(scene.tx(), *rx)?;
+        Ok(bt_beams::report(&moved, &t.result.paths))
+    };
+    if options.parallel {
+        receivers.par_iter().zip(&traced).map(one).collect()
+    } else {
+        receivers.iter().zip(&traced).map(one).collect()
+    }
+}
+
+/// Load a scene; `tx`/`rx` override the file's (meshes need both).
+#[pyfunction]
+#[pyo3(signature = (source, *, tx=None, rx=None, min_reflector_area=0.25, merge_angle_deg=1.0,
+                    merge_distance=1e-3))]
+fn load(
+    py: Python<'_>,
+    source: String,
+    tx: Option<[f64; 3]>,
+    rx: Option<[f64; 3]>,
+    min_reflector_area: f64,
+    merge_angle_deg: f64,
+    merge_distance: f64,
+) -> PyResult<PyScene> {
+    let options = LoadOptions {
+        terminals: Terminals {
+            tx: tx.map(vec3),
+            rx: rx.map(vec3),
+        },
+        merge: bt_mesh::MergeOptions {
+            angle_tol_deg: merge_angle_deg,
+            dist_tol_m: merge_distance,
+            ..bt_mesh::MergeOptions::default()
+        },
+        min_reflector_area_m2: min_reflector_area,
+        ..LoadOptions::default()
+    };
+    let loaded = py.detach(|| load_scene(&source, &options)).map_err(error)?;
+    Ok(PyScene {
+        scene: Arc::new(loaded.scene),
+        source,
+        warnings: loaded.warnings,
+    })
+}
+
+/// Names of the built-in scenes (`load("builtin:NAME")`).
+#[pyfunction]
+fn builtin_names() -> Vec<&'static str> {
+    bt_scene::builtin_names().to_vec()
+}
+
+#[pymodule]
+fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add("BeamtraceError", m.py().get_type::<BeamtraceError>())?;
+    m.add("PATH_COLUMNS", columns::names())?;
+    m.add(
+        "DEFAULT_MAX_CANDIDATES",
+        bt_solve::pipeline::DEFAULT_MAX_CANDIDATES,
+    )?;
+    m.add_class::<PyScene>()?;
+    m.add_function(wrap_pyfunction!(load, m)?)?;
+    m.add_function(wrap_pyfunction!(builtin_names, m)?)?;
+    Ok(())
+}

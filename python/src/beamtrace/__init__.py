@@ -1,0 +1,265 @@
+"""Real-time radio ray tracing from Python.
+
+>>> import beamtrace
+>>> scene = beamtrace.load("builtin:living-room")
+>>> paths = scene.trace(scene.tx, scene.rx, max_order=3)
+>>> paths.length_m[:3]          # metres, ranked by order then length
+>>> paths.aoa_deg               # (n, 2): azimuth, elevation in degrees
+
+Everything is computed by the Rust library the ``beamtrace`` CLI uses (same loading, the same
+trace pipeline, the same report as ``beamtrace trace --json``). Units: metres, seconds,
+degrees, dB; angles as in docs/conventions.md (azimuth from +x towards +y, elevation from the
+horizontal plane; the arrival direction points from RX towards where the wave comes from).
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Any, Dict, List, Optional, Sequence, Union
+
+import numpy as np
+import numpy.typing as npt
+
+from . import _native
+from ._native import BeamtraceError
+
+__all__ = [
+    "BeamtraceError",
+    "Paths",
+    "Scene",
+    "builtin_names",
+    "load",
+]
+
+Point = Union[Sequence[float], npt.NDArray[np.float64]]
+"""A position in metres: three numbers x, y, z."""
+
+
+class Paths:
+    """The specular paths from one TX to one RX, ranked (order, then length, then angle).
+
+    Per-path columns are NumPy arrays of length ``n = len(paths)``; per-reflection values are
+    lists of ``n`` arrays. Every field of ``beamtrace trace --json``'s path objects is here
+    under the same name. ``iterations``/``residual_m`` exist for the IPC solver only.
+    """
+
+    rank: npt.NDArray[np.int64]
+    """1-based rank, shape (n,)."""
+    order: npt.NDArray[np.int64]
+    """Number of reflections (0 = line of sight), shape (n,)."""
+    surfaces: List[List[str]]
+    """Names of the reflecting surfaces of each path, TX side first."""
+    points: List[npt.NDArray[np.float64]]
+    """Interaction points of each path, (k, 3) metres, TX side first (TX and RX excluded)."""
+    length_m: npt.NDArray[np.float64]
+    """Unfolded length, metres, shape (n,)."""
+    delay_s: npt.NDArray[np.float64]
+    """Propagation delay, seconds, shape (n,)."""
+    aod_deg: npt.NDArray[np.float64]
+    """Angle of departure (azimuth, elevation), degrees, shape (n, 2)."""
+    aoa_deg: npt.NDArray[np.float64]
+    """Angle of arrival (azimuth, elevation), degrees, shape (n, 2)."""
+    incidence_deg: List[npt.NDArray[np.float64]]
+    """Angle of incidence at each reflection from the surface normal, degrees, (k,) each."""
+    free_space_loss_db: npt.NDArray[np.float64]
+    """Friis free-space loss over the unfolded length, dB, shape (n,)."""
+    reflection_loss_db: npt.NDArray[np.float64]
+    """Sum of the materials' reflection losses, dB, shape (n,)."""
+    loss_db: npt.NDArray[np.float64]
+    """Total loss, dB, shape (n,)."""
+    iterations: npt.NDArray[np.int64]
+    """IPC rounds per path (IPC solver only), shape (n,)."""
+    residual_m: npt.NDArray[np.float64]
+    """IPC's last mean displacement, metres (IPC solver only), shape (n,)."""
+
+    def __init__(self, columns: Dict[str, Any]) -> None:
+        self._columns = dict(columns)
+        self.__dict__.update(self._columns)
+
+    def __len__(self) -> int:
+        return len(self._columns["order"])
+
+    def __repr__(self) -> str:
+        orders = np.bincount(self._columns["order"]) if len(self) else []
+        return f"Paths({len(self)} paths, per order {list(map(int, orders))})"
+
+    @property
+    def columns(self) -> List[str]:
+        """Names of the columns present."""
+        return list(self._columns)
+
+    def to_dict(self) -> Dict[str, Any]:
+        """The columns as a dict (name -> array or list)."""
+        return dict(self._columns)
+
+    def __getstate__(self) -> Dict[str, Any]:
+        return self._columns
+
+    def __setstate__(self, state: Dict[str, Any]) -> None:
+        self.__init__(state)  # type: ignore[misc]
+
+
+def _point(value: Optional[Point], name: str) -> Optional[tuple]:
+    if value is None:
+        return None
+    a = np.asarray(value, dtype=np.float64)
+    if a.shape != (3,):
+        raise ValueError(f"{name} must be three numbers x, y, z (metres), got shape {a.shape}")
+    return tuple(float(x) for x in a)
+
+
+def _receivers(rx: Any) -> npt.NDArray[np.float64]:
+    a = np.ascontiguousarray(rx, dtype=np.float64)
+    if a.ndim != 2 or a.shape[1] != 3:
+        raise ValueError(f"rx must have shape (m, 3), metres, got shape {a.shape}")
+    return a
+
+
+class Scene:
+    """A validated scene (surfaces, materials, a default TX and RX), loaded by :func:`load`."""
+
+    def __init__(self, native: Any) -> None:
+        self._native = native
+
+    @property
+    def name(self) -> str:
+        """Scene name."""
+        return self._native.name
+
+    @property
+    def tx(self) -> npt.NDArray[np.float64]:
+        """The scene's transmitter position, metres."""
+        return np.array(self._native.tx)
+
+    @property
+    def rx(self) -> npt.NDArray[np.float64]:
+        """The scene's receiver position, metres."""
+        return np.array(self._native.rx)
+
+    @property
+    def frequency_hz(self) -> float:
+        """Carrier frequency, Hz."""
+        return self._native.frequency_hz
+
+    @property
+    def surface_names(self) -> List[str]:
+        """Names of all surfaces (reflectors and blockers), in scene order."""
+        return self._native.surface_names
+
+    @property
+    def warnings(self) -> List[str]:
+        """Non-fatal notes of the import (merged faces, unknown materials, ...)."""
+        return self._native.warnings
+
+    def __repr__(self) -> str:
+        return f"Scene({self.name!r}, {len(self.surface_names)} surfaces)"
+
+    def trace(
+        self,
+        tx: Optional[Point] = None,
+        rx: Optional[Point] = None,
+        max_order: int = 3,
+        solver: str = "image",
+        candidates: str = "beam-tree",
+        *,
+        max_candidates: int = _native.DEFAULT_MAX_CANDIDATES,
+        ipc_order: str = "gauss-seidel",
+        ipc_accel: str = "none",
+        sbr_step_deg: Optional[float] = None,
+        sbr_rays: Optional[int] = None,
+        sbr_planar: bool = False,
+        parallel: bool = True,
+    ) -> Paths:
+        """Trace every specular path from ``tx`` to ``rx`` (metres; the scene's own if None).
+
+        Options are ``beamtrace trace``'s flags: ``solver`` "image" | "ipc" | "sbr",
+        ``candidates`` "beam-tree" | "wvrn" | "exhaustive", ``ipc_order`` "gauss-seidel" |
+        "jacobi", ``ipc_accel`` "none" | "newton", ``sbr_step_deg`` or ``sbr_rays``. Raises
+        :class:`BeamtraceError` when a position is invalid (on a surface, equal to the other
+        terminal) or the candidate budget is exceeded, ``ValueError`` on a bad option.
+        """
+        columns = self._native.trace(
+            _point(tx, "tx"),
+            _point(rx, "rx"),
+            _options(locals()),
+        )
+        return Paths(columns)
+
+    def trace_many(
+        self,
+        tx: Optional[Point],
+        rx: Any,
+        max_order: int = 3,
+        solver: str = "image",
+        candidates: str = "beam-tree",
+        *,
+        max_candidates: int = _native.DEFAULT_MAX_CANDIDATES,
+        ipc_order: str = "gauss-seidel",
+        ipc_accel: str = "none",
+        sbr_step_deg: Optional[float] = None,
+        sbr_rays: Optional[int] = None,
+        sbr_planar: bool = False,
+        parallel: bool = True,
+    ) -> List[Paths]:
+        """Trace one ``tx`` to every row of ``rx`` (an (m, 3) array, metres): one
+        :class:`Paths` per receiver, in order, equal to calling :meth:`trace` for each.
+
+        Receivers run in parallel on all cores with the GIL released. A receiver on a surface
+        or at the TX fails the call with :class:`BeamtraceError`.
+        """
+        results = self._native.trace_many(
+            _point(tx, "tx"),
+            _receivers(rx),
+            _options(locals()),
+        )
+        return [Paths(c) for c in results]
+
+
+_OPTION_NAMES = (
+    "max_order",
+    "solver",
+    "candidates",
+    "max_candidates",
+    "ipc_order",
+    "ipc_accel",
+    "sbr_step_deg",
+    "sbr_rays",
+    "sbr_planar",
+    "parallel",
+)
+
+
+def _options(arguments: Dict[str, Any]) -> Dict[str, Any]:
+    return {name: arguments[name] for name in _OPTION_NAMES}
+
+
+def load(
+    source: Union[str, "os.PathLike[str]"],
+    *,
+    tx: Optional[Point] = None,
+    rx: Optional[Point] = None,
+    min_reflector_area: float = 0.25,
+    merge_angle_deg: float = 1.0,
+    merge_distance: float = 1e-3,
+) -> Scene:
+    """Load a scene: a file the CLI reads (.json, .toml, .obj, .ply) or ``"builtin:NAME"``.
+
+    ``tx``/``rx`` override the file's terminals (meshes carry none: give both). The mesh
+    options are ``beamtrace trace``'s ``--min-reflector-area`` (m²), ``--merge-angle-deg`` and
+    ``--merge-distance`` (m). Raises :class:`BeamtraceError` with the CLI's message (naming the
+    file, line or field) when the scene cannot be read or is invalid.
+    """
+    native = _native.load(
+        os.fspath(source),
+        tx=_point(tx, "tx"),
+        rx=_point(rx, "rx"),
+        min_reflector_area=min_reflector_area,
+        merge_angle_deg=merge_angle_deg,
+        merge_distance=merge_distance,
+    )
+    return Scene(native)
+
+
+def builtin_names() -> List[str]:
+    """Names of the built-in scenes, loadable as ``load("builtin:NAME")``."""
+    return list(_native.builtin_names())

@@ -1,0 +1,42 @@
+"""Type stub of the native module (crates/bt-python); use the wrappers in ``beamtrace``."""
+
+from typing import Any, Dict, List, Optional, Tuple
+
+import numpy as np
+import numpy.typing as npt
+
+PATH_COLUMNS: List[str]
+DEFAULT_MAX_CANDIDATES: int
+
+class BeamtraceError(Exception): ...
+
+_Point = Optional[Tuple[float, float, float]]
+
+class Scene:
+    @property
+    def name(self) -> str: ...
+    @property
+    def tx(self) -> List[float]: ...
+    @property
+    def rx(self) -> List[float]: ...
+    @property
+    def frequency_hz(self) -> float: ...
+    @property
+    def surface_names(self) -> List[str]: ...
+    @property
+    def warnings(self) -> List[str]: ...
+    def trace(self, tx: _Point, rx: _Point, keywords: Dict[str, Any]) -> Dict[str, Any]: ...
+    def trace_many(
+        self, tx: _Point, receivers: npt.NDArray[np.float64], keywords: Dict[str, Any]
+    ) -> List[Dict[str, Any]]: ...
+
+def load(
+    source: str,
+    *,
+    tx: _Point = None,
+    rx: _Point = None,
+    min_reflector_area: float = 0.25,
+    merge_angle_deg: float = 1.0,
+    merge_distance: float = 1e-3,
+) -> Scene: ...
+def builtin_names() -> List[str]: ...

@@ -1,0 +1,84 @@
+"""Errors reach Python as exceptions with the CLI's messages."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import beamtrace
+from conftest import TESTDATA
+
+
+def assert_cli_says(done, message: str) -> None:
+    """The CLI failed cleanly with `error: MESSAGE` (anyhow may append the cause chain, which
+    for file errors repeats the OS message: `PATH: No such file ...: No such file ...`)."""
+    assert done.returncode not in (0, 101), done.stderr
+    text = done.stderr.strip()
+    assert text == f"error: {message}" or text.startswith(f"error: {message}: "), (text, message)
+
+
+def test_missing_file_names_the_file(cli, tmp_path):
+    missing = tmp_path / "no-such-room.json"
+    with pytest.raises(beamtrace.BeamtraceError) as info:
+        beamtrace.load(missing)
+    message = str(info.value)
+    assert "no-such-room.json" in message
+    assert_cli_says(cli("trace", str(missing)), message)
+
+
+def test_invalid_scene_lists_every_problem_like_the_cli(cli):
+    bad = TESTDATA / "bad-scene.toml"
+    with pytest.raises(beamtrace.BeamtraceError) as info:
+        beamtrace.load(bad)
+    done = cli("scene", "check", str(bad))
+    assert done.returncode == 1
+    assert str(info.value) == done.stdout.strip()
+
+
+def test_mesh_without_terminals_says_what_is_missing():
+    with pytest.raises(beamtrace.BeamtraceError, match="meshes carry no tx"):
+        beamtrace.load(TESTDATA / "box-room.obj")
+
+
+def test_unknown_builtin_lists_the_builtins():
+    with pytest.raises(beamtrace.BeamtraceError, match="living-room"):
+        beamtrace.load("builtin:kitchen")
+
+
+def test_receiver_on_a_surface_is_an_error(cli):
+    scene = beamtrace.load("builtin:living-room")
+    with pytest.raises(beamtrace.BeamtraceError, match="rx") as info:
+        scene.trace(scene.tx, [2.0, 2.0, 0.0])  # on the floor
+    assert_cli_says(cli("trace", "builtin:living-room", "--rx", "2,2,0"), str(info.value))
+    # trace_many fails the call with that receiver's error.
+    with pytest.raises(beamtrace.BeamtraceError):
+        scene.trace_many(None, np.array([[2.0, 2.0, 1.0], [2.0, 2.0, 0.0]]))
+
+
+def test_budget_error_carries_the_cli_message(cli):
+    scene = beamtrace.load("builtin:living-room")
+    with pytest.raises(beamtrace.BeamtraceError, match="candidate budget exceeded") as info:
+        scene.trace(max_order=3, candidates="exhaustive", max_candidates=100)
+    done = cli("trace", "builtin:living-room", "--candidates", "exhaustive",
+               "--max-candidates", "100")
+    assert_cli_says(done, str(info.value))
+
+
+@pytest.mark.parametrize(
+    "options, message",
+    [
+        ({"solver": "magic"}, "solver must be one of"),
+        ({"candidates": "all"}, "candidates must be one of"),
+        ({"solver": "sbr", "sbr_step_deg": 0.0}, "sbr step must be a positive"),
+    ],
+)
+def test_bad_options_are_value_errors(options, message):
+    scene = beamtrace.load("builtin:living-room")
+    with pytest.raises(ValueError, match=message):
+        scene.trace(**options)
+
+
+def test_bad_point_shape_is_a_value_error():
+    scene = beamtrace.load("builtin:living-room")
+    with pytest.raises(ValueError, match="three numbers"):
+        scene.trace([1.0, 2.0], None)

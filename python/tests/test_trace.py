@@ -1,0 +1,77 @@
+"""Scene.trace against the CLI's `beamtrace trace --json` (the same report, every field)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import beamtrace
+from conftest import TESTDATA, vec
+
+
+def assert_same_as_cli(paths: beamtrace.Paths, doc: dict) -> None:
+    """Every field of every path equal to the CLI's JSON (floats to the last bit)."""
+    expected = doc["paths"]
+    assert len(paths) == len(expected) == doc["stats"]["valid_paths"]
+    assert len(paths) > 0
+    for i, e in enumerate(expected):
+        assert paths.rank[i] == e["rank"]
+        assert paths.order[i] == e["order"]
+        assert paths.surfaces[i] == e["surfaces"]
+        assert paths.points[i].shape == (e["order"], 3)
+        assert paths.points[i].tolist() == e["points"]
+        assert paths.length_m[i] == e["length_m"]
+        assert paths.delay_s[i] == e["delay_s"]
+        for key in ("aod_deg", "aoa_deg"):
+            assert paths.to_dict()[key][i].tolist() == [
+                e[key]["azimuth"],
+                e[key]["elevation"],
+            ]
+        assert paths.incidence_deg[i].tolist() == e["incidence_deg"]
+        for key in ("free_space_loss_db", "reflection_loss_db", "loss_db"):
+            assert paths.to_dict()[key][i] == e[key]
+        if "iterations" in e:
+            assert paths.iterations[i] == e["iterations"]
+            assert paths.residual_m[i] == e["residual_m"]
+    # Columns carry every field of the CLI's path objects, and nothing the CLI lacks.
+    assert set(paths.columns) == set(expected[0])
+
+
+def test_living_room_matches_cli(cli_json):
+    scene = beamtrace.load("builtin:living-room")
+    paths = scene.trace(scene.tx, scene.rx, max_order=3)
+    assert_same_as_cli(paths, cli_json("builtin:living-room", "--max-order", "3"))
+    assert paths.order.dtype == np.int64
+    assert paths.aod_deg.shape == (len(paths), 2)
+    assert paths.delay_s.dtype == np.float64
+
+
+def test_moved_terminals_and_ipc_match_cli(cli_json):
+    tx, rx = [1.0, 3.5, 2.0], [4.2, 1.1, 1.3]
+    scene = beamtrace.load("builtin:living-room")
+    paths = scene.trace(tx, rx, max_order=2, solver="ipc", ipc_order="jacobi")
+    doc = cli_json(
+        "builtin:living-room",
+        "--tx", vec(tx), "--rx", vec(rx),
+        "--max-order", "2", "--solver", "ipc", "--ipc-order", "jacobi",
+    )
+    assert_same_as_cli(paths, doc)
+    assert "iterations" in paths.columns
+
+
+def test_mesh_with_terminals_matches_cli(cli_json):
+    tx, rx = [1.0, 1.0, 1.5], [3.0, 2.0, 1.2]
+    mesh = TESTDATA / "box-room.obj"
+    scene = beamtrace.load(mesh, tx=tx, rx=rx)
+    paths = scene.trace(max_order=2, candidates="exhaustive")
+    doc = cli_json(str(mesh), "--tx", vec(tx), "--rx", vec(rx), "--max-order", "2",
+                   "--candidates", "exhaustive")
+    assert_same_as_cli(paths, doc)
+
+
+def test_scene_properties():
+    scene = beamtrace.load("builtin:living-room")
+    assert scene.name == "living-room"
+    assert scene.frequency_hz == pytest.approx(28e9)
+    assert len(scene.surface_names) == 31
+    assert "living-room" in beamtrace.builtin_names()
