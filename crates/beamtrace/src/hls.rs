@@ -169,7 +169,8 @@ fn fixed_error(
     }
     let mut sum = 0.0;
     let mut count = 0usize;
-    for path in &reference.paths {
+    // Line of sight (no surface) needs no accelerator: the host adds it.
+    for path in reference.paths.iter().filter(|p| !p.surfaces.is_empty()) {
         if step.host_sequences.contains(&path.surfaces) {
             err.host_solved += 1;
             continue;
