@@ -4,10 +4,10 @@
 use crate::args::{HlsArgs, HlsCommand, HlsGenArgs};
 use anyhow::{Context, bail};
 use bt_hls::PlanOptions;
-use indicatif::{ProgressBar, ProgressStyle};
 use bt_paths::AllVisible;
 use bt_scene::Scene;
 use bt_schedule::{GaParams, Problem};
+use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use std::path::Path;
 use std::process::ExitCode;
@@ -249,7 +249,10 @@ fn generate(args: &HlsGenArgs) -> anyhow::Result<ExitCode> {
         report_steps(args, summaries)
     } else {
         let s = &summaries[0];
-        write(&args.output.join("summary.json"), &serde_json::to_string_pretty(s)?)?;
+        write(
+            &args.output.join("summary.json"),
+            &serde_json::to_string_pretty(s)?,
+        )?;
         if args.plan_only {
             write(
                 &args.output.join("schedule.json"),

@@ -60,7 +60,10 @@ fn living_room_steps_run_on_one_design_bit_exact() {
         assert_eq!(s["fixed_vs_f64"]["spurious"], 0, "{s}");
     }
     assert!(dir.join("rtl/bt_top.v").exists());
-    assert!(!dir.join("step-0/rtl").exists(), "one design, not one per step");
+    assert!(
+        !dir.join("step-0/rtl").exists(),
+        "one design, not one per step"
+    );
     let (ok, out) = beamtrace(&["hls", "sim", dir.to_str().unwrap()]);
     assert!(ok, "{out}");
     assert!(out.contains("verilator (10 steps, 10 runs)"), "{out}");
@@ -68,7 +71,9 @@ fn living_room_steps_run_on_one_design_bit_exact() {
     assert!(out.contains("runs as predicted: true"), "{out}");
     let predicted = steps[0]["predicted_cycles"].as_u64().unwrap();
     assert!(
-        out.contains(&format!("CYCLES of run 0 {predicted} (predicted {predicted})")),
+        out.contains(&format!(
+            "CYCLES of run 0 {predicted} (predicted {predicted})"
+        )),
         "{out}"
     );
     std::fs::remove_dir_all(&dir).ok();

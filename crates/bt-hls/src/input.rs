@@ -355,7 +355,6 @@ impl Design {
     pub fn cycles_per_slot(&self) -> u32 {
         crate::plan::cycles_per_slot(self.num_instances) as u32
     }
-
 }
 
 /// The fixed-point model of the platform's planes alone (no path): quantised planes and
@@ -424,7 +423,9 @@ fn step_design(platform: &Platform, k: usize, w: &StepWork) -> Result<StepDesign
         .map_err(|e| HlsError::Schedule(format!("step {k}: {e}")))?;
     let makespan = schedule.makespan();
     if makespan == 0 {
-        return Err(HlsError::Schedule(format!("step {k}: schedule holds no job")));
+        return Err(HlsError::Schedule(format!(
+            "step {k}: schedule holds no job"
+        )));
     }
     let columns = schedule
         .instances

@@ -31,7 +31,7 @@ use bt_schedule::Schedule;
 
 pub use bt_fixed::{BoundsM, EarlyStop, FixedOutcome, PathResult};
 pub use error::HlsError;
-pub use input::{ADDRESS_BITS, Capacity, HlsInput, PE_LATENCY, Platform, PlaneSpec, StepWork};
+pub use input::{ADDRESS_BITS, Capacity, HlsInput, PE_LATENCY, PlaneSpec, Platform, StepWork};
 pub use pe::{POINT_BITS, pe_module_name};
 pub use plan::{Plan, PlanOptions, ScheduleKind, cycles_per_slot, plan, run_cycles};
 pub use tools::{
@@ -187,13 +187,21 @@ fn schedule_writes(d: &Design, s: &StepDesign, ops: &mut Vec<BusOp>) {
 
 /// One run of step `s`: write the start points (bank 0) and TX/RX, start, read CYCLES, every
 /// status word and every final point.
-fn run_ops(d: &Design, s: &StepDesign, step: usize, [tx, rx]: [FixedPoint; 2]) -> (Vec<BusOp>, VectorExpectation) {
+fn run_ops(
+    d: &Design,
+    s: &StepDesign,
+    step: usize,
+    [tx, rx]: [FixedPoint; 2],
+) -> (Vec<BusOp>, VectorExpectation) {
     let mut ops = Vec::new();
     for p in 0..s.num_paths as usize {
         for (i, pt) in s.model.init_points(p).iter().enumerate() {
             let g = s.first_point[p] + i as u32;
             for (k, c) in pt.iter().enumerate() {
-                ops.push(BusOp::Write(point_addr(d, g, 0, k as u32), c.floor_mm().0 as u32));
+                ops.push(BusOp::Write(
+                    point_addr(d, g, 0, k as u32),
+                    c.floor_mm().0 as u32,
+                ));
             }
             ops.push(BusOp::Write(point_addr(d, g, 0, 3), frac_word(pt)));
         }
@@ -375,7 +383,10 @@ pub fn rtl_modules(platform: &Platform) -> Result<Vec<(String, String)>, HlsErro
     rtl_of(platform, &model)
 }
 
-fn rtl_of(platform: &Platform, model: &bt_fixed::FixedIpc) -> Result<Vec<(String, String)>, HlsError> {
+fn rtl_of(
+    platform: &Platform,
+    model: &bt_fixed::FixedIpc,
+) -> Result<Vec<(String, String)>, HlsError> {
     let planes: std::collections::BTreeSet<u32> =
         platform.instances.iter().map(|i| i.plane).collect();
     let mut out = Vec::new();
@@ -451,10 +462,7 @@ pub fn generate_steps(
     }
     write(out_dir, "platform.json", &to_json(platform)?, &mut files)?;
     write(out_dir, "work.json", &to_json(&work)?, &mut files)?;
-    let load_writes = ops
-        .iter()
-        .filter(|o| matches!(o, BusOp::Write(..)))
-        .count() as u64;
+    let load_writes = ops.iter().filter(|o| matches!(o, BusOp::Write(..))).count() as u64;
     let report = Report {
         files: Vec::new(),
         num_instances: d.num_instances,

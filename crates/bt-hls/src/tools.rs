@@ -213,7 +213,10 @@ pub fn simulate_with(
             if !out.status.success() {
                 return Err(failure("iverilog", &out));
             }
-            ("vvp".to_string(), vec!["-n".to_string(), "sim.vvp".to_string()])
+            (
+                "vvp".to_string(),
+                vec!["-n".to_string(), "sim.vvp".to_string()],
+            )
         }
         Simulator::Verilator => {
             let mut args: Vec<String> = [

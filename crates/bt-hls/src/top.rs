@@ -177,10 +177,7 @@ pub(crate) fn top_module(d: &TopParams) -> Module {
         Expr::slice("avs_address", ptb + 2, 3),
     ));
     items.push(Item::Wire("host_wr".into(), 1));
-    items.push(Item::Assign(
-        id("host_wr"),
-        id("avs_write").and(id("idle")),
-    ));
+    items.push(Item::Assign(id("host_wr"), id("avs_write").and(id("idle"))));
     items.push(Item::Wire("pt_we".into(), 1));
     items.push(Item::Assign(
         id("pt_we"),
@@ -206,19 +203,22 @@ pub(crate) fn top_module(d: &TopParams) -> Module {
         ),
         nb(
             id("sched_q"),
-            Expr::id("sched").at(Expr::concat(vec![id("slot"), Expr::slice("cnt", ib - 1, 0)])),
+            Expr::id("sched").at(Expr::concat(vec![
+                id("slot"),
+                Expr::slice("cnt", ib - 1, 0),
+            ])),
         ),
         nb(
             id("sq_ok"),
-            or(state_is(S_LOAD), state_is(S_WB))
-                .and(Expr::bin(BinaryOp::Lt, id("cnt"), lit(cnt_bits, k.into()))),
+            or(state_is(S_LOAD), state_is(S_WB)).and(Expr::bin(
+                BinaryOp::Lt,
+                id("cnt"),
+                lit(cnt_bits, k.into()),
+            )),
         ),
         nb(id("sq_inst"), Expr::slice("cnt", ib - 1, 0)),
     ]));
-    let fields = [
-        ("rom_path", pb, 1),
-        ("rom_point", ptb, 1 + pb),
-    ];
+    let fields = [("rom_path", pb, 1), ("rom_point", ptb, 1 + pb)];
     items.push(Item::Wire("rom_valid".into(), 1));
     items.push(Item::Assign(
         id("rom_valid"),
@@ -514,7 +514,11 @@ pub(crate) fn top_module(d: &TopParams) -> Module {
     let mut on_start = vec![
         nb(
             id("state"),
-            Expr::mux(no_slot.clone(), lit(STATE_BITS, S_IDLE), lit(STATE_BITS, S_LOAD)),
+            Expr::mux(
+                no_slot.clone(),
+                lit(STATE_BITS, S_IDLE),
+                lit(STATE_BITS, S_LOAD),
+            ),
         ),
         nb(id("cnt"), lit(cnt_bits, 0)),
         nb(id("slot"), lit(sb, 0)),

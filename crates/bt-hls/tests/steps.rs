@@ -57,8 +57,8 @@ fn one_design_runs_every_step_bit_exact() {
     let lint = bt_hls::lint(&dir).unwrap();
     assert!(lint.warnings.is_empty(), "{}", lint.warnings.join("\n"));
     let mut seen = Vec::new();
-    let sim = bt_hls::simulate_with(&dir, bt_hls::Simulator::Verilator, &mut |p| seen.push(p))
-        .unwrap();
+    let sim =
+        bt_hls::simulate_with(&dir, bt_hls::Simulator::Verilator, &mut |p| seen.push(p)).unwrap();
     eprintln!("{sim:#?}");
     assert_eq!(sim.mismatches, 0, "{:#?}", sim.mismatch_details);
     assert!(sim.passed());
