@@ -154,8 +154,10 @@ fn fixed_error(
 ) -> FixedError {
     let candidates = bt_paths::enumerate(scene, max_order, &AllVisible);
     let reference = bt_solve::trace(scene, &candidates, &bt_solve::Solver::Image, true);
-    let mut err = FixedError::default();
-    err.left_bounds = results.iter().filter(|r| r.left_bounds).count();
+    let mut err = FixedError {
+        left_bounds: results.iter().filter(|r| r.left_bounds).count(),
+        ..FixedError::default()
+    };
     for (seq, r) in step.sequences.iter().zip(results) {
         match bt_study::fpga::host_accepts(scene, seq, r) {
             Ok(_) => {

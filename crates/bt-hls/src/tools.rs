@@ -252,7 +252,7 @@ pub fn simulate_with(
         progress(SimProgress::Runs { done, total })
     })?;
     let text = std::fs::read_to_string(&result).map_err(io_err(&result))?;
-    Ok(compare(simulator, &text, &ops, &runs)?)
+    compare(simulator, &text, &ops, &runs)
 }
 
 /// Runs the simulation binary in `dir`, reporting each `P <n>` line of its stdout.

@@ -15,6 +15,14 @@ const SEED: u64 = 2024;
 const PLANES: u32 = 25;
 const DUPLICATION_BUDGET: u32 = 40;
 
+/// Path count from environment variable `name`, else `default`.
+fn env_paths(name: &str, default: u32) -> u32 {
+    std::env::var(name)
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(default)
+}
+
 fn report(name: &str, problem: &Problem, run: impl Fn() -> Schedule) {
     let start = Instant::now();
     let schedule = run();
@@ -35,10 +43,7 @@ fn report(name: &str, problem: &Problem, run: impl Fn() -> Schedule) {
 }
 
 fn bench(c: &mut Criterion) {
-    let paths = std::env::var("BT_SCHEDULE_BENCH_PATHS")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(2000);
+    let paths = env_paths("BT_SCHEDULE_BENCH_PATHS", 2000);
     let problem = synthetic::living_room(SEED, PLANES, paths);
     let jobs: u64 = problem
         .paths
@@ -82,10 +87,7 @@ fn bench(c: &mut Criterion) {
 /// candidates of order <= 3 in the living room; `BT_SCHEDULE_STEP_PATHS` changes it), list
 /// scheduler (the host's, target <= 1 ms) against the GA (offline sizing).
 fn bench_step(c: &mut Criterion) {
-    let paths = std::env::var("BT_SCHEDULE_STEP_PATHS")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(200);
+    let paths = env_paths("BT_SCHEDULE_STEP_PATHS", 200);
     let problem = synthetic::living_room(SEED, PLANES, paths);
     let originals = Budget::originals_only(&problem);
     let params = GaParams::default();
