@@ -335,6 +335,18 @@ pub enum CandidatesArg {
     Exhaustive,
 }
 
+impl CandidatesArg {
+    /// The pipeline's candidate mode.
+    pub fn mode(self) -> bt_solve::pipeline::CandidateMode {
+        use bt_solve::pipeline::CandidateMode;
+        match self {
+            CandidatesArg::BeamTree => CandidateMode::BeamTree,
+            CandidatesArg::Wvrn => CandidateMode::Wvrn,
+            CandidatesArg::Exhaustive => CandidateMode::Exhaustive,
+        }
+    }
+}
+
 impl SolveArgs {
     /// The candidate generator the arguments select (the old `--wvrn`/`--no-wvrn` win).
     pub fn candidate_mode(&self) -> bt_solve::pipeline::CandidateMode {
@@ -345,11 +357,7 @@ impl SolveArgs {
         if self.wvrn {
             return CandidateMode::Wvrn;
         }
-        match self.candidates {
-            CandidatesArg::BeamTree => CandidateMode::BeamTree,
-            CandidatesArg::Wvrn => CandidateMode::Wvrn,
-            CandidatesArg::Exhaustive => CandidateMode::Exhaustive,
-        }
+        self.candidates.mode()
     }
 }
 
@@ -512,16 +520,36 @@ pub struct HlsArgs {
 pub enum HlsCommand {
     /// Generate the accelerator for a scene into a directory.
     Gen(HlsGenArgs),
-    /// Co-simulate a generated directory (Icarus Verilog) against the Rust model.
+    /// Co-simulate a generated directory (every step's bus program) against the Rust model.
     Sim {
         /// Directory written by `hls gen`.
         dir: PathBuf,
+        /// Simulator: Verilator (compiled, fast) or Icarus Verilog (interpreted, small designs).
+        #[arg(long, value_enum, default_value_t = SimulatorArg::Verilator)]
+        simulator: SimulatorArg,
     },
     /// Synthesise a generated directory with Yosys for the Cyclone IV E and report resources.
     Synth {
         /// Directory written by `hls gen`.
         dir: PathBuf,
     },
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum SimulatorArg {
+    /// Verilator 5 (`--binary --timing`).
+    Verilator,
+    /// Icarus Verilog.
+    Icarus,
+}
+
+impl SimulatorArg {
+    pub fn kind(self) -> bt_hls::Simulator {
+        match self {
+            SimulatorArg::Verilator => bt_hls::Simulator::Verilator,
+            SimulatorArg::Icarus => bt_hls::Simulator::Icarus,
+        }
+    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -551,8 +579,11 @@ pub struct HlsGenArgs {
     /// Highest reflection order of the candidate paths.
     #[arg(long, default_value_t = 3)]
     pub max_order: usize,
-    /// Scheduler.
-    #[arg(long, value_enum, default_value_t = ScheduleArg::Ga)]
+    /// Candidate generator of each step (as `trace --candidates`).
+    #[arg(long, value_enum, default_value_t = CandidatesArg::BeamTree)]
+    pub candidates: CandidatesArg,
+    /// Scheduler of each step: the list scheduler (host, per step) or the GA (offline sizing).
+    #[arg(long, value_enum, default_value_t = ScheduleArg::List)]
     pub schedule: ScheduleArg,
     /// Total PE instances allowed (default: planes + 25 % for duplicates).
     #[arg(long)]
@@ -572,8 +603,10 @@ pub struct HlsGenArgs {
     /// Budget: stop before the work rather than enumerate more candidate paths than this.
     #[arg(long, default_value_t = bt_solve::pipeline::DEFAULT_MAX_CANDIDATES)]
     pub max_candidates: u64,
-    /// Every time step of a dynamic scene: one accelerator (or, with --plan-only, schedule)
-    /// per step into OUTPUT/step-<k>/, per-step cycle counts into OUTPUT/steps.json.
+    /// Every time step of a dynamic scene through ONE accelerator (synthesised once for the
+    /// static planes; each step's candidates, start points and schedule are loaded over the
+    /// bus): the design and the bus program of all steps into OUTPUT, per-step summaries into
+    /// OUTPUT/step-<k>/, the per-step table into OUTPUT/steps.json.
     #[arg(long)]
     pub steps: bool,
 }

@@ -1,6 +1,6 @@
-//! `beamtrace hls`: one time step of the built-in living room compiled to RTL and co-simulated
-//! bit for bit against the fixed-point model, with the cycle count equal to the prediction; the
-//! GA schedule never longer than the list schedule.
+//! `beamtrace hls`: every time step of the dynamic living room run through one design and
+//! co-simulated bit for bit against the fixed-point model, with the cycle counts equal to the
+//! prediction; the GA schedule never longer than the list schedule.
 
 use serde_json::Value;
 use std::path::PathBuf;
@@ -29,34 +29,51 @@ fn summary(dir: &std::path::Path) -> Value {
     serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap()
 }
 
+/// CI's multi-step co-simulation: the 10 steps of the dynamic living room (order 1) on ONE
+/// design, each step's schedule, start points and TX/RX loaded over the bus, Verilator.
 #[test]
-fn living_room_first_order_cosimulates_bit_exact() {
+fn living_room_steps_run_on_one_design_bit_exact() {
     let dir = tmp("lr1");
     let (ok, out) = beamtrace(&[
         "hls",
         "gen",
-        "builtin:living-room",
+        "builtin:living-room-dynamic",
+        "--steps",
         "--max-order",
         "1",
         "-o",
         dir.to_str().unwrap(),
     ]);
     assert!(ok, "{out}");
-    let s = summary(&dir);
-    assert!(
-        s["fixed_vs_f64"]["max_angle_error_tx_deg"]
-            .as_f64()
-            .unwrap()
-            < 0.1,
-        "{s}"
-    );
+    let doc: Value =
+        serde_json::from_str(&std::fs::read_to_string(dir.join("steps.json")).unwrap()).unwrap();
+    let steps = doc["steps"].as_array().unwrap();
+    assert_eq!(steps.len(), 10);
+    for s in steps {
+        assert!(
+            s["fixed_vs_f64"]["max_angle_error_tx_deg"]
+                .as_f64()
+                .unwrap()
+                < 0.1,
+            "{s}"
+        );
+        assert_eq!(s["fixed_vs_f64"]["spurious"], 0, "{s}");
+    }
     assert!(dir.join("rtl/bt_top.v").exists());
+    assert!(
+        !dir.join("step-0/rtl").exists(),
+        "one design, not one per step"
+    );
     let (ok, out) = beamtrace(&["hls", "sim", dir.to_str().unwrap()]);
     assert!(ok, "{out}");
+    assert!(out.contains("verilator (10 steps, 10 runs)"), "{out}");
     assert!(out.contains(" 0 mismatches"), "{out}");
-    let predicted = s["predicted_cycles"].as_u64().unwrap();
+    assert!(out.contains("runs as predicted: true"), "{out}");
+    let predicted = steps[0]["predicted_cycles"].as_u64().unwrap();
     assert!(
-        out.contains(&format!("CYCLES {predicted} (predicted {predicted})")),
+        out.contains(&format!(
+            "CYCLES of run 0 {predicted} (predicted {predicted})"
+        )),
         "{out}"
     );
     std::fs::remove_dir_all(&dir).ok();

@@ -5,6 +5,7 @@
 //   C <n>             clock edges from the start command to ins_irq
 //   T <n>             clock edges used by the whole program
 //   E <text>          protocol error
+// and prints "P <n>" on stdout after the n-th run (progress).
 // Lint: a behavioural testbench (blocking clock toggle, 32-bit program words of which the
 // address uses 16 bits); the generated RTL itself carries no lint pragma.
 // verilator lint_off BLKSEQ
@@ -21,13 +22,14 @@ module bt_tb;
   wire [31:0] readdata;
   wire readdatavalid;
   wire irq;
-  reg [31:0] prog [0:262143];
+  reg [31:0] prog [0:4194303];
   reg [31:0] op;
   reg [31:0] arg_a;
   integer pc;
   integer fd;
   integer total;
   integer wait_cycles;
+  integer runs;
 
   bt_top dut (
     .clk(clk),
@@ -55,6 +57,7 @@ module bt_tb;
     $readmemh("stim.hex", prog);
     fd = $fopen("sim_out.txt", "w");
     total = 0;
+    runs = 0;
     repeat (4) @(posedge clk);
     #1 rst_n = 1'b1;
     @(posedge clk);
@@ -90,6 +93,9 @@ module bt_tb;
         end
         if (!irq) $fwrite(fd, "E timeout\n");
         $fwrite(fd, "C %0d\n", wait_cycles);
+        runs = runs + 1;
+        $display("P %0d", runs);
+        $fflush;
       end else begin
         $fwrite(fd, "E bad op %h at %0d\n", op, pc);
       end

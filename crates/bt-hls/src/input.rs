@@ -4,7 +4,7 @@ use bt_fixed::{
     BoundsM, EarlyStop, FixedIpc, FixedPoint, PROPORTION_ITERATIONS, PathResult, PlaneInput,
     quantize_point,
 };
-use bt_schedule::{PathJob, Problem, Schedule};
+use bt_schedule::{PathJob, PeInstance, Problem, Schedule};
 
 use crate::HlsError;
 
@@ -119,32 +119,102 @@ pub const PE_LATENCY: u32 = 5 + PROPORTION_ITERATIONS;
 /// Largest word address the 16-bit Avalon address port can reach.
 pub const ADDRESS_BITS: u32 = 16;
 
-/// Whether `num_paths` paths with `num_points` points in all fit the Avalon-MM address space
-/// of [`ADDRESS_BITS`] bits (status words and four words per point). Cheap: callers check it
-/// before scheduling, which can take long on a design that would be refused anyway.
-pub fn check_capacity(num_paths: u64, num_points: u64) -> Result<(), HlsError> {
-    let path_bits = bits_for(num_paths);
-    let point_bits = bits_for(num_points);
-    let status_bits = path_bits.max(4);
-    let point_region_bits = (point_bits + 2).max(status_bits + 1);
-    if point_region_bits + 1 > ADDRESS_BITS {
-        return Err(HlsError::TooLarge(format!(
-            "{num_points} points and {num_paths} paths need more than {ADDRESS_BITS} address bits \
-             (at most {} points): lower --max-order or use fewer reflectors",
-            1u64 << (ADDRESS_BITS - 3)
-        )));
-    }
-    Ok(())
-}
-
 /// `ceil(log2(n))`, at least 1.
 pub(crate) fn bits_for(n: u64) -> u32 {
     (64 - n.saturating_sub(1).leading_zeros()).max(1)
 }
 
-/// The validated design: input, model, schedule and every derived size.
+/// How much per-step work the synthesised accelerator holds: the sizes of its RAMs (path
+/// flags, point memory, schedule memory). Work is loaded over the bus per time step.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct Capacity {
+    /// Candidate paths per run.
+    pub paths: u32,
+    /// Path points per run (sum of the paths' orders).
+    pub points: u32,
+    /// Schedule slots per run (the makespan).
+    pub slots: u32,
+}
+
+/// The accelerator as synthesised once per static room: one PE per plane (plus duplicates)
+/// with its constants baked in, the convergence threshold, early stopping, and the capacity of
+/// the RAMs the host fills per time step.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Platform {
+    /// Reflection planes; PE module `bt_pe_<i>` is built for plane `i`.
+    pub planes: Vec<PlaneSpec>,
+    /// Convergence threshold on a round's L∞ displacement, fine LSB (1/256 mm).
+    pub threshold_lsb: u32,
+    /// Early stopping on the planes' `bounds_m`; `None`: off.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub early_stop: Option<EarlyStop>,
+    /// PE instances (columns of the schedule memory), sorted by `(plane, copy)`.
+    pub instances: Vec<PeInstance>,
+    /// RAM sizes.
+    pub capacity: Capacity,
+}
+
+/// One accelerator run's work as the host loads it: candidates, start points, TX/RX (the
+/// [`HlsInput`], whose planes must be the platform's) and the PE schedule.
+#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct StepWork {
+    /// Candidates, start points, TX/RX, test vectors.
+    pub input: HlsInput,
+    /// PE schedule (its instances must exist on the platform).
+    pub schedule: Schedule,
+}
+
+impl Platform {
+    /// The smallest platform that runs every step of `work`: the planes, threshold and early
+    /// stopping of the first step, one PE per plane (more where a step's schedule duplicates
+    /// it), and RAMs for the largest step.
+    pub fn fitting(work: &[StepWork]) -> Result<Platform, HlsError> {
+        let Some(first) = work.first() else {
+            return Err(HlsError::InvalidInput {
+                problems: vec!["no step to run".into()],
+            });
+        };
+        let n = first.input.planes.len();
+        let mut copies = vec![1u32; n];
+        let mut capacity = Capacity {
+            paths: 1,
+            points: 1,
+            slots: 1,
+        };
+        for w in work {
+            for inst in &w.schedule.instances {
+                if let Some(c) = copies.get_mut(inst.plane as usize) {
+                    *c = (*c).max(inst.copy + 1);
+                }
+            }
+            let points: usize = w.input.paths.iter().map(Vec::len).sum();
+            capacity.paths = capacity.paths.max(w.input.paths.len() as u32);
+            capacity.points = capacity.points.max(points as u32);
+            capacity.slots = capacity.slots.max(w.schedule.makespan());
+        }
+        let instances = copies
+            .iter()
+            .enumerate()
+            .flat_map(|(plane, &c)| {
+                (0..c).map(move |copy| PeInstance {
+                    plane: plane as u32,
+                    copy,
+                })
+            })
+            .collect();
+        Ok(Platform {
+            planes: first.input.planes.clone(),
+            threshold_lsb: first.input.threshold_lsb,
+            early_stop: first.input.early_stop,
+            instances,
+            capacity,
+        })
+    }
+}
+
+/// One step of a [`Design`]: the validated work and everything derived from it.
 #[derive(Debug, Clone)]
-pub(crate) struct Design {
+pub(crate) struct StepDesign {
     pub input: HlsInput,
     pub model: FixedIpc,
     pub schedule: Schedule,
@@ -152,106 +222,251 @@ pub(crate) struct Design {
     pub budgets: Vec<u32>,
     /// Global index of the first point of each path.
     pub first_point: Vec<u32>,
-    pub num_points: u32,
     pub num_paths: u32,
-    pub num_instances: u32,
     pub makespan: u32,
-    /// Bits of a path index, point index, instance index, slot index.
+    /// Platform column of each schedule instance.
+    pub columns: Vec<u32>,
+}
+
+/// The validated design: platform, per-step work and every derived size.
+#[derive(Debug, Clone)]
+pub(crate) struct Design {
+    pub platform: Platform,
+    /// Model of the platform's planes (early-stopping boxes included), for the PEs and boxes.
+    pub model: FixedIpc,
+    pub steps: Vec<StepDesign>,
+    pub num_instances: u32,
+    /// Bits of a path index, point index, instance index.
+    pub path_bits: u32,
+    pub point_bits: u32,
+    pub inst_bits: u32,
+    /// Word address of the first path status, of the first point word, of the first
+    /// schedule entry.
+    pub status_base: u32,
+    pub point_base: u32,
+    pub sched_base: u32,
+}
+
+/// Index widths and bus regions of a platform.
+#[derive(Debug, Clone, Copy)]
+pub(crate) struct Layout {
+    pub num_instances: u32,
     pub path_bits: u32,
     pub point_bits: u32,
     pub inst_bits: u32,
     pub slot_bits: u32,
-    /// Word address of the first path status and of the first point word.
     pub status_base: u32,
     pub point_base: u32,
+    pub sched_base: u32,
+}
+
+impl Layout {
+    /// Regions: status `[2^s, 2^(s+1))` with `s = max(4, path bits)`, points
+    /// `[2^q, 2^(q+1))` (8 words per point: 2 banks of 4) with `q > s`, schedule
+    /// `[2^r, 2^(r+1))` with `r > q`; all below 2^16.
+    pub fn of(platform: &Platform) -> Result<Layout, HlsError> {
+        let cap = platform.capacity;
+        let num_instances = platform.instances.len() as u32;
+        let path_bits = bits_for(cap.paths.into());
+        let point_bits = bits_for(cap.points.into());
+        let inst_bits = bits_for(num_instances.into());
+        let slot_bits = bits_for(cap.slots.into());
+        let status_bits = path_bits.max(4);
+        let point_region_bits = (point_bits + 3).max(status_bits + 1);
+        let sched_region_bits = (slot_bits + inst_bits).max(point_region_bits + 1);
+        if sched_region_bits + 1 > ADDRESS_BITS {
+            return Err(HlsError::TooLarge(format!(
+                "{} paths, {} points and {} slots x {} PEs need more than {ADDRESS_BITS} address bits",
+                cap.paths, cap.points, cap.slots, num_instances
+            )));
+        }
+        if sched_entry_bits(path_bits, point_bits) > 32 {
+            return Err(HlsError::TooLarge(format!(
+                "a schedule entry for {} paths and {} points exceeds one 32-bit word",
+                cap.paths, cap.points
+            )));
+        }
+        if num_instances > 255 {
+            return Err(HlsError::TooLarge(format!(
+                "{num_instances} PE instances (INFO holds 8 bits)"
+            )));
+        }
+        Ok(Layout {
+            num_instances,
+            path_bits,
+            point_bits,
+            inst_bits,
+            slot_bits,
+            status_base: 1 << status_bits,
+            point_base: 1 << point_region_bits,
+            sched_base: 1 << sched_region_bits,
+        })
+    }
+}
+
+/// Schedule-entry fields: `{end, last, first, point, path, valid}` from bit 0 up.
+pub(crate) fn sched_entry_bits(path_bits: u32, point_bits: u32) -> u32 {
+    4 + path_bits + point_bits
 }
 
 impl Design {
-    pub fn new(input: &HlsInput, schedule: &Schedule) -> Result<Design, HlsError> {
-        let model = input.model()?;
+    pub fn new(platform: &Platform, work: &[StepWork]) -> Result<Design, HlsError> {
         let mut problems = Vec::new();
-        if input.paths.is_empty() {
-            problems.push("no candidate path".to_string());
-        }
-        for (i, p) in input.planes.iter().enumerate() {
+        for (i, p) in platform.planes.iter().enumerate() {
             if p.name.is_empty() {
                 problems.push(format!("plane {i} has an empty name"));
             }
         }
-        if let Err(e) = input.vectors() {
-            problems.push(format!("test vector: {e}"));
+        if work.is_empty() {
+            problems.push("no step to run".into());
+        }
+        if platform.instances.is_empty() {
+            problems.push("the platform has no PE".into());
+        }
+        for inst in &platform.instances {
+            if inst.plane as usize >= platform.planes.len() {
+                problems.push(format!("PE of plane {} out of range", inst.plane));
+            }
         }
         if !problems.is_empty() {
             return Err(HlsError::InvalidInput { problems });
         }
-        let mut budgets = vec![0u32; input.paths.len()];
-        for row in &schedule.slots {
-            for job in row.iter().flatten() {
-                if let Some(b) = budgets.get_mut(job.path as usize) {
-                    *b = (*b).max(job.round + 1);
-                }
-            }
+        let model = platform_model(platform)?;
+        let mut steps = Vec::with_capacity(work.len());
+        for (k, w) in work.iter().enumerate() {
+            steps.push(step_design(platform, k, w)?);
         }
-        let problem = Problem {
-            num_planes: input.planes.len() as u32,
-            paths: input
-                .paths
-                .iter()
-                .zip(&budgets)
-                .map(|(planes, &rounds)| PathJob {
-                    planes: planes.clone(),
-                    rounds,
-                })
-                .collect(),
-        };
-        schedule
-            .check(&problem)
-            .map_err(|e| HlsError::Schedule(e.to_string()))?;
-        let makespan = schedule.makespan();
-        let mut first_point = Vec::with_capacity(input.paths.len());
-        let mut num_points = 0u32;
-        for p in &input.paths {
-            first_point.push(num_points);
-            num_points += p.len() as u32;
-        }
-        let num_paths = input.paths.len() as u32;
-        let num_instances = schedule.instances.len() as u32;
-        let path_bits = bits_for(num_paths.into());
-        let point_bits = bits_for(num_points.into());
-        let status_bits = path_bits.max(4);
-        let point_region_bits = (point_bits + 2).max(status_bits + 1);
-        check_capacity(num_paths.into(), num_points.into())?;
-        if makespan == 0 {
-            return Err(HlsError::Schedule("schedule holds no job".into()));
-        }
+        let l = Layout::of(platform)?;
         Ok(Design {
-            input: input.clone(),
+            platform: platform.clone(),
             model,
-            schedule: schedule.clone(),
-            budgets,
-            first_point,
-            num_points,
-            num_paths,
-            num_instances,
-            makespan,
-            path_bits,
-            point_bits,
-            inst_bits: bits_for(num_instances.into()),
-            slot_bits: bits_for(makespan.into()),
-            status_base: 1 << status_bits,
-            point_base: 1 << point_region_bits,
+            steps,
+            num_instances: l.num_instances,
+            path_bits: l.path_bits,
+            point_bits: l.point_bits,
+            inst_bits: l.inst_bits,
+            status_base: l.status_base,
+            point_base: l.point_base,
+            sched_base: l.sched_base,
         })
-    }
-
-    /// Cycles from the start command to `done` (the `CYCLES` register): initialise the point
-    /// memory (one point per cycle), then per slot load operands (instances + 1), run the PEs
-    /// ([`PE_LATENCY`]) and write back (instances + 1).
-    pub fn predicted_cycles(&self) -> u64 {
-        crate::plan::run_cycles(self.num_points.into(), self.num_instances, self.makespan)
     }
 
     /// Cycles of one schedule slot.
     pub fn cycles_per_slot(&self) -> u32 {
         crate::plan::cycles_per_slot(self.num_instances) as u32
     }
+}
+
+/// The fixed-point model of the platform's planes alone (no path): quantised planes and
+/// early-stopping boxes, which the PEs and `bt_top` bake in.
+pub(crate) fn platform_model(platform: &Platform) -> Result<FixedIpc, HlsError> {
+    let input = HlsInput {
+        planes: platform.planes.clone(),
+        paths: Vec::new(),
+        init_points: Vec::new(),
+        tx: [0.0; 3],
+        rx: [1.0; 3],
+        threshold_lsb: platform.threshold_lsb,
+        max_rounds: 1,
+        test_vectors: Vec::new(),
+        early_stop: platform.early_stop,
+    };
+    input.model()
+}
+
+fn step_design(platform: &Platform, k: usize, w: &StepWork) -> Result<StepDesign, HlsError> {
+    let input = &w.input;
+    let schedule = &w.schedule;
+    let mut problems = Vec::new();
+    if input.paths.is_empty() {
+        problems.push(format!("step {k}: no candidate path"));
+    }
+    if input.planes != platform.planes {
+        problems.push(format!(
+            "step {k}: its planes differ from the platform's (a moving surface needs the host)"
+        ));
+    }
+    if input.threshold_lsb != platform.threshold_lsb || input.early_stop != platform.early_stop {
+        problems.push(format!(
+            "step {k}: threshold or early stopping differs from the platform's"
+        ));
+    }
+    if let Err(e) = input.vectors() {
+        problems.push(format!("step {k} test vector: {e}"));
+    }
+    if !problems.is_empty() {
+        return Err(HlsError::InvalidInput { problems });
+    }
+    let model = input.model()?;
+    let mut budgets = vec![0u32; input.paths.len()];
+    for row in &schedule.slots {
+        for job in row.iter().flatten() {
+            if let Some(b) = budgets.get_mut(job.path as usize) {
+                *b = (*b).max(job.round + 1);
+            }
+        }
+    }
+    let problem = Problem {
+        num_planes: input.planes.len() as u32,
+        paths: input
+            .paths
+            .iter()
+            .zip(&budgets)
+            .map(|(planes, &rounds)| PathJob {
+                planes: planes.clone(),
+                rounds,
+            })
+            .collect(),
+    };
+    schedule
+        .check(&problem)
+        .map_err(|e| HlsError::Schedule(format!("step {k}: {e}")))?;
+    let makespan = schedule.makespan();
+    if makespan == 0 {
+        return Err(HlsError::Schedule(format!(
+            "step {k}: schedule holds no job"
+        )));
+    }
+    let columns = schedule
+        .instances
+        .iter()
+        .map(|inst| {
+            platform
+                .instances
+                .iter()
+                .position(|p| p == inst)
+                .map(|c| c as u32)
+                .ok_or_else(|| {
+                    HlsError::Schedule(format!(
+                        "step {k}: PE (plane {}, copy {}) is not on the platform",
+                        inst.plane, inst.copy
+                    ))
+                })
+        })
+        .collect::<Result<Vec<u32>, HlsError>>()?;
+    let mut first_point = Vec::with_capacity(input.paths.len());
+    let mut num_points = 0u32;
+    for p in &input.paths {
+        first_point.push(num_points);
+        num_points += p.len() as u32;
+    }
+    let num_paths = input.paths.len() as u32;
+    let cap = platform.capacity;
+    if num_paths > cap.paths || num_points > cap.points || makespan > cap.slots {
+        return Err(HlsError::TooLarge(format!(
+            "step {k}: {num_paths} paths, {num_points} points, {makespan} slots exceed the \
+             platform's capacity of {} paths, {} points, {} slots",
+            cap.paths, cap.points, cap.slots
+        )));
+    }
+    Ok(StepDesign {
+        input: input.clone(),
+        model,
+        schedule: schedule.clone(),
+        budgets,
+        first_point,
+        num_paths,
+        makespan,
+        columns,
+    })
 }

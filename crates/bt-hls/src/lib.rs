@@ -32,14 +32,17 @@ use bt_schedule::Schedule;
 
 pub use bt_fixed::{BoundsM, EarlyStop, FixedOutcome, PathResult};
 pub use error::HlsError;
-pub use input::{ADDRESS_BITS, HlsInput, PE_LATENCY, PlaneSpec, check_capacity};
+pub use input::{ADDRESS_BITS, Capacity, HlsInput, PE_LATENCY, PlaneSpec, Platform, StepWork};
 pub use pe::{POINT_BITS, pe_module_name};
 pub use plan::{Plan, PlanOptions, ScheduleKind, cycles_per_slot, plan, run_cycles};
-pub use tools::{LintReport, SimReport, SynthReport, lint, simulate, synthesize};
+pub use tools::{
+    LintReport, SimProgress, SimReport, Simulator, SynthReport, lint, simulate, simulate_with,
+    synthesize,
+};
 pub use top::MAP_VERSION;
 
 use error::io_err;
-use input::Design;
+use input::{Design, StepDesign};
 
 /// Word addresses of the control registers (Avalon-MM, 32-bit words).
 pub mod regs {
@@ -47,7 +50,7 @@ pub mod regs {
     pub const CTRL: u32 = 0;
     /// R: clock cycles of the last run (start command to done).
     pub const CYCLES: u32 = 1;
-    /// R: `{instances[7:0], version[7:0], paths[15:0]}`.
+    /// R: `{instances[7:0], version[7:0], path capacity[15:0]}`.
     pub const INFO: u32 = 2;
     /// R: convergence threshold, fine LSB.
     pub const THRESHOLD: u32 = 3;
@@ -55,6 +58,8 @@ pub mod regs {
     pub const TX: u32 = 4;
     /// RW: RX x, y, z (millimetre words) at 8, 9, 10.
     pub const RX: u32 = 8;
+    /// RW: slots of the loaded schedule (the run's makespan).
+    pub const SLOTS: u32 = 12;
 }
 
 /// What [`generate`] produced.
@@ -62,45 +67,74 @@ pub mod regs {
 pub struct Report {
     /// Written files, relative to the output directory, sorted.
     pub files: Vec<String>,
-    /// PE instances (columns of the schedule).
+    /// PE instances (columns of the schedule memory).
     pub num_instances: u32,
-    /// Schedule makespan, slots.
-    pub makespan: u32,
-    /// Cycles per slot: `2·(instances + 1) + PE_LATENCY`.
+    /// RAM sizes of the platform.
+    pub capacity: Capacity,
+    /// Schedule makespan of each step, slots.
+    pub makespans: Vec<u32>,
+    /// Cycles per slot: `2·(instances + 2) + PE_LATENCY`.
     pub cycles_per_slot: u32,
-    /// Predicted `CYCLES` register value: `points + makespan · cycles_per_slot`.
-    pub predicted_cycles: u64,
-    /// Predicted testbench clock edges for the whole bus program (see [`bus_cycles_formula`]).
+    /// Predicted `CYCLES` register value of every run (steps in order, each step's vectors in
+    /// order): `makespan · cycles_per_slot`.
+    pub run_cycles: Vec<u64>,
+    /// Predicted testbench clock edges for the whole bus program (1 per write, 2 per read,
+    /// 1 + CYCLES per start).
     pub predicted_tb_cycles: u64,
+    /// Bus writes the host makes to load every step's work (schedule, start points, TX/RX).
+    pub load_writes: u64,
     /// Word address of path 0's status word.
     pub status_base: u32,
     /// Word address of point 0's first word.
     pub point_base: u32,
+    /// Word address of the first schedule entry.
+    pub sched_base: u32,
     /// Register map and cycle formulas (markdown), also in `report.md`.
     pub docs: String,
 }
 
-/// The exact testbench cost of one vector, in clock edges: 6 single-cycle writes (TX, RX),
-/// the start write plus `cycles`, and 2 edges per read (`1 + paths + 4·points` reads).
-pub fn bus_cycles_formula(cycles: u64, num_paths: u64, num_points: u64) -> u64 {
-    6 + 1 + cycles + 2 * (1 + num_paths + 4 * num_points)
+/// One bus operation of the host program (and of the testbench's stimulus).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub enum BusOp {
+    /// Single-cycle write `(word address, data)`.
+    Write(u32, u32),
+    /// Read `(word address, expected data from the model)`.
+    Read(u32, u32),
+    /// Write CTRL = 1 and wait for the interrupt; the run's predicted `CYCLES`.
+    Start(u64),
 }
 
-/// Expected bus words of one vector, from the fixed-point model.
+impl BusOp {
+    /// Testbench clock edges of the operation.
+    pub fn tb_cycles(self) -> u64 {
+        match self {
+            BusOp::Write(..) => 1,
+            BusOp::Read(..) => 2,
+            BusOp::Start(c) => 1 + c,
+        }
+    }
+}
+
+/// Expected bus words of one run, from the fixed-point model.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct VectorExpectation {
+    /// Time step (index into the design's work).
+    pub step: usize,
     /// TX, millimetre words.
     pub tx: FixedPoint,
     /// RX, millimetre words.
     pub rx: FixedPoint,
     /// `(word address, expected data)` of every read, in program order.
     pub reads: Vec<(u32, u32)>,
+    /// Predicted `CYCLES`.
+    pub cycles: u64,
     /// Model outcome per path.
     pub paths: Vec<PathResult>,
 }
 
 /// The status word of a path:
-/// `{rounds[15:0], 12'b0, left_bounds, overflow, zero_sum, converged}`.
+/// `{rounds[15:0], 12'b0, left_bounds, overflow, zero_sum, converged}`. The final points are
+/// in bank `rounds & 1`.
 pub fn status_word(r: &PathResult) -> u32 {
     (r.rounds.min(0xffff) << 16)
         | (u32::from(r.left_bounds) << 3)
@@ -109,109 +143,222 @@ pub fn status_word(r: &PathResult) -> u32 {
         | u32::from(r.converged)
 }
 
-fn expectations(d: &Design) -> Result<Vec<VectorExpectation>, HlsError> {
-    let predicted = d.predicted_cycles() as u32;
-    d.input
-        .vectors()?
-        .into_iter()
-        .map(|[tx, rx]| {
-            let paths = d.model.run_fixed(tx, rx, Some(&d.budgets));
-            let mut reads = vec![(regs::CYCLES, predicted)];
-            for (p, r) in paths.iter().enumerate() {
-                reads.push((d.status_base + p as u32, status_word(r)));
-            }
-            for (p, r) in paths.iter().enumerate() {
-                for (i, pt) in r.points.iter().enumerate() {
-                    let base = d.point_base + 4 * (d.first_point[p] + i as u32);
-                    for (k, c) in pt.iter().enumerate() {
-                        reads.push((base + k as u32, c.floor_mm().0 as u32));
-                    }
-                    let frac = u32::from(pt[0].frac())
-                        | u32::from(pt[1].frac()) << 8
-                        | u32::from(pt[2].frac()) << 16;
-                    reads.push((base + 3, frac));
-                }
-            }
-            Ok(VectorExpectation {
-                tx,
-                rx,
-                reads,
-                paths,
-            })
-        })
-        .collect()
+/// Word address of word `word` (0-3) of point `g` in `bank`.
+fn point_addr(d: &Design, g: u32, bank: u32, word: u32) -> u32 {
+    d.point_base + 8 * g + 4 * bank + word
 }
 
-fn bus_program(vectors: &[VectorExpectation]) -> Vec<u32> {
-    let mut prog = Vec::new();
-    for v in vectors {
-        for (k, c) in v.tx.iter().enumerate() {
-            prog.extend([1, regs::TX + k as u32, c.0 as u32]);
+/// The schedule-memory writes of one step: every entry of slots `0..makespan`, every column
+/// (empty entries are written as 0, so nothing of an earlier step survives), then `SLOTS`.
+fn schedule_writes(d: &Design, s: &StepDesign, ops: &mut Vec<BusOp>) {
+    let (pb, ptb, ib) = (d.path_bits, d.point_bits, d.inst_bits);
+    let k = d.num_instances as usize;
+    let mut last_of_round = std::collections::BTreeMap::new();
+    for (t, row) in s.schedule.slots.iter().enumerate() {
+        for (i, job) in row.iter().enumerate() {
+            if let Some(job) = job {
+                last_of_round.insert((job.path, job.round), (t, s.columns[i]));
+            }
         }
-        for (k, c) in v.rx.iter().enumerate() {
-            prog.extend([1, regs::RX + k as u32, c.0 as u32]);
+    }
+    for t in 0..s.makespan as usize {
+        let mut row = vec![0u32; k];
+        for (i, job) in s.schedule.slots[t].iter().enumerate() {
+            let Some(job) = job else { continue };
+            let col = s.columns[i];
+            let n = s.input.paths[job.path as usize].len() as u32;
+            let point = s.first_point[job.path as usize] + job.point;
+            let end = last_of_round[&(job.path, job.round)] == (t, col);
+            row[col as usize] = 1
+                | job.path << 1
+                | point << (1 + pb)
+                | u32::from(job.point == 0) << (1 + pb + ptb)
+                | u32::from(job.point + 1 == n) << (2 + pb + ptb)
+                | u32::from(end) << (3 + pb + ptb);
         }
-        prog.extend([3, regs::CTRL, 1]);
-        for &(addr, _) in &v.reads {
-            prog.extend([2, addr, 0]);
+        for (col, word) in row.into_iter().enumerate() {
+            ops.push(BusOp::Write(
+                d.sched_base + ((t as u32) << ib) + col as u32,
+                word,
+            ));
+        }
+    }
+    ops.push(BusOp::Write(regs::SLOTS, s.makespan));
+}
+
+/// One run of step `s`: write the start points (bank 0) and TX/RX, start, read CYCLES, every
+/// status word and every final point.
+fn run_ops(
+    d: &Design,
+    s: &StepDesign,
+    step: usize,
+    [tx, rx]: [FixedPoint; 2],
+) -> (Vec<BusOp>, VectorExpectation) {
+    let mut ops = Vec::new();
+    for p in 0..s.num_paths as usize {
+        for (i, pt) in s.model.init_points(p).iter().enumerate() {
+            let g = s.first_point[p] + i as u32;
+            for (k, c) in pt.iter().enumerate() {
+                ops.push(BusOp::Write(
+                    point_addr(d, g, 0, k as u32),
+                    c.floor_mm().0 as u32,
+                ));
+            }
+            ops.push(BusOp::Write(point_addr(d, g, 0, 3), frac_word(pt)));
+        }
+    }
+    for (k, c) in tx.iter().enumerate() {
+        ops.push(BusOp::Write(regs::TX + k as u32, c.0 as u32));
+    }
+    for (k, c) in rx.iter().enumerate() {
+        ops.push(BusOp::Write(regs::RX + k as u32, c.0 as u32));
+    }
+    let cycles = crate::plan::run_cycles(d.num_instances, s.makespan);
+    ops.push(BusOp::Start(cycles));
+    let paths = s.model.run_fixed(tx, rx, Some(&s.budgets));
+    let mut reads = vec![(regs::CYCLES, cycles as u32)];
+    for (p, r) in paths.iter().enumerate() {
+        reads.push((d.status_base + p as u32, status_word(r)));
+    }
+    for (p, r) in paths.iter().enumerate() {
+        for (i, pt) in r.points.iter().enumerate() {
+            let g = s.first_point[p] + i as u32;
+            let bank = r.rounds & 1;
+            for (k, c) in pt.iter().enumerate() {
+                reads.push((point_addr(d, g, bank, k as u32), c.floor_mm().0 as u32));
+            }
+            reads.push((point_addr(d, g, bank, 3), frac_word(pt)));
+        }
+    }
+    ops.extend(reads.iter().map(|&(a, v)| BusOp::Read(a, v)));
+    let v = VectorExpectation {
+        step,
+        tx,
+        rx,
+        reads,
+        cycles,
+        paths,
+    };
+    (ops, v)
+}
+
+fn frac_word(pt: &bt_fixed::FinePoint) -> u32 {
+    u32::from(pt[0].frac()) | u32::from(pt[1].frac()) << 8 | u32::from(pt[2].frac()) << 16
+}
+
+/// The whole host program of the design (every step: load the schedule once, then per vector
+/// load the start points and TX/RX, run, read back) and the model's expectation per run.
+fn host_program(d: &Design) -> Result<(Vec<BusOp>, Vec<VectorExpectation>), HlsError> {
+    let mut ops = Vec::new();
+    let mut runs = Vec::new();
+    for (k, s) in d.steps.iter().enumerate() {
+        schedule_writes(d, s, &mut ops);
+        for v in s.input.vectors()? {
+            let (o, e) = run_ops(d, s, k, v);
+            ops.extend(o);
+            runs.push(e);
+        }
+    }
+    Ok((ops, runs))
+}
+
+/// The testbench stimulus: 3 words per operation (1 = write addr data, 2 = read addr, 3 =
+/// start addr data, 0 = end).
+fn stimulus(ops: &[BusOp]) -> Vec<u32> {
+    let mut prog = Vec::with_capacity(3 * ops.len() + 3);
+    for op in ops {
+        match *op {
+            BusOp::Write(a, v) => prog.extend([1, a, v]),
+            BusOp::Read(a, _) => prog.extend([2, a, 0]),
+            BusOp::Start(_) => prog.extend([3, regs::CTRL, 1]),
         }
     }
     prog.extend([0, 0, 0]);
     prog
 }
 
-fn register_map(d: &Design, report_cycles: u64, tb_cycles: u64) -> String {
+/// Words the testbench's program memory holds (`prog` in `bt_tb.v`).
+pub const TB_PROGRAM_WORDS: usize = 1 << 22;
+
+fn register_map(d: &Design) -> String {
+    let cap = d.platform.capacity;
     let mut s = String::new();
     s.push_str("# bt_top register map (Avalon-MM slave)\n\n");
     s.push_str(
         "32-bit data, word addresses on `avs_address[15:0]`, no waitrequest, single-cycle writes, \
          pipelined reads with a fixed latency of 2 cycles (`avs_readdatavalid` marks the data), \
          interrupt `ins_irq` = done (level, cleared by the next start). Coordinates on the bus \
-         are millimetre words (two's complement, metres x 1000).\n\n",
+         are millimetre words (two's complement, metres x 1000). Writes other than CTRL are \
+         ignored while busy.\n\n",
     );
     s.push_str("| address | access | name | content |\n|---|---|---|---|\n");
     s.push_str("| 0x0000 | W | CTRL | bit 0 = 1 starts a run (ignored while busy) |\n");
     s.push_str("| 0x0000 | R | STATUS | bit 0 busy, bit 1 done |\n");
     s.push_str("| 0x0001 | R | CYCLES | clock cycles of the last run |\n");
     s.push_str(&format!(
-        "| 0x0002 | R | INFO | `{{instances[7:0], version[7:0], paths[15:0]}}` = 0x{:08x} |\n",
-        (d.num_instances << 24) | (MAP_VERSION << 16) | (d.num_paths & 0xffff)
+        "| 0x0002 | R | INFO | `{{instances[7:0], version[7:0], path capacity[15:0]}}` = 0x{:08x} |\n",
+        (d.num_instances << 24) | (MAP_VERSION << 16) | (cap.paths & 0xffff)
     ));
     s.push_str(&format!(
         "| 0x0003 | R | THRESHOLD | {} fine LSB (1/256 mm) |\n",
-        d.input.threshold_lsb
+        d.platform.threshold_lsb
     ));
     s.push_str("| 0x0004-0x0006 | RW | TX_X, TX_Y, TX_Z | transmitter, mm |\n");
     s.push_str("| 0x0008-0x000a | RW | RX_X, RX_Y, RX_Z | receiver, mm |\n");
     s.push_str(&format!(
+        "| 0x000c | RW | SLOTS | slots of the loaded schedule, 1 to {} |\n",
+        cap.slots
+    ));
+    s.push_str(&format!(
         "| 0x{:04x} + p | R | PATH_STATUS[p] | `{{rounds[15:0], 12'b0, left_bounds, overflow, zero_sum, converged}}`, p < {} |\n",
-        d.status_base, d.num_paths
+        d.status_base, cap.paths
     ));
     s.push_str(&format!(
-        "| 0x{:04x} + 4i + {{0,1,2}} | R | POINT[i].X/Y/Z | floor(mm) of point i, i < {} |\n",
-        d.point_base, d.num_points
+        "| 0x{:04x} + 8i + 4b + {{0,1,2}} | RW | POINT[i].X/Y/Z, bank b | floor(mm) of point i, i < {} |\n",
+        d.point_base, cap.points
     ));
     s.push_str(&format!(
-        "| 0x{:04x} + 4i + 3 | R | POINT[i].FRAC | `{{8'b0, z_frac, y_frac, x_frac}}` (1/256 mm; value = mm + frac/256) |\n\n",
+        "| 0x{:04x} + 8i + 4b + 3 | RW | POINT[i].FRAC, bank b | `{{8'b0, z_frac, y_frac, x_frac}}` (1/256 mm; value = mm + frac/256); a write stores the point (X, Y, Z written before) |\n",
         d.point_base
     ));
+    s.push_str(&format!(
+        "| 0x{:04x} + (t << {}) + c | W | SCHED[t][c] | job of PE column c in slot t: `{{end, last, first, point[{}:0], path[{}:0], valid}}` from bit 0 up, t < {} |\n\n",
+        d.sched_base,
+        d.inst_bits,
+        d.point_bits - 1,
+        d.path_bits - 1,
+        cap.slots
+    ));
+    s.push_str("PE columns: ");
+    let cols: Vec<String> = d
+        .platform
+        .instances
+        .iter()
+        .enumerate()
+        .map(|(c, i)| format!("{c} = plane {} copy {}", i.plane, i.copy))
+        .collect();
+    s.push_str(&cols.join(", "));
+    s.push_str(".\n\n");
     s.push_str(
-        "Point words are valid only while idle (after done). Point i of path p is global index \
-                `first_point[p] + i`, paths in input order, points TX side first.\n\n",
-    );
-    s.push_str(
-        "Driver sequence: write TX_X..RX_Z, write CTRL = 1, wait for `ins_irq` (or poll STATUS \
-                bit 1), read CYCLES, PATH_STATUS[*], POINT[*].\n\n",
+        "Per time step the host writes the schedule (every entry of slots 0..SLOTS-1, empty ones \
+         as 0) and SLOTS; per run it writes every path point's start value into bank 0 \
+         (X, Y, Z, then FRAC), TX_X..RX_Z, CTRL = 1, waits for `ins_irq` (or polls STATUS bit 1), \
+         then reads CYCLES, PATH_STATUS[*] and each point in bank `rounds & 1` of its path. \
+         Point i of path p is global index `first_point[p] + i` (paths in order, points TX \
+         side first); `first`/`last` mark the points next to TX/RX, `end` the last job of a \
+         path's round.\n\n",
     );
     s.push_str("## Cycle formulas (exact, checked by co-simulation)\n\n");
     s.push_str(&format!(
-        "* CYCLES = points + makespan x (2 x (instances + 1) + PE_LATENCY) = {} + {} x (2 x ({} + 1) + {}) = {}\n",
-        d.num_points, d.makespan, d.num_instances, PE_LATENCY, report_cycles
+        "* CYCLES = SLOTS x (2 x (instances + 2) + PE_LATENCY) = SLOTS x (2 x ({} + 2) + {}) = SLOTS x {}\n",
+        d.num_instances,
+        PE_LATENCY,
+        d.cycles_per_slot()
     ));
-    s.push_str(&format!(
-        "* testbench edges per vector = 6 writes + (1 + CYCLES) + 2 x (1 + paths + 4 x points) reads; all vectors: {tb_cycles}\n"
-    ));
-    s.push_str("* at 50 MHz (the paper's clock) one run takes CYCLES x 20 ns\n");
+    s.push_str(
+        "* testbench edges: 1 per write, 2 per read, 1 + CYCLES per start\n\
+         * at 50 MHz (the paper's clock) one run takes CYCLES x 20 ns\n",
+    );
     s
 }
 
@@ -226,65 +373,77 @@ fn write(
     Ok(())
 }
 
-/// The generated modules (PEs of the planes the schedule instantiates, then `bt_top`), as
+/// The generated modules (PEs of the platform's planes, then `bt_top`), as
 /// `(module name, Verilog text)`. Pure function of the inputs.
-pub fn rtl_modules(
-    input: &HlsInput,
-    schedule: &Schedule,
-) -> Result<Vec<(String, String)>, HlsError> {
-    let d = Design::new(input, schedule)?;
-    rtl_of(&d)
+pub fn rtl_modules(platform: &Platform) -> Result<Vec<(String, String)>, HlsError> {
+    let model = input::platform_model(platform)?;
+    rtl_of(platform, &model)
 }
 
-fn rtl_of(d: &Design) -> Result<Vec<(String, String)>, HlsError> {
+fn rtl_of(
+    platform: &Platform,
+    model: &bt_fixed::FixedIpc,
+) -> Result<Vec<(String, String)>, HlsError> {
     let planes: std::collections::BTreeSet<u32> =
-        d.schedule.instances.iter().map(|i| i.plane).collect();
+        platform.instances.iter().map(|i| i.plane).collect();
     let mut out = Vec::new();
     for p in planes {
-        let spec = &d.input.planes[p as usize];
-        let m = pe::pe_module(p as usize, &spec.name, &d.model.planes()[p as usize])?;
+        let spec = &platform.planes[p as usize];
+        let m = pe::pe_module(p as usize, &spec.name, &model.planes()[p as usize])?;
         out.push((m.name.clone(), verilog::print_module(&m)));
     }
-    let top = top::top_module(d);
+    let top = top::top_module(&top::TopParams::of(platform, model)?);
     out.push((top.name.clone(), verilog::print_module(&top)));
     Ok(out)
 }
 
-/// Generates the accelerator for `input` scheduled by `schedule` into `out_dir`:
-/// `rtl/<module>.v`, `tb/bt_tb.v`, `tb/stim.hex`, `vectors/vector_<n>.json`,
-/// `schedule.json`, `hls_input.json`, `report.md`. Deterministic: same inputs, same bytes.
+/// Generates the accelerator of one run: [`generate_steps`] with the smallest platform for
+/// `input` scheduled by `schedule`.
+pub fn generate(input: &HlsInput, schedule: &Schedule, out_dir: &Path) -> Result<Report, HlsError> {
+    let work = vec![StepWork {
+        input: input.clone(),
+        schedule: schedule.clone(),
+    }];
+    generate_steps(&Platform::fitting(&work)?, &work, out_dir)
+}
+
+/// Generates ONE accelerator (`platform`) and the host program that runs every step of `work`
+/// through it into `out_dir`: `rtl/<module>.v`, `tb/bt_tb.v`, `tb/stim.hex`,
+/// `vectors/vector_<n>.json` (one per run), `platform.json`, `work.json`, `report.md`,
+/// `report.json`. Deterministic: same inputs, same bytes.
+///
 /// The directory is built aside and swapped in (`bt_output::OutputDir`): files of the user's in
 /// `out_dir` are never touched, files of a previous run are replaced.
-pub fn generate(input: &HlsInput, schedule: &Schedule, out_dir: &Path) -> Result<Report, HlsError> {
+pub fn generate_steps(
+    platform: &Platform,
+    work: &[StepWork],
+    out_dir: &Path,
+) -> Result<Report, HlsError> {
     let mut out = OutputDir::begin(out_dir, &[])?;
-    let report = generate_into(input, schedule, &mut out)?;
+    let report = generate_steps_into(platform, work, &mut out)?;
     out.commit()?;
     Ok(report)
 }
 
-/// [`generate`] into an output directory under construction (the caller adds its own files
-/// and commits).
-pub fn generate_into(
-    input: &HlsInput,
-    schedule: &Schedule,
+/// [`generate_steps`] into an output directory under construction (the caller adds its own
+/// files and commits).
+pub fn generate_steps_into(
+    platform: &Platform,
+    work: &[StepWork],
     out_dir: &mut OutputDir,
 ) -> Result<Report, HlsError> {
-    let d = Design::new(input, schedule)?;
-    let modules = rtl_of(&d)?;
-    let vectors = expectations(&d)?;
-    let prog = bus_program(&vectors);
-    if prog.len() > 262_144 {
+    let d = Design::new(platform, work)?;
+    let modules = rtl_of(platform, &d.model)?;
+    let (ops, runs) = host_program(&d)?;
+    let prog = stimulus(&ops);
+    if prog.len() > TB_PROGRAM_WORDS {
         return Err(HlsError::TooLarge(format!(
-            "bus program of {} words exceeds the testbench's 262144",
+            "bus program of {} words exceeds the testbench's {TB_PROGRAM_WORDS}",
             prog.len()
         )));
     }
-    let predicted_cycles = d.predicted_cycles();
-    let predicted_tb_cycles: u64 = vectors
-        .iter()
-        .map(|_| bus_cycles_formula(predicted_cycles, d.num_paths.into(), d.num_points.into()))
-        .sum();
-    let docs = register_map(&d, predicted_cycles, predicted_tb_cycles);
+    let predicted_tb_cycles: u64 = ops.iter().map(|o| o.tb_cycles()).sum();
+    let docs = register_map(&d);
     let mut files = Vec::new();
     for (name, text) in &modules {
         write(
@@ -302,7 +461,7 @@ pub fn generate_into(
     )?;
     let hex: String = prog.iter().map(|w| format!("{w:08x}\n")).collect();
     write(out_dir, "tb/stim.hex", hex.as_bytes(), &mut files)?;
-    for (n, v) in vectors.iter().enumerate() {
+    for (n, v) in runs.iter().enumerate() {
         write(
             out_dir,
             &format!("vectors/vector_{n}.json"),
@@ -310,28 +469,35 @@ pub fn generate_into(
             &mut files,
         )?;
     }
-    write(out_dir, "schedule.json", &to_json(schedule)?, &mut files)?;
-    write(out_dir, "hls_input.json", &to_json(input)?, &mut files)?;
+    write(out_dir, "platform.json", &to_json(platform)?, &mut files)?;
+    write(out_dir, "work.json", &to_json(&work)?, &mut files)?;
+    let load_writes = ops.iter().filter(|o| matches!(o, BusOp::Write(..))).count() as u64;
     let report = Report {
         files: Vec::new(),
         num_instances: d.num_instances,
-        makespan: d.makespan,
+        capacity: platform.capacity,
+        makespans: d.steps.iter().map(|s| s.makespan).collect(),
         cycles_per_slot: d.cycles_per_slot(),
-        predicted_cycles,
+        run_cycles: runs.iter().map(|r| r.cycles).collect(),
         predicted_tb_cycles,
+        load_writes,
         status_base: d.status_base,
         point_base: d.point_base,
+        sched_base: d.sched_base,
         docs: docs.clone(),
     };
     let mut md = docs;
     md.push_str(&format!(
-        "\n## Design\n\n* {} paths, {} points, {} PE instances ({} planes), makespan {} slots\n* PE latency {} cycles\n",
-        d.num_paths,
-        d.num_points,
+        "\n## Design\n\n* {} PE instances ({} planes), capacity {} paths, {} points, {} slots\n* PE latency {} cycles\n* {} steps, {} runs; makespan per step {:?}\n",
         d.num_instances,
         modules.len() - 1,
-        d.makespan,
-        PE_LATENCY
+        platform.capacity.paths,
+        platform.capacity.points,
+        platform.capacity.slots,
+        PE_LATENCY,
+        d.steps.len(),
+        runs.len(),
+        report.makespans
     ));
     write(out_dir, "report.md", md.as_bytes(), &mut files)?;
     write(out_dir, "report.json", &to_json(&report)?, &mut files)?;
@@ -339,7 +505,7 @@ pub fn generate_into(
     Ok(Report { files, ..report })
 }
 
-fn to_json<T: serde::Serialize>(v: &T) -> Result<Vec<u8>, HlsError> {
+fn to_json<T: serde::Serialize + ?Sized>(v: &T) -> Result<Vec<u8>, HlsError> {
     let mut s = serde_json::to_vec_pretty(v).map_err(|e| HlsError::Parse {
         what: "json serialisation".into(),
         message: e.to_string(),
@@ -356,9 +522,7 @@ pub(crate) fn read_json<T: serde::de::DeserializeOwned>(path: &Path) -> Result<T
     })
 }
 
-/// Paths of the generated RTL files in `out_dir`, sorted: the `rtl/*.v` files the generator
-/// listed in the directory's manifest (a user's own files beside them are not ours to
-/// simulate), or every `rtl/*.v` of a directory without a manifest.
+/// Paths of the generated RTL files in `out_dir`, sorted.
 pub fn rtl_files(out_dir: &Path) -> Result<Vec<PathBuf>, HlsError> {
     if let Some(listed) = bt_output::manifest_files(out_dir) {
         return Ok(listed
@@ -377,10 +541,9 @@ pub fn rtl_files(out_dir: &Path) -> Result<Vec<PathBuf>, HlsError> {
     Ok(files)
 }
 
-pub(crate) fn recompute(out_dir: &Path) -> Result<(Design, Vec<VectorExpectation>), HlsError> {
-    let input: HlsInput = read_json(&out_dir.join("hls_input.json"))?;
-    let schedule: Schedule = read_json(&out_dir.join("schedule.json"))?;
-    let d = Design::new(&input, &schedule)?;
-    let v = expectations(&d)?;
-    Ok((d, v))
+pub(crate) fn recompute(out_dir: &Path) -> Result<(Vec<BusOp>, Vec<VectorExpectation>), HlsError> {
+    let platform: Platform = read_json(&out_dir.join("platform.json"))?;
+    let work: Vec<StepWork> = read_json(&out_dir.join("work.json"))?;
+    let d = Design::new(&platform, &work)?;
+    host_program(&d)
 }

@@ -57,16 +57,17 @@ pub struct Plan {
     pub predicted_cycles: u64,
 }
 
-/// Cycles of one schedule slot with `instances` PE instances: load operands (instances + 1),
-/// run the PEs ([`PE_LATENCY`]), write back (instances + 1).
+/// Cycles of one schedule slot with `instances` PE instances: load operands (instances + 2:
+/// the schedule memory's registered read adds one), run the PEs ([`PE_LATENCY`]), write back
+/// (instances + 2).
 pub fn cycles_per_slot(instances: u32) -> u64 {
-    2 * (u64::from(instances) + 1) + u64::from(PE_LATENCY)
+    2 * (u64::from(instances) + 2) + u64::from(PE_LATENCY)
 }
 
-/// Cycles of one accelerator run (the `CYCLES` register): initialise the point memory (one
-/// point per cycle), then `makespan` slots of [`cycles_per_slot`].
-pub fn run_cycles(points: u64, instances: u32, makespan: u32) -> u64 {
-    points + u64::from(makespan) * cycles_per_slot(instances)
+/// Cycles of one accelerator run (the `CYCLES` register): `makespan` slots of
+/// [`cycles_per_slot`] (the host writes the start points before the start command).
+pub fn run_cycles(instances: u32, makespan: u32) -> u64 {
+    u64::from(makespan) * cycles_per_slot(instances)
 }
 
 /// Schedule `problem` (from [`crate::HlsInput::problem`] or
@@ -104,7 +105,7 @@ pub fn plan(problem: &Problem, options: &PlanOptions) -> Result<Plan, HlsError> 
     let stats = schedule.stats(problem);
     let points: u64 = problem.paths.iter().map(|p| p.planes.len() as u64).sum();
     Ok(Plan {
-        predicted_cycles: run_cycles(points, stats.instances, stats.makespan),
+        predicted_cycles: run_cycles(stats.instances, stats.makespan),
         cycles_per_slot: cycles_per_slot(stats.instances),
         schedule,
         stats,

@@ -1,4 +1,4 @@
-//! Driving the external tools: Verilator (lint), Icarus Verilog (co-simulation), Yosys
+//! Driving the external tools: Verilator (lint, co-simulation), Icarus Verilog (co-simulation), Yosys
 //! (synthesis). A missing tool is [`HlsError::ToolMissing`], never a panic.
 
 use std::collections::BTreeMap;
@@ -6,7 +6,7 @@ use std::path::Path;
 use std::process::{Command, Output};
 
 use crate::error::io_err;
-use crate::{HlsError, bus_cycles_formula, recompute, rtl_files};
+use crate::{BusOp, HlsError, VectorExpectation, recompute, rtl_files};
 
 /// Runs `tool args` in `dir`; maps "not found" to [`HlsError::ToolMissing`].
 fn run(tool: &str, package: &str, args: &[String], dir: &Path) -> Result<Output, HlsError> {
@@ -105,18 +105,58 @@ pub fn lint(out_dir: &Path) -> Result<LintReport, HlsError> {
     Ok(report)
 }
 
+/// Which simulator runs the testbench.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Simulator {
+    /// Verilator 5 (`--binary --timing`): compiles the design to C++, fast enough for
+    /// room-scale designs (the default).
+    #[default]
+    Verilator,
+    /// Icarus Verilog (`iverilog -g2005`, `vvp`): an interpreter, for small designs.
+    Icarus,
+}
+
+impl Simulator {
+    /// Name in outputs.
+    pub fn name(self) -> &'static str {
+        match self {
+            Simulator::Verilator => "verilator",
+            Simulator::Icarus => "icarus",
+        }
+    }
+}
+
+/// Progress of [`simulate_with`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum SimProgress {
+    /// Compiling the design and testbench.
+    Compiling,
+    /// `done` of `total` accelerator runs finished in simulation.
+    Runs {
+        /// Runs finished.
+        done: u64,
+        /// Runs in the program.
+        total: u64,
+    },
+}
+
 /// Result of [`simulate`].
 #[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct SimReport {
-    /// `CYCLES` register read back after the design vector's run.
+    /// The simulator used.
+    pub simulator: Simulator,
+    /// `CYCLES` register read back after the first run.
     pub cycles: u64,
-    /// The exact prediction `points + makespan · cycles_per_slot`.
+    /// Its exact prediction `makespan · cycles_per_slot`.
     pub predicted_cycles: u64,
-    /// Testbench-measured edges from start to `ins_irq`, per vector.
+    /// Testbench-measured edges from start to `ins_irq`, per run.
     pub irq_cycles: Vec<u64>,
+    /// Predicted `CYCLES` per run.
+    pub predicted_run_cycles: Vec<u64>,
     /// Testbench edges of the whole bus program.
     pub tb_cycles: u64,
-    /// Predicted testbench edges ([`bus_cycles_formula`] summed over vectors).
+    /// Predicted testbench edges (1 per write, 2 per read, 1 + CYCLES per start).
     pub predicted_tb_cycles: u64,
     /// Words that differ from the `bt-fixed` model (plus protocol errors).
     pub mismatches: usize,
@@ -124,53 +164,174 @@ pub struct SimReport {
     pub mismatch_details: Vec<String>,
     /// Words read and compared.
     pub words_compared: usize,
-    /// Test vectors run.
+    /// Accelerator runs (every vector of every step).
     pub vectors: usize,
+    /// Time steps loaded.
+    pub steps: usize,
 }
 
-/// Compiles and runs the testbench with Icarus Verilog (`iverilog -g2005`, `vvp`), then
-/// compares every word read with the `bt-fixed` model recomputed from `hls_input.json` and
-/// `schedule.json`, and the cycle counts with their exact formulas.
-pub fn simulate(out_dir: &Path) -> Result<SimReport, HlsError> {
-    let (d, vectors) = recompute(out_dir)?;
-    let mut args: Vec<String> = vec![
-        "-g2005".into(),
-        "-o".into(),
-        "tb/sim.vvp".into(),
-        "-s".into(),
-        "bt_tb".into(),
-    ];
-    args.extend(rel_rtl(out_dir)?);
-    args.push("tb/bt_tb.v".into());
-    let out = run("iverilog", "iverilog", &args, out_dir)?;
-    if !out.status.success() {
-        return Err(failure("iverilog", &out));
+impl SimReport {
+    /// No mismatch, and every run's cycles and the program's edges as predicted.
+    pub fn passed(&self) -> bool {
+        self.mismatches == 0
+            && self.irq_cycles == self.predicted_run_cycles
+            && self.tb_cycles == self.predicted_tb_cycles
     }
+}
+
+/// [`simulate_with`] Verilator, without progress.
+pub fn simulate(out_dir: &Path) -> Result<SimReport, HlsError> {
+    simulate_with(out_dir, Simulator::Verilator, &mut |_| {})
+}
+
+/// Builds and runs the testbench with `simulator`, then compares every word read with the
+/// `bt-fixed` model recomputed from `platform.json` and `work.json`, and the cycle counts
+/// with their exact formulas. `progress` hears of the compilation and of every finished run.
+pub fn simulate_with(
+    out_dir: &Path,
+    simulator: Simulator,
+    progress: &mut dyn FnMut(SimProgress),
+) -> Result<SimReport, HlsError> {
+    let (ops, runs) = recompute(out_dir)?;
     let tb = out_dir.join("tb");
     let result = tb.join("sim_out.txt");
     let _ = std::fs::remove_file(&result);
-    let out = run("vvp", "iverilog", &["-n".into(), "sim.vvp".into()], &tb)?;
-    if !out.status.success() {
-        return Err(failure("vvp", &out));
-    }
+    progress(SimProgress::Compiling);
+    let total = runs.len() as u64;
+    let (exe, args) = match simulator {
+        Simulator::Icarus => {
+            let mut args: Vec<String> = vec![
+                "-g2005".into(),
+                "-o".into(),
+                "tb/sim.vvp".into(),
+                "-s".into(),
+                "bt_tb".into(),
+            ];
+            args.extend(rel_rtl(out_dir)?);
+            args.push("tb/bt_tb.v".into());
+            let out = run("iverilog", "iverilog", &args, out_dir)?;
+            if !out.status.success() {
+                return Err(failure("iverilog", &out));
+            }
+            (
+                "vvp".to_string(),
+                vec!["-n".to_string(), "sim.vvp".to_string()],
+            )
+        }
+        Simulator::Verilator => {
+            let mut args: Vec<String> = [
+                "--binary",
+                "--timing",
+                "-Wno-fatal",
+                "-Wno-lint",
+                "-Wno-style",
+                "--top-module",
+                "bt_tb",
+                "-Mdir",
+                "tb/obj_dir",
+                "-o",
+                "bt_sim",
+                "-j",
+                "2",
+            ]
+            .iter()
+            .map(|s| s.to_string())
+            .collect();
+            args.extend(rel_rtl(out_dir)?);
+            args.push("tb/bt_tb.v".into());
+            let out = run("verilator", "verilator", &args, out_dir)?;
+            if !out.status.success() {
+                return Err(failure("verilator", &out));
+            }
+            let exe = out_dir.join("tb/obj_dir/bt_sim");
+            (exe.display().to_string(), Vec::new())
+        }
+    };
+    progress(SimProgress::Runs { done: 0, total });
+    run_streaming(&exe, simulator, &args, &tb, &mut |done| {
+        progress(SimProgress::Runs { done, total })
+    })?;
     let text = std::fs::read_to_string(&result).map_err(io_err(&result))?;
-    let expected: Vec<(u32, u32)> = vectors
+    compare(simulator, &text, &ops, &runs)
+}
+
+/// Runs the simulation binary in `dir`, reporting each `P <n>` line of its stdout.
+fn run_streaming(
+    exe: &str,
+    simulator: Simulator,
+    args: &[String],
+    dir: &Path,
+    on_run: &mut dyn FnMut(u64),
+) -> Result<(), HlsError> {
+    use std::io::BufRead;
+    let package = match simulator {
+        Simulator::Icarus => "iverilog",
+        Simulator::Verilator => "verilator",
+    };
+    let mut child = Command::new(exe)
+        .args(args)
+        .current_dir(dir)
+        .stdout(std::process::Stdio::piped())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .map_err(|e| HlsError::ToolFailed {
+            tool: format!("{exe} ({package})"),
+            message: e.to_string(),
+        })?;
+    let mut tail = Vec::new();
+    if let Some(stdout) = child.stdout.take() {
+        for line in std::io::BufReader::new(stdout).lines() {
+            let line = line.map_err(io_err(dir))?;
+            match line.strip_prefix("P ").and_then(|n| n.trim().parse().ok()) {
+                Some(n) => on_run(n),
+                None => {
+                    tail.push(line);
+                    if tail.len() > 30 {
+                        tail.remove(0);
+                    }
+                }
+            }
+        }
+    }
+    let out = child.wait_with_output().map_err(io_err(dir))?;
+    if !out.status.success() {
+        let mut message = String::from_utf8_lossy(&out.stderr).into_owned();
+        message.push_str(&tail.join("\n"));
+        return Err(HlsError::ToolFailed {
+            tool: exe.to_string(),
+            message,
+        });
+    }
+    Ok(())
+}
+
+/// Compares the testbench's `sim_out.txt` with the model's expectations.
+fn compare(
+    simulator: Simulator,
+    text: &str,
+    ops: &[BusOp],
+    runs: &[VectorExpectation],
+) -> Result<SimReport, HlsError> {
+    let expected: Vec<(u32, u32)> = ops
         .iter()
-        .flat_map(|v| v.reads.iter().copied())
+        .filter_map(|o| match *o {
+            BusOp::Read(a, v) => Some((a, v)),
+            _ => None,
+        })
         .collect();
-    let predicted_cycles = d.predicted_cycles();
-    let predicted_tb_cycles = vectors.len() as u64
-        * bus_cycles_formula(predicted_cycles, d.num_paths.into(), d.num_points.into());
     let mut report = SimReport {
+        simulator,
         cycles: 0,
-        predicted_cycles,
+        predicted_cycles: runs.first().map_or(0, |r| r.cycles),
         irq_cycles: Vec::new(),
+        predicted_run_cycles: runs.iter().map(|r| r.cycles).collect(),
         tb_cycles: 0,
-        predicted_tb_cycles,
+        predicted_tb_cycles: ops.iter().map(|o| o.tb_cycles()).sum(),
         mismatches: 0,
         mismatch_details: Vec::new(),
         words_compared: 0,
-        vectors: vectors.len(),
+        vectors: runs.len(),
+        steps: runs.last().map_or(0, |r| r.step + 1),
     };
     let note = |r: &mut SimReport, s: String| {
         r.mismatches += 1;
@@ -185,6 +346,16 @@ pub fn simulate(out_dir: &Path) -> Result<SimReport, HlsError> {
                 message: format!("bad field {s:?}"),
             })
     };
+    // Run index of each read, for the messages.
+    let mut run_of_read = Vec::with_capacity(expected.len());
+    let mut run = 0usize;
+    for o in ops {
+        match o {
+            BusOp::Start(_) => run += 1,
+            BusOp::Read(..) => run_of_read.push(run.saturating_sub(1)),
+            BusOp::Write(..) => {}
+        }
+    }
     let mut reads = 0usize;
     for line in text.lines() {
         let mut f = line.split_whitespace();
@@ -194,11 +365,12 @@ pub fn simulate(out_dir: &Path) -> Result<SimReport, HlsError> {
                 match expected.get(reads) {
                     Some(&(ea, ed)) if ea == addr => {
                         if ed != data {
-                            let v = reads / (expected.len() / vectors.len()).max(1);
+                            let v = run_of_read[reads];
+                            let step = runs.get(v).map_or(0, |r| r.step);
                             note(
                                 &mut report,
                                 format!(
-                                    "vector {v} addr 0x{addr:04x}: rtl 0x{data:08x}, model 0x{ed:08x}"
+                                    "run {v} (step {step}) addr 0x{addr:04x}: rtl 0x{data:08x}, model 0x{ed:08x}"
                                 ),
                             );
                         }

@@ -1,22 +1,21 @@
 //! `bt_top`: PE matrix, scheduler ROM, coordinate updater-buffer, convergence flags and the
 //! Avalon-MM slave. Twin of `bt_fixed::FixedIpc::run_fixed` with the schedule's budgets.
 
-use bt_fixed::{FineCoord, width};
+use bt_fixed::width;
 
-use crate::input::{ADDRESS_BITS, Design, PE_LATENCY, bits_for};
+use crate::input::{ADDRESS_BITS, Layout, PE_LATENCY, bits_for, sched_entry_bits};
 use crate::pe::{POINT_BITS, SUM_BITS, pe_module_name, port};
 use crate::verilog::{BinaryOp, Direction, Expr, Item, Module, Stmt, UnaryOp};
 
 /// FSM state encodings.
 const S_IDLE: u128 = 0;
-const S_INIT: u128 = 1;
 const S_LOAD: u128 = 2;
 const S_EXEC: u128 = 3;
 const S_WB: u128 = 4;
 const STATE_BITS: u32 = 3;
 
 /// Register-map version reported in `INFO[15:8]`.
-pub const MAP_VERSION: u32 = 2;
+pub const MAP_VERSION: u32 = 3;
 
 /// Width of the early-stopping comparisons (`bt_fixed::FineBox::outside`): a 40-bit point
 /// plus or minus `(L1 move) << 4` and the ±2^41 box bounds fit in 48 signed bits.
@@ -41,43 +40,58 @@ fn or(a: Expr, b: Expr) -> Expr {
     Expr::bin(BinaryOp::Or, a, b)
 }
 
-/// Packs a fine point as the 120-bit `{z, y, x}` literal.
-fn point_literal(p: &[FineCoord; 3]) -> Expr {
-    let cw = width::COORD;
-    let mask = (1u128 << cw) - 1;
-    let v = (p[0].0 as u128 & mask)
-        | ((p[1].0 as u128 & mask) << cw)
-        | ((p[2].0 as u128 & mask) << (2 * cw));
-    lit(POINT_BITS, v)
+/// The platform-derived sizes `bt_top` is built from.
+pub(crate) struct TopParams<'a> {
+    pub platform: &'a crate::Platform,
+    pub model: &'a bt_fixed::FixedIpc,
+    pub layout: Layout,
 }
 
-pub(crate) fn top_module(d: &Design) -> Module {
-    let k = d.num_instances;
-    let (pb, ptb, ib, sb) = (d.path_bits, d.point_bits, d.inst_bits, d.slot_bits);
+impl<'a> TopParams<'a> {
+    pub fn of(
+        platform: &'a crate::Platform,
+        model: &'a bt_fixed::FixedIpc,
+    ) -> Result<Self, crate::HlsError> {
+        Ok(TopParams {
+            platform,
+            model,
+            layout: Layout::of(platform)?,
+        })
+    }
+}
+
+pub(crate) fn top_module(d: &TopParams) -> Module {
+    let l = &d.layout;
+    let k = l.num_instances;
+    let (pb, ptb, ib, sb) = (l.path_bits, l.point_bits, l.inst_bits, l.slot_bits);
     let np2 = 1u32 << pb;
     let depth = 1u32 << (ptb + 1);
     let cw = width::COORD;
     let dispw = cw + 1;
-    let cnt_bits = bits_for(u64::from(d.num_points.max(k + 1).max(PE_LATENCY)) + 1);
-    let status_bits = d.status_base.trailing_zeros();
-    let point_bits_addr = d.point_base.trailing_zeros();
+    let sw = sched_entry_bits(pb, ptb);
+    let cnt_bits = bits_for(u64::from((k + 2).max(PE_LATENCY)) + 1);
+    let status_bits = l.status_base.trailing_zeros();
+    let point_bits_addr = l.point_base.trailing_zeros();
+    let sched_bits_addr = l.sched_base.trailing_zeros();
+    let cap = d.platform.capacity;
     let mut items = Vec::new();
     let mut unused: Vec<Expr> = vec![lit(1, 0)];
     let early = d.model.early_stop().map(|(s, b)| (*s, b.to_vec()));
 
     items.push(Item::Comment(format!(
-        "{} paths, {} points, {} PE instances, makespan {} slots, {} cycles per slot, threshold {} fine LSB",
-        d.num_paths,
-        d.num_points,
+        "{} PE instances, capacity {} paths, {} points, {} slots; {} cycles per slot, threshold {} fine LSB",
         k,
-        d.makespan,
-        d.cycles_per_slot(),
-        d.input.threshold_lsb
+        cap.paths,
+        cap.points,
+        cap.slots,
+        crate::plan::cycles_per_slot(k),
+        d.platform.threshold_lsb
     )));
     for (n, w) in [
         ("state", STATE_BITS),
         ("cnt", cnt_bits),
         ("slot", sb),
+        ("slots_r", sb + 1),
         ("cycles", 32),
         ("done", 1),
         ("tx_x", 32),
@@ -86,6 +100,9 @@ pub(crate) fn top_module(d: &Design) -> Module {
         ("rx_x", 32),
         ("rx_y", 32),
         ("rx_z", 32),
+        ("st_x", 32),
+        ("st_y", 32),
+        ("st_z", 32),
         ("cur", np2),
         ("conv", np2),
         ("dz", np2),
@@ -95,6 +112,9 @@ pub(crate) fn top_module(d: &Design) -> Module {
         ("pov", np2),
         ("rd_a", POINT_BITS),
         ("rd_b", POINT_BITS),
+        ("sched_q", sw),
+        ("sq_ok", 1),
+        ("sq_inst", ib),
         ("ld_q_en", 1),
         ("ld_q_first", 1),
         ("ld_q_last", 1),
@@ -127,103 +147,95 @@ pub(crate) fn top_module(d: &Design) -> Module {
         items.push(Item::Wire(format!("pe_zs_{j}"), 1));
     }
 
-    // Scheduler ROM: {slot, instance} -> job.
-    items.push(Item::Comment(
-        "PE scheduler ROM: entry {slot, instance} -> {valid, path, point, first, last, round_end}"
-            .into(),
-    ));
-    for (n, w) in [
-        ("rom_valid", 1),
-        ("rom_path", pb),
-        ("rom_point", ptb),
-        ("rom_first", 1),
-        ("rom_last", 1),
-        ("rom_end", 1),
-    ] {
-        items.push(Item::Reg(n.into(), w));
-    }
-    items.push(Item::Wire("rom_index".into(), sb + ib));
+    // Bus address decode.
+    let hi = ADDRESS_BITS - 1;
+    items.push(Item::Wire("idle".into(), 1));
+    items.push(Item::Assign(id("idle"), state_is(S_IDLE)));
+    items.push(Item::Wire("is_ctrl".into(), 1));
     items.push(Item::Assign(
-        id("rom_index"),
-        Expr::concat(vec![id("slot"), Expr::slice("cnt", ib - 1, 0)]),
+        id("is_ctrl"),
+        Expr::slice("avs_address", hi, 4).eq(lit(ADDRESS_BITS - 4, 0)),
     ));
-    // Last job of each (path, round) in (slot, instance) order.
-    let mut last_of_round = std::collections::BTreeMap::new();
-    for (t, row) in d.schedule.slots.iter().enumerate() {
-        for (i, job) in row.iter().enumerate() {
-            if let Some(job) = job {
-                last_of_round.insert((job.path, job.round), (t, i));
-            }
-        }
-    }
-    let mut arms = Vec::new();
-    for (t, row) in d.schedule.slots.iter().enumerate() {
-        for (i, job) in row.iter().enumerate() {
-            let Some(job) = job else { continue };
-            let n = d.input.paths[job.path as usize].len() as u32;
-            let point = d.first_point[job.path as usize] + job.point;
-            let index = ((t as u128) << ib) | i as u128;
-            arms.push((
-                lit(sb + ib, index),
-                vec![
-                    bl("rom_valid", lit(1, 1)),
-                    bl("rom_path", lit(pb, job.path.into())),
-                    bl("rom_point", lit(ptb, point.into())),
-                    bl("rom_first", lit(1, u128::from(job.point == 0))),
-                    bl("rom_last", lit(1, u128::from(job.point + 1 == n))),
-                    bl(
-                        "rom_end",
-                        lit(
-                            1,
-                            u128::from(last_of_round[&(job.path, job.round)] == (t, i)),
-                        ),
-                    ),
-                ],
-            ));
-        }
-    }
-    let rom_defaults = vec![
-        bl("rom_valid", lit(1, 0)),
-        bl("rom_path", lit(pb, 0)),
-        bl("rom_point", lit(ptb, 0)),
-        bl("rom_first", lit(1, 0)),
-        bl("rom_last", lit(1, 0)),
-        bl("rom_end", lit(1, 0)),
-    ];
-    let mut rom = rom_defaults.clone();
-    rom.push(Stmt::Case(id("rom_index"), arms, rom_defaults));
-    items.push(Item::AlwaysComb(rom));
-
-    // Initial points ROM and point -> path ROM.
-    items.push(Item::Reg("init_point".into(), POINT_BITS));
-    items.push(Item::Reg("bus_path".into(), pb));
+    items.push(Item::Wire("is_status".into(), 1));
+    items.push(Item::Assign(
+        id("is_status"),
+        Expr::slice("avs_address", hi, status_bits).eq(lit(ADDRESS_BITS - status_bits, 1)),
+    ));
+    items.push(Item::Wire("is_point".into(), 1));
+    items.push(Item::Assign(
+        id("is_point"),
+        Expr::slice("avs_address", hi, point_bits_addr).eq(lit(ADDRESS_BITS - point_bits_addr, 1)),
+    ));
+    items.push(Item::Wire("is_sched".into(), 1));
+    items.push(Item::Assign(
+        id("is_sched"),
+        Expr::slice("avs_address", hi, sched_bits_addr).eq(lit(ADDRESS_BITS - sched_bits_addr, 1)),
+    ));
     items.push(Item::Wire("bus_point".into(), ptb));
     items.push(Item::Assign(
         id("bus_point"),
-        Expr::slice("avs_address", ptb + 1, 2),
+        Expr::slice("avs_address", ptb + 2, 3),
     ));
-    let mut init_arms = Vec::new();
-    let mut path_arms = Vec::new();
-    for p in 0..d.num_paths as usize {
-        for (i, pt) in d.model.init_points(p).iter().enumerate() {
-            let g = d.first_point[p] + i as u32;
-            init_arms.push((
-                lit(ptb, g.into()),
-                vec![bl("init_point", point_literal(pt))],
-            ));
-            path_arms.push((lit(ptb, g.into()), vec![bl("bus_path", lit(pb, p as u128))]));
-        }
+    items.push(Item::Wire("host_wr".into(), 1));
+    items.push(Item::Assign(id("host_wr"), id("avs_write").and(id("idle"))));
+    items.push(Item::Wire("pt_we".into(), 1));
+    items.push(Item::Assign(
+        id("pt_we"),
+        id("host_wr")
+            .and(id("is_point"))
+            .and(Expr::slice("avs_address", 1, 0).eq(lit(2, 3))),
+    ));
+
+    // Schedule memory (M9K): entry {slot, column}, written by the host, read one cycle after
+    // the address {slot, cnt}: the entry of column cnt - 1 is in sched_q.
+    items.push(Item::Comment(format!(
+        "PE schedule memory, written per step by the host: entry {{slot, column}} -> {{end, last, first, point, path, valid}} ({sw} bits)"
+    )));
+    items.push(Item::Memory("sched".into(), sw, 1 << (sb + ib)));
+    items.push(Item::AlwaysFf(vec![
+        Stmt::If(
+            id("host_wr").and(id("is_sched")),
+            vec![nb(
+                Expr::id("sched").at(Expr::slice("avs_address", sb + ib - 1, 0)),
+                Expr::slice("avs_writedata", sw - 1, 0),
+            )],
+            vec![],
+        ),
+        nb(
+            id("sched_q"),
+            Expr::id("sched").at(Expr::concat(vec![
+                id("slot"),
+                Expr::slice("cnt", ib - 1, 0),
+            ])),
+        ),
+        nb(
+            id("sq_ok"),
+            or(state_is(S_LOAD), state_is(S_WB)).and(Expr::bin(
+                BinaryOp::Lt,
+                id("cnt"),
+                lit(cnt_bits, k.into()),
+            )),
+        ),
+        nb(id("sq_inst"), Expr::slice("cnt", ib - 1, 0)),
+    ]));
+    let fields = [("rom_path", pb, 1), ("rom_point", ptb, 1 + pb)];
+    items.push(Item::Wire("rom_valid".into(), 1));
+    items.push(Item::Assign(
+        id("rom_valid"),
+        Expr::bit("sched_q", 0).and(id("sq_ok")),
+    ));
+    for (n, w, lo) in fields {
+        items.push(Item::Wire(n.into(), w));
+        items.push(Item::Assign(id(n), Expr::slice("sched_q", lo + w - 1, lo)));
     }
-    items.push(Item::AlwaysComb(vec![Stmt::Case(
-        Expr::slice("cnt", ptb - 1, 0),
-        init_arms,
-        vec![bl("init_point", lit(POINT_BITS, 0))],
-    )]));
-    items.push(Item::AlwaysComb(vec![Stmt::Case(
-        id("bus_point"),
-        path_arms,
-        vec![bl("bus_path", lit(pb, 0))],
-    )]));
+    for (n, bit) in [
+        ("rom_first", 1 + pb + ptb),
+        ("rom_last", 2 + pb + ptb),
+        ("rom_end", 3 + pb + ptb),
+    ] {
+        items.push(Item::Wire(n.into(), 1));
+        items.push(Item::Assign(id(n), Expr::bit("sched_q", bit)));
+    }
 
     // Coordinate updater-buffer: two banks per point, bank = cur[path] holds the last committed round.
     items.push(Item::Comment(
@@ -241,11 +253,9 @@ pub(crate) fn top_module(d: &Design) -> Module {
     }
     items.push(Item::Reg("wr_data".into(), POINT_BITS));
     let one_pt = lit(ptb, 1);
+    let bus_cell = Expr::concat(vec![id("bus_point"), Expr::bit("avs_address", 2)]);
     items.push(Item::AlwaysComb(vec![
-        bl(
-            "ra_addr",
-            Expr::concat(vec![id("bus_point"), Expr::id("cur").at(id("bus_path"))]),
-        ),
+        bl("ra_addr", bus_cell.clone()),
         Stmt::If(
             state_is(S_LOAD),
             vec![bl(
@@ -365,7 +375,7 @@ pub(crate) fn top_module(d: &Design) -> Module {
         big_terms.push(Expr::bin(
             BinaryOp::Gt,
             id(&abs),
-            lit(dispw, d.input.threshold_lsb.into()),
+            lit(dispw, d.platform.threshold_lsb.into()),
         ));
     }
     items.push(Item::Comment(
@@ -407,13 +417,18 @@ pub(crate) fn top_module(d: &Design) -> Module {
         id("any_ov"),
         or(at_wb("pov"), id("pe_sel_ov")),
     ));
+    let host_point = Expr::concat(vec![
+        id("st_z"),
+        Expr::slice("avs_writedata", 23, 16),
+        id("st_y"),
+        Expr::slice("avs_writedata", 15, 8),
+        id("st_x"),
+        Expr::slice("avs_writedata", 7, 0),
+    ]);
     items.push(Item::AlwaysComb(vec![
-        bl("wr_en", state_is(S_INIT).or(id("wb_go"))),
-        bl(
-            "wr_addr",
-            Expr::concat(vec![Expr::slice("cnt", ptb - 1, 0), lit(1, 0)]),
-        ),
-        bl("wr_data", id("init_point")),
+        bl("wr_en", id("pt_we").or(id("wb_go"))),
+        bl("wr_addr", bus_cell),
+        bl("wr_data", host_point),
         Stmt::If(
             state_is(S_WB),
             vec![
@@ -446,7 +461,7 @@ pub(crate) fn top_module(d: &Design) -> Module {
         id("pe_start"),
         state_is(S_EXEC).and(id("cnt").eq(lit(cnt_bits, 0))),
     ));
-    for (j, inst) in d.schedule.instances.iter().enumerate() {
+    for (j, inst) in d.platform.instances.iter().enumerate() {
         items.push(Item::Instance {
             module: pe_module_name(inst.plane as usize),
             name: format!("u_pe_{j}"),
@@ -488,19 +503,27 @@ pub(crate) fn top_module(d: &Design) -> Module {
     }
 
     // Main FSM.
-    let k_cnt = lit(cnt_bits, k.into());
+    let k_cnt = lit(cnt_bits, u128::from(k + 1));
     let cnt_inc = id("cnt").plus(lit(cnt_bits, 1));
     let start_req = id("avs_write")
         .and(id("avs_address").eq(lit(ADDRESS_BITS, 0)))
         .and(Expr::bit("avs_writedata", 0))
         .and(state_is(S_IDLE));
     let all_zero = lit(np2, 0);
+    let no_slot = id("slots_r").eq(lit(sb + 1, 0));
     let mut on_start = vec![
-        nb(id("state"), lit(STATE_BITS, S_INIT)),
+        nb(
+            id("state"),
+            Expr::mux(
+                no_slot.clone(),
+                lit(STATE_BITS, S_IDLE),
+                lit(STATE_BITS, S_LOAD),
+            ),
+        ),
         nb(id("cnt"), lit(cnt_bits, 0)),
         nb(id("slot"), lit(sb, 0)),
         nb(id("cycles"), lit(32, 0)),
-        nb(id("done"), lit(1, 0)),
+        nb(id("done"), no_slot),
     ];
     for v in ["cur", "conv", "dz", "ov", "pbig", "pdz", "pov"] {
         on_start.push(nb(id(v), all_zero.clone()));
@@ -512,23 +535,11 @@ pub(crate) fn top_module(d: &Design) -> Module {
     for p in 0..np2 {
         on_start.push(nb(Expr::id("rounds").at(lit(pb, p.into())), lit(16, 0)));
     }
-    let init = vec![
-        nb(id("cnt"), cnt_inc.clone()),
-        Stmt::If(
-            id("cnt").eq(lit(cnt_bits, u128::from(d.num_points - 1))),
-            vec![
-                nb(id("state"), lit(STATE_BITS, S_LOAD)),
-                nb(id("cnt"), lit(cnt_bits, 0)),
-            ],
-            vec![],
-        ),
-    ];
-    let not_last = Expr::bin(BinaryOp::Ne, id("cnt"), k_cnt.clone());
     let load = vec![
-        nb(id("ld_q_en"), not_last.clone().and(id("rom_valid"))),
+        nb(id("ld_q_en"), id("rom_valid")),
         nb(id("ld_q_first"), id("rom_first")),
         nb(id("ld_q_last"), id("rom_last")),
-        nb(id("ld_q_inst"), Expr::slice("cnt", ib - 1, 0)),
+        nb(id("ld_q_inst"), id("sq_inst")),
         Stmt::If(
             id("cnt").eq(k_cnt.clone()),
             vec![
@@ -592,18 +603,20 @@ pub(crate) fn top_module(d: &Design) -> Module {
         .collect(),
     )];
     let wb = vec![
-        nb(id("wb_q_en"), not_last.and(id("rom_valid"))),
+        nb(id("wb_q_en"), id("rom_valid")),
         nb(id("wb_q_end"), id("rom_end")),
         nb(id("wb_q_path"), id("rom_path")),
         nb(id("wb_q_point"), id("rom_point")),
-        nb(id("wb_q_inst"), Expr::slice("cnt", ib - 1, 0)),
+        nb(id("wb_q_inst"), id("sq_inst")),
         Stmt::If(id("wb_go"), commit, vec![]),
         Stmt::If(
             id("cnt").eq(k_cnt),
             vec![
                 nb(id("cnt"), lit(cnt_bits, 0)),
                 Stmt::If(
-                    id("slot").eq(lit(sb, u128::from(d.makespan - 1))),
+                    Expr::concat(vec![lit(1, 0), id("slot")])
+                        .plus(lit(sb + 1, 1))
+                        .eq(id("slots_r")),
                     vec![
                         nb(id("state"), lit(STATE_BITS, S_IDLE)),
                         nb(id("done"), lit(1, 1)),
@@ -618,11 +631,10 @@ pub(crate) fn top_module(d: &Design) -> Module {
         ),
     ];
     items.push(Item::Comment(format!(
-        "main FSM: IDLE -> INIT ({} cycles) -> per slot LOAD ({}) EXEC ({}) WB ({}) -> IDLE with done",
-        d.num_points,
-        k + 1,
+        "main FSM: IDLE -> per slot LOAD ({}) EXEC ({}) WB ({}) -> IDLE with done after SLOTS slots",
+        k + 2,
         PE_LATENCY,
-        k + 1
+        k + 2
     )));
     items.push(Item::Wire("start_req".into(), 1));
     items.push(Item::Assign(id("start_req"), start_req));
@@ -650,7 +662,6 @@ pub(crate) fn top_module(d: &Design) -> Module {
                         lit(STATE_BITS, S_IDLE),
                         vec![Stmt::If(id("start_req"), on_start, vec![])],
                     ),
-                    (lit(STATE_BITS, S_INIT), init),
                     (lit(STATE_BITS, S_LOAD), load),
                     (lit(STATE_BITS, S_EXEC), exec),
                     (lit(STATE_BITS, S_WB), wb),
@@ -677,9 +688,10 @@ pub(crate) fn top_module(d: &Design) -> Module {
             nb(id("rx_x"), lit(32, 0)),
             nb(id("rx_y"), lit(32, 0)),
             nb(id("rx_z"), lit(32, 0)),
+            nb(id("slots_r"), lit(sb + 1, 0)),
         ],
         vec![Stmt::If(
-            id("avs_write"),
+            id("host_wr"),
             vec![
                 wr(4, "tx_x"),
                 wr(5, "tx_y"),
@@ -687,27 +699,29 @@ pub(crate) fn top_module(d: &Design) -> Module {
                 wr(8, "rx_x"),
                 wr(9, "rx_y"),
                 wr(10, "rx_z"),
+                Stmt::If(
+                    id("avs_address").eq(lit(ADDRESS_BITS, crate::regs::SLOTS.into())),
+                    vec![nb(id("slots_r"), Expr::slice("avs_writedata", sb, 0))],
+                    vec![],
+                ),
+                Stmt::If(
+                    id("is_point"),
+                    vec![Stmt::Case(
+                        Expr::slice("avs_address", 1, 0),
+                        vec![
+                            (lit(2, 0), vec![nb(id("st_x"), id("avs_writedata"))]),
+                            (lit(2, 1), vec![nb(id("st_y"), id("avs_writedata"))]),
+                            (lit(2, 2), vec![nb(id("st_z"), id("avs_writedata"))]),
+                        ],
+                        vec![],
+                    )],
+                    vec![],
+                ),
             ],
             vec![],
         )],
     )]));
     // Avalon-MM slave: pipelined reads, fixed latency 2 (address -> registered select -> readdata).
-    let hi = ADDRESS_BITS - 1;
-    items.push(Item::Wire("is_ctrl".into(), 1));
-    items.push(Item::Assign(
-        id("is_ctrl"),
-        Expr::slice("avs_address", hi, 4).eq(lit(ADDRESS_BITS - 4, 0)),
-    ));
-    items.push(Item::Wire("is_status".into(), 1));
-    items.push(Item::Assign(
-        id("is_status"),
-        Expr::slice("avs_address", hi, status_bits).eq(lit(ADDRESS_BITS - status_bits, 1)),
-    ));
-    items.push(Item::Wire("is_point".into(), 1));
-    items.push(Item::Assign(
-        id("is_point"),
-        Expr::slice("avs_address", hi, point_bits_addr).eq(lit(ADDRESS_BITS - point_bits_addr, 1)),
-    ));
     items.push(Item::AlwaysFf(vec![Stmt::If(
         id("rst_n").lnot(),
         vec![
@@ -736,7 +750,7 @@ pub(crate) fn top_module(d: &Design) -> Module {
             nb(id("avs_readdata"), id("read_mux")),
         ],
     )]));
-    let info = (k << 24) | (MAP_VERSION << 16) | (d.num_paths & 0xffff);
+    let info = (k << 24) | (MAP_VERSION << 16) | (cap.paths & 0xffff);
     items.push(Item::Reg("read_mux".into(), 32));
     let rqp = |v: &str| Expr::id(v).at(id("rq_path"));
     let ctrl_arms = vec![
@@ -755,7 +769,7 @@ pub(crate) fn top_module(d: &Design) -> Module {
         (lit(4, 2), vec![bl("read_mux", lit(32, info.into()))]),
         (
             lit(4, 3),
-            vec![bl("read_mux", lit(32, d.input.threshold_lsb.into()))],
+            vec![bl("read_mux", lit(32, d.platform.threshold_lsb.into()))],
         ),
         (lit(4, 4), vec![bl("read_mux", id("tx_x"))]),
         (lit(4, 5), vec![bl("read_mux", id("tx_y"))]),
@@ -763,6 +777,13 @@ pub(crate) fn top_module(d: &Design) -> Module {
         (lit(4, 8), vec![bl("read_mux", id("rx_x"))]),
         (lit(4, 9), vec![bl("read_mux", id("rx_y"))]),
         (lit(4, 10), vec![bl("read_mux", id("rx_z"))]),
+        (
+            lit(4, 12),
+            vec![bl(
+                "read_mux",
+                Expr::concat(vec![lit(31 - sb, 0), id("slots_r")]),
+            )],
+        ),
     ];
     let point_arms = vec![
         (
@@ -865,7 +886,7 @@ pub(crate) fn top_module(d: &Design) -> Module {
 /// comparisons are unsigned ones with the sign bit flipped (the box constants are flipped
 /// when generated).
 fn early_stop_logic(
-    d: &Design,
+    d: &TopParams,
     stop: &bt_fixed::EarlyStop,
     boxes: &[bt_fixed::FineBox],
     items: &mut Vec<Item>,
@@ -883,7 +904,7 @@ fn early_stop_logic(
         }
     }
     let arms = d
-        .schedule
+        .platform
         .instances
         .iter()
         .enumerate()
@@ -894,7 +915,7 @@ fn early_stop_logic(
                 stmts.push(bl(&format!("box_lo_{axis}"), biased(b.lo[a])));
                 stmts.push(bl(&format!("box_hi_{axis}"), biased(b.hi[a])));
             }
-            (lit(d.inst_bits, j as u128), stmts)
+            (lit(d.layout.inst_bits, j as u128), stmts)
         })
         .collect();
     items.push(Item::Comment(

@@ -34,12 +34,13 @@ fn golden_cycle_count_and_pe_module() {
     let r = &g.report;
     let pinned = serde_json::json!({
         "instances": r.num_instances,
-        "makespan": r.makespan,
+        "makespans": r.makespans,
         "cycles_per_slot": r.cycles_per_slot,
-        "predicted_cycles": r.predicted_cycles,
+        "run_cycles": r.run_cycles,
         "predicted_tb_cycles": r.predicted_tb_cycles,
         "status_base": r.status_base,
         "point_base": r.point_base,
+        "sched_base": r.sched_base,
     });
     golden(
         "small_scene_cycles.json",
@@ -52,7 +53,11 @@ fn golden_cycle_count_and_pe_module() {
 #[test]
 fn generation_is_deterministic() {
     let g = generated();
-    let again = bt_hls::rtl_modules(&g.input, &g.schedule).unwrap();
+    let work = [bt_hls::StepWork {
+        input: g.input.clone(),
+        schedule: g.schedule.clone(),
+    }];
+    let again = bt_hls::rtl_modules(&bt_hls::Platform::fitting(&work).unwrap()).unwrap();
     for (name, text) in again {
         let on_disk = std::fs::read_to_string(g.dir.join(format!("rtl/{name}.v"))).unwrap();
         assert_eq!(on_disk, text, "{name} differs between two generations");
@@ -104,15 +109,19 @@ fn synthesis_smoke_test_reports_cell_counts() {
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("bt_hls_tiny_scene");
     let _ = std::fs::remove_dir_all(&dir);
     bt_hls::generate(&input, &schedule, &dir).unwrap();
-    let sim = bt_hls::simulate(&dir).unwrap();
+    // Icarus stays an option (`hls sim --simulator icarus`): it runs the same testbench.
+    let sim = bt_hls::simulate_with(&dir, bt_hls::Simulator::Icarus, &mut |_| {}).unwrap();
     assert_eq!(sim.mismatches, 0, "{:#?}", sim.mismatch_details);
     assert_eq!(sim.cycles, sim.predicted_cycles);
+    assert!(sim.passed());
     let synth = bt_hls::synthesize(&dir).unwrap();
     eprintln!("tiny scene: {synth:#?}");
     assert!(synth.logic_cells > 100, "{synth:?}");
     assert!(synth.registers > 100, "{synth:?}");
     assert!(synth.percent_of_ep4ce115 > 0.0 && synth.percent_of_ep4ce115 < 100.0);
-    // The point memory (two copies of 8 x 120 bits) is inferred into M9K, not registers.
+    // The point memory (two copies of 8 x 120 bits) and the schedule memory (32 entries
+    // {slot, column} of 8 bits: 2 path bits, 2 point bits, 4 flags) are inferred into M9K,
+    // not registers.
     assert!(synth.m9k_blocks > 0, "{synth:?}");
-    assert_eq!(synth.memory_bits, 2 * 8 * 120, "{synth:?}");
+    assert_eq!(synth.memory_bits, 2 * 8 * 120 + 32 * 8, "{synth:?}");
 }

@@ -37,23 +37,10 @@ fn vec3(v: [f64; 3]) -> Vec3 {
     Vec3::from_array(v)
 }
 
-/// Load a scene file (`.json`, `.toml`, `.obj`, `.ply`) or a built-in scene (`builtin:NAME`).
+/// Load any source the CLI reads (`builtin:NAME`, JSON/TOML, OBJ/PLY meshes, point clouds,
+/// Mitsuba XML): the library's one loading entry.
 fn load_scene(source: &str, options: &LoadOptions) -> Result<bt_scene::io::Loaded, SceneError> {
-    if let Some(name) = source.strip_prefix("builtin:") {
-        return match bt_scene::builtin_scene(name, options.terminals) {
-            Some(scene) => scene.map(|scene| bt_scene::io::Loaded {
-                scene,
-                warnings: Vec::new(),
-            }),
-            None => Err(SceneError::UnsupportedFormat {
-                path: format!(
-                    "{source} (built-in scenes: {})",
-                    bt_scene::builtin_names().join(", ")
-                ),
-            }),
-        };
-    }
-    bt_scene::io::load(Path::new(source), options)
+    bt_scene::io::load(source, options)
 }
 
 /// A validated scene, ready to trace from any TX to any RX.

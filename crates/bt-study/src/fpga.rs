@@ -3,7 +3,7 @@
 
 use bt_geom::{Real, Vec3};
 use bt_hls::{EarlyStop, HlsInput, PathResult, PlaneSpec};
-use bt_paths::{AllVisible, enumerate};
+use bt_paths::{AllVisible, CandidateSet, enumerate};
 use bt_scene::{Scene, SurfaceId};
 use bt_solve::{Validity, validate::validate};
 
@@ -75,33 +75,67 @@ pub enum HostRejection {
     ReflectionLaw,
 }
 
-/// The HLS input of a scene: one plane per reflector (PE `bt_pe_<i>` for the `i`-th
-/// reflector), every candidate path of order 1 to `max_order` (exhaustive enumeration with
-/// the side test, as the paper computes *all* paths on the FPGA), starting points at the
-/// polygon centroids; `threshold_lsb` in 1/256 mm, `max_rounds` the round cap; early stopping
-/// ([`EarlyStop::default`]) on every plane's polygon bounding box. Also returns
-/// the surface sequence of every input path (`input.paths[p]` is `sequences[p]`).
-pub fn hls_input(
+/// Reflectors whose polygon is the same in every scene of `steps` (same id, name and
+/// vertices): the planes an accelerator synthesised once per room bakes into its PEs. A
+/// moving reflector (the door) is solved by the host instead (`docs/hardware.md`).
+pub fn static_reflectors(steps: &[Scene]) -> Vec<SurfaceId> {
+    let Some(first) = steps.first() else {
+        return Vec::new();
+    };
+    first
+        .reflectors()
+        .filter(|id| {
+            let s = first.surface(*id);
+            steps.iter().all(|scene| {
+                (id.0 as usize) < scene.surfaces().len() && {
+                    let t = scene.surface(*id);
+                    t.name == s.name && t.polygon.vertices() == s.polygon.vertices()
+                }
+            })
+        })
+        .collect()
+}
+
+/// One step's accelerator work: the HLS input over the platform's planes and the candidates
+/// left to the host because they touch a surface that is not a platform plane.
+#[derive(Debug, Clone)]
+pub struct StepInput {
+    /// Candidates over platform planes, start points at the polygon centroids.
+    pub input: HlsInput,
+    /// Surface sequence of every input path (`input.paths[p]` is `sequences[p]`).
+    pub sequences: Vec<Vec<SurfaceId>>,
+    /// Candidates through a moving surface: solved by the host (image method).
+    pub host_sequences: Vec<Vec<SurfaceId>>,
+}
+
+/// The HLS input of one step: `planes` are the platform's reflectors (PE `bt_pe_<i>` for
+/// `planes[i]`), `candidates` the step's candidate sequences (empty ones skipped); a
+/// candidate through a surface not in `planes` goes to the host. `threshold_lsb` in 1/256 mm,
+/// `max_rounds` the round cap; early stopping ([`EarlyStop::default`]) on every plane's
+/// polygon bounding box.
+pub fn step_input(
     scene: &Scene,
-    max_order: usize,
+    planes: &[SurfaceId],
+    candidates: &CandidateSet,
     threshold_lsb: u32,
     max_rounds: u32,
-) -> (HlsInput, Vec<Vec<SurfaceId>>) {
-    let reflectors: Vec<SurfaceId> = scene.reflectors().collect();
-    // Candidates consist of reflectors only, so every id has a plane index.
+) -> StepInput {
     let mut plane_of = vec![u32::MAX; scene.surfaces().len()];
-    for (i, id) in reflectors.iter().enumerate() {
+    for (i, id) in planes.iter().enumerate() {
         plane_of[id.0 as usize] = i as u32;
     }
-    let candidates = enumerate(scene, max_order, &AllVisible);
     let mut paths = Vec::new();
     let mut init_points = Vec::new();
     let mut sequences = Vec::new();
+    let mut host_sequences = Vec::new();
     for seq in candidates.iter() {
         if seq.is_empty() {
             continue;
         }
-        debug_assert!(seq.iter().all(|id| plane_of[id.0 as usize] != u32::MAX));
+        if seq.iter().any(|id| plane_of[id.0 as usize] == u32::MAX) {
+            host_sequences.push(seq.to_vec());
+            continue;
+        }
         paths.push(seq.iter().map(|id| plane_of[id.0 as usize]).collect());
         init_points.push(
             seq.iter()
@@ -110,7 +144,7 @@ pub fn hls_input(
         );
         sequences.push(seq.to_vec());
     }
-    let planes = reflectors
+    let planes = planes
         .iter()
         .map(|id| {
             let s = scene.surface(*id);
@@ -135,5 +169,28 @@ pub fn hls_input(
         test_vectors: Vec::new(),
         early_stop: Some(EarlyStop::default()),
     };
-    (input, sequences)
+    StepInput {
+        input,
+        sequences,
+        host_sequences,
+    }
+}
+
+/// The HLS input of a scene: one plane per reflector (PE `bt_pe_<i>` for the `i`-th
+/// reflector), every candidate path of order 1 to `max_order` (exhaustive enumeration with
+/// the side test, as the paper computes *all* paths on the FPGA), starting points at the
+/// polygon centroids; `threshold_lsb` in 1/256 mm, `max_rounds` the round cap; early stopping
+/// ([`EarlyStop::default`]) on every plane's polygon bounding box. Also returns
+/// the surface sequence of every input path (`input.paths[p]` is `sequences[p]`).
+pub fn hls_input(
+    scene: &Scene,
+    max_order: usize,
+    threshold_lsb: u32,
+    max_rounds: u32,
+) -> (HlsInput, Vec<Vec<SurfaceId>>) {
+    let reflectors: Vec<SurfaceId> = scene.reflectors().collect();
+    let candidates = enumerate(scene, max_order, &AllVisible);
+    let s = step_input(scene, &reflectors, &candidates, threshold_lsb, max_rounds);
+    debug_assert!(s.host_sequences.is_empty());
+    (s.input, s.sequences)
 }
