@@ -143,6 +143,119 @@ pub struct SceneArgs {
     /// Meshes: faces whose planes differ by less than this (metres) merge into one surface.
     #[arg(long, default_value_t = 1e-3)]
     pub merge_distance: f64,
+    #[command(flatten)]
+    pub material: MaterialArgs,
+}
+
+/// Carrier and radio material overrides (any scene source).
+#[derive(Debug, Args, Clone, Default)]
+pub struct MaterialArgs {
+    /// Carrier frequency, Hz (overrides the scene's; meshes and point clouds default to 28e9).
+    #[arg(long)]
+    pub frequency: Option<f64>,
+    /// Radio material of every surface: itu:NAME (ITU-R P.2040-3, e.g. itu:concrete) or
+    /// custom:EPS_R,SIGMA (relative permittivity, conductivity in S/m).
+    #[arg(long, value_parser = parse_material)]
+    pub material: Option<MaterialArg>,
+    /// With --material: slab thickness in metres (default: a half-space).
+    #[arg(long, requires = "material")]
+    pub thickness: Option<f64>,
+}
+
+/// `--material` as given.
+#[derive(Debug, Clone, PartialEq)]
+pub enum MaterialArg {
+    /// `itu:NAME`.
+    Itu(String),
+    /// `custom:EPS_R,SIGMA`.
+    Custom(f64, f64),
+}
+
+impl MaterialArgs {
+    /// The radio material `--material`/`--thickness` select, checked.
+    pub fn radio(&self) -> anyhow::Result<Option<bt_channel::RadioMaterial>> {
+        let radio = match &self.material {
+            None => return Ok(None),
+            Some(MaterialArg::Itu(name)) => bt_channel::RadioMaterial::itu(name, self.thickness),
+            Some(MaterialArg::Custom(eps, sigma)) => {
+                bt_channel::RadioMaterial::custom(*eps, *sigma, self.thickness)
+            }
+        };
+        Ok(Some(radio.context("--material/--thickness")?))
+    }
+}
+
+fn parse_material(s: &str) -> anyhow::Result<MaterialArg> {
+    if let Some(name) = s.strip_prefix("itu:") {
+        bt_channel::ItuMaterial::parse(name)?;
+        return Ok(MaterialArg::Itu(name.to_string()));
+    }
+    if let Some(values) = s.strip_prefix("custom:") {
+        let parts: Vec<&str> = values.split(',').map(str::trim).collect();
+        if let [eps, sigma] = parts[..] {
+            let eps: f64 = eps
+                .parse()
+                .with_context(|| format!("\"{eps}\" is not a number"))?;
+            let sigma: f64 = sigma
+                .parse()
+                .with_context(|| format!("\"{sigma}\" is not a number"))?;
+            return Ok(MaterialArg::Custom(eps, sigma));
+        }
+    }
+    bail!("expected itu:NAME (e.g. itu:concrete) or custom:EPS_R,SIGMA, got \"{s}\"")
+}
+
+/// Antennas at both ends and the transmitted power.
+#[derive(Debug, Args, Clone)]
+pub struct RadioArgs {
+    /// TX antenna pattern: iso or tr38901 (3GPP TR 38.901 element, 8 dBi).
+    #[arg(long, default_value = "iso", value_parser = parse_pattern)]
+    pub tx_pattern: bt_channel::Pattern,
+    /// RX antenna pattern: iso or tr38901.
+    #[arg(long, default_value = "iso", value_parser = parse_pattern)]
+    pub rx_pattern: bt_channel::Pattern,
+    /// TX polarisation: V, H, +45 or -45.
+    #[arg(long, default_value = "V", value_parser = parse_polarization, allow_hyphen_values = true)]
+    pub tx_polarization: bt_channel::Polarization,
+    /// RX polarisation: V, H, +45 or -45.
+    #[arg(long, default_value = "V", value_parser = parse_polarization, allow_hyphen_values = true)]
+    pub rx_polarization: bt_channel::Polarization,
+    /// TX antenna/array orientation YAW,PITCH,ROLL in degrees (0,0,0: boresight +x).
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, default_value = "0,0,0")]
+    pub tx_orientation: Vec3,
+    /// RX antenna/array orientation YAW,PITCH,ROLL in degrees.
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, default_value = "0,0,0")]
+    pub rx_orientation: Vec3,
+    /// Transmitted power, dBm (for power_dbm).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub tx_power_dbm: f64,
+}
+
+fn parse_pattern(s: &str) -> Result<bt_channel::Pattern, bt_channel::ChannelError> {
+    s.parse()
+}
+
+fn parse_polarization(s: &str) -> Result<bt_channel::Polarization, bt_channel::ChannelError> {
+    s.parse()
+}
+
+impl RadioArgs {
+    /// The report's radio options.
+    pub fn options(&self) -> anyhow::Result<bt_beams::RadioOptions> {
+        if !self.tx_power_dbm.is_finite() {
+            bail!("--tx-power-dbm must be a finite number of dBm");
+        }
+        let antenna = |pattern, polarization, o: Vec3| bt_channel::Antenna {
+            pattern,
+            polarization,
+            orientation: bt_channel::Orientation::from_degrees(o.x, o.y, o.z),
+        };
+        Ok(bt_beams::RadioOptions {
+            tx: antenna(self.tx_pattern, self.tx_polarization, self.tx_orientation),
+            rx: antenna(self.rx_pattern, self.rx_polarization, self.rx_orientation),
+            tx_power_dbm: self.tx_power_dbm,
+        })
+    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -175,6 +288,8 @@ pub enum IpcAccelArg {
 pub struct TraceArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
+    #[command(flatten)]
+    pub radio: RadioArgs,
     /// Highest reflection order.
     #[arg(long, default_value_t = 3)]
     pub max_order: usize,
@@ -293,6 +408,8 @@ pub struct DemoArgs {
     /// Highest reflection order.
     #[arg(long, default_value_t = 3)]
     pub max_order: usize,
+    #[command(flatten)]
+    pub radio: RadioArgs,
     /// Print the JSON document instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -308,7 +425,9 @@ impl DemoArgs {
                 min_reflector_area: 0.25,
                 merge_angle_deg: 1.0,
                 merge_distance: 1e-3,
+                material: MaterialArgs::default(),
             },
+            radio: self.radio,
             max_order: self.max_order,
             solver: self.solver,
             ipc_order: IpcOrderArg::GaussSeidel,

@@ -102,6 +102,7 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
         parallel: !args.single_thread,
     };
     let incremental = !args.from_scratch;
+    let radio = args.radio.options()?;
     let mut tracer = IncrementalTracer::new(options);
     let mut steps = Vec::with_capacity(dynamic.len());
     for (k, scene) in dynamic.scenes().iter().enumerate() {
@@ -112,7 +113,7 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
             trace_scratch(scene, k, &options)
         };
         let time_s = t0.elapsed().as_secs_f64();
-        let paths = bt_beams::report(scene, &result.trace.paths);
+        let paths = bt_beams::report(scene, &result.trace.paths, &radio)?;
         let step = StepDocument {
             step: k,
             tx: scene.tx().to_array(),

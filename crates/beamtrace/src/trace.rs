@@ -10,8 +10,25 @@ use std::path::Path;
 use std::process::ExitCode;
 use std::time::Instant;
 
-/// Load the scene named on the command line (a file or `builtin:NAME`).
-pub fn load_scene(args: &SceneArgs) -> Result<Loaded, SceneError> {
+/// Load the scene named on the command line (a file or `builtin:NAME`), with the carrier and
+/// radio material overrides (`--frequency`, `--material`, `--thickness`) applied.
+pub fn load_scene(args: &SceneArgs) -> anyhow::Result<Loaded> {
+    let radio = args.material.radio()?;
+    let mut loaded = load_source(args, radio)?;
+    if radio.is_some() && loaded.scene.materials().values().any(|m| m.radio != radio) {
+        // Built-in scenes and point clouds do not go through LoadOptions.
+        loaded.scene = loaded.scene.with_radio_material(radio.expect("checked"))?;
+    }
+    if let Some(f) = args.material.frequency {
+        loaded.scene = loaded.scene.with_frequency(f)?;
+    }
+    Ok(loaded)
+}
+
+fn load_source(
+    args: &SceneArgs,
+    radio: Option<bt_channel::RadioMaterial>,
+) -> Result<Loaded, SceneError> {
     let terminals = Terminals {
         tx: args.tx,
         rx: args.rx,
@@ -59,7 +76,11 @@ pub fn load_scene(args: &SceneArgs) -> Result<Loaded, SceneError> {
             ..bt_mesh::MergeOptions::default()
         },
         min_reflector_area_m2: args.min_reflector_area,
-        ..LoadOptions::default()
+        frequency_hz: args
+            .material
+            .frequency
+            .unwrap_or(bt_scene::DEFAULT_FREQUENCY_HZ),
+        radio,
     };
     bt_scene::io::load(path, &options)
 }
@@ -133,12 +154,15 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
     let options = trace_options(args, solver);
     let traced = bt_solve::pipeline::trace_scene(&scene, &options)?;
     let t3 = Instant::now();
-    let paths = bt_beams::report(&scene, &traced.result.paths);
+    let radio = args.radio.options()?;
+    let paths = bt_beams::report(&scene, &traced.result.paths, &radio)?;
+    warn_near_field(&paths, &scene);
     let t4 = Instant::now();
     let doc = TraceDocument::new(
         &scene,
         &solver,
         args.max_order,
+        &radio,
         paths,
         traced.candidates,
         traced.result.counts,
@@ -155,6 +179,21 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
         output::print_table(&doc);
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Friis needs the far field: say so when a path is shorter than a wavelength (its loss is
+/// clamped at 0 dB by `bt_channel::free_space`).
+pub fn warn_near_field(paths: &[bt_beams::PathReport], scene: &Scene) {
+    if let Some(p) = paths.iter().find(|p| p.near_field) {
+        eprintln!(
+            "warning: path {} is {:.4} m long, under one wavelength ({:.4} m) at {:.3} GHz: \
+             near field, Friis does not hold (loss clamped at 0 dB)",
+            p.rank,
+            p.length_m,
+            bt_beams::SPEED_OF_LIGHT / scene.frequency_hz(),
+            scene.frequency_hz() / 1e9
+        );
+    }
 }
 
 pub fn check(args: &SceneArgs) -> anyhow::Result<ExitCode> {
@@ -178,10 +217,13 @@ pub fn check(args: &SceneArgs) -> anyhow::Result<ExitCode> {
             );
             Ok(ExitCode::SUCCESS)
         }
-        Err(e @ SceneError::Invalid { .. }) => {
-            println!("{e}");
-            Ok(ExitCode::from(1))
-        }
-        Err(e) => Err(e.into()),
+        Err(e) => match e.downcast::<SceneError>() {
+            Ok(e @ SceneError::Invalid { .. }) => {
+                println!("{e}");
+                Ok(ExitCode::from(1))
+            }
+            Ok(e) => Err(e.into()),
+            Err(e) => Err(e),
+        },
     }
 }
