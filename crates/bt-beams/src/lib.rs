@@ -7,6 +7,10 @@
 //! TX towards the first interaction point (or RX); the arrival direction is RX towards the last
 //! interaction point (or TX), i.e. where the wave comes from, as Sionna RT and MATLAB report it.
 
+pub mod sweep;
+
+pub use sweep::{BeamPair, BeamRanking, Sweep, sweep};
+
 use bt_channel::{Antenna, Bounce, ChannelError, Complex64, SurfaceResponse, Tap};
 use bt_geom::{Real, Vec3};
 use bt_scene::{Scene, SurfaceId};

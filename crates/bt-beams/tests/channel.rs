@@ -27,9 +27,12 @@ fn two_ray_ground_reflection_gain_and_phase() {
         "surfaces": [ {{ "name": "ground", "material": "ground",
           "vertices": [[-100, -100, 0], [100, -100, 0], [100, 100, 0], [-100, 100, 0]] }} ] }}"#
     );
-    let scene =
-        Scene::from_description(&parse_json(&json, "two-ray").unwrap(), "two-ray", Terminals::default())
-            .unwrap();
+    let scene = Scene::from_description(
+        &parse_json(&json, "two-ray").unwrap(),
+        "two-ray",
+        Terminals::default(),
+    )
+    .unwrap();
     let lambda = C / f;
     let r1 = d.hypot(h1 - h2);
     let r2 = d.hypot(h1 + h2);
@@ -39,7 +42,10 @@ fn two_ray_ground_reflection_gain_and_phase() {
     let s = (eta - (1.0 - cos * cos)).sqrt();
     let gamma_v = (eta * cos - s) / (eta * cos + s);
     let gamma_h = (cos - s) / (cos + s);
-    for (pol, gamma, los_sign) in [(Polarization::V, gamma_v, 1.0), (Polarization::H, gamma_h, -1.0)] {
+    for (pol, gamma, los_sign) in [
+        (Polarization::V, gamma_v, 1.0),
+        (Polarization::H, gamma_h, -1.0),
+    ] {
         let antenna = Antenna {
             polarization: pol,
             ..Antenna::default()
@@ -56,7 +62,10 @@ fn two_ray_ground_reflection_gain_and_phase() {
         // V·V at the horizon: +λ/(4πr1). H·H: φ̂ at TX and at RX point opposite ways (the
         // field basis follows each antenna's own azimuth), so −λ/(4πr1): docs/channel.md.
         let expected_los = Complex64::new(los_sign * lambda / (4.0 * PI * r1), 0.0);
-        assert!((los.gain - expected_los).norm() < 1e-12 * expected_los.norm(), "{pol:?} los");
+        assert!(
+            (los.gain - expected_los).norm() < 1e-12 * expected_los.norm(),
+            "{pol:?} los"
+        );
         // V is TM, H is TE; both keep the LoS sign convention.
         let expected = gamma * (los_sign * lambda / (4.0 * PI * r2));
         assert!(
@@ -72,7 +81,10 @@ fn two_ray_ground_reflection_gain_and_phase() {
         let textbook = (Complex64::from_polar(1.0 / r1, -k * r1)
             + gamma * Complex64::from_polar(1.0 / r2, -k * r2))
             * (los_sign * lambda / (4.0 * PI));
-        assert!((h - textbook).norm() < 1e-9 * textbook.norm(), "{h} vs {textbook}");
+        assert!(
+            (h - textbook).norm() < 1e-9 * textbook.norm(),
+            "{h} vs {textbook}"
+        );
     }
 }
 
@@ -91,9 +103,25 @@ fn reciprocity_in_the_living_room() {
         polarization: Polarization::H,
         orientation: Orientation::from_degrees(-30.0, 10.0, 20.0),
     };
-    let forward = trace(&scene, 2, &RadioOptions { tx: a, rx: b, tx_power_dbm: 0.0 });
+    let forward = trace(
+        &scene,
+        2,
+        &RadioOptions {
+            tx: a,
+            rx: b,
+            tx_power_dbm: 0.0,
+        },
+    );
     let swapped = scene.with_terminals(scene.rx(), scene.tx()).unwrap();
-    let backward = trace(&swapped, 2, &RadioOptions { tx: b, rx: a, tx_power_dbm: 0.0 });
+    let backward = trace(
+        &swapped,
+        2,
+        &RadioOptions {
+            tx: b,
+            rx: a,
+            tx_power_dbm: 0.0,
+        },
+    );
     assert_eq!(forward.len(), backward.len());
     assert!(forward.len() > 10);
     for p in &forward {
@@ -111,4 +139,56 @@ fn reciprocity_in_the_living_room() {
         );
         assert!(p.gain.norm() > 0.0);
     }
+}
+
+/// Line of sight 30° off both arrays' boresights: the DFT beam with spatial frequency
+/// d·sin 30° = 1/4 (index 2 of 8) wins at both ends, with the full array gain 8 × 8.
+#[test]
+fn beam_sweep_finds_the_line_of_sight_pair() {
+    let rx = [10.0, 10.0 * (30f64).to_radians().tan(), 0.0];
+    let json = format!(
+        r#"{{ "tx": [0, 0, 0], "rx": [{}, {}, 0], "surfaces": [] }}"#,
+        rx[0], rx[1]
+    );
+    let scene = Scene::from_description(
+        &parse_json(&json, "los").unwrap(),
+        "los",
+        Terminals::default(),
+    )
+    .unwrap();
+    let radio = RadioOptions {
+        tx_power_dbm: 20.0,
+        ..RadioOptions::default()
+    };
+    let paths = trace(&scene, 1, &radio);
+    assert_eq!(paths.len(), 1);
+    let tx = bt_channel::Array::new(1, 8, 0.5, Orientation::default()).unwrap();
+    let rx_array =
+        bt_channel::Array::new(1, 8, 0.5, Orientation::from_degrees(180.0, 0.0, 0.0)).unwrap();
+    let expected = 20.0 + 20.0 * (paths[0].gain.norm() * 8.0).log10();
+    for ranking in [bt_beams::BeamRanking::Power, bt_beams::BeamRanking::Paper] {
+        let s =
+            bt_beams::sweep(&paths, &tx, &rx_array, scene.frequency_hz(), 20.0, ranking).unwrap();
+        let best = &s.pairs[0];
+        assert_eq!((best.tx_beam, best.rx_beam), (2, 2), "{ranking:?}");
+        assert!((best.power_dbm.unwrap() - expected).abs() < 1e-9);
+        let dir = best.tx_direction_deg.unwrap();
+        assert!((dir.azimuth - 30.0).abs() < 1e-9, "{dir:?}");
+    }
+    let all = bt_beams::sweep(
+        &paths,
+        &tx,
+        &rx_array,
+        scene.frequency_hz(),
+        20.0,
+        bt_beams::BeamRanking::Power,
+    )
+    .unwrap();
+    assert_eq!(all.pairs.len(), 64);
+    assert!(
+        all.pairs
+            .windows(2)
+            .all(|w| w[0].power_dbm.unwrap_or(f64::NEG_INFINITY)
+                >= w[1].power_dbm.unwrap_or(f64::NEG_INFINITY))
+    );
 }
