@@ -30,6 +30,12 @@ pub enum Command {
     /// Build the weak visibility relationship network (WVRN) of a scene and export it as a
     /// table, JSON or Graphviz DOT.
     Wvrn(WvrnArgs),
+    /// Channel impulse response (taps: gain, delay) as CSV, frequency response at subcarriers,
+    /// and a power-delay-profile plot (SVG and PNG).
+    Channel(ChannelArgs),
+    /// Beam sweep: received power of every TX/RX beam pair of DFT codebooks on ULA/UPA arrays,
+    /// the best pair and the ranked list.
+    Beams(BeamsArgs),
     /// Scene utilities.
     Scene {
         #[command(subcommand)]
@@ -417,19 +423,130 @@ pub struct DemoArgs {
 
 impl DemoArgs {
     pub fn into_trace(self) -> TraceArgs {
+        let scene = SceneArgs {
+            scene: "builtin:living-room".into(),
+            tx: None,
+            rx: None,
+            min_reflector_area: 0.25,
+            merge_angle_deg: 1.0,
+            merge_distance: 1e-3,
+            material: MaterialArgs::default(),
+        };
+        TraceArgs::basic(scene, self.radio, self.max_order, self.solver, self.json)
+    }
+}
+
+/// What `channel` and `beams` trace.
+#[derive(Debug, Args, Clone)]
+pub struct PathArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    #[command(flatten)]
+    pub radio: RadioArgs,
+    /// Highest reflection order.
+    #[arg(long, default_value_t = 3)]
+    pub max_order: usize,
+    /// Path solver.
+    #[arg(long, value_enum, default_value_t = SolverArg::Image)]
+    pub solver: SolverArg,
+}
+
+impl PathArgs {
+    /// The equivalent `trace` arguments (defaults for everything else).
+    pub fn trace_args(&self) -> TraceArgs {
+        TraceArgs::basic(
+            self.scene.clone(),
+            self.radio.clone(),
+            self.max_order,
+            self.solver,
+            false,
+        )
+    }
+}
+
+#[derive(Debug, Args, Clone)]
+pub struct ChannelArgs {
+    #[command(flatten)]
+    pub paths: PathArgs,
+    /// Channel impulse response CSV to write (one tap per path, by delay).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Also write the frequency response at the subcarriers to this CSV.
+    #[arg(long)]
+    pub cfr: Option<PathBuf>,
+    /// Number of subcarriers of the frequency response, centred on the carrier.
+    #[arg(long, default_value_t = 64)]
+    pub subcarriers: usize,
+    /// Subcarrier spacing, Hz.
+    #[arg(long, default_value_t = 120e3)]
+    pub subcarrier_spacing: f64,
+    /// Power-delay-profile plot: writes STEM.svg and STEM.png.
+    #[arg(long)]
+    pub pdp: Option<PathBuf>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum RankingArg {
+    /// By received power, strongest first.
+    Power,
+    /// The paper's path ranking: the best pair for each path, paths by order, length, angle.
+    Paper,
+}
+
+#[derive(Debug, Args, Clone)]
+pub struct BeamsArgs {
+    #[command(flatten)]
+    pub paths: PathArgs,
+    /// TX array ROWSxCOLUMNS (1xN is a horizontal ULA), elements in the antenna's local y-z
+    /// plane, boresight along the antenna orientation.
+    #[arg(long, default_value = "1x8", value_parser = parse_array_shape)]
+    pub tx_array: (usize, usize),
+    /// RX array ROWSxCOLUMNS.
+    #[arg(long, default_value = "1x8", value_parser = parse_array_shape)]
+    pub rx_array: (usize, usize),
+    /// TX element spacing, wavelengths.
+    #[arg(long, default_value_t = 0.5)]
+    pub tx_spacing: f64,
+    /// RX element spacing, wavelengths.
+    #[arg(long, default_value_t = 0.5)]
+    pub rx_spacing: f64,
+    /// Ranking of the beam pairs.
+    #[arg(long, value_enum, default_value_t = RankingArg::Power)]
+    pub ranking: RankingArg,
+    /// Print this many pairs of the ranked list (the JSON holds them all).
+    #[arg(long, default_value_t = 10)]
+    pub top: usize,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+    /// Write the JSON to this file.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+/// Parse `ROWSxCOLUMNS`, e.g. `1x8` or `4x4`.
+pub fn parse_array_shape(s: &str) -> anyhow::Result<(usize, usize)> {
+    let parse = |p: &str| p.trim().parse::<usize>().ok().filter(|n| *n > 0);
+    match s.split_once(['x', 'X']).map(|(a, b)| (parse(a), parse(b))) {
+        Some((Some(rows), Some(columns))) => Ok((rows, columns)),
+        _ => bail!("expected ROWSxCOLUMNS with positive counts (e.g. 1x8 or 4x4), got \"{s}\""),
+    }
+}
+
+impl TraceArgs {
+    /// Arguments with defaults for everything but the scene, radio, order, solver and output.
+    pub fn basic(
+        scene: SceneArgs,
+        radio: RadioArgs,
+        max_order: usize,
+        solver: SolverArg,
+        json: bool,
+    ) -> TraceArgs {
         TraceArgs {
-            scene: SceneArgs {
-                scene: "builtin:living-room".into(),
-                tx: None,
-                rx: None,
-                min_reflector_area: 0.25,
-                merge_angle_deg: 1.0,
-                merge_distance: 1e-3,
-                material: MaterialArgs::default(),
-            },
-            radio: self.radio,
-            max_order: self.max_order,
-            solver: self.solver,
+            scene,
+            radio,
+            max_order,
+            solver,
             ipc_order: IpcOrderArg::GaussSeidel,
             ipc_threshold: None,
             ipc_max_iterations: bt_solve::ipc::DEFAULT_MAX_ITERATIONS,
@@ -438,7 +555,7 @@ impl DemoArgs {
             sbr_rays: None,
             sbr_planar: false,
             single_thread: false,
-            json: self.json,
+            json,
             out: None,
             candidates: CandidatesArg::BeamTree,
             wvrn: false,
