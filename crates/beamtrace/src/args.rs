@@ -164,7 +164,7 @@ pub struct MaterialArgs {
     #[arg(long, value_parser = parse_material)]
     pub material: Option<MaterialArg>,
     /// With --material: slab thickness in metres (default: a half-space).
-    #[arg(long, requires = "material")]
+    #[arg(long, requires = "material", allow_hyphen_values = true)]
     pub thickness: Option<f64>,
 }
 
