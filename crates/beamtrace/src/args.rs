@@ -638,6 +638,8 @@ pub struct HlsArgs {
     pub command: HlsCommand,
 }
 
+// Parsed once per run: the size of the largest variant (scene arguments) does not matter.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Subcommand, Clone)]
 pub enum HlsCommand {
     /// Generate the accelerator for a scene into a directory.

@@ -59,8 +59,7 @@ impl TraceDocument {
         max_order: usize,
         radio: &RadioOptions,
         paths: Vec<PathReport>,
-        candidates: CandidateStats,
-        outcomes: OutcomeCounts,
+        (candidates, outcomes): (CandidateStats, OutcomeCounts),
         times: [Duration; 4],
     ) -> Self {
         let [load, cand, solve, report] = times.map(|d| d.as_secs_f64());

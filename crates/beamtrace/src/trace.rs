@@ -15,9 +15,11 @@ use std::time::Instant;
 pub fn load_scene(args: &SceneArgs) -> anyhow::Result<Loaded> {
     let radio = args.material.radio()?;
     let mut loaded = load_source(args, radio)?;
-    if radio.is_some() && loaded.scene.materials().values().any(|m| m.radio != radio) {
+    if let Some(r) = radio
+        && loaded.scene.materials().values().any(|m| m.radio != radio)
+    {
         // Built-in scenes and point clouds do not go through LoadOptions.
-        loaded.scene = loaded.scene.with_radio_material(radio.expect("checked"))?;
+        loaded.scene = loaded.scene.with_radio_material(r)?;
     }
     if let Some(f) = args.material.frequency {
         loaded.scene = loaded.scene.with_frequency(f)?;
@@ -164,8 +166,7 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
         args.max_order,
         &radio,
         paths,
-        traced.candidates,
-        traced.result.counts,
+        (traced.candidates, traced.result.counts),
         [t1 - t0, traced.time.candidates, traced.time.solve, t4 - t3],
     );
     let json = serde_json::to_string_pretty(&doc).context("serialising the trace")?;
