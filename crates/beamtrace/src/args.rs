@@ -293,15 +293,7 @@ pub enum IpcAccelArg {
 #[derive(Debug, Args, Clone)]
 pub struct TraceArgs {
     #[command(flatten)]
-    pub scene: SceneArgs,
-    #[command(flatten)]
-    pub radio: RadioArgs,
-    /// Highest reflection order.
-    #[arg(long, default_value_t = 3)]
-    pub max_order: usize,
-    /// Path solver.
-    #[arg(long, value_enum, default_value_t = SolverArg::Image)]
-    pub solver: SolverArg,
+    pub paths: PathArgs,
     /// IPC update order.
     #[arg(long, value_enum, default_value_t = IpcOrderArg::GaussSeidel)]
     pub ipc_order: IpcOrderArg,
@@ -432,7 +424,13 @@ impl DemoArgs {
             merge_distance: 1e-3,
             material: MaterialArgs::default(),
         };
-        TraceArgs::basic(scene, self.radio, self.max_order, self.solver, self.json)
+        let paths = PathArgs {
+            scene,
+            radio: self.radio,
+            max_order: self.max_order,
+            solver: self.solver,
+        };
+        TraceArgs::basic(paths, self.json)
     }
 }
 
@@ -454,13 +452,7 @@ pub struct PathArgs {
 impl PathArgs {
     /// The equivalent `trace` arguments (defaults for everything else).
     pub fn trace_args(&self) -> TraceArgs {
-        TraceArgs::basic(
-            self.scene.clone(),
-            self.radio.clone(),
-            self.max_order,
-            self.solver,
-            false,
-        )
+        TraceArgs::basic(self.clone(), false)
     }
 }
 
@@ -534,19 +526,10 @@ pub fn parse_array_shape(s: &str) -> anyhow::Result<(usize, usize)> {
 }
 
 impl TraceArgs {
-    /// Arguments with defaults for everything but the scene, radio, order, solver and output.
-    pub fn basic(
-        scene: SceneArgs,
-        radio: RadioArgs,
-        max_order: usize,
-        solver: SolverArg,
-        json: bool,
-    ) -> TraceArgs {
+    /// Arguments with defaults for everything but what to trace and the output.
+    pub fn basic(paths: PathArgs, json: bool) -> TraceArgs {
         TraceArgs {
-            scene,
-            radio,
-            max_order,
-            solver,
+            paths,
             ipc_order: IpcOrderArg::GaussSeidel,
             ipc_threshold: None,
             ipc_max_iterations: bt_solve::ipc::DEFAULT_MAX_ITERATIONS,

@@ -92,17 +92,17 @@ pub fn load_dynamic(args: &SceneArgs) -> anyhow::Result<DynamicScene> {
 }
 
 pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
-    let dynamic = load_dynamic(&args.scene)?;
+    let dynamic = load_dynamic(&args.paths.scene)?;
     let scene0 = dynamic.step(0);
     let solver = solver_for(args, scene0)?;
     let options = StepOptions {
-        max_order: args.max_order,
+        max_order: args.paths.max_order,
         solver,
         wvrn: args.candidate_mode() != bt_solve::pipeline::CandidateMode::Exhaustive,
         parallel: !args.single_thread,
     };
     let incremental = !args.from_scratch;
-    let radio = args.radio.options()?;
+    let radio = args.paths.radio.options()?;
     let mut tracer = IncrementalTracer::new(options);
     let mut steps = Vec::with_capacity(dynamic.len());
     for (k, scene) in dynamic.scenes().iter().enumerate() {
@@ -140,7 +140,7 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
         format_version: FORMAT_VERSION,
         scene: scene0.name().to_string(),
         frequency_hz: scene0.frequency_hz(),
-        max_order: args.max_order,
+        max_order: args.paths.max_order,
         solver,
         wvrn: options.wvrn,
         incremental,

@@ -89,7 +89,7 @@ fn load_source(
 
 /// The solver the arguments select, with defaults scaled to the scene.
 pub fn solver_for(args: &TraceArgs, scene: &Scene) -> anyhow::Result<Solver> {
-    Ok(match args.solver {
+    Ok(match args.paths.solver {
         SolverArg::Image => Solver::Image,
         SolverArg::Ipc => {
             let order = match args.ipc_order {
@@ -133,7 +133,7 @@ pub fn solver_for(args: &TraceArgs, scene: &Scene) -> anyhow::Result<Solver> {
 /// The pipeline options the arguments select.
 pub fn trace_options(args: &TraceArgs, solver: Solver) -> bt_solve::pipeline::TraceOptions {
     bt_solve::pipeline::TraceOptions {
-        max_order: args.max_order,
+        max_order: args.paths.max_order,
         solver,
         candidates: args.candidate_mode(),
         parallel: !args.single_thread,
@@ -146,7 +146,7 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
         return crate::steps::run(args);
     }
     let t0 = Instant::now();
-    let loaded = load_scene(&args.scene)?;
+    let loaded = load_scene(&args.paths.scene)?;
     for w in &loaded.warnings {
         eprintln!("warning: {w}");
     }
@@ -156,14 +156,14 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
     let options = trace_options(args, solver);
     let traced = bt_solve::pipeline::trace_scene(&scene, &options)?;
     let t3 = Instant::now();
-    let radio = args.radio.options()?;
+    let radio = args.paths.radio.options()?;
     let paths = bt_beams::report(&scene, &traced.result.paths, &radio)?;
     warn_near_field(&paths, &scene);
     let t4 = Instant::now();
     let doc = TraceDocument::new(
         &scene,
         &solver,
-        args.max_order,
+        args.paths.max_order,
         &radio,
         paths,
         (traced.candidates, traced.result.counts),

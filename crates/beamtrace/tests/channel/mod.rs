@@ -1,21 +1,11 @@
-//! The radio channel from the command line: gains in `trace --json`, `channel` (CIR, CFR,
+//! (A module of `cli.rs`: one test binary.) The radio channel from the command line: gains in `trace --json`, `channel` (CIR, CFR,
 //! power-delay profile), `beams` (codebook sweep), material and frequency overrides, and clear
 //! errors on bad input.
 
+use super::{assert_clear_error, beamtrace, repo};
 use serde_json::Value;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
-
-fn beamtrace(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_beamtrace"))
-        .args(args)
-        .output()
-        .expect("binary runs")
-}
+use std::path::PathBuf;
+use std::process::Output;
 
 fn ok(args: &[&str]) -> Output {
     let o = beamtrace(args);
@@ -29,23 +19,6 @@ fn ok(args: &[&str]) -> Output {
 
 fn json(args: &[&str]) -> Value {
     serde_json::from_slice(&ok(args).stdout).expect("valid JSON")
-}
-
-fn assert_clear_error(args: &[&str], needles: &[&str]) {
-    let o = beamtrace(args);
-    let code = o.status.code();
-    assert!(
-        code.is_some() && code != Some(0) && code != Some(101),
-        "{args:?}: exit {code:?}"
-    );
-    let text = format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    );
-    for n in needles {
-        assert!(text.contains(n), "{args:?}: message lacks {n:?}:\n{text}");
-    }
 }
 
 fn temp_dir(name: &str) -> PathBuf {
@@ -249,38 +222,29 @@ fn channel_writes_cir_cfr_and_the_pdp_plot() {
 
 #[test]
 fn beams_finds_the_best_pair_and_keeps_the_paper_ranking() {
-    let power = json(&[
-        "beams",
-        "builtin:living-room",
-        "--tx-array",
-        "1x8",
-        "--rx-array",
-        "1x8",
-        "--tx-orientation",
-        "180,0,0",
-        "--json",
-        "--max-order",
-        "2",
-    ]);
+    let sweep = |extra: &[&str]| {
+        let mut args = vec![
+            "beams",
+            "builtin:living-room",
+            "--tx-array",
+            "1x8",
+            "--rx-array",
+            "1x8",
+            "--tx-orientation",
+            "180,0,0",
+            "--json",
+            "--max-order",
+            "2",
+        ];
+        args.extend_from_slice(extra);
+        json(&args)
+    };
+    let power = sweep(&[]);
     let pairs = power["pairs"].as_array().unwrap();
     assert_eq!(pairs.len(), 64);
     let p = |v: &Value| v["power_dbm"].as_f64().unwrap_or(f64::NEG_INFINITY);
     assert!(pairs.windows(2).all(|w| p(&w[0]) >= p(&w[1])));
-    let paper = json(&[
-        "beams",
-        "builtin:living-room",
-        "--tx-array",
-        "1x8",
-        "--rx-array",
-        "1x8",
-        "--tx-orientation",
-        "180,0,0",
-        "--json",
-        "--max-order",
-        "2",
-        "--ranking",
-        "paper",
-    ]);
+    let paper = sweep(&["--ranking", "paper"]);
     let first = &paper["pairs"][0];
     assert_eq!(first["path_rank"], 1);
     // Every pair the paper ranking picks is in the power list with the same power.
