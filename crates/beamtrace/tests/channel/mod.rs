@@ -96,48 +96,22 @@ fn a_perfect_conductor_mesh_keeps_every_reflection_at_full_strength() {
             p["surfaces"]
         );
     }
+    let fails = |extra: &[&str], needles: &[&str]| {
+        let mut args = vec!["trace", mesh.as_str(), "--tx", "1,1,1.5", "--rx", "4,3,1.2"];
+        args.extend_from_slice(extra);
+        assert_clear_error(&args, needles);
+    };
     // ITU brick is not defined at 60 GHz: a clear error naming it.
-    assert_clear_error(
-        &[
-            "trace",
-            &mesh,
-            "--tx",
-            "1,1,1.5",
-            "--rx",
-            "4,3,1.2",
-            "--material",
-            "itu:brick",
-            "--frequency",
-            "60e9",
-        ],
+    fails(
+        &["--material", "itu:brick", "--frequency", "60e9"],
         &["brick", "1–40 GHz", "60"],
     );
-    assert_clear_error(
-        &[
-            "trace",
-            &mesh,
-            "--tx",
-            "1,1,1.5",
-            "--rx",
-            "4,3,1.2",
-            "--material",
-            "itu:marmalade",
-        ],
+    fails(
+        &["--material", "itu:marmalade"],
         &["unknown ITU material \"marmalade\""],
     );
-    assert_clear_error(
-        &[
-            "trace",
-            &mesh,
-            "--tx",
-            "1,1,1.5",
-            "--rx",
-            "4,3,1.2",
-            "--material",
-            "itu:wood",
-            "--thickness",
-            "-1",
-        ],
+    fails(
+        &["--material", "itu:wood", "--thickness", "-1"],
         &["thickness"],
     );
 }
