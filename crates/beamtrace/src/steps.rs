@@ -54,6 +54,16 @@ pub struct StepStats {
 /// Load a scene as a dynamic scene: JSON/TOML files and built-ins with their steps; meshes
 /// (and any other static source) as one step.
 pub fn load_dynamic(args: &SceneArgs) -> anyhow::Result<DynamicScene> {
+    let overrides = args.material.frequency.is_some() || args.material.material.is_some();
+    let dynamic_source = args.scene.starts_with("builtin:")
+        || [".json", ".toml"]
+            .iter()
+            .any(|e| args.scene.to_ascii_lowercase().ends_with(e));
+    if overrides && dynamic_source {
+        bail!(
+            "--frequency and --material are not supported with --steps on scene files yet: set \"frequency_hz\" and the materials in the scene"
+        );
+    }
     let terminals = Terminals {
         tx: args.tx,
         rx: args.rx,

@@ -261,3 +261,17 @@ fn near_field_is_clamped_and_warned() {
     assert!(f(&los["free_space_loss_db"]) >= 0.0 && f(&los["gain_db"]) <= 0.0);
     assert!(String::from_utf8_lossy(&o.stderr).contains("near field"));
 }
+
+#[test]
+fn overrides_are_refused_where_they_would_be_ignored() {
+    assert_clear_error(
+        &[
+            "trace",
+            "builtin:living-room-dynamic",
+            "--steps",
+            "--frequency",
+            "60e9",
+        ],
+        &["--frequency and --material are not supported with --steps"],
+    );
+}
