@@ -1,6 +1,7 @@
 //! The JSON document of a trace (documented in `docs/output-format.md`) and the table view.
 
-use bt_beams::PathReport;
+use bt_beams::{PathReport, RadioOptions};
+use bt_channel::Antenna;
 use bt_paths::CandidateStats;
 use bt_scene::Scene;
 use bt_solve::{OutcomeCounts, Solver};
@@ -19,8 +20,17 @@ pub struct TraceDocument {
     pub frequency_hz: f64,
     pub max_order: usize,
     pub solver: Solver,
+    pub radio: Radio,
     pub paths: Vec<PathReport>,
     pub stats: Stats,
+}
+
+/// Antennas and transmitted power of the gains.
+#[derive(Debug, Serialize)]
+pub struct Radio {
+    pub tx_antenna: Antenna,
+    pub rx_antenna: Antenna,
+    pub tx_power_dbm: f64,
 }
 
 #[derive(Debug, Serialize)]
@@ -28,6 +38,8 @@ pub struct Stats {
     pub candidates: CandidateStats,
     pub outcomes: OutcomeCounts,
     pub valid_paths: usize,
+    /// Total received power (power sum over the paths), dBm; null without any power.
+    pub received_power_dbm: Option<f64>,
     /// Wall-clock seconds per stage (the only part of the document that varies between runs).
     pub time_s: StageTimes,
 }
@@ -45,9 +57,9 @@ impl TraceDocument {
         scene: &Scene,
         solver: &Solver,
         max_order: usize,
+        radio: &RadioOptions,
         paths: Vec<PathReport>,
-        candidates: CandidateStats,
-        outcomes: OutcomeCounts,
+        (candidates, outcomes): (CandidateStats, OutcomeCounts),
         times: [Duration; 4],
     ) -> Self {
         let [load, cand, solve, report] = times.map(|d| d.as_secs_f64());
@@ -59,10 +71,16 @@ impl TraceDocument {
             frequency_hz: scene.frequency_hz(),
             max_order,
             solver: *solver,
+            radio: Radio {
+                tx_antenna: radio.tx,
+                rx_antenna: radio.rx,
+                tx_power_dbm: radio.tx_power_dbm,
+            },
             stats: Stats {
                 candidates,
                 outcomes,
                 valid_paths: paths.len(),
+                received_power_dbm: bt_beams::received_power_dbm(&paths, radio.tx_power_dbm),
                 time_s: StageTimes {
                     load,
                     candidates: cand,
@@ -85,8 +103,17 @@ pub fn print_table(doc: &TraceDocument) {
         doc.max_order
     );
     println!(
-        "{:>4} {:>3} {:>8} {:>8} {:>8} {:>7} {:>8} {:>7} {:>7}  surfaces",
-        "rank", "ord", "length_m", "delay_ns", "aod_az", "aod_el", "aoa_az", "aoa_el", "loss_db"
+        "{:>4} {:>3} {:>8} {:>8} {:>8} {:>7} {:>8} {:>7} {:>7} {:>8}  surfaces",
+        "rank",
+        "ord",
+        "length_m",
+        "delay_ns",
+        "aod_az",
+        "aod_el",
+        "aoa_az",
+        "aoa_el",
+        "loss_db",
+        "gain_db"
     );
     for p in &doc.paths {
         let names = if p.surfaces.is_empty() {
@@ -95,7 +122,7 @@ pub fn print_table(doc: &TraceDocument) {
             p.surfaces.join(" > ")
         };
         println!(
-            "{:>4} {:>3} {:>8.3} {:>8.3} {:>8.2} {:>7.2} {:>8.2} {:>7.2} {:>7.2}  {}",
+            "{:>4} {:>3} {:>8.3} {:>8.3} {:>8.2} {:>7.2} {:>8.2} {:>7.2} {:>7.2} {:>8}  {}",
             p.rank,
             p.order,
             p.length_m,
@@ -105,6 +132,8 @@ pub fn print_table(doc: &TraceDocument) {
             p.aoa_deg.azimuth,
             p.aoa_deg.elevation,
             p.loss_db,
+            p.gain_db
+                .map_or_else(|| "-inf".to_string(), |g| format!("{g:.2}")),
             names
         );
     }

@@ -75,6 +75,7 @@ pub fn run_living_room(args: &StudyLivingRoomArgs) -> anyhow::Result<ExitCode> {
         min_reflector_area: 0.25,
         merge_angle_deg: 1.0,
         merge_distance: 1e-3,
+        material: Default::default(),
     })?;
     let bar = ProgressBar::new(scene.len() as u64);
     bar.set_style(

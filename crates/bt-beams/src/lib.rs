@@ -1,18 +1,35 @@
 //! What a beam manager needs from each path: length, delay, departure and arrival directions,
-//! incidence angles, loss; and the paper's ranking (order first, then length, then angle).
+//! incidence angles, loss, the polarised complex gain (`bt-channel`, `docs/channel.md`); and the
+//! paper's ranking (order first, then length, then angle).
 //!
 //! Angle conventions (`docs/conventions.md`): azimuth from +x towards +y, in (-180°, 180°];
 //! elevation from the horizontal plane, positive up, in [-90°, 90°]. The departure direction is
 //! TX towards the first interaction point (or RX); the arrival direction is RX towards the last
 //! interaction point (or TX), i.e. where the wave comes from, as Sionna RT and MATLAB report it.
 
+pub mod sweep;
+
+pub use sweep::{BeamPair, BeamRanking, Sweep, sweep};
+
+use bt_channel::{Antenna, Bounce, ChannelError, Complex64, SurfaceResponse, Tap};
 use bt_geom::{Real, Vec3};
 use bt_scene::{Scene, SurfaceId};
 use bt_solve::FoundPath;
-use serde::Serialize;
+use serde::{Serialize, Serializer};
 
 /// Speed of light in vacuum, m/s.
-pub const SPEED_OF_LIGHT: Real = 299_792_458.0;
+pub use bt_channel::SPEED_OF_LIGHT;
+
+/// The radio side of a report: antennas at both ends and the transmitted power.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct RadioOptions {
+    /// Transmitting antenna (default: isotropic, vertical).
+    pub tx: Antenna,
+    /// Receiving antenna (default: isotropic, vertical).
+    pub rx: Antenna,
+    /// Transmitted power, dBm (default 0).
+    pub tx_power_dbm: Real,
+}
 
 /// A direction as azimuth and elevation, degrees.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -80,6 +97,23 @@ pub struct PathReport {
     pub reflection_loss_db: Real,
     /// Total loss: free space plus reflections, dB.
     pub loss_db: Real,
+    /// Complex path gain [re, im] (antennas, polarisation, reflections, λ/(4π·length); no
+    /// propagation phase).
+    #[serde(serialize_with = "complex_pair")]
+    pub gain: Complex64,
+    /// 20·log10|gain|, dB; `null` when the path carries no power.
+    pub gain_db: Option<Real>,
+    /// Received power of this path alone, dBm (transmitted power + gain_db); `null` with it.
+    pub power_dbm: Option<Real>,
+    /// The path is shorter than a wavelength: Friis does not hold (the loss is clamped at 0 dB).
+    #[serde(skip)]
+    pub near_field: bool,
+    /// Unit departure direction at TX (world frame).
+    #[serde(skip)]
+    pub departure: Vec3,
+    /// Unit arrival direction at RX, towards where the wave comes from (world frame).
+    #[serde(skip)]
+    pub arrival: Vec3,
     /// IPC rounds (IPC solver only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub iterations: Option<u32>,
@@ -88,13 +122,39 @@ pub struct PathReport {
     pub residual_m: Option<Real>,
 }
 
-/// Free-space path loss (Friis), dB, for `length` metres at `frequency_hz`.
+fn complex_pair<S: Serializer>(c: &Complex64, s: S) -> Result<S::Ok, S::Error> {
+    [c.re, c.im].serialize(s)
+}
+
+/// Free-space path loss (Friis), dB, for `length` metres at `frequency_hz`; never negative
+/// (clamped below λ/(4π), see [`bt_channel::free_space`]).
 pub fn free_space_loss_db(length: Real, frequency_hz: Real) -> Real {
-    20.0 * (4.0 * std::f64::consts::PI * length * frequency_hz / SPEED_OF_LIGHT).log10()
+    bt_channel::free_space(length, frequency_hz).loss_db
+}
+
+/// How a surface of the scene reflects: its radio model, or its constant loss as a scaled
+/// conductor when it has none.
+pub fn surface_response(scene: &Scene, id: SurfaceId) -> SurfaceResponse {
+    let m = scene.material_of(id);
+    match m.radio {
+        Some(radio) => SurfaceResponse::Radio(radio),
+        None => SurfaceResponse::ConstantLoss {
+            loss_db: m.reflection_loss_db,
+        },
+    }
+}
+
+/// `value` in dB (10·log10 of a power ratio), `None` for zero.
+fn power_db(value: Real) -> Option<Real> {
+    (value > 0.0).then(|| 10.0 * value.log10())
 }
 
 /// Describe one found path (rank 0 until [`rank`] runs).
-pub fn describe(scene: &Scene, path: &FoundPath) -> PathReport {
+pub fn describe(
+    scene: &Scene,
+    path: &FoundPath,
+    radio: &RadioOptions,
+) -> Result<PathReport, ChannelError> {
     let (tx, rx) = (scene.tx(), scene.rx());
     let mut vertices = Vec::with_capacity(path.points.len() + 2);
     vertices.push(tx);
@@ -121,8 +181,25 @@ pub fn describe(scene: &Scene, path: &FoundPath) -> PathReport {
         .map(|id| scene.material_of(*id).reflection_loss_db)
         .fold(0.0, |a, b| a + b);
     let free_space_loss_db = free_space_loss_db(length_m, scene.frequency_hz());
+    let bounces: Vec<Bounce> = path
+        .surfaces
+        .iter()
+        .map(|id| Bounce {
+            normal: scene.surface(*id).polygon.plane().normal,
+            response: surface_response(scene, *id),
+        })
+        .collect();
+    let gain = bt_channel::path_gain(
+        scene.tx(),
+        &path.points,
+        scene.rx(),
+        &bounces,
+        (&radio.tx, &radio.rx),
+        scene.frequency_hz(),
+    )?;
+    let gain_db = power_db(gain.norm_sqr());
     let n = vertices.len();
-    PathReport {
+    Ok(PathReport {
         rank: 0,
         order: path.surfaces.len(),
         surfaces: path
@@ -140,15 +217,47 @@ pub fn describe(scene: &Scene, path: &FoundPath) -> PathReport {
         free_space_loss_db,
         reflection_loss_db,
         loss_db: free_space_loss_db + reflection_loss_db,
+        gain,
+        gain_db,
+        power_dbm: gain_db.map(|g| g + radio.tx_power_dbm),
+        near_field: bt_channel::free_space(length_m, scene.frequency_hz()).near_field,
+        departure: (vertices[1] - vertices[0]).normalize(),
+        arrival: (vertices[n - 2] - vertices[n - 1]).normalize(),
         iterations: path.iterations,
         residual_m: path.residual,
-    }
+    })
+}
+
+/// The channel taps of reported paths (gain, delay), in report order.
+pub fn taps(paths: &[PathReport]) -> Vec<Tap> {
+    paths
+        .iter()
+        .map(|p| Tap {
+            gain: p.gain,
+            delay_s: p.delay_s,
+        })
+        .collect()
+}
+
+/// Total received power of the paths, dBm: transmitted power + 10·log10 Σ|gain|² (a power sum:
+/// the wideband average, without interference between paths); `None` without power.
+pub fn received_power_dbm(paths: &[PathReport], tx_power_dbm: Real) -> Option<Real> {
+    power_db(bt_channel::total_power(&taps(paths))).map(|g| g + tx_power_dbm)
 }
 
 /// Describe and rank all paths: by order, then length, then the largest incidence angle
-/// (closer to normal first), then surface ids — the paper's principles, made total.
-pub fn report(scene: &Scene, paths: &[FoundPath]) -> Vec<PathReport> {
-    let mut reports: Vec<PathReport> = paths.iter().map(|p| describe(scene, p)).collect();
+/// (closer to normal first), then surface ids — the paper's principles, made total. Fails only
+/// if a material has no radio model at the scene's frequency (scenes are validated against
+/// that).
+pub fn report(
+    scene: &Scene,
+    paths: &[FoundPath],
+    radio: &RadioOptions,
+) -> Result<Vec<PathReport>, ChannelError> {
+    let mut reports = paths
+        .iter()
+        .map(|p| describe(scene, p, radio))
+        .collect::<Result<Vec<_>, _>>()?;
     let key = |r: &PathReport| r.incidence_deg.iter().copied().fold(0.0, Real::max);
     reports.sort_by(|a, b| {
         a.order
@@ -160,7 +269,7 @@ pub fn report(scene: &Scene, paths: &[FoundPath]) -> Vec<PathReport> {
     for (i, r) in reports.iter_mut().enumerate() {
         r.rank = i + 1;
     }
-    reports
+    Ok(reports)
 }
 
 #[cfg(test)]
@@ -175,6 +284,12 @@ mod tests {
         assert!((d.azimuth - 180.0).abs() < 1e-12 && (d.elevation - 45.0).abs() < 1e-12);
         let v = Vec3::new(0.3, -0.4, 0.2).normalize();
         assert!((Direction::of(v).unit() - v).length() < 1e-12);
+    }
+
+    #[test]
+    fn friis_never_gains_in_the_near_field() {
+        assert_eq!(free_space_loss_db(1e-5, 28e9), 0.0);
+        assert!(free_space_loss_db(0.01, 28e9) > 0.0);
     }
 
     #[test]

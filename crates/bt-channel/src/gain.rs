@@ -57,6 +57,8 @@ pub struct Bounce {
 pub struct FreeSpace {
     /// λ/(4π·max(length, λ/(4π))): never above 1, i.e. never a negative loss.
     pub amplitude: Real,
+    /// Friis loss 20·log10(4π·max(length, λ/(4π))·f/c), dB (>= 0).
+    pub loss_db: Real,
     /// The path is shorter than one wavelength: Friis does not hold there (near field), and
     /// below λ/(4π) the amplitude is clamped to 1 (0 dB loss).
     pub near_field: bool,
@@ -67,8 +69,10 @@ pub struct FreeSpace {
 pub fn free_space(length: Real, frequency_hz: Real) -> FreeSpace {
     let wavelength = SPEED_OF_LIGHT / frequency_hz;
     let floor = wavelength / (4.0 * PI);
+    let clamped = length.max(floor);
     FreeSpace {
-        amplitude: floor / length.max(floor),
+        amplitude: floor / clamped,
+        loss_db: 20.0 * (4.0 * PI * clamped * frequency_hz / SPEED_OF_LIGHT).log10(),
         near_field: length < wavelength,
     }
 }
@@ -183,6 +187,7 @@ mod tests {
     fn near_field_never_gains() {
         let fs = free_space(1e-4, F);
         assert_eq!(fs.amplitude, 1.0);
+        assert_eq!(fs.loss_db, 0.0);
         assert!(fs.near_field);
         let fs = free_space(1.0, F);
         assert!(fs.amplitude < 1.0 && !fs.near_field);

@@ -41,6 +41,44 @@ macro_rules! figure {
     }};
 }
 
+/// Write the power-delay profile of `taps` as `<stem>.svg` and `<stem>.png` (each to a temporary
+/// file in the same directory, then renamed into place). Returns the files written.
+pub fn write_power_delay_profile(
+    stem: &Path,
+    title: &str,
+    taps: &[plot::PdpTap],
+) -> Result<Vec<PathBuf>, StudyError> {
+    let mut out = Vec::new();
+    for ext in ["svg", "png"] {
+        let path = stem.with_extension(ext);
+        let name = path.file_name().and_then(|n| n.to_str()).unwrap_or("pdp");
+        let temp = path.with_file_name(format!(".{name}.{}.tmp.{ext}", std::process::id()));
+        let plot_error = |message: String| StudyError::Plot {
+            path: path.display().to_string(),
+            message,
+        };
+        let drawn = if ext == "svg" {
+            let root = SVGBackend::new(&temp, (900, 500)).into_drawing_area();
+            plot::power_delay_profile(&root, (title, taps))
+                .and_then(|()| root.present().map_err(|e| e.to_string()))
+        } else {
+            let root = BitMapBackend::new(&temp, (900, 500)).into_drawing_area();
+            plot::power_delay_profile(&root, (title, taps))
+                .and_then(|()| root.present().map_err(|e| e.to_string()))
+        };
+        if let Err(message) = drawn {
+            let _ = std::fs::remove_file(&temp);
+            return Err(plot_error(message));
+        }
+        std::fs::rename(&temp, &path).map_err(|source| StudyError::Io {
+            path: path.display().to_string(),
+            source,
+        })?;
+        out.push(path);
+    }
+    Ok(out)
+}
+
 /// Write every output of a study into `dir` (created if missing); returns the files written.
 pub fn write_outputs(dir: &Path, results: &StudyResults) -> Result<Vec<PathBuf>, StudyError> {
     std::fs::create_dir_all(dir).map_err(|source| StudyError::Io {
