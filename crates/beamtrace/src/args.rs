@@ -157,7 +157,8 @@ pub struct SceneArgs {
 /// Carrier and radio material overrides (any scene source).
 #[derive(Debug, Args, Clone, Default)]
 pub struct MaterialArgs {
-    /// Carrier frequency, Hz (overrides the scene's; meshes and point clouds default to 28e9).
+    /// Carrier frequency, Hz (overrides the scene's, at every step with --steps; meshes, point
+    /// clouds and XML scenes default to 28e9).
     #[arg(long)]
     pub frequency: Option<f64>,
     /// Radio material of every surface: itu:NAME (ITU-R P.2040-3, e.g. itu:concrete) or
