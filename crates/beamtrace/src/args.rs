@@ -36,6 +36,12 @@ pub enum Command {
     /// Write one self-contained HTML page showing the scene and its paths in 3-D (three.js
     /// inlined, no network needed); dynamic scenes get a time-step slider.
     View(ViewArgs),
+    /// Channel impulse response (taps: gain, delay) as CSV, frequency response at subcarriers,
+    /// and a power-delay-profile plot (SVG and PNG).
+    Channel(ChannelArgs),
+    /// Beam sweep: received power of every TX/RX beam pair of DFT codebooks on ULA/UPA arrays,
+    /// the best pair and the ranked list.
+    Beams(BeamsArgs),
     /// Scene utilities.
     Scene {
         #[command(subcommand)]
@@ -162,6 +168,120 @@ pub struct SceneArgs {
     /// Meshes: faces whose planes differ by less than this (metres) merge into one surface.
     #[arg(long, default_value_t = 1e-3)]
     pub merge_distance: f64,
+    #[command(flatten)]
+    pub material: MaterialArgs,
+}
+
+/// Carrier and radio material overrides (any scene source).
+#[derive(Debug, Args, Clone, Default)]
+pub struct MaterialArgs {
+    /// Carrier frequency, Hz (overrides the scene's, at every step with --steps; meshes, point
+    /// clouds and XML scenes default to 28e9).
+    #[arg(long)]
+    pub frequency: Option<f64>,
+    /// Radio material of every surface: itu:NAME (ITU-R P.2040-3, e.g. itu:concrete) or
+    /// custom:EPS_R,SIGMA (relative permittivity, conductivity in S/m).
+    #[arg(long, value_parser = parse_material)]
+    pub material: Option<MaterialArg>,
+    /// With --material: slab thickness in metres (default: a half-space).
+    #[arg(long, requires = "material", allow_hyphen_values = true)]
+    pub thickness: Option<f64>,
+}
+
+/// `--material` as given.
+#[derive(Debug, Clone, PartialEq)]
+pub enum MaterialArg {
+    /// `itu:NAME`.
+    Itu(String),
+    /// `custom:EPS_R,SIGMA`.
+    Custom(f64, f64),
+}
+
+impl MaterialArgs {
+    /// The radio material `--material`/`--thickness` select, checked.
+    pub fn radio(&self) -> anyhow::Result<Option<bt_channel::RadioMaterial>> {
+        let radio = match &self.material {
+            None => return Ok(None),
+            Some(MaterialArg::Itu(name)) => bt_channel::RadioMaterial::itu(name, self.thickness),
+            Some(MaterialArg::Custom(eps, sigma)) => {
+                bt_channel::RadioMaterial::custom(*eps, *sigma, self.thickness)
+            }
+        };
+        Ok(Some(radio.context("--material/--thickness")?))
+    }
+}
+
+fn parse_material(s: &str) -> anyhow::Result<MaterialArg> {
+    if let Some(name) = s.strip_prefix("itu:") {
+        bt_channel::ItuMaterial::parse(name)?;
+        return Ok(MaterialArg::Itu(name.to_string()));
+    }
+    if let Some(values) = s.strip_prefix("custom:") {
+        let parts: Vec<&str> = values.split(',').map(str::trim).collect();
+        if let [eps, sigma] = parts[..] {
+            let eps: f64 = eps
+                .parse()
+                .with_context(|| format!("\"{eps}\" is not a number"))?;
+            let sigma: f64 = sigma
+                .parse()
+                .with_context(|| format!("\"{sigma}\" is not a number"))?;
+            return Ok(MaterialArg::Custom(eps, sigma));
+        }
+    }
+    bail!("expected itu:NAME (e.g. itu:concrete) or custom:EPS_R,SIGMA, got \"{s}\"")
+}
+
+/// Antennas at both ends and the transmitted power.
+#[derive(Debug, Args, Clone)]
+pub struct RadioArgs {
+    /// TX antenna pattern: iso or tr38901 (3GPP TR 38.901 element, 8 dBi).
+    #[arg(long, default_value = "iso", value_parser = parse_pattern)]
+    pub tx_pattern: bt_channel::Pattern,
+    /// RX antenna pattern: iso or tr38901.
+    #[arg(long, default_value = "iso", value_parser = parse_pattern)]
+    pub rx_pattern: bt_channel::Pattern,
+    /// TX polarisation: V, H, +45 or -45.
+    #[arg(long, default_value = "V", value_parser = parse_polarization, allow_hyphen_values = true)]
+    pub tx_polarization: bt_channel::Polarization,
+    /// RX polarisation: V, H, +45 or -45.
+    #[arg(long, default_value = "V", value_parser = parse_polarization, allow_hyphen_values = true)]
+    pub rx_polarization: bt_channel::Polarization,
+    /// TX antenna/array orientation YAW,PITCH,ROLL in degrees (0,0,0: boresight +x).
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, default_value = "0,0,0")]
+    pub tx_orientation: Vec3,
+    /// RX antenna/array orientation YAW,PITCH,ROLL in degrees.
+    #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, default_value = "0,0,0")]
+    pub rx_orientation: Vec3,
+    /// Transmitted power, dBm (for power_dbm).
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    pub tx_power_dbm: f64,
+}
+
+fn parse_pattern(s: &str) -> Result<bt_channel::Pattern, bt_channel::ChannelError> {
+    s.parse()
+}
+
+fn parse_polarization(s: &str) -> Result<bt_channel::Polarization, bt_channel::ChannelError> {
+    s.parse()
+}
+
+impl RadioArgs {
+    /// The report's radio options.
+    pub fn options(&self) -> anyhow::Result<bt_beams::RadioOptions> {
+        if !self.tx_power_dbm.is_finite() {
+            bail!("--tx-power-dbm must be a finite number of dBm");
+        }
+        let antenna = |pattern, polarization, o: Vec3| bt_channel::Antenna {
+            pattern,
+            polarization,
+            orientation: bt_channel::Orientation::from_degrees(o.x, o.y, o.z),
+        };
+        Ok(bt_beams::RadioOptions {
+            tx: antenna(self.tx_pattern, self.tx_polarization, self.tx_orientation),
+            rx: antenna(self.rx_pattern, self.rx_polarization, self.rx_orientation),
+            tx_power_dbm: self.tx_power_dbm,
+        })
+    }
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
@@ -194,6 +314,8 @@ pub enum IpcAccelArg {
 pub struct TraceArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
+    #[command(flatten)]
+    pub radio: RadioArgs,
     #[command(flatten)]
     pub solve: SolveArgs,
     /// Print the JSON document instead of a table.
@@ -393,6 +515,8 @@ pub struct DemoArgs {
     /// Highest reflection order.
     #[arg(long, default_value_t = 3)]
     pub max_order: usize,
+    #[command(flatten)]
+    pub radio: RadioArgs,
     /// Print the JSON document instead of a table.
     #[arg(long)]
     pub json: bool,
@@ -408,7 +532,9 @@ impl DemoArgs {
                 min_reflector_area: 0.25,
                 merge_angle_deg: 1.0,
                 merge_distance: 1e-3,
+                material: MaterialArgs::default(),
             },
+            radio: self.radio,
             solve: SolveArgs::with(self.max_order, self.solver),
             json: self.json,
             out: None,
@@ -416,6 +542,106 @@ impl DemoArgs {
             jsonl: false,
             from_scratch: false,
         }
+    }
+}
+
+/// What `channel` and `beams` trace.
+#[derive(Debug, Args, Clone)]
+pub struct PathArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    #[command(flatten)]
+    pub radio: RadioArgs,
+    /// Highest reflection order.
+    #[arg(long, default_value_t = 3)]
+    pub max_order: usize,
+    /// Path solver.
+    #[arg(long, value_enum, default_value_t = SolverArg::Image)]
+    pub solver: SolverArg,
+}
+
+impl PathArgs {
+    /// The equivalent `trace` arguments (defaults for everything else).
+    pub fn trace_args(&self) -> TraceArgs {
+        TraceArgs {
+            scene: self.scene.clone(),
+            radio: self.radio.clone(),
+            solve: SolveArgs::with(self.max_order, self.solver),
+            json: false,
+            out: None,
+            steps: false,
+            jsonl: false,
+            from_scratch: false,
+        }
+    }
+}
+
+#[derive(Debug, Args, Clone)]
+pub struct ChannelArgs {
+    #[command(flatten)]
+    pub paths: PathArgs,
+    /// Channel impulse response CSV to write (one tap per path, by delay).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Also write the frequency response at the subcarriers to this CSV.
+    #[arg(long)]
+    pub cfr: Option<PathBuf>,
+    /// Number of subcarriers of the frequency response, centred on the carrier.
+    #[arg(long, default_value_t = 64)]
+    pub subcarriers: usize,
+    /// Subcarrier spacing, Hz.
+    #[arg(long, default_value_t = 120e3)]
+    pub subcarrier_spacing: f64,
+    /// Power-delay-profile plot: writes STEM.svg and STEM.png.
+    #[arg(long)]
+    pub pdp: Option<PathBuf>,
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum RankingArg {
+    /// By received power, strongest first.
+    Power,
+    /// The paper's path ranking: the best pair for each path, paths by order, length, angle.
+    Paper,
+}
+
+#[derive(Debug, Args, Clone)]
+pub struct BeamsArgs {
+    #[command(flatten)]
+    pub paths: PathArgs,
+    /// TX array ROWSxCOLUMNS (1xN is a horizontal ULA), elements in the antenna's local y-z
+    /// plane, boresight along the antenna orientation.
+    #[arg(long, default_value = "1x8", value_parser = parse_array_shape)]
+    pub tx_array: (usize, usize),
+    /// RX array ROWSxCOLUMNS.
+    #[arg(long, default_value = "1x8", value_parser = parse_array_shape)]
+    pub rx_array: (usize, usize),
+    /// TX element spacing, wavelengths.
+    #[arg(long, default_value_t = 0.5)]
+    pub tx_spacing: f64,
+    /// RX element spacing, wavelengths.
+    #[arg(long, default_value_t = 0.5)]
+    pub rx_spacing: f64,
+    /// Ranking of the beam pairs.
+    #[arg(long, value_enum, default_value_t = RankingArg::Power)]
+    pub ranking: RankingArg,
+    /// Print this many pairs of the ranked list (the JSON holds them all).
+    #[arg(long, default_value_t = 10)]
+    pub top: usize,
+    /// Print JSON instead of a table.
+    #[arg(long)]
+    pub json: bool,
+    /// Write the JSON to this file.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+}
+
+/// Parse `ROWSxCOLUMNS`, e.g. `1x8` or `4x4`.
+pub fn parse_array_shape(s: &str) -> anyhow::Result<(usize, usize)> {
+    let parse = |p: &str| p.trim().parse::<usize>().ok().filter(|n| *n > 0);
+    match s.split_once(['x', 'X']).map(|(a, b)| (parse(a), parse(b))) {
+        Some((Some(rows), Some(columns))) => Ok((rows, columns)),
+        _ => bail!("expected ROWSxCOLUMNS with positive counts (e.g. 1x8 or 4x4), got \"{s}\""),
     }
 }
 
@@ -516,6 +742,8 @@ pub struct HlsArgs {
     pub command: HlsCommand,
 }
 
+// Parsed once per run: the size of the largest variant (scene arguments) does not matter.
+#[allow(clippy::large_enum_variant)]
 #[derive(Debug, Subcommand, Clone)]
 pub enum HlsCommand {
     /// Generate the accelerator for a scene into a directory.

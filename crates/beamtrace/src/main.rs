@@ -2,6 +2,7 @@
 //! library crates.
 
 mod args;
+mod channel;
 mod cloud;
 mod files;
 mod hls;
@@ -56,6 +57,8 @@ fn run(cli: args::Cli) -> anyhow::Result<ExitCode> {
         args::Command::Wvrn(a) => wvrn::run(&a),
         args::Command::Sweep(a) => sweep::run(&a),
         args::Command::View(a) => view::run(&a),
+        args::Command::Channel(a) => channel::run_channel(&a),
+        args::Command::Beams(a) => channel::run_beams(&a),
         args::Command::Extract(a) => cloud::run_extract(&a),
         args::Command::Hls(a) => hls::run(&a),
         args::Command::Sample(a) => cloud::run_sample(&a),

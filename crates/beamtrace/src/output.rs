@@ -1,6 +1,7 @@
 //! The JSON document of a trace (documented in `docs/output-format.md`) and the table view.
 
-use bt_beams::PathReport;
+use bt_beams::{PathReport, RadioOptions};
+use bt_channel::Antenna;
 use bt_paths::CandidateStats;
 use bt_paths::beamtree::TreeStats;
 use bt_scene::Scene;
@@ -20,8 +21,17 @@ pub struct TraceDocument {
     pub frequency_hz: f64,
     pub max_order: usize,
     pub solver: Solver,
+    pub radio: Radio,
     pub paths: Vec<PathReport>,
     pub stats: Stats,
+}
+
+/// Antennas and transmitted power of the gains.
+#[derive(Debug, Serialize)]
+pub struct Radio {
+    pub tx_antenna: Antenna,
+    pub rx_antenna: Antenna,
+    pub tx_power_dbm: f64,
 }
 
 #[derive(Debug, Serialize)]
@@ -32,6 +42,8 @@ pub struct Stats {
     pub tree: Option<TreeStats>,
     pub outcomes: OutcomeCounts,
     pub valid_paths: usize,
+    /// Total received power (power sum over the paths), dBm; null without any power.
+    pub received_power_dbm: Option<f64>,
     /// Wall-clock seconds per stage (the only part of the document that varies between runs).
     pub time_s: StageTimes,
 }
@@ -49,10 +61,9 @@ impl TraceDocument {
         scene: &Scene,
         solver: &Solver,
         max_order: usize,
+        radio: &RadioOptions,
         paths: Vec<PathReport>,
-        candidates: CandidateStats,
-        tree: Option<TreeStats>,
-        outcomes: OutcomeCounts,
+        (candidates, tree, outcomes): (CandidateStats, Option<TreeStats>, OutcomeCounts),
         times: [Duration; 4],
     ) -> Self {
         let [load, cand, solve, report] = times.map(|d| d.as_secs_f64());
@@ -64,11 +75,17 @@ impl TraceDocument {
             frequency_hz: scene.frequency_hz(),
             max_order,
             solver: *solver,
+            radio: Radio {
+                tx_antenna: radio.tx,
+                rx_antenna: radio.rx,
+                tx_power_dbm: radio.tx_power_dbm,
+            },
             stats: Stats {
                 candidates,
                 tree,
                 outcomes,
                 valid_paths: paths.len(),
+                received_power_dbm: bt_beams::received_power_dbm(&paths, radio.tx_power_dbm),
                 time_s: StageTimes {
                     load,
                     candidates: cand,
@@ -91,8 +108,17 @@ pub fn print_table(doc: &TraceDocument) {
         doc.max_order
     );
     println!(
-        "{:>4} {:>3} {:>8} {:>8} {:>8} {:>7} {:>8} {:>7} {:>7}  surfaces",
-        "rank", "ord", "length_m", "delay_ns", "aod_az", "aod_el", "aoa_az", "aoa_el", "loss_db"
+        "{:>4} {:>3} {:>8} {:>8} {:>8} {:>7} {:>8} {:>7} {:>7} {:>8}  surfaces",
+        "rank",
+        "ord",
+        "length_m",
+        "delay_ns",
+        "aod_az",
+        "aod_el",
+        "aoa_az",
+        "aoa_el",
+        "loss_db",
+        "gain_db"
     );
     for p in &doc.paths {
         let names = if p.surfaces.is_empty() {
@@ -105,7 +131,7 @@ pub fn print_table(doc: &TraceDocument) {
                 .join(" > ")
         };
         println!(
-            "{:>4} {:>3} {:>8.3} {:>8.3} {:>8.2} {:>7.2} {:>8.2} {:>7.2} {:>7.2}  {}",
+            "{:>4} {:>3} {:>8.3} {:>8.3} {:>8.2} {:>7.2} {:>8.2} {:>7.2} {:>7.2} {:>8}  {}",
             p.rank,
             p.order,
             p.length_m,
@@ -115,6 +141,8 @@ pub fn print_table(doc: &TraceDocument) {
             p.aoa_deg.azimuth,
             p.aoa_deg.elevation,
             p.loss_db,
+            p.gain_db
+                .map_or_else(|| "-inf".to_string(), |g| format!("{g:.2}")),
             names
         );
     }

@@ -52,10 +52,14 @@ pub struct StepStats {
 /// Load a scene as a dynamic scene: JSON/TOML files and built-ins with their steps; meshes
 /// (and any other static source) as one step. Import warnings go to stderr.
 pub fn load_dynamic(args: &SceneArgs) -> anyhow::Result<DynamicScene> {
+    let options = load_options(args)?;
     let (bar, mut progress) = crate::cloud::extraction_progress();
-    let loaded = bt_scene::load_dynamic(&args.scene, &load_options(args), &mut progress);
+    let loaded = bt_scene::load_dynamic(&args.scene, &options, &mut progress);
     bar.finish_and_clear();
-    let (scene, warnings) = loaded?;
+    let (mut scene, warnings) = loaded?;
+    if let Some(f) = args.material.frequency {
+        scene = scene.with_frequency(f)?;
+    }
     for w in &warnings {
         eprintln!("warning: {w}");
     }
@@ -74,6 +78,7 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
         parallel: !args.solve.single_thread,
     };
     let incremental = !args.from_scratch;
+    let radio = args.radio.options()?;
     let mut tracer = IncrementalTracer::new(options);
     let mut steps = Vec::with_capacity(dynamic.len());
     for (k, scene) in dynamic.scenes().iter().enumerate() {
@@ -84,7 +89,7 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
             trace_scratch(scene, k, &options)?
         };
         let time_s = t0.elapsed().as_secs_f64();
-        let paths = bt_beams::report(scene, &result.trace.paths);
+        let paths = bt_beams::report(scene, &result.trace.paths, &radio)?;
         let step = StepDocument {
             step: k,
             tx: scene.tx().to_array(),

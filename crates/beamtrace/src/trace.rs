@@ -9,9 +9,11 @@ use bt_solve::{Acceleration, IpcOptions, SbrOptions, Solver, UpdateOrder};
 use std::process::ExitCode;
 use std::time::Instant;
 
-/// The load options the scene arguments select.
-pub fn load_options(args: &SceneArgs) -> LoadOptions {
-    LoadOptions {
+/// The load options the scene arguments select: `--material`/`--thickness` give every
+/// material of any source that radio model; `--frequency` is the carrier of sources that carry
+/// none (meshes, point clouds, XML scenes).
+pub fn load_options(args: &SceneArgs) -> anyhow::Result<LoadOptions> {
+    Ok(LoadOptions {
         terminals: Terminals {
             tx: args.tx,
             rx: args.rx,
@@ -22,17 +24,28 @@ pub fn load_options(args: &SceneArgs) -> LoadOptions {
             ..bt_mesh::MergeOptions::default()
         },
         min_reflector_area_m2: args.min_reflector_area,
+        frequency_hz: args
+            .material
+            .frequency
+            .unwrap_or(bt_scene::DEFAULT_FREQUENCY_HZ),
+        radio: args.material.radio()?,
         ..LoadOptions::default()
-    }
+    })
 }
 
 /// Load the scene named on the command line (a file or `builtin:NAME`), with a progress bar
-/// while a point cloud's planes are extracted.
-pub fn load_scene(args: &SceneArgs) -> Result<Loaded, SceneError> {
+/// while a point cloud's planes are extracted, and `--frequency` applied to scene files and
+/// built-ins too.
+pub fn load_scene(args: &SceneArgs) -> anyhow::Result<Loaded> {
+    let options = load_options(args)?;
     let (bar, mut progress) = crate::cloud::extraction_progress();
-    let loaded = bt_scene::load_with_progress(&args.scene, &load_options(args), &mut progress);
+    let loaded = bt_scene::load_with_progress(&args.scene, &options, &mut progress);
     bar.finish_and_clear();
-    loaded
+    let mut loaded = loaded?;
+    if let Some(f) = args.material.frequency {
+        loaded.scene = loaded.scene.with_frequency(f)?;
+    }
+    Ok(loaded)
 }
 
 /// The solver the arguments select, with defaults scaled to the scene.
@@ -101,27 +114,17 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
     let options = trace_options(&args.solve, solver);
     let traced = bt_solve::pipeline::trace_scene(&scene, &options)?;
     let t3 = Instant::now();
-    let paths = bt_beams::report(&scene, &traced.result.paths);
-    if let Some(p) = paths
-        .iter()
-        .find(|p| bt_beams::in_near_field(p.length_m, scene.frequency_hz()))
-    {
-        eprintln!(
-            "warning: a path is {:.3e} m long, shorter than one wavelength ({:.3e} m): Friis does \
-             not hold in the near field; its free-space loss is clamped to the value at one wavelength",
-            p.length_m,
-            bt_beams::near_field_limit_m(scene.frequency_hz())
-        );
-    }
+    let radio = args.radio.options()?;
+    let paths = bt_beams::report(&scene, &traced.result.paths, &radio)?;
+    warn_near_field(&paths, &scene);
     let t4 = Instant::now();
     let doc = TraceDocument::new(
         &scene,
         &solver,
         args.solve.max_order,
+        &radio,
         paths,
-        traced.candidates,
-        traced.tree,
-        traced.result.counts,
+        (traced.candidates, traced.tree, traced.result.counts),
         [t1 - t0, traced.time.candidates, traced.time.solve, t4 - t3],
     );
     let json = serde_json::to_string_pretty(&doc).context("serialising the trace")?;
@@ -135,6 +138,21 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
         output::print_table(&doc);
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Friis needs the far field: say so when a path is shorter than a wavelength (its loss is
+/// clamped at 0 dB by `bt_channel::free_space`).
+pub fn warn_near_field(paths: &[bt_beams::PathReport], scene: &Scene) {
+    if let Some(p) = paths.iter().find(|p| p.near_field) {
+        eprintln!(
+            "warning: path {} is {:.4} m long, under one wavelength ({:.4} m) at {:.3} GHz: \
+             near field, Friis does not hold (its loss is clamped to the value at one wavelength)",
+            p.rank,
+            p.length_m,
+            bt_beams::SPEED_OF_LIGHT / scene.frequency_hz(),
+            scene.frequency_hz() / 1e9
+        );
+    }
 }
 
 pub fn check(args: &SceneArgs) -> anyhow::Result<ExitCode> {
@@ -158,10 +176,13 @@ pub fn check(args: &SceneArgs) -> anyhow::Result<ExitCode> {
             );
             Ok(ExitCode::SUCCESS)
         }
-        Err(e @ SceneError::Invalid { .. }) => {
-            println!("{e}");
-            Ok(ExitCode::from(1))
-        }
-        Err(e) => Err(e.into()),
+        Err(e) => match e.downcast::<SceneError>() {
+            Ok(e @ SceneError::Invalid { .. }) => {
+                println!("{e}");
+                Ok(ExitCode::from(1))
+            }
+            Ok(e) => Err(e.into()),
+            Err(e) => Err(e),
+        },
     }
 }

@@ -25,7 +25,11 @@ pub fn run(args: &ViewArgs) -> anyhow::Result<ExitCode> {
             let mut steps = Vec::with_capacity(scenes.len());
             for scene in &scenes {
                 let traced = bt_solve::pipeline::trace_scene(scene, &options)?;
-                let reports = bt_beams::report(scene, &traced.result.paths);
+                let reports = bt_beams::report(
+                    scene,
+                    &traced.result.paths,
+                    &bt_beams::RadioOptions::default(),
+                )?;
                 steps.push(StepPaths::from_reports(scene, &reports));
             }
             steps

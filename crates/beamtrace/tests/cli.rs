@@ -1,6 +1,9 @@
 //! Integration tests of the `beamtrace` binary: the README's commands, every input format, bad
 //! input (clear errors, never a panic) and the golden JSON of the built-in scene.
 
+#[path = "channel/mod.rs"]
+mod channel;
+
 use serde_json::Value;
 use std::path::{Path, PathBuf};
 use std::process::{Command, Output};

@@ -1,5 +1,6 @@
 //! What a beam manager needs from each path: length, delay, departure and arrival directions,
-//! incidence angles, loss; and the paper's ranking (order first, then length, then angle).
+//! incidence angles, loss, the polarised complex gain (`bt-channel`, `docs/channel.md`); and the
+//! paper's ranking (order first, then length, then angle).
 //!
 //! Angle conventions (`docs/conventions.md`): azimuth from +x towards +y, in (-180°, 180°];
 //! elevation from the horizontal plane, positive up, in [-90°, 90°]. The departure direction is
@@ -7,13 +8,29 @@
 //! interaction point (or TX), i.e. where the wave comes from, as Sionna RT and MATLAB report it.
 #![warn(missing_docs)]
 
+pub mod sweep;
+
+pub use sweep::{BeamPair, BeamRanking, Sweep, sweep};
+
+use bt_channel::{Antenna, Bounce, Complex64, SurfaceResponse, Tap};
 use bt_geom::{Real, Vec3};
 use bt_scene::{Scene, SurfaceId};
 use bt_solve::FoundPath;
-use serde::Serialize;
+use serde::{Serialize, Serializer};
 
 /// Speed of light in vacuum, m/s.
-pub const SPEED_OF_LIGHT: Real = 299_792_458.0;
+pub use bt_channel::{ChannelError, SPEED_OF_LIGHT};
+
+/// The radio side of a report: antennas at both ends and the transmitted power.
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
+pub struct RadioOptions {
+    /// Transmitting antenna (default: isotropic, vertical).
+    pub tx: Antenna,
+    /// Receiving antenna (default: isotropic, vertical).
+    pub rx: Antenna,
+    /// Transmitted power, dBm (default 0).
+    pub tx_power_dbm: Real,
+}
 
 /// A direction as azimuth and elevation, degrees.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -81,6 +98,23 @@ pub struct PathReport {
     pub reflection_loss_db: Real,
     /// Total loss: free space plus reflections, dB.
     pub loss_db: Real,
+    /// Complex path gain [re, im] (antennas, polarisation, reflections, λ/(4π·length); no
+    /// propagation phase).
+    #[serde(serialize_with = "complex_pair")]
+    pub gain: Complex64,
+    /// 20·log10|gain|, dB; `null` when the path carries no power.
+    pub gain_db: Option<Real>,
+    /// Received power of this path alone, dBm (transmitted power + gain_db); `null` with it.
+    pub power_dbm: Option<Real>,
+    /// The path is shorter than a wavelength: Friis does not hold (the loss is clamped at 0 dB).
+    #[serde(skip)]
+    pub near_field: bool,
+    /// Unit departure direction at TX (world frame).
+    #[serde(skip)]
+    pub departure: Vec3,
+    /// Unit arrival direction at RX, towards where the wave comes from (world frame).
+    #[serde(skip)]
+    pub arrival: Vec3,
     /// IPC rounds (IPC solver only).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub iterations: Option<u32>,
@@ -89,28 +123,41 @@ pub struct PathReport {
     pub residual_m: Option<Real>,
 }
 
+fn complex_pair<S: Serializer>(c: &Complex64, s: S) -> Result<S::Ok, S::Error> {
+    [c.re, c.im].serialize(s)
+}
+
 /// Free-space path loss (Friis), dB, for `length` metres at `frequency_hz`. Friis holds in the
 /// far field only: below one wavelength it would turn into a gain (−78.6 dB at 100 nm and
-/// 28 GHz), so the length is clamped to [`near_field_limit_m`] and the loss is never below
-/// 20 log10(4π) ≈ 21.98 dB. The one place the clamp lives; [`in_near_field`] tells callers to
-/// warn.
+/// 28 GHz), so [`bt_channel::free_space`] (the one home of the clamp) clamps the length to one
+/// wavelength and the loss is never below 20 log10(4π) ≈ 21.98 dB.
 pub fn free_space_loss_db(length: Real, frequency_hz: Real) -> Real {
-    let length = length.max(near_field_limit_m(frequency_hz));
-    20.0 * (4.0 * std::f64::consts::PI * length * frequency_hz / SPEED_OF_LIGHT).log10()
+    bt_channel::free_space(length, frequency_hz).loss_db
 }
 
-/// The shortest length Friis is used at: one wavelength, metres.
-pub fn near_field_limit_m(frequency_hz: Real) -> Real {
-    SPEED_OF_LIGHT / frequency_hz
+/// How a surface of the scene reflects: its radio model, or its constant loss as a scaled
+/// conductor when it has none.
+pub fn surface_response(scene: &Scene, id: SurfaceId) -> SurfaceResponse {
+    let m = scene.material_of(id);
+    match m.radio {
+        Some(radio) => SurfaceResponse::Radio(radio),
+        None => SurfaceResponse::ConstantLoss {
+            loss_db: m.reflection_loss_db,
+        },
+    }
 }
 
-/// Whether a path of `length` metres is shorter than [`near_field_limit_m`] (its loss clamped).
-pub fn in_near_field(length: Real, frequency_hz: Real) -> bool {
-    length < near_field_limit_m(frequency_hz)
+/// `value` in dB (10·log10 of a power ratio), `None` for zero.
+fn power_db(value: Real) -> Option<Real> {
+    (value > 0.0).then(|| 10.0 * value.log10())
 }
 
 /// Describe one found path (rank 0 until [`rank`] runs).
-pub fn describe(scene: &Scene, path: &FoundPath) -> PathReport {
+pub fn describe(
+    scene: &Scene,
+    path: &FoundPath,
+    radio: &RadioOptions,
+) -> Result<PathReport, ChannelError> {
     let (tx, rx) = (scene.tx(), scene.rx());
     let mut vertices = Vec::with_capacity(path.points.len() + 2);
     vertices.push(tx);
@@ -137,8 +184,25 @@ pub fn describe(scene: &Scene, path: &FoundPath) -> PathReport {
         .map(|id| scene.material_of(*id).reflection_loss_db)
         .fold(0.0, |a, b| a + b);
     let free_space_loss_db = free_space_loss_db(length_m, scene.frequency_hz());
+    let bounces: Vec<Bounce> = path
+        .surfaces
+        .iter()
+        .map(|id| Bounce {
+            normal: scene.surface(*id).polygon.plane().normal,
+            response: surface_response(scene, *id),
+        })
+        .collect();
+    let gain = bt_channel::path_gain(
+        scene.tx(),
+        &path.points,
+        scene.rx(),
+        &bounces,
+        (&radio.tx, &radio.rx),
+        scene.frequency_hz(),
+    )?;
+    let gain_db = power_db(gain.norm_sqr());
     let n = vertices.len();
-    PathReport {
+    Ok(PathReport {
         rank: 0,
         order: path.surfaces.len(),
         surfaces: path
@@ -156,15 +220,47 @@ pub fn describe(scene: &Scene, path: &FoundPath) -> PathReport {
         free_space_loss_db,
         reflection_loss_db,
         loss_db: free_space_loss_db + reflection_loss_db,
+        gain,
+        gain_db,
+        power_dbm: gain_db.map(|g| g + radio.tx_power_dbm),
+        near_field: bt_channel::free_space(length_m, scene.frequency_hz()).near_field,
+        departure: (vertices[1] - vertices[0]).normalize(),
+        arrival: (vertices[n - 2] - vertices[n - 1]).normalize(),
         iterations: path.iterations,
         residual_m: path.residual,
-    }
+    })
+}
+
+/// The channel taps of reported paths (gain, delay), in report order.
+pub fn taps(paths: &[PathReport]) -> Vec<Tap> {
+    paths
+        .iter()
+        .map(|p| Tap {
+            gain: p.gain,
+            delay_s: p.delay_s,
+        })
+        .collect()
+}
+
+/// Total received power of the paths, dBm: transmitted power + 10·log10 Σ|gain|² (a power sum:
+/// the wideband average, without interference between paths); `None` without power.
+pub fn received_power_dbm(paths: &[PathReport], tx_power_dbm: Real) -> Option<Real> {
+    power_db(bt_channel::total_power(&taps(paths))).map(|g| g + tx_power_dbm)
 }
 
 /// Describe and rank all paths: by order, then length, then the largest incidence angle
-/// (closer to normal first), then surface ids — the paper's principles, made total.
-pub fn report(scene: &Scene, paths: &[FoundPath]) -> Vec<PathReport> {
-    let mut reports: Vec<PathReport> = paths.iter().map(|p| describe(scene, p)).collect();
+/// (closer to normal first), then surface ids — the paper's principles, made total. Fails only
+/// if a material has no radio model at the scene's frequency (scenes are validated against
+/// that).
+pub fn report(
+    scene: &Scene,
+    paths: &[FoundPath],
+    radio: &RadioOptions,
+) -> Result<Vec<PathReport>, ChannelError> {
+    let mut reports = paths
+        .iter()
+        .map(|p| describe(scene, p, radio))
+        .collect::<Result<Vec<_>, _>>()?;
     let key = |r: &PathReport| r.incidence_deg.iter().copied().fold(0.0, Real::max);
     reports.sort_by(|a, b| {
         a.order
@@ -176,7 +272,7 @@ pub fn report(scene: &Scene, paths: &[FoundPath]) -> Vec<PathReport> {
     for (i, r) in reports.iter_mut().enumerate() {
         r.rank = i + 1;
     }
-    reports
+    Ok(reports)
 }
 
 #[cfg(test)]
@@ -202,7 +298,10 @@ mod tests {
         for length in [1e-7, 1e-3, lambda * 0.5, lambda] {
             let l = free_space_loss_db(length, f);
             assert!((l - floor).abs() < 1e-9, "{length}: {l}");
-            assert_eq!(in_near_field(length, f), length < lambda);
+            assert_eq!(
+                bt_channel::free_space(length, f).near_field,
+                length < lambda
+            );
         }
         assert!(free_space_loss_db(2.0 * lambda, f) > floor + 6.0);
     }

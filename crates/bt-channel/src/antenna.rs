@@ -48,8 +48,8 @@ impl Polarization {
 
 /// Orientation of an antenna or array: intrinsic rotations yaw about z, then pitch about the
 /// new y, then roll about the new x (radians); R = Rz(yaw)·Ry(pitch)·Rx(roll) maps local to
-/// world. Zero: boresight along world +x, local z up.
-#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
+/// world. Zero: boresight along world +x, local z up. Serialised in degrees (`yaw_deg`, ...).
+#[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct Orientation {
     /// Rotation about world z, radians.
     pub yaw: Real,
@@ -57,6 +57,17 @@ pub struct Orientation {
     pub pitch: Real,
     /// Rotation about the resulting x axis, radians.
     pub roll: Real,
+}
+
+impl Serialize for Orientation {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeStruct;
+        let mut st = s.serialize_struct("Orientation", 3)?;
+        st.serialize_field("yaw_deg", &self.yaw.to_degrees())?;
+        st.serialize_field("pitch_deg", &self.pitch.to_degrees())?;
+        st.serialize_field("roll_deg", &self.roll.to_degrees())?;
+        st.end()
+    }
 }
 
 impl Orientation {

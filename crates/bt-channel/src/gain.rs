@@ -57,18 +57,22 @@ pub struct Bounce {
 pub struct FreeSpace {
     /// λ/(4π·max(length, λ/(4π))): never above 1, i.e. never a negative loss.
     pub amplitude: Real,
+    /// Friis loss 20·log10(4π·max(length, λ/(4π))·f/c), dB (>= 0).
+    pub loss_db: Real,
     /// The path is shorter than one wavelength: Friis does not hold there (near field), and
     /// below λ/(4π) the amplitude is clamped to 1 (0 dB loss).
     pub near_field: bool,
 }
 
 /// The one home of the Friis factor: amplitude λ/(4π·d) for `length` metres at
-/// `frequency_hz`, clamped so that the loss is never negative (d < λ/(4π)).
+/// `frequency_hz`. Friis holds in the far field only, so `d` is clamped to one wavelength:
+/// amplitude ≤ 1/(4π), loss ≥ 20 log10(4π) ≈ 21.98 dB, and `near_field` says it happened.
 pub fn free_space(length: Real, frequency_hz: Real) -> FreeSpace {
     let wavelength = SPEED_OF_LIGHT / frequency_hz;
-    let floor = wavelength / (4.0 * PI);
+    let clamped = length.max(wavelength);
     FreeSpace {
-        amplitude: floor / length.max(floor),
+        amplitude: wavelength / (4.0 * PI * clamped),
+        loss_db: 20.0 * (4.0 * PI * clamped * frequency_hz / SPEED_OF_LIGHT).log10(),
         near_field: length < wavelength,
     }
 }
@@ -182,7 +186,8 @@ mod tests {
     #[test]
     fn near_field_never_gains() {
         let fs = free_space(1e-4, F);
-        assert_eq!(fs.amplitude, 1.0);
+        assert!((fs.amplitude - 1.0 / (4.0 * PI)).abs() < 1e-15);
+        assert!((fs.loss_db - 20.0 * (4.0 * PI).log10()).abs() < 1e-12);
         assert!(fs.near_field);
         let fs = free_space(1.0, F);
         assert!(fs.amplitude < 1.0 && !fs.near_field);

@@ -26,6 +26,9 @@ pub enum CoverageError {
     /// Tracing failed for a reason that holds for every point (the candidate budget).
     #[error(transparent)]
     Trace(#[from] TraceError),
+    /// The path gains could not be computed (a material undefined at the carrier).
+    #[error(transparent)]
+    Channel(#[from] bt_beams::ChannelError),
     /// A figure could not be drawn or written.
     #[error(transparent)]
     Plot(#[from] bt_plot::PlotError),
@@ -90,7 +93,8 @@ pub fn sweep(
                     let moved = scene
                         .with_terminals(scene.tx(), *rx)
                         .map_err(TraceError::from)?;
-                    summarise(&bt_beams::report(&moved, &traced.result.paths))
+                    let radio = bt_beams::RadioOptions::default();
+                    summarise(&bt_beams::report(&moved, &traced.result.paths, &radio)?)
                 }
                 Err(TraceError::Scene(e)) => PointStatus::Skipped(skip_reason(&e)),
                 Err(e) => return Err(e.into()),

@@ -19,7 +19,6 @@ use pyo3::exceptions::{PyException, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use rayon::prelude::*;
-use std::path::Path;
 use std::sync::Arc;
 
 create_exception!(
@@ -125,10 +124,16 @@ impl PyScene {
             .trace_options(&scene)
             .map_err(PyValueError::new_err)?;
         let paths = py.detach(|| {
-            bt_solve::pipeline::trace_scene(&scene, &options)
-                .map(|traced| bt_beams::report(&scene, &traced.result.paths))
+            bt_solve::pipeline::trace_scene(&scene, &options).map(|traced| {
+                bt_beams::report(
+                    &scene,
+                    &traced.result.paths,
+                    &bt_beams::RadioOptions::default(),
+                )
+            })
         });
-        columns::to_dict(py, &paths.map_err(|e| self.error(e))?)
+        let paths = paths.map_err(|e| self.error(e))?.map_err(error)?;
+        columns::to_dict(py, &paths)
     }
 
     /// Trace one TX to each row of `receivers` (m × 3, metres) in parallel without the GIL;
@@ -183,7 +188,12 @@ fn trace_and_report(
     let traced = bt_solve::pipeline::trace_receivers(scene, receivers, options)?;
     let one = |(rx, t): (&Vec3, &bt_solve::pipeline::Traced)| {
         let moved = scene.with_terminals(scene.tx(), *rx)?;
-        Ok(bt_beams::report(&moved, &t.result.paths))
+        bt_beams::report(&moved, &t.result.paths, &bt_beams::RadioOptions::default()).map_err(|e| {
+            TraceError::Scene(SceneError::Parse {
+                path: scene.name().to_string(),
+                message: e.to_string(),
+            })
+        })
     };
     if options.parallel {
         receivers.par_iter().zip(&traced).map(one).collect()

@@ -331,6 +331,19 @@ impl DynamicScene {
         })
     }
 
+    /// A copy with carrier `frequency_hz` at every step (CLI `--frequency`), see
+    /// [`Scene::with_frequency`].
+    pub fn with_frequency(&self, frequency_hz: Real) -> Result<Self, SceneError> {
+        Ok(Self {
+            scenes: self
+                .scenes
+                .iter()
+                .map(|s| s.with_frequency(frequency_hz))
+                .collect::<Result<_, _>>()?,
+            objects: self.objects.clone(),
+        })
+    }
+
     /// The validated scene of step `k` (0-based). Panics when `k >= len()`.
     pub fn step(&self, k: usize) -> &Scene {
         &self.scenes[k]

@@ -25,7 +25,13 @@ fn options(order: usize, mode: CandidateMode, solver: Solver) -> TraceOptions {
 
 fn whole_trace(scene: &Scene, options: &TraceOptions) -> usize {
     let traced = trace_scene(scene, options).expect("trace runs");
-    bt_beams::report(scene, &traced.result.paths).len()
+    bt_beams::report(
+        scene,
+        &traced.result.paths,
+        &bt_beams::RadioOptions::default(),
+    )
+    .expect("gains")
+    .len()
 }
 
 fn living_room(c: &mut Criterion) {

@@ -43,7 +43,7 @@ fn living_room(c: &mut Criterion) {
         b.iter(|| {
             let c = enumerate(black_box(&scene), 3, &AllVisible);
             let r = trace(&scene, &c, &Solver::Image, false);
-            bt_beams::report(&scene, &r.paths)
+            bt_beams::report(&scene, &r.paths, &bt_beams::RadioOptions::default())
         })
     });
     group.finish();

@@ -319,3 +319,78 @@ pub fn rooms<DB: DrawingBackend>(
     }
     Ok(())
 }
+
+/// One tap of a power-delay profile: delay in nanoseconds, received power in dBm, order.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PdpTap {
+    /// Delay, ns.
+    pub delay_ns: Real,
+    /// Received power of the path, dBm.
+    pub power_dbm: Real,
+    /// Reflection order (colours the stems).
+    pub order: usize,
+}
+
+/// A power-delay profile: one stem per path from the floor of the axis to its power, coloured
+/// by reflection order, `title` on top.
+pub fn power_delay_profile<DB: DrawingBackend>(
+    root: &DrawingArea<DB, Shift>,
+    (title, taps): (&str, &[PdpTap]),
+) -> Result<(), String> {
+    blank(root)?;
+    let finite = || taps.iter().filter(|t| t.power_dbm.is_finite());
+    let (p_lo, p_hi) = finite().fold((Real::INFINITY, Real::NEG_INFINITY), |(lo, hi), t| {
+        (lo.min(t.power_dbm), hi.max(t.power_dbm))
+    });
+    let (p_lo, p_hi) = if p_lo.is_finite() {
+        ((p_lo - 10.0).floor(), (p_hi + 5.0).ceil())
+    } else {
+        (-150.0, 0.0)
+    };
+    let t_hi = finite().map(|t| t.delay_ns).fold(1.0, Real::max) * 1.05;
+    let mut chart = ChartBuilder::on(root)
+        .caption(title, (FAMILY, 18))
+        .margin(12)
+        .x_label_area_size(40)
+        .y_label_area_size(60)
+        .build_cartesian_2d(0.0..t_hi, p_lo..p_hi)
+        .map_err(fail)?;
+    chart
+        .configure_mesh()
+        .x_desc("delay (ns)")
+        .y_desc("received power (dBm)")
+        .label_style((FAMILY, 12))
+        .axis_desc_style((FAMILY, 14))
+        .draw()
+        .map_err(fail)?;
+    let max_order = finite().map(|t| t.order).max().unwrap_or(0);
+    for order in 0..=max_order {
+        let colour = Palette99::pick(order).to_rgba();
+        let stems: Vec<_> = finite().filter(|t| t.order == order).collect();
+        if stems.is_empty() {
+            continue;
+        }
+        chart
+            .draw_series(stems.iter().map(|t| {
+                PathElement::new(
+                    vec![(t.delay_ns, p_lo), (t.delay_ns, t.power_dbm)],
+                    colour.stroke_width(2),
+                )
+            }))
+            .map_err(fail)?;
+        chart
+            .draw_series(
+                stems
+                    .iter()
+                    .map(|t| Circle::new((t.delay_ns, t.power_dbm), 3, colour.filled())),
+            )
+            .map_err(fail)?
+            .label(if order == 0 {
+                "line of sight".to_string()
+            } else {
+                format!("order {order}")
+            })
+            .legend(move |(x, y)| Circle::new((x + 10, y), 3, colour.filled()));
+    }
+    legend(&mut chart, SeriesLabelPosition::UpperRight, 12)
+}

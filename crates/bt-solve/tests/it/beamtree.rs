@@ -4,14 +4,14 @@
 //! image method; a kept tree answers new receivers like a fresh trace; IPC started inside the
 //! windows finds what the image method finds.
 
+use crate::common::*;
 use bt_geom::{Real, Vec3};
 use bt_paths::beamtree::{BeamTree, TreeOptions};
 use bt_scene::{Scene, Terminals};
 use bt_solve::pipeline::{CandidateMode, TraceOptions, trace_receivers, trace_scene};
 use bt_solve::{FoundPath, Solver, UpdateOrder};
-use crate::common::*;
-use proptest::prelude::*;
 use bt_testkit::nasty_scene;
+use proptest::prelude::*;
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 

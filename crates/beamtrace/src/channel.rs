@@ -1,0 +1,276 @@
+//! `beamtrace channel` (CIR, CFR, power-delay profile) and `beamtrace beams` (codebook sweep).
+
+use crate::args::{BeamsArgs, ChannelArgs, PathArgs, RankingArg};
+use crate::trace::{load_scene, solver_for, trace_options, warn_near_field};
+use anyhow::{Context, bail};
+use bt_beams::{BeamRanking, PathReport, RadioOptions};
+use bt_scene::Scene;
+use serde::Serialize;
+use std::fmt::Write as _;
+use std::path::Path;
+use std::process::ExitCode;
+
+/// Subcarriers × paths above which the frequency response is refused (a stated budget).
+const MAX_CFR_PRODUCTS: u64 = 500_000_000;
+
+/// Load, trace and report the paths the arguments select.
+fn traced_paths(args: &PathArgs) -> anyhow::Result<(Scene, Vec<PathReport>, RadioOptions)> {
+    let loaded = load_scene(&args.scene)?;
+    for w in &loaded.warnings {
+        eprintln!("warning: {w}");
+    }
+    let scene = loaded.scene;
+    let trace_args = args.trace_args();
+    let solver = solver_for(&trace_args.solve, &scene)?;
+    let traced =
+        bt_solve::pipeline::trace_scene(&scene, &trace_options(&trace_args.solve, solver))?;
+    let radio = args.radio.options()?;
+    let paths = bt_beams::report(&scene, &traced.result.paths, &radio)?;
+    warn_near_field(&paths, &scene);
+    Ok((scene, paths, radio))
+}
+
+/// Write `text` to `path` atomically: a temporary file in the same directory, then a rename.
+pub fn write_atomic(path: &Path, text: &str) -> anyhow::Result<()> {
+    let name = path
+        .file_name()
+        .and_then(|n| n.to_str())
+        .with_context(|| format!("{} is not a file name", path.display()))?;
+    let temp = path.with_file_name(format!(".{name}.{}.tmp", std::process::id()));
+    std::fs::write(&temp, text).with_context(|| format!("writing {}", temp.display()))?;
+    std::fs::rename(&temp, path).with_context(|| {
+        let _ = std::fs::remove_file(&temp);
+        format!("renaming {} to {}", temp.display(), path.display())
+    })
+}
+
+/// A CSV field: quoted, with quotes doubled, when it holds a comma, quote or line break.
+fn csv_field(s: &str) -> String {
+    if s.contains([',', '"', '\n', '\r']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
+fn opt(v: Option<f64>) -> String {
+    v.map_or_else(String::new, |v| format!("{v}"))
+}
+
+/// The CIR as CSV: one tap per path, sorted by delay.
+fn cir_csv(paths: &[PathReport], carrier_hz: f64) -> String {
+    let mut by_delay: Vec<&PathReport> = paths.iter().collect();
+    by_delay.sort_by(|a, b| a.delay_s.total_cmp(&b.delay_s).then(a.rank.cmp(&b.rank)));
+    let mut out = String::from(
+        "rank,order,delay_s,gain_re,gain_im,gain_db,power_dbm,baseband_re,baseband_im,surfaces\n",
+    );
+    for p in by_delay {
+        let tap = bt_channel::Tap {
+            gain: p.gain,
+            delay_s: p.delay_s,
+        };
+        let bb = tap.baseband(carrier_hz);
+        let _ = writeln!(
+            out,
+            "{},{},{},{},{},{},{},{},{},{}",
+            p.rank,
+            p.order,
+            p.delay_s,
+            p.gain.re,
+            p.gain.im,
+            opt(p.gain_db),
+            opt(p.power_dbm),
+            bb.re,
+            bb.im,
+            csv_field(&p.surfaces.join(" > "))
+        );
+    }
+    out
+}
+
+fn cfr_csv(paths: &[PathReport], carrier_hz: f64, args: &ChannelArgs) -> anyhow::Result<String> {
+    let n = args.subcarriers;
+    if n == 0 || (n as u64).saturating_mul(paths.len().max(1) as u64) > MAX_CFR_PRODUCTS {
+        bail!(
+            "--subcarriers {n} × {} paths: need at least 1 subcarrier and at most {MAX_CFR_PRODUCTS} products",
+            paths.len()
+        );
+    }
+    if !(args.subcarrier_spacing.is_finite() && args.subcarrier_spacing > 0.0) {
+        bail!("--subcarrier-spacing must be a positive number of Hz");
+    }
+    let offsets = bt_channel::subcarriers(n, args.subcarrier_spacing);
+    let h = bt_channel::frequency_response(&bt_beams::taps(paths), carrier_hz, &offsets);
+    let mut out = String::from("subcarrier,offset_hz,frequency_hz,re,im,gain_db\n");
+    for (k, (df, v)) in offsets.iter().zip(&h).enumerate() {
+        let p = v.norm_sqr();
+        let db = (p > 0.0).then(|| 10.0 * p.log10());
+        let _ = writeln!(
+            out,
+            "{k},{df},{},{},{},{}",
+            carrier_hz + df,
+            v.re,
+            v.im,
+            opt(db)
+        );
+    }
+    Ok(out)
+}
+
+pub fn run_channel(args: &ChannelArgs) -> anyhow::Result<ExitCode> {
+    let (scene, paths, radio) = traced_paths(&args.paths)?;
+    let carrier = scene.frequency_hz();
+    write_atomic(&args.out, &cir_csv(&paths, carrier))?;
+    println!("{}: {} taps", args.out.display(), paths.len());
+    if let Some(path) = &args.cfr {
+        write_atomic(path, &cfr_csv(&paths, carrier, args)?)?;
+        println!("{}: {} subcarriers", path.display(), args.subcarriers);
+    }
+    if let Some(stem) = &args.pdp {
+        let taps: Vec<bt_study::plot::PdpTap> = paths
+            .iter()
+            .map(|p| bt_study::plot::PdpTap {
+                delay_ns: p.delay_s * 1e9,
+                power_dbm: p.power_dbm.unwrap_or(f64::NEG_INFINITY),
+                order: p.order,
+            })
+            .collect();
+        let title = format!(
+            "power-delay profile: {} at {:.3} GHz, {} dBm",
+            scene.name(),
+            carrier / 1e9,
+            radio.tx_power_dbm
+        );
+        for written in bt_study::io::write_power_delay_profile(stem, &title, &taps)? {
+            println!("{}", written.display());
+        }
+    }
+    match bt_beams::received_power_dbm(&paths, radio.tx_power_dbm) {
+        Some(p) => println!(
+            "received power {p:.2} dBm (power sum over {} paths)",
+            paths.len()
+        ),
+        None => println!("no power received"),
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+#[derive(Debug, Serialize)]
+struct BeamsDocument<'a> {
+    scene: &'a str,
+    frequency_hz: f64,
+    tx_power_dbm: f64,
+    tx_array: ArrayDoc,
+    rx_array: ArrayDoc,
+    paths: usize,
+    #[serde(flatten)]
+    sweep: &'a bt_beams::Sweep,
+}
+
+#[derive(Debug, Serialize)]
+struct ArrayDoc {
+    rows: usize,
+    columns: usize,
+    spacing_wavelengths: f64,
+    orientation: bt_channel::Orientation,
+}
+
+impl ArrayDoc {
+    fn of(a: &bt_channel::Array) -> ArrayDoc {
+        ArrayDoc {
+            rows: a.rows,
+            columns: a.columns,
+            spacing_wavelengths: a.spacing_wavelengths,
+            orientation: a.orientation,
+        }
+    }
+}
+
+pub fn run_beams(args: &BeamsArgs) -> anyhow::Result<ExitCode> {
+    let (scene, paths, radio) = traced_paths(&args.paths)?;
+    let array = |(rows, columns): (usize, usize), spacing: f64, which: &str, o| {
+        bt_channel::Array::new(rows, columns, spacing, o)
+            .with_context(|| format!("--{which}-array"))
+    };
+    let tx = array(args.tx_array, args.tx_spacing, "tx", radio.tx.orientation)?;
+    let rx = array(args.rx_array, args.rx_spacing, "rx", radio.rx.orientation)?;
+    let ranking = match args.ranking {
+        RankingArg::Power => BeamRanking::Power,
+        RankingArg::Paper => BeamRanking::Paper,
+    };
+    let sweep = bt_beams::sweep(
+        &paths,
+        &tx,
+        &rx,
+        scene.frequency_hz(),
+        radio.tx_power_dbm,
+        ranking,
+    )?;
+    let doc = BeamsDocument {
+        scene: scene.name(),
+        frequency_hz: scene.frequency_hz(),
+        tx_power_dbm: radio.tx_power_dbm,
+        tx_array: ArrayDoc::of(&tx),
+        rx_array: ArrayDoc::of(&rx),
+        paths: paths.len(),
+        sweep: &sweep,
+    };
+    let json = serde_json::to_string_pretty(&doc).context("serialising the beam sweep")?;
+    if let Some(path) = &args.out {
+        write_atomic(path, &format!("{json}\n"))?;
+    }
+    if args.json {
+        println!("{json}");
+    } else {
+        print_beams(&doc, args.top);
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn print_beams(doc: &BeamsDocument, top: usize) {
+    let dir = |d: &Option<bt_beams::Direction>| {
+        d.map_or_else(
+            || "invisible".to_string(),
+            |d| format!("{:7.2} {:6.2}", d.azimuth, d.elevation),
+        )
+    };
+    println!(
+        "scene {}  {:.2} GHz  {} paths  tx {}x{} ({} beams)  rx {}x{} ({} beams)  ranking {:?}",
+        doc.scene,
+        doc.frequency_hz / 1e9,
+        doc.paths,
+        doc.tx_array.rows,
+        doc.tx_array.columns,
+        doc.sweep.tx_beams,
+        doc.rx_array.rows,
+        doc.rx_array.columns,
+        doc.sweep.rx_beams,
+        doc.sweep.ranking
+    );
+    println!(
+        "{:>4} {:>7} {:>7} {:>14} {:>14} {:>10} {:>5}",
+        "rank", "tx_beam", "rx_beam", "tx_az/el", "rx_az/el", "power_dbm", "path"
+    );
+    for p in doc.sweep.pairs.iter().take(top) {
+        println!(
+            "{:>4} {:>7} {:>7} {:>14} {:>14} {:>10} {:>5}",
+            p.rank,
+            p.tx_beam,
+            p.rx_beam,
+            dir(&p.tx_direction_deg),
+            dir(&p.rx_direction_deg),
+            p.power_dbm
+                .map_or_else(|| "-inf".to_string(), |v| format!("{v:.2}")),
+            p.path_rank
+                .map_or_else(|| "-".to_string(), |r| r.to_string())
+        );
+    }
+    if let Some(best) = doc.sweep.pairs.first() {
+        println!(
+            "best pair: tx beam {}, rx beam {} ({} pairs ranked)",
+            best.tx_beam,
+            best.rx_beam,
+            doc.sweep.pairs.len()
+        );
+    }
+}

@@ -1,0 +1,296 @@
+//! (A module of `cli.rs`: one test binary.) The radio channel from the command line: gains in `trace --json`, `channel` (CIR, CFR,
+//! power-delay profile), `beams` (codebook sweep), material and frequency overrides, and clear
+//! errors on bad input.
+
+use super::{assert_clear_error, beamtrace, repo};
+use serde_json::Value;
+use std::path::PathBuf;
+use std::process::Output;
+
+fn ok(args: &[&str]) -> Output {
+    let o = beamtrace(args);
+    assert!(
+        o.status.success(),
+        "{args:?}: {}",
+        String::from_utf8_lossy(&o.stderr)
+    );
+    o
+}
+
+fn json(args: &[&str]) -> Value {
+    serde_json::from_slice(&ok(args).stdout).expect("valid JSON")
+}
+
+fn temp_dir(name: &str) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("bt-channel-cli-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}
+
+fn f(v: &Value) -> f64 {
+    v.as_f64().expect("a number")
+}
+
+#[test]
+fn trace_json_reports_gains_and_received_power() {
+    let doc = json(&[
+        "trace",
+        "builtin:living-room",
+        "--json",
+        "--tx-power-dbm",
+        "23",
+    ]);
+    let paths = doc["paths"].as_array().unwrap();
+    let mut sum = 0.0;
+    for p in paths {
+        let (re, im) = (f(&p["gain"][0]), f(&p["gain"][1]));
+        let db = 10.0 * (re * re + im * im).log10();
+        assert!((f(&p["gain_db"]) - db).abs() < 1e-9);
+        assert!((f(&p["power_dbm"]) - db - 23.0).abs() < 1e-9);
+        sum += re * re + im * im;
+        // Vertical isotropic antennas and line of sight: exactly Friis, real and positive.
+        if p["order"] == 0 {
+            assert!(
+                (f(&p["gain_db"]) + f(&p["free_space_loss_db"])).abs() < 1e-9
+                    && im == 0.0
+                    && re > 0.0
+            );
+        }
+    }
+    let total = f(&doc["stats"]["received_power_dbm"]);
+    assert!((total - (23.0 + 10.0 * sum.log10())).abs() < 1e-9);
+    assert_eq!(doc["radio"]["tx_power_dbm"], 23.0);
+}
+
+#[test]
+fn a_perfect_conductor_mesh_keeps_every_reflection_at_full_strength() {
+    let mesh = repo()
+        .join("testdata/scenes/box-room.obj")
+        .display()
+        .to_string();
+    let doc = json(&[
+        "trace",
+        &mesh,
+        "--tx",
+        "1,1,1.5",
+        "--rx",
+        "4,3,1.2",
+        "--max-order",
+        "2",
+        "--json",
+        "--material",
+        "custom:1,1e12",
+        "--frequency",
+        "5e9",
+    ]);
+    assert_eq!(doc["frequency_hz"], 5e9);
+    let paths = doc["paths"].as_array().unwrap();
+    assert!(paths.len() > 10);
+    for p in paths {
+        // |R_TE| = |R_TM| = 1 − O(1/√|η|) ≈ 1 − 5e-7: only the spreading loss remains,
+        // whatever the polarisation mix.
+        assert!(
+            (f(&p["gain_db"]) + f(&p["free_space_loss_db"])).abs() < 1e-4,
+            "{}",
+            p["surfaces"]
+        );
+    }
+    let fails = |extra: &[&str], needles: &[&str]| {
+        let mut args = vec!["trace", mesh.as_str(), "--tx", "1,1,1.5", "--rx", "4,3,1.2"];
+        args.extend_from_slice(extra);
+        assert_clear_error(&args, needles);
+    };
+    // ITU brick is not defined at 60 GHz: a clear error naming it.
+    fails(
+        &["--material", "itu:brick", "--frequency", "60e9"],
+        &["brick", "1–40 GHz", "60"],
+    );
+    fails(
+        &["--material", "itu:marmalade"],
+        &["unknown ITU material \"marmalade\""],
+    );
+    fails(
+        &["--material", "itu:wood", "--thickness", "-1"],
+        &["thickness"],
+    );
+}
+
+#[test]
+fn channel_writes_cir_cfr_and_the_pdp_plot() {
+    let dir = temp_dir("channel");
+    let cir = dir.join("cir.csv");
+    let cfr = dir.join("cfr.csv");
+    let pdp = dir.join("pdp");
+    let o = ok(&[
+        "channel",
+        "builtin:living-room",
+        "--out",
+        cir.to_str().unwrap(),
+        "--cfr",
+        cfr.to_str().unwrap(),
+        "--subcarriers",
+        "16",
+        "--subcarrier-spacing",
+        "1e6",
+        "--pdp",
+        pdp.to_str().unwrap(),
+        "--max-order",
+        "2",
+    ]);
+    assert!(String::from_utf8_lossy(&o.stdout).contains("received power"));
+    let trace = json(&["trace", "builtin:living-room", "--max-order", "2", "--json"]);
+    let n_paths = trace["paths"].as_array().unwrap().len();
+    let text = std::fs::read_to_string(&cir).unwrap();
+    let rows: Vec<Vec<&str>> = text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    assert_eq!(rows.len(), n_paths);
+    let delays: Vec<f64> = rows.iter().map(|r| r[2].parse().unwrap()).collect();
+    assert!(
+        delays.windows(2).all(|w| w[0] <= w[1]),
+        "taps sorted by delay"
+    );
+    // The response at the carrier is the sum of the baseband taps (columns 7 and 8).
+    let (mut re, mut im) = (0.0, 0.0);
+    for r in &rows {
+        re += r[7].parse::<f64>().unwrap();
+        im += r[8].parse::<f64>().unwrap();
+    }
+    let cfr_text = std::fs::read_to_string(&cfr).unwrap();
+    let cfr_rows: Vec<Vec<&str>> = cfr_text
+        .lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect();
+    assert_eq!(cfr_rows.len(), 16);
+    let centre = &cfr_rows[8];
+    assert_eq!(centre[1], "0");
+    let (h_re, h_im): (f64, f64) = (centre[3].parse().unwrap(), centre[4].parse().unwrap());
+    assert!((h_re - re).abs() < 1e-12 && (h_im - im).abs() < 1e-12);
+    for ext in ["svg", "png"] {
+        let meta = std::fs::metadata(pdp.with_extension(ext)).unwrap();
+        assert!(meta.len() > 1000);
+    }
+    let svg = std::fs::read_to_string(pdp.with_extension("svg")).unwrap();
+    assert!(svg.contains("delay (ns)") && svg.contains("line of sight"));
+    // No temporary files are left behind.
+    assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 4);
+    assert_clear_error(
+        &[
+            "channel",
+            "builtin:living-room",
+            "--out",
+            cir.to_str().unwrap(),
+            "--cfr",
+            cfr.to_str().unwrap(),
+            "--subcarriers",
+            "0",
+        ],
+        &["--subcarriers"],
+    );
+    let _ = std::fs::remove_dir_all(&dir);
+}
+
+#[test]
+fn beams_finds_the_best_pair_and_keeps_the_paper_ranking() {
+    let sweep = |extra: &[&str]| {
+        let mut args = vec![
+            "beams",
+            "builtin:living-room",
+            "--tx-array",
+            "1x8",
+            "--rx-array",
+            "1x8",
+            "--tx-orientation",
+            "180,0,0",
+            "--json",
+            "--max-order",
+            "2",
+        ];
+        args.extend_from_slice(extra);
+        json(&args)
+    };
+    let power = sweep(&[]);
+    let pairs = power["pairs"].as_array().unwrap();
+    assert_eq!(pairs.len(), 64);
+    let p = |v: &Value| v["power_dbm"].as_f64().unwrap_or(f64::NEG_INFINITY);
+    assert!(pairs.windows(2).all(|w| p(&w[0]) >= p(&w[1])));
+    let paper = sweep(&["--ranking", "paper"]);
+    let first = &paper["pairs"][0];
+    assert_eq!(first["path_rank"], 1);
+    // Every pair the paper ranking picks is in the power list with the same power.
+    for q in paper["pairs"].as_array().unwrap() {
+        let same = pairs
+            .iter()
+            .find(|x| x["tx_beam"] == q["tx_beam"] && x["rx_beam"] == q["rx_beam"])
+            .unwrap();
+        assert_eq!(same["power_dbm"], q["power_dbm"]);
+    }
+    let table =
+        String::from_utf8_lossy(&ok(&["beams", "builtin:living-room", "--top", "3"]).stdout)
+            .into_owned();
+    assert!(table.contains("best pair: tx beam"));
+    assert_clear_error(
+        &["beams", "builtin:living-room", "--tx-array", "8"],
+        &["ROWSxCOLUMNS"],
+    );
+    assert_clear_error(
+        &["beams", "builtin:living-room", "--rx-spacing", "0"],
+        &["spacing"],
+    );
+}
+
+#[test]
+fn near_field_is_clamped_and_warned() {
+    let o = ok(&[
+        "trace",
+        "builtin:living-room",
+        "--tx",
+        "3,2,1",
+        "--rx",
+        "3.0005,2,1",
+        "--max-order",
+        "0",
+        "--json",
+    ]);
+    let doc: Value = serde_json::from_slice(&o.stdout).unwrap();
+    let los = &doc["paths"][0];
+    assert!(f(&los["free_space_loss_db"]) >= 0.0 && f(&los["gain_db"]) <= 0.0);
+    assert!(String::from_utf8_lossy(&o.stderr).contains("near field"));
+}
+
+/// `--frequency` and `--material` reach every step of a dynamic scene (they load through the
+/// same `bt_scene::load_dynamic` as every source); a material the table does not define at the
+/// carrier is still refused, naming it.
+#[test]
+fn overrides_apply_to_every_step_of_a_dynamic_scene() {
+    let o = beamtrace(&[
+        "trace",
+        "builtin:living-room-dynamic",
+        "--steps",
+        "--max-order",
+        "1",
+        "--frequency",
+        "60e9",
+        "--json",
+    ]);
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let doc: Value = serde_json::from_slice(&o.stdout).unwrap();
+    assert_eq!(doc["frequency_hz"].as_f64(), Some(60e9));
+    assert_eq!(doc["steps"].as_array().unwrap().len(), 10);
+    assert_clear_error(
+        &[
+            "trace",
+            "builtin:living-room-dynamic",
+            "--steps",
+            "--frequency",
+            "60e9",
+            "--material",
+            "itu:brick",
+        ],
+        &["brick"],
+    );
+}
