@@ -306,8 +306,7 @@ fn bad_inputs_give_clear_errors() {
 /// from the static, dynamic and WVRN paths.
 #[test]
 fn unknown_builtin_is_one_error_everywhere() {
-    let expected =
-        "unknown built-in scene \"nowhere\" (built-in scenes: living-room, living-room-dynamic)";
+    let expected = "unknown built-in scene \"nowhere\" (built-in scenes: living-room, living-room-dynamic, city)";
     for command in [
         &["trace", "builtin:nowhere"][..],
         &["trace", "builtin:nowhere", "--steps"],

@@ -276,7 +276,8 @@ impl Layout {
         let sched_region_bits = (slot_bits + inst_bits).max(point_region_bits + 1);
         if sched_region_bits + 1 > ADDRESS_BITS {
             return Err(HlsError::TooLarge(format!(
-                "{} paths, {} points and {} slots x {} PEs need more than {ADDRESS_BITS} address bits",
+                "{} paths, {} points and {} slots x {} PEs need more than {ADDRESS_BITS} address bits: \
+                 lower --max-order or use fewer reflectors",
                 cap.paths, cap.points, cap.slots, num_instances
             )));
         }

@@ -38,11 +38,11 @@ pub struct TreeOptions {
 }
 
 impl TreeOptions {
-    /// Order `max_order`, 5 million nodes, occlusion culling on.
+    /// Order `max_order`, 2 million nodes (about 1 GB), occlusion culling on.
     pub fn new(max_order: usize) -> Self {
         TreeOptions {
             max_order,
-            max_nodes: 5_000_000,
+            max_nodes: 2_000_000,
             occlusion: true,
         }
     }
@@ -53,8 +53,8 @@ impl TreeOptions {
 pub enum TreeError {
     /// More nodes than the budget.
     #[error(
-        "beam tree budget exceeded: more than {budget} nodes by depth {depth} of {max_order} \
-         ({nodes} so far); lower the order or raise the budget with --max-candidates"
+        "candidate budget exceeded: the beam tree holds more than {budget} nodes by depth {depth} \
+         of {max_order} ({nodes} so far); lower the order or raise the budget with --max-candidates"
     )]
     Budget {
         /// Nodes built when the budget ran out.

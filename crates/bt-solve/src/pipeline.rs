@@ -27,7 +27,7 @@ pub enum CandidateMode {
 }
 
 /// Default budget on candidate sequences (see [`TraceOptions::max_candidates`]).
-pub const DEFAULT_MAX_CANDIDATES: u64 = 5_000_000;
+pub const DEFAULT_MAX_CANDIDATES: u64 = 2_000_000;
 
 /// What to trace and how.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
