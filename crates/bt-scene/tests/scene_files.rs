@@ -164,7 +164,7 @@ fn one_loading_entry_for_every_source() {
     let unknown = load("builtin:attic", &options).unwrap_err().to_string();
     assert_eq!(
         unknown,
-        "unknown built-in scene \"attic\" (built-in scenes: living-room, living-room-dynamic)"
+        "unknown built-in scene \"attic\" (built-in scenes: living-room, living-room-dynamic, city)"
     );
     let dynamic_unknown = load_dynamic("builtin:attic", &options, &mut |_| {})
         .unwrap_err()
