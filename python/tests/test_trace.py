@@ -30,6 +30,10 @@ def assert_same_as_cli(paths: beamtrace.Paths, doc: dict) -> None:
         assert paths.incidence_deg[i].tolist() == e["incidence_deg"]
         for key in ("free_space_loss_db", "reflection_loss_db", "loss_db"):
             assert paths.to_dict()[key][i] == e[key]
+        assert paths.gain[i] == complex(e["gain"][0], e["gain"][1])
+        for key in ("gain_db", "power_dbm"):
+            want = e[key] if e[key] is not None else -np.inf
+            assert paths.to_dict()[key][i] == want
         if "iterations" in e:
             assert paths.iterations[i] == e["iterations"]
             assert paths.residual_m[i] == e["residual_m"]

@@ -16,10 +16,6 @@ enum Column {
     /// A real number per path: `float64`, shape (n,).
     Real(fn(&PathReport) -> f64),
     /// A complex number per path: `complex128`, shape (n,).
-    #[expect(
-        dead_code,
-        reason = "ready for the channel's complex gain: one line in COLUMNS"
-    )]
     Complex(fn(&PathReport) -> numpy::Complex64),
     /// A direction per path: `float64`, shape (n, 2), columns azimuth and elevation (degrees).
     Direction(fn(&PathReport) -> Direction),
@@ -49,6 +45,20 @@ const COLUMNS: &[(&str, Column)] = &[
     ("free_space_loss_db", Column::Real(|p| p.free_space_loss_db)),
     ("reflection_loss_db", Column::Real(|p| p.reflection_loss_db)),
     ("loss_db", Column::Real(|p| p.loss_db)),
+    // The channel (docs/channel.md): complex gain without the propagation phase; dB and dBm
+    // are −inf where the JSON has null (a path that carries no power).
+    (
+        "gain",
+        Column::Complex(|p| numpy::Complex64::new(p.gain.re, p.gain.im)),
+    ),
+    (
+        "gain_db",
+        Column::Real(|p| p.gain_db.unwrap_or(f64::NEG_INFINITY)),
+    ),
+    (
+        "power_dbm",
+        Column::Real(|p| p.power_dbm.unwrap_or(f64::NEG_INFINITY)),
+    ),
     ("iterations", Column::OptionalCount(|p| p.iterations)),
     ("residual_m", Column::OptionalReal(|p| p.residual_m)),
 ];

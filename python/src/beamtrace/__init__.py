@@ -67,6 +67,13 @@ class Paths:
     """Sum of the materials' reflection losses, dB, shape (n,)."""
     loss_db: npt.NDArray[np.float64]
     """Total loss, dB, shape (n,)."""
+    gain: npt.NDArray[np.complex128]
+    """Complex path gain (antennas, polarised bounces, λ/(4π·length); no propagation phase),
+    shape (n,)."""
+    gain_db: npt.NDArray[np.float64]
+    """20·log10|gain|, dB (−inf for a path carrying no power), shape (n,)."""
+    power_dbm: npt.NDArray[np.float64]
+    """Received power of the path for the transmitted power (default 0 dBm), dBm, shape (n,)."""
     iterations: npt.NDArray[np.int64]
     """IPC rounds per path (IPC solver only), shape (n,)."""
     residual_m: npt.NDArray[np.float64]
