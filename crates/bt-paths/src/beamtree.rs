@@ -177,18 +177,23 @@ struct Parent<'n> {
 }
 
 impl BeamTree {
-    /// Build the tree of `scene`'s TX to `options.max_order`.
-    pub fn build(scene: &Scene, options: TreeOptions) -> Result<Self, TreeError> {
-        let prep = Prepared::new(scene, options);
-        let mut tree = BeamTree {
-            max_order: options.max_order,
+    /// A tree with no node yet, for the scene and options of `prep`.
+    fn empty(prep: &Prepared) -> Self {
+        BeamTree {
+            max_order: prep.options.max_order,
             tol: prep.tol,
             nodes: Vec::new(),
             levels: Vec::new(),
             verts: Vec::new(),
             planes: Vec::new(),
             stats: TreeStats::default(),
-        };
+        }
+    }
+
+    /// Build the tree of `scene`'s TX to `options.max_order`.
+    pub fn build(scene: &Scene, options: TreeOptions) -> Result<Self, TreeError> {
+        let prep = Prepared::new(scene, options);
+        let mut tree = BeamTree::empty(&prep);
         let mut scratch = Scratch::default();
         for depth in 1..=options.max_order {
             tree.grow_level(&prep, depth, &mut scratch, None)?;
@@ -507,50 +512,59 @@ fn occlude(
         })
         .collect();
     // Only a surface that the ray to some window vertex crosses can cover or clip the window
-    // (the covered part of a convex window contains a vertex); nearest first.
-    scratch.items.clear();
+    // (the covered part of a convex window contains a vertex). Ray by ray, nearest first, so a
+    // window hidden by the first wall in front costs one BVH walk.
+    let margin = COVER * prep.tol;
+    let rays: Vec<(Vec3, Vec3)> = starts
+        .iter()
+        .copied()
+        .zip(scratch.a.iter().copied())
+        .collect();
+    let mut tested = std::mem::take(&mut scratch.items);
+    tested.clear();
     let mut hits: Vec<(Real, u32)> = Vec::new();
-    for (a, q) in starts.iter().zip(&scratch.a) {
-        scene.bvh().visit_segment(*a, *q, |item| {
-            if Some(item) == parent.surface || item == s || !prep.convex[item as usize] {
+    let mut covered = false;
+    'rays: for (a, q) in rays {
+        hits.clear();
+        scene.bvh().visit_segment(a, q, |item| {
+            if Some(item) == parent.surface
+                || item == s
+                || !prep.convex[item as usize]
+                || tested.contains(&item)
+            {
                 return;
             }
             let polygon = &scene.surface(SurfaceId(item)).polygon;
-            if polygon.blocks_segment(*a, *q, 0.0, 0.0) {
+            if polygon.blocks_segment(a, q, 0.0, 0.0) {
                 hits.push((polygon.centroid().distance_squared(parent.apex), item));
             }
         });
-    }
-    hits.sort_unstable_by(|x, y| x.1.cmp(&y.1));
-    hits.dedup_by_key(|h| h.1);
-    hits.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
-    scratch.items.extend(hits.iter().map(|h| h.1));
-    let margin = COVER * prep.tol;
-    let items = std::mem::take(&mut scratch.items);
-    let mut covered = false;
-    for &o in &items {
-        let polygon = &scene.surface(SurfaceId(o)).polygon;
-        if !between(polygon.plane(), &starts, &scratch.a, margin) {
-            continue;
-        }
-        match shadow(polygon, parent.apex, &scratch.a, margin) {
-            Shadow::Covers => {
-                covered = true;
-                break;
+        hits.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+        for &(_, o) in &hits {
+            tested.push(o);
+            let polygon = &scene.surface(SurfaceId(o)).polygon;
+            if !between(polygon.plane(), &starts, &scratch.a, margin) {
+                continue;
             }
-            Shadow::AllBut(plane) => {
-                convex::clip(&scratch.a, &plane, EPS * prep.tol, &mut scratch.b);
-                std::mem::swap(&mut scratch.a, &mut scratch.b);
-                stats.occluder_clips += 1;
-                if scratch.a.len() < 3 {
+            match shadow(polygon, parent.apex, &scratch.a, margin) {
+                Shadow::Covers => {
                     covered = true;
-                    break;
+                    break 'rays;
                 }
+                Shadow::AllBut(plane) => {
+                    convex::clip(&scratch.a, &plane, EPS * prep.tol, &mut scratch.b);
+                    std::mem::swap(&mut scratch.a, &mut scratch.b);
+                    stats.occluder_clips += 1;
+                    if scratch.a.len() < 3 {
+                        covered = true;
+                        break 'rays;
+                    }
+                }
+                Shadow::None => {}
             }
-            Shadow::None => {}
         }
     }
-    scratch.items = items;
+    scratch.items = tested;
     covered
 }
 
@@ -620,15 +634,7 @@ fn shadow(occluder: &bt_geom::Polygon, apex: Vec3, window: &[Vec3], margin: Real
 /// order `max_order - 1` and the last level is tested against RX without being materialised.
 pub fn candidates(scene: &Scene, options: TreeOptions) -> Result<CandidateSet, TreeError> {
     let prep = Prepared::new(scene, options);
-    let mut tree = BeamTree {
-        max_order: options.max_order,
-        tol: prep.tol,
-        nodes: Vec::new(),
-        levels: Vec::new(),
-        verts: Vec::new(),
-        planes: Vec::new(),
-        stats: TreeStats::default(),
-    };
+    let mut tree = BeamTree::empty(&prep);
     let mut scratch = Scratch::default();
     let rx = scene.rx();
     let mut last = CandidateSet::with_starts();

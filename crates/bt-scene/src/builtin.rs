@@ -28,7 +28,7 @@ pub fn builtin_json(name: &str) -> Option<&'static str> {
 /// (2.2 m) and RX at laptop height (0.72 m).
 ///
 /// `city` is the seeded synthetic city of [`crate::city`] (a triangle mesh through the mesh
-/// pipeline), TX on a 10 m mast in a street, RX at 1.5 m in the next street.
+/// pipeline), TX on a 10 m mast in a street, RX at 1.5 m 180 m down the same street.
 pub fn builtin_scene(name: &str, terminals: Terminals) -> Option<Result<Scene, SceneError>> {
     if name == "city" {
         return Some(city_scene(terminals));
@@ -40,20 +40,9 @@ pub fn builtin_scene(name: &str, terminals: Terminals) -> Option<Result<Scene, S
 
 fn city_scene(terminals: Terminals) -> Result<Scene, SceneError> {
     let city = crate::city::CityOptions::default();
-    let obj = crate::city::city_obj(&city);
-    let source = "builtin:city";
-    let options = crate::io::LoadOptions {
-        terminals: Terminals {
-            tx: terminals.tx.or(Some(city.street_point(10, 1000.0, 10.0))),
-            rx: terminals.rx.or(Some(city.street_point(11, 1180.0, 1.5))),
-        },
-        ..crate::io::LoadOptions::default()
+    let terminals = Terminals {
+        tx: terminals.tx.or(Some(city.street_point(10, 1000.0, 10.0))),
+        rx: terminals.rx.or(Some(city.street_point(10, 1180.0, 1.5))),
     };
-    let import = bt_mesh::read_obj(obj.as_bytes(), Some(source), &options.merge).map_err(|e| {
-        SceneError::Parse {
-            path: source.to_string(),
-            message: e.to_string(),
-        }
-    })?;
-    crate::io::from_mesh(import, "city", source, &options).map(|loaded| loaded.scene)
+    crate::city::city_scene(&city, terminals)
 }

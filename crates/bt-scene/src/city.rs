@@ -1,7 +1,7 @@
 //! A seeded synthetic city: box buildings on a ground plane, written as a triangle mesh and
 //! imported like any OBJ (welding, coplanar merging), so it exercises the mesh pipeline and
 //! the candidate generator at city scale. `builtin:city` is 3,900 buildings (39,002 triangles,
-//! about 19,500 surfaces over 2.3 km × 2.3 km) with TX on a street mast and RX at handset height.
+//! about 19,500 surfaces over 2.3 km × 2.3 km) with TX on a 10 m street mast and RX at handset height 180 m down the same street.
 
 use bt_geom::{Real, Vec3};
 use rand::{Rng, SeedableRng};
@@ -99,6 +99,27 @@ pub fn city_obj(options: &CityOptions) -> String {
         }
     }
     obj
+}
+
+/// The city as a validated scene (mesh import with the default merge options; `terminals` must
+/// give TX and RX).
+pub fn city_scene(
+    options: &CityOptions,
+    terminals: crate::Terminals,
+) -> Result<crate::Scene, crate::SceneError> {
+    let obj = city_obj(options);
+    let source = "builtin:city";
+    let load = crate::io::LoadOptions {
+        terminals,
+        ..crate::io::LoadOptions::default()
+    };
+    let import = bt_mesh::read_obj(obj.as_bytes(), Some(source), &load.merge).map_err(|e| {
+        crate::SceneError::Parse {
+            path: source.to_string(),
+            message: e.to_string(),
+        }
+    })?;
+    crate::io::from_mesh(import, "city", source, &load).map(|loaded| loaded.scene)
 }
 
 #[cfg(test)]

@@ -161,6 +161,11 @@ fn one_loading_entry_for_every_source() {
     let (one, _) = load_dynamic(&ply, &boxed, &mut |_| {}).unwrap();
     assert_eq!(one.len(), 1);
 
+    let city = load("builtin:city", &options).unwrap().scene;
+    assert!(city.surfaces().len() > 19_000, "{}", city.surfaces().len());
+    let (city_steps, _) = load_dynamic("builtin:city", &options, &mut |_| {}).unwrap();
+    assert_eq!(city_steps.len(), 1);
+
     let unknown = load("builtin:attic", &options).unwrap_err().to_string();
     assert_eq!(
         unknown,

@@ -104,6 +104,15 @@ fn load_any(
 ) -> Result<Loaded, SceneError> {
     let path = match Source::parse(source) {
         Source::Builtin(name) => {
+            // Generated built-ins (the city) have no JSON: they build their own scene.
+            if builtin_json(&name).is_none()
+                && let Some(scene) = crate::builtin_scene(&name, options.terminals)
+            {
+                return Ok(Loaded {
+                    scene: scene?,
+                    warnings: Vec::new(),
+                });
+            }
             let desc = builtin_description(&name)?;
             let scene = Scene::from_description(&desc, source, options.terminals)?;
             return Ok(Loaded {
@@ -141,6 +150,12 @@ pub fn load_dynamic(
     progress: &mut dyn FnMut(LoadProgress),
 ) -> Result<(DynamicScene, Vec<String>), SceneError> {
     let desc = match Source::parse(source) {
+        // A generated built-in (no JSON) is static: one step, loaded below.
+        Source::Builtin(name)
+            if builtin_json(&name).is_none() && builtin_names().contains(&name.as_str()) =>
+        {
+            None
+        }
         Source::Builtin(name) => Some(builtin_description(&name)?),
         Source::File(path) => match Format::of(&path)? {
             format @ (Format::Json | Format::Toml) => Some(read_description(&path, format)?),

@@ -190,3 +190,38 @@ fn ipc_finds_the_wall_floor_path_that_centroid_starts_missed() {
     let length: Real = v.windows(2).map(|w| w[0].distance(w[1])).sum();
     assert!((length - 3.960).abs() < 5e-4, "{length}");
 }
+
+#[test]
+fn a_small_city_agrees_with_exhaustive_enumeration_at_orders_one_and_two() {
+    // 6 × 6 lots of box buildings on a ground plane (about 180 surfaces), TX on a mast, RX in
+    // the street and on a roof corner's mirror ray: culling by buildings is exercised.
+    let city = bt_scene::city::CityOptions {
+        lots: 6,
+        ..bt_scene::city::CityOptions::default()
+    };
+    for (rx_y, rx_z) in [(95.0, 1.5), (150.0, 12.0), (20.0, 3.0)] {
+        let terminals = Terminals {
+            tx: Some(city.street_point(0, 60.0, 10.0)),
+            rx: Some(city.street_point(0, rx_y, rx_z)),
+        };
+        let scene = bt_scene::city::city_scene(&city, terminals).unwrap();
+        for order in 1..=2 {
+            let reference = paths(&scene, order, CandidateMode::Exhaustive);
+            let traced = trace_scene(
+                &scene,
+                &options(order, CandidateMode::BeamTree, Solver::Image),
+            )
+            .unwrap();
+            assert_eq!(
+                sequences(&traced.result.paths),
+                sequences(&reference),
+                "order {order}"
+            );
+            let tree = traced.tree.unwrap();
+            assert!(
+                order < 2 || tree.occluded > 0,
+                "culling exercised: {tree:?}"
+            );
+        }
+    }
+}
