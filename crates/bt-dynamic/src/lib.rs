@@ -270,10 +270,6 @@ impl IncrementalTracer {
         let (tx, rx) = (scene.tx(), scene.rx());
 
         // Walk both candidate sets in their common order (by length, then by ids).
-        enum Plan {
-            Reuse(usize),
-            Solve(Option<usize>),
-        }
         let mut plans = Vec::with_capacity(candidates.len());
         let mut j = 0;
         for seq in candidates.iter() {
@@ -303,89 +299,24 @@ impl IncrementalTracer {
         }
 
         // Solve the affected candidates (in parallel, order preserved).
-        let todo: Vec<usize> = plans
-            .iter()
-            .enumerate()
-            .filter_map(|(i, p)| matches!(p, Plan::Solve(_)).then_some(i))
-            .collect();
-        // Each chunk returns its outcomes and the points of its candidates, concatenated.
-        let solve_range = |range: &[usize]| -> (Vec<(CandidateOutcome, bool)>, Vec<Vec3>) {
-            let mut scratch = Vec::new();
-            let mut all_points = Vec::new();
-            let outcomes = range
-                .iter()
-                .map(|&i| {
-                    let seq = candidates.get(i);
-                    let start = all_points.len();
-                    all_points.resize(start + seq.len(), Vec3::ZERO);
-                    scratch.resize(seq.len(), Vec3::ZERO);
-                    let Plan::Solve(old) = plans[i] else {
-                        unreachable!()
-                    };
-                    let warm = old.and_then(|o| {
-                        let r = &prev.records[o];
-                        let pts = &prev.points[r.start as usize..r.start as usize + seq.len()];
-                        warm_start(&r.outcome, pts)
-                    });
-                    let from_previous = warm.is_some();
-                    let warm = warm.or(candidates.start(i));
-                    let points = &mut all_points[start..];
-                    let outcome = bt_solve::solve_candidate_from(
-                        scene,
-                        seq,
-                        &options.solver,
-                        warm,
-                        points,
-                        &mut scratch,
-                    );
-                    (
-                        outcome,
-                        from_previous && matches!(options.solver, Solver::Ipc(_)),
-                    )
-                })
-                .collect();
-            (outcomes, all_points)
-        };
-        const CHUNK: usize = 64;
-        let (solved, solved_points) = if options.parallel && todo.len() >= 256 {
-            let parts: Vec<_> = todo.par_chunks(CHUNK).map(solve_range).collect();
-            let mut out = (Vec::with_capacity(todo.len()), Vec::new());
-            for (o, p) in parts {
-                out.0.extend(o);
-                out.1.extend(p);
-            }
-            out
-        } else {
-            solve_range(&todo)
-        };
+        let (solved, solved_points) = solve_planned(
+            scene,
+            &options,
+            &candidates,
+            &plans,
+            (&prev.records, &prev.points),
+        );
         update.solved = solved.len();
         update.warm_started = solved.iter().filter(|s| s.1).count();
         update.reused = candidates.len() - solved.len();
 
-        let mut records = Vec::with_capacity(candidates.len());
-        let mut points = Vec::with_capacity(prev.points.len());
-        let mut fresh = solved.into_iter();
-        let mut fresh_points = 0;
-        for (i, plan) in plans.iter().enumerate() {
-            let n = candidates.get(i).len();
-            let start = points.len() as u32;
-            match plan {
-                Plan::Reuse(o) => {
-                    let r = &prev.records[*o];
-                    points.extend_from_slice(&prev.points[r.start as usize..r.start as usize + n]);
-                    records.push(Record {
-                        outcome: r.outcome,
-                        start,
-                    });
-                }
-                Plan::Solve(_) => {
-                    let (outcome, _) = fresh.next().expect("one result per planned solve");
-                    points.extend_from_slice(&solved_points[fresh_points..fresh_points + n]);
-                    fresh_points += n;
-                    records.push(Record { outcome, start });
-                }
-            }
-        }
+        let (records, points) = assemble(
+            &candidates,
+            &plans,
+            (&prev.records, &prev.points),
+            solved,
+            &solved_points,
+        );
         let state = State {
             scene: scene.clone(),
             wvrn,
@@ -497,6 +428,117 @@ impl State {
             update,
         }
     }
+}
+
+/// What the incremental step does with one candidate: reuse the previous outcome at this index,
+/// or solve it (warm-started from the previous step's candidate at this index, if any).
+enum Plan {
+    Reuse(usize),
+    Solve(Option<usize>),
+}
+
+/// Solve the candidates planned for solving, in parallel with order preserved: their outcomes
+/// (and whether IPC was warm-started from the previous step) and their points, concatenated.
+fn solve_planned(
+    scene: &Scene,
+    options: &StepOptions,
+    candidates: &CandidateSet,
+    plans: &[Plan],
+    prev: (&[Record], &[Vec3]),
+) -> (Vec<(CandidateOutcome, bool)>, Vec<Vec3>) {
+    let (prev_records, prev_points) = prev;
+    let todo: Vec<usize> = plans
+        .iter()
+        .enumerate()
+        .filter_map(|(i, p)| matches!(p, Plan::Solve(_)).then_some(i))
+        .collect();
+    // Each chunk returns its outcomes and the points of its candidates, concatenated.
+    let solve_range = |range: &[usize]| -> (Vec<(CandidateOutcome, bool)>, Vec<Vec3>) {
+        let mut scratch = Vec::new();
+        let mut all_points = Vec::new();
+        let outcomes = range
+            .iter()
+            .map(|&i| {
+                let seq = candidates.get(i);
+                let start = all_points.len();
+                all_points.resize(start + seq.len(), Vec3::ZERO);
+                scratch.resize(seq.len(), Vec3::ZERO);
+                let Plan::Solve(old) = plans[i] else {
+                    unreachable!()
+                };
+                let warm = old.and_then(|o| {
+                    let r = &prev_records[o];
+                    let pts = &prev_points[r.start as usize..r.start as usize + seq.len()];
+                    warm_start(&r.outcome, pts)
+                });
+                let from_previous = warm.is_some();
+                let warm = warm.or(candidates.start(i));
+                let points = &mut all_points[start..];
+                let outcome = bt_solve::solve_candidate_from(
+                    scene,
+                    seq,
+                    &options.solver,
+                    warm,
+                    points,
+                    &mut scratch,
+                );
+                (
+                    outcome,
+                    from_previous && matches!(options.solver, Solver::Ipc(_)),
+                )
+            })
+            .collect();
+        (outcomes, all_points)
+    };
+    const CHUNK: usize = 64;
+    if options.parallel && todo.len() >= 256 {
+        let parts: Vec<_> = todo.par_chunks(CHUNK).map(solve_range).collect();
+        let mut out = (Vec::with_capacity(todo.len()), Vec::new());
+        for (o, p) in parts {
+            out.0.extend(o);
+            out.1.extend(p);
+        }
+        out
+    } else {
+        solve_range(&todo)
+    }
+}
+
+/// The step's records and points in candidate order: reused ones copied from the previous
+/// step, solved ones taken in order from `solved` / `solved_points`.
+fn assemble(
+    candidates: &CandidateSet,
+    plans: &[Plan],
+    prev: (&[Record], &[Vec3]),
+    solved: Vec<(CandidateOutcome, bool)>,
+    solved_points: &[Vec3],
+) -> (Vec<Record>, Vec<Vec3>) {
+    let (prev_records, prev_points) = prev;
+    let mut records = Vec::with_capacity(candidates.len());
+    let mut points = Vec::with_capacity(prev_points.len());
+    let mut fresh = solved.into_iter();
+    let mut fresh_points = 0;
+    for (i, plan) in plans.iter().enumerate() {
+        let n = candidates.get(i).len();
+        let start = points.len() as u32;
+        match plan {
+            Plan::Reuse(o) => {
+                let r = &prev_records[*o];
+                points.extend_from_slice(&prev_points[r.start as usize..r.start as usize + n]);
+                records.push(Record {
+                    outcome: r.outcome,
+                    start,
+                });
+            }
+            Plan::Solve(_) => {
+                let (outcome, _) = fresh.next().expect("one result per planned solve");
+                points.extend_from_slice(&solved_points[fresh_points..fresh_points + n]);
+                fresh_points += n;
+                records.push(Record { outcome, start });
+            }
+        }
+    }
+    (records, points)
 }
 
 /// The order of [`bt_paths::enumerate`]'s output: by length, then lexicographically by id
