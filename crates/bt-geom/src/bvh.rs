@@ -54,19 +54,29 @@ impl Bvh {
 
     /// Calls `hit(item)` for every item whose box the segment `a -> b` touches, stopping at and
     /// returning the first item for which `hit` returns true.
-    pub fn any_hit(&self, a: Vec3, b: Vec3, mut hit: impl FnMut(u32) -> bool) -> Option<u32> {
+    pub fn any_hit(&self, a: Vec3, b: Vec3, hit: impl FnMut(u32) -> bool) -> Option<u32> {
+        let d = b - a;
+        let inv = Vec3::new(1.0 / d.x, 1.0 / d.y, 1.0 / d.z);
+        self.walk(|min, max| segment_hits_box(a, inv, min, max), hit)
+    }
+
+    /// The one traversal: descend into nodes whose box passes `box_test`, call `hit` on the
+    /// items of the leaves reached, stop at (and return) the first item `hit` accepts.
+    fn walk(
+        &self,
+        mut box_test: impl FnMut(Vec3, Vec3) -> bool,
+        mut hit: impl FnMut(u32) -> bool,
+    ) -> Option<u32> {
         if self.nodes.is_empty() {
             return None;
         }
-        let d = b - a;
-        let inv = Vec3::new(1.0 / d.x, 1.0 / d.y, 1.0 / d.z);
         let mut stack = [0u32; 64];
         let mut top = 1;
         while top > 0 {
             top -= 1;
             let index = stack[top];
             let node = self.nodes[index as usize];
-            if !segment_hits_box(a, inv, node.min, node.max) {
+            if !box_test(node.min, node.max) {
                 continue;
             }
             if node.count > 0 {
@@ -91,30 +101,11 @@ impl Bvh {
     /// Calls `visit(item)` for every item whose box passes `box_test(min, max)`, descending only
     /// into nodes whose box passes it. `box_test` must be conservative (a node's box contains its
     /// items' boxes): answering `false` for a box prunes everything inside it.
-    pub fn visit(&self, mut box_test: impl FnMut(Vec3, Vec3) -> bool, mut visit: impl FnMut(u32)) {
-        if self.nodes.is_empty() {
-            return;
-        }
-        let mut stack = [0u32; 64];
-        let mut top = 1;
-        while top > 0 {
-            top -= 1;
-            let index = stack[top];
-            let node = self.nodes[index as usize];
-            if !box_test(node.min, node.max) {
-                continue;
-            }
-            if node.count > 0 {
-                let start = node.start_or_right as usize;
-                for &item in &self.order[start..start + node.count as usize] {
-                    visit(item);
-                }
-            } else if top + 2 <= stack.len() {
-                stack[top] = node.start_or_right;
-                stack[top + 1] = index + 1;
-                top += 2;
-            }
-        }
+    pub fn visit(&self, box_test: impl FnMut(Vec3, Vec3) -> bool, mut visit: impl FnMut(u32)) {
+        self.walk(box_test, |item| {
+            visit(item);
+            false
+        });
     }
 
     /// Calls `visit(item)` for every item whose box the segment `a -> b` touches.
