@@ -30,18 +30,9 @@ fn traced_paths(args: &PathArgs) -> anyhow::Result<(Scene, Vec<PathReport>, Radi
     Ok((scene, paths, radio))
 }
 
-/// Write `text` to `path` atomically: a temporary file in the same directory, then a rename.
-pub fn write_atomic(path: &Path, text: &str) -> anyhow::Result<()> {
-    let name = path
-        .file_name()
-        .and_then(|n| n.to_str())
-        .with_context(|| format!("{} is not a file name", path.display()))?;
-    let temp = path.with_file_name(format!(".{name}.{}.tmp", std::process::id()));
-    std::fs::write(&temp, text).with_context(|| format!("writing {}", temp.display()))?;
-    std::fs::rename(&temp, path).with_context(|| {
-        let _ = std::fs::remove_file(&temp);
-        format!("renaming {} to {}", temp.display(), path.display())
-    })
+/// Write `text` to `path` through the CLI's one writer (atomic, never over the scene file).
+fn write_text(path: &Path, text: &str, args: &PathArgs) -> anyhow::Result<()> {
+    crate::files::write(path, text.as_bytes(), &crate::inputs(&args.scene), &[])
 }
 
 /// A CSV field: quoted, with quotes doubled, when it holds a comma, quote or line break.
@@ -120,10 +111,10 @@ fn cfr_csv(paths: &[PathReport], carrier_hz: f64, args: &ChannelArgs) -> anyhow:
 pub fn run_channel(args: &ChannelArgs) -> anyhow::Result<ExitCode> {
     let (scene, paths, radio) = traced_paths(&args.paths)?;
     let carrier = scene.frequency_hz();
-    write_atomic(&args.out, &cir_csv(&paths, carrier))?;
+    write_text(&args.out, &cir_csv(&paths, carrier), &args.paths)?;
     println!("{}: {} taps", args.out.display(), paths.len());
     if let Some(path) = &args.cfr {
-        write_atomic(path, &cfr_csv(&paths, carrier, args)?)?;
+        write_text(path, &cfr_csv(&paths, carrier, args)?, &args.paths)?;
         println!("{}: {} subcarriers", path.display(), args.subcarriers);
     }
     if let Some(stem) = &args.pdp {
@@ -217,7 +208,7 @@ pub fn run_beams(args: &BeamsArgs) -> anyhow::Result<ExitCode> {
     };
     let json = serde_json::to_string_pretty(&doc).context("serialising the beam sweep")?;
     if let Some(path) = &args.out {
-        write_atomic(path, &format!("{json}\n"))?;
+        write_text(path, &format!("{json}\n"), &args.paths)?;
     }
     if args.json {
         println!("{json}");

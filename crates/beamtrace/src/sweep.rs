@@ -2,7 +2,6 @@
 //! coverage.csv and the heat map into the output directory.
 
 use crate::args::SweepArgs;
-use crate::output::write_atomic;
 use crate::trace::{load_scene, solver_for, trace_options};
 use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressStyle};
@@ -35,7 +34,12 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<ExitCode> {
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
     let csv = args.out.join("coverage.csv");
-    write_atomic(&csv, bt_coverage::csv(&rows).as_bytes())?;
+    crate::files::write(
+        &csv,
+        bt_coverage::csv(&rows).as_bytes(),
+        &crate::inputs(&args.scene),
+        &[],
+    )?;
     let map = bt_coverage::HeatMap {
         scene: &scene,
         grid: &args.grid,

@@ -2,7 +2,6 @@
 //! scene) and its paths, traced here or read from a `trace --json` document.
 
 use crate::args::ViewArgs;
-use crate::output::write_atomic;
 use crate::steps::load_dynamic;
 use crate::trace::{solver_for, trace_options};
 use anyhow::Context;
@@ -36,7 +35,12 @@ pub fn run(args: &ViewArgs) -> anyhow::Result<ExitCode> {
         }
     };
     let html = bt_view::page(&scenes, &paths);
-    write_atomic(&args.output, html.as_bytes())?;
+    crate::files::write(
+        &args.output,
+        html.as_bytes(),
+        &crate::inputs(&args.scene),
+        &[],
+    )?;
     let total: usize = paths.iter().map(|s| s.paths.len()).sum();
     println!(
         "{}: {} time step(s), {} paths -> {} ({} KiB)",
