@@ -341,6 +341,7 @@ fn plan_step(
     let results = model.run(step.input.tx, step.input.rx)?;
     let problem: Problem = step.input.problem_for(&results);
     let t2 = Instant::now();
+    let bar = crate::progress::spinner(&format!("scheduling {} paths", step.input.paths.len()));
     let plan = bt_hls::plan(
         &problem,
         &PlanOptions {
@@ -352,6 +353,7 @@ fn plan_step(
             },
         },
     )?;
+    bar.finish_and_clear();
     let t3 = Instant::now();
     let fixed = fixed_deviation(scene, &step, &results, args.max_order);
     Ok(PlannedStep {
