@@ -54,6 +54,7 @@ impl Bvh {
 
     /// Calls `hit(item)` for every item whose box the segment `a -> b` touches, stopping at and
     /// returning the first item for which `hit` returns true.
+    #[inline(always)]
     pub fn any_hit(&self, a: Vec3, b: Vec3, hit: impl FnMut(u32) -> bool) -> Option<u32> {
         let d = b - a;
         let inv = Vec3::new(1.0 / d.x, 1.0 / d.y, 1.0 / d.z);
@@ -62,6 +63,7 @@ impl Bvh {
 
     /// The one traversal: descend into nodes whose box passes `box_test`, call `hit` on the
     /// items of the leaves reached, stop at (and return) the first item `hit` accepts.
+    #[inline(always)]
     fn walk(
         &self,
         mut box_test: impl FnMut(Vec3, Vec3) -> bool,
@@ -101,6 +103,7 @@ impl Bvh {
     /// Calls `visit(item)` for every item whose box passes `box_test(min, max)`, descending only
     /// into nodes whose box passes it. `box_test` must be conservative (a node's box contains its
     /// items' boxes): answering `false` for a box prunes everything inside it.
+    #[inline]
     pub fn visit(&self, box_test: impl FnMut(Vec3, Vec3) -> bool, mut visit: impl FnMut(u32)) {
         self.walk(box_test, |item| {
             visit(item);
@@ -109,6 +112,7 @@ impl Bvh {
     }
 
     /// Calls `visit(item)` for every item whose box the segment `a -> b` touches.
+    #[inline]
     pub fn visit_segment(&self, a: Vec3, b: Vec3, visit: impl FnMut(u32)) {
         let d = b - a;
         let inv = Vec3::new(1.0 / d.x, 1.0 / d.y, 1.0 / d.z);
@@ -127,7 +131,7 @@ pub fn box_meets_halfspaces(min: Vec3, max: Vec3, planes: &[crate::Plane], eps: 
             if p.normal.y >= 0.0 { max.y } else { min.y },
             if p.normal.z >= 0.0 { max.z } else { min.z },
         );
-        p.signed_distance(far) >= -eps
+        p.signed_distance_unfused(far) >= -eps
     })
 }
 

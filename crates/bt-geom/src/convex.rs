@@ -6,7 +6,9 @@ use crate::{Plane, Polygon, Real, Vec2, Vec3};
 
 /// Clip the convex polygon `poly` to the half-space `{x : plane.signed_distance(x) >= -eps}`
 /// (Sutherland-Hodgman), writing the result to `out` (cleared first). `eps` (m) grows the kept
-/// side so that round-off never removes a point that lies on the plane.
+/// side so that round-off never removes a point that lies on the plane; it must be far above
+/// the round-off of the unfused distances used here
+/// ([`Plane::signed_distance_unfused`]).
 pub fn clip(poly: &[Vec3], plane: &Plane, eps: Real, out: &mut Vec<Vec3>) {
     out.clear();
     let n = poly.len();
@@ -14,9 +16,9 @@ pub fn clip(poly: &[Vec3], plane: &Plane, eps: Real, out: &mut Vec<Vec3>) {
         return;
     }
     let mut prev = poly[n - 1];
-    let mut d_prev = plane.signed_distance(prev) + eps;
+    let mut d_prev = plane.signed_distance_unfused(prev) + eps;
     for &cur in poly {
-        let d_cur = plane.signed_distance(cur) + eps;
+        let d_cur = plane.signed_distance_unfused(cur) + eps;
         if d_cur >= 0.0 {
             if d_prev < 0.0 {
                 out.push(crossing(prev, cur, d_prev, d_cur));

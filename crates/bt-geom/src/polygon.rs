@@ -280,13 +280,14 @@ impl Polygon {
     /// Whether the open segment `a -> b` passes through the polygon: it crosses the plane at a
     /// parameter `t` in `[t_min, 1 - t_min]` at a point inside the polygon or within `tol` of
     /// its boundary (grazing an edge counts as blocked: the conservative choice for occlusion).
+    #[inline(always)]
     pub fn blocks_segment(&self, a: Vec3, b: Vec3, t_min: Real, tol: Real) -> bool {
         let da = self.plane.signed_distance(a);
         let db = self.plane.signed_distance(b);
         if (da > tol && db > tol) || (da < -tol && db < -tol) {
             return false;
         }
-        match self.plane.line_parameter(a, b) {
+        match Plane::crossing_parameter(da, db, a, b) {
             Some(t) if t >= t_min && t <= 1.0 - t_min => self.contains(a + t * (b - a), tol),
             _ => false,
         }

@@ -33,17 +33,35 @@ pub struct TreeOptions {
     pub max_order: usize,
     /// Budget on materialised nodes: the build stops with [`TreeError::Budget`] beyond it.
     pub max_nodes: u64,
-    /// Remove or shrink windows covered by convex occluders (exact; on by default).
-    pub occlusion: bool,
+    /// When to remove or shrink windows covered by convex occluders (exact either way).
+    pub culling: Culling,
+}
+
+/// When the tree tests its nodes for occlusion ([`occlude`]). Culling never changes the paths
+/// found, only how much the tree and the solver do: in a room most windows are visible and the
+/// test costs more than the children it could save; in a city it removes most nodes.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Culling {
+    /// Never.
+    Off,
+    /// Every node as it is built.
+    Always,
+    /// Every node as it is built in scenes of more than 64 reflectors; in smaller ones a node
+    /// only when it is about to get children and their count times the levels still to build
+    /// reaches `min_work` (then leaves are never tested: validation rejects their blocked paths).
+    Auto {
+        /// Children × levels below which a small scene's node is not tested.
+        min_work: usize,
+    },
 }
 
 impl TreeOptions {
-    /// Order `max_order`, 2 million nodes (about 1 GB), occlusion culling on.
+    /// Order `max_order`, 2 million nodes (about 1 GB), [`Culling::Auto`] (64).
     pub fn new(max_order: usize) -> Self {
         TreeOptions {
             max_order,
             max_nodes: 2_000_000,
-            occlusion: true,
+            culling: Culling::Auto { min_work: 64 },
         }
     }
 }
@@ -91,6 +109,28 @@ struct Node {
     image: Vec3,
     window: (u32, u32),
     planes: (u32, u32),
+    /// False once occlusion culling has removed the node (its beam is hidden).
+    live: bool,
+}
+
+/// What occlusion culling did to a node.
+enum Cull {
+    Removed,
+    Clipped,
+    Kept,
+}
+
+/// Whether to test a parent of a small scene for occlusion before building its children
+/// ([`Culling::Auto`]): `children` (by the bounding test) times the levels still to build
+/// (`depth` is the children's) reach `min_work`.
+fn worth_culling(prep: &Prepared<'_>, children: usize, depth: usize) -> bool {
+    match prep.options.culling {
+        Culling::Auto { min_work } if !prep.cull_at_build => {
+            let levels = prep.options.max_order + 1 - depth;
+            children.saturating_mul(levels) >= min_work
+        }
+        _ => false,
+    }
 }
 
 const ROOT: u32 = u32::MAX;
@@ -116,38 +156,64 @@ const GROW: Real = 4.0;
 const EPS: Real = 1.0;
 const COVER: Real = 4.0;
 
+/// Up to this many reflectors, a parent's children are found by testing every reflector's box
+/// against its beam (already in index order) rather than by walking the BVH: in a room every
+/// beam meets most boxes, so the walk only adds its inner nodes and a sort.
+const LINEAR_SCAN: usize = 64;
+
 /// Per-surface data of one build.
 struct Prepared<'a> {
     scene: &'a Scene,
     tol: Real,
     /// Grown convex hull of each reflector (empty for blockers).
     hulls: Vec<Vec<Vec3>>,
+    /// Inward side planes of each grown hull's edges (perpendicular to the surface), in
+    /// `edges[edge_ranges[s]]`: a point of the surface's plane lies in the hull when it is on
+    /// the inner side of all of them.
+    edges: Vec<Plane>,
+    edge_ranges: Vec<(u32, u32)>,
     /// Whether each surface is convex (only convex surfaces cull).
     convex: Vec<bool>,
     reflectors: Vec<u32>,
     options: TreeOptions,
+    /// Test every node for occlusion as it is built (see [`Culling`]).
+    cull_at_build: bool,
 }
 
 impl<'a> Prepared<'a> {
     fn new(scene: &'a Scene, options: TreeOptions) -> Self {
         let tol = scene.length_tolerance();
         let surfaces = scene.surfaces();
-        let hulls = surfaces
+        let hulls: Vec<Vec<Vec3>> = surfaces
             .iter()
             .map(|s| match s.kind {
                 SurfaceKind::Reflector => convex::grown_hull(&s.polygon, GROW * tol),
                 SurfaceKind::Blocker => Vec::new(),
             })
             .collect();
+        let mut edges = Vec::new();
+        let edge_ranges = surfaces
+            .iter()
+            .zip(&hulls)
+            .map(|(s, hull)| push_range(&mut edges, &hull_edge_planes(s.polygon.plane(), hull)))
+            .collect();
         let convex = surfaces
             .iter()
             .map(|s| convex::is_convex(&s.polygon))
             .collect();
-        let reflectors = scene.reflectors().map(|id| id.0).collect();
+        let reflectors: Vec<u32> = scene.reflectors().map(|id| id.0).collect();
+        let cull_at_build = match options.culling {
+            Culling::Off => false,
+            Culling::Always => true,
+            Culling::Auto { .. } => reflectors.len() > LINEAR_SCAN,
+        };
         Prepared {
+            cull_at_build,
             scene,
             tol,
             hulls,
+            edges,
+            edge_ranges,
             convex,
             reflectors,
             options,
@@ -157,6 +223,43 @@ impl<'a> Prepared<'a> {
     fn plane(&self, s: u32) -> &Plane {
         self.scene.surface(SurfaceId(s)).polygon.plane()
     }
+
+    /// Whether `x`, a point of surface `s`'s plane, lies in its grown hull (margin `eps`).
+    fn in_hull(&self, s: u32, x: Vec3, eps: Real) -> bool {
+        let (lo, hi) = self.edge_ranges[s as usize];
+        self.edges[lo as usize..hi as usize]
+            .iter()
+            .all(|pl| pl.signed_distance_unfused(x) >= -eps)
+    }
+}
+
+/// The inward side planes of the convex `hull`'s edges, perpendicular to `plane`.
+fn hull_edge_planes(plane: &Plane, hull: &[Vec3]) -> Vec<Plane> {
+    let n = hull.len();
+    let inner = convex::vertex_mean(hull);
+    (0..n)
+        .filter_map(|i| {
+            let (a, b) = (hull[i], hull[(i + 1) % n]);
+            let normal = plane.normal.cross(b - a).normalize_or_zero();
+            (normal != Vec3::ZERO).then(|| orient_towards(Plane::from_point_normal(a, normal), inner))
+        })
+        .collect()
+}
+
+/// `plane`, flipped if needed so that `inner` is on its non-negative side.
+fn orient_towards(plane: Plane, inner: Vec3) -> Plane {
+    if plane.signed_distance_unfused(inner) < 0.0 {
+        flip(plane)
+    } else {
+        plane
+    }
+}
+
+fn flip(plane: Plane) -> Plane {
+    Plane {
+        normal: -plane.normal,
+        offset: -plane.offset,
+    }
 }
 
 /// Scratch buffers reused across children.
@@ -165,6 +268,11 @@ struct Scratch {
     a: Vec<Vec3>,
     b: Vec<Vec3>,
     items: Vec<u32>,
+    /// Occlusion: ray starts and ends (the window on entry) per window vertex, and the
+    /// surfaces one ray crosses.
+    starts: Vec<Vec3>,
+    rays: Vec<Vec3>,
+    hits: Vec<(Real, u32)>,
 }
 
 /// A parent's view for generating children: apex, near plane and beam planes.
@@ -231,7 +339,7 @@ impl BeamTree {
         let mut starts = Vec::with_capacity(self.max_order);
         for &(lo, hi) in &self.levels {
             for i in lo..hi {
-                if self.holds(i, rx) {
+                if self.nodes[i].live && self.holds(i, rx) {
                     self.prefix(i as u32, &mut seq, &mut starts);
                     set.push_with_starts(&seq, &starts);
                 }
@@ -258,7 +366,7 @@ impl BeamTree {
         let eps = EPS * self.tol;
         self.planes[lo as usize..hi as usize]
             .iter()
-            .all(|pl| pl.signed_distance(p) >= -eps)
+            .all(|pl| pl.signed_distance_unfused(p) >= -eps)
     }
 
     /// The surface sequence and window centres of node `i`, TX side first.
@@ -297,21 +405,21 @@ impl BeamTree {
             (parents.0 as u32..parents.1 as u32).collect()
         };
         let mut children = Vec::new();
+        let mut plane_copy: Vec<Plane> = Vec::new();
         for p in parent_ids {
-            let (apex, surface, planes) = if p == ROOT {
-                (prep.scene.tx(), None, (0u32, 0u32))
-            } else {
-                let n = self.nodes[p as usize];
-                (n.image, Some(n.surface), n.planes)
-            };
-            let plane_copy: Vec<Plane> = self.planes[planes.0 as usize..planes.1 as usize].to_vec();
-            let parent = Parent {
-                index: p,
-                surface,
-                apex,
-                planes: &plane_copy,
-            };
-            self.child_candidates(prep, &parent, &mut children);
+            let mut parent = self.parent_view(prep, p, &mut plane_copy);
+            let leaf_level = leaf.is_some();
+            self.child_candidates(prep, &parent, leaf_level, &mut children);
+            if p != ROOT && worth_culling(prep, children.len(), depth) {
+                match self.cull(prep, p, scratch) {
+                    Cull::Removed => continue,
+                    Cull::Kept => {}
+                    Cull::Clipped => {
+                        parent = self.parent_view(prep, p, &mut plane_copy);
+                        self.child_candidates(prep, &parent, leaf_level, &mut children);
+                    }
+                }
+            }
             for &s in &children {
                 self.stats.tested += 1;
                 match leaf.as_mut() {
@@ -337,14 +445,82 @@ impl BeamTree {
         Ok(())
     }
 
-    /// Reflectors that may meet the parent's beam, in increasing index order.
-    fn child_candidates(&self, prep: &Prepared, parent: &Parent, out: &mut Vec<u32>) {
+    /// Node `p` (or the root) as a parent, its beam planes copied into `planes`.
+    fn parent_view<'b>(&self, prep: &Prepared<'_>, p: u32, planes: &'b mut Vec<Plane>) -> Parent<'b> {
+        let (apex, surface, range) = if p == ROOT {
+            (prep.scene.tx(), None, (0u32, 0u32))
+        } else {
+            let n = &self.nodes[p as usize];
+            (n.image, Some(n.surface), n.planes)
+        };
+        planes.clear();
+        planes.extend_from_slice(&self.planes[range.0 as usize..range.1 as usize]);
+        Parent {
+            index: p,
+            surface,
+            apex,
+            planes,
+        }
+    }
+
+    /// Occlusion culling of node `i` (see [`occlude`]): removes it, or shrinks its window and
+    /// beam, or leaves it as it is.
+    fn cull(&mut self, prep: &Prepared<'_>, i: u32, scratch: &mut Scratch) -> Cull {
+        let node = self.nodes[i as usize];
+        let mut no_planes = Vec::new();
+        let parent = self.parent_view(prep, node.parent, &mut no_planes);
+        scratch.a.clear();
+        scratch
+            .a
+            .extend_from_slice(&self.verts[node.window.0 as usize..node.window.1 as usize]);
+        let clips = self.stats.occluder_clips;
+        if occlude(prep, &parent, node.surface, scratch, &mut self.stats) {
+            self.stats.occluded += 1;
+            self.nodes[i as usize].live = false;
+            return Cull::Removed;
+        }
+        if self.stats.occluder_clips == clips {
+            return Cull::Kept;
+        }
+        let planes = beam_planes(prep.plane(node.surface), node.image, &scratch.a);
+        let n = &mut self.nodes[i as usize];
+        n.window = push_range(&mut self.verts, &scratch.a);
+        n.planes = push_range(&mut self.planes, &planes);
+        Cull::Clipped
+    }
+
+    /// Reflectors that may meet the parent's beam, in increasing index order. On the last level
+    /// of a single-receiver trace (`leaf_level`) of a small scene, every reflector: the leaf
+    /// test costs about as much as the box test it would save.
+    fn child_candidates(
+        &self,
+        prep: &Prepared<'_>,
+        parent: &Parent<'_>,
+        leaf_level: bool,
+        out: &mut Vec<u32>,
+    ) {
         out.clear();
         if parent.index == ROOT {
             out.extend_from_slice(&prep.reflectors);
             return;
         }
         let eps = EPS * prep.tol;
+        if prep.reflectors.len() <= LINEAR_SCAN && leaf_level {
+            out.extend(
+                prep.reflectors
+                    .iter()
+                    .copied()
+                    .filter(|&s| Some(s) != parent.surface),
+            );
+            return;
+        }
+        if prep.reflectors.len() <= LINEAR_SCAN {
+            out.extend(prep.reflectors.iter().copied().filter(|&s| {
+                let (lo, hi) = prep.scene.surface(SurfaceId(s)).polygon.bounds();
+                Some(s) != parent.surface && box_meets_halfspaces(lo, hi, parent.planes, eps)
+            }));
+            return;
+        }
         let scene = prep.scene;
         scene.bvh().visit(
             |lo, hi| box_meets_halfspaces(lo, hi, parent.planes, eps),
@@ -362,7 +538,7 @@ impl BeamTree {
     /// Try child `s` of `parent`; push it when its window is not empty and not occluded.
     fn child(&mut self, prep: &Prepared, parent: &Parent, s: u32, scratch: &mut Scratch) {
         let plane = *prep.plane(s);
-        if plane.signed_distance(parent.apex).abs() <= prep.tol {
+        if plane.signed_distance_unfused(parent.apex).abs() <= prep.tol {
             // Every ray from the apex to this plane runs in it: all such paths graze.
             self.stats.empty += 1;
             return;
@@ -381,7 +557,7 @@ impl BeamTree {
             self.stats.empty += 1;
             return;
         }
-        if prep.options.occlusion && occlude(prep, parent, s, scratch, &mut self.stats) {
+        if prep.cull_at_build && occlude(prep, parent, s, scratch, &mut self.stats) {
             self.stats.occluded += 1;
             return;
         }
@@ -395,6 +571,7 @@ impl BeamTree {
             image,
             window,
             planes,
+            live: true,
         });
     }
 
@@ -411,22 +588,29 @@ impl BeamTree {
         let plane = *prep.plane(s);
         let tol = prep.tol;
         let eps = EPS * tol;
-        let d_apex = plane.signed_distance(parent.apex);
+        let d_apex = plane.signed_distance_unfused(parent.apex);
+        let d_rx = plane.signed_distance_unfused(rx);
         // RX must be on the apex's side of the plane (the reflected side) and off it.
-        if d_apex.abs() <= tol || plane.signed_distance(rx) * d_apex.signum() < -eps {
+        if d_apex.abs() <= tol || d_rx * d_apex.signum() < -eps {
             return;
         }
-        let image = plane.mirror(parent.apex);
-        let Some(t) = plane.line_parameter(image, rx) else {
+        // The image-method point: where the ray from the apex to RX's mirror image crosses
+        // the plane (the same point as on the ray from the apex's image to RX).
+        let rx_image = rx - (2.0 * d_rx) * plane.normal;
+        let t = d_apex / (d_apex + d_rx);
+        if !t.is_finite() {
             return;
-        };
-        let x = image + t * (rx - image);
-        let polygon = &prep.scene.surface(SurfaceId(s)).polygon;
-        if !polygon.contains(x, GROW * tol)
-            || !parent.planes.iter().all(|p| p.signed_distance(x) >= -eps)
+        }
+        let x = parent.apex + t * (rx_image - parent.apex);
+        if !parent
+            .planes
+            .iter()
+            .all(|p| p.signed_distance_unfused(x) >= -eps)
+            || !prep.in_hull(s, x, eps)
         {
             return;
         }
+        let polygon = &prep.scene.surface(SurfaceId(s)).polygon;
         let mut seq = Vec::with_capacity(self.max_order);
         let mut starts = Vec::with_capacity(self.max_order);
         self.prefix(parent.index, &mut seq, &mut starts);
@@ -457,11 +641,8 @@ fn push_range<T: Copy>(arena: &mut Vec<T>, items: &[T]) -> (u32, u32) {
 /// degenerate (apex on the edge's line) are left out, which only widens the beam.
 fn beam_planes(plane: &Plane, apex: Vec3, window: &[Vec3]) -> Vec<Plane> {
     let mut out = Vec::with_capacity(window.len() + 1);
-    let near = if plane.signed_distance(apex) > 0.0 {
-        Plane {
-            normal: -plane.normal,
-            offset: -plane.offset,
-        }
+    let near = if plane.signed_distance_unfused(apex) > 0.0 {
+        flip(*plane)
     } else {
         *plane
     };
@@ -475,14 +656,10 @@ fn beam_planes(plane: &Plane, apex: Vec3, window: &[Vec3]) -> Vec<Plane> {
         if !(len > 1e-12 * (a - apex).length() * (b - apex).length()) {
             continue;
         }
-        let mut side = Plane::from_point_normal(apex, normal / len);
-        if side.signed_distance(inner) < 0.0 {
-            side = Plane {
-                normal: -side.normal,
-                offset: -side.offset,
-            };
-        }
-        out.push(side);
+        out.push(orient_towards(
+            Plane::from_point_normal(apex, normal / len),
+            inner,
+        ));
     }
     out
 }
@@ -500,31 +677,30 @@ fn occlude(
     let scene = prep.scene;
     let start_plane = parent.surface.map(|p| *prep.plane(p));
     // Start points of the rays through the window's vertices, on the parent's plane (or TX).
-    let starts: Vec<Vec3> = scratch
-        .a
-        .iter()
-        .map(|&q| match &start_plane {
-            None => parent.apex,
-            Some(pl) => match pl.line_parameter(parent.apex, q) {
-                Some(t) => parent.apex + t * (q - parent.apex),
-                None => q,
-            },
-        })
-        .collect();
+    let mut starts = std::mem::take(&mut scratch.starts);
+    starts.clear();
+    starts.extend(scratch.a.iter().map(|&q| match &start_plane {
+        None => parent.apex,
+        Some(pl) => match pl.line_parameter(parent.apex, q) {
+            Some(t) => parent.apex + t * (q - parent.apex),
+            None => q,
+        },
+    }));
     // Only a surface that the ray to some window vertex crosses can cover or clip the window
     // (the covered part of a convex window contains a vertex). Ray by ray, nearest first, so a
     // window hidden by the first wall in front costs one BVH walk.
     let margin = COVER * prep.tol;
-    let rays: Vec<(Vec3, Vec3)> = starts
-        .iter()
-        .copied()
-        .zip(scratch.a.iter().copied())
-        .collect();
     let mut tested = std::mem::take(&mut scratch.items);
     tested.clear();
-    let mut hits: Vec<(Real, u32)> = Vec::new();
+    let mut hits = std::mem::take(&mut scratch.hits);
     let mut covered = false;
-    'rays: for (a, q) in rays {
+    // The rays are those of the window as it was on entry (a clip below only shrinks it).
+    let rays = scratch.a.len();
+    let mut window_rays = std::mem::take(&mut scratch.rays);
+    window_rays.clear();
+    window_rays.extend_from_slice(&scratch.a);
+    'rays: for k in 0..rays {
+        let (a, q) = (starts[k], window_rays[k]);
         hits.clear();
         scene.bvh().visit_segment(a, q, |item| {
             if Some(item) == parent.surface
@@ -565,13 +741,16 @@ fn occlude(
         }
     }
     scratch.items = tested;
+    scratch.hits = hits;
+    scratch.starts = starts;
+    scratch.rays = window_rays;
     covered
 }
 
 /// Whether every segment start lies strictly on one side of `plane` and every window vertex
 /// strictly on the other, by `margin`: then each ray crosses the plane strictly between them.
 fn between(plane: &Plane, starts: &[Vec3], window: &[Vec3], margin: Real) -> bool {
-    let side = |p: &Vec3| plane.signed_distance(*p);
+    let side = |p: &Vec3| plane.signed_distance_unfused(*p);
     let front = starts.iter().all(|p| side(p) > margin) && window.iter().all(|q| side(q) < -margin);
     let back = starts.iter().all(|p| side(p) < -margin) && window.iter().all(|q| side(q) > margin);
     front || back
@@ -606,23 +785,18 @@ fn shadow(occluder: &bt_geom::Polygon, apex: Vec3, window: &[Vec3], margin: Real
         if !(len > 1e-12 * (moved - apex).length() * dir.length()) {
             return Shadow::None;
         }
-        let mut plane = Plane::from_point_normal(apex, pn / len);
-        if plane.signed_distance(moved + inward) < 0.0 {
-            plane = Plane {
-                normal: -plane.normal,
-                offset: -plane.offset,
-            };
-        }
-        if window.iter().all(|q| plane.signed_distance(*q) > 0.0) {
+        let plane = orient_towards(Plane::from_point_normal(apex, pn / len), moved + inward);
+        if window.iter().all(|q| plane.signed_distance_unfused(*q) > 0.0) {
             continue;
         }
-        if open.is_some() || window.iter().all(|q| plane.signed_distance(*q) <= 0.0) {
+        if open.is_some()
+            || window
+                .iter()
+                .all(|q| plane.signed_distance_unfused(*q) <= 0.0)
+        {
             return Shadow::None;
         }
-        open = Some(Plane {
-            normal: -plane.normal,
-            offset: -plane.offset,
-        });
+        open = Some(flip(plane));
     }
     match open {
         None => Shadow::Covers,

@@ -119,9 +119,8 @@ pub fn candidates(scene: &Scene, options: &TraceOptions) -> Result<CandidateSet,
 
 fn tree_options(options: &TraceOptions) -> TreeOptions {
     TreeOptions {
-        max_order: options.max_order,
         max_nodes: options.max_candidates,
-        occlusion: true,
+        ..TreeOptions::new(options.max_order)
     }
 }
 

@@ -6,7 +6,7 @@
 
 use crate::common::*;
 use bt_geom::{Real, Vec3};
-use bt_paths::beamtree::{BeamTree, TreeOptions};
+use bt_paths::beamtree::{BeamTree, Culling, TreeOptions};
 use bt_scene::{Scene, Terminals};
 use bt_solve::pipeline::{CandidateMode, TraceOptions, trace_receivers, trace_scene};
 use bt_solve::{FoundPath, Solver, UpdateOrder};
@@ -56,6 +56,27 @@ proptest! {
         let reference = paths(&scene, order, CandidateMode::Exhaustive);
         let tree = paths(&scene, order, CandidateMode::BeamTree);
         assert_same(&tree, &reference)?;
+    }
+
+    /// Every culling policy, on scenes small enough that the default policy rarely culls: at
+    /// build time (`Always`), before each parent's children (`Auto` with no threshold, which
+    /// also re-queries the children of clipped parents), never (`Off`).
+    #[test]
+    fn every_culling_policy_equals_exhaustive_enumeration(
+        seed in 0u64..1_000_000, n in 1usize..9, terminals in 0u8..3, order in 1usize..4,
+        policy in 0usize..3,
+    ) {
+        let Some(scene) = nasty_scene(seed, n, terminals) else { return Ok(()) };
+        let culling = [Culling::Always, Culling::Auto { min_work: 0 }, Culling::Off][policy];
+        let reference = paths(&scene, order, CandidateMode::Exhaustive);
+        let set = bt_paths::beamtree::candidates(&scene, TreeOptions { culling, ..TreeOptions::new(order) })
+            .expect("tree builds");
+        let tree = bt_solve::trace(&scene, &set, &Solver::Image, false).paths;
+        assert_same(&tree, &reference)?;
+        let kept = BeamTree::build(&scene, TreeOptions { culling, ..TreeOptions::new(order) })
+            .expect("tree builds");
+        let walked = bt_solve::trace(&scene, &kept.candidates(scene.rx()), &Solver::Image, false).paths;
+        assert_same(&walked, &reference)?;
     }
 
     #[test]
