@@ -266,6 +266,9 @@ fn mean_displacement(sum: Real, n: usize) -> Real {
     if n == 0 { 0.0 } else { sum / n as Real }
 }
 
+// Inlined so that the FMA-compiled candidate loop (`run_range_fma`) compiles it with FMA:
+// a call would run every `mul_add` of the rounds through the software fallback.
+#[inline(always)]
 fn run(
     scene: &Scene,
     seq: &[SurfaceId],
