@@ -29,8 +29,10 @@ use bt_paths::{CandidateSet, CandidateStats};
 use bt_scene::dynamic::{DynamicScene, moved_surfaces};
 use bt_scene::{Scene, SurfaceId};
 use bt_solve::pipeline::{CandidateMode, TraceError, TraceOptions};
-use bt_solve::{CandidateOutcome, FoundPath, IpcOutcome, Solver, TraceResult, Validity};
-use rayon::prelude::*;
+use bt_solve::{
+    Batch, CandidateOutcome, FoundPath, IpcOutcome, Solver, Todo, TraceResult, Validity, found_path,
+    solve_batch,
+};
 use serde::Serialize;
 use std::cmp::Ordering;
 
@@ -334,46 +336,17 @@ impl IncrementalTracer {
         let options = self.options;
         let wvrn = options.wvrn(scene);
         let candidates = options.candidates(scene, wvrn.as_ref())?;
-        let idx: Vec<usize> = (0..candidates.len()).collect();
-        let solve = |range: &[usize]| -> Vec<(CandidateOutcome, Vec<Vec3>)> {
-            let mut scratch = Vec::new();
-            range
-                .iter()
-                .map(|&i| {
-                    let seq = candidates.get(i);
-                    let mut points = vec![Vec3::ZERO; seq.len()];
-                    scratch.resize(seq.len(), Vec3::ZERO);
-                    let o = bt_solve::solve_candidate_from(
-                        scene,
-                        seq,
-                        &options.solver,
-                        candidates.start(i),
-                        &mut points,
-                        &mut scratch,
-                    );
-                    (o, points)
-                })
-                .collect()
+        let batch = Batch {
+            scene,
+            candidates: &candidates,
+            solver: &options.solver,
+            parallel: options.parallel,
         };
-        let solved: Vec<(CandidateOutcome, Vec<Vec3>)> = if options.parallel && idx.len() >= 256 {
-            idx.par_chunks(64)
-                .map(solve)
-                .collect::<Vec<_>>()
-                .into_iter()
-                .flatten()
-                .collect()
-        } else {
-            solve(&idx)
-        };
-        let mut records = Vec::with_capacity(solved.len());
-        let mut points = Vec::new();
-        for (outcome, pts) in solved {
-            records.push(Record {
-                outcome,
-                start: points.len() as u32,
-            });
-            points.extend(pts);
-        }
+        let (records, points) = concat(solve_batch(&batch, Todo::All, |_| None, keep_all));
+        let records: Vec<Record> = records
+            .into_iter()
+            .map(|(outcome, start, _)| Record { outcome, start })
+            .collect();
         let update = UpdateStats {
             full: true,
             solved: records.len(),
@@ -400,25 +373,8 @@ impl State {
         for (i, r) in self.records.iter().enumerate() {
             let seq = self.candidates.get(i);
             trace.counts.add(&r.outcome);
-            if let CandidateOutcome::Solved {
-                validity: Validity::Valid,
-                ipc,
-            } = r.outcome
-            {
-                let (iterations, residual) = match ipc {
-                    Some(IpcOutcome::Converged {
-                        iterations,
-                        residual,
-                    }) => (Some(iterations), Some(residual)),
-                    _ => (None, None),
-                };
-                trace.paths.push(FoundPath {
-                    surfaces: seq.to_vec(),
-                    points: self.points[r.start as usize..r.start as usize + seq.len()].to_vec(),
-                    iterations,
-                    residual,
-                });
-            }
+            let points = &self.points[r.start as usize..r.start as usize + seq.len()];
+            trace.paths.extend(found_path(seq, &r.outcome, points));
         }
         StepTrace {
             step: self.step,
@@ -452,56 +408,50 @@ fn solve_planned(
         .enumerate()
         .filter_map(|(i, p)| matches!(p, Plan::Solve(_)).then_some(i))
         .collect();
-    // Each chunk returns its outcomes and the points of its candidates, concatenated.
-    let solve_range = |range: &[usize]| -> (Vec<(CandidateOutcome, bool)>, Vec<Vec3>) {
-        let mut scratch = Vec::new();
-        let mut all_points = Vec::new();
-        let outcomes = range
-            .iter()
-            .map(|&i| {
-                let seq = candidates.get(i);
-                let start = all_points.len();
-                all_points.resize(start + seq.len(), Vec3::ZERO);
-                scratch.resize(seq.len(), Vec3::ZERO);
-                let Plan::Solve(old) = plans[i] else {
-                    unreachable!()
-                };
-                let warm = old.and_then(|o| {
-                    let r = &prev_records[o];
-                    let pts = &prev_points[r.start as usize..r.start as usize + seq.len()];
-                    warm_start(&r.outcome, pts)
-                });
-                let from_previous = warm.is_some();
-                let warm = warm.or(candidates.start(i));
-                let points = &mut all_points[start..];
-                let outcome = bt_solve::solve_candidate_from(
-                    scene,
-                    seq,
-                    &options.solver,
-                    warm,
-                    points,
-                    &mut scratch,
-                );
-                (
-                    outcome,
-                    from_previous && matches!(options.solver, Solver::Ipc(_)),
-                )
-            })
-            .collect();
-        (outcomes, all_points)
+    // The previous step's converged points of the candidate planned at `i`, if any.
+    let warm = |i: usize| {
+        let Plan::Solve(Some(o)) = plans[i] else {
+            return None;
+        };
+        let r = &prev_records[o];
+        let n = candidates.get(i).len();
+        warm_start(&r.outcome, &prev_points[r.start as usize..r.start as usize + n])
     };
-    const CHUNK: usize = 64;
-    if options.parallel && todo.len() >= 256 {
-        let parts: Vec<_> = todo.par_chunks(CHUNK).map(solve_range).collect();
-        let mut out = (Vec::with_capacity(todo.len()), Vec::new());
-        for (o, p) in parts {
-            out.0.extend(o);
-            out.1.extend(p);
-        }
-        out
-    } else {
-        solve_range(&todo)
+    let is_ipc = matches!(options.solver, Solver::Ipc(_));
+    let batch = Batch {
+        scene,
+        candidates,
+        solver: &options.solver,
+        parallel: options.parallel,
+    };
+    let (records, points) = concat(solve_batch(&batch, Todo::Only(&todo), warm, keep_all));
+    let outcomes = records
+        .into_iter()
+        .map(|(outcome, _, i)| (outcome, is_ipc && warm(i).is_some()))
+        .collect();
+    (outcomes, points)
+}
+
+/// Per chunk: each solved candidate's outcome, the offset of its points in the chunk's points,
+/// and its index; the points concatenated.
+type Solved = (Vec<(CandidateOutcome, u32, usize)>, Vec<Vec3>);
+
+/// The [`solve_batch`] fold that keeps every outcome and every point.
+fn keep_all(acc: &mut Solved, i: usize, outcome: &CandidateOutcome, points: &[Vec3]) {
+    acc.0.push((*outcome, acc.1.len() as u32, i));
+    acc.1.extend_from_slice(points);
+}
+
+/// The chunks of [`keep_all`] joined in order, with point offsets into the joined points.
+fn concat(parts: Vec<Solved>) -> Solved {
+    let mut out: Solved = Default::default();
+    for (records, points) in parts {
+        let base = out.1.len() as u32;
+        out.0
+            .extend(records.into_iter().map(|(o, start, i)| (o, start + base, i)));
+        out.1.extend(points);
     }
+    out
 }
 
 /// The step's records and points in candidate order: reused ones copied from the previous

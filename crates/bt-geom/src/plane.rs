@@ -84,7 +84,6 @@ impl Plane {
     /// Parameter `t` where the line `a + t (b - a)` crosses the plane, or `None` when the line
     /// is parallel to it (|n · (b - a)| below `f64::EPSILON` times the segment length).
     #[inline]
-    #[inline]
     pub fn line_parameter(&self, a: Vec3, b: Vec3) -> Option<Real> {
         Self::crossing_parameter(self.signed_distance(a), self.signed_distance(b), a, b)
     }

@@ -286,7 +286,7 @@ struct Parent<'n> {
 
 impl BeamTree {
     /// A tree with no node yet, for the scene and options of `prep`.
-    fn empty(prep: &Prepared) -> Self {
+    fn empty(prep: &Prepared<'_>) -> Self {
         BeamTree {
             max_order: prep.options.max_order,
             tol: prep.tol,
@@ -388,7 +388,7 @@ impl BeamTree {
     /// `leaf_rx`, the level is not materialised: children holding RX are emitted into `out`.
     fn grow_level(
         &mut self,
-        prep: &Prepared,
+        prep: &Prepared<'_>,
         depth: usize,
         scratch: &mut Scratch,
         mut leaf: Option<(Vec3, &mut CandidateSet)>,
@@ -536,7 +536,7 @@ impl BeamTree {
     }
 
     /// Try child `s` of `parent`; push it when its window is not empty and not occluded.
-    fn child(&mut self, prep: &Prepared, parent: &Parent, s: u32, scratch: &mut Scratch) {
+    fn child(&mut self, prep: &Prepared<'_>, parent: &Parent<'_>, s: u32, scratch: &mut Scratch) {
         let plane = *prep.plane(s);
         if plane.signed_distance_unfused(parent.apex).abs() <= prep.tol {
             // Every ray from the apex to this plane runs in it: all such paths graze.
@@ -579,8 +579,8 @@ impl BeamTree {
     /// without building its window (the image method's crossing point is tested instead).
     fn leaf_child(
         &mut self,
-        prep: &Prepared,
-        parent: &Parent,
+        prep: &Prepared<'_>,
+        parent: &Parent<'_>,
         s: u32,
         rx: Vec3,
         out: &mut CandidateSet,
@@ -668,8 +668,8 @@ fn beam_planes(plane: &Plane, apex: Vec3, window: &[Vec3]) -> Vec<Plane> {
 /// convex surface between the parent's window (or TX) and the new window covers all of it;
 /// shrinks the window when one covers all of it but the part beyond one edge.
 fn occlude(
-    prep: &Prepared,
-    parent: &Parent,
+    prep: &Prepared<'_>,
+    parent: &Parent<'_>,
     s: u32,
     scratch: &mut Scratch,
     stats: &mut TreeStats,

@@ -10,6 +10,7 @@
 //! of every outcome; one bad candidate never aborts the batch.
 #![warn(missing_docs)]
 
+pub mod batch;
 pub mod image;
 pub mod ipc;
 mod newton;
@@ -20,9 +21,9 @@ pub mod validate;
 use bt_geom::{Real, Vec3};
 use bt_paths::CandidateSet;
 use bt_scene::{Scene, SurfaceId};
-use rayon::prelude::*;
 use serde::Serialize;
 
+pub use batch::{Batch, Todo, found_path, solve_batch};
 pub use ipc::{Acceleration, DegenerateKind, IpcOptions, IpcOutcome, UpdateOrder};
 pub use sbr::{SbrLaunch, SbrOptions};
 pub use validate::Validity;
@@ -203,9 +204,6 @@ pub fn solve_candidate_from(
     }
 }
 
-/// Maximum order handled with stack buffers; longer sequences use heap buffers.
-const STACK_ORDER: usize = 8;
-
 /// Run `solver` on every candidate. `parallel` spreads candidates over rayon's pool; the
 /// output is identical either way (order-preserving).
 pub fn trace(
@@ -218,101 +216,26 @@ pub fn trace(
         let max_order = candidates.iter().map(<[SurfaceId]>::len).max().unwrap_or(0);
         return sbr::to_trace_result(&sbr::trace_detailed(scene, options, max_order, parallel));
     }
-    let run = |range: std::ops::Range<usize>| run_range(scene, candidates, solver, range);
-    let total = candidates.len();
-    if !parallel || total < 256 {
-        return run(0..total);
-    }
-    const CHUNK: usize = 128;
-    let parts: Vec<TraceResult> = (0..total.div_ceil(CHUNK))
-        .into_par_iter()
-        .map(|c| run(c * CHUNK..((c + 1) * CHUNK).min(total)))
-        .collect();
+    let batch = Batch {
+        scene,
+        candidates,
+        solver,
+        parallel,
+    };
+    let parts = solve_batch(
+        &batch,
+        Todo::All,
+        |_| None,
+        |out: &mut TraceResult, i, outcome, points| {
+            out.counts.add(outcome);
+            out.paths
+                .extend(found_path(candidates.get(i), outcome, points));
+        },
+    );
     let mut out = TraceResult::default();
     for part in parts {
         out.paths.extend(part.paths);
         out.counts.merge(&part.counts);
-    }
-    out
-}
-
-/// The candidate loop of [`trace`] over `range`.
-///
-/// Compiled twice: with the `fma` target feature when the CPU has it (checked at run time),
-/// and without. The solvers use `mul_add` for robust side tests; without the feature every
-/// `mul_add` is a call into the software-dispatched `fma` of compiler-builtins, which also
-/// spills every live float register (a third of the instructions of an IPC round). FMA is
-/// correctly rounded either way, and Rust never contracts a separate multiply and add, so
-/// both versions give bit-identical results.
-fn run_range(
-    scene: &Scene,
-    candidates: &CandidateSet,
-    solver: &Solver,
-    range: std::ops::Range<usize>,
-) -> TraceResult {
-    #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("fma") {
-        // SAFETY: the CPU supports FMA (checked just above).
-        return unsafe { run_range_fma(scene, candidates, solver, range) };
-    }
-    run_range_impl(scene, candidates, solver, range)
-}
-
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "fma")]
-fn run_range_fma(
-    scene: &Scene,
-    candidates: &CandidateSet,
-    solver: &Solver,
-    range: std::ops::Range<usize>,
-) -> TraceResult {
-    run_range_impl(scene, candidates, solver, range)
-}
-
-#[inline(always)]
-fn run_range_impl(
-    scene: &Scene,
-    candidates: &CandidateSet,
-    solver: &Solver,
-    range: std::ops::Range<usize>,
-) -> TraceResult {
-    let mut out = TraceResult::default();
-    let mut stack_points = [Vec3::ZERO; STACK_ORDER];
-    let mut stack_scratch = [Vec3::ZERO; STACK_ORDER];
-    let mut heap_points = Vec::new();
-    let mut heap_scratch = Vec::new();
-    for i in range {
-        let seq = candidates.get(i);
-        let n = seq.len();
-        let (points, scratch) = if n <= STACK_ORDER {
-            (&mut stack_points[..n], &mut stack_scratch[..n])
-        } else {
-            heap_points.resize(n, Vec3::ZERO);
-            heap_scratch.resize(n, Vec3::ZERO);
-            (&mut heap_points[..], &mut heap_scratch[..])
-        };
-        let outcome =
-            solve_candidate_from(scene, seq, solver, candidates.start(i), points, scratch);
-        out.counts.add(&outcome);
-        if let CandidateOutcome::Solved {
-            validity: Validity::Valid,
-            ipc,
-        } = outcome
-        {
-            let (iterations, residual) = match ipc {
-                Some(IpcOutcome::Converged {
-                    iterations,
-                    residual,
-                }) => (Some(iterations), Some(residual)),
-                _ => (None, None),
-            };
-            out.paths.push(FoundPath {
-                surfaces: seq.to_vec(),
-                points: points.to_vec(),
-                iterations,
-                residual,
-            });
-        }
     }
     out
 }

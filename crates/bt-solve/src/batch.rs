@@ -1,0 +1,190 @@
+//! The one batch-solve loop: every consumer that solves many candidates (the static
+//! [`crate::trace`], the incremental tracer of `bt-dynamic`) goes through [`solve_batch`], which
+//! owns the chunking and parallelism, the FMA dispatch, the start points (a caller's warm start,
+//! else the candidate set's window start, else the centroids) and the per-candidate buffers.
+//! [`found_path`] turns a valid outcome into a [`FoundPath`].
+
+use crate::{CandidateOutcome, FoundPath, IpcOutcome, Solver, Validity, solve_candidate_from};
+use bt_geom::Vec3;
+use bt_paths::CandidateSet;
+use bt_scene::{Scene, SurfaceId};
+use rayon::prelude::*;
+
+/// Candidates per parallel chunk.
+const CHUNK: usize = 128;
+/// Below this many candidates a batch runs on the calling thread.
+const PARALLEL_FROM: usize = 256;
+/// Maximum order handled with stack buffers; longer sequences use heap buffers.
+const STACK_ORDER: usize = 8;
+
+/// Which candidates of a set a batch solves.
+#[derive(Debug, Clone, Copy)]
+pub enum Todo<'t> {
+    /// Every candidate, in set order.
+    All,
+    /// These indices into the set, in this order.
+    Only(&'t [usize]),
+}
+
+impl Todo<'_> {
+    fn len(&self, set: &CandidateSet) -> usize {
+        match self {
+            Todo::All => set.len(),
+            Todo::Only(v) => v.len(),
+        }
+    }
+
+    fn index(&self, k: usize) -> usize {
+        match self {
+            Todo::All => k,
+            Todo::Only(v) => v[k],
+        }
+    }
+}
+
+/// What a batch solves: the scene, its candidates and the solver; `parallel` spreads chunks
+/// over rayon's pool (the output is identical either way).
+#[derive(Clone, Copy)]
+pub struct Batch<'a> {
+    /// The scene (TX, RX, surfaces).
+    pub scene: &'a Scene,
+    /// The candidate sequences (and their window start points, if any).
+    pub candidates: &'a CandidateSet,
+    /// The solver.
+    pub solver: &'a Solver,
+    /// Whether to use rayon's pool for large batches.
+    pub parallel: bool,
+}
+
+/// Solve the candidates of `todo`. IPC starts from `warm(i)` when it gives points for candidate
+/// `i`, else from the set's start points, else from the centroids. `each(acc, i, outcome,
+/// points)` folds every candidate's result, in `todo` order within a chunk, into its chunk's
+/// accumulator (`R::default()` to begin); the accumulators come back in chunk order.
+pub fn solve_batch<'w, R, W, F>(batch: &Batch<'_>, todo: Todo<'_>, warm: W, each: F) -> Vec<R>
+where
+    R: Default + Send,
+    W: Fn(usize) -> Option<&'w [Vec3]> + Sync,
+    F: Fn(&mut R, usize, &CandidateOutcome, &[Vec3]) + Sync,
+{
+    let total = todo.len(batch.candidates);
+    let run = |range: std::ops::Range<usize>| run_chunk(batch, todo, range, &warm, &each);
+    if !batch.parallel || total < PARALLEL_FROM {
+        return vec![run(0..total)];
+    }
+    (0..total.div_ceil(CHUNK))
+        .into_par_iter()
+        .map(|c| run(c * CHUNK..((c + 1) * CHUNK).min(total)))
+        .collect()
+}
+
+/// One chunk: positions `range` of `todo`.
+///
+/// Compiled twice: with the `fma` target feature when the CPU has it (checked at run time),
+/// and without. The solvers use `mul_add` for robust side tests; without the feature every
+/// `mul_add` is a call into the software-dispatched `fma` of compiler-builtins, which also
+/// spills every live float register (a third of the instructions of an IPC round). FMA is
+/// correctly rounded either way, and Rust never contracts a separate multiply and add, so
+/// both versions give bit-identical results. The solvers and validation are `inline(always)`
+/// down to the BVH walk so that they are compiled into the FMA version.
+fn run_chunk<'w, R, W, F>(
+    batch: &Batch<'_>,
+    todo: Todo<'_>,
+    range: std::ops::Range<usize>,
+    warm: &W,
+    each: &F,
+) -> R
+where
+    R: Default,
+    W: Fn(usize) -> Option<&'w [Vec3]>,
+    F: Fn(&mut R, usize, &CandidateOutcome, &[Vec3]),
+{
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("fma") {
+        // SAFETY: the CPU supports FMA (checked just above).
+        return unsafe { run_chunk_fma(batch, todo, range, warm, each) };
+    }
+    run_chunk_impl(batch, todo, range, warm, each)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "fma")]
+fn run_chunk_fma<'w, R, W, F>(
+    batch: &Batch<'_>,
+    todo: Todo<'_>,
+    range: std::ops::Range<usize>,
+    warm: &W,
+    each: &F,
+) -> R
+where
+    R: Default,
+    W: Fn(usize) -> Option<&'w [Vec3]>,
+    F: Fn(&mut R, usize, &CandidateOutcome, &[Vec3]),
+{
+    run_chunk_impl(batch, todo, range, warm, each)
+}
+
+#[inline(always)]
+fn run_chunk_impl<'w, R, W, F>(
+    batch: &Batch<'_>,
+    todo: Todo<'_>,
+    range: std::ops::Range<usize>,
+    warm: &W,
+    each: &F,
+) -> R
+where
+    R: Default,
+    W: Fn(usize) -> Option<&'w [Vec3]>,
+    F: Fn(&mut R, usize, &CandidateOutcome, &[Vec3]),
+{
+    let mut acc = R::default();
+    let mut stack_points = [Vec3::ZERO; STACK_ORDER];
+    let mut stack_scratch = [Vec3::ZERO; STACK_ORDER];
+    let mut heap_points = Vec::new();
+    let mut heap_scratch = Vec::new();
+    for k in range {
+        let i = todo.index(k);
+        let seq = batch.candidates.get(i);
+        let n = seq.len();
+        let (points, scratch) = if n <= STACK_ORDER {
+            (&mut stack_points[..n], &mut stack_scratch[..n])
+        } else {
+            heap_points.resize(n, Vec3::ZERO);
+            heap_scratch.resize(n, Vec3::ZERO);
+            (&mut heap_points[..], &mut heap_scratch[..])
+        };
+        let start = warm(i).or_else(|| batch.candidates.start(i));
+        let outcome =
+            solve_candidate_from(batch.scene, seq, batch.solver, start, points, scratch);
+        each(&mut acc, i, &outcome, points);
+    }
+    acc
+}
+
+/// The path of a valid outcome (`None` for any other outcome): `seq` and its solved `points`,
+/// with IPC's rounds and residual when IPC converged.
+pub fn found_path(
+    seq: &[SurfaceId],
+    outcome: &CandidateOutcome,
+    points: &[Vec3],
+) -> Option<FoundPath> {
+    let CandidateOutcome::Solved {
+        validity: Validity::Valid,
+        ipc,
+    } = outcome
+    else {
+        return None;
+    };
+    let (iterations, residual) = match ipc {
+        Some(IpcOutcome::Converged {
+            iterations,
+            residual,
+        }) => (Some(*iterations), Some(*residual)),
+        _ => (None, None),
+    };
+    Some(FoundPath {
+        surfaces: seq.to_vec(),
+        points: points.to_vec(),
+        iterations,
+        residual,
+    })
+}
