@@ -241,9 +241,12 @@ impl IncrementalTracer {
         let reflector_moved = moved
             .iter()
             .any(|id| scene.surface(*id).kind == bt_scene::SurfaceKind::Reflector);
-        // The beam tree's occlusion culling uses blockers too: any motion rederives it.
+        // The beam tree depends on the reflectors and on the occluders that culled a node;
+        // any other motion (a person walking) only changes validation.
         let generator_stale = match options.candidates {
-            CandidateMode::BeamTree => !moved.is_empty(),
+            CandidateMode::BeamTree => {
+                reflector_moved || moved.iter().any(|id| culled_by(&prev.candidates, *id))
+            }
             _ => reflector_moved || links_changed,
         };
         let candidates = if everything || generator_stale {
@@ -529,6 +532,14 @@ fn touches(
         let (lo, hi) = (a.min(b), a.max(b));
         meets(union, lo, hi) && boxes.iter().any(|bx| meets(*bx, lo, hi))
     })
+}
+
+/// Whether surface `id` removed or shrank a node of the beam tree behind `set` (true when the
+/// set carries no tree statistics: then nothing is known).
+fn culled_by(set: &CandidateSet, id: SurfaceId) -> bool {
+    set.tree
+        .as_ref()
+        .is_none_or(|t| t.occluders.binary_search(&id.0).is_ok())
 }
 
 /// Previous points usable as an IPC warm start: those of a converged run.

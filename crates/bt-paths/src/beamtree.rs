@@ -99,6 +99,11 @@ pub struct TreeStats {
     pub occluded: u64,
     /// Windows shrunk by an occluder.
     pub occluder_clips: u64,
+    /// The surfaces that removed or shrank a node, ascending: the only non-reflectors the tree
+    /// depends on. While none of them and no reflector moves (and TX, RX stay), the tree's
+    /// candidates stay a superset of what a new tree would give, with the same valid paths.
+    #[serde(skip)]
+    pub occluders: Vec<u32>,
 }
 
 /// One node: a prefix ending on `surface`.
@@ -436,6 +441,8 @@ impl BeamTree {
                 });
             }
         }
+        self.stats.occluders.sort_unstable();
+        self.stats.occluders.dedup();
         if leaf.is_none() {
             self.levels.push((start, self.nodes.len()));
             self.stats
@@ -724,10 +731,12 @@ fn occlude(
             }
             match shadow(polygon, parent.apex, &scratch.a, margin) {
                 Shadow::Covers => {
+                    stats.occluders.push(o);
                     covered = true;
                     break 'rays;
                 }
                 Shadow::AllBut(plane) => {
+                    stats.occluders.push(o);
                     convex::clip(&scratch.a, &plane, EPS * prep.tol, &mut scratch.b);
                     std::mem::swap(&mut scratch.a, &mut scratch.b);
                     stats.occluder_clips += 1;
