@@ -112,7 +112,10 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
     let solver = solver_for(&args.solve, &scene)?;
     let t1 = Instant::now();
     let options = trace_options(&args.solve, solver);
-    let traced = bt_solve::pipeline::trace_scene(&scene, &options)?;
+    let (bar, mut progress) = crate::progress::tree_progress();
+    let traced = bt_solve::pipeline::trace_scene_with_progress(&scene, &options, &mut progress);
+    bar.finish_and_clear();
+    let traced = traced?;
     let t3 = Instant::now();
     let radio = args.radio.options()?;
     let paths = bt_beams::report(&scene, &traced.result.paths, &radio)?;

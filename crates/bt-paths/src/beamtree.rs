@@ -86,6 +86,28 @@ pub enum TreeError {
     },
 }
 
+/// Where a build stands, reported to a progress callback at each level's start and every
+/// [`PROGRESS_EVERY`] parents: large trees (cities, high orders) take seconds.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct BuildProgress {
+    /// Depth being built (1 = first reflection).
+    pub depth: usize,
+    /// The order asked for.
+    pub max_order: usize,
+    /// Parents of this level whose children are done.
+    pub parents_done: usize,
+    /// Parents of this level.
+    pub parents: usize,
+    /// Nodes materialised so far (all levels).
+    pub nodes: u64,
+}
+
+/// Parents between two progress reports.
+pub const PROGRESS_EVERY: usize = 256;
+
+/// A progress callback ([`BuildProgress`]).
+pub type Progress<'p> = &'p mut dyn FnMut(BuildProgress);
+
 /// What the tree did, for `stats.tree` in the JSON output.
 #[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
 pub struct TreeStats {
@@ -305,11 +327,20 @@ impl BeamTree {
 
     /// Build the tree of `scene`'s TX to `options.max_order`.
     pub fn build(scene: &Scene, options: TreeOptions) -> Result<Self, TreeError> {
+        Self::build_with_progress(scene, options, &mut |_| {})
+    }
+
+    /// [`BeamTree::build`], reporting to `progress`.
+    pub fn build_with_progress(
+        scene: &Scene,
+        options: TreeOptions,
+        progress: Progress<'_>,
+    ) -> Result<Self, TreeError> {
         let prep = Prepared::new(scene, options);
         let mut tree = BeamTree::empty(&prep);
         let mut scratch = Scratch::default();
         for depth in 1..=options.max_order {
-            tree.grow_level(&prep, depth, &mut scratch, None)?;
+            tree.grow_level(&prep, depth, &mut scratch, None, progress)?;
         }
         Ok(tree)
     }
@@ -397,6 +428,7 @@ impl BeamTree {
         depth: usize,
         scratch: &mut Scratch,
         mut leaf: Option<(Vec3, &mut CandidateSet)>,
+        progress: Progress<'_>,
     ) -> Result<(), TreeError> {
         let parents = if depth == 1 {
             (0, 0)
@@ -411,7 +443,17 @@ impl BeamTree {
         };
         let mut children = Vec::new();
         let mut plane_copy: Vec<Plane> = Vec::new();
-        for p in parent_ids {
+        let parents = parent_ids.len();
+        for (done, p) in parent_ids.into_iter().enumerate() {
+            if done % PROGRESS_EVERY == 0 {
+                progress(BuildProgress {
+                    depth,
+                    max_order: prep.options.max_order,
+                    parents_done: done,
+                    parents,
+                    nodes: self.nodes.len() as u64,
+                });
+            }
             let mut parent = self.parent_view(prep, p, &mut plane_copy);
             let leaf_level = leaf.is_some();
             self.child_candidates(prep, &parent, leaf_level, &mut children);
@@ -816,6 +858,15 @@ fn shadow(occluder: &bt_geom::Polygon, apex: Vec3, window: &[Vec3], margin: Real
 /// The candidates of `scene` for its own RX up to `options.max_order`: the tree is built to
 /// order `max_order - 1` and the last level is tested against RX without being materialised.
 pub fn candidates(scene: &Scene, options: TreeOptions) -> Result<CandidateSet, TreeError> {
+    candidates_with_progress(scene, options, &mut |_| {})
+}
+
+/// [`candidates`], reporting to `progress`.
+pub fn candidates_with_progress(
+    scene: &Scene,
+    options: TreeOptions,
+    progress: Progress<'_>,
+) -> Result<CandidateSet, TreeError> {
     let prep = Prepared::new(scene, options);
     let mut tree = BeamTree::empty(&prep);
     let mut scratch = Scratch::default();
@@ -823,9 +874,9 @@ pub fn candidates(scene: &Scene, options: TreeOptions) -> Result<CandidateSet, T
     let mut last = CandidateSet::with_starts();
     for depth in 1..=options.max_order {
         if depth == options.max_order {
-            tree.grow_level(&prep, depth, &mut scratch, Some((rx, &mut last)))?;
+            tree.grow_level(&prep, depth, &mut scratch, Some((rx, &mut last)), progress)?;
         } else {
-            tree.grow_level(&prep, depth, &mut scratch, None)?;
+            tree.grow_level(&prep, depth, &mut scratch, None, progress)?;
         }
     }
     let mut set = tree.candidates(rx);

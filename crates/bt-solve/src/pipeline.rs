@@ -6,6 +6,7 @@
 
 use crate::{Solver, TraceResult};
 use bt_geom::Vec3;
+pub use bt_paths::beamtree::{BuildProgress, Progress};
 use bt_paths::beamtree::{BeamTree, TreeOptions, TreeStats};
 use bt_paths::{AllVisible, CandidateSet, CandidateStats};
 use bt_scene::{Scene, SceneError};
@@ -106,10 +107,22 @@ pub struct Traced {
 
 /// Generate the candidates of `scene` under `options` (with the budget checked).
 pub fn candidates(scene: &Scene, options: &TraceOptions) -> Result<CandidateSet, TraceError> {
+    candidates_with_progress(scene, options, &mut |_| {})
+}
+
+/// [`candidates`], reporting the beam tree's build to `progress` (the enumerating modes report
+/// nothing: their budget is checked before they start).
+pub fn candidates_with_progress(
+    scene: &Scene,
+    options: &TraceOptions,
+    progress: Progress<'_>,
+) -> Result<CandidateSet, TraceError> {
     check_budget(scene, options)?;
     Ok(match options.candidates {
         CandidateMode::Exhaustive => bt_paths::enumerate(scene, options.max_order, &AllVisible),
-        CandidateMode::BeamTree => bt_paths::beamtree::candidates(scene, tree_options(options))?,
+        CandidateMode::BeamTree => {
+            bt_paths::beamtree::candidates_with_progress(scene, tree_options(options), progress)?
+        }
         CandidateMode::Wvrn => {
             let wvrn = bt_paths::wvrn::Wvrn::build(scene);
             bt_paths::enumerate(scene, options.max_order, &wvrn)
@@ -164,8 +177,17 @@ pub fn exhaustive_count(n: u64, max_order: usize) -> u64 {
 
 /// Trace `scene` from its TX to its RX.
 pub fn trace_scene(scene: &Scene, options: &TraceOptions) -> Result<Traced, TraceError> {
+    trace_scene_with_progress(scene, options, &mut |_| {})
+}
+
+/// [`trace_scene`], reporting the candidate generation to `progress`.
+pub fn trace_scene_with_progress(
+    scene: &Scene,
+    options: &TraceOptions,
+    progress: Progress<'_>,
+) -> Result<Traced, TraceError> {
     let t0 = Instant::now();
-    let set = candidates(scene, options)?;
+    let set = candidates_with_progress(scene, options, progress)?;
     let t1 = Instant::now();
     Ok(solve_set(scene, set, options, t1 - t0))
 }

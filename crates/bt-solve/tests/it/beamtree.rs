@@ -246,3 +246,32 @@ fn a_small_city_agrees_with_exhaustive_enumeration_at_orders_one_and_two() {
         }
     }
 }
+
+#[test]
+fn the_build_reports_progress_level_by_level() {
+    let city = bt_scene::city::CityOptions {
+        lots: 6,
+        ..bt_scene::city::CityOptions::default()
+    };
+    let terminals = Terminals {
+        tx: Some(city.street_point(0, 60.0, 10.0)),
+        rx: Some(city.street_point(0, 95.0, 1.5)),
+    };
+    let scene = bt_scene::city::city_scene(&city, terminals).unwrap();
+    let mut reports = Vec::new();
+    let kept = BeamTree::build_with_progress(&scene, TreeOptions::new(3), &mut |p| {
+        reports.push(p)
+    })
+    .unwrap();
+    // Each level starts with a report of no parent done; the root level has one parent.
+    let starts: Vec<_> = reports.iter().filter(|p| p.parents_done == 0).collect();
+    assert_eq!(starts.iter().map(|p| p.depth).collect::<Vec<_>>(), [1, 2, 3]);
+    assert_eq!(starts[0].parents, 1);
+    let per_depth = &kept.stats().nodes_per_depth;
+    assert_eq!(starts[1].parents as u64, per_depth[0]);
+    assert_eq!(starts[2].nodes, per_depth[0] + per_depth[1]);
+    for w in reports.windows(2) {
+        assert!(w[0].nodes <= w[1].nodes && w[1].parents_done < w[1].parents.max(1));
+    }
+    assert!(reports.iter().any(|p| p.parents_done > 0), "{} reports", reports.len());
+}
