@@ -119,18 +119,23 @@ impl Scene {
     /// Pairs of surfaces (lower id first) that lie in one plane and overlap (the centroid of
     /// one inside the other) but name different materials: every path reflecting there is
     /// found twice, with two losses. A warning, not an error (meshes can hold such faces).
-    /// Pairs are compared only when their bounding boxes meet.
+    /// Pairs are compared only when their bounding boxes meet (found through the BVH: a city
+    /// mesh has 20,000 surfaces, 200 million pairs).
     pub fn coplanar_conflicts(&self) -> Vec<(SurfaceId, SurfaceId)> {
         let eps = self.length_tolerance();
-        let boxes: Vec<(Vec3, Vec3)> = self.surfaces.iter().map(|s| s.polygon.bounds()).collect();
         let mut out = Vec::new();
+        let mut near = Vec::new();
         for (i, a) in self.surfaces.iter().enumerate() {
-            for (j, b) in self.surfaces.iter().enumerate().skip(i + 1) {
-                let ((alo, ahi), (blo, bhi)) = (boxes[i], boxes[j]);
-                if a.material == b.material
-                    || (alo - bhi).max_element() > eps
-                    || (blo - ahi).max_element() > eps
-                {
+            let (alo, ahi) = a.polygon.bounds();
+            near.clear();
+            self.bvh.visit(
+                |lo, hi| (alo - hi).max_element() <= eps && (lo - ahi).max_element() <= eps,
+                |j| near.push(j as usize),
+            );
+            near.sort_unstable();
+            for &j in near.iter().filter(|&&j| j > i) {
+                let b = &self.surfaces[j];
+                if a.material == b.material {
                     continue;
                 }
                 let (pa, pb) = (&a.polygon, &b.polygon);

@@ -279,3 +279,29 @@ fn frequency_and_material_overrides_are_checked() {
     assert!(s.with_radio_material(brick).is_ok());
     assert!(at_60.with_radio_material(brick).is_err());
 }
+
+#[test]
+fn coplanar_conflicts_are_the_overlapping_pairs_with_other_materials() {
+    // Ten 1 m tiles in the plane x = 0 sharing edges (alternating materials: neighbours do not
+    // overlap), then copies of tiles 2, 5 and 7 in another material: exactly three conflicts.
+    let tile = |k: usize, material: &str| {
+        let y = k as f64;
+        format!(
+            r#"{{ "name": "t{k}-{material}", "material": "{material}",
+                 "vertices": [[0,{y},0],[0,{},0],[0,{},1],[0,{y},1]] }}"#,
+            y + 1.0,
+            y + 1.0
+        )
+    };
+    let mut surfaces: Vec<String> = (0..10)
+        .map(|k| tile(k, if k % 2 == 0 { "concrete" } else { "wood" }))
+        .collect();
+    surfaces.extend([2, 5, 7].map(|k| tile(k, "glass")));
+    let json = format!(
+        r#"{{ "tx": [1, 0.5, 0.5], "rx": [2, 3.5, 0.5], "surfaces": [{}] }}"#,
+        surfaces.join(",")
+    );
+    let found = scene(&json).unwrap().coplanar_conflicts();
+    let pairs: Vec<(u32, u32)> = found.iter().map(|(a, b)| (a.0, b.0)).collect();
+    assert_eq!(pairs, [(2, 10), (5, 11), (7, 12)]);
+}
