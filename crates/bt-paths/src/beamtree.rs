@@ -299,6 +299,9 @@ struct Scratch {
     /// surfaces one ray crosses.
     starts: Vec<Vec3>,
     rays: Vec<Vec3>,
+    /// The occluder that covered the last culled window: siblings behind the same wall are
+    /// tried against it before any BVH walk.
+    last_cover: Option<u32>,
     hits: Vec<(Real, u32)>,
 }
 
@@ -735,10 +738,20 @@ fn occlude(
             None => q,
         },
     }));
+    let margin = COVER * prep.tol;
+    if let Some(o) = scratch.last_cover.filter(|&o| Some(o) != parent.surface && o != s) {
+        let polygon = &scene.surface(SurfaceId(o)).polygon;
+        if between(polygon.plane(), &starts, &scratch.a, margin)
+            && matches!(shadow(polygon, parent.apex, &scratch.a, margin), Shadow::Covers)
+        {
+            stats.occluders.push(o);
+            scratch.starts = starts;
+            return true;
+        }
+    }
     // Only a surface that the ray to some window vertex crosses can cover or clip the window
     // (the covered part of a convex window contains a vertex). Ray by ray, nearest first, so a
     // window hidden by the first wall in front costs one BVH walk.
-    let margin = COVER * prep.tol;
     let mut tested = std::mem::take(&mut scratch.items);
     tested.clear();
     let mut hits = std::mem::take(&mut scratch.hits);
@@ -774,6 +787,7 @@ fn occlude(
             match shadow(polygon, parent.apex, &scratch.a, margin) {
                 Shadow::Covers => {
                     stats.occluders.push(o);
+                    scratch.last_cover = Some(o);
                     covered = true;
                     break 'rays;
                 }
