@@ -192,6 +192,8 @@ const LINEAR_SCAN: usize = 64;
 struct Prepared<'a> {
     scene: &'a Scene,
     tol: Real,
+    /// Each surface's plane, contiguous (the leaf test reads one per child).
+    planes: Vec<Plane>,
     /// Grown convex hull of each reflector (empty for blockers).
     hulls: Vec<Vec<Vec3>>,
     /// Inward side planes of each grown hull's edges (perpendicular to the surface), in
@@ -235,6 +237,7 @@ impl<'a> Prepared<'a> {
             Culling::Auto { .. } => reflectors.len() > LINEAR_SCAN,
         };
         Prepared {
+            planes: surfaces.iter().map(|s| *s.polygon.plane()).collect(),
             cull_at_build,
             scene,
             tol,
@@ -248,7 +251,7 @@ impl<'a> Prepared<'a> {
     }
 
     fn plane(&self, s: u32) -> &Plane {
-        self.scene.surface(SurfaceId(s)).polygon.plane()
+        &self.planes[s as usize]
     }
 
     /// Whether `x`, a point of surface `s`'s plane, lies in its grown hull (margin `eps`).
