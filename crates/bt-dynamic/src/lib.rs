@@ -322,6 +322,20 @@ impl IncrementalTracer {
             solved,
             &solved_points,
         );
+        let solved = (candidates, records, points);
+        Ok(self.keep(scene, step, wvrn, solved, update))
+    }
+
+    /// Keep step `step` of `scene` (its WVRN, candidates, records and points) for the next
+    /// step and return its result.
+    fn keep(
+        &mut self,
+        scene: &Scene,
+        step: usize,
+        wvrn: Option<Wvrn>,
+        (candidates, records, points): (CandidateSet, Vec<Record>, Vec<Vec3>),
+        update: UpdateStats,
+    ) -> StepTrace {
         let state = State {
             scene: scene.clone(),
             wvrn,
@@ -332,7 +346,7 @@ impl IncrementalTracer {
         };
         let result = state.result(update);
         self.state = Some(state);
-        Ok(result)
+        result
     }
 
     fn full(&mut self, scene: &Scene, step: usize) -> Result<StepTrace, TraceError> {
@@ -356,17 +370,8 @@ impl IncrementalTracer {
             candidates_rederived: true,
             ..UpdateStats::default()
         };
-        let state = State {
-            scene: scene.clone(),
-            wvrn,
-            candidates,
-            records,
-            points,
-            step,
-        };
-        let result = state.result(update);
-        self.state = Some(state);
-        Ok(result)
+        let solved = (candidates, records, points);
+        Ok(self.keep(scene, step, wvrn, solved, update))
     }
 }
 

@@ -67,97 +67,97 @@ where
     F: Fn(&mut R, usize, &CandidateOutcome, &[Vec3]) + Sync,
 {
     let total = todo.len(batch.candidates);
-    let run = |range: std::ops::Range<usize>| run_chunk(batch, todo, range, &warm, &each);
+    let chunk = Chunk {
+        batch,
+        todo,
+        warm: &warm,
+        each: &each,
+    };
     if !batch.parallel || total < PARALLEL_FROM {
-        return vec![run(0..total)];
+        return vec![chunk.run(0..total)];
     }
     (0..total.div_ceil(CHUNK))
         .into_par_iter()
-        .map(|c| run(c * CHUNK..((c + 1) * CHUNK).min(total)))
+        .map(|c| chunk.run(c * CHUNK..((c + 1) * CHUNK).min(total)))
         .collect()
 }
 
-/// One chunk: positions `range` of `todo`.
-///
-/// Compiled twice: with the `fma` target feature when the CPU has it (checked at run time),
-/// and without. The solvers use `mul_add` for robust side tests; without the feature every
-/// `mul_add` is a call into the software-dispatched `fma` of compiler-builtins, which also
-/// spills every live float register (a third of the instructions of an IPC round). FMA is
-/// correctly rounded either way, and Rust never contracts a separate multiply and add, so
-/// both versions give bit-identical results. The solvers and validation are `inline(always)`
-/// down to the BVH walk so that they are compiled into the FMA version.
-fn run_chunk<'w, R, W, F>(
-    batch: &Batch<'_>,
-    todo: Todo<'_>,
-    range: std::ops::Range<usize>,
-    warm: &W,
-    each: &F,
-) -> R
+/// What every chunk of a batch shares.
+struct Chunk<'c, W, F> {
+    batch: &'c Batch<'c>,
+    todo: Todo<'c>,
+    warm: &'c W,
+    each: &'c F,
+}
+
+impl<'w, W, F> Chunk<'_, W, F>
 where
-    R: Default,
     W: Fn(usize) -> Option<&'w [Vec3]>,
-    F: Fn(&mut R, usize, &CandidateOutcome, &[Vec3]),
 {
+    /// Positions `range` of the batch's `todo`.
+    ///
+    /// Compiled twice: with the `fma` target feature when the CPU has it (checked at run
+    /// time), and without. The solvers use `mul_add` for robust side tests; without the
+    /// feature every `mul_add` is a call into the software-dispatched `fma` of
+    /// compiler-builtins, which also spills every live float register (a third of the
+    /// instructions of an IPC round). FMA is correctly rounded either way, and Rust never
+    /// contracts a separate multiply and add, so both versions give bit-identical results.
+    /// The solvers and validation are `inline(always)` down to the BVH walk so that they are
+    /// compiled into the FMA version.
+    fn run<R: Default>(&self, range: std::ops::Range<usize>) -> R
+    where
+        F: Fn(&mut R, usize, &CandidateOutcome, &[Vec3]),
+    {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("fma") {
+            // SAFETY: the CPU supports FMA (checked just above).
+            return unsafe { self.run_fma(range) };
+        }
+        self.run_impl(range)
+    }
+
     #[cfg(target_arch = "x86_64")]
-    if std::arch::is_x86_feature_detected!("fma") {
-        // SAFETY: the CPU supports FMA (checked just above).
-        return unsafe { run_chunk_fma(batch, todo, range, warm, each) };
+    #[target_feature(enable = "fma")]
+    fn run_fma<R: Default>(&self, range: std::ops::Range<usize>) -> R
+    where
+        F: Fn(&mut R, usize, &CandidateOutcome, &[Vec3]),
+    {
+        self.run_impl(range)
     }
-    run_chunk_impl(batch, todo, range, warm, each)
-}
 
-#[cfg(target_arch = "x86_64")]
-#[target_feature(enable = "fma")]
-fn run_chunk_fma<'w, R, W, F>(
-    batch: &Batch<'_>,
-    todo: Todo<'_>,
-    range: std::ops::Range<usize>,
-    warm: &W,
-    each: &F,
-) -> R
-where
-    R: Default,
-    W: Fn(usize) -> Option<&'w [Vec3]>,
-    F: Fn(&mut R, usize, &CandidateOutcome, &[Vec3]),
-{
-    run_chunk_impl(batch, todo, range, warm, each)
-}
-
-#[inline(always)]
-fn run_chunk_impl<'w, R, W, F>(
-    batch: &Batch<'_>,
-    todo: Todo<'_>,
-    range: std::ops::Range<usize>,
-    warm: &W,
-    each: &F,
-) -> R
-where
-    R: Default,
-    W: Fn(usize) -> Option<&'w [Vec3]>,
-    F: Fn(&mut R, usize, &CandidateOutcome, &[Vec3]),
-{
-    let mut acc = R::default();
-    let mut stack_points = [Vec3::ZERO; STACK_ORDER];
-    let mut stack_scratch = [Vec3::ZERO; STACK_ORDER];
-    let mut heap_points = Vec::new();
-    let mut heap_scratch = Vec::new();
-    for k in range {
-        let i = todo.index(k);
-        let seq = batch.candidates.get(i);
-        let n = seq.len();
-        let (points, scratch) = if n <= STACK_ORDER {
-            (&mut stack_points[..n], &mut stack_scratch[..n])
-        } else {
-            heap_points.resize(n, Vec3::ZERO);
-            heap_scratch.resize(n, Vec3::ZERO);
-            (&mut heap_points[..], &mut heap_scratch[..])
-        };
-        let start = warm(i).or_else(|| batch.candidates.start(i));
-        let outcome =
-            solve_candidate_from(batch.scene, seq, batch.solver, start, points, scratch);
-        each(&mut acc, i, &outcome, points);
+    #[inline(always)]
+    fn run_impl<R: Default>(&self, range: std::ops::Range<usize>) -> R
+    where
+        F: Fn(&mut R, usize, &CandidateOutcome, &[Vec3]),
+    {
+        let Batch {
+            scene,
+            candidates,
+            solver,
+            ..
+        } = *self.batch;
+        let mut acc = R::default();
+        let mut stack_points = [Vec3::ZERO; STACK_ORDER];
+        let mut stack_scratch = [Vec3::ZERO; STACK_ORDER];
+        let mut heap_points = Vec::new();
+        let mut heap_scratch = Vec::new();
+        for k in range {
+            let i = self.todo.index(k);
+            let seq = candidates.get(i);
+            let n = seq.len();
+            let (points, scratch) = if n <= STACK_ORDER {
+                (&mut stack_points[..n], &mut stack_scratch[..n])
+            } else {
+                heap_points.resize(n, Vec3::ZERO);
+                heap_scratch.resize(n, Vec3::ZERO);
+                (&mut heap_points[..], &mut heap_scratch[..])
+            };
+            let start = (self.warm)(i).or_else(|| candidates.start(i));
+            let outcome = solve_candidate_from(scene, seq, solver, start, points, scratch);
+            (self.each)(&mut acc, i, &outcome, points);
+        }
+        acc
     }
-    acc
 }
 
 /// The path of a valid outcome (`None` for any other outcome): `seq` and its solved `points`,
