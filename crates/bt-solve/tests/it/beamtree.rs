@@ -31,6 +31,33 @@ fn paths(scene: &Scene, max_order: usize, mode: CandidateMode) -> Vec<FoundPath>
         .paths
 }
 
+/// A beam-tree trace of `scene` at `order`, asserted to find the paths of exhaustive
+/// enumeration.
+fn traced_like_exhaustive(scene: &Scene, order: usize) -> bt_solve::pipeline::Traced {
+    let reference = paths(scene, order, CandidateMode::Exhaustive);
+    let traced = trace_scene(scene, &options(order, CandidateMode::BeamTree, Solver::Image))
+        .expect("trace runs");
+    assert_eq!(
+        sequences(&traced.result.paths),
+        sequences(&reference),
+        "order {order}"
+    );
+    traced
+}
+
+/// The 6 × 6-lot city (about 180 surfaces), TX on a mast, RX in the street at `(y, z)`.
+fn small_city(rx_y: Real, rx_z: Real) -> Scene {
+    let city = bt_scene::city::CityOptions {
+        lots: 6,
+        ..bt_scene::city::CityOptions::default()
+    };
+    let terminals = Terminals {
+        tx: Some(city.street_point(0, 60.0, 10.0)),
+        rx: Some(city.street_point(0, rx_y, rx_z)),
+    };
+    bt_scene::city::city_scene(&city, terminals).unwrap()
+}
+
 fn assert_same(a: &[FoundPath], b: &[FoundPath]) -> Result<(), TestCaseError> {
     prop_assert_eq!(sequences(a), sequences(b));
     for (p, q) in a.iter().zip(b) {
@@ -137,17 +164,7 @@ fn living_room_same_paths_and_few_candidates() {
         .unwrap()
         .unwrap();
     for order in 1..=4 {
-        let reference = paths(&scene, order, CandidateMode::Exhaustive);
-        let traced = trace_scene(
-            &scene,
-            &options(order, CandidateMode::BeamTree, Solver::Image),
-        )
-        .unwrap();
-        assert_eq!(
-            sequences(&traced.result.paths),
-            sequences(&reference),
-            "order {order}"
-        );
+        let traced = traced_like_exhaustive(&scene, order);
         if order == 3 {
             // the target: at most 200 of the 9,594 exhaustive candidates
             assert!(
@@ -216,28 +233,10 @@ fn ipc_finds_the_wall_floor_path_that_centroid_starts_missed() {
 fn a_small_city_agrees_with_exhaustive_enumeration_at_orders_one_and_two() {
     // 6 × 6 lots of box buildings on a ground plane (about 180 surfaces), TX on a mast, RX in
     // the street and on a roof corner's mirror ray: culling by buildings is exercised.
-    let city = bt_scene::city::CityOptions {
-        lots: 6,
-        ..bt_scene::city::CityOptions::default()
-    };
     for (rx_y, rx_z) in [(95.0, 1.5), (150.0, 12.0), (20.0, 3.0)] {
-        let terminals = Terminals {
-            tx: Some(city.street_point(0, 60.0, 10.0)),
-            rx: Some(city.street_point(0, rx_y, rx_z)),
-        };
-        let scene = bt_scene::city::city_scene(&city, terminals).unwrap();
+        let scene = small_city(rx_y, rx_z);
         for order in 1..=2 {
-            let reference = paths(&scene, order, CandidateMode::Exhaustive);
-            let traced = trace_scene(
-                &scene,
-                &options(order, CandidateMode::BeamTree, Solver::Image),
-            )
-            .unwrap();
-            assert_eq!(
-                sequences(&traced.result.paths),
-                sequences(&reference),
-                "order {order}"
-            );
+            let traced = traced_like_exhaustive(&scene, order);
             let tree = traced.tree.unwrap();
             assert!(
                 order < 2 || tree.occluded > 0,
@@ -249,15 +248,7 @@ fn a_small_city_agrees_with_exhaustive_enumeration_at_orders_one_and_two() {
 
 #[test]
 fn the_build_reports_progress_level_by_level() {
-    let city = bt_scene::city::CityOptions {
-        lots: 6,
-        ..bt_scene::city::CityOptions::default()
-    };
-    let terminals = Terminals {
-        tx: Some(city.street_point(0, 60.0, 10.0)),
-        rx: Some(city.street_point(0, 95.0, 1.5)),
-    };
-    let scene = bt_scene::city::city_scene(&city, terminals).unwrap();
+    let scene = small_city(95.0, 1.5);
     let mut reports = Vec::new();
     let kept = BeamTree::build_with_progress(&scene, TreeOptions::new(3), &mut |p| {
         reports.push(p)
