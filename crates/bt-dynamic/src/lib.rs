@@ -445,7 +445,14 @@ fn solve_planned(
 type Solved = (Vec<(CandidateOutcome, u32, usize)>, Vec<Vec3>);
 
 /// The [`solve_batch`] fold that keeps every outcome and every point.
-fn keep_all(acc: &mut Solved, i: usize, outcome: &CandidateOutcome, points: &[Vec3]) {
+#[inline(always)]
+fn keep_all(
+    acc: &mut Solved,
+    i: usize,
+    _: &[SurfaceId],
+    outcome: &CandidateOutcome,
+    points: &[Vec3],
+) {
     acc.0.push((*outcome, acc.1.len() as u32, i));
     acc.1.extend_from_slice(points);
 }

@@ -57,14 +57,14 @@ pub struct Batch<'a> {
 }
 
 /// Solve the candidates of `todo`. IPC starts from `warm(i)` when it gives points for candidate
-/// `i`, else from the set's start points, else from the centroids. `each(acc, i, outcome,
-/// points)` folds every candidate's result, in `todo` order within a chunk, into its chunk's
+/// `i`, else from the set's start points, else from the centroids. `each(acc, i, seq,
+/// outcome, points)` folds every candidate's result, in `todo` order within a chunk, into its chunk's
 /// accumulator (`R::default()` to begin); the accumulators come back in chunk order.
 pub fn solve_batch<'w, R, W, F>(batch: &Batch<'_>, todo: Todo<'_>, warm: W, each: F) -> Vec<R>
 where
     R: Default + Send,
     W: Fn(usize) -> Option<&'w [Vec3]> + Sync,
-    F: Fn(&mut R, usize, &CandidateOutcome, &[Vec3]) + Sync,
+    F: Fn(&mut R, usize, &[SurfaceId], &CandidateOutcome, &[Vec3]) + Sync,
 {
     let total = todo.len(batch.candidates);
     let chunk = Chunk {
@@ -106,7 +106,7 @@ where
     /// compiled into the FMA version.
     fn run<R: Default>(&self, range: std::ops::Range<usize>) -> R
     where
-        F: Fn(&mut R, usize, &CandidateOutcome, &[Vec3]),
+        F: Fn(&mut R, usize, &[SurfaceId], &CandidateOutcome, &[Vec3]),
     {
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("fma") {
@@ -120,7 +120,7 @@ where
     #[target_feature(enable = "fma")]
     fn run_fma<R: Default>(&self, range: std::ops::Range<usize>) -> R
     where
-        F: Fn(&mut R, usize, &CandidateOutcome, &[Vec3]),
+        F: Fn(&mut R, usize, &[SurfaceId], &CandidateOutcome, &[Vec3]),
     {
         self.run_impl(range)
     }
@@ -128,7 +128,7 @@ where
     #[inline(always)]
     fn run_impl<R: Default>(&self, range: std::ops::Range<usize>) -> R
     where
-        F: Fn(&mut R, usize, &CandidateOutcome, &[Vec3]),
+        F: Fn(&mut R, usize, &[SurfaceId], &CandidateOutcome, &[Vec3]),
     {
         let Batch {
             scene,
@@ -154,7 +154,7 @@ where
             };
             let start = (self.warm)(i).or_else(|| candidates.start(i));
             let outcome = solve_candidate_from(scene, seq, solver, start, points, scratch);
-            (self.each)(&mut acc, i, &outcome, points);
+            (self.each)(&mut acc, i, seq, &outcome, points);
         }
         acc
     }

@@ -204,6 +204,19 @@ pub fn solve_candidate_from(
     }
 }
 
+/// The [`solve_batch`] fold of [`trace`]: count every outcome, keep the valid paths.
+#[inline(always)]
+fn keep_valid(
+    out: &mut TraceResult,
+    _: usize,
+    seq: &[SurfaceId],
+    outcome: &CandidateOutcome,
+    points: &[Vec3],
+) {
+    out.counts.add(outcome);
+    out.paths.extend(found_path(seq, outcome, points));
+}
+
 /// Run `solver` on every candidate. `parallel` spreads candidates over rayon's pool; the
 /// output is identical either way (order-preserving).
 pub fn trace(
@@ -222,16 +235,7 @@ pub fn trace(
         solver,
         parallel,
     };
-    let parts = solve_batch(
-        &batch,
-        Todo::All,
-        |_| None,
-        |out: &mut TraceResult, i, outcome, points| {
-            out.counts.add(outcome);
-            out.paths
-                .extend(found_path(candidates.get(i), outcome, points));
-        },
-    );
+    let parts = solve_batch(&batch, Todo::All, |_| None, keep_valid);
     let mut out = TraceResult::default();
     for part in parts {
         out.paths.extend(part.paths);
