@@ -1,0 +1,70 @@
+//! A fixed workload for instruction counts (docs/performance.md): the living room at order 3,
+//! `N` times. Wall-clock benchmarks are in `benches/beamtree.rs`; this probe exists so that
+//! valgrind's cachegrind can count instructions, which do not depend on the machine's load:
+//!
+//! ```text
+//! cargo build --release -p bt-solve --example treeprobe
+//! valgrind --tool=cachegrind --cache-sim=no target/release/examples/treeprobe cand 11
+//! ```
+//!
+//! WHAT: `cand` (beam-tree candidates), `image` / `exh` (whole image-method trace with the beam
+//! tree / exhaustive candidates), `ipc` (whole IPC Gauss-Seidel trace), `walk` (a new RX on a
+//! kept tree, walk only), `newrx` (walk + image method + validation).
+
+use bt_paths::beamtree::{BeamTree, TreeOptions, candidates};
+use bt_scene::{Scene, Terminals, Vec3};
+use bt_solve::pipeline::{CandidateMode, TraceOptions, trace_scene};
+use bt_solve::{IpcOptions, Solver, UpdateOrder};
+
+fn trace_options(solver: Solver, candidates: CandidateMode) -> TraceOptions {
+    TraceOptions {
+        solver,
+        candidates,
+        parallel: false,
+        max_candidates: u64::MAX,
+        ..TraceOptions::new(3)
+    }
+}
+
+fn traced_paths(scene: &Scene, options: &TraceOptions) -> usize {
+    trace_scene(scene, options).unwrap().result.paths.len()
+}
+
+/// The RX of call `i`: a few millimetres apart, so that no call repeats the previous one.
+fn moved_rx(scene: &Scene, i: usize) -> Vec3 {
+    scene.rx() + Vec3::new(0.001 * (i % 7) as f64, 0.0, 0.0)
+}
+
+fn run(what: &str, scene: &Scene, i: usize, tree: &BeamTree) -> usize {
+    match what {
+        "cand" => candidates(scene, TreeOptions::new(3)).unwrap().len(),
+        "image" => traced_paths(scene, &trace_options(Solver::Image, CandidateMode::BeamTree)),
+        "exh" => traced_paths(scene, &trace_options(Solver::Image, CandidateMode::Exhaustive)),
+        "ipc" => {
+            let ipc = Solver::Ipc(IpcOptions::for_scene(scene, UpdateOrder::GaussSeidel));
+            traced_paths(scene, &trace_options(ipc, CandidateMode::BeamTree))
+        }
+        "walk" => tree.candidates(moved_rx(scene, i)).len(),
+        "newrx" => {
+            let rx = moved_rx(scene, i);
+            let set = tree.candidates(rx);
+            let moved = scene.with_terminals(scene.tx(), rx).unwrap();
+            bt_solve::trace(&moved, &set, &Solver::Image, false).paths.len()
+        }
+        other => panic!("unknown workload {other:?}: cand, image, exh, ipc, walk or newrx"),
+    }
+}
+
+fn main() {
+    let args: Vec<String> = std::env::args().collect();
+    let (what, n) = match args.as_slice() {
+        [_, what, n] => (what.as_str(), n.parse::<usize>().expect("N is a count")),
+        _ => panic!("usage: treeprobe WHAT N"),
+    };
+    let scene = bt_scene::builtin_scene("living-room", Terminals::default())
+        .unwrap()
+        .unwrap();
+    let tree = BeamTree::build(&scene, TreeOptions::new(3)).unwrap();
+    let total: usize = (0..n).map(|i| run(what, &scene, i, &tree)).sum();
+    println!("{total}");
+}
