@@ -41,6 +41,31 @@ fn failed_fill_keeps_the_old_file() {
 }
 
 #[test]
+fn path_writer_sees_the_extension_and_a_failure_keeps_the_old_file() {
+    let dir = scratch("via");
+    let f = dir.join("fig.png");
+    write_atomic(&f, b"old").unwrap();
+    let r: Result<(), OutputError> = write_atomic_via(&f, |tmp| {
+        assert_eq!(tmp.extension().unwrap(), "png");
+        assert_eq!(tmp.parent(), f.parent());
+        std::fs::write(tmp, b"half").unwrap();
+        Err(OutputError::BadRelative("simulated".into()))
+    });
+    assert!(r.is_err());
+    assert_eq!(std::fs::read(&f).unwrap(), b"old");
+    assert_eq!(listing(&dir), ["fig.png"]);
+    write_atomic_via(&f, |tmp| {
+        std::fs::write(tmp, b"new").map_err(|e| OutputError::Io {
+            path: tmp.display().to_string(),
+            source: e,
+        })
+    })
+    .unwrap();
+    assert_eq!(std::fs::read(&f).unwrap(), b"new");
+    assert_eq!(listing(&dir), ["fig.png"]);
+}
+
+#[test]
 fn output_equal_to_input_is_refused_in_any_spelling() {
     let dir = scratch("same");
     let f = dir.join("cloud.ply");
