@@ -1,7 +1,8 @@
 //! PLY mesh reader (ASCII, binary little endian, binary big endian).
 //!
-//! The header is parsed here rather than by `ply-rs` so that every element count is checked
-//! against the body length before anything is allocated: a header claiming billions of vertices
+//! The header is parsed by bt-formats' PLY grammar (shared with bt-pointcloud) and the body
+//! here, rather than by `ply-rs`, so that every element count is checked against the body
+//! length before anything is allocated: a header claiming billions of vertices
 //! in a small file is an error, not an out-of-memory abort. Only `vertex` (`x`, `y`, `z` of any
 //! scalar type; other properties skipped) and `face` (`vertex_indices` or `vertex_index` list
 //! with integer count and index types; other properties skipped) are used; other elements are
@@ -11,49 +12,10 @@ use crate::error::{MeshError, Position};
 use crate::raw::RawMesh;
 use bt_geom::{Real, Vec3};
 
-use bt_formats::{PlyFormat as Format, Scalar};
-
-#[derive(Debug, Clone, Copy)]
-enum Kind {
-    Scalar(Scalar),
-    List { count: Scalar, item: Scalar },
-}
-
-#[derive(Debug)]
-struct Property {
-    name: String,
-    kind: Kind,
-}
-
-#[derive(Debug)]
-struct Element {
-    name: String,
-    count: u64,
-    properties: Vec<Property>,
-}
-
-impl Element {
-    /// Fewest body bytes one entry can occupy: binary scalars at their size and list counts
-    /// with zero items; in ASCII one character plus one separator per property.
-    fn min_bytes(&self, format: Format) -> u64 {
-        self.properties
-            .iter()
-            .map(|p| match (format, p.kind) {
-                (Format::Ascii, _) => 2,
-                (_, Kind::Scalar(s)) | (_, Kind::List { count: s, .. }) => s.size() as u64,
-            })
-            .sum()
-    }
-}
-
-struct Header {
-    format: Format,
-    elements: Vec<Element>,
-    /// Byte offset of the body.
-    body_start: usize,
-    /// Number of header lines (the body's first line is `lines + 1`).
-    lines: usize,
-}
+use bt_formats::{
+    PlyFormat as Format, PlyHeader as Header, PlyHeaderError, PlyHeaderErrorKind,
+    PlyPropertyKind as Kind, Scalar,
+};
 
 /// Parses PLY bytes into a validated polygon soup.
 pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
@@ -203,109 +165,25 @@ pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
     Ok(mesh)
 }
 
+/// The header through bt-formats' one PLY grammar; its errors keep this reader's variants: an
+/// encoding or version it cannot read is `Unsupported`, a missing `end_header` `Truncated`.
 fn parse_header(bytes: &[u8], file: &str) -> Result<Header, MeshError> {
-    let syntax = |line: usize, detail: String| MeshError::Syntax {
-        file: file.to_owned(),
-        position: Position::Line(line),
-        detail,
-    };
-    let mut pos = 0usize;
-    let mut line_no = 0usize;
-    let mut format = None;
-    let mut elements: Vec<Element> = Vec::new();
-    loop {
-        let Some(len) = bytes[pos..].iter().position(|&b| b == b'\n') else {
-            return Err(MeshError::Truncated {
-                file: file.to_owned(),
-                position: Position::Line(line_no + 1),
-                detail: "header has no end_header line".into(),
-            });
-        };
-        let raw = &bytes[pos..pos + len];
-        pos += len + 1;
-        line_no += 1;
-        let text = std::str::from_utf8(raw)
-            .map_err(|_| syntax(line_no, "header line is not text".into()))?
-            .trim_end_matches('\r');
-        let tokens: Vec<&str> = text.split_whitespace().collect();
-        if line_no == 1 {
-            if text.trim() != "ply" {
-                return Err(syntax(
-                    1,
-                    "not a PLY file: first line must be \"ply\"".into(),
-                ));
-            }
-            continue;
+    Header::parse(bytes).map_err(|PlyHeaderError { line, kind }| {
+        let file = file.to_owned();
+        let detail = kind.to_string();
+        match kind {
+            k if k.is_unsupported() => MeshError::Unsupported { file, detail },
+            PlyHeaderErrorKind::NoEndHeader => MeshError::Truncated {
+                file,
+                position: Position::Line(line),
+                detail,
+            },
+            _ => MeshError::Syntax {
+                file,
+                position: Position::Line(line),
+                detail,
+            },
         }
-        match tokens.as_slice() {
-            [] => {}
-            ["comment" | "obj_info", ..] => {}
-            ["format", kind, version] => {
-                if *version != "1.0" {
-                    return Err(MeshError::Unsupported {
-                        file: file.to_owned(),
-                        detail: format!("PLY format version {version}"),
-                    });
-                }
-                format = Some(
-                    Format::from_name(kind).ok_or_else(|| MeshError::Unsupported {
-                        file: file.to_owned(),
-                        detail: format!("PLY format {kind:?}"),
-                    })?,
-                );
-            }
-            ["element", name, count] => {
-                let count: u64 = count.parse().map_err(|_| {
-                    syntax(line_no, format!("element count {count:?} is not a count"))
-                })?;
-                elements.push(Element {
-                    name: (*name).to_owned(),
-                    count,
-                    properties: Vec::new(),
-                });
-            }
-            ["property", rest @ ..] => {
-                let element = elements
-                    .last_mut()
-                    .ok_or_else(|| syntax(line_no, "property before any element".into()))?;
-                let scalar = |name: &str| {
-                    Scalar::from_ply_name(name)
-                        .ok_or_else(|| syntax(line_no, format!("unknown property type {name:?}")))
-                };
-                let property = match rest {
-                    ["list", count, item, name] => Property {
-                        name: (*name).to_owned(),
-                        kind: Kind::List {
-                            count: scalar(count)?,
-                            item: scalar(item)?,
-                        },
-                    },
-                    [ty, name] => Property {
-                        name: (*name).to_owned(),
-                        kind: Kind::Scalar(scalar(ty)?),
-                    },
-                    _ => return Err(syntax(line_no, format!("malformed property {text:?}"))),
-                };
-                if let Kind::List { count, .. } = property.kind {
-                    if !count.is_integer() {
-                        return Err(syntax(
-                            line_no,
-                            format!("list {:?} has a non-integer count type", property.name),
-                        ));
-                    }
-                }
-                element.properties.push(property);
-            }
-            ["end_header"] => break,
-            _ => return Err(syntax(line_no, format!("unexpected header line {text:?}"))),
-        }
-    }
-    let format = format.ok_or_else(|| syntax(line_no, "header has no format line".into()))?;
-    Ok(Header {
-        format,
-        elements,
-        body_start: pos,
-        lines: line_no,
     })
 }
 
