@@ -22,60 +22,13 @@ pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
     let header = parse_header(bytes, file)?;
     let body = &bytes[header.body_start..];
     check_counts(&header, body.len() as u64, file)?;
-
-    let unsupported = |detail: String| MeshError::Unsupported {
-        file: file.to_owned(),
-        detail,
-    };
-    let vertex_element = header
-        .elements
-        .iter()
-        .position(|e| e.name == "vertex")
-        .ok_or_else(|| unsupported("no \"vertex\" element".into()))?;
-    let face_element = header
-        .elements
-        .iter()
-        .position(|e| e.name == "face")
-        .ok_or_else(|| unsupported("no \"face\" element: point clouds are not meshes".into()))?;
-    let xyz_slots: Vec<usize> = ["x", "y", "z"]
-        .iter()
-        .map(|axis| {
-            header.elements[vertex_element]
-                .properties
-                .iter()
-                .position(|p| p.name == *axis && matches!(p.kind, Kind::Scalar(_)))
-                .ok_or_else(|| {
-                    unsupported(format!("vertex element has no scalar property {axis:?}"))
-                })
-        })
-        .collect::<Result<_, _>>()?;
-    let index_slot = header.elements[face_element]
-        .properties
-        .iter()
-        .position(|p| {
-            (p.name == "vertex_indices" || p.name == "vertex_index")
-                && matches!(p.kind, Kind::List { .. })
-        })
-        .ok_or_else(|| {
-            unsupported("face element has no \"vertex_indices\" or \"vertex_index\" list".into())
-        })?;
-    if let Kind::List { item, .. } = header.elements[face_element].properties[index_slot].kind {
-        if !item.is_integer() {
-            return Err(unsupported(
-                "face vertex list must use an integer index type".into(),
-            ));
-        }
-    }
-    let vertex_count = header.elements[vertex_element].count;
-    if vertex_count > u64::from(u32::MAX) {
-        return Err(unsupported(format!("more than {} vertices", u32::MAX)));
-    }
+    let layout = Layout::of(&header, file)?;
 
     let mut mesh = RawMesh::new();
     // Counts were checked against the body length above, so these reservations are bounded by
     // the file size.
-    mesh.positions.reserve(vertex_count as usize);
-    let face_count = header.elements[face_element].count as usize;
+    mesh.positions.reserve(layout.vertex_count as usize);
+    let face_count = header.elements[layout.face_element].count as usize;
     mesh.face_start.reserve(face_count);
     mesh.indices.reserve(face_count.saturating_mul(3));
     mesh.face_name.reserve(face_count);
@@ -91,6 +44,7 @@ pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
     let mut values: Vec<Real> = Vec::new();
     let mut face: Vec<u32> = Vec::new();
     for (e, element) in header.elements.iter().enumerate() {
+        let indices = (e == layout.face_element).then_some(layout.index_slot);
         for index in 0..element.count {
             reader.skip_space();
             let start = Position::Element {
@@ -98,59 +52,15 @@ pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
                 index,
                 line: (header.format == Format::Ascii).then_some(reader.line),
             };
-            values.clear();
-            for (slot, property) in element.properties.iter().enumerate() {
-                match property.kind {
-                    Kind::Scalar(s) => values.push(reader.read(s, &property.name, &start)?),
-                    Kind::List { count, item } => {
-                        let n = reader.read(count, &property.name, &start)?;
-                        if n < 0.0 {
-                            return Err(MeshError::Syntax {
-                                file: file.to_owned(),
-                                position: start,
-                                detail: format!("list {:?} has negative length {n}", property.name),
-                            });
-                        }
-                        let collect = e == face_element && slot == index_slot;
-                        if collect {
-                            face.clear();
-                        }
-                        // No reservation by `n`: every read consumes input, so a huge count
-                        // ends in a truncation error, not an allocation.
-                        for _ in 0..n as u64 {
-                            let v = reader.read(item, &property.name, &start)?;
-                            if collect {
-                                if v < 0.0 || v >= vertex_count as Real {
-                                    return Err(MeshError::IndexOutOfRange {
-                                        file: file.to_owned(),
-                                        position: start,
-                                        index: v as i64,
-                                        vertex_count: vertex_count as usize,
-                                    });
-                                }
-                                face.push(v as u32);
-                            }
-                        }
-                        values.push(n);
-                    }
-                }
-            }
-            if e == vertex_element {
-                let mut xyz = [0.0; 3];
-                for (k, (&slot, axis)) in xyz_slots.iter().zip(['x', 'y', 'z']).enumerate() {
-                    let value = values[slot];
-                    if !value.is_finite() {
-                        return Err(MeshError::NonFiniteCoordinate {
-                            file: file.to_owned(),
-                            position: start,
-                            axis,
-                            value,
-                        });
-                    }
-                    xyz[k] = value;
-                }
-                mesh.positions.push(Vec3::from_array(xyz));
-            } else if e == face_element {
+            let entry = Entry {
+                values: &mut values,
+                face: &mut face,
+                at: &start,
+            };
+            reader.entry(element, indices, layout.vertex_count, entry)?;
+            if e == layout.vertex_element {
+                mesh.positions.push(layout.position(&values, file, start)?);
+            } else if e == layout.face_element {
                 if face.len() < 3 {
                     return Err(MeshError::FaceTooSmall {
                         file: file.to_owned(),
@@ -163,6 +73,98 @@ pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
         }
     }
     Ok(mesh)
+}
+
+/// Where the reader finds what it uses: the vertex and face elements, the slots of `x`, `y`,
+/// `z` among the vertex properties and of the index list among the face properties.
+struct Layout {
+    vertex_element: usize,
+    face_element: usize,
+    xyz_slots: [usize; 3],
+    index_slot: usize,
+    vertex_count: u64,
+}
+
+impl Layout {
+    /// The layout of `header`, or why this reader cannot use it (`Unsupported`).
+    fn of(header: &Header, file: &str) -> Result<Layout, MeshError> {
+        let unsupported = |detail: String| MeshError::Unsupported {
+            file: file.to_owned(),
+            detail,
+        };
+        let element = |name: &str| header.elements.iter().position(|e| e.name == name);
+        let vertex_element =
+            element("vertex").ok_or_else(|| unsupported("no \"vertex\" element".into()))?;
+        let face_element = element("face").ok_or_else(|| {
+            unsupported("no \"face\" element: point clouds are not meshes".into())
+        })?;
+        let mut xyz_slots = [0; 3];
+        for (slot, axis) in xyz_slots.iter_mut().zip(["x", "y", "z"]) {
+            *slot = header.elements[vertex_element]
+                .properties
+                .iter()
+                .position(|p| p.name == axis && matches!(p.kind, Kind::Scalar(_)))
+                .ok_or_else(|| {
+                    unsupported(format!("vertex element has no scalar property {axis:?}"))
+                })?;
+        }
+        let index_slot = header.elements[face_element]
+            .properties
+            .iter()
+            .position(|p| {
+                (p.name == "vertex_indices" || p.name == "vertex_index")
+                    && matches!(p.kind, Kind::List { .. })
+            })
+            .ok_or_else(|| {
+                unsupported(
+                    "face element has no \"vertex_indices\" or \"vertex_index\" list".into(),
+                )
+            })?;
+        if let Kind::List { item, .. } = header.elements[face_element].properties[index_slot].kind
+            && !item.is_integer()
+        {
+            return Err(unsupported(
+                "face vertex list must use an integer index type".into(),
+            ));
+        }
+        let vertex_count = header.elements[vertex_element].count;
+        if vertex_count > u64::from(u32::MAX) {
+            return Err(unsupported(format!("more than {} vertices", u32::MAX)));
+        }
+        Ok(Layout {
+            vertex_element,
+            face_element,
+            xyz_slots,
+            index_slot,
+            vertex_count,
+        })
+    }
+
+    /// The vertex position among one vertex entry's `values` (all finite).
+    fn position(&self, values: &[Real], file: &str, at: Position) -> Result<Vec3, MeshError> {
+        let mut xyz = [0.0; 3];
+        for (k, (&slot, axis)) in self.xyz_slots.iter().zip(['x', 'y', 'z']).enumerate() {
+            let value = values[slot];
+            if !value.is_finite() {
+                return Err(MeshError::NonFiniteCoordinate {
+                    file: file.to_owned(),
+                    position: at,
+                    axis,
+                    value,
+                });
+            }
+            xyz[k] = value;
+        }
+        Ok(Vec3::from_array(xyz))
+    }
+}
+
+/// What reading one entry fills: each property's value (a list's length for a list), the
+/// face's vertex indices when the entry is a face, and the entry's position for errors.
+struct Entry<'a> {
+    values: &'a mut Vec<Real>,
+    face: &'a mut Vec<u32>,
+    at: &'a Position,
 }
 
 /// The header through bt-formats' one PLY grammar; its errors keep this reader's variants: an
@@ -239,6 +241,56 @@ impl Reader<'_> {
             }
             self.pos += 1;
         }
+    }
+
+    /// Reads one entry of `element`; the list in slot `indices` (the face's vertex indices)
+    /// is collected into `entry.face`, each index checked against `vertex_count`.
+    fn entry(
+        &mut self,
+        element: &bt_formats::PlyElement,
+        indices: Option<usize>,
+        vertex_count: u64,
+        entry: Entry<'_>,
+    ) -> Result<(), MeshError> {
+        let Entry { values, face, at } = entry;
+        values.clear();
+        for (slot, property) in element.properties.iter().enumerate() {
+            match property.kind {
+                Kind::Scalar(s) => values.push(self.read(s, &property.name, at)?),
+                Kind::List { count, item } => {
+                    let n = self.read(count, &property.name, at)?;
+                    if n < 0.0 {
+                        return Err(MeshError::Syntax {
+                            file: self.file.to_owned(),
+                            position: at.clone(),
+                            detail: format!("list {:?} has negative length {n}", property.name),
+                        });
+                    }
+                    let collect = indices == Some(slot);
+                    if collect {
+                        face.clear();
+                    }
+                    // No reservation by `n`: every read consumes input, so a huge count
+                    // ends in a truncation error, not an allocation.
+                    for _ in 0..n as u64 {
+                        let v = self.read(item, &property.name, at)?;
+                        if collect {
+                            if v < 0.0 || v >= vertex_count as Real {
+                                return Err(MeshError::IndexOutOfRange {
+                                    file: self.file.to_owned(),
+                                    position: at.clone(),
+                                    index: v as i64,
+                                    vertex_count: vertex_count as usize,
+                                });
+                            }
+                            face.push(v as u32);
+                        }
+                    }
+                    values.push(n);
+                }
+            }
+        }
+        Ok(())
     }
 
     /// One scalar of type `ty` as f64 (exact for every PLY integer type).
