@@ -320,17 +320,7 @@ fn layout(fields: &[Field], data_line: usize) -> Result<Layout, PointCloudError>
             other => Ok(other),
         }
     };
-    let mut xyz = [0usize; 3];
-    for (k, name) in ["x", "y", "z"].into_iter().enumerate() {
-        xyz[k] = find(name)?.ok_or_else(|| PointCloudError::MissingField {
-            origin: Origin(None),
-            field: name.into(),
-        })?;
-    }
-    let normal = match (find("normal_x")?, find("normal_y")?, find("normal_z")?) {
-        (Some(a), Some(b), Some(c)) => Some([a, b, c]),
-        _ => None,
-    };
+    let (xyz, normal) = super::point_columns(find, ["normal_x", "normal_y", "normal_z"])?;
 
     Ok(Layout {
         col,
@@ -487,24 +477,9 @@ pub fn write_pcd<W: Write>(
         n = cloud.len(),
     );
     w.write_all(head.as_bytes()).map_err(io_err)?;
-    let mut buf = Vec::with_capacity(64);
-    for (i, p) in cloud.points().iter().enumerate() {
-        buf.clear();
-        let mut vals = vec![p.x, p.y, p.z];
-        if let Some(ns) = cloud.normals() {
-            vals.extend([ns[i].x, ns[i].y, ns[i].z]);
-        }
-        match data {
-            PcdData::Ascii => {
-                let s: Vec<String> = vals.iter().map(|v| format!("{v:?}")).collect();
-                buf.extend_from_slice(s.join(" ").as_bytes());
-                buf.push(b'\n');
-            }
-            PcdData::Binary => vals
-                .iter()
-                .for_each(|v| buf.extend_from_slice(&v.to_le_bytes())),
-        }
-        w.write_all(&buf).map_err(io_err)?;
-    }
-    Ok(())
+    let encoding = match data {
+        PcdData::Ascii => super::Encoding::Ascii,
+        PcdData::Binary => super::Encoding::LittleEndian,
+    };
+    super::write_records(cloud, &mut w, encoding)
 }

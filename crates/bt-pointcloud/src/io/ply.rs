@@ -50,17 +50,7 @@ pub fn parse_ply(bytes: &[u8], opts: &ReadOptions) -> Result<LoadedCloud, PointC
             other => Ok(other),
         }
     };
-    let mut xyz = [0usize; 3];
-    for (k, name) in ["x", "y", "z"].into_iter().enumerate() {
-        xyz[k] = find(name)?.ok_or_else(|| PointCloudError::MissingField {
-            origin: Origin(None),
-            field: name.to_string(),
-        })?;
-    }
-    let normal_idx = match (find("nx")?, find("ny")?, find("nz")?) {
-        (Some(a), Some(b), Some(c)) => Some([a, b, c]),
-        _ => None,
-    };
+    let (xyz, normal_idx) = super::point_columns(find, ["nx", "ny", "nz"])?;
 
     // Check every claim up to the vertex element against the byte length before allocating.
     let available = bytes.len() - h.body_start;
@@ -252,26 +242,10 @@ pub fn write_ply<W: Write>(
     }
     head.push_str("end_header\n");
     w.write_all(head.as_bytes()).map_err(io_err)?;
-    let mut buf = Vec::with_capacity(64);
-    for (i, p) in cloud.points().iter().enumerate() {
-        buf.clear();
-        let mut vals = vec![p.x, p.y, p.z];
-        if let Some(ns) = cloud.normals() {
-            vals.extend([ns[i].x, ns[i].y, ns[i].z]);
-        }
-        let all = vals.iter();
-        match format {
-            PlyFormat::Ascii => {
-                let s: Vec<String> = all.map(|v| format!("{v:?}")).collect();
-                buf.extend_from_slice(s.join(" ").as_bytes());
-                buf.push(b'\n');
-            }
-            PlyFormat::BinaryLittleEndian => {
-                all.for_each(|v| buf.extend_from_slice(&v.to_le_bytes()))
-            }
-            PlyFormat::BinaryBigEndian => all.for_each(|v| buf.extend_from_slice(&v.to_be_bytes())),
-        }
-        w.write_all(&buf).map_err(io_err)?;
-    }
-    Ok(())
+    let encoding = match format {
+        PlyFormat::Ascii => super::Encoding::Ascii,
+        PlyFormat::BinaryLittleEndian => super::Encoding::LittleEndian,
+        PlyFormat::BinaryBigEndian => super::Encoding::BigEndian,
+    };
+    super::write_records(cloud, &mut w, encoding)
 }
