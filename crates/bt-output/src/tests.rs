@@ -16,14 +16,20 @@ fn listing(dir: &Path) -> Vec<String> {
     v
 }
 
+/// `file` holds `content` and is the only entry of its directory (no temporary file left).
+fn assert_alone(file: &Path, content: &[u8]) {
+    assert_eq!(std::fs::read(file).unwrap(), content);
+    let name = file.file_name().unwrap().to_string_lossy();
+    assert_eq!(listing(file.parent().unwrap()), [name]);
+}
+
 #[test]
 fn atomic_write_replaces_and_leaves_no_temporary() {
     let dir = scratch("atomic");
     let f = dir.join("a.json");
     write_atomic(&f, b"one").unwrap();
     write_atomic(&f, b"two").unwrap();
-    assert_eq!(std::fs::read(&f).unwrap(), b"two");
-    assert_eq!(listing(&dir), ["a.json"]);
+    assert_alone(&f, b"two");
 }
 
 #[test]
@@ -36,8 +42,7 @@ fn failed_fill_keeps_the_old_file() {
         Err(OutputError::BadRelative("simulated".into()))
     });
     assert!(r.is_err());
-    assert_eq!(std::fs::read(&f).unwrap(), b"old");
-    assert_eq!(listing(&dir), ["a.csv"]);
+    assert_alone(&f, b"old");
 }
 
 #[test]
@@ -52,8 +57,7 @@ fn path_writer_sees_the_extension_and_a_failure_keeps_the_old_file() {
         Err(OutputError::BadRelative("simulated".into()))
     });
     assert!(r.is_err());
-    assert_eq!(std::fs::read(&f).unwrap(), b"old");
-    assert_eq!(listing(&dir), ["fig.png"]);
+    assert_alone(&f, b"old");
     write_atomic_via(&f, |tmp| {
         std::fs::write(tmp, b"new").map_err(|e| OutputError::Io {
             path: tmp.display().to_string(),
@@ -61,8 +65,7 @@ fn path_writer_sees_the_extension_and_a_failure_keeps_the_old_file() {
         })
     })
     .unwrap();
-    assert_eq!(std::fs::read(&f).unwrap(), b"new");
-    assert_eq!(listing(&dir), ["fig.png"]);
+    assert_alone(&f, b"new");
 }
 
 #[test]
