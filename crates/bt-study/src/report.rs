@@ -203,9 +203,18 @@ pub fn ratios(results: &StudyResults) -> Ratios {
 /// `summary.md`: settings, per-solver totals, the paper's conclusions as measured ratios, and
 /// a breakdown by shape.
 pub fn summary(results: &StudyResults) -> String {
+    let mut s = String::new();
+    summary_settings(&mut s, results);
+    summary_per_solver(&mut s, results);
+    summary_ratios(&mut s, results);
+    summary_by_shape(&mut s, results);
+    s
+}
+
+/// The title and the settings of the run.
+fn summary_settings(s: &mut String, results: &StudyResults) {
     let c = &results.config;
     let sbr = c.sbr_options();
-    let mut s = String::new();
     let _ = writeln!(s, "# 2-D validation study\n");
     let _ = writeln!(
         s,
@@ -226,6 +235,10 @@ pub fn summary(results: &StudyResults) -> String {
         sbr.ray_count(),
         sbr.capture_factor(),
     );
+}
+
+/// The per-solver totals table.
+fn summary_per_solver(s: &mut String, results: &StudyResults) {
     let _ = writeln!(s, "## Per solver\n");
     let _ = writeln!(
         s,
@@ -249,6 +262,10 @@ pub fn summary(results: &StudyResults) -> String {
             t.median_time_s * 1e3
         );
     }
+}
+
+/// The paper's conclusions as measured ratios.
+fn summary_ratios(s: &mut String, results: &StudyResults) {
     let r = ratios(results);
     let _ = writeln!(s, "\n## The paper's conclusions, measured\n");
     let _ = writeln!(s, "| quantity | measured | paper (Figs. 6-7) |");
@@ -284,6 +301,10 @@ pub fn summary(results: &StudyResults) -> String {
         r.sbr_over_ipc_error,
         r.sbr_over_ipc_error.log10()
     );
+}
+
+/// The per-shape table (image, IPC and SBR side by side).
+fn summary_by_shape(s: &mut String, results: &StudyResults) {
     let _ = writeln!(s, "\n## By shape\n");
     let _ = writeln!(
         s,
@@ -313,5 +334,4 @@ pub fn summary(results: &StudyResults) -> String {
             ms(sbr)
         );
     }
-    s
 }
