@@ -77,12 +77,8 @@ pub struct StudyLivingRoomArgs {
     /// SBR grid step over the whole sphere, degrees (the paper: 1, i.e. 64,800 rays).
     #[arg(long, default_value_t = 1.0)]
     pub sbr_step_deg: f64,
-    /// Budget: refuse an SBR grid of more rays than this.
-    #[arg(long, default_value_t = bt_solve::sbr::DEFAULT_MAX_RAYS)]
-    pub max_rays: u64,
-    /// Budget: stop before the work rather than enumerate more candidates than this.
-    #[arg(long, default_value_t = bt_solve::pipeline::DEFAULT_MAX_CANDIDATES)]
-    pub max_candidates: u64,
+    #[command(flatten)]
+    pub budgets: StudyBudgetArgs,
     /// Highest reflection order.
     #[arg(long, default_value_t = 3)]
     pub max_order: usize,
@@ -109,6 +105,17 @@ pub struct StudyLivingRoomArgs {
     pub max_rounds: u32,
 }
 
+/// The budgets both studies check before any work.
+#[derive(Debug, Args, Clone)]
+pub struct StudyBudgetArgs {
+    /// Budget: refuse an SBR grid of more rays than this.
+    #[arg(long, default_value_t = bt_solve::sbr::DEFAULT_MAX_RAYS)]
+    pub max_rays: u64,
+    /// Budget: stop before the work rather than enumerate more candidates than this.
+    #[arg(long, default_value_t = bt_solve::pipeline::DEFAULT_MAX_CANDIDATES)]
+    pub max_candidates: u64,
+}
+
 #[derive(Debug, Args, Clone)]
 pub struct Study2dArgs {
     /// Number of rooms (shapes cycle L, T, U, convex: 100 gives 25 of each, as Table I).
@@ -126,12 +133,8 @@ pub struct Study2dArgs {
     /// SBR angular step, degrees (the paper: 1).
     #[arg(long, default_value_t = 1.0)]
     pub sbr_step_deg: f64,
-    /// Budget: refuse an SBR grid of more rays than this.
-    #[arg(long, default_value_t = bt_solve::sbr::DEFAULT_MAX_RAYS)]
-    pub max_rays: u64,
-    /// Budget: stop before the work rather than enumerate more candidates than this.
-    #[arg(long, default_value_t = bt_solve::pipeline::DEFAULT_MAX_CANDIDATES)]
-    pub max_candidates: u64,
+    #[command(flatten)]
+    pub budgets: StudyBudgetArgs,
     /// Launch SBR rays over the whole sphere (azimuth × elevation grid) instead of only in the
     /// plane of the room.
     #[arg(long)]

@@ -218,7 +218,7 @@ pub fn run_beams(args: &BeamsArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-fn print_beams(doc: &BeamsDocument, top: usize) {
+fn print_beams(doc: &BeamsDocument<'_>, top: usize) {
     let dir = |d: &Option<bt_beams::Direction>| {
         d.map_or_else(
             || "invisible".to_string(),

@@ -24,7 +24,7 @@ pub fn run_2d(args: &Study2dArgs) -> anyhow::Result<ExitCode> {
     }
     let sbr = bt_solve::SbrOptions::grid(args.sbr_step_deg);
     let sbr = if args.sbr_sphere { sbr } else { sbr.planar() };
-    if let Some(problem) = sbr.over_budget(args.max_rays) {
+    if let Some(problem) = sbr.over_budget(args.budgets.max_rays) {
         anyhow::bail!("{problem}");
     }
     // indicatif draws to stderr and hides itself when stderr is not a terminal.
@@ -82,12 +82,13 @@ pub fn run_living_room(args: &StudyLivingRoomArgs) -> anyhow::Result<ExitCode> {
         merge_distance: 1e-3,
         material: Default::default(),
     })?;
-    if let Some(problem) = bt_solve::SbrOptions::grid(args.sbr_step_deg).over_budget(args.max_rays)
+    if let Some(problem) =
+        bt_solve::SbrOptions::grid(args.sbr_step_deg).over_budget(args.budgets.max_rays)
     {
         anyhow::bail!("{problem}");
     }
     for step in scene.scenes() {
-        bt_solve::pipeline::exhaustive_budget(step, args.max_order, args.max_candidates)?;
+        bt_solve::pipeline::exhaustive_budget(step, args.max_order, args.budgets.max_candidates)?;
     }
     let bar = ProgressBar::new(scene.len() as u64);
     bar.set_style(

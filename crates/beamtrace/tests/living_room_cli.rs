@@ -49,18 +49,22 @@ fn study_living_room_writes_consistent_csv_and_figures() {
     let dir = tmp("study");
     let scene = short_living_room(&dir, 2);
     let out = dir.join("out");
-    let (ok, stdout, stderr) = beamtrace(&[
-        "study",
-        "living-room",
-        "--out",
-        out.to_str().unwrap(),
-        "--steps-from",
-        &scene,
-        "--sbr-step-deg",
-        "5",
-        "--max-order",
-        "2",
-    ]);
+    // The short study into `out` (a fast SBR and order 2).
+    let study = |out: &Path| {
+        beamtrace(&[
+            "study",
+            "living-room",
+            "--out",
+            out.to_str().unwrap(),
+            "--steps-from",
+            &scene,
+            "--sbr-step-deg",
+            "5",
+            "--max-order",
+            "2",
+        ])
+    };
+    let (ok, stdout, stderr) = study(&out);
     assert!(ok, "{stdout}{stderr}");
     assert!(stdout.contains("FPGA IPC error"), "{stdout}");
 
@@ -176,18 +180,7 @@ fn study_living_room_writes_consistent_csv_and_figures() {
     }
     // Deterministic except the times: a second run gives the same errors and cycles.
     let out2 = dir.join("out2");
-    let (ok, stdout, stderr) = beamtrace(&[
-        "study",
-        "living-room",
-        "--out",
-        out2.to_str().unwrap(),
-        "--steps-from",
-        &scene,
-        "--sbr-step-deg",
-        "5",
-        "--max-order",
-        "2",
-    ]);
+    let (ok, stdout, stderr) = study(&out2);
     assert!(ok, "{stdout}{stderr}");
     let strip_times = |text: &str| -> Vec<String> {
         text.lines()

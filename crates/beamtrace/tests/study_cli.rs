@@ -8,6 +8,17 @@ fn beamtrace() -> Command {
     Command::new(env!("CARGO_BIN_EXE_beamtrace"))
 }
 
+/// Runs `command` and asserts it succeeded (its stderr as the message).
+fn succeed(command: &mut Command) -> std::process::Output {
+    let run = command.output().unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    run
+}
+
 fn temp_dir(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("beamtrace-{name}-{}", std::process::id()));
     let _ = std::fs::remove_dir_all(&dir);
@@ -17,27 +28,22 @@ fn temp_dir(name: &str) -> PathBuf {
 #[test]
 fn study_2d_writes_csv_summary_and_figures() {
     let out = temp_dir("study");
-    let run = beamtrace()
-        .args([
-            "study",
-            "2d",
-            "--rooms",
-            "4",
-            "--steps",
-            "2",
-            "--sbr-step-deg",
-            "2",
-            "--seed",
-            "5",
-        ])
-        .arg("--out")
-        .arg(&out)
-        .output()
-        .unwrap();
-    assert!(
-        run.status.success(),
-        "{}",
-        String::from_utf8_lossy(&run.stderr)
+    let run = succeed(
+        beamtrace()
+            .args([
+                "study",
+                "2d",
+                "--rooms",
+                "4",
+                "--steps",
+                "2",
+                "--sbr-step-deg",
+                "2",
+                "--seed",
+                "5",
+            ])
+            .arg("--out")
+            .arg(&out),
     );
     let stdout = String::from_utf8_lossy(&run.stdout);
     assert!(stdout.contains("seed 5"), "{stdout}");
@@ -79,17 +85,12 @@ fn trace_with_sbr_on_a_scene_file() {
     )
     .unwrap();
     let json = |extra: &[&str]| {
-        let run = beamtrace()
-            .arg("trace")
-            .arg(&scene)
-            .args(["--max-order", "2", "--json"])
-            .args(extra)
-            .output()
-            .unwrap();
-        assert!(
-            run.status.success(),
-            "{}",
-            String::from_utf8_lossy(&run.stderr)
+        let run = succeed(
+            beamtrace()
+                .arg("trace")
+                .arg(&scene)
+                .args(["--max-order", "2", "--json"])
+                .args(extra),
         );
         serde_json::from_slice::<serde_json::Value>(&run.stdout).unwrap()
     };

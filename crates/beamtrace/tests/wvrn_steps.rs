@@ -87,15 +87,18 @@ fn wvrn_dot_and_json_describe_the_same_graph() {
 
 #[test]
 fn trace_steps_json_and_jsonl() {
-    let doc: serde_json::Value = serde_json::from_str(&beamtrace(&[
-        "trace",
-        "builtin:living-room-dynamic",
-        "--steps",
-        "--max-order",
-        "2",
-        "--json",
-    ]))
-    .unwrap();
+    // `trace --steps` of the dynamic living room at order 2, then `extra`.
+    let trace = |extra: &[&str]| {
+        let steps = [
+            "trace",
+            "builtin:living-room-dynamic",
+            "--steps",
+            "--max-order",
+            "2",
+        ];
+        beamtrace(&[&steps[..], extra].concat())
+    };
+    let doc: serde_json::Value = serde_json::from_str(&trace(&["--json"])).unwrap();
     let steps = doc["steps"].as_array().unwrap();
     assert_eq!(steps.len(), 10);
     for (k, s) in steps.iter().enumerate() {
@@ -113,30 +116,15 @@ fn trace_steps_json_and_jsonl() {
             .any(|p| p["order"] == 0)
     };
     assert!(los(&steps[0]) && !los(&steps[2]) && !los(&steps[3]) && los(&steps[4]));
-    let lines = beamtrace(&[
-        "trace",
-        "builtin:living-room-dynamic",
-        "--steps",
-        "--max-order",
-        "2",
-        "--jsonl",
-    ]);
+    let lines = trace(&["--jsonl"]);
     let lines: Vec<serde_json::Value> = lines
         .lines()
         .map(|l| serde_json::from_str(l).unwrap())
         .collect();
     assert_eq!(lines.len(), 10);
     // From scratch gives the same paths as the incremental default.
-    let scratch: serde_json::Value = serde_json::from_str(&beamtrace(&[
-        "trace",
-        "builtin:living-room-dynamic",
-        "--steps",
-        "--max-order",
-        "2",
-        "--json",
-        "--from-scratch",
-    ]))
-    .unwrap();
+    let scratch: serde_json::Value =
+        serde_json::from_str(&trace(&["--json", "--from-scratch"])).unwrap();
     for k in 0..10 {
         assert_eq!(scratch["steps"][k]["paths"], steps[k]["paths"], "step {k}");
     }

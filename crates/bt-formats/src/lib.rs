@@ -2,11 +2,16 @@
 //! numeric scalar types, their spellings in PLY headers (`float`, `uchar`, `int32`, ...) and in
 //! PCD headers (`TYPE` letter + `SIZE`), their sizes, and exact decoding of one binary value.
 //!
-//! No I/O and no error type: the readers own their headers' grammar and their error messages
-//! (file, line, element), this crate only answers "which type is this, how many bytes, what
-//! value". Values decode to `f64` exactly (every PLY/PCD type up to 32 bits is exact in f64;
+//! [`ply`] holds the one PLY header grammar both readers parse with ([`PlyHeader::parse`]); its
+//! [`PlyHeaderError`] names the line and the offending text, and each reader wraps it into its
+//! own error type (file name, variant). No I/O. Values decode to `f64` exactly (every PLY/PCD type up to 32 bits is exact in f64;
 //! 64-bit integers round to the nearest f64).
 #![warn(missing_docs)]
+
+pub mod ply;
+pub use ply::{
+    PlyElement, PlyHeader, PlyHeaderError, PlyHeaderErrorKind, PlyProperty, PlyPropertyKind,
+};
 
 /// A numeric scalar type of PLY or PCD.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

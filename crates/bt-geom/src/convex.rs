@@ -132,18 +132,7 @@ pub fn is_convex(polygon: &Polygon) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    fn l_shape() -> Polygon {
-        Polygon::new(vec![
-            Vec3::new(0., 0., 0.),
-            Vec3::new(2., 0., 0.),
-            Vec3::new(2., 1., 0.),
-            Vec3::new(1., 1., 0.),
-            Vec3::new(1., 2., 0.),
-            Vec3::new(0., 2., 0.),
-        ])
-        .unwrap()
-    }
+    use crate::fixtures::l_shape;
 
     #[test]
     fn grown_hull_contains_the_polygon_band_and_is_convex() {

@@ -11,6 +11,9 @@ pub mod poly2;
 pub mod polygon;
 pub mod tol;
 
+#[cfg(test)]
+mod fixtures;
+
 pub use bvh::{Bvh, Occluder};
 pub use plane::{Plane, Side};
 pub use polygon::{Polygon, PolygonError};

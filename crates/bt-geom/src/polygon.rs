@@ -345,15 +345,7 @@ mod tests {
     #[test]
     fn concave_polygon_inside_test() {
         // An L: the notch at (1.5, 1.5) is outside.
-        let l = Polygon::new(vec![
-            Vec3::new(0., 0., 0.),
-            Vec3::new(2., 0., 0.),
-            Vec3::new(2., 1., 0.),
-            Vec3::new(1., 1., 0.),
-            Vec3::new(1., 2., 0.),
-            Vec3::new(0., 2., 0.),
-        ])
-        .unwrap();
+        let l = crate::fixtures::l_shape();
         assert!((l.area() - 3.0).abs() < 1e-12);
         assert!(l.contains(Vec3::new(0.5, 1.5, 0.), 1e-9));
         assert!(!l.contains(Vec3::new(1.5, 1.5, 0.), 1e-9));

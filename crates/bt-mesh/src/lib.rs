@@ -134,9 +134,7 @@ pub fn read_obj(
     file: Option<&str>,
     opts: &MergeOptions,
 ) -> Result<MeshImport, MeshError> {
-    opts.validate()?;
-    let file = file.unwrap_or(UNNAMED);
-    finish(obj::parse(bytes, file)?, opts, file)
+    read(bytes, MeshFormat::Obj, file, opts)
 }
 
 /// Reads a PLY mesh (ASCII, binary little or big endian) from bytes and merges its faces into
@@ -146,9 +144,32 @@ pub fn read_ply(
     file: Option<&str>,
     opts: &MergeOptions,
 ) -> Result<MeshImport, MeshError> {
-    opts.validate()?;
+    read(bytes, MeshFormat::Ply, file, opts)
+}
+
+/// [`read_obj`] or [`read_ply`] by `format`.
+fn read(
+    bytes: &[u8],
+    format: MeshFormat,
+    file: Option<&str>,
+    opts: &MergeOptions,
+) -> Result<MeshImport, MeshError> {
     let file = file.unwrap_or(UNNAMED);
-    finish(ply::parse(bytes, file)?, opts, file)
+    finish(parse(bytes, format, file, opts)?, opts, file)
+}
+
+/// Checks `opts` and parses `bytes` as `format` into the polygon soup the merge starts from.
+fn parse(
+    bytes: &[u8],
+    format: MeshFormat,
+    file: &str,
+    opts: &MergeOptions,
+) -> Result<raw::RawMesh, MeshError> {
+    opts.validate()?;
+    match format {
+        MeshFormat::Obj => obj::parse(bytes, file),
+        MeshFormat::Ply => ply::parse(bytes, file),
+    }
 }
 
 /// Mesh file formats, for callers that choose the reader themselves.
@@ -171,12 +192,8 @@ pub fn read_transformed(
     opts: &MergeOptions,
     to_world: &dyn Fn(Vec3) -> Vec3,
 ) -> Result<MeshImport, MeshError> {
-    opts.validate()?;
     let file = file.unwrap_or(UNNAMED);
-    let mut raw = match format {
-        MeshFormat::Obj => obj::parse(bytes, file)?,
-        MeshFormat::Ply => ply::parse(bytes, file)?,
-    };
+    let mut raw = parse(bytes, format, file, opts)?;
     for (vertex, p) in raw.positions.iter_mut().enumerate() {
         *p = to_world(*p);
         if !p.is_finite() {

@@ -418,7 +418,8 @@ struct Traced {
     zero_loops: usize,
 }
 
-fn trace_group(faces: &[Face], group: &Group, points: &[Vec3], zero_length: Real) -> Traced {
+/// The area-weighted normal and centroid of a group's faces.
+fn group_plane(faces: &[Face], group: &Group) -> (Vec3, Vec3) {
     let mut normal_sum = Vec3::ZERO;
     let mut centroid_sum = Vec3::ZERO;
     let mut area_sum = 0.0;
@@ -427,16 +428,12 @@ fn trace_group(faces: &[Face], group: &Group, points: &[Vec3], zero_length: Real
         centroid_sum += faces[f].centroid * faces[f].area;
         area_sum += faces[f].area;
     }
-    let normal = normal_sum.normalize();
-    let origin = centroid_sum / area_sum;
-    let u = normal.any_orthonormal_vector();
-    let v = normal.cross(u);
-    let project = |id: u32| {
-        let d = points[id as usize] - origin;
-        Vec2::new(d.dot(u), d.dot(v))
-    };
+    (normal_sum.normalize(), centroid_sum / area_sum)
+}
 
-    // Directed half-edges in face order; boundary = undirected edge used once in the group.
+/// The group's boundary as directed edges `(from, to)` in face order: the half-edges whose
+/// undirected edge the group uses once.
+fn boundary_edges(faces: &[Face], group: &Group) -> Vec<(u32, u32)> {
     let mut half: Vec<(u64, u32, u32)> = Vec::new();
     for &f in &group.faces {
         let vs = &faces[f].vertices;
@@ -453,12 +450,22 @@ fn trace_group(faces: &[Face], group: &Group, points: &[Vec3], zero_length: Real
             is_boundary[run[0]] = true;
         }
     }
-    let boundary: Vec<(u32, u32)> = half
-        .iter()
+    half.iter()
         .zip(&is_boundary)
         .filter(|(_, b)| **b)
         .map(|(&(_, a, b), _)| (a, b))
-        .collect();
+        .collect()
+}
+
+fn trace_group(faces: &[Face], group: &Group, points: &[Vec3], zero_length: Real) -> Traced {
+    let (normal, origin) = group_plane(faces, group);
+    let u = normal.any_orthonormal_vector();
+    let v = normal.cross(u);
+    let project = |id: u32| {
+        let d = points[id as usize] - origin;
+        Vec2::new(d.dot(u), d.dot(v))
+    };
+    let boundary = boundary_edges(faces, group);
     let mut outgoing: HashMap<u32, Vec<usize>> = HashMap::new();
     for (h, &(a, _)) in boundary.iter().enumerate() {
         outgoing.entry(a).or_default().push(h);

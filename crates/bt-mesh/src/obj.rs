@@ -27,12 +27,6 @@ pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
     let mut unknown: BTreeSet<String> = BTreeSet::new();
     let mut face: Vec<u32> = Vec::new();
 
-    let syntax = |line: usize, detail: String| MeshError::Syntax {
-        file: file.to_owned(),
-        position: Position::Line(line),
-        detail,
-    };
-
     for (line_no, text) in logical_lines(bytes) {
         let text = match text.find('#') {
             Some(i) => &text[..i],
@@ -42,69 +36,23 @@ pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
         let Some(keyword) = tokens.next() else {
             continue;
         };
+        let at = Line {
+            file,
+            line: line_no,
+        };
         match keyword {
             "v" => {
-                let mut xyz = [0.0f64; 3];
-                for (k, axis) in ['x', 'y', 'z'].into_iter().enumerate() {
-                    let token = tokens.next().ok_or_else(|| {
-                        syntax(line_no, format!("vertex has no {axis} coordinate"))
-                    })?;
-                    let value: Real = token.parse().map_err(|_| {
-                        syntax(
-                            line_no,
-                            format!("vertex {axis} coordinate {token:?} is not a number"),
-                        )
-                    })?;
-                    if !value.is_finite() {
-                        return Err(MeshError::NonFiniteCoordinate {
-                            file: file.to_owned(),
-                            position: Position::Line(line_no),
-                            axis,
-                            value,
-                        });
-                    }
-                    xyz[k] = value;
-                }
+                let position = at.vertex(tokens)?;
                 if mesh.positions.len() == u32::MAX as usize {
                     return Err(MeshError::Unsupported {
                         file: file.to_owned(),
                         detail: format!("more than {} vertices", u32::MAX),
                     });
                 }
-                mesh.positions.push(Vec3::from_array(xyz));
+                mesh.positions.push(position);
             }
             "f" => {
-                face.clear();
-                for token in tokens {
-                    let index = parse_reference(token)
-                        .map_err(|detail| syntax(line_no, format!("face {detail}")))?;
-                    let count = mesh.positions.len();
-                    let resolved = match index {
-                        0 => None,
-                        i if i > 0 => u32::try_from(i - 1).ok(),
-                        i => i64::try_from(count)
-                            .ok()
-                            .map(|c| c + i)
-                            .filter(|&r| r >= 0)
-                            .map(|r| r as u32),
-                    };
-                    let Some(resolved) = resolved else {
-                        return Err(MeshError::IndexOutOfRange {
-                            file: file.to_owned(),
-                            position: Position::Line(line_no),
-                            index,
-                            vertex_count: count,
-                        });
-                    };
-                    face.push(resolved);
-                }
-                if face.len() < 3 {
-                    return Err(MeshError::FaceTooSmall {
-                        file: file.to_owned(),
-                        position: Position::Line(line_no),
-                        count: face.len(),
-                    });
-                }
+                at.face(tokens, mesh.positions.len(), &mut face)?;
                 mesh.push_face(&face, group.or(object), material);
                 face_line.push(line_no);
             }
@@ -152,6 +100,88 @@ pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
         ));
     }
     Ok(mesh)
+}
+
+/// One statement's place, for its errors.
+struct Line<'a> {
+    file: &'a str,
+    line: usize,
+}
+
+impl Line<'_> {
+    fn syntax(&self, detail: String) -> MeshError {
+        MeshError::Syntax {
+            file: self.file.to_owned(),
+            position: Position::Line(self.line),
+            detail,
+        }
+    }
+
+    /// The position of a `v` statement from the tokens after `v` (finite x, y, z).
+    fn vertex<'t>(&self, mut tokens: impl Iterator<Item = &'t str>) -> Result<Vec3, MeshError> {
+        let mut xyz = [0.0f64; 3];
+        for (k, axis) in ['x', 'y', 'z'].into_iter().enumerate() {
+            let token = tokens
+                .next()
+                .ok_or_else(|| self.syntax(format!("vertex has no {axis} coordinate")))?;
+            let value: Real = token.parse().map_err(|_| {
+                self.syntax(format!(
+                    "vertex {axis} coordinate {token:?} is not a number"
+                ))
+            })?;
+            if !value.is_finite() {
+                return Err(MeshError::NonFiniteCoordinate {
+                    file: self.file.to_owned(),
+                    position: Position::Line(self.line),
+                    axis,
+                    value,
+                });
+            }
+            xyz[k] = value;
+        }
+        Ok(Vec3::from_array(xyz))
+    }
+
+    /// The 0-based vertex indices of an `f` statement into `face`, from the tokens after `f`;
+    /// negative (relative) references resolve against the `count` vertices read so far.
+    fn face<'t>(
+        &self,
+        tokens: impl Iterator<Item = &'t str>,
+        count: usize,
+        face: &mut Vec<u32>,
+    ) -> Result<(), MeshError> {
+        face.clear();
+        for token in tokens {
+            let index =
+                parse_reference(token).map_err(|detail| self.syntax(format!("face {detail}")))?;
+            let resolved = match index {
+                0 => None,
+                i if i > 0 => u32::try_from(i - 1).ok(),
+                i => i64::try_from(count)
+                    .ok()
+                    .map(|c| c + i)
+                    .filter(|&r| r >= 0)
+                    .map(|r| r as u32),
+            };
+            let Some(resolved) = resolved else {
+                return Err(MeshError::IndexOutOfRange {
+                    file: self.file.to_owned(),
+                    position: Position::Line(self.line),
+                    index,
+                    vertex_count: count,
+                });
+            };
+            face.push(resolved);
+        }
+        if face.len() < 3 {
+            return Err(MeshError::FaceTooSmall {
+                file: self.file.to_owned(),
+                position: Position::Line(self.line),
+                count: face.len(),
+            });
+        }
+        Ok(())
+    }
 }
 
 /// The vertex index of one `f` token (`v`, `v/vt`, `v//vn`, `v/vt/vn`); the other parts must be

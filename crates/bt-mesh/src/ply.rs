@@ -1,7 +1,8 @@
 //! PLY mesh reader (ASCII, binary little endian, binary big endian).
 //!
-//! The header is parsed here rather than by `ply-rs` so that every element count is checked
-//! against the body length before anything is allocated: a header claiming billions of vertices
+//! The header is parsed by bt-formats' PLY grammar (shared with bt-pointcloud) and the body
+//! here, rather than by `ply-rs`, so that every element count is checked against the body
+//! length before anything is allocated: a header claiming billions of vertices
 //! in a small file is an error, not an out-of-memory abort. Only `vertex` (`x`, `y`, `z` of any
 //! scalar type; other properties skipped) and `face` (`vertex_indices` or `vertex_index` list
 //! with integer count and index types; other properties skipped) are used; other elements are
@@ -11,109 +12,23 @@ use crate::error::{MeshError, Position};
 use crate::raw::RawMesh;
 use bt_geom::{Real, Vec3};
 
-use bt_formats::{PlyFormat as Format, Scalar};
-
-#[derive(Debug, Clone, Copy)]
-enum Kind {
-    Scalar(Scalar),
-    List { count: Scalar, item: Scalar },
-}
-
-#[derive(Debug)]
-struct Property {
-    name: String,
-    kind: Kind,
-}
-
-#[derive(Debug)]
-struct Element {
-    name: String,
-    count: u64,
-    properties: Vec<Property>,
-}
-
-impl Element {
-    /// Fewest body bytes one entry can occupy: binary scalars at their size and list counts
-    /// with zero items; in ASCII one character plus one separator per property.
-    fn min_bytes(&self, format: Format) -> u64 {
-        self.properties
-            .iter()
-            .map(|p| match (format, p.kind) {
-                (Format::Ascii, _) => 2,
-                (_, Kind::Scalar(s)) | (_, Kind::List { count: s, .. }) => s.size() as u64,
-            })
-            .sum()
-    }
-}
-
-struct Header {
-    format: Format,
-    elements: Vec<Element>,
-    /// Byte offset of the body.
-    body_start: usize,
-    /// Number of header lines (the body's first line is `lines + 1`).
-    lines: usize,
-}
+use bt_formats::{
+    PlyFormat as Format, PlyHeader as Header, PlyHeaderError, PlyHeaderErrorKind,
+    PlyPropertyKind as Kind, Scalar,
+};
 
 /// Parses PLY bytes into a validated polygon soup.
 pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
     let header = parse_header(bytes, file)?;
     let body = &bytes[header.body_start..];
     check_counts(&header, body.len() as u64, file)?;
-
-    let unsupported = |detail: String| MeshError::Unsupported {
-        file: file.to_owned(),
-        detail,
-    };
-    let vertex_element = header
-        .elements
-        .iter()
-        .position(|e| e.name == "vertex")
-        .ok_or_else(|| unsupported("no \"vertex\" element".into()))?;
-    let face_element = header
-        .elements
-        .iter()
-        .position(|e| e.name == "face")
-        .ok_or_else(|| unsupported("no \"face\" element: point clouds are not meshes".into()))?;
-    let xyz_slots: Vec<usize> = ["x", "y", "z"]
-        .iter()
-        .map(|axis| {
-            header.elements[vertex_element]
-                .properties
-                .iter()
-                .position(|p| p.name == *axis && matches!(p.kind, Kind::Scalar(_)))
-                .ok_or_else(|| {
-                    unsupported(format!("vertex element has no scalar property {axis:?}"))
-                })
-        })
-        .collect::<Result<_, _>>()?;
-    let index_slot = header.elements[face_element]
-        .properties
-        .iter()
-        .position(|p| {
-            (p.name == "vertex_indices" || p.name == "vertex_index")
-                && matches!(p.kind, Kind::List { .. })
-        })
-        .ok_or_else(|| {
-            unsupported("face element has no \"vertex_indices\" or \"vertex_index\" list".into())
-        })?;
-    if let Kind::List { item, .. } = header.elements[face_element].properties[index_slot].kind {
-        if !item.is_integer() {
-            return Err(unsupported(
-                "face vertex list must use an integer index type".into(),
-            ));
-        }
-    }
-    let vertex_count = header.elements[vertex_element].count;
-    if vertex_count > u64::from(u32::MAX) {
-        return Err(unsupported(format!("more than {} vertices", u32::MAX)));
-    }
+    let layout = Layout::of(&header, file)?;
 
     let mut mesh = RawMesh::new();
     // Counts were checked against the body length above, so these reservations are bounded by
     // the file size.
-    mesh.positions.reserve(vertex_count as usize);
-    let face_count = header.elements[face_element].count as usize;
+    mesh.positions.reserve(layout.vertex_count as usize);
+    let face_count = header.elements[layout.face_element].count as usize;
     mesh.face_start.reserve(face_count);
     mesh.indices.reserve(face_count.saturating_mul(3));
     mesh.face_name.reserve(face_count);
@@ -129,6 +44,7 @@ pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
     let mut values: Vec<Real> = Vec::new();
     let mut face: Vec<u32> = Vec::new();
     for (e, element) in header.elements.iter().enumerate() {
+        let indices = (e == layout.face_element).then_some(layout.index_slot);
         for index in 0..element.count {
             reader.skip_space();
             let start = Position::Element {
@@ -136,59 +52,15 @@ pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
                 index,
                 line: (header.format == Format::Ascii).then_some(reader.line),
             };
-            values.clear();
-            for (slot, property) in element.properties.iter().enumerate() {
-                match property.kind {
-                    Kind::Scalar(s) => values.push(reader.read(s, &property.name, &start)?),
-                    Kind::List { count, item } => {
-                        let n = reader.read(count, &property.name, &start)?;
-                        if n < 0.0 {
-                            return Err(MeshError::Syntax {
-                                file: file.to_owned(),
-                                position: start,
-                                detail: format!("list {:?} has negative length {n}", property.name),
-                            });
-                        }
-                        let collect = e == face_element && slot == index_slot;
-                        if collect {
-                            face.clear();
-                        }
-                        // No reservation by `n`: every read consumes input, so a huge count
-                        // ends in a truncation error, not an allocation.
-                        for _ in 0..n as u64 {
-                            let v = reader.read(item, &property.name, &start)?;
-                            if collect {
-                                if v < 0.0 || v >= vertex_count as Real {
-                                    return Err(MeshError::IndexOutOfRange {
-                                        file: file.to_owned(),
-                                        position: start,
-                                        index: v as i64,
-                                        vertex_count: vertex_count as usize,
-                                    });
-                                }
-                                face.push(v as u32);
-                            }
-                        }
-                        values.push(n);
-                    }
-                }
-            }
-            if e == vertex_element {
-                let mut xyz = [0.0; 3];
-                for (k, (&slot, axis)) in xyz_slots.iter().zip(['x', 'y', 'z']).enumerate() {
-                    let value = values[slot];
-                    if !value.is_finite() {
-                        return Err(MeshError::NonFiniteCoordinate {
-                            file: file.to_owned(),
-                            position: start,
-                            axis,
-                            value,
-                        });
-                    }
-                    xyz[k] = value;
-                }
-                mesh.positions.push(Vec3::from_array(xyz));
-            } else if e == face_element {
+            let entry = Entry {
+                values: &mut values,
+                face: &mut face,
+                at: &start,
+            };
+            reader.entry(element, indices, layout.vertex_count, entry)?;
+            if e == layout.vertex_element {
+                mesh.positions.push(layout.position(&values, file, start)?);
+            } else if e == layout.face_element {
                 if face.len() < 3 {
                     return Err(MeshError::FaceTooSmall {
                         file: file.to_owned(),
@@ -203,109 +75,117 @@ pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
     Ok(mesh)
 }
 
-fn parse_header(bytes: &[u8], file: &str) -> Result<Header, MeshError> {
-    let syntax = |line: usize, detail: String| MeshError::Syntax {
-        file: file.to_owned(),
-        position: Position::Line(line),
-        detail,
-    };
-    let mut pos = 0usize;
-    let mut line_no = 0usize;
-    let mut format = None;
-    let mut elements: Vec<Element> = Vec::new();
-    loop {
-        let Some(len) = bytes[pos..].iter().position(|&b| b == b'\n') else {
-            return Err(MeshError::Truncated {
-                file: file.to_owned(),
-                position: Position::Line(line_no + 1),
-                detail: "header has no end_header line".into(),
-            });
+/// Where the reader finds what it uses: the vertex and face elements, the slots of `x`, `y`,
+/// `z` among the vertex properties and of the index list among the face properties.
+struct Layout {
+    vertex_element: usize,
+    face_element: usize,
+    xyz_slots: [usize; 3],
+    index_slot: usize,
+    vertex_count: u64,
+}
+
+impl Layout {
+    /// The layout of `header`, or why this reader cannot use it (`Unsupported`).
+    fn of(header: &Header, file: &str) -> Result<Layout, MeshError> {
+        let unsupported = |detail: String| MeshError::Unsupported {
+            file: file.to_owned(),
+            detail,
         };
-        let raw = &bytes[pos..pos + len];
-        pos += len + 1;
-        line_no += 1;
-        let text = std::str::from_utf8(raw)
-            .map_err(|_| syntax(line_no, "header line is not text".into()))?
-            .trim_end_matches('\r');
-        let tokens: Vec<&str> = text.split_whitespace().collect();
-        if line_no == 1 {
-            if text.trim() != "ply" {
-                return Err(syntax(
-                    1,
-                    "not a PLY file: first line must be \"ply\"".into(),
-                ));
-            }
-            continue;
-        }
-        match tokens.as_slice() {
-            [] => {}
-            ["comment" | "obj_info", ..] => {}
-            ["format", kind, version] => {
-                if *version != "1.0" {
-                    return Err(MeshError::Unsupported {
-                        file: file.to_owned(),
-                        detail: format!("PLY format version {version}"),
-                    });
-                }
-                format = Some(
-                    Format::from_name(kind).ok_or_else(|| MeshError::Unsupported {
-                        file: file.to_owned(),
-                        detail: format!("PLY format {kind:?}"),
-                    })?,
-                );
-            }
-            ["element", name, count] => {
-                let count: u64 = count.parse().map_err(|_| {
-                    syntax(line_no, format!("element count {count:?} is not a count"))
+        let element = |name: &str| header.elements.iter().position(|e| e.name == name);
+        let vertex_element =
+            element("vertex").ok_or_else(|| unsupported("no \"vertex\" element".into()))?;
+        let face_element = element("face").ok_or_else(|| {
+            unsupported("no \"face\" element: point clouds are not meshes".into())
+        })?;
+        let mut xyz_slots = [0; 3];
+        for (slot, axis) in xyz_slots.iter_mut().zip(["x", "y", "z"]) {
+            *slot = header.elements[vertex_element]
+                .properties
+                .iter()
+                .position(|p| p.name == axis && matches!(p.kind, Kind::Scalar(_)))
+                .ok_or_else(|| {
+                    unsupported(format!("vertex element has no scalar property {axis:?}"))
                 })?;
-                elements.push(Element {
-                    name: (*name).to_owned(),
-                    count,
-                    properties: Vec::new(),
+        }
+        let index_slot = header.elements[face_element]
+            .properties
+            .iter()
+            .position(|p| {
+                (p.name == "vertex_indices" || p.name == "vertex_index")
+                    && matches!(p.kind, Kind::List { .. })
+            })
+            .ok_or_else(|| {
+                unsupported(
+                    "face element has no \"vertex_indices\" or \"vertex_index\" list".into(),
+                )
+            })?;
+        if let Kind::List { item, .. } = header.elements[face_element].properties[index_slot].kind
+            && !item.is_integer()
+        {
+            return Err(unsupported(
+                "face vertex list must use an integer index type".into(),
+            ));
+        }
+        let vertex_count = header.elements[vertex_element].count;
+        if vertex_count > u64::from(u32::MAX) {
+            return Err(unsupported(format!("more than {} vertices", u32::MAX)));
+        }
+        Ok(Layout {
+            vertex_element,
+            face_element,
+            xyz_slots,
+            index_slot,
+            vertex_count,
+        })
+    }
+
+    /// The vertex position among one vertex entry's `values` (all finite).
+    fn position(&self, values: &[Real], file: &str, at: Position) -> Result<Vec3, MeshError> {
+        let mut xyz = [0.0; 3];
+        for (k, (&slot, axis)) in self.xyz_slots.iter().zip(['x', 'y', 'z']).enumerate() {
+            let value = values[slot];
+            if !value.is_finite() {
+                return Err(MeshError::NonFiniteCoordinate {
+                    file: file.to_owned(),
+                    position: at,
+                    axis,
+                    value,
                 });
             }
-            ["property", rest @ ..] => {
-                let element = elements
-                    .last_mut()
-                    .ok_or_else(|| syntax(line_no, "property before any element".into()))?;
-                let scalar = |name: &str| {
-                    Scalar::from_ply_name(name)
-                        .ok_or_else(|| syntax(line_no, format!("unknown property type {name:?}")))
-                };
-                let property = match rest {
-                    ["list", count, item, name] => Property {
-                        name: (*name).to_owned(),
-                        kind: Kind::List {
-                            count: scalar(count)?,
-                            item: scalar(item)?,
-                        },
-                    },
-                    [ty, name] => Property {
-                        name: (*name).to_owned(),
-                        kind: Kind::Scalar(scalar(ty)?),
-                    },
-                    _ => return Err(syntax(line_no, format!("malformed property {text:?}"))),
-                };
-                if let Kind::List { count, .. } = property.kind {
-                    if !count.is_integer() {
-                        return Err(syntax(
-                            line_no,
-                            format!("list {:?} has a non-integer count type", property.name),
-                        ));
-                    }
-                }
-                element.properties.push(property);
-            }
-            ["end_header"] => break,
-            _ => return Err(syntax(line_no, format!("unexpected header line {text:?}"))),
+            xyz[k] = value;
         }
+        Ok(Vec3::from_array(xyz))
     }
-    let format = format.ok_or_else(|| syntax(line_no, "header has no format line".into()))?;
-    Ok(Header {
-        format,
-        elements,
-        body_start: pos,
-        lines: line_no,
+}
+
+/// What reading one entry fills: each property's value (a list's length for a list), the
+/// face's vertex indices when the entry is a face, and the entry's position for errors.
+struct Entry<'a> {
+    values: &'a mut Vec<Real>,
+    face: &'a mut Vec<u32>,
+    at: &'a Position,
+}
+
+/// The header through bt-formats' one PLY grammar; its errors keep this reader's variants: an
+/// encoding or version it cannot read is `Unsupported`, a missing `end_header` `Truncated`.
+fn parse_header(bytes: &[u8], file: &str) -> Result<Header, MeshError> {
+    Header::parse(bytes).map_err(|PlyHeaderError { line, kind }| {
+        let file = file.to_owned();
+        let detail = kind.to_string();
+        match kind {
+            k if k.is_unsupported() => MeshError::Unsupported { file, detail },
+            PlyHeaderErrorKind::NoEndHeader => MeshError::Truncated {
+                file,
+                position: Position::Line(line),
+                detail,
+            },
+            _ => MeshError::Syntax {
+                file,
+                position: Position::Line(line),
+                detail,
+            },
+        }
     })
 }
 
@@ -361,6 +241,56 @@ impl Reader<'_> {
             }
             self.pos += 1;
         }
+    }
+
+    /// Reads one entry of `element`; the list in slot `indices` (the face's vertex indices)
+    /// is collected into `entry.face`, each index checked against `vertex_count`.
+    fn entry(
+        &mut self,
+        element: &bt_formats::PlyElement,
+        indices: Option<usize>,
+        vertex_count: u64,
+        entry: Entry<'_>,
+    ) -> Result<(), MeshError> {
+        let Entry { values, face, at } = entry;
+        values.clear();
+        for (slot, property) in element.properties.iter().enumerate() {
+            match property.kind {
+                Kind::Scalar(s) => values.push(self.read(s, &property.name, at)?),
+                Kind::List { count, item } => {
+                    let n = self.read(count, &property.name, at)?;
+                    if n < 0.0 {
+                        return Err(MeshError::Syntax {
+                            file: self.file.to_owned(),
+                            position: at.clone(),
+                            detail: format!("list {:?} has negative length {n}", property.name),
+                        });
+                    }
+                    let collect = indices == Some(slot);
+                    if collect {
+                        face.clear();
+                    }
+                    // No reservation by `n`: every read consumes input, so a huge count
+                    // ends in a truncation error, not an allocation.
+                    for _ in 0..n as u64 {
+                        let v = self.read(item, &property.name, at)?;
+                        if collect {
+                            if v < 0.0 || v >= vertex_count as Real {
+                                return Err(MeshError::IndexOutOfRange {
+                                    file: self.file.to_owned(),
+                                    position: at.clone(),
+                                    index: v as i64,
+                                    vertex_count: vertex_count as usize,
+                                });
+                            }
+                            face.push(v as u32);
+                        }
+                    }
+                    values.push(n);
+                }
+            }
+        }
+        Ok(())
     }
 
     /// One scalar of type `ty` as f64 (exact for every PLY integer type).

@@ -2,8 +2,8 @@
 //!
 //! Rules (`docs/reliability.md`):
 //! - a file is written to a temporary file in its target directory and renamed over the
-//!   target ([`write_atomic`], [`write_atomic_with`]): a killed run leaves the old file or the
-//!   new one, never half of one;
+//!   target ([`write_atomic`], [`write_atomic_with`], [`write_atomic_via`]): a killed run
+//!   leaves the old file or the new one, never half of one;
 //! - an output directory is built aside in `DIR.tmp-<pid>-<n>` ([`OutputDir`]) and its files are
 //!   moved into `DIR` only when complete (the whole directory is renamed into place when `DIR`
 //!   does not exist yet); a failed run leaves `DIR` as it was and removes its staging directory;
@@ -96,25 +96,38 @@ pub fn write_atomic_with<E: From<OutputError>>(
     path: &Path,
     fill: impl FnOnce(&mut BufWriter<File>) -> Result<(), E>,
 ) -> Result<(), E> {
+    write_atomic_via(path, |tmp| {
+        let file = File::create(tmp).map_err(io(path))?;
+        let mut w = BufWriter::new(file);
+        fill(&mut w)?;
+        let file = w.into_inner().map_err(|e| io(path)(e.into_error()))?;
+        file.sync_all().map_err(io(path))?;
+        Ok(())
+    })
+}
+
+/// Write `path` atomically through `produce`, which creates the whole file at the temporary
+/// path it is given (for writers that only take a path, such as plotters' backends). The
+/// temporary file is a hidden sibling of `path` that keeps its extension, so a writer that
+/// picks the format by extension picks the right one. On any error the temporary file is
+/// removed and `path` is untouched.
+pub fn write_atomic_via<E: From<OutputError>>(
+    path: &Path,
+    produce: impl FnOnce(&Path) -> Result<(), E>,
+) -> Result<(), E> {
     if path.is_dir() {
         return Err(OutputError::IsDirectory(path.display().to_string()).into());
     }
-    let dir = parent_of(path);
-    let hidden = Path::new(dir).join(format!(
-        ".{}",
-        path.file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default()
-    ));
-    let tmp = sibling(&hidden, ".tmp");
-    let file = File::create(&tmp).map_err(io(path))?;
-    let mut w = BufWriter::new(file);
-    let result = fill(&mut w).and_then(|()| {
-        let file = w.into_inner().map_err(|e| io(path)(e.into_error()))?;
-        file.sync_all().map_err(io(path))?;
-        std::fs::rename(&tmp, path).map_err(io(path))?;
-        Ok(())
-    });
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let mut tmp = sibling(&parent_of(path).join(format!(".{name}")), ".tmp");
+    if let Some(ext) = path.extension() {
+        tmp.as_mut_os_string().push(".");
+        tmp.as_mut_os_string().push(ext);
+    }
+    let result = produce(&tmp).and_then(|()| Ok(std::fs::rename(&tmp, path).map_err(io(path))?));
     if result.is_err() {
         let _ = std::fs::remove_file(&tmp);
     }

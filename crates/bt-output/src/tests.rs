@@ -16,14 +16,20 @@ fn listing(dir: &Path) -> Vec<String> {
     v
 }
 
+/// `file` holds `content` and is the only entry of its directory (no temporary file left).
+fn assert_alone(file: &Path, content: &[u8]) {
+    assert_eq!(std::fs::read(file).unwrap(), content);
+    let name = file.file_name().unwrap().to_string_lossy();
+    assert_eq!(listing(file.parent().unwrap()), [name]);
+}
+
 #[test]
 fn atomic_write_replaces_and_leaves_no_temporary() {
     let dir = scratch("atomic");
     let f = dir.join("a.json");
     write_atomic(&f, b"one").unwrap();
     write_atomic(&f, b"two").unwrap();
-    assert_eq!(std::fs::read(&f).unwrap(), b"two");
-    assert_eq!(listing(&dir), ["a.json"]);
+    assert_alone(&f, b"two");
 }
 
 #[test]
@@ -36,8 +42,30 @@ fn failed_fill_keeps_the_old_file() {
         Err(OutputError::BadRelative("simulated".into()))
     });
     assert!(r.is_err());
-    assert_eq!(std::fs::read(&f).unwrap(), b"old");
-    assert_eq!(listing(&dir), ["a.csv"]);
+    assert_alone(&f, b"old");
+}
+
+#[test]
+fn path_writer_sees_the_extension_and_a_failure_keeps_the_old_file() {
+    let dir = scratch("via");
+    let f = dir.join("fig.png");
+    write_atomic(&f, b"old").unwrap();
+    let r: Result<(), OutputError> = write_atomic_via(&f, |tmp| {
+        assert_eq!(tmp.extension().unwrap(), "png");
+        assert_eq!(tmp.parent(), f.parent());
+        std::fs::write(tmp, b"half").unwrap();
+        Err(OutputError::BadRelative("simulated".into()))
+    });
+    assert!(r.is_err());
+    assert_alone(&f, b"old");
+    write_atomic_via(&f, |tmp| {
+        std::fs::write(tmp, b"new").map_err(|e| OutputError::Io {
+            path: tmp.display().to_string(),
+            source: e,
+        })
+    })
+    .unwrap();
+    assert_alone(&f, b"new");
 }
 
 #[test]

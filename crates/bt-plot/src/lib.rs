@@ -97,8 +97,21 @@ fn with_extension(stem: &Path, ext: &str) -> PathBuf {
     PathBuf::from(name)
 }
 
-/// Draw into `.{name}.tmp-{pid}.{ext}` beside `path` (the backends pick the format by
-/// extension), then rename it over `path`; the temporary file is removed on failure.
+/// Why an atomic figure write failed: the drawing, or the file operations of `bt-output`.
+enum Failure {
+    Draw(String),
+    Output(bt_output::OutputError),
+}
+
+impl From<bt_output::OutputError> for Failure {
+    fn from(e: bt_output::OutputError) -> Self {
+        Failure::Output(e)
+    }
+}
+
+/// Draw into a temporary file beside `path` that keeps its extension (the backends pick the
+/// format by extension) and rename it over `path` (`bt_output::write_atomic_via`); the
+/// temporary file is removed on failure.
 fn atomically(
     path: &Path,
     draw: impl FnOnce(&Path) -> Result<(), String>,
@@ -107,15 +120,12 @@ fn atomically(
         path: path.display().to_string(),
         message,
     };
-    let name = path.file_name().map(|n| n.to_string_lossy().into_owned());
-    let ext = path.extension().map(|e| e.to_string_lossy().into_owned());
-    let (Some(name), Some(ext)) = (name, ext) else {
+    if path.file_name().is_none() || path.extension().is_none() {
         return Err(error("not a file name".into()));
-    };
-    let tmp = path.with_file_name(format!(".{name}.tmp-{}.{ext}", std::process::id()));
-    let result = draw(&tmp).and_then(|()| std::fs::rename(&tmp, path).map_err(fail));
-    if result.is_err() {
-        let _ = std::fs::remove_file(&tmp);
     }
-    result.map_err(error)
+    bt_output::write_atomic_via(path, |tmp| draw(tmp).map_err(Failure::Draw)).map_err(|e| match e {
+        Failure::Draw(message) => error(message),
+        Failure::Output(bt_output::OutputError::Io { source, .. }) => error(source.to_string()),
+        Failure::Output(other) => error(other.to_string()),
+    })
 }

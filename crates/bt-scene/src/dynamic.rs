@@ -145,63 +145,16 @@ impl DynamicScene {
         terminals: Terminals,
     ) -> Result<Self, SceneError> {
         let mut problems: Vec<Problem> = Vec::new();
-        let mut push =
-            |location: String, message: String| problems.push(Problem { location, message });
-        let steps = desc.steps.unwrap_or(1);
-        if steps == 0 {
-            push("steps".into(), "must be at least 1".into());
-        }
-        if steps > MAX_STEPS {
-            push("steps".into(), format!("is {steps}, at most {MAX_STEPS}"));
-        }
-        // Clamped so the per-step poses built before the error is returned stay small.
-        let steps = steps.clamp(1, MAX_STEPS) as usize;
-        let mut terminal_steps = |field: &str, values: &Option<Vec<[Real; 3]>>| {
-            let v: Option<Vec<Vec3>> = values
-                .as_ref()
-                .map(|v| v.iter().map(|p| Vec3::from_array(*p)).collect());
-            if let Some(v) = &v {
-                if v.len() != steps {
-                    push(
-                        field.into(),
-                        format!("has {} positions, expected one per step ({steps})", v.len()),
-                    );
-                }
-                if let Some(i) = v.iter().position(|p| !p.is_finite()) {
-                    push(
-                        format!("{field}[{i}]"),
-                        "coordinates must be finite numbers".into(),
-                    );
-                }
-            }
-            v
+        let steps = step_count(desc.steps, &mut problems);
+        let terminals = StepTerminals {
+            fixed: terminals,
+            tx: terminal_steps("tx_steps", &desc.tx_steps, steps, &mut problems),
+            rx: terminal_steps("rx_steps", &desc.rx_steps, steps, &mut problems),
         };
-        let tx_steps = terminal_steps("tx_steps", &desc.tx_steps);
-        let rx_steps = terminal_steps("rx_steps", &desc.rx_steps);
-
         // Step 0 terminals decide the base scene; validation of the file's geometry happens
         // there (every static problem reported by the static validator).
-        let base_terminals = Terminals {
-            tx: terminals
-                .tx
-                .or_else(|| tx_steps.as_ref().and_then(|v| v.first().copied())),
-            rx: terminals
-                .rx
-                .or_else(|| rx_steps.as_ref().and_then(|v| v.first().copied())),
-        };
-        let base = Scene::from_description(desc, source_name, base_terminals);
-
-        let mut motions: Vec<(String, Vec<Pose>)> = Vec::new();
-        for (name, object) in &desc.objects {
-            match poses(object, steps) {
-                Ok(p) => motions.push((name.clone(), p)),
-                Err(list) => {
-                    for (field, message) in list {
-                        push(format!("objects.{name}{field}"), message);
-                    }
-                }
-            }
-        }
+        let base = Scene::from_description(desc, source_name, terminals.at(0));
+        let motions = object_motions(desc, steps, &mut problems);
         let base = match base {
             Ok(base) => base,
             Err(SceneError::Invalid {
@@ -209,31 +162,15 @@ impl DynamicScene {
                 ..
             }) => {
                 base_problems.extend(problems);
-                return Err(SceneError::Invalid {
-                    source_name: source_name.to_string(),
-                    problems: base_problems,
-                });
+                return Err(invalid(source_name, base_problems));
             }
             Err(e) => return Err(e),
         };
 
         let members = members(desc, &base, &mut problems);
-        let copies = steps.saturating_mul(base.surfaces().len().max(1));
-        if copies > MAX_SURFACE_STEPS {
-            problems.push(Problem {
-                location: "steps".into(),
-                message: format!(
-                    "{steps} steps of {} surfaces make {copies} surface copies, at most \
-                     {MAX_SURFACE_STEPS} (every step is a full copy of the scene)",
-                    base.surfaces().len()
-                ),
-            });
-        }
+        check_surface_copies(steps, base.surfaces().len(), &mut problems);
         if !problems.is_empty() {
-            return Err(SceneError::Invalid {
-                source_name: source_name.to_string(),
-                problems,
-            });
+            return Err(invalid(source_name, problems));
         }
         let objects: Vec<DynamicObject> = motions
             .into_iter()
@@ -243,64 +180,11 @@ impl DynamicScene {
                 poses,
             })
             .collect();
-
-        let mut scenes = Vec::with_capacity(steps);
-        for k in 0..steps {
-            let mut surfaces: Vec<Surface> = base.surfaces().to_vec();
-            for object in &objects {
-                let pose = object.poses[k];
-                if pose.is_identity() {
-                    continue;
-                }
-                for id in &object.surfaces {
-                    let s = &mut surfaces[id.index()];
-                    let moved = s
-                        .polygon
-                        .vertices()
-                        .iter()
-                        .map(|p| pose.apply(*p))
-                        .collect();
-                    match Polygon::new(moved) {
-                        Ok(p) => s.polygon = p,
-                        Err(e) => problems.push(Problem {
-                            location: format!(
-                                "steps[{k}] object \"{}\" surface \"{}\"",
-                                object.name, s.name
-                            ),
-                            message: e.to_string(),
-                        }),
-                    }
-                }
-            }
-            let tx = terminals
-                .tx
-                .or_else(|| tx_steps.as_ref().and_then(|v| v.get(k).copied()))
-                .unwrap_or(base.tx());
-            let rx = terminals
-                .rx
-                .or_else(|| rx_steps.as_ref().and_then(|v| v.get(k).copied()))
-                .unwrap_or(base.rx());
-            let extent = crate::model::scene_extent(&surfaces, tx, rx);
-            if let Err(list) = check_terminals(&surfaces, tx, rx, extent) {
-                problems.extend(list.into_iter().map(|p| Problem {
-                    location: format!("steps[{k}] {}", p.location),
-                    message: p.message,
-                }));
-            }
-            scenes.push(Scene::assemble(
-                base.name().to_string(),
-                surfaces,
-                tx,
-                rx,
-                base.frequency_hz(),
-                base.materials().clone(),
-            ));
-        }
+        let scenes = (0..steps)
+            .map(|k| step_scene(k, &base, &objects, &terminals, &mut problems))
+            .collect();
         if !problems.is_empty() {
-            return Err(SceneError::Invalid {
-                source_name: source_name.to_string(),
-                problems,
-            });
+            return Err(invalid(source_name, problems));
         }
         Ok(Self { scenes, objects })
     }
@@ -402,6 +286,165 @@ pub fn builtin_dynamic_scene(
 }
 
 type FieldProblems = Vec<(String, String)>;
+
+fn invalid(source_name: &str, problems: Vec<Problem>) -> SceneError {
+    SceneError::Invalid {
+        source_name: source_name.to_string(),
+        problems,
+    }
+}
+
+/// The file's `steps` (default 1), clamped to `1..=MAX_STEPS` so the per-step poses built
+/// before an error is returned stay small; a value outside is a problem.
+fn step_count(steps: Option<u32>, problems: &mut Vec<Problem>) -> usize {
+    let steps = steps.unwrap_or(1);
+    let mut push = |message: String| {
+        problems.push(Problem {
+            location: "steps".into(),
+            message,
+        })
+    };
+    if steps == 0 {
+        push("must be at least 1".into());
+    }
+    if steps > MAX_STEPS {
+        push(format!("is {steps}, at most {MAX_STEPS}"));
+    }
+    steps.clamp(1, MAX_STEPS) as usize
+}
+
+/// A per-step terminal list of the file (`tx_steps` / `rx_steps`): one finite position per step.
+fn terminal_steps(
+    field: &str,
+    values: &Option<Vec<[Real; 3]>>,
+    steps: usize,
+    problems: &mut Vec<Problem>,
+) -> Option<Vec<Vec3>> {
+    let v: Vec<Vec3> = values
+        .as_ref()?
+        .iter()
+        .map(|p| Vec3::from_array(*p))
+        .collect();
+    if v.len() != steps {
+        problems.push(Problem {
+            location: field.into(),
+            message: format!("has {} positions, expected one per step ({steps})", v.len()),
+        });
+    }
+    if let Some(i) = v.iter().position(|p| !p.is_finite()) {
+        problems.push(Problem {
+            location: format!("{field}[{i}]"),
+            message: "coordinates must be finite numbers".into(),
+        });
+    }
+    Some(v)
+}
+
+/// The terminals of each step: the caller's override, else the file's per-step list, else
+/// (`None`) the base scene's.
+struct StepTerminals {
+    fixed: Terminals,
+    tx: Option<Vec<Vec3>>,
+    rx: Option<Vec<Vec3>>,
+}
+
+impl StepTerminals {
+    fn at(&self, k: usize) -> Terminals {
+        let listed = |v: &Option<Vec<Vec3>>| v.as_ref().and_then(|v| v.get(k).copied());
+        Terminals {
+            tx: self.fixed.tx.or_else(|| listed(&self.tx)),
+            rx: self.fixed.rx.or_else(|| listed(&self.rx)),
+        }
+    }
+}
+
+/// The poses of every object at every step, by object name; the problems of bad motions.
+fn object_motions(
+    desc: &SceneDescription,
+    steps: usize,
+    problems: &mut Vec<Problem>,
+) -> Vec<(String, Vec<Pose>)> {
+    let mut motions = Vec::new();
+    for (name, object) in &desc.objects {
+        match poses(object, steps) {
+            Ok(p) => motions.push((name.clone(), p)),
+            Err(list) => problems.extend(list.into_iter().map(|(field, message)| Problem {
+                location: format!("objects.{name}{field}"),
+                message,
+            })),
+        }
+    }
+    motions
+}
+
+/// The budget of surface copies kept for all steps ([`MAX_SURFACE_STEPS`]).
+fn check_surface_copies(steps: usize, surfaces: usize, problems: &mut Vec<Problem>) {
+    let copies = steps.saturating_mul(surfaces.max(1));
+    if copies > MAX_SURFACE_STEPS {
+        problems.push(Problem {
+            location: "steps".into(),
+            message: format!(
+                "{steps} steps of {surfaces} surfaces make {copies} surface copies, at most \
+                 {MAX_SURFACE_STEPS} (every step is a full copy of the scene)"
+            ),
+        });
+    }
+}
+
+/// Step `k`: the base scene with every object moved to its pose and the step's terminals;
+/// a polygon a pose breaks and a terminal check that fails are problems of the step.
+fn step_scene(
+    k: usize,
+    base: &Scene,
+    objects: &[DynamicObject],
+    terminals: &StepTerminals,
+    problems: &mut Vec<Problem>,
+) -> Scene {
+    let mut surfaces: Vec<Surface> = base.surfaces().to_vec();
+    for object in objects {
+        let pose = object.poses[k];
+        if pose.is_identity() {
+            continue;
+        }
+        for id in &object.surfaces {
+            let s = &mut surfaces[id.index()];
+            let moved = s
+                .polygon
+                .vertices()
+                .iter()
+                .map(|p| pose.apply(*p))
+                .collect();
+            match Polygon::new(moved) {
+                Ok(p) => s.polygon = p,
+                Err(e) => problems.push(Problem {
+                    location: format!(
+                        "steps[{k}] object \"{}\" surface \"{}\"",
+                        object.name, s.name
+                    ),
+                    message: e.to_string(),
+                }),
+            }
+        }
+    }
+    let at = terminals.at(k);
+    let tx = at.tx.unwrap_or(base.tx());
+    let rx = at.rx.unwrap_or(base.rx());
+    let extent = crate::model::scene_extent(&surfaces, tx, rx);
+    if let Err(list) = check_terminals(&surfaces, tx, rx, extent) {
+        problems.extend(list.into_iter().map(|p| Problem {
+            location: format!("steps[{k}] {}", p.location),
+            message: p.message,
+        }));
+    }
+    Scene::assemble(
+        base.name().to_string(),
+        surfaces,
+        tx,
+        rx,
+        base.frequency_hz(),
+        base.materials().clone(),
+    )
+}
 
 /// Poses of one object at steps `0..steps`.
 fn poses(object: &ObjectDesc, steps: usize) -> Result<Vec<Pose>, FieldProblems> {

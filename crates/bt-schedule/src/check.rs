@@ -40,6 +40,18 @@ impl Schedule {
     pub fn check(&self, problem: &Problem) -> Result<(), ScheduleError> {
         let prep = Prepared::new(problem)?;
         let mut report = Report::new();
+        self.check_instances(problem, &mut report);
+        let at = self.check_slots(problem, &prep, &mut report);
+        check_rounds(problem, &prep, &at, &mut report);
+        if report.is_empty() {
+            Ok(())
+        } else {
+            Err(ScheduleError::IllegalSchedule(report))
+        }
+    }
+
+    /// Instances are distinct and of existing planes.
+    fn check_instances(&self, problem: &Problem, report: &mut Report<ScheduleViolation>) {
         let mut seen = BTreeSet::new();
         for (i, inst) in self.instances.iter().enumerate() {
             if !seen.insert(*inst) {
@@ -56,7 +68,17 @@ impl Schedule {
                 });
             }
         }
+    }
 
+    /// Every slot row has one entry per instance, each a job of `problem` on an instance of
+    /// its point's plane, no job twice; returns the slot of each job (`NONE` where missing),
+    /// by job index.
+    fn check_slots(
+        &self,
+        problem: &Problem,
+        prep: &Prepared<'_>,
+        report: &mut Report<ScheduleViolation>,
+    ) -> Vec<u32> {
         let mut at = vec![NONE; prep.total_jobs()];
         for (t, row) in self.slots.iter().enumerate() {
             let slot = to_u32(t);
@@ -70,7 +92,7 @@ impl Schedule {
             for (i, cell) in row.iter().enumerate().take(self.instances.len()) {
                 let Some(job) = *cell else { continue };
                 let instance = to_u32(i);
-                let Some(index) = job_index(&prep, job) else {
+                let Some(index) = job_index(prep, job) else {
                     report.push(ScheduleViolation::UnknownJob {
                         slot,
                         instance,
@@ -99,47 +121,7 @@ impl Schedule {
                 }
             }
         }
-
-        for (p, path) in problem.paths.iter().enumerate() {
-            let k = path.planes.len();
-            let base = prep.job_offset[p] as usize;
-            let mut previous_end = None;
-            for round in 0..path.rounds {
-                let first = base + round as usize * k;
-                let (mut start, mut end) = (None::<u32>, None::<u32>);
-                for (point, &slot) in at[first..first + k].iter().enumerate() {
-                    if slot == NONE {
-                        report.push(ScheduleViolation::MissingJob {
-                            job: Job {
-                                path: p as u32,
-                                round,
-                                point: point as u32,
-                            },
-                        });
-                    } else {
-                        start = Some(start.map_or(slot, |s| s.min(slot)));
-                        end = Some(end.map_or(slot, |e| e.max(slot)));
-                    }
-                }
-                if let (Some(start), Some(previous_end)) = (start, previous_end) {
-                    if start <= previous_end {
-                        report.push(ScheduleViolation::Dependency {
-                            path: p as u32,
-                            round,
-                            start,
-                            previous_end,
-                        });
-                    }
-                }
-                previous_end = end.or(previous_end);
-            }
-        }
-
-        if report.is_empty() {
-            Ok(())
-        } else {
-            Err(ScheduleError::IllegalSchedule(report))
-        }
+        at
     }
 
     /// Measures the schedule. Meant for schedules that pass [`Schedule::check`]; on others it
@@ -233,6 +215,50 @@ pub(crate) fn lower_bound(problem: &Problem, copies: &[u32]) -> u32 {
         .max()
         .unwrap_or(0);
     u32::try_from(load_bound.max(chain)).unwrap_or(u32::MAX)
+}
+
+/// Every job of every round is placed, and (Jacobi order) each round of a path starts after
+/// the previous round's last job; `at` is the slot of each job by index.
+fn check_rounds(
+    problem: &Problem,
+    prep: &Prepared<'_>,
+    at: &[u32],
+    report: &mut Report<ScheduleViolation>,
+) {
+    for (p, path) in problem.paths.iter().enumerate() {
+        let k = path.planes.len();
+        let base = prep.job_offset[p] as usize;
+        let mut previous_end = None;
+        for round in 0..path.rounds {
+            let first = base + round as usize * k;
+            let (mut start, mut end) = (None::<u32>, None::<u32>);
+            for (point, &slot) in at[first..first + k].iter().enumerate() {
+                if slot == NONE {
+                    report.push(ScheduleViolation::MissingJob {
+                        job: Job {
+                            path: p as u32,
+                            round,
+                            point: point as u32,
+                        },
+                    });
+                } else {
+                    start = Some(start.map_or(slot, |s| s.min(slot)));
+                    end = Some(end.map_or(slot, |e| e.max(slot)));
+                }
+            }
+            if let (Some(start), Some(previous_end)) = (start, previous_end) {
+                if start <= previous_end {
+                    report.push(ScheduleViolation::Dependency {
+                        path: p as u32,
+                        round,
+                        start,
+                        previous_end,
+                    });
+                }
+            }
+            previous_end = end.or(previous_end);
+        }
+    }
 }
 
 /// Job index of a job of the problem, `None` if out of range.

@@ -92,16 +92,12 @@ fn living_room_sized_problem_schedules_legally() {
     let problem = bt_schedule::synthetic::living_room(3, 25, 300);
     problem.validate().unwrap();
     let budget = Budget { max_instances: 35 };
+    let params = GaParams {
+        generations: 3,
+        ..GaParams::default()
+    };
     let list = schedule_list(&problem, &Budget::originals_only(&problem)).unwrap();
-    let ga = schedule_ga(
-        &problem,
-        &budget,
-        &GaParams {
-            generations: 3,
-            ..GaParams::default()
-        },
-    )
-    .unwrap();
+    let ga = schedule_ga(&problem, &budget, &params).unwrap();
     list.check(&problem).unwrap();
     ga.check(&problem).unwrap();
     let (l, g) = (list.stats(&problem), ga.stats(&problem));
@@ -111,14 +107,6 @@ fn living_room_sized_problem_schedules_legally() {
     );
     assert!(g.duplicates > 0);
     // Same seed, same schedule, also through the parallel fitness evaluation.
-    let again = schedule_ga(
-        &problem,
-        &budget,
-        &GaParams {
-            generations: 3,
-            ..GaParams::default()
-        },
-    )
-    .unwrap();
+    let again = schedule_ga(&problem, &budget, &params).unwrap();
     assert_eq!(again, ga);
 }

@@ -2,7 +2,7 @@
 //! `summary.md` and the figures as SVG and PNG into an output directory.
 
 use crate::living_room::{self, LivingRoomResults};
-use crate::run::StudyResults;
+use crate::run::{RoomDrawing, StudyResults};
 use crate::{StudyError, plot, report};
 use bt_output::OutputDir;
 use plotters::prelude::*;
@@ -15,26 +15,42 @@ fn write(out: &mut OutputDir, rel: &str, text: &str) -> Result<(), StudyError> {
     Ok(out.write(rel, text.as_bytes())?)
 }
 
-/// Draw one figure with `$draw(&root, $data)` to `$dir/$stem.svg` and `$dir/$stem.png`.
+/// Draw one figure with `$draw(&root, $data)` (`$data: &$ty`) as `$stem.svg` and `$stem.png`
+/// of `$out` (see [`write_figure`]).
 macro_rules! figure {
-    ($out:expr, $stem:expr, $size:expr, $draw:path, $data:expr) => {{
-        for ext in ["svg", "png"] {
-            let path = $out.path(&format!("{}.{ext}", $stem))?;
-            let plot_error = |message: String| StudyError::Plot {
-                path: path.display().to_string(),
-                message,
-            };
-            if ext == "svg" {
-                let root = SVGBackend::new(&path, $size).into_drawing_area();
-                $draw(&root, $data).map_err(plot_error)?;
-                root.present().map_err(|e| plot_error(e.to_string()))?;
-            } else {
-                let root = BitMapBackend::new(&path, $size).into_drawing_area();
-                $draw(&root, $data).map_err(plot_error)?;
-                root.present().map_err(|e| plot_error(e.to_string()))?;
+    ($out:expr, $stem:expr, $size:expr, $draw:path, $data:expr, $ty:ty) => {{
+        struct Drawn<'a>(&'a $ty);
+        impl bt_plot::Figure for Drawn<'_> {
+            fn draw<DB: DrawingBackend>(
+                &self,
+                root: &DrawingArea<DB, plotters::coord::Shift>,
+            ) -> Result<(), String> {
+                $draw(root, self.0)
             }
         }
+        write_figure(&mut $out, $stem, $size, &Drawn($data))?;
     }};
+}
+
+/// `figure` as `stem.svg` and `stem.png` in `out`, through `bt_plot::write_svg_png` (the one
+/// home of drawing a figure on both backends).
+fn write_figure(
+    out: &mut OutputDir,
+    stem: &str,
+    size: (u32, u32),
+    figure: &impl bt_plot::Figure,
+) -> Result<(), StudyError> {
+    let svg = out.path(&format!("{stem}.svg"))?;
+    out.path(&format!("{stem}.png"))?;
+    bt_plot::write_svg_png(&svg.with_extension(""), size, figure).map_err(plot_error)?;
+    Ok(())
+}
+
+fn plot_error(e: bt_plot::PlotError) -> StudyError {
+    StudyError::Plot {
+        path: e.path,
+        message: e.message,
+    }
 }
 
 /// Write the power-delay profile of `taps` as `<stem>.svg` and `<stem>.png` (each to a temporary
@@ -53,12 +69,8 @@ pub fn write_power_delay_profile(
             plot::power_delay_profile(root, (self.0, self.1))
         }
     }
-    let written = bt_plot::write_svg_png(stem, (900, 500), &Pdp(title, taps)).map_err(|e| {
-        StudyError::Plot {
-            path: e.path,
-            message: e.message,
-        }
-    })?;
+    let written =
+        bt_plot::write_svg_png(stem, (900, 500), &Pdp(title, taps)).map_err(plot_error)?;
     Ok(written.to_vec())
 }
 
@@ -73,14 +85,16 @@ pub fn write_outputs(dir: &Path, results: &StudyResults) -> Result<Vec<PathBuf>,
         "fig6-angular-error",
         (1200, 900),
         plot::angular_error,
-        results
+        results,
+        StudyResults
     );
     figure!(
         out,
         "fig7-elapsed-time",
         (1200, 480),
         plot::elapsed_time,
-        results
+        results,
+        StudyResults
     );
     let drawings = &results.drawings;
     let cols = drawings
@@ -90,7 +104,14 @@ pub fn write_outputs(dir: &Path, results: &StudyResults) -> Result<Vec<PathBuf>,
         .unwrap_or(1)
         .max(1) as u32;
     let size = (ROOM_CELL * cols, ROOM_CELL * drawings.len().max(1) as u32);
-    figure!(out, "fig5-rooms", size, plot::rooms, drawings);
+    figure!(
+        out,
+        "fig5-rooms",
+        size,
+        plot::rooms,
+        drawings,
+        [RoomDrawing]
+    );
     Ok(out.commit()?)
 }
 
@@ -119,7 +140,8 @@ pub fn write_living_room(
         "fig17-angular-error",
         (1200, 480),
         living_room::plot::angular_error,
-        results
+        results,
+        LivingRoomResults
     );
     let rays = &results.rays;
     let size = (1200, 420 * rays.len().max(1) as u32);
@@ -128,14 +150,16 @@ pub fn write_living_room(
         "fig18-ray-directions",
         size,
         living_room::plot::ray_directions,
-        rays
+        rays,
+        [living_room::StepRays]
     );
     figure!(
         out,
         "fig19-run-time",
         (1000, 560),
         living_room::plot::run_time,
-        results
+        results,
+        LivingRoomResults
     );
     Ok(out.commit()?)
 }

@@ -2,7 +2,7 @@
 //! draw. Pure functions of the results: writing files is [`crate::io`]'s job.
 
 use crate::room::Shape;
-use crate::run::{Row, StudyResults, StudySolver};
+use crate::run::{AngularErrors, Row, StudyResults, StudySolver};
 use bt_geom::Real;
 use std::collections::BTreeMap;
 use std::fmt::Write;
@@ -31,10 +31,10 @@ pub fn csv(results: &StudyResults) -> String {
             r.matched,
             r.missed,
             r.spurious,
-            r.mean_err_tx_deg,
-            r.max_err_tx_deg,
-            r.mean_err_rx_deg,
-            r.max_err_rx_deg,
+            r.errors.mean_err_tx_deg,
+            r.errors.max_err_tx_deg,
+            r.errors.mean_err_rx_deg,
+            r.errors.max_err_rx_deg,
             r.time_s
         );
     }
@@ -55,8 +55,8 @@ pub enum Quantity {
 impl Quantity {
     fn of(self, r: &Row) -> Option<Real> {
         match self {
-            Quantity::ErrorTx if r.matched > 0 => Some(r.mean_err_tx_deg),
-            Quantity::ErrorRx if r.matched > 0 => Some(r.mean_err_rx_deg),
+            Quantity::ErrorTx if r.matched > 0 => Some(r.errors.mean_err_tx_deg),
+            Quantity::ErrorRx if r.matched > 0 => Some(r.errors.mean_err_rx_deg),
             Quantity::Time => Some(r.time_s),
             _ => None,
         }
@@ -108,14 +108,8 @@ pub struct Totals {
     pub missed: usize,
     /// Spurious paths.
     pub spurious: usize,
-    /// Mean of the rows' mean departure errors (rows with matches), degrees.
-    pub mean_err_tx_deg: Real,
-    /// Largest departure error, degrees.
-    pub max_err_tx_deg: Real,
-    /// Mean of the rows' mean arrival errors, degrees.
-    pub mean_err_rx_deg: Real,
-    /// Largest arrival error, degrees.
-    pub max_err_rx_deg: Real,
+    /// Mean of the rows' mean errors (rows with matches) and the largest errors, degrees.
+    pub errors: AngularErrors,
     /// Total time, seconds.
     pub time_s: Real,
     /// Median time per row, seconds.
@@ -146,10 +140,18 @@ pub fn totals(rows: &[Row], keep: impl Fn(&Row) -> bool) -> BTreeMap<StudySolver
                 paths: rs.iter().map(|r| r.paths).sum(),
                 missed: rs.iter().map(|r| r.missed).sum(),
                 spurious: rs.iter().map(|r| r.spurious).sum(),
-                mean_err_tx_deg: mean(|r| r.mean_err_tx_deg),
-                max_err_tx_deg: rs.iter().map(|r| r.max_err_tx_deg).fold(0.0, Real::max),
-                mean_err_rx_deg: mean(|r| r.mean_err_rx_deg),
-                max_err_rx_deg: rs.iter().map(|r| r.max_err_rx_deg).fold(0.0, Real::max),
+                errors: AngularErrors {
+                    mean_err_tx_deg: mean(|r| r.errors.mean_err_tx_deg),
+                    max_err_tx_deg: rs
+                        .iter()
+                        .map(|r| r.errors.max_err_tx_deg)
+                        .fold(0.0, Real::max),
+                    mean_err_rx_deg: mean(|r| r.errors.mean_err_rx_deg),
+                    max_err_rx_deg: rs
+                        .iter()
+                        .map(|r| r.errors.max_err_rx_deg)
+                        .fold(0.0, Real::max),
+                },
                 time_s: times.iter().sum(),
                 median_time_s: times.get(times.len() / 2).copied().unwrap_or(0.0),
             };
@@ -192,18 +194,27 @@ pub fn ratios(results: &StudyResults) -> Ratios {
         sbr_over_ipc_time: sbr.time_s / gs.time_s,
         sbr_over_jacobi_time: sbr.time_s / jacobi.time_s,
         ipc_over_image_time: gs.time_s / image.time_s,
-        sbr_over_ipc_error: sbr.mean_err_tx_deg / gs.mean_err_tx_deg,
-        sbr_error_deg: sbr.mean_err_tx_deg,
-        ipc_error_deg: gs.mean_err_tx_deg,
+        sbr_over_ipc_error: sbr.errors.mean_err_tx_deg / gs.errors.mean_err_tx_deg,
+        sbr_error_deg: sbr.errors.mean_err_tx_deg,
+        ipc_error_deg: gs.errors.mean_err_tx_deg,
     }
 }
 
 /// `summary.md`: settings, per-solver totals, the paper's conclusions as measured ratios, and
 /// a breakdown by shape.
 pub fn summary(results: &StudyResults) -> String {
+    let mut s = String::new();
+    summary_settings(&mut s, results);
+    summary_per_solver(&mut s, results);
+    summary_ratios(&mut s, results);
+    summary_by_shape(&mut s, results);
+    s
+}
+
+/// The title and the settings of the run.
+fn summary_settings(s: &mut String, results: &StudyResults) {
     let c = &results.config;
     let sbr = c.sbr_options();
-    let mut s = String::new();
     let _ = writeln!(s, "# 2-D validation study\n");
     let _ = writeln!(
         s,
@@ -224,6 +235,10 @@ pub fn summary(results: &StudyResults) -> String {
         sbr.ray_count(),
         sbr.capture_factor(),
     );
+}
+
+/// The per-solver totals table.
+fn summary_per_solver(s: &mut String, results: &StudyResults) {
     let _ = writeln!(s, "## Per solver\n");
     let _ = writeln!(
         s,
@@ -239,14 +254,18 @@ pub fn summary(results: &StudyResults) -> String {
             t.paths,
             t.missed,
             t.spurious,
-            t.mean_err_tx_deg,
-            t.max_err_tx_deg,
-            t.mean_err_rx_deg,
-            t.max_err_rx_deg,
+            t.errors.mean_err_tx_deg,
+            t.errors.max_err_tx_deg,
+            t.errors.mean_err_rx_deg,
+            t.errors.max_err_rx_deg,
             t.time_s,
             t.median_time_s * 1e3
         );
     }
+}
+
+/// The paper's conclusions as measured ratios.
+fn summary_ratios(s: &mut String, results: &StudyResults) {
     let r = ratios(results);
     let _ = writeln!(s, "\n## The paper's conclusions, measured\n");
     let _ = writeln!(s, "| quantity | measured | paper (Figs. 6-7) |");
@@ -282,6 +301,10 @@ pub fn summary(results: &StudyResults) -> String {
         r.sbr_over_ipc_error,
         r.sbr_over_ipc_error.log10()
     );
+}
+
+/// The per-shape table (image, IPC and SBR side by side).
+fn summary_by_shape(s: &mut String, results: &StudyResults) {
     let _ = writeln!(s, "\n## By shape\n");
     let _ = writeln!(
         s,
@@ -303,13 +326,12 @@ pub fn summary(results: &StudyResults) -> String {
             image.paths,
             sbr.missed,
             sbr.spurious,
-            sbr.mean_err_tx_deg,
-            gs.mean_err_tx_deg,
+            sbr.errors.mean_err_tx_deg,
+            gs.errors.mean_err_tx_deg,
             ms(image),
             ms(gs),
             ms(jacobi),
             ms(sbr)
         );
     }
-    s
 }

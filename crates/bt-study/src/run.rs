@@ -129,18 +129,40 @@ pub struct Row {
     pub missed: usize,
     /// Solver paths the image method does not have.
     pub spurious: usize,
-    /// Mean angle between the solver's and the exact departure direction over matched paths,
-    /// degrees (0 when nothing matched).
-    pub mean_err_tx_deg: Real,
-    /// Largest such angle, degrees.
-    pub max_err_tx_deg: Real,
-    /// Mean angle between the solver's and the exact arrival direction, degrees.
-    pub mean_err_rx_deg: Real,
-    /// Largest such angle, degrees.
-    pub max_err_rx_deg: Real,
+    /// Angular errors of the matched paths (columns `mean_err_tx_deg` ... `max_err_rx_deg`).
+    #[serde(flatten)]
+    pub errors: AngularErrors,
     /// Single-threaded wall-clock time from scene to paths (candidate enumeration included for
     /// the image method and IPC), seconds.
     pub time_s: Real,
+}
+
+/// Angular errors of a solver's matched paths against the exact directions, degrees: the mean
+/// and the largest angle between departure directions at TX and between arrival directions at
+/// RX (zeros when nothing matched). Of one row, or (in [`crate::report::Totals`]) the mean of
+/// the rows' means and the largest of their maxima.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
+pub struct AngularErrors {
+    /// Mean departure error, degrees.
+    pub mean_err_tx_deg: Real,
+    /// Largest departure error, degrees.
+    pub max_err_tx_deg: Real,
+    /// Mean arrival error, degrees.
+    pub mean_err_rx_deg: Real,
+    /// Largest arrival error, degrees.
+    pub max_err_rx_deg: Real,
+}
+
+impl From<[Real; 4]> for AngularErrors {
+    /// From `[mean TX, max TX, mean RX, max RX]` (the order [`compare`] returns).
+    fn from([mean_tx, max_tx, mean_rx, max_rx]: [Real; 4]) -> Self {
+        Self {
+            mean_err_tx_deg: mean_tx,
+            max_err_tx_deg: max_tx,
+            mean_err_rx_deg: mean_rx,
+            max_err_rx_deg: max_rx,
+        }
+    }
 }
 
 /// A room drawn in Fig. 5: its contour, terminals and image-method paths at a few steps.
@@ -345,7 +367,7 @@ fn row(
     found: &PathMap,
     time_s: Real,
 ) -> Row {
-    let (matched, missed, spurious, [mean_tx, max_tx, mean_rx, max_rx]) = compare(reference, found);
+    let (matched, missed, spurious, errors) = compare(reference, found);
     Row {
         room: room.index,
         shape: room.shape,
@@ -356,10 +378,7 @@ fn row(
         matched,
         missed,
         spurious,
-        mean_err_tx_deg: mean_tx,
-        max_err_tx_deg: max_tx,
-        mean_err_rx_deg: mean_rx,
-        max_err_rx_deg: max_rx,
+        errors: errors.into(),
         time_s,
     }
 }

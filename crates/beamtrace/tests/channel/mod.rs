@@ -116,37 +116,43 @@ fn a_perfect_conductor_mesh_keeps_every_reflection_at_full_strength() {
     );
 }
 
+/// The data rows of a CSV text (header skipped), split at commas.
+fn csv_rows(text: &str) -> Vec<Vec<&str>> {
+    text.lines()
+        .skip(1)
+        .map(|l| l.split(',').collect())
+        .collect()
+}
+
 #[test]
 fn channel_writes_cir_cfr_and_the_pdp_plot() {
     let dir = temp_dir("channel");
     let cir = dir.join("cir.csv");
     let cfr = dir.join("cfr.csv");
     let pdp = dir.join("pdp");
-    let o = ok(&[
+    // `channel` writing both CSV files; the number of subcarriers and more follow.
+    let (cir_arg, cfr_arg) = (cir.to_str().unwrap(), cfr.to_str().unwrap());
+    let both = [
         "channel",
         "builtin:living-room",
         "--out",
-        cir.to_str().unwrap(),
+        cir_arg,
         "--cfr",
-        cfr.to_str().unwrap(),
+        cfr_arg,
         "--subcarriers",
-        "16",
-        "--subcarrier-spacing",
-        "1e6",
-        "--pdp",
-        pdp.to_str().unwrap(),
-        "--max-order",
-        "2",
-    ]);
+    ];
+    let pdp_arg = pdp.to_str().unwrap();
+    let o = ok(&[
+        &both[..],
+        &["16", "--subcarrier-spacing", "1e6", "--pdp", pdp_arg],
+        &["--max-order", "2"],
+    ]
+    .concat());
     assert!(String::from_utf8_lossy(&o.stdout).contains("received power"));
     let trace = json(&["trace", "builtin:living-room", "--max-order", "2", "--json"]);
     let n_paths = trace["paths"].as_array().unwrap().len();
     let text = std::fs::read_to_string(&cir).unwrap();
-    let rows: Vec<Vec<&str>> = text
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').collect())
-        .collect();
+    let rows = csv_rows(&text);
     assert_eq!(rows.len(), n_paths);
     let delays: Vec<f64> = rows.iter().map(|r| r[2].parse().unwrap()).collect();
     assert!(
@@ -160,11 +166,7 @@ fn channel_writes_cir_cfr_and_the_pdp_plot() {
         im += r[8].parse::<f64>().unwrap();
     }
     let cfr_text = std::fs::read_to_string(&cfr).unwrap();
-    let cfr_rows: Vec<Vec<&str>> = cfr_text
-        .lines()
-        .skip(1)
-        .map(|l| l.split(',').collect())
-        .collect();
+    let cfr_rows = csv_rows(&cfr_text);
     assert_eq!(cfr_rows.len(), 16);
     let centre = &cfr_rows[8];
     assert_eq!(centre[1], "0");
@@ -178,19 +180,7 @@ fn channel_writes_cir_cfr_and_the_pdp_plot() {
     assert!(svg.contains("delay (ns)") && svg.contains("line of sight"));
     // No temporary files are left behind.
     assert_eq!(std::fs::read_dir(&dir).unwrap().count(), 4);
-    assert_clear_error(
-        &[
-            "channel",
-            "builtin:living-room",
-            "--out",
-            cir.to_str().unwrap(),
-            "--cfr",
-            cfr.to_str().unwrap(),
-            "--subcarriers",
-            "0",
-        ],
-        &["--subcarriers"],
-    );
+    assert_clear_error(&[&both[..], &["0"]].concat(), &["--subcarriers"]);
     let _ = std::fs::remove_dir_all(&dir);
 }
 

@@ -123,6 +123,9 @@ pub(super) fn separate_parallel(
     changed
 }
 
+/// A plane as (unit normal, offset).
+type PlaneEq = (Vec3, Real);
+
 /// Competitive, locally voted assignment of two parallel patches' points; `None` when the
 /// two do not form distinct layers (then nothing should change).
 fn separate_pair(
@@ -133,93 +136,139 @@ fn separate_pair(
 ) -> Option<(Vec<u32>, Vec<u32>)> {
     let la = layer_of(pts, pa)?;
     let lb = layer_of(pts, pb)?;
-    let grow = Vec3::splat(radius);
-    let within = |p: Vec3, l: &Layer| !(p.cmplt(l.lo - grow).any() || p.cmpgt(l.hi + grow).any());
-    // Contested points: each patch's points inside the other's (grown) bounding box.
-    let contested: Vec<u32> = pa
-        .iter()
-        .copied()
-        .filter(|&i| within(pts[i as usize], &lb))
-        .chain(pb.iter().copied().filter(|&i| within(pts[i as usize], &la)))
-        .collect();
-    if contested.is_empty() {
-        return None;
-    }
-    let centre = contested
-        .iter()
-        .fold(Vec3::ZERO, |c, &i| c + pts[i as usize])
-        / contested.len() as Real;
-    let fixed_a: Vec<u32> = pa
-        .iter()
-        .copied()
-        .filter(|&i| !within(pts[i as usize], &lb))
-        .collect();
-    let fixed_b: Vec<u32> = pb
-        .iter()
-        .copied()
-        .filter(|&i| !within(pts[i as usize], &la))
-        .collect();
+    let contest = Contest::new(pts, (pa, &la), (pb, &lb), radius)?;
+    let centre = contest.centre;
+    let (flat, adjacency) = contest.neighbours(pts, la.normal, radius);
 
-    // Neighbour lists in the common 2-D frame, computed once (the points do not move, only
-    // their labels change).
-    let (u, v) = frame(la.normal);
-    let flat: Vec<Vec2> = contested
-        .iter()
-        .map(|&i| Vec2::new(pts[i as usize].dot(u), pts[i as usize].dot(v)))
-        .collect();
-    let near = Grid::new(&flat, radius);
-    let adjacency: Vec<Vec<u32>> = (0..contested.len())
-        .into_par_iter()
-        .map(|k| {
-            let mut out = Vec::new();
-            near.visit(&flat, k, |m| out.push(m));
-            out
-        })
-        .collect();
-    drop(near);
-
-    let (mut na, mut da) = (la.normal, la.offset);
-    let (mut nb, mut db) = if lb.normal.dot(la.normal) < 0.0 {
-        (-lb.normal, -lb.offset)
-    } else {
-        (lb.normal, lb.offset)
-    };
-    let orig_b: Vec<bool> = contested
-        .iter()
-        .map(|&i| pb.binary_search(&i).is_ok())
-        .collect();
+    let (mut a, mut b) = (
+        (la.normal, la.offset),
+        facing(lb.normal, lb.offset, la.normal),
+    );
     // Start from "nearer plane"; then each round decides by the posterior with the local
     // prior (share of neighbours currently in each layer) and Gaussian residuals.
-    let mut to_b: Vec<bool> = contested
+    let mut to_b: Vec<bool> = contest
+        .points
         .par_iter()
         .map(|&i| {
             let p = pts[i as usize];
-            (nb.dot(p) - db).abs() < (na.dot(p) - da).abs()
+            (b.0.dot(p) - b.1).abs() < (a.0.dot(p) - a.1).abs()
         })
         .collect();
-    let share = |k: usize, in_b: &[bool]| {
-        let nb_k = &adjacency[k];
-        nb_k.iter().filter(|&&m| in_b[m as usize]).count() as Real / nb_k.len().max(1) as Real
-    };
-    // Presence over twice the radius: four times the neighbours, so the share is steady
-    // enough to test against a floor even at a layer's corner (a quarter disk).
-    let wide = Grid::new(&flat, 2.0 * radius);
-    let share0_b: Vec<Real> = (0..contested.len())
-        .into_par_iter()
-        .map(|k| {
-            let (mut all, mut b) = (0usize, 0usize);
-            wide.visit(&flat, k, |m| {
-                all += 1;
-                b += usize::from(to_b[m as usize]);
-            });
-            b as Real / all.max(1) as Real
-        })
-        .collect();
-    drop(wide);
-    let mut sigma = outer_sigma(pts, &contested, &to_b, centre, (na, da), (nb, db))?;
+    let share0_b = presence_of_b(&flat, &to_b, radius);
+    let mut sigma = outer_sigma(pts, &contest.points, &to_b, centre, a, b)?;
     for _ in 0..ROUNDS {
+        let next = contest.vote(pts, (&adjacency, &share0_b), &to_b, (a, b), sigma);
+        (a, b) = contest.refit(pts, &next)?;
+        let done = next == to_b;
+        to_b = next;
+        sigma = outer_sigma(pts, &contest.points, &to_b, centre, a, b)?;
+        if done {
+            break;
+        }
+    }
+
+    // Distinct layers? Separation measured where the points are.
+    let sep = ((b.0.dot(centre) - b.1) - (a.0.dot(centre) - a.1)).abs();
+    if sep < tol::LAYER_SEPARATION_SIGMAS * sigma {
+        return None;
+    }
+    Some(contest.assign(&to_b))
+}
+
+/// The plane `(normal, offset)` oriented so its normal points the way of `towards`.
+fn facing(normal: Vec3, offset: Real, towards: Vec3) -> PlaneEq {
+    if normal.dot(towards) < 0.0 {
+        (-normal, -offset)
+    } else {
+        (normal, offset)
+    }
+}
+
+/// The points two parallel patches compete for (each patch's points inside the other's grown
+/// bounding box) and those each keeps whatever the vote.
+struct Contest {
+    /// Contested point indices: A's, then B's.
+    points: Vec<u32>,
+    /// Whether each contested point came from patch B (RANSAC's choice).
+    orig_b: Vec<bool>,
+    /// Mean of the contested points.
+    centre: Vec3,
+    fixed_a: Vec<u32>,
+    fixed_b: Vec<u32>,
+}
+
+impl Contest {
+    /// `None` when no point is contested.
+    fn new(
+        pts: &[Vec3],
+        (pa, la): (&[u32], &Layer),
+        (pb, lb): (&[u32], &Layer),
+        radius: Real,
+    ) -> Option<Contest> {
+        let grow = Vec3::splat(radius);
+        let within =
+            |p: Vec3, l: &Layer| !(p.cmplt(l.lo - grow).any() || p.cmpgt(l.hi + grow).any());
+        let (contested_a, fixed_a): (Vec<u32>, Vec<u32>) =
+            pa.iter().partition(|&&i| within(pts[i as usize], lb));
+        let (contested_b, fixed_b): (Vec<u32>, Vec<u32>) =
+            pb.iter().partition(|&&i| within(pts[i as usize], la));
+        let points: Vec<u32> = contested_a.into_iter().chain(contested_b).collect();
+        if points.is_empty() {
+            return None;
+        }
+        let centre =
+            points.iter().fold(Vec3::ZERO, |c, &i| c + pts[i as usize]) / points.len() as Real;
+        let orig_b = points
+            .iter()
+            .map(|&i| pb.binary_search(&i).is_ok())
+            .collect();
+        Some(Contest {
+            points,
+            orig_b,
+            centre,
+            fixed_a,
+            fixed_b,
+        })
+    }
+
+    /// The contested points in the 2-D frame of `normal` and each one's neighbours within
+    /// `radius`, computed once (the points do not move, only their labels change).
+    fn neighbours(&self, pts: &[Vec3], normal: Vec3, radius: Real) -> (Vec<Vec2>, Vec<Vec<u32>>) {
+        let (u, v) = frame(normal);
+        let flat: Vec<Vec2> = self
+            .points
+            .iter()
+            .map(|&i| Vec2::new(pts[i as usize].dot(u), pts[i as usize].dot(v)))
+            .collect();
+        let near = Grid::new(&flat, radius);
+        let adjacency = (0..self.points.len())
+            .into_par_iter()
+            .map(|k| {
+                let mut out = Vec::new();
+                near.visit(&flat, k, |m| out.push(m));
+                out
+            })
+            .collect();
+        (flat, adjacency)
+    }
+
+    /// One round of the vote: each contested point's layer by the posterior with the local
+    /// prior (`adjacency`: share of neighbours in B now; `share0_b`: presence of B around the
+    /// point from the start) and Gaussian residuals of width `sigma` to planes `(a, b)`.
+    fn vote(
+        &self,
+        pts: &[Vec3],
+        (adjacency, share0_b): (&[Vec<u32>], &[Real]),
+        to_b: &[bool],
+        ((na, da), (nb, db)): (PlaneEq, PlaneEq),
+        sigma: Real,
+    ) -> Vec<bool> {
         let inv = 0.5 / (sigma * sigma);
-        let next: Vec<bool> = (0..contested.len())
+        let share = |k: usize| {
+            let nb_k = &adjacency[k];
+            nb_k.iter().filter(|&&m| to_b[m as usize]).count() as Real / nb_k.len().max(1) as Real
+        };
+        (0..self.points.len())
             .into_par_iter()
             .map(|k| {
                 // A layer absent around the point (share of "nearer" neighbours, fixed by the
@@ -230,60 +279,76 @@ fn separate_pair(
                 if share0_b[k] > 1.0 - tol::LAYER_MIN_SHARE {
                     return true;
                 }
-                let wb = share(k, &to_b).clamp(tol::LAYER_MIN_SHARE, 1.0 - tol::LAYER_MIN_SHARE);
+                let wb = share(k).clamp(tol::LAYER_MIN_SHARE, 1.0 - tol::LAYER_MIN_SHARE);
                 let wa = 1.0 - wb;
-                let p = pts[contested[k] as usize];
+                let p = pts[self.points[k] as usize];
                 let (ra, rb) = (na.dot(p) - da, nb.dot(p) - db);
                 let want_b = wb.ln() - rb * rb * inv > wa.ln() - ra * ra * inv;
                 // Leaving the patch RANSAC gave it for the other takes a layer that is
                 // established around the point, not just present nearby.
                 let target = if want_b { wb } else { wa };
-                if want_b != orig_b[k] && target < tol::LAYER_JOIN_SHARE {
-                    orig_b[k]
+                if want_b != self.orig_b[k] && target < tol::LAYER_JOIN_SHARE {
+                    self.orig_b[k]
                 } else {
                     want_b
                 }
             })
-            .collect();
-        let side = |want_b: bool| {
-            contested
-                .iter()
-                .zip(&next)
-                .filter(move |(_, b)| **b == want_b)
-                .map(|(&i, _)| pts[i as usize])
-        };
-        let fa = fit_plane(fixed_a.iter().map(|&i| pts[i as usize]).chain(side(false)));
-        let fb = fit_plane(fixed_b.iter().map(|&i| pts[i as usize]).chain(side(true)));
-        let (Some(fa), Some(fb)) = (fa, fb) else {
-            return None;
-        };
-        let done = next == to_b;
-        to_b = next;
-        (na, da) = (fa.normal, fa.offset);
-        (nb, db) = if fb.normal.dot(na) < 0.0 {
-            (-fb.normal, -fb.offset)
-        } else {
-            (fb.normal, fb.offset)
-        };
-        sigma = outer_sigma(pts, &contested, &to_b, centre, (na, da), (nb, db))?;
-        if done {
-            break;
-        }
+            .collect()
     }
 
-    // Distinct layers? Separation measured where the points are.
-    let sep = ((nb.dot(centre) - db) - (na.dot(centre) - da)).abs();
-    if sep < tol::LAYER_SEPARATION_SIGMAS * sigma {
-        return None;
+    /// Both planes refitted to the fixed points and the contested ones labelled for each,
+    /// B's normal facing A's; `None` when a side cannot be fitted.
+    fn refit(&self, pts: &[Vec3], to_b: &[bool]) -> Option<(PlaneEq, PlaneEq)> {
+        let fit = |fixed: &[u32], want_b: bool| {
+            let contested = self
+                .points
+                .iter()
+                .zip(to_b)
+                .filter(move |(_, b)| **b == want_b);
+            fit_plane(
+                fixed
+                    .iter()
+                    .chain(contested.map(|(i, _)| i))
+                    .map(|&i| pts[i as usize]),
+            )
+        };
+        let fa = fit(&self.fixed_a, false)?;
+        let fb = fit(&self.fixed_b, true)?;
+        Some((
+            (fa.normal, fa.offset),
+            facing(fb.normal, fb.offset, fa.normal),
+        ))
     }
-    let mut a = fixed_a;
-    let mut b = fixed_b;
-    for (&i, &tb) in contested.iter().zip(&to_b) {
-        if tb { b.push(i) } else { a.push(i) }
+
+    /// The two patches' sorted point lists after the vote `to_b`.
+    fn assign(self, to_b: &[bool]) -> (Vec<u32>, Vec<u32>) {
+        let mut a = self.fixed_a;
+        let mut b = self.fixed_b;
+        for (&i, &tb) in self.points.iter().zip(to_b) {
+            if tb { b.push(i) } else { a.push(i) }
+        }
+        a.sort_unstable();
+        b.sort_unstable();
+        (a, b)
     }
-    a.sort_unstable();
-    b.sort_unstable();
-    Some((a, b))
+}
+
+/// Presence of layer B around each contested point over twice the radius (four times the
+/// neighbours, so the share is steady enough to test against a floor even at a layer's
+/// corner, a quarter disk), from the starting labels `to_b`.
+fn presence_of_b(flat: &[Vec2], to_b: &[bool], radius: Real) -> Vec<Real> {
+    let wide = Grid::new(flat, 2.0 * radius);
+    (0..flat.len())
+        .into_par_iter()
+        .map(|k| {
+            let (mut all, mut b) = (0usize, 0usize);
+            wide.visit(flat, k, |m| {
+                all += 1;
+                b += usize::from(to_b[m as usize]);
+            });
+            b as Real / all.max(1) as Real
+        })
+        .collect()
 }
 
 /// Noise σ of two parallel layers, metres: RMS residual of each layer's points on the side

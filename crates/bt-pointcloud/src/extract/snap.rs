@@ -182,107 +182,140 @@ pub(crate) fn snap_all(
     patches
         .par_iter()
         .enumerate()
-        .map(|(pi, p)| {
-            let mut lines = lines_of(&p.poly);
-            let n = p.poly.len();
-            let mut snapped = vec![false; n];
-            let mut any = false;
-            for i in 0..n {
-                let line = &mut lines[i];
-                let (a, b) = (p.poly[i], p.poly[(i + 1) % n]);
-                let (a3, b3) = (p.lift(a), p.lift(b));
-                let (elo, ehi) = (
-                    a3.min(b3) - Vec3::splat(snap),
-                    a3.max(b3) + Vec3::splat(snap),
-                );
-                let mut best: Option<(Real, Line2)> = None;
-                for (qi, q) in patches.iter().enumerate() {
-                    if qi == pi || p.normal.dot(q.normal).abs() > tol::SNAP_MAX_COS {
-                        continue;
-                    }
-                    if (ehi.cmplt(q.lo)).any() || (elo.cmpgt(q.hi)).any() {
-                        continue;
-                    }
-                    let l = p.normal.cross(q.normal);
-                    let l2 = l.length_squared();
-                    let x0 = (p.offset * q.normal.cross(l) + q.offset * l.cross(p.normal)) / l2;
-                    let dir = l / l2.sqrt();
-                    let mut d2 = Vec2::new(dir.dot(p.u), dir.dot(p.v)).normalize_or_zero();
-                    let e = (b - a).normalize_or_zero();
-                    if d2.dot(e) < 0.0 {
-                        d2 = -d2;
-                    }
-                    let o2 = p.local(x0);
-                    let cand = Line2 { p: o2, d: d2 };
-                    let dist = |x: Vec2| (x - o2).perp_dot(d2).abs();
-                    let worst = dist(a).max(dist(b));
-                    if worst > snap || e.perp_dot(d2).abs() > tol::SNAP_EDGE_SIN {
-                        continue;
-                    }
-                    // Most of the edge's span, moved onto the line, must lie on or next to Q
-                    // (most, not all: a floor edge runs past a doorway in the wall).
-                    let on_line = |x: Vec2| o2 + d2 * (x - o2).dot(d2);
-                    let near = (0..=ADJ_SAMPLES)
-                        .filter(|&k| {
-                            let x = a + (b - a) * (k as Real / ADJ_SAMPLES as Real);
-                            distance_to_polygon(&q.poly, q.local(p.lift(on_line(x)))) <= snap
-                        })
-                        .count();
-                    let adj = 2 * near > ADJ_SAMPLES + 1;
-                    if adj
-                        && best.is_none_or(|(w, _)| worst < w)
-                        && gap_is_surface(p, q, a, b, cand, cell, cloud)
-                    {
-                        best = Some((worst, cand));
-                    }
-                }
-                if let Some((_, l)) = best {
-                    *line = l;
-                    snapped[i] = true;
-                    any = true;
-                }
-            }
-            if !any {
-                return p.poly.clone();
-            }
-            // A short chamfer left between two snapped edges (a corner where both
-            // neighbours stole points) is dropped so the corner is the lines' intersection.
-            let mut old = p.poly.clone();
-            loop {
-                let n = lines.len();
-                if n <= 3 {
-                    break;
-                }
-                let cur = polygon_from_lines(&lines, &old);
-                let chamfer = (0..n).find(|&i| {
-                    let (prev, next) = ((i + n - 1) % n, (i + 1) % n);
-                    !snapped[i]
-                        && snapped[prev]
-                        && snapped[next]
-                        && cur[i].distance(cur[next]) < 2.0 * snap + cell
-                        && intersect(lines[prev], lines[next]).is_some_and(|x| {
-                            x.distance(cur[i]).max(x.distance(cur[next])) <= 2.0 * snap + cell
-                        })
-                });
-                let Some(i) = chamfer else { break };
-                let next = (i + 1) % n;
-                old[next] = (old[i] + old[next]) * 0.5;
-                lines.remove(i);
-                snapped.remove(i);
-                old.remove(i);
-            }
-            let out = polygon_from_lines(&lines, &old);
-            let near_old = out
-                .iter()
-                .all(|&x| distance_to_boundary(&p.poly, x) <= 2.0 * snap + cell);
-            if near_old
-                && is_simple(&out)
-                && signed_area(&out) > tol::AREA_REL * signed_area(&p.poly)
-            {
-                out
-            } else {
-                p.poly.clone()
-            }
-        })
+        .map(|(pi, _)| snap_patch(pi, patches, snap, cell, cloud))
         .collect()
+}
+
+/// Patch `pi` of [`snap_all`]: each edge onto the best adjoining line, short chamfers between
+/// snapped edges dropped, the result kept only if it stays near the old outline, simple and
+/// not much smaller.
+fn snap_patch(
+    pi: usize,
+    patches: &[PatchGeom],
+    snap: Real,
+    cell: Real,
+    cloud: &Cloud<'_>,
+) -> Vec<Vec2> {
+    let p = &patches[pi];
+    let mut lines = lines_of(&p.poly);
+    let n = p.poly.len();
+    let mut snapped = vec![false; n];
+    let mut any = false;
+    for i in 0..n {
+        let edge = (p.poly[i], p.poly[(i + 1) % n]);
+        if let Some(l) = best_line(pi, patches, edge, (snap, cell), cloud) {
+            lines[i] = l;
+            snapped[i] = true;
+            any = true;
+        }
+    }
+    if !any {
+        return p.poly.clone();
+    }
+    let old = drop_chamfers(&mut lines, &mut snapped, p.poly.clone(), snap, cell);
+    let out = polygon_from_lines(&lines, &old);
+    let near_old = out
+        .iter()
+        .all(|&x| distance_to_boundary(&p.poly, x) <= 2.0 * snap + cell);
+    if near_old && is_simple(&out) && signed_area(&out) > tol::AREA_REL * signed_area(&p.poly) {
+        out
+    } else {
+        p.poly.clone()
+    }
+}
+
+/// The intersection line with another patch that edge `(a, b)` of patch `pi` should snap to:
+/// of the non-parallel patches whose line lies within `snap` of both ends and nearly along
+/// the edge, next to most of the edge's span, across a gap the data cannot show to be real,
+/// the one nearest the edge.
+fn best_line(
+    pi: usize,
+    patches: &[PatchGeom],
+    (a, b): (Vec2, Vec2),
+    (snap, cell): (Real, Real),
+    cloud: &Cloud<'_>,
+) -> Option<Line2> {
+    let p = &patches[pi];
+    let (a3, b3) = (p.lift(a), p.lift(b));
+    let (elo, ehi) = (
+        a3.min(b3) - Vec3::splat(snap),
+        a3.max(b3) + Vec3::splat(snap),
+    );
+    let mut best: Option<(Real, Line2)> = None;
+    for (qi, q) in patches.iter().enumerate() {
+        if qi == pi || p.normal.dot(q.normal).abs() > tol::SNAP_MAX_COS {
+            continue;
+        }
+        if (ehi.cmplt(q.lo)).any() || (elo.cmpgt(q.hi)).any() {
+            continue;
+        }
+        let l = p.normal.cross(q.normal);
+        let l2 = l.length_squared();
+        let x0 = (p.offset * q.normal.cross(l) + q.offset * l.cross(p.normal)) / l2;
+        let dir = l / l2.sqrt();
+        let mut d2 = Vec2::new(dir.dot(p.u), dir.dot(p.v)).normalize_or_zero();
+        let e = (b - a).normalize_or_zero();
+        if d2.dot(e) < 0.0 {
+            d2 = -d2;
+        }
+        let o2 = p.local(x0);
+        let cand = Line2 { p: o2, d: d2 };
+        let dist = |x: Vec2| (x - o2).perp_dot(d2).abs();
+        let worst = dist(a).max(dist(b));
+        if worst > snap || e.perp_dot(d2).abs() > tol::SNAP_EDGE_SIN {
+            continue;
+        }
+        // Most of the edge's span, moved onto the line, must lie on or next to Q
+        // (most, not all: a floor edge runs past a doorway in the wall).
+        let on_line = |x: Vec2| o2 + d2 * (x - o2).dot(d2);
+        let near = (0..=ADJ_SAMPLES)
+            .filter(|&k| {
+                let x = a + (b - a) * (k as Real / ADJ_SAMPLES as Real);
+                distance_to_polygon(&q.poly, q.local(p.lift(on_line(x)))) <= snap
+            })
+            .count();
+        let adj = 2 * near > ADJ_SAMPLES + 1;
+        if adj
+            && best.is_none_or(|(w, _)| worst < w)
+            && gap_is_surface(p, q, a, b, cand, cell, cloud)
+        {
+            best = Some((worst, cand));
+        }
+    }
+    best.map(|(_, l)| l)
+}
+
+/// Drops each short chamfer left between two snapped edges (a corner where both neighbours
+/// stole points) so the corner is the lines' intersection; returns the outline `old` with the
+/// same edges removed (the reference points of [`polygon_from_lines`]).
+fn drop_chamfers(
+    lines: &mut Vec<Line2>,
+    snapped: &mut Vec<bool>,
+    mut old: Vec<Vec2>,
+    snap: Real,
+    cell: Real,
+) -> Vec<Vec2> {
+    loop {
+        let n = lines.len();
+        if n <= 3 {
+            return old;
+        }
+        let cur = polygon_from_lines(lines, &old);
+        let chamfer = (0..n).find(|&i| {
+            let (prev, next) = ((i + n - 1) % n, (i + 1) % n);
+            !snapped[i]
+                && snapped[prev]
+                && snapped[next]
+                && cur[i].distance(cur[next]) < 2.0 * snap + cell
+                && intersect(lines[prev], lines[next]).is_some_and(|x| {
+                    x.distance(cur[i]).max(x.distance(cur[next])) <= 2.0 * snap + cell
+                })
+        });
+        let Some(i) = chamfer else { return old };
+        let next = (i + 1) % n;
+        old[next] = (old[i] + old[next]) * 0.5;
+        lines.remove(i);
+        snapped.remove(i);
+        old.remove(i);
+    }
 }

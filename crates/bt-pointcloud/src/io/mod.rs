@@ -132,6 +132,67 @@ pub fn write_path(cloud: &PointCloud, path: &Path) -> Result<(), PointCloudError
     })
 }
 
+/// The columns of `x`, `y`, `z` (each required: a missing one is `MissingField`) and of the
+/// three normal components `normal` (all three or none), looked up by `find`, which refuses a
+/// column the reader cannot use (a list, a COUNT above 1).
+pub(crate) fn point_columns(
+    find: impl Fn(&str) -> Result<Option<usize>, PointCloudError>,
+    normal: [&str; 3],
+) -> Result<([usize; 3], Option<[usize; 3]>), PointCloudError> {
+    let mut xyz = [0usize; 3];
+    for (k, name) in ["x", "y", "z"].into_iter().enumerate() {
+        xyz[k] = find(name)?.ok_or_else(|| PointCloudError::MissingField {
+            origin: Origin(None),
+            field: name.to_string(),
+        })?;
+    }
+    let normal = match (find(normal[0])?, find(normal[1])?, find(normal[2])?) {
+        (Some(a), Some(b), Some(c)) => Some([a, b, c]),
+        _ => None,
+    };
+    Ok((xyz, normal))
+}
+
+/// How a writer encodes the values of a point record.
+#[derive(Debug, Clone, Copy)]
+pub(crate) enum Encoding {
+    /// One line per point, values in the shortest spelling that reads back to the same `Real`.
+    Ascii,
+    /// `f64` little endian.
+    LittleEndian,
+    /// `f64` big endian.
+    BigEndian,
+}
+
+/// Writes one record per point of `cloud` after its header: `x y z`, then `nx ny nz` when the
+/// cloud has normals.
+pub(crate) fn write_records<W: std::io::Write>(
+    cloud: &PointCloud,
+    w: &mut W,
+    encoding: Encoding,
+) -> Result<(), PointCloudError> {
+    let mut buf = Vec::with_capacity(64);
+    for (i, p) in cloud.points().iter().enumerate() {
+        buf.clear();
+        let mut vals = vec![p.x, p.y, p.z];
+        if let Some(ns) = cloud.normals() {
+            vals.extend([ns[i].x, ns[i].y, ns[i].z]);
+        }
+        let all = vals.iter();
+        match encoding {
+            Encoding::Ascii => {
+                let s: Vec<String> = all.map(|v| format!("{v:?}")).collect();
+                buf.extend_from_slice(s.join(" ").as_bytes());
+                buf.push(b'\n');
+            }
+            Encoding::LittleEndian => all.for_each(|v| buf.extend_from_slice(&v.to_le_bytes())),
+            Encoding::BigEndian => all.for_each(|v| buf.extend_from_slice(&v.to_be_bytes())),
+        }
+        w.write_all(&buf).map_err(io_err)?;
+    }
+    Ok(())
+}
+
 /// Whether a header's claim of at least `min_bytes` of data is absurd given `available`
 /// bytes (rather than a file cut short).
 pub(crate) fn is_absurd(min_bytes: u128, available: usize) -> bool {

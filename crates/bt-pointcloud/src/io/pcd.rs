@@ -141,77 +141,20 @@ fn read_keywords(bytes: &[u8]) -> Result<Keywords, PointCloudError> {
         let mut tok = line.split_ascii_whitespace();
         let Some(key) = tok.next() else { continue };
         let rest: Vec<&str> = tok.collect();
-        let ints = |what: &str| -> Result<Vec<u64>, PointCloudError> {
-            rest.iter()
-                .map(|t| {
-                    t.parse::<u64>().map_err(|_| {
-                        header_err(
-                            line_no,
-                            format!("{what}: '{t}' is not a non-negative integer"),
-                        )
-                    })
-                })
-                .collect()
-        };
-        let one = |what: &str| -> Result<u64, PointCloudError> {
-            match ints(what)?.as_slice() {
-                [v] => Ok(*v),
-                _ => Err(header_err(
-                    line_no,
-                    format!("{what} takes exactly one value"),
-                )),
-            }
-        };
+        let one = |what: &str| one_int(&rest, what, line_no);
         match key.to_ascii_uppercase().as_str() {
             "VERSION" | "VIEWPOINT" => {}
             "FIELDS" => names = Some(rest.iter().map(|s| s.to_string()).collect()),
-            "SIZE" => sizes = Some(ints("SIZE")?.into_iter().map(|v| v as usize).collect()),
-            "COUNT" => {
-                let c = ints("COUNT")?;
-                if c.iter().any(|&v| v == 0 || v > 1 << 20) {
-                    return Err(header_err(
-                        line_no,
-                        "COUNT values must be between 1 and 2^20",
-                    ));
-                }
-                counts = Some(c.into_iter().map(|v| v as usize).collect());
+            "SIZE" => {
+                let v = ints(&rest, "SIZE", line_no)?;
+                sizes = Some(v.into_iter().map(|v| v as usize).collect());
             }
-            "TYPE" => {
-                let mut t = Vec::new();
-                for s in &rest {
-                    match *s {
-                        "F" | "I" | "U" => t.push(s.as_bytes()[0]),
-                        _ => {
-                            return Err(header_err(
-                                line_no,
-                                format!("TYPE '{s}' is not F, I or U"),
-                            ));
-                        }
-                    }
-                }
-                types = Some(t);
-            }
+            "COUNT" => counts = Some(count_values(&rest, line_no)?),
+            "TYPE" => types = Some(type_letters(&rest, line_no)?),
             "WIDTH" => width = Some(one("WIDTH")?),
             "HEIGHT" => height = Some(one("HEIGHT")?),
             "POINTS" => points = Some(one("POINTS")?),
             "DATA" => {
-                let binary = match rest.as_slice() {
-                    ["ascii"] => false,
-                    ["binary"] => true,
-                    ["binary_compressed"] => {
-                        return Err(PointCloudError::Unsupported {
-                            origin: Origin(None),
-                            line: line_no,
-                            what: "DATA binary_compressed (decompress with pcl_convert_pcd_ascii_binary)".into(),
-                        });
-                    }
-                    _ => {
-                        return Err(header_err(
-                            line_no,
-                            format!("unknown DATA encoding '{}'", rest.join(" ")),
-                        ));
-                    }
-                };
                 return Ok(Keywords {
                     names,
                     sizes,
@@ -220,13 +163,68 @@ fn read_keywords(bytes: &[u8]) -> Result<Keywords, PointCloudError> {
                     width,
                     height,
                     points,
-                    binary,
+                    binary: data_is_binary(&rest, line_no)?,
                     data_start: pos,
                     data_line: line_no,
                 });
             }
             other => return Err(header_err(line_no, format!("unknown keyword '{other}'"))),
         }
+    }
+}
+
+/// The values of a header line `what` on line `line`: non-negative integers.
+fn ints(rest: &[&str], what: &str, line: usize) -> Result<Vec<u64>, PointCloudError> {
+    rest.iter()
+        .map(|t| {
+            t.parse::<u64>().map_err(|_| {
+                header_err(line, format!("{what}: '{t}' is not a non-negative integer"))
+            })
+        })
+        .collect()
+}
+
+/// The one value of a header line `what` (WIDTH, HEIGHT, POINTS).
+fn one_int(rest: &[&str], what: &str, line: usize) -> Result<u64, PointCloudError> {
+    match ints(rest, what, line)?.as_slice() {
+        [v] => Ok(*v),
+        _ => Err(header_err(line, format!("{what} takes exactly one value"))),
+    }
+}
+
+/// The values of `COUNT`, each between 1 and 2^20.
+fn count_values(rest: &[&str], line: usize) -> Result<Vec<usize>, PointCloudError> {
+    let c = ints(rest, "COUNT", line)?;
+    if c.iter().any(|&v| v == 0 || v > 1 << 20) {
+        return Err(header_err(line, "COUNT values must be between 1 and 2^20"));
+    }
+    Ok(c.into_iter().map(|v| v as usize).collect())
+}
+
+/// The letters of `TYPE` (`F`, `I` or `U`).
+fn type_letters(rest: &[&str], line: usize) -> Result<Vec<u8>, PointCloudError> {
+    rest.iter()
+        .map(|s| match *s {
+            "F" | "I" | "U" => Ok(s.as_bytes()[0]),
+            _ => Err(header_err(line, format!("TYPE '{s}' is not F, I or U"))),
+        })
+        .collect()
+}
+
+/// Whether the `DATA` line says `binary` (else `ascii`); `binary_compressed` is unsupported.
+fn data_is_binary(rest: &[&str], line: usize) -> Result<bool, PointCloudError> {
+    match rest {
+        ["ascii"] => Ok(false),
+        ["binary"] => Ok(true),
+        ["binary_compressed"] => Err(PointCloudError::Unsupported {
+            origin: Origin(None),
+            line,
+            what: "DATA binary_compressed (decompress with pcl_convert_pcd_ascii_binary)".into(),
+        }),
+        _ => Err(header_err(
+            line,
+            format!("unknown DATA encoding '{}'", rest.join(" ")),
+        )),
     }
 }
 
@@ -320,17 +318,7 @@ fn layout(fields: &[Field], data_line: usize) -> Result<Layout, PointCloudError>
             other => Ok(other),
         }
     };
-    let mut xyz = [0usize; 3];
-    for (k, name) in ["x", "y", "z"].into_iter().enumerate() {
-        xyz[k] = find(name)?.ok_or_else(|| PointCloudError::MissingField {
-            origin: Origin(None),
-            field: name.into(),
-        })?;
-    }
-    let normal = match (find("normal_x")?, find("normal_y")?, find("normal_z")?) {
-        (Some(a), Some(b), Some(c)) => Some([a, b, c]),
-        _ => None,
-    };
+    let (xyz, normal) = super::point_columns(find, ["normal_x", "normal_y", "normal_z"])?;
 
     Ok(Layout {
         col,
@@ -487,24 +475,9 @@ pub fn write_pcd<W: Write>(
         n = cloud.len(),
     );
     w.write_all(head.as_bytes()).map_err(io_err)?;
-    let mut buf = Vec::with_capacity(64);
-    for (i, p) in cloud.points().iter().enumerate() {
-        buf.clear();
-        let mut vals = vec![p.x, p.y, p.z];
-        if let Some(ns) = cloud.normals() {
-            vals.extend([ns[i].x, ns[i].y, ns[i].z]);
-        }
-        match data {
-            PcdData::Ascii => {
-                let s: Vec<String> = vals.iter().map(|v| format!("{v:?}")).collect();
-                buf.extend_from_slice(s.join(" ").as_bytes());
-                buf.push(b'\n');
-            }
-            PcdData::Binary => vals
-                .iter()
-                .for_each(|v| buf.extend_from_slice(&v.to_le_bytes())),
-        }
-        w.write_all(&buf).map_err(io_err)?;
-    }
-    Ok(())
+    let encoding = match data {
+        PcdData::Ascii => super::Encoding::Ascii,
+        PcdData::Binary => super::Encoding::LittleEndian,
+    };
+    super::write_records(cloud, &mut w, encoding)
 }

@@ -49,3 +49,14 @@ pub fn max_point_distance(a: &[FoundPath], b: &[FoundPath]) -> Real {
         .flat_map(|(p, q)| p.points.iter().zip(&q.points).map(|(x, y)| x.distance(*y)))
         .fold(0.0, Real::max)
 }
+
+/// The proptest settings of the random-scene comparisons (IPC and Newton against the image
+/// method): a fixed RNG seed, so every run sees the same scenes (CI is deterministic); raise
+/// the case count with PROPTEST_CASES to explore.
+pub fn random_scene_config() -> proptest::test_runner::Config {
+    proptest::test_runner::Config {
+        cases: 24,
+        rng_seed: proptest::test_runner::RngSeed::Fixed(0x05ee_d1bc),
+        ..proptest::test_runner::Config::default()
+    }
+}

@@ -6,13 +6,7 @@ use bt_solve::{Solver, UpdateOrder};
 use proptest::prelude::*;
 
 proptest! {
-    // Fixed RNG seed: the same scenes on every run (CI is deterministic); raise the case
-    // count with PROPTEST_CASES to explore.
-    #![proptest_config(ProptestConfig {
-        cases: 24,
-        rng_seed: proptest::test_runner::RngSeed::Fixed(0x05ee_d1bc),
-        ..ProptestConfig::default()
-    })]
+    #![proptest_config(random_scene_config())]
 
     #[test]
     fn ipc_equals_image_method_on_random_scenes(seed in 0u64..1_000_000, n in 1usize..6) {

@@ -31,11 +31,7 @@ fn check_agreement(
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig {
-        cases: 24,
-        rng_seed: proptest::test_runner::RngSeed::Fixed(0x05ee_d1bc),
-        ..ProptestConfig::default()
-    })]
+    #![proptest_config(random_scene_config())]
 
     /// The scenes of `ipc_equals_image_method_on_random_scenes`, with Newton after both orders.
     #[test]

@@ -49,7 +49,7 @@ pub(super) struct Ctx<'a> {
 
 impl Ctx<'_> {
     /// An error at `node`'s start: `file: line L, column C: message`.
-    pub(super) fn error(&self, node: Node, message: impl Into<String>) -> SceneError {
+    pub(super) fn error(&self, node: Node<'_, '_>, message: impl Into<String>) -> SceneError {
         let pos = self.pos(node);
         SceneError::Xml {
             path: self.file.to_string(),
@@ -60,13 +60,13 @@ impl Ctx<'_> {
     }
 
     /// The line of `node`, for messages that outlive the parse.
-    fn line(&self, node: Node) -> u32 {
+    fn line(&self, node: Node<'_, '_>) -> u32 {
         self.pos(node).line
     }
 
     /// Where `node` starts, in O(log lines + line length) (roxmltree's own `text_pos_at`
     /// scans from the start of the text: quadratic over a file of many shapes).
-    fn pos(&self, node: Node) -> XmlPos {
+    fn pos(&self, node: Node<'_, '_>) -> XmlPos {
         let offset = node.range().start.min(self.text.len());
         let line = self.line_starts.partition_point(|&s| s <= offset);
         let start = self.line_starts[line - 1];
@@ -81,7 +81,11 @@ impl Ctx<'_> {
     }
 
     /// Attribute `name` with `$param` substituted from the `<default>`s (`\$` is a literal `$`).
-    pub(super) fn attr(&self, node: Node, name: &str) -> Result<Option<String>, SceneError> {
+    pub(super) fn attr(
+        &self,
+        node: Node<'_, '_>,
+        name: &str,
+    ) -> Result<Option<String>, SceneError> {
         let Some(raw) = node.attribute(name) else {
             return Ok(None);
         };
@@ -114,7 +118,7 @@ impl Ctx<'_> {
     }
 
     /// A required attribute.
-    pub(super) fn required(&self, node: Node, name: &str) -> Result<String, SceneError> {
+    pub(super) fn required(&self, node: Node<'_, '_>, name: &str) -> Result<String, SceneError> {
         self.attr(node, name)?.ok_or_else(|| {
             self.error(
                 node,
@@ -124,7 +128,7 @@ impl Ctx<'_> {
     }
 
     /// A finite number from attribute `name`.
-    pub(super) fn number(&self, node: Node, name: &str) -> Result<Real, SceneError> {
+    pub(super) fn number(&self, node: Node<'_, '_>, name: &str) -> Result<Real, SceneError> {
         let text = self.required(node, name)?;
         parse_number(&text).ok_or_else(|| {
             self.error(
@@ -229,7 +233,12 @@ pub fn parse_xml(text: &str, file: &str) -> Result<XmlScene, SceneError> {
     Ok(scene)
 }
 
-fn add_bsdf(ctx: &mut Ctx, scene: &mut XmlScene, node: Node, id: String) -> Result<(), SceneError> {
+fn add_bsdf(
+    ctx: &mut Ctx<'_>,
+    scene: &mut XmlScene,
+    node: Node<'_, '_>,
+    id: String,
+) -> Result<(), SceneError> {
     if scene.bsdfs.len() >= MAX_XML_BSDFS {
         return Err(ctx.error(
             node,
@@ -253,7 +262,7 @@ fn add_bsdf(ctx: &mut Ctx, scene: &mut XmlScene, node: Node, id: String) -> Resu
 
 /// A bsdf's radio meaning: Sionna's radio materials by their properties, any other (visual)
 /// Mitsuba bsdf by its id (Sionna 0.x: `mat-itu_concrete`, `itu_glass`), contents ignored.
-fn parse_bsdf(ctx: &Ctx, node: Node) -> Result<XmlRadio, SceneError> {
+fn parse_bsdf(ctx: &Ctx<'_>, node: Node<'_, '_>) -> Result<XmlRadio, SceneError> {
     let kind = ctx.required(node, "type")?;
     let radio = kind == "itu-radio-material" || kind == "radio-material";
     if !radio {
@@ -315,7 +324,11 @@ fn parse_bsdf(ctx: &Ctx, node: Node) -> Result<XmlRadio, SceneError> {
     })
 }
 
-fn parse_shape(ctx: &mut Ctx, scene: &mut XmlScene, node: Node) -> Result<XmlShape, SceneError> {
+fn parse_shape(
+    ctx: &mut Ctx<'_>,
+    scene: &mut XmlScene,
+    node: Node<'_, '_>,
+) -> Result<XmlShape, SceneError> {
     let kind = match ctx.required(node, "type")?.as_str() {
         "ply" => MeshKind::Ply,
         "obj" => MeshKind::Obj,
@@ -355,11 +368,11 @@ fn parse_shape(ctx: &mut Ctx, scene: &mut XmlScene, node: Node) -> Result<XmlSha
 }
 
 fn shape_child(
-    ctx: &mut Ctx,
+    ctx: &mut Ctx<'_>,
     scene: &mut XmlScene,
     shape: &mut XmlShape,
     filename: &mut Option<String>,
-    child: Node,
+    child: Node<'_, '_>,
 ) -> Result<(), SceneError> {
     match tag(child) {
         "string" if ctx.required(child, "name")? == "filename" => {
@@ -443,7 +456,12 @@ fn shape_child(
 }
 
 /// Record the shape's bsdf: one per shape.
-fn set_bsdf(ctx: &Ctx, shape: &mut XmlShape, id: String, at: Node) -> Result<(), SceneError> {
+fn set_bsdf(
+    ctx: &Ctx<'_>,
+    shape: &mut XmlShape,
+    id: String,
+    at: Node<'_, '_>,
+) -> Result<(), SceneError> {
     if shape.bsdf.is_some() {
         return Err(ctx.error(at, "<shape> has more than one bsdf"));
     }
@@ -452,7 +470,7 @@ fn set_bsdf(ctx: &Ctx, shape: &mut XmlShape, id: String, at: Node) -> Result<(),
 }
 
 /// Every shape's bsdf reference names a bsdf of the file.
-fn check_refs(ctx: &Ctx, scene: &XmlScene) -> Result<(), SceneError> {
+fn check_refs(ctx: &Ctx<'_>, scene: &XmlScene) -> Result<(), SceneError> {
     for shape in &scene.shapes {
         if let Some((id, at)) = &shape.bsdf
             && !ctx.bsdf_ids.contains(id)
