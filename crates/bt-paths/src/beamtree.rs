@@ -708,7 +708,7 @@ fn beam_planes(plane: &Plane, apex: Vec3, window: &[Vec3]) -> Vec<Plane> {
         let (a, b) = (window[i], window[(i + 1) % n]);
         let normal = (a - apex).cross(b - apex);
         let len = normal.length();
-        if !(len > 1e-12 * (a - apex).length() * (b - apex).length()) {
+        if !spans_a_plane(len, (a - apex).length() * (b - apex).length()) {
             continue;
         }
         out.push(orient_towards(
@@ -717,6 +717,12 @@ fn beam_planes(plane: &Plane, apex: Vec3, window: &[Vec3]) -> Vec<Plane> {
         ));
     }
     out
+}
+
+/// Whether a cross product of length `len` from two vectors whose lengths multiply to `scale`
+/// spans a plane: false for (nearly) parallel vectors, and for NaN.
+fn spans_a_plane(len: Real, scale: Real) -> bool {
+    len > 1e-12 * scale
 }
 
 /// Occlusion culling of the window in `scratch.a` (child `s` of `parent`): returns true when a
@@ -850,7 +856,7 @@ fn shadow(occluder: &bt_geom::Polygon, apex: Vec3, window: &[Vec3], margin: Real
         let moved = a + margin * inward;
         let pn = (moved - apex).cross(dir);
         let len = pn.length();
-        if !(len > 1e-12 * (moved - apex).length() * dir.length()) {
+        if !spans_a_plane(len, (moved - apex).length() * dir.length()) {
             return Shadow::None;
         }
         let plane = orient_towards(Plane::from_point_normal(apex, pn / len), moved + inward);

@@ -12,7 +12,7 @@ use roxmltree::Node;
 const MIN_ABS_DETERMINANT: Real = 1e-12;
 
 /// The affine map of a `<transform>` element (metres to metres).
-pub(super) fn parse_transform(ctx: &Ctx, node: Node) -> Result<DMat4, SceneError> {
+pub(super) fn parse_transform(ctx: &Ctx<'_>, node: Node<'_, '_>) -> Result<DMat4, SceneError> {
     let mut m = DMat4::IDENTITY;
     for op in elements(node) {
         let step = match tag(op) {
@@ -44,7 +44,7 @@ pub(super) fn parse_transform(ctx: &Ctx, node: Node) -> Result<DMat4, SceneError
 
 /// `x`/`y`/`z` attributes (missing ones `default`), or `value` with one number (all three) or
 /// three; commas or spaces separate.
-fn vector(ctx: &Ctx, op: Node, default: Real) -> Result<Vec3, SceneError> {
+fn vector(ctx: &Ctx<'_>, op: Node<'_, '_>, default: Real) -> Result<Vec3, SceneError> {
     if let Some(value) = ctx.attr(op, "value")? {
         if ["x", "y", "z"].iter().any(|a| op.attribute(*a).is_some()) {
             return Err(ctx.error(op, format!("<{}> mixes value= with x/y/z", tag(op))));
@@ -69,7 +69,7 @@ fn vector(ctx: &Ctx, op: Node, default: Real) -> Result<Vec3, SceneError> {
 }
 
 /// `<rotate x=".." y=".." z=".." angle="degrees"/>`: right-handed about the axis.
-fn rotation(ctx: &Ctx, op: Node) -> Result<DMat4, SceneError> {
+fn rotation(ctx: &Ctx<'_>, op: Node<'_, '_>) -> Result<DMat4, SceneError> {
     let axis = vector(ctx, op, 0.0)?;
     let angle_deg = ctx.number(op, "angle")?;
     let len = axis.length();
@@ -80,7 +80,7 @@ fn rotation(ctx: &Ctx, op: Node) -> Result<DMat4, SceneError> {
 }
 
 /// `<matrix value="16 numbers"/>` (or 9 for the linear part), row by row as Mitsuba reads it.
-fn matrix(ctx: &Ctx, op: Node) -> Result<DMat4, SceneError> {
+fn matrix(ctx: &Ctx<'_>, op: Node<'_, '_>) -> Result<DMat4, SceneError> {
     let value = ctx.required(op, "value")?;
     let v = numbers(ctx, op, &value)?;
     let n = match v.len() {
@@ -105,7 +105,7 @@ fn matrix(ctx: &Ctx, op: Node) -> Result<DMat4, SceneError> {
     Ok(m)
 }
 
-fn numbers(ctx: &Ctx, op: Node, text: &str) -> Result<Vec<Real>, SceneError> {
+fn numbers(ctx: &Ctx<'_>, op: Node<'_, '_>, text: &str) -> Result<Vec<Real>, SceneError> {
     text.split(|c: char| c.is_whitespace() || c == ',')
         .filter(|t| !t.is_empty())
         .map(|t| {
