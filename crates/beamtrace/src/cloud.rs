@@ -129,7 +129,10 @@ pub fn run_sample(args: &SampleArgs) -> anyhow::Result<ExitCode> {
         .scene
         .surfaces()
         .iter()
-        .map(|s| s.polygon.vertices().to_vec())
+        .map(|s| {
+            let world = |v: &glam::DVec3| loaded.scene.to_world(*v);
+            s.polygon.vertices().iter().map(world).collect()
+        })
         .collect();
     let area: f64 = loaded
         .scene

@@ -170,8 +170,8 @@ pub fn check(args: &SceneArgs) -> anyhow::Result<ExitCode> {
                 reflectors,
                 scene.surfaces().len() - reflectors,
                 scene.extent(),
-                scene.tx().to_array(),
-                scene.rx().to_array(),
+                scene.tx_world().to_array(),
+                scene.rx_world().to_array(),
                 scene.frequency_hz() / 1e9
             );
             Ok(ExitCode::SUCCESS)

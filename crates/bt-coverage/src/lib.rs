@@ -90,9 +90,7 @@ pub fn sweep(
         for (rx, outcome) in chunk.iter().zip(trace_each_receiver(scene, chunk, options)) {
             let status = match outcome {
                 Ok(traced) => {
-                    let moved = scene
-                        .with_terminals(scene.tx(), *rx)
-                        .map_err(TraceError::from)?;
+                    let moved = scene.with_receiver(*rx).map_err(TraceError::from)?;
                     let radio = bt_beams::RadioOptions::default();
                     summarise(&bt_beams::report(&moved, &traced.result.paths, &radio)?)
                 }
@@ -196,6 +194,52 @@ fn csv_field(s: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_far_hall_sweeps_like_the_hall_at_the_origin() {
+        let desc = bt_testkit::hall_description();
+        let offset = Vec3::new(-7.5e6, 1.25e6, 10.0);
+        let terminals = bt_scene::Terminals::default();
+        let near = Scene::from_description(&desc, "hall", terminals).unwrap();
+        let far = bt_testkit::translated(&desc, offset);
+        let far = Scene::from_description(&far, "hall", terminals).unwrap();
+        // a grid over the hall, one point on the stage's top (skipped in both)
+        let mut points: Vec<Vec3> = (0..12)
+            .map(|i| Vec3::new(5.0 + 4.5 * i as Real, 3.0 + 3.0 * (i % 5) as Real, 1.5))
+            .collect();
+        points.push(Vec3::new(6.0, 20.0, 1.25));
+        let moved: Vec<Vec3> = points.iter().map(|p| *p + offset).collect();
+        let options = TraceOptions::new(2);
+        let a = sweep(&near, &points, &options, &mut |_, _| {}).unwrap();
+        let b = sweep(&far, &moved, &options, &mut |_, _| {}).unwrap();
+        assert!(
+            matches!(a[12].status, PointStatus::Skipped(_)),
+            "{:?}",
+            a[12]
+        );
+        for (r, s) in a.iter().zip(&b) {
+            assert_eq!(s.rx, r.rx + offset, "rows keep the world grid point");
+            match (&r.status, &s.status) {
+                (
+                    PointStatus::Traced {
+                        paths: n,
+                        strongest: Some(x),
+                        ..
+                    },
+                    PointStatus::Traced {
+                        paths: m,
+                        strongest: Some(y),
+                        ..
+                    },
+                ) => {
+                    assert_eq!((n, &x.surfaces), (m, &y.surfaces), "at {}", r.rx);
+                    assert!((x.length_m - y.length_m).abs() <= 1e-9 * x.length_m);
+                }
+                (PointStatus::Skipped(_), PointStatus::Skipped(_)) => {}
+                other => panic!("at {}: {other:?}", r.rx),
+            }
+        }
+    }
 
     #[test]
     fn csv_fields_with_separators_are_quoted() {

@@ -107,8 +107,8 @@ impl StepPaths {
     /// The ranked reports of a trace of `scene`.
     pub fn from_reports(scene: &Scene, paths: &[PathReport]) -> Self {
         StepPaths {
-            tx: scene.tx().to_array(),
-            rx: scene.rx().to_array(),
+            tx: scene.tx_world().to_array(),
+            rx: scene.rx_world().to_array(),
             paths: paths.iter().map(ViewPath::from).collect(),
         }
     }
@@ -216,7 +216,9 @@ pub fn page(scenes: &[&Scene], paths: &[StepPaths]) -> String {
                         SurfaceKind::Reflector => colour_of(&s.material),
                         SurfaceKind::Blocker => BLOCKER,
                     },
-                    vertices: s.polygon.vertices().iter().map(|v| v.to_array()).collect(),
+                    vertices: (s.polygon.vertices().iter())
+                        .map(|v| scene.to_world(*v).to_array())
+                        .collect(),
                 })
                 .collect(),
             tx: step.tx,

@@ -131,9 +131,14 @@ pub fn from_mesh(
         });
     }
     let mut problems: Vec<Problem> = Vec::new();
+    let (tx, rx) = (options.terminals.tx, options.terminals.rx);
+    let origin = crate::frame::recentre(&mut raw, [tx, rx], &mut problems);
     let surfaces = build_surfaces(raw, &materials, &mut problems);
-    let (tx, rx) = match (options.terminals.tx, options.terminals.rx) {
-        (Some(tx), Some(rx)) => (tx, rx),
+    let (tx, rx) = match (tx, rx) {
+        (Some(tx), Some(rx)) => (
+            crate::frame::to_local(tx, origin),
+            crate::frame::to_local(rx, origin),
+        ),
         (tx, rx) => {
             for (field, v) in [("tx", tx), ("rx", rx)] {
                 if v.is_none() {
@@ -150,7 +155,7 @@ pub fn from_mesh(
         }
     };
     let extent = crate::model::scene_extent(&surfaces, tx, rx);
-    if let Err(p) = check_terminals(&surfaces, tx, rx, extent) {
+    if let Err(p) = check_terminals(&surfaces, tx, rx, extent, origin) {
         problems.extend(p);
     }
     problems.extend(radio_problems(&surfaces, &materials, options.frequency_hz));
@@ -163,6 +168,7 @@ pub fn from_mesh(
     Ok(Loaded {
         scene: Scene::assemble(
             name.to_string(),
+            origin,
             surfaces,
             tx,
             rx,
