@@ -8,6 +8,7 @@ mod builtin;
 pub mod city;
 mod description;
 pub mod dynamic;
+mod enclosure;
 mod frame;
 pub mod io;
 mod material;

@@ -174,10 +174,44 @@ impl Scene {
         out
     }
 
+    /// Closed shells (watertight groups of surfaces, e.g. a box with all six faces or a closed
+    /// mesh solid) that hold exactly one of TX and RX, with the terminal inside ("tx" or "rx"):
+    /// no path can connect the two. A shell holding both (the room itself) is not listed, nor
+    /// one whose sides cannot be told within the tolerance (the test only answers when sure).
+    pub fn separating_shells(&self) -> Vec<(&'static str, Vec<SurfaceId>)> {
+        let eps = self.length_tolerance();
+        let inside =
+            |shell: &[SurfaceId], p| crate::enclosure::encloses(&self.surfaces, shell, p, eps);
+        crate::enclosure::closed_shells(&self.surfaces)
+            .into_iter()
+            .filter_map(
+                |shell| match (inside(&shell, self.tx)?, inside(&shell, self.rx)?) {
+                    (true, false) => Some(("tx", shell)),
+                    (false, true) => Some(("rx", shell)),
+                    _ => None,
+                },
+            )
+            .collect()
+    }
+
     /// Warnings about a valid scene that likely does not mean what it says (printable: names
     /// escaped).
     pub fn warnings(&self) -> Vec<String> {
-        self.coplanar_conflicts()
+        let enclosed = self.separating_shells().into_iter().map(|(inside, shell)| {
+            let names: Vec<String> = (shell.iter().take(3))
+                .map(|id| format!("\"{}\"", crate::name::escape(&self.surface(*id).name)))
+                .collect();
+            let more = if shell.len() > 3 { ", ..." } else { "" };
+            let outside = if inside == "tx" { "rx" } else { "tx" };
+            format!(
+                "{inside} lies inside the closed solid of {} surfaces ({}{more}) and {outside} \
+                 outside it: no path can connect them",
+                shell.len(),
+                names.join(", ")
+            )
+        });
+        let conflicts = self
+            .coplanar_conflicts()
             .into_iter()
             .map(|(a, b)| {
                 let (a, b) = (self.surface(a), self.surface(b));
@@ -189,8 +223,8 @@ impl Scene {
                     crate::name::escape(&b.name),
                     crate::name::escape(&b.material)
                 )
-            })
-            .collect()
+            });
+        conflicts.chain(enclosed).collect()
     }
 
     /// A copy with other TX/RX positions (metres, world frame, like the scene file's),

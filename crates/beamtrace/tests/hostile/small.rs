@@ -229,3 +229,67 @@ fn a_scene_far_from_the_origin_traces_like_the_same_scene_at_it() {
         }
     }
 }
+
+#[test]
+fn a_terminal_shut_inside_a_closed_solid_is_warned_about() {
+    let dir = scratch("shut-in");
+    let desc = serde_json::json!({
+        "tx": [4.5, 1.5, 1.0], "rx": [1, 1, 1],
+        "boxes": [
+            { "name": "room", "min": [0, 0, 0], "max": [6, 4, 3] },
+            { "name": "safe", "material": "metal", "min": [4, 1, 0.5], "max": [5, 2, 1.5] }
+        ]
+    });
+    let scene = scene_with(&dir, "safe.json", &desc.to_string());
+    let needle = "tx lies inside the closed solid of 6 surfaces (\"safe.top\", \"safe.bottom\"";
+    for command in [&["scene", "check"][..], &["trace"][..]] {
+        let r = beamtrace(&[command, &[scene.as_str()][..]].concat());
+        assert_ok(&r);
+        assert!(text(&r).contains(needle), "{}", text(&r));
+        assert!(
+            text(&r).contains("no path can connect them"),
+            "{}",
+            text(&r)
+        );
+    }
+    // RX in the safe too: paths exist inside it, no warning; an open safe: no warning.
+    let mut both = desc.clone();
+    both["rx"] = serde_json::json!([4.25, 1.25, 0.75]);
+    let r = beamtrace(&[
+        "scene",
+        "check",
+        &scene_with(&dir, "both.json", &both.to_string()),
+    ]);
+    assert!(!text(&r).contains("closed solid"), "{}", text(&r));
+    let mut open = desc.clone();
+    open["boxes"][1]["omit"] = serde_json::json!(["top"]);
+    let r = beamtrace(&[
+        "scene",
+        "check",
+        &scene_with(&dir, "open.json", &open.to_string()),
+    ]);
+    assert!(!text(&r).contains("closed solid"), "{}", text(&r));
+    // A closed mesh (a triangulated cube) with RX inside, TX outside.
+    let mut obj = String::from("o cube\n");
+    for v in 0..8 {
+        let c = |bit: usize| if v & bit != 0 { 2 } else { 0 };
+        obj.push_str(&format!("v {} {} {}\n", c(1), c(2), c(4)));
+    }
+    for f in [
+        "1 3 4 2", "5 6 8 7", "1 2 6 5", "3 7 8 4", "1 5 7 3", "2 4 8 6",
+    ] {
+        let i: Vec<&str> = f.split(' ').collect();
+        obj.push_str(&format!(
+            "f {} {} {}\nf {} {} {}\n",
+            i[0], i[1], i[2], i[0], i[2], i[3]
+        ));
+    }
+    let cube = scene_with(&dir, "cube.obj", &obj);
+    let r = beamtrace(&["scene", "check", &cube, "--tx", "5,1,1", "--rx", "1,1,1"]);
+    assert_ok(&r);
+    assert!(
+        text(&r).contains("rx lies inside the closed solid of 6 surfaces"),
+        "{}",
+        text(&r)
+    );
+}
