@@ -168,6 +168,10 @@ pub struct SceneArgs {
     /// Meshes: faces whose planes differ by less than this (metres) merge into one surface.
     #[arg(long, default_value_t = 1e-3)]
     pub merge_distance: f64,
+    /// Meshes (also inside XML scenes): budget on vertices and on faces per file; a larger
+    /// mesh stops before the merge.
+    #[arg(long, default_value_t = bt_mesh::DEFAULT_MAX_ELEMENTS)]
+    pub max_mesh_elements: u64,
     #[command(flatten)]
     pub material: MaterialArgs,
 }
@@ -532,6 +536,7 @@ impl DemoArgs {
                 min_reflector_area: 0.25,
                 merge_angle_deg: 1.0,
                 merge_distance: 1e-3,
+                max_mesh_elements: bt_mesh::DEFAULT_MAX_ELEMENTS,
                 material: MaterialArgs::default(),
             },
             radio: self.radio,

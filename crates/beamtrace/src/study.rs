@@ -80,6 +80,7 @@ pub fn run_living_room(args: &StudyLivingRoomArgs) -> anyhow::Result<ExitCode> {
         min_reflector_area: 0.25,
         merge_angle_deg: 1.0,
         merge_distance: 1e-3,
+        max_mesh_elements: bt_mesh::DEFAULT_MAX_ELEMENTS,
         material: Default::default(),
     })?;
     if let Some(problem) = bt_solve::SbrOptions::grid(args.sbr_step_deg).over_budget(args.max_rays)

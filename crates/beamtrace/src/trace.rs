@@ -21,6 +21,7 @@ pub fn load_options(args: &SceneArgs) -> anyhow::Result<LoadOptions> {
         merge: bt_mesh::MergeOptions {
             angle_tol_deg: args.merge_angle_deg,
             dist_tol_m: args.merge_distance,
+            max_elements: args.max_mesh_elements,
             ..bt_mesh::MergeOptions::default()
         },
         min_reflector_area_m2: args.min_reflector_area,

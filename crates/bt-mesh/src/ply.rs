@@ -56,10 +56,22 @@ struct Header {
 }
 
 /// Parses PLY bytes into a validated polygon soup.
-pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
+/// Parse a PLY mesh; refuses a header declaring more than `max_elements` vertices or faces.
+pub(crate) fn parse(bytes: &[u8], file: &str, max_elements: u64) -> Result<RawMesh, MeshError> {
     let header = parse_header(bytes, file)?;
     let body = &bytes[header.body_start..];
     check_counts(&header, body.len() as u64, file)?;
+    for (name, element) in [("vertex", "vertices"), ("face", "faces")] {
+        let declared = header.elements.iter().filter(|e| e.name == name);
+        if let Some(e) = declared.into_iter().find(|e| e.count > max_elements) {
+            return Err(MeshError::Budget {
+                file: file.to_owned(),
+                element,
+                count: e.count.to_string(),
+                budget: max_elements,
+            });
+        }
+    }
 
     let unsupported = |detail: String| MeshError::Unsupported {
         file: file.to_owned(),

@@ -123,3 +123,70 @@ fn a_polygon_with_too_many_vertices_is_refused_not_checked_for_minutes() {
     let r = beamtrace(&["scene", "check", &scene]);
     assert_refused(&r, &["20001 vertices", "10000"]);
 }
+
+#[test]
+fn meshes_beyond_the_element_budget_stop_early_naming_count_budget_and_option() {
+    let dir = scratch("mesh-budget");
+    // A triangulated cube: 8 vertices, 12 faces, as OBJ and as ASCII PLY.
+    let corners: Vec<[u8; 3]> = (0..8u8)
+        .map(|v| [v & 1, (v >> 1) & 1, (v >> 2) & 1])
+        .collect();
+    let quads = [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ];
+    let triangles: Vec<[usize; 3]> = quads
+        .iter()
+        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+        .collect();
+    let mut obj = String::new();
+    let mut ply = format!(
+        "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\n\
+         property float z\nelement face {}\nproperty list uchar int vertex_indices\nend_header\n",
+        triangles.len()
+    );
+    for c in &corners {
+        obj.push_str(&format!("v {} {} {}\n", c[0], c[1], c[2]));
+        ply.push_str(&format!("{} {} {}\n", c[0], c[1], c[2]));
+    }
+    for t in &triangles {
+        obj.push_str(&format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1));
+        ply.push_str(&format!("3 {} {} {}\n", t[0], t[1], t[2]));
+    }
+    let obj = scene_with(&dir, "cube.obj", &obj);
+    let ply = scene_with(&dir, "cube.ply", &ply);
+    let terminals = ["--tx", "2,2,2", "--rx", "3,2,2"];
+    for (file, budget, needle) in [
+        (
+            &obj,
+            "5",
+            "at least 6 (line 6) vertices, more than the budget of 5 vertices",
+        ),
+        (
+            &obj,
+            "10",
+            "at least 11 (line 19) faces, more than the budget of 10 faces",
+        ),
+        (&ply, "10", "12 faces, more than the budget of 10 faces"),
+        (&ply, "7", "8 vertices, more than the budget of 7 vertices"),
+    ] {
+        let mut args = vec![
+            "scene",
+            "check",
+            file.as_str(),
+            "--max-mesh-elements",
+            budget,
+        ];
+        args.extend(terminals);
+        assert_refused(&beamtrace(&args), &[needle, "--max-mesh-elements"]);
+    }
+    for file in [&obj, &ply] {
+        let mut args = vec!["scene", "check", file.as_str(), "--max-mesh-elements", "12"];
+        args.extend(terminals);
+        assert_ok(&beamtrace(&args));
+    }
+}
