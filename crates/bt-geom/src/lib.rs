@@ -6,12 +6,14 @@
 
 pub mod bvh;
 pub mod convex;
+pub mod count;
 pub mod plane;
 pub mod poly2;
 pub mod polygon;
 pub mod tol;
 
 pub use bvh::{Bvh, Occluder};
+pub use count::{AtLeast, Count};
 pub use plane::{Plane, Side};
 pub use polygon::{Polygon, PolygonError};
 

@@ -123,7 +123,8 @@ pub enum MeshError {
     /// A PLY header claims more elements than the body can possibly hold. Checked before any
     /// allocation, so a hostile header cannot exhaust memory.
     #[error(
-        "{file}: element {element:?} claims {count} entries, which need at least {min_bytes} bytes, but the body has only {body_bytes} bytes"
+        "{file}: element {element:?} claims {count} entries, which need {} bytes, but the body has only {body_bytes} bytes",
+        bt_geom::AtLeast(*.min_bytes)
     )]
     CountTooLarge {
         /// File name as given.

@@ -63,11 +63,12 @@ impl TraceOptions {
 pub enum TraceError {
     /// The work would exceed the candidate budget.
     #[error(
-        "candidate budget exceeded: {estimate} candidates at order {max_order} (budget {budget}); \
-         lower the order or raise the budget with --max-candidates"
+        "candidate budget exceeded: {} candidates at order {max_order} (budget {budget}); \
+         lower the order or raise the budget with --max-candidates",
+        bt_geom::Count(*.estimate)
     )]
     Budget {
-        /// Candidates (or tree nodes) counted or estimated.
+        /// Candidates (or tree nodes) counted or estimated (saturating: `u64::MAX` means more).
         estimate: u64,
         /// The budget.
         budget: u64,

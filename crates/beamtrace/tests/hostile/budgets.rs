@@ -190,3 +190,37 @@ fn meshes_beyond_the_element_budget_stop_early_naming_count_budget_and_option() 
         assert_ok(&beamtrace(&args));
     }
 }
+
+#[test]
+fn saturated_estimates_print_as_a_bound_not_as_u64_max() {
+    let dir = scratch("saturated");
+    // Candidates: 25 reflectors at order 50 overflow u64.
+    let wvrn = beamtrace(&["wvrn", "builtin:living-room", "--max-order", "50"]);
+    // Grid: 1e600 points per axis.
+    let out = dir.join("sweep");
+    let grid = "0:1e300:1e-300,0:1e300:1e-300,1";
+    let sweep = beamtrace(&[
+        "sweep",
+        "builtin:living-room",
+        "--grid",
+        grid,
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    // PLY: a vertex count whose byte size overflows u64.
+    let header = "ply\nformat binary_little_endian 1.0\nelement vertex 18446744073709551615\n\
+                  property float x\nproperty float y\nproperty float z\nelement face 1\n\
+                  property list uchar int vertex_indices\nend_header\n";
+    let ply = scene_with(&dir, "huge.ply", &format!("{header}{}", "\0".repeat(64)));
+    let mesh = beamtrace(&["scene", "check", &ply, "--tx", "1,1,1", "--rx", "2,2,2"]);
+    for (r, needle) in [
+        (wvrn, "more than 1.8e19 candidates at order 50"),
+        (sweep, "grid has more than 1.8e19 points"),
+        (mesh, "which need more than 1.8e19 bytes"),
+    ] {
+        assert_refused(&r, &[needle]);
+        // the PLY's own count is what the file says; no estimate may print as u64::MAX
+        let estimates = text(&r).replace("vertex\" claims 18446744073709551615", "");
+        assert!(!estimates.contains("18446744073709551615"), "{}", text(&r));
+    }
+}
