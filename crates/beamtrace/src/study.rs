@@ -81,6 +81,7 @@ pub fn run_living_room(args: &StudyLivingRoomArgs) -> anyhow::Result<ExitCode> {
         merge_angle_deg: 1.0,
         merge_distance: 1e-3,
         max_mesh_elements: bt_mesh::DEFAULT_MAX_ELEMENTS,
+        max_cloud_points: bt_pointcloud::io::DEFAULT_MAX_POINTS,
         material: Default::default(),
     })?;
     if let Some(problem) = bt_solve::SbrOptions::grid(args.sbr_step_deg).over_budget(args.max_rays)

@@ -25,6 +25,10 @@ pub fn load_options(args: &SceneArgs) -> anyhow::Result<LoadOptions> {
             ..bt_mesh::MergeOptions::default()
         },
         min_reflector_area_m2: args.min_reflector_area,
+        cloud: bt_pointcloud::io::ReadOptions {
+            max_points: args.max_cloud_points,
+            ..Default::default()
+        },
         frequency_hz: args
             .material
             .frequency

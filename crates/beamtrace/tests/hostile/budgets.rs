@@ -224,3 +224,34 @@ fn saturated_estimates_print_as_a_bound_not_as_u64_max() {
         assert!(!estimates.contains("18446744073709551615"), "{}", text(&r));
     }
 }
+
+#[test]
+fn point_clouds_beyond_the_point_budget_stop_before_reading() {
+    let dir = scratch("cloud-budget");
+    let mut ply = String::from(
+        "ply\nformat ascii 1.0\nelement vertex 100\nproperty float x\nproperty float y\n\
+         property float z\nend_header\n",
+    );
+    for i in 0..100 {
+        ply.push_str(&format!("{} {} 0\n", i % 10, i / 10));
+    }
+    let pcd_header = "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n\
+                      WIDTH 100\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 100\nDATA ascii\n";
+    let body: String = ply.lines().skip(7).map(|l| format!("{l}\n")).collect();
+    let ply = scene_with(&dir, "cloud.ply", &ply);
+    let pcd = scene_with(&dir, "cloud.pcd", &format!("{pcd_header}{body}"));
+    let out = dir.join("x.json");
+    for file in [&ply, &pcd] {
+        let needle = "declares 100 points, more than the budget of 50 points";
+        let trace = ["trace", file.as_str(), "--tx", "1,1,1", "--rx", "2,2,2"];
+        let r = beamtrace(&[&trace[..], &["--max-cloud-points", "50"]].concat());
+        assert_refused(&r, &[needle, "--max-cloud-points"]);
+        let extract = ["extract", file.as_str(), "-o", out.to_str().unwrap()];
+        let r = beamtrace(&[&extract[..], &["--max-cloud-points", "50"]].concat());
+        assert_refused(&r, &[needle, "--max-cloud-points"]);
+        // at the budget: read (the extraction may then find what it finds)
+        let r = beamtrace(&[&extract[..], &["--max-cloud-points", "100"]].concat());
+        assert_ok(&r);
+        assert!(!text(&r).contains("more than the budget"), "{}", text(&r));
+    }
+}

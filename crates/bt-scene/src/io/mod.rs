@@ -34,6 +34,9 @@ pub struct LoadOptions {
     pub frequency_hz: Real,
     /// Plane-extraction parameters for point clouds (PLY without faces, PCD).
     pub extract: bt_pointcloud::ExtractParams,
+    /// Point-cloud reading: budget on the points a file declares (`max_points`, CLI
+    /// `--max-cloud-points`) and the policy for non-finite points.
+    pub cloud: bt_pointcloud::io::ReadOptions,
     /// A radio material for every surface (CLI `--material itu:NAME --thickness M`), replacing
     /// the radio model of every material of the loaded scene, whatever its format.
     pub radio: Option<bt_channel::RadioMaterial>,
@@ -47,6 +50,7 @@ impl Default for LoadOptions {
             min_reflector_area_m2: 0.25,
             frequency_hz: DEFAULT_FREQUENCY_HZ,
             extract: bt_pointcloud::ExtractParams::default(),
+            cloud: bt_pointcloud::io::ReadOptions::default(),
             radio: None,
         }
     }
