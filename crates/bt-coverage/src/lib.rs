@@ -59,6 +59,10 @@ pub enum PointStatus {
         shortest_delay_s: Option<Real>,
         /// The strongest path (`None` without paths).
         strongest: Option<Strongest>,
+        /// Total received power of all paths, dBm: `trace --json`'s `received_power_dbm`
+        /// (`bt_beams::received_power_dbm`, isotropic antennas, 0 dBm transmitted; `None`
+        /// without paths).
+        received_power_dbm: Option<Real>,
     },
     /// Not traced: the point lies on a surface or at the TX (the reason, from the scene's
     /// validation).
@@ -92,7 +96,8 @@ pub fn sweep(
                 Ok(traced) => {
                     let moved = scene.with_receiver(*rx).map_err(TraceError::from)?;
                     let radio = bt_beams::RadioOptions::default();
-                    summarise(&bt_beams::report(&moved, &traced.result.paths, &radio)?)
+                    let reports = bt_beams::report(&moved, &traced.result.paths, &radio)?;
+                    summarise(&reports, radio.tx_power_dbm)
                 }
                 Err(TraceError::Scene(e)) => PointStatus::Skipped(skip_reason(&e)),
                 Err(e) => return Err(e.into()),
@@ -116,8 +121,8 @@ fn skip_reason(e: &bt_scene::SceneError) -> String {
     }
 }
 
-/// A point's summary from its ranked path reports.
-pub fn summarise(paths: &[PathReport]) -> PointStatus {
+/// A point's summary from its ranked path reports, transmitting `tx_power_dbm`.
+pub fn summarise(paths: &[PathReport], tx_power_dbm: Real) -> PointStatus {
     let shortest_delay_s = paths.iter().map(|p| p.delay_s).min_by(Real::total_cmp);
     // Reports come ranked, and min_by keeps the first of equal losses: the better ranked.
     let strongest = paths
@@ -133,11 +138,12 @@ pub fn summarise(paths: &[PathReport]) -> PointStatus {
         paths: paths.len(),
         shortest_delay_s,
         strongest,
+        received_power_dbm: bt_beams::received_power_dbm(paths, tx_power_dbm),
     }
 }
 
 /// The CSV header of [`csv`].
-pub const CSV_HEADER: &str = "x_m,y_m,z_m,status,paths,shortest_delay_ns,strongest_order,strongest_loss_db,strongest_length_m,strongest_surfaces,note";
+pub const CSV_HEADER: &str = "x_m,y_m,z_m,status,paths,shortest_delay_ns,strongest_order,strongest_loss_db,strongest_length_m,strongest_surfaces,received_power_dbm,note";
 
 /// The rows as CSV (RFC 4180: fields with commas, quotes or line breaks are quoted; surface
 /// names are data). Skipped points have empty result fields and the reason in `note`.
@@ -154,6 +160,7 @@ pub fn csv(rows: &[Row]) -> String {
                 paths,
                 shortest_delay_s,
                 strongest,
+                received_power_dbm,
             } => {
                 let delay = shortest_delay_s
                     .map(|d| format!("{:.6}", d * 1e9))
@@ -170,10 +177,13 @@ pub fn csv(rows: &[Row]) -> String {
                         )
                     })
                     .unwrap_or_else(|| ",,,".to_string());
-                format!("{coords},ok,{paths},{delay},{best},")
+                let power = received_power_dbm
+                    .map(|p| format!("{p:.4}"))
+                    .unwrap_or_default();
+                format!("{coords},ok,{paths},{delay},{best},{power},")
             }
             PointStatus::Skipped(reason) => {
-                format!("{coords},skipped,,,,,,,{}", csv_field(reason))
+                format!("{coords},skipped,,,,,,,,{}", csv_field(reason))
             }
         };
         out.push_str(&line);
@@ -259,11 +269,11 @@ mod tests {
         let line = text.lines().nth(1).unwrap();
         assert_eq!(
             line,
-            "1.000000,2.000000,0.000000,skipped,,,,,,,\"lies on surface \"\"floor, west\"\"\""
+            "1.000000,2.000000,0.000000,skipped,,,,,,,,\"lies on surface \"\"floor, west\"\"\""
         );
         assert_eq!(
             CSV_HEADER.split(',').count(),
-            "1,2,0,skipped,,,,,,,x".split(',').count()
+            "1,2,0,skipped,,,,,,,,x".split(',').count()
         );
     }
 }

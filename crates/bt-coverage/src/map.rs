@@ -38,6 +38,7 @@ impl MapQuantity {
             paths,
             shortest_delay_s,
             strongest,
+            ..
         } = status
         else {
             return None;
