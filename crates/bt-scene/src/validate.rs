@@ -5,7 +5,7 @@ use crate::frame::{to_local, to_world};
 use crate::material::{DEFAULT_MATERIAL, Material, default_materials};
 use crate::model::{Scene, Surface, SurfaceKind, scene_extent};
 use bt_channel::RadioMaterial;
-use bt_geom::{Bvh, Polygon, Real, Vec3, tol};
+use bt_geom::{Bvh, Polygon, Real, Vec3};
 use serde::Serialize;
 use std::collections::BTreeSet;
 use std::fmt;
