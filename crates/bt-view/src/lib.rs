@@ -324,6 +324,26 @@ mod tests {
     }
 
     #[test]
+    fn a_far_scene_is_drawn_at_its_world_coordinates() {
+        let json = r#"{ "tx": [10000001, 10000001, 101], "rx": [10000004, 10000002, 101.5],
+            "boxes": [ { "name": "room", "min": [10000000, 10000000, 100],
+                         "max": [10000006, 10000004, 103] } ] }"#;
+        let desc: bt_scene::SceneDescription = serde_json::from_str(json).unwrap();
+        let scene = Scene::from_description(&desc, "far", Default::default()).unwrap();
+        assert!(
+            scene.origin() != bt_scene::Vec3::ZERO,
+            "solved in a local frame"
+        );
+        let steps = [StepPaths::from_reports(&scene, &[])];
+        let html = page(&[&scene], &steps);
+        assert!(html.contains("[10000001.0,10000001.0,101.0]"), "world tx");
+        assert!(
+            html.contains("[10000006.0,10000004.0,103.0]"),
+            "world vertex"
+        );
+    }
+
+    #[test]
     fn placeholders_inside_values_are_not_expanded() {
         let page = fill("a{{X}}b{{Y}}c", &[("{{X}}", "{{Y}}"), ("{{Y}}", "y")]);
         assert_eq!(page, "a{{Y}}byc");
