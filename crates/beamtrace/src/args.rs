@@ -171,6 +171,13 @@ pub struct SceneArgs {
     /// Meshes: faces whose planes differ by less than this (metres) merge into one surface.
     #[arg(long, default_value_t = 1e-3)]
     pub merge_distance: f64,
+    /// Meshes (also inside XML scenes): budget on vertices and on faces per file; a larger
+    /// mesh stops before the merge.
+    #[arg(long, default_value_t = bt_mesh::DEFAULT_MAX_ELEMENTS)]
+    pub max_mesh_elements: u64,
+    /// Point clouds: budget on the points a file declares; a larger cloud stops before reading.
+    #[arg(long, default_value_t = bt_pointcloud::io::DEFAULT_MAX_POINTS)]
+    pub max_cloud_points: u64,
     #[command(flatten)]
     pub material: MaterialArgs,
 }
@@ -535,6 +542,8 @@ impl DemoArgs {
                 min_reflector_area: 0.25,
                 merge_angle_deg: 1.0,
                 merge_distance: 1e-3,
+                max_mesh_elements: bt_mesh::DEFAULT_MAX_ELEMENTS,
+                max_cloud_points: bt_pointcloud::io::DEFAULT_MAX_POINTS,
                 material: MaterialArgs::default(),
             },
             radio: self.radio,
@@ -714,6 +723,9 @@ pub struct ExtractArgs {
     /// RX X,Y,Z in metres to store in the scene (optional).
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
     pub rx: Option<Vec3>,
+    /// Budget on the points the cloud declares; a larger cloud stops before reading.
+    #[arg(long, default_value_t = bt_pointcloud::io::DEFAULT_MAX_POINTS)]
+    pub max_cloud_points: u64,
 }
 
 #[derive(Debug, Args, Clone)]

@@ -32,8 +32,16 @@ pub fn extraction_progress() -> (ProgressBar, impl FnMut(Progress)) {
 }
 
 /// Read a cloud and extract its planes, with a progress bar on stderr.
-fn extract_from(path: &Path, params: &ExtractParams) -> anyhow::Result<(Extraction, u64)> {
-    let loaded = bt_pointcloud::io::read_path(path, &ReadOptions::default())?;
+fn extract_from(
+    path: &Path,
+    params: &ExtractParams,
+    max_points: u64,
+) -> anyhow::Result<(Extraction, u64)> {
+    let read = ReadOptions {
+        max_points,
+        ..ReadOptions::default()
+    };
+    let loaded = bt_pointcloud::io::read_path(path, &read)?;
     let (bar, mut progress) = extraction_progress();
     let extraction =
         bt_pointcloud::extract_planes_with_progress(&loaded.cloud, params, &mut progress)
@@ -69,7 +77,7 @@ pub fn run_extract(args: &ExtractArgs) -> anyhow::Result<ExitCode> {
         min_reflector_area_m2: args.min_reflector_area,
         ..ExtractParams::default()
     };
-    let (extraction, skipped) = extract_from(&args.cloud, &params)?;
+    let (extraction, skipped) = extract_from(&args.cloud, &params, args.max_cloud_points)?;
     let name = args
         .cloud
         .file_stem()
@@ -129,7 +137,10 @@ pub fn run_sample(args: &SampleArgs) -> anyhow::Result<ExitCode> {
         .scene
         .surfaces()
         .iter()
-        .map(|s| s.polygon.vertices().to_vec())
+        .map(|s| {
+            let world = |v: &glam::DVec3| loaded.scene.to_world(*v);
+            s.polygon.vertices().iter().map(world).collect()
+        })
         .collect();
     let area: f64 = loaded
         .scene

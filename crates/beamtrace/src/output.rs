@@ -70,8 +70,8 @@ impl TraceDocument {
         Self {
             format_version: FORMAT_VERSION,
             scene: scene.name().to_string(),
-            tx: scene.tx().to_array(),
-            rx: scene.rx().to_array(),
+            tx: scene.tx_world().to_array(),
+            rx: scene.rx_world().to_array(),
             frequency_hz: scene.frequency_hz(),
             max_order,
             solver: *solver,

@@ -92,8 +92,8 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
         let paths = bt_beams::report(scene, &result.trace.paths, &radio)?;
         let step = StepDocument {
             step: k,
-            tx: scene.tx().to_array(),
-            rx: scene.rx().to_array(),
+            tx: scene.tx_world().to_array(),
+            rx: scene.rx_world().to_array(),
             stats: StepStats {
                 candidates: result.candidates,
                 outcomes: result.trace.counts,

@@ -80,6 +80,8 @@ pub fn run_living_room(args: &StudyLivingRoomArgs) -> anyhow::Result<ExitCode> {
         min_reflector_area: 0.25,
         merge_angle_deg: 1.0,
         merge_distance: 1e-3,
+        max_mesh_elements: bt_mesh::DEFAULT_MAX_ELEMENTS,
+        max_cloud_points: bt_pointcloud::io::DEFAULT_MAX_POINTS,
         material: Default::default(),
     })?;
     if let Some(problem) =

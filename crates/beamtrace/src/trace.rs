@@ -21,9 +21,14 @@ pub fn load_options(args: &SceneArgs) -> anyhow::Result<LoadOptions> {
         merge: bt_mesh::MergeOptions {
             angle_tol_deg: args.merge_angle_deg,
             dist_tol_m: args.merge_distance,
+            max_elements: args.max_mesh_elements,
             ..bt_mesh::MergeOptions::default()
         },
         min_reflector_area_m2: args.min_reflector_area,
+        cloud: bt_pointcloud::io::ReadOptions {
+            max_points: args.max_cloud_points,
+            ..Default::default()
+        },
         frequency_hz: args
             .material
             .frequency
@@ -173,8 +178,8 @@ pub fn check(args: &SceneArgs) -> anyhow::Result<ExitCode> {
                 reflectors,
                 scene.surfaces().len() - reflectors,
                 scene.extent(),
-                scene.tx().to_array(),
-                scene.rx().to_array(),
+                scene.tx_world().to_array(),
+                scene.rx_world().to_array(),
                 scene.frequency_hz() / 1e9
             );
             Ok(ExitCode::SUCCESS)

@@ -34,6 +34,23 @@ fn sweep(grid: &str, extra: &[&str], name: &str) -> (PathBuf, String) {
     (dir, csv)
 }
 
+/// `trace --json` of the living room at order 2 to the receiver of a CSV row's fields.
+fn trace_at(fields: &[&str]) -> Value {
+    let rx = format!("{},{},{}", fields[0], fields[1], fields[2]);
+    let args = [
+        "trace",
+        "builtin:living-room",
+        "--rx",
+        &rx,
+        "--max-order",
+        "2",
+        "--json",
+    ];
+    let o = beamtrace(&args);
+    assert!(o.status.success());
+    serde_json::from_slice(&o.stdout).unwrap()
+}
+
 #[test]
 fn every_point_equals_its_own_trace() {
     let grid = "0.7:5.2:1.5,0.6:3.9:1.1,1.1";
@@ -51,18 +68,7 @@ fn every_point_equals_its_own_trace() {
     for line in lines {
         let f: Vec<&str> = line.split(',').collect();
         assert_eq!(f[3], "ok", "{line}");
-        let rx = format!("{},{},{}", f[0], f[1], f[2]);
-        let o = beamtrace(&[
-            "trace",
-            "builtin:living-room",
-            "--rx",
-            &rx,
-            "--max-order",
-            "2",
-            "--json",
-        ]);
-        assert!(o.status.success());
-        let doc: Value = serde_json::from_slice(&o.stdout).unwrap();
+        let doc = trace_at(&f);
         let paths = doc["paths"].as_array().unwrap();
         assert_eq!(f[4].parse::<usize>().unwrap(), paths.len(), "{line}");
         let delay = paths
@@ -111,7 +117,9 @@ fn tiny_grid_matches_the_golden_csv_and_marks_the_tx() {
         std::fs::read_to_string(&golden).expect("golden file (UPDATE_GOLDEN=1 writes it)");
     assert_eq!(csv, expected, "rerun with UPDATE_GOLDEN=1 if intended");
     assert!(
-        csv.contains("5.600000,0.600000,2.200000,skipped,,,,,,,tx and rx are at the same position")
+        csv.contains(
+            "5.600000,0.600000,2.200000,skipped,,,,,,,,tx and rx are at the same position"
+        )
     );
     let (dir1, single) = sweep(
         "5.0:5.6:0.3,0.6:1.2:0.6,2.2",
@@ -162,4 +170,29 @@ fn bad_grids_are_refused_with_the_field_named() {
         "x",
     ]);
     assert!(String::from_utf8_lossy(&o.stderr).contains("--rx is not used"));
+}
+
+#[test]
+fn received_power_column_equals_trace_json_received_power() {
+    let (dir, csv) = sweep(
+        "1.0:4.0:3.0,1.5:1.5:1.0,1.1",
+        &["--max-order", "2"],
+        "power",
+    );
+    let header: Vec<&str> = csv.lines().next().unwrap().split(',').collect();
+    let column = header
+        .iter()
+        .position(|h| *h == "received_power_dbm")
+        .unwrap();
+    let lines: Vec<&str> = csv.lines().skip(1).collect();
+    assert_eq!(lines.len(), 2);
+    for line in lines {
+        let f: Vec<&str> = line.split(',').collect();
+        let doc = trace_at(&f);
+        let expected = doc["stats"]["received_power_dbm"].as_f64().unwrap();
+        let got: f64 = f[column].parse().unwrap();
+        assert!((got - expected).abs() < 1e-4, "{line}: {got} vs {expected}");
+        assert!(got < -40.0 && got > -120.0, "{line}: {got} dBm");
+    }
+    let _ = std::fs::remove_dir_all(dir);
 }

@@ -211,7 +211,11 @@ pub fn describe(
             .map(|id| scene.surface(*id).name.clone())
             .collect(),
         surface_ids: path.surfaces.clone(),
-        points: path.points.iter().map(|p| p.to_array()).collect(),
+        points: path
+            .points
+            .iter()
+            .map(|p| scene.to_world(*p).to_array())
+            .collect(),
         length_m,
         delay_s: length_m / SPEED_OF_LIGHT,
         aod_deg: Direction::of(vertices[1] - vertices[0]),

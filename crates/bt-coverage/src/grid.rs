@@ -21,8 +21,9 @@ pub enum GridError {
     },
     /// More points than the budget.
     #[error(
-        "grid has {points} points ({nx} × {ny}), more than the budget of {budget}; \
-         use a coarser step or raise the budget with --max-points"
+        "grid has {} points ({} × {}), more than the budget of {budget}; \
+         use a coarser step or raise the budget with --max-points",
+        bt_geom::Count(*.points), bt_geom::Count(*.nx), bt_geom::Count(*.ny)
     )]
     TooLarge {
         /// Points the grid would have (saturating).

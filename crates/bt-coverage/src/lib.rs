@@ -59,6 +59,10 @@ pub enum PointStatus {
         shortest_delay_s: Option<Real>,
         /// The strongest path (`None` without paths).
         strongest: Option<Strongest>,
+        /// Total received power of all paths, dBm: `trace --json`'s `received_power_dbm`
+        /// (`bt_beams::received_power_dbm`, isotropic antennas, 0 dBm transmitted; `None`
+        /// without paths).
+        received_power_dbm: Option<Real>,
     },
     /// Not traced: the point lies on a surface or at the TX (the reason, from the scene's
     /// validation).
@@ -90,11 +94,10 @@ pub fn sweep(
         for (rx, outcome) in chunk.iter().zip(trace_each_receiver(scene, chunk, options)) {
             let status = match outcome {
                 Ok(traced) => {
-                    let moved = scene
-                        .with_terminals(scene.tx(), *rx)
-                        .map_err(TraceError::from)?;
+                    let moved = scene.with_receiver(*rx).map_err(TraceError::from)?;
                     let radio = bt_beams::RadioOptions::default();
-                    summarise(&bt_beams::report(&moved, &traced.result.paths, &radio)?)
+                    let reports = bt_beams::report(&moved, &traced.result.paths, &radio)?;
+                    summarise(&reports, radio.tx_power_dbm)
                 }
                 Err(TraceError::Scene(e)) => PointStatus::Skipped(skip_reason(&e)),
                 Err(e) => return Err(e.into()),
@@ -118,8 +121,8 @@ fn skip_reason(e: &bt_scene::SceneError) -> String {
     }
 }
 
-/// A point's summary from its ranked path reports.
-pub fn summarise(paths: &[PathReport]) -> PointStatus {
+/// A point's summary from its ranked path reports, transmitting `tx_power_dbm`.
+pub fn summarise(paths: &[PathReport], tx_power_dbm: Real) -> PointStatus {
     let shortest_delay_s = paths.iter().map(|p| p.delay_s).min_by(Real::total_cmp);
     // Reports come ranked, and min_by keeps the first of equal losses: the better ranked.
     let strongest = paths
@@ -135,11 +138,12 @@ pub fn summarise(paths: &[PathReport]) -> PointStatus {
         paths: paths.len(),
         shortest_delay_s,
         strongest,
+        received_power_dbm: bt_beams::received_power_dbm(paths, tx_power_dbm),
     }
 }
 
 /// The CSV header of [`csv`].
-pub const CSV_HEADER: &str = "x_m,y_m,z_m,status,paths,shortest_delay_ns,strongest_order,strongest_loss_db,strongest_length_m,strongest_surfaces,note";
+pub const CSV_HEADER: &str = "x_m,y_m,z_m,status,paths,shortest_delay_ns,strongest_order,strongest_loss_db,strongest_length_m,strongest_surfaces,received_power_dbm,note";
 
 /// The rows as CSV (RFC 4180: fields with commas, quotes or line breaks are quoted; surface
 /// names are data). Skipped points have empty result fields and the reason in `note`.
@@ -156,6 +160,7 @@ pub fn csv(rows: &[Row]) -> String {
                 paths,
                 shortest_delay_s,
                 strongest,
+                received_power_dbm,
             } => {
                 let delay = shortest_delay_s
                     .map(|d| format!("{:.6}", d * 1e9))
@@ -172,10 +177,13 @@ pub fn csv(rows: &[Row]) -> String {
                         )
                     })
                     .unwrap_or_else(|| ",,,".to_string());
-                format!("{coords},ok,{paths},{delay},{best},")
+                let power = received_power_dbm
+                    .map(|p| format!("{p:.4}"))
+                    .unwrap_or_default();
+                format!("{coords},ok,{paths},{delay},{best},{power},")
             }
             PointStatus::Skipped(reason) => {
-                format!("{coords},skipped,,,,,,,{}", csv_field(reason))
+                format!("{coords},skipped,,,,,,,,{}", csv_field(reason))
             }
         };
         out.push_str(&line);
@@ -198,6 +206,52 @@ mod tests {
     use super::*;
 
     #[test]
+    fn a_far_hall_sweeps_like_the_hall_at_the_origin() {
+        let desc = bt_testkit::hall_description();
+        let offset = Vec3::new(-7.5e6, 1.25e6, 10.0);
+        let terminals = bt_scene::Terminals::default();
+        let near = Scene::from_description(&desc, "hall", terminals).unwrap();
+        let far = bt_testkit::translated(&desc, offset);
+        let far = Scene::from_description(&far, "hall", terminals).unwrap();
+        // a grid over the hall, one point on the stage's top (skipped in both)
+        let mut points: Vec<Vec3> = (0..12)
+            .map(|i| Vec3::new(5.0 + 4.5 * i as Real, 3.0 + 3.0 * (i % 5) as Real, 1.5))
+            .collect();
+        points.push(Vec3::new(6.0, 20.0, 1.25));
+        let moved: Vec<Vec3> = points.iter().map(|p| *p + offset).collect();
+        let options = TraceOptions::new(2);
+        let a = sweep(&near, &points, &options, &mut |_, _| {}).unwrap();
+        let b = sweep(&far, &moved, &options, &mut |_, _| {}).unwrap();
+        assert!(
+            matches!(a[12].status, PointStatus::Skipped(_)),
+            "{:?}",
+            a[12]
+        );
+        for (r, s) in a.iter().zip(&b) {
+            assert_eq!(s.rx, r.rx + offset, "rows keep the world grid point");
+            match (&r.status, &s.status) {
+                (
+                    PointStatus::Traced {
+                        paths: n,
+                        strongest: Some(x),
+                        ..
+                    },
+                    PointStatus::Traced {
+                        paths: m,
+                        strongest: Some(y),
+                        ..
+                    },
+                ) => {
+                    assert_eq!((n, &x.surfaces), (m, &y.surfaces), "at {}", r.rx);
+                    assert!((x.length_m - y.length_m).abs() <= 1e-9 * x.length_m);
+                }
+                (PointStatus::Skipped(_), PointStatus::Skipped(_)) => {}
+                other => panic!("at {}: {other:?}", r.rx),
+            }
+        }
+    }
+
+    #[test]
     fn csv_fields_with_separators_are_quoted() {
         assert_eq!(csv_field("wall"), "wall");
         assert_eq!(csv_field("a,b"), "\"a,b\"");
@@ -215,11 +269,11 @@ mod tests {
         let line = text.lines().nth(1).unwrap();
         assert_eq!(
             line,
-            "1.000000,2.000000,0.000000,skipped,,,,,,,\"lies on surface \"\"floor, west\"\"\""
+            "1.000000,2.000000,0.000000,skipped,,,,,,,,\"lies on surface \"\"floor, west\"\"\""
         );
         assert_eq!(
             CSV_HEADER.split(',').count(),
-            "1,2,0,skipped,,,,,,,x".split(',').count()
+            "1,2,0,skipped,,,,,,,,x".split(',').count()
         );
     }
 }

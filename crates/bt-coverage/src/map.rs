@@ -38,6 +38,7 @@ impl MapQuantity {
             paths,
             shortest_delay_s,
             strongest,
+            ..
         } = status
         else {
             return None;
@@ -156,8 +157,15 @@ impl HeatMap<'_> {
                 SurfaceKind::Reflector => BLACK.mix(0.8),
                 SurfaceKind::Blocker => RGBColor(120, 120, 120).mix(0.9),
             };
-            let mut outline: Vec<(Real, Real)> =
-                s.polygon.vertices().iter().map(|v| (v.x, v.y)).collect();
+            let mut outline: Vec<(Real, Real)> = s
+                .polygon
+                .vertices()
+                .iter()
+                .map(|v| {
+                    let v = self.scene.to_world(*v);
+                    (v.x, v.y)
+                })
+                .collect();
             outline.push(outline[0]);
             chart
                 .draw_series(std::iter::once(PathElement::new(
@@ -166,7 +174,7 @@ impl HeatMap<'_> {
                 )))
                 .map_err(fail)?;
         }
-        let tx = self.scene.tx();
+        let tx = self.scene.tx_world();
         chart
             .draw_series(std::iter::once(TriangleMarker::new(
                 (tx.x, tx.y),

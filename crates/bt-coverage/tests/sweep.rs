@@ -53,6 +53,7 @@ fn box_room_sweep_matches_the_image_lattice_at_every_point() {
                 paths,
                 shortest_delay_s,
                 strongest,
+                ..
             } = &row.status
             else {
                 panic!("{p}: skipped")

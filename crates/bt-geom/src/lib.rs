@@ -6,6 +6,7 @@
 
 pub mod bvh;
 pub mod convex;
+pub mod count;
 pub mod plane;
 pub mod poly2;
 pub mod polygon;
@@ -15,6 +16,7 @@ pub mod tol;
 mod fixtures;
 
 pub use bvh::{Bvh, Occluder};
+pub use count::{AtLeast, Count};
 pub use plane::{Plane, Side};
 pub use polygon::{Polygon, PolygonError};
 

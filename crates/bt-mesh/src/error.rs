@@ -123,7 +123,8 @@ pub enum MeshError {
     /// A PLY header claims more elements than the body can possibly hold. Checked before any
     /// allocation, so a hostile header cannot exhaust memory.
     #[error(
-        "{file}: element {element:?} claims {count} entries, which need at least {min_bytes} bytes, but the body has only {body_bytes} bytes"
+        "{file}: element {element:?} claims {count} entries, which need {} bytes, but the body has only {body_bytes} bytes",
+        bt_geom::AtLeast(*.min_bytes)
     )]
     CountTooLarge {
         /// File name as given.
@@ -136,6 +137,22 @@ pub enum MeshError {
         min_bytes: u64,
         /// Bytes available after the header.
         body_bytes: u64,
+    },
+    /// The file holds more vertices or faces than [`crate::MergeOptions::max_elements`].
+    #[error(
+        "{file}: {count} {element}, more than the budget of {budget} {element}; raise it \
+         with --max-mesh-elements (load options: merge.max_elements)"
+    )]
+    Budget {
+        /// File name as given.
+        file: String,
+        /// `vertices` or `faces`.
+        element: &'static str,
+        /// How many: the header's count (PLY), or "at least N (line L)" (OBJ, which stops
+        /// reading at the first element beyond the budget).
+        count: String,
+        /// The budget.
+        budget: u64,
     },
     /// The PLY body ends before all elements the header declares were read.
     #[error("{file}: {position}: file is truncated: {detail}")]

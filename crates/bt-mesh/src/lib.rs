@@ -52,6 +52,20 @@ pub struct MergeOptions {
     /// Vertices closer than this, in metres, are welded into one, `>= 0` (0: exact duplicates
     /// only). Also the length under which boundary vertices count as collinear or repeated.
     pub weld_tol_m: Real,
+    /// Budget: the most vertices, and the most faces, a file may hold (CLI
+    /// `--max-mesh-elements`). Checked against a PLY header's counts before any allocation and
+    /// while an OBJ file is read, so a huge mesh stops early instead of exhausting memory in
+    /// the merge (about 0.2 kB per face and vertex: a 180,000-face OBJ peaks at 60 MB in
+    /// `scene check`). Default [`DEFAULT_MAX_ELEMENTS`] (at most ~2 GB).
+    #[serde(skip_serializing, default = "default_max_elements")]
+    pub max_elements: u64,
+}
+
+/// Default of [`MergeOptions::max_elements`]: 5 million vertices and 5 million faces.
+pub const DEFAULT_MAX_ELEMENTS: u64 = 5_000_000;
+
+fn default_max_elements() -> u64 {
+    DEFAULT_MAX_ELEMENTS
 }
 
 impl Default for MergeOptions {
@@ -60,6 +74,7 @@ impl Default for MergeOptions {
             angle_tol_deg: DEFAULT_ANGLE_TOL_DEG,
             dist_tol_m: DEFAULT_DIST_TOL_M,
             weld_tol_m: DEFAULT_WELD_TOL_M,
+            max_elements: DEFAULT_MAX_ELEMENTS,
         }
     }
 }
@@ -167,8 +182,8 @@ fn parse(
 ) -> Result<raw::RawMesh, MeshError> {
     opts.validate()?;
     match format {
-        MeshFormat::Obj => obj::parse(bytes, file),
-        MeshFormat::Ply => ply::parse(bytes, file),
+        MeshFormat::Obj => obj::parse(bytes, file, opts.max_elements),
+        MeshFormat::Ply => ply::parse(bytes, file, opts.max_elements),
     }
 }
 

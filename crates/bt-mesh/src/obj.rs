@@ -14,8 +14,8 @@ use std::collections::BTreeSet;
 use crate::error::{MeshError, Position};
 use crate::raw::{RawMesh, intern};
 
-/// Parses OBJ bytes into a validated polygon soup.
-pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
+/// Parses OBJ bytes into a validated polygon soup; stops at the first vertex or face beyond `max_elements` of its kind.
+pub(crate) fn parse(bytes: &[u8], file: &str, max_elements: u64) -> Result<RawMesh, MeshError> {
     let mut mesh = RawMesh::new();
     // Line of each face, to report positive indices that turn out out of range at the end
     // (OBJ files may in principle reference vertices defined later).
@@ -49,10 +49,18 @@ pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
                         detail: format!("more than {} vertices", u32::MAX),
                     });
                 }
+                crate::raw::check_budget(
+                    file,
+                    "vertices",
+                    mesh.positions.len(),
+                    max_elements,
+                    line_no,
+                )?;
                 mesh.positions.push(position);
             }
             "f" => {
                 at.face(tokens, mesh.positions.len(), &mut face)?;
+                crate::raw::check_budget(file, "faces", mesh.face_count(), max_elements, line_no)?;
                 mesh.push_face(&face, group.or(object), material);
                 face_line.push(line_no);
             }
@@ -250,7 +258,7 @@ mod tests {
     #[test]
     fn negative_indices_are_relative_to_vertices_so_far() {
         let text = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\nv 5 5 5\nf 1 2 -2\n";
-        let mesh = parse(text, "t.obj").unwrap();
+        let mesh = parse(text, "t.obj", u64::MAX).unwrap();
         assert_eq!(mesh.face(0), &[0, 1, 2]);
         assert_eq!(mesh.face(1), &[0, 1, 2]);
     }
@@ -258,7 +266,7 @@ mod tests {
     #[test]
     fn names_and_materials_follow_statements() {
         let text = b"mtllib missing.mtl\no Room\nv 0 0 0\nv 1 0 0\nv 0 1 0\nusemtl concrete\nf 1 2 3\ng wall west\nusemtl\nf 1 2 3\n";
-        let mesh = parse(text, "t.obj").unwrap();
+        let mesh = parse(text, "t.obj", u64::MAX).unwrap();
         assert_eq!(mesh.names, ["Room", "wall west"]);
         assert_eq!(mesh.materials, ["concrete"]);
         assert_eq!(mesh.face_name, [Some(0), Some(1)]);
@@ -268,7 +276,7 @@ mod tests {
     #[test]
     fn continuation_lines_keep_first_line_number() {
         let text = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 \\\n 3\nf 1 2 \\\n 9\n";
-        match parse(text, "t.obj") {
+        match parse(text, "t.obj", u64::MAX) {
             Err(MeshError::IndexOutOfRange {
                 position: Position::Line(6),
                 index: 9,

@@ -17,11 +17,12 @@ use bt_formats::{
     PlyPropertyKind as Kind, Scalar,
 };
 
-/// Parses PLY bytes into a validated polygon soup.
-pub(crate) fn parse(bytes: &[u8], file: &str) -> Result<RawMesh, MeshError> {
+/// Parses PLY bytes into a validated polygon soup; refuses a header declaring more than `max_elements` vertices or faces.
+pub(crate) fn parse(bytes: &[u8], file: &str, max_elements: u64) -> Result<RawMesh, MeshError> {
     let header = parse_header(bytes, file)?;
     let body = &bytes[header.body_start..];
     check_counts(&header, body.len() as u64, file)?;
+    check_budget(&header, file, max_elements)?;
     let layout = Layout::of(&header, file)?;
 
     let mut mesh = RawMesh::new();
@@ -165,6 +166,22 @@ struct Entry<'a> {
     values: &'a mut Vec<Real>,
     face: &'a mut Vec<u32>,
     at: &'a Position,
+}
+
+/// Refuses a header declaring more than `max_elements` vertices or faces, before allocating.
+fn check_budget(header: &Header, file: &str, max_elements: u64) -> Result<(), MeshError> {
+    for (name, element) in [("vertex", "vertices"), ("face", "faces")] {
+        let declared = header.elements.iter().filter(|e| e.name == name);
+        if let Some(e) = declared.into_iter().find(|e| e.count > max_elements) {
+            return Err(MeshError::Budget {
+                file: file.to_owned(),
+                element,
+                count: e.count.to_string(),
+                budget: max_elements,
+            });
+        }
+    }
+    Ok(())
 }
 
 /// The header through bt-formats' one PLY grammar; its errors keep this reader's variants: an

@@ -58,3 +58,23 @@ pub(crate) fn intern(table: &mut Vec<String>, name: &str) -> u32 {
         }
     }
 }
+
+/// Refuse the next element of kind `element` (`vertices` or `faces`) of an OBJ file when
+/// `so_far` of them already fill the budget `max_elements`.
+pub(crate) fn check_budget(
+    file: &str,
+    element: &'static str,
+    so_far: usize,
+    max_elements: u64,
+    line: usize,
+) -> Result<(), crate::MeshError> {
+    if (so_far as u64) < max_elements {
+        return Ok(());
+    }
+    Err(crate::MeshError::Budget {
+        file: file.to_owned(),
+        element,
+        count: format!("at least {} (line {line})", max_elements.saturating_add(1)),
+        budget: max_elements,
+    })
+}

@@ -88,6 +88,19 @@ pub enum PointCloudError {
         /// The missing field name.
         field: String,
     },
+    /// The header declares more points than the budget [`crate::io::ReadOptions::max_points`].
+    #[error(
+        "{origin}header declares {claimed} points, more than the budget of {budget} points; \
+         raise it with --max-cloud-points (read options: max_points)"
+    )]
+    OverBudget {
+        /// File concerned, if known.
+        origin: Origin,
+        /// Number of points declared by the header.
+        claimed: u64,
+        /// The budget.
+        budget: u64,
+    },
     /// The header claims more points than the remaining bytes can possibly hold; detected
     /// before any allocation for the points.
     #[error(
@@ -159,6 +172,7 @@ impl PointCloudError {
             | Self::Unsupported { origin, .. }
             | Self::MissingField { origin, .. }
             | Self::CountExceedsData { origin, .. }
+            | Self::OverBudget { origin, .. }
             | Self::Truncated { origin, .. }
             | Self::BadValue { origin, .. }
             | Self::NonFinite { origin, .. } => *origin = o,

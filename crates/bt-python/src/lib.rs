@@ -54,8 +54,8 @@ struct PyScene {
 impl PyScene {
     /// The scene with other terminals (the scene's own where `None`).
     fn moved(&self, tx: Option<[f64; 3]>, rx: Option<[f64; 3]>) -> PyResult<Scene> {
-        let tx = tx.map(vec3).unwrap_or(self.scene.tx());
-        let rx = rx.map(vec3).unwrap_or(self.scene.rx());
+        let tx = tx.map(vec3).unwrap_or(self.scene.tx_world());
+        let rx = rx.map(vec3).unwrap_or(self.scene.rx_world());
         self.scene
             .with_terminals(tx, rx)
             .map_err(|e| self.error(TraceError::Scene(e)))
@@ -84,12 +84,12 @@ impl PyScene {
     /// Transmitter position, metres.
     #[getter]
     fn tx(&self) -> [f64; 3] {
-        self.scene.tx().to_array()
+        self.scene.tx_world().to_array()
     }
     /// Receiver position, metres.
     #[getter]
     fn rx(&self) -> [f64; 3] {
-        self.scene.rx().to_array()
+        self.scene.rx_world().to_array()
     }
     /// Carrier frequency, Hz.
     #[getter]
@@ -187,7 +187,7 @@ fn trace_and_report(
 ) -> Result<Vec<Vec<bt_beams::PathReport>>, TraceError> {
     let traced = bt_solve::pipeline::trace_receivers(scene, receivers, options)?;
     let one = |(rx, t): (&Vec3, &bt_solve::pipeline::Traced)| {
-        let moved = scene.with_terminals(scene.tx(), *rx)?;
+        let moved = scene.with_receiver(*rx)?;
         bt_beams::report(&moved, &t.result.paths, &bt_beams::RadioOptions::default()).map_err(|e| {
             TraceError::Scene(SceneError::Parse {
                 path: scene.name().to_string(),

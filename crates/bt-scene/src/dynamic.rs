@@ -13,6 +13,7 @@
 //! across steps; TX and RX are fixed unless the file gives `tx_steps` / `rx_steps`.
 
 use crate::description::{BOX_FACES, SceneDescription};
+use crate::frame::to_local;
 use crate::model::{Scene, Surface, SurfaceId};
 use crate::validate::{Problem, SceneError, Terminals, check_terminals};
 use crate::{builtin_json, io::parse_json};
@@ -400,12 +401,19 @@ fn step_scene(
     terminals: &StepTerminals,
     problems: &mut Vec<Problem>,
 ) -> Scene {
+    // Every step shares the base scene's local frame (warm starts and reuse compare positions
+    // across steps): world inputs (pivots, terminals) are moved into it.
+    let origin = base.origin();
     let mut surfaces: Vec<Surface> = base.surfaces().to_vec();
     for object in objects {
         let pose = object.poses[k];
         if pose.is_identity() {
             continue;
         }
+        let pose = Pose {
+            pivot: to_local(pose.pivot, origin),
+            ..pose
+        };
         for id in &object.surfaces {
             let s = &mut surfaces[id.index()];
             let moved = s
@@ -427,10 +435,10 @@ fn step_scene(
         }
     }
     let at = terminals.at(k);
-    let tx = at.tx.unwrap_or(base.tx());
-    let rx = at.rx.unwrap_or(base.rx());
+    let tx = at.tx.map_or(base.tx(), |p| to_local(p, origin));
+    let rx = at.rx.map_or(base.rx(), |p| to_local(p, origin));
     let extent = crate::model::scene_extent(&surfaces, tx, rx);
-    if let Err(list) = check_terminals(&surfaces, tx, rx, extent) {
+    if let Err(list) = check_terminals(&surfaces, tx, rx, extent, origin) {
         problems.extend(list.into_iter().map(|p| Problem {
             location: format!("steps[{k}] {}", p.location),
             message: p.message,
@@ -438,6 +446,7 @@ fn step_scene(
     }
     Scene::assemble(
         base.name().to_string(),
+        origin,
         surfaces,
         tx,
         rx,
@@ -663,6 +672,41 @@ mod tests {
                "crate": {{ "translate": [0.1, 0.2, 0] }} {extra} }} }}"#
         );
         serde_json::from_str(&json).unwrap()
+    }
+
+    #[test]
+    fn a_far_dynamic_scene_moves_in_one_local_frame_like_at_the_origin() {
+        let near = DynamicScene::from_description(&door_scene(""), "t", Terminals::default());
+        let near = near.unwrap();
+        let offset = Vec3::new(1e7, -3e6, 50.0);
+        let mut far = door_scene("");
+        let shift = |p: &mut [Real; 3]| *p = (Vec3::from_array(*p) + offset).to_array();
+        far.surfaces
+            .iter_mut()
+            .for_each(|s| s.vertices.iter_mut().for_each(shift));
+        for b in &mut far.boxes {
+            shift(&mut b.min);
+            shift(&mut b.max);
+        }
+        far.tx.iter_mut().chain(far.rx.iter_mut()).for_each(shift);
+        far.objects
+            .values_mut()
+            .for_each(|o| o.pivot.iter_mut().for_each(shift));
+        let far = DynamicScene::from_description(&far, "t", Terminals::default()).unwrap();
+        let origin = far.step(0).origin();
+        assert!(origin.abs().max_element() > 1e6, "recentred: {origin}");
+        for k in 0..near.len() {
+            let (a, b) = (near.step(k), far.step(k));
+            assert_eq!(b.origin(), origin, "one frame for every step");
+            assert!(b.tx().abs().max_element() < 16.0, "local tx {}", b.tx());
+            assert_eq!(b.tx_world(), a.tx() + offset);
+            for (s, t) in a.surfaces().iter().zip(b.surfaces()) {
+                for (p, q) in s.polygon.vertices().iter().zip(t.polygon.vertices()) {
+                    let error = (b.to_world(*q) - (*p + offset)).abs().max_element();
+                    assert!(error <= 4e-9, "step {k} {}: {error:e}", s.name);
+                }
+            }
+        }
     }
 
     #[test]

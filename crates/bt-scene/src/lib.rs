@@ -8,6 +8,8 @@ mod builtin;
 pub mod city;
 mod description;
 pub mod dynamic;
+mod enclosure;
+mod frame;
 pub mod io;
 mod material;
 mod model;
@@ -16,6 +18,7 @@ mod validate;
 
 pub use builtin::{builtin_json, builtin_names, builtin_scene};
 pub use description::{BoxDesc, MaterialDesc, SceneDescription, SurfaceDesc};
+pub use frame::RECENTRE_RATIO;
 pub use io::{LoadOptions, Loaded, Source, load, load_dynamic, load_with_progress};
 pub use material::{DEFAULT_MATERIAL, Material, default_materials};
 pub use model::{Scene, Surface, SurfaceId, SurfaceKind};

@@ -1,7 +1,7 @@
 //! The validated scene model.
 
 use crate::material::Material;
-use bt_geom::{Bvh, Polygon, Real, Vec3, tol};
+use bt_geom::{Bvh, Polygon, Real, Vec3};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
@@ -42,9 +42,14 @@ pub struct Surface {
 
 /// A validated scene. Construct it with [`crate::io`] loaders or [`Scene::from_description`];
 /// every surface is a valid planar polygon, TX and RX are finite, distinct and off every surface.
+///
+/// Positions are stored in the scene-local frame (`local = world − origin()`, see
+/// [`Scene::origin`]): [`Scene::tx`], [`Scene::rx`], the surfaces' polygons and every path point
+/// a solver finds are local; [`Scene::to_world`] turns them back into the input's coordinates.
 #[derive(Debug, Clone)]
 pub struct Scene {
     pub(crate) name: String,
+    pub(crate) origin: Vec3,
     pub(crate) surfaces: Vec<Surface>,
     pub(crate) tx: Vec3,
     pub(crate) rx: Vec3,
@@ -76,13 +81,36 @@ impl Scene {
             .filter(|(_, s)| s.kind == SurfaceKind::Reflector)
             .map(|(i, _)| SurfaceId(i as u32))
     }
-    /// Transmitter position, metres.
+    /// Transmitter position, metres, scene-local frame.
     pub fn tx(&self) -> Vec3 {
         self.tx
     }
-    /// Receiver position, metres.
+    /// Receiver position, metres, scene-local frame.
     pub fn rx(&self) -> Vec3 {
         self.rx
+    }
+    /// Transmitter position, metres, world frame (as given in the input).
+    pub fn tx_world(&self) -> Vec3 {
+        self.to_world(self.tx)
+    }
+    /// Receiver position, metres, world frame (as given in the input).
+    pub fn rx_world(&self) -> Vec3 {
+        self.to_world(self.rx)
+    }
+    /// World position of the scene-local frame's origin, metres: zero for scenes near the world
+    /// origin, a power-of-two-grid point near the scene's centre for scenes far from it
+    /// (`frame` module of this crate).
+    pub fn origin(&self) -> Vec3 {
+        self.origin
+    }
+    /// A point of the scene-local frame (solver output) in world coordinates, metres. The
+    /// identity (bit for bit, signed zeros kept) when [`Scene::origin`] is zero.
+    pub fn to_world(&self, local: Vec3) -> Vec3 {
+        crate::frame::to_world(local, self.origin)
+    }
+    /// A world point (a receiver given later, a grid point) in the scene-local frame, metres.
+    pub fn to_local(&self, world: Vec3) -> Vec3 {
+        crate::frame::to_local(world, self.origin)
     }
     /// Carrier frequency, Hz.
     pub fn frequency_hz(&self) -> Real {
@@ -102,7 +130,7 @@ impl Scene {
     }
     /// Length tolerance of geometric decisions for this scene, metres.
     pub fn length_tolerance(&self) -> Real {
-        tol::scaled(tol::REL_GEOMETRY, self.extent)
+        crate::frame::scene_tolerance(self.extent)
     }
     /// BVH over all surfaces (for occlusion tests).
     pub fn bvh(&self) -> &Bvh {
@@ -151,10 +179,44 @@ impl Scene {
         out
     }
 
+    /// Closed shells (watertight groups of surfaces, e.g. a box with all six faces or a closed
+    /// mesh solid) that hold exactly one of TX and RX, with the terminal inside ("tx" or "rx"):
+    /// no path can connect the two. A shell holding both (the room itself) is not listed, nor
+    /// one whose sides cannot be told within the tolerance (the test only answers when sure).
+    pub fn separating_shells(&self) -> Vec<(&'static str, Vec<SurfaceId>)> {
+        let eps = self.length_tolerance();
+        let inside =
+            |shell: &[SurfaceId], p| crate::enclosure::encloses(&self.surfaces, shell, p, eps);
+        crate::enclosure::closed_shells(&self.surfaces)
+            .into_iter()
+            .filter_map(
+                |shell| match (inside(&shell, self.tx)?, inside(&shell, self.rx)?) {
+                    (true, false) => Some(("tx", shell)),
+                    (false, true) => Some(("rx", shell)),
+                    _ => None,
+                },
+            )
+            .collect()
+    }
+
     /// Warnings about a valid scene that likely does not mean what it says (printable: names
     /// escaped).
     pub fn warnings(&self) -> Vec<String> {
-        self.coplanar_conflicts()
+        let enclosed = self.separating_shells().into_iter().map(|(inside, shell)| {
+            let names: Vec<String> = (shell.iter().take(3))
+                .map(|id| format!("\"{}\"", crate::name::escape(&self.surface(*id).name)))
+                .collect();
+            let more = if shell.len() > 3 { ", ..." } else { "" };
+            let outside = if inside == "tx" { "rx" } else { "tx" };
+            format!(
+                "{inside} lies inside the closed solid of {} surfaces ({}{more}) and {outside} \
+                 outside it: no path can connect them",
+                shell.len(),
+                names.join(", ")
+            )
+        });
+        let conflicts = self
+            .coplanar_conflicts()
             .into_iter()
             .map(|(a, b)| {
                 let (a, b) = (self.surface(a), self.surface(b));
@@ -166,22 +228,36 @@ impl Scene {
                     crate::name::escape(&b.name),
                     crate::name::escape(&b.material)
                 )
-            })
-            .collect()
+            });
+        conflicts.chain(enclosed).collect()
     }
 
-    /// A copy with other TX/RX positions, validated like the originals.
+    /// A copy with other TX/RX positions (metres, world frame, like the scene file's),
+    /// validated like the originals; the scene keeps its local frame.
     pub fn with_terminals(&self, tx: Vec3, rx: Vec3) -> Result<Scene, crate::SceneError> {
-        crate::validate::check_terminals(&self.surfaces, tx, rx, self.extent_with(tx, rx))
-            .map_err(|problems| crate::SceneError::Invalid {
-                source_name: self.name.clone(),
-                problems,
-            })?;
+        let (tx, rx) = (self.to_local(tx), self.to_local(rx));
+        crate::validate::check_terminals(
+            &self.surfaces,
+            tx,
+            rx,
+            self.extent_with(tx, rx),
+            self.origin,
+        )
+        .map_err(|problems| crate::SceneError::Invalid {
+            source_name: self.name.clone(),
+            problems,
+        })?;
         let mut scene = self.clone();
         scene.tx = tx;
         scene.rx = rx;
         scene.extent = self.extent_with(tx, rx);
         Ok(scene)
+    }
+
+    /// A copy with another RX (metres, world frame) and the same TX: the receiver of a sweep
+    /// grid point or of `trace_receivers`.
+    pub fn with_receiver(&self, rx: Vec3) -> Result<Scene, crate::SceneError> {
+        self.with_terminals(self.tx_world(), rx)
     }
 
     /// A copy at another carrier frequency (Hz), checked against the radio models of the

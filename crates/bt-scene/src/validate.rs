@@ -1,10 +1,11 @@
 //! Validation of a [`SceneDescription`] into a [`Scene`], collecting every problem at once.
 
 use crate::description::{BOX_FACES, SceneDescription};
+use crate::frame::{to_local, to_world};
 use crate::material::{DEFAULT_MATERIAL, Material, default_materials};
 use crate::model::{Scene, Surface, SurfaceKind, scene_extent};
 use bt_channel::RadioMaterial;
-use bt_geom::{Bvh, Polygon, Real, Vec3, tol};
+use bt_geom::{Bvh, Polygon, Real, Vec3};
 use serde::Serialize;
 use std::collections::BTreeSet;
 use std::fmt;
@@ -203,6 +204,11 @@ impl Scene {
                 });
             }
         }
+        let given = [
+            terminals.tx.or(desc.tx.map(Vec3::from_array)),
+            terminals.rx.or(desc.rx.map(Vec3::from_array)),
+        ];
+        let origin = crate::frame::recentre(&mut raw, given, &mut problems);
         let surfaces = build_surfaces(raw, &materials, &mut problems);
         if frequency_ok {
             problems
@@ -210,24 +216,17 @@ impl Scene {
                 .extend(radio_problems(&surfaces, &materials, frequency_hz));
         }
 
-        let tx = terminal(
-            "tx",
-            terminals.tx.or(desc.tx.map(Vec3::from_array)),
-            &mut problems,
-        );
-        let rx = terminal(
-            "rx",
-            terminals.rx.or(desc.rx.map(Vec3::from_array)),
-            &mut problems,
-        );
+        let tx = terminal("tx", given[0], &mut problems);
+        let rx = terminal("rx", given[1], &mut problems);
         let (Some(tx), Some(rx)) = (tx, rx) else {
             return Err(SceneError::Invalid {
                 source_name: source_name.to_string(),
                 problems: problems.0,
             });
         };
+        let (tx, rx) = (to_local(tx, origin), to_local(rx, origin));
         let extent = scene_extent(&surfaces, tx, rx);
-        if let Err(p) = check_terminals(&surfaces, tx, rx, extent) {
+        if let Err(p) = check_terminals(&surfaces, tx, rx, extent, origin) {
             problems.0.extend(p);
         }
         if !problems.0.is_empty() {
@@ -239,6 +238,7 @@ impl Scene {
         let name = desc.name.clone().unwrap_or_else(|| source_name.to_string());
         Ok(Scene::assemble(
             name,
+            origin,
             surfaces,
             tx,
             rx,
@@ -250,8 +250,10 @@ impl Scene {
 
 impl Scene {
     /// Assemble an already validated scene (internal: loaders use it after their checks).
+    /// `surfaces`, `tx` and `rx` are in the local frame whose origin is `origin` (world).
     pub(crate) fn assemble(
         name: String,
+        origin: Vec3,
         surfaces: Vec<Surface>,
         tx: Vec3,
         rx: Vec3,
@@ -263,6 +265,7 @@ impl Scene {
         let bvh = Bvh::build(&polygons);
         Scene {
             name,
+            origin,
             surfaces,
             tx,
             rx,
@@ -482,15 +485,18 @@ fn terminal(field: &str, value: Option<Vec3>, problems: &mut Collector) -> Optio
     }
 }
 
-/// TX and RX must be distinct and must not lie on any surface.
+/// TX and RX must be distinct and must not lie on any surface. Surfaces and terminals are in the
+/// local frame whose origin is `origin` (world): the resolution check looks at the world
+/// coordinates.
 pub(crate) fn check_terminals(
     surfaces: &[Surface],
     tx: Vec3,
     rx: Vec3,
     extent: Real,
+    origin: Vec3,
 ) -> Result<(), Vec<Problem>> {
     let mut problems = Vec::new();
-    let eps = tol::scaled(tol::REL_GEOMETRY, extent);
+    let eps = crate::frame::scene_tolerance(extent);
     if !tx.is_finite() {
         problems.report("tx", "coordinates must be finite numbers");
     }
@@ -498,15 +504,9 @@ pub(crate) fn check_terminals(
         problems.report("rx", "coordinates must be finite numbers");
     }
     for (field, p) in [("tx", tx), ("rx", rx)] {
-        let magnitude = p.abs().max_element();
-        if magnitude * Real::EPSILON >= eps {
-            problems.report(
-                field,
-                format!(
-                    "coordinates of magnitude {magnitude:.3e} m cannot be resolved to the scene's \
-                     tolerance {eps:.1e} m in double precision; move the scene nearer the origin"
-                ),
-            );
+        let magnitude = to_world(p, origin).abs().max_element();
+        if let Some(why) = crate::frame::unresolvable(magnitude, eps) {
+            problems.report(field, why);
         }
     }
     if problems.is_empty() && tx.distance(rx) <= eps {

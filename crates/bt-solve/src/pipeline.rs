@@ -64,11 +64,12 @@ impl TraceOptions {
 pub enum TraceError {
     /// The work would exceed the candidate budget.
     #[error(
-        "candidate budget exceeded: {estimate} candidates at order {max_order} (budget {budget}); \
-         lower the order or raise the budget with --max-candidates"
+        "candidate budget exceeded: {} candidates at order {max_order} (budget {budget}); \
+         lower the order or raise the budget with --max-candidates",
+        bt_geom::Count(*.estimate)
     )]
     Budget {
-        /// Candidates (or tree nodes) counted or estimated.
+        /// Candidates (or tree nodes) counted or estimated (saturating: `u64::MAX` means more).
         estimate: u64,
         /// The budget.
         budget: u64,
@@ -213,7 +214,8 @@ fn solve_set(
     }
 }
 
-/// Trace `scene`'s TX to each of `receivers` (one result per receiver, in order). Receivers
+/// Trace `scene`'s TX to each of `receivers` (metres, world frame: converted into the scene's
+/// local frame here; the paths found are local, see [`Scene::to_world`]). Receivers
 /// run in parallel when `options.parallel`; each one's own trace is then single-threaded.
 /// A receiver on a surface or at the TX fails the whole call with that receiver's error
 /// (see [`trace_each_receiver`] for one result per receiver).
@@ -250,12 +252,12 @@ pub fn trace_each_receiver(
         _ => None,
     };
     let one = |rx: &Vec3| -> Result<Traced, TraceError> {
-        let moved = scene.with_terminals(scene.tx(), *rx)?;
+        let moved = scene.with_receiver(*rx)?;
         match &tree {
             // The tree's margins hold for receivers whose scene tolerance is no larger.
             Some(tree) if moved.length_tolerance() <= tree.tolerance() => {
                 let t0 = Instant::now();
-                let set = tree.candidates(*rx);
+                let set = tree.candidates(moved.rx());
                 Ok(solve_set(&moved, set, &inner, t0.elapsed()))
             }
             _ => trace_scene(&moved, &inner),

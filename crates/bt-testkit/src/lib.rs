@@ -265,3 +265,51 @@ pub fn nasty_scene(seed: u64, n: usize, terminals: u8) -> Option<Scene> {
     // such draws are skipped (the scene validator says why), not forced.
     Scene::from_description(&d, "nasty", Terminals::default()).ok()
 }
+
+/// `desc` moved by `offset` (metres): every surface vertex, box corner, terminal (also per
+/// step) and rotation pivot; directions (axes, per-step translations) stay. The reference of
+/// the position-independence tests: the same scene far from the origin.
+pub fn translated(desc: &SceneDescription, offset: Vec3) -> SceneDescription {
+    let shift = |p: [Real; 3]| (Vec3::from_array(p) + offset).to_array();
+    let mut d = desc.clone();
+    for s in &mut d.surfaces {
+        s.vertices.iter_mut().for_each(|v| *v = shift(*v));
+    }
+    for b in &mut d.boxes {
+        (b.min, b.max) = (shift(b.min), shift(b.max));
+    }
+    d.tx = d.tx.map(shift);
+    d.rx = d.rx.map(shift);
+    for steps in [&mut d.tx_steps, &mut d.rx_steps].into_iter().flatten() {
+        steps.iter_mut().for_each(|p| *p = shift(*p));
+    }
+    for o in d.objects.values_mut() {
+        o.pivot = o.pivot.map(shift);
+    }
+    d
+}
+
+/// A hall of 60 m × 40 m × 12 m (concrete walls, floor and ceiling) with a stage, two pillars,
+/// a row of display panels, a metal cabinet and two blockers (crowds), TX on the stage and RX
+/// across the hall: the "hall-sized room" of the position-independence tests.
+pub fn hall_description() -> SceneDescription {
+    let json = r#"{
+        "name": "hall",
+        "tx": [8.0, 20.0, 3.5], "rx": [47.5, 13.25, 1.5],
+        "boxes": [
+            { "name": "hall", "min": [0, 0, 0], "max": [60, 40, 12], "material": "concrete" },
+            { "name": "stage", "min": [2, 12, 0], "max": [10, 28, 1.25] },
+            { "name": "pillar-a", "min": [20, 9.5, 0], "max": [21, 10.5, 12] },
+            { "name": "pillar-b", "min": [38, 29.5, 0], "max": [39, 30.5, 12] },
+            { "name": "cabinet", "min": [52, 36, 0], "max": [58, 38.5, 2.5], "material": "metal" },
+            { "name": "crowd-a", "min": [25, 18, 0], "max": [28, 24, 1.75], "kind": "blocker" },
+            { "name": "crowd-b", "min": [33, 5, 0], "max": [36, 8, 1.75], "kind": "blocker" }
+        ],
+        "surfaces": [
+            { "name": "panel-1", "vertices": [[30, 39.5, 2], [34, 39.5, 2], [34, 39.5, 5], [30, 39.5, 5]] },
+            { "name": "panel-2", "vertices": [[59.5, 15, 2], [59.5, 22, 2], [59.5, 22, 6], [59.5, 15, 6]] },
+            { "name": "banner", "vertices": [[14, 0.5, 6], [26, 0.5, 6], [26, 0.5, 9], [14, 0.5, 9]], "kind": "blocker" }
+        ]
+    }"#;
+    serde_json::from_str(json).expect("hall description parses")
+}

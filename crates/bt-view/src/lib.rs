@@ -107,8 +107,8 @@ impl StepPaths {
     /// The ranked reports of a trace of `scene`.
     pub fn from_reports(scene: &Scene, paths: &[PathReport]) -> Self {
         StepPaths {
-            tx: scene.tx().to_array(),
-            rx: scene.rx().to_array(),
+            tx: scene.tx_world().to_array(),
+            rx: scene.rx_world().to_array(),
             paths: paths.iter().map(ViewPath::from).collect(),
         }
     }
@@ -216,7 +216,9 @@ pub fn page(scenes: &[&Scene], paths: &[StepPaths]) -> String {
                         SurfaceKind::Reflector => colour_of(&s.material),
                         SurfaceKind::Blocker => BLOCKER,
                     },
-                    vertices: s.polygon.vertices().iter().map(|v| v.to_array()).collect(),
+                    vertices: (s.polygon.vertices().iter())
+                        .map(|v| scene.to_world(*v).to_array())
+                        .collect(),
                 })
                 .collect(),
             tx: step.tx,
@@ -318,6 +320,26 @@ mod tests {
         assert!(
             !VIEWER.contains("innerHTML"),
             "names must only reach textContent"
+        );
+    }
+
+    #[test]
+    fn a_far_scene_is_drawn_at_its_world_coordinates() {
+        let json = r#"{ "tx": [10000001, 10000001, 101], "rx": [10000004, 10000002, 101.5],
+            "boxes": [ { "name": "room", "min": [10000000, 10000000, 100],
+                         "max": [10000006, 10000004, 103] } ] }"#;
+        let desc: bt_scene::SceneDescription = serde_json::from_str(json).unwrap();
+        let scene = Scene::from_description(&desc, "far", Default::default()).unwrap();
+        assert!(
+            scene.origin() != bt_scene::Vec3::ZERO,
+            "solved in a local frame"
+        );
+        let steps = [StepPaths::from_reports(&scene, &[])];
+        let html = page(&[&scene], &steps);
+        assert!(html.contains("[10000001.0,10000001.0,101.0]"), "world tx");
+        assert!(
+            html.contains("[10000006.0,10000004.0,103.0]"),
+            "world vertex"
         );
     }
 

@@ -123,3 +123,135 @@ fn a_polygon_with_too_many_vertices_is_refused_not_checked_for_minutes() {
     let r = beamtrace(&["scene", "check", &scene]);
     assert_refused(&r, &["20001 vertices", "10000"]);
 }
+
+#[test]
+fn meshes_beyond_the_element_budget_stop_early_naming_count_budget_and_option() {
+    let dir = scratch("mesh-budget");
+    // A triangulated cube: 8 vertices, 12 faces, as OBJ and as ASCII PLY.
+    let corners: Vec<[u8; 3]> = (0..8u8)
+        .map(|v| [v & 1, (v >> 1) & 1, (v >> 2) & 1])
+        .collect();
+    let quads = [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ];
+    let triangles: Vec<[usize; 3]> = quads
+        .iter()
+        .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
+        .collect();
+    let mut obj = String::new();
+    let mut ply = format!(
+        "ply\nformat ascii 1.0\nelement vertex 8\nproperty float x\nproperty float y\n\
+         property float z\nelement face {}\nproperty list uchar int vertex_indices\nend_header\n",
+        triangles.len()
+    );
+    for c in &corners {
+        obj.push_str(&format!("v {} {} {}\n", c[0], c[1], c[2]));
+        ply.push_str(&format!("{} {} {}\n", c[0], c[1], c[2]));
+    }
+    for t in &triangles {
+        obj.push_str(&format!("f {} {} {}\n", t[0] + 1, t[1] + 1, t[2] + 1));
+        ply.push_str(&format!("3 {} {} {}\n", t[0], t[1], t[2]));
+    }
+    let obj = scene_with(&dir, "cube.obj", &obj);
+    let ply = scene_with(&dir, "cube.ply", &ply);
+    let terminals = ["--tx", "2,2,2", "--rx", "3,2,2"];
+    for (file, budget, needle) in [
+        (
+            &obj,
+            "5",
+            "at least 6 (line 6) vertices, more than the budget of 5 vertices",
+        ),
+        (
+            &obj,
+            "10",
+            "at least 11 (line 19) faces, more than the budget of 10 faces",
+        ),
+        (&ply, "10", "12 faces, more than the budget of 10 faces"),
+        (&ply, "7", "8 vertices, more than the budget of 7 vertices"),
+    ] {
+        let mut args = vec![
+            "scene",
+            "check",
+            file.as_str(),
+            "--max-mesh-elements",
+            budget,
+        ];
+        args.extend(terminals);
+        assert_refused(&beamtrace(&args), &[needle, "--max-mesh-elements"]);
+    }
+    for file in [&obj, &ply] {
+        let mut args = vec!["scene", "check", file.as_str(), "--max-mesh-elements", "12"];
+        args.extend(terminals);
+        assert_ok(&beamtrace(&args));
+    }
+}
+
+#[test]
+fn saturated_estimates_print_as_a_bound_not_as_u64_max() {
+    let dir = scratch("saturated");
+    // Candidates: 25 reflectors at order 50 overflow u64.
+    let wvrn = beamtrace(&["wvrn", "builtin:living-room", "--max-order", "50"]);
+    // Grid: 1e600 points per axis.
+    let out = dir.join("sweep");
+    let grid = "0:1e300:1e-300,0:1e300:1e-300,1";
+    let sweep = beamtrace(&[
+        "sweep",
+        "builtin:living-room",
+        "--grid",
+        grid,
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    // PLY: a vertex count whose byte size overflows u64.
+    let header = "ply\nformat binary_little_endian 1.0\nelement vertex 18446744073709551615\n\
+                  property float x\nproperty float y\nproperty float z\nelement face 1\n\
+                  property list uchar int vertex_indices\nend_header\n";
+    let ply = scene_with(&dir, "huge.ply", &format!("{header}{}", "\0".repeat(64)));
+    let mesh = beamtrace(&["scene", "check", &ply, "--tx", "1,1,1", "--rx", "2,2,2"]);
+    for (r, needle) in [
+        (wvrn, "more than 1.8e19 candidates at order 50"),
+        (sweep, "grid has more than 1.8e19 points"),
+        (mesh, "which need more than 1.8e19 bytes"),
+    ] {
+        assert_refused(&r, &[needle]);
+        // the PLY's own count is what the file says; no estimate may print as u64::MAX
+        let estimates = text(&r).replace("vertex\" claims 18446744073709551615", "");
+        assert!(!estimates.contains("18446744073709551615"), "{}", text(&r));
+    }
+}
+
+#[test]
+fn point_clouds_beyond_the_point_budget_stop_before_reading() {
+    let dir = scratch("cloud-budget");
+    let mut ply = String::from(
+        "ply\nformat ascii 1.0\nelement vertex 100\nproperty float x\nproperty float y\n\
+         property float z\nend_header\n",
+    );
+    for i in 0..100 {
+        ply.push_str(&format!("{} {} 0\n", i % 10, i / 10));
+    }
+    let pcd_header = "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\n\
+                      WIDTH 100\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 100\nDATA ascii\n";
+    let body: String = ply.lines().skip(7).map(|l| format!("{l}\n")).collect();
+    let ply = scene_with(&dir, "cloud.ply", &ply);
+    let pcd = scene_with(&dir, "cloud.pcd", &format!("{pcd_header}{body}"));
+    let out = dir.join("x.json");
+    for file in [&ply, &pcd] {
+        let needle = "declares 100 points, more than the budget of 50 points";
+        let trace = ["trace", file.as_str(), "--tx", "1,1,1", "--rx", "2,2,2"];
+        let r = beamtrace(&[&trace[..], &["--max-cloud-points", "50"]].concat());
+        assert_refused(&r, &[needle, "--max-cloud-points"]);
+        let extract = ["extract", file.as_str(), "-o", out.to_str().unwrap()];
+        let r = beamtrace(&[&extract[..], &["--max-cloud-points", "50"]].concat());
+        assert_refused(&r, &[needle, "--max-cloud-points"]);
+        // at the budget: read (the extraction may then find what it finds)
+        let r = beamtrace(&[&extract[..], &["--max-cloud-points", "100"]].concat());
+        assert_ok(&r);
+        assert!(!text(&r).contains("more than the budget"), "{}", text(&r));
+    }
+}

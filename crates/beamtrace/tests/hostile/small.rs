@@ -147,3 +147,149 @@ fn duplicate_coplanar_faces_with_different_materials_are_warned_about() {
     let scene = scene_with(&dir, "same.json", &same);
     assert!(!text(&beamtrace(&["scene", "check", &scene])).contains("overlap"));
 }
+
+/// `value` with every coordinate triple under a position key moved by `offset`.
+fn shifted(value: &Value, offset: [f64; 3]) -> Value {
+    let shift = |p: &Value| -> Value {
+        let p: Vec<f64> = p
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|c| c.as_f64().unwrap())
+            .collect();
+        serde_json::json!([p[0] + offset[0], p[1] + offset[1], p[2] + offset[2]])
+    };
+    let mut out = value.clone();
+    for key in ["tx", "rx"] {
+        out[key] = shift(&value[key]);
+    }
+    for b in out["boxes"].as_array_mut().into_iter().flatten() {
+        for key in ["min", "max"] {
+            b[key] = shift(&b[key]);
+        }
+    }
+    for s in out["surfaces"].as_array_mut().into_iter().flatten() {
+        let moved: Vec<Value> = s["vertices"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(shift)
+            .collect();
+        s["vertices"] = Value::Array(moved);
+    }
+    out
+}
+
+#[test]
+fn a_scene_far_from_the_origin_traces_like_the_same_scene_at_it() {
+    let dir = scratch("far");
+    let room: Value = serde_json::from_str(bt_scene::builtin_json("living-room").unwrap()).unwrap();
+    let near = scene_with(&dir, "near.json", &room.to_string());
+    for offset in [[1e7, 1e7, 100.0], [-3.2e5, 2.7e6, -50.0]] {
+        let far = scene_with(&dir, "far.json", &shifted(&room, offset).to_string());
+        for solver in ["image", "ipc"] {
+            let args = ["--solver", solver, "--max-order", "3"];
+            let a = trace_json(&[&[near.as_str()][..], &args].concat());
+            let b = trace_json(&[&[far.as_str()][..], &args].concat());
+            let (pa, pb) = (
+                a["paths"].as_array().unwrap(),
+                b["paths"].as_array().unwrap(),
+            );
+            assert!(pa.len() > 20, "{solver}: {} paths", pa.len());
+            assert_eq!(pa.len(), pb.len(), "{solver} at {offset:?}: path counts");
+            for k in 0..3 {
+                let tx = b["tx"][k].as_f64().unwrap() - offset[k];
+                assert!(
+                    (tx - a["tx"][k].as_f64().unwrap()).abs() < 1e-8,
+                    "tx in world"
+                );
+            }
+            for (p, q) in pa.iter().zip(pb) {
+                assert_eq!(p["surfaces"], q["surfaces"], "{solver} at {offset:?}");
+                let (lp, lq) = (
+                    p["length_m"].as_f64().unwrap(),
+                    q["length_m"].as_f64().unwrap(),
+                );
+                assert!(
+                    (lp - lq).abs() <= 1e-9 * lp,
+                    "{solver}: length {lp} vs {lq}"
+                );
+                let points = p["points"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .zip(q["points"].as_array().unwrap());
+                for (u, v) in points {
+                    for k in 0..3 {
+                        let d = v[k].as_f64().unwrap() - offset[k] - u[k].as_f64().unwrap();
+                        assert!(d.abs() <= 1e-6, "{solver}: point {u} vs {v}");
+                    }
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn a_terminal_shut_inside_a_closed_solid_is_warned_about() {
+    let dir = scratch("shut-in");
+    let desc = serde_json::json!({
+        "tx": [4.5, 1.5, 1.0], "rx": [1, 1, 1],
+        "boxes": [
+            { "name": "room", "min": [0, 0, 0], "max": [6, 4, 3] },
+            { "name": "safe", "material": "metal", "min": [4, 1, 0.5], "max": [5, 2, 1.5] }
+        ]
+    });
+    let scene = scene_with(&dir, "safe.json", &desc.to_string());
+    let needle = "tx lies inside the closed solid of 6 surfaces (\"safe.top\", \"safe.bottom\"";
+    for command in [&["scene", "check"][..], &["trace"][..]] {
+        let r = beamtrace(&[command, &[scene.as_str()][..]].concat());
+        assert_ok(&r);
+        assert!(text(&r).contains(needle), "{}", text(&r));
+        assert!(
+            text(&r).contains("no path can connect them"),
+            "{}",
+            text(&r)
+        );
+    }
+    // RX in the safe too: paths exist inside it, no warning; an open safe: no warning.
+    let mut both = desc.clone();
+    both["rx"] = serde_json::json!([4.25, 1.25, 0.75]);
+    let r = beamtrace(&[
+        "scene",
+        "check",
+        &scene_with(&dir, "both.json", &both.to_string()),
+    ]);
+    assert!(!text(&r).contains("closed solid"), "{}", text(&r));
+    let mut open = desc.clone();
+    open["boxes"][1]["omit"] = serde_json::json!(["top"]);
+    let r = beamtrace(&[
+        "scene",
+        "check",
+        &scene_with(&dir, "open.json", &open.to_string()),
+    ]);
+    assert!(!text(&r).contains("closed solid"), "{}", text(&r));
+    // A closed mesh (a triangulated cube) with RX inside, TX outside.
+    let mut obj = String::from("o cube\n");
+    for v in 0..8 {
+        let c = |bit: usize| if v & bit != 0 { 2 } else { 0 };
+        obj.push_str(&format!("v {} {} {}\n", c(1), c(2), c(4)));
+    }
+    for f in [
+        "1 3 4 2", "5 6 8 7", "1 2 6 5", "3 7 8 4", "1 5 7 3", "2 4 8 6",
+    ] {
+        let i: Vec<&str> = f.split(' ').collect();
+        obj.push_str(&format!(
+            "f {} {} {}\nf {} {} {}\n",
+            i[0], i[1], i[2], i[0], i[2], i[3]
+        ));
+    }
+    let cube = scene_with(&dir, "cube.obj", &obj);
+    let r = beamtrace(&["scene", "check", &cube, "--tx", "5,1,1", "--rx", "1,1,1"]);
+    assert_ok(&r);
+    assert!(
+        text(&r).contains("rx lies inside the closed solid of 6 surfaces"),
+        "{}",
+        text(&r)
+    );
+}

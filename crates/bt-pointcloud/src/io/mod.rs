@@ -41,10 +41,38 @@ pub enum NonFinitePolicy {
 }
 
 /// Options for the readers.
-#[derive(Debug, Clone, Copy, Default, PartialEq, Eq)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct ReadOptions {
     /// Policy for NaN / infinite coordinates.
     pub non_finite: NonFinitePolicy,
+    /// Budget: the most points a file may declare (CLI `--max-cloud-points`), checked against
+    /// the header before any point is stored; default [`DEFAULT_MAX_POINTS`].
+    pub max_points: u64,
+}
+
+/// Default of [`ReadOptions::max_points`]: 20 million points, the budget `sample` writes
+/// clouds under (plane extraction then holds every point with its normal and neighbours).
+pub const DEFAULT_MAX_POINTS: u64 = 20_000_000;
+
+impl Default for ReadOptions {
+    fn default() -> Self {
+        ReadOptions {
+            non_finite: NonFinitePolicy::default(),
+            max_points: DEFAULT_MAX_POINTS,
+        }
+    }
+}
+
+/// Refuse a header declaring more points than the budget.
+fn check_budget(claimed: u64, opts: &ReadOptions) -> Result<(), PointCloudError> {
+    if claimed <= opts.max_points {
+        return Ok(());
+    }
+    Err(PointCloudError::OverBudget {
+        origin: Origin(None),
+        claimed,
+        budget: opts.max_points,
+    })
 }
 
 /// A cloud read from a file together with what the reader had to leave out.

@@ -94,6 +94,7 @@ pub fn parse_pcd(bytes: &[u8], opts: &ReadOptions) -> Result<LoadedCloud, PointC
             available,
         });
     }
+    super::check_budget(count, opts)?;
     let capacity = count.min((available as u128 / min_per_point.max(1)) as u64) as usize;
     let mut sink = PointSink::new(capacity, layout.normal.is_some(), opts.non_finite);
     if header.binary {

@@ -73,6 +73,7 @@ pub fn parse_ply(bytes: &[u8], opts: &ReadOptions) -> Result<LoadedCloud, PointC
         });
     }
 
+    super::check_budget(vertex.count, opts)?;
     let per_vertex = u128::from(vertex.min_bytes(h.format).max(1));
     let capacity = vertex.count.min((available as u128 / per_vertex) as u64) as usize;
     let mut sink = PointSink::new(capacity, normal_idx.is_some(), opts.non_finite);

@@ -29,6 +29,7 @@ fn pcd(d: PcdData) -> Vec<u8> {
 
 const OPTS: ReadOptions = ReadOptions {
     non_finite: NonFinitePolicy::Skip,
+    max_points: bt_pointcloud::io::DEFAULT_MAX_POINTS,
 };
 
 #[test]
@@ -178,6 +179,7 @@ fn nan_points_are_skipped_or_rejected() {
         p,
         &ReadOptions {
             non_finite: NonFinitePolicy::Reject,
+            ..ReadOptions::default()
         },
     ) {
         Err(e @ E::NonFinite { .. }) => assert!(e.to_string().contains("line 9 (point 1)"), "{e}"),
@@ -189,7 +191,7 @@ fn nan_points_are_skipped_or_rejected() {
     }
     assert_eq!(parse_ply(&b, &OPTS).unwrap().skipped_non_finite, 1);
     assert!(matches!(
-        parse_ply(&b, &ReadOptions { non_finite: NonFinitePolicy::Reject }),
+        parse_ply(&b, &ReadOptions { non_finite: NonFinitePolicy::Reject, ..ReadOptions::default() }),
         Err(E::NonFinite { at, .. }) if at.element == 1 && at.line.is_none()
     ));
     assert!(matches!(

@@ -146,6 +146,7 @@ fn reads_hand_written_files_from_testdata() {
         &dir.join("organised_rgb_nan.pcd"),
         &ReadOptions {
             non_finite: NonFinitePolicy::Reject,
+            ..ReadOptions::default()
         },
     )
     .unwrap_err();

@@ -7,7 +7,6 @@ use crate::model::{Scene, SurfaceKind};
 use crate::validate::SceneError;
 use crate::{SceneDescription, SurfaceDesc};
 use bt_pointcloud::Extraction;
-use bt_pointcloud::io::ReadOptions;
 use std::path::Path;
 
 /// Bytes of a PLY file searched for `end_header` when deciding mesh or cloud.
@@ -84,7 +83,7 @@ pub(super) fn load_cloud(
     progress: &mut dyn FnMut(LoadProgress),
 ) -> Result<Loaded, SceneError> {
     let display = path.display().to_string();
-    let cloud = bt_pointcloud::io::read_path(path, &ReadOptions::default())?;
+    let cloud = bt_pointcloud::io::read_path(path, &options.cloud)?;
     let extraction =
         bt_pointcloud::extract_planes_with_progress(&cloud.cloud, &options.extract, progress)
             .map_err(|e| e.with_path(path))?;

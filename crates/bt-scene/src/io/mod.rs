@@ -34,6 +34,9 @@ pub struct LoadOptions {
     pub frequency_hz: Real,
     /// Plane-extraction parameters for point clouds (PLY without faces, PCD).
     pub extract: bt_pointcloud::ExtractParams,
+    /// Point-cloud reading: budget on the points a file declares (`max_points`, CLI
+    /// `--max-cloud-points`) and the policy for non-finite points.
+    pub cloud: bt_pointcloud::io::ReadOptions,
     /// A radio material for every surface (CLI `--material itu:NAME --thickness M`), replacing
     /// the radio model of every material of the loaded scene, whatever its format.
     pub radio: Option<bt_channel::RadioMaterial>,
@@ -47,6 +50,7 @@ impl Default for LoadOptions {
             min_reflector_area_m2: 0.25,
             frequency_hz: DEFAULT_FREQUENCY_HZ,
             extract: bt_pointcloud::ExtractParams::default(),
+            cloud: bt_pointcloud::io::ReadOptions::default(),
             radio: None,
         }
     }
@@ -131,9 +135,14 @@ pub fn from_mesh(
         });
     }
     let mut problems: Vec<Problem> = Vec::new();
+    let (tx, rx) = (options.terminals.tx, options.terminals.rx);
+    let origin = crate::frame::recentre(&mut raw, [tx, rx], &mut problems);
     let surfaces = build_surfaces(raw, &materials, &mut problems);
-    let (tx, rx) = match (options.terminals.tx, options.terminals.rx) {
-        (Some(tx), Some(rx)) => (tx, rx),
+    let (tx, rx) = match (tx, rx) {
+        (Some(tx), Some(rx)) => (
+            crate::frame::to_local(tx, origin),
+            crate::frame::to_local(rx, origin),
+        ),
         (tx, rx) => {
             for (field, v) in [("tx", tx), ("rx", rx)] {
                 if v.is_none() {
@@ -150,7 +159,7 @@ pub fn from_mesh(
         }
     };
     let extent = crate::model::scene_extent(&surfaces, tx, rx);
-    if let Err(p) = check_terminals(&surfaces, tx, rx, extent) {
+    if let Err(p) = check_terminals(&surfaces, tx, rx, extent, origin) {
         problems.extend(p);
     }
     problems.extend(radio_problems(&surfaces, &materials, options.frequency_hz));
@@ -163,6 +172,7 @@ pub fn from_mesh(
     Ok(Loaded {
         scene: Scene::assemble(
             name.to_string(),
+            origin,
             surfaces,
             tx,
             rx,

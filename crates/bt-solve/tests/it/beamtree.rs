@@ -71,7 +71,7 @@ fn assert_same(a: &[FoundPath], b: &[FoundPath]) -> Result<(), TestCaseError> {
 proptest! {
     #![proptest_config(ProptestConfig {
         cases: 96,
-        rng_seed: proptest::test_runner::RngSeed::Fixed(0xbea3_7ee),
+        rng_seed: proptest::test_runner::RngSeed::Fixed(0x0bea_37ee),
         ..ProptestConfig::default()
     })]
 

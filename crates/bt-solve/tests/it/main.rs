@@ -7,3 +7,4 @@ mod beamtree;
 mod common;
 mod ipc_vs_image;
 mod newton;
+mod translation;
