@@ -17,6 +17,7 @@ pub fn run_2d(args: &Study2dArgs) -> anyhow::Result<ExitCode> {
         max_order: args.max_order,
         sbr_step_deg: args.sbr_step_deg,
         sbr_sphere: args.sbr_sphere,
+        max_candidates: args.budgets.max_candidates,
     };
     let problems = config.problems();
     if !problems.is_empty() {

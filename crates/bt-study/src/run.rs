@@ -26,6 +26,10 @@ pub struct StudyConfig {
     pub sbr_step_deg: Real,
     /// Launch SBR rays over the whole sphere instead of the horizontal plane only.
     pub sbr_sphere: bool,
+    /// Budget on beam-tree nodes per scene (`--max-candidates`): a room whose tree would
+    /// exceed it stops the study with that error.
+    #[serde(skip)]
+    pub max_candidates: u64,
 }
 
 impl Default for StudyConfig {
@@ -38,6 +42,7 @@ impl Default for StudyConfig {
             max_order: 3,
             sbr_step_deg: 1.0,
             sbr_sphere: false,
+            max_candidates: bt_solve::pipeline::DEFAULT_MAX_CANDIDATES,
         }
     }
 }
@@ -252,7 +257,7 @@ pub(crate) fn run_solver(
             ));
         }
     };
-    let candidates = study_candidates(scene, config.max_order);
+    let candidates = study_candidates(scene, config)?;
     let result = trace(scene, &candidates, &s, false);
     let elapsed = start.elapsed().as_secs_f64();
     let map = result
@@ -344,7 +349,7 @@ pub fn run(
             if draw && drawing.steps.contains(&step) {
                 drawing
                     .paths
-                    .push(exact_polylines(&scene, config.max_order));
+                    .push(exact_polylines(&scene, config)?);
             }
             progress(index * config.steps + step + 1, total);
         }
@@ -383,21 +388,26 @@ fn row(
     }
 }
 
-/// The study's candidates: the beam tree (the generator every consumer uses), unbudgeted since
-/// the study caps its order.
-fn study_candidates(scene: &Scene, max_order: usize) -> CandidateSet {
+/// The study's candidates: the beam tree (the generator every consumer uses), within the
+/// study's node budget.
+fn study_candidates(scene: &Scene, config: &StudyConfig) -> Result<CandidateSet, StudyError> {
     let options = bt_solve::pipeline::TraceOptions {
         parallel: false,
-        max_candidates: u64::MAX,
-        ..bt_solve::pipeline::TraceOptions::new(max_order)
+        max_candidates: config.max_candidates,
+        ..bt_solve::pipeline::TraceOptions::new(config.max_order)
     };
-    // Without a budget the beam tree has no error to return.
-    bt_solve::pipeline::candidates(scene, &options).expect("an unbudgeted beam tree cannot fail")
+    bt_solve::pipeline::candidates(scene, &options).map_err(|e| StudyError::Scene {
+        name: scene.name().to_string(),
+        message: e.to_string(),
+    })
 }
 
-fn exact_polylines(scene: &Scene, max_order: usize) -> Vec<(usize, Vec<Vec2>)> {
-    let candidates = study_candidates(scene, max_order);
-    trace(scene, &candidates, &Solver::Image, false)
+fn exact_polylines(
+    scene: &Scene,
+    config: &StudyConfig,
+) -> Result<Vec<(usize, Vec<Vec2>)>, StudyError> {
+    let candidates = study_candidates(scene, config)?;
+    Ok(trace(scene, &candidates, &Solver::Image, false)
         .paths
         .iter()
         .map(|p| {
@@ -406,7 +416,7 @@ fn exact_polylines(scene: &Scene, max_order: usize) -> Vec<(usize, Vec<Vec2>)> {
             line.push(scene.rx().truncate());
             (p.surfaces.len(), line)
         })
-        .collect()
+        .collect())
 }
 
 #[cfg(test)]

@@ -139,6 +139,7 @@ impl LivingRoomConfig {
             max_order: self.max_order,
             sbr_step_deg: self.sbr_step_deg,
             sbr_sphere: true,
+            ..StudyConfig::default()
         }
     }
 }

@@ -131,3 +131,15 @@ fn invalid_settings_are_reported() {
     let e = run(&config, &mut |_, _| {}).unwrap_err().to_string();
     assert!(e.contains("rooms") && e.contains("sbr step"), "{e}");
 }
+
+#[test]
+fn the_candidate_budget_stops_the_study() {
+    let config = StudyConfig {
+        rooms: 1,
+        steps: 1,
+        max_candidates: 3,
+        ..tiny()
+    };
+    let e = run(&config, &mut |_, _| {}).unwrap_err().to_string();
+    assert!(e.contains("room-0-step-0") && e.contains("--max-candidates"), "{e}");
+}
