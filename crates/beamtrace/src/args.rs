@@ -825,6 +825,14 @@ pub struct HlsGenArgs {
     /// Round cap of the fixed-point IPC.
     #[arg(long, default_value_t = 256)]
     pub max_rounds: u32,
+    /// M9K blocks the point and schedule memories may take (default: the EP4CE115's 432);
+    /// a design that needs more is refused.
+    #[arg(long, default_value_t = bt_hls::EP4CE115_M9K_BLOCKS)]
+    pub m9k_budget: u32,
+    /// With --steps: start every step from the beam tree's window centres instead of the
+    /// points the previous step converged to.
+    #[arg(long)]
+    pub cold_start: bool,
     /// Model and schedule only (cycle counts, errors): skip writing RTL (for large scenes).
     #[arg(long)]
     pub plan_only: bool,

@@ -104,6 +104,9 @@ pub struct HlsSummary {
     pub points: usize,
     /// Candidates through a moving surface, solved by the host (image method).
     pub host_paths: usize,
+    /// Paths started from the points they converged to at the previous step (`--steps`
+    /// without `--cold-start`).
+    pub warm_started: usize,
     pub schedule: &'static str,
     pub seed: u64,
     pub pe_budget: u32,
@@ -225,9 +228,11 @@ fn generate(args: &HlsGenArgs) -> anyhow::Result<ExitCode> {
         .with_context(|| format!("creating {}", args.output.display()))?;
     // The platform: one PE per reflector that no step moves.
     let planes = bt_study::fpga::static_reflectors(&scenes);
-    let mut planned = Vec::with_capacity(scenes.len());
+    let mut planned: Vec<PlannedStep> = Vec::with_capacity(scenes.len());
     for (k, scene) in scenes.iter().enumerate() {
-        planned.push(plan_step(scene, &planes, args, args.steps.then_some(k))?);
+        let previous = planned.last().map(|p| (&p.step, p.results.as_slice()));
+        let step = plan_step(scene, &planes, args, args.steps.then_some(k), previous)?;
+        planned.push(step);
     }
     let work: Vec<bt_hls::StepWork> = planned
         .iter()
@@ -236,7 +241,10 @@ fn generate(args: &HlsGenArgs) -> anyhow::Result<ExitCode> {
             schedule: p.plan.schedule.clone(),
         })
         .collect();
-    let platform = bt_hls::Platform::fitting(&work)?;
+    let platform = bt_hls::Platform {
+        m9k_budget: args.m9k_budget,
+        ..bt_hls::Platform::fitting(&work)?
+    };
     let k = platform.instances.len() as u32;
     let rtl_written = !args.plan_only;
     if rtl_written {
@@ -273,6 +281,10 @@ fn generate(args: &HlsGenArgs) -> anyhow::Result<ExitCode> {
 /// One step planned on the host: candidates, accelerator input, model results, schedule.
 struct PlannedStep {
     step: bt_study::fpga::StepInput,
+    /// The model's results (what the accelerator reads back), for the next step's warm start.
+    results: Vec<bt_hls::PathResult>,
+    /// Paths that start from the previous step's converged points.
+    warm_started: usize,
     plan: bt_hls::Plan,
     fixed: FixedDeviation,
     host_time_s: f64,
@@ -291,6 +303,7 @@ impl PlannedStep {
             paths: self.step.input.paths.len(),
             points: self.plan.points as usize,
             host_paths: self.step.host_sequences.len(),
+            warm_started: self.warm_started,
             schedule: args.schedule.kind().name(),
             seed: args.seed,
             pe_budget: self.plan.pe_budget,
@@ -313,6 +326,7 @@ fn plan_step(
     planes: &[bt_scene::SurfaceId],
     args: &HlsGenArgs,
     index: Option<usize>,
+    previous: Option<(&bt_study::fpga::StepInput, &[bt_hls::PathResult])>,
 ) -> anyhow::Result<PlannedStep> {
     let t0 = Instant::now();
     let options = bt_solve::pipeline::TraceOptions {
@@ -321,13 +335,19 @@ fn plan_step(
         ..bt_solve::pipeline::TraceOptions::new(args.max_order)
     };
     let candidates = bt_solve::pipeline::candidates(scene, &options)?;
-    let step = bt_study::fpga::step_input(
+    let mut step = bt_study::fpga::step_input(
         scene,
         planes,
         &candidates,
         args.threshold_lsb,
         args.max_rounds,
     );
+    let warm_started = match previous {
+        Some((prev, results)) if !args.cold_start => {
+            bt_study::fpga::warm_start(&mut step, prev, results)
+        }
+        _ => 0,
+    };
     let t1 = Instant::now();
     if step.input.paths.is_empty() {
         let at = index.map(|k| format!(" step {k}")).unwrap_or_default();
@@ -358,6 +378,8 @@ fn plan_step(
     let fixed = fixed_deviation(scene, &step, &results, args.max_order);
     Ok(PlannedStep {
         step,
+        results,
+        warm_started,
         plan,
         fixed,
         host_time_s: ((t1 - t0) + (t3 - t2)).as_secs_f64(),

@@ -116,8 +116,33 @@ impl HlsInput {
 /// so no output cycle.
 pub const PE_LATENCY: u32 = 5 + PROPORTION_ITERATIONS;
 
-/// Largest word address the 16-bit Avalon address port can reach.
-pub const ADDRESS_BITS: u32 = 16;
+/// Narrowest Avalon word address of a design, bits: the control, status, point and schedule
+/// regions of [`Layout::of`] take what they need above it (the port is
+/// `avs_address[address_bits-1:0]`, at least 16 bits).
+pub const MIN_ADDRESS_BITS: u32 = 16;
+
+/// Widest Avalon word address, bits (the testbench's program words are 32 bits).
+pub const MAX_ADDRESS_BITS: u32 = 30;
+
+/// M9K blocks of the EP4CE115 (the paper's Cyclone IV E), 9,216 bits each.
+pub const EP4CE115_M9K_BLOCKS: u32 = 432;
+
+/// M9K blocks a simple dual-port RAM of `depth` words of `width` bits takes: the best of the
+/// block's shapes (8K x 1, 4K x 2, 2K x 4, 1K x 9, 512 x 18, 256 x 36), as `bt_m9k.txt` maps them.
+pub fn m9k_blocks(depth: u64, width: u64) -> u64 {
+    [
+        (8192, 1),
+        (4096, 2),
+        (2048, 4),
+        (1024, 9),
+        (512, 18),
+        (256, 36),
+    ]
+    .iter()
+    .map(|&(d, w)| depth.div_ceil(d) * width.div_ceil(w))
+    .min()
+    .unwrap_or(0)
+}
 
 /// `ceil(log2(n))`, at least 1.
 pub(crate) fn bits_for(n: u64) -> u32 {
@@ -152,6 +177,14 @@ pub struct Platform {
     pub instances: Vec<PeInstance>,
     /// RAM sizes.
     pub capacity: Capacity,
+    /// M9K blocks the RAMs may take (point memory copies and schedule memory); a design that
+    /// needs more is refused. Default: the EP4CE115's [`EP4CE115_M9K_BLOCKS`].
+    #[serde(default = "default_m9k_budget")]
+    pub m9k_budget: u32,
+}
+
+fn default_m9k_budget() -> u32 {
+    EP4CE115_M9K_BLOCKS
 }
 
 /// One accelerator run's work as the host loads it: candidates, start points, TX/RX (the
@@ -208,6 +241,7 @@ impl Platform {
             early_stop: first.input.early_stop,
             instances,
             capacity,
+            m9k_budget: EP4CE115_M9K_BLOCKS,
         })
     }
 }
@@ -240,6 +274,8 @@ pub(crate) struct Design {
     pub path_bits: u32,
     pub point_bits: u32,
     pub inst_bits: u32,
+    /// Width of `avs_address`, bits.
+    pub address_bits: u32,
     /// Word address of the first path status, of the first point word, of the first
     /// schedule entry.
     pub status_base: u32,
@@ -255,6 +291,8 @@ pub(crate) struct Layout {
     pub point_bits: u32,
     pub inst_bits: u32,
     pub slot_bits: u32,
+    /// Width of `avs_address`, bits.
+    pub address_bits: u32,
     pub status_base: u32,
     pub point_base: u32,
     pub sched_base: u32,
@@ -263,7 +301,8 @@ pub(crate) struct Layout {
 impl Layout {
     /// Regions: status `[2^s, 2^(s+1))` with `s = max(4, path bits)`, points
     /// `[2^q, 2^(q+1))` (8 words per point: 2 banks of 4) with `q > s`, schedule
-    /// `[2^r, 2^(r+1))` with `r > q`; all below 2^16.
+    /// `[2^r, 2^(r+1))` with `r > q`; the address is `max(16, r + 1)` bits. Refused: more than
+    /// [`MAX_ADDRESS_BITS`], or RAMs over the platform's M9K budget.
     pub fn of(platform: &Platform) -> Result<Layout, HlsError> {
         let cap = platform.capacity;
         let num_instances = platform.instances.len() as u32;
@@ -274,14 +313,26 @@ impl Layout {
         let status_bits = path_bits.max(4);
         let point_region_bits = (point_bits + 3).max(status_bits + 1);
         let sched_region_bits = (slot_bits + inst_bits).max(point_region_bits + 1);
-        if sched_region_bits + 1 > ADDRESS_BITS {
+        let address_bits = (sched_region_bits + 1).max(MIN_ADDRESS_BITS);
+        if address_bits > MAX_ADDRESS_BITS {
             return Err(HlsError::TooLarge(format!(
-                "{} paths, {} points and {} slots x {} PEs need more than {ADDRESS_BITS} address bits: \
-                 lower --max-order or use fewer reflectors",
+                "{} paths, {} points and {} slots x {} PEs need {address_bits} address bits, more \
+                 than {MAX_ADDRESS_BITS}: lower --max-order or use fewer reflectors",
                 cap.paths, cap.points, cap.slots, num_instances
             )));
         }
-        if sched_entry_bits(path_bits, point_bits) > 32 {
+        let sw = sched_entry_bits(path_bits, point_bits);
+        let blocks = 2 * m9k_blocks(1 << (point_bits + 1), crate::pe::POINT_BITS.into())
+            + m9k_blocks(1 << (slot_bits + inst_bits), sw.into());
+        if blocks > platform.m9k_budget.into() {
+            return Err(HlsError::TooLarge(format!(
+                "{} paths, {} points and {} slots x {} PEs need {blocks} M9K blocks for the point \
+                 and schedule memories, more than the budget of {}: lower --max-order or use \
+                 fewer reflectors",
+                cap.paths, cap.points, cap.slots, num_instances, platform.m9k_budget
+            )));
+        }
+        if sw > 32 {
             return Err(HlsError::TooLarge(format!(
                 "a schedule entry for {} paths and {} points exceeds one 32-bit word",
                 cap.paths, cap.points
@@ -298,6 +349,7 @@ impl Layout {
             point_bits,
             inst_bits,
             slot_bits,
+            address_bits,
             status_base: 1 << status_bits,
             point_base: 1 << point_region_bits,
             sched_base: 1 << sched_region_bits,
@@ -346,6 +398,7 @@ impl Design {
             path_bits: l.path_bits,
             point_bits: l.point_bits,
             inst_bits: l.inst_bits,
+            address_bits: l.address_bits,
             status_base: l.status_base,
             point_base: l.point_base,
             sched_base: l.sched_base,
@@ -470,4 +523,63 @@ fn step_design(platform: &Platform, k: usize, w: &StepWork) -> Result<StepDesign
         makespan,
         columns,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn platform(paths: u32, points: u32, slots: u32, pes: u32, m9k_budget: u32) -> Platform {
+        Platform {
+            planes: vec![PlaneSpec {
+                name: "floor".into(),
+                normal: [0.0, 0.0, 1.0],
+                offset_m: 0.0,
+                bounds_m: None,
+            }],
+            threshold_lsb: 16,
+            early_stop: None,
+            instances: (0..pes).map(|copy| PeInstance { plane: 0, copy }).collect(),
+            capacity: Capacity {
+                paths,
+                points,
+                slots,
+            },
+            m9k_budget,
+        }
+    }
+
+    #[test]
+    fn m9k_blocks_take_the_best_shape() {
+        // 64 K x 19 bits: 8 blocks deep x 19 wide (8K x 1) beats 16 x 10 (4K x 2).
+        assert_eq!(m9k_blocks(65_536, 19), 152);
+        // 512 x 120 bits: 512 x 18 shape, 7 blocks wide.
+        assert_eq!(m9k_blocks(512, 120), 7);
+        assert_eq!(m9k_blocks(1, 1), 1);
+    }
+
+    #[test]
+    fn an_order_three_room_widens_the_address_instead_of_failing() {
+        // The living room at order 3: 104 paths, 270 points, 2,342 slots x 25 PEs.
+        let l = Layout::of(&platform(104, 270, 2342, 25, EP4CE115_M9K_BLOCKS)).unwrap();
+        // {slot (12 bits), column (5 bits)} entries: region 2^17, so 18 address bits.
+        assert_eq!(l.sched_base, 1 << 17);
+        assert_eq!(l.address_bits, 18);
+        let small = Layout::of(&platform(18, 18, 2, 24, EP4CE115_M9K_BLOCKS)).unwrap();
+        assert_eq!(small.address_bits, MIN_ADDRESS_BITS);
+    }
+
+    #[test]
+    fn memories_over_the_m9k_budget_are_refused_with_the_numbers() {
+        let e = Layout::of(&platform(104, 270, 2342, 25, 100)).unwrap_err();
+        let text = e.to_string();
+        assert!(matches!(e, HlsError::TooLarge(_)), "{text}");
+        // Point memories 2 x 1 K x 120 bits (two banks of 270 points; 14 blocks each),
+        // schedule 128 K x 20 bits ({slot, column} x {end, last, first, point 9, path 7,
+        // valid}; 8K x 1 shape: 16 x 20 = 320 blocks).
+        assert!(
+            text.contains("348 M9K blocks") && text.contains("budget of 100"),
+            "{text}"
+        );
+    }
 }

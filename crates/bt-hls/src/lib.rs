@@ -32,7 +32,8 @@ use bt_schedule::Schedule;
 
 pub use bt_fixed::{BoundsM, EarlyStop, FixedOutcome, PathResult};
 pub use error::HlsError;
-pub use input::{ADDRESS_BITS, Capacity, HlsInput, PE_LATENCY, PlaneSpec, Platform, StepWork};
+pub use input::{Capacity, EP4CE115_M9K_BLOCKS, MAX_ADDRESS_BITS, MIN_ADDRESS_BITS, m9k_blocks};
+pub use input::{HlsInput, PE_LATENCY, PlaneSpec, Platform, StepWork};
 pub use pe::{POINT_BITS, pe_module_name};
 pub use plan::{Plan, PlanOptions, ScheduleKind, cycles_per_slot, plan, run_cycles};
 pub use tools::{
@@ -284,13 +285,14 @@ fn register_map(d: &Design) -> String {
     let cap = d.platform.capacity;
     let mut s = String::new();
     s.push_str("# bt_top register map (Avalon-MM slave)\n\n");
-    s.push_str(
-        "32-bit data, word addresses on `avs_address[15:0]`, no waitrequest, single-cycle writes, \
+    s.push_str(&format!(
+        "32-bit data, word addresses on `avs_address[{}:0]`, no waitrequest, single-cycle writes, \
          pipelined reads with a fixed latency of 2 cycles (`avs_readdatavalid` marks the data), \
          interrupt `ins_irq` = done (level, cleared by the next start). Coordinates on the bus \
          are millimetre words (two's complement, metres x 1000). Writes other than CTRL are \
          ignored while busy.\n\n",
-    );
+        d.address_bits - 1
+    ));
     s.push_str("| address | access | name | content |\n|---|---|---|---|\n");
     s.push_str("| 0x0000 | W | CTRL | bit 0 = 1 starts a run (ignored while busy) |\n");
     s.push_str("| 0x0000 | R | STATUS | bit 0 busy, bit 1 done |\n");
