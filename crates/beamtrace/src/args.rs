@@ -86,8 +86,9 @@ pub struct StudyLivingRoomArgs {
     /// Highest reflection order.
     #[arg(long, default_value_t = 3)]
     pub max_order: usize,
-    /// PE scheduler of each step's accelerator.
-    #[arg(long, value_enum, default_value_t = ScheduleArg::Ga)]
+    /// PE scheduler of each step's accelerator: the list scheduler (host, per step, as
+    /// `hls gen`) or the GA (offline sizing).
+    #[arg(long, value_enum, default_value_t = ScheduleArg::List)]
     pub schedule: ScheduleArg,
     /// GA seed (echoed into the outputs).
     #[arg(long, default_value_t = 1)]
@@ -107,6 +108,10 @@ pub struct StudyLivingRoomArgs {
     /// Round cap of the fixed-point IPC.
     #[arg(long, default_value_t = 256)]
     pub max_rounds: u32,
+    /// Start every step's accelerator run from the beam tree's window centres instead of the
+    /// points the previous step converged to.
+    #[arg(long)]
+    pub cold_start: bool,
 }
 
 #[derive(Debug, Args, Clone)]
