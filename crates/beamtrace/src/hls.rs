@@ -112,7 +112,8 @@ pub struct HlsSummary {
     pub list_makespan: u32,
     /// PE instances of the platform (the one design all steps run on).
     pub platform_instances: u32,
-    pub cycles_per_slot: u64,
+    /// Mean cycles of a slot (`2·(jobs + 2) + PE_LATENCY` per slot; idle PEs cost nothing).
+    pub mean_cycles_per_slot: f64,
     pub predicted_cycles: u64,
     pub latency_s_at_50mhz: f64,
     /// Host work per step, seconds: candidates, accelerator input and the PE schedule.
@@ -193,7 +194,7 @@ fn summary(
     k: u32,
     rtl_written: bool,
 ) -> HlsSummary {
-    let cycles = bt_hls::run_cycles(k, p.plan.stats.makespan);
+    let cycles = p.plan.predicted_cycles;
     HlsSummary {
         scene: scene.name().to_string(),
         step: args.steps.then_some(p.index),
@@ -209,7 +210,7 @@ fn summary(
         list_makespan: p.plan.list_makespan,
         stats: p.plan.stats,
         platform_instances: k,
-        cycles_per_slot: bt_hls::cycles_per_slot(k),
+        mean_cycles_per_slot: p.plan.mean_cycles_per_slot,
         predicted_cycles: cycles,
         latency_s_at_50mhz: cycles as f64 / CLOCK_HZ,
         host_time_s: p.host_time_s,
@@ -349,9 +350,9 @@ fn print_summary(s: &HlsSummary, dir: &Path) {
         100.0 * s.stats.utilisation
     );
     println!(
-        "cycles per run {} ({} per slot, {} PEs on the platform) = {:.3} ms at 50 MHz; host {:.3} ms (+ {:.3} ms model run for the round budgets)",
+        "cycles per run {} ({:.1} per slot, {} PEs on the platform) = {:.3} ms at 50 MHz; host {:.3} ms (+ {:.3} ms model run for the round budgets)",
         s.predicted_cycles,
-        s.cycles_per_slot,
+        s.mean_cycles_per_slot,
         s.platform_instances,
         s.latency_s_at_50mhz * 1e3,
         s.host_time_s * 1e3,

@@ -159,6 +159,10 @@ pub struct Capacity {
     pub points: u32,
     /// Schedule slots per run (the makespan).
     pub slots: u32,
+    /// Schedule-memory entries per run: the jobs, packed slot after slot (an empty slot takes
+    /// one entry), [`crate::schedule_entries`].
+    #[serde(default)]
+    pub entries: u32,
 }
 
 /// The accelerator as synthesised once per static room: one PE per plane (plus duplicates)
@@ -213,6 +217,7 @@ impl Platform {
             paths: 1,
             points: 1,
             slots: 1,
+            entries: 1,
         };
         for w in work {
             for inst in &w.schedule.instances {
@@ -224,6 +229,9 @@ impl Platform {
             capacity.paths = capacity.paths.max(w.input.paths.len() as u32);
             capacity.points = capacity.points.max(points as u32);
             capacity.slots = capacity.slots.max(w.schedule.makespan());
+            capacity.entries = capacity
+                .entries
+                .max(crate::plan::schedule_entries(&w.schedule));
         }
         let instances = copies
             .iter()
@@ -291,6 +299,8 @@ pub(crate) struct Layout {
     pub point_bits: u32,
     pub inst_bits: u32,
     pub slot_bits: u32,
+    /// Bits of a schedule-memory entry index.
+    pub entry_bits: u32,
     /// Width of `avs_address`, bits.
     pub address_bits: u32,
     pub status_base: u32,
@@ -312,24 +322,25 @@ impl Layout {
         let slot_bits = bits_for(cap.slots.into());
         let status_bits = path_bits.max(4);
         let point_region_bits = (point_bits + 3).max(status_bits + 1);
-        let sched_region_bits = (slot_bits + inst_bits).max(point_region_bits + 1);
+        let entry_bits = bits_for(cap.entries.max(1).into());
+        let sched_region_bits = entry_bits.max(point_region_bits + 1);
         let address_bits = (sched_region_bits + 1).max(MIN_ADDRESS_BITS);
         if address_bits > MAX_ADDRESS_BITS {
             return Err(HlsError::TooLarge(format!(
-                "{} paths, {} points and {} slots x {} PEs need {address_bits} address bits, more \
-                 than {MAX_ADDRESS_BITS}: lower --max-order or use fewer reflectors",
-                cap.paths, cap.points, cap.slots, num_instances
+                "{} paths, {} points and {} schedule entries need {address_bits} address bits, \
+                 more than {MAX_ADDRESS_BITS}: lower --max-order or use fewer reflectors",
+                cap.paths, cap.points, cap.entries
             )));
         }
-        let sw = sched_entry_bits(path_bits, point_bits);
+        let sw = sched_entry_bits(path_bits, point_bits, inst_bits);
         let blocks = 2 * m9k_blocks(1 << (point_bits + 1), crate::pe::POINT_BITS.into())
-            + m9k_blocks(1 << (slot_bits + inst_bits), sw.into());
+            + m9k_blocks(1 << entry_bits, sw.into());
         if blocks > platform.m9k_budget.into() {
             return Err(HlsError::TooLarge(format!(
-                "{} paths, {} points and {} slots x {} PEs need {blocks} M9K blocks for the point \
-                 and schedule memories, more than the budget of {}: lower --max-order or use \
-                 fewer reflectors",
-                cap.paths, cap.points, cap.slots, num_instances, platform.m9k_budget
+                "{} paths, {} points and {} schedule entries ({} slots, {} PEs) need {blocks} M9K \
+                 blocks for the point and schedule memories, more than the budget of {}: lower \
+                 --max-order or use fewer reflectors",
+                cap.paths, cap.points, cap.entries, cap.slots, num_instances, platform.m9k_budget
             )));
         }
         if sw > 32 {
@@ -349,6 +360,7 @@ impl Layout {
             point_bits,
             inst_bits,
             slot_bits,
+            entry_bits,
             address_bits,
             status_base: 1 << status_bits,
             point_base: 1 << point_region_bits,
@@ -357,9 +369,10 @@ impl Layout {
     }
 }
 
-/// Schedule-entry fields: `{end, last, first, point, path, valid}` from bit 0 up.
-pub(crate) fn sched_entry_bits(path_bits: u32, point_bits: u32) -> u32 {
-    4 + path_bits + point_bits
+/// Schedule-entry fields: `{column, tail, end, last, first, point, path, valid}` from bit 0
+/// up (`tail` marks a slot's last entry, `column` the PE).
+pub(crate) fn sched_entry_bits(path_bits: u32, point_bits: u32, inst_bits: u32) -> u32 {
+    5 + path_bits + point_bits + inst_bits
 }
 
 impl Design {
@@ -403,11 +416,6 @@ impl Design {
             point_base: l.point_base,
             sched_base: l.sched_base,
         })
-    }
-
-    /// Cycles of one schedule slot.
-    pub fn cycles_per_slot(&self) -> u32 {
-        crate::plan::cycles_per_slot(self.num_instances) as u32
     }
 }
 
@@ -506,11 +514,17 @@ fn step_design(platform: &Platform, k: usize, w: &StepWork) -> Result<StepDesign
     }
     let num_paths = input.paths.len() as u32;
     let cap = platform.capacity;
-    if num_paths > cap.paths || num_points > cap.points || makespan > cap.slots {
+    let entries = crate::plan::schedule_entries(schedule);
+    if num_paths > cap.paths
+        || num_points > cap.points
+        || makespan > cap.slots
+        || entries > cap.entries
+    {
         return Err(HlsError::TooLarge(format!(
-            "step {k}: {num_paths} paths, {num_points} points, {makespan} slots exceed the \
-             platform's capacity of {} paths, {} points, {} slots",
-            cap.paths, cap.points, cap.slots
+            "step {k}: {num_paths} paths, {num_points} points, {makespan} slots, {entries} \
+             schedule entries exceed the platform's capacity of {} paths, {} points, {} slots, \
+             {} entries",
+            cap.paths, cap.points, cap.slots, cap.entries
         )));
     }
     Ok(StepDesign {
@@ -529,7 +543,7 @@ fn step_design(platform: &Platform, k: usize, w: &StepWork) -> Result<StepDesign
 mod tests {
     use super::*;
 
-    fn platform(paths: u32, points: u32, slots: u32, pes: u32, m9k_budget: u32) -> Platform {
+    fn platform(paths: u32, points: u32, entries: u32, pes: u32, m9k_budget: u32) -> Platform {
         Platform {
             planes: vec![PlaneSpec {
                 name: "floor".into(),
@@ -543,7 +557,8 @@ mod tests {
             capacity: Capacity {
                 paths,
                 points,
-                slots,
+                slots: 2342,
+                entries,
             },
             m9k_budget,
         }
@@ -559,27 +574,30 @@ mod tests {
     }
 
     #[test]
-    fn an_order_three_room_widens_the_address_instead_of_failing() {
-        // The living room at order 3: 104 paths, 270 points, 2,342 slots x 25 PEs.
-        let l = Layout::of(&platform(104, 270, 2342, 25, EP4CE115_M9K_BLOCKS)).unwrap();
-        // {slot (12 bits), column (5 bits)} entries: region 2^17, so 18 address bits.
-        assert_eq!(l.sched_base, 1 << 17);
-        assert_eq!(l.address_bits, 18);
-        let small = Layout::of(&platform(18, 18, 2, 24, EP4CE115_M9K_BLOCKS)).unwrap();
-        assert_eq!(small.address_bits, MIN_ADDRESS_BITS);
+    fn the_address_widens_with_the_schedule_memory() {
+        // The living room at order 3: 104 paths, 270 points, ~12,000 packed schedule entries
+        // (2^14): the schedule region 2^14 fits the 16-bit minimum.
+        let l = Layout::of(&platform(104, 270, 12_000, 25, EP4CE115_M9K_BLOCKS)).unwrap();
+        assert_eq!((l.sched_base, l.address_bits), (1 << 14, MIN_ADDRESS_BITS));
+        // 70,000 entries (2^17) need 18 address bits instead of a refusal.
+        let l = Layout::of(&platform(104, 270, 70_000, 25, EP4CE115_M9K_BLOCKS)).unwrap();
+        assert_eq!((l.sched_base, l.address_bits), (1 << 17, 18));
     }
 
     #[test]
     fn memories_over_the_m9k_budget_are_refused_with_the_numbers() {
-        let e = Layout::of(&platform(104, 270, 2342, 25, 100)).unwrap_err();
+        // Point memories 2 x 1 K x 120 bits (two banks of 270 points; 14 blocks each),
+        // schedule 256 K x 26 bits ({column 5, tail, end, last, first, point 9, path 7,
+        // valid}; 1K x 9 shape: 256 x 3 = 768 blocks): 796 blocks, over the EP4CE115's 432.
+        let e = Layout::of(&platform(104, 270, 200_000, 25, EP4CE115_M9K_BLOCKS)).unwrap_err();
         let text = e.to_string();
         assert!(matches!(e, HlsError::TooLarge(_)), "{text}");
-        // Point memories 2 x 1 K x 120 bits (two banks of 270 points; 14 blocks each),
-        // schedule 128 K x 20 bits ({slot, column} x {end, last, first, point 9, path 7,
-        // valid}; 8K x 1 shape: 16 x 20 = 320 blocks).
         assert!(
-            text.contains("348 M9K blocks") && text.contains("budget of 100"),
+            text.contains("796 M9K blocks") && text.contains("budget of 432"),
             "{text}"
         );
+        // The order-3 room itself: 2 x 14 + 16K x 26 (1K x 9 shape: 16 x 3 = 48) = 76 blocks.
+        let e = Layout::of(&platform(104, 270, 12_000, 25, 75)).unwrap_err();
+        assert!(e.to_string().contains("76 M9K blocks"), "{e}");
     }
 }

@@ -15,7 +15,6 @@ fn golden_cycle_count() {
     let pinned = serde_json::json!({
         "instances": r.num_instances,
         "makespans": r.makespans,
-        "cycles_per_slot": r.cycles_per_slot,
         "run_cycles": r.run_cycles,
         "predicted_tb_cycles": r.predicted_tb_cycles,
         "status_base": r.status_base,

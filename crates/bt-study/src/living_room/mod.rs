@@ -231,8 +231,8 @@ pub struct FpgaStep {
     pub utilisation: Real,
     /// PE instances of the one platform every step runs on.
     pub platform_instances: u32,
-    /// Cycles per schedule slot on that platform.
-    pub cycles_per_slot: u64,
+    /// Mean cycles of a schedule slot (`2·(jobs + 2) + PE_LATENCY`; idle PEs cost nothing).
+    pub mean_cycles_per_slot: Real,
     /// Predicted `CYCLES` of the run on that platform (exact; co-simulation checks it).
     pub cycles: u64,
     /// Per-step latency, `cycles / CLOCK_HZ`, seconds.
@@ -325,8 +325,8 @@ struct FixedStep {
 /// The accelerator at one step ([`fpga::plan_step`]: beam-tree candidates over the platform's
 /// planes, warm start from the previous step, the bit-exact model, the PE schedule): the
 /// results the host accepts ([`fpga::host_accepts`]), the candidates through a moving surface
-/// solved by the host (image method, validated), line of sight from the host. The cycles are
-/// filled in once the platform (all steps) is known.
+/// solved by the host (image method, validated), line of sight from the host. The platform's
+/// PE count is filled in once all steps are known.
 fn fixed_point_step(
     scene: &Scene,
     planes: &[bt_scene::SurfaceId],
@@ -393,9 +393,9 @@ fn fixed_point_step(
         latency_factor: plan.stats.latency_factor,
         utilisation: plan.stats.utilisation,
         platform_instances: 0,
-        cycles_per_slot: 0,
-        cycles: 0,
-        latency_s: 0.0,
+        mean_cycles_per_slot: plan.mean_cycles_per_slot,
+        cycles: plan.predicted_cycles,
+        latency_s: plan.predicted_cycles as Real / CLOCK_HZ,
         host_time_s: planned.host_time_s,
     };
     Ok(FixedStep {
@@ -406,8 +406,9 @@ fn fixed_point_step(
     })
 }
 
-/// Every step's cycles on the one platform all steps run on ([`bt_hls::Platform::fitting`]).
-fn fill_platform_cycles(
+/// The PE count of the one platform all steps run on ([`bt_hls::Platform::fitting`]); a
+/// step's cycles depend on its schedule only.
+fn fill_platform_instances(
     fpga: &mut [FpgaStep],
     work: &[bt_hls::StepWork],
 ) -> Result<(), StudyError> {
@@ -418,9 +419,6 @@ fn fill_platform_cycles(
     let k = platform.instances.len() as u32;
     for f in fpga {
         f.platform_instances = k;
-        f.cycles_per_slot = bt_hls::cycles_per_slot(k);
-        f.cycles = bt_hls::run_cycles(k, f.makespan);
-        f.latency_s = f.cycles as Real / CLOCK_HZ;
     }
     Ok(())
 }
@@ -513,7 +511,7 @@ pub fn run(
         }
         progress(step + 1, steps);
     }
-    fill_platform_cycles(&mut fpga, &work)?;
+    fill_platform_instances(&mut fpga, &work)?;
     let step0 = scene.step(0);
     Ok(LivingRoomResults {
         config: config.clone(),

@@ -15,7 +15,7 @@ mean_err_tx_deg,max_err_tx_deg,mean_err_rx_deg,max_err_rx_deg,time_s,fpga_cycles
 /// Column names of `fpga.csv`.
 pub const FPGA_CSV_HEADER: &str = "scene,step,paths,host_paths,warm_started,points,converged,not_converged,degenerate,\
 left_bounds,reflection_rejected,missed,spurious,instances,duplicates,pe_budget,makespan,list_makespan,\
-latency_factor,utilisation,platform_instances,cycles_per_slot,cycles,latency_s,host_time_s";
+latency_factor,utilisation,platform_instances,mean_cycles_per_slot,cycles,latency_s,host_time_s";
 
 /// `results.csv`: one line per step and solver; floats in Rust's shortest round-trip
 /// scientific notation. `fpga_cycles` and `fpga_latency_s` (the accelerator's predicted run,
@@ -65,7 +65,7 @@ pub fn fpga_csv(results: &LivingRoomResults) -> String {
     for f in &results.fpga {
         let _ = writeln!(
             out,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:e},{},{},{},{:e},{:e}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:e},{},{:e},{},{:e},{:e}",
             results.scene_name,
             f.step,
             f.paths,
@@ -87,7 +87,7 @@ pub fn fpga_csv(results: &LivingRoomResults) -> String {
             f.latency_factor,
             f.utilisation,
             f.platform_instances,
-            f.cycles_per_slot,
+            f.mean_cycles_per_slot,
             f.cycles,
             f.latency_s,
             f.host_time_s

@@ -13,10 +13,11 @@ module bt_top (
   output reg  avs_readdatavalid,
   output wire ins_irq
 );
-  // 7 PE instances, capacity 26 paths, 46 points, 237 slots; 55 cycles per slot, threshold 16 fine LSB
+  // 7 PE instances, capacity 26 paths, 46 points, 237 slots; 2 x (jobs + 2) + 37 cycles per slot, threshold 16 fine LSB
   reg [2:0] state;
   reg [5:0] cnt;
   reg [7:0] slot;
+  reg [10:0] sbase;
   reg [8:0] slots_r;
   reg [31:0] cycles;
   reg done;
@@ -38,14 +39,16 @@ module bt_top (
   reg [31:0] pov;
   reg [119:0] rd_a;
   reg [119:0] rd_b;
-  reg [14:0] sched_q;
+  reg [18:0] sched_q;
   reg sq_ok;
-  reg [2:0] sq_inst;
+  reg seen_tail;
   reg ld_q_en;
+  reg ld_q_tail;
   reg ld_q_first;
   reg ld_q_last;
   reg [2:0] ld_q_inst;
   reg wb_q_en;
+  reg wb_q_tail;
   reg wb_q_end;
   reg [4:0] wb_q_path;
   reg [5:0] wb_q_point;
@@ -95,15 +98,20 @@ module bt_top (
   assign host_wr = (avs_write && idle);
   wire pt_we;
   assign pt_we = ((host_wr && is_point) && (avs_address[1:0] == 2'd3));
-  // PE schedule memory, written per step by the host: entry {slot, column} -> {end, last, first, point, path, valid} (15 bits)
-  reg [14:0] sched [0:2047];
+  // PE schedule memory, written per step by the host: entry -> {column, tail, end, last, first, point, path, valid} (19 bits)
+  wire [10:0] sched_addr;
+  assign sched_addr = (sbase + {5'd0, cnt});
+  wire rom_tail;
+  assign rom_tail = (sched_q[15] && sq_ok);
+  wire stop;
+  assign stop = (seen_tail | rom_tail);
+  reg [18:0] sched [0:2047];
   always @(posedge clk) begin
     if ((host_wr && is_sched)) begin
-      sched[avs_address[10:0]] <= avs_writedata[14:0];
+      sched[avs_address[10:0]] <= avs_writedata[18:0];
     end
-    sched_q <= sched[{slot, cnt[2:0]}];
-    sq_ok <= (((state == 3'd2) | (state == 3'd4)) && (cnt < 6'd7));
-    sq_inst <= cnt[2:0];
+    sched_q <= sched[sched_addr];
+    sq_ok <= ((((state == 3'd2) | (state == 3'd4)) && (cnt < 6'd7)) && !(stop));
   end
   wire rom_valid;
   assign rom_valid = (sched_q[0] && sq_ok);
@@ -111,6 +119,8 @@ module bt_top (
   assign rom_path = sched_q[5:1];
   wire [5:0] rom_point;
   assign rom_point = sched_q[11:6];
+  wire [2:0] rom_inst;
+  assign rom_inst = sched_q[18:16];
   wire rom_first;
   assign rom_first = sched_q[12];
   wire rom_last;
@@ -335,7 +345,7 @@ module bt_top (
   assign pe_load_4 = (((state == 3'd2) && ld_q_en) && (ld_q_inst == 3'd4));
   assign pe_load_5 = (((state == 3'd2) && ld_q_en) && (ld_q_inst == 3'd5));
   assign pe_load_6 = (((state == 3'd2) && ld_q_en) && (ld_q_inst == 3'd6));
-  // main FSM: IDLE -> per slot LOAD (9) EXEC (37) WB (9) -> IDLE with done after SLOTS slots
+  // main FSM: IDLE -> per slot LOAD (jobs + 2) EXEC (37) WB (jobs + 2) -> IDLE with done after SLOTS slots
   wire start_req;
   assign start_req = (((avs_write && (avs_address == 16'h0)) && avs_writedata[0]) && (state == 3'd0));
   always @(posedge clk) begin
@@ -346,7 +356,10 @@ module bt_top (
       cycles <= 32'h0;
       done <= 1'd0;
       ld_q_en <= 1'd0;
+      ld_q_tail <= 1'd0;
       wb_q_en <= 1'd0;
+      wb_q_tail <= 1'd0;
+      seen_tail <= 1'd0;
     end else begin
       if ((state != 3'd0)) begin
         cycles <= (cycles + 32'h1);
@@ -357,6 +370,7 @@ module bt_top (
             state <= ((slots_r == 9'h0) ? 3'd0 : 3'd2);
             cnt <= 6'd0;
             slot <= 8'd0;
+            sbase <= 11'h0;
             cycles <= 32'h0;
             done <= (slots_r == 9'h0);
             cur <= 32'h0;
@@ -402,14 +416,17 @@ module bt_top (
         end
         3'd2: begin
           ld_q_en <= rom_valid;
+          ld_q_tail <= rom_tail;
           ld_q_first <= rom_first;
           ld_q_last <= rom_last;
-          ld_q_inst <= sq_inst;
-          if ((cnt == 6'd8)) begin
+          ld_q_inst <= rom_inst;
+          if (ld_q_tail) begin
             state <= 3'd3;
             cnt <= 6'd0;
+            seen_tail <= 1'd0;
           end else begin
             cnt <= (cnt + 6'd1);
+            seen_tail <= stop;
           end
         end
         3'd3: begin
@@ -422,10 +439,11 @@ module bt_top (
         end
         3'd4: begin
           wb_q_en <= rom_valid;
+          wb_q_tail <= rom_tail;
           wb_q_end <= rom_end;
           wb_q_path <= rom_path;
           wb_q_point <= rom_point;
-          wb_q_inst <= sq_inst;
+          wb_q_inst <= rom_inst;
           if (wb_go) begin
             if (wb_q_end) begin
               cur[wb_q_path] <= ~(cur[wb_q_path]);
@@ -442,8 +460,10 @@ module bt_top (
               pov[wb_q_path] <= any_ov;
             end
           end
-          if ((cnt == 6'd8)) begin
+          if (wb_q_tail) begin
             cnt <= 6'd0;
+            seen_tail <= 1'd0;
+            sbase <= ((sbase + {5'd0, cnt}) - 11'h1);
             if ((({1'd0, slot} + 9'h1) == slots_r)) begin
               state <= 3'd0;
               done <= 1'd1;
@@ -453,6 +473,7 @@ module bt_top (
             end
           end else begin
             cnt <= (cnt + 6'd1);
+            seen_tail <= stop;
           end
         end
         default: begin
@@ -539,7 +560,7 @@ module bt_top (
             read_mux = cycles;
           end
           4'd2: begin
-            read_mux = 32'h703001a;
+            read_mux = 32'h704001a;
           end
           4'd3: begin
             read_mux = 32'h10;

@@ -13,10 +13,11 @@ module bt_top (
   output reg  avs_readdatavalid,
   output wire ins_irq
 );
-  // 8 PE instances, capacity 26 paths, 46 points, 135 slots; 57 cycles per slot, threshold 16 fine LSB
+  // 8 PE instances, capacity 26 paths, 46 points, 135 slots; 2 x (jobs + 2) + 37 cycles per slot, threshold 16 fine LSB
   reg [2:0] state;
   reg [5:0] cnt;
   reg [7:0] slot;
+  reg [9:0] sbase;
   reg [8:0] slots_r;
   reg [31:0] cycles;
   reg done;
@@ -38,14 +39,16 @@ module bt_top (
   reg [31:0] pov;
   reg [119:0] rd_a;
   reg [119:0] rd_b;
-  reg [14:0] sched_q;
+  reg [18:0] sched_q;
   reg sq_ok;
-  reg [2:0] sq_inst;
+  reg seen_tail;
   reg ld_q_en;
+  reg ld_q_tail;
   reg ld_q_first;
   reg ld_q_last;
   reg [2:0] ld_q_inst;
   reg wb_q_en;
+  reg wb_q_tail;
   reg wb_q_end;
   reg [4:0] wb_q_path;
   reg [5:0] wb_q_point;
@@ -93,22 +96,27 @@ module bt_top (
   wire is_point;
   assign is_point = (avs_address[15:9] == 7'd1);
   wire is_sched;
-  assign is_sched = (avs_address[15:11] == 5'd1);
+  assign is_sched = (avs_address[15:10] == 6'd1);
   wire [5:0] bus_point;
   assign bus_point = avs_address[8:3];
   wire host_wr;
   assign host_wr = (avs_write && idle);
   wire pt_we;
   assign pt_we = ((host_wr && is_point) && (avs_address[1:0] == 2'd3));
-  // PE schedule memory, written per step by the host: entry {slot, column} -> {end, last, first, point, path, valid} (15 bits)
-  reg [14:0] sched [0:2047];
+  // PE schedule memory, written per step by the host: entry -> {column, tail, end, last, first, point, path, valid} (19 bits)
+  wire [9:0] sched_addr;
+  assign sched_addr = (sbase + {4'd0, cnt});
+  wire rom_tail;
+  assign rom_tail = (sched_q[15] && sq_ok);
+  wire stop;
+  assign stop = (seen_tail | rom_tail);
+  reg [18:0] sched [0:1023];
   always @(posedge clk) begin
     if ((host_wr && is_sched)) begin
-      sched[avs_address[10:0]] <= avs_writedata[14:0];
+      sched[avs_address[9:0]] <= avs_writedata[18:0];
     end
-    sched_q <= sched[{slot, cnt[2:0]}];
-    sq_ok <= (((state == 3'd2) | (state == 3'd4)) && (cnt < 6'd8));
-    sq_inst <= cnt[2:0];
+    sched_q <= sched[sched_addr];
+    sq_ok <= ((((state == 3'd2) | (state == 3'd4)) && (cnt < 6'd8)) && !(stop));
   end
   wire rom_valid;
   assign rom_valid = (sched_q[0] && sq_ok);
@@ -116,6 +124,8 @@ module bt_top (
   assign rom_path = sched_q[5:1];
   wire [5:0] rom_point;
   assign rom_point = sched_q[11:6];
+  wire [2:0] rom_inst;
+  assign rom_inst = sched_q[18:16];
   wire rom_first;
   assign rom_first = sched_q[12];
   wire rom_last;
@@ -465,7 +475,7 @@ module bt_top (
   assign pe_load_5 = (((state == 3'd2) && ld_q_en) && (ld_q_inst == 3'd5));
   assign pe_load_6 = (((state == 3'd2) && ld_q_en) && (ld_q_inst == 3'd6));
   assign pe_load_7 = (((state == 3'd2) && ld_q_en) && (ld_q_inst == 3'd7));
-  // main FSM: IDLE -> per slot LOAD (10) EXEC (37) WB (10) -> IDLE with done after SLOTS slots
+  // main FSM: IDLE -> per slot LOAD (jobs + 2) EXEC (37) WB (jobs + 2) -> IDLE with done after SLOTS slots
   wire start_req;
   assign start_req = (((avs_write && (avs_address == 16'h0)) && avs_writedata[0]) && (state == 3'd0));
   always @(posedge clk) begin
@@ -476,7 +486,10 @@ module bt_top (
       cycles <= 32'h0;
       done <= 1'd0;
       ld_q_en <= 1'd0;
+      ld_q_tail <= 1'd0;
       wb_q_en <= 1'd0;
+      wb_q_tail <= 1'd0;
+      seen_tail <= 1'd0;
     end else begin
       if ((state != 3'd0)) begin
         cycles <= (cycles + 32'h1);
@@ -487,6 +500,7 @@ module bt_top (
             state <= ((slots_r == 9'h0) ? 3'd0 : 3'd2);
             cnt <= 6'd0;
             slot <= 8'd0;
+            sbase <= 10'h0;
             cycles <= 32'h0;
             done <= (slots_r == 9'h0);
             cur <= 32'h0;
@@ -534,14 +548,17 @@ module bt_top (
         end
         3'd2: begin
           ld_q_en <= rom_valid;
+          ld_q_tail <= rom_tail;
           ld_q_first <= rom_first;
           ld_q_last <= rom_last;
-          ld_q_inst <= sq_inst;
-          if ((cnt == 6'd9)) begin
+          ld_q_inst <= rom_inst;
+          if (ld_q_tail) begin
             state <= 3'd3;
             cnt <= 6'd0;
+            seen_tail <= 1'd0;
           end else begin
             cnt <= (cnt + 6'd1);
+            seen_tail <= stop;
           end
         end
         3'd3: begin
@@ -554,10 +571,11 @@ module bt_top (
         end
         3'd4: begin
           wb_q_en <= rom_valid;
+          wb_q_tail <= rom_tail;
           wb_q_end <= rom_end;
           wb_q_path <= rom_path;
           wb_q_point <= rom_point;
-          wb_q_inst <= sq_inst;
+          wb_q_inst <= rom_inst;
           if (wb_go) begin
             if (wb_q_end) begin
               cur[wb_q_path] <= ~(cur[wb_q_path]);
@@ -577,8 +595,10 @@ module bt_top (
               plb[wb_q_path] <= any_lb;
             end
           end
-          if ((cnt == 6'd9)) begin
+          if (wb_q_tail) begin
             cnt <= 6'd0;
+            seen_tail <= 1'd0;
+            sbase <= ((sbase + {4'd0, cnt}) - 10'h1);
             if ((({1'd0, slot} + 9'h1) == slots_r)) begin
               state <= 3'd0;
               done <= 1'd1;
@@ -588,6 +608,7 @@ module bt_top (
             end
           end else begin
             cnt <= (cnt + 6'd1);
+            seen_tail <= stop;
           end
         end
         default: begin
@@ -674,7 +695,7 @@ module bt_top (
             read_mux = cycles;
           end
           4'd2: begin
-            read_mux = 32'h803001a;
+            read_mux = 32'h804001a;
           end
           4'd3: begin
             read_mux = 32'h10;
