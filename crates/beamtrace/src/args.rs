@@ -99,7 +99,8 @@ pub struct StudyLivingRoomArgs {
     /// GA generations after the initial population (hls gen uses 12).
     #[arg(long, default_value_t = 2)]
     pub ga_generations: u32,
-    /// Total PE instances per step (default: planes used + 25 % for duplicates).
+    /// Total PE instances per step: with the GA, default planes used + 25 % for duplicates;
+    /// with the list scheduler, extra PEs become copies of the busiest planes (default none).
     #[arg(long)]
     pub pe_budget: Option<u32>,
     /// Fixed-point convergence threshold on a round's largest displacement, in 1/256 mm.
@@ -818,7 +819,8 @@ pub struct HlsGenArgs {
     /// Scheduler of each step: the list scheduler (host, per step) or the GA (offline sizing).
     #[arg(long, value_enum, default_value_t = ScheduleArg::List)]
     pub schedule: ScheduleArg,
-    /// Total PE instances allowed (default: planes + 25 % for duplicates).
+    /// Total PE instances per step: with the GA, default planes used + 25 % for duplicates;
+    /// with the list scheduler, extra PEs become copies of the busiest planes (default none).
     #[arg(long)]
     pub pe_budget: Option<u32>,
     /// GA seed.
