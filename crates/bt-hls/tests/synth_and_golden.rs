@@ -96,9 +96,9 @@ fn synthesis_smoke_test_reports_cell_counts() {
     assert!(synth.logic_cells > 100, "{synth:?}");
     assert!(synth.registers > 100, "{synth:?}");
     assert!(synth.percent_of_ep4ce115 > 0.0 && synth.percent_of_ep4ce115 < 100.0);
-    // The point memory (two copies of 8 x 120 bits) and the schedule memory (32 entries
-    // {slot, column} of 8 bits: 2 path bits, 2 point bits, 4 flags) are inferred into M9K,
-    // not registers.
+    // The point memory (two copies of 8 x 120 bits) and the packed schedule memory (the
+    // entries rounded up to 32, of 10 bits: 1 column bit, tail, end, last, first, 2 point
+    // bits, 2 path bits, valid) are inferred into M9K, not registers.
     assert!(synth.m9k_blocks > 0, "{synth:?}");
-    assert_eq!(synth.memory_bits, 2 * 8 * 120 + 32 * 8, "{synth:?}");
+    assert_eq!(synth.memory_bits, 2 * 8 * 120 + 32 * 10, "{synth:?}");
 }
