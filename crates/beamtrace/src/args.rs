@@ -82,8 +82,9 @@ pub struct StudyLivingRoomArgs {
     /// Highest reflection order.
     #[arg(long, default_value_t = 3)]
     pub max_order: usize,
-    /// PE scheduler of each step's accelerator.
-    #[arg(long, value_enum, default_value_t = ScheduleArg::Ga)]
+    /// PE scheduler of each step's accelerator: the list scheduler (host, per step, as
+    /// `hls gen`) or the GA (offline sizing).
+    #[arg(long, value_enum, default_value_t = ScheduleArg::List)]
     pub schedule: ScheduleArg,
     /// GA seed (echoed into the outputs).
     #[arg(long, default_value_t = 1)]
@@ -94,7 +95,8 @@ pub struct StudyLivingRoomArgs {
     /// GA generations after the initial population (hls gen uses 12).
     #[arg(long, default_value_t = 2)]
     pub ga_generations: u32,
-    /// Total PE instances per step (default: planes used + 25 % for duplicates).
+    /// Total PE instances per step: with the GA, default planes used + 25 % for duplicates;
+    /// with the list scheduler, extra PEs become copies of the busiest planes (default none).
     #[arg(long)]
     pub pe_budget: Option<u32>,
     /// Fixed-point convergence threshold on a round's largest displacement, in 1/256 mm.
@@ -103,6 +105,10 @@ pub struct StudyLivingRoomArgs {
     /// Round cap of the fixed-point IPC.
     #[arg(long, default_value_t = 256)]
     pub max_rounds: u32,
+    /// Start every step's accelerator run from the beam tree's window centres instead of the
+    /// points the previous step converged to.
+    #[arg(long)]
+    pub cold_start: bool,
 }
 
 /// The budgets both studies check before any work.
@@ -828,7 +834,8 @@ pub struct HlsGenArgs {
     /// Scheduler of each step: the list scheduler (host, per step) or the GA (offline sizing).
     #[arg(long, value_enum, default_value_t = ScheduleArg::List)]
     pub schedule: ScheduleArg,
-    /// Total PE instances allowed (default: planes + 25 % for duplicates).
+    /// Total PE instances per step: with the GA, default planes used + 25 % for duplicates;
+    /// with the list scheduler, extra PEs become copies of the busiest planes (default none).
     #[arg(long)]
     pub pe_budget: Option<u32>,
     /// GA seed.
@@ -840,6 +847,14 @@ pub struct HlsGenArgs {
     /// Round cap of the fixed-point IPC.
     #[arg(long, default_value_t = 256)]
     pub max_rounds: u32,
+    /// M9K blocks the point and schedule memories may take (default: the EP4CE115's 432);
+    /// a design that needs more is refused.
+    #[arg(long, default_value_t = bt_hls::EP4CE115_M9K_BLOCKS)]
+    pub m9k_budget: u32,
+    /// With --steps: start every step from the beam tree's window centres instead of the
+    /// points the previous step converged to.
+    #[arg(long)]
+    pub cold_start: bool,
     /// Model and schedule only (cycle counts, errors): skip writing RTL (for large scenes).
     #[arg(long)]
     pub plan_only: bool,

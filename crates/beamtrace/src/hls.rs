@@ -4,14 +4,12 @@
 use crate::args::{HlsArgs, HlsCommand, HlsGenArgs};
 use anyhow::{Context, bail};
 use bt_hls::{OutputDir, PlanOptions};
-use bt_paths::AllVisible;
 use bt_scene::Scene;
-use bt_schedule::{GaParams, Problem};
+use bt_schedule::GaParams;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use std::path::Path;
 use std::process::ExitCode;
-use std::time::Instant;
 
 /// Clock of the paper's platform (Cyclone IV E at 50 MHz), Hz.
 pub const CLOCK_HZ: f64 = bt_study::living_room::CLOCK_HZ;
@@ -104,6 +102,9 @@ pub struct HlsSummary {
     pub points: usize,
     /// Candidates through a moving surface, solved by the host (image method).
     pub host_paths: usize,
+    /// Paths started from the points they converged to at the previous step (`--steps`
+    /// without `--cold-start`).
+    pub warm_started: usize,
     pub schedule: &'static str,
     pub seed: u64,
     pub pe_budget: u32,
@@ -111,7 +112,8 @@ pub struct HlsSummary {
     pub list_makespan: u32,
     /// PE instances of the platform (the one design all steps run on).
     pub platform_instances: u32,
-    pub cycles_per_slot: u64,
+    /// Mean cycles of a slot (`2·(jobs + 2) + PE_LATENCY` per slot; idle PEs cost nothing).
+    pub mean_cycles_per_slot: f64,
     pub predicted_cycles: u64,
     pub latency_s_at_50mhz: f64,
     /// Host work per step, seconds: candidates, accelerator input and the PE schedule.
@@ -119,96 +121,8 @@ pub struct HlsSummary {
     /// Seconds the host spends running the fixed-point model to size each path's round
     /// budget (not yet replaced by a fixed budget; see docs/hardware.md).
     pub budget_model_time_s: f64,
-    pub fixed_vs_f64: FixedDeviation,
+    pub fixed_vs_f64: bt_accel::FixedDeviation,
     pub rtl_written: bool,
-}
-
-/// Fixed-point model vs the f64 reference (image method over every candidate of the order).
-#[derive(Debug, Serialize, Default)]
-pub struct FixedDeviation {
-    pub valid_paths_compared: usize,
-    pub max_point_error_mm: f64,
-    pub mean_point_error_mm: f64,
-    pub max_angle_error_tx_deg: f64,
-    pub max_angle_error_rx_deg: f64,
-    /// Valid paths (in f64) the fixed-point model does not converge on.
-    pub not_converged: usize,
-    /// Exact paths lost: not among the accelerator's candidates (and not the host's), or
-    /// rejected by the host check (`bt_study::fpga::host_accepts`).
-    pub missed: usize,
-    /// Exact paths through a moving surface, solved by the host.
-    pub host_solved: usize,
-    /// Candidates frozen by early stopping.
-    pub left_bounds: usize,
-    /// Converged, f64-valid results rejected by the reflection-law check.
-    pub reflection_rejected: usize,
-    /// Results the host accepts that are no path of the image method (false convergences).
-    pub spurious: usize,
-}
-
-fn fixed_deviation(
-    scene: &Scene,
-    step: &bt_study::fpga::StepInput,
-    results: &[bt_hls::PathResult],
-    max_order: usize,
-) -> FixedDeviation {
-    let candidates = bt_paths::enumerate(scene, max_order, &AllVisible);
-    let reference = bt_solve::trace(scene, &candidates, &bt_solve::Solver::Image, true);
-    let mut err = FixedDeviation {
-        left_bounds: results.iter().filter(|r| r.left_bounds).count(),
-        ..FixedDeviation::default()
-    };
-    for (seq, r) in step.sequences.iter().zip(results) {
-        match bt_study::fpga::host_accepts(scene, seq, r) {
-            Ok(_) => {
-                if !reference.paths.iter().any(|p| p.surfaces == *seq) {
-                    err.spurious += 1;
-                }
-            }
-            Err(bt_study::fpga::HostRejection::ReflectionLaw) => err.reflection_rejected += 1,
-            Err(_) => {}
-        }
-    }
-    let mut sum = 0.0;
-    let mut count = 0usize;
-    // Line of sight (no surface) needs no accelerator: the host adds it.
-    for path in reference.paths.iter().filter(|p| !p.surfaces.is_empty()) {
-        if step.host_sequences.contains(&path.surfaces) {
-            err.host_solved += 1;
-            continue;
-        }
-        let Some(k) = step.sequences.iter().position(|s| *s == path.surfaces) else {
-            err.missed += 1;
-            continue;
-        };
-        let r = &results[k];
-        if !r.converged {
-            err.not_converged += 1;
-        }
-        if bt_study::fpga::host_accepts(scene, &step.sequences[k], r).is_err() {
-            err.missed += 1;
-        }
-        err.valid_paths_compared += 1;
-        for (q, p) in r.points_m.iter().zip(&path.points) {
-            let d = (glam::DVec3::from_array(*q) - *p).length() * 1e3;
-            err.max_point_error_mm = err.max_point_error_mm.max(d);
-            sum += d;
-            count += 1;
-        }
-        let angle = |a: glam::DVec3, b: glam::DVec3| a.angle_between(b).to_degrees();
-        let (tx, rx) = (scene.tx(), scene.rx());
-        let first = glam::DVec3::from_array(r.points_m[0]);
-        let last = glam::DVec3::from_array(*r.points_m.last().expect("order >= 1"));
-        err.max_angle_error_tx_deg = err
-            .max_angle_error_tx_deg
-            .max(angle(first - tx, path.points[0] - tx));
-        err.max_angle_error_rx_deg = err.max_angle_error_rx_deg.max(angle(
-            last - rx,
-            *path.points.last().expect("order >= 1") - rx,
-        ));
-    }
-    err.mean_point_error_mm = if count > 0 { sum / count as f64 } else { 0.0 };
-    err
 }
 
 fn generate(args: &HlsGenArgs) -> anyhow::Result<ExitCode> {
@@ -224,19 +138,21 @@ fn generate(args: &HlsGenArgs) -> anyhow::Result<ExitCode> {
     let mut out = OutputDir::begin(&args.output, &crate::inputs(&args.scene))
         .with_context(|| format!("creating {}", args.output.display()))?;
     // The platform: one PE per reflector that no step moves.
-    let planes = bt_study::fpga::static_reflectors(&scenes);
-    let mut planned = Vec::with_capacity(scenes.len());
+    let planes = bt_accel::static_reflectors(&scenes);
+    let options = step_options(args);
+    let mut planned: Vec<bt_accel::PlannedStep> = Vec::with_capacity(scenes.len());
     for (k, scene) in scenes.iter().enumerate() {
-        planned.push(plan_step(scene, &planes, args, args.steps.then_some(k))?);
+        let bar = crate::progress::spinner(&format!("planning step {k} of {}", scenes.len()));
+        let step = bt_accel::plan_step(scene, &planes, k, &options, planned.last())
+            .with_context(|| args.scene.scene.clone())?;
+        bar.finish_and_clear();
+        planned.push(step);
     }
-    let work: Vec<bt_hls::StepWork> = planned
-        .iter()
-        .map(|p| bt_hls::StepWork {
-            input: p.step.input.clone(),
-            schedule: p.plan.schedule.clone(),
-        })
-        .collect();
-    let platform = bt_hls::Platform::fitting(&work)?;
+    let work: Vec<bt_hls::StepWork> = planned.iter().map(bt_accel::PlannedStep::work).collect();
+    let platform = bt_hls::Platform {
+        m9k_budget: args.m9k_budget,
+        ..bt_hls::Platform::fitting(&work)?
+    };
     let k = platform.instances.len() as u32;
     let rtl_written = !args.plan_only;
     if rtl_written {
@@ -246,7 +162,7 @@ fn generate(args: &HlsGenArgs) -> anyhow::Result<ExitCode> {
     let summaries: Vec<HlsSummary> = scenes
         .iter()
         .zip(planned)
-        .map(|(scene, p)| p.summary(scene, args, k, rtl_written))
+        .map(|(scene, p)| summary(p, scene, args, k, rtl_written))
         .collect();
     if args.steps {
         let doc = report_steps(args, summaries, &mut out)?;
@@ -270,81 +186,51 @@ fn generate(args: &HlsGenArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// One step planned on the host: candidates, accelerator input, model results, schedule.
-struct PlannedStep {
-    step: bt_study::fpga::StepInput,
-    plan: bt_hls::Plan,
-    fixed: FixedDeviation,
-    host_time_s: f64,
-    budget_model_time_s: f64,
-    index: Option<usize>,
-}
-
-impl PlannedStep {
-    fn summary(self, scene: &Scene, args: &HlsGenArgs, k: u32, rtl_written: bool) -> HlsSummary {
-        let cycles = bt_hls::run_cycles(k, self.plan.stats.makespan);
-        HlsSummary {
-            scene: scene.name().to_string(),
-            step: self.index,
-            max_order: args.max_order,
-            planes: self.step.input.planes.len(),
-            paths: self.step.input.paths.len(),
-            points: self.plan.points as usize,
-            host_paths: self.step.host_sequences.len(),
-            schedule: args.schedule.kind().name(),
-            seed: args.seed,
-            pe_budget: self.plan.pe_budget,
-            list_makespan: self.plan.list_makespan,
-            stats: self.plan.stats,
-            platform_instances: k,
-            cycles_per_slot: bt_hls::cycles_per_slot(k),
-            predicted_cycles: cycles,
-            latency_s_at_50mhz: cycles as f64 / CLOCK_HZ,
-            host_time_s: self.host_time_s,
-            budget_model_time_s: self.budget_model_time_s,
-            fixed_vs_f64: self.fixed,
-            rtl_written,
-        }
-    }
-}
-
-fn plan_step(
+/// `hls gen`'s per-step report from a planned step on a platform of `k` PEs.
+fn summary(
+    p: bt_accel::PlannedStep,
     scene: &Scene,
-    planes: &[bt_scene::SurfaceId],
     args: &HlsGenArgs,
-    index: Option<usize>,
-) -> anyhow::Result<PlannedStep> {
-    let t0 = Instant::now();
-    let options = bt_solve::pipeline::TraceOptions {
-        candidates: args.candidates.mode(),
-        parallel: false,
-        ..bt_solve::pipeline::TraceOptions::new(args.max_order)
-    };
-    let candidates = bt_solve::pipeline::candidates(scene, &options)?;
-    let step = bt_study::fpga::step_input(
-        scene,
-        planes,
-        &candidates,
-        args.threshold_lsb,
-        args.max_rounds,
-    );
-    let t1 = Instant::now();
-    if step.input.paths.is_empty() {
-        let at = index.map(|k| format!(" step {k}")).unwrap_or_default();
-        bail!(
-            "{}{at}: no candidate reflection path over static planes up to order {}",
-            args.scene.scene,
-            args.max_order
-        );
+    k: u32,
+    rtl_written: bool,
+) -> HlsSummary {
+    let cycles = p.plan.predicted_cycles;
+    HlsSummary {
+        scene: scene.name().to_string(),
+        step: args.steps.then_some(p.index),
+        max_order: args.max_order,
+        planes: p.step.input.planes.len(),
+        paths: p.step.input.paths.len(),
+        points: p.plan.points as usize,
+        host_paths: p.step.host_sequences.len(),
+        warm_started: p.warm_started,
+        schedule: args.schedule.kind().name(),
+        seed: args.seed,
+        pe_budget: p.plan.pe_budget,
+        list_makespan: p.plan.list_makespan,
+        stats: p.plan.stats,
+        platform_instances: k,
+        mean_cycles_per_slot: p.plan.mean_cycles_per_slot,
+        predicted_cycles: cycles,
+        latency_s_at_50mhz: cycles as f64 / CLOCK_HZ,
+        host_time_s: p.host_time_s,
+        budget_model_time_s: p.budget_model_time_s,
+        fixed_vs_f64: p.fixed,
+        rtl_written,
     }
-    let model = step.input.model()?;
-    let results = model.run(step.input.tx, step.input.rx)?;
-    let problem: Problem = step.input.problem_for(&results);
-    let t2 = Instant::now();
-    let bar = crate::progress::spinner(&format!("scheduling {} paths", step.input.paths.len()));
-    let plan = bt_hls::plan(
-        &problem,
-        &PlanOptions {
+}
+
+/// How `hls gen` plans each step.
+fn step_options(args: &HlsGenArgs) -> bt_accel::StepOptions {
+    bt_accel::StepOptions {
+        trace: bt_solve::pipeline::TraceOptions {
+            candidates: args.candidates.mode(),
+            max_candidates: args.max_candidates,
+            ..bt_solve::pipeline::TraceOptions::new(args.max_order)
+        },
+        threshold_lsb: args.threshold_lsb,
+        max_rounds: args.max_rounds,
+        plan: PlanOptions {
             schedule: args.schedule.kind(),
             pe_budget: args.pe_budget,
             ga: GaParams {
@@ -352,18 +238,8 @@ fn plan_step(
                 ..GaParams::default()
             },
         },
-    )?;
-    bar.finish_and_clear();
-    let t3 = Instant::now();
-    let fixed = fixed_deviation(scene, &step, &results, args.max_order);
-    Ok(PlannedStep {
-        step,
-        plan,
-        fixed,
-        host_time_s: ((t1 - t0) + (t3 - t2)).as_secs_f64(),
-        budget_model_time_s: (t2 - t1).as_secs_f64(),
-        index,
-    })
+        warm_start: !args.cold_start,
+    }
 }
 
 /// `hls gen --steps`: the per-step table, `DIR/steps.json` and `DIR/step-<k>/` (schedule and
@@ -474,9 +350,9 @@ fn print_summary(s: &HlsSummary, dir: &Path) {
         100.0 * s.stats.utilisation
     );
     println!(
-        "cycles per run {} ({} per slot, {} PEs on the platform) = {:.3} ms at 50 MHz; host {:.3} ms (+ {:.3} ms model run for the round budgets)",
+        "cycles per run {} ({:.1} per slot, {} PEs on the platform) = {:.3} ms at 50 MHz; host {:.3} ms (+ {:.3} ms model run for the round budgets)",
         s.predicted_cycles,
-        s.cycles_per_slot,
+        s.mean_cycles_per_slot,
         s.platform_instances,
         s.latency_s_at_50mhz * 1e3,
         s.host_time_s * 1e3,

@@ -69,6 +69,7 @@ pub fn run_living_room(args: &StudyLivingRoomArgs) -> anyhow::Result<ExitCode> {
         ga_population: args.ga_population,
         ga_generations: args.ga_generations,
         pe_budget: args.pe_budget,
+        warm_start: !args.cold_start,
     };
     let problems = config.problems();
     if !problems.is_empty() {

@@ -162,6 +162,24 @@ fn study_living_room_writes_consistent_csv_and_figures() {
 
     let fpga = std::fs::read_to_string(out.join("fpga.csv")).expect("fpga.csv");
     assert_eq!(fpga.lines().count(), 1 + 2, "{fpga}");
+    // Per-step latency on the one platform, every exact path found (against the exhaustive
+    // image method), and the second step warm-started from the first.
+    let fpga_header: Vec<&str> = fpga.lines().next().unwrap().split(',').collect();
+    let fcol = |name: &str| fpga_header.iter().position(|h| *h == name).expect(name);
+    for (k, line) in fpga.lines().skip(1).enumerate() {
+        let f: Vec<&str> = line.split(',').collect();
+        let cycles: f64 = f[fcol("cycles")].parse().unwrap();
+        let latency: f64 = f[fcol("latency_s")].parse().unwrap();
+        assert!((latency - cycles / 50e6).abs() <= 1e-12, "{line}");
+        assert_eq!(f[fcol("missed")], "0", "{line}");
+        assert_eq!(f[fcol("spurious")], "0", "{line}");
+        assert!(
+            f[fcol("host_time_s")].parse::<f64>().unwrap() > 0.0,
+            "{line}"
+        );
+        let warm: usize = f[fcol("warm_started")].parse().unwrap();
+        assert_eq!(warm > 0, k > 0, "{line}");
+    }
     let summary = std::fs::read_to_string(out.join("summary.md")).expect("summary.md");
     assert!(
         summary.contains("The paper's conclusions, measured"),

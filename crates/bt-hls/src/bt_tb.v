@@ -6,16 +6,18 @@
 //   T <n>             clock edges used by the whole program
 //   E <text>          protocol error
 // and prints "P <n>" on stdout after the n-th run (progress).
-// Lint: a behavioural testbench (blocking clock toggle, 32-bit program words of which the
-// address uses 16 bits); the generated RTL itself carries no lint pragma.
+// Lint: a behavioural testbench (blocking clock toggle; the 32-bit address register drives
+// bt_top's narrower avs_address, whose width depends on the design); the generated RTL
+// itself carries no lint pragma.
 // verilator lint_off BLKSEQ
 // verilator lint_off UNUSEDSIGNAL
+// verilator lint_off WIDTH
 `timescale 1ns / 1ps
 `default_nettype none
 module bt_tb;
   reg clk = 1'b0;
   reg rst_n = 1'b0;
-  reg [15:0] address = 16'd0;
+  reg [31:0] address = 32'd0;
   reg read = 1'b0;
   reg write = 1'b0;
   reg [31:0] writedata = 32'd0;
@@ -67,13 +69,13 @@ module bt_tb;
     while (op != 32'd0) begin
       arg_a = prog[pc + 1];
       if (op == 32'd1) begin
-        address = arg_a[15:0];
+        address = arg_a;
         writedata = prog[pc + 2];
         write = 1'b1;
         tick;
         write = 1'b0;
       end else if (op == 32'd2) begin
-        address = arg_a[15:0];
+        address = arg_a;
         read = 1'b1;
         tick;
         read = 1'b0;
@@ -81,7 +83,7 @@ module bt_tb;
         if (!readdatavalid) $fwrite(fd, "E readdatavalid low for %h\n", address);
         $fwrite(fd, "R %h %h\n", address, readdata);
       end else if (op == 32'd3) begin
-        address = arg_a[15:0];
+        address = arg_a;
         writedata = prog[pc + 2];
         write = 1'b1;
         tick;

@@ -116,8 +116,33 @@ impl HlsInput {
 /// so no output cycle.
 pub const PE_LATENCY: u32 = 5 + PROPORTION_ITERATIONS;
 
-/// Largest word address the 16-bit Avalon address port can reach.
-pub const ADDRESS_BITS: u32 = 16;
+/// Narrowest Avalon word address of a design, bits: the control, status, point and schedule
+/// regions of [`Layout::of`] take what they need above it (the port is
+/// `avs_address[address_bits-1:0]`, at least 16 bits).
+pub const MIN_ADDRESS_BITS: u32 = 16;
+
+/// Widest Avalon word address, bits (the testbench's program words are 32 bits).
+pub const MAX_ADDRESS_BITS: u32 = 30;
+
+/// M9K blocks of the EP4CE115 (the paper's Cyclone IV E), 9,216 bits each.
+pub const EP4CE115_M9K_BLOCKS: u32 = 432;
+
+/// M9K blocks a simple dual-port RAM of `depth` words of `width` bits takes: the best of the
+/// block's shapes (8K x 1, 4K x 2, 2K x 4, 1K x 9, 512 x 18, 256 x 36), as `bt_m9k.txt` maps them.
+pub fn m9k_blocks(depth: u64, width: u64) -> u64 {
+    [
+        (8192, 1),
+        (4096, 2),
+        (2048, 4),
+        (1024, 9),
+        (512, 18),
+        (256, 36),
+    ]
+    .iter()
+    .map(|&(d, w)| depth.div_ceil(d) * width.div_ceil(w))
+    .min()
+    .unwrap_or(0)
+}
 
 /// `ceil(log2(n))`, at least 1.
 pub(crate) fn bits_for(n: u64) -> u32 {
@@ -134,6 +159,10 @@ pub struct Capacity {
     pub points: u32,
     /// Schedule slots per run (the makespan).
     pub slots: u32,
+    /// Schedule-memory entries per run: the jobs, packed slot after slot (an empty slot takes
+    /// one entry), [`crate::schedule_entries`].
+    #[serde(default)]
+    pub entries: u32,
 }
 
 /// The accelerator as synthesised once per static room: one PE per plane (plus duplicates)
@@ -152,6 +181,14 @@ pub struct Platform {
     pub instances: Vec<PeInstance>,
     /// RAM sizes.
     pub capacity: Capacity,
+    /// M9K blocks the RAMs may take (point memory copies and schedule memory); a design that
+    /// needs more is refused. Default: the EP4CE115's [`EP4CE115_M9K_BLOCKS`].
+    #[serde(default = "default_m9k_budget")]
+    pub m9k_budget: u32,
+}
+
+fn default_m9k_budget() -> u32 {
+    EP4CE115_M9K_BLOCKS
 }
 
 /// One accelerator run's work as the host loads it: candidates, start points, TX/RX (the
@@ -180,6 +217,7 @@ impl Platform {
             paths: 1,
             points: 1,
             slots: 1,
+            entries: 1,
         };
         for w in work {
             for inst in &w.schedule.instances {
@@ -191,6 +229,9 @@ impl Platform {
             capacity.paths = capacity.paths.max(w.input.paths.len() as u32);
             capacity.points = capacity.points.max(points as u32);
             capacity.slots = capacity.slots.max(w.schedule.makespan());
+            capacity.entries = capacity
+                .entries
+                .max(crate::plan::schedule_entries(&w.schedule));
         }
         let instances = copies
             .iter()
@@ -208,6 +249,7 @@ impl Platform {
             early_stop: first.input.early_stop,
             instances,
             capacity,
+            m9k_budget: EP4CE115_M9K_BLOCKS,
         })
     }
 }
@@ -240,6 +282,8 @@ pub(crate) struct Design {
     pub path_bits: u32,
     pub point_bits: u32,
     pub inst_bits: u32,
+    /// Width of `avs_address`, bits.
+    pub address_bits: u32,
     /// Word address of the first path status, of the first point word, of the first
     /// schedule entry.
     pub status_base: u32,
@@ -255,6 +299,10 @@ pub(crate) struct Layout {
     pub point_bits: u32,
     pub inst_bits: u32,
     pub slot_bits: u32,
+    /// Bits of a schedule-memory entry index.
+    pub entry_bits: u32,
+    /// Width of `avs_address`, bits.
+    pub address_bits: u32,
     pub status_base: u32,
     pub point_base: u32,
     pub sched_base: u32,
@@ -263,7 +311,8 @@ pub(crate) struct Layout {
 impl Layout {
     /// Regions: status `[2^s, 2^(s+1))` with `s = max(4, path bits)`, points
     /// `[2^q, 2^(q+1))` (8 words per point: 2 banks of 4) with `q > s`, schedule
-    /// `[2^r, 2^(r+1))` with `r > q`; all below 2^16.
+    /// `[2^r, 2^(r+1))` with `r > q`; the address is `max(16, r + 1)` bits. Refused: more than
+    /// [`MAX_ADDRESS_BITS`], or RAMs over the platform's M9K budget.
     pub fn of(platform: &Platform) -> Result<Layout, HlsError> {
         let cap = platform.capacity;
         let num_instances = platform.instances.len() as u32;
@@ -273,15 +322,28 @@ impl Layout {
         let slot_bits = bits_for(cap.slots.into());
         let status_bits = path_bits.max(4);
         let point_region_bits = (point_bits + 3).max(status_bits + 1);
-        let sched_region_bits = (slot_bits + inst_bits).max(point_region_bits + 1);
-        if sched_region_bits + 1 > ADDRESS_BITS {
+        let entry_bits = bits_for(cap.entries.max(1).into());
+        let sched_region_bits = entry_bits.max(point_region_bits + 1);
+        let address_bits = (sched_region_bits + 1).max(MIN_ADDRESS_BITS);
+        if address_bits > MAX_ADDRESS_BITS {
             return Err(HlsError::TooLarge(format!(
-                "{} paths, {} points and {} slots x {} PEs need more than {ADDRESS_BITS} address bits: \
-                 lower --max-order or use fewer reflectors",
-                cap.paths, cap.points, cap.slots, num_instances
+                "{} paths, {} points and {} schedule entries need {address_bits} address bits, \
+                 more than {MAX_ADDRESS_BITS}: lower --max-order or use fewer reflectors",
+                cap.paths, cap.points, cap.entries
             )));
         }
-        if sched_entry_bits(path_bits, point_bits) > 32 {
+        let sw = sched_entry_bits(path_bits, point_bits, inst_bits);
+        let blocks = 2 * m9k_blocks(1 << (point_bits + 1), crate::pe::POINT_BITS.into())
+            + m9k_blocks(1 << entry_bits, sw.into());
+        if blocks > platform.m9k_budget.into() {
+            return Err(HlsError::TooLarge(format!(
+                "{} paths, {} points and {} schedule entries ({} slots, {} PEs) need {blocks} M9K \
+                 blocks for the point and schedule memories, more than the budget of {}: lower \
+                 --max-order or use fewer reflectors",
+                cap.paths, cap.points, cap.entries, cap.slots, num_instances, platform.m9k_budget
+            )));
+        }
+        if sw > 32 {
             return Err(HlsError::TooLarge(format!(
                 "a schedule entry for {} paths and {} points exceeds one 32-bit word",
                 cap.paths, cap.points
@@ -298,6 +360,8 @@ impl Layout {
             point_bits,
             inst_bits,
             slot_bits,
+            entry_bits,
+            address_bits,
             status_base: 1 << status_bits,
             point_base: 1 << point_region_bits,
             sched_base: 1 << sched_region_bits,
@@ -305,9 +369,10 @@ impl Layout {
     }
 }
 
-/// Schedule-entry fields: `{end, last, first, point, path, valid}` from bit 0 up.
-pub(crate) fn sched_entry_bits(path_bits: u32, point_bits: u32) -> u32 {
-    4 + path_bits + point_bits
+/// Schedule-entry fields: `{column, tail, end, last, first, point, path, valid}` from bit 0
+/// up (`tail` marks a slot's last entry, `column` the PE).
+pub(crate) fn sched_entry_bits(path_bits: u32, point_bits: u32, inst_bits: u32) -> u32 {
+    5 + path_bits + point_bits + inst_bits
 }
 
 impl Design {
@@ -346,15 +411,11 @@ impl Design {
             path_bits: l.path_bits,
             point_bits: l.point_bits,
             inst_bits: l.inst_bits,
+            address_bits: l.address_bits,
             status_base: l.status_base,
             point_base: l.point_base,
             sched_base: l.sched_base,
         })
-    }
-
-    /// Cycles of one schedule slot.
-    pub fn cycles_per_slot(&self) -> u32 {
-        crate::plan::cycles_per_slot(self.num_instances) as u32
     }
 }
 
@@ -453,11 +514,17 @@ fn step_design(platform: &Platform, k: usize, w: &StepWork) -> Result<StepDesign
     }
     let num_paths = input.paths.len() as u32;
     let cap = platform.capacity;
-    if num_paths > cap.paths || num_points > cap.points || makespan > cap.slots {
+    let entries = crate::plan::schedule_entries(schedule);
+    if num_paths > cap.paths
+        || num_points > cap.points
+        || makespan > cap.slots
+        || entries > cap.entries
+    {
         return Err(HlsError::TooLarge(format!(
-            "step {k}: {num_paths} paths, {num_points} points, {makespan} slots exceed the \
-             platform's capacity of {} paths, {} points, {} slots",
-            cap.paths, cap.points, cap.slots
+            "step {k}: {num_paths} paths, {num_points} points, {makespan} slots, {entries} \
+             schedule entries exceed the platform's capacity of {} paths, {} points, {} slots, \
+             {} entries",
+            cap.paths, cap.points, cap.slots, cap.entries
         )));
     }
     Ok(StepDesign {
@@ -470,4 +537,67 @@ fn step_design(platform: &Platform, k: usize, w: &StepWork) -> Result<StepDesign
         makespan,
         columns,
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn platform(paths: u32, points: u32, entries: u32, pes: u32, m9k_budget: u32) -> Platform {
+        Platform {
+            planes: vec![PlaneSpec {
+                name: "floor".into(),
+                normal: [0.0, 0.0, 1.0],
+                offset_m: 0.0,
+                bounds_m: None,
+            }],
+            threshold_lsb: 16,
+            early_stop: None,
+            instances: (0..pes).map(|copy| PeInstance { plane: 0, copy }).collect(),
+            capacity: Capacity {
+                paths,
+                points,
+                slots: 2342,
+                entries,
+            },
+            m9k_budget,
+        }
+    }
+
+    #[test]
+    fn m9k_blocks_take_the_best_shape() {
+        // 64 K x 19 bits: 8 blocks deep x 19 wide (8K x 1) beats 16 x 10 (4K x 2).
+        assert_eq!(m9k_blocks(65_536, 19), 152);
+        // 512 x 120 bits: 512 x 18 shape, 7 blocks wide.
+        assert_eq!(m9k_blocks(512, 120), 7);
+        assert_eq!(m9k_blocks(1, 1), 1);
+    }
+
+    #[test]
+    fn the_address_widens_with_the_schedule_memory() {
+        // The living room at order 3: 104 paths, 270 points, ~12,000 packed schedule entries
+        // (2^14): the schedule region 2^14 fits the 16-bit minimum.
+        let l = Layout::of(&platform(104, 270, 12_000, 25, EP4CE115_M9K_BLOCKS)).unwrap();
+        assert_eq!((l.sched_base, l.address_bits), (1 << 14, MIN_ADDRESS_BITS));
+        // 70,000 entries (2^17) need 18 address bits instead of a refusal.
+        let l = Layout::of(&platform(104, 270, 70_000, 25, EP4CE115_M9K_BLOCKS)).unwrap();
+        assert_eq!((l.sched_base, l.address_bits), (1 << 17, 18));
+    }
+
+    #[test]
+    fn memories_over_the_m9k_budget_are_refused_with_the_numbers() {
+        // Point memories 2 x 1 K x 120 bits (two banks of 270 points; 14 blocks each),
+        // schedule 256 K x 26 bits ({column 5, tail, end, last, first, point 9, path 7,
+        // valid}; 1K x 9 shape: 256 x 3 = 768 blocks): 796 blocks, over the EP4CE115's 432.
+        let e = Layout::of(&platform(104, 270, 200_000, 25, EP4CE115_M9K_BLOCKS)).unwrap_err();
+        let text = e.to_string();
+        assert!(matches!(e, HlsError::TooLarge(_)), "{text}");
+        assert!(
+            text.contains("796 M9K blocks") && text.contains("budget of 432"),
+            "{text}"
+        );
+        // The order-3 room itself: 2 x 14 + 16K x 26 (1K x 9 shape: 16 x 3 = 48) = 76 blocks.
+        let e = Layout::of(&platform(104, 270, 12_000, 25, 75)).unwrap_err();
+        assert!(e.to_string().contains("76 M9K blocks"), "{e}");
+    }
 }

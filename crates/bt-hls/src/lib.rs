@@ -32,9 +32,10 @@ use bt_schedule::Schedule;
 
 pub use bt_fixed::{BoundsM, EarlyStop, FixedOutcome, PathResult};
 pub use error::HlsError;
-pub use input::{ADDRESS_BITS, Capacity, HlsInput, PE_LATENCY, PlaneSpec, Platform, StepWork};
+pub use input::{Capacity, EP4CE115_M9K_BLOCKS, MAX_ADDRESS_BITS, MIN_ADDRESS_BITS, m9k_blocks};
+pub use input::{HlsInput, PE_LATENCY, PlaneSpec, Platform, StepWork};
 pub use pe::{POINT_BITS, pe_module_name};
-pub use plan::{Plan, PlanOptions, ScheduleKind, cycles_per_slot, plan, run_cycles};
+pub use plan::{Plan, PlanOptions, ScheduleKind, plan, run_cycles, schedule_entries, slot_cycles};
 pub use tools::{
     LintReport, SimProgress, SimReport, Simulator, SynthReport, lint, simulate, simulate_with,
     synthesize,
@@ -73,10 +74,8 @@ pub struct Report {
     pub capacity: Capacity,
     /// Schedule makespan of each step, slots.
     pub makespans: Vec<u32>,
-    /// Cycles per slot: `2·(instances + 2) + PE_LATENCY`.
-    pub cycles_per_slot: u32,
     /// Predicted `CYCLES` register value of every run (steps in order, each step's vectors in
-    /// order): `makespan · cycles_per_slot`.
+    /// order): the sum over the step's slots of `2·(jobs + 2) + PE_LATENCY`.
     pub run_cycles: Vec<u64>,
     /// Predicted testbench clock edges for the whole bus program (1 per write, 2 per read,
     /// 1 + CYCLES per start).
@@ -148,39 +147,58 @@ fn point_addr(d: &Design, g: u32, bank: u32, word: u32) -> u32 {
     d.point_base + 8 * g + 4 * bank + word
 }
 
-/// The schedule-memory writes of one step: every entry of slots `0..makespan`, every column
-/// (empty entries are written as 0, so nothing of an earlier step survives), then `SLOTS`.
+/// The schedule-memory writes of one step: slot after slot (`0..makespan`) its jobs in
+/// ascending PE column, packed from entry 0, each slot's last flagged `tail` (an empty slot
+/// gets one invalid tail entry), then `SLOTS`. Entries after a slot's tail are never read, so nothing of an earlier
+/// step needs clearing.
 fn schedule_writes(d: &Design, s: &StepDesign, ops: &mut Vec<BusOp>) {
-    let (pb, ptb, ib) = (d.path_bits, d.point_bits, d.inst_bits);
-    let k = d.num_instances as usize;
+    let (pb, ptb) = (d.path_bits, d.point_bits);
+    // Each slot's jobs in write-back order (ascending column).
+    let rows: Vec<Vec<(u32, bt_schedule::Job)>> = s.schedule.slots[..s.makespan as usize]
+        .iter()
+        .map(|row| {
+            let mut jobs: Vec<(u32, bt_schedule::Job)> = row
+                .iter()
+                .enumerate()
+                .filter_map(|(i, job)| job.map(|j| (s.columns[i], j)))
+                .collect();
+            jobs.sort_by_key(|&(col, _)| col);
+            jobs
+        })
+        .collect();
     let mut last_of_round = std::collections::BTreeMap::new();
-    for (t, row) in s.schedule.slots.iter().enumerate() {
-        for (i, job) in row.iter().enumerate() {
-            if let Some(job) = job {
-                last_of_round.insert((job.path, job.round), (t, s.columns[i]));
-            }
+    for (t, jobs) in rows.iter().enumerate() {
+        for (e, (_, job)) in jobs.iter().enumerate() {
+            last_of_round.insert((job.path, job.round), (t, e));
         }
     }
-    for t in 0..s.makespan as usize {
-        let mut row = vec![0u32; k];
-        for (i, job) in s.schedule.slots[t].iter().enumerate() {
-            let Some(job) = job else { continue };
-            let col = s.columns[i];
-            let n = s.input.paths[job.path as usize].len() as u32;
-            let point = s.first_point[job.path as usize] + job.point;
-            let end = last_of_round[&(job.path, job.round)] == (t, col);
-            row[col as usize] = 1
-                | job.path << 1
-                | point << (1 + pb)
-                | u32::from(job.point == 0) << (1 + pb + ptb)
-                | u32::from(job.point + 1 == n) << (2 + pb + ptb)
-                | u32::from(end) << (3 + pb + ptb);
+    let tail_bit = 1u32 << (4 + pb + ptb);
+    let mut entry = 0u32;
+    for (t, jobs) in rows.iter().enumerate() {
+        let mut words: Vec<u32> = jobs
+            .iter()
+            .enumerate()
+            .map(|(e, &(col, job))| {
+                let n = s.input.paths[job.path as usize].len() as u32;
+                let point = s.first_point[job.path as usize] + job.point;
+                let end = last_of_round[&(job.path, job.round)] == (t, e);
+                1 | job.path << 1
+                    | point << (1 + pb)
+                    | u32::from(job.point == 0) << (1 + pb + ptb)
+                    | u32::from(job.point + 1 == n) << (2 + pb + ptb)
+                    | u32::from(end) << (3 + pb + ptb)
+                    | col << (5 + pb + ptb)
+            })
+            .collect();
+        if words.is_empty() {
+            words.push(0);
         }
-        for (col, word) in row.into_iter().enumerate() {
-            ops.push(BusOp::Write(
-                d.sched_base + ((t as u32) << ib) + col as u32,
-                word,
-            ));
+        if let Some(last) = words.last_mut() {
+            *last |= tail_bit;
+        }
+        for word in words {
+            ops.push(BusOp::Write(d.sched_base + entry, word));
+            entry += 1;
         }
     }
     ops.push(BusOp::Write(regs::SLOTS, s.makespan));
@@ -213,7 +231,7 @@ fn run_ops(
     for (k, c) in rx.iter().enumerate() {
         ops.push(BusOp::Write(regs::RX + k as u32, c.0 as u32));
     }
-    let cycles = crate::plan::run_cycles(d.num_instances, s.makespan);
+    let cycles = crate::plan::run_cycles(&s.schedule);
     ops.push(BusOp::Start(cycles));
     let paths = s.model.run_fixed(tx, rx, Some(&s.budgets));
     let mut reads = vec![(regs::CYCLES, cycles as u32)];
@@ -284,13 +302,14 @@ fn register_map(d: &Design) -> String {
     let cap = d.platform.capacity;
     let mut s = String::new();
     s.push_str("# bt_top register map (Avalon-MM slave)\n\n");
-    s.push_str(
-        "32-bit data, word addresses on `avs_address[15:0]`, no waitrequest, single-cycle writes, \
+    s.push_str(&format!(
+        "32-bit data, word addresses on `avs_address[{}:0]`, no waitrequest, single-cycle writes, \
          pipelined reads with a fixed latency of 2 cycles (`avs_readdatavalid` marks the data), \
          interrupt `ins_irq` = done (level, cleared by the next start). Coordinates on the bus \
          are millimetre words (two's complement, metres x 1000). Writes other than CTRL are \
          ignored while busy.\n\n",
-    );
+        d.address_bits - 1
+    ));
     s.push_str("| address | access | name | content |\n|---|---|---|---|\n");
     s.push_str("| 0x0000 | W | CTRL | bit 0 = 1 starts a run (ignored while busy) |\n");
     s.push_str("| 0x0000 | R | STATUS | bit 0 busy, bit 1 done |\n");
@@ -322,11 +341,12 @@ fn register_map(d: &Design) -> String {
         d.point_base
     ));
     s.push_str(&format!(
-        "| 0x{:04x} + (t << {}) + c | W | SCHED[t][c] | job of PE column c in slot t: `{{end, last, first, point[{}:0], path[{}:0], valid}}` from bit 0 up, t < {} |\n\n",
+        "| 0x{:04x} + j | W | SCHED[j] | schedule entry j (the jobs of slot 0, then slot 1, ..., each slot's in ascending PE column): `{{column[{}:0], tail, end, last, first, point[{}:0], path[{}:0], valid}}` from bit 0 up, `tail` on a slot's last entry, j < {}, slots < {} |\n\n",
         d.sched_base,
-        d.inst_bits,
+        d.inst_bits - 1,
         d.point_bits - 1,
         d.path_bits - 1,
+        cap.entries,
         cap.slots
     ));
     s.push_str("PE columns: ");
@@ -340,8 +360,9 @@ fn register_map(d: &Design) -> String {
     s.push_str(&cols.join(", "));
     s.push_str(".\n\n");
     s.push_str(
-        "Per time step the host writes the schedule (every entry of slots 0..SLOTS-1, empty ones \
-         as 0) and SLOTS; per run it writes every path point's start value into bank 0 \
+        "Per time step the host writes the schedule (the jobs of each slot 0..SLOTS-1 packed from \
+         entry 0, the last one with `tail` set; an empty slot as one entry with only `tail`) and \
+         SLOTS; per run it writes every path point's start value into bank 0 \
          (X, Y, Z, then FRAC), TX_X..RX_Z, CTRL = 1, waits for `ins_irq` (or polls STATUS bit 1), \
          then reads CYCLES, PATH_STATUS[*] and each point in bank `rounds & 1` of its path. \
          Point i of path p is global index `first_point[p] + i` (paths in order, points TX \
@@ -350,10 +371,8 @@ fn register_map(d: &Design) -> String {
     );
     s.push_str("## Cycle formulas (exact, checked by co-simulation)\n\n");
     s.push_str(&format!(
-        "* CYCLES = SLOTS x (2 x (instances + 2) + PE_LATENCY) = SLOTS x (2 x ({} + 2) + {}) = SLOTS x {}\n",
-        d.num_instances,
-        PE_LATENCY,
-        d.cycles_per_slot()
+        "* CYCLES = sum over slots of (2 x (jobs + 2) + PE_LATENCY), PE_LATENCY = {PE_LATENCY} \
+         (an empty slot counts as 1 job); idle PEs cost nothing\n"
     ));
     s.push_str(
         "* testbench edges: 1 per write, 2 per read, 1 + CYCLES per start\n\
@@ -477,7 +496,6 @@ pub fn generate_steps_into(
         num_instances: d.num_instances,
         capacity: platform.capacity,
         makespans: d.steps.iter().map(|s| s.makespan).collect(),
-        cycles_per_slot: d.cycles_per_slot(),
         run_cycles: runs.iter().map(|r| r.cycles).collect(),
         predicted_tb_cycles,
         load_writes,

@@ -12,7 +12,9 @@ use crate::input::PE_LATENCY;
 pub enum ScheduleKind {
     /// The paper's three passes: GA, PE duplication, ASAP fill ([`bt_schedule::schedule_ga`]).
     Ga,
-    /// The list scheduler, one PE per plane, no duplicate ([`bt_schedule::schedule_list`]).
+    /// The list scheduler: one PE per plane ([`bt_schedule::schedule_list`]), or, with a
+    /// [`PlanOptions::pe_budget`] above the planes used, the extra PEs as copies of the busiest
+    /// planes ([`bt_schedule::schedule_list_duplicated`]).
     List,
 }
 
@@ -31,8 +33,8 @@ impl ScheduleKind {
 pub struct PlanOptions {
     /// Scheduler.
     pub schedule: ScheduleKind,
-    /// Total PE instances allowed; `None`: the planes used plus 25 % for duplicates. Never
-    /// below the planes used (one original PE each).
+    /// Total PE instances allowed; `None`: the planes used plus 25 % for the GA's duplicates,
+    /// none for the list scheduler. Never below the planes used (one original PE each).
     pub pe_budget: Option<u32>,
     /// GA parameters (seed included); ignored by the list scheduler.
     pub ga: GaParams,
@@ -51,23 +53,41 @@ pub struct Plan {
     pub pe_budget: u32,
     /// Path points (the point memory initialised before the first slot).
     pub points: u64,
-    /// Cycles of one schedule slot ([`cycles_per_slot`]).
-    pub cycles_per_slot: u64,
+    /// Mean cycles of a schedule slot ([`slot_cycles`]): `predicted_cycles / makespan`.
+    pub mean_cycles_per_slot: f64,
     /// Cycles from start to done ([`run_cycles`]): what the `CYCLES` register will read.
     pub predicted_cycles: u64,
 }
 
-/// Cycles of one schedule slot with `instances` PE instances: load operands (instances + 2:
-/// the schedule memory's registered read adds one), run the PEs ([`PE_LATENCY`]), write back
-/// (instances + 2).
-pub fn cycles_per_slot(instances: u32) -> u64 {
-    2 * (u64::from(instances) + 2) + u64::from(PE_LATENCY)
+/// Cycles of one schedule slot holding `jobs` jobs: load operands (jobs + 2: the schedule
+/// memory's registered read adds one), run the PEs ([`PE_LATENCY`]), write back (jobs + 2).
+/// The slot's jobs are packed in the schedule memory, so idle PEs cost nothing; an empty slot
+/// counts as one job (its one entry only marks the slot's end).
+pub fn slot_cycles(jobs: u32) -> u64 {
+    2 * (u64::from(jobs.max(1)) + 2) + u64::from(PE_LATENCY)
 }
 
-/// Cycles of one accelerator run (the `CYCLES` register): `makespan` slots of
-/// [`cycles_per_slot`] (the host writes the start points before the start command).
-pub fn run_cycles(instances: u32, makespan: u32) -> u64 {
-    u64::from(makespan) * cycles_per_slot(instances)
+/// Schedule-memory entries of `schedule`: its jobs packed slot after slot up to the makespan,
+/// an empty slot as one entry (which only marks the slot's end).
+pub fn schedule_entries(schedule: &Schedule) -> u32 {
+    schedule
+        .slots
+        .iter()
+        .take(schedule.makespan() as usize)
+        .map(|row| (row.iter().flatten().count() as u32).max(1))
+        .sum()
+}
+
+/// Cycles of one accelerator run of `schedule` (the `CYCLES` register): [`slot_cycles`] of
+/// every slot up to the makespan (the host writes the start points before the start command).
+/// Independent of how many PEs the platform has.
+pub fn run_cycles(schedule: &Schedule) -> u64 {
+    schedule
+        .slots
+        .iter()
+        .take(schedule.makespan() as usize)
+        .map(|row| slot_cycles(row.iter().flatten().count() as u32))
+        .sum()
 }
 
 /// Schedule `problem` (from [`crate::HlsInput::problem`] or
@@ -97,16 +117,20 @@ pub fn plan(problem: &Problem, options: &PlanOptions) -> Result<Plan, HlsError> 
         },
     )?;
     let list_makespan = list.stats(problem).makespan;
-    let schedule = match options.schedule {
-        ScheduleKind::List => list,
-        ScheduleKind::Ga => bt_schedule::schedule_ga(problem, &budget, &options.ga)?,
+    let schedule = match (options.schedule, options.pe_budget) {
+        // Extra PEs asked for: copies of the busiest planes (offline sizing of the platform).
+        (ScheduleKind::List, Some(b)) if b > planes_used => {
+            bt_schedule::schedule_list_duplicated(problem, &budget)?
+        }
+        (ScheduleKind::List, _) => list,
+        (ScheduleKind::Ga, _) => bt_schedule::schedule_ga(problem, &budget, &options.ga)?,
     };
     schedule.check(problem)?;
     let stats = schedule.stats(problem);
     let points: u64 = problem.paths.iter().map(|p| p.planes.len() as u64).sum();
     Ok(Plan {
-        predicted_cycles: run_cycles(stats.instances, stats.makespan),
-        cycles_per_slot: cycles_per_slot(stats.instances),
+        predicted_cycles: run_cycles(&schedule),
+        mean_cycles_per_slot: run_cycles(&schedule) as f64 / f64::from(stats.makespan.max(1)),
         schedule,
         stats,
         list_makespan,

@@ -3,7 +3,7 @@
 
 use bt_fixed::width;
 
-use crate::input::{ADDRESS_BITS, Layout, PE_LATENCY, bits_for, sched_entry_bits};
+use crate::input::{Layout, PE_LATENCY, bits_for, sched_entry_bits};
 use crate::pe::{POINT_BITS, SUM_BITS, pe_module_name, port};
 use crate::verilog::{BinaryOp, Direction, Expr, Item, Module, Stmt, UnaryOp};
 
@@ -15,7 +15,7 @@ const S_WB: u128 = 4;
 const STATE_BITS: u32 = 3;
 
 /// Register-map version reported in `INFO[15:8]`.
-pub const MAP_VERSION: u32 = 3;
+pub const MAP_VERSION: u32 = 4;
 
 /// Width of the early-stopping comparisons (`bt_fixed::FineBox::outside`): a 40-bit point
 /// plus or minus `(L1 move) << 4` and the ±2^41 box bounds fit in 48 signed bits.
@@ -60,15 +60,25 @@ impl<'a> TopParams<'a> {
     }
 }
 
-pub(crate) fn top_module(d: &TopParams) -> Module {
+/// `name` (`from` bits) as an `to`-bit unsigned value: zero-extended or truncated.
+fn zero_extend(name: &str, from: u32, to: u32) -> Expr {
+    match from.cmp(&to) {
+        std::cmp::Ordering::Less => Expr::concat(vec![lit(to - from, 0), id(name)]),
+        std::cmp::Ordering::Equal => id(name),
+        std::cmp::Ordering::Greater => Expr::slice(name, to - 1, 0),
+    }
+}
+
+pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
     let l = &d.layout;
     let k = l.num_instances;
     let (pb, ptb, ib, sb) = (l.path_bits, l.point_bits, l.inst_bits, l.slot_bits);
+    let eb = l.entry_bits;
     let np2 = 1u32 << pb;
     let depth = 1u32 << (ptb + 1);
     let cw = width::COORD;
     let dispw = cw + 1;
-    let sw = sched_entry_bits(pb, ptb);
+    let sw = sched_entry_bits(pb, ptb, ib);
     let cnt_bits = bits_for(u64::from((k + 2).max(PE_LATENCY)) + 1);
     let status_bits = l.status_base.trailing_zeros();
     let point_bits_addr = l.point_base.trailing_zeros();
@@ -79,18 +89,19 @@ pub(crate) fn top_module(d: &TopParams) -> Module {
     let early = d.model.early_stop().map(|(s, b)| (*s, b.to_vec()));
 
     items.push(Item::Comment(format!(
-        "{} PE instances, capacity {} paths, {} points, {} slots; {} cycles per slot, threshold {} fine LSB",
+        "{} PE instances, capacity {} paths, {} points, {} slots; 2 x (jobs + 2) + {} cycles per slot, threshold {} fine LSB",
         k,
         cap.paths,
         cap.points,
         cap.slots,
-        crate::plan::cycles_per_slot(k),
+        PE_LATENCY,
         d.platform.threshold_lsb
     )));
     for (n, w) in [
         ("state", STATE_BITS),
         ("cnt", cnt_bits),
         ("slot", sb),
+        ("sbase", eb),
         ("slots_r", sb + 1),
         ("cycles", 32),
         ("done", 1),
@@ -114,12 +125,14 @@ pub(crate) fn top_module(d: &TopParams) -> Module {
         ("rd_b", POINT_BITS),
         ("sched_q", sw),
         ("sq_ok", 1),
-        ("sq_inst", ib),
+        ("seen_tail", 1),
         ("ld_q_en", 1),
+        ("ld_q_tail", 1),
         ("ld_q_first", 1),
         ("ld_q_last", 1),
         ("ld_q_inst", ib),
         ("wb_q_en", 1),
+        ("wb_q_tail", 1),
         ("wb_q_end", 1),
         ("wb_q_path", pb),
         ("wb_q_point", ptb),
@@ -148,28 +161,29 @@ pub(crate) fn top_module(d: &TopParams) -> Module {
     }
 
     // Bus address decode.
-    let hi = ADDRESS_BITS - 1;
+    let ab = l.address_bits;
+    let hi = ab - 1;
     items.push(Item::Wire("idle".into(), 1));
     items.push(Item::Assign(id("idle"), state_is(S_IDLE)));
     items.push(Item::Wire("is_ctrl".into(), 1));
     items.push(Item::Assign(
         id("is_ctrl"),
-        Expr::slice("avs_address", hi, 4).eq(lit(ADDRESS_BITS - 4, 0)),
+        Expr::slice("avs_address", hi, 4).eq(lit(ab - 4, 0)),
     ));
     items.push(Item::Wire("is_status".into(), 1));
     items.push(Item::Assign(
         id("is_status"),
-        Expr::slice("avs_address", hi, status_bits).eq(lit(ADDRESS_BITS - status_bits, 1)),
+        Expr::slice("avs_address", hi, status_bits).eq(lit(ab - status_bits, 1)),
     ));
     items.push(Item::Wire("is_point".into(), 1));
     items.push(Item::Assign(
         id("is_point"),
-        Expr::slice("avs_address", hi, point_bits_addr).eq(lit(ADDRESS_BITS - point_bits_addr, 1)),
+        Expr::slice("avs_address", hi, point_bits_addr).eq(lit(ab - point_bits_addr, 1)),
     ));
     items.push(Item::Wire("is_sched".into(), 1));
     items.push(Item::Assign(
         id("is_sched"),
-        Expr::slice("avs_address", hi, sched_bits_addr).eq(lit(ADDRESS_BITS - sched_bits_addr, 1)),
+        Expr::slice("avs_address", hi, sched_bits_addr).eq(lit(ab - sched_bits_addr, 1)),
     ));
     items.push(Item::Wire("bus_point".into(), ptb));
     items.push(Item::Assign(
@@ -186,39 +200,52 @@ pub(crate) fn top_module(d: &TopParams) -> Module {
             .and(Expr::slice("avs_address", 1, 0).eq(lit(2, 3))),
     ));
 
-    // Schedule memory (M9K): entry {slot, column}, written by the host, read one cycle after
-    // the address {slot, cnt}: the entry of column cnt - 1 is in sched_q.
+    // Schedule memory (M9K): the jobs packed slot after slot (ascending PE column, each
+    // slot's last one flagged `tail`), written by the host, read one cycle after the address
+    // sbase + cnt (sbase = the slot's first entry): entry cnt - 1 is in sched_q. Entries after
+    // the tail are never used (`stop`), so a slot takes 2 x (jobs + 2) + PE_LATENCY cycles
+    // whatever the PE count.
     items.push(Item::Comment(format!(
-        "PE schedule memory, written per step by the host: entry {{slot, column}} -> {{end, last, first, point, path, valid}} ({sw} bits)"
+        "PE schedule memory, written per step by the host: entry -> {{column, tail, end, last, first, point, path, valid}} ({sw} bits)"
     )));
-    items.push(Item::Memory("sched".into(), sw, 1 << (sb + ib)));
+    items.push(Item::Wire("sched_addr".into(), eb));
+    items.push(Item::Assign(
+        id("sched_addr"),
+        id("sbase").plus(zero_extend("cnt", cnt_bits, eb)),
+    ));
+    items.push(Item::Wire("rom_tail".into(), 1));
+    items.push(Item::Assign(
+        id("rom_tail"),
+        Expr::bit("sched_q", 4 + pb + ptb).and(id("sq_ok")),
+    ));
+    items.push(Item::Wire("stop".into(), 1));
+    items.push(Item::Assign(
+        id("stop"),
+        or(id("seen_tail"), id("rom_tail")),
+    ));
+    items.push(Item::Memory("sched".into(), sw, 1 << eb));
     items.push(Item::AlwaysFf(vec![
         Stmt::If(
             id("host_wr").and(id("is_sched")),
             vec![nb(
-                Expr::id("sched").at(Expr::slice("avs_address", sb + ib - 1, 0)),
+                Expr::id("sched").at(Expr::slice("avs_address", eb - 1, 0)),
                 Expr::slice("avs_writedata", sw - 1, 0),
             )],
             vec![],
         ),
-        nb(
-            id("sched_q"),
-            Expr::id("sched").at(Expr::concat(vec![
-                id("slot"),
-                Expr::slice("cnt", ib - 1, 0),
-            ])),
-        ),
+        nb(id("sched_q"), Expr::id("sched").at(id("sched_addr"))),
         nb(
             id("sq_ok"),
-            or(state_is(S_LOAD), state_is(S_WB)).and(Expr::bin(
-                BinaryOp::Lt,
-                id("cnt"),
-                lit(cnt_bits, k.into()),
-            )),
+            or(state_is(S_LOAD), state_is(S_WB))
+                .and(Expr::bin(BinaryOp::Lt, id("cnt"), lit(cnt_bits, k.into())))
+                .and(id("stop").lnot()),
         ),
-        nb(id("sq_inst"), Expr::slice("cnt", ib - 1, 0)),
     ]));
-    let fields = [("rom_path", pb, 1), ("rom_point", ptb, 1 + pb)];
+    let fields = [
+        ("rom_path", pb, 1),
+        ("rom_point", ptb, 1 + pb),
+        ("rom_inst", ib, 5 + pb + ptb),
+    ];
     items.push(Item::Wire("rom_valid".into(), 1));
     items.push(Item::Assign(
         id("rom_valid"),
@@ -503,10 +530,9 @@ pub(crate) fn top_module(d: &TopParams) -> Module {
     }
 
     // Main FSM.
-    let k_cnt = lit(cnt_bits, u128::from(k + 1));
     let cnt_inc = id("cnt").plus(lit(cnt_bits, 1));
     let start_req = id("avs_write")
-        .and(id("avs_address").eq(lit(ADDRESS_BITS, 0)))
+        .and(id("avs_address").eq(lit(ab, 0)))
         .and(Expr::bit("avs_writedata", 0))
         .and(state_is(S_IDLE));
     let all_zero = lit(np2, 0);
@@ -522,6 +548,7 @@ pub(crate) fn top_module(d: &TopParams) -> Module {
         ),
         nb(id("cnt"), lit(cnt_bits, 0)),
         nb(id("slot"), lit(sb, 0)),
+        nb(id("sbase"), lit(eb, 0)),
         nb(id("cycles"), lit(32, 0)),
         nb(id("done"), no_slot),
     ];
@@ -537,16 +564,21 @@ pub(crate) fn top_module(d: &TopParams) -> Module {
     }
     let load = vec![
         nb(id("ld_q_en"), id("rom_valid")),
+        nb(id("ld_q_tail"), id("rom_tail")),
         nb(id("ld_q_first"), id("rom_first")),
         nb(id("ld_q_last"), id("rom_last")),
-        nb(id("ld_q_inst"), id("sq_inst")),
+        nb(id("ld_q_inst"), id("rom_inst")),
         Stmt::If(
-            id("cnt").eq(k_cnt.clone()),
+            id("ld_q_tail"),
             vec![
                 nb(id("state"), lit(STATE_BITS, S_EXEC)),
                 nb(id("cnt"), lit(cnt_bits, 0)),
+                nb(id("seen_tail"), lit(1, 0)),
             ],
-            vec![nb(id("cnt"), cnt_inc.clone())],
+            vec![
+                nb(id("cnt"), cnt_inc.clone()),
+                nb(id("seen_tail"), id("stop")),
+            ],
         ),
     ];
     let exec = vec![Stmt::If(
@@ -604,15 +636,24 @@ pub(crate) fn top_module(d: &TopParams) -> Module {
     )];
     let wb = vec![
         nb(id("wb_q_en"), id("rom_valid")),
+        nb(id("wb_q_tail"), id("rom_tail")),
         nb(id("wb_q_end"), id("rom_end")),
         nb(id("wb_q_path"), id("rom_path")),
         nb(id("wb_q_point"), id("rom_point")),
-        nb(id("wb_q_inst"), id("sq_inst")),
+        nb(id("wb_q_inst"), id("rom_inst")),
         Stmt::If(id("wb_go"), commit, vec![]),
         Stmt::If(
-            id("cnt").eq(k_cnt),
+            id("wb_q_tail"),
             vec![
                 nb(id("cnt"), lit(cnt_bits, 0)),
+                nb(id("seen_tail"), lit(1, 0)),
+                // The slot had cnt - 1 entries (its tail was read at cnt - 2).
+                nb(
+                    id("sbase"),
+                    id("sbase")
+                        .plus(zero_extend("cnt", cnt_bits, eb))
+                        .minus(lit(eb, 1)),
+                ),
                 Stmt::If(
                     Expr::concat(vec![lit(1, 0), id("slot")])
                         .plus(lit(sb + 1, 1))
@@ -627,14 +668,11 @@ pub(crate) fn top_module(d: &TopParams) -> Module {
                     ],
                 ),
             ],
-            vec![nb(id("cnt"), cnt_inc)],
+            vec![nb(id("cnt"), cnt_inc), nb(id("seen_tail"), id("stop"))],
         ),
     ];
     items.push(Item::Comment(format!(
-        "main FSM: IDLE -> per slot LOAD ({}) EXEC ({}) WB ({}) -> IDLE with done after SLOTS slots",
-        k + 2,
-        PE_LATENCY,
-        k + 2
+        "main FSM: IDLE -> per slot LOAD (jobs + 2) EXEC ({PE_LATENCY}) WB (jobs + 2) -> IDLE with done after SLOTS slots"
     )));
     items.push(Item::Wire("start_req".into(), 1));
     items.push(Item::Assign(id("start_req"), start_req));
@@ -647,7 +685,10 @@ pub(crate) fn top_module(d: &TopParams) -> Module {
             nb(id("cycles"), lit(32, 0)),
             nb(id("done"), lit(1, 0)),
             nb(id("ld_q_en"), lit(1, 0)),
+            nb(id("ld_q_tail"), lit(1, 0)),
             nb(id("wb_q_en"), lit(1, 0)),
+            nb(id("wb_q_tail"), lit(1, 0)),
+            nb(id("seen_tail"), lit(1, 0)),
         ],
         vec![
             Stmt::If(
@@ -674,7 +715,7 @@ pub(crate) fn top_module(d: &TopParams) -> Module {
     // Avalon-MM slave: writes.
     let wr = |addr: u32, reg: &str| {
         Stmt::If(
-            id("avs_address").eq(lit(ADDRESS_BITS, addr.into())),
+            id("avs_address").eq(lit(ab, addr.into())),
             vec![nb(id(reg), id("avs_writedata"))],
             vec![],
         )
@@ -700,7 +741,7 @@ pub(crate) fn top_module(d: &TopParams) -> Module {
                 wr(9, "rx_y"),
                 wr(10, "rx_z"),
                 Stmt::If(
-                    id("avs_address").eq(lit(ADDRESS_BITS, crate::regs::SLOTS.into())),
+                    id("avs_address").eq(lit(ab, crate::regs::SLOTS.into())),
                     vec![nb(id("slots_r"), Expr::slice("avs_writedata", sb, 0))],
                     vec![],
                 ),
@@ -862,13 +903,13 @@ pub(crate) fn top_module(d: &TopParams) -> Module {
             "bt_top: IPC ray-tracing accelerator generated by bt-hls (register map in report.md)."
                 .into(),
             format!(
-                "Avalon-MM slave, 32-bit words, word address {ADDRESS_BITS} bits, fixed read latency 2, irq = done."
+                "Avalon-MM slave, 32-bit words, word address {ab} bits, fixed read latency 2, irq = done."
             ),
         ],
         ports: vec![
             port("clk", Direction::Input, 1),
             port("rst_n", Direction::Input, 1),
-            port("avs_address", Direction::Input, ADDRESS_BITS),
+            port("avs_address", Direction::Input, ab),
             port("avs_read", Direction::Input, 1),
             port("avs_write", Direction::Input, 1),
             port("avs_writedata", Direction::Input, 32),
@@ -886,7 +927,7 @@ pub(crate) fn top_module(d: &TopParams) -> Module {
 /// comparisons are unsigned ones with the sign bit flipped (the box constants are flipped
 /// when generated).
 fn early_stop_logic(
-    d: &TopParams,
+    d: &TopParams<'_>,
     stop: &bt_fixed::EarlyStop,
     boxes: &[bt_fixed::FineBox],
     items: &mut Vec<Item>,

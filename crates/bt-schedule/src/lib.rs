@@ -36,7 +36,7 @@ pub mod synthetic;
 pub use check::ScheduleStats;
 pub use error::{ProblemIssue, REPORT_LIMIT, Report, ScheduleError, ScheduleViolation};
 pub use ga::{GaParams, schedule_ga};
-pub use list::schedule_list;
+pub use list::{schedule_list, schedule_list_duplicated, size_copies};
 
 /// One candidate path as the scheduler sees it.
 #[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]

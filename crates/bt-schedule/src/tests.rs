@@ -374,3 +374,50 @@ fn schedule_round_trips_through_json() {
     let back: Schedule = serde_json::from_str(&text).unwrap();
     assert_eq!(back, schedule);
 }
+
+#[test]
+fn the_duplicating_list_scheduler_copies_the_busiest_plane() {
+    // Plane 0 carries 2 x 4 jobs, planes 1 and 2 four each: the one extra PE goes to plane 0
+    // and the makespan halves to 4 (the optimum: 16 jobs on 4 PEs).
+    let problem = Problem {
+        num_planes: 3,
+        paths: vec![path(&[0, 1], 4), path(&[0, 2], 4)],
+    };
+    let budget = Budget { max_instances: 4 };
+    assert_eq!(
+        crate::size_copies(&problem, &budget).unwrap(),
+        vec![2, 1, 1]
+    );
+    let dup = crate::schedule_list_duplicated(&problem, &budget).unwrap();
+    dup.check(&problem).unwrap();
+    let stats = dup.stats(&problem);
+    assert_eq!((stats.makespan, stats.duplicates), (4, 1));
+    // A budget below one PE per used plane is refused; more copies than jobs are not made.
+    assert!(crate::size_copies(&problem, &Budget { max_instances: 2 }).is_err());
+    let copies = crate::size_copies(&problem, &Budget { max_instances: 100 }).unwrap();
+    assert_eq!(copies, vec![8, 4, 4]);
+}
+
+#[test]
+fn the_duplicating_list_scheduler_is_legal_and_never_slower_on_synthetic_rooms() {
+    for seed in 0..6 {
+        let problem = crate::synthetic::living_room(seed, 25, 120);
+        let base = Budget::originals_only(&problem);
+        let plain = schedule_list(&problem, &base)
+            .unwrap()
+            .stats(&problem)
+            .makespan;
+        let more = Budget {
+            max_instances: base.max_instances + 8,
+        };
+        let dup = crate::schedule_list_duplicated(&problem, &more).unwrap();
+        dup.check(&problem).unwrap();
+        let stats = dup.stats(&problem);
+        assert!(stats.instances <= more.max_instances, "seed {seed}");
+        assert!(
+            stats.makespan <= plain,
+            "seed {seed}: {} vs {plain}",
+            stats.makespan
+        );
+    }
+}

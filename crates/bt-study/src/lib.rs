@@ -14,7 +14,6 @@
 #![warn(missing_docs)]
 
 pub mod embed;
-pub mod fpga;
 pub mod io;
 pub mod living_room;
 pub mod plot;

@@ -52,10 +52,14 @@ fn hls_gen_that_cannot_fit_fails_fast_and_creates_nothing() {
         "hls",
         "gen",
         "builtin:living-room",
+        "--max-order",
+        "1",
+        "--m9k-budget",
+        "4",
         "-o",
         out.to_str().unwrap(),
     ]);
-    assert_refused(&r, &["address bits", "--max-order"]);
+    assert_refused(&r, &["M9K blocks", "budget of 4", "--max-order"]);
     assert!(!out.exists(), "a failed run leaves no folder");
     assert!(tree(&dir).is_empty(), "{:?}", tree(&dir));
 }

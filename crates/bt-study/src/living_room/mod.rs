@@ -17,12 +17,13 @@ pub mod plot;
 pub mod report;
 
 use crate::run::{Directions, PathMap, compare, exact_directions, run_solver};
-use crate::{StudyConfig, StudyError, StudySolver, fpga};
+use crate::{StudyConfig, StudyError, StudySolver};
+use bt_accel as fpga;
 use bt_geom::{Real, Vec3};
 use bt_hls::{PlanOptions, ScheduleKind};
 use bt_scene::Scene;
 use bt_scene::dynamic::DynamicScene;
-use bt_schedule::{GaParams, Problem};
+use bt_schedule::GaParams;
 use bt_solve::{SbrOptions, Validity, validate::validate};
 use serde::Serialize;
 use std::time::Instant;
@@ -62,13 +63,14 @@ pub struct LivingRoomConfig {
     pub ga_generations: u32,
     /// Total PE instances per step; `None`: the planes used plus 25 %.
     pub pe_budget: Option<u32>,
+    /// Start each step from the points the previous step converged to ([`fpga::warm_start`]).
+    pub warm_start: bool,
 }
 
 impl Default for LivingRoomConfig {
-    /// The paper's setting: third order, 1° SBR sphere, the `hls gen` defaults (threshold
-    /// 16/256 mm, 256 rounds, GA seed 1) but a smaller GA (population 4, 2 generations instead
-    /// of 12 × 12): on the living room's ~9,600 candidates it reaches the same makespan at
-    /// step 0 in a sixth of the time (the duplication and ASAP passes do most of the work).
+    /// The paper's setting: third order, 1° SBR sphere, the `hls gen --steps` defaults
+    /// (beam-tree candidates, threshold 16/256 mm, 256 rounds, the list scheduler per step,
+    /// warm start); with `schedule: Ga` a small GA (population 4, 2 generations, seed 1).
     fn default() -> Self {
         Self {
             scene: "builtin:living-room-dynamic".into(),
@@ -76,11 +78,12 @@ impl Default for LivingRoomConfig {
             sbr_step_deg: 1.0,
             threshold_lsb: 16,
             max_rounds: 256,
-            schedule: ScheduleKind::Ga,
+            schedule: ScheduleKind::List,
             seed: 1,
             ga_population: 4,
             ga_generations: 2,
             pe_budget: None,
+            warm_start: true,
         }
     }
 }
@@ -103,6 +106,18 @@ impl LivingRoomConfig {
                 elite: GaParams::default().elite.min(self.ga_population),
                 ..GaParams::default()
             },
+        }
+    }
+
+    /// How every step is planned: beam-tree candidates (as `hls gen`), the threshold, round
+    /// cap, scheduler and warm start of the settings.
+    pub fn step_options(&self) -> fpga::StepOptions {
+        fpga::StepOptions {
+            trace: bt_solve::pipeline::TraceOptions::new(self.max_order),
+            threshold_lsb: self.threshold_lsb,
+            max_rounds: self.max_rounds,
+            plan: self.plan_options(),
+            warm_start: self.warm_start,
         }
     }
 
@@ -178,9 +193,13 @@ pub struct Row {
 pub struct FpgaStep {
     /// Time step, from 0.
     pub step: usize,
-    /// Candidate paths of order ≥ 1 computed by the accelerator.
+    /// Candidate paths of order ≥ 1 computed by the accelerator (beam tree, static planes).
     pub paths: usize,
-    /// Their points.
+    /// Candidates through a moving surface, solved by the host (image method).
+    pub host_paths: usize,
+    /// Paths started from the points they converged to at the previous step.
+    pub warm_started: usize,
+    /// Points of the accelerator's paths.
     pub points: u64,
     /// Paths converged in the fixed-point model.
     pub converged: usize,
@@ -193,7 +212,11 @@ pub struct FpgaStep {
     /// Converged, valid paths the host rejected for breaking the reflection law
     /// ([`fpga::REFLECTION_TOLERANCE_DEG`]): false convergences of the fixed-point model.
     pub reflection_rejected: usize,
-    /// PE instances of the schedule (originals and duplicates).
+    /// Exact paths (image method, every sequence) neither the accelerator nor the host found.
+    pub missed: usize,
+    /// Accepted accelerator results that are no exact path.
+    pub spurious: usize,
+    /// PE instances the step's schedule uses.
     pub instances: u32,
     /// Duplicated PEs.
     pub duplicates: u32,
@@ -207,20 +230,16 @@ pub struct FpgaStep {
     pub latency_factor: u64,
     /// Busy PE cells / all cells.
     pub utilisation: Real,
-    /// Cycles per schedule slot.
-    pub cycles_per_slot: u64,
-    /// Predicted `CYCLES` of the run (exact; co-simulation checks the formula).
+    /// PE instances of the one platform every step runs on.
+    pub platform_instances: u32,
+    /// Mean cycles of a schedule slot (`2·(jobs + 2) + PE_LATENCY`; idle PEs cost nothing).
+    pub mean_cycles_per_slot: Real,
+    /// Predicted `CYCLES` of the run on that platform (exact; co-simulation checks it).
     pub cycles: u64,
-    /// `cycles / CLOCK_HZ`, seconds.
+    /// Per-step latency, `cycles / CLOCK_HZ`, seconds.
     pub latency_s: Real,
-    /// Candidate paths the host accepted (converged in fixed point and valid in f64).
-    pub accepted_paths: usize,
-    /// Cycles of a run computing only the accepted paths, with the same scheduler: the bound
-    /// a perfect early rejection of invalid candidates (the paper's Section VI-C proposal)
-    /// could reach. 0 when no path was accepted.
-    pub accepted_cycles: u64,
-    /// Wall-clock time of the scheduler, seconds (may use every core).
-    pub schedule_time_s: Real,
+    /// Host work of the step (candidates, accelerator input, schedule), seconds.
+    pub host_time_s: Real,
 }
 
 /// A ray direction at both ends, degrees: azimuth from +x towards +y in (-180, 180],
@@ -296,89 +315,77 @@ fn angles(d: &Directions) -> RayAngles {
     }
 }
 
-/// What the fixed-point model produced at one step.
+/// What the accelerator produced at one step.
 struct FixedStep {
     paths: PathMap,
     time_s: Real,
     fpga: FpgaStep,
+    planned: fpga::PlannedStep,
 }
 
-/// The accelerator at one step: build its input, run the bit-exact model (timed, as a
-/// software emulation), keep the converged paths that validate in f64 (the host's check, as
-/// the paper's Raspberry Pi post-processor), add line of sight from the host, then schedule.
+/// The accelerator at one step ([`fpga::plan_step`]: beam-tree candidates over the platform's
+/// planes, warm start from the previous step, the bit-exact model, the PE schedule): the
+/// results the host accepts ([`fpga::host_accepts`]), the candidates through a moving surface
+/// solved by the host (image method, validated), line of sight from the host. The platform's
+/// PE count is filled in once all steps are known.
 fn fixed_point_step(
     scene: &Scene,
+    planes: &[bt_scene::SurfaceId],
     step: usize,
     config: &LivingRoomConfig,
+    previous: Option<&fpga::PlannedStep>,
 ) -> Result<FixedStep, StudyError> {
-    let hardware = |e: &dyn std::fmt::Display| StudyError::Step {
-        step,
-        message: e.to_string(),
-    };
-    let (tx, rx) = (scene.tx(), scene.rx());
+    let planned =
+        fpga::plan_step(scene, planes, step, &config.step_options(), previous).map_err(|e| {
+            StudyError::Step {
+                step,
+                message: e.to_string(),
+            }
+        })?;
     let start = Instant::now();
-    let (input, sequences) = fpga::hls_input(
-        scene,
-        config.max_order,
-        config.threshold_lsb,
-        config.max_rounds,
-    );
-    if input.paths.is_empty() {
-        return Err(StudyError::Step {
-            step,
-            message: format!(
-                "no candidate reflection path up to order {} for the accelerator",
-                config.max_order
-            ),
-        });
-    }
-    let model = input.model().map_err(|e| hardware(&e))?;
-    let results = model.run(input.tx, input.rx).map_err(|e| hardware(&e))?;
+    let (tx, rx) = (scene.tx(), scene.rx());
     let mut paths = PathMap::new();
     if validate(scene, &[], tx, rx, &[]) == Validity::Valid {
         paths.insert(Vec::new(), exact_directions(scene, &[]));
     }
-    let mut accepted = Vec::new();
     let mut reflection_rejected = 0;
-    for (p, (seq, r)) in sequences.iter().zip(&results).enumerate() {
+    let s = &planned.step;
+    for (seq, r) in s.sequences.iter().zip(&planned.results) {
         match fpga::host_accepts(scene, seq, r) {
             Ok(points) => {
                 paths.insert(seq.clone(), exact_directions(scene, &points));
-                accepted.push(p);
             }
             Err(fpga::HostRejection::ReflectionLaw) => reflection_rejected += 1,
             Err(_) => {}
         }
     }
-    let time_s = start.elapsed().as_secs_f64();
-    let problem = input.problem_for(&results);
-    let start = Instant::now();
-    let plan = bt_hls::plan(&problem, &config.plan_options()).map_err(|e| hardware(&e))?;
-    let schedule_time_s = start.elapsed().as_secs_f64();
-    // The oracle bound of the paper's early-stopping strategy: only the accepted paths run.
-    let accepted_cycles = if accepted.is_empty() {
-        0
-    } else {
-        let sub = Problem {
-            num_planes: problem.num_planes,
-            paths: accepted.iter().map(|&p| problem.paths[p].clone()).collect(),
-        };
-        bt_hls::plan(&sub, &config.plan_options())
-            .map_err(|e| hardware(&e))?
-            .predicted_cycles
-    };
+    for seq in &s.host_sequences {
+        let mut points = vec![Vec3::ZERO; seq.len()];
+        if bt_solve::image::solve(scene, seq, tx, rx, &mut points).is_ok()
+            && validate(scene, seq, tx, rx, &points) == Validity::Valid
+        {
+            paths.insert(seq.clone(), exact_directions(scene, &points));
+        }
+    }
+    let time_s = planned.host_time_s + planned.budget_model_time_s + start.elapsed().as_secs_f64();
+    let results = &planned.results;
     let converged = results.iter().filter(|r| r.converged).count();
     let degenerate = results.iter().filter(|r| r.overflow || r.zero_sum).count();
     let left_bounds = results.iter().filter(|r| r.left_bounds).count();
+    let plan = &planned.plan;
     let fpga = FpgaStep {
         step,
-        paths: input.paths.len(),
+        paths: s.input.paths.len(),
+        host_paths: s.host_sequences.len(),
+        warm_started: planned.warm_started,
         points: plan.points,
         converged,
         not_converged: results.len() - converged - degenerate - left_bounds,
         degenerate,
         left_bounds,
         reflection_rejected,
+        missed: planned.fixed.missed,
+        spurious: planned.fixed.spurious,
         instances: plan.stats.instances,
         duplicates: plan.stats.duplicates,
         pe_budget: plan.pe_budget,
@@ -386,18 +393,35 @@ fn fixed_point_step(
         list_makespan: plan.list_makespan,
         latency_factor: plan.stats.latency_factor,
         utilisation: plan.stats.utilisation,
-        cycles_per_slot: plan.cycles_per_slot,
+        platform_instances: 0,
+        mean_cycles_per_slot: plan.mean_cycles_per_slot,
         cycles: plan.predicted_cycles,
         latency_s: plan.predicted_cycles as Real / CLOCK_HZ,
-        accepted_paths: accepted.len(),
-        accepted_cycles,
-        schedule_time_s,
+        host_time_s: planned.host_time_s,
     };
     Ok(FixedStep {
         paths,
         time_s,
         fpga,
+        planned,
     })
+}
+
+/// The PE count of the one platform all steps run on ([`bt_hls::Platform::fitting`]); a
+/// step's cycles depend on its schedule only.
+fn fill_platform_instances(
+    fpga: &mut [FpgaStep],
+    work: &[bt_hls::StepWork],
+) -> Result<(), StudyError> {
+    let platform = bt_hls::Platform::fitting(work).map_err(|e| StudyError::Step {
+        step: 0,
+        message: e.to_string(),
+    })?;
+    let k = platform.instances.len() as u32;
+    for f in fpga {
+        f.platform_instances = k;
+    }
+    Ok(())
 }
 
 fn row(
@@ -442,6 +466,10 @@ pub fn run(
     let mut rows = Vec::with_capacity(steps * SOLVERS.len());
     let mut fpga = Vec::with_capacity(steps);
     let mut rays = Vec::new();
+    // The platform: one PE per reflector that no step moves.
+    let planes = fpga::static_reflectors(scene.scenes());
+    let mut work = Vec::with_capacity(steps);
+    let mut previous = None;
     for (step, s) in scene.scenes().iter().enumerate() {
         let (reference, time_s) = run_solver(s, StudySolver::Image, &solver_config)?;
         rows.push(row(
@@ -463,7 +491,7 @@ pub fn run(
                 sbr_paths = found;
             }
         }
-        let fixed = fixed_point_step(s, step, config)?;
+        let fixed = fixed_point_step(s, &planes, step, config, previous.as_ref())?;
         rows.push(row(
             step,
             StudySolver::IpcFixedPoint,
@@ -472,6 +500,8 @@ pub fn run(
             fixed.time_s,
         ));
         fpga.push(fixed.fpga);
+        work.push(fixed.planned.work());
+        previous = Some(fixed.planned);
         if drawn.contains(&step) {
             rays.push(StepRays {
                 step,
@@ -482,6 +512,7 @@ pub fn run(
         }
         progress(step + 1, steps);
     }
+    fill_platform_instances(&mut fpga, &work)?;
     let step0 = scene.step(0);
     Ok(LivingRoomResults {
         config: config.clone(),

@@ -11,8 +11,6 @@ use plotters::prelude::*;
 
 /// Colour of the accelerator's latency series in Fig. 19.
 const FPGA_COLOUR: RGBColor = RGBColor(255, 127, 14);
-/// Colour of the accelerator's early-stopping bound in Fig. 19.
-const ACCEPTED_COLOUR: RGBColor = RGBColor(188, 128, 40);
 
 fn per_step(
     results: &LivingRoomResults,
@@ -58,10 +56,8 @@ pub fn angular_error<DB: DrawingBackend>(
     Ok(())
 }
 
-/// Fig. 19: run time per time step: every solver single-threaded on the CPU, the
-/// accelerator's predicted latency (cycles / 50 MHz), and the latency of a run of only the
-/// paths the host accepts (the early-stopping bound, see [`super::FpgaStep::accepted_cycles`]).
-/// Log y.
+/// Fig. 19: run time per time step: every solver single-threaded on the CPU and the
+/// accelerator's predicted latency per step (cycles on the one platform / 50 MHz). Log y.
 pub fn run_time<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     results: &LivingRoomResults,
@@ -84,15 +80,6 @@ pub fn run_time<DB: DrawingBackend>(
         label: format!("ipc on the FPGA (cycles / {} MHz)", super::CLOCK_HZ / 1e6),
         colour: FPGA_COLOUR,
         points: results.fpga.iter().map(|f| (f.step, f.latency_s)).collect(),
-    });
-    series.push(Series {
-        label: "ipc on the FPGA, accepted paths only (early-stopping bound)".into(),
-        colour: ACCEPTED_COLOUR,
-        points: results
-            .fpga
-            .iter()
-            .map(|f| (f.step, f.accepted_cycles as Real / super::CLOCK_HZ))
-            .collect(),
     });
     panel(
         root,

@@ -13,9 +13,9 @@ pub const CSV_HEADER: &str = "scene,step,solver,paths,matched,missed,spurious,\
 mean_err_tx_deg,max_err_tx_deg,mean_err_rx_deg,max_err_rx_deg,time_s,fpga_cycles,fpga_latency_s";
 
 /// Column names of `fpga.csv`.
-pub const FPGA_CSV_HEADER: &str = "scene,step,paths,points,converged,not_converged,degenerate,left_bounds,reflection_rejected,\
-instances,duplicates,pe_budget,makespan,list_makespan,latency_factor,utilisation,\
-cycles_per_slot,cycles,latency_s,accepted_paths,accepted_cycles,schedule_time_s";
+pub const FPGA_CSV_HEADER: &str = "scene,step,paths,host_paths,warm_started,points,converged,not_converged,degenerate,\
+left_bounds,reflection_rejected,missed,spurious,instances,duplicates,pe_budget,makespan,list_makespan,\
+latency_factor,utilisation,platform_instances,mean_cycles_per_slot,cycles,latency_s,host_time_s";
 
 /// `results.csv`: one line per step and solver; floats in Rust's shortest round-trip
 /// scientific notation. `fpga_cycles` and `fpga_latency_s` (the accelerator's predicted run,
@@ -57,7 +57,7 @@ pub fn csv(results: &LivingRoomResults) -> String {
 }
 
 /// `fpga.csv`: the accelerator of every step (candidate paths, fixed-point outcomes, the PE
-/// schedule and its cycles); `schedule_time_s` is the only varying column.
+/// schedule and its cycles on the one platform); `host_time_s` is the only varying column.
 pub fn fpga_csv(results: &LivingRoomResults) -> String {
     let mut out = String::new();
     out.push_str(FPGA_CSV_HEADER);
@@ -65,16 +65,20 @@ pub fn fpga_csv(results: &LivingRoomResults) -> String {
     for f in &results.fpga {
         let _ = writeln!(
             out,
-            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:e},{},{},{:e},{},{},{:e}",
+            "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:e},{},{:e},{},{:e},{:e}",
             results.scene_name,
             f.step,
             f.paths,
+            f.host_paths,
+            f.warm_started,
             f.points,
             f.converged,
             f.not_converged,
             f.degenerate,
             f.left_bounds,
             f.reflection_rejected,
+            f.missed,
+            f.spurious,
             f.instances,
             f.duplicates,
             f.pe_budget,
@@ -82,12 +86,11 @@ pub fn fpga_csv(results: &LivingRoomResults) -> String {
             f.list_makespan,
             f.latency_factor,
             f.utilisation,
-            f.cycles_per_slot,
+            f.platform_instances,
+            f.mean_cycles_per_slot,
             f.cycles,
             f.latency_s,
-            f.accepted_paths,
-            f.accepted_cycles,
-            f.schedule_time_s
+            f.host_time_s
         );
     }
     out
@@ -161,9 +164,6 @@ pub struct Headline {
     pub fpga_mean_latency_s: Real,
     /// Smallest and largest accelerator latency over the steps, seconds.
     pub fpga_latency_range_s: (Real, Real),
-    /// Mean latency of runs computing only the accepted paths (the early-stopping bound),
-    /// seconds.
-    pub fpga_accepted_mean_latency_s: Real,
     /// Mean SBR time / mean IPC (Gauss-Seidel) time, both single-threaded CPU.
     pub sbr_over_ipc_time: Real,
     /// Mean SBR time / mean IPC (Jacobi) time.
@@ -200,12 +200,6 @@ pub fn headline(results: &LivingRoomResults) -> Headline {
         sbr_over_fixed_error: sbr.mean_err_tx_deg / fixed.mean_err_tx_deg,
         fpga_mean_latency_s: mean_lat,
         fpga_latency_range_s: if lat.is_empty() { (0.0, 0.0) } else { range },
-        fpga_accepted_mean_latency_s: results
-            .fpga
-            .iter()
-            .map(|f| f.accepted_cycles as Real / CLOCK_HZ)
-            .sum::<Real>()
-            / results.fpga.len().max(1) as Real,
         sbr_over_ipc_time: sbr.mean_time_s / gs.mean_time_s,
         sbr_over_jacobi_time: sbr.mean_time_s / jacobi.mean_time_s,
         sbr_cpu_over_fpga: sbr.mean_time_s / mean_lat,
@@ -223,6 +217,15 @@ fn find(results: &LivingRoomResults, step: usize, solver: StudySolver) -> Option
 /// `summary.md`: settings, per-solver totals, a per-step table and the paper's conclusions
 /// as measured numbers.
 pub fn summary(results: &LivingRoomResults) -> String {
+    let mut s = settings(results);
+    s.push_str(&per_solver(results));
+    s.push_str(&per_step(results));
+    s.push_str(&conclusions(results));
+    s
+}
+
+/// The settings paragraph of `summary.md`.
+fn settings(results: &LivingRoomResults) -> String {
     let c = &results.config;
     let sbr = c.sbr_options();
     let mut s = String::new();
@@ -233,10 +236,12 @@ pub fn summary(results: &LivingRoomResults) -> String {
          SBR: {}° azimuth × elevation grid over the sphere ({} rays), capture radius {:.4} × \
          unfolded length.\n\
          Fixed-point IPC: the accelerator's bit-exact model (`bt-fixed`, Jacobi rounds, \
-         millimetre words, 1/256 mm inside), threshold {}/256 mm, at most {} rounds, every \
-         candidate of order 1-{}; converged paths are validated in f64 by the host, which also \
-         checks line of sight. One PE schedule per step: {} (seed {}, GA population {}, {} \
-         generations), PE budget {}; latency = predicted cycles / {} MHz.\n\
+         millimetre words, 1/256 mm inside), threshold {}/256 mm, at most {} rounds, on the \
+         beam tree's candidates of order 1-{} over the static reflectors (one platform for \
+         all steps; candidates through the moving door go to the host's image method), {}; \
+         converged paths are checked by the host (`bt_accel::host_accepts`), which also adds \
+         line of sight. One PE schedule per step: {} (seed {}, GA population {}, {} \
+         generations), PE budget {}; latency = predicted cycles on the platform / {} MHz.\n\
          Every solver runs single-threaded; times are wall clock from the scene to the paths \
          (candidate enumeration included).\n",
         results.scene_name,
@@ -250,6 +255,11 @@ pub fn summary(results: &LivingRoomResults) -> String {
         c.threshold_lsb,
         c.max_rounds,
         c.max_order,
+        if c.warm_start {
+            "each step starting from the points the previous step converged to"
+        } else {
+            "every step from the beam tree's window centres"
+        },
         c.schedule.name(),
         c.seed,
         c.ga_population,
@@ -258,6 +268,12 @@ pub fn summary(results: &LivingRoomResults) -> String {
             .map_or_else(|| "planes used + 25 %".to_string(), |b| b.to_string()),
         CLOCK_HZ / 1e6,
     );
+    s
+}
+
+/// The per-solver totals of `summary.md`.
+fn per_solver(results: &LivingRoomResults) -> String {
+    let mut s = String::new();
     let _ = writeln!(s, "## Per solver, all steps\n");
     let _ = writeln!(
         s,
@@ -281,44 +297,38 @@ pub fn summary(results: &LivingRoomResults) -> String {
             t.mean_time_s * 1e3
         );
     }
-    let h = headline(results);
     let _ = writeln!(
         s,
         "| FPGA (predicted, {} MHz) | | | | | | | | {:.3} |",
         CLOCK_HZ / 1e6,
-        h.fpga_mean_latency_s * 1e3
+        headline(results).fpga_mean_latency_s * 1e3
     );
+    s
+}
+
+/// The per-step table of `summary.md`: accuracy, CPU times, the accelerator's latency per
+/// step and the host's time.
+fn per_step(results: &LivingRoomResults) -> String {
+    let mut s = String::new();
     let _ = writeln!(s, "\n## Per step\n");
     let _ = writeln!(
         s,
         "Errors are means over the step's matched paths, TX / RX, degrees; SBR and fixed-point \
-         missed / spurious paths against the image method; times in ms.\n"
+         missed / spurious paths against the image method; times in ms; FPGA ms = the step's \
+         latency at {} MHz; host ms = the host's work for the step (candidates, input, \
+         schedule).\n",
+        CLOCK_HZ / 1e6
     );
     let _ = writeln!(
         s,
-        "| step | exact paths | candidates | IPC GS err | fixed-point err | SBR err | SBR miss/spur | fixed miss/spur | image | IPC GS | IPC Jacobi | SBR | FPGA cycles | FPGA ms | accepted only: cycles |"
+        "| step | exact paths | candidates | host paths | warm | IPC GS err | fixed-point err | SBR err | SBR miss/spur | fixed miss/spur | image | IPC GS | IPC Jacobi | SBR | makespan | FPGA cycles | FPGA ms | host ms |"
     );
     let _ = writeln!(
         s,
-        "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
+        "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
     );
     for f in &results.fpga {
-        let k = f.step;
-        let get = |solver| {
-            find(results, k, solver).cloned().unwrap_or(Row {
-                step: k,
-                solver,
-                paths: 0,
-                matched: 0,
-                missed: 0,
-                spurious: 0,
-                mean_err_tx_deg: 0.0,
-                max_err_tx_deg: 0.0,
-                mean_err_rx_deg: 0.0,
-                max_err_rx_deg: 0.0,
-                time_s: 0.0,
-            })
-        };
+        let get = |solver| row_or_empty(results, f.step, solver);
         let (image, gs, jacobi, sbr, fixed) = (
             get(StudySolver::Image),
             get(StudySolver::IpcGaussSeidel),
@@ -329,10 +339,12 @@ pub fn summary(results: &LivingRoomResults) -> String {
         let err = |r: &Row| format!("{:.1e} / {:.1e}", r.mean_err_tx_deg, r.mean_err_rx_deg);
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {} | {} / {} | {} / {} | {:.2} | {:.2} | {:.2} | {:.2} | {} | {:.3} | {} |",
-            k,
+            "| {} | {} | {} | {} | {} | {} | {} | {} | {} / {} | {} / {} | {:.2} | {:.2} | {:.2} | {:.2} | {} | {} | {:.3} | {:.2} |",
+            f.step,
             image.paths,
             f.paths,
+            f.host_paths,
+            f.warm_started,
             err(&gs),
             err(&fixed),
             err(&sbr),
@@ -344,70 +356,85 @@ pub fn summary(results: &LivingRoomResults) -> String {
             gs.time_s * 1e3,
             jacobi.time_s * 1e3,
             sbr.time_s * 1e3,
+            f.makespan,
             f.cycles,
             f.latency_s * 1e3,
-            f.accepted_cycles
+            f.host_time_s * 1e3
         );
     }
+    s
+}
+
+/// The row of `solver` at `step`, or an empty one.
+fn row_or_empty(results: &LivingRoomResults, step: usize, solver: StudySolver) -> Row {
+    find(results, step, solver).cloned().unwrap_or(Row {
+        step,
+        solver,
+        paths: 0,
+        matched: 0,
+        missed: 0,
+        spurious: 0,
+        mean_err_tx_deg: 0.0,
+        max_err_tx_deg: 0.0,
+        mean_err_rx_deg: 0.0,
+        max_err_rx_deg: 0.0,
+        time_s: 0.0,
+    })
+}
+
+/// The paper's conclusions, measured: the last table of `summary.md`.
+fn conclusions(results: &LivingRoomResults) -> String {
+    let h = headline(results);
+    let mut s = String::new();
     let _ = writeln!(s, "\n## The paper's conclusions, measured\n");
     let _ = writeln!(s, "| quantity | measured | paper |");
     let _ = writeln!(s, "|---|---:|---:|");
-    let _ = writeln!(
-        s,
-        "| FPGA IPC (fixed-point model) mean angular error, TX / RX (°) | {:.3e} / {:.3e} | < 0.1 (Fig. 17) |",
-        h.fixed_err_deg[0], h.fixed_err_deg[1]
-    );
-    let _ = writeln!(
-        s,
-        "| FPGA IPC largest angular error, TX / RX (°) | {:.3e} / {:.3e} | within the 10° tolerance (Fig. 18) |",
-        h.fixed_max_err_deg[0], h.fixed_max_err_deg[1]
-    );
-    let _ = writeln!(
-        s,
-        "| SBR mean angular error, TX / RX (°) | {:.3e} / {:.3e} | clusters around the GO rays (Fig. 18) |",
-        h.sbr_err_deg[0], h.sbr_err_deg[1]
-    );
-    let _ = writeln!(
-        s,
-        "| SBR error / FPGA IPC error (TX) | {:.3e} | > 100 (Fig. 17) |",
-        h.sbr_over_fixed_error
-    );
-    let _ = writeln!(
-        s,
-        "| IPC f64 (Gauss-Seidel) mean angular error, TX / RX (°) | {:.3e} / {:.3e} | — |",
-        h.ipc_err_deg[0], h.ipc_err_deg[1]
-    );
-    let _ = writeln!(
-        s,
-        "| FPGA IPC time per step (cycles / 50 MHz), mean (min-max) | {:.3} ms ({:.3}-{:.3}) | ≈ 1 ms (Fig. 19) |",
-        h.fpga_mean_latency_s * 1e3,
-        h.fpga_latency_range_s.0 * 1e3,
-        h.fpga_latency_range_s.1 * 1e3
-    );
-    let _ = writeln!(
-        s,
-        "| FPGA IPC time per step, only the paths the host accepts (early-stopping bound), mean | {:.4} ms | — (Section VI-C proposes early stopping) |",
-        h.fpga_accepted_mean_latency_s * 1e3
-    );
-    let _ = writeln!(
-        s,
-        "| SBR time / IPC (Gauss-Seidel) time, one CPU core | {:.3} | > 1 (Fig. 19: IPC faster on the same platform) |",
-        h.sbr_over_ipc_time
-    );
-    let _ = writeln!(
-        s,
-        "| SBR time / IPC (Jacobi) time, one CPU core | {:.3} | — |",
-        h.sbr_over_jacobi_time
-    );
-    let _ = writeln!(
-        s,
-        "| SBR (one CPU core) / FPGA IPC time | {:.3e} | ≈ 9e4 (≈ 500 × the FPGA SBR's 200 ms, vs 1 ms; Figs. 19-20) |",
-        h.sbr_cpu_over_fpga
-    );
-    let _ = writeln!(
-        s,
-        "| IPC Gauss-Seidel (one CPU core) / FPGA IPC time | {:.3e} | — |",
-        h.ipc_cpu_over_fpga
-    );
+    let lines = [
+        format!(
+            "| FPGA IPC (fixed-point model) mean angular error, TX / RX (°) | {:.3e} / {:.3e} | < 0.1 (Fig. 17) |",
+            h.fixed_err_deg[0], h.fixed_err_deg[1]
+        ),
+        format!(
+            "| FPGA IPC largest angular error, TX / RX (°) | {:.3e} / {:.3e} | within the 10° tolerance (Fig. 18) |",
+            h.fixed_max_err_deg[0], h.fixed_max_err_deg[1]
+        ),
+        format!(
+            "| SBR mean angular error, TX / RX (°) | {:.3e} / {:.3e} | clusters around the GO rays (Fig. 18) |",
+            h.sbr_err_deg[0], h.sbr_err_deg[1]
+        ),
+        format!(
+            "| SBR error / FPGA IPC error (TX) | {:.3e} | > 100 (Fig. 17) |",
+            h.sbr_over_fixed_error
+        ),
+        format!(
+            "| IPC f64 (Gauss-Seidel) mean angular error, TX / RX (°) | {:.3e} / {:.3e} | — |",
+            h.ipc_err_deg[0], h.ipc_err_deg[1]
+        ),
+        format!(
+            "| FPGA IPC time per step (cycles / 50 MHz), mean (min-max) | {:.3} ms ({:.3}-{:.3}) | ≈ 1 ms (Fig. 19) |",
+            h.fpga_mean_latency_s * 1e3,
+            h.fpga_latency_range_s.0 * 1e3,
+            h.fpga_latency_range_s.1 * 1e3
+        ),
+        format!(
+            "| SBR time / IPC (Gauss-Seidel) time, one CPU core | {:.3} | > 1 (Fig. 19: IPC faster on the same platform) |",
+            h.sbr_over_ipc_time
+        ),
+        format!(
+            "| SBR time / IPC (Jacobi) time, one CPU core | {:.3} | — |",
+            h.sbr_over_jacobi_time
+        ),
+        format!(
+            "| SBR (one CPU core) / FPGA IPC time | {:.3e} | ≈ 9e4 (≈ 500 × the FPGA SBR's 200 ms, vs 1 ms; Figs. 19-20) |",
+            h.sbr_cpu_over_fpga
+        ),
+        format!(
+            "| IPC Gauss-Seidel (one CPU core) / FPGA IPC time | {:.3e} | — |",
+            h.ipc_cpu_over_fpga
+        ),
+    ];
+    for line in lines {
+        let _ = writeln!(s, "{line}");
+    }
     s
 }

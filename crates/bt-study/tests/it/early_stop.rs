@@ -4,9 +4,9 @@
 //! reflection-law check; a valid path the host still rejects ran exactly as without early
 //! stopping (a round-cap or quantisation effect, not ours).
 
+use bt_accel::{HostRejection, hls_input, host_accepts};
 use bt_paths::{AllVisible, enumerate};
 use bt_scene::{Scene, Terminals};
-use bt_study::fpga::{HostRejection, hls_input, host_accepts};
 use bt_testkit::random_scene;
 
 const SEED: u64 = 0x005e_ede5;

@@ -5,7 +5,7 @@ use bt_geom::{Real, Vec3};
 use bt_hls::{EarlyStop, HlsInput, PathResult, PlaneSpec};
 use bt_paths::{AllVisible, CandidateSet, enumerate};
 use bt_scene::{Scene, SurfaceId};
-use bt_solve::{Validity, validate::validate};
+use bt_solve::{Validity, image, validate::validate};
 
 /// Largest reflection-law error the host accepts on a fixed-point path, degrees: the angle
 /// between the mirrored incoming direction and the outgoing one at any bounce. Valid paths of
@@ -38,8 +38,8 @@ pub fn reflection_error_deg(
 }
 
 /// The host's check of one accelerator result (the paper's post-processor): converged, valid
-/// in f64 (inside every polygon, same side, unblocked) and obeying the reflection law within
-/// [`REFLECTION_TOLERANCE_DEG`].
+/// in f64 (inside every polygon, same side, unblocked), obeying the reflection law within
+/// [`REFLECTION_TOLERANCE_DEG`], and not an edge case ([`HostRejection::EdgeCase`]).
 pub fn host_accepts(
     scene: &Scene,
     seq: &[SurfaceId],
@@ -60,6 +60,15 @@ pub fn host_accepts(
     if reflection_error_deg(scene, seq, tx, rx, &points) > REFLECTION_TOLERANCE_DEG {
         return Err(HostRejection::ReflectionLaw);
     }
+    // The fixed-point points lie within a few millimetres of the exact ones, so a ray that
+    // passes a blocker's or polygon's edge by less than that is decided on the exact points of
+    // the converged sequence (the image method: microseconds on the host).
+    let mut exact = vec![Vec3::ZERO; seq.len()];
+    if image::solve(scene, seq, tx, rx, &mut exact).is_err()
+        || validate(scene, seq, tx, rx, &exact) != Validity::Valid
+    {
+        return Err(HostRejection::EdgeCase);
+    }
     Ok(points)
 }
 
@@ -73,6 +82,10 @@ pub enum HostRejection {
     /// Converged and valid, but breaks the reflection law by more than the tolerance: a false
     /// convergence of the fixed-point iteration.
     ReflectionLaw,
+    /// Converged, valid and obeying the reflection law, but the exact points of the sequence
+    /// are not a valid path: the fixed-point points slip past an edge (a blocker's, a
+    /// polygon's) that the exact ray hits, closer than the fixed-point error.
+    EdgeCase,
 }
 
 /// Reflectors whose polygon is the same in every scene of `steps` (same id, name and
@@ -128,7 +141,7 @@ pub fn step_input(
     let mut init_points = Vec::new();
     let mut sequences = Vec::new();
     let mut host_sequences = Vec::new();
-    for seq in candidates.iter() {
+    for (i, seq) in candidates.iter().enumerate() {
         if seq.is_empty() {
             continue;
         }
@@ -137,11 +150,13 @@ pub fn step_input(
             continue;
         }
         paths.push(seq.iter().map(|id| plane_of[id.0 as usize]).collect());
-        init_points.push(
-            seq.iter()
+        init_points.push(match candidates.start(i) {
+            Some(starts) => starts.iter().map(|p| p.to_array()).collect(),
+            None => seq
+                .iter()
                 .map(|id| scene.surface(*id).polygon.centroid().to_array())
                 .collect(),
-        );
+        });
         sequences.push(seq.to_vec());
     }
     let planes = planes
@@ -193,4 +208,28 @@ pub fn hls_input(
     let s = step_input(scene, &reflectors, &candidates, threshold_lsb, max_rounds);
     debug_assert!(s.host_sequences.is_empty());
     (s.input, s.sequences)
+}
+
+/// Warm start from the previous time step (as `bt-dynamic` warm-starts its IPC): every path of
+/// `step` whose surface sequence the accelerator ran at the previous step and brought to
+/// convergence starts from the points it converged to there (`previous.sequences[p]` and
+/// `results[p]`, the accelerator's read-back), instead of the beam tree's window centres. The
+/// PEs see the planes, TX and RX only, so with those unchanged such a path converges in one
+/// round; a path that did not converge keeps its cold start. Returns the paths warm-started.
+pub fn warm_start(step: &mut StepInput, previous: &StepInput, results: &[PathResult]) -> usize {
+    let converged: std::collections::HashMap<&[SurfaceId], &PathResult> = previous
+        .sequences
+        .iter()
+        .zip(results)
+        .filter(|(_, r)| r.converged)
+        .map(|(s, r)| (s.as_slice(), r))
+        .collect();
+    let mut warm = 0;
+    for (seq, init) in step.sequences.iter().zip(&mut step.input.init_points) {
+        if let Some(r) = converged.get(seq.as_slice()) {
+            init.clone_from(&r.points_m);
+            warm += 1;
+        }
+    }
+    warm
 }
