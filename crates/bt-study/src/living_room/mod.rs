@@ -16,7 +16,7 @@
 pub mod plot;
 pub mod report;
 
-use crate::run::{Directions, PathMap, compare, exact_directions, run_solver};
+use crate::run::{AngularErrors, Directions, PathMap, compare, exact_directions, run_solver};
 use crate::{StudyConfig, StudyError, StudySolver};
 use bt_accel as fpga;
 use bt_geom::{Real, Vec3};
@@ -174,15 +174,10 @@ pub struct Row {
     pub missed: usize,
     /// Solver paths the image method does not have.
     pub spurious: usize,
-    /// Mean angle between the solver's and the exact departure direction at TX over matched
-    /// paths, degrees (0 when nothing matched).
-    pub mean_err_tx_deg: Real,
-    /// Largest such angle, degrees.
-    pub max_err_tx_deg: Real,
-    /// Mean angle between the solver's and the exact arrival direction at RX, degrees.
-    pub mean_err_rx_deg: Real,
-    /// Largest such angle, degrees.
-    pub max_err_rx_deg: Real,
+    /// Angles between the solver's and the exact departure (TX) and arrival (RX) directions
+    /// over matched paths, degrees (zeros when nothing matched).
+    #[serde(flatten)]
+    pub errors: AngularErrors,
     /// Single-threaded wall-clock time from scene to paths, seconds (candidate enumeration
     /// included; for the fixed-point model: building its input and running it in software).
     pub time_s: Real,
@@ -431,7 +426,7 @@ fn row(
     found: &PathMap,
     time_s: Real,
 ) -> Row {
-    let (matched, missed, spurious, [mean_tx, max_tx, mean_rx, max_rx]) = compare(reference, found);
+    let (matched, missed, spurious, errors) = compare(reference, found);
     Row {
         step,
         solver,
@@ -439,10 +434,7 @@ fn row(
         matched,
         missed,
         spurious,
-        mean_err_tx_deg: mean_tx,
-        max_err_tx_deg: max_tx,
-        mean_err_rx_deg: mean_rx,
-        max_err_rx_deg: max_rx,
+        errors: errors.into(),
         time_s,
     }
 }
@@ -572,8 +564,8 @@ mod tests {
                 StudySolver::IpcFixedPoint => 0.1,
                 StudySolver::Sbr => 90.0,
             };
-            assert!(r.max_err_tx_deg <= limit, "{r:?}");
-            assert!(r.max_err_rx_deg <= limit, "{r:?}");
+            assert!(r.errors.max_err_tx_deg <= limit, "{r:?}");
+            assert!(r.errors.max_err_rx_deg <= limit, "{r:?}");
         }
         for f in &results.fpga {
             assert!(f.cycles > f.points && f.makespan > 0, "{f:?}");

@@ -43,8 +43,8 @@ pub fn angular_error<DB: DrawingBackend>(
     let panels = root.split_evenly((1, 2));
     type Side = fn(&super::Row) -> Real;
     let sides: [(&str, Side); 2] = [
-        ("(a) TX side", |r| r.mean_err_tx_deg),
-        ("(b) RX side", |r| r.mean_err_rx_deg),
+        ("(a) TX side", |r| r.errors.mean_err_tx_deg),
+        ("(b) RX side", |r| r.errors.mean_err_rx_deg),
     ];
     for (area, (title, value)) in panels.iter().zip(sides) {
         let series: Vec<Series> = solvers

@@ -4,6 +4,7 @@
 use super::{CLOCK_HZ, LivingRoomResults, Row, SOLVERS};
 use crate::StudySolver;
 use crate::report::pick;
+use crate::run::AngularErrors;
 use bt_geom::Real;
 use std::collections::BTreeMap;
 use std::fmt::Write;
@@ -45,10 +46,10 @@ pub fn csv(results: &LivingRoomResults) -> String {
             r.matched,
             r.missed,
             r.spurious,
-            r.mean_err_tx_deg,
-            r.max_err_tx_deg,
-            r.mean_err_rx_deg,
-            r.max_err_rx_deg,
+            r.errors.mean_err_tx_deg,
+            r.errors.max_err_tx_deg,
+            r.errors.mean_err_rx_deg,
+            r.errors.max_err_rx_deg,
             r.time_s,
             fpga
         );
@@ -107,14 +108,9 @@ pub struct Totals {
     pub missed: usize,
     /// Spurious paths.
     pub spurious: usize,
-    /// Mean angular error at TX over every matched path of every step, degrees.
-    pub mean_err_tx_deg: Real,
-    /// Largest angular error at TX, degrees.
-    pub max_err_tx_deg: Real,
-    /// Mean angular error at RX over every matched path, degrees.
-    pub mean_err_rx_deg: Real,
-    /// Largest angular error at RX, degrees.
-    pub max_err_rx_deg: Real,
+    /// Angular errors over every matched path of every step (means weighted by matched
+    /// paths), degrees.
+    pub errors: AngularErrors,
     /// Mean time per step, seconds.
     pub mean_time_s: Real,
 }
@@ -129,18 +125,18 @@ pub fn totals(rows: &[Row]) -> BTreeMap<StudySolver, Totals> {
         t.paths += r.paths;
         t.missed += r.missed;
         t.spurious += r.spurious;
-        t.mean_err_tx_deg += r.mean_err_tx_deg * r.matched as Real;
-        t.mean_err_rx_deg += r.mean_err_rx_deg * r.matched as Real;
-        t.max_err_tx_deg = t.max_err_tx_deg.max(r.max_err_tx_deg);
-        t.max_err_rx_deg = t.max_err_rx_deg.max(r.max_err_rx_deg);
+        t.errors.mean_err_tx_deg += r.errors.mean_err_tx_deg * r.matched as Real;
+        t.errors.mean_err_rx_deg += r.errors.mean_err_rx_deg * r.matched as Real;
+        t.errors.max_err_tx_deg = t.errors.max_err_tx_deg.max(r.errors.max_err_tx_deg);
+        t.errors.max_err_rx_deg = t.errors.max_err_rx_deg.max(r.errors.max_err_rx_deg);
         t.mean_time_s += r.time_s;
         *matched += r.matched;
     }
     out.into_iter()
         .map(|(s, (mut t, matched))| {
             let m = matched.max(1) as Real;
-            t.mean_err_tx_deg /= m;
-            t.mean_err_rx_deg /= m;
+            t.errors.mean_err_tx_deg /= m;
+            t.errors.mean_err_rx_deg /= m;
             t.mean_time_s /= t.steps.max(1) as Real;
             (s, t)
         })
@@ -193,11 +189,11 @@ pub fn headline(results: &LivingRoomResults) -> Headline {
             (lo.min(x), hi.max(x))
         });
     Headline {
-        fixed_err_deg: [fixed.mean_err_tx_deg, fixed.mean_err_rx_deg],
-        fixed_max_err_deg: [fixed.max_err_tx_deg, fixed.max_err_rx_deg],
-        sbr_err_deg: [sbr.mean_err_tx_deg, sbr.mean_err_rx_deg],
-        ipc_err_deg: [gs.mean_err_tx_deg, gs.mean_err_rx_deg],
-        sbr_over_fixed_error: sbr.mean_err_tx_deg / fixed.mean_err_tx_deg,
+        fixed_err_deg: [fixed.errors.mean_err_tx_deg, fixed.errors.mean_err_rx_deg],
+        fixed_max_err_deg: [fixed.errors.max_err_tx_deg, fixed.errors.max_err_rx_deg],
+        sbr_err_deg: [sbr.errors.mean_err_tx_deg, sbr.errors.mean_err_rx_deg],
+        ipc_err_deg: [gs.errors.mean_err_tx_deg, gs.errors.mean_err_rx_deg],
+        sbr_over_fixed_error: sbr.errors.mean_err_tx_deg / fixed.errors.mean_err_tx_deg,
         fpga_mean_latency_s: mean_lat,
         fpga_latency_range_s: if lat.is_empty() { (0.0, 0.0) } else { range },
         sbr_over_ipc_time: sbr.mean_time_s / gs.mean_time_s,
@@ -290,10 +286,10 @@ fn per_solver(results: &LivingRoomResults) -> String {
             t.paths,
             t.missed,
             t.spurious,
-            t.mean_err_tx_deg,
-            t.max_err_tx_deg,
-            t.mean_err_rx_deg,
-            t.max_err_rx_deg,
+            t.errors.mean_err_tx_deg,
+            t.errors.max_err_tx_deg,
+            t.errors.mean_err_rx_deg,
+            t.errors.max_err_rx_deg,
             t.mean_time_s * 1e3
         );
     }
@@ -336,7 +332,7 @@ fn per_step(results: &LivingRoomResults) -> String {
             get(StudySolver::Sbr),
             get(StudySolver::IpcFixedPoint),
         );
-        let err = |r: &Row| format!("{:.1e} / {:.1e}", r.mean_err_tx_deg, r.mean_err_rx_deg);
+        let err = |r: &Row| format!("{:.1e} / {:.1e}", r.errors.mean_err_tx_deg, r.errors.mean_err_rx_deg);
         let _ = writeln!(
             s,
             "| {} | {} | {} | {} | {} | {} | {} | {} | {} / {} | {} / {} | {:.2} | {:.2} | {:.2} | {:.2} | {} | {} | {:.3} | {:.2} |",
@@ -374,10 +370,7 @@ fn row_or_empty(results: &LivingRoomResults, step: usize, solver: StudySolver) -
         matched: 0,
         missed: 0,
         spurious: 0,
-        mean_err_tx_deg: 0.0,
-        max_err_tx_deg: 0.0,
-        mean_err_rx_deg: 0.0,
-        max_err_rx_deg: 0.0,
+        errors: AngularErrors::default(),
         time_s: 0.0,
     })
 }
