@@ -25,6 +25,7 @@ use bt_geom::bvh::box_meets_halfspaces;
 use bt_geom::{Plane, Real, Vec3, convex};
 use bt_scene::{Scene, SurfaceId, SurfaceKind};
 use serde::Serialize;
+use std::cell::OnceCell;
 
 /// How the tree is built.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -188,21 +189,17 @@ const COVER: Real = 4.0;
 /// beam meets most boxes, so the walk only adds its inner nodes and a sort.
 const LINEAR_SCAN: usize = 64;
 
-/// Per-surface data of one build.
+/// Per-surface data of one build. Hulls and convexity are computed on first use: a city
+/// trace at order 1 tests 19,846 reflectors and needs the hull of a handful.
 struct Prepared<'a> {
     scene: &'a Scene,
     tol: Real,
     /// Each surface's plane, contiguous (the leaf test reads one per child).
     planes: Vec<Plane>,
-    /// Grown convex hull of each reflector (empty for blockers).
-    hulls: Vec<Vec<Vec3>>,
-    /// Inward side planes of each grown hull's edges (perpendicular to the surface), in
-    /// `edges[edge_ranges[s]]`: a point of the surface's plane lies in the hull when it is on
-    /// the inner side of all of them.
-    edges: Vec<Plane>,
-    edge_ranges: Vec<(u32, u32)>,
-    /// Whether each surface is convex (only convex surfaces cull).
-    convex: Vec<bool>,
+    /// Grown convex hull of each reflector (empty for blockers), once asked for.
+    hulls: Vec<OnceCell<Vec<Vec3>>>,
+    /// Whether each surface is convex (only convex surfaces cull), once asked for.
+    convex: Vec<OnceCell<bool>>,
     reflectors: Vec<u32>,
     options: TreeOptions,
     /// Test every node for occlusion as it is built (see [`Culling`]).
@@ -211,25 +208,7 @@ struct Prepared<'a> {
 
 impl<'a> Prepared<'a> {
     fn new(scene: &'a Scene, options: TreeOptions) -> Self {
-        let tol = scene.length_tolerance();
         let surfaces = scene.surfaces();
-        let hulls: Vec<Vec<Vec3>> = surfaces
-            .iter()
-            .map(|s| match s.kind {
-                SurfaceKind::Reflector => convex::grown_hull(&s.polygon, GROW * tol),
-                SurfaceKind::Blocker => Vec::new(),
-            })
-            .collect();
-        let mut edges = Vec::new();
-        let edge_ranges = surfaces
-            .iter()
-            .zip(&hulls)
-            .map(|(s, hull)| push_range(&mut edges, &hull_edge_planes(s.polygon.plane(), hull)))
-            .collect();
-        let convex = surfaces
-            .iter()
-            .map(|s| convex::is_convex(&s.polygon))
-            .collect();
         let reflectors: Vec<u32> = scene.reflectors().map(|id| id.0).collect();
         let cull_at_build = match options.culling {
             Culling::Off => false,
@@ -238,13 +217,11 @@ impl<'a> Prepared<'a> {
         };
         Prepared {
             planes: surfaces.iter().map(|s| *s.polygon.plane()).collect(),
+            hulls: surfaces.iter().map(|_| OnceCell::new()).collect(),
+            convex: surfaces.iter().map(|_| OnceCell::new()).collect(),
             cull_at_build,
             scene,
-            tol,
-            hulls,
-            edges,
-            edge_ranges,
-            convex,
+            tol: scene.length_tolerance(),
             reflectors,
             options,
         }
@@ -254,26 +231,22 @@ impl<'a> Prepared<'a> {
         &self.planes[s as usize]
     }
 
-    /// Whether `x`, a point of surface `s`'s plane, lies in its grown hull (margin `eps`).
-    fn in_hull(&self, s: u32, x: Vec3, eps: Real) -> bool {
-        let (lo, hi) = self.edge_ranges[s as usize];
-        self.edges[lo as usize..hi as usize]
-            .iter()
-            .all(|pl| pl.signed_distance_unfused(x) >= -eps)
-    }
-}
-
-/// The inward side planes of the convex `hull`'s edges, perpendicular to `plane`.
-fn hull_edge_planes(plane: &Plane, hull: &[Vec3]) -> Vec<Plane> {
-    let n = hull.len();
-    let inner = convex::vertex_mean(hull);
-    (0..n)
-        .filter_map(|i| {
-            let (a, b) = (hull[i], hull[(i + 1) % n]);
-            let normal = plane.normal.cross(b - a).normalize_or_zero();
-            (normal != Vec3::ZERO).then(|| orient_towards(Plane::from_point_normal(a, normal), inner))
+    /// The grown convex hull of surface `s` (empty for a blocker).
+    fn hull(&self, s: u32) -> &[Vec3] {
+        self.hulls[s as usize].get_or_init(|| {
+            let surface = self.scene.surface(SurfaceId(s));
+            match surface.kind {
+                SurfaceKind::Reflector => convex::grown_hull(&surface.polygon, GROW * self.tol),
+                SurfaceKind::Blocker => Vec::new(),
+            }
         })
-        .collect()
+    }
+
+    /// Whether surface `s` is convex.
+    fn is_convex(&self, s: u32) -> bool {
+        *self.convex[s as usize]
+            .get_or_init(|| convex::is_convex(&self.scene.surface(SurfaceId(s)).polygon))
+    }
 }
 
 /// `plane`, flipped if needed so that `inner` is on its non-negative side.
@@ -600,7 +573,7 @@ impl BeamTree {
         }
         let eps = EPS * prep.tol;
         scratch.a.clear();
-        scratch.a.extend_from_slice(&prep.hulls[s as usize]);
+        scratch.a.extend_from_slice(prep.hull(s));
         for pl in parent.planes {
             convex::clip(&scratch.a, pl, eps, &mut scratch.b);
             std::mem::swap(&mut scratch.a, &mut scratch.b);
@@ -661,16 +634,18 @@ impl BeamTree {
             .planes
             .iter()
             .all(|p| p.signed_distance_unfused(x) >= -eps)
-            || !prep.in_hull(s, x, eps)
         {
             return;
         }
         let polygon = &prep.scene.surface(SurfaceId(s)).polygon;
+        if !polygon.contains(x, GROW * tol) {
+            return;
+        }
         let mut seq = Vec::with_capacity(self.max_order);
         let mut starts = Vec::with_capacity(self.max_order);
         self.prefix(parent.index, &mut seq, &mut starts);
         seq.push(SurfaceId(s));
-        let mut window = prep.hulls[s as usize].clone();
+        let mut window = prep.hull(s).to_vec();
         let mut tmp = Vec::new();
         for pl in parent.planes {
             convex::clip(&window, pl, eps, &mut tmp);
@@ -776,7 +751,7 @@ fn occlude(
         scene.bvh().visit_segment(a, q, |item| {
             if Some(item) == parent.surface
                 || item == s
-                || !prep.convex[item as usize]
+                || !prep.is_convex(item)
                 || tested.contains(&item)
             {
                 return;
