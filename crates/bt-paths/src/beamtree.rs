@@ -201,6 +201,8 @@ struct Prepared<'a> {
     /// Whether each surface is convex (only convex surfaces cull), once asked for.
     convex: Vec<OnceCell<bool>>,
     reflectors: Vec<u32>,
+    /// Whether each surface reflects (children are reflectors only).
+    is_reflector: Vec<bool>,
     options: TreeOptions,
     /// Test every node for occlusion as it is built (see [`Culling`]).
     cull_at_build: bool,
@@ -219,6 +221,10 @@ impl<'a> Prepared<'a> {
             planes: surfaces.iter().map(|s| *s.polygon.plane()).collect(),
             hulls: surfaces.iter().map(|_| OnceCell::new()).collect(),
             convex: surfaces.iter().map(|_| OnceCell::new()).collect(),
+            is_reflector: surfaces
+                .iter()
+                .map(|s| s.kind == SurfaceKind::Reflector)
+                .collect(),
             cull_at_build,
             scene,
             tol: scene.length_tolerance(),
@@ -553,9 +559,7 @@ impl BeamTree {
         scene.bvh().visit(
             |lo, hi| box_meets_halfspaces(lo, hi, parent.planes, eps),
             |item| {
-                if Some(item) != parent.surface
-                    && scene.surface(SurfaceId(item)).kind == SurfaceKind::Reflector
-                {
+                if Some(item) != parent.surface && prep.is_reflector[item as usize] {
                     out.push(item);
                 }
             },
@@ -757,7 +761,7 @@ fn occlude(
                 return;
             }
             let polygon = &scene.surface(SurfaceId(item)).polygon;
-            if polygon.blocks_segment(a, q, 0.0, 0.0) {
+            if crosses(polygon, a, q) {
                 hits.push((polygon.centroid().distance_squared(parent.apex), item));
             }
         });
@@ -794,6 +798,22 @@ fn occlude(
     scratch.starts = starts;
     scratch.rays = window_rays;
     covered
+}
+
+/// Whether the segment `a -> q` passes through `polygon` (its plane crossed, the crossing inside
+/// or on the boundary). Only picks which occluders to try: [`between`] and [`shadow`] decide,
+/// with margins, so the unfused distances' round-off cannot matter.
+fn crosses(polygon: &bt_geom::Polygon, a: Vec3, q: Vec3) -> bool {
+    let plane = polygon.plane();
+    let (da, dq) = (
+        plane.signed_distance_unfused(a),
+        plane.signed_distance_unfused(q),
+    );
+    if (da > 0.0 && dq > 0.0) || (da < 0.0 && dq < 0.0) || da == dq {
+        return false;
+    }
+    let t = da / (da - dq);
+    polygon.contains(a + t * (q - a), 0.0)
 }
 
 /// Whether every segment start lies strictly on one side of `plane` and every window vertex
