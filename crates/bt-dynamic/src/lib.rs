@@ -218,7 +218,7 @@ impl IncrementalTracer {
             return Ok(result);
         }
         let moved = prev.as_ref().and_then(|p| moved_surfaces(&p.scene, scene));
-        let (Some(prev), Some(moved)) = (prev, moved) else {
+        let (Some(mut prev), Some(moved)) = (prev, moved) else {
             return self.full(scene, step);
         };
         let mut update = UpdateStats {
@@ -226,82 +226,12 @@ impl IncrementalTracer {
             terminals_moved: prev.scene.tx() != scene.tx() || prev.scene.rx() != scene.rx(),
             ..UpdateStats::default()
         };
-        let tol = scene.length_tolerance();
-        let everything = update.terminals_moved || tol != prev.scene.length_tolerance();
-
-        let mut wvrn = prev.wvrn;
-        let mut links_changed = false;
-        if let Some(w) = &mut wvrn {
-            let delta = w.update(scene, &moved);
-            update.wvrn_recomputed_pairs = delta.recomputed_pairs;
-            update.wvrn_retested_pairs = delta.retested_pairs;
-            update.wvrn_links_changed = delta.changed.len();
-            links_changed = delta.rebuilt || !delta.changed.is_empty();
-        }
-        let reflector_moved = moved
-            .iter()
-            .any(|id| scene.surface(*id).kind == bt_scene::SurfaceKind::Reflector);
-        // The beam tree depends on the reflectors and on the occluders that culled a node;
-        // any other motion (a person walking) only changes validation.
-        let generator_stale = match options.candidates {
-            CandidateMode::BeamTree => {
-                reflector_moved || moved.iter().any(|id| culled_by(&prev.candidates, *id))
-            }
-            _ => reflector_moved || links_changed,
-        };
-        let candidates = if everything || generator_stale {
-            update.candidates_rederived = true;
-            options.candidates(scene, wvrn.as_ref())?
-        } else {
-            prev.candidates.clone()
-        };
-
-        // Moved surfaces' boxes before and after, padded by the validation's tolerance band.
-        let pad = Vec3::splat(4.0 * tol.max(prev.scene.length_tolerance()));
-        let mut is_moved = vec![false; scene.surfaces().len()];
-        let mut boxes: Vec<(Vec3, Vec3)> = Vec::with_capacity(2 * moved.len());
-        for id in &moved {
-            is_moved[id.index()] = true;
-            for s in [&prev.scene, scene] {
-                let (lo, hi) = s.surface(*id).polygon.bounds();
-                boxes.push((lo - pad, hi + pad));
-            }
-        }
-        let union = boxes
-            .iter()
-            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), (a, b)| {
-                (lo.min(*a), hi.max(*b))
-            });
-        let (tx, rx) = (scene.tx(), scene.rx());
-
-        // Walk both candidate sets in their common order (by length, then by ids).
-        let mut plans = Vec::with_capacity(candidates.len());
-        let mut j = 0;
-        for seq in candidates.iter() {
-            while j < prev.candidates.len()
-                && canonical(prev.candidates.get(j), seq) == Ordering::Less
-            {
-                j += 1;
-            }
-            let old = (j < prev.candidates.len() && prev.candidates.get(j) == seq).then_some(j);
-            let plan = match old {
-                None => Plan::Solve(None),
-                Some(_) if everything || seq.iter().any(|id| is_moved[id.index()]) => {
-                    Plan::Solve(old)
-                }
-                Some(o) => {
-                    let record = &prev.records[o];
-                    let pts =
-                        &prev.points[record.start as usize..record.start as usize + seq.len()];
-                    if depends_on_others(&record.outcome) && touches(&boxes, union, tx, rx, pts) {
-                        Plan::Solve(old)
-                    } else {
-                        Plan::Reuse(o)
-                    }
-                }
-            };
-            plans.push(plan);
-        }
+        let everything =
+            update.terminals_moved || scene.length_tolerance() != prev.scene.length_tolerance();
+        let wvrn = prev.wvrn.take();
+        let (wvrn, candidates) =
+            next_candidates(&options, (wvrn, &prev), scene, &moved, everything, &mut update)?;
+        let plans = plan(&prev, scene, &candidates, &moved, everything);
 
         // Solve the affected candidates (in parallel, order preserved).
         let (solved, solved_points) = solve_planned(
@@ -392,6 +322,99 @@ impl State {
             update,
         }
     }
+}
+
+/// The step's WVRN (the previous one, taken out of `prev`, updated for the moved surfaces)
+/// and candidates: the previous ones while nothing they depend on moved, else generated anew
+/// (counted in `update`).
+fn next_candidates(
+    options: &StepOptions,
+    (mut wvrn, prev): (Option<Wvrn>, &State),
+    scene: &Scene,
+    moved: &[SurfaceId],
+    everything: bool,
+    update: &mut UpdateStats,
+) -> Result<(Option<Wvrn>, CandidateSet), TraceError> {
+    let mut links_changed = false;
+    if let Some(w) = &mut wvrn {
+        let delta = w.update(scene, moved);
+        update.wvrn_recomputed_pairs = delta.recomputed_pairs;
+        update.wvrn_retested_pairs = delta.retested_pairs;
+        update.wvrn_links_changed = delta.changed.len();
+        links_changed = delta.rebuilt || !delta.changed.is_empty();
+    }
+    let reflector_moved = moved
+        .iter()
+        .any(|id| scene.surface(*id).kind == bt_scene::SurfaceKind::Reflector);
+    // The beam tree depends on the reflectors and on the occluders that culled a node;
+    // any other motion (a person walking) only changes validation.
+    let generator_stale = match options.candidates {
+        CandidateMode::BeamTree => {
+            reflector_moved || moved.iter().any(|id| culled_by(&prev.candidates, *id))
+        }
+        _ => reflector_moved || links_changed,
+    };
+    let candidates = if everything || generator_stale {
+        update.candidates_rederived = true;
+        options.candidates(scene, wvrn.as_ref())?
+    } else {
+        prev.candidates.clone()
+    };
+    Ok((wvrn, candidates))
+}
+
+/// Per candidate of the step: reuse the previous outcome, or solve (warm-started from the
+/// previous candidate with the same sequence, if any). Both sets are walked in their common
+/// order (by length, then by ids).
+fn plan(
+    prev: &State,
+    scene: &Scene,
+    candidates: &CandidateSet,
+    moved: &[SurfaceId],
+    everything: bool,
+) -> Vec<Plan> {
+    // Moved surfaces' boxes before and after, padded by the validation's tolerance band.
+    let tol = scene.length_tolerance();
+    let pad = Vec3::splat(4.0 * tol.max(prev.scene.length_tolerance()));
+    let mut is_moved = vec![false; scene.surfaces().len()];
+    let mut boxes: Vec<(Vec3, Vec3)> = Vec::with_capacity(2 * moved.len());
+    for id in moved {
+        is_moved[id.index()] = true;
+        for s in [&prev.scene, scene] {
+            let (lo, hi) = s.surface(*id).polygon.bounds();
+            boxes.push((lo - pad, hi + pad));
+        }
+    }
+    let union = boxes
+        .iter()
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), (a, b)| {
+            (lo.min(*a), hi.max(*b))
+        });
+    let (tx, rx) = (scene.tx(), scene.rx());
+    let mut plans = Vec::with_capacity(candidates.len());
+    let mut j = 0;
+    for seq in candidates.iter() {
+        while j < prev.candidates.len() && canonical(prev.candidates.get(j), seq) == Ordering::Less
+        {
+            j += 1;
+        }
+        let old = (j < prev.candidates.len() && prev.candidates.get(j) == seq).then_some(j);
+        let plan = match old {
+            None => Plan::Solve(None),
+            Some(_) if everything || seq.iter().any(|id| is_moved[id.index()]) => Plan::Solve(old),
+            Some(o) => {
+                let record = &prev.records[o];
+                let pts = &prev.points[record.start as usize..record.start as usize + seq.len()];
+                if depends_on_others(&record.outcome) && touches(&boxes, union, tx, rx, pts) {
+                    Plan::Solve(old)
+                } else {
+                    Plan::Reuse(o)
+                }
+            }
+        };
+        plans.push(plan);
+    }
+    plans
 }
 
 /// What the incremental step does with one candidate: reuse the previous outcome at this index,
