@@ -136,6 +136,40 @@ struct System {
 }
 
 impl System {
+    /// The Newton system of the path length in the points' in-plane frames (`frames[k]`),
+    /// from the segments' unit directions and inverse lengths (`dirs[j]`, segment `j` ending
+    /// at point `j`): block-tridiagonal Hessian and minus the gradient. Returns the Hessian's
+    /// scale, its largest diagonal entry (the stiffest segment's 1/ℓ).
+    fn assemble(&mut self, frames: &[(Vec3, Vec3)], dirs: &[(Vec3, Real)]) -> Real {
+        let n = frames.len();
+        let mut scale: Real = 0.0;
+        for k in 0..n {
+            let (u, v) = frames[k];
+            let (r_in, inv_in) = dirs[k];
+            let (r_out, inv_out) = dirs[k + 1];
+            let g = r_in - r_out;
+            let b = bilinear(u, v, r_in, inv_in) + bilinear(u, v, r_out, inv_out);
+            self.diag[k] = M2 {
+                a: bilinear(u, u, r_in, inv_in) + bilinear(u, u, r_out, inv_out),
+                b,
+                c: b,
+                d: bilinear(v, v, r_in, inv_in) + bilinear(v, v, r_out, inv_out),
+            };
+            scale = scale.max(self.diag[k].a).max(self.diag[k].d);
+            self.rhs[k] = [-u.dot(g), -v.dot(g)];
+            if k + 1 < n {
+                let (u2, v2) = frames[k + 1];
+                self.upper[k] = M2 {
+                    a: -bilinear(u, u2, r_out, inv_out),
+                    b: -bilinear(u, v2, r_out, inv_out),
+                    c: -bilinear(v, u2, r_out, inv_out),
+                    d: -bilinear(v, v2, r_out, inv_out),
+                };
+            }
+        }
+        scale
+    }
+
     /// Solve (H + mu I) δ = −g by block elimination into `step`; false when a pivot block is
     /// singular.
     fn solve(&self, n: usize, mu: Real, step: &mut [[Real; 2]; MAX_ORDER]) -> bool {
@@ -236,32 +270,7 @@ pub fn polish(
                 None => return fail(points, steps),
             }
         }
-        // Hessian scale: the largest diagonal entry (the stiffest segment's 1/ℓ).
-        let mut scale: Real = 0.0;
-        for k in 0..n {
-            let (u, v) = frames[k];
-            let (r_in, inv_in) = dirs[k];
-            let (r_out, inv_out) = dirs[k + 1];
-            let g = r_in - r_out;
-            let b = bilinear(u, v, r_in, inv_in) + bilinear(u, v, r_out, inv_out);
-            system.diag[k] = M2 {
-                a: bilinear(u, u, r_in, inv_in) + bilinear(u, u, r_out, inv_out),
-                b,
-                c: b,
-                d: bilinear(v, v, r_in, inv_in) + bilinear(v, v, r_out, inv_out),
-            };
-            scale = scale.max(system.diag[k].a).max(system.diag[k].d);
-            system.rhs[k] = [-u.dot(g), -v.dot(g)];
-            if k + 1 < n {
-                let (u2, v2) = frames[k + 1];
-                system.upper[k] = M2 {
-                    a: -bilinear(u, u2, r_out, inv_out),
-                    b: -bilinear(u, v2, r_out, inv_out),
-                    c: -bilinear(v, u2, r_out, inv_out),
-                    d: -bilinear(v, v2, r_out, inv_out),
-                };
-            }
-        }
+        let scale = system.assemble(&frames[..n], &dirs[..=n]);
         let mu_min = 1e-9 * scale;
         current[..n].copy_from_slice(points);
         // Try: undamped full step, undamped half step, then growing damping.
