@@ -150,60 +150,9 @@ impl Scene {
                 ),
             );
         }
-        let mut materials = default_materials();
-        for (name, m) in &desc.materials {
-            if let Err(e) = crate::name::check(name) {
-                problems.push("materials", e);
-            }
-            let location = format!("materials.{}", crate::name::escape(name));
-            if let Some(material) = material_from_desc(
-                &location,
-                m,
-                frequency_ok.then_some(frequency_hz),
-                &mut problems,
-            ) {
-                materials.insert(name.clone(), material);
-            }
-        }
-
-        let mut raw: Vec<RawSurface> = Vec::new();
-        for (i, s) in desc.surfaces.iter().enumerate() {
-            raw.push(RawSurface {
-                location: format!("surfaces[{i}] \"{}\"", crate::name::escape(&s.name)),
-                name: s.name.clone(),
-                material: s.material.clone(),
-                kind: s.kind.unwrap_or(SurfaceKind::Reflector),
-                vertices: s.vertices.iter().map(|v| Vec3::from_array(*v)).collect(),
-            });
-        }
-        for (i, b) in desc.boxes.iter().enumerate() {
-            let location = format!("boxes[{i}] \"{}\"", crate::name::escape(&b.name));
-            for o in &b.omit {
-                if !BOX_FACES.iter().any(|(f, _, _)| f == o) {
-                    problems.push(format!("{location}.omit"), format!("unknown face \"{o}\" (expected top, bottom, west, east, south or north)"));
-                }
-            }
-            let (lo, hi) = (Vec3::from_array(b.min), Vec3::from_array(b.max));
-            if !(lo.is_finite() && hi.is_finite()) || lo.cmpge(hi).any() {
-                problems.push(
-                    location,
-                    "min must be finite and strictly below max on every axis",
-                );
-                continue;
-            }
-            for (face, axis, is_max) in BOX_FACES {
-                if b.omit.iter().any(|o| o == face) {
-                    continue;
-                }
-                raw.push(RawSurface {
-                    location: format!("{location}.{face}"),
-                    name: format!("{}.{face}", b.name),
-                    material: b.material.clone(),
-                    kind: b.kind.unwrap_or(SurfaceKind::Reflector),
-                    vertices: box_face(lo, hi, axis, is_max),
-                });
-            }
-        }
+        let materials =
+            described_materials(desc, frequency_ok.then_some(frequency_hz), &mut problems);
+        let mut raw = raw_surfaces(desc, &mut problems);
         let given = [
             terminals.tx.or(desc.tx.map(Vec3::from_array)),
             terminals.rx.or(desc.rx.map(Vec3::from_array)),
@@ -246,6 +195,74 @@ impl Scene {
             materials,
         ))
     }
+}
+
+/// The built-in materials and the description's own, checked (names, radio models at
+/// `frequency_hz` when it is valid).
+fn described_materials(
+    desc: &SceneDescription,
+    frequency_hz: Option<Real>,
+    problems: &mut Collector,
+) -> std::collections::BTreeMap<String, Material> {
+    let mut materials = default_materials();
+    for (name, m) in &desc.materials {
+        if let Err(e) = crate::name::check(name) {
+            problems.push("materials", e);
+        }
+        let location = format!("materials.{}", crate::name::escape(name));
+        if let Some(material) = material_from_desc(&location, m, frequency_hz, &mut *problems) {
+            materials.insert(name.clone(), material);
+        }
+    }
+    materials
+}
+
+/// The description's surfaces and its boxes' faces, before any geometric check.
+fn raw_surfaces(desc: &SceneDescription, problems: &mut Collector) -> Vec<RawSurface> {
+    let mut raw: Vec<RawSurface> = Vec::new();
+    for (i, s) in desc.surfaces.iter().enumerate() {
+        raw.push(RawSurface {
+            location: format!("surfaces[{i}] \"{}\"", crate::name::escape(&s.name)),
+            name: s.name.clone(),
+            material: s.material.clone(),
+            kind: s.kind.unwrap_or(SurfaceKind::Reflector),
+            vertices: s.vertices.iter().map(|v| Vec3::from_array(*v)).collect(),
+        });
+    }
+    for (i, b) in desc.boxes.iter().enumerate() {
+        let location = format!("boxes[{i}] \"{}\"", crate::name::escape(&b.name));
+        for o in &b.omit {
+            if !BOX_FACES.iter().any(|(f, _, _)| f == o) {
+                problems.push(
+                    format!("{location}.omit"),
+                    format!(
+                        "unknown face \"{o}\" (expected top, bottom, west, east, south or north)"
+                    ),
+                );
+            }
+        }
+        let (lo, hi) = (Vec3::from_array(b.min), Vec3::from_array(b.max));
+        if !(lo.is_finite() && hi.is_finite()) || lo.cmpge(hi).any() {
+            problems.push(
+                location,
+                "min must be finite and strictly below max on every axis",
+            );
+            continue;
+        }
+        for (face, axis, is_max) in BOX_FACES {
+            if b.omit.iter().any(|o| o == face) {
+                continue;
+            }
+            raw.push(RawSurface {
+                location: format!("{location}.{face}"),
+                name: format!("{}.{face}", b.name),
+                material: b.material.clone(),
+                kind: b.kind.unwrap_or(SurfaceKind::Reflector),
+                vertices: box_face(lo, hi, axis, is_max),
+            });
+        }
+    }
+    raw
 }
 
 impl Scene {
