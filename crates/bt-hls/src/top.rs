@@ -5,7 +5,7 @@ use bt_fixed::width;
 
 use crate::input::{Layout, PE_LATENCY, bits_for, sched_entry_bits};
 use crate::pe::{POINT_BITS, SUM_BITS, pe_module_name, port};
-use crate::verilog::{BinaryOp, Direction, Expr, Item, Module, Stmt, UnaryOp};
+use crate::verilog::{BinaryOp, Direction, Expr, Item, Module, Signal, Stmt, UnaryOp};
 
 /// FSM state encodings.
 const S_IDLE: u128 = 0;
@@ -69,25 +69,62 @@ fn zero_extend(name: &str, from: u32, to: u32) -> Expr {
     }
 }
 
-pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
-    let l = &d.layout;
-    let k = l.num_instances;
-    let (pb, ptb, ib, sb) = (l.path_bits, l.point_bits, l.inst_bits, l.slot_bits);
-    let eb = l.entry_bits;
-    let np2 = 1u32 << pb;
-    let depth = 1u32 << (ptb + 1);
-    let cw = width::COORD;
-    let dispw = cw + 1;
-    let sw = sched_entry_bits(pb, ptb, ib);
-    let cnt_bits = bits_for(u64::from((k + 2).max(PE_LATENCY)) + 1);
-    let status_bits = l.status_base.trailing_zeros();
-    let point_bits_addr = l.point_base.trailing_zeros();
-    let sched_bits_addr = l.sched_base.trailing_zeros();
-    let cap = d.platform.capacity;
-    let mut items = Vec::new();
-    let mut unused: Vec<Expr> = vec![lit(1, 0)];
-    let early = d.model.early_stop().map(|(s, b)| (*s, b.to_vec()));
+/// The sizes every block of `bt_top` is built from, derived once from the layout.
+struct Dims<'a> {
+    /// The platform, its model and layout.
+    p: &'a TopParams<'a>,
+    /// PE instances.
+    k: u32,
+    /// Path, point, instance, slot and schedule-entry address bits.
+    pb: u32,
+    ptb: u32,
+    ib: u32,
+    sb: u32,
+    eb: u32,
+    /// Path slots (`2^pb`): the width of the per-path flag vectors.
+    np2: u32,
+    /// Width of the step counter `cnt`.
+    cnt_bits: u32,
+    /// Word address bits of the Avalon-MM slave.
+    ab: u32,
+    /// Early stopping rule and the widened box of every plane, when enabled.
+    early: Option<(bt_fixed::EarlyStop, Vec<bt_fixed::FineBox>)>,
+}
 
+impl<'a> Dims<'a> {
+    fn of(p: &'a TopParams<'a>) -> Self {
+        let l = &p.layout;
+        Dims {
+            p,
+            k: l.num_instances,
+            pb: l.path_bits,
+            ptb: l.point_bits,
+            ib: l.inst_bits,
+            sb: l.slot_bits,
+            eb: l.entry_bits,
+            np2: 1u32 << l.path_bits,
+            cnt_bits: bits_for(u64::from((l.num_instances + 2).max(PE_LATENCY)) + 1),
+            ab: l.address_bits,
+            early: p.model.early_stop().map(|(s, b)| (*s, b.to_vec())),
+        }
+    }
+}
+
+/// The per-instance wires of the PE matrix.
+struct PeWires {
+    /// `pe_load_<j>`: latch the broadcast operands.
+    load: Signal,
+    /// `pe_sum_<j>`: the unsaturated result.
+    sum: Signal,
+    /// `pe_zs_<j>`: zero distance sum (degenerate path).
+    zs: Signal,
+}
+
+/// Header comment, the controller's registers, the per-path flag vectors, the `rounds` and
+/// point memories and the PE wires. All state is declared first, as the golden files show it.
+fn declare_state(t: &Dims<'_>, items: &mut Vec<Item>) -> Vec<PeWires> {
+    let (k, pb, ptb, ib, sb, eb, np2) = (t.k, t.pb, t.ptb, t.ib, t.sb, t.eb, t.np2);
+    let cap = t.p.platform.capacity;
     items.push(Item::Comment(format!(
         "{} PE instances, capacity {} paths, {} points, {} slots; 2 x (jobs + 2) + {} cycles per slot, threshold {} fine LSB",
         k,
@@ -95,11 +132,11 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
         cap.points,
         cap.slots,
         PE_LATENCY,
-        d.platform.threshold_lsb
+        t.p.platform.threshold_lsb
     )));
     for (n, w) in [
         ("state", STATE_BITS),
-        ("cnt", cnt_bits),
+        ("cnt", t.cnt_bits),
         ("slot", sb),
         ("sbase", eb),
         ("slots_r", sb + 1),
@@ -123,7 +160,7 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
         ("pov", np2),
         ("rd_a", POINT_BITS),
         ("rd_b", POINT_BITS),
-        ("sched_q", sw),
+        ("sched_q", sched_entry_bits(pb, ptb, ib)),
         ("sq_ok", 1),
         ("seen_tail", 1),
         ("ld_q_en", 1),
@@ -145,125 +182,211 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
     ] {
         items.push(Item::Reg(n.into(), w));
     }
-    if early.is_some() {
+    if t.early.is_some() {
         items.push(Item::Reg("lb".into(), np2));
         items.push(Item::Reg("plb".into(), np2));
     }
     items.push(Item::Memory("rounds".into(), 16, np2));
     // Two copies of the point memory (one per read port, both written): each is a plain
     // 1-write 1-read array with a registered read, which Yosys maps to M9K blocks.
+    let depth = 1u32 << (ptb + 1);
     items.push(Item::Memory("pm_a".into(), POINT_BITS, depth));
     items.push(Item::Memory("pm_b".into(), POINT_BITS, depth));
-    for j in 0..k {
-        items.push(Item::Wire(format!("pe_load_{j}"), 1));
-        items.push(Item::Wire(format!("pe_sum_{j}"), SUM_BITS));
-        items.push(Item::Wire(format!("pe_zs_{j}"), 1));
-    }
+    (0..k)
+        .map(|j| PeWires {
+            load: Signal::wire(items, format!("pe_load_{j}"), 1),
+            sum: Signal::wire(items, format!("pe_sum_{j}"), SUM_BITS),
+            zs: Signal::wire(items, format!("pe_zs_{j}"), 1),
+        })
+        .collect()
+}
 
-    // Bus address decode.
-    let ab = l.address_bits;
+/// The Avalon-MM address decode: which region a bus access hits, and the host's write strobes.
+struct Decode {
+    /// The controller is idle (the host owns the memories).
+    idle: Signal,
+    /// Control registers (`avs_address < 16`).
+    is_ctrl: Signal,
+    /// Per-path status words.
+    is_status: Signal,
+    /// Point memory window.
+    is_point: Signal,
+    /// Schedule memory window.
+    is_sched: Signal,
+    /// The point index of a point-window address.
+    bus_point: Signal,
+    /// A host write while idle.
+    host_wr: Signal,
+    /// The host writes a point's last word (fractions): the point memory write strobe.
+    pt_we: Signal,
+}
+
+/// Bus address decode.
+fn bus_decode(t: &Dims<'_>, items: &mut Vec<Item>) -> Decode {
+    let l = &t.p.layout;
+    let ab = t.ab;
     let hi = ab - 1;
-    items.push(Item::Wire("idle".into(), 1));
-    items.push(Item::Assign(id("idle"), state_is(S_IDLE)));
-    items.push(Item::Wire("is_ctrl".into(), 1));
-    items.push(Item::Assign(
-        id("is_ctrl"),
+    let window = |items: &mut Vec<Item>, name: &str, base: u32| {
+        let bits = base.trailing_zeros();
+        Signal::assigned(
+            items,
+            name,
+            1,
+            Expr::slice("avs_address", hi, bits).eq(lit(ab - bits, 1)),
+        )
+    };
+    let idle = Signal::assigned(items, "idle", 1, state_is(S_IDLE));
+    let is_ctrl = Signal::assigned(
+        items,
+        "is_ctrl",
+        1,
         Expr::slice("avs_address", hi, 4).eq(lit(ab - 4, 0)),
-    ));
-    items.push(Item::Wire("is_status".into(), 1));
-    items.push(Item::Assign(
-        id("is_status"),
-        Expr::slice("avs_address", hi, status_bits).eq(lit(ab - status_bits, 1)),
-    ));
-    items.push(Item::Wire("is_point".into(), 1));
-    items.push(Item::Assign(
-        id("is_point"),
-        Expr::slice("avs_address", hi, point_bits_addr).eq(lit(ab - point_bits_addr, 1)),
-    ));
-    items.push(Item::Wire("is_sched".into(), 1));
-    items.push(Item::Assign(
-        id("is_sched"),
-        Expr::slice("avs_address", hi, sched_bits_addr).eq(lit(ab - sched_bits_addr, 1)),
-    ));
-    items.push(Item::Wire("bus_point".into(), ptb));
-    items.push(Item::Assign(
-        id("bus_point"),
-        Expr::slice("avs_address", ptb + 2, 3),
-    ));
-    items.push(Item::Wire("host_wr".into(), 1));
-    items.push(Item::Assign(id("host_wr"), id("avs_write").and(id("idle"))));
-    items.push(Item::Wire("pt_we".into(), 1));
-    items.push(Item::Assign(
-        id("pt_we"),
-        id("host_wr")
-            .and(id("is_point"))
+    );
+    let is_status = window(items, "is_status", l.status_base);
+    let is_point = window(items, "is_point", l.point_base);
+    let is_sched = window(items, "is_sched", l.sched_base);
+    let bus_point = Signal::assigned(
+        items,
+        "bus_point",
+        t.ptb,
+        Expr::slice("avs_address", t.ptb + 2, 3),
+    );
+    let host_wr = Signal::assigned(items, "host_wr", 1, id("avs_write").and(idle.e()));
+    let pt_we = Signal::assigned(
+        items,
+        "pt_we",
+        1,
+        host_wr
+            .e()
+            .and(is_point.e())
             .and(Expr::slice("avs_address", 1, 0).eq(lit(2, 3))),
-    ));
+    );
+    Decode {
+        idle,
+        is_ctrl,
+        is_status,
+        is_point,
+        is_sched,
+        bus_point,
+        host_wr,
+        pt_we,
+    }
+}
 
-    // Schedule memory (M9K): the jobs packed slot after slot (ascending PE column, each
-    // slot's last one flagged `tail`), written by the host, read one cycle after the address
-    // sbase + cnt (sbase = the slot's first entry): entry cnt - 1 is in sched_q. Entries after
-    // the tail are never used (`stop`), so a slot takes 2 x (jobs + 2) + PE_LATENCY cycles
-    // whatever the PE count.
+/// The fields of the schedule entry read this cycle (`sched_q`, gated by `sq_ok`).
+struct ScheduleRead {
+    /// The entry is a job.
+    valid: Signal,
+    /// The slot's last entry.
+    tail: Signal,
+    /// The slot's tail was read (this cycle or before): later entries are not used.
+    stop: Signal,
+    /// Path, point (1-based, inner points) and PE column of the job.
+    path: Signal,
+    point: Signal,
+    inst: Signal,
+    /// The job's previous point is the transmitter.
+    first: Signal,
+    /// The job's next point is the receiver.
+    last: Signal,
+    /// The job closes its path's round.
+    end: Signal,
+}
+
+/// Schedule memory (M9K): the jobs packed slot after slot (ascending PE column, each slot's
+/// last one flagged `tail`), written by the host, read one cycle after the address
+/// sbase + cnt (sbase = the slot's first entry): entry cnt - 1 is in sched_q. Entries after
+/// the tail are never used (`stop`), so a slot takes 2 x (jobs + 2) + PE_LATENCY cycles
+/// whatever the PE count.
+fn schedule_memory(t: &Dims<'_>, bus: &Decode, items: &mut Vec<Item>) -> ScheduleRead {
+    let (pb, ptb, ib, eb, cnt_bits) = (t.pb, t.ptb, t.ib, t.eb, t.cnt_bits);
+    let sw = sched_entry_bits(pb, ptb, ib);
     items.push(Item::Comment(format!(
         "PE schedule memory, written per step by the host: entry -> {{column, tail, end, last, first, point, path, valid}} ({sw} bits)"
     )));
-    items.push(Item::Wire("sched_addr".into(), eb));
-    items.push(Item::Assign(
-        id("sched_addr"),
+    let sched_addr = Signal::assigned(
+        items,
+        "sched_addr",
+        eb,
         id("sbase").plus(zero_extend("cnt", cnt_bits, eb)),
-    ));
-    items.push(Item::Wire("rom_tail".into(), 1));
-    items.push(Item::Assign(
-        id("rom_tail"),
+    );
+    let tail = Signal::assigned(
+        items,
+        "rom_tail",
+        1,
         Expr::bit("sched_q", 4 + pb + ptb).and(id("sq_ok")),
-    ));
-    items.push(Item::Wire("stop".into(), 1));
-    items.push(Item::Assign(
-        id("stop"),
-        or(id("seen_tail"), id("rom_tail")),
-    ));
+    );
+    let stop = Signal::assigned(items, "stop", 1, or(id("seen_tail"), tail.e()));
     items.push(Item::Memory("sched".into(), sw, 1 << eb));
     items.push(Item::AlwaysFf(vec![
         Stmt::If(
-            id("host_wr").and(id("is_sched")),
+            bus.host_wr.e().and(bus.is_sched.e()),
             vec![nb(
                 Expr::id("sched").at(Expr::slice("avs_address", eb - 1, 0)),
                 Expr::slice("avs_writedata", sw - 1, 0),
             )],
             vec![],
         ),
-        nb(id("sched_q"), Expr::id("sched").at(id("sched_addr"))),
+        nb(id("sched_q"), Expr::id("sched").at(sched_addr.e())),
         nb(
             id("sq_ok"),
             or(state_is(S_LOAD), state_is(S_WB))
-                .and(Expr::bin(BinaryOp::Lt, id("cnt"), lit(cnt_bits, k.into())))
-                .and(id("stop").lnot()),
+                .and(Expr::bin(
+                    BinaryOp::Lt,
+                    id("cnt"),
+                    lit(cnt_bits, t.k.into()),
+                ))
+                .and(stop.e().lnot()),
         ),
     ]));
-    let fields = [
-        ("rom_path", pb, 1),
-        ("rom_point", ptb, 1 + pb),
-        ("rom_inst", ib, 5 + pb + ptb),
-    ];
-    items.push(Item::Wire("rom_valid".into(), 1));
-    items.push(Item::Assign(
-        id("rom_valid"),
+    let valid = Signal::assigned(
+        items,
+        "rom_valid",
+        1,
         Expr::bit("sched_q", 0).and(id("sq_ok")),
-    ));
-    for (n, w, lo) in fields {
-        items.push(Item::Wire(n.into(), w));
-        items.push(Item::Assign(id(n), Expr::slice("sched_q", lo + w - 1, lo)));
+    );
+    let field = |items: &mut Vec<Item>, n: &str, w: u32, lo: u32| {
+        Signal::assigned(items, n, w, Expr::slice("sched_q", lo + w - 1, lo))
+    };
+    let path = field(items, "rom_path", pb, 1);
+    let point = field(items, "rom_point", ptb, 1 + pb);
+    let inst = field(items, "rom_inst", ib, 5 + pb + ptb);
+    let first = field(items, "rom_first", 1, 1 + pb + ptb);
+    let last = field(items, "rom_last", 1, 2 + pb + ptb);
+    let end = field(items, "rom_end", 1, 3 + pb + ptb);
+    ScheduleRead {
+        valid,
+        tail,
+        stop,
+        path,
+        point,
+        inst,
+        first,
+        last,
+        end,
     }
-    for (n, bit) in [
-        ("rom_first", 1 + pb + ptb),
-        ("rom_last", 2 + pb + ptb),
-        ("rom_end", 3 + pb + ptb),
-    ] {
-        items.push(Item::Wire(n.into(), 1));
-        items.push(Item::Assign(id(n), Expr::bit("sched_q", bit)));
-    }
+}
 
+/// Builds `bt_top`: an outline that calls one builder per block, in the order the blocks
+/// appear in the emitted file.
+pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
+    let t = Dims::of(d);
+    let mut items = Vec::new();
+    let pe = declare_state(&t, &mut items);
+    let bus = bus_decode(&t, &mut items);
+    let rom = schedule_memory(&t, &bus, &mut items);
+    let l = &d.layout;
+    let k = l.num_instances;
+    let (pb, ptb, ib, sb) = (l.path_bits, l.point_bits, l.inst_bits, l.slot_bits);
+    let eb = l.entry_bits;
+    let np2 = 1u32 << pb;
+    let cw = width::COORD;
+    let dispw = cw + 1;
+    let cnt_bits = t.cnt_bits;
+    let cap = d.platform.capacity;
+    let ab = t.ab;
+    let mut unused: Vec<Expr> = vec![lit(1, 0)];
+    let early = t.early.clone();
     // Coordinate updater-buffer: two banks per point, bank = cur[path] holds the last committed round.
     items.push(Item::Comment(
         "coordinate updater-buffer: address {point, bank}; cur[path] = bank of the committed round"
