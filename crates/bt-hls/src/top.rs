@@ -367,85 +367,105 @@ fn schedule_memory(t: &Dims<'_>, bus: &Decode, items: &mut Vec<Item>) -> Schedul
     }
 }
 
-/// Builds `bt_top`: an outline that calls one builder per block, in the order the blocks
-/// appear in the emitted file.
-pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
-    let t = Dims::of(d);
-    let mut items = Vec::new();
-    let pe = declare_state(&t, &mut items);
-    let bus = bus_decode(&t, &mut items);
-    let rom = schedule_memory(&t, &bus, &mut items);
-    let l = &d.layout;
-    let k = l.num_instances;
-    let (pb, ptb, ib, sb) = (l.path_bits, l.point_bits, l.inst_bits, l.slot_bits);
-    let eb = l.entry_bits;
-    let np2 = 1u32 << pb;
-    let cw = width::COORD;
-    let dispw = cw + 1;
-    let cnt_bits = t.cnt_bits;
-    let cap = d.platform.capacity;
-    let ab = t.ab;
-    let mut unused: Vec<Expr> = vec![lit(1, 0)];
-    let early = t.early.clone();
-    // Coordinate updater-buffer: two banks per point, bank = cur[path] holds the last committed round.
+/// The ports of the coordinate updater-buffer (the two point memory copies).
+struct UpdaterPorts {
+    /// Read addresses of the two copies (port a: previous or own point, port b: next point).
+    ra_addr: Signal,
+    rb_addr: Signal,
+    /// Write enable, address `{point, bank}` and data of the common write port.
+    wr_en: Signal,
+    wr_addr: Signal,
+    wr_data: Signal,
+}
+
+/// `{bus_point, avs_address[2]}`: the memory cell a point-window bus access addresses.
+fn bus_cell(bus: &Decode) -> Expr {
+    Expr::concat(vec![bus.bus_point.e(), Expr::bit("avs_address", 2)])
+}
+
+/// Coordinate updater-buffer, read side: two banks per point, bank = cur[path] holds the last
+/// committed round. Port a reads the job's previous point at load and its own point at
+/// write-back (the old value, for the displacement); port b reads the next point.
+fn updater_read_ports(
+    t: &Dims<'_>,
+    bus: &Decode,
+    rom: &ScheduleRead,
+    items: &mut Vec<Item>,
+) -> UpdaterPorts {
+    let ptb = t.ptb;
     items.push(Item::Comment(
         "coordinate updater-buffer: address {point, bank}; cur[path] = bank of the committed round"
             .into(),
     ));
-    let rom_bank = Expr::id("cur").at(id("rom_path"));
-    for (n, w) in [
-        ("ra_addr", ptb + 1),
-        ("rb_addr", ptb + 1),
-        ("wr_addr", ptb + 1),
-        ("wr_en", 1),
-    ] {
-        items.push(Item::Reg(n.into(), w));
-    }
-    items.push(Item::Reg("wr_data".into(), POINT_BITS));
+    let rom_bank = Expr::id("cur").at(rom.path.e());
+    let ra_addr = Signal::reg(items, "ra_addr", ptb + 1);
+    let rb_addr = Signal::reg(items, "rb_addr", ptb + 1);
+    let wr_addr = Signal::reg(items, "wr_addr", ptb + 1);
+    let wr_en = Signal::reg(items, "wr_en", 1);
+    let wr_data = Signal::reg(items, "wr_data", POINT_BITS);
     let one_pt = lit(ptb, 1);
-    let bus_cell = Expr::concat(vec![id("bus_point"), Expr::bit("avs_address", 2)]);
     items.push(Item::AlwaysComb(vec![
-        bl("ra_addr", bus_cell.clone()),
+        Stmt::Blocking(ra_addr.e(), bus_cell(bus)),
         Stmt::If(
             state_is(S_LOAD),
-            vec![bl(
-                "ra_addr",
-                Expr::concat(vec![
-                    id("rom_point").minus(one_pt.clone()),
-                    rom_bank.clone(),
-                ]),
+            vec![Stmt::Blocking(
+                ra_addr.e(),
+                Expr::concat(vec![rom.point.e().minus(one_pt.clone()), rom_bank.clone()]),
             )],
             vec![Stmt::If(
                 state_is(S_WB),
-                vec![bl(
-                    "ra_addr",
-                    Expr::concat(vec![id("rom_point"), rom_bank.clone()]),
+                vec![Stmt::Blocking(
+                    ra_addr.e(),
+                    Expr::concat(vec![rom.point.e(), rom_bank.clone()]),
                 )],
                 vec![],
             )],
         ),
-        bl(
-            "rb_addr",
-            Expr::concat(vec![id("rom_point").plus(one_pt), rom_bank]),
+        Stmt::Blocking(
+            rb_addr.e(),
+            Expr::concat(vec![rom.point.e().plus(one_pt), rom_bank]),
         ),
     ]));
-    // Write-back: PE output select, saturation (once, for all PEs), displacement, freeze.
-    items.push(Item::Reg("pe_sel_sum".into(), SUM_BITS));
-    items.push(Item::Reg("pe_sel_zs".into(), 1));
-    let sel_arms = (0..k)
-        .map(|j| {
+    UpdaterPorts {
+        ra_addr,
+        rb_addr,
+        wr_en,
+        wr_addr,
+        wr_data,
+    }
+}
+
+/// The selected PE's result at write-back, saturated once for all PEs.
+struct Selected {
+    /// The saturated point `{z, y, x}`.
+    point: Signal,
+    /// Some axis saturated.
+    ov: Signal,
+    /// The PE reported a zero distance sum.
+    zs: Signal,
+}
+
+/// Write-back, PE output select and saturation (twin of the model's `saturate`).
+fn pe_output_select(t: &Dims<'_>, pe: &[PeWires], items: &mut Vec<Item>) -> Selected {
+    let cw = width::COORD;
+    let sel_sum = Signal::reg(items, "pe_sel_sum", SUM_BITS);
+    let zs = Signal::reg(items, "pe_sel_zs", 1);
+    let sel_arms = pe
+        .iter()
+        .enumerate()
+        .map(|(j, w)| {
             (
-                lit(ib, j.into()),
+                lit(t.ib, j as u128),
                 vec![
-                    bl("pe_sel_sum", id(&format!("pe_sum_{j}"))),
-                    bl("pe_sel_zs", id(&format!("pe_zs_{j}"))),
+                    Stmt::Blocking(sel_sum.e(), w.sum.e()),
+                    Stmt::Blocking(zs.e(), w.zs.e()),
                 ],
             )
         })
         .collect();
     let sel_default = vec![
-        bl("pe_sel_sum", lit(SUM_BITS, 0)),
-        bl("pe_sel_zs", lit(1, 0)),
+        Stmt::Blocking(sel_sum.e(), lit(SUM_BITS, 0)),
+        Stmt::Blocking(zs.e(), lit(1, 0)),
     ];
     items.push(Item::AlwaysComb(vec![Stmt::Case(
         id("wb_q_inst"),
@@ -456,117 +476,168 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
     let mut sat_parts = Vec::new();
     let mut ovf_terms = Vec::new();
     for (a, axis) in ["x", "y", "z"].iter().enumerate() {
-        let sum = format!("sum_{axis}");
-        items.push(Item::Wire(sum.clone(), spw));
-        items.push(Item::Assign(
-            id(&sum),
-            Expr::slice("pe_sel_sum", spw * (a as u32 + 1) - 1, spw * a as u32),
-        ));
-        let ovf = format!("ovf_{axis}");
-        let top = Expr::slice(&sum, spw - 1, cw - 1);
+        let sum = Signal::assigned(
+            items,
+            format!("sum_{axis}"),
+            spw,
+            sel_sum.slice(spw * (a as u32 + 1) - 1, spw * a as u32),
+        );
+        let top = sum.slice(spw - 1, cw - 1);
         let topw = spw - cw + 1;
-        items.push(Item::Wire(ovf.clone(), 1));
-        items.push(Item::Assign(
-            id(&ovf),
+        let ovf = Signal::assigned(
+            items,
+            format!("ovf_{axis}"),
+            1,
             Expr::bin(
                 BinaryOp::LogicAnd,
                 Expr::bin(BinaryOp::Ne, top.clone(), lit(topw, 0)),
                 Expr::bin(BinaryOp::Ne, top, lit(topw, (1u128 << topw) - 1)),
             ),
-        ));
-        let sat = format!("sat_{axis}");
-        items.push(Item::Wire(sat.clone(), cw));
-        items.push(Item::Assign(
-            id(&sat),
+        );
+        let sat = Signal::assigned(
+            items,
+            format!("sat_{axis}"),
+            cw,
             Expr::mux(
-                id(&ovf),
+                ovf.e(),
                 Expr::mux(
-                    Expr::bit(&sum, spw - 1),
+                    sum.bit(spw - 1),
                     lit(cw, 1 << (cw - 1)),
                     lit(cw, (1 << (cw - 1)) - 1),
                 ),
-                Expr::slice(&sum, cw - 1, 0),
+                sum.slice(cw - 1, 0),
             ),
-        ));
-        sat_parts.insert(0, id(&sat));
-        ovf_terms.push(id(&ovf));
+        );
+        sat_parts.insert(0, sat.e());
+        ovf_terms.push(ovf.e());
     }
-    items.push(Item::Wire("pe_sel".into(), POINT_BITS));
-    items.push(Item::Assign(id("pe_sel"), Expr::concat(sat_parts)));
-    items.push(Item::Wire("pe_sel_ov".into(), 1));
-    items.push(Item::Assign(
-        id("pe_sel_ov"),
+    let point = Signal::assigned(items, "pe_sel", POINT_BITS, Expr::concat(sat_parts));
+    let ov = Signal::assigned(
+        items,
+        "pe_sel_ov",
+        1,
         ovf_terms.into_iter().reduce(or).expect("3 axes"),
-    ));
-    let mut big_terms = Vec::new();
+    );
+    Selected { point, ov, zs }
+}
+
+/// The move of the written point against its stored value.
+struct Displacement {
+    /// `new_<axis>`: the written coordinate.
+    new: Vec<Signal>,
+    /// `adiff_<axis>`: |new − old| per axis.
+    adiff: Vec<Signal>,
+    /// `wb_big`: the L∞ move exceeds the threshold.
+    big: Signal,
+}
+
+/// Write-back displacement: per-axis |new − old| and the threshold test.
+fn displacement(t: &Dims<'_>, sel: &Selected, items: &mut Vec<Item>) -> Displacement {
+    let cw = width::COORD;
+    let dispw = cw + 1;
+    let (mut new, mut adiff, mut big_terms) = (Vec::new(), Vec::new(), Vec::new());
     for (a, axis) in ["x", "y", "z"].iter().enumerate() {
         let (hi, lo) = (cw * (a as u32 + 1) - 1, cw * a as u32);
-        let (nw, ow) = (format!("new_{axis}"), format!("old_{axis}"));
-        items.push(Item::Wire(nw.clone(), cw));
-        items.push(Item::Assign(id(&nw), Expr::slice("pe_sel", hi, lo)));
-        items.push(Item::Wire(ow.clone(), cw));
-        items.push(Item::Assign(id(&ow), Expr::slice("rd_a", hi, lo)));
-        let diff = format!("diff_{axis}");
-        items.push(Item::Wire(diff.clone(), dispw));
-        items.push(Item::Assign(
-            id(&diff),
-            crate::pe::sext(&nw, cw, dispw).minus(crate::pe::sext(&ow, cw, dispw)),
-        ));
-        let abs = format!("adiff_{axis}");
-        items.push(Item::Wire(abs.clone(), dispw));
-        items.push(Item::Assign(
-            id(&abs),
+        let nw = Signal::assigned(items, format!("new_{axis}"), cw, sel.point.slice(hi, lo));
+        let ow = Signal::assigned(
+            items,
+            format!("old_{axis}"),
+            cw,
+            Expr::slice("rd_a", hi, lo),
+        );
+        let diff = Signal::assigned(
+            items,
+            format!("diff_{axis}"),
+            dispw,
+            crate::pe::sext(nw.name(), cw, dispw).minus(crate::pe::sext(ow.name(), cw, dispw)),
+        );
+        let abs = Signal::assigned(
+            items,
+            format!("adiff_{axis}"),
+            dispw,
             Expr::mux(
-                Expr::bit(&diff, dispw - 1),
-                id(&diff).inv().plus(lit(dispw, 1)),
-                id(&diff),
+                diff.bit(dispw - 1),
+                diff.e().inv().plus(lit(dispw, 1)),
+                diff.e(),
             ),
-        ));
+        );
         big_terms.push(Expr::bin(
             BinaryOp::Gt,
-            id(&abs),
-            lit(dispw, d.platform.threshold_lsb.into()),
+            abs.e(),
+            lit(dispw, t.p.platform.threshold_lsb.into()),
         ));
+        new.push(nw);
+        adiff.push(abs);
     }
     items.push(Item::Comment(
         "wb_big: L-infinity displacement of the written point exceeds the threshold".into(),
     ));
-    items.push(Item::Wire("wb_big".into(), 1));
-    items.push(Item::Assign(
-        id("wb_big"),
+    let big = Signal::assigned(
+        items,
+        "wb_big",
+        1,
         big_terms.into_iter().reduce(or).expect("3 axes"),
-    ));
+    );
+    Displacement { new, adiff, big }
+}
+
+/// The write-back decision and the round's accumulated flags of the written path.
+struct WritebackFlags {
+    /// Commit the PE's result (write-back state, a job, path not frozen).
+    go: Signal,
+    /// Some point of the path moved more than the threshold this round.
+    any_big: Signal,
+    /// Some point of the path had a zero distance sum this round.
+    any_dz: Signal,
+    /// Some point of the path saturated this round.
+    any_ov: Signal,
+    /// Some point of the path left its box this round (early stopping only).
+    any_lb: Option<Signal>,
+}
+
+/// Write-back flags: a path is frozen once converged, degenerate, saturated or (early
+/// stopping) left its box; the `any_*` flags fold this job into its round's flags.
+fn writeback_flags(
+    sel: &Selected,
+    disp: &Displacement,
+    wb_lb: Option<Signal>,
+    items: &mut Vec<Item>,
+) -> WritebackFlags {
     let at_wb = |v: &str| Expr::id(v).at(id("wb_q_path"));
-    if let Some((stop, boxes)) = &early {
-        early_stop_logic(d, stop, boxes, &mut items);
-    }
-    items.push(Item::Wire("wb_frozen".into(), 1));
+    let frozen_sig = Signal::wire(items, "wb_frozen", 1);
     let mut frozen = or(or(at_wb("conv"), at_wb("dz")), at_wb("ov"));
-    if early.is_some() {
-        frozen = or(frozen, at_wb("lb"));
-        items.push(Item::Wire("any_lb".into(), 1));
-        items.push(Item::Assign(id("any_lb"), or(at_wb("plb"), id("wb_lb"))));
+    let any_lb = wb_lb.map(|lb| {
+        frozen = or(frozen.clone(), at_wb("lb"));
+        Signal::assigned(items, "any_lb", 1, or(at_wb("plb"), lb.e()))
+    });
+    items.push(Item::Assign(frozen_sig.e(), frozen));
+    let go = Signal::assigned(
+        items,
+        "wb_go",
+        1,
+        state_is(S_WB).and(id("wb_q_en")).and(frozen_sig.e().lnot()),
+    );
+    let any_big = Signal::assigned(items, "any_big", 1, or(at_wb("pbig"), disp.big.e()));
+    let any_dz = Signal::assigned(items, "any_dz", 1, or(at_wb("pdz"), sel.zs.e()));
+    let any_ov = Signal::assigned(items, "any_ov", 1, or(at_wb("pov"), sel.ov.e()));
+    WritebackFlags {
+        go,
+        any_big,
+        any_dz,
+        any_ov,
+        any_lb,
     }
-    items.push(Item::Assign(id("wb_frozen"), frozen));
-    items.push(Item::Wire("wb_go".into(), 1));
-    items.push(Item::Assign(
-        id("wb_go"),
-        state_is(S_WB)
-            .and(id("wb_q_en"))
-            .and(id("wb_frozen").lnot()),
-    ));
-    items.push(Item::Wire("any_big".into(), 1));
-    items.push(Item::Assign(id("any_big"), or(at_wb("pbig"), id("wb_big"))));
-    items.push(Item::Wire("any_dz".into(), 1));
-    items.push(Item::Assign(
-        id("any_dz"),
-        or(at_wb("pdz"), id("pe_sel_zs")),
-    ));
-    items.push(Item::Wire("any_ov".into(), 1));
-    items.push(Item::Assign(
-        id("any_ov"),
-        or(at_wb("pov"), id("pe_sel_ov")),
-    ));
+}
+
+/// Coordinate updater-buffer, write side: the host's point writes while idle, the selected
+/// PE's result into the other bank at write-back; both memory copies take every write.
+fn updater_write_port(
+    bus: &Decode,
+    ports: &UpdaterPorts,
+    sel: &Selected,
+    flags: &WritebackFlags,
+    items: &mut Vec<Item>,
+) {
     let host_point = Expr::concat(vec![
         id("st_z"),
         Expr::slice("avs_writedata", 23, 16),
@@ -576,34 +647,67 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
         Expr::slice("avs_writedata", 7, 0),
     ]);
     items.push(Item::AlwaysComb(vec![
-        bl("wr_en", id("pt_we").or(id("wb_go"))),
-        bl("wr_addr", bus_cell),
-        bl("wr_data", host_point),
+        Stmt::Blocking(ports.wr_en.e(), bus.pt_we.e().or(flags.go.e())),
+        Stmt::Blocking(ports.wr_addr.e(), bus_cell(bus)),
+        Stmt::Blocking(ports.wr_data.e(), host_point),
         Stmt::If(
             state_is(S_WB),
             vec![
-                bl(
-                    "wr_addr",
+                Stmt::Blocking(
+                    ports.wr_addr.e(),
                     Expr::concat(vec![
                         id("wb_q_point"),
                         Expr::id("cur").at(id("wb_q_path")).inv(),
                     ]),
                 ),
-                bl("wr_data", id("pe_sel")),
+                Stmt::Blocking(ports.wr_data.e(), sel.point.e()),
             ],
             vec![],
         ),
     ]));
-    for (mem, rd, addr) in [("pm_a", "rd_a", "ra_addr"), ("pm_b", "rd_b", "rb_addr")] {
+    for (mem, rd, addr) in [
+        ("pm_a", "rd_a", &ports.ra_addr),
+        ("pm_b", "rd_b", &ports.rb_addr),
+    ] {
         items.push(Item::AlwaysFf(vec![
             Stmt::If(
-                id("wr_en"),
-                vec![nb(Expr::id(mem).at(id("wr_addr")), id("wr_data"))],
+                ports.wr_en.e(),
+                vec![nb(Expr::id(mem).at(ports.wr_addr.e()), ports.wr_data.e())],
                 vec![],
             ),
-            nb(id(rd), Expr::id(mem).at(id(addr))),
+            nb(id(rd), Expr::id(mem).at(addr.e())),
         ]));
     }
+}
+
+/// Builds `bt_top`: an outline that calls one builder per block, in the order the blocks
+/// appear in the emitted file.
+pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
+    let t = Dims::of(d);
+    let mut items = Vec::new();
+    let pe = declare_state(&t, &mut items);
+    let bus = bus_decode(&t, &mut items);
+    let rom = schedule_memory(&t, &bus, &mut items);
+    let l = &d.layout;
+    let k = l.num_instances;
+    let (pb, ib, sb) = (l.path_bits, l.inst_bits, l.slot_bits);
+    let eb = l.entry_bits;
+    let np2 = 1u32 << pb;
+    let cw = width::COORD;
+    let cnt_bits = t.cnt_bits;
+    let cap = d.platform.capacity;
+    let ab = t.ab;
+    let mut unused: Vec<Expr> = vec![lit(1, 0)];
+    let early = t.early.clone();
+    let ports = updater_read_ports(&t, &bus, &rom, &mut items);
+    let sel = pe_output_select(&t, &pe, &mut items);
+    let disp = displacement(&t, &sel, &mut items);
+    let wb_lb = t
+        .early
+        .as_ref()
+        .map(|(stop, boxes)| early_stop_logic(d, stop, boxes, &disp, &mut items));
+    let flags = writeback_flags(&sel, &disp, wb_lb, &mut items);
+    updater_write_port(&bus, &ports, &sel, &flags, &mut items);
 
     // PE matrix.
     items.push(Item::Wire("pe_start".into(), 1));
@@ -1053,8 +1157,9 @@ fn early_stop_logic(
     d: &TopParams<'_>,
     stop: &bt_fixed::EarlyStop,
     boxes: &[bt_fixed::FineBox],
+    disp: &Displacement,
     items: &mut Vec<Item>,
-) {
+) -> Signal {
     let w = BOX_BITS;
     let bias = 1i128 << (w - 1);
     let biased = |v: i64| lit(w, ((i128::from(v) + bias) as u128) & ((1u128 << w) - 1));
@@ -1093,11 +1198,13 @@ fn early_stop_logic(
     )]));
     let dispw = width::COORD + 1;
     let mvw = w - bt_fixed::EarlyStop::MAX_SHIFT;
-    let zext = |n: &str| Expr::concat(vec![lit(mvw - dispw, 0), id(n)]);
+    let zext = |s: &Signal| Expr::concat(vec![lit(mvw - dispw, 0), s.e()]);
     items.push(Item::Wire("mv_l1".into(), mvw));
     items.push(Item::Assign(
         id("mv_l1"),
-        zext("adiff_x").plus(zext("adiff_y")).plus(zext("adiff_z")),
+        zext(&disp.adiff[0])
+            .plus(zext(&disp.adiff[1]))
+            .plus(zext(&disp.adiff[2])),
     ));
     let shift = stop.displacement_shift;
     items.push(Item::Wire("slack".into(), w));
@@ -1107,12 +1214,12 @@ fn early_stop_logic(
     }
     items.push(Item::Assign(id("slack"), Expr::concat(parts)));
     let mut terms = Vec::new();
-    for axis in axes {
+    for (axis, new) in axes.iter().zip(&disp.new) {
         let pw = format!("bp_{axis}");
         items.push(Item::Wire(pw.clone(), w));
         items.push(Item::Assign(
             id(&pw),
-            crate::pe::sext(&format!("new_{axis}"), width::COORD, w),
+            crate::pe::sext(new.name(), width::COORD, w),
         ));
         for (side, expr) in [
             ("lo", id(&pw).plus(id("slack"))),
@@ -1144,6 +1251,5 @@ fn early_stop_logic(
         "wb_lb: outside the box by more than (L1 move) << {shift}, in round >= {}",
         stop.min_rounds
     )));
-    items.push(Item::Wire("wb_lb".into(), 1));
-    items.push(Item::Assign(id("wb_lb"), late.and(outside)));
+    Signal::assigned(items, "wb_lb", 1, late.and(outside))
 }
