@@ -680,90 +680,68 @@ fn updater_write_port(
     }
 }
 
-/// Builds `bt_top`: an outline that calls one builder per block, in the order the blocks
-/// appear in the emitted file.
-pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
-    let t = Dims::of(d);
-    let mut items = Vec::new();
-    let pe = declare_state(&t, &mut items);
-    let bus = bus_decode(&t, &mut items);
-    let rom = schedule_memory(&t, &bus, &mut items);
-    let l = &d.layout;
-    let k = l.num_instances;
-    let (pb, ib, sb) = (l.path_bits, l.inst_bits, l.slot_bits);
-    let eb = l.entry_bits;
-    let np2 = 1u32 << pb;
-    let cw = width::COORD;
-    let cnt_bits = t.cnt_bits;
-    let cap = d.platform.capacity;
-    let ab = t.ab;
-    let mut unused: Vec<Expr> = vec![lit(1, 0)];
-    let early = t.early.clone();
-    let ports = updater_read_ports(&t, &bus, &rom, &mut items);
-    let sel = pe_output_select(&t, &pe, &mut items);
-    let disp = displacement(&t, &sel, &mut items);
-    let wb_lb = t
-        .early
-        .as_ref()
-        .map(|(stop, boxes)| early_stop_logic(d, stop, boxes, &disp, &mut items));
-    let flags = writeback_flags(&sel, &disp, wb_lb, &mut items);
-    updater_write_port(&bus, &ports, &sel, &flags, &mut items);
-
-    // PE matrix.
-    items.push(Item::Wire("pe_start".into(), 1));
-    items.push(Item::Assign(
-        id("pe_start"),
-        state_is(S_EXEC).and(id("cnt").eq(lit(cnt_bits, 0))),
-    ));
-    for (j, inst) in d.platform.instances.iter().enumerate() {
+/// PE matrix and operand load: one instance per platform instance; the operands (previous and
+/// next point, or the transmitter/receiver at a path's ends) are broadcast one instance per
+/// cycle, memory data one cycle after the address, and the addressed PE latches them.
+fn pe_matrix(t: &Dims<'_>, pe: &[PeWires], items: &mut Vec<Item>) {
+    let start = Signal::assigned(
+        items,
+        "pe_start",
+        1,
+        state_is(S_EXEC).and(id("cnt").eq(lit(t.cnt_bits, 0))),
+    );
+    // The operand wires follow the instances in the file: build them aside first.
+    let mut operands = Vec::new();
+    let fine = |n: &str| Expr::concat(vec![id(n), lit(8, 0)]);
+    let tx_fine = Expr::concat(vec![fine("tx_z"), fine("tx_y"), fine("tx_x")]);
+    let rx_fine = Expr::concat(vec![fine("rx_z"), fine("rx_y"), fine("rx_x")]);
+    let prev = Signal::assigned(
+        &mut operands,
+        "opnd_prev",
+        POINT_BITS,
+        Expr::mux(id("ld_q_first"), tx_fine, id("rd_a")),
+    );
+    let next = Signal::assigned(
+        &mut operands,
+        "opnd_next",
+        POINT_BITS,
+        Expr::mux(id("ld_q_last"), rx_fine, id("rd_b")),
+    );
+    for (j, (inst, w)) in t.p.platform.instances.iter().zip(pe).enumerate() {
         items.push(Item::Instance {
             module: pe_module_name(inst.plane as usize),
             name: format!("u_pe_{j}"),
             ports: vec![
                 ("clk".into(), id("clk")),
                 ("rst_n".into(), id("rst_n")),
-                ("load".into(), id(&format!("pe_load_{j}"))),
-                ("start".into(), id("pe_start")),
-                ("s_prev".into(), id("opnd_prev")),
-                ("s_next".into(), id("opnd_next")),
-                ("s_sum".into(), id(&format!("pe_sum_{j}"))),
-                ("zero_sum".into(), id(&format!("pe_zs_{j}"))),
+                ("load".into(), w.load.e()),
+                ("start".into(), start.e()),
+                ("s_prev".into(), prev.e()),
+                ("s_next".into(), next.e()),
+                ("s_sum".into(), w.sum.e()),
+                ("zero_sum".into(), w.zs.e()),
             ],
         });
-    }
-
-    // Operand load (one instance per cycle, memory data one cycle after the address): the
-    // operands are broadcast and the addressed PE latches them.
-    let fine = |n: &str| Expr::concat(vec![id(n), lit(8, 0)]);
-    let tx_fine = Expr::concat(vec![fine("tx_z"), fine("tx_y"), fine("tx_x")]);
-    let rx_fine = Expr::concat(vec![fine("rx_z"), fine("rx_y"), fine("rx_x")]);
-    items.push(Item::Wire("opnd_prev".into(), POINT_BITS));
-    items.push(Item::Assign(
-        id("opnd_prev"),
-        Expr::mux(id("ld_q_first"), tx_fine, id("rd_a")),
-    ));
-    items.push(Item::Wire("opnd_next".into(), POINT_BITS));
-    items.push(Item::Assign(
-        id("opnd_next"),
-        Expr::mux(id("ld_q_last"), rx_fine, id("rd_b")),
-    ));
-    for j in 0..k {
-        items.push(Item::Assign(
-            id(&format!("pe_load_{j}")),
+        operands.push(Item::Assign(
+            w.load.e(),
             state_is(S_LOAD)
                 .and(id("ld_q_en"))
-                .and(id("ld_q_inst").eq(lit(ib, j.into()))),
+                .and(id("ld_q_inst").eq(lit(t.ib, j as u128))),
         ));
     }
+    items.extend(operands);
+}
 
-    // Main FSM.
-    let cnt_inc = id("cnt").plus(lit(cnt_bits, 1));
-    let start_req = id("avs_write")
-        .and(id("avs_address").eq(lit(ab, 0)))
-        .and(Expr::bit("avs_writedata", 0))
-        .and(state_is(S_IDLE));
-    let all_zero = lit(np2, 0);
-    let no_slot = id("slots_r").eq(lit(sb + 1, 0));
+/// `cnt + 1`.
+fn cnt_inc(t: &Dims<'_>) -> Expr {
+    id("cnt").plus(lit(t.cnt_bits, 1))
+}
+
+/// IDLE on a start request: clear the counters and every path's flags and rounds; with no
+/// slot to run, report done at once.
+fn fsm_on_start(t: &Dims<'_>) -> Vec<Stmt> {
+    let all_zero = lit(t.np2, 0);
+    let no_slot = id("slots_r").eq(lit(t.sb + 1, 0));
     let mut on_start = vec![
         nb(
             id("state"),
@@ -773,68 +751,79 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
                 lit(STATE_BITS, S_LOAD),
             ),
         ),
-        nb(id("cnt"), lit(cnt_bits, 0)),
-        nb(id("slot"), lit(sb, 0)),
-        nb(id("sbase"), lit(eb, 0)),
+        nb(id("cnt"), lit(t.cnt_bits, 0)),
+        nb(id("slot"), lit(t.sb, 0)),
+        nb(id("sbase"), lit(t.eb, 0)),
         nb(id("cycles"), lit(32, 0)),
         nb(id("done"), no_slot),
     ];
     for v in ["cur", "conv", "dz", "ov", "pbig", "pdz", "pov"] {
         on_start.push(nb(id(v), all_zero.clone()));
     }
-    if early.is_some() {
+    if t.early.is_some() {
         on_start.push(nb(id("lb"), all_zero.clone()));
         on_start.push(nb(id("plb"), all_zero.clone()));
     }
-    for p in 0..np2 {
-        on_start.push(nb(Expr::id("rounds").at(lit(pb, p.into())), lit(16, 0)));
+    for p in 0..t.np2 {
+        on_start.push(nb(Expr::id("rounds").at(lit(t.pb, p.into())), lit(16, 0)));
     }
-    let load = vec![
-        nb(id("ld_q_en"), id("rom_valid")),
-        nb(id("ld_q_tail"), id("rom_tail")),
-        nb(id("ld_q_first"), id("rom_first")),
-        nb(id("ld_q_last"), id("rom_last")),
-        nb(id("ld_q_inst"), id("rom_inst")),
+    on_start
+}
+
+/// LOAD: register the schedule entry for the operand broadcast until the slot's tail, then EXEC.
+fn fsm_load(t: &Dims<'_>, rom: &ScheduleRead) -> Vec<Stmt> {
+    vec![
+        nb(id("ld_q_en"), rom.valid.e()),
+        nb(id("ld_q_tail"), rom.tail.e()),
+        nb(id("ld_q_first"), rom.first.e()),
+        nb(id("ld_q_last"), rom.last.e()),
+        nb(id("ld_q_inst"), rom.inst.e()),
         Stmt::If(
             id("ld_q_tail"),
             vec![
                 nb(id("state"), lit(STATE_BITS, S_EXEC)),
-                nb(id("cnt"), lit(cnt_bits, 0)),
+                nb(id("cnt"), lit(t.cnt_bits, 0)),
                 nb(id("seen_tail"), lit(1, 0)),
             ],
-            vec![
-                nb(id("cnt"), cnt_inc.clone()),
-                nb(id("seen_tail"), id("stop")),
-            ],
+            vec![nb(id("cnt"), cnt_inc(t)), nb(id("seen_tail"), rom.stop.e())],
         ),
-    ];
-    let exec = vec![Stmt::If(
-        id("cnt").eq(lit(cnt_bits, u128::from(PE_LATENCY - 1))),
+    ]
+}
+
+/// EXEC: wait `PE_LATENCY` cycles for every PE of the slot, then WB.
+fn fsm_exec(t: &Dims<'_>) -> Vec<Stmt> {
+    vec![Stmt::If(
+        id("cnt").eq(lit(t.cnt_bits, u128::from(PE_LATENCY - 1))),
         vec![
             nb(id("state"), lit(STATE_BITS, S_WB)),
-            nb(id("cnt"), lit(cnt_bits, 0)),
+            nb(id("cnt"), lit(t.cnt_bits, 0)),
         ],
-        vec![nb(id("cnt"), cnt_inc.clone())],
-    )];
+        vec![nb(id("cnt"), cnt_inc(t))],
+    )]
+}
+
+/// A committed job's effect on its path's flags: at the round's end, flip the bank, count the
+/// round and decide convergence; inside the round, accumulate the flags.
+fn path_commit(f: &WritebackFlags) -> Vec<Stmt> {
     let wbp = |v: &str| Expr::id(v).at(id("wb_q_path"));
-    let mut conv_next = id("any_big")
+    let mut conv_next = f
+        .any_big
+        .e()
         .lnot()
-        .and(id("any_dz").lnot())
-        .and(id("any_ov").lnot());
+        .and(f.any_dz.e().lnot())
+        .and(f.any_ov.e().lnot());
     let mut at_end = Vec::new();
     let mut in_round = Vec::new();
-    if early.is_some() {
-        conv_next = conv_next.and(id("any_lb").lnot());
+    if let Some(any_lb) = &f.any_lb {
+        conv_next = conv_next.and(any_lb.e().lnot());
         at_end.push(nb(
             wbp("lb"),
-            id("any_lb")
-                .and(id("any_dz").lnot())
-                .and(id("any_ov").lnot()),
+            any_lb.e().and(f.any_dz.e().lnot()).and(f.any_ov.e().lnot()),
         ));
         at_end.push(nb(wbp("plb"), lit(1, 0)));
-        in_round.push(nb(wbp("plb"), id("any_lb")));
+        in_round.push(nb(wbp("plb"), any_lb.e()));
     }
-    let commit = vec![Stmt::If(
+    vec![Stmt::If(
         id("wb_q_end"),
         vec![
             nb(wbp("cur"), wbp("cur").inv()),
@@ -842,8 +831,8 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
                 Expr::id("rounds").at(id("wb_q_path")),
                 Expr::id("rounds").at(id("wb_q_path")).plus(lit(16, 1)),
             ),
-            nb(wbp("dz"), id("any_dz")),
-            nb(wbp("ov"), id("any_ov")),
+            nb(wbp("dz"), f.any_dz.e()),
+            nb(wbp("ov"), f.any_ov.e()),
             nb(wbp("conv"), conv_next),
             nb(wbp("pbig"), lit(1, 0)),
             nb(wbp("pdz"), lit(1, 0)),
@@ -853,22 +842,28 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
         .chain(at_end)
         .collect(),
         vec![
-            nb(wbp("pbig"), id("any_big")),
-            nb(wbp("pdz"), id("any_dz")),
-            nb(wbp("pov"), id("any_ov")),
+            nb(wbp("pbig"), f.any_big.e()),
+            nb(wbp("pdz"), f.any_dz.e()),
+            nb(wbp("pov"), f.any_ov.e()),
         ]
         .into_iter()
         .chain(in_round)
         .collect(),
-    )];
-    let wb = vec![
-        nb(id("wb_q_en"), id("rom_valid")),
-        nb(id("wb_q_tail"), id("rom_tail")),
-        nb(id("wb_q_end"), id("rom_end")),
-        nb(id("wb_q_path"), id("rom_path")),
-        nb(id("wb_q_point"), id("rom_point")),
-        nb(id("wb_q_inst"), id("rom_inst")),
-        Stmt::If(id("wb_go"), commit, vec![]),
+    )]
+}
+
+/// WB: register the entry for the write-back, commit, and at the slot's tail move to the next
+/// slot's LOAD (or IDLE with done after the last slot).
+fn fsm_writeback(t: &Dims<'_>, rom: &ScheduleRead, f: &WritebackFlags) -> Vec<Stmt> {
+    let (sb, eb, cnt_bits) = (t.sb, t.eb, t.cnt_bits);
+    vec![
+        nb(id("wb_q_en"), rom.valid.e()),
+        nb(id("wb_q_tail"), rom.tail.e()),
+        nb(id("wb_q_end"), rom.end.e()),
+        nb(id("wb_q_path"), rom.path.e()),
+        nb(id("wb_q_point"), rom.point.e()),
+        nb(id("wb_q_inst"), rom.inst.e()),
+        Stmt::If(f.go.e(), path_commit(f), vec![]),
         Stmt::If(
             id("wb_q_tail"),
             vec![
@@ -895,20 +890,33 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
                     ],
                 ),
             ],
-            vec![nb(id("cnt"), cnt_inc), nb(id("seen_tail"), id("stop"))],
+            vec![nb(id("cnt"), cnt_inc(t)), nb(id("seen_tail"), rom.stop.e())],
         ),
-    ];
+    ]
+}
+
+/// The main FSM (controller): IDLE -> per slot LOAD, EXEC, WB -> IDLE with done, and the
+/// cycle counter.
+fn controller(t: &Dims<'_>, rom: &ScheduleRead, f: &WritebackFlags, items: &mut Vec<Item>) {
+    let cnt_bits = t.cnt_bits;
     items.push(Item::Comment(format!(
         "main FSM: IDLE -> per slot LOAD (jobs + 2) EXEC ({PE_LATENCY}) WB (jobs + 2) -> IDLE with done after SLOTS slots"
     )));
-    items.push(Item::Wire("start_req".into(), 1));
-    items.push(Item::Assign(id("start_req"), start_req));
+    let start_req = Signal::assigned(
+        items,
+        "start_req",
+        1,
+        id("avs_write")
+            .and(id("avs_address").eq(lit(t.ab, 0)))
+            .and(Expr::bit("avs_writedata", 0))
+            .and(state_is(S_IDLE)),
+    );
     items.push(Item::AlwaysFf(vec![Stmt::If(
         id("rst_n").lnot(),
         vec![
             nb(id("state"), lit(STATE_BITS, S_IDLE)),
             nb(id("cnt"), lit(cnt_bits, 0)),
-            nb(id("slot"), lit(sb, 0)),
+            nb(id("slot"), lit(t.sb, 0)),
             nb(id("cycles"), lit(32, 0)),
             nb(id("done"), lit(1, 0)),
             nb(id("ld_q_en"), lit(1, 0)),
@@ -928,16 +936,46 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
                 vec![
                     (
                         lit(STATE_BITS, S_IDLE),
-                        vec![Stmt::If(id("start_req"), on_start, vec![])],
+                        vec![Stmt::If(start_req.e(), fsm_on_start(t), vec![])],
                     ),
-                    (lit(STATE_BITS, S_LOAD), load),
-                    (lit(STATE_BITS, S_EXEC), exec),
-                    (lit(STATE_BITS, S_WB), wb),
+                    (lit(STATE_BITS, S_LOAD), fsm_load(t, rom)),
+                    (lit(STATE_BITS, S_EXEC), fsm_exec(t)),
+                    (lit(STATE_BITS, S_WB), fsm_writeback(t, rom, f)),
                 ],
                 vec![nb(id("state"), lit(STATE_BITS, S_IDLE))],
             ),
         ],
     )]));
+}
+
+/// Builds `bt_top`: an outline that calls one builder per block, in the order the blocks
+/// appear in the emitted file.
+pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
+    let t = Dims::of(d);
+    let mut items = Vec::new();
+    let pe = declare_state(&t, &mut items);
+    let bus = bus_decode(&t, &mut items);
+    let rom = schedule_memory(&t, &bus, &mut items);
+    let l = &d.layout;
+    let k = l.num_instances;
+    let (pb, sb) = (l.path_bits, l.slot_bits);
+    let cw = width::COORD;
+    let cap = d.platform.capacity;
+    let ab = t.ab;
+    let mut unused: Vec<Expr> = vec![lit(1, 0)];
+    let early = t.early.clone();
+    let ports = updater_read_ports(&t, &bus, &rom, &mut items);
+    let sel = pe_output_select(&t, &pe, &mut items);
+    let disp = displacement(&t, &sel, &mut items);
+    let wb_lb = t
+        .early
+        .as_ref()
+        .map(|(stop, boxes)| early_stop_logic(d, stop, boxes, &disp, &mut items));
+    let flags = writeback_flags(&sel, &disp, wb_lb, &mut items);
+    updater_write_port(&bus, &ports, &sel, &flags, &mut items);
+
+    pe_matrix(&t, &pe, &mut items);
+    controller(&t, &rom, &flags, &mut items);
 
     // Avalon-MM slave: writes.
     let wr = |addr: u32, reg: &str| {
