@@ -203,8 +203,6 @@ fn declare_state(t: &Dims<'_>, items: &mut Vec<Item>) -> Vec<PeWires> {
 
 /// The Avalon-MM address decode: which region a bus access hits, and the host's write strobes.
 struct Decode {
-    /// The controller is idle (the host owns the memories).
-    idle: Signal,
     /// Control registers (`avs_address < 16`).
     is_ctrl: Signal,
     /// Per-path status words.
@@ -262,7 +260,6 @@ fn bus_decode(t: &Dims<'_>, items: &mut Vec<Item>) -> Decode {
             .and(Expr::slice("avs_address", 1, 0).eq(lit(2, 3))),
     );
     Decode {
-        idle,
         is_ctrl,
         is_status,
         is_point,
@@ -948,36 +945,10 @@ fn controller(t: &Dims<'_>, rom: &ScheduleRead, f: &WritebackFlags, items: &mut 
     )]));
 }
 
-/// Builds `bt_top`: an outline that calls one builder per block, in the order the blocks
-/// appear in the emitted file.
-pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
-    let t = Dims::of(d);
-    let mut items = Vec::new();
-    let pe = declare_state(&t, &mut items);
-    let bus = bus_decode(&t, &mut items);
-    let rom = schedule_memory(&t, &bus, &mut items);
-    let l = &d.layout;
-    let k = l.num_instances;
-    let (pb, sb) = (l.path_bits, l.slot_bits);
-    let cw = width::COORD;
-    let cap = d.platform.capacity;
-    let ab = t.ab;
-    let mut unused: Vec<Expr> = vec![lit(1, 0)];
-    let early = t.early.clone();
-    let ports = updater_read_ports(&t, &bus, &rom, &mut items);
-    let sel = pe_output_select(&t, &pe, &mut items);
-    let disp = displacement(&t, &sel, &mut items);
-    let wb_lb = t
-        .early
-        .as_ref()
-        .map(|(stop, boxes)| early_stop_logic(d, stop, boxes, &disp, &mut items));
-    let flags = writeback_flags(&sel, &disp, wb_lb, &mut items);
-    updater_write_port(&bus, &ports, &sel, &flags, &mut items);
-
-    pe_matrix(&t, &pe, &mut items);
-    controller(&t, &rom, &flags, &mut items);
-
-    // Avalon-MM slave: writes.
+/// Avalon-MM slave, writes: the transmitter, receiver and slot-count registers and the
+/// staging words of a point (its last word, the fractions, goes to the point memory).
+fn register_writes(t: &Dims<'_>, bus: &Decode, items: &mut Vec<Item>) {
+    let (ab, sb) = (t.ab, t.sb);
     let wr = |addr: u32, reg: &str| {
         Stmt::If(
             id("avs_address").eq(lit(ab, addr.into())),
@@ -997,7 +968,7 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
             nb(id("slots_r"), lit(sb + 1, 0)),
         ],
         vec![Stmt::If(
-            id("host_wr"),
+            bus.host_wr.e(),
             vec![
                 wr(4, "tx_x"),
                 wr(5, "tx_y"),
@@ -1011,7 +982,7 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
                     vec![],
                 ),
                 Stmt::If(
-                    id("is_point"),
+                    bus.is_point.e(),
                     vec![Stmt::Case(
                         Expr::slice("avs_address", 1, 0),
                         vec![
@@ -1027,7 +998,13 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
             vec![],
         )],
     )]));
-    // Avalon-MM slave: pipelined reads, fixed latency 2 (address -> registered select -> readdata).
+}
+
+/// Avalon-MM slave, pipelined reads with a fixed latency of 2 (address -> registered select ->
+/// readdata). Returns the read multiplexer's register, declared after the pipeline.
+fn read_pipeline(t: &Dims<'_>, bus: &Decode, items: &mut Vec<Item>) -> Signal {
+    let mut mux_decl = Vec::new();
+    let read_mux = Signal::reg(&mut mux_decl, "read_mux", 32);
     items.push(Item::AlwaysFf(vec![Stmt::If(
         id("rst_n").lnot(),
         vec![
@@ -1040,70 +1017,63 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
             nb(
                 id("rq_kind"),
                 Expr::mux(
-                    id("is_ctrl"),
+                    bus.is_ctrl.e(),
                     lit(2, 1),
                     Expr::mux(
-                        id("is_status"),
+                        bus.is_status.e(),
                         lit(2, 2),
-                        Expr::mux(id("is_point"), lit(2, 3), lit(2, 0)),
+                        Expr::mux(bus.is_point.e(), lit(2, 3), lit(2, 0)),
                     ),
                 ),
             ),
             nb(id("rq_reg"), Expr::slice("avs_address", 3, 0)),
             nb(id("rq_word"), Expr::slice("avs_address", 1, 0)),
-            nb(id("rq_path"), Expr::slice("avs_address", pb - 1, 0)),
+            nb(id("rq_path"), Expr::slice("avs_address", t.pb - 1, 0)),
             nb(id("avs_readdatavalid"), id("rq_valid")),
-            nb(id("avs_readdata"), id("read_mux")),
+            nb(id("avs_readdata"), read_mux.e()),
         ],
     )]));
-    let info = (k << 24) | (MAP_VERSION << 16) | (cap.paths & 0xffff);
-    items.push(Item::Reg("read_mux".into(), 32));
+    items.extend(mux_decl);
+    read_mux
+}
+
+/// The control registers' read values by word address (register map in `docs/hardware.md`).
+fn control_read_arms(t: &Dims<'_>, mux: &Signal) -> Vec<(Expr, Vec<Stmt>)> {
+    let platform = t.p.platform;
+    let info = (t.k << 24) | (MAP_VERSION << 16) | (platform.capacity.paths & 0xffff);
+    let read = |addr: u128, value: Expr| (lit(4, addr), vec![Stmt::Blocking(mux.e(), value)]);
+    vec![
+        read(
+            0,
+            Expr::concat(vec![
+                lit(30, 0),
+                id("done"),
+                Expr::bin(BinaryOp::Ne, id("state"), lit(STATE_BITS, S_IDLE)),
+            ]),
+        ),
+        read(1, id("cycles")),
+        read(2, lit(32, info.into())),
+        read(3, lit(32, platform.threshold_lsb.into())),
+        read(4, id("tx_x")),
+        read(5, id("tx_y")),
+        read(6, id("tx_z")),
+        read(8, id("rx_x")),
+        read(9, id("rx_y")),
+        read(10, id("rx_z")),
+        read(12, Expr::concat(vec![lit(31 - t.sb, 0), id("slots_r")])),
+    ]
+}
+
+/// The read multiplexer: control registers, a path's status word, or a point's words (three
+/// integer words, then the packed fractions).
+fn read_mux(t: &Dims<'_>, mux: &Signal, items: &mut Vec<Item>) {
+    let cw = width::COORD;
+    let set = |value: Expr| vec![Stmt::Blocking(mux.e(), value)];
     let rqp = |v: &str| Expr::id(v).at(id("rq_path"));
-    let ctrl_arms = vec![
-        (
-            lit(4, 0),
-            vec![bl(
-                "read_mux",
-                Expr::concat(vec![
-                    lit(30, 0),
-                    id("done"),
-                    Expr::bin(BinaryOp::Ne, id("state"), lit(STATE_BITS, S_IDLE)),
-                ]),
-            )],
-        ),
-        (lit(4, 1), vec![bl("read_mux", id("cycles"))]),
-        (lit(4, 2), vec![bl("read_mux", lit(32, info.into()))]),
-        (
-            lit(4, 3),
-            vec![bl("read_mux", lit(32, d.platform.threshold_lsb.into()))],
-        ),
-        (lit(4, 4), vec![bl("read_mux", id("tx_x"))]),
-        (lit(4, 5), vec![bl("read_mux", id("tx_y"))]),
-        (lit(4, 6), vec![bl("read_mux", id("tx_z"))]),
-        (lit(4, 8), vec![bl("read_mux", id("rx_x"))]),
-        (lit(4, 9), vec![bl("read_mux", id("rx_y"))]),
-        (lit(4, 10), vec![bl("read_mux", id("rx_z"))]),
-        (
-            lit(4, 12),
-            vec![bl(
-                "read_mux",
-                Expr::concat(vec![lit(31 - sb, 0), id("slots_r")]),
-            )],
-        ),
-    ];
     let point_arms = vec![
-        (
-            lit(2, 0),
-            vec![bl("read_mux", Expr::slice("rd_a", cw - 1, 8))],
-        ),
-        (
-            lit(2, 1),
-            vec![bl("read_mux", Expr::slice("rd_a", 2 * cw - 1, cw + 8))],
-        ),
-        (
-            lit(2, 2),
-            vec![bl("read_mux", Expr::slice("rd_a", 3 * cw - 1, 2 * cw + 8))],
-        ),
+        (lit(2, 0), set(Expr::slice("rd_a", cw - 1, 8))),
+        (lit(2, 1), set(Expr::slice("rd_a", 2 * cw - 1, cw + 8))),
+        (lit(2, 2), set(Expr::slice("rd_a", 3 * cw - 1, 2 * cw + 8))),
     ];
     let frac_word = Expr::concat(vec![
         lit(8, 0),
@@ -1111,8 +1081,20 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
         Expr::slice("rd_a", cw + 7, cw),
         Expr::slice("rd_a", 7, 0),
     ]);
+    let status_word = Expr::concat(vec![
+        Expr::id("rounds").at(id("rq_path")),
+        lit(12, 0),
+        if t.early.is_some() {
+            rqp("lb")
+        } else {
+            lit(1, 0)
+        },
+        rqp("ov"),
+        rqp("dz"),
+        rqp("conv"),
+    ]);
     items.push(Item::AlwaysComb(vec![
-        bl("read_mux", lit(32, 0)),
+        Stmt::Blocking(mux.e(), lit(32, 0)),
         Stmt::Case(
             id("rq_kind"),
             vec![
@@ -1120,48 +1102,36 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
                     lit(2, 1),
                     vec![Stmt::Case(
                         id("rq_reg"),
-                        ctrl_arms,
-                        vec![bl("read_mux", lit(32, 0))],
+                        control_read_arms(t, mux),
+                        set(lit(32, 0)),
                     )],
                 ),
-                (
-                    lit(2, 2),
-                    vec![bl(
-                        "read_mux",
-                        Expr::concat(vec![
-                            Expr::id("rounds").at(id("rq_path")),
-                            lit(12, 0),
-                            if early.is_some() {
-                                rqp("lb")
-                            } else {
-                                lit(1, 0)
-                            },
-                            rqp("ov"),
-                            rqp("dz"),
-                            rqp("conv"),
-                        ]),
-                    )],
-                ),
+                (lit(2, 2), set(status_word)),
                 (
                     lit(2, 3),
-                    vec![Stmt::Case(
-                        id("rq_word"),
-                        point_arms,
-                        vec![bl("read_mux", frac_word)],
-                    )],
+                    vec![Stmt::Case(id("rq_word"), point_arms, set(frac_word))],
                 ),
             ],
-            vec![bl("read_mux", lit(32, 0))],
+            set(lit(32, 0)),
         ),
     ]));
+}
+
+/// The interrupt (`ins_irq = done`) and `bt_unused_ok`, which reads the bits no block uses so
+/// the linter sees them consumed on purpose.
+fn interrupt_and_unused(items: &mut Vec<Item>) {
     items.push(Item::Assign(id("ins_irq"), id("done")));
-    unused.push(Expr::slice("avs_writedata", 31, 1));
+    let unused = vec![lit(1, 0), Expr::slice("avs_writedata", 31, 1)];
     items.push(Item::Wire("bt_unused_ok".into(), 1));
     items.push(Item::Assign(
         id("bt_unused_ok"),
         Expr::Unary(UnaryOp::ReduceAnd, Box::new(Expr::concat(unused))),
     ));
+}
 
+/// The `bt_top` module around `items`: header and the Avalon-MM ports.
+fn top_shell(t: &Dims<'_>, items: Vec<Item>) -> Module {
+    let ab = t.ab;
     Module {
         name: "bt_top".into(),
         header: vec![
@@ -1184,6 +1154,32 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
         ],
         items,
     }
+}
+
+/// Builds `bt_top`: an outline that calls one builder per block, in the order the blocks
+/// appear in the emitted file.
+pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
+    let t = Dims::of(d);
+    let mut items = Vec::new();
+    let pe = declare_state(&t, &mut items);
+    let bus = bus_decode(&t, &mut items);
+    let rom = schedule_memory(&t, &bus, &mut items);
+    let ports = updater_read_ports(&t, &bus, &rom, &mut items);
+    let sel = pe_output_select(&t, &pe, &mut items);
+    let disp = displacement(&t, &sel, &mut items);
+    let wb_lb = t
+        .early
+        .as_ref()
+        .map(|(stop, boxes)| early_stop_logic(d, stop, boxes, &disp, &mut items));
+    let flags = writeback_flags(&sel, &disp, wb_lb, &mut items);
+    updater_write_port(&bus, &ports, &sel, &flags, &mut items);
+    pe_matrix(&t, &pe, &mut items);
+    controller(&t, &rom, &flags, &mut items);
+    register_writes(&t, &bus, &mut items);
+    let mux = read_pipeline(&t, &bus, &mut items);
+    read_mux(&t, &mux, &mut items);
+    interrupt_and_unused(&mut items);
+    top_shell(&t, items)
 }
 
 /// Early stopping at write-back (twin of `bt_fixed::FineBox::outside` and the `min_rounds`
