@@ -24,9 +24,6 @@ const BOX_BITS: u32 = 48;
 fn nb(l: Expr, r: Expr) -> Stmt {
     Stmt::NonBlocking(l, r)
 }
-fn bl(l: &str, r: Expr) -> Stmt {
-    Stmt::Blocking(Expr::id(l), r)
-}
 fn id(n: &str) -> Expr {
     Expr::id(n)
 }
@@ -1182,29 +1179,32 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
     top_shell(&t, items)
 }
 
-/// Early stopping at write-back (twin of `bt_fixed::FineBox::outside` and the `min_rounds`
-/// rule of `FixedIpc::run_path`): `wb_lb` = the written point lies outside its instance's
-/// widened box by more than `(L1 move) << shift`, in a round ≥ `min_rounds`. Signed 48-bit
-/// comparisons are unsigned ones with the sign bit flipped (the box constants are flipped
-/// when generated).
-fn early_stop_logic(
+/// The widened polygon box of the written instance's plane, per axis (sign bit flipped).
+struct InstanceBox {
+    /// `box_lo_<axis>`.
+    lo: Vec<Signal>,
+    /// `box_hi_<axis>`.
+    hi: Vec<Signal>,
+}
+
+/// Early stopping, box table: the box of the instance being written (`wb_q_inst`), its
+/// constants biased by 2^47 so that signed comparisons become unsigned ones.
+fn instance_box(
     d: &TopParams<'_>,
-    stop: &bt_fixed::EarlyStop,
     boxes: &[bt_fixed::FineBox],
-    disp: &Displacement,
     items: &mut Vec<Item>,
-) -> Signal {
+) -> InstanceBox {
     let w = BOX_BITS;
     let bias = 1i128 << (w - 1);
     let biased = |v: i64| lit(w, ((i128::from(v) + bias) as u128) & ((1u128 << w) - 1));
-    let axes = ["x", "y", "z"];
-    let mut defaults = Vec::new();
-    for axis in axes {
-        for side in ["lo", "hi"] {
-            let n = format!("box_{side}_{axis}");
-            items.push(Item::Reg(n.clone(), w));
-            defaults.push(bl(&n, lit(w, 0)));
-        }
+    let (mut lo, mut hi, mut defaults) = (Vec::new(), Vec::new(), Vec::new());
+    for axis in ["x", "y", "z"] {
+        lo.push(Signal::reg(items, format!("box_lo_{axis}"), w));
+        hi.push(Signal::reg(items, format!("box_hi_{axis}"), w));
+    }
+    for (l, h) in lo.iter().zip(&hi) {
+        defaults.push(Stmt::Blocking(l.e(), lit(w, 0)));
+        defaults.push(Stmt::Blocking(h.e(), lit(w, 0)));
     }
     let arms = d
         .platform
@@ -1214,9 +1214,9 @@ fn early_stop_logic(
         .map(|(j, inst)| {
             let b = &boxes[inst.plane as usize];
             let mut stmts = Vec::new();
-            for (a, axis) in axes.iter().enumerate() {
-                stmts.push(bl(&format!("box_lo_{axis}"), biased(b.lo[a])));
-                stmts.push(bl(&format!("box_hi_{axis}"), biased(b.hi[a])));
+            for a in 0..3 {
+                stmts.push(Stmt::Blocking(lo[a].e(), biased(b.lo[a])));
+                stmts.push(Stmt::Blocking(hi[a].e(), biased(b.hi[a])));
             }
             (lit(d.layout.inst_bits, j as u128), stmts)
         })
@@ -1230,6 +1230,24 @@ fn early_stop_logic(
         arms,
         defaults,
     )]));
+    InstanceBox { lo, hi }
+}
+
+/// Early stopping at write-back (twin of `bt_fixed::FineBox::outside` and the `min_rounds`
+/// rule of `FixedIpc::run_path`): `wb_lb` = the written point lies outside its instance's
+/// widened box by more than `(L1 move) << shift`, in a round ≥ `min_rounds`. Signed 48-bit
+/// comparisons are unsigned ones with the sign bit flipped (the box constants are flipped
+/// when generated).
+fn early_stop_logic(
+    d: &TopParams<'_>,
+    stop: &bt_fixed::EarlyStop,
+    boxes: &[bt_fixed::FineBox],
+    disp: &Displacement,
+    items: &mut Vec<Item>,
+) -> Signal {
+    let w = BOX_BITS;
+    let axes = ["x", "y", "z"];
+    let bx = instance_box(d, boxes, items);
     let dispw = width::COORD + 1;
     let mvw = w - bt_fixed::EarlyStop::MAX_SHIFT;
     let zext = |s: &Signal| Expr::concat(vec![lit(mvw - dispw, 0), s.e()]);
@@ -1248,7 +1266,7 @@ fn early_stop_logic(
     }
     items.push(Item::Assign(id("slack"), Expr::concat(parts)));
     let mut terms = Vec::new();
-    for (axis, new) in axes.iter().zip(&disp.new) {
+    for (a, (axis, new)) in axes.iter().zip(&disp.new).enumerate() {
         let pw = format!("bp_{axis}");
         items.push(Item::Wire(pw.clone(), w));
         items.push(Item::Assign(
@@ -1268,7 +1286,8 @@ fn early_stop_logic(
             } else {
                 BinaryOp::Gt
             };
-            terms.push(Expr::bin(op, flipped, id(&format!("box_{side}_{axis}"))));
+            let bound = if side == "lo" { &bx.lo[a] } else { &bx.hi[a] };
+            terms.push(Expr::bin(op, flipped, bound.e()));
         }
     }
     let outside = terms.into_iter().reduce(or).expect("3 axes");
