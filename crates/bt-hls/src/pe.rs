@@ -4,7 +4,7 @@
 use bt_fixed::{FixedPlane, GUARD_BITS, NORMAL_FRAC, PROPORTION_ITERATIONS, width};
 
 use crate::HlsError;
-use crate::verilog::{BinaryOp, Direction, Expr, Item, Module, Port, Stmt, UnaryOp};
+use crate::verilog::{BinaryOp, Direction, Expr, Item, Module, Port, Signal, Stmt, UnaryOp};
 
 /// Width of a packed point `{z, y, x}` of fine words.
 pub const POINT_BITS: u32 = 3 * width::COORD;
@@ -133,22 +133,54 @@ pub(crate) fn pe_module(
     plane_name: &str,
     plane: &FixedPlane,
 ) -> Result<Module, HlsError> {
-    let cw = width::COORD;
-    let g = GUARD_BITS;
-    let xw = width::DISTANCE; // network input: s (40 bits, sign-extended), d or t (42 bits)
-    debug_assert_eq!(width::PROJECTION, xw);
-    let (deltaw, sumw, accw) = (width::DELTA, width::DISTANCE_SUM, width::DOT_ACC);
-    let (lw, ew, lpw, aw) = (
-        width::HALF_SUM,
-        width::SEARCH_DIFF,
-        width::HALF_DELTA,
-        width::POINT_ACC,
-    );
-    let spw = width::SUM_POINT;
-    let last_step = FIRST_ITERATION_STEP + PROPORTION_ITERATIONS - 1;
-    let stepw = 64 - u64::from(last_step).leading_zeros();
+    debug_assert_eq!(width::PROJECTION, XW);
     let mut items = Vec::new();
+    let mut unused = Vec::new();
     let csd: Vec<bt_fixed::Csd> = plane.normal.iter().map(|n| n.csd()).collect();
+    let regs = pe_state(index, plane_name, plane, &csd, &mut items);
+    let nets = csd_networks(&regs, &csd, &mut items)?;
+    let d_new = signed_distance(plane, &nets, &mut items, &mut unused)?;
+    let t = projections(index, &regs, &nets, &mut items, &mut unused)?;
+    let setup = setup_values(&regs, &mut items, &mut unused);
+    let halving = halving_step(&regs, &mut items, &mut unused);
+    pe_outputs(&regs, &mut items);
+    sequencer(&regs, &d_new, &t, &setup, &halving, &mut items);
+    items.push(Item::Wire("bt_unused_ok".into(), 1));
+    unused.insert(0, Expr::lit(1, 0));
+    items.push(Item::Assign(
+        Expr::id("bt_unused_ok"),
+        Expr::Unary(UnaryOp::ReduceAnd, Box::new(Expr::concat(unused))),
+    ));
+    Ok(pe_shell(index, plane_name, items))
+}
+
+/// Network input width: s (40 bits, sign-extended), d or t (42 bits).
+const XW: u32 = width::DISTANCE;
+
+/// The PE's registers (see the step table of [`pe_module`]).
+struct PeRegs {
+    /// Step counter.
+    step: Signal,
+    /// Zero distance sum.
+    zs: Signal,
+    /// `d_prev`, then `E`.
+    r_e: Signal,
+    /// `d_next`, then `L`.
+    r_l: Signal,
+    /// Per axis: `s_prev`, `t_prev`, then the `B_p` accumulator.
+    a: Vec<Signal>,
+    /// Per axis: `s_next`, `t_next`, then `L_p`.
+    b: Vec<Signal>,
+}
+
+/// The plane's header comment and the PE's registers.
+fn pe_state(
+    index: usize,
+    plane_name: &str,
+    plane: &FixedPlane,
+    csd: &[bt_fixed::Csd],
+    items: &mut Vec<Item>,
+) -> PeRegs {
     items.push(Item::Comment(format!(
         "plane {index} '{plane_name}': n = ({}, {}, {}) (Q2.30 raw {}, {}, {}), offset = {} fine LSB\n\
          CSD digits per component: {}, {}, {}",
@@ -163,100 +195,149 @@ pub(crate) fn pe_module(
         csd[1].digits.len(),
         csd[2].digits.len()
     )));
-    let mut unused = Vec::new();
-    items.push(Item::Reg("step".into(), stepw));
-    items.push(Item::Reg("zs".into(), 1));
-    items.push(Item::Reg("r_e".into(), ew));
-    items.push(Item::Reg("r_l".into(), lw));
+    let step = Signal::reg(items, "step", step_bits());
+    let zs = Signal::reg(items, "zs", 1);
+    let r_e = Signal::reg(items, "r_e", width::SEARCH_DIFF);
+    let r_l = Signal::reg(items, "r_l", width::HALF_SUM);
+    let (mut a, mut b) = (Vec::new(), Vec::new());
     for axis in AXES {
-        items.push(Item::Reg(format!("a_{axis}"), aw));
-        items.push(Item::Reg(format!("b_{axis}"), lpw));
+        a.push(Signal::reg(items, format!("a_{axis}"), width::POINT_ACC));
+        b.push(Signal::reg(items, format!("b_{axis}"), width::HALF_DELTA));
     }
-    // Shared networks: input selected by step[1:0] (0 = a, 1 = b, 2 = r_e, 3 = r_l).
+    PeRegs {
+        step,
+        zs,
+        r_e,
+        r_l,
+        a,
+        b,
+    }
+}
+
+/// The last step of the PE's counter and the counter's width.
+fn last_step() -> u32 {
+    FIRST_ITERATION_STEP + PROPORTION_ITERATIONS - 1
+}
+fn step_bits() -> u32 {
+    64 - u64::from(last_step()).leading_zeros()
+}
+
+/// The low [`XW`] bits of a register (the network input).
+fn low(s: &Signal) -> Expr {
+    s.slice(XW - 1, 0)
+}
+
+/// One shared CSD network: `net = x_in · n_k / 2^base`.
+struct Network {
+    /// The lowest digit shift (the network's exact low bits are all zero below it).
+    base: u32,
+    /// `net_<axis>`, `DOT_ACC − base` bits.
+    net: Signal,
+}
+
+/// Shared networks, one per non-zero normal component: input selected by step[1:0] (0 = a,
+/// 1 = b, 2 = r_e, 3 = r_l).
+fn csd_networks(
+    r: &PeRegs,
+    csd: &[bt_fixed::Csd],
+    items: &mut Vec<Item>,
+) -> Result<Vec<Option<Network>>, HlsError> {
     items.push(Item::Comment(
         "one CSD network per non-zero normal component, shared by d_prev, d_next, t_prev, t_next"
             .into(),
     ));
-    let low = |n: &str| Expr::slice(n, xw - 1, 0);
-    let s1 = Expr::bit("step", 1);
-    let s0 = Expr::bit("step", 0);
-    // Lowest digit shift per component (the network's exact low bits are all zero below it).
-    let base: Vec<Option<u32>> = csd
-        .iter()
-        .map(|c| c.digits.iter().map(|d| d.shift).min())
-        .collect();
+    let (s1, s0) = (r.step.bit(1), r.step.bit(0));
+    let mut nets = Vec::new();
     for (k, axis) in AXES.iter().enumerate() {
-        let Some(bk) = base[k] else { continue };
-        let xin = format!("x_in_{axis}");
-        items.push(Item::Wire(xin.clone(), xw));
-        items.push(Item::Assign(
-            Expr::id(&xin),
+        let Some(bk) = csd[k].digits.iter().map(|d| d.shift).min() else {
+            nets.push(None);
+            continue;
+        };
+        let xin = Signal::assigned(
+            items,
+            format!("x_in_{axis}"),
+            XW,
             Expr::mux(
                 s1.clone(),
-                Expr::mux(s0.clone(), low("r_l"), low("r_e")),
-                Expr::mux(
-                    s0.clone(),
-                    low(&format!("b_{axis}")),
-                    low(&format!("a_{axis}")),
-                ),
+                Expr::mux(s0.clone(), low(&r.r_l), low(&r.r_e)),
+                Expr::mux(s0.clone(), low(&r.b[k]), low(&r.a[k])),
             ),
-        ));
-        let net = format!("net_{axis}");
-        let nw = accw - bk;
+        );
+        let nw = width::DOT_ACC - bk;
         items.push(Item::Comment(format!(
             "net_{axis} = x_in_{axis} * n_{axis} / 2^{bk} ({} digits)",
             csd[k].digits.len()
         )));
-        items.push(Item::Wire(net.clone(), nw));
-        items.push(Item::Assign(
-            Expr::id(&net),
-            csd_sum(&xin, xw, &csd[k], bk, nw)?,
-        ));
+        let net = Signal::assigned(
+            items,
+            format!("net_{axis}"),
+            nw,
+            csd_sum(xin.name(), XW, &csd[k], bk, nw)?,
+        );
+        nets.push(Some(Network { base: bk, net }));
     }
-    // Signed distance: round_half_up((Σ n_k x_k − offset·2^30) / 2^30), exact below bit `sd`.
+    Ok(nets)
+}
+
+/// Signed distance: round_half_up((Σ n_k x_k − offset·2^30) / 2^30), exact below bit `sd`.
+/// Returns `d_new`.
+fn signed_distance(
+    plane: &FixedPlane,
+    nets: &[Option<Network>],
+    items: &mut Vec<Item>,
+    unused: &mut Vec<Expr>,
+) -> Result<Signal, HlsError> {
+    let accw = width::DOT_ACC;
     let nf = NORMAL_FRAC;
-    let sd = base.iter().flatten().copied().min().unwrap_or(nf).min(nf);
+    let sd = nets
+        .iter()
+        .flatten()
+        .map(|n| n.base)
+        .min()
+        .unwrap_or(nf)
+        .min(nf);
     let dot_const = (1i128 << (nf - 1)) - (i128::from(plane.offset.0) << nf);
     let dw = accw - sd;
     let mut dot = Expr::lit_signed(dw, dot_const >> sd);
-    for (k, axis) in AXES.iter().enumerate() {
-        let Some(bk) = base[k] else { continue };
-        dot = dot.plus(shifted_term(
-            &format!("net_{axis}"),
-            accw - bk,
-            bk - sd,
-            dw,
-        )?);
+    for n in nets.iter().flatten() {
+        dot = dot.plus(shifted_term(n.net.name(), accw - n.base, n.base - sd, dw)?);
     }
     items.push(Item::Comment(format!(
         "dot = (n . x_in - offset * 2^30 + 2^29) / 2^{sd}; d = dot >> {}",
         nf - sd
     )));
-    items.push(Item::Wire("dot".into(), dw));
-    items.push(Item::Assign(Expr::id("dot"), dot));
+    let dot = Signal::assigned(items, "dot", dw, dot);
     if nf > sd {
-        unused.push(Expr::slice("dot", nf - sd - 1, 0));
+        unused.push(dot.slice(nf - sd - 1, 0));
     }
-    items.push(Item::Wire("d_new".into(), xw));
-    items.push(Item::Assign(
-        Expr::id("d_new"),
-        Expr::slice("dot", dw - 1, nf - sd),
-    ));
-    // Projections: t_k = base_k − round_half_up(d · n_k / 2^30), base = a (step 2) or b (step 3).
+    Ok(Signal::assigned(
+        items,
+        "d_new",
+        XW,
+        dot.slice(dw - 1, nf - sd),
+    ))
+}
+
+/// Projections: t_k = base_k − round_half_up(d · n_k / 2^30), base = a (step 2) or b (step 3).
+fn projections(
+    index: usize,
+    r: &PeRegs,
+    nets: &[Option<Network>],
+    items: &mut Vec<Item>,
+    unused: &mut Vec<Expr>,
+) -> Result<Vec<Signal>, HlsError> {
+    let nf = NORMAL_FRAC;
+    let s0 = r.step.bit(0);
+    let mut ts = Vec::new();
     for (k, axis) in AXES.iter().enumerate() {
-        let pbase = Expr::mux(
-            s0.clone(),
-            low(&format!("b_{axis}")),
-            low(&format!("a_{axis}")),
-        );
-        let t = format!("t_{axis}");
-        items.push(Item::Wire(t.clone(), xw));
-        let Some(bk) = base[k] else {
-            items.push(Item::Assign(Expr::id(&t), pbase));
+        let pbase = Expr::mux(s0.clone(), low(&r.b[k]), low(&r.a[k]));
+        let t = Signal::wire(items, format!("t_{axis}"), XW);
+        let Some(Network { base: bk, net }) = &nets[k] else {
+            items.push(Item::Assign(t.e(), pbase));
+            ts.push(t);
             continue;
         };
-        let net = format!("net_{axis}");
-        let nw = accw - bk;
+        let (bk, nw) = (*bk, net.width());
         let p = if bk >= nf {
             // Multiple of 2^30: the rounding half cannot carry.
             if bk > nf {
@@ -264,227 +345,310 @@ pub(crate) fn pe_module(
                     "normal component {axis} of plane {index} has a digit above 2^30"
                 )));
             }
-            Expr::id(&net)
+            net.e()
         } else {
-            let pr = format!("p_round_{axis}");
-            items.push(Item::Wire(pr.clone(), nw));
-            items.push(Item::Assign(
-                Expr::id(&pr),
-                Expr::id(&net).plus(Expr::lit(nw, 1u128 << (nf - 1 - bk))),
-            ));
-            unused.push(Expr::slice(&pr, nf - bk - 1, 0));
-            Expr::slice(&pr, nw - 1, nf - bk)
+            let pr = Signal::assigned(
+                items,
+                format!("p_round_{axis}"),
+                nw,
+                net.e().plus(Expr::lit(nw, 1u128 << (nf - 1 - bk))),
+            );
+            unused.push(pr.slice(nf - bk - 1, 0));
+            pr.slice(nw - 1, nf - bk)
         };
-        items.push(Item::Assign(Expr::id(&t), pbase.minus(p)));
+        items.push(Item::Assign(t.e(), pbase.minus(p)));
+        ts.push(t);
     }
-    // Step 4: m, n, delta, and the Algorithm 3 initial values.
-    for (abs, r) in [("m_dist", "r_e"), ("n_dist", "r_l")] {
-        items.push(Item::Wire(abs.into(), xw));
-        items.push(Item::Assign(
-            Expr::id(abs),
+    Ok(ts)
+}
+
+/// The step-4 values: `m + n`, `n − m` and per axis `δ` and `t_prev + t_next + 1`.
+struct SetupValues {
+    dist_sum: Signal,
+    dist_diff: Signal,
+    delta: Vec<Signal>,
+    tsum: Vec<Signal>,
+}
+
+/// Step 4: m, n, delta, and the Algorithm 3 initial values.
+fn setup_values(r: &PeRegs, items: &mut Vec<Item>, unused: &mut Vec<Expr>) -> SetupValues {
+    let (deltaw, sumw) = (width::DELTA, width::DISTANCE_SUM);
+    let abs = |items: &mut Vec<Item>, name: &str, reg: &Signal| {
+        Signal::assigned(
+            items,
+            name,
+            XW,
             Expr::mux(
-                Expr::bit(r, xw - 1),
-                low(r).inv().plus(Expr::lit(xw, 1)),
-                low(r),
+                reg.bit(XW - 1),
+                low(reg).inv().plus(Expr::lit(XW, 1)),
+                low(reg),
             ),
-        ));
-    }
-    debug_assert_eq!(sumw, xw);
-    items.push(Item::Wire("dist_sum".into(), sumw));
-    items.push(Item::Assign(
-        Expr::id("dist_sum"),
-        Expr::id("m_dist").plus(Expr::id("n_dist")),
-    ));
-    items.push(Item::Wire("dist_diff".into(), sumw + 1));
-    items.push(Item::Assign(
-        Expr::id("dist_diff"),
-        Expr::concat(vec![Expr::lit(1, 0), Expr::id("n_dist")])
-            .minus(Expr::concat(vec![Expr::lit(1, 0), Expr::id("m_dist")])),
-    ));
-    for axis in AXES {
-        let (a, b) = (format!("a_{axis}"), format!("b_{axis}"));
-        let delta = format!("delta_{axis}");
-        items.push(Item::Wire(delta.clone(), deltaw));
-        items.push(Item::Assign(
-            Expr::id(&delta),
-            sext_slice(&b, xw - 1, 0, deltaw).minus(sext_slice(&a, xw - 1, 0, deltaw)),
+        )
+    };
+    let m = abs(items, "m_dist", &r.r_e);
+    let n = abs(items, "n_dist", &r.r_l);
+    debug_assert_eq!(sumw, XW);
+    let dist_sum = Signal::assigned(items, "dist_sum", sumw, m.e().plus(n.e()));
+    let dist_diff = Signal::assigned(
+        items,
+        "dist_diff",
+        sumw + 1,
+        Expr::concat(vec![Expr::lit(1, 0), n.e()])
+            .minus(Expr::concat(vec![Expr::lit(1, 0), m.e()])),
+    );
+    let (mut delta, mut tsum) = (Vec::new(), Vec::new());
+    for (k, axis) in AXES.iter().enumerate() {
+        let (a, b) = (r.a[k].name(), r.b[k].name());
+        delta.push(Signal::assigned(
+            items,
+            format!("delta_{axis}"),
+            deltaw,
+            sext_slice(b, XW - 1, 0, deltaw).minus(sext_slice(a, XW - 1, 0, deltaw)),
         ));
         // t_prev + t_next + 1 as one adder: {b, 1} + {a, 1} = 2·(a + b + 1).
-        let tsum = format!("tsum_{axis}");
-        items.push(Item::Wire(tsum.clone(), deltaw + 1));
-        items.push(Item::Assign(
-            Expr::id(&tsum),
-            Expr::concat(vec![sext_slice(&b, xw - 1, 0, deltaw), Expr::lit(1, 1)]).plus(
-                Expr::concat(vec![sext_slice(&a, xw - 1, 0, deltaw), Expr::lit(1, 1)]),
+        let ts = Signal::assigned(
+            items,
+            format!("tsum_{axis}"),
+            deltaw + 1,
+            Expr::concat(vec![sext_slice(b, XW - 1, 0, deltaw), Expr::lit(1, 1)]).plus(
+                Expr::concat(vec![sext_slice(a, XW - 1, 0, deltaw), Expr::lit(1, 1)]),
             ),
-        ));
-        unused.push(Expr::bit(&tsum, 0));
+        );
+        unused.push(ts.bit(0));
+        tsum.push(ts);
     }
-    // One halving step.
+    SetupValues {
+        dist_sum,
+        dist_diff,
+        delta,
+        tsum,
+    }
+}
+
+/// The next values of one halving step of Algorithm 3.
+struct Halving {
+    /// `E ± L/2`.
+    e_next: Expr,
+    /// Per axis `L_p / 2`.
+    lp_half: Vec<Signal>,
+    /// Per axis `a ± L_p/2`.
+    a_next: Vec<Expr>,
+}
+
+/// One halving step (the sign of `E` decides the direction).
+fn halving_step(r: &PeRegs, items: &mut Vec<Item>, unused: &mut Vec<Expr>) -> Halving {
+    let g = GUARD_BITS;
+    let (lw, ew, lpw, aw) = (
+        width::HALF_SUM,
+        width::SEARCH_DIFF,
+        width::HALF_DELTA,
+        width::POINT_ACC,
+    );
     items.push(Item::Comment(format!(
         "Algorithm 3 on {g} guard bits, {PROPORTION_ITERATIONS} steps frozen once L = 0; E = B - m*2^{g} replaces B, m and the comparator"
     )));
-    items.push(Item::Wire("go_up".into(), 1));
-    items.push(Item::Assign(Expr::id("go_up"), Expr::bit("r_e", ew - 1)));
-    let l_half = Expr::concat(vec![
-        Expr::lit(ew - lw + 1, 0),
-        Expr::slice("r_l", lw - 1, 1),
-    ]);
+    let go_up = Signal::assigned(items, "go_up", 1, r.r_e.bit(ew - 1));
+    let l_half = Expr::concat(vec![Expr::lit(ew - lw + 1, 0), r.r_l.slice(lw - 1, 1)]);
     let e_next = add_sub(
-        &mut items,
-        &mut unused,
+        items,
+        unused,
         "e_next",
-        Expr::id("r_e"),
+        r.r_e.e(),
         l_half,
-        Expr::id("go_up").lnot(),
+        go_up.e().lnot(),
         ew,
     );
-    let mut a_next = Vec::new();
-    for axis in AXES {
-        let b = format!("b_{axis}");
-        let lph = format!("lp_half_{axis}");
-        items.push(Item::Wire(lph.clone(), lpw));
-        items.push(Item::Assign(
-            Expr::id(&lph),
-            Expr::concat(vec![Expr::bit(&b, lpw - 1), Expr::slice(&b, lpw - 1, 1)]),
-        ));
+    let (mut lp_half, mut a_next) = (Vec::new(), Vec::new());
+    for (k, axis) in AXES.iter().enumerate() {
+        let b = &r.b[k];
+        let lph = Signal::assigned(
+            items,
+            format!("lp_half_{axis}"),
+            lpw,
+            Expr::concat(vec![b.bit(lpw - 1), b.slice(lpw - 1, 1)]),
+        );
         a_next.push(add_sub(
-            &mut items,
-            &mut unused,
+            items,
+            unused,
             &format!("a_next_{axis}"),
-            Expr::id(format!("a_{axis}")),
-            sext(&lph, lpw, aw),
-            Expr::id("go_up").lnot(),
+            r.a[k].e(),
+            sext(lph.name(), lpw, aw),
+            go_up.e().lnot(),
             aw,
         ));
+        lp_half.push(lph);
     }
-    // Output: the unsaturated point t_prev + round(B_p / 2^G) = a >> G.
-    let mut sum_parts = Vec::new();
-    for axis in AXES {
-        sum_parts.insert(0, Expr::slice(format!("a_{axis}"), aw - 1, g));
+    Halving {
+        e_next,
+        lp_half,
+        a_next,
     }
-    debug_assert_eq!(aw - g, spw);
-    items.push(Item::Assign(Expr::id("s_sum"), Expr::concat(sum_parts)));
-    items.push(Item::Assign(Expr::id("zero_sum"), Expr::id("zs")));
+}
 
-    // Sequencer.
-    let nb = |l: &str, r: Expr| Stmt::NonBlocking(Expr::id(l), r);
-    let step_is = |v: u32| Expr::id("step").eq(Expr::lit(stepw, v.into()));
-    let mut load = Vec::new();
-    for (k, axis) in AXES.iter().enumerate() {
-        let (hi, lo) = (cw * (k as u32 + 1) - 1, cw * k as u32);
-        load.push(nb(&format!("a_{axis}"), sext_slice("s_prev", hi, lo, aw)));
-        load.push(nb(&format!("b_{axis}"), sext_slice("s_next", hi, lo, lpw)));
+/// Output: the unsaturated point t_prev + round(B_p / 2^G) = a >> G, and the zero flag.
+fn pe_outputs(r: &PeRegs, items: &mut Vec<Item>) {
+    let (g, aw) = (GUARD_BITS, width::POINT_ACC);
+    let mut sum_parts = Vec::new();
+    for a in &r.a {
+        sum_parts.insert(0, a.slice(aw - 1, g));
     }
-    let idle = vec![Stmt::If(
+    debug_assert_eq!(aw - g, width::SUM_POINT);
+    items.push(Item::Assign(Expr::id("s_sum"), Expr::concat(sum_parts)));
+    items.push(Item::Assign(Expr::id("zero_sum"), r.zs.e()));
+}
+
+/// `reg <= value;`
+fn nb(reg: &Signal, value: Expr) -> Stmt {
+    Stmt::NonBlocking(reg.e(), value)
+}
+
+/// `step <= value;`
+fn goto(r: &PeRegs, value: u32) -> Stmt {
+    nb(&r.step, Expr::lit(step_bits(), value.into()))
+}
+
+/// Idle: on `start` latch `d_prev` and go to step 1; on `load` latch the operands.
+fn seq_idle(r: &PeRegs, d_new: &Signal) -> Vec<Stmt> {
+    let (cw, aw, lpw) = (width::COORD, width::POINT_ACC, width::HALF_DELTA);
+    let mut load = Vec::new();
+    for k in 0..AXES.len() {
+        let (hi, lo) = (cw * (k as u32 + 1) - 1, cw * k as u32);
+        load.push(nb(&r.a[k], sext_slice("s_prev", hi, lo, aw)));
+        load.push(nb(&r.b[k], sext_slice("s_next", hi, lo, lpw)));
+    }
+    vec![Stmt::If(
         Expr::id("start"),
         vec![
-            nb("r_e", sext("d_new", xw, ew)),
-            nb("step", Expr::lit(stepw, 1)),
+            nb(&r.r_e, sext(d_new.name(), XW, width::SEARCH_DIFF)),
+            goto(r, 1),
         ],
         vec![Stmt::If(Expr::id("load"), load, vec![])],
-    )];
-    let mut proj_prev = Vec::new();
-    let mut proj_next = Vec::new();
+    )]
+}
+
+/// Step 4: the Algorithm 3 initial values.
+fn seq_setup(r: &PeRegs, s: &SetupValues) -> Vec<Stmt> {
+    let g = GUARD_BITS;
+    let (deltaw, sumw, ew, aw) = (
+        width::DELTA,
+        width::DISTANCE_SUM,
+        width::SEARCH_DIFF,
+        width::POINT_ACC,
+    );
     let mut setup = vec![
         nb(
-            "r_e",
+            &r.r_e,
             Expr::concat(vec![
-                Expr::bit("dist_diff", sumw).repeat(ew - (sumw + 1) - (g - 1)),
-                Expr::id("dist_diff"),
+                s.dist_diff.bit(sumw).repeat(ew - (sumw + 1) - (g - 1)),
+                s.dist_diff.e(),
                 Expr::lit(1, 0).repeat(g - 1),
             ]),
         ),
         nb(
-            "r_l",
-            Expr::concat(vec![Expr::id("dist_sum"), Expr::lit(1, 0).repeat(g - 1)]),
+            &r.r_l,
+            Expr::concat(vec![s.dist_sum.e(), Expr::lit(1, 0).repeat(g - 1)]),
         ),
-        nb("zs", Expr::id("dist_sum").eq(Expr::lit(sumw, 0))),
+        nb(&r.zs, s.dist_sum.e().eq(Expr::lit(sumw, 0))),
     ];
-    debug_assert_eq!(lw, sumw + g - 1);
-    debug_assert_eq!(lpw, deltaw + g - 1);
-    let mut iterate = vec![
-        nb(
-            "r_l",
-            Expr::concat(vec![Expr::lit(1, 0), Expr::slice("r_l", lw - 1, 1)]),
-        ),
-        nb("r_e", e_next),
-    ];
-    for (k, axis) in AXES.iter().enumerate() {
-        let (a, b, t) = (
-            format!("a_{axis}"),
-            format!("b_{axis}"),
-            format!("t_{axis}"),
-        );
-        proj_prev.push(nb(&a, sext(&t, xw, aw)));
-        proj_next.push(nb(&b, sext(&t, xw, lpw)));
+    debug_assert_eq!(width::HALF_SUM, sumw + g - 1);
+    debug_assert_eq!(width::HALF_DELTA, deltaw + g - 1);
+    for k in 0..AXES.len() {
         setup.push(nb(
-            &b,
-            Expr::concat(vec![
-                Expr::id(format!("delta_{axis}")),
-                Expr::lit(1, 0).repeat(g - 1),
-            ]),
+            &r.b[k],
+            Expr::concat(vec![s.delta[k].e(), Expr::lit(1, 0).repeat(g - 1)]),
         ));
         // t_prev·2^G + 2^(G−1) + B_p0 = (t_prev + t_next + 1)·2^(G−1), modulo 2^POINT_ACC.
-        let tsum = format!("tsum_{axis}");
         setup.push(nb(
-            &a,
+            &r.a[k],
             Expr::concat(vec![
-                Expr::bit(&tsum, deltaw).repeat(aw - deltaw - (g - 1)),
-                Expr::slice(&tsum, deltaw, 1),
+                s.tsum[k].bit(deltaw).repeat(aw - deltaw - (g - 1)),
+                s.tsum[k].slice(deltaw, 1),
                 Expr::lit(1, 0).repeat(g - 1),
             ]),
         ));
-        iterate.push(nb(&b, Expr::id(format!("lp_half_{axis}"))));
-        iterate.push(nb(&a, a_next[k].clone()));
     }
     debug_assert!(aw >= deltaw + g);
-    proj_prev.push(nb("step", Expr::lit(stepw, 3)));
-    proj_next.push(nb("step", Expr::lit(stepw, 4)));
-    setup.push(nb("step", Expr::lit(stepw, FIRST_ITERATION_STEP.into())));
-    let iterate = vec![
+    setup.push(goto(r, FIRST_ITERATION_STEP));
+    setup
+}
+
+/// Steps 5 ..: one halving step while `L ≠ 0`, back to idle after the last.
+fn seq_iterate(r: &PeRegs, h: &Halving) -> Vec<Stmt> {
+    let (lw, stepw) = (width::HALF_SUM, step_bits());
+    let mut iterate = vec![
+        nb(
+            &r.r_l,
+            Expr::concat(vec![Expr::lit(1, 0), r.r_l.slice(lw - 1, 1)]),
+        ),
+        nb(&r.r_e, h.e_next.clone()),
+    ];
+    for k in 0..AXES.len() {
+        iterate.push(nb(&r.b[k], h.lp_half[k].e()));
+        iterate.push(nb(&r.a[k], h.a_next[k].clone()));
+    }
+    vec![
         Stmt::If(
-            Expr::bin(BinaryOp::Ne, Expr::id("r_l"), Expr::lit(lw, 0)),
+            Expr::bin(BinaryOp::Ne, r.r_l.e(), Expr::lit(lw, 0)),
             iterate,
             vec![],
         ),
         Stmt::If(
-            step_is(last_step),
-            vec![nb("step", Expr::lit(stepw, 0))],
-            vec![nb("step", Expr::id("step").plus(Expr::lit(stepw, 1)))],
+            r.step.e().eq(Expr::lit(stepw, last_step().into())),
+            vec![goto(r, 0)],
+            vec![nb(&r.step, r.step.e().plus(Expr::lit(stepw, 1)))],
         ),
-    ];
+    ]
+}
+
+/// The sequencer: the step counter's `case` over the table of [`pe_module`].
+fn sequencer(
+    r: &PeRegs,
+    d_new: &Signal,
+    t: &[Signal],
+    s: &SetupValues,
+    h: &Halving,
+    items: &mut Vec<Item>,
+) {
+    let (stepw, xw) = (step_bits(), XW);
+    let (aw, lpw) = (width::POINT_ACC, width::HALF_DELTA);
+    let mut proj_prev: Vec<Stmt> = (0..AXES.len())
+        .map(|k| nb(&r.a[k], sext(t[k].name(), xw, aw)))
+        .collect();
+    let mut proj_next: Vec<Stmt> = (0..AXES.len())
+        .map(|k| nb(&r.b[k], sext(t[k].name(), xw, lpw)))
+        .collect();
+    proj_prev.push(goto(r, 3));
+    proj_next.push(goto(r, 4));
     items.push(Item::AlwaysFf(vec![Stmt::If(
         Expr::id("rst_n").lnot(),
-        vec![nb("step", Expr::lit(stepw, 0))],
+        vec![goto(r, 0)],
         vec![Stmt::Case(
-            Expr::id("step"),
+            r.step.e(),
             vec![
-                (Expr::lit(stepw, 0), idle),
+                (Expr::lit(stepw, 0), seq_idle(r, d_new)),
                 (
                     Expr::lit(stepw, 1),
                     vec![
                         nb(
-                            "r_l",
-                            Expr::concat(vec![Expr::lit(lw - xw, 0), Expr::id("d_new")]),
+                            &r.r_l,
+                            Expr::concat(vec![Expr::lit(width::HALF_SUM - xw, 0), d_new.e()]),
                         ),
-                        nb("step", Expr::lit(stepw, 2)),
+                        goto(r, 2),
                     ],
                 ),
                 (Expr::lit(stepw, 2), proj_prev),
                 (Expr::lit(stepw, 3), proj_next),
-                (Expr::lit(stepw, 4), setup),
+                (Expr::lit(stepw, 4), seq_setup(r, s)),
             ],
-            iterate,
+            seq_iterate(r, h),
         )],
     )]));
-    items.push(Item::Wire("bt_unused_ok".into(), 1));
-    unused.insert(0, Expr::lit(1, 0));
-    items.push(Item::Assign(
-        Expr::id("bt_unused_ok"),
-        Expr::Unary(UnaryOp::ReduceAnd, Box::new(Expr::concat(unused))),
-    ));
-    Ok(Module {
+}
+
+/// The `bt_pe_<index>` module around `items`: header and ports.
+fn pe_shell(index: usize, plane_name: &str, items: Vec<Item>) -> Module {
+    let spw = width::SUM_POINT;
+    Module {
         name: pe_module_name(index),
         header: vec![
             format!(
@@ -509,7 +673,7 @@ pub(crate) fn pe_module(
             port("zero_sum", Direction::Output, 1),
         ],
         items,
-    })
+    }
 }
 
 /// `name[hi:lo]` sign-extended to `total` bits.

@@ -5,7 +5,7 @@ use bt_fixed::width;
 
 use crate::input::{Layout, PE_LATENCY, bits_for, sched_entry_bits};
 use crate::pe::{POINT_BITS, SUM_BITS, pe_module_name, port};
-use crate::verilog::{BinaryOp, Direction, Expr, Item, Module, Stmt, UnaryOp};
+use crate::verilog::{BinaryOp, Direction, Expr, Item, Module, Signal, Stmt, UnaryOp};
 
 /// FSM state encodings.
 const S_IDLE: u128 = 0;
@@ -23,9 +23,6 @@ const BOX_BITS: u32 = 48;
 
 fn nb(l: Expr, r: Expr) -> Stmt {
     Stmt::NonBlocking(l, r)
-}
-fn bl(l: &str, r: Expr) -> Stmt {
-    Stmt::Blocking(Expr::id(l), r)
 }
 fn id(n: &str) -> Expr {
     Expr::id(n)
@@ -69,25 +66,62 @@ fn zero_extend(name: &str, from: u32, to: u32) -> Expr {
     }
 }
 
-pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
-    let l = &d.layout;
-    let k = l.num_instances;
-    let (pb, ptb, ib, sb) = (l.path_bits, l.point_bits, l.inst_bits, l.slot_bits);
-    let eb = l.entry_bits;
-    let np2 = 1u32 << pb;
-    let depth = 1u32 << (ptb + 1);
-    let cw = width::COORD;
-    let dispw = cw + 1;
-    let sw = sched_entry_bits(pb, ptb, ib);
-    let cnt_bits = bits_for(u64::from((k + 2).max(PE_LATENCY)) + 1);
-    let status_bits = l.status_base.trailing_zeros();
-    let point_bits_addr = l.point_base.trailing_zeros();
-    let sched_bits_addr = l.sched_base.trailing_zeros();
-    let cap = d.platform.capacity;
-    let mut items = Vec::new();
-    let mut unused: Vec<Expr> = vec![lit(1, 0)];
-    let early = d.model.early_stop().map(|(s, b)| (*s, b.to_vec()));
+/// The sizes every block of `bt_top` is built from, derived once from the layout.
+struct Dims<'a> {
+    /// The platform, its model and layout.
+    p: &'a TopParams<'a>,
+    /// PE instances.
+    k: u32,
+    /// Path, point, instance, slot and schedule-entry address bits.
+    pb: u32,
+    ptb: u32,
+    ib: u32,
+    sb: u32,
+    eb: u32,
+    /// Path slots (`2^pb`): the width of the per-path flag vectors.
+    np2: u32,
+    /// Width of the step counter `cnt`.
+    cnt_bits: u32,
+    /// Word address bits of the Avalon-MM slave.
+    ab: u32,
+    /// Early stopping rule and the widened box of every plane, when enabled.
+    early: Option<(bt_fixed::EarlyStop, Vec<bt_fixed::FineBox>)>,
+}
 
+impl<'a> Dims<'a> {
+    fn of(p: &'a TopParams<'a>) -> Self {
+        let l = &p.layout;
+        Dims {
+            p,
+            k: l.num_instances,
+            pb: l.path_bits,
+            ptb: l.point_bits,
+            ib: l.inst_bits,
+            sb: l.slot_bits,
+            eb: l.entry_bits,
+            np2: 1u32 << l.path_bits,
+            cnt_bits: bits_for(u64::from((l.num_instances + 2).max(PE_LATENCY)) + 1),
+            ab: l.address_bits,
+            early: p.model.early_stop().map(|(s, b)| (*s, b.to_vec())),
+        }
+    }
+}
+
+/// The per-instance wires of the PE matrix.
+struct PeWires {
+    /// `pe_load_<j>`: latch the broadcast operands.
+    load: Signal,
+    /// `pe_sum_<j>`: the unsaturated result.
+    sum: Signal,
+    /// `pe_zs_<j>`: zero distance sum (degenerate path).
+    zs: Signal,
+}
+
+/// Header comment, the controller's registers, the per-path flag vectors, the `rounds` and
+/// point memories and the PE wires. All state is declared first, as the golden files show it.
+fn declare_state(t: &Dims<'_>, items: &mut Vec<Item>) -> Vec<PeWires> {
+    let (k, pb, ptb, ib, sb, eb, np2) = (t.k, t.pb, t.ptb, t.ib, t.sb, t.eb, t.np2);
+    let cap = t.p.platform.capacity;
     items.push(Item::Comment(format!(
         "{} PE instances, capacity {} paths, {} points, {} slots; 2 x (jobs + 2) + {} cycles per slot, threshold {} fine LSB",
         k,
@@ -95,11 +129,11 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
         cap.points,
         cap.slots,
         PE_LATENCY,
-        d.platform.threshold_lsb
+        t.p.platform.threshold_lsb
     )));
     for (n, w) in [
         ("state", STATE_BITS),
-        ("cnt", cnt_bits),
+        ("cnt", t.cnt_bits),
         ("slot", sb),
         ("sbase", eb),
         ("slots_r", sb + 1),
@@ -123,7 +157,7 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
         ("pov", np2),
         ("rd_a", POINT_BITS),
         ("rd_b", POINT_BITS),
-        ("sched_q", sw),
+        ("sched_q", sched_entry_bits(pb, ptb, ib)),
         ("sq_ok", 1),
         ("seen_tail", 1),
         ("ld_q_en", 1),
@@ -145,184 +179,287 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
     ] {
         items.push(Item::Reg(n.into(), w));
     }
-    if early.is_some() {
+    if t.early.is_some() {
         items.push(Item::Reg("lb".into(), np2));
         items.push(Item::Reg("plb".into(), np2));
     }
     items.push(Item::Memory("rounds".into(), 16, np2));
     // Two copies of the point memory (one per read port, both written): each is a plain
     // 1-write 1-read array with a registered read, which Yosys maps to M9K blocks.
+    let depth = 1u32 << (ptb + 1);
     items.push(Item::Memory("pm_a".into(), POINT_BITS, depth));
     items.push(Item::Memory("pm_b".into(), POINT_BITS, depth));
-    for j in 0..k {
-        items.push(Item::Wire(format!("pe_load_{j}"), 1));
-        items.push(Item::Wire(format!("pe_sum_{j}"), SUM_BITS));
-        items.push(Item::Wire(format!("pe_zs_{j}"), 1));
-    }
+    (0..k)
+        .map(|j| PeWires {
+            load: Signal::wire(items, format!("pe_load_{j}"), 1),
+            sum: Signal::wire(items, format!("pe_sum_{j}"), SUM_BITS),
+            zs: Signal::wire(items, format!("pe_zs_{j}"), 1),
+        })
+        .collect()
+}
 
-    // Bus address decode.
-    let ab = l.address_bits;
+/// The Avalon-MM address decode: which region a bus access hits, and the host's write strobes.
+struct Decode {
+    /// Control registers (`avs_address < 16`).
+    is_ctrl: Signal,
+    /// Per-path status words.
+    is_status: Signal,
+    /// Point memory window.
+    is_point: Signal,
+    /// Schedule memory window.
+    is_sched: Signal,
+    /// The point index of a point-window address.
+    bus_point: Signal,
+    /// A host write while idle.
+    host_wr: Signal,
+    /// The host writes a point's last word (fractions): the point memory write strobe.
+    pt_we: Signal,
+}
+
+/// Bus address decode.
+fn bus_decode(t: &Dims<'_>, items: &mut Vec<Item>) -> Decode {
+    let l = &t.p.layout;
+    let ab = t.ab;
     let hi = ab - 1;
-    items.push(Item::Wire("idle".into(), 1));
-    items.push(Item::Assign(id("idle"), state_is(S_IDLE)));
-    items.push(Item::Wire("is_ctrl".into(), 1));
-    items.push(Item::Assign(
-        id("is_ctrl"),
+    let window = |items: &mut Vec<Item>, name: &str, base: u32| {
+        let bits = base.trailing_zeros();
+        Signal::assigned(
+            items,
+            name,
+            1,
+            Expr::slice("avs_address", hi, bits).eq(lit(ab - bits, 1)),
+        )
+    };
+    let idle = Signal::assigned(items, "idle", 1, state_is(S_IDLE));
+    let is_ctrl = Signal::assigned(
+        items,
+        "is_ctrl",
+        1,
         Expr::slice("avs_address", hi, 4).eq(lit(ab - 4, 0)),
-    ));
-    items.push(Item::Wire("is_status".into(), 1));
-    items.push(Item::Assign(
-        id("is_status"),
-        Expr::slice("avs_address", hi, status_bits).eq(lit(ab - status_bits, 1)),
-    ));
-    items.push(Item::Wire("is_point".into(), 1));
-    items.push(Item::Assign(
-        id("is_point"),
-        Expr::slice("avs_address", hi, point_bits_addr).eq(lit(ab - point_bits_addr, 1)),
-    ));
-    items.push(Item::Wire("is_sched".into(), 1));
-    items.push(Item::Assign(
-        id("is_sched"),
-        Expr::slice("avs_address", hi, sched_bits_addr).eq(lit(ab - sched_bits_addr, 1)),
-    ));
-    items.push(Item::Wire("bus_point".into(), ptb));
-    items.push(Item::Assign(
-        id("bus_point"),
-        Expr::slice("avs_address", ptb + 2, 3),
-    ));
-    items.push(Item::Wire("host_wr".into(), 1));
-    items.push(Item::Assign(id("host_wr"), id("avs_write").and(id("idle"))));
-    items.push(Item::Wire("pt_we".into(), 1));
-    items.push(Item::Assign(
-        id("pt_we"),
-        id("host_wr")
-            .and(id("is_point"))
+    );
+    let is_status = window(items, "is_status", l.status_base);
+    let is_point = window(items, "is_point", l.point_base);
+    let is_sched = window(items, "is_sched", l.sched_base);
+    let bus_point = Signal::assigned(
+        items,
+        "bus_point",
+        t.ptb,
+        Expr::slice("avs_address", t.ptb + 2, 3),
+    );
+    let host_wr = Signal::assigned(items, "host_wr", 1, id("avs_write").and(idle.e()));
+    let pt_we = Signal::assigned(
+        items,
+        "pt_we",
+        1,
+        host_wr
+            .e()
+            .and(is_point.e())
             .and(Expr::slice("avs_address", 1, 0).eq(lit(2, 3))),
-    ));
+    );
+    Decode {
+        is_ctrl,
+        is_status,
+        is_point,
+        is_sched,
+        bus_point,
+        host_wr,
+        pt_we,
+    }
+}
 
-    // Schedule memory (M9K): the jobs packed slot after slot (ascending PE column, each
-    // slot's last one flagged `tail`), written by the host, read one cycle after the address
-    // sbase + cnt (sbase = the slot's first entry): entry cnt - 1 is in sched_q. Entries after
-    // the tail are never used (`stop`), so a slot takes 2 x (jobs + 2) + PE_LATENCY cycles
-    // whatever the PE count.
+/// The fields of the schedule entry read this cycle (`sched_q`, gated by `sq_ok`).
+struct ScheduleRead {
+    /// The entry is a job.
+    valid: Signal,
+    /// The slot's last entry.
+    tail: Signal,
+    /// The slot's tail was read (this cycle or before): later entries are not used.
+    stop: Signal,
+    /// Path, point (1-based, inner points) and PE column of the job.
+    path: Signal,
+    point: Signal,
+    inst: Signal,
+    /// The job's previous point is the transmitter.
+    first: Signal,
+    /// The job's next point is the receiver.
+    last: Signal,
+    /// The job closes its path's round.
+    end: Signal,
+}
+
+/// Schedule memory (M9K): the jobs packed slot after slot (ascending PE column, each slot's
+/// last one flagged `tail`), written by the host, read one cycle after the address
+/// sbase + cnt (sbase = the slot's first entry): entry cnt - 1 is in sched_q. Entries after
+/// the tail are never used (`stop`), so a slot takes 2 x (jobs + 2) + PE_LATENCY cycles
+/// whatever the PE count.
+fn schedule_memory(t: &Dims<'_>, bus: &Decode, items: &mut Vec<Item>) -> ScheduleRead {
+    let (pb, ptb, ib, eb, cnt_bits) = (t.pb, t.ptb, t.ib, t.eb, t.cnt_bits);
+    let sw = sched_entry_bits(pb, ptb, ib);
     items.push(Item::Comment(format!(
         "PE schedule memory, written per step by the host: entry -> {{column, tail, end, last, first, point, path, valid}} ({sw} bits)"
     )));
-    items.push(Item::Wire("sched_addr".into(), eb));
-    items.push(Item::Assign(
-        id("sched_addr"),
+    let sched_addr = Signal::assigned(
+        items,
+        "sched_addr",
+        eb,
         id("sbase").plus(zero_extend("cnt", cnt_bits, eb)),
-    ));
-    items.push(Item::Wire("rom_tail".into(), 1));
-    items.push(Item::Assign(
-        id("rom_tail"),
+    );
+    let tail = Signal::assigned(
+        items,
+        "rom_tail",
+        1,
         Expr::bit("sched_q", 4 + pb + ptb).and(id("sq_ok")),
-    ));
-    items.push(Item::Wire("stop".into(), 1));
-    items.push(Item::Assign(
-        id("stop"),
-        or(id("seen_tail"), id("rom_tail")),
-    ));
+    );
+    let stop = Signal::assigned(items, "stop", 1, or(id("seen_tail"), tail.e()));
     items.push(Item::Memory("sched".into(), sw, 1 << eb));
     items.push(Item::AlwaysFf(vec![
         Stmt::If(
-            id("host_wr").and(id("is_sched")),
+            bus.host_wr.e().and(bus.is_sched.e()),
             vec![nb(
                 Expr::id("sched").at(Expr::slice("avs_address", eb - 1, 0)),
                 Expr::slice("avs_writedata", sw - 1, 0),
             )],
             vec![],
         ),
-        nb(id("sched_q"), Expr::id("sched").at(id("sched_addr"))),
+        nb(id("sched_q"), Expr::id("sched").at(sched_addr.e())),
         nb(
             id("sq_ok"),
             or(state_is(S_LOAD), state_is(S_WB))
-                .and(Expr::bin(BinaryOp::Lt, id("cnt"), lit(cnt_bits, k.into())))
-                .and(id("stop").lnot()),
+                .and(Expr::bin(
+                    BinaryOp::Lt,
+                    id("cnt"),
+                    lit(cnt_bits, t.k.into()),
+                ))
+                .and(stop.e().lnot()),
         ),
     ]));
-    let fields = [
-        ("rom_path", pb, 1),
-        ("rom_point", ptb, 1 + pb),
-        ("rom_inst", ib, 5 + pb + ptb),
-    ];
-    items.push(Item::Wire("rom_valid".into(), 1));
-    items.push(Item::Assign(
-        id("rom_valid"),
+    let valid = Signal::assigned(
+        items,
+        "rom_valid",
+        1,
         Expr::bit("sched_q", 0).and(id("sq_ok")),
-    ));
-    for (n, w, lo) in fields {
-        items.push(Item::Wire(n.into(), w));
-        items.push(Item::Assign(id(n), Expr::slice("sched_q", lo + w - 1, lo)));
+    );
+    let field = |items: &mut Vec<Item>, n: &str, w: u32, lo: u32| {
+        Signal::assigned(items, n, w, Expr::slice("sched_q", lo + w - 1, lo))
+    };
+    let path = field(items, "rom_path", pb, 1);
+    let point = field(items, "rom_point", ptb, 1 + pb);
+    let inst = field(items, "rom_inst", ib, 5 + pb + ptb);
+    let first = field(items, "rom_first", 1, 1 + pb + ptb);
+    let last = field(items, "rom_last", 1, 2 + pb + ptb);
+    let end = field(items, "rom_end", 1, 3 + pb + ptb);
+    ScheduleRead {
+        valid,
+        tail,
+        stop,
+        path,
+        point,
+        inst,
+        first,
+        last,
+        end,
     }
-    for (n, bit) in [
-        ("rom_first", 1 + pb + ptb),
-        ("rom_last", 2 + pb + ptb),
-        ("rom_end", 3 + pb + ptb),
-    ] {
-        items.push(Item::Wire(n.into(), 1));
-        items.push(Item::Assign(id(n), Expr::bit("sched_q", bit)));
-    }
+}
 
-    // Coordinate updater-buffer: two banks per point, bank = cur[path] holds the last committed round.
+/// The ports of the coordinate updater-buffer (the two point memory copies).
+struct UpdaterPorts {
+    /// Read addresses of the two copies (port a: previous or own point, port b: next point).
+    ra_addr: Signal,
+    rb_addr: Signal,
+    /// Write enable, address `{point, bank}` and data of the common write port.
+    wr_en: Signal,
+    wr_addr: Signal,
+    wr_data: Signal,
+}
+
+/// `{bus_point, avs_address[2]}`: the memory cell a point-window bus access addresses.
+fn bus_cell(bus: &Decode) -> Expr {
+    Expr::concat(vec![bus.bus_point.e(), Expr::bit("avs_address", 2)])
+}
+
+/// Coordinate updater-buffer, read side: two banks per point, bank = cur[path] holds the last
+/// committed round. Port a reads the job's previous point at load and its own point at
+/// write-back (the old value, for the displacement); port b reads the next point.
+fn updater_read_ports(
+    t: &Dims<'_>,
+    bus: &Decode,
+    rom: &ScheduleRead,
+    items: &mut Vec<Item>,
+) -> UpdaterPorts {
+    let ptb = t.ptb;
     items.push(Item::Comment(
         "coordinate updater-buffer: address {point, bank}; cur[path] = bank of the committed round"
             .into(),
     ));
-    let rom_bank = Expr::id("cur").at(id("rom_path"));
-    for (n, w) in [
-        ("ra_addr", ptb + 1),
-        ("rb_addr", ptb + 1),
-        ("wr_addr", ptb + 1),
-        ("wr_en", 1),
-    ] {
-        items.push(Item::Reg(n.into(), w));
-    }
-    items.push(Item::Reg("wr_data".into(), POINT_BITS));
+    let rom_bank = Expr::id("cur").at(rom.path.e());
+    let ra_addr = Signal::reg(items, "ra_addr", ptb + 1);
+    let rb_addr = Signal::reg(items, "rb_addr", ptb + 1);
+    let wr_addr = Signal::reg(items, "wr_addr", ptb + 1);
+    let wr_en = Signal::reg(items, "wr_en", 1);
+    let wr_data = Signal::reg(items, "wr_data", POINT_BITS);
     let one_pt = lit(ptb, 1);
-    let bus_cell = Expr::concat(vec![id("bus_point"), Expr::bit("avs_address", 2)]);
     items.push(Item::AlwaysComb(vec![
-        bl("ra_addr", bus_cell.clone()),
+        Stmt::Blocking(ra_addr.e(), bus_cell(bus)),
         Stmt::If(
             state_is(S_LOAD),
-            vec![bl(
-                "ra_addr",
-                Expr::concat(vec![
-                    id("rom_point").minus(one_pt.clone()),
-                    rom_bank.clone(),
-                ]),
+            vec![Stmt::Blocking(
+                ra_addr.e(),
+                Expr::concat(vec![rom.point.e().minus(one_pt.clone()), rom_bank.clone()]),
             )],
             vec![Stmt::If(
                 state_is(S_WB),
-                vec![bl(
-                    "ra_addr",
-                    Expr::concat(vec![id("rom_point"), rom_bank.clone()]),
+                vec![Stmt::Blocking(
+                    ra_addr.e(),
+                    Expr::concat(vec![rom.point.e(), rom_bank.clone()]),
                 )],
                 vec![],
             )],
         ),
-        bl(
-            "rb_addr",
-            Expr::concat(vec![id("rom_point").plus(one_pt), rom_bank]),
+        Stmt::Blocking(
+            rb_addr.e(),
+            Expr::concat(vec![rom.point.e().plus(one_pt), rom_bank]),
         ),
     ]));
-    // Write-back: PE output select, saturation (once, for all PEs), displacement, freeze.
-    items.push(Item::Reg("pe_sel_sum".into(), SUM_BITS));
-    items.push(Item::Reg("pe_sel_zs".into(), 1));
-    let sel_arms = (0..k)
-        .map(|j| {
+    UpdaterPorts {
+        ra_addr,
+        rb_addr,
+        wr_en,
+        wr_addr,
+        wr_data,
+    }
+}
+
+/// The selected PE's result at write-back, saturated once for all PEs.
+struct Selected {
+    /// The saturated point `{z, y, x}`.
+    point: Signal,
+    /// Some axis saturated.
+    ov: Signal,
+    /// The PE reported a zero distance sum.
+    zs: Signal,
+}
+
+/// Write-back, PE output select and saturation (twin of the model's `saturate`).
+fn pe_output_select(t: &Dims<'_>, pe: &[PeWires], items: &mut Vec<Item>) -> Selected {
+    let cw = width::COORD;
+    let sel_sum = Signal::reg(items, "pe_sel_sum", SUM_BITS);
+    let zs = Signal::reg(items, "pe_sel_zs", 1);
+    let sel_arms = pe
+        .iter()
+        .enumerate()
+        .map(|(j, w)| {
             (
-                lit(ib, j.into()),
+                lit(t.ib, j as u128),
                 vec![
-                    bl("pe_sel_sum", id(&format!("pe_sum_{j}"))),
-                    bl("pe_sel_zs", id(&format!("pe_zs_{j}"))),
+                    Stmt::Blocking(sel_sum.e(), w.sum.e()),
+                    Stmt::Blocking(zs.e(), w.zs.e()),
                 ],
             )
         })
         .collect();
     let sel_default = vec![
-        bl("pe_sel_sum", lit(SUM_BITS, 0)),
-        bl("pe_sel_zs", lit(1, 0)),
+        Stmt::Blocking(sel_sum.e(), lit(SUM_BITS, 0)),
+        Stmt::Blocking(zs.e(), lit(1, 0)),
     ];
     items.push(Item::AlwaysComb(vec![Stmt::Case(
         id("wb_q_inst"),
@@ -333,117 +470,168 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
     let mut sat_parts = Vec::new();
     let mut ovf_terms = Vec::new();
     for (a, axis) in ["x", "y", "z"].iter().enumerate() {
-        let sum = format!("sum_{axis}");
-        items.push(Item::Wire(sum.clone(), spw));
-        items.push(Item::Assign(
-            id(&sum),
-            Expr::slice("pe_sel_sum", spw * (a as u32 + 1) - 1, spw * a as u32),
-        ));
-        let ovf = format!("ovf_{axis}");
-        let top = Expr::slice(&sum, spw - 1, cw - 1);
+        let sum = Signal::assigned(
+            items,
+            format!("sum_{axis}"),
+            spw,
+            sel_sum.slice(spw * (a as u32 + 1) - 1, spw * a as u32),
+        );
+        let top = sum.slice(spw - 1, cw - 1);
         let topw = spw - cw + 1;
-        items.push(Item::Wire(ovf.clone(), 1));
-        items.push(Item::Assign(
-            id(&ovf),
+        let ovf = Signal::assigned(
+            items,
+            format!("ovf_{axis}"),
+            1,
             Expr::bin(
                 BinaryOp::LogicAnd,
                 Expr::bin(BinaryOp::Ne, top.clone(), lit(topw, 0)),
                 Expr::bin(BinaryOp::Ne, top, lit(topw, (1u128 << topw) - 1)),
             ),
-        ));
-        let sat = format!("sat_{axis}");
-        items.push(Item::Wire(sat.clone(), cw));
-        items.push(Item::Assign(
-            id(&sat),
+        );
+        let sat = Signal::assigned(
+            items,
+            format!("sat_{axis}"),
+            cw,
             Expr::mux(
-                id(&ovf),
+                ovf.e(),
                 Expr::mux(
-                    Expr::bit(&sum, spw - 1),
+                    sum.bit(spw - 1),
                     lit(cw, 1 << (cw - 1)),
                     lit(cw, (1 << (cw - 1)) - 1),
                 ),
-                Expr::slice(&sum, cw - 1, 0),
+                sum.slice(cw - 1, 0),
             ),
-        ));
-        sat_parts.insert(0, id(&sat));
-        ovf_terms.push(id(&ovf));
+        );
+        sat_parts.insert(0, sat.e());
+        ovf_terms.push(ovf.e());
     }
-    items.push(Item::Wire("pe_sel".into(), POINT_BITS));
-    items.push(Item::Assign(id("pe_sel"), Expr::concat(sat_parts)));
-    items.push(Item::Wire("pe_sel_ov".into(), 1));
-    items.push(Item::Assign(
-        id("pe_sel_ov"),
+    let point = Signal::assigned(items, "pe_sel", POINT_BITS, Expr::concat(sat_parts));
+    let ov = Signal::assigned(
+        items,
+        "pe_sel_ov",
+        1,
         ovf_terms.into_iter().reduce(or).expect("3 axes"),
-    ));
-    let mut big_terms = Vec::new();
+    );
+    Selected { point, ov, zs }
+}
+
+/// The move of the written point against its stored value.
+struct Displacement {
+    /// `new_<axis>`: the written coordinate.
+    new: Vec<Signal>,
+    /// `adiff_<axis>`: |new − old| per axis.
+    adiff: Vec<Signal>,
+    /// `wb_big`: the L∞ move exceeds the threshold.
+    big: Signal,
+}
+
+/// Write-back displacement: per-axis |new − old| and the threshold test.
+fn displacement(t: &Dims<'_>, sel: &Selected, items: &mut Vec<Item>) -> Displacement {
+    let cw = width::COORD;
+    let dispw = cw + 1;
+    let (mut new, mut adiff, mut big_terms) = (Vec::new(), Vec::new(), Vec::new());
     for (a, axis) in ["x", "y", "z"].iter().enumerate() {
         let (hi, lo) = (cw * (a as u32 + 1) - 1, cw * a as u32);
-        let (nw, ow) = (format!("new_{axis}"), format!("old_{axis}"));
-        items.push(Item::Wire(nw.clone(), cw));
-        items.push(Item::Assign(id(&nw), Expr::slice("pe_sel", hi, lo)));
-        items.push(Item::Wire(ow.clone(), cw));
-        items.push(Item::Assign(id(&ow), Expr::slice("rd_a", hi, lo)));
-        let diff = format!("diff_{axis}");
-        items.push(Item::Wire(diff.clone(), dispw));
-        items.push(Item::Assign(
-            id(&diff),
-            crate::pe::sext(&nw, cw, dispw).minus(crate::pe::sext(&ow, cw, dispw)),
-        ));
-        let abs = format!("adiff_{axis}");
-        items.push(Item::Wire(abs.clone(), dispw));
-        items.push(Item::Assign(
-            id(&abs),
+        let nw = Signal::assigned(items, format!("new_{axis}"), cw, sel.point.slice(hi, lo));
+        let ow = Signal::assigned(
+            items,
+            format!("old_{axis}"),
+            cw,
+            Expr::slice("rd_a", hi, lo),
+        );
+        let diff = Signal::assigned(
+            items,
+            format!("diff_{axis}"),
+            dispw,
+            crate::pe::sext(nw.name(), cw, dispw).minus(crate::pe::sext(ow.name(), cw, dispw)),
+        );
+        let abs = Signal::assigned(
+            items,
+            format!("adiff_{axis}"),
+            dispw,
             Expr::mux(
-                Expr::bit(&diff, dispw - 1),
-                id(&diff).inv().plus(lit(dispw, 1)),
-                id(&diff),
+                diff.bit(dispw - 1),
+                diff.e().inv().plus(lit(dispw, 1)),
+                diff.e(),
             ),
-        ));
+        );
         big_terms.push(Expr::bin(
             BinaryOp::Gt,
-            id(&abs),
-            lit(dispw, d.platform.threshold_lsb.into()),
+            abs.e(),
+            lit(dispw, t.p.platform.threshold_lsb.into()),
         ));
+        new.push(nw);
+        adiff.push(abs);
     }
     items.push(Item::Comment(
         "wb_big: L-infinity displacement of the written point exceeds the threshold".into(),
     ));
-    items.push(Item::Wire("wb_big".into(), 1));
-    items.push(Item::Assign(
-        id("wb_big"),
+    let big = Signal::assigned(
+        items,
+        "wb_big",
+        1,
         big_terms.into_iter().reduce(or).expect("3 axes"),
-    ));
+    );
+    Displacement { new, adiff, big }
+}
+
+/// The write-back decision and the round's accumulated flags of the written path.
+struct WritebackFlags {
+    /// Commit the PE's result (write-back state, a job, path not frozen).
+    go: Signal,
+    /// Some point of the path moved more than the threshold this round.
+    any_big: Signal,
+    /// Some point of the path had a zero distance sum this round.
+    any_dz: Signal,
+    /// Some point of the path saturated this round.
+    any_ov: Signal,
+    /// Some point of the path left its box this round (early stopping only).
+    any_lb: Option<Signal>,
+}
+
+/// Write-back flags: a path is frozen once converged, degenerate, saturated or (early
+/// stopping) left its box; the `any_*` flags fold this job into its round's flags.
+fn writeback_flags(
+    sel: &Selected,
+    disp: &Displacement,
+    wb_lb: Option<Signal>,
+    items: &mut Vec<Item>,
+) -> WritebackFlags {
     let at_wb = |v: &str| Expr::id(v).at(id("wb_q_path"));
-    if let Some((stop, boxes)) = &early {
-        early_stop_logic(d, stop, boxes, &mut items);
-    }
-    items.push(Item::Wire("wb_frozen".into(), 1));
+    let frozen_sig = Signal::wire(items, "wb_frozen", 1);
     let mut frozen = or(or(at_wb("conv"), at_wb("dz")), at_wb("ov"));
-    if early.is_some() {
-        frozen = or(frozen, at_wb("lb"));
-        items.push(Item::Wire("any_lb".into(), 1));
-        items.push(Item::Assign(id("any_lb"), or(at_wb("plb"), id("wb_lb"))));
+    let any_lb = wb_lb.map(|lb| {
+        frozen = or(frozen.clone(), at_wb("lb"));
+        Signal::assigned(items, "any_lb", 1, or(at_wb("plb"), lb.e()))
+    });
+    items.push(Item::Assign(frozen_sig.e(), frozen));
+    let go = Signal::assigned(
+        items,
+        "wb_go",
+        1,
+        state_is(S_WB).and(id("wb_q_en")).and(frozen_sig.e().lnot()),
+    );
+    let any_big = Signal::assigned(items, "any_big", 1, or(at_wb("pbig"), disp.big.e()));
+    let any_dz = Signal::assigned(items, "any_dz", 1, or(at_wb("pdz"), sel.zs.e()));
+    let any_ov = Signal::assigned(items, "any_ov", 1, or(at_wb("pov"), sel.ov.e()));
+    WritebackFlags {
+        go,
+        any_big,
+        any_dz,
+        any_ov,
+        any_lb,
     }
-    items.push(Item::Assign(id("wb_frozen"), frozen));
-    items.push(Item::Wire("wb_go".into(), 1));
-    items.push(Item::Assign(
-        id("wb_go"),
-        state_is(S_WB)
-            .and(id("wb_q_en"))
-            .and(id("wb_frozen").lnot()),
-    ));
-    items.push(Item::Wire("any_big".into(), 1));
-    items.push(Item::Assign(id("any_big"), or(at_wb("pbig"), id("wb_big"))));
-    items.push(Item::Wire("any_dz".into(), 1));
-    items.push(Item::Assign(
-        id("any_dz"),
-        or(at_wb("pdz"), id("pe_sel_zs")),
-    ));
-    items.push(Item::Wire("any_ov".into(), 1));
-    items.push(Item::Assign(
-        id("any_ov"),
-        or(at_wb("pov"), id("pe_sel_ov")),
-    ));
+}
+
+/// Coordinate updater-buffer, write side: the host's point writes while idle, the selected
+/// PE's result into the other bank at write-back; both memory copies take every write.
+fn updater_write_port(
+    bus: &Decode,
+    ports: &UpdaterPorts,
+    sel: &Selected,
+    flags: &WritebackFlags,
+    items: &mut Vec<Item>,
+) {
     let host_point = Expr::concat(vec![
         id("st_z"),
         Expr::slice("avs_writedata", 23, 16),
@@ -453,90 +641,101 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
         Expr::slice("avs_writedata", 7, 0),
     ]);
     items.push(Item::AlwaysComb(vec![
-        bl("wr_en", id("pt_we").or(id("wb_go"))),
-        bl("wr_addr", bus_cell),
-        bl("wr_data", host_point),
+        Stmt::Blocking(ports.wr_en.e(), bus.pt_we.e().or(flags.go.e())),
+        Stmt::Blocking(ports.wr_addr.e(), bus_cell(bus)),
+        Stmt::Blocking(ports.wr_data.e(), host_point),
         Stmt::If(
             state_is(S_WB),
             vec![
-                bl(
-                    "wr_addr",
+                Stmt::Blocking(
+                    ports.wr_addr.e(),
                     Expr::concat(vec![
                         id("wb_q_point"),
                         Expr::id("cur").at(id("wb_q_path")).inv(),
                     ]),
                 ),
-                bl("wr_data", id("pe_sel")),
+                Stmt::Blocking(ports.wr_data.e(), sel.point.e()),
             ],
             vec![],
         ),
     ]));
-    for (mem, rd, addr) in [("pm_a", "rd_a", "ra_addr"), ("pm_b", "rd_b", "rb_addr")] {
+    for (mem, rd, addr) in [
+        ("pm_a", "rd_a", &ports.ra_addr),
+        ("pm_b", "rd_b", &ports.rb_addr),
+    ] {
         items.push(Item::AlwaysFf(vec![
             Stmt::If(
-                id("wr_en"),
-                vec![nb(Expr::id(mem).at(id("wr_addr")), id("wr_data"))],
+                ports.wr_en.e(),
+                vec![nb(Expr::id(mem).at(ports.wr_addr.e()), ports.wr_data.e())],
                 vec![],
             ),
-            nb(id(rd), Expr::id(mem).at(id(addr))),
+            nb(id(rd), Expr::id(mem).at(addr.e())),
         ]));
     }
+}
 
-    // PE matrix.
-    items.push(Item::Wire("pe_start".into(), 1));
-    items.push(Item::Assign(
-        id("pe_start"),
-        state_is(S_EXEC).and(id("cnt").eq(lit(cnt_bits, 0))),
-    ));
-    for (j, inst) in d.platform.instances.iter().enumerate() {
+/// PE matrix and operand load: one instance per platform instance; the operands (previous and
+/// next point, or the transmitter/receiver at a path's ends) are broadcast one instance per
+/// cycle, memory data one cycle after the address, and the addressed PE latches them.
+fn pe_matrix(t: &Dims<'_>, pe: &[PeWires], items: &mut Vec<Item>) {
+    let start = Signal::assigned(
+        items,
+        "pe_start",
+        1,
+        state_is(S_EXEC).and(id("cnt").eq(lit(t.cnt_bits, 0))),
+    );
+    // The operand wires follow the instances in the file: build them aside first.
+    let mut operands = Vec::new();
+    let fine = |n: &str| Expr::concat(vec![id(n), lit(8, 0)]);
+    let tx_fine = Expr::concat(vec![fine("tx_z"), fine("tx_y"), fine("tx_x")]);
+    let rx_fine = Expr::concat(vec![fine("rx_z"), fine("rx_y"), fine("rx_x")]);
+    let prev = Signal::assigned(
+        &mut operands,
+        "opnd_prev",
+        POINT_BITS,
+        Expr::mux(id("ld_q_first"), tx_fine, id("rd_a")),
+    );
+    let next = Signal::assigned(
+        &mut operands,
+        "opnd_next",
+        POINT_BITS,
+        Expr::mux(id("ld_q_last"), rx_fine, id("rd_b")),
+    );
+    for (j, (inst, w)) in t.p.platform.instances.iter().zip(pe).enumerate() {
         items.push(Item::Instance {
             module: pe_module_name(inst.plane as usize),
             name: format!("u_pe_{j}"),
             ports: vec![
                 ("clk".into(), id("clk")),
                 ("rst_n".into(), id("rst_n")),
-                ("load".into(), id(&format!("pe_load_{j}"))),
-                ("start".into(), id("pe_start")),
-                ("s_prev".into(), id("opnd_prev")),
-                ("s_next".into(), id("opnd_next")),
-                ("s_sum".into(), id(&format!("pe_sum_{j}"))),
-                ("zero_sum".into(), id(&format!("pe_zs_{j}"))),
+                ("load".into(), w.load.e()),
+                ("start".into(), start.e()),
+                ("s_prev".into(), prev.e()),
+                ("s_next".into(), next.e()),
+                ("s_sum".into(), w.sum.e()),
+                ("zero_sum".into(), w.zs.e()),
             ],
         });
-    }
-
-    // Operand load (one instance per cycle, memory data one cycle after the address): the
-    // operands are broadcast and the addressed PE latches them.
-    let fine = |n: &str| Expr::concat(vec![id(n), lit(8, 0)]);
-    let tx_fine = Expr::concat(vec![fine("tx_z"), fine("tx_y"), fine("tx_x")]);
-    let rx_fine = Expr::concat(vec![fine("rx_z"), fine("rx_y"), fine("rx_x")]);
-    items.push(Item::Wire("opnd_prev".into(), POINT_BITS));
-    items.push(Item::Assign(
-        id("opnd_prev"),
-        Expr::mux(id("ld_q_first"), tx_fine, id("rd_a")),
-    ));
-    items.push(Item::Wire("opnd_next".into(), POINT_BITS));
-    items.push(Item::Assign(
-        id("opnd_next"),
-        Expr::mux(id("ld_q_last"), rx_fine, id("rd_b")),
-    ));
-    for j in 0..k {
-        items.push(Item::Assign(
-            id(&format!("pe_load_{j}")),
+        operands.push(Item::Assign(
+            w.load.e(),
             state_is(S_LOAD)
                 .and(id("ld_q_en"))
-                .and(id("ld_q_inst").eq(lit(ib, j.into()))),
+                .and(id("ld_q_inst").eq(lit(t.ib, j as u128))),
         ));
     }
+    items.extend(operands);
+}
 
-    // Main FSM.
-    let cnt_inc = id("cnt").plus(lit(cnt_bits, 1));
-    let start_req = id("avs_write")
-        .and(id("avs_address").eq(lit(ab, 0)))
-        .and(Expr::bit("avs_writedata", 0))
-        .and(state_is(S_IDLE));
-    let all_zero = lit(np2, 0);
-    let no_slot = id("slots_r").eq(lit(sb + 1, 0));
+/// `cnt + 1`.
+fn cnt_inc(t: &Dims<'_>) -> Expr {
+    id("cnt").plus(lit(t.cnt_bits, 1))
+}
+
+/// IDLE on a start request: clear the counters and every path's flags and rounds; with no
+/// slot to run, report done at once.
+fn fsm_on_start(t: &Dims<'_>) -> Vec<Stmt> {
+    let all_zero = lit(t.np2, 0);
+    let no_slot = id("slots_r").eq(lit(t.sb + 1, 0));
     let mut on_start = vec![
         nb(
             id("state"),
@@ -546,68 +745,79 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
                 lit(STATE_BITS, S_LOAD),
             ),
         ),
-        nb(id("cnt"), lit(cnt_bits, 0)),
-        nb(id("slot"), lit(sb, 0)),
-        nb(id("sbase"), lit(eb, 0)),
+        nb(id("cnt"), lit(t.cnt_bits, 0)),
+        nb(id("slot"), lit(t.sb, 0)),
+        nb(id("sbase"), lit(t.eb, 0)),
         nb(id("cycles"), lit(32, 0)),
         nb(id("done"), no_slot),
     ];
     for v in ["cur", "conv", "dz", "ov", "pbig", "pdz", "pov"] {
         on_start.push(nb(id(v), all_zero.clone()));
     }
-    if early.is_some() {
+    if t.early.is_some() {
         on_start.push(nb(id("lb"), all_zero.clone()));
         on_start.push(nb(id("plb"), all_zero.clone()));
     }
-    for p in 0..np2 {
-        on_start.push(nb(Expr::id("rounds").at(lit(pb, p.into())), lit(16, 0)));
+    for p in 0..t.np2 {
+        on_start.push(nb(Expr::id("rounds").at(lit(t.pb, p.into())), lit(16, 0)));
     }
-    let load = vec![
-        nb(id("ld_q_en"), id("rom_valid")),
-        nb(id("ld_q_tail"), id("rom_tail")),
-        nb(id("ld_q_first"), id("rom_first")),
-        nb(id("ld_q_last"), id("rom_last")),
-        nb(id("ld_q_inst"), id("rom_inst")),
+    on_start
+}
+
+/// LOAD: register the schedule entry for the operand broadcast until the slot's tail, then EXEC.
+fn fsm_load(t: &Dims<'_>, rom: &ScheduleRead) -> Vec<Stmt> {
+    vec![
+        nb(id("ld_q_en"), rom.valid.e()),
+        nb(id("ld_q_tail"), rom.tail.e()),
+        nb(id("ld_q_first"), rom.first.e()),
+        nb(id("ld_q_last"), rom.last.e()),
+        nb(id("ld_q_inst"), rom.inst.e()),
         Stmt::If(
             id("ld_q_tail"),
             vec![
                 nb(id("state"), lit(STATE_BITS, S_EXEC)),
-                nb(id("cnt"), lit(cnt_bits, 0)),
+                nb(id("cnt"), lit(t.cnt_bits, 0)),
                 nb(id("seen_tail"), lit(1, 0)),
             ],
-            vec![
-                nb(id("cnt"), cnt_inc.clone()),
-                nb(id("seen_tail"), id("stop")),
-            ],
+            vec![nb(id("cnt"), cnt_inc(t)), nb(id("seen_tail"), rom.stop.e())],
         ),
-    ];
-    let exec = vec![Stmt::If(
-        id("cnt").eq(lit(cnt_bits, u128::from(PE_LATENCY - 1))),
+    ]
+}
+
+/// EXEC: wait `PE_LATENCY` cycles for every PE of the slot, then WB.
+fn fsm_exec(t: &Dims<'_>) -> Vec<Stmt> {
+    vec![Stmt::If(
+        id("cnt").eq(lit(t.cnt_bits, u128::from(PE_LATENCY - 1))),
         vec![
             nb(id("state"), lit(STATE_BITS, S_WB)),
-            nb(id("cnt"), lit(cnt_bits, 0)),
+            nb(id("cnt"), lit(t.cnt_bits, 0)),
         ],
-        vec![nb(id("cnt"), cnt_inc.clone())],
-    )];
+        vec![nb(id("cnt"), cnt_inc(t))],
+    )]
+}
+
+/// A committed job's effect on its path's flags: at the round's end, flip the bank, count the
+/// round and decide convergence; inside the round, accumulate the flags.
+fn path_commit(f: &WritebackFlags) -> Vec<Stmt> {
     let wbp = |v: &str| Expr::id(v).at(id("wb_q_path"));
-    let mut conv_next = id("any_big")
+    let mut conv_next = f
+        .any_big
+        .e()
         .lnot()
-        .and(id("any_dz").lnot())
-        .and(id("any_ov").lnot());
+        .and(f.any_dz.e().lnot())
+        .and(f.any_ov.e().lnot());
     let mut at_end = Vec::new();
     let mut in_round = Vec::new();
-    if early.is_some() {
-        conv_next = conv_next.and(id("any_lb").lnot());
+    if let Some(any_lb) = &f.any_lb {
+        conv_next = conv_next.and(any_lb.e().lnot());
         at_end.push(nb(
             wbp("lb"),
-            id("any_lb")
-                .and(id("any_dz").lnot())
-                .and(id("any_ov").lnot()),
+            any_lb.e().and(f.any_dz.e().lnot()).and(f.any_ov.e().lnot()),
         ));
         at_end.push(nb(wbp("plb"), lit(1, 0)));
-        in_round.push(nb(wbp("plb"), id("any_lb")));
+        in_round.push(nb(wbp("plb"), any_lb.e()));
     }
-    let commit = vec![Stmt::If(
+    vec![Stmt::If(
         id("wb_q_end"),
         vec![
             nb(wbp("cur"), wbp("cur").inv()),
@@ -615,8 +825,8 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
                 Expr::id("rounds").at(id("wb_q_path")),
                 Expr::id("rounds").at(id("wb_q_path")).plus(lit(16, 1)),
             ),
-            nb(wbp("dz"), id("any_dz")),
-            nb(wbp("ov"), id("any_ov")),
+            nb(wbp("dz"), f.any_dz.e()),
+            nb(wbp("ov"), f.any_ov.e()),
             nb(wbp("conv"), conv_next),
             nb(wbp("pbig"), lit(1, 0)),
             nb(wbp("pdz"), lit(1, 0)),
@@ -626,22 +836,28 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
         .chain(at_end)
         .collect(),
         vec![
-            nb(wbp("pbig"), id("any_big")),
-            nb(wbp("pdz"), id("any_dz")),
-            nb(wbp("pov"), id("any_ov")),
+            nb(wbp("pbig"), f.any_big.e()),
+            nb(wbp("pdz"), f.any_dz.e()),
+            nb(wbp("pov"), f.any_ov.e()),
         ]
         .into_iter()
         .chain(in_round)
         .collect(),
-    )];
-    let wb = vec![
-        nb(id("wb_q_en"), id("rom_valid")),
-        nb(id("wb_q_tail"), id("rom_tail")),
-        nb(id("wb_q_end"), id("rom_end")),
-        nb(id("wb_q_path"), id("rom_path")),
-        nb(id("wb_q_point"), id("rom_point")),
-        nb(id("wb_q_inst"), id("rom_inst")),
-        Stmt::If(id("wb_go"), commit, vec![]),
+    )]
+}
+
+/// WB: register the entry for the write-back, commit, and at the slot's tail move to the next
+/// slot's LOAD (or IDLE with done after the last slot).
+fn fsm_writeback(t: &Dims<'_>, rom: &ScheduleRead, f: &WritebackFlags) -> Vec<Stmt> {
+    let (sb, eb, cnt_bits) = (t.sb, t.eb, t.cnt_bits);
+    vec![
+        nb(id("wb_q_en"), rom.valid.e()),
+        nb(id("wb_q_tail"), rom.tail.e()),
+        nb(id("wb_q_end"), rom.end.e()),
+        nb(id("wb_q_path"), rom.path.e()),
+        nb(id("wb_q_point"), rom.point.e()),
+        nb(id("wb_q_inst"), rom.inst.e()),
+        Stmt::If(f.go.e(), path_commit(f), vec![]),
         Stmt::If(
             id("wb_q_tail"),
             vec![
@@ -668,20 +884,33 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
                     ],
                 ),
             ],
-            vec![nb(id("cnt"), cnt_inc), nb(id("seen_tail"), id("stop"))],
+            vec![nb(id("cnt"), cnt_inc(t)), nb(id("seen_tail"), rom.stop.e())],
         ),
-    ];
+    ]
+}
+
+/// The main FSM (controller): IDLE -> per slot LOAD, EXEC, WB -> IDLE with done, and the
+/// cycle counter.
+fn controller(t: &Dims<'_>, rom: &ScheduleRead, f: &WritebackFlags, items: &mut Vec<Item>) {
+    let cnt_bits = t.cnt_bits;
     items.push(Item::Comment(format!(
         "main FSM: IDLE -> per slot LOAD (jobs + 2) EXEC ({PE_LATENCY}) WB (jobs + 2) -> IDLE with done after SLOTS slots"
     )));
-    items.push(Item::Wire("start_req".into(), 1));
-    items.push(Item::Assign(id("start_req"), start_req));
+    let start_req = Signal::assigned(
+        items,
+        "start_req",
+        1,
+        id("avs_write")
+            .and(id("avs_address").eq(lit(t.ab, 0)))
+            .and(Expr::bit("avs_writedata", 0))
+            .and(state_is(S_IDLE)),
+    );
     items.push(Item::AlwaysFf(vec![Stmt::If(
         id("rst_n").lnot(),
         vec![
             nb(id("state"), lit(STATE_BITS, S_IDLE)),
             nb(id("cnt"), lit(cnt_bits, 0)),
-            nb(id("slot"), lit(sb, 0)),
+            nb(id("slot"), lit(t.sb, 0)),
             nb(id("cycles"), lit(32, 0)),
             nb(id("done"), lit(1, 0)),
             nb(id("ld_q_en"), lit(1, 0)),
@@ -701,18 +930,22 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
                 vec![
                     (
                         lit(STATE_BITS, S_IDLE),
-                        vec![Stmt::If(id("start_req"), on_start, vec![])],
+                        vec![Stmt::If(start_req.e(), fsm_on_start(t), vec![])],
                     ),
-                    (lit(STATE_BITS, S_LOAD), load),
-                    (lit(STATE_BITS, S_EXEC), exec),
-                    (lit(STATE_BITS, S_WB), wb),
+                    (lit(STATE_BITS, S_LOAD), fsm_load(t, rom)),
+                    (lit(STATE_BITS, S_EXEC), fsm_exec(t)),
+                    (lit(STATE_BITS, S_WB), fsm_writeback(t, rom, f)),
                 ],
                 vec![nb(id("state"), lit(STATE_BITS, S_IDLE))],
             ),
         ],
     )]));
+}
 
-    // Avalon-MM slave: writes.
+/// Avalon-MM slave, writes: the transmitter, receiver and slot-count registers and the
+/// staging words of a point (its last word, the fractions, goes to the point memory).
+fn register_writes(t: &Dims<'_>, bus: &Decode, items: &mut Vec<Item>) {
+    let (ab, sb) = (t.ab, t.sb);
     let wr = |addr: u32, reg: &str| {
         Stmt::If(
             id("avs_address").eq(lit(ab, addr.into())),
@@ -732,7 +965,7 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
             nb(id("slots_r"), lit(sb + 1, 0)),
         ],
         vec![Stmt::If(
-            id("host_wr"),
+            bus.host_wr.e(),
             vec![
                 wr(4, "tx_x"),
                 wr(5, "tx_y"),
@@ -746,7 +979,7 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
                     vec![],
                 ),
                 Stmt::If(
-                    id("is_point"),
+                    bus.is_point.e(),
                     vec![Stmt::Case(
                         Expr::slice("avs_address", 1, 0),
                         vec![
@@ -762,7 +995,13 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
             vec![],
         )],
     )]));
-    // Avalon-MM slave: pipelined reads, fixed latency 2 (address -> registered select -> readdata).
+}
+
+/// Avalon-MM slave, pipelined reads with a fixed latency of 2 (address -> registered select ->
+/// readdata). Returns the read multiplexer's register, declared after the pipeline.
+fn read_pipeline(t: &Dims<'_>, bus: &Decode, items: &mut Vec<Item>) -> Signal {
+    let mut mux_decl = Vec::new();
+    let read_mux = Signal::reg(&mut mux_decl, "read_mux", 32);
     items.push(Item::AlwaysFf(vec![Stmt::If(
         id("rst_n").lnot(),
         vec![
@@ -775,70 +1014,63 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
             nb(
                 id("rq_kind"),
                 Expr::mux(
-                    id("is_ctrl"),
+                    bus.is_ctrl.e(),
                     lit(2, 1),
                     Expr::mux(
-                        id("is_status"),
+                        bus.is_status.e(),
                         lit(2, 2),
-                        Expr::mux(id("is_point"), lit(2, 3), lit(2, 0)),
+                        Expr::mux(bus.is_point.e(), lit(2, 3), lit(2, 0)),
                     ),
                 ),
             ),
             nb(id("rq_reg"), Expr::slice("avs_address", 3, 0)),
             nb(id("rq_word"), Expr::slice("avs_address", 1, 0)),
-            nb(id("rq_path"), Expr::slice("avs_address", pb - 1, 0)),
+            nb(id("rq_path"), Expr::slice("avs_address", t.pb - 1, 0)),
             nb(id("avs_readdatavalid"), id("rq_valid")),
-            nb(id("avs_readdata"), id("read_mux")),
+            nb(id("avs_readdata"), read_mux.e()),
         ],
     )]));
-    let info = (k << 24) | (MAP_VERSION << 16) | (cap.paths & 0xffff);
-    items.push(Item::Reg("read_mux".into(), 32));
+    items.extend(mux_decl);
+    read_mux
+}
+
+/// The control registers' read values by word address (register map in `docs/hardware.md`).
+fn control_read_arms(t: &Dims<'_>, mux: &Signal) -> Vec<(Expr, Vec<Stmt>)> {
+    let platform = t.p.platform;
+    let info = (t.k << 24) | (MAP_VERSION << 16) | (platform.capacity.paths & 0xffff);
+    let read = |addr: u128, value: Expr| (lit(4, addr), vec![Stmt::Blocking(mux.e(), value)]);
+    vec![
+        read(
+            0,
+            Expr::concat(vec![
+                lit(30, 0),
+                id("done"),
+                Expr::bin(BinaryOp::Ne, id("state"), lit(STATE_BITS, S_IDLE)),
+            ]),
+        ),
+        read(1, id("cycles")),
+        read(2, lit(32, info.into())),
+        read(3, lit(32, platform.threshold_lsb.into())),
+        read(4, id("tx_x")),
+        read(5, id("tx_y")),
+        read(6, id("tx_z")),
+        read(8, id("rx_x")),
+        read(9, id("rx_y")),
+        read(10, id("rx_z")),
+        read(12, Expr::concat(vec![lit(31 - t.sb, 0), id("slots_r")])),
+    ]
+}
+
+/// The read multiplexer: control registers, a path's status word, or a point's words (three
+/// integer words, then the packed fractions).
+fn read_mux(t: &Dims<'_>, mux: &Signal, items: &mut Vec<Item>) {
+    let cw = width::COORD;
+    let set = |value: Expr| vec![Stmt::Blocking(mux.e(), value)];
     let rqp = |v: &str| Expr::id(v).at(id("rq_path"));
-    let ctrl_arms = vec![
-        (
-            lit(4, 0),
-            vec![bl(
-                "read_mux",
-                Expr::concat(vec![
-                    lit(30, 0),
-                    id("done"),
-                    Expr::bin(BinaryOp::Ne, id("state"), lit(STATE_BITS, S_IDLE)),
-                ]),
-            )],
-        ),
-        (lit(4, 1), vec![bl("read_mux", id("cycles"))]),
-        (lit(4, 2), vec![bl("read_mux", lit(32, info.into()))]),
-        (
-            lit(4, 3),
-            vec![bl("read_mux", lit(32, d.platform.threshold_lsb.into()))],
-        ),
-        (lit(4, 4), vec![bl("read_mux", id("tx_x"))]),
-        (lit(4, 5), vec![bl("read_mux", id("tx_y"))]),
-        (lit(4, 6), vec![bl("read_mux", id("tx_z"))]),
-        (lit(4, 8), vec![bl("read_mux", id("rx_x"))]),
-        (lit(4, 9), vec![bl("read_mux", id("rx_y"))]),
-        (lit(4, 10), vec![bl("read_mux", id("rx_z"))]),
-        (
-            lit(4, 12),
-            vec![bl(
-                "read_mux",
-                Expr::concat(vec![lit(31 - sb, 0), id("slots_r")]),
-            )],
-        ),
-    ];
     let point_arms = vec![
-        (
-            lit(2, 0),
-            vec![bl("read_mux", Expr::slice("rd_a", cw - 1, 8))],
-        ),
-        (
-            lit(2, 1),
-            vec![bl("read_mux", Expr::slice("rd_a", 2 * cw - 1, cw + 8))],
-        ),
-        (
-            lit(2, 2),
-            vec![bl("read_mux", Expr::slice("rd_a", 3 * cw - 1, 2 * cw + 8))],
-        ),
+        (lit(2, 0), set(Expr::slice("rd_a", cw - 1, 8))),
+        (lit(2, 1), set(Expr::slice("rd_a", 2 * cw - 1, cw + 8))),
+        (lit(2, 2), set(Expr::slice("rd_a", 3 * cw - 1, 2 * cw + 8))),
     ];
     let frac_word = Expr::concat(vec![
         lit(8, 0),
@@ -846,8 +1078,20 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
         Expr::slice("rd_a", cw + 7, cw),
         Expr::slice("rd_a", 7, 0),
     ]);
+    let status_word = Expr::concat(vec![
+        Expr::id("rounds").at(id("rq_path")),
+        lit(12, 0),
+        if t.early.is_some() {
+            rqp("lb")
+        } else {
+            lit(1, 0)
+        },
+        rqp("ov"),
+        rqp("dz"),
+        rqp("conv"),
+    ]);
     items.push(Item::AlwaysComb(vec![
-        bl("read_mux", lit(32, 0)),
+        Stmt::Blocking(mux.e(), lit(32, 0)),
         Stmt::Case(
             id("rq_kind"),
             vec![
@@ -855,48 +1099,36 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
                     lit(2, 1),
                     vec![Stmt::Case(
                         id("rq_reg"),
-                        ctrl_arms,
-                        vec![bl("read_mux", lit(32, 0))],
+                        control_read_arms(t, mux),
+                        set(lit(32, 0)),
                     )],
                 ),
-                (
-                    lit(2, 2),
-                    vec![bl(
-                        "read_mux",
-                        Expr::concat(vec![
-                            Expr::id("rounds").at(id("rq_path")),
-                            lit(12, 0),
-                            if early.is_some() {
-                                rqp("lb")
-                            } else {
-                                lit(1, 0)
-                            },
-                            rqp("ov"),
-                            rqp("dz"),
-                            rqp("conv"),
-                        ]),
-                    )],
-                ),
+                (lit(2, 2), set(status_word)),
                 (
                     lit(2, 3),
-                    vec![Stmt::Case(
-                        id("rq_word"),
-                        point_arms,
-                        vec![bl("read_mux", frac_word)],
-                    )],
+                    vec![Stmt::Case(id("rq_word"), point_arms, set(frac_word))],
                 ),
             ],
-            vec![bl("read_mux", lit(32, 0))],
+            set(lit(32, 0)),
         ),
     ]));
+}
+
+/// The interrupt (`ins_irq = done`) and `bt_unused_ok`, which reads the bits no block uses so
+/// the linter sees them consumed on purpose.
+fn interrupt_and_unused(items: &mut Vec<Item>) {
     items.push(Item::Assign(id("ins_irq"), id("done")));
-    unused.push(Expr::slice("avs_writedata", 31, 1));
+    let unused = vec![lit(1, 0), Expr::slice("avs_writedata", 31, 1)];
     items.push(Item::Wire("bt_unused_ok".into(), 1));
     items.push(Item::Assign(
         id("bt_unused_ok"),
         Expr::Unary(UnaryOp::ReduceAnd, Box::new(Expr::concat(unused))),
     ));
+}
 
+/// The `bt_top` module around `items`: header and the Avalon-MM ports.
+fn top_shell(t: &Dims<'_>, items: Vec<Item>) -> Module {
+    let ab = t.ab;
     Module {
         name: "bt_top".into(),
         header: vec![
@@ -921,28 +1153,58 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
     }
 }
 
-/// Early stopping at write-back (twin of `bt_fixed::FineBox::outside` and the `min_rounds`
-/// rule of `FixedIpc::run_path`): `wb_lb` = the written point lies outside its instance's
-/// widened box by more than `(L1 move) << shift`, in a round ≥ `min_rounds`. Signed 48-bit
-/// comparisons are unsigned ones with the sign bit flipped (the box constants are flipped
-/// when generated).
-fn early_stop_logic(
+/// Builds `bt_top`: an outline that calls one builder per block, in the order the blocks
+/// appear in the emitted file.
+pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
+    let t = Dims::of(d);
+    let mut items = Vec::new();
+    let pe = declare_state(&t, &mut items);
+    let bus = bus_decode(&t, &mut items);
+    let rom = schedule_memory(&t, &bus, &mut items);
+    let ports = updater_read_ports(&t, &bus, &rom, &mut items);
+    let sel = pe_output_select(&t, &pe, &mut items);
+    let disp = displacement(&t, &sel, &mut items);
+    let wb_lb = t
+        .early
+        .as_ref()
+        .map(|(stop, boxes)| early_stop_logic(d, stop, boxes, &disp, &mut items));
+    let flags = writeback_flags(&sel, &disp, wb_lb, &mut items);
+    updater_write_port(&bus, &ports, &sel, &flags, &mut items);
+    pe_matrix(&t, &pe, &mut items);
+    controller(&t, &rom, &flags, &mut items);
+    register_writes(&t, &bus, &mut items);
+    let mux = read_pipeline(&t, &bus, &mut items);
+    read_mux(&t, &mux, &mut items);
+    interrupt_and_unused(&mut items);
+    top_shell(&t, items)
+}
+
+/// The widened polygon box of the written instance's plane, per axis (sign bit flipped).
+struct InstanceBox {
+    /// `box_lo_<axis>`.
+    lo: Vec<Signal>,
+    /// `box_hi_<axis>`.
+    hi: Vec<Signal>,
+}
+
+/// Early stopping, box table: the box of the instance being written (`wb_q_inst`), its
+/// constants biased by 2^47 so that signed comparisons become unsigned ones.
+fn instance_box(
     d: &TopParams<'_>,
-    stop: &bt_fixed::EarlyStop,
     boxes: &[bt_fixed::FineBox],
     items: &mut Vec<Item>,
-) {
+) -> InstanceBox {
     let w = BOX_BITS;
     let bias = 1i128 << (w - 1);
     let biased = |v: i64| lit(w, ((i128::from(v) + bias) as u128) & ((1u128 << w) - 1));
-    let axes = ["x", "y", "z"];
-    let mut defaults = Vec::new();
-    for axis in axes {
-        for side in ["lo", "hi"] {
-            let n = format!("box_{side}_{axis}");
-            items.push(Item::Reg(n.clone(), w));
-            defaults.push(bl(&n, lit(w, 0)));
-        }
+    let (mut lo, mut hi, mut defaults) = (Vec::new(), Vec::new(), Vec::new());
+    for axis in ["x", "y", "z"] {
+        lo.push(Signal::reg(items, format!("box_lo_{axis}"), w));
+        hi.push(Signal::reg(items, format!("box_hi_{axis}"), w));
+    }
+    for (l, h) in lo.iter().zip(&hi) {
+        defaults.push(Stmt::Blocking(l.e(), lit(w, 0)));
+        defaults.push(Stmt::Blocking(h.e(), lit(w, 0)));
     }
     let arms = d
         .platform
@@ -952,9 +1214,9 @@ fn early_stop_logic(
         .map(|(j, inst)| {
             let b = &boxes[inst.plane as usize];
             let mut stmts = Vec::new();
-            for (a, axis) in axes.iter().enumerate() {
-                stmts.push(bl(&format!("box_lo_{axis}"), biased(b.lo[a])));
-                stmts.push(bl(&format!("box_hi_{axis}"), biased(b.hi[a])));
+            for a in 0..3 {
+                stmts.push(Stmt::Blocking(lo[a].e(), biased(b.lo[a])));
+                stmts.push(Stmt::Blocking(hi[a].e(), biased(b.hi[a])));
             }
             (lit(d.layout.inst_bits, j as u128), stmts)
         })
@@ -968,13 +1230,33 @@ fn early_stop_logic(
         arms,
         defaults,
     )]));
+    InstanceBox { lo, hi }
+}
+
+/// Early stopping at write-back (twin of `bt_fixed::FineBox::outside` and the `min_rounds`
+/// rule of `FixedIpc::run_path`): `wb_lb` = the written point lies outside its instance's
+/// widened box by more than `(L1 move) << shift`, in a round ≥ `min_rounds`. Signed 48-bit
+/// comparisons are unsigned ones with the sign bit flipped (the box constants are flipped
+/// when generated).
+fn early_stop_logic(
+    d: &TopParams<'_>,
+    stop: &bt_fixed::EarlyStop,
+    boxes: &[bt_fixed::FineBox],
+    disp: &Displacement,
+    items: &mut Vec<Item>,
+) -> Signal {
+    let w = BOX_BITS;
+    let axes = ["x", "y", "z"];
+    let bx = instance_box(d, boxes, items);
     let dispw = width::COORD + 1;
     let mvw = w - bt_fixed::EarlyStop::MAX_SHIFT;
-    let zext = |n: &str| Expr::concat(vec![lit(mvw - dispw, 0), id(n)]);
+    let zext = |s: &Signal| Expr::concat(vec![lit(mvw - dispw, 0), s.e()]);
     items.push(Item::Wire("mv_l1".into(), mvw));
     items.push(Item::Assign(
         id("mv_l1"),
-        zext("adiff_x").plus(zext("adiff_y")).plus(zext("adiff_z")),
+        zext(&disp.adiff[0])
+            .plus(zext(&disp.adiff[1]))
+            .plus(zext(&disp.adiff[2])),
     ));
     let shift = stop.displacement_shift;
     items.push(Item::Wire("slack".into(), w));
@@ -984,12 +1266,12 @@ fn early_stop_logic(
     }
     items.push(Item::Assign(id("slack"), Expr::concat(parts)));
     let mut terms = Vec::new();
-    for axis in axes {
+    for (a, (axis, new)) in axes.iter().zip(&disp.new).enumerate() {
         let pw = format!("bp_{axis}");
         items.push(Item::Wire(pw.clone(), w));
         items.push(Item::Assign(
             id(&pw),
-            crate::pe::sext(&format!("new_{axis}"), width::COORD, w),
+            crate::pe::sext(new.name(), width::COORD, w),
         ));
         for (side, expr) in [
             ("lo", id(&pw).plus(id("slack"))),
@@ -1004,7 +1286,8 @@ fn early_stop_logic(
             } else {
                 BinaryOp::Gt
             };
-            terms.push(Expr::bin(op, flipped, id(&format!("box_{side}_{axis}"))));
+            let bound = if side == "lo" { &bx.lo[a] } else { &bx.hi[a] };
+            terms.push(Expr::bin(op, flipped, bound.e()));
         }
     }
     let outside = terms.into_iter().reduce(or).expect("3 axes");
@@ -1021,6 +1304,5 @@ fn early_stop_logic(
         "wb_lb: outside the box by more than (L1 move) << {shift}, in round >= {}",
         stop.min_rounds
     )));
-    items.push(Item::Wire("wb_lb".into(), 1));
-    items.push(Item::Assign(id("wb_lb"), late.and(outside)));
+    Signal::assigned(items, "wb_lb", 1, late.and(outside))
 }

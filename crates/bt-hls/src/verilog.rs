@@ -149,6 +149,67 @@ impl Expr {
     }
 }
 
+/// A declared net or register: the one spelling of its name. A builder declares a signal once
+/// and hands the handle to the blocks that read it, so a misspelt name is a compile error
+/// rather than a silent new wire.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct Signal {
+    name: String,
+    width: u32,
+}
+
+impl Signal {
+    /// Declares `wire [width-1:0] name;` in `items`.
+    pub fn wire(items: &mut Vec<Item>, name: impl Into<String>, width: u32) -> Signal {
+        let s = Signal {
+            name: name.into(),
+            width,
+        };
+        items.push(Item::Wire(s.name.clone(), width));
+        s
+    }
+    /// Declares a wire and its `assign name = value;` in `items`.
+    pub fn assigned(
+        items: &mut Vec<Item>,
+        name: impl Into<String>,
+        width: u32,
+        value: Expr,
+    ) -> Signal {
+        let s = Signal::wire(items, name, width);
+        items.push(Item::Assign(s.e(), value));
+        s
+    }
+    /// Declares `reg [width-1:0] name;` in `items`.
+    pub fn reg(items: &mut Vec<Item>, name: impl Into<String>, width: u32) -> Signal {
+        let s = Signal {
+            name: name.into(),
+            width,
+        };
+        items.push(Item::Reg(s.name.clone(), width));
+        s
+    }
+    /// The name.
+    pub fn name(&self) -> &str {
+        &self.name
+    }
+    /// Width in bits.
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+    /// The signal as an expression.
+    pub fn e(&self) -> Expr {
+        Expr::id(self.name.clone())
+    }
+    /// `name[hi:lo]`.
+    pub fn slice(&self, hi: u32, lo: u32) -> Expr {
+        Expr::slice(self.name.clone(), hi, lo)
+    }
+    /// `name[bit]`.
+    pub fn bit(&self, bit: u32) -> Expr {
+        Expr::bit(self.name.clone(), bit)
+    }
+}
+
 /// A statement inside an `always` block.
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub enum Stmt {
