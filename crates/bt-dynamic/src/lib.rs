@@ -30,8 +30,8 @@ use bt_scene::dynamic::{DynamicScene, moved_surfaces};
 use bt_scene::{Scene, SurfaceId};
 use bt_solve::pipeline::{CandidateMode, TraceError, TraceOptions};
 use bt_solve::{
-    Batch, CandidateOutcome, FoundPath, IpcOutcome, Solver, Todo, TraceResult, Validity, found_path,
-    solve_batch,
+    Batch, CandidateOutcome, FoundPath, IpcOutcome, Solver, Todo, TraceResult, Validity,
+    found_path, solve_batch,
 };
 use serde::Serialize;
 use std::cmp::Ordering;
@@ -229,8 +229,14 @@ impl IncrementalTracer {
         let everything =
             update.terminals_moved || scene.length_tolerance() != prev.scene.length_tolerance();
         let wvrn = prev.wvrn.take();
-        let (wvrn, candidates) =
-            next_candidates(&options, (wvrn, &prev), scene, &moved, everything, &mut update)?;
+        let (wvrn, candidates) = next_candidates(
+            &options,
+            (wvrn, &prev),
+            scene,
+            &moved,
+            everything,
+            &mut update,
+        )?;
         let plans = plan(&prev, scene, &candidates, &moved, everything);
 
         // Solve the affected candidates (in parallel, order preserved).
@@ -446,7 +452,10 @@ fn solve_planned(
         };
         let r = &prev_records[o];
         let n = candidates.get(i).len();
-        warm_start(&r.outcome, &prev_points[r.start as usize..r.start as usize + n])
+        warm_start(
+            &r.outcome,
+            &prev_points[r.start as usize..r.start as usize + n],
+        )
     };
     let is_ipc = matches!(options.solver, Solver::Ipc(_));
     let batch = Batch {
@@ -485,8 +494,11 @@ fn concat(parts: Vec<Solved>) -> Solved {
     let mut out: Solved = Default::default();
     for (records, points) in parts {
         let base = out.1.len() as u32;
-        out.0
-            .extend(records.into_iter().map(|(o, start, i)| (o, start + base, i)));
+        out.0.extend(
+            records
+                .into_iter()
+                .map(|(o, start, i)| (o, start + base, i)),
+        );
         out.1.extend(points);
     }
     out

@@ -480,7 +480,12 @@ impl BeamTree {
     }
 
     /// Node `p` (or the root) as a parent, its beam planes copied into `planes`.
-    fn parent_view<'b>(&self, prep: &Prepared<'_>, p: u32, planes: &'b mut Vec<Plane>) -> Parent<'b> {
+    fn parent_view<'b>(
+        &self,
+        prep: &Prepared<'_>,
+        p: u32,
+        planes: &'b mut Vec<Plane>,
+    ) -> Parent<'b> {
         let (apex, surface, range) = if p == ROOT {
             (prep.scene.tx(), None, (0u32, 0u32))
         } else {
@@ -727,10 +732,16 @@ fn occlude(
         },
     }));
     let margin = COVER * prep.tol;
-    if let Some(o) = scratch.last_cover.filter(|&o| Some(o) != parent.surface && o != s) {
+    if let Some(o) = scratch
+        .last_cover
+        .filter(|&o| Some(o) != parent.surface && o != s)
+    {
         let polygon = &scene.surface(SurfaceId(o)).polygon;
         if between(polygon.plane(), &starts, &scratch.a, margin)
-            && matches!(shadow(polygon, parent.apex, &scratch.a, margin), Shadow::Covers)
+            && matches!(
+                shadow(polygon, parent.apex, &scratch.a, margin),
+                Shadow::Covers
+            )
         {
             stats.occluders.push(o);
             scratch.starts = starts;
@@ -855,7 +866,10 @@ fn shadow(occluder: &bt_geom::Polygon, apex: Vec3, window: &[Vec3], margin: Real
             return Shadow::None;
         }
         let plane = orient_towards(Plane::from_point_normal(apex, pn / len), moved + inward);
-        if window.iter().all(|q| plane.signed_distance_unfused(*q) > 0.0) {
+        if window
+            .iter()
+            .all(|q| plane.signed_distance_unfused(*q) > 0.0)
+        {
             continue;
         }
         if open.is_some()

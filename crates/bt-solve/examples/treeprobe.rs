@@ -38,8 +38,14 @@ fn moved_rx(scene: &Scene, i: usize) -> Vec3 {
 fn run(what: &str, scene: &Scene, i: usize, tree: &BeamTree) -> usize {
     match what {
         "cand" => candidates(scene, TreeOptions::new(3)).unwrap().len(),
-        "image" => traced_paths(scene, &trace_options(Solver::Image, CandidateMode::BeamTree)),
-        "exh" => traced_paths(scene, &trace_options(Solver::Image, CandidateMode::Exhaustive)),
+        "image" => traced_paths(
+            scene,
+            &trace_options(Solver::Image, CandidateMode::BeamTree),
+        ),
+        "exh" => traced_paths(
+            scene,
+            &trace_options(Solver::Image, CandidateMode::Exhaustive),
+        ),
         "ipc" => {
             let ipc = Solver::Ipc(IpcOptions::for_scene(scene, UpdateOrder::GaussSeidel));
             traced_paths(scene, &trace_options(ipc, CandidateMode::BeamTree))
@@ -49,7 +55,9 @@ fn run(what: &str, scene: &Scene, i: usize, tree: &BeamTree) -> usize {
             let rx = moved_rx(scene, i);
             let set = tree.candidates(rx);
             let moved = scene.with_terminals(scene.tx(), rx).unwrap();
-            bt_solve::trace(&moved, &set, &Solver::Image, false).paths.len()
+            bt_solve::trace(&moved, &set, &Solver::Image, false)
+                .paths
+                .len()
         }
         other => panic!("unknown workload {other:?}: cand, image, exh, ipc, walk or newrx"),
     }

@@ -6,8 +6,8 @@
 
 use crate::{Solver, TraceResult};
 use bt_geom::Vec3;
-pub use bt_paths::beamtree::{BuildProgress, Progress};
 use bt_paths::beamtree::{BeamTree, TreeOptions, TreeStats};
+pub use bt_paths::beamtree::{BuildProgress, Progress};
 use bt_paths::{AllVisible, CandidateSet, CandidateStats};
 use bt_scene::{Scene, SceneError};
 use rayon::prelude::*;

@@ -347,9 +347,7 @@ pub fn run(
                 }
             }
             if draw && drawing.steps.contains(&step) {
-                drawing
-                    .paths
-                    .push(exact_polylines(&scene, config)?);
+                drawing.paths.push(exact_polylines(&scene, config)?);
             }
             progress(index * config.steps + step + 1, total);
         }

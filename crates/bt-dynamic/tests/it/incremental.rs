@@ -195,7 +195,10 @@ fn a_walking_person_keeps_the_beam_tree() {
     // their paths still equal a from-scratch trace. The door is held shut here.
     let json = bt_scene::builtin_json("living-room-dynamic").unwrap();
     let mut description = bt_scene::io::parse_json(json, "test").unwrap();
-    description.objects.remove("door").expect("the door is an object");
+    description
+        .objects
+        .remove("door")
+        .expect("the door is an object");
     for surface in &mut description.surfaces {
         if surface.object.as_deref() == Some("door") {
             surface.object = None;
@@ -221,7 +224,10 @@ fn a_walking_person_keeps_the_beam_tree() {
             let reflector_moved = moved
                 .iter()
                 .any(|id| scene.surface(*id).kind == bt_scene::SurfaceKind::Reflector);
-            assert_eq!(step.update.candidates_rederived, reflector_moved, "step {k}");
+            assert_eq!(
+                step.update.candidates_rederived, reflector_moved,
+                "step {k}"
+            );
             kept += usize::from(!reflector_moved);
         }
     }

@@ -35,8 +35,11 @@ fn paths(scene: &Scene, max_order: usize, mode: CandidateMode) -> Vec<FoundPath>
 /// enumeration.
 fn traced_like_exhaustive(scene: &Scene, order: usize) -> bt_solve::pipeline::Traced {
     let reference = paths(scene, order, CandidateMode::Exhaustive);
-    let traced = trace_scene(scene, &options(order, CandidateMode::BeamTree, Solver::Image))
-        .expect("trace runs");
+    let traced = trace_scene(
+        scene,
+        &options(order, CandidateMode::BeamTree, Solver::Image),
+    )
+    .expect("trace runs");
     assert_eq!(
         sequences(&traced.result.paths),
         sequences(&reference),
@@ -250,13 +253,14 @@ fn a_small_city_agrees_with_exhaustive_enumeration_at_orders_one_and_two() {
 fn the_build_reports_progress_level_by_level() {
     let scene = small_city(95.0, 1.5);
     let mut reports = Vec::new();
-    let kept = BeamTree::build_with_progress(&scene, TreeOptions::new(3), &mut |p| {
-        reports.push(p)
-    })
-    .unwrap();
+    let kept = BeamTree::build_with_progress(&scene, TreeOptions::new(3), &mut |p| reports.push(p))
+        .unwrap();
     // Each level starts with a report of no parent done; the root level has one parent.
     let starts: Vec<_> = reports.iter().filter(|p| p.parents_done == 0).collect();
-    assert_eq!(starts.iter().map(|p| p.depth).collect::<Vec<_>>(), [1, 2, 3]);
+    assert_eq!(
+        starts.iter().map(|p| p.depth).collect::<Vec<_>>(),
+        [1, 2, 3]
+    );
     assert_eq!(starts[0].parents, 1);
     let per_depth = &kept.stats().nodes_per_depth;
     assert_eq!(starts[1].parents as u64, per_depth[0]);
@@ -264,5 +268,9 @@ fn the_build_reports_progress_level_by_level() {
     for w in reports.windows(2) {
         assert!(w[0].nodes <= w[1].nodes && w[1].parents_done < w[1].parents.max(1));
     }
-    assert!(reports.iter().any(|p| p.parents_done > 0), "{} reports", reports.len());
+    assert!(
+        reports.iter().any(|p| p.parents_done > 0),
+        "{} reports",
+        reports.len()
+    );
 }

@@ -332,7 +332,12 @@ fn per_step(results: &LivingRoomResults) -> String {
             get(StudySolver::Sbr),
             get(StudySolver::IpcFixedPoint),
         );
-        let err = |r: &Row| format!("{:.1e} / {:.1e}", r.errors.mean_err_tx_deg, r.errors.mean_err_rx_deg);
+        let err = |r: &Row| {
+            format!(
+                "{:.1e} / {:.1e}",
+                r.errors.mean_err_tx_deg, r.errors.mean_err_rx_deg
+            )
+        };
         let _ = writeln!(
             s,
             "| {} | {} | {} | {} | {} | {} | {} | {} | {} / {} | {} / {} | {:.2} | {:.2} | {:.2} | {:.2} | {} | {} | {:.3} | {:.2} |",

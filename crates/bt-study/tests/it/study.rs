@@ -141,5 +141,8 @@ fn the_candidate_budget_stops_the_study() {
         ..tiny()
     };
     let e = run(&config, &mut |_, _| {}).unwrap_err().to_string();
-    assert!(e.contains("room-0-step-0") && e.contains("--max-candidates"), "{e}");
+    assert!(
+        e.contains("room-0-step-0") && e.contains("--max-candidates"),
+        "{e}"
+    );
 }
