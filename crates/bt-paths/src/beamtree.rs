@@ -455,7 +455,7 @@ impl BeamTree {
             for &s in &children {
                 self.stats.tested += 1;
                 match leaf.as_mut() {
-                    Some((rx, out)) => self.leaf_child(prep, &parent, s, *rx, out),
+                    Some((rx, out)) => self.leaf_child(prep, &parent, s, *rx, out, scratch),
                     None => self.child(prep, &parent, s, scratch),
                 }
             }
@@ -544,19 +544,11 @@ impl BeamTree {
             return;
         }
         let eps = EPS * prep.tol;
-        if prep.reflectors.len() <= LINEAR_SCAN && leaf_level {
-            out.extend(
-                prep.reflectors
-                    .iter()
-                    .copied()
-                    .filter(|&s| Some(s) != parent.surface),
-            );
-            return;
-        }
         if prep.reflectors.len() <= LINEAR_SCAN {
             out.extend(prep.reflectors.iter().copied().filter(|&s| {
                 let (lo, hi) = prep.scene.surface(SurfaceId(s)).polygon.bounds();
-                Some(s) != parent.surface && box_meets_halfspaces(lo, hi, parent.planes, eps)
+                Some(s) != parent.surface
+                    && (leaf_level || box_meets_halfspaces(lo, hi, parent.planes, eps))
             }));
             return;
         }
@@ -580,16 +572,7 @@ impl BeamTree {
             self.stats.empty += 1;
             return;
         }
-        let eps = EPS * prep.tol;
-        scratch.a.clear();
-        scratch.a.extend_from_slice(prep.hull(s));
-        for pl in parent.planes {
-            convex::clip(&scratch.a, pl, eps, &mut scratch.b);
-            std::mem::swap(&mut scratch.a, &mut scratch.b);
-            if scratch.a.len() < 3 {
-                break;
-            }
-        }
+        window_in_beam(prep, parent, s, scratch);
         if scratch.a.len() < 3 {
             self.stats.empty += 1;
             return;
@@ -621,6 +604,7 @@ impl BeamTree {
         s: u32,
         rx: Vec3,
         out: &mut CandidateSet,
+        scratch: &mut Scratch,
     ) {
         let plane = *prep.plane(s);
         let tol = prep.tol;
@@ -654,18 +638,27 @@ impl BeamTree {
         let mut starts = Vec::with_capacity(self.max_order);
         self.prefix(parent.index, &mut seq, &mut starts);
         seq.push(SurfaceId(s));
-        let mut window = prep.hull(s).to_vec();
-        let mut tmp = Vec::new();
-        for pl in parent.planes {
-            convex::clip(&window, pl, eps, &mut tmp);
-            std::mem::swap(&mut window, &mut tmp);
-        }
-        starts.push(if window.len() >= 3 {
-            convex::vertex_mean(&window)
+        window_in_beam(prep, parent, s, scratch);
+        starts.push(if scratch.a.len() >= 3 {
+            convex::vertex_mean(&scratch.a)
         } else {
             polygon.centroid()
         });
         out.push_with_starts(&seq, &starts);
+    }
+}
+
+/// Child `s`'s window, its grown hull clipped by `parent`'s beam planes, into `scratch.a`
+/// (fewer than 3 vertices: empty).
+fn window_in_beam(prep: &Prepared<'_>, parent: &Parent<'_>, s: u32, scratch: &mut Scratch) {
+    scratch.a.clear();
+    scratch.a.extend_from_slice(prep.hull(s));
+    for pl in parent.planes {
+        convex::clip(&scratch.a, pl, EPS * prep.tol, &mut scratch.b);
+        std::mem::swap(&mut scratch.a, &mut scratch.b);
+        if scratch.a.len() < 3 {
+            break;
+        }
     }
 }
 
@@ -772,7 +765,7 @@ fn occlude(
                 return;
             }
             let polygon = &scene.surface(SurfaceId(item)).polygon;
-            if crosses(polygon, a, q) {
+            if polygon.blocks_segment(a, q, 0.0, 0.0) {
                 hits.push((polygon.centroid().distance_squared(parent.apex), item));
             }
         });
@@ -809,22 +802,6 @@ fn occlude(
     scratch.starts = starts;
     scratch.rays = window_rays;
     covered
-}
-
-/// Whether the segment `a -> q` passes through `polygon` (its plane crossed, the crossing inside
-/// or on the boundary). Only picks which occluders to try: [`between`] and [`shadow`] decide,
-/// with margins, so the unfused distances' round-off cannot matter.
-fn crosses(polygon: &bt_geom::Polygon, a: Vec3, q: Vec3) -> bool {
-    let plane = polygon.plane();
-    let (da, dq) = (
-        plane.signed_distance_unfused(a),
-        plane.signed_distance_unfused(q),
-    );
-    if (da > 0.0 && dq > 0.0) || (da < 0.0 && dq < 0.0) || da == dq {
-        return false;
-    }
-    let t = da / (da - dq);
-    polygon.contains(a + t * (q - a), 0.0)
 }
 
 /// Whether every segment start lies strictly on one side of `plane` and every window vertex
@@ -912,11 +889,8 @@ pub fn candidates_with_progress(
         }
     }
     let mut set = tree.candidates(rx);
-    let mut seq_starts = Vec::new();
     for i in 0..last.len() {
-        seq_starts.clear();
-        seq_starts.extend_from_slice(last.start(i).unwrap_or(&[]));
-        set.push_with_starts(last.get(i), &seq_starts);
+        set.push_with_starts(last.get(i), last.start(i).unwrap_or(&[]));
     }
     set.stats = tree.candidate_stats(set.len() as u64);
     set.tree = Some(tree.stats.clone());
