@@ -5,25 +5,20 @@ use crate::args::{ExtractArgs, SampleArgs};
 use anyhow::{Context, bail};
 use bt_pointcloud::io::ReadOptions;
 use bt_pointcloud::{ExtractParams, Extraction, PointCloud, Progress};
-use indicatif::{ProgressBar, ProgressDrawTarget, ProgressStyle};
+use indicatif::ProgressBar;
 use std::path::Path;
 use std::process::ExitCode;
 
 /// A progress bar for plane extraction on stderr, shown from the first report on, and the
 /// callback that feeds it.
 pub fn extraction_progress() -> (ProgressBar, impl FnMut(Progress)) {
-    let bar = ProgressBar::hidden();
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{spinner} extracting planes {bar:30} {pos}/{len} points assigned, {msg} [{elapsed_precise}, ETA {eta}]",
-        )
-        .expect("static template"),
+    let deferred = crate::progress::Deferred::new(
+        "{spinner} extracting planes {bar:30} {pos}/{len} points assigned, {msg} [{elapsed_precise}, ETA {eta}]",
+        std::time::Duration::ZERO,
     );
-    let feed = bar.clone();
+    let bar = deferred.bar();
     let callback = move |p: Progress| {
-        if feed.is_hidden() {
-            feed.set_draw_target(ProgressDrawTarget::stderr());
-        }
+        let feed = deferred.show_after();
         feed.set_length(p.points_total as u64);
         feed.set_position(p.points_assigned as u64);
         feed.set_message(format!("{} planes", p.ransac_planes));

@@ -15,23 +15,52 @@ pub fn spinner(what: &str) -> ProgressBar {
     bar
 }
 
+/// A bar in the style `template`, hidden until [`Deferred::show_after`] finds that the work
+/// has run for `delay` (the first report, for a zero delay).
+pub struct Deferred {
+    bar: ProgressBar,
+    start: std::time::Instant,
+    delay: Duration,
+}
+
+impl Deferred {
+    /// A hidden bar with `template`, to be drawn once `delay` has passed.
+    pub fn new(template: &str, delay: Duration) -> Self {
+        let bar = ProgressBar::hidden();
+        bar.set_style(ProgressStyle::with_template(template).expect("static template"));
+        Deferred {
+            bar,
+            start: std::time::Instant::now(),
+            delay,
+        }
+    }
+
+    /// The bar (for `finish_and_clear`).
+    pub fn bar(&self) -> ProgressBar {
+        self.bar.clone()
+    }
+
+    /// The bar, drawn on stderr from now on if the delay has passed.
+    pub fn show_after(&self) -> &ProgressBar {
+        if self.bar.is_hidden() && self.start.elapsed() >= self.delay {
+            self.bar
+                .set_draw_target(indicatif::ProgressDrawTarget::stderr());
+        }
+        &self.bar
+    }
+}
+
 /// A bar for the beam tree's build, drawn once the build has run for half a second (a room's
 /// tree takes a millisecond; a city's at order 3 takes seconds): depth, parents of the level
 /// done, nodes so far.
 pub fn tree_progress() -> (ProgressBar, impl FnMut(bt_solve::pipeline::BuildProgress)) {
-    let bar = ProgressBar::hidden();
-    bar.set_style(
-        ProgressStyle::with_template(
-            "{spinner} beam tree {msg} {bar:30} {pos}/{len} parents [{elapsed_precise}, ETA {eta}]",
-        )
-        .expect("static template"),
+    let deferred = Deferred::new(
+        "{spinner} beam tree {msg} {bar:30} {pos}/{len} parents [{elapsed_precise}, ETA {eta}]",
+        Duration::from_millis(500),
     );
-    let feed = bar.clone();
-    let start = std::time::Instant::now();
+    let bar = deferred.bar();
     let callback = move |p: bt_solve::pipeline::BuildProgress| {
-        if feed.is_hidden() && start.elapsed() > Duration::from_millis(500) {
-            feed.set_draw_target(indicatif::ProgressDrawTarget::stderr());
-        }
+        let feed = deferred.show_after();
         feed.set_length(p.parents as u64);
         feed.set_position(p.parents_done as u64);
         feed.set_message(format!(
