@@ -112,7 +112,9 @@ fn reciprocity_in_the_living_room() {
             tx_power_dbm: 0.0,
         },
     );
-    let swapped = scene.with_terminals(scene.rx(), scene.tx()).unwrap();
+    let swapped = scene
+        .with_terminals(scene.rx_world(), scene.tx_world())
+        .unwrap();
     let backward = trace(
         &swapped,
         2,

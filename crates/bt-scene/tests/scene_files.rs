@@ -99,7 +99,10 @@ fn rx_on_a_surface_is_rejected_and_overrides_apply() {
     .unwrap();
     assert_eq!(ok.rx(), Vec3::new(0.5, 0.5, 0.2));
     // Beside the polygon in its plane is fine.
-    assert!(ok.with_terminals(ok.tx(), Vec3::new(3.0, 0.0, 0.0)).is_ok());
+    assert!(
+        ok.with_terminals(ok.tx_world(), Vec3::new(3.0, 0.0, 0.0))
+            .is_ok()
+    );
 }
 
 #[test]

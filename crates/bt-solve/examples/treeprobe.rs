@@ -30,7 +30,8 @@ fn traced_paths(scene: &Scene, options: &TraceOptions) -> usize {
     trace_scene(scene, options).unwrap().result.paths.len()
 }
 
-/// The RX of call `i`: a few millimetres apart, so that no call repeats the previous one.
+/// The RX of call `i` (scene-local frame): a few millimetres apart, so that no call repeats
+/// the previous one.
 fn moved_rx(scene: &Scene, i: usize) -> Vec3 {
     scene.rx() + Vec3::new(0.001 * (i % 7) as f64, 0.0, 0.0)
 }
@@ -54,7 +55,7 @@ fn run(what: &str, scene: &Scene, i: usize, tree: &BeamTree) -> usize {
         "newrx" => {
             let rx = moved_rx(scene, i);
             let set = tree.candidates(rx);
-            let moved = scene.with_terminals(scene.tx(), rx).unwrap();
+            let moved = scene.with_receiver(scene.to_world(rx)).unwrap();
             bt_solve::trace(&moved, &set, &Solver::Image, false)
                 .paths
                 .len()

@@ -122,17 +122,17 @@ proptest! {
             hi.max(scene.surfaces()[i].polygon.bounds().1)
         });
         let receivers: Vec<Vec3> = (0..6)
-            .map(|_| Vec3::new(
+            .map(|_| scene.to_world(Vec3::new(
                 rng.random_range(bounds.x + 0.05..top.x - 0.05),
                 rng.random_range(bounds.y + 0.05..top.y - 0.05),
                 rng.random_range(bounds.z + 0.05..top.z - 0.05),
-            ))
-            .filter(|rx| scene.with_terminals(scene.tx(), *rx).is_ok())
+            )))
+            .filter(|rx| scene.with_receiver(*rx).is_ok())
             .collect();
         let opts = options(3, CandidateMode::BeamTree, Solver::Image);
         let many = trace_receivers(&scene, &receivers, &opts).expect("receivers trace");
         for (rx, got) in receivers.iter().zip(&many) {
-            let moved = scene.with_terminals(scene.tx(), *rx).unwrap();
+            let moved = scene.with_receiver(*rx).unwrap();
             let reference = paths(&moved, 3, CandidateMode::Exhaustive);
             assert_same(&got.result.paths, &reference)?;
         }
