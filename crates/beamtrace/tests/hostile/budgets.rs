@@ -58,6 +58,21 @@ fn hls_and_study_respect_the_candidate_budget() {
     ]);
     assert_refused(&r, &["candidate budget exceeded", "budget 100"]);
     assert!(!out.exists());
+    // The 2-D study accepted --max-candidates and ignored it.
+    let r = beamtrace(&[
+        "study",
+        "2d",
+        "--rooms",
+        "1",
+        "--steps",
+        "1",
+        "--max-candidates",
+        "3",
+        "--out",
+        out.to_str().unwrap(),
+    ]);
+    assert_refused(&r, &["room-0-step-0", "--max-candidates"]);
+    assert!(!out.exists());
 }
 
 #[test]
