@@ -1,5 +1,6 @@
 //! WVRN build time and candidate reduction on the living room; time per step of the dynamic
-//! living room, incremental vs from scratch (single thread, image method, order 3).
+//! living room, incremental vs from scratch, per candidate generator (single thread, image
+//! method, order 3).
 //!
 //! `cargo bench -p bt-dynamic`; the reduction ratio and the incremental/scratch ratio of the
 //! mean step times are printed to stderr before the criterion groups run.
@@ -10,21 +11,18 @@ use bt_paths::{AllVisible, enumerate};
 use bt_scene::Terminals;
 use bt_scene::dynamic::builtin_dynamic_scene;
 use bt_solve::Solver;
+use bt_solve::pipeline::CandidateMode;
 use criterion::{BatchSize, Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
 use std::time::Instant;
 
 const ORDER: usize = 3;
 
-fn options(wvrn: bool) -> StepOptions {
+fn options(candidates: CandidateMode) -> StepOptions {
     StepOptions {
         max_order: ORDER,
         solver: Solver::Image,
-        candidates: if wvrn {
-            bt_solve::pipeline::CandidateMode::Wvrn
-        } else {
-            bt_solve::pipeline::CandidateMode::Exhaustive
-        },
+        candidates,
         max_candidates: u64::MAX,
         parallel: false,
     }
@@ -84,8 +82,12 @@ fn steps(c: &mut Criterion) {
         .unwrap()
         .unwrap();
     let n = dynamic.len();
-    for wvrn in [true, false] {
-        let opts = options(wvrn);
+    for mode in [
+        CandidateMode::Wvrn,
+        CandidateMode::Exhaustive,
+        CandidateMode::BeamTree,
+    ] {
+        let opts = options(mode);
         // Tracers positioned after step k - 1, to time step k alone.
         let mut tracer = IncrementalTracer::new(opts);
         let mut before: Vec<IncrementalTracer> = Vec::new();
@@ -111,14 +113,18 @@ fn steps(c: &mut Criterion) {
         }
         let incremental = t0.elapsed().as_secs_f64() / (rounds * (n - 1)) as f64;
         eprintln!(
-            "dynamic living room (wvrn {wvrn}), steps 1-{}: scratch {:.3} ms/step, incremental {:.3} ms/step (incl. state clone), ratio {:.3}",
+            "dynamic living room ({mode:?}), steps 1-{}: scratch {:.3} ms/step, incremental {:.3} ms/step (incl. state clone), ratio {:.3}",
             n - 1,
             scratch * 1e3,
             incremental * 1e3,
             incremental / scratch
         );
 
-        let name = if wvrn { "wvrn" } else { "exhaustive" };
+        let name = match mode {
+            CandidateMode::Wvrn => "wvrn",
+            CandidateMode::Exhaustive => "exhaustive",
+            CandidateMode::BeamTree => "beam-tree",
+        };
         let mut g = c.benchmark_group(format!("steps-{name}"));
         g.throughput(Throughput::Elements((n - 1) as u64));
         g.bench_function("scratch/steps-1-9", |b| {

@@ -6,9 +6,14 @@
 //!    ([`bt_scene::dynamic::moved_surfaces`]); TX/RX compared too.
 //! 2. *WVRN*: [`Wvrn::update`] recomputes the pairs touching moved nodes and re-tests the other
 //!    links against the moved occluders only (the paper's red vs green edges).
-//! 3. *Candidates*: the candidate set depends only on the links and the side masks of reflectors
-//!    and terminals, so it is reused when no reflector or terminal moved and no link changed;
-//!    otherwise the enumeration runs again (a DFS far cheaper than solving, see the benchmark).
+//! 3. *Candidates*: in beam-tree mode (the default) the tracer keeps a beam tree of the full
+//!    order. While no reflector and none of the tree's occluders moved (a person walking), the
+//!    tree stays and only a moved RX needs a walk; a moved reflector rebuilds only the subtrees
+//!    it touches ([`BeamTree::rebuild`]): nodes whose prefix avoids it are copied, and it is
+//!    tested afresh as a child of each copied parent. In WVRN and exhaustive mode the
+//!    candidate set depends only on the links and the side masks of reflectors and
+//!    terminals, so it is reused when no reflector or terminal moved and no link changed;
+//!    otherwise the enumeration runs again.
 //! 4. *Paths*: a candidate's outcome is reused when it existed in the previous step, none of its
 //!    surfaces moved, the terminals and the length tolerance are unchanged, and its outcome does
 //!    not depend on other surfaces, or no moved surface's bounding box (before or after the
@@ -24,6 +29,7 @@
 #![warn(missing_docs)]
 
 use bt_geom::{Real, Vec3};
+use bt_paths::beamtree::BeamTree;
 use bt_paths::wvrn::{Wvrn, WvrnStats};
 use bt_paths::{CandidateSet, CandidateStats};
 use bt_scene::dynamic::{DynamicScene, moved_surfaces};
@@ -67,8 +73,14 @@ pub struct UpdateStats {
     pub wvrn_retested_pairs: usize,
     /// WVRN pairs whose linked-ness changed.
     pub wvrn_links_changed: usize,
-    /// The candidate enumeration ran again (else the previous set was reused).
+    /// The candidate enumeration ran again, or the beam tree was walked for a new RX (else
+    /// the previous set was reused).
     pub candidates_rederived: bool,
+    /// Beam-tree nodes copied from the previous step's tree (a moved reflector rebuilds only
+    /// the subtrees it touches).
+    pub tree_nodes_reused: u64,
+    /// Beam-tree nodes built this step.
+    pub tree_nodes_built: u64,
     /// Candidates solved and validated this step.
     pub solved: usize,
     /// Of those, IPC runs warm-started from the previous step's points.
@@ -118,6 +130,33 @@ impl StepOptions {
     fn wvrn(&self, scene: &Scene) -> Option<Wvrn> {
         (self.candidates == CandidateMode::Wvrn).then(|| Wvrn::build(scene))
     }
+
+    /// A first step's generator and candidates: the WVRN, or the beam tree materialised to
+    /// the full order (kept for the next steps: a new RX is a walk, a moved reflector
+    /// rebuilds only its subtrees), or exhaustive enumeration.
+    fn generate(&self, scene: &Scene) -> Result<(Generator, CandidateSet), TraceError> {
+        if self.candidates == CandidateMode::BeamTree {
+            let options = bt_solve::pipeline::tree_options(&self.trace_options());
+            let tree = BeamTree::build(scene, options)?;
+            let candidates = tree.candidates(scene.rx());
+            let generator = Generator {
+                wvrn: None,
+                tree: Some(tree),
+            };
+            return Ok((generator, candidates));
+        }
+        let wvrn = self.wvrn(scene);
+        let candidates = self.candidates(scene, wvrn.as_ref())?;
+        Ok((Generator { wvrn, tree: None }, candidates))
+    }
+}
+
+/// What the tracer keeps of a step's candidate generator: the WVRN (WVRN mode) or the beam
+/// tree (beam-tree mode), or nothing (exhaustive).
+#[derive(Clone, Default)]
+struct Generator {
+    wvrn: Option<Wvrn>,
+    tree: Option<BeamTree>,
 }
 
 /// Trace one scene from scratch: candidates ([`bt_solve::pipeline::candidates`], or the WVRN),
@@ -173,7 +212,7 @@ struct Record {
 #[derive(Clone)]
 struct State {
     scene: Scene,
-    wvrn: Option<Wvrn>,
+    generator: Generator,
     candidates: CandidateSet,
     records: Vec<Record>,
     points: Vec<Vec3>,
@@ -209,7 +248,7 @@ impl IncrementalTracer {
             let result = trace_scratch(scene, step, &options)?;
             self.state = Some(State {
                 scene: scene.clone(),
-                wvrn: None,
+                generator: Generator::default(),
                 candidates: CandidateSet::default(),
                 records: Vec::new(),
                 points: Vec::new(),
@@ -228,10 +267,10 @@ impl IncrementalTracer {
         };
         let everything =
             update.terminals_moved || scene.length_tolerance() != prev.scene.length_tolerance();
-        let wvrn = prev.wvrn.take();
-        let (wvrn, candidates) = next_candidates(
+        let generator = std::mem::take(&mut prev.generator);
+        let (generator, candidates) = next_candidates(
             &options,
-            (wvrn, &prev),
+            (generator, &prev),
             scene,
             &moved,
             everything,
@@ -259,22 +298,22 @@ impl IncrementalTracer {
             &solved_points,
         );
         let solved = (candidates, records, points);
-        Ok(self.keep(scene, step, wvrn, solved, update))
+        Ok(self.keep(scene, step, generator, solved, update))
     }
 
-    /// Keep step `step` of `scene` (its WVRN, candidates, records and points) for the next
-    /// step and return its result.
+    /// Keep step `step` of `scene` (its WVRN or beam tree, candidates, records and points) for
+    /// the next step and return its result.
     fn keep(
         &mut self,
         scene: &Scene,
         step: usize,
-        wvrn: Option<Wvrn>,
+        generator: Generator,
         (candidates, records, points): (CandidateSet, Vec<Record>, Vec<Vec3>),
         update: UpdateStats,
     ) -> StepTrace {
         let state = State {
             scene: scene.clone(),
-            wvrn,
+            generator,
             candidates,
             records,
             points,
@@ -287,8 +326,7 @@ impl IncrementalTracer {
 
     fn full(&mut self, scene: &Scene, step: usize) -> Result<StepTrace, TraceError> {
         let options = self.options;
-        let wvrn = options.wvrn(scene);
-        let candidates = options.candidates(scene, wvrn.as_ref())?;
+        let (generator, candidates) = options.generate(scene)?;
         let batch = Batch {
             scene,
             candidates: &candidates,
@@ -304,10 +342,11 @@ impl IncrementalTracer {
             full: true,
             solved: records.len(),
             candidates_rederived: true,
+            tree_nodes_built: generator.tree.as_ref().map_or(0, |t| t.len() as u64),
             ..UpdateStats::default()
         };
         let solved = (candidates, records, points);
-        Ok(self.keep(scene, step, wvrn, solved, update))
+        Ok(self.keep(scene, step, generator, solved, update))
     }
 }
 
@@ -324,23 +363,27 @@ impl State {
             step: self.step,
             trace,
             candidates: self.candidates.stats,
-            wvrn: self.wvrn.as_ref().map(Wvrn::stats),
+            wvrn: self.generator.wvrn.as_ref().map(Wvrn::stats),
             update,
         }
     }
 }
 
-/// The step's WVRN (the previous one, taken out of `prev`, updated for the moved surfaces)
-/// and candidates: the previous ones while nothing they depend on moved, else generated anew
-/// (counted in `update`).
+/// The step's generator (the previous one, taken out of `prev`, updated for the moved
+/// surfaces) and candidates: the previous ones while nothing they depend on moved, else
+/// generated anew (counted in `update`).
 fn next_candidates(
     options: &StepOptions,
-    (mut wvrn, prev): (Option<Wvrn>, &State),
+    (generator, prev): (Generator, &State),
     scene: &Scene,
     moved: &[SurfaceId],
     everything: bool,
     update: &mut UpdateStats,
-) -> Result<(Option<Wvrn>, CandidateSet), TraceError> {
+) -> Result<(Generator, CandidateSet), TraceError> {
+    if let Some(tree) = generator.tree {
+        return next_from_tree(tree, prev, scene, moved, update);
+    }
+    let mut wvrn = generator.wvrn;
     let mut links_changed = false;
     if let Some(w) = &mut wvrn {
         let delta = w.update(scene, moved);
@@ -352,21 +395,47 @@ fn next_candidates(
     let reflector_moved = moved
         .iter()
         .any(|id| scene.surface(*id).kind == bt_scene::SurfaceKind::Reflector);
-    // The beam tree depends on the reflectors and on the occluders that culled a node;
-    // any other motion (a person walking) only changes validation.
-    let generator_stale = match options.candidates {
-        CandidateMode::BeamTree => {
-            reflector_moved || moved.iter().any(|id| culled_by(&prev.candidates, *id))
-        }
-        _ => reflector_moved || links_changed,
-    };
-    let candidates = if everything || generator_stale {
+    let generator = Generator { wvrn, tree: None };
+    if everything || reflector_moved || links_changed {
         update.candidates_rederived = true;
-        options.candidates(scene, wvrn.as_ref())?
+        let candidates = options.candidates(scene, generator.wvrn.as_ref())?;
+        return Ok((generator, candidates));
+    }
+    Ok((generator, prev.candidates.clone()))
+}
+
+/// The beam-tree step: the tree is kept while no reflector and no occluder of it moved (a
+/// blocker walking through the room changes validation only), else rebuilt, reusing every
+/// subtree the motion cannot have changed ([`BeamTree::rebuild`]); its walk for RX gives the
+/// candidates (the previous ones when neither the tree nor RX changed).
+fn next_from_tree(
+    tree: BeamTree,
+    prev: &State,
+    scene: &Scene,
+    moved: &[SurfaceId],
+    update: &mut UpdateStats,
+) -> Result<(Generator, CandidateSet), TraceError> {
+    let (tree, rebuilt) = if tree.unchanged_by(scene, moved) {
+        (tree, false)
+    } else {
+        let (tree, stats) = tree.rebuild(scene, moved)?;
+        update.tree_nodes_reused = stats.reused;
+        update.tree_nodes_built = stats.built;
+        (tree, true)
+    };
+    let candidates = if rebuilt || scene.rx() != prev.scene.rx() {
+        update.candidates_rederived = true;
+        tree.candidates(scene.rx())
     } else {
         prev.candidates.clone()
     };
-    Ok((wvrn, candidates))
+    Ok((
+        Generator {
+            wvrn: None,
+            tree: Some(tree),
+        },
+        candidates,
+    ))
 }
 
 /// Per candidate of the step: reuse the previous outcome, or solve (warm-started from the
@@ -579,14 +648,6 @@ fn touches(
         let (lo, hi) = (a.min(b), a.max(b));
         meets(union, lo, hi) && boxes.iter().any(|bx| meets(*bx, lo, hi))
     })
-}
-
-/// Whether surface `id` removed or shrank a node of the beam tree behind `set` (true when the
-/// set carries no tree statistics: then nothing is known).
-fn culled_by(set: &CandidateSet, id: SurfaceId) -> bool {
-    set.tree
-        .as_ref()
-        .is_none_or(|t| t.occluders.binary_search(&id.0).is_ok())
 }
 
 /// Previous points usable as an IPC warm start: those of a converged run.

@@ -27,6 +27,9 @@ use bt_scene::{Scene, SurfaceId, SurfaceKind};
 use serde::Serialize;
 use std::cell::OnceCell;
 
+mod rebuild;
+pub use rebuild::RebuildStats;
+
 /// How the tree is built.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct TreeOptions {
@@ -114,7 +117,8 @@ pub type Progress<'p> = &'p mut dyn FnMut(BuildProgress);
 pub struct TreeStats {
     /// Materialised nodes per depth (index 0 = depth 1).
     pub nodes_per_depth: Vec<u64>,
-    /// Child sequences examined (each a surface meeting a beam's bounding test).
+    /// Child sequences examined (each a surface meeting a beam's bounding test); a rebuilt
+    /// tree ([`BeamTree::rebuild`]) counts its copied nodes too.
     pub tested: u64,
     /// Sequences whose window clipped to nothing (or grazing image sources).
     pub empty: u64,
@@ -169,6 +173,12 @@ const ROOT: u32 = u32::MAX;
 pub struct BeamTree {
     max_order: usize,
     tol: Real,
+    /// What the tree was built for: a rebuild ([`BeamTree::rebuild`]) reuses nodes only for
+    /// the same options, TX, surfaces and reflectors.
+    options: TreeOptions,
+    tx: Vec3,
+    reflectors: Vec<u32>,
+    surfaces: usize,
     /// Nodes level by level; `levels[d]` = range of depth `d + 1`.
     nodes: Vec<Node>,
     levels: Vec<(usize, usize)>,
@@ -302,6 +312,10 @@ impl BeamTree {
         BeamTree {
             max_order: prep.options.max_order,
             tol: prep.tol,
+            options: prep.options,
+            tx: prep.scene.tx(),
+            reflectors: prep.reflectors.clone(),
+            surfaces: prep.planes.len(),
             nodes: Vec::new(),
             levels: Vec::new(),
             verts: Vec::new(),
@@ -439,44 +453,73 @@ impl BeamTree {
                     nodes: self.nodes.len() as u64,
                 });
             }
-            let mut parent = self.parent_view(prep, p, &mut plane_copy);
-            let leaf_level = leaf.is_some();
-            self.child_candidates(prep, &parent, leaf_level, &mut children);
-            if p != ROOT && worth_culling(prep, children.len(), depth) {
-                match self.cull(prep, p, scratch) {
-                    Cull::Removed => continue,
-                    Cull::Kept => {}
-                    Cull::Clipped => {
-                        parent = self.parent_view(prep, p, &mut plane_copy);
-                        self.child_candidates(prep, &parent, leaf_level, &mut children);
-                    }
+            let leaf = leaf.as_mut().map(|(rx, out)| (*rx, &mut **out));
+            let bufs = (&mut plane_copy, &mut children);
+            self.grow_children(prep, p, depth, scratch, leaf, bufs);
+            self.check_budget(prep, depth)?;
+        }
+        self.end_level(start, leaf.is_none());
+        Ok(())
+    }
+
+    /// Build the children of parent `p` (a node of depth `depth - 1`, or the root): the
+    /// reflectors meeting its beam, after occlusion culling of `p` where it pays. With `leaf`,
+    /// children holding RX are emitted instead of materialised. `bufs`: scratch for the
+    /// parent's planes and its children.
+    fn grow_children(
+        &mut self,
+        prep: &Prepared<'_>,
+        p: u32,
+        depth: usize,
+        scratch: &mut Scratch,
+        mut leaf: Option<(Vec3, &mut CandidateSet)>,
+        (plane_copy, children): (&mut Vec<Plane>, &mut Vec<u32>),
+    ) {
+        let mut parent = self.parent_view(prep, p, plane_copy);
+        let leaf_level = leaf.is_some();
+        self.child_candidates(prep, &parent, leaf_level, children);
+        if p != ROOT && worth_culling(prep, children.len(), depth) {
+            match self.cull(prep, p, scratch) {
+                Cull::Removed => return,
+                Cull::Kept => {}
+                Cull::Clipped => {
+                    parent = self.parent_view(prep, p, plane_copy);
+                    self.child_candidates(prep, &parent, leaf_level, children);
                 }
-            }
-            for &s in &children {
-                self.stats.tested += 1;
-                match leaf.as_mut() {
-                    Some((rx, out)) => self.leaf_child(prep, &parent, s, *rx, out, scratch),
-                    None => self.child(prep, &parent, s, scratch),
-                }
-            }
-            if self.nodes.len() as u64 > prep.options.max_nodes {
-                return Err(TreeError::Budget {
-                    nodes: self.nodes.len() as u64,
-                    depth,
-                    max_order: prep.options.max_order,
-                    budget: prep.options.max_nodes,
-                });
             }
         }
+        for &s in children.iter() {
+            self.stats.tested += 1;
+            match leaf.as_mut() {
+                Some((rx, out)) => self.leaf_child(prep, &parent, s, *rx, out, scratch),
+                None => self.child(prep, &parent, s, scratch),
+            }
+        }
+    }
+
+    /// Stop with [`TreeError::Budget`] once the tree holds more nodes than the budget.
+    fn check_budget(&self, prep: &Prepared<'_>, depth: usize) -> Result<(), TreeError> {
+        if self.nodes.len() as u64 > prep.options.max_nodes {
+            return Err(TreeError::Budget {
+                nodes: self.nodes.len() as u64,
+                depth,
+                max_order: prep.options.max_order,
+                budget: prep.options.max_nodes,
+            });
+        }
+        Ok(())
+    }
+
+    /// Close the level whose nodes start at `start`: record it when `materialised`.
+    fn end_level(&mut self, start: usize, materialised: bool) {
         self.stats.occluders.sort_unstable();
         self.stats.occluders.dedup();
-        if leaf.is_none() {
+        if materialised {
             self.levels.push((start, self.nodes.len()));
             self.stats
                 .nodes_per_depth
                 .push((self.nodes.len() - start) as u64);
         }
-        Ok(())
     }
 
     /// Node `p` (or the root) as a parent, its beam planes copied into `planes`.

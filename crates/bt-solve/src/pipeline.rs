@@ -131,7 +131,8 @@ pub fn candidates_with_progress(
     })
 }
 
-fn tree_options(options: &TraceOptions) -> TreeOptions {
+/// The beam-tree options of a trace: its order, and its candidate budget as the node budget.
+pub fn tree_options(options: &TraceOptions) -> TreeOptions {
     TreeOptions {
         max_nodes: options.max_candidates,
         ..TreeOptions::new(options.max_order)

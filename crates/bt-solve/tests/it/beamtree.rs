@@ -274,3 +274,76 @@ fn the_build_reports_progress_level_by_level() {
         reports.len()
     );
 }
+
+/// The candidates of `tree` for `scene`'s RX, traced with the image method.
+fn walked_paths(scene: &Scene, tree: &BeamTree) -> Vec<FoundPath> {
+    bt_solve::trace(scene, &tree.candidates(scene.rx()), &Solver::Image, false).paths
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig {
+        cases: 24,
+        rng_seed: proptest::test_runner::RngSeed::Fixed(0x0bea_3701),
+        ..ProptestConfig::default()
+    })]
+
+    /// Time steps of random scenes with moving boxes and spinning panels: the tree rebuilt
+    /// from the previous step's equals a fresh build (node for node without culling; the same
+    /// paths, also equal to exhaustive enumeration, under every policy).
+    #[test]
+    fn a_rebuilt_tree_equals_a_fresh_one_after_motion(
+        seed in 0u64..1_000_000, order in 2usize..4, policy in 0usize..3,
+    ) {
+        let (_, dynamic) = bt_testkit::partitioned::random_dynamic(seed, 4);
+        let culling = [Culling::Off, Culling::Always, Culling::Auto { min_work: 0 }][policy];
+        let opts = TreeOptions { culling, ..TreeOptions::new(order) };
+        let scenes = dynamic.scenes();
+        let mut tree = BeamTree::build(&scenes[0], opts).expect("tree builds");
+        for pair in scenes.windows(2) {
+            let moved = bt_scene::dynamic::moved_surfaces(&pair[0], &pair[1]).expect("same surfaces");
+            let (rebuilt, stats) = tree.rebuild(&pair[1], &moved).expect("tree rebuilds");
+            let fresh = BeamTree::build(&pair[1], opts).expect("tree builds");
+            // Copied nodes keep their margins: node for node only at the same tolerance.
+            let same_tol = pair[0].length_tolerance() == pair[1].length_tolerance();
+            if culling == Culling::Off && same_tol {
+                prop_assert!(!stats.full);
+                prop_assert_eq!(rebuilt.len(), fresh.len());
+                let (a, b) = (rebuilt.candidates(pair[1].rx()), fresh.candidates(pair[1].rx()));
+                prop_assert_eq!(a.iter().collect::<Vec<_>>(), b.iter().collect::<Vec<_>>());
+            }
+            let reference = paths(&pair[1], order, CandidateMode::Exhaustive);
+            assert_same(&walked_paths(&pair[1], &rebuilt), &reference)?;
+            assert_same(&walked_paths(&pair[1], &fresh), &reference)?;
+            prop_assert!(stats.full || pair[1].length_tolerance() <= pair[0].length_tolerance());
+            tree = rebuilt;
+        }
+    }
+}
+
+/// The living room's door swings at every step: only the subtrees through the door are
+/// built again, and every step's paths equal a fresh build's.
+#[test]
+fn the_swinging_door_rebuilds_only_its_subtrees() {
+    let dynamic =
+        bt_scene::dynamic::builtin_dynamic_scene("living-room-dynamic", Terminals::default())
+            .expect("builtin")
+            .expect("dynamic");
+    let scenes = dynamic.scenes();
+    let opts = TreeOptions::new(3);
+    let mut tree = BeamTree::build(&scenes[0], opts).expect("tree builds");
+    let mut reused = 0;
+    for pair in scenes.windows(2) {
+        let moved = bt_scene::dynamic::moved_surfaces(&pair[0], &pair[1]).expect("same surfaces");
+        let (rebuilt, stats) = tree.rebuild(&pair[1], &moved).expect("tree rebuilds");
+        let fresh = BeamTree::build(&pair[1], opts).expect("tree builds");
+        assert_eq!(
+            sequences(&walked_paths(&pair[1], &rebuilt)),
+            sequences(&walked_paths(&pair[1], &fresh))
+        );
+        assert!(!stats.full, "no moved surface culled a node");
+        assert!(stats.built < stats.reused, "{stats:?}");
+        reused += stats.reused;
+        tree = rebuilt;
+    }
+    assert!(reused > 0);
+}
