@@ -272,3 +272,33 @@ fn the_swinging_door_rebuilds_only_the_subtrees_it_touches() {
         }
     }
 }
+
+#[test]
+fn a_walking_handset_is_a_walk_of_the_kept_tree() {
+    // RX moves 0.3 m per step through the living room while the door swings and the person
+    // walks: every step equals a from-scratch trace.
+    let json = bt_scene::builtin_json("living-room-dynamic").unwrap();
+    let mut description = bt_scene::io::parse_json(json, "test").unwrap();
+    let rx = description.rx.expect("the living room has an RX");
+    description.rx_steps = Some(
+        (0..10)
+            .map(|k| [rx[0] - 0.3 * k as f64, rx[1], rx[2]])
+            .collect(),
+    );
+    let dynamic =
+        DynamicScene::from_description(&description, "test", Terminals::default()).unwrap();
+    let options = StepOptions {
+        max_order: 3,
+        solver: Solver::Image,
+        candidates: CandidateMode::BeamTree,
+        max_candidates: u64::MAX,
+        parallel: false,
+    };
+    let mut tracer = IncrementalTracer::new(options);
+    for (k, scene) in dynamic.scenes().iter().enumerate() {
+        let step = tracer.step(scene).unwrap();
+        let scratch = trace_scratch(scene, k, &options).unwrap();
+        assert_eq!(step.trace.paths, scratch.trace.paths, "step {k}");
+        assert!(k == 0 || step.update.terminals_moved, "step {k}");
+    }
+}
