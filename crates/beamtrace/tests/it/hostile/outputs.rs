@@ -1,6 +1,6 @@
 //! Outputs never destroy data.
 
-use crate::*;
+use super::*;
 
 #[test]
 fn hls_gen_keeps_the_users_files_and_replaces_its_own() {

@@ -2,7 +2,7 @@
 //! option that raises it. Runs are held under an address-space limit (`MEMORY_LIMIT_BYTES`):
 //! on main these cases allocated 8 GB to 10 TB.
 
-use crate::*;
+use super::*;
 
 #[test]
 fn wvrn_at_order_50_stops_at_the_candidate_budget() {

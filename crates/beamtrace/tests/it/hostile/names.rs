@@ -1,6 +1,6 @@
 //! Names are data: checked at load, escaped wherever printed.
 
-use crate::*;
+use super::*;
 
 /// The injection: a surface name that ends the Verilog comment and opens a module.
 const INJECTION: &str = "wall\nmodule pwn; initial $display(\"pwned\"); endmodule\n//";
