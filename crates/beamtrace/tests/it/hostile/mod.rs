@@ -59,6 +59,13 @@ pub fn assert_refused(o: &Output, needles: &[&str]) {
     }
 }
 
+/// A clear refusal ([`assert_refused`]) of a run that was to write `out`, which it left
+/// unwritten.
+pub fn assert_refused_writing_nothing(args: &[&str], out: &Path, needles: &[&str]) {
+    assert_refused(&beamtrace(args), needles);
+    assert!(!out.exists(), "{args:?} wrote {}", out.display());
+}
+
 pub fn assert_ok(o: &Output) {
     assert!(o.status.success(), "exit {:?}:\n{}", o.status, text(o));
 }
