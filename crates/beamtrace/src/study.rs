@@ -75,17 +75,7 @@ pub fn run_living_room(args: &StudyLivingRoomArgs) -> anyhow::Result<ExitCode> {
     if !problems.is_empty() {
         anyhow::bail!("{}", problems.join("; "));
     }
-    let scene = crate::steps::load_dynamic(&SceneArgs {
-        scene: args.steps_from.clone(),
-        tx: None,
-        rx: None,
-        min_reflector_area: 0.25,
-        merge_angle_deg: 1.0,
-        merge_distance: 1e-3,
-        max_mesh_elements: bt_mesh::DEFAULT_MAX_ELEMENTS,
-        max_cloud_points: bt_pointcloud::io::DEFAULT_MAX_POINTS,
-        material: Default::default(),
-    })?;
+    let scene = crate::steps::load_dynamic(&SceneArgs::defaults_for(&args.steps_from))?;
     if let Some(problem) =
         bt_solve::SbrOptions::grid(args.sbr_step_deg).over_budget(args.budgets.max_rays)
     {
