@@ -188,6 +188,21 @@ pub struct SceneArgs {
     pub material: MaterialArgs,
 }
 
+impl SceneArgs {
+    /// `scene` with every other option at its command-line default: parsed by clap, so these
+    /// defaults are the ones `--help` shows.
+    pub fn defaults_for(scene: &str) -> SceneArgs {
+        #[derive(Parser)]
+        struct SceneOnly {
+            #[command(flatten)]
+            scene: SceneArgs,
+        }
+        SceneOnly::try_parse_from(["beamtrace", "--", scene])
+            .expect("a lone positional scene always parses")
+            .scene
+    }
+}
+
 /// Carrier and radio material overrides (any scene source).
 #[derive(Debug, Args, Clone, Default)]
 pub struct MaterialArgs {
@@ -541,17 +556,7 @@ pub struct DemoArgs {
 impl DemoArgs {
     pub fn into_trace(self) -> TraceArgs {
         TraceArgs {
-            scene: SceneArgs {
-                scene: "builtin:living-room".into(),
-                tx: None,
-                rx: None,
-                min_reflector_area: 0.25,
-                merge_angle_deg: 1.0,
-                merge_distance: 1e-3,
-                max_mesh_elements: bt_mesh::DEFAULT_MAX_ELEMENTS,
-                max_cloud_points: bt_pointcloud::io::DEFAULT_MAX_POINTS,
-                material: MaterialArgs::default(),
-            },
+            scene: SceneArgs::defaults_for("builtin:living-room"),
             radio: self.radio,
             solve: SolveArgs::with(self.max_order, self.solver),
             json: self.json,
@@ -882,4 +887,22 @@ pub fn with_default_subcommands(
         }
     }
     args
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn scene_defaults_are_the_command_lines() {
+        let a = SceneArgs::defaults_for("-room.json");
+        assert_eq!(a.scene, "-room.json");
+        assert!(a.tx.is_none() && a.rx.is_none() && a.material.material.is_none());
+        assert_eq!(
+            (a.min_reflector_area, a.merge_angle_deg, a.merge_distance),
+            (0.25, 1.0, 1e-3)
+        );
+        assert_eq!(a.max_mesh_elements, bt_mesh::DEFAULT_MAX_ELEMENTS);
+        assert_eq!(a.max_cloud_points, bt_pointcloud::io::DEFAULT_MAX_POINTS);
+    }
 }

@@ -15,6 +15,19 @@ pub fn spinner(what: &str) -> ProgressBar {
     bar
 }
 
+/// A bar over `len` units called `units` ("room-steps", "time steps"), with the elapsed time
+/// and an estimate of the rest.
+pub fn counter(len: u64, units: &str) -> ProgressBar {
+    let bar = ProgressBar::new(len);
+    bar.set_style(
+        ProgressStyle::with_template(&format!(
+            "{{bar:40}} {{pos}}/{{len}} {units}  {{elapsed}} (eta {{eta}})"
+        ))
+        .expect("static template"),
+    );
+    bar
+}
+
 /// A bar in the style `template`, hidden until [`Deferred::show_after`] finds that the work
 /// has run for `delay` (the first report, for a zero delay).
 pub struct Deferred {

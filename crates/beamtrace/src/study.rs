@@ -2,10 +2,8 @@
 //! its outputs (the studies themselves live in `bt-study`).
 
 use crate::args::{SceneArgs, Study2dArgs, StudyLivingRoomArgs};
-use anyhow::Context;
 use bt_study::living_room::{self, LivingRoomConfig};
 use bt_study::{StudyConfig, report};
-use indicatif::{ProgressBar, ProgressStyle};
 use std::io::Write;
 use std::process::ExitCode;
 
@@ -29,11 +27,7 @@ pub fn run_2d(args: &Study2dArgs) -> anyhow::Result<ExitCode> {
         anyhow::bail!("{problem}");
     }
     // indicatif draws to stderr and hides itself when stderr is not a terminal.
-    let bar = ProgressBar::new((config.rooms * config.steps) as u64);
-    bar.set_style(
-        ProgressStyle::with_template("{bar:40} {pos}/{len} room-steps  {elapsed} (eta {eta})")
-            .context("progress bar template")?,
-    );
+    let bar = crate::progress::counter((config.rooms * config.steps) as u64, "room-steps");
     let results = bt_study::run(&config, &mut |done, _| bar.set_position(done as u64))?;
     bar.finish_and_clear();
     let files = bt_study::io::write_outputs(&args.out, &results)?;
@@ -75,17 +69,7 @@ pub fn run_living_room(args: &StudyLivingRoomArgs) -> anyhow::Result<ExitCode> {
     if !problems.is_empty() {
         anyhow::bail!("{}", problems.join("; "));
     }
-    let scene = crate::steps::load_dynamic(&SceneArgs {
-        scene: args.steps_from.clone(),
-        tx: None,
-        rx: None,
-        min_reflector_area: 0.25,
-        merge_angle_deg: 1.0,
-        merge_distance: 1e-3,
-        max_mesh_elements: bt_mesh::DEFAULT_MAX_ELEMENTS,
-        max_cloud_points: bt_pointcloud::io::DEFAULT_MAX_POINTS,
-        material: Default::default(),
-    })?;
+    let scene = crate::steps::load_dynamic(&SceneArgs::defaults_for(&args.steps_from))?;
     if let Some(problem) =
         bt_solve::SbrOptions::grid(args.sbr_step_deg).over_budget(args.budgets.max_rays)
     {
@@ -94,11 +78,7 @@ pub fn run_living_room(args: &StudyLivingRoomArgs) -> anyhow::Result<ExitCode> {
     for step in scene.scenes() {
         bt_solve::pipeline::exhaustive_budget(step, args.max_order, args.budgets.max_candidates)?;
     }
-    let bar = ProgressBar::new(scene.len() as u64);
-    bar.set_style(
-        ProgressStyle::with_template("{bar:40} {pos}/{len} time steps  {elapsed} (eta {eta})")
-            .context("progress bar template")?,
-    );
+    let bar = crate::progress::counter(scene.len() as u64, "time steps");
     bar.tick();
     let results = bt_study::living_room::run(&scene, &config, &mut |done, _| {
         bar.set_position(done as u64)

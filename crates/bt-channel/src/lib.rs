@@ -5,6 +5,8 @@
 //! Frames and units: world frame of `docs/conventions.md` (metres, z up), Hz, radians inside
 //! the library. Every formula and sign convention: `docs/channel.md`.
 
+#![warn(missing_docs)]
+
 pub mod antenna;
 pub mod codebook;
 pub mod gain;

@@ -6,6 +6,8 @@
 //! entry), in chunks so a caller can show progress. A grid point on a surface or at the TX is
 //! a [`PointStatus::Skipped`] row, not a failure of the sweep; a candidate budget error is.
 
+#![warn(missing_docs)]
+
 pub mod grid;
 mod map;
 

@@ -232,7 +232,7 @@ impl bt_plot::Figure for HeatMap<'_> {
 }
 
 /// Pixel size of a heat map: 800 px across the longer side of the window plus the bar.
-pub fn size(map: &HeatMap) -> (u32, u32) {
+pub fn size(map: &HeatMap<'_>) -> (u32, u32) {
     let ((x0, x1), (y0, y1)) = map.window();
     let (w, h) = (x1 - x0, y1 - y0);
     let scale = 800.0 / w.max(h);

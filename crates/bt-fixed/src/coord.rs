@@ -51,7 +51,7 @@ impl Coord {
 ///
 /// Why: with whole-millimetre state the Jacobi iteration stagnates once a round's true move
 /// drops below 0.5 mm (error ≈ 0.5 mm / (1 − contraction)) and rounding noise sustains limit
-/// cycles: on the seeded rooms of `tests/vs_f64.rs` that gave 73 mm / 0.58 degree worst case and
+/// cycles: on the seeded rooms of `tests/it/vs_f64.rs` that gave 73 mm / 0.58 degree worst case and
 /// 6 % of paths never converging at a 1 mm threshold; 8 fraction bits bring it to ≈ 0.25 mm and
 /// 0.003 degree. The bus keeps the paper's 32-bit millimetre words.
 pub const POINT_FRAC: u32 = 8;

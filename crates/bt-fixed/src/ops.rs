@@ -16,7 +16,7 @@ pub const GUARD_BITS: u32 = 16;
 pub const PROPORTION_ITERATIONS: u32 = 32;
 
 /// Bit widths of every intermediate, shared with the RTL generator (`bt-hls` declares its wires
-/// with exactly these widths). `tests/widths.rs` proves, over the whole input domain (any 32-bit
+/// with exactly these widths). `tests/it/widths.rs` proves, over the whole input domain (any 32-bit
 /// coordinates, any unit normal, any 32-bit offset), that no value leaves its width.
 pub mod width {
     use super::GUARD_BITS;
@@ -137,7 +137,7 @@ pub struct Proportion {
 /// < 1 guard LSB; `B_p` carries at most `i` guard LSBs of truncation error (bias towards −∞)
 /// after `i` iterations, then one round-half-up. `B` carries the same kind of error, so the
 /// decision sequence is a binary search on `m/(m+n)` perturbed by ≤ `i / ((m+n)·2^G)`. The
-/// proved bound (`tests/algorithm3.rs`), with `i` = iterations run and `L_i` the final `L`:
+/// proved bound (`tests/it/algorithm3.rs`), with `i` = iterations run and `L_i` the final `L`:
 ///
 /// `|out − l·m/(m+n)| ≤ 1/2 + i/2^G + |l|·(L_i/((m+n)·2^G) + 2i/((m+n)·2^G))`
 ///
@@ -149,7 +149,7 @@ pub struct Proportion {
 ///
 /// Verilog twin: the `bt_pe_<i>` registers `r_l` (`L`), `r_e` (`E = B − m·2^G`, whose sign is
 /// the comparison), `b_{x,y,z}` (`L_p`) and `a_{x,y,z}` (`t_prev·2^G + 2^(G−1) + B_p`, see
-/// [`width::POINT_ACC`]), one iteration per clock; `tests/rtl_form.rs` proves the re-arrangement
+/// [`width::POINT_ACC`]), one iteration per clock; `tests/it/rtl_form.rs` proves the re-arrangement
 /// exact.
 pub fn halving_proportion(m: u64, n: u64, l: [i64; 3]) -> Proportion {
     let sum = u128::from(m) + u128::from(n);

@@ -1,8 +1,10 @@
 //! Convex polygons in 3-D as plain vertex lists: clipping by half-spaces, the outward-grown
-//! convex hull of a [`Polygon`], and a convexity test. These are the windows of the beam tree
+//! convex hull of a [`Polygon`], and the two convexity rules of a [`Polygon`] (straight
+//! corners allowed or not; both [`poly2::is_convex`]). These are the windows of the beam tree
 //! (`bt_paths::beamtree`); every operation errs on the side of keeping more (conservative).
 
-use crate::{Plane, Polygon, Real, Vec2, Vec3};
+use crate::poly2::{self, StraightCorners};
+use crate::{Plane, Polygon, Real, Vec2, Vec3, tol};
 
 /// Clip the convex polygon `poly` to the half-space `{x : plane.signed_distance(x) >= -eps}`
 /// (Sutherland-Hodgman), writing the result to `out` (cleared first). `eps` (m) grows the kept
@@ -109,24 +111,22 @@ pub fn hull_2d(points: &[Vec2]) -> Vec<Vec2> {
     hull
 }
 
-/// Whether the polygon is convex (no reflex corner; collinear corners allowed).
+/// Whether the polygon is convex, straight corners allowed (|sine of the turn| at most
+/// [`tol::SIN_STRAIGHT_CORNER`]): a polygon whose windows may be clipped as convex (the beam
+/// tree). [`is_strictly_convex`] is the rule without straight corners.
 pub fn is_convex(polygon: &Polygon) -> bool {
-    let local = polygon.local_vertices();
-    let n = local.len();
-    let mut sign = 0.0;
-    for i in 0..n {
-        let (a, b, c) = (local[i], local[(i + 1) % n], local[(i + 2) % n]);
-        let turn = (b - a).perp_dot(c - b);
-        if turn.abs() <= 1e-12 * (b - a).length() * (c - b).length() {
-            continue;
-        }
-        if sign == 0.0 {
-            sign = turn.signum();
-        } else if turn.signum() != sign {
-            return false;
-        }
-    }
-    true
+    let straight = StraightCorners::Allowed {
+        sin_tol: tol::SIN_STRAIGHT_CORNER,
+    };
+    poly2::is_convex(polygon.local_vertices(), straight)
+}
+
+/// Whether every corner of the polygon turns the same way, exactly (no straight corner, no
+/// tolerance): an occluder the weak visibility network may use in its proof
+/// (`bt_paths::wvrn::occludes`). A nearly straight corner whose turn rounds the wrong way
+/// makes the polygon count as non-convex, which only skips it as an occluder (the safe side).
+pub fn is_strictly_convex(polygon: &Polygon) -> bool {
+    poly2::is_convex(polygon.local_vertices(), StraightCorners::Refused)
 }
 
 #[cfg(test)]
@@ -141,6 +141,15 @@ mod tests {
         let hp = Polygon::new(hull.clone()).unwrap();
         assert!(is_convex(&hp));
         assert!(!is_convex(&l));
+        assert!(!is_strictly_convex(&l));
+        let square = Polygon::new(vec![
+            Vec3::new(0., 0., 0.),
+            Vec3::new(1., 0., 0.),
+            Vec3::new(1., 1., 0.),
+            Vec3::new(0., 1., 0.),
+        ])
+        .unwrap();
+        assert!(is_convex(&square) && is_strictly_convex(&square));
         // every point within 0.1 of the L lies in the grown hull
         for i in 0..=40 {
             for j in 0..=40 {

@@ -1,11 +1,11 @@
 //! Polygon primitives on plain vertex lists: signed area, even-odd point-in-polygon, segment
-//! contact, simplicity, and the Newell area vector of a 3-D polygon.
+//! contact, simplicity, convexity, and the Newell area vector of a 3-D polygon.
 //!
 //! The one home of these predicates for every crate (the validated [`Polygon`](crate::Polygon),
 //! mesh merging, point-cloud boundaries, the study's room generator). Polygons are closed
 //! implicitly (the last vertex joins the first); 2-D coordinates are metres in whatever in-plane
 //! frame the caller uses. All tests are exact on the given floats: no tolerance is applied here,
-//! callers that want one apply it around these calls.
+//! callers that want one apply it around these calls (or pass it, as [`is_convex`] takes it).
 
 use crate::{Real, Vec2, Vec3};
 
@@ -111,6 +111,51 @@ pub fn is_simple(pts: &[Vec2]) -> bool {
     !folds && first_crossing(pts).is_none()
 }
 
+/// What [`is_convex`] makes of a straight corner: a vertex where the boundary goes on without
+/// turning (its two edges collinear).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum StraightCorners {
+    /// Skipped: a corner counts as straight when the |sine| of its turn is at most `sin_tol`,
+    /// so a vertex in the middle of an edge keeps a polygon convex.
+    Allowed {
+        /// Largest |sine| of the turn angle of a straight corner (dimensionless).
+        sin_tol: Real,
+    },
+    /// Refused, with no tolerance: an exactly straight corner makes the polygon non-convex, and
+    /// so does a nearly straight one whose turn rounds the wrong way. The safe side for a caller
+    /// whose proof needs every corner to turn the same way.
+    Refused,
+}
+
+/// Whether the closed polygon is convex: at least three vertices and no two corners turning
+/// opposite ways (counter-clockwise or clockwise alike); straight corners as `straight` says.
+pub fn is_convex(pts: &[Vec2], straight: StraightCorners) -> bool {
+    let n = pts.len();
+    if n < 3 {
+        return false;
+    }
+    let (mut left, mut right) = (false, false);
+    for i in 0..n {
+        let (a, b, c) = (pts[i], pts[(i + 1) % n], pts[(i + 2) % n]);
+        let turn = (b - a).perp_dot(c - b);
+        match straight {
+            StraightCorners::Allowed { sin_tol } => {
+                if turn.abs() <= sin_tol * (b - a).length() * (c - b).length() {
+                    continue;
+                }
+            }
+            StraightCorners::Refused => {
+                if turn == 0.0 {
+                    return false;
+                }
+            }
+        }
+        left |= turn > 0.0;
+        right |= turn < 0.0;
+    }
+    !(left && right)
+}
+
 /// Newell's area vector of a closed 3-D polygon: its direction is the normal (right-hand rule on
 /// the vertex order), its length twice the area (m²). Summed about the vertex mean, so it is
 /// robust for any simple polygon, planar or nearly so, far from the origin. Zero below three
@@ -134,6 +179,30 @@ mod tests {
 
     fn v(x: Real, y: Real) -> Vec2 {
         Vec2::new(x, y)
+    }
+
+    #[test]
+    fn convexity_and_straight_corners() {
+        let square = [v(0., 0.), v(1., 0.), v(1., 1.), v(0., 1.)];
+        let with_midpoint = [v(0., 0.), v(0.5, 0.), v(1., 0.), v(1., 1.), v(0., 1.)];
+        let l = [
+            v(0., 0.),
+            v(2., 0.),
+            v(2., 1.),
+            v(1., 1.),
+            v(1., 2.),
+            v(0., 2.),
+        ];
+        let allowed = StraightCorners::Allowed { sin_tol: 1e-12 };
+        for straight in [allowed, StraightCorners::Refused] {
+            assert!(is_convex(&square, straight));
+            let clockwise: Vec<Vec2> = square.iter().rev().copied().collect();
+            assert!(is_convex(&clockwise, straight));
+            assert!(!is_convex(&l, straight));
+            assert!(!is_convex(&square[..2], straight));
+        }
+        assert!(is_convex(&with_midpoint, allowed));
+        assert!(!is_convex(&with_midpoint, StraightCorners::Refused));
     }
 
     #[test]

@@ -20,6 +20,10 @@ pub const REL_AREA: Real = 1e-12;
 /// Vertices closer than this relative distance (to the polygon extent) are repeated vertices.
 pub const REL_VERTEX_MERGE: Real = 1e-9;
 
+/// Largest |sine| of the turn at a polygon corner that still counts as straight (1e-12,
+/// dimensionless): [`crate::convex::is_convex`] skips such corners.
+pub const SIN_STRAIGHT_CORNER: Real = 1e-12;
+
 /// Angle tolerance in radians for the reflection law check of found paths (1e-9 rad).
 pub const ANGLE_REFLECTION_LAW: Real = 1e-9;
 

@@ -12,6 +12,8 @@
 //! - an output that is one of the inputs is refused ([`refuse_input`]);
 //! - the format follows the extension or the output is refused ([`extension_in`]).
 
+#![warn(missing_docs)]
+
 use std::collections::BTreeSet;
 use std::fs::File;
 use std::io::{BufWriter, Write};

@@ -27,6 +27,7 @@
 //! (never drops a real link) but not minimal. Sampling is never used to remove a link.
 
 use crate::{Node, Visibility};
+use bt_geom::convex::is_strictly_convex;
 use bt_geom::{Polygon, Real, Vec3};
 use bt_scene::{Scene, SurfaceId, SurfaceKind};
 use serde::Serialize;
@@ -124,7 +125,7 @@ impl Wvrn {
             convex: scene
                 .surfaces()
                 .iter()
-                .map(|s| is_convex(&s.polygon))
+                .map(|s| is_strictly_convex(&s.polygon))
                 .collect(),
             sides: vec![(0, 0.0); n * m],
             tx: scene.tx(),
@@ -177,7 +178,7 @@ impl Wvrn {
         let mut moved_mask = vec![false; self.slot.len()];
         for id in moved {
             moved_mask[id.index()] = true;
-            self.convex[id.index()] = is_convex(&scene.surface(*id).polygon);
+            self.convex[id.index()] = is_strictly_convex(&scene.surface(*id).polygon);
             if self.slot[id.index()] != NONE {
                 dirty[self.slot[id.index()] as usize] = true;
             }
@@ -424,29 +425,6 @@ impl Visibility for Wvrn {
     }
 }
 
-/// Whether the polygon is convex: all turns of its boundary have one strict sign (seen in its
-/// own 2-D frame). Nearly collinear vertices whose turn rounds the wrong way make it count as
-/// non-convex, which only skips it as an occluder (the safe side).
-pub fn is_convex(polygon: &Polygon) -> bool {
-    let local: Vec<_> = polygon
-        .vertices()
-        .iter()
-        .map(|p| polygon.to_local(*p))
-        .collect();
-    let n = local.len();
-    let (mut pos, mut neg) = (false, false);
-    for i in 0..n {
-        let (a, b, c) = (local[i], local[(i + 1) % n], local[(i + 2) % n]);
-        let turn = (b - a).perp_dot(c - b);
-        pos |= turn > 0.0;
-        neg |= turn < 0.0;
-        if turn == 0.0 {
-            return false;
-        }
-    }
-    pos != neg
-}
-
 /// Separation from an occluder's plane required of both nodes' points: room for the path
 /// points' uncertainty (`2 tol`) and the validation's tolerance band, so that perturbed
 /// segments still cross the plane strictly inside (`t` in `[t_min, 1 - t_min]`).
@@ -480,7 +458,7 @@ fn side_class(plane: &bt_geom::Plane, points: &[Vec3], sep: Real) -> (i8, Real) 
 /// Whether the convex polygon `c` provably blocks every segment of a valid path between a point
 /// near `conv(a)` and a point near `conv(b)` (within `2 tol`), under the validation rule
 /// ([`Polygon::blocks_segment`] with tolerance `tol`). See the module docs for the proof.
-/// `c` must be convex (see [`is_convex`]); for a non-convex `c` the answer means nothing.
+/// `c` must be convex ([`is_strictly_convex`]); for a non-convex `c` the answer means nothing.
 pub fn occludes(c: &Polygon, a: &[Vec3], b: &[Vec3], tol: Real) -> bool {
     let sep = separation(tol);
     let (side_a, min_a) = side_class(c.plane(), a, sep);
@@ -536,22 +514,6 @@ mod tests {
     fn quad(c: [Real; 3], u: [Real; 3], v: [Real; 3]) -> Vec<Vec3> {
         let (c, u, v) = (Vec3::from(c), Vec3::from(u), Vec3::from(v));
         vec![c - u - v, c + u - v, c + u + v, c - u + v]
-    }
-
-    #[test]
-    fn convexity() {
-        let square = Polygon::new(quad([0., 0., 0.], [1., 0., 0.], [0., 1., 0.])).unwrap();
-        assert!(is_convex(&square));
-        let l = Polygon::new(vec![
-            Vec3::new(0., 0., 0.),
-            Vec3::new(2., 0., 0.),
-            Vec3::new(2., 1., 0.),
-            Vec3::new(1., 1., 0.),
-            Vec3::new(1., 2., 0.),
-            Vec3::new(0., 2., 0.),
-        ])
-        .unwrap();
-        assert!(!is_convex(&l));
     }
 
     #[test]

@@ -5,6 +5,8 @@
 //! Vera licence, `assets/DejaVuSans-LICENSE.txt`) is compiled in and registered as
 //! `sans-serif` by [`register_font`].
 
+#![warn(missing_docs)]
+
 use plotters::coord::{CoordTranslate, Shift};
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};

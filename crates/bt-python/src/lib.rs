@@ -5,6 +5,8 @@
 //! Python layer (`python/src/beamtrace`) normalises arrays and wraps the columns in `Paths`.
 //! Tracing releases the GIL; `trace_many` spreads receivers over rayon's pool.
 
+#![warn(missing_docs)]
+
 mod columns;
 mod options;
 

@@ -6,6 +6,8 @@
 //! The page exposes `window.beamtraceView = { steps, step, pathLines, paths, surfaces, ready }`
 //! so a browser test can check what was drawn.
 
+#![warn(missing_docs)]
+
 use bt_beams::PathReport;
 use bt_geom::Real;
 use bt_scene::{Scene, SurfaceKind};

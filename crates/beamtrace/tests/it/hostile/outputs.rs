@@ -1,6 +1,6 @@
 //! Outputs never destroy data.
 
-use crate::*;
+use super::*;
 
 #[test]
 fn hls_gen_keeps_the_users_files_and_replaces_its_own() {
@@ -48,19 +48,21 @@ fn hls_gen_keeps_the_users_files_and_replaces_its_own() {
 fn hls_gen_that_cannot_fit_fails_fast_and_creates_nothing() {
     let dir = scratch("hls-fail");
     let out = dir.join("accel");
-    let r = beamtrace(&[
-        "hls",
-        "gen",
-        "builtin:living-room",
-        "--max-order",
-        "1",
-        "--m9k-budget",
-        "4",
-        "-o",
-        out.to_str().unwrap(),
-    ]);
-    assert_refused(&r, &["M9K blocks", "budget of 4", "--max-order"]);
-    assert!(!out.exists(), "a failed run leaves no folder");
+    assert_refused_writing_nothing(
+        &[
+            "hls",
+            "gen",
+            "builtin:living-room",
+            "--max-order",
+            "1",
+            "--m9k-budget",
+            "4",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        &out,
+        &["M9K blocks", "budget of 4", "--max-order"],
+    );
     assert!(tree(&dir).is_empty(), "{:?}", tree(&dir));
 }
 
@@ -129,9 +131,11 @@ fn extract_writes_the_format_its_extension_names_or_refuses() {
         "no null where a value is promised:\n{text}"
     );
     let yaml = dir.join("room.yaml");
-    let r = beamtrace(&["extract", c, "-o", yaml.to_str().unwrap()]);
-    assert_refused(&r, &["room.yaml", ".json or .toml"]);
-    assert!(!yaml.exists());
+    assert_refused_writing_nothing(
+        &["extract", c, "-o", yaml.to_str().unwrap()],
+        &yaml,
+        &["room.yaml", ".json or .toml"],
+    );
 }
 
 #[test]
@@ -144,11 +148,11 @@ fn trace_out_refuses_the_scene_file_and_other_formats() {
     assert_refused(&beamtrace(&["trace", s, "--out", s]), &["it is the input"]);
     assert_eq!(std::fs::read(&scene).unwrap(), before);
     let csv = dir.join("paths.csv");
-    assert_refused(
-        &beamtrace(&["trace", s, "--out", csv.to_str().unwrap()]),
+    assert_refused_writing_nothing(
+        &["trace", s, "--out", csv.to_str().unwrap()],
+        &csv,
         &["paths.csv", ".json"],
     );
-    assert!(!csv.exists());
     let out = dir.join("paths.json");
     assert_ok(&beamtrace(&["trace", s, "--out", out.to_str().unwrap()]));
     assert_eq!(tree(&dir), ["paths.json", "scene.json"]);

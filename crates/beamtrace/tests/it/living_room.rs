@@ -4,28 +4,10 @@
 //! fixed-point accelerator < 0.1°, SBR visibly worse), the figures exist, and every step gets
 //! its own schedule (run on one platform) with a positive cycle count.
 
+use crate::common::*;
 use serde_json::Value;
 use std::collections::BTreeMap;
-use std::path::{Path, PathBuf};
-use std::process::Command;
-
-fn beamtrace(args: &[&str]) -> (bool, String, String) {
-    let o = Command::new(env!("CARGO_BIN_EXE_beamtrace"))
-        .args(args)
-        .output()
-        .expect("binary runs");
-    (
-        o.status.success(),
-        String::from_utf8_lossy(&o.stdout).into_owned(),
-        String::from_utf8_lossy(&o.stderr).into_owned(),
-    )
-}
-
-fn tmp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("beamtrace-lr-{}-{name}", std::process::id()));
-    std::fs::create_dir_all(&dir).expect("temp dir");
-    dir
-}
+use std::path::Path;
 
 /// The built-in dynamic living room cut to `steps` steps: the person walks as before, the door
 /// opens by 10° per step.
@@ -46,12 +28,12 @@ fn short_living_room(dir: &Path, steps: usize) -> String {
 
 #[test]
 fn study_living_room_writes_consistent_csv_and_figures() {
-    let dir = tmp("study");
+    let dir = scratch("living-room-study");
     let scene = short_living_room(&dir, 2);
     let out = dir.join("out");
     // The short study into `out` (a fast SBR and order 2).
     let study = |out: &Path| {
-        beamtrace(&[
+        run_ok(&[
             "study",
             "living-room",
             "--out",
@@ -64,8 +46,7 @@ fn study_living_room_writes_consistent_csv_and_figures() {
             "2",
         ])
     };
-    let (ok, stdout, stderr) = study(&out);
-    assert!(ok, "{stdout}{stderr}");
+    let stdout = stdout(&study(&out));
     assert!(stdout.contains("FPGA IPC error"), "{stdout}");
 
     let csv = std::fs::read_to_string(out.join("results.csv")).expect("results.csv");
@@ -198,8 +179,7 @@ fn study_living_room_writes_consistent_csv_and_figures() {
     }
     // Deterministic except the times: a second run gives the same errors and cycles.
     let out2 = dir.join("out2");
-    let (ok, stdout, stderr) = study(&out2);
-    assert!(ok, "{stdout}{stderr}");
+    study(&out2);
     let strip_times = |text: &str| -> Vec<String> {
         text.lines()
             .map(|l| {
@@ -218,10 +198,10 @@ fn study_living_room_writes_consistent_csv_and_figures() {
 
 #[test]
 fn hls_gen_steps_plans_every_step() {
-    let dir = tmp("hls");
+    let dir = scratch("living-room-hls");
     let scene = short_living_room(&dir, 3);
     let out = dir.join("out");
-    let (ok, stdout, stderr) = beamtrace(&[
+    let stdout = stdout(&run_ok(&[
         "hls",
         "gen",
         &scene,
@@ -231,10 +211,8 @@ fn hls_gen_steps_plans_every_step() {
         "2",
         "-o",
         out.to_str().unwrap(),
-    ]);
-    assert!(ok, "{stdout}{stderr}");
-    let doc: Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("steps.json")).unwrap()).unwrap();
+    ]));
+    let doc = read_json(&out.join("steps.json"));
     let steps = doc["steps"].as_array().expect("steps");
     assert_eq!(steps.len(), 3, "{doc}");
     assert_eq!(doc["cycles"].as_array().map(Vec::len), Some(3), "{doc}");
@@ -253,9 +231,7 @@ fn hls_gen_steps_plans_every_step() {
         );
         let step_dir = out.join(format!("step-{k}"));
         assert!(!out.join("rtl").exists());
-        let own: Value =
-            serde_json::from_str(&std::fs::read_to_string(step_dir.join("summary.json")).unwrap())
-                .unwrap();
+        let own = read_json(&step_dir.join("summary.json"));
         assert_eq!(own["predicted_cycles"], cycles);
         assert!(own["host_time_s"].as_f64().unwrap() > 0.0, "{own}");
         assert!(own["latency_s_at_50mhz"].as_f64().unwrap() > 0.0, "{own}");

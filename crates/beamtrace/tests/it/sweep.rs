@@ -2,34 +2,18 @@
 //! CSV of a tiny grid (with a point at the TX, marked skipped), determinism across thread
 //! counts, and bad grids refused with a clear message.
 
+use crate::common::*;
 use serde_json::Value;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
+use std::path::PathBuf;
 
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
-
-fn beamtrace(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_beamtrace"))
-        .args(args)
-        .output()
-        .expect("binary runs")
-}
-
-fn tmp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("bt-sweep-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    dir
-}
-
+/// Sweeps the living room over `grid` into a new folder `out` (in the scratch folder `name`):
+/// that folder and the CSV.
 fn sweep(grid: &str, extra: &[&str], name: &str) -> (PathBuf, String) {
-    let dir = tmp_dir(name);
+    let dir = scratch(&format!("sweep-{name}")).join("out");
     let d = dir.display().to_string();
     let mut args = vec!["sweep", "builtin:living-room", "--grid", grid, "--out", &d];
     args.extend_from_slice(extra);
-    let o = beamtrace(&args);
-    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    run_ok(&args);
     let csv = std::fs::read_to_string(dir.join("coverage.csv")).unwrap();
     (dir, csv)
 }
@@ -46,9 +30,7 @@ fn trace_at(fields: &[&str]) -> Value {
         "2",
         "--json",
     ];
-    let o = beamtrace(&args);
-    assert!(o.status.success());
-    serde_json::from_slice(&o.stdout).unwrap()
+    run_json(&args)
 }
 
 #[test]
@@ -102,7 +84,7 @@ fn every_point_equals_its_own_trace() {
             .collect();
         assert_eq!(f[9], names.join(" > "), "{line}");
     }
-    let _ = std::fs::remove_dir_all(dir);
+    let _ = std::fs::remove_dir_all(dir.parent().unwrap());
 }
 
 #[test]
@@ -127,8 +109,8 @@ fn tiny_grid_matches_the_golden_csv_and_marks_the_tx() {
         "single",
     );
     assert_eq!(csv, single, "output depends on the thread count");
-    let _ = std::fs::remove_dir_all(dir);
-    let _ = std::fs::remove_dir_all(dir1);
+    let _ = std::fs::remove_dir_all(dir.parent().unwrap());
+    let _ = std::fs::remove_dir_all(dir1.parent().unwrap());
 }
 
 #[test]
@@ -144,8 +126,8 @@ fn bad_grids_are_refused_with_the_field_named() {
             "use a coarser step or raise the budget with --max-points",
         ),
     ];
+    let dir = scratch("sweep-bad").join("out");
     for (grid, message) in cases {
-        let dir = tmp_dir("bad");
         let o = beamtrace(&[
             "sweep",
             "builtin:living-room",
@@ -154,7 +136,7 @@ fn bad_grids_are_refused_with_the_field_named() {
             "--out",
             &dir.display().to_string(),
         ]);
-        let err = String::from_utf8_lossy(&o.stderr);
+        let err = stderr(&o);
         assert_eq!(o.status.code(), Some(2), "{grid}: {err}");
         assert!(err.contains(message), "{grid}: {err}");
         assert!(!dir.exists(), "{grid}: wrote output");
@@ -169,7 +151,7 @@ fn bad_grids_are_refused_with_the_field_named() {
         "--out",
         "x",
     ]);
-    assert!(String::from_utf8_lossy(&o.stderr).contains("--rx is not used"));
+    assert!(stderr(&o).contains("--rx is not used"));
 }
 
 #[test]
@@ -194,5 +176,5 @@ fn received_power_column_equals_trace_json_received_power() {
         assert!((got - expected).abs() < 1e-4, "{line}: {got} vs {expected}");
         assert!(got < -40.0 && got > -120.0, "{line}: {got} dBm");
     }
-    let _ = std::fs::remove_dir_all(dir);
+    let _ = std::fs::remove_dir_all(dir.parent().unwrap());
 }

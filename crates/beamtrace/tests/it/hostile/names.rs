@@ -1,6 +1,6 @@
 //! Names are data: checked at load, escaped wherever printed.
 
-use crate::*;
+use super::*;
 
 /// The injection: a surface name that ends the Verilog comment and opens a module.
 const INJECTION: &str = "wall\nmodule pwn; initial $display(\"pwned\"); endmodule\n//";
@@ -31,17 +31,19 @@ fn the_injection_name_is_refused_at_load_with_the_name_escaped() {
     );
     // Nor does it reach RTL: hls gen refuses the scene before writing anything.
     let out = dir.join("accel");
-    let r = beamtrace(&[
-        "hls",
-        "gen",
-        &scene,
-        "--max-order",
-        "1",
-        "-o",
-        out.to_str().unwrap(),
-    ]);
-    assert_refused(&r, &["U+000A"]);
-    assert!(!out.exists());
+    assert_refused_writing_nothing(
+        &[
+            "hls",
+            "gen",
+            &scene,
+            "--max-order",
+            "1",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        &out,
+        &["U+000A"],
+    );
 }
 
 #[test]

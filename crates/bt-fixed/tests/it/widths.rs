@@ -1,12 +1,10 @@
 //! The intermediate widths of `bt_fixed::width` (which are the RTL wire widths) hold for the
 //! whole input domain: any 40-bit coordinates, any unit normal, any 40-bit offset.
 
-mod common;
-
+use crate::common::*;
 use bt_fixed::{
     FineCoord, FinePoint, FixedPlane, GUARD_BITS, NORMAL_FRAC, PeTrace, intersection_point, width,
 };
-use common::*;
 use proptest::prelude::*;
 
 fn check(plane: &FixedPlane, prev: FinePoint, next: FinePoint) -> PeTrace {

@@ -1,72 +1,18 @@
 //! Point cloud to scene, end to end through the CLI: sample the built-in living room into a
 //! noisy cloud (5 mm), extract its planes, and compare with the original surfaces and paths.
 
+use crate::common::*;
+use bt_geom::{Vec3, poly2};
 use serde_json::Value;
-use std::path::PathBuf;
-use std::process::Command;
 
-fn beamtrace(args: &[&str]) -> std::process::Output {
-    let o = Command::new(env!("CARGO_BIN_EXE_beamtrace"))
-        .args(args)
-        .output()
-        .expect("binary runs");
-    assert!(
-        o.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    o
+/// (unit normal, area, centroid) of a planar polygon: Newell's area vector, the vertex mean.
+fn plane_of(vertices: &[Vec3]) -> (Vec3, f64, Vec3) {
+    let s = poly2::newell(vertices);
+    let c = vertices.iter().copied().sum::<Vec3>() / vertices.len() as f64;
+    (s.normalize(), s.length() / 2.0, c)
 }
 
-fn tmp(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("beamtrace-pc-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir.join(name)
-}
-
-type V = [f64; 3];
-fn sub(a: V, b: V) -> V {
-    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
-}
-fn cross(a: V, b: V) -> V {
-    [
-        a[1] * b[2] - a[2] * b[1],
-        a[2] * b[0] - a[0] * b[2],
-        a[0] * b[1] - a[1] * b[0],
-    ]
-}
-fn dot(a: V, b: V) -> f64 {
-    a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
-}
-fn norm(a: V) -> f64 {
-    dot(a, a).sqrt()
-}
-
-/// (unit normal, area, centroid) of a planar polygon by Newell's method.
-fn plane_of(vertices: &[V]) -> (V, f64, V) {
-    let n = vertices.len();
-    let mut s = [0.0; 3];
-    let mut c = [0.0; 3];
-    for i in 0..n {
-        let x = cross(vertices[i], vertices[(i + 1) % n]);
-        for k in 0..3 {
-            s[k] += x[k];
-            c[k] += vertices[i][k] / n as f64;
-        }
-    }
-    let area = norm(s) / 2.0;
-    (
-        [
-            s[0] / (2.0 * area),
-            s[1] / (2.0 * area),
-            s[2] / (2.0 * area),
-        ],
-        area,
-        c,
-    )
-}
-
-fn polygons(doc: &Value) -> Vec<(String, String, Vec<V>)> {
+fn polygons(doc: &Value) -> Vec<(String, String, Vec<Vec3>)> {
     doc["surfaces"]
         .as_array()
         .unwrap()
@@ -76,7 +22,7 @@ fn polygons(doc: &Value) -> Vec<(String, String, Vec<V>)> {
                 .as_array()
                 .unwrap()
                 .iter()
-                .map(|p| serde_json::from_value::<V>(p.clone()).unwrap())
+                .map(|p| Vec3::from_array(serde_json::from_value(p.clone()).unwrap()))
                 .collect();
             (
                 s["name"].as_str().unwrap().to_string(),
@@ -89,9 +35,9 @@ fn polygons(doc: &Value) -> Vec<(String, String, Vec<V>)> {
 
 #[test]
 fn extraction_recovers_the_living_room_and_its_paths() {
-    let cloud = tmp("living-room.ply");
-    let scene = tmp("extracted.json");
-    beamtrace(&[
+    let dir = scratch("pointcloud-extract");
+    let (cloud, scene) = (dir.join("living-room.ply"), dir.join("extracted.json"));
+    run_ok(&[
         "sample",
         "builtin:living-room",
         "-o",
@@ -103,7 +49,7 @@ fn extraction_recovers_the_living_room_and_its_paths() {
         "--seed",
         "3",
     ]);
-    beamtrace(&[
+    run_ok(&[
         "extract",
         cloud.to_str().unwrap(),
         "-o",
@@ -114,7 +60,7 @@ fn extraction_recovers_the_living_room_and_its_paths() {
 
     let original: Value =
         serde_json::from_str(bt_scene::builtin_json("living-room").unwrap()).unwrap();
-    let extracted: Value = serde_json::from_str(&std::fs::read_to_string(&scene).unwrap()).unwrap();
+    let extracted = read_json(&scene);
     let found = polygons(&extracted);
     let mut failures = Vec::new();
     // Every reflector of the original scene comes back: normal within 1°, offset within 2 cm,
@@ -128,13 +74,13 @@ fn extraction_recovers_the_living_room_and_its_paths() {
             .iter()
             .map(|(fname, fkind, fv)| {
                 let (m, farea, fc) = plane_of(fv);
-                let angle = dot(n, m).abs().min(1.0).acos().to_degrees();
-                let offset = dot(m, sub(c, fc)).abs();
+                let angle = n.dot(m).abs().min(1.0).acos().to_degrees();
+                let offset = m.dot(c - fc).abs();
                 (
                     angle,
                     offset,
                     (farea - area).abs() / area,
-                    norm(sub(c, fc)),
+                    (c - fc).length(),
                     fname.clone(),
                     fkind.clone(),
                 )
@@ -163,7 +109,7 @@ fn extraction_recovers_the_living_room_and_its_paths() {
     // Tracing the extracted scene gives the same paths: same count per order, lengths within
     // 1 cm, departure directions within 1°.
     let trace = |s: &str| -> Vec<Value> {
-        let o = beamtrace(&[
+        let v = run_json(&[
             "trace",
             s,
             "--tx",
@@ -172,7 +118,6 @@ fn extraction_recovers_the_living_room_and_its_paths() {
             "2.3,2.1,0.72",
             "--json",
         ]);
-        let v: Value = serde_json::from_slice(&o.stdout).unwrap();
         v["paths"].as_array().unwrap().clone()
     };
     let a = trace("builtin:living-room");
@@ -206,18 +151,16 @@ fn extraction_recovers_the_living_room_and_its_paths() {
             p["surfaces"]
         );
     }
-    std::fs::remove_dir_all(cloud.parent().unwrap()).ok();
+    std::fs::remove_dir_all(dir).ok();
 }
 
 #[test]
 fn a_point_cloud_traces_directly_and_bad_clouds_are_reported() {
-    let cloud = tmp("box.pcd");
-    beamtrace(&[
+    let dir = scratch("pointcloud-trace");
+    let cloud = dir.join("box.pcd");
+    run_ok(&[
         "sample",
-        &format!(
-            "{}/../../testdata/scenes/one-wall.json",
-            env!("CARGO_MANIFEST_DIR")
-        ),
+        &testdata("one-wall.json"),
         "-o",
         cloud.to_str().unwrap(),
         "--density",
@@ -225,7 +168,7 @@ fn a_point_cloud_traces_directly_and_bad_clouds_are_reported() {
         "--noise",
         "0.002",
     ]);
-    let o = beamtrace(&[
+    let v = run_json(&[
         "trace",
         cloud.to_str().unwrap(),
         "--tx",
@@ -234,25 +177,22 @@ fn a_point_cloud_traces_directly_and_bad_clouds_are_reported() {
         "2,2,1",
         "--json",
     ]);
-    let v: Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(
         v["paths"].as_array().unwrap().len(),
         2,
         "line of sight and the wall reflection"
     );
-    let truncated = tmp("truncated.pcd");
+    let truncated = dir.join("truncated.pcd");
     let bytes = std::fs::read(&cloud).unwrap();
     std::fs::write(&truncated, &bytes[..bytes.len() / 3]).unwrap();
-    let bad = Command::new(env!("CARGO_BIN_EXE_beamtrace"))
-        .args([
-            "extract",
-            truncated.to_str().unwrap(),
-            "-o",
-            tmp("x.json").to_str().unwrap(),
-        ])
-        .output()
-        .unwrap();
-    let msg = String::from_utf8_lossy(&bad.stderr);
+    let bad = beamtrace(&[
+        "extract",
+        truncated.to_str().unwrap(),
+        "-o",
+        dir.join("x.json").to_str().unwrap(),
+    ]);
+    let msg = stderr(&bad);
     assert_eq!(bad.status.code(), Some(2), "{msg}");
     assert!(msg.contains("truncated.pcd"), "{msg}");
+    std::fs::remove_dir_all(dir).ok();
 }

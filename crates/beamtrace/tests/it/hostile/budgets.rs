@@ -2,7 +2,7 @@
 //! option that raises it. Runs are held under an address-space limit (`MEMORY_LIMIT_BYTES`):
 //! on main these cases allocated 8 GB to 10 TB.
 
-use crate::*;
+use super::*;
 
 #[test]
 fn wvrn_at_order_50_stops_at_the_candidate_budget() {
@@ -35,44 +35,50 @@ fn dynamic_steps_respect_the_candidate_budget() {
 fn hls_and_study_respect_the_candidate_budget() {
     let dir = scratch("budget-hls");
     let out = dir.join("a");
-    let r = beamtrace(&[
-        "hls",
-        "gen",
-        "builtin:living-room",
-        "--max-order",
-        "30",
-        "-o",
-        out.to_str().unwrap(),
-    ]);
-    assert_refused(&r, &["candidate budget exceeded", "--max-candidates"]);
-    assert!(!out.exists());
-    let r = beamtrace(&[
-        "study",
-        "living-room",
-        "--max-order",
-        "3",
-        "--max-candidates",
-        "100",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert_refused(&r, &["candidate budget exceeded", "budget 100"]);
-    assert!(!out.exists());
+    assert_refused_writing_nothing(
+        &[
+            "hls",
+            "gen",
+            "builtin:living-room",
+            "--max-order",
+            "30",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        &out,
+        &["candidate budget exceeded", "--max-candidates"],
+    );
+    assert_refused_writing_nothing(
+        &[
+            "study",
+            "living-room",
+            "--max-order",
+            "3",
+            "--max-candidates",
+            "100",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &out,
+        &["candidate budget exceeded", "budget 100"],
+    );
     // The 2-D study accepted --max-candidates and ignored it.
-    let r = beamtrace(&[
-        "study",
-        "2d",
-        "--rooms",
-        "1",
-        "--steps",
-        "1",
-        "--max-candidates",
-        "3",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
-    assert_refused(&r, &["room-0-step-0", "--max-candidates"]);
-    assert!(!out.exists());
+    assert_refused_writing_nothing(
+        &[
+            "study",
+            "2d",
+            "--rooms",
+            "1",
+            "--steps",
+            "1",
+            "--max-candidates",
+            "3",
+            "--out",
+            out.to_str().unwrap(),
+        ],
+        &out,
+        &["room-0-step-0", "--max-candidates"],
+    );
 }
 
 #[test]
@@ -108,16 +114,18 @@ fn sbr_grids_beyond_the_ray_budget_are_refused_not_answered_with_zero_paths() {
 fn sampling_beyond_the_point_budget_is_refused_before_allocating() {
     let dir = scratch("budget-sample");
     let out = dir.join("c.ply");
-    let r = beamtrace(&[
-        "sample",
-        "builtin:living-room",
-        "--density",
-        "1e12",
-        "-o",
-        out.to_str().unwrap(),
-    ]);
-    assert_refused(&r, &["point budget exceeded", "--max-points"]);
-    assert!(!out.exists());
+    assert_refused_writing_nothing(
+        &[
+            "sample",
+            "builtin:living-room",
+            "--density",
+            "1e12",
+            "-o",
+            out.to_str().unwrap(),
+        ],
+        &out,
+        &["point budget exceeded", "--max-points"],
+    );
 }
 
 #[test]

@@ -6,31 +6,18 @@ mod names;
 mod outputs;
 mod small;
 
-use std::path::{Path, PathBuf};
+pub use crate::common::{scratch, text};
+use std::path::Path;
 use std::process::{Command, Output};
 
-pub fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
-
 pub fn one_wall() -> String {
-    repo()
-        .join("testdata/scenes/one-wall.json")
-        .display()
-        .to_string()
-}
-
-/// A fresh scratch directory for one test.
-pub fn scratch(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("beamtrace-hostile-{}-{name}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    crate::common::testdata("one-wall.json")
 }
 
 /// Address-space limit of every run: the runaway cases of the issue asked for 8 GB to 10 TB.
 const MEMORY_LIMIT_BYTES: u64 = 3 << 30;
 
+/// Runs the binary under the memory limit.
 pub fn beamtrace(args: &[&str]) -> Output {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_beamtrace"));
     cmd.args(args);
@@ -57,14 +44,6 @@ fn limit_memory(cmd: &mut Command) {
 #[cfg(not(unix))]
 fn limit_memory(_: &mut Command) {}
 
-pub fn text(o: &Output) -> String {
-    format!(
-        "{}{}",
-        String::from_utf8_lossy(&o.stdout),
-        String::from_utf8_lossy(&o.stderr)
-    )
-}
-
 /// A clear failure: exit code 1 or 2 (not success, not a panic, not a signal) and every needle
 /// in the output.
 pub fn assert_refused(o: &Output, needles: &[&str]) {
@@ -78,6 +57,13 @@ pub fn assert_refused(o: &Output, needles: &[&str]) {
     for n in needles {
         assert!(t.contains(n), "message lacks {n:?}:\n{t}");
     }
+}
+
+/// A clear refusal ([`assert_refused`]) of a run that was to write `out`, which it left
+/// unwritten.
+pub fn assert_refused_writing_nothing(args: &[&str], out: &Path, needles: &[&str]) {
+    assert_refused(&beamtrace(args), needles);
+    assert!(!out.exists(), "{args:?} wrote {}", out.display());
 }
 
 pub fn assert_ok(o: &Output) {

@@ -1,5 +1,4 @@
-// Shared proptest strategies (included with `mod common;`).
-#![allow(dead_code)]
+//! Shared proptest strategies.
 
 use bt_fixed::{FineCoord, FinePoint, FixedPlane};
 use proptest::prelude::*;

@@ -1,12 +1,10 @@
 //! Every fixed-point operation against an exact i128 oracle (proptest).
 
-mod common;
-
+use crate::common::*;
 use bt_fixed::{
     Coord, Csd, FineCoord, NORMAL_FRAC, NormalComponent, displacement_linf, project,
     quantize_point, round_shift, signed_distance,
 };
-use common::*;
 use proptest::prelude::*;
 
 proptest! {

@@ -1,6 +1,6 @@
 //! The smaller cases of issue 9.
 
-use crate::*;
+use super::*;
 use serde_json::Value;
 
 #[test]

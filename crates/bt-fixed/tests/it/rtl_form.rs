@@ -10,13 +10,11 @@
 //! This file emulates those registers in i128 with the RTL's widths (wrapping where the RTL
 //! wraps) and compares; co-simulation in `bt-hls` then compares the Verilog with the model.
 
-mod common;
-
+use crate::common::*;
 use bt_fixed::{
     FinePoint, FixedPlane, GUARD_BITS, NORMAL_FRAC, PROPORTION_ITERATIONS, intersection_point,
     width,
 };
-use common::*;
 use proptest::prelude::*;
 
 /// Two's-complement wrap of `v` to `bits` bits.

@@ -1,19 +1,11 @@
 //! CLI integration tests of `beamtrace wvrn` and `beamtrace trace --steps`.
 
+use crate::common::run_ok;
 use std::collections::BTreeSet;
-use std::process::Command;
 
+/// Standard output of a successful run.
 fn beamtrace(args: &[&str]) -> String {
-    let out = Command::new(env!("CARGO_BIN_EXE_beamtrace"))
-        .args(args)
-        .output()
-        .expect("run beamtrace");
-    assert!(
-        out.status.success(),
-        "beamtrace {args:?} failed: {}",
-        String::from_utf8_lossy(&out.stderr)
-    );
-    String::from_utf8(out.stdout).expect("utf-8 output")
+    String::from_utf8(run_ok(args).stdout).expect("utf-8 output")
 }
 
 /// Minimal DOT check: balanced braces, quoted node declarations, every edge between declared
@@ -68,7 +60,7 @@ fn wvrn_dot_and_json_describe_the_same_graph() {
             .any(|p| p["a"] == 0 && p["b"] == 1 && p["reason"] == "occluded")
     );
     // Graphviz, when installed, must accept it.
-    if let Ok(mut child) = Command::new("dot")
+    if let Ok(mut child) = std::process::Command::new("dot")
         .arg("-Tsvg")
         .stdin(std::process::Stdio::piped())
         .stdout(std::process::Stdio::null())

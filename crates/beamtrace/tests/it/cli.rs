@@ -1,70 +1,16 @@
 //! Integration tests of the `beamtrace` binary: the README's commands, every input format, bad
 //! input (clear errors, never a panic) and the golden JSON of the built-in scene.
 
-#[path = "channel/mod.rs"]
-mod channel;
-
+use crate::common::*;
 use serde_json::Value;
-use std::path::{Path, PathBuf};
-use std::process::{Command, Output};
-
-fn repo() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
-}
-
-fn testdata(name: &str) -> String {
-    repo()
-        .join("testdata/scenes")
-        .join(name)
-        .display()
-        .to_string()
-}
-
-fn beamtrace(args: &[&str]) -> Output {
-    Command::new(env!("CARGO_BIN_EXE_beamtrace"))
-        .args(args)
-        .output()
-        .expect("binary runs")
-}
-
-fn stdout(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stdout).into_owned()
-}
-
-fn stderr(o: &Output) -> String {
-    String::from_utf8_lossy(&o.stderr).into_owned()
-}
+use std::path::Path;
 
 /// Runs and parses `--json` output, asserting success.
 fn trace_json(args: &[&str]) -> Value {
     let mut all = vec!["trace"];
     all.extend_from_slice(args);
     all.push("--json");
-    let o = beamtrace(&all);
-    assert!(o.status.success(), "{:?} failed: {}", all, stderr(&o));
-    serde_json::from_slice(&o.stdout).expect("valid JSON")
-}
-
-/// A failing command: non-zero exit, not a panic (101), and stderr mentions every needle.
-fn assert_clear_error(args: &[&str], needles: &[&str]) {
-    let o = beamtrace(args);
-    let code = o.status.code();
-    assert!(
-        code.is_some() && code != Some(0) && code != Some(101),
-        "{args:?}: exit {code:?}"
-    );
-    let text = format!("{}{}", stdout(&o), stderr(&o));
-    assert!(!text.contains("panicked"), "{args:?} panicked: {text}");
-    for n in needles {
-        assert!(text.contains(n), "{args:?}: message lacks {n:?}:\n{text}");
-    }
-}
-
-/// A fresh folder for files a test writes.
-fn scratch_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("beamtrace-{name}-{}", std::process::id()));
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
+    run_json(&all)
 }
 
 /// Write `text` to `dir/name`; the path as an argument.
@@ -81,9 +27,7 @@ fn without_timings(mut v: Value) -> Value {
 
 #[test]
 fn demo_prints_a_table_of_paths() {
-    let o = beamtrace(&["demo"]);
-    assert!(o.status.success(), "{}", stderr(&o));
-    let out = stdout(&o);
+    let out = stdout(&run_ok(&["demo"]));
     assert!(out.contains("(line of sight)"));
     assert!(out.contains("valid paths from"));
 }
@@ -231,14 +175,13 @@ fn scene_check_reports_every_problem() {
 
 #[test]
 fn scene_check_accepts_the_builtin_scene() {
-    let o = beamtrace(&["scene", "check", "builtin:living-room"]);
-    assert!(o.status.success());
+    let o = run_ok(&["scene", "check", "builtin:living-room"]);
     assert!(stdout(&o).contains("25 reflectors"), "{}", stdout(&o));
 }
 
 #[test]
 fn bad_inputs_give_clear_errors() {
-    let dir = scratch_dir("cli");
+    let dir = scratch("cli-bad-inputs");
     let write = |name: &str, text: &str| write_in(&dir, name, text);
     let malformed = write(
         "malformed.json",
@@ -352,7 +295,7 @@ fn xml_scene_traces_like_its_json_twin() {
     let expected = (9.0f64 + 4.0 + 3.2 * 3.2).sqrt();
     assert!((floor["length_m"].as_f64().unwrap() - expected).abs() < 1e-9);
     // The glass pane (Sionna 0.x style id) and the custom wall keep their own materials.
-    let check = beamtrace(&[
+    let check = run_ok(&[
         "scene",
         "check",
         &testdata("sionna/room.xml"),
@@ -361,7 +304,6 @@ fn xml_scene_traces_like_its_json_twin() {
         "--rx",
         rx,
     ]);
-    assert!(check.status.success(), "{}", stderr(&check));
     assert!(
         stdout(&check).contains("3 surfaces (3 reflectors"),
         "{}",
@@ -371,7 +313,7 @@ fn xml_scene_traces_like_its_json_twin() {
 
 #[test]
 fn bad_xml_scenes_name_the_element_and_line() {
-    let dir = scratch_dir("xml");
+    let dir = scratch("cli-bad-xml");
     let write = |name: &str, text: &str| write_in(&dir, name, text);
     let terminals = ["--tx", "0,0,1", "--rx", "1,1,1"];
     let run = |file: &str, needles: &[&str]| {

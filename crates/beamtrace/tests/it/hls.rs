@@ -2,39 +2,16 @@
 //! co-simulated bit for bit against the fixed-point model, with the cycle counts equal to the
 //! prediction; the GA schedule never longer than the list schedule.
 
+use crate::common::*;
 use serde_json::Value;
-use std::path::PathBuf;
-use std::process::Command;
-
-fn beamtrace(args: &[&str]) -> (bool, String) {
-    let o = Command::new(env!("CARGO_BIN_EXE_beamtrace"))
-        .args(args)
-        .output()
-        .expect("binary runs");
-    (
-        o.status.success(),
-        format!(
-            "{}{}",
-            String::from_utf8_lossy(&o.stdout),
-            String::from_utf8_lossy(&o.stderr)
-        ),
-    )
-}
-
-fn tmp(name: &str) -> PathBuf {
-    std::env::temp_dir().join(format!("beamtrace-hls-{}-{name}", std::process::id()))
-}
-
-fn summary(dir: &std::path::Path) -> Value {
-    serde_json::from_str(&std::fs::read_to_string(dir.join("summary.json")).unwrap()).unwrap()
-}
 
 /// CI's multi-step co-simulation: the 10 steps of the dynamic living room (order 1) on ONE
 /// design, each step's schedule, start points and TX/RX loaded over the bus, Verilator.
 #[test]
 fn living_room_steps_run_on_one_design_bit_exact() {
-    let dir = tmp("lr1");
-    let (ok, out) = beamtrace(&[
+    let root = scratch("hls-steps");
+    let dir = root.join("out");
+    run_ok(&[
         "hls",
         "gen",
         "builtin:living-room-dynamic",
@@ -44,9 +21,7 @@ fn living_room_steps_run_on_one_design_bit_exact() {
         "-o",
         dir.to_str().unwrap(),
     ]);
-    assert!(ok, "{out}");
-    let doc: Value =
-        serde_json::from_str(&std::fs::read_to_string(dir.join("steps.json")).unwrap()).unwrap();
+    let doc = read_json(&dir.join("steps.json"));
     let steps = doc["steps"].as_array().unwrap();
     assert_eq!(steps.len(), 10);
     for s in steps {
@@ -64,8 +39,7 @@ fn living_room_steps_run_on_one_design_bit_exact() {
         !dir.join("step-0/rtl").exists(),
         "one design, not one per step"
     );
-    let (ok, out) = beamtrace(&["hls", "sim", dir.to_str().unwrap()]);
-    assert!(ok, "{out}");
+    let out = text(&run_ok(&["hls", "sim", dir.to_str().unwrap()]));
     assert!(out.contains("verilator (10 steps, 10 runs)"), "{out}");
     assert!(out.contains(" 0 mismatches"), "{out}");
     assert!(out.contains("runs as predicted: true"), "{out}");
@@ -76,14 +50,13 @@ fn living_room_steps_run_on_one_design_bit_exact() {
         )),
         "{out}"
     );
-    std::fs::remove_dir_all(&dir).ok();
+    std::fs::remove_dir_all(&root).ok();
 }
 
 #[test]
 fn ga_is_never_longer_than_list_and_duplication_helps() {
-    let planes_only = tmp("ga");
-    let dup = tmp("dup");
-    let list = tmp("list");
+    let root = scratch("hls-schedules");
+    let (planes_only, dup, list) = (root.join("ga"), root.join("dup"), root.join("list"));
     for (dir, extra) in [
         (&planes_only, vec!["--schedule", "ga", "--pe-budget", "1"]),
         (&dup, vec!["--schedule", "ga", "--pe-budget", "40"]),
@@ -100,9 +73,9 @@ fn ga_is_never_longer_than_list_and_duplication_helps() {
             dir.to_str().unwrap(),
         ];
         args.extend(extra);
-        let (ok, out) = beamtrace(&args);
-        assert!(ok, "{out}");
+        run_ok(&args);
     }
+    let summary = |dir: &std::path::Path| read_json(&dir.join("summary.json"));
     let (g, d, l) = (summary(&planes_only), summary(&dup), summary(&list));
     let makespan = |v: &Value| v["stats"]["makespan"].as_u64().unwrap();
     // --pe-budget below the planes used is raised to one PE per plane: no duplicates.
@@ -120,26 +93,26 @@ fn ga_is_never_longer_than_list_and_duplication_helps() {
         makespan(&g)
     );
     assert_eq!(l["list_makespan"], l["stats"]["makespan"]);
-    for dir in [planes_only, dup, list] {
-        std::fs::remove_dir_all(dir).ok();
-    }
+    std::fs::remove_dir_all(root).ok();
 }
 
 #[test]
 fn hls_errors_are_clear() {
-    let (ok, out) = beamtrace(&["hls", "sim", "/no/such/dir"]);
+    let o = beamtrace(&["hls", "sim", "/no/such/dir"]);
+    let (ok, out) = (o.status.success(), text(&o));
     assert!(
         !ok && out.contains("/no/such/dir") && !out.contains("panicked"),
         "{out}"
     );
-    let (ok, out) = beamtrace(&[
+    let o = beamtrace(&[
         "hls",
         "gen",
         "builtin:living-room",
         "--max-order",
         "0",
         "-o",
-        tmp("x").to_str().unwrap(),
+        scratch("hls-errors").join("x").to_str().unwrap(),
     ]);
+    let (ok, out) = (o.status.success(), text(&o));
     assert!(!ok && out.contains("--max-order"), "{out}");
 }

@@ -1,32 +1,9 @@
-//! (A module of `cli.rs`: one test binary.) The radio channel from the command line: gains in `trace --json`, `channel` (CIR, CFR,
+//! The radio channel from the command line: gains in `trace --json`, `channel` (CIR, CFR,
 //! power-delay profile), `beams` (codebook sweep), material and frequency overrides, and clear
 //! errors on bad input.
 
-use super::{assert_clear_error, beamtrace, repo};
+use crate::common::*;
 use serde_json::Value;
-use std::path::PathBuf;
-use std::process::Output;
-
-fn ok(args: &[&str]) -> Output {
-    let o = beamtrace(args);
-    assert!(
-        o.status.success(),
-        "{args:?}: {}",
-        String::from_utf8_lossy(&o.stderr)
-    );
-    o
-}
-
-fn json(args: &[&str]) -> Value {
-    serde_json::from_slice(&ok(args).stdout).expect("valid JSON")
-}
-
-fn temp_dir(name: &str) -> PathBuf {
-    let dir = std::env::temp_dir().join(format!("bt-channel-cli-{name}-{}", std::process::id()));
-    let _ = std::fs::remove_dir_all(&dir);
-    std::fs::create_dir_all(&dir).unwrap();
-    dir
-}
 
 fn f(v: &Value) -> f64 {
     v.as_f64().expect("a number")
@@ -34,7 +11,7 @@ fn f(v: &Value) -> f64 {
 
 #[test]
 fn trace_json_reports_gains_and_received_power() {
-    let doc = json(&[
+    let doc = run_json(&[
         "trace",
         "builtin:living-room",
         "--json",
@@ -69,7 +46,7 @@ fn a_perfect_conductor_mesh_keeps_every_reflection_at_full_strength() {
         .join("testdata/scenes/box-room.obj")
         .display()
         .to_string();
-    let doc = json(&[
+    let doc = run_json(&[
         "trace",
         &mesh,
         "--tx",
@@ -126,7 +103,7 @@ fn csv_rows(text: &str) -> Vec<Vec<&str>> {
 
 #[test]
 fn channel_writes_cir_cfr_and_the_pdp_plot() {
-    let dir = temp_dir("channel");
+    let dir = scratch("channel-outputs");
     let cir = dir.join("cir.csv");
     let cfr = dir.join("cfr.csv");
     let pdp = dir.join("pdp");
@@ -142,14 +119,16 @@ fn channel_writes_cir_cfr_and_the_pdp_plot() {
         "--subcarriers",
     ];
     let pdp_arg = pdp.to_str().unwrap();
-    let o = ok(&[
-        &both[..],
-        &["16", "--subcarrier-spacing", "1e6", "--pdp", pdp_arg],
-        &["--max-order", "2"],
-    ]
-    .concat());
+    let o = run_ok(
+        &[
+            &both[..],
+            &["16", "--subcarrier-spacing", "1e6", "--pdp", pdp_arg],
+            &["--max-order", "2"],
+        ]
+        .concat(),
+    );
     assert!(String::from_utf8_lossy(&o.stdout).contains("received power"));
-    let trace = json(&["trace", "builtin:living-room", "--max-order", "2", "--json"]);
+    let trace = run_json(&["trace", "builtin:living-room", "--max-order", "2", "--json"]);
     let n_paths = trace["paths"].as_array().unwrap().len();
     let text = std::fs::read_to_string(&cir).unwrap();
     let rows = csv_rows(&text);
@@ -201,7 +180,7 @@ fn beams_finds_the_best_pair_and_keeps_the_paper_ranking() {
             "2",
         ];
         args.extend_from_slice(extra);
-        json(&args)
+        run_json(&args)
     };
     let power = sweep(&[]);
     let pairs = power["pairs"].as_array().unwrap();
@@ -220,7 +199,7 @@ fn beams_finds_the_best_pair_and_keeps_the_paper_ranking() {
         assert_eq!(same["power_dbm"], q["power_dbm"]);
     }
     let table =
-        String::from_utf8_lossy(&ok(&["beams", "builtin:living-room", "--top", "3"]).stdout)
+        String::from_utf8_lossy(&run_ok(&["beams", "builtin:living-room", "--top", "3"]).stdout)
             .into_owned();
     assert!(table.contains("best pair: tx beam"));
     assert_clear_error(
@@ -235,7 +214,7 @@ fn beams_finds_the_best_pair_and_keeps_the_paper_ranking() {
 
 #[test]
 fn near_field_is_clamped_and_warned() {
-    let o = ok(&[
+    let o = run_ok(&[
         "trace",
         "builtin:living-room",
         "--tx",

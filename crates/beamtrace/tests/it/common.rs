@@ -1,0 +1,92 @@
+//! What every test module shares: the repository, the binary, its output and scratch folders.
+
+use serde_json::Value;
+use std::collections::BTreeSet;
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+use std::sync::Mutex;
+
+/// The repository root (for `testdata/`).
+pub fn repo() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
+}
+
+/// `testdata/scenes/NAME` as an argument.
+pub fn testdata(name: &str) -> String {
+    repo()
+        .join("testdata/scenes")
+        .join(name)
+        .display()
+        .to_string()
+}
+
+/// Runs the binary with `args`.
+pub fn beamtrace(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_beamtrace"))
+        .args(args)
+        .output()
+        .expect("binary runs")
+}
+
+/// Runs the binary and asserts it succeeded (its stderr as the message).
+pub fn run_ok(args: &[&str]) -> Output {
+    let o = beamtrace(args);
+    assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+    o
+}
+
+/// Runs the binary, asserts it succeeded and parses its standard output as JSON.
+pub fn run_json(args: &[&str]) -> Value {
+    serde_json::from_slice(&run_ok(args).stdout).expect("valid JSON")
+}
+
+/// A failing command: non-zero exit, not a panic (101), and stderr mentions every needle.
+pub fn assert_clear_error(args: &[&str], needles: &[&str]) {
+    let o = beamtrace(args);
+    let code = o.status.code();
+    assert!(
+        code.is_some() && code != Some(0) && code != Some(101),
+        "{args:?}: exit {code:?}"
+    );
+    let text = text(&o);
+    assert!(!text.contains("panicked"), "{args:?} panicked: {text}");
+    for n in needles {
+        assert!(text.contains(n), "{args:?}: message lacks {n:?}:\n{text}");
+    }
+}
+
+/// Standard output, lossy UTF-8.
+pub fn stdout(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stdout).into_owned()
+}
+
+/// Standard error, lossy UTF-8.
+pub fn stderr(o: &Output) -> String {
+    String::from_utf8_lossy(&o.stderr).into_owned()
+}
+
+/// Standard output followed by standard error.
+pub fn text(o: &Output) -> String {
+    format!("{}{}", stdout(o), stderr(o))
+}
+
+/// A JSON file the binary wrote.
+pub fn read_json(path: &Path) -> Value {
+    let text =
+        std::fs::read_to_string(path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()));
+    serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// A fresh, empty folder for the files of one test. All tests share one process (one pid in
+/// the name), so each name may be taken once.
+pub fn scratch(name: &str) -> PathBuf {
+    static TAKEN: Mutex<BTreeSet<String>> = Mutex::new(BTreeSet::new());
+    assert!(
+        TAKEN.lock().unwrap().insert(name.to_string()),
+        "scratch folder {name:?} taken by two tests"
+    );
+    let dir = std::env::temp_dir().join(format!("beamtrace-it-{}-{name}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    std::fs::create_dir_all(&dir).unwrap();
+    dir
+}

@@ -1,0 +1,13 @@
+//! Integration tests of the `beamtrace` binary, one test binary for the crate (one link): each
+//! module runs the built binary on one part of the CLI; `common` holds what they share.
+
+mod channel;
+mod cli;
+mod common;
+mod hls;
+mod hostile;
+mod living_room;
+mod pointcloud;
+mod study;
+mod sweep;
+mod wvrn_steps;
