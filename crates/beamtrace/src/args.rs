@@ -781,6 +781,10 @@ pub enum HlsCommand {
     Synth {
         /// Directory written by `hls gen`.
         dir: PathBuf,
+        /// Build adders from plain LUTs (Yosys's own mapping, about two cells per bit) instead
+        /// of the carry chain (one cell per bit, as Quartus): for comparison.
+        #[arg(long)]
+        lut_adders: bool,
     },
 }
 

@@ -18,12 +18,26 @@ pub fn run(args: &HlsArgs) -> anyhow::Result<ExitCode> {
     match &args.command {
         HlsCommand::Gen(a) => generate(a),
         HlsCommand::Sim { dir, simulator } => simulate(dir, simulator.kind()),
-        HlsCommand::Synth { dir } => {
-            let r = bt_hls::synthesize(dir)
+        HlsCommand::Synth { dir, lut_adders } => {
+            let adders = if *lut_adders {
+                bt_hls::AdderMapping::Luts
+            } else {
+                bt_hls::AdderMapping::CarryChain
+            };
+            let options = bt_hls::SynthOptions {
+                adders,
+                netlist: false,
+            };
+            let r = bt_hls::synthesize_with(dir, &options)
                 .with_context(|| format!("synthesising {}", dir.display()))?;
             println!(
-                "{}: Yosys synth_intel -family cycloneive (EP4CE115, 114,480 LEs)",
-                dir.display()
+                "{}: Yosys synth_intel -family cycloneive (EP4CE115, 114,480 LEs), adders {}",
+                dir.display(),
+                if *lut_adders {
+                    "in LUTs"
+                } else {
+                    "on the carry chain"
+                }
             );
             println!("  logic cells      {:>10}", r.logic_cells);
             println!("  registers        {:>10}", r.registers);

@@ -422,35 +422,69 @@ pub struct SynthReport {
 /// Logic elements of the EP4CE115 (paper's Cyclone IV E device).
 pub const EP4CE115_LES: u64 = 114_480;
 
+/// How [`synthesize_with`] builds adders, subtractors and comparisons.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum AdderMapping {
+    /// On the logic elements' carry chain in arithmetic mode, one logic cell per bit, as
+    /// Quartus does (`bt_alu_map.v` + `bt_carry_map.v`; the default).
+    #[default]
+    CarryChain,
+    /// Yosys 0.23's own mapping: carry-lookahead logic in plain LUTs, about two cells per bit
+    /// (kept to compare with).
+    Luts,
+}
+
+/// Options of [`synthesize_with`].
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct SynthOptions {
+    /// How adders are mapped.
+    pub adders: AdderMapping,
+    /// Also write the mapped netlist to `synth/netlist.v` (Yosys `write_verilog -noattr`;
+    /// simulates with the Cyclone IV E cell models, see [`cell_models`]).
+    pub netlist: bool,
+}
+
+/// [`synthesize_with`] the default options (carry chains, no netlist).
+pub fn synthesize(out_dir: &Path) -> Result<SynthReport, HlsError> {
+    synthesize_with(out_dir, &SynthOptions::default())
+}
+
 /// Runs Yosys `synth_intel -family cycloneive -top bt_top` (the EP4CE115 is a Cyclone IV E)
-/// on `rtl/*.v`, logging to `synth/yosys.log`, and parses the final cell counts.
+/// on the generated `rtl/*.v` of `out_dir`, logging to `synth/yosys.log`, and parses the final
+/// cell counts.
 ///
 /// Block RAM: synth_intel's own M9K mapping aborts in Yosys 0.23 ("Can't find object for
 /// defparam `INIT`": its techmap module declares no `INIT` parameter, so every memory fails, and
-/// it would also tie the write data to the read port). The script therefore runs synth_intel up
-/// to `map_bram`, maps memories with this crate's rules (`bt_m9k.txt`: simple dual-port M9K,
-/// no initial contents) onto `altsyncram` cells, and resumes at `map_ffram`. The point memory
-/// lands in M9K; the `rounds` array (cleared on start) and the ROMs stay in logic.
-pub fn synthesize(out_dir: &Path) -> Result<SynthReport, HlsError> {
-    let files = rel_rtl(out_dir)?;
-    let synth = out_dir.join("synth");
+/// it would also tie the write data to the read port). The script therefore maps memories with
+/// this crate's rules (`bt_m9k.txt`: simple dual-port M9K, no initial contents) onto
+/// `altsyncram` cells where synth_intel's `map_bram` step would, then resumes at `map_ffram`.
+/// Adders: see [`AdderMapping`].
+pub fn synthesize_with(out_dir: &Path, options: &SynthOptions) -> Result<SynthReport, HlsError> {
+    synthesize_rtl(out_dir, &rel_rtl(out_dir)?, "bt_top", options)
+}
+
+/// The flow of [`synthesize_with`] on any Verilog `files` (relative to `work_dir`) with top
+/// module `top`: writes `work_dir/synth/` (maps, `yosys.log`, `stat.txt`, optionally
+/// `netlist.v`). Used on the generated design and, by the tests, on small arithmetic modules.
+pub fn synthesize_rtl(
+    work_dir: &Path,
+    files: &[String],
+    top: &str,
+    options: &SynthOptions,
+) -> Result<SynthReport, HlsError> {
+    let synth = work_dir.join("synth");
     std::fs::create_dir_all(&synth).map_err(io_err(&synth))?;
     for (name, text) in [
         ("bt_m9k.txt", include_str!("bt_m9k.txt")),
         ("bt_m9k_map.v", include_str!("bt_m9k_map.v")),
+        ("bt_alu_map.v", include_str!("bt_alu_map.v")),
+        ("bt_carry_map.v", include_str!("bt_carry_map.v")),
     ] {
         let path = synth.join(name);
         std::fs::write(&path, text).map_err(io_err(&path))?;
     }
-    let script = format!(
-        "read_verilog {}; \
-         synth_intel -family cycloneive -top bt_top -run :map_bram; \
-         memory_bram -rules synth/bt_m9k.txt; \
-         techmap -map synth/bt_m9k_map.v; \
-         synth_intel -family cycloneive -top bt_top -run map_ffram:; \
-         tee -o synth/stat.txt stat",
-        files.join(" ")
-    );
+    let script = yosys_script(files, top, options);
     let out = run(
         "yosys",
         "yosys",
@@ -461,16 +495,49 @@ pub fn synthesize(out_dir: &Path) -> Result<SynthReport, HlsError> {
             "-p".into(),
             script,
         ],
-        out_dir,
+        work_dir,
     )?;
     if !out.status.success() {
         return Err(failure("yosys", &out));
     }
     let stat_path = synth.join("stat.txt");
     let stat = std::fs::read_to_string(&stat_path).map_err(io_err(&stat_path))?;
-    let cells = parse_stat(&stat);
     let log_path = synth.join("yosys.log");
     let log = std::fs::read_to_string(&log_path).map_err(io_err(&log_path))?;
+    Ok(synth_report(parse_stat(&stat), parse_bram_bits(&log)))
+}
+
+/// The Yosys script: synth_intel's steps, with its `coarse` step spelled out (Yosys 0.23's
+/// `synth -run coarse`) so that `bt_alu_map.v` runs before `alumacc`, the M9K mapping in place
+/// of `map_bram`, and `bt_carry_map.v` before the generic `techmap` of `map_ffram`.
+fn yosys_script(files: &[String], top: &str, options: &SynthOptions) -> String {
+    let chain = options.adders == AdderMapping::CarryChain;
+    let synth_intel = format!("synth_intel -family cycloneive -top {top}");
+    let mut steps = vec![
+        format!("read_verilog {}", files.join(" ")),
+        format!("{synth_intel} -run :coarse"),
+        "proc; opt_expr; opt_clean; check; opt -nodffe -nosdff; fsm; opt; wreduce; peepopt; \
+         opt_clean"
+            .to_string(),
+    ];
+    if chain {
+        steps.push("techmap -map synth/bt_alu_map.v".into());
+    }
+    steps.push("alumacc; share; opt; memory -nomap; opt_clean".into());
+    steps.push("memory_bram -rules synth/bt_m9k.txt; techmap -map synth/bt_m9k_map.v".into());
+    if chain {
+        steps.push("techmap -map synth/bt_carry_map.v".into());
+    }
+    steps.push(format!("{synth_intel} -run map_ffram:"));
+    steps.push("tee -o synth/stat.txt stat".into());
+    if options.netlist {
+        steps.push("write_verilog -noattr synth/netlist.v".into());
+    }
+    steps.join("; ")
+}
+
+/// Totals of a final `stat` and the bits mapped into M9K.
+fn synth_report(cells: BTreeMap<String, u64>, memory_bits: u64) -> SynthReport {
     let count = |suffix: &str| {
         cells
             .iter()
@@ -480,16 +547,41 @@ pub fn synthesize(out_dir: &Path) -> Result<SynthReport, HlsError> {
     };
     let logic_cells = count("lcell_comb");
     let registers = count("dffeas");
-    let m9k_blocks = count("altsyncram");
-    let memory_bits = parse_bram_bits(&log);
-    Ok(SynthReport {
+    SynthReport {
         logic_cells,
         registers,
         memory_bits,
-        m9k_blocks,
+        m9k_blocks: count("altsyncram"),
         percent_of_ep4ce115: 100.0 * logic_cells.max(registers) as f64 / EP4CE115_LES as f64,
         cells,
-    })
+    }
+}
+
+/// Simulation models of the mapped cells: Yosys's `intel/cycloneive/cells_sim.v` (from
+/// `yosys-config --datdir`, else `/usr/share/yosys`) with one fix: Yosys 0.23's
+/// `cycloneive_lcell_comb` never drives its internal `cin_w`, so every carry-chain cell would
+/// simulate as X; the fix adds `assign cin_w = cin;`.
+pub fn cell_models() -> Result<String, HlsError> {
+    let datdir = Command::new("yosys-config")
+        .arg("--datdir")
+        .output()
+        .ok()
+        .filter(|o| o.status.success())
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+        .unwrap_or_else(|| "/usr/share/yosys".into());
+    let path = Path::new(&datdir).join("intel/cycloneive/cells_sim.v");
+    let text = std::fs::read_to_string(&path).map_err(io_err(&path))?;
+    let anchor = "assign datad_w = datad;";
+    if !text.contains(anchor) {
+        return Err(HlsError::Parse {
+            what: path.display().to_string(),
+            message: format!("no `{anchor}` in cycloneive_lcell_comb"),
+        });
+    }
+    if text.contains("assign cin_w") {
+        return Ok(text);
+    }
+    Ok(text.replacen(anchor, &format!("{anchor}\n   assign cin_w = cin;"), 1))
 }
 
 /// Bits (`Properties: ... bits=N`) of every memory that `memory_bram` mapped onto
