@@ -42,13 +42,17 @@ module _80_bt_neg (A, Y);
 	(* force_downto *)
 	output [Y_WIDTH-1:0] Y;
 
-	// -a = ~a + 1: a constant second operand with BI = 0 keeps it on the chain
-	// (bt_carry_map.v leaves constant subtractions, which are comparisons, to LUTs).
+	// -a = ~a + 1, a extended to the result's width first (so an unsigned operand's
+	// inverted upper bits are ones): a constant second operand with BI = 0 keeps it on the
+	// chain (bt_carry_map.v leaves constant subtractions, which are comparisons, to LUTs).
 	(* force_downto *)
-	wire [A_WIDTH-1:0] not_a = ~A;
+	wire [Y_WIDTH-1:0] a_ext;
+	\$pos #(.A_SIGNED(A_SIGNED), .A_WIDTH(A_WIDTH), .Y_WIDTH(Y_WIDTH)) extend (.A(A), .Y(a_ext));
+	(* force_downto *)
+	wire [Y_WIDTH-1:0] not_a = ~a_ext;
 	(* force_downto *)
 	wire [Y_WIDTH-1:0] unused_x, unused_co;
-	\$alu #(.A_SIGNED(A_SIGNED), .B_SIGNED(A_SIGNED), .A_WIDTH(A_WIDTH), .B_WIDTH(1),
+	\$alu #(.A_SIGNED(0), .B_SIGNED(0), .A_WIDTH(Y_WIDTH), .B_WIDTH(1),
 		.Y_WIDTH(Y_WIDTH)) _TECHMAP_REPLACE_ (.A(not_a), .B(1'b0), .CI(1'b1), .BI(1'b0),
 		.X(unused_x), .Y(Y), .CO(unused_co));
 endmodule

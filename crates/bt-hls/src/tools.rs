@@ -192,6 +192,35 @@ pub fn simulate_with(
     simulator: Simulator,
     progress: &mut dyn FnMut(SimProgress),
 ) -> Result<SimReport, HlsError> {
+    simulate_sources(out_dir, &rel_rtl(out_dir)?, simulator, progress)
+}
+
+/// [`simulate_with`] on the netlist of [`synthesize_with`] (run with
+/// [`SynthOptions::netlist`]) instead of the RTL: `synth/netlist.v` with the cell models of
+/// [`cell_models`] (written to `synth/cells_sim.v`), the same testbench and the same comparison
+/// with the `bt-fixed` model.
+pub fn simulate_netlist(
+    out_dir: &Path,
+    simulator: Simulator,
+    progress: &mut dyn FnMut(SimProgress),
+) -> Result<SimReport, HlsError> {
+    let models = out_dir.join("synth/cells_sim.v");
+    std::fs::write(&models, cell_models()?).map_err(io_err(&models))?;
+    let sources = [
+        "synth/netlist.v".to_string(),
+        "synth/cells_sim.v".to_string(),
+    ];
+    simulate_sources(out_dir, &sources, simulator, progress)
+}
+
+/// Builds the testbench with `sources` (relative to `out_dir`) as the design, runs it and
+/// compares (see [`simulate_with`]).
+fn simulate_sources(
+    out_dir: &Path,
+    sources: &[String],
+    simulator: Simulator,
+    progress: &mut dyn FnMut(SimProgress),
+) -> Result<SimReport, HlsError> {
     let (ops, runs) = recompute(out_dir)?;
     let tb = out_dir.join("tb");
     let result = tb.join("sim_out.txt");
@@ -207,7 +236,7 @@ pub fn simulate_with(
                 "-s".into(),
                 "bt_tb".into(),
             ];
-            args.extend(rel_rtl(out_dir)?);
+            args.extend(sources.iter().cloned());
             args.push("tb/bt_tb.v".into());
             let out = run("iverilog", "iverilog", &args, out_dir)?;
             if !out.status.success() {
@@ -237,7 +266,7 @@ pub fn simulate_with(
             .iter()
             .map(|s| s.to_string())
             .collect();
-            args.extend(rel_rtl(out_dir)?);
+            args.extend(sources.iter().cloned());
             args.push("tb/bt_tb.v".into());
             let out = run("verilator", "verilator", &args, out_dir)?;
             if !out.status.success() {
@@ -480,6 +509,7 @@ pub fn synthesize_rtl(
         ("bt_m9k_map.v", include_str!("bt_m9k_map.v")),
         ("bt_alu_map.v", include_str!("bt_alu_map.v")),
         ("bt_carry_map.v", include_str!("bt_carry_map.v")),
+        ("bt_altsyncram_bb.v", include_str!("bt_altsyncram_bb.v")),
     ] {
         let path = synth.join(name);
         std::fs::write(&path, text).map_err(io_err(&path))?;
@@ -509,13 +539,15 @@ pub fn synthesize_rtl(
 
 /// The Yosys script: synth_intel's steps, with its `coarse` step spelled out (Yosys 0.23's
 /// `synth -run coarse`) so that `bt_alu_map.v` runs before `alumacc`, the M9K mapping in place
-/// of `map_bram`, and `bt_carry_map.v` before the generic `techmap` of `map_ffram`.
+/// of `map_bram` (onto an `altsyncram` blackbox whose port widths follow its parameters,
+/// `bt_altsyncram_bb.v`), and `bt_carry_map.v` before the generic `techmap` of `map_ffram`.
 fn yosys_script(files: &[String], top: &str, options: &SynthOptions) -> String {
     let chain = options.adders == AdderMapping::CarryChain;
     let synth_intel = format!("synth_intel -family cycloneive -top {top}");
     let mut steps = vec![
         format!("read_verilog {}", files.join(" ")),
         format!("{synth_intel} -run :coarse"),
+        "read_verilog -lib synth/bt_altsyncram_bb.v".to_string(),
         "proc; opt_expr; opt_clean; check; opt -nodffe -nosdff; fsm; opt; wreduce; peepopt; \
          opt_clean"
             .to_string(),
@@ -557,10 +589,12 @@ fn synth_report(cells: BTreeMap<String, u64>, memory_bits: u64) -> SynthReport {
     }
 }
 
-/// Simulation models of the mapped cells: Yosys's `intel/cycloneive/cells_sim.v` (from
-/// `yosys-config --datdir`, else `/usr/share/yosys`) with one fix: Yosys 0.23's
-/// `cycloneive_lcell_comb` never drives its internal `cin_w`, so every carry-chain cell would
-/// simulate as X; the fix adds `assign cin_w = cin;`.
+/// Simulation models of a netlist from [`synthesize_rtl`]: `cycloneive_lcell_comb` from
+/// Yosys's `intel/cycloneive/cells_sim.v` (found through `yosys-config --datdir`, else in
+/// `/usr/share/yosys`) with one fix, and this crate's `dffeas` and `altsyncram`
+/// (`bt_cells_sim.v`). Yosys 0.23's `cycloneive_lcell_comb` never drives its internal `cin_w`,
+/// so every carry-chain cell would simulate as X (the fix adds `assign cin_w = cin;`); its
+/// `dffeas` ignores the clock enable and the clear, and it has no `altsyncram` model.
 pub fn cell_models() -> Result<String, HlsError> {
     let datdir = Command::new("yosys-config")
         .arg("--datdir")
@@ -571,17 +605,22 @@ pub fn cell_models() -> Result<String, HlsError> {
         .unwrap_or_else(|| "/usr/share/yosys".into());
     let path = Path::new(&datdir).join("intel/cycloneive/cells_sim.v");
     let text = std::fs::read_to_string(&path).map_err(io_err(&path))?;
+    let missing = |what: &str| HlsError::Parse {
+        what: path.display().to_string(),
+        message: format!("no `{what}` in cycloneive_lcell_comb"),
+    };
+    let (begin, end) = ("module cycloneive_lcell_comb", "endmodule");
+    let from = text.find(begin).ok_or_else(|| missing(begin))?;
+    let to = from + text[from..].find(end).ok_or_else(|| missing(end))? + end.len();
+    let mut lcell = text[from..to].to_string();
     let anchor = "assign datad_w = datad;";
-    if !text.contains(anchor) {
-        return Err(HlsError::Parse {
-            what: path.display().to_string(),
-            message: format!("no `{anchor}` in cycloneive_lcell_comb"),
-        });
+    if !lcell.contains("assign cin_w") {
+        if !lcell.contains(anchor) {
+            return Err(missing(anchor));
+        }
+        lcell = lcell.replacen(anchor, &format!("{anchor}\n   assign cin_w = cin;"), 1);
     }
-    if text.contains("assign cin_w") {
-        return Ok(text);
-    }
-    Ok(text.replacen(anchor, &format!("{anchor}\n   assign cin_w = cin;"), 1))
+    Ok(format!("{lcell}\n\n{}", include_str!("bt_cells_sim.v")))
 }
 
 /// Bits (`Properties: ... bits=N`) of every memory that `memory_bram` mapped onto
