@@ -785,6 +785,10 @@ pub enum HlsCommand {
         /// of the carry chain (one cell per bit, as Quartus): for comparison.
         #[arg(long)]
         lut_adders: bool,
+        /// Keep the module hierarchy and report each block's cells (bt_top and every PE);
+        /// the totals then lack the optimisations across PE ports of the flat run.
+        #[arg(long)]
+        per_block: bool,
     },
 }
 

@@ -444,8 +444,24 @@ pub struct SynthReport {
     /// Logic elements estimate `max(logic_cells, registers)` (each LE holds one LUT and one
     /// register; Quartus packing can only add to this) as a percentage of the EP4CE115's 114,480.
     pub percent_of_ep4ce115: f64,
-    /// Every cell type and count of the final `stat`.
+    /// Every cell type and count of the final `stat` (summed over the modules with
+    /// [`SynthOptions::per_block`]).
     pub cells: BTreeMap<String, u64>,
+    /// One row per module with [`SynthOptions::per_block`] (`bt_top`, then each PE), else empty.
+    pub blocks: Vec<BlockArea>,
+}
+
+/// Cells of one module of a hierarchical synthesis ([`SynthOptions::per_block`]).
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct BlockArea {
+    /// Module name (`bt_top`: controller, memories, write-back; `bt_pe_<i>`: plane i's PE).
+    pub module: String,
+    /// `cycloneive_lcell_comb` cells.
+    pub logic_cells: u64,
+    /// `dffeas` cells.
+    pub registers: u64,
+    /// `altsyncram` cells (M9K blocks).
+    pub m9k_blocks: u64,
 }
 
 /// Logic elements of the EP4CE115 (paper's Cyclone IV E device).
@@ -472,6 +488,10 @@ pub struct SynthOptions {
     /// Also write the mapped netlist to `synth/netlist.v` (Yosys `write_verilog -noattr`;
     /// simulates with the Cyclone IV E cell models, see [`cell_models`]).
     pub netlist: bool,
+    /// Keep the module hierarchy (`synth_intel -noflatten`) and report each module's cells in
+    /// [`SynthReport::blocks`]; the totals are then their sum, without the optimisations across
+    /// a PE's ports that the flat run makes.
+    pub per_block: bool,
 }
 
 /// [`synthesize_with`] the default options (carry chains, no netlist).
@@ -489,8 +509,15 @@ pub fn synthesize(out_dir: &Path) -> Result<SynthReport, HlsError> {
 /// this crate's rules (`bt_m9k.txt`: simple dual-port M9K, no initial contents) onto
 /// `altsyncram` cells where synth_intel's `map_bram` step would, then resumes at `map_ffram`.
 /// Adders: see [`AdderMapping`].
+/// The "Area" section of `report.md` is replaced by this run's ([`area_markdown`]).
 pub fn synthesize_with(out_dir: &Path, options: &SynthOptions) -> Result<SynthReport, HlsError> {
-    synthesize_rtl(out_dir, &rel_rtl(out_dir)?, "bt_top", options)
+    let report = synthesize_rtl(out_dir, &rel_rtl(out_dir)?, "bt_top", options)?;
+    let path = out_dir.join("report.md");
+    let text = std::fs::read_to_string(&path).map_err(io_err(&path))?;
+    let kept = text.split("\n## Area (Yosys").next().unwrap_or_default();
+    let md = format!("{}\n\n{}", kept.trim_end(), area_markdown(&report, options));
+    bt_output::write_atomic(&path, md.as_bytes())?;
+    Ok(report)
 }
 
 /// The flow of [`synthesize_with`] on any Verilog `files` (relative to `work_dir`) with top
@@ -534,7 +561,77 @@ pub fn synthesize_rtl(
     let stat = std::fs::read_to_string(&stat_path).map_err(io_err(&stat_path))?;
     let log_path = synth.join("yosys.log");
     let log = std::fs::read_to_string(&log_path).map_err(io_err(&log_path))?;
-    Ok(synth_report(parse_stat(&stat), parse_bram_bits(&log)))
+    if !options.per_block {
+        return Ok(synth_report(parse_stat(&stat), parse_bram_bits(&log)));
+    }
+    let modules = parse_module_stats(&stat);
+    let mut cells = BTreeMap::new();
+    for (_, m) in &modules {
+        for (k, v) in m {
+            if !modules.iter().any(|(name, _)| name == k) {
+                *cells.entry(k.clone()).or_insert(0) += v;
+            }
+        }
+    }
+    let mut report = synth_report(cells, parse_bram_bits(&log));
+    report.blocks = modules
+        .iter()
+        .map(|(module, m)| {
+            let r = synth_report(m.clone(), 0);
+            BlockArea {
+                module: module.clone(),
+                logic_cells: r.logic_cells,
+                registers: r.registers,
+                m9k_blocks: r.m9k_blocks,
+            }
+        })
+        .collect();
+    Ok(report)
+}
+
+/// Each module's section (`=== name ===`) of a hierarchical `stat`, `bt_top` first.
+fn parse_module_stats(stat: &str) -> Vec<(String, BTreeMap<String, u64>)> {
+    let mut out: Vec<(String, BTreeMap<String, u64>)> = stat
+        .split("=== ")
+        .skip(1)
+        .filter_map(|section| {
+            let (name, body) = section.split_once(" ===")?;
+            (name != "design hierarchy").then(|| (name.to_string(), parse_stat(body)))
+        })
+        .collect();
+    out.sort_by_key(|(name, _)| name != "bt_top");
+    out
+}
+
+/// The "Area" section `hls synth` writes into a generated directory's `report.md`: totals
+/// and, with [`SynthOptions::per_block`], one row per module.
+pub fn area_markdown(r: &SynthReport, options: &SynthOptions) -> String {
+    let adders = match options.adders {
+        AdderMapping::CarryChain => "adders on the carry chain",
+        AdderMapping::Luts => "adders in LUTs",
+    };
+    let flat = if options.per_block {
+        "hierarchy kept"
+    } else {
+        "flattened"
+    };
+    let mut md = format!(
+        "## Area (Yosys synth_intel -family cycloneive, {adders}, {flat})\n\n\
+         * logic cells {}, registers {}, M9K blocks {} ({} memory bits)\n\
+         * {:.1} % of the EP4CE115 (max(logic cells, registers) / {EP4CE115_LES})\n",
+        r.logic_cells, r.registers, r.m9k_blocks, r.memory_bits, r.percent_of_ep4ce115
+    );
+    if !r.blocks.is_empty() {
+        md.push_str("\n| block | logic cells | registers | M9K | share of logic cells |\n|---|---:|---:|---:|---:|\n");
+        for b in &r.blocks {
+            let share = 100.0 * b.logic_cells as f64 / r.logic_cells.max(1) as f64;
+            md.push_str(&format!(
+                "| `{}` | {} | {} | {} | {share:.1} % |\n",
+                b.module, b.logic_cells, b.registers, b.m9k_blocks
+            ));
+        }
+    }
+    md
 }
 
 /// The Yosys script: synth_intel's steps, with its `coarse` step spelled out (Yosys 0.23's
@@ -543,7 +640,8 @@ pub fn synthesize_rtl(
 /// `bt_altsyncram_bb.v`), and `bt_carry_map.v` before the generic `techmap` of `map_ffram`.
 fn yosys_script(files: &[String], top: &str, options: &SynthOptions) -> String {
     let chain = options.adders == AdderMapping::CarryChain;
-    let synth_intel = format!("synth_intel -family cycloneive -top {top}");
+    let hierarchy = if options.per_block { " -noflatten" } else { "" };
+    let synth_intel = format!("synth_intel -family cycloneive -top {top}{hierarchy}");
     let mut steps = vec![
         format!("read_verilog {}", files.join(" ")),
         format!("{synth_intel} -run :coarse"),
@@ -586,6 +684,7 @@ fn synth_report(cells: BTreeMap<String, u64>, memory_bits: u64) -> SynthReport {
         m9k_blocks: count("altsyncram"),
         percent_of_ep4ce115: 100.0 * logic_cells.max(registers) as f64 / EP4CE115_LES as f64,
         cells,
+        blocks: Vec::new(),
     }
 }
 
@@ -687,6 +786,16 @@ mod tests {
         let c = super::parse_stat(stat);
         assert_eq!(c["cycloneive_lcell_comb"], 5);
         assert_eq!(c["dffeas"], 2);
+    }
+
+    #[test]
+    fn parses_each_module_of_a_hierarchical_stat() {
+        let stat = "=== bt_pe_0 ===\n   Number of cells:   3\n     cycloneive_lcell_comb    2\n     dffeas    1\n\n=== bt_top ===\n   Number of cells:   4\n     bt_pe_0    1\n     cycloneive_lcell_comb    3\n\n=== design hierarchy ===\n   Number of cells:   7\n     cycloneive_lcell_comb    5\n";
+        let m = super::parse_module_stats(stat);
+        let names: Vec<&str> = m.iter().map(|(n, _)| n.as_str()).collect();
+        assert_eq!(names, ["bt_top", "bt_pe_0"]);
+        assert_eq!(m[0].1["cycloneive_lcell_comb"], 3);
+        assert_eq!(m[1].1["dffeas"], 1);
     }
 
     #[test]

@@ -246,7 +246,7 @@ fn carry_chain_adders_are_bit_exact_and_smaller_than_luts() {
         "bt_arith",
         &bt_hls::SynthOptions {
             adders: bt_hls::AdderMapping::Luts,
-            netlist: false,
+            ..Default::default()
         },
     )
     .unwrap();
@@ -257,6 +257,7 @@ fn carry_chain_adders_are_bit_exact_and_smaller_than_luts() {
         &bt_hls::SynthOptions {
             adders: bt_hls::AdderMapping::CarryChain,
             netlist: true,
+            ..Default::default()
         },
     )
     .unwrap();
