@@ -1,5 +1,6 @@
 // bt-hls: simulation models for a netlist of bt-hls's Yosys flow, beside
-// cycloneive_lcell_comb from Yosys's cells_sim.v (see `cell_models`).
+// cycloneive_lcell_comb from Yosys's cells_sim.v (see `cell_models`). The synthesis script
+// also reads this file as blackboxes: its altsyncram's port widths follow the parameters.
 //
 // dffeas: Yosys 0.23's model ignores `ena` and `clrn` (it loads `d` on every edge); this one
 // follows the Cyclone IV E register: asynchronous clear (clrn) and preset (prn), clock enable,

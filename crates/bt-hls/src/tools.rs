@@ -536,7 +536,7 @@ pub fn synthesize_rtl(
         ("bt_m9k_map.v", include_str!("bt_m9k_map.v")),
         ("bt_alu_map.v", include_str!("bt_alu_map.v")),
         ("bt_carry_map.v", include_str!("bt_carry_map.v")),
-        ("bt_altsyncram_bb.v", include_str!("bt_altsyncram_bb.v")),
+        ("bt_cells_sim.v", include_str!("bt_cells_sim.v")),
     ] {
         let path = synth.join(name);
         std::fs::write(&path, text).map_err(io_err(&path))?;
@@ -636,8 +636,10 @@ pub fn area_markdown(r: &SynthReport, options: &SynthOptions) -> String {
 
 /// The Yosys script: synth_intel's steps, with its `coarse` step spelled out (Yosys 0.23's
 /// `synth -run coarse`) so that `bt_alu_map.v` runs before `alumacc`, the M9K mapping in place
-/// of `map_bram` (onto an `altsyncram` blackbox whose port widths follow its parameters,
-/// `bt_altsyncram_bb.v`), and `bt_carry_map.v` before the generic `techmap` of `map_ffram`.
+/// of `map_bram`, and `bt_carry_map.v` before the generic `techmap` of `map_ffram`. The cell
+/// models of `bt_cells_sim.v`, read as blackboxes after synth_intel's `begin`, replace Yosys
+/// 0.23's `altsyncram` blackbox, whose fixed 8-bit addresses and 36-bit data cut every wider
+/// M9K address in the netlist ("Resizing cell port ... address_a from 13 bits to 8 bits").
 fn yosys_script(files: &[String], top: &str, options: &SynthOptions) -> String {
     let chain = options.adders == AdderMapping::CarryChain;
     let hierarchy = if options.per_block { " -noflatten" } else { "" };
@@ -645,7 +647,7 @@ fn yosys_script(files: &[String], top: &str, options: &SynthOptions) -> String {
     let mut steps = vec![
         format!("read_verilog {}", files.join(" ")),
         format!("{synth_intel} -run :coarse"),
-        "read_verilog -lib synth/bt_altsyncram_bb.v".to_string(),
+        "read_verilog -lib synth/bt_cells_sim.v".to_string(),
         "proc; opt_expr; opt_clean; check; opt -nodffe -nosdff; fsm; opt; wreduce; peepopt; \
          opt_clean"
             .to_string(),
