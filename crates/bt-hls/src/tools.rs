@@ -599,7 +599,8 @@ fn parse_module_stats(stat: &str) -> Vec<(String, BTreeMap<String, u64>)> {
             (name != "design hierarchy").then(|| (name.to_string(), parse_stat(body)))
         })
         .collect();
-    out.sort_by_key(|(name, _)| name != "bt_top");
+    // bt_top, then the PEs in plane order (bt_pe_2 before bt_pe_10).
+    out.sort_by_key(|(name, _)| (name != "bt_top", name.len(), name.clone()));
     out
 }
 
