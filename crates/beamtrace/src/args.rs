@@ -786,6 +786,14 @@ pub enum HlsCommand {
     Synth {
         /// Directory written by `hls gen`.
         dir: PathBuf,
+        /// Build adders from plain LUTs (Yosys's own mapping, about two cells per bit) instead
+        /// of the carry chain (one cell per bit, as Quartus): for comparison.
+        #[arg(long)]
+        lut_adders: bool,
+        /// Keep the module hierarchy and report each block's cells (bt_top and every PE);
+        /// the totals then lack the optimisations across PE ports of the flat run.
+        #[arg(long)]
+        per_block: bool,
     },
 }
 

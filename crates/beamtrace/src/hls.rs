@@ -18,12 +18,31 @@ pub fn run(args: &HlsArgs) -> anyhow::Result<ExitCode> {
     match &args.command {
         HlsCommand::Gen(a) => generate(a),
         HlsCommand::Sim { dir, simulator } => simulate(dir, simulator.kind()),
-        HlsCommand::Synth { dir } => {
-            let r = bt_hls::synthesize(dir)
+        HlsCommand::Synth {
+            dir,
+            lut_adders,
+            per_block,
+        } => {
+            let adders = if *lut_adders {
+                bt_hls::AdderMapping::Luts
+            } else {
+                bt_hls::AdderMapping::CarryChain
+            };
+            let options = bt_hls::SynthOptions {
+                adders,
+                netlist: false,
+                per_block: *per_block,
+            };
+            let r = bt_hls::synthesize_with(dir, &options)
                 .with_context(|| format!("synthesising {}", dir.display()))?;
             println!(
-                "{}: Yosys synth_intel -family cycloneive (EP4CE115, 114,480 LEs)",
-                dir.display()
+                "{}: Yosys synth_intel -family cycloneive (EP4CE115, 114,480 LEs), adders {}",
+                dir.display(),
+                if *lut_adders {
+                    "in LUTs"
+                } else {
+                    "on the carry chain"
+                }
             );
             println!("  logic cells      {:>10}", r.logic_cells);
             println!("  registers        {:>10}", r.registers);
@@ -34,6 +53,16 @@ pub fn run(args: &HlsArgs) -> anyhow::Result<ExitCode> {
             println!(
                 "  share of EP4CE115 {:>9.2} %   (paper, Table III: IPC 4 %-43 % of LEs)",
                 r.percent_of_ep4ce115
+            );
+            for b in &r.blocks {
+                println!(
+                    "  {:<16} {:>8} logic cells {:>7} registers {:>3} M9K",
+                    b.module, b.logic_cells, b.registers, b.m9k_blocks
+                );
+            }
+            println!(
+                "  (area section written to {})",
+                dir.join("report.md").display()
             );
             Ok(ExitCode::SUCCESS)
         }

@@ -37,8 +37,9 @@ pub use input::{HlsInput, PE_LATENCY, PlaneSpec, Platform, StepWork};
 pub use pe::{POINT_BITS, pe_module_name};
 pub use plan::{Plan, PlanOptions, ScheduleKind, plan, run_cycles, schedule_entries, slot_cycles};
 pub use tools::{
-    LintReport, SimProgress, SimReport, Simulator, SynthReport, lint, simulate, simulate_with,
-    synthesize,
+    AdderMapping, BlockArea, EP4CE115_LES, LintReport, SimProgress, SimReport, Simulator,
+    SynthOptions, SynthReport, area_markdown, cell_models, lint, simulate, simulate_netlist,
+    simulate_with, synthesize, synthesize_rtl, synthesize_with,
 };
 pub use top::MAP_VERSION;
 

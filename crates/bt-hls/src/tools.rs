@@ -192,6 +192,35 @@ pub fn simulate_with(
     simulator: Simulator,
     progress: &mut dyn FnMut(SimProgress),
 ) -> Result<SimReport, HlsError> {
+    simulate_sources(out_dir, &rel_rtl(out_dir)?, simulator, progress)
+}
+
+/// [`simulate_with`] on the netlist of [`synthesize_with`] (run with
+/// [`SynthOptions::netlist`]) instead of the RTL: `synth/netlist.v` with the cell models of
+/// [`cell_models`] (written to `synth/cells_sim.v`), the same testbench and the same comparison
+/// with the `bt-fixed` model.
+pub fn simulate_netlist(
+    out_dir: &Path,
+    simulator: Simulator,
+    progress: &mut dyn FnMut(SimProgress),
+) -> Result<SimReport, HlsError> {
+    let models = out_dir.join("synth/cells_sim.v");
+    std::fs::write(&models, cell_models()?).map_err(io_err(&models))?;
+    let sources = [
+        "synth/netlist.v".to_string(),
+        "synth/cells_sim.v".to_string(),
+    ];
+    simulate_sources(out_dir, &sources, simulator, progress)
+}
+
+/// Builds the testbench with `sources` (relative to `out_dir`) as the design, runs it and
+/// compares (see [`simulate_with`]).
+fn simulate_sources(
+    out_dir: &Path,
+    sources: &[String],
+    simulator: Simulator,
+    progress: &mut dyn FnMut(SimProgress),
+) -> Result<SimReport, HlsError> {
     let (ops, runs) = recompute(out_dir)?;
     let tb = out_dir.join("tb");
     let result = tb.join("sim_out.txt");
@@ -207,7 +236,7 @@ pub fn simulate_with(
                 "-s".into(),
                 "bt_tb".into(),
             ];
-            args.extend(rel_rtl(out_dir)?);
+            args.extend(sources.iter().cloned());
             args.push("tb/bt_tb.v".into());
             let out = run("iverilog", "iverilog", &args, out_dir)?;
             if !out.status.success() {
@@ -237,7 +266,7 @@ pub fn simulate_with(
             .iter()
             .map(|s| s.to_string())
             .collect();
-            args.extend(rel_rtl(out_dir)?);
+            args.extend(sources.iter().cloned());
             args.push("tb/bt_tb.v".into());
             let out = run("verilator", "verilator", &args, out_dir)?;
             if !out.status.success() {
@@ -415,42 +444,104 @@ pub struct SynthReport {
     /// Logic elements estimate `max(logic_cells, registers)` (each LE holds one LUT and one
     /// register; Quartus packing can only add to this) as a percentage of the EP4CE115's 114,480.
     pub percent_of_ep4ce115: f64,
-    /// Every cell type and count of the final `stat`.
+    /// Every cell type and count of the final `stat` (summed over the modules with
+    /// [`SynthOptions::per_block`]).
     pub cells: BTreeMap<String, u64>,
+    /// One row per module with [`SynthOptions::per_block`] (`bt_top`, then each PE), else empty.
+    pub blocks: Vec<BlockArea>,
+}
+
+/// Cells of one module of a hierarchical synthesis ([`SynthOptions::per_block`]).
+#[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct BlockArea {
+    /// Module name (`bt_top`: controller, memories, write-back; `bt_pe_<i>`: plane i's PE).
+    pub module: String,
+    /// `cycloneive_lcell_comb` cells.
+    pub logic_cells: u64,
+    /// `dffeas` cells.
+    pub registers: u64,
+    /// `altsyncram` cells (M9K blocks).
+    pub m9k_blocks: u64,
 }
 
 /// Logic elements of the EP4CE115 (paper's Cyclone IV E device).
 pub const EP4CE115_LES: u64 = 114_480;
 
+/// How [`synthesize_with`] builds adders, subtractors and comparisons.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum AdderMapping {
+    /// On the logic elements' carry chain in arithmetic mode, one logic cell per bit, as
+    /// Quartus does (`bt_alu_map.v` + `bt_carry_map.v`; the default).
+    #[default]
+    CarryChain,
+    /// Yosys 0.23's own mapping: carry-lookahead logic in plain LUTs, about two cells per bit
+    /// (kept to compare with).
+    Luts,
+}
+
+/// Options of [`synthesize_with`].
+#[derive(Debug, Clone, PartialEq, Eq, Default)]
+pub struct SynthOptions {
+    /// How adders are mapped.
+    pub adders: AdderMapping,
+    /// Also write the mapped netlist to `synth/netlist.v` (Yosys `write_verilog -noattr`;
+    /// simulates with the Cyclone IV E cell models, see [`cell_models`]).
+    pub netlist: bool,
+    /// Keep the module hierarchy (`synth_intel -noflatten`) and report each module's cells in
+    /// [`SynthReport::blocks`]; the totals are then their sum, without the optimisations across
+    /// a PE's ports that the flat run makes.
+    pub per_block: bool,
+}
+
+/// [`synthesize_with`] the default options (carry chains, no netlist).
+pub fn synthesize(out_dir: &Path) -> Result<SynthReport, HlsError> {
+    synthesize_with(out_dir, &SynthOptions::default())
+}
+
 /// Runs Yosys `synth_intel -family cycloneive -top bt_top` (the EP4CE115 is a Cyclone IV E)
-/// on `rtl/*.v`, logging to `synth/yosys.log`, and parses the final cell counts.
+/// on the generated `rtl/*.v` of `out_dir`, logging to `synth/yosys.log`, and parses the final
+/// cell counts.
 ///
 /// Block RAM: synth_intel's own M9K mapping aborts in Yosys 0.23 ("Can't find object for
 /// defparam `INIT`": its techmap module declares no `INIT` parameter, so every memory fails, and
-/// it would also tie the write data to the read port). The script therefore runs synth_intel up
-/// to `map_bram`, maps memories with this crate's rules (`bt_m9k.txt`: simple dual-port M9K,
-/// no initial contents) onto `altsyncram` cells, and resumes at `map_ffram`. The point memory
-/// lands in M9K; the `rounds` array (cleared on start) and the ROMs stay in logic.
-pub fn synthesize(out_dir: &Path) -> Result<SynthReport, HlsError> {
-    let files = rel_rtl(out_dir)?;
-    let synth = out_dir.join("synth");
+/// it would also tie the write data to the read port). The script therefore maps memories with
+/// this crate's rules (`bt_m9k.txt`: simple dual-port M9K, no initial contents) onto
+/// `altsyncram` cells where synth_intel's `map_bram` step would, then resumes at `map_ffram`.
+/// Adders: see [`AdderMapping`].
+/// The "Area" section of `report.md` is replaced by this run's ([`area_markdown`]).
+pub fn synthesize_with(out_dir: &Path, options: &SynthOptions) -> Result<SynthReport, HlsError> {
+    let report = synthesize_rtl(out_dir, &rel_rtl(out_dir)?, "bt_top", options)?;
+    let path = out_dir.join("report.md");
+    let text = std::fs::read_to_string(&path).map_err(io_err(&path))?;
+    let kept = text.split("\n## Area (Yosys").next().unwrap_or_default();
+    let md = format!("{}\n\n{}", kept.trim_end(), area_markdown(&report, options));
+    bt_output::write_atomic(&path, md.as_bytes())?;
+    Ok(report)
+}
+
+/// The flow of [`synthesize_with`] on any Verilog `files` (relative to `work_dir`) with top
+/// module `top`: writes `work_dir/synth/` (maps, `yosys.log`, `stat.txt`, optionally
+/// `netlist.v`). Used on the generated design and, by the tests, on small arithmetic modules.
+pub fn synthesize_rtl(
+    work_dir: &Path,
+    files: &[String],
+    top: &str,
+    options: &SynthOptions,
+) -> Result<SynthReport, HlsError> {
+    let synth = work_dir.join("synth");
     std::fs::create_dir_all(&synth).map_err(io_err(&synth))?;
     for (name, text) in [
         ("bt_m9k.txt", include_str!("bt_m9k.txt")),
         ("bt_m9k_map.v", include_str!("bt_m9k_map.v")),
+        ("bt_alu_map.v", include_str!("bt_alu_map.v")),
+        ("bt_carry_map.v", include_str!("bt_carry_map.v")),
+        ("bt_cells_sim.v", include_str!("bt_cells_sim.v")),
     ] {
         let path = synth.join(name);
         std::fs::write(&path, text).map_err(io_err(&path))?;
     }
-    let script = format!(
-        "read_verilog {}; \
-         synth_intel -family cycloneive -top bt_top -run :map_bram; \
-         memory_bram -rules synth/bt_m9k.txt; \
-         techmap -map synth/bt_m9k_map.v; \
-         synth_intel -family cycloneive -top bt_top -run map_ffram:; \
-         tee -o synth/stat.txt stat",
-        files.join(" ")
-    );
+    let script = yosys_script(files, top, options);
     let out = run(
         "yosys",
         "yosys",
@@ -461,16 +552,125 @@ pub fn synthesize(out_dir: &Path) -> Result<SynthReport, HlsError> {
             "-p".into(),
             script,
         ],
-        out_dir,
+        work_dir,
     )?;
     if !out.status.success() {
         return Err(failure("yosys", &out));
     }
     let stat_path = synth.join("stat.txt");
     let stat = std::fs::read_to_string(&stat_path).map_err(io_err(&stat_path))?;
-    let cells = parse_stat(&stat);
     let log_path = synth.join("yosys.log");
     let log = std::fs::read_to_string(&log_path).map_err(io_err(&log_path))?;
+    if !options.per_block {
+        return Ok(synth_report(parse_stat(&stat), parse_bram_bits(&log)));
+    }
+    let modules = parse_module_stats(&stat);
+    let mut cells = BTreeMap::new();
+    for (_, m) in &modules {
+        for (k, v) in m {
+            if !modules.iter().any(|(name, _)| name == k) {
+                *cells.entry(k.clone()).or_insert(0) += v;
+            }
+        }
+    }
+    let mut report = synth_report(cells, parse_bram_bits(&log));
+    report.blocks = modules
+        .iter()
+        .map(|(module, m)| {
+            let r = synth_report(m.clone(), 0);
+            BlockArea {
+                module: module.clone(),
+                logic_cells: r.logic_cells,
+                registers: r.registers,
+                m9k_blocks: r.m9k_blocks,
+            }
+        })
+        .collect();
+    Ok(report)
+}
+
+/// Each module's section (`=== name ===`) of a hierarchical `stat`, `bt_top` first.
+fn parse_module_stats(stat: &str) -> Vec<(String, BTreeMap<String, u64>)> {
+    let mut out: Vec<(String, BTreeMap<String, u64>)> = stat
+        .split("=== ")
+        .skip(1)
+        .filter_map(|section| {
+            let (name, body) = section.split_once(" ===")?;
+            (name != "design hierarchy").then(|| (name.to_string(), parse_stat(body)))
+        })
+        .collect();
+    // bt_top, then the PEs in plane order (bt_pe_2 before bt_pe_10).
+    out.sort_by_key(|(name, _)| (name != "bt_top", name.len(), name.clone()));
+    out
+}
+
+/// The "Area" section `hls synth` writes into a generated directory's `report.md`: totals
+/// and, with [`SynthOptions::per_block`], one row per module.
+pub fn area_markdown(r: &SynthReport, options: &SynthOptions) -> String {
+    let adders = match options.adders {
+        AdderMapping::CarryChain => "adders on the carry chain",
+        AdderMapping::Luts => "adders in LUTs",
+    };
+    let flat = if options.per_block {
+        "hierarchy kept"
+    } else {
+        "flattened"
+    };
+    let mut md = format!(
+        "## Area (Yosys synth_intel -family cycloneive, {adders}, {flat})\n\n\
+         * logic cells {}, registers {}, M9K blocks {} ({} memory bits)\n\
+         * {:.1} % of the EP4CE115 (max(logic cells, registers) / {EP4CE115_LES})\n",
+        r.logic_cells, r.registers, r.m9k_blocks, r.memory_bits, r.percent_of_ep4ce115
+    );
+    if !r.blocks.is_empty() {
+        md.push_str("\n| block | logic cells | registers | M9K | share of logic cells |\n|---|---:|---:|---:|---:|\n");
+        for b in &r.blocks {
+            let share = 100.0 * b.logic_cells as f64 / r.logic_cells.max(1) as f64;
+            md.push_str(&format!(
+                "| `{}` | {} | {} | {} | {share:.1} % |\n",
+                b.module, b.logic_cells, b.registers, b.m9k_blocks
+            ));
+        }
+    }
+    md
+}
+
+/// The Yosys script: synth_intel's steps, with its `coarse` step spelled out (Yosys 0.23's
+/// `synth -run coarse`) so that `bt_alu_map.v` runs before `alumacc`, the M9K mapping in place
+/// of `map_bram`, and `bt_carry_map.v` before the generic `techmap` of `map_ffram`. The cell
+/// models of `bt_cells_sim.v`, read as blackboxes after synth_intel's `begin`, replace Yosys
+/// 0.23's `altsyncram` blackbox, whose fixed 8-bit addresses and 36-bit data cut every wider
+/// M9K address in the netlist ("Resizing cell port ... address_a from 13 bits to 8 bits").
+fn yosys_script(files: &[String], top: &str, options: &SynthOptions) -> String {
+    let chain = options.adders == AdderMapping::CarryChain;
+    let hierarchy = if options.per_block { " -noflatten" } else { "" };
+    let synth_intel = format!("synth_intel -family cycloneive -top {top}{hierarchy}");
+    let mut steps = vec![
+        format!("read_verilog {}", files.join(" ")),
+        format!("{synth_intel} -run :coarse"),
+        "read_verilog -lib synth/bt_cells_sim.v".to_string(),
+        "proc; opt_expr; opt_clean; check; opt -nodffe -nosdff; fsm; opt; wreduce; peepopt; \
+         opt_clean"
+            .to_string(),
+    ];
+    if chain {
+        steps.push("techmap -map synth/bt_alu_map.v".into());
+    }
+    steps.push("alumacc; share; opt; memory -nomap; opt_clean".into());
+    steps.push("memory_bram -rules synth/bt_m9k.txt; techmap -map synth/bt_m9k_map.v".into());
+    if chain {
+        steps.push("techmap -map synth/bt_carry_map.v".into());
+    }
+    steps.push(format!("{synth_intel} -run map_ffram:"));
+    steps.push("tee -o synth/stat.txt stat".into());
+    if options.netlist {
+        steps.push("write_verilog -noattr synth/netlist.v".into());
+    }
+    steps.join("; ")
+}
+
+/// Totals of a final `stat` and the bits mapped into M9K.
+fn synth_report(cells: BTreeMap<String, u64>, memory_bits: u64) -> SynthReport {
     let count = |suffix: &str| {
         cells
             .iter()
@@ -480,16 +680,49 @@ pub fn synthesize(out_dir: &Path) -> Result<SynthReport, HlsError> {
     };
     let logic_cells = count("lcell_comb");
     let registers = count("dffeas");
-    let m9k_blocks = count("altsyncram");
-    let memory_bits = parse_bram_bits(&log);
-    Ok(SynthReport {
+    SynthReport {
         logic_cells,
         registers,
         memory_bits,
-        m9k_blocks,
+        m9k_blocks: count("altsyncram"),
         percent_of_ep4ce115: 100.0 * logic_cells.max(registers) as f64 / EP4CE115_LES as f64,
         cells,
-    })
+        blocks: Vec::new(),
+    }
+}
+
+/// Simulation models of a netlist from [`synthesize_rtl`]: `cycloneive_lcell_comb` from
+/// Yosys's `intel/cycloneive/cells_sim.v` (found through `yosys-config --datdir`, else in
+/// `/usr/share/yosys`) with one fix, and this crate's `dffeas` and `altsyncram`
+/// (`bt_cells_sim.v`). Yosys 0.23's `cycloneive_lcell_comb` never drives its internal `cin_w`,
+/// so every carry-chain cell would simulate as X (the fix adds `assign cin_w = cin;`); its
+/// `dffeas` ignores the clock enable and the clear, and it has no `altsyncram` model.
+pub fn cell_models() -> Result<String, HlsError> {
+    let datdir = Command::new("yosys-config")
+        .arg("--datdir")
+        .output()
+        .ok()
+        .filter(|o| o.status.success())
+        .map(|o| String::from_utf8_lossy(&o.stdout).trim().to_string())
+        .unwrap_or_else(|| "/usr/share/yosys".into());
+    let path = Path::new(&datdir).join("intel/cycloneive/cells_sim.v");
+    let text = std::fs::read_to_string(&path).map_err(io_err(&path))?;
+    let missing = |what: &str| HlsError::Parse {
+        what: path.display().to_string(),
+        message: format!("no `{what}` in cycloneive_lcell_comb"),
+    };
+    let (begin, end) = ("module cycloneive_lcell_comb", "endmodule");
+    let from = text.find(begin).ok_or_else(|| missing(begin))?;
+    let to = from + text[from..].find(end).ok_or_else(|| missing(end))? + end.len();
+    let mut lcell = text[from..to].to_string();
+    let anchor = "assign datad_w = datad;";
+    if !lcell.contains("assign cin_w") {
+        if !lcell.contains(anchor) {
+            return Err(missing(anchor));
+        }
+        lcell = lcell.replacen(anchor, &format!("{anchor}\n   assign cin_w = cin;"), 1);
+    }
+    Ok(format!("{lcell}\n\n{}", include_str!("bt_cells_sim.v")))
 }
 
 /// Bits (`Properties: ... bits=N`) of every memory that `memory_bram` mapped onto
@@ -556,6 +789,16 @@ mod tests {
         let c = super::parse_stat(stat);
         assert_eq!(c["cycloneive_lcell_comb"], 5);
         assert_eq!(c["dffeas"], 2);
+    }
+
+    #[test]
+    fn parses_each_module_of_a_hierarchical_stat() {
+        let stat = "=== bt_pe_0 ===\n   Number of cells:   3\n     cycloneive_lcell_comb    2\n     dffeas    1\n\n=== bt_top ===\n   Number of cells:   4\n     bt_pe_0    1\n     cycloneive_lcell_comb    3\n\n=== design hierarchy ===\n   Number of cells:   7\n     cycloneive_lcell_comb    5\n";
+        let m = super::parse_module_stats(stat);
+        let names: Vec<&str> = m.iter().map(|(n, _)| n.as_str()).collect();
+        assert_eq!(names, ["bt_top", "bt_pe_0"]);
+        assert_eq!(m[0].1["cycloneive_lcell_comb"], 3);
+        assert_eq!(m[1].1["dffeas"], 1);
     }
 
     #[test]
