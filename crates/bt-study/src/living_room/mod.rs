@@ -16,7 +16,9 @@
 pub mod plot;
 pub mod report;
 
-use crate::run::{AngularErrors, Directions, PathMap, compare, exact_directions, run_solver};
+use crate::run::{
+    Comparison, Directions, PathMap, exact_directions, max_order_problem, run_solver,
+};
 use crate::{StudyConfig, StudyError, StudySolver};
 use bt_accel as fpga;
 use bt_geom::{Real, Vec3};
@@ -127,12 +129,7 @@ impl LivingRoomConfig {
         if self.max_order == 0 {
             p.push("max order must be at least 1 (the accelerator traces reflections)".into());
         }
-        if self.max_order > 6 {
-            p.push(format!(
-                "max order {} is too high for a study (at most 6)",
-                self.max_order
-            ));
-        }
+        p.extend(max_order_problem(self.max_order));
         if self.ga_population == 0 {
             p.push("ga population must be at least 1".into());
         }
@@ -164,23 +161,9 @@ impl LivingRoomConfig {
 pub struct Row {
     /// Time step, from 0.
     pub step: usize,
-    /// Solver.
-    pub solver: StudySolver,
-    /// Paths the solver found.
-    pub paths: usize,
-    /// Of those, paths whose surface sequence the image method also found.
-    pub matched: usize,
-    /// Image-method paths the solver did not find.
-    pub missed: usize,
-    /// Solver paths the image method does not have.
-    pub spurious: usize,
-    /// Angles between the solver's and the exact departure (TX) and arrival (RX) directions
-    /// over matched paths, degrees (zeros when nothing matched).
+    /// The solver's paths compared with the image method's (columns `solver` ... `time_s`).
     #[serde(flatten)]
-    pub errors: AngularErrors,
-    /// Single-threaded wall-clock time from scene to paths, seconds (candidate enumeration
-    /// included; for the fixed-point model: building its input and running it in software).
-    pub time_s: Real,
+    pub comparison: Comparison,
 }
 
 /// The accelerator at one time step: its input, the fixed-point outcomes and the schedule.
@@ -426,16 +409,9 @@ fn row(
     found: &PathMap,
     time_s: Real,
 ) -> Row {
-    let (matched, missed, spurious, errors) = compare(reference, found);
     Row {
         step,
-        solver,
-        paths: found.len(),
-        matched,
-        missed,
-        spurious,
-        errors: errors.into(),
-        time_s,
+        comparison: Comparison::new(solver, reference, found, time_s),
     }
 }
 
@@ -557,7 +533,7 @@ mod tests {
         let results = run(&scene, &config, &mut |_, _| {}).expect("study runs");
         assert_eq!(results.rows.len(), scene.len() * SOLVERS.len());
         assert_eq!(results.fpga.len(), scene.len());
-        for r in &results.rows {
+        for r in results.rows.iter().map(|r| &r.comparison) {
             let limit = match r.solver {
                 StudySolver::Image => 0.0,
                 StudySolver::IpcGaussSeidel | StudySolver::IpcJacobi => 1e-6,
