@@ -402,19 +402,6 @@ fn fill_platform_instances(
     Ok(())
 }
 
-fn row(
-    step: usize,
-    solver: StudySolver,
-    reference: &PathMap,
-    found: &PathMap,
-    time_s: Real,
-) -> Row {
-    Row {
-        step,
-        comparison: Comparison::new(solver, reference, found, time_s),
-    }
-}
-
 /// Run the study over every step of `scene`. `progress(done, total)` is called after every
 /// step. Steps and solvers run one after the other, every solver single-threaded, so the times
 /// compare fairly (only the scheduler, which is not timed as a solver, uses every core). All
@@ -440,13 +427,11 @@ pub fn run(
     let mut previous = None;
     for (step, s) in scene.scenes().iter().enumerate() {
         let (reference, time_s) = run_solver(s, StudySolver::Image, &solver_config)?;
-        rows.push(row(
+        let row = |solver, found: &PathMap, time_s| Row {
             step,
-            StudySolver::Image,
-            &reference,
-            &reference,
-            time_s,
-        ));
+            comparison: Comparison::new(solver, &reference, found, time_s),
+        };
+        rows.push(row(StudySolver::Image, &reference, time_s));
         let mut sbr_paths = PathMap::new();
         for solver in [
             StudySolver::IpcGaussSeidel,
@@ -454,19 +439,13 @@ pub fn run(
             StudySolver::Sbr,
         ] {
             let (found, time_s) = run_solver(s, solver, &solver_config)?;
-            rows.push(row(step, solver, &reference, &found, time_s));
+            rows.push(row(solver, &found, time_s));
             if solver == StudySolver::Sbr {
                 sbr_paths = found;
             }
         }
         let fixed = fixed_point_step(s, &planes, step, config, previous.as_ref())?;
-        rows.push(row(
-            step,
-            StudySolver::IpcFixedPoint,
-            &reference,
-            &fixed.paths,
-            fixed.time_s,
-        ));
+        rows.push(row(StudySolver::IpcFixedPoint, &fixed.paths, fixed.time_s));
         fpga.push(fixed.fpga);
         work.push(fixed.planned.work());
         previous = Some(fixed.planned);
