@@ -16,7 +16,7 @@ use bt_channel::{Antenna, Bounce, Complex64, SurfaceResponse, Tap};
 use bt_geom::{Real, Vec3};
 use bt_scene::{Scene, SurfaceId};
 use bt_solve::FoundPath;
-use serde::{Serialize, Serializer};
+use serde::{Deserialize, Serialize, Serializer};
 
 /// Speed of light in vacuum, m/s.
 pub use bt_channel::{ChannelError, SPEED_OF_LIGHT};
@@ -32,8 +32,9 @@ pub struct RadioOptions {
     pub tx_power_dbm: Real,
 }
 
-/// A direction as azimuth and elevation, degrees.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+/// A direction as azimuth and elevation, degrees (`docs/conventions.md`); also what the
+/// viewer reads back from a trace document.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Direction {
     /// From +x towards +y, degrees in (-180, 180].
     pub azimuth: Real,

@@ -4,15 +4,11 @@
 
 use bt_coverage::{Grid, PointStatus, sweep};
 use bt_geom::Vec3;
-use bt_scene::{Scene, SceneDescription, Terminals};
+use bt_scene::Scene;
 use bt_solve::pipeline::TraceOptions;
 
 fn box_room(size: [f64; 3], tx: [f64; 3]) -> Scene {
-    let json = format!(
-        r#"{{ "tx": {tx:?}, "rx": [0.5, 0.5, 0.5], "boxes": [ {{ "name": "room", "min": [0, 0, 0], "max": {size:?} }} ] }}"#
-    );
-    let d: SceneDescription = serde_json::from_str(&json).unwrap();
-    Scene::from_description(&d, "box", Terminals::default()).unwrap()
+    bt_testkit::box_room(size.into(), tx.into(), Vec3::splat(0.5))
 }
 
 /// Paths of order ≤ `max` in an empty box: one per lattice image with |a|+|b|+|c| ≤ max.

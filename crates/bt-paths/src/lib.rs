@@ -276,13 +276,15 @@ impl Dfs<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use bt_scene::{SceneDescription, Terminals};
+    use bt_geom::Vec3;
+    use bt_testkit::scene_from_json;
 
     fn box_room() -> Scene {
-        let json = r#"{ "tx": [1, 1, 1], "rx": [3, 2, 1.5],
-            "boxes": [ { "name": "room", "min": [0, 0, 0], "max": [4, 3, 2.5] } ] }"#;
-        let d: SceneDescription = serde_json::from_str(json).unwrap();
-        Scene::from_description(&d, "box", Terminals::default()).unwrap()
+        bt_testkit::box_room(
+            Vec3::new(4.0, 3.0, 2.5),
+            Vec3::new(1.0, 1.0, 1.0),
+            Vec3::new(3.0, 2.0, 1.5),
+        )
     }
 
     #[test]
@@ -304,8 +306,7 @@ mod tests {
             "surfaces": [
               { "name": "a", "vertices": [[-1,-1,0],[1,-1,0],[1,1,0],[-1,1,0]] },
               { "name": "b", "vertices": [[-1,-1,2],[1,-1,2],[1,1,2],[-1,1,2]] } ] }"#;
-        let d: SceneDescription = serde_json::from_str(json).unwrap();
-        let scene = Scene::from_description(&d, "plates", Terminals::default()).unwrap();
+        let scene = scene_from_json(json);
         let set = enumerate(&scene, 2, &AllVisible);
         // First order: TX and RX lie on opposite sides of both plates: pruned (2).
         // a-b: TX below a, b above a -> opposite sides of a: pruned (1).

@@ -504,12 +504,7 @@ fn crossings_inside(
 mod tests {
     use super::*;
     use crate::{AllVisible, enumerate};
-    use bt_scene::{SceneDescription, Terminals};
-
-    fn scene(json: &str) -> Scene {
-        let d: SceneDescription = serde_json::from_str(json).unwrap();
-        Scene::from_description(&d, "t", Terminals::default()).unwrap()
-    }
+    use bt_testkit::scene_from_json as scene;
 
     fn quad(c: [Real; 3], u: [Real; 3], v: [Real; 3]) -> Vec<Vec3> {
         let (c, u, v) = (Vec3::from(c), Vec3::from(u), Vec3::from(v));

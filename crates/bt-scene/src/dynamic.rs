@@ -206,25 +206,23 @@ impl DynamicScene {
         &self,
         radio: bt_channel::RadioMaterial,
     ) -> Result<Self, SceneError> {
-        Ok(Self {
-            scenes: self
-                .scenes
-                .iter()
-                .map(|s| s.with_radio_material(radio))
-                .collect::<Result<_, _>>()?,
-            objects: self.objects.clone(),
-        })
+        self.map_steps(|s| s.with_radio_material(radio))
     }
 
     /// A copy with carrier `frequency_hz` at every step (CLI `--frequency`), see
     /// [`Scene::with_frequency`].
     pub fn with_frequency(&self, frequency_hz: Real) -> Result<Self, SceneError> {
+        self.map_steps(|s| s.with_frequency(frequency_hz))
+    }
+
+    /// A copy with `f` applied to the scene of every step (the objects unchanged); the first
+    /// error stops it.
+    fn map_steps(
+        &self,
+        f: impl Fn(&Scene) -> Result<Scene, SceneError>,
+    ) -> Result<Self, SceneError> {
         Ok(Self {
-            scenes: self
-                .scenes
-                .iter()
-                .map(|s| s.with_frequency(frequency_hz))
-                .collect::<Result<_, _>>()?,
+            scenes: self.scenes.iter().map(f).collect::<Result<_, _>>()?,
             objects: self.objects.clone(),
         })
     }

@@ -552,14 +552,14 @@ mod tests {
     use super::*;
     use crate::{Solver, image};
     use bt_paths::{AllVisible, enumerate};
-    use bt_scene::{SceneDescription, Terminals};
     use std::collections::BTreeSet;
 
     fn box_room() -> Scene {
-        let json = r#"{ "tx": [1.1, 0.9, 1.2], "rx": [3.2, 2.1, 1.6],
-            "boxes": [ { "name": "room", "min": [0, 0, 0], "max": [4, 3, 2.5] } ] }"#;
-        let d: SceneDescription = serde_json::from_str(json).unwrap();
-        Scene::from_description(&d, "box", Terminals::default()).unwrap()
+        bt_testkit::box_room(
+            Vec3::new(4.0, 3.0, 2.5),
+            Vec3::new(1.1, 0.9, 1.2),
+            Vec3::new(3.2, 2.1, 1.6),
+        )
     }
 
     fn angle_deg(a: Vec3, b: Vec3) -> Real {

@@ -2,14 +2,16 @@
 //! draw. Pure functions of the results: writing files is [`crate::io`]'s job.
 
 use crate::room::Shape;
-use crate::run::{AngularErrors, Row, StudyResults, StudySolver};
+use crate::run::{AngularErrors, Comparison, Row, StudyResults, StudySolver};
 use bt_geom::Real;
 use std::collections::BTreeMap;
 use std::fmt::Write;
 
 /// Column names of `results.csv`.
-pub const CSV_HEADER: &str = "seed,room,shape,edges,step,solver,paths,matched,missed,spurious,\
-mean_err_tx_deg,max_err_tx_deg,mean_err_rx_deg,max_err_rx_deg,time_s";
+pub const CSV_HEADER: &str = concat!(
+    "seed,room,shape,edges,step,",
+    crate::run::comparison_csv_columns!()
+);
 
 /// `results.csv`: a header and one line per row; floats in Rust's shortest round-trip
 /// scientific notation (`1.5e-13`).
@@ -18,25 +20,17 @@ pub fn csv(results: &StudyResults) -> String {
     out.push_str(CSV_HEADER);
     out.push('\n');
     for r in &results.rows {
-        let _ = writeln!(
+        let _ = write!(
             out,
-            "{},{},{},{},{},{},{},{},{},{},{:e},{:e},{:e},{:e},{:e}",
+            "{},{},{},{},{},",
             results.config.seed,
             r.room,
             r.shape.name(),
             r.edges,
-            r.step,
-            r.solver.name(),
-            r.paths,
-            r.matched,
-            r.missed,
-            r.spurious,
-            r.errors.mean_err_tx_deg,
-            r.errors.max_err_tx_deg,
-            r.errors.mean_err_rx_deg,
-            r.errors.max_err_rx_deg,
-            r.time_s
+            r.step
         );
+        r.comparison.write_csv(&mut out);
+        out.push('\n');
     }
     out
 }
@@ -53,7 +47,7 @@ pub enum Quantity {
 }
 
 impl Quantity {
-    fn of(self, r: &Row) -> Option<Real> {
+    fn of(self, r: &Comparison) -> Option<Real> {
         match self {
             Quantity::ErrorTx if r.matched > 0 => Some(r.errors.mean_err_tx_deg),
             Quantity::ErrorRx if r.matched > 0 => Some(r.errors.mean_err_rx_deg),
@@ -84,8 +78,8 @@ pub fn mean_by(
             GroupBy::Step => r.step,
             GroupBy::Edges => r.edges,
         };
-        if let Some(v) = quantity.of(r) {
-            let e = sums.entry((r.solver, key)).or_insert((0.0, 0));
+        if let Some(v) = quantity.of(&r.comparison) {
+            let e = sums.entry((r.comparison.solver, key)).or_insert((0.0, 0));
             e.0 += v;
             e.1 += 1;
         }
@@ -118,15 +112,16 @@ pub struct Totals {
 
 /// Totals per solver over `rows` selected by `keep`.
 pub fn totals(rows: &[Row], keep: impl Fn(&Row) -> bool) -> BTreeMap<StudySolver, Totals> {
-    let mut groups: BTreeMap<StudySolver, Vec<&Row>> = BTreeMap::new();
+    let mut groups: BTreeMap<StudySolver, Vec<&Comparison>> = BTreeMap::new();
     for r in rows.iter().filter(|r| keep(r)) {
-        groups.entry(r.solver).or_default().push(r);
+        let c = &r.comparison;
+        groups.entry(c.solver).or_default().push(c);
     }
     groups
         .into_iter()
         .map(|(solver, rs)| {
-            let with_matches: Vec<&&Row> = rs.iter().filter(|r| r.matched > 0).collect();
-            let mean = |f: fn(&Row) -> Real| {
+            let with_matches: Vec<&&Comparison> = rs.iter().filter(|r| r.matched > 0).collect();
+            let mean = |f: fn(&Comparison) -> Real| {
                 if with_matches.is_empty() {
                     0.0
                 } else {
@@ -248,16 +243,13 @@ fn summary_per_solver(s: &mut String, results: &StudyResults) {
     for (solver, t) in totals(&results.rows, |_| true) {
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {:.3e} | {:.3e} | {:.3e} | {:.3e} | {:.3} | {:.3} |",
+            "| {} | {} | {} | {} | {} | {} | {:.3} | {:.3} |",
             solver.name(),
             t.rows,
             t.paths,
             t.missed,
             t.spurious,
-            t.errors.mean_err_tx_deg,
-            t.errors.max_err_tx_deg,
-            t.errors.mean_err_rx_deg,
-            t.errors.max_err_rx_deg,
+            t.errors.table_cells(),
             t.time_s,
             t.median_time_s * 1e3
         );

@@ -9,6 +9,7 @@ use bt_scene::{Scene, SurfaceId};
 use bt_solve::{IpcOptions, SbrOptions, Solver, UpdateOrder, sbr, trace};
 use serde::Serialize;
 use std::collections::BTreeMap;
+use std::fmt::Write;
 use std::time::Instant;
 
 /// Settings of a study.
@@ -63,17 +64,23 @@ impl StudyConfig {
         if self.steps == 0 {
             p.push("steps must be at least 1".to_string());
         }
-        if self.max_order > 6 {
-            p.push(format!(
-                "max order {} is too high for a study (at most 6)",
-                self.max_order
-            ));
-        }
+        p.extend(max_order_problem(self.max_order));
         if let Some(m) = self.sbr_options().problem() {
             p.push(m);
         }
         p
     }
+}
+
+/// Highest reflection order either study accepts: the candidate count grows exponentially
+/// with the order.
+pub const MAX_STUDY_ORDER: usize = 6;
+
+/// The problem with a study's highest reflection order, if it exceeds [`MAX_STUDY_ORDER`].
+pub(crate) fn max_order_problem(max_order: usize) -> Option<String> {
+    (max_order > MAX_STUDY_ORDER).then(|| {
+        format!("max order {max_order} is too high for a study (at most {MAX_STUDY_ORDER})")
+    })
 }
 
 /// The solvers compared.
@@ -124,6 +131,25 @@ pub struct Row {
     pub edges: usize,
     /// Time step, from 0.
     pub step: usize,
+    /// The solver's paths compared with the image method's (columns `solver` ... `time_s`).
+    #[serde(flatten)]
+    pub comparison: Comparison,
+}
+
+/// Column names of [`Comparison::write_csv`], in its order: a literal, so that each study's
+/// `CSV_HEADER` can `concat!` its own columns around it.
+macro_rules! comparison_csv_columns {
+    () => {
+        "solver,paths,matched,missed,spurious,\
+mean_err_tx_deg,max_err_tx_deg,mean_err_rx_deg,max_err_rx_deg,time_s"
+    };
+}
+pub(crate) use comparison_csv_columns;
+
+/// One solver's paths in one scene compared with the image method's (the reference) by
+/// surface sequence: the block both studies' rows share.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Comparison {
     /// Solver.
     pub solver: StudySolver,
     /// Paths the solver found.
@@ -137,9 +163,86 @@ pub struct Row {
     /// Angular errors of the matched paths (columns `mean_err_tx_deg` ... `max_err_rx_deg`).
     #[serde(flatten)]
     pub errors: AngularErrors,
-    /// Single-threaded wall-clock time from scene to paths (candidate enumeration included for
-    /// the image method and IPC), seconds.
+    /// Single-threaded wall-clock time from scene to paths, seconds (candidate enumeration
+    /// included for the image method and IPC; for the fixed-point model: building its input
+    /// and running it in software).
     pub time_s: Real,
+}
+
+impl Comparison {
+    /// `found` (by `solver`, in `time_s` seconds) against `reference`: matched, missed and
+    /// spurious paths, and the mean and largest departure and arrival errors over the matched
+    /// ones (zeros when nothing matched).
+    pub(crate) fn new(
+        solver: StudySolver,
+        reference: &PathMap,
+        found: &PathMap,
+        time_s: Real,
+    ) -> Self {
+        let mut tx = Vec::new();
+        let mut rx = Vec::new();
+        for (seq, d) in found {
+            if let Some(e) = reference.get(seq) {
+                tx.push(angle_deg(d.departure, e.departure));
+                rx.push(angle_deg(d.arrival, e.arrival));
+            }
+        }
+        let mean = |v: &[Real]| {
+            if v.is_empty() {
+                0.0
+            } else {
+                v.iter().sum::<Real>() / v.len() as Real
+            }
+        };
+        let max = |v: &[Real]| v.iter().copied().fold(0.0, Real::max);
+        Self {
+            solver,
+            paths: found.len(),
+            matched: tx.len(),
+            missed: reference.keys().filter(|k| !found.contains_key(*k)).count(),
+            spurious: found.len() - tx.len(),
+            errors: AngularErrors {
+                mean_err_tx_deg: mean(&tx),
+                max_err_tx_deg: max(&tx),
+                mean_err_rx_deg: mean(&rx),
+                max_err_rx_deg: max(&rx),
+            },
+            time_s,
+        }
+    }
+
+    /// No paths, no errors, no time: a row a study lacks.
+    pub(crate) fn empty(solver: StudySolver) -> Self {
+        Self {
+            solver,
+            paths: 0,
+            matched: 0,
+            missed: 0,
+            spurious: 0,
+            errors: AngularErrors::default(),
+            time_s: 0.0,
+        }
+    }
+
+    /// The columns of `comparison_csv_columns!`, comma-separated, no line end; floats in
+    /// Rust's shortest round-trip scientific notation (`1.5e-13`).
+    pub fn write_csv(&self, out: &mut String) {
+        let e = &self.errors;
+        let _ = write!(
+            out,
+            "{},{},{},{},{},{:e},{:e},{:e},{:e},{:e}",
+            self.solver.name(),
+            self.paths,
+            self.matched,
+            self.missed,
+            self.spurious,
+            e.mean_err_tx_deg,
+            e.max_err_tx_deg,
+            e.mean_err_rx_deg,
+            e.max_err_rx_deg,
+            self.time_s
+        );
+    }
 }
 
 /// Angular errors of a solver's matched paths against the exact directions, degrees: the mean
@@ -158,15 +261,14 @@ pub struct AngularErrors {
     pub max_err_rx_deg: Real,
 }
 
-impl From<[Real; 4]> for AngularErrors {
-    /// From `[mean TX, max TX, mean RX, max RX]` (the order [`compare`] returns).
-    fn from([mean_tx, max_tx, mean_rx, max_rx]: [Real; 4]) -> Self {
-        Self {
-            mean_err_tx_deg: mean_tx,
-            max_err_tx_deg: max_tx,
-            mean_err_rx_deg: mean_rx,
-            max_err_rx_deg: max_rx,
-        }
+impl AngularErrors {
+    /// The four errors as cells of a Markdown table row, `mean TX | max TX | mean RX | max RX`,
+    /// three significant digits in scientific notation.
+    pub(crate) fn table_cells(&self) -> String {
+        format!(
+            "{:.3e} | {:.3e} | {:.3e} | {:.3e}",
+            self.mean_err_tx_deg, self.max_err_tx_deg, self.mean_err_rx_deg, self.max_err_rx_deg
+        )
     }
 }
 
@@ -271,37 +373,6 @@ pub(crate) fn run_solver(
     Ok((map, elapsed))
 }
 
-/// Matched, missed and spurious paths of `found` against `reference`, and the mean and largest
-/// departure and arrival errors over the matched ones, degrees (`[mean TX, max TX, mean RX,
-/// max RX]`, zeros when nothing matched).
-pub(crate) fn compare(reference: &PathMap, found: &PathMap) -> (usize, usize, usize, [Real; 4]) {
-    let mut tx = Vec::new();
-    let mut rx = Vec::new();
-    for (seq, d) in found {
-        if let Some(e) = reference.get(seq) {
-            tx.push(angle_deg(d.departure, e.departure));
-            rx.push(angle_deg(d.arrival, e.arrival));
-        }
-    }
-    let matched = tx.len();
-    let missed = reference.keys().filter(|k| !found.contains_key(*k)).count();
-    let spurious = found.len() - matched;
-    let mean = |v: &[Real]| {
-        if v.is_empty() {
-            0.0
-        } else {
-            v.iter().sum::<Real>() / v.len() as Real
-        }
-    };
-    let max = |v: &[Real]| v.iter().copied().fold(0.0, Real::max);
-    (
-        matched,
-        missed,
-        spurious,
-        [mean(&tx), max(&tx), mean(&rx), max(&rx)],
-    )
-}
-
 /// The time steps drawn in Fig. 5: all when there are at most four, else four spread evenly.
 pub fn drawn_steps(steps: usize) -> Vec<usize> {
     if steps <= 4 {
@@ -370,19 +441,12 @@ fn row(
     found: &PathMap,
     time_s: Real,
 ) -> Row {
-    let (matched, missed, spurious, errors) = compare(reference, found);
     Row {
         room: room.index,
         shape: room.shape,
         edges: room.edges,
         step,
-        solver,
-        paths: found.len(),
-        matched,
-        missed,
-        spurious,
-        errors: errors.into(),
-        time_s,
+        comparison: Comparison::new(solver, reference, found, time_s),
     }
 }
 

@@ -8,7 +8,7 @@
 
 #![warn(missing_docs)]
 
-use bt_beams::PathReport;
+use bt_beams::{Direction, PathReport};
 use bt_geom::Real;
 use bt_scene::{Scene, SurfaceKind};
 use serde::{Deserialize, Serialize};
@@ -57,20 +57,11 @@ pub struct ViewPath {
     /// Delay, seconds.
     pub delay_s: Real,
     /// Departure direction (azimuth, elevation), degrees.
-    pub aod_deg: Angles,
+    pub aod_deg: Direction,
     /// Arrival direction (azimuth, elevation), degrees.
-    pub aoa_deg: Angles,
+    pub aoa_deg: Direction,
     /// Total loss, dB.
     pub loss_db: Real,
-}
-
-/// Azimuth and elevation, degrees (`docs/conventions.md`).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub struct Angles {
-    /// From +x towards +y.
-    pub azimuth: Real,
-    /// From the horizontal plane, positive up.
-    pub elevation: Real,
 }
 
 impl From<&PathReport> for ViewPath {
@@ -81,14 +72,8 @@ impl From<&PathReport> for ViewPath {
             points: p.points.clone(),
             length_m: p.length_m,
             delay_s: p.delay_s,
-            aod_deg: Angles {
-                azimuth: p.aod_deg.azimuth,
-                elevation: p.aod_deg.elevation,
-            },
-            aoa_deg: Angles {
-                azimuth: p.aoa_deg.azimuth,
-                elevation: p.aoa_deg.elevation,
-            },
+            aod_deg: p.aod_deg,
+            aoa_deg: p.aoa_deg,
             loss_db: p.loss_db,
         }
     }

@@ -4,7 +4,7 @@
 
 use bt_testkit::partitioned as common;
 
-use bt_dynamic::{IncrementalTracer, StepOptions, max_point_distance, trace_scratch};
+use bt_dynamic::{IncrementalTracer, StepOptions, StepTrace, max_point_distance, trace_scratch};
 use bt_paths::wvrn::Wvrn;
 use bt_scene::Terminals;
 use bt_scene::dynamic::{DynamicScene, builtin_dynamic_scene, moved_surfaces};
@@ -17,9 +17,22 @@ fn living_room() -> DynamicScene {
         .unwrap()
 }
 
-fn assert_same_as_scratch(dynamic: &DynamicScene, options: &StepOptions) -> (usize, usize) {
+/// The image method on `candidates` up to `max_order`, without a candidate budget.
+fn image(candidates: CandidateMode, max_order: usize, parallel: bool) -> StepOptions {
+    StepOptions {
+        max_order,
+        solver: Solver::Image,
+        candidates,
+        max_candidates: u64::MAX,
+        parallel,
+    }
+}
+
+/// Trace every step of `dynamic` incrementally, assert that each equals a from-scratch trace,
+/// and return the incremental steps.
+fn same_as_scratch(dynamic: &DynamicScene, options: &StepOptions) -> Vec<StepTrace> {
     let mut tracer = IncrementalTracer::new(*options);
-    let (mut solved, mut total) = (0, 0);
+    let mut steps = Vec::with_capacity(dynamic.len());
     for (k, scene) in dynamic.scenes().iter().enumerate() {
         let inc = tracer.step(scene).unwrap();
         let scratch = trace_scratch(scene, k, options).unwrap();
@@ -43,12 +56,20 @@ fn assert_same_as_scratch(dynamic: &DynamicScene, options: &StepOptions) -> (usi
         }
         assert_eq!(inc.trace.paths, scratch.trace.paths, "step {k}: paths");
         assert_eq!(inc.wvrn, scratch.wvrn, "step {k}: wvrn stats");
-        if k > 0 {
-            solved += inc.update.solved;
-            total += inc.update.solved + inc.update.reused;
-        }
+        steps.push(inc);
     }
-    (solved, total)
+    steps
+}
+
+/// [`same_as_scratch`], returning the candidates re-solved and all candidates over steps 1...
+fn assert_same_as_scratch(dynamic: &DynamicScene, options: &StepOptions) -> (usize, usize) {
+    same_as_scratch(dynamic, options)
+        .iter()
+        .skip(1)
+        .fold((0, 0), |(solved, total), inc| {
+            let u = &inc.update;
+            (solved + u.solved, total + u.solved + u.reused)
+        })
 }
 
 #[test]
@@ -61,14 +82,7 @@ fn dynamic_living_room_matches_scratch_with_and_without_wvrn() {
         CandidateMode::Wvrn,
         CandidateMode::Exhaustive,
     ] {
-        let options = StepOptions {
-            max_order: 3,
-            solver: Solver::Image,
-            candidates: wvrn,
-            max_candidates: u64::MAX,
-            parallel: true,
-        };
-        let (solved, total) = assert_same_as_scratch(&dynamic, &options);
+        let (solved, total) = assert_same_as_scratch(&dynamic, &image(wvrn, 3, true));
         eprintln!(
             "living room ({wvrn:?}): re-solved {solved} of {total} candidates over steps 1-9"
         );
@@ -93,14 +107,7 @@ fn dynamic_living_room_matches_scratch_with_and_without_wvrn() {
 #[test]
 fn person_blocks_the_line_of_sight_at_steps_2_and_3() {
     let dynamic = living_room();
-    let options = StepOptions {
-        max_order: 1,
-        solver: Solver::Image,
-        candidates: CandidateMode::Wvrn,
-        max_candidates: u64::MAX,
-        parallel: false,
-    };
-    let mut tracer = IncrementalTracer::new(options);
+    let mut tracer = IncrementalTracer::new(image(CandidateMode::Wvrn, 1, false));
     let los: Vec<bool> = dynamic
         .scenes()
         .iter()
@@ -125,14 +132,7 @@ fn random_motions_match_scratch() {
     for seed in [1u64, 2, 3, 4] {
         let (used, dynamic) = common::random_dynamic(seed * 77, 6);
         for (candidates, max_order) in [(CandidateMode::Wvrn, 2), (CandidateMode::BeamTree, 3)] {
-            let options = StepOptions {
-                max_order,
-                solver: Solver::Image,
-                candidates,
-                max_candidates: u64::MAX,
-                parallel: true,
-            };
-            assert_same_as_scratch(&dynamic, &options);
+            same_as_scratch(&dynamic, &image(candidates, max_order, true));
         }
         // The WVRN update is exact too.
         let mut w = Wvrn::build(dynamic.step(0));
@@ -170,23 +170,16 @@ fn ipc_warm_start_agrees_with_the_image_method() {
     let dynamic = living_room();
     let scene0 = dynamic.step(0);
     let ipc = Solver::Ipc(IpcOptions::for_scene(scene0, UpdateOrder::GaussSeidel));
-    let options = StepOptions {
-        max_order: 2,
+    let reference_options = image(CandidateMode::Wvrn, 2, true);
+    let mut tracer = IncrementalTracer::new(StepOptions {
         solver: ipc,
-        candidates: CandidateMode::Wvrn,
-        max_candidates: u64::MAX,
-        parallel: true,
-    };
-    let image = StepOptions {
-        solver: Solver::Image,
-        ..options
-    };
-    let mut tracer = IncrementalTracer::new(options);
+        ..reference_options
+    });
     let mut warm = 0;
     for (k, scene) in dynamic.scenes().iter().enumerate() {
         let inc = tracer.step(scene).unwrap();
         warm += inc.update.warm_started;
-        let reference = trace_scratch(scene, k, &image).unwrap();
+        let reference = trace_scratch(scene, k, &reference_options).unwrap();
         let worst = max_point_distance(&inc.trace.paths, &reference.trace.paths)
             .unwrap_or_else(|| panic!("step {k}: IPC found other paths than the image method"));
         assert!(
@@ -215,30 +208,19 @@ fn a_walking_person_keeps_the_beam_tree() {
     }
     let dynamic =
         DynamicScene::from_description(&description, "test", Terminals::default()).unwrap();
-    let options = StepOptions {
-        max_order: 3,
-        solver: Solver::Image,
-        candidates: CandidateMode::BeamTree,
-        max_candidates: u64::MAX,
-        parallel: false,
-    };
-    let mut tracer = IncrementalTracer::new(options);
+    let steps = same_as_scratch(&dynamic, &image(CandidateMode::BeamTree, 3, false));
     let mut kept = 0;
-    for (k, scene) in dynamic.scenes().iter().enumerate() {
-        let step = tracer.step(scene).unwrap();
-        let scratch = trace_scratch(scene, k, &options).unwrap();
-        assert_eq!(step.trace.paths, scratch.trace.paths, "step {k}");
-        if k > 0 {
-            let moved = moved_surfaces(dynamic.step(k - 1), scene).unwrap();
-            let reflector_moved = moved
-                .iter()
-                .any(|id| scene.surface(*id).kind == bt_scene::SurfaceKind::Reflector);
-            assert_eq!(
-                step.update.candidates_rederived, reflector_moved,
-                "step {k}"
-            );
-            kept += usize::from(!reflector_moved);
-        }
+    for (k, step) in steps.iter().enumerate().skip(1) {
+        let scene = dynamic.step(k);
+        let moved = moved_surfaces(dynamic.step(k - 1), scene).unwrap();
+        let reflector_moved = moved
+            .iter()
+            .any(|id| scene.surface(*id).kind == bt_scene::SurfaceKind::Reflector);
+        assert_eq!(
+            step.update.candidates_rederived, reflector_moved,
+            "step {k}"
+        );
+        kept += usize::from(!reflector_moved);
     }
     assert!(kept > 0, "some step moves only the person");
 }
@@ -247,29 +229,16 @@ fn a_walking_person_keeps_the_beam_tree() {
 fn the_swinging_door_rebuilds_only_the_subtrees_it_touches() {
     // Each step turns the door (a reflector) by 10°: the tracer's beam tree copies every node
     // whose prefix avoids the door and tests the door afresh under each copied parent.
-    let dynamic = living_room();
-    let options = StepOptions {
-        max_order: 3,
-        solver: Solver::Image,
-        candidates: CandidateMode::BeamTree,
-        max_candidates: u64::MAX,
-        parallel: false,
-    };
-    let mut tracer = IncrementalTracer::new(options);
-    for (k, scene) in dynamic.scenes().iter().enumerate() {
-        let step = tracer.step(scene).unwrap();
-        let scratch = trace_scratch(scene, k, &options).unwrap();
-        assert_eq!(step.trace.paths, scratch.trace.paths, "step {k}");
-        if k > 0 {
-            let u = &step.update;
-            assert!(u.candidates_rederived, "step {k}: the door moved");
-            assert!(
-                u.tree_nodes_reused > 4 * u.tree_nodes_built,
-                "step {k}: {} nodes copied, {} built",
-                u.tree_nodes_reused,
-                u.tree_nodes_built
-            );
-        }
+    let steps = same_as_scratch(&living_room(), &image(CandidateMode::BeamTree, 3, false));
+    for (k, step) in steps.iter().enumerate().skip(1) {
+        let u = &step.update;
+        assert!(u.candidates_rederived, "step {k}: the door moved");
+        assert!(
+            u.tree_nodes_reused > 4 * u.tree_nodes_built,
+            "step {k}: {} nodes copied, {} built",
+            u.tree_nodes_reused,
+            u.tree_nodes_built
+        );
     }
 }
 
@@ -287,18 +256,8 @@ fn a_walking_handset_is_a_walk_of_the_kept_tree() {
     );
     let dynamic =
         DynamicScene::from_description(&description, "test", Terminals::default()).unwrap();
-    let options = StepOptions {
-        max_order: 3,
-        solver: Solver::Image,
-        candidates: CandidateMode::BeamTree,
-        max_candidates: u64::MAX,
-        parallel: false,
-    };
-    let mut tracer = IncrementalTracer::new(options);
-    for (k, scene) in dynamic.scenes().iter().enumerate() {
-        let step = tracer.step(scene).unwrap();
-        let scratch = trace_scratch(scene, k, &options).unwrap();
-        assert_eq!(step.trace.paths, scratch.trace.paths, "step {k}");
-        assert!(k == 0 || step.update.terminals_moved, "step {k}");
+    let steps = same_as_scratch(&dynamic, &image(CandidateMode::BeamTree, 3, false));
+    for (k, step) in steps.iter().enumerate().skip(1) {
+        assert!(step.update.terminals_moved, "step {k}");
     }
 }

@@ -16,7 +16,9 @@
 pub mod plot;
 pub mod report;
 
-use crate::run::{AngularErrors, Directions, PathMap, compare, exact_directions, run_solver};
+use crate::run::{
+    Comparison, Directions, PathMap, exact_directions, max_order_problem, run_solver,
+};
 use crate::{StudyConfig, StudyError, StudySolver};
 use bt_accel as fpga;
 use bt_geom::{Real, Vec3};
@@ -127,12 +129,7 @@ impl LivingRoomConfig {
         if self.max_order == 0 {
             p.push("max order must be at least 1 (the accelerator traces reflections)".into());
         }
-        if self.max_order > 6 {
-            p.push(format!(
-                "max order {} is too high for a study (at most 6)",
-                self.max_order
-            ));
-        }
+        p.extend(max_order_problem(self.max_order));
         if self.ga_population == 0 {
             p.push("ga population must be at least 1".into());
         }
@@ -164,23 +161,9 @@ impl LivingRoomConfig {
 pub struct Row {
     /// Time step, from 0.
     pub step: usize,
-    /// Solver.
-    pub solver: StudySolver,
-    /// Paths the solver found.
-    pub paths: usize,
-    /// Of those, paths whose surface sequence the image method also found.
-    pub matched: usize,
-    /// Image-method paths the solver did not find.
-    pub missed: usize,
-    /// Solver paths the image method does not have.
-    pub spurious: usize,
-    /// Angles between the solver's and the exact departure (TX) and arrival (RX) directions
-    /// over matched paths, degrees (zeros when nothing matched).
+    /// The solver's paths compared with the image method's (columns `solver` ... `time_s`).
     #[serde(flatten)]
-    pub errors: AngularErrors,
-    /// Single-threaded wall-clock time from scene to paths, seconds (candidate enumeration
-    /// included; for the fixed-point model: building its input and running it in software).
-    pub time_s: Real,
+    pub comparison: Comparison,
 }
 
 /// The accelerator at one time step: its input, the fixed-point outcomes and the schedule.
@@ -419,26 +402,6 @@ fn fill_platform_instances(
     Ok(())
 }
 
-fn row(
-    step: usize,
-    solver: StudySolver,
-    reference: &PathMap,
-    found: &PathMap,
-    time_s: Real,
-) -> Row {
-    let (matched, missed, spurious, errors) = compare(reference, found);
-    Row {
-        step,
-        solver,
-        paths: found.len(),
-        matched,
-        missed,
-        spurious,
-        errors: errors.into(),
-        time_s,
-    }
-}
-
 /// Run the study over every step of `scene`. `progress(done, total)` is called after every
 /// step. Steps and solvers run one after the other, every solver single-threaded, so the times
 /// compare fairly (only the scheduler, which is not timed as a solver, uses every core). All
@@ -464,13 +427,11 @@ pub fn run(
     let mut previous = None;
     for (step, s) in scene.scenes().iter().enumerate() {
         let (reference, time_s) = run_solver(s, StudySolver::Image, &solver_config)?;
-        rows.push(row(
+        let row = |solver, found: &PathMap, time_s| Row {
             step,
-            StudySolver::Image,
-            &reference,
-            &reference,
-            time_s,
-        ));
+            comparison: Comparison::new(solver, &reference, found, time_s),
+        };
+        rows.push(row(StudySolver::Image, &reference, time_s));
         let mut sbr_paths = PathMap::new();
         for solver in [
             StudySolver::IpcGaussSeidel,
@@ -478,19 +439,13 @@ pub fn run(
             StudySolver::Sbr,
         ] {
             let (found, time_s) = run_solver(s, solver, &solver_config)?;
-            rows.push(row(step, solver, &reference, &found, time_s));
+            rows.push(row(solver, &found, time_s));
             if solver == StudySolver::Sbr {
                 sbr_paths = found;
             }
         }
         let fixed = fixed_point_step(s, &planes, step, config, previous.as_ref())?;
-        rows.push(row(
-            step,
-            StudySolver::IpcFixedPoint,
-            &reference,
-            &fixed.paths,
-            fixed.time_s,
-        ));
+        rows.push(row(StudySolver::IpcFixedPoint, &fixed.paths, fixed.time_s));
         fpga.push(fixed.fpga);
         work.push(fixed.planned.work());
         previous = Some(fixed.planned);
@@ -557,7 +512,7 @@ mod tests {
         let results = run(&scene, &config, &mut |_, _| {}).expect("study runs");
         assert_eq!(results.rows.len(), scene.len() * SOLVERS.len());
         assert_eq!(results.fpga.len(), scene.len());
-        for r in &results.rows {
+        for r in results.rows.iter().map(|r| &r.comparison) {
             let limit = match r.solver {
                 StudySolver::Image => 0.0,
                 StudySolver::IpcGaussSeidel | StudySolver::IpcJacobi => 1e-6,

@@ -5,6 +5,7 @@
 use super::{LivingRoomResults, RayAngles, StepRays};
 use crate::StudySolver;
 use crate::plot::{FAMILY, Series, TIME_FLOOR_S, blank, colour, error_panel, fail, legend, panel};
+use crate::run::Comparison;
 use bt_geom::Real;
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -15,13 +16,13 @@ const FPGA_COLOUR: RGBColor = RGBColor(255, 127, 14);
 fn per_step(
     results: &LivingRoomResults,
     solver: StudySolver,
-    value: impl Fn(&super::Row) -> Real,
+    value: impl Fn(&Comparison) -> Real,
 ) -> Series {
     let points = results
         .rows
         .iter()
-        .filter(|r| r.solver == solver)
-        .map(|r| (r.step, value(r)))
+        .filter(|r| r.comparison.solver == solver)
+        .map(|r| (r.step, value(&r.comparison)))
         .collect();
     Series::of(solver, points)
 }
@@ -41,7 +42,7 @@ pub fn angular_error<DB: DrawingBackend>(
         StudySolver::Sbr,
     ];
     let panels = root.split_evenly((1, 2));
-    type Side = fn(&super::Row) -> Real;
+    type Side = fn(&Comparison) -> Real;
     let sides: [(&str, Side); 2] = [
         ("(a) TX side", |r| r.errors.mean_err_tx_deg),
         ("(b) RX side", |r| r.errors.mean_err_rx_deg),

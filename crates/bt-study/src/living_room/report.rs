@@ -4,14 +4,17 @@
 use super::{CLOCK_HZ, LivingRoomResults, Row, SOLVERS};
 use crate::StudySolver;
 use crate::report::pick;
-use crate::run::AngularErrors;
+use crate::run::{AngularErrors, Comparison};
 use bt_geom::Real;
 use std::collections::BTreeMap;
 use std::fmt::Write;
 
 /// Column names of `results.csv`.
-pub const CSV_HEADER: &str = "scene,step,solver,paths,matched,missed,spurious,\
-mean_err_tx_deg,max_err_tx_deg,mean_err_rx_deg,max_err_rx_deg,time_s,fpga_cycles,fpga_latency_s";
+pub const CSV_HEADER: &str = concat!(
+    "scene,step,",
+    crate::run::comparison_csv_columns!(),
+    ",fpga_cycles,fpga_latency_s"
+);
 
 /// Column names of `fpga.csv`.
 pub const FPGA_CSV_HEADER: &str = "scene,step,paths,host_paths,warm_started,points,converged,not_converged,degenerate,\
@@ -26,7 +29,7 @@ pub fn csv(results: &LivingRoomResults) -> String {
     out.push_str(CSV_HEADER);
     out.push('\n');
     for r in &results.rows {
-        let fpga = if r.solver == StudySolver::IpcFixedPoint {
+        let fpga = if r.comparison.solver == StudySolver::IpcFixedPoint {
             results
                 .fpga
                 .iter()
@@ -36,23 +39,9 @@ pub fn csv(results: &LivingRoomResults) -> String {
         } else {
             ",".into()
         };
-        let _ = writeln!(
-            out,
-            "{},{},{},{},{},{},{},{:e},{:e},{:e},{:e},{:e},{}",
-            results.scene_name,
-            r.step,
-            r.solver.name(),
-            r.paths,
-            r.matched,
-            r.missed,
-            r.spurious,
-            r.errors.mean_err_tx_deg,
-            r.errors.max_err_tx_deg,
-            r.errors.mean_err_rx_deg,
-            r.errors.max_err_rx_deg,
-            r.time_s,
-            fpga
-        );
+        let _ = write!(out, "{},{},", results.scene_name, r.step);
+        r.comparison.write_csv(&mut out);
+        let _ = writeln!(out, ",{fpga}");
     }
     out
 }
@@ -119,7 +108,7 @@ pub struct Totals {
 /// paths, as the paper averages the rays of a step).
 pub fn totals(rows: &[Row]) -> BTreeMap<StudySolver, Totals> {
     let mut out: BTreeMap<StudySolver, (Totals, usize)> = BTreeMap::new();
-    for r in rows {
+    for r in rows.iter().map(|r| &r.comparison) {
         let (t, matched) = out.entry(r.solver).or_default();
         t.steps += 1;
         t.paths += r.paths;
@@ -203,11 +192,13 @@ pub fn headline(results: &LivingRoomResults) -> Headline {
     }
 }
 
-fn find(results: &LivingRoomResults, step: usize, solver: StudySolver) -> Option<&Row> {
+/// The comparison of `solver` at `step`, or an empty one.
+fn find(results: &LivingRoomResults, step: usize, solver: StudySolver) -> Comparison {
     results
         .rows
         .iter()
-        .find(|r| r.step == step && r.solver == solver)
+        .find(|r| r.step == step && r.comparison.solver == solver)
+        .map_or_else(|| Comparison::empty(solver), |r| r.comparison.clone())
 }
 
 /// `summary.md`: settings, per-solver totals, a per-step table and the paper's conclusions
@@ -281,15 +272,12 @@ fn per_solver(results: &LivingRoomResults) -> String {
         let Some(t) = t.get(&solver) else { continue };
         let _ = writeln!(
             s,
-            "| {} | {} | {} | {} | {:.3e} | {:.3e} | {:.3e} | {:.3e} | {:.3} |",
+            "| {} | {} | {} | {} | {} | {:.3} |",
             solver.name(),
             t.paths,
             t.missed,
             t.spurious,
-            t.errors.mean_err_tx_deg,
-            t.errors.max_err_tx_deg,
-            t.errors.mean_err_rx_deg,
-            t.errors.max_err_rx_deg,
+            t.errors.table_cells(),
             t.mean_time_s * 1e3
         );
     }
@@ -324,7 +312,7 @@ fn per_step(results: &LivingRoomResults) -> String {
         "|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|"
     );
     for f in &results.fpga {
-        let get = |solver| row_or_empty(results, f.step, solver);
+        let get = |solver| find(results, f.step, solver);
         let (image, gs, jacobi, sbr, fixed) = (
             get(StudySolver::Image),
             get(StudySolver::IpcGaussSeidel),
@@ -332,7 +320,7 @@ fn per_step(results: &LivingRoomResults) -> String {
             get(StudySolver::Sbr),
             get(StudySolver::IpcFixedPoint),
         );
-        let err = |r: &Row| {
+        let err = |r: &Comparison| {
             format!(
                 "{:.1e} / {:.1e}",
                 r.errors.mean_err_tx_deg, r.errors.mean_err_rx_deg
@@ -364,20 +352,6 @@ fn per_step(results: &LivingRoomResults) -> String {
         );
     }
     s
-}
-
-/// The row of `solver` at `step`, or an empty one.
-fn row_or_empty(results: &LivingRoomResults, step: usize, solver: StudySolver) -> Row {
-    find(results, step, solver).cloned().unwrap_or(Row {
-        step,
-        solver,
-        paths: 0,
-        matched: 0,
-        missed: 0,
-        spurious: 0,
-        errors: AngularErrors::default(),
-        time_s: 0.0,
-    })
 }
 
 /// The paper's conclusions, measured: the last table of `summary.md`.

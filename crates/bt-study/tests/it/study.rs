@@ -55,15 +55,22 @@ fn tiny_study_is_consistent() {
     }
     assert!(sbr_error > 0.0);
     // Every room has paths, and SBR with a 2° step finds most of them.
-    for r in results.rows.iter().filter(|r| r.solver == StudySolver::Sbr) {
+    for r in results
+        .rows
+        .iter()
+        .filter(|r| r.comparison.solver == StudySolver::Sbr)
+    {
         let image = results
             .rows
             .iter()
-            .find(|i| i.solver == StudySolver::Image && i.room == r.room && i.step == r.step)
+            .find(|i| {
+                i.comparison.solver == StudySolver::Image && i.room == r.room && i.step == r.step
+            })
+            .map(|i| &i.comparison)
             .unwrap();
         assert!(image.paths > 0);
         assert!(
-            r.missed * 4 <= image.paths,
+            r.comparison.missed * 4 <= image.paths,
             "{r:?} vs {} exact paths",
             image.paths
         );
@@ -75,7 +82,9 @@ fn tiny_study_is_consistent() {
 #[test]
 fn results_are_deterministic_apart_from_times() {
     let strip = |mut r: bt_study::StudyResults| {
-        r.rows.iter_mut().for_each(|row| row.time_s = 0.0);
+        r.rows
+            .iter_mut()
+            .for_each(|row| row.comparison.time_s = 0.0);
         report::csv(&r)
     };
     let config = StudyConfig {
