@@ -76,8 +76,14 @@ pub struct PlannedStep {
     pub budget_model_time_s: f64,
 }
 
+/// Whether the PE copies are sized once for all steps: the list scheduler with a PE budget
+/// (the GA keeps its own duplication per step).
+fn fixed_copies(plan: &PlanOptions) -> bool {
+    plan.schedule == bt_hls::ScheduleKind::List && plan.pe_budget.is_some()
+}
+
 /// Plan step `index` of a scene on a platform whose PEs are `planes`; `previous` is the step
-/// before (for the warm start).
+/// before (for the warm start and, with a PE budget, the platform's PE copies).
 pub fn plan_step(
     scene: &Scene,
     planes: &[SurfaceId],
@@ -123,7 +129,15 @@ pub fn plan_step(
         .map_err(|e| hardware(e.into()))?;
     let problem = step.input.problem_for(&results);
     let t2 = Instant::now();
-    let plan = bt_hls::plan(&problem, &options.plan).map_err(hardware)?;
+    let plan = match previous {
+        // Copies sized once, at the first step, within the PE budget; every later step is
+        // scheduled onto them, so that one design runs the whole stream.
+        Some(p) if fixed_copies(&options.plan) => {
+            bt_hls::plan_on(&problem, &options.plan, &p.plan.schedule.copies())
+        }
+        _ => bt_hls::plan(&problem, &options.plan),
+    }
+    .map_err(hardware)?;
     let t3 = Instant::now();
     let fixed = fixed_deviation(scene, &step, &results, trace.max_order);
     Ok(PlannedStep {

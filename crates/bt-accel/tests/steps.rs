@@ -98,3 +98,39 @@ fn a_ray_slipping_past_an_edge_is_decided_on_the_exact_points() {
     assert_eq!(p.fixed.spurious, 0, "{:?}", p.fixed);
     assert_eq!(p.fixed.missed, 0, "{:?}", p.fixed);
 }
+
+#[test]
+fn a_pe_budget_sizes_the_copies_once_for_every_step() {
+    // With the list scheduler and a PE budget, the first step picks the copies (its busiest
+    // planes) and the later steps are scheduled onto the same PEs: one platform, and no
+    // later step slower than on a platform without copies.
+    let scene = builtin_dynamic_scene("living-room-dynamic", Terminals::default())
+        .unwrap()
+        .unwrap();
+    let steps = &scene.scenes()[..4];
+    let planes = static_reflectors(scene.scenes());
+    let mut with_copies = options(2, true);
+    with_copies.plan.pe_budget = Some(16);
+    let (mut dup, mut plain): (Vec<PlannedStep>, Vec<PlannedStep>) = (Vec::new(), Vec::new());
+    for (k, s) in steps.iter().enumerate() {
+        let d = plan_step(s, &planes, k, &with_copies, dup.last()).unwrap();
+        let p = plan_step(s, &planes, k, &options(2, true), plain.last()).unwrap();
+        dup.push(d);
+        plain.push(p);
+    }
+    let copies = dup[0].plan.schedule.copies();
+    assert!(copies.iter().sum::<u32>() > copies.iter().filter(|&&c| c > 0).count() as u32);
+    for (d, p) in dup.iter().zip(&plain) {
+        let c = d.plan.schedule.copies();
+        for (plane, &n) in c.iter().enumerate() {
+            let first = copies.get(plane).copied().unwrap_or(0);
+            assert!(n == first || (first == 0 && n == 1), "step {}: plane {plane}", d.index);
+        }
+        assert!(d.plan.stats.makespan <= p.plan.stats.makespan, "step {}", d.index);
+        assert_eq!((d.fixed.missed, d.fixed.spurious), (0, 0), "step {}", d.index);
+    }
+    let work: Vec<bt_hls::StepWork> = dup.iter().map(PlannedStep::work).collect();
+    let platform = bt_hls::Platform::fitting(&work).unwrap();
+    let extra: u32 = copies.iter().map(|&c| c.saturating_sub(1)).sum();
+    assert_eq!(platform.instances.len() as u32, planes.len() as u32 + extra);
+}

@@ -35,7 +35,9 @@ pub use error::HlsError;
 pub use input::{Capacity, EP4CE115_M9K_BLOCKS, MAX_ADDRESS_BITS, MIN_ADDRESS_BITS, m9k_blocks};
 pub use input::{HlsInput, PE_LATENCY, PlaneSpec, Platform, StepWork};
 pub use pe::{POINT_BITS, pe_module_name};
-pub use plan::{Plan, PlanOptions, ScheduleKind, plan, run_cycles, schedule_entries, slot_cycles};
+pub use plan::{
+    Plan, PlanOptions, ScheduleKind, plan, plan_on, run_cycles, schedule_entries, slot_cycles,
+};
 pub use tools::{
     AdderMapping, BlockArea, EP4CE115_LES, LintReport, SimProgress, SimReport, Simulator,
     SynthOptions, SynthReport, area_markdown, cell_models, lint, simulate, simulate_netlist,

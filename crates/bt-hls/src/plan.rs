@@ -94,6 +94,21 @@ pub fn run_cycles(schedule: &Schedule) -> u64 {
 /// [`crate::HlsInput::problem_for`]) and predict the run's cycles. Deterministic for the
 /// options (the GA is seeded).
 pub fn plan(problem: &Problem, options: &PlanOptions) -> Result<Plan, HlsError> {
+    plan_with(problem, options, None)
+}
+
+/// [`plan`] with the list scheduler onto a platform sized beforehand: `copies[p]` PEs of
+/// plane `p` ([`bt_schedule::schedule_list_on`]), e.g. the copies the first time step chose
+/// within the PE budget, so that every step runs on the same design.
+pub fn plan_on(problem: &Problem, options: &PlanOptions, copies: &[u32]) -> Result<Plan, HlsError> {
+    plan_with(problem, options, Some(copies))
+}
+
+fn plan_with(
+    problem: &Problem,
+    options: &PlanOptions,
+    copies: Option<&[u32]>,
+) -> Result<Plan, HlsError> {
     let planes_used = {
         let mut used: Vec<u32> = problem
             .paths
@@ -118,6 +133,7 @@ pub fn plan(problem: &Problem, options: &PlanOptions) -> Result<Plan, HlsError> 
     )?;
     let list_makespan = list.stats(problem).makespan;
     let schedule = match (options.schedule, options.pe_budget) {
+        _ if copies.is_some() => bt_schedule::schedule_list_on(problem, copies.unwrap_or(&[]))?,
         // Extra PEs asked for: copies of the busiest planes (offline sizing of the platform).
         (ScheduleKind::List, Some(b)) if b > planes_used => {
             bt_schedule::schedule_list_duplicated(problem, &budget)?
@@ -127,6 +143,7 @@ pub fn plan(problem: &Problem, options: &PlanOptions) -> Result<Plan, HlsError> 
     };
     schedule.check(problem)?;
     let stats = schedule.stats(problem);
+    let pe_budget = budget.max_instances.max(schedule.instances.len() as u32);
     let points: u64 = problem.paths.iter().map(|p| p.planes.len() as u64).sum();
     Ok(Plan {
         predicted_cycles: run_cycles(&schedule),
@@ -134,7 +151,7 @@ pub fn plan(problem: &Problem, options: &PlanOptions) -> Result<Plan, HlsError> 
         schedule,
         stats,
         list_makespan,
-        pe_budget: budget.max_instances,
+        pe_budget,
         points,
     })
 }

@@ -36,7 +36,7 @@ pub mod synthetic;
 pub use check::ScheduleStats;
 pub use error::{ProblemIssue, REPORT_LIMIT, Report, ScheduleError, ScheduleViolation};
 pub use ga::{GaParams, schedule_ga};
-pub use list::{schedule_list, schedule_list_duplicated, size_copies};
+pub use list::{schedule_list, schedule_list_duplicated, schedule_list_on, size_copies};
 
 /// One candidate path as the scheduler sees it.
 #[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -92,6 +92,21 @@ pub struct Schedule {
     pub instances: Vec<PeInstance>,
     /// One row per slot, `instances.len()` entries per row; `None` = the PE idles.
     pub slots: Vec<Vec<Option<Job>>>,
+}
+
+impl Schedule {
+    /// PE copies per plane (index = plane, up to the highest plane with an instance).
+    pub fn copies(&self) -> Vec<u32> {
+        let mut copies = Vec::new();
+        for inst in &self.instances {
+            let p = inst.plane as usize;
+            if copies.len() <= p {
+                copies.resize(p + 1, 0);
+            }
+            copies[p] = copies[p].max(inst.copy + 1);
+        }
+        copies
+    }
 }
 
 /// How many PE instances a schedule may use in total (originals plus duplicates).

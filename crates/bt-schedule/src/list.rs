@@ -63,8 +63,20 @@ pub fn schedule_list_duplicated(
     problem: &Problem,
     budget: &Budget,
 ) -> Result<Schedule, ScheduleError> {
+    schedule_list_on(problem, &size_copies(problem, budget)?)
+}
+
+/// [`schedule_list_duplicated`] on a platform sized beforehand: `copies[p]` PEs of plane `p`
+/// (raised to one for every plane the problem uses), e.g. the copies a platform was sized with
+/// once for all its time steps.
+pub fn schedule_list_on(problem: &Problem, copies: &[u32]) -> Result<Schedule, ScheduleError> {
     let prep = Prepared::new(problem)?;
-    let copies = size_copies(problem, budget)?;
+    let copies: Vec<u32> = prep
+        .base_copies()
+        .iter()
+        .enumerate()
+        .map(|(p, &base)| base.max(copies.get(p).copied().unwrap_or(0)))
+        .collect();
     let inst = InstanceSet::from_copies(&copies);
     let mut order: Vec<u32> = (0..problem.paths.len() as u32).collect();
     let jobs = |p: u32| {
