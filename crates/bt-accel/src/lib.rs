@@ -6,6 +6,7 @@
 //! Dependency direction: `bt-scene`, `bt-paths`, `bt-solve` (candidates, image method,
 //! validation) and `bt-hls` (model, schedule) → `bt-accel` → `bt-study`, `beamtrace`.
 //! No file I/O.
+#![warn(missing_docs)]
 
 mod bridge;
 mod deviation;
