@@ -124,10 +124,23 @@ fn a_pe_budget_sizes_the_copies_once_for_every_step() {
         let c = d.plan.schedule.copies();
         for (plane, &n) in c.iter().enumerate() {
             let first = copies.get(plane).copied().unwrap_or(0);
-            assert!(n == first || (first == 0 && n == 1), "step {}: plane {plane}", d.index);
+            assert!(
+                n == first || (first == 0 && n == 1),
+                "step {}: plane {plane}",
+                d.index
+            );
         }
-        assert!(d.plan.stats.makespan <= p.plan.stats.makespan, "step {}", d.index);
-        assert_eq!((d.fixed.missed, d.fixed.spurious), (0, 0), "step {}", d.index);
+        assert!(
+            d.plan.stats.makespan <= p.plan.stats.makespan,
+            "step {}",
+            d.index
+        );
+        assert_eq!(
+            (d.fixed.missed, d.fixed.spurious),
+            (0, 0),
+            "step {}",
+            d.index
+        );
     }
     let work: Vec<bt_hls::StepWork> = dup.iter().map(PlannedStep::work).collect();
     let platform = bt_hls::Platform::fitting(&work).unwrap();
