@@ -15,6 +15,12 @@ pub trait Occluder {
     fn bounds(&self) -> (Vec3, Vec3);
 }
 
+impl<T: Occluder> Occluder for &T {
+    fn bounds(&self) -> (Vec3, Vec3) {
+        (*self).bounds()
+    }
+}
+
 impl Occluder for crate::Polygon {
     fn bounds(&self) -> (Vec3, Vec3) {
         crate::Polygon::bounds(self)

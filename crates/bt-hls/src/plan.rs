@@ -132,14 +132,15 @@ fn plan_with(
         },
     )?;
     let list_makespan = list.stats(problem).makespan;
-    let schedule = match (options.schedule, options.pe_budget) {
-        _ if copies.is_some() => bt_schedule::schedule_list_on(problem, copies.unwrap_or(&[]))?,
+    let schedule = match (copies, options.schedule, options.pe_budget) {
+        // A platform sized beforehand: the list scheduler onto its copies.
+        (Some(copies), _, _) => bt_schedule::schedule_list_on(problem, copies)?,
         // Extra PEs asked for: copies of the busiest planes (offline sizing of the platform).
-        (ScheduleKind::List, Some(b)) if b > planes_used => {
+        (None, ScheduleKind::List, Some(b)) if b > planes_used => {
             bt_schedule::schedule_list_duplicated(problem, &budget)?
         }
-        (ScheduleKind::List, _) => list,
-        (ScheduleKind::Ga, _) => bt_schedule::schedule_ga(problem, &budget, &options.ga)?,
+        (None, ScheduleKind::List, _) => list,
+        (None, ScheduleKind::Ga, _) => bt_schedule::schedule_ga(problem, &budget, &options.ga)?,
     };
     schedule.check(problem)?;
     let stats = schedule.stats(problem);

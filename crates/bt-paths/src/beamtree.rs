@@ -230,15 +230,6 @@ struct RxVisible {
     bvh: bt_geom::bvh::Bvh,
 }
 
-/// A surface's box as a BVH item.
-struct Boxed((Vec3, Vec3));
-
-impl bt_geom::bvh::Occluder for Boxed {
-    fn bounds(&self) -> (Vec3, Vec3) {
-        self.0
-    }
-}
-
 impl<'a> Prepared<'a> {
     fn new(scene: &'a Scene, options: TreeOptions) -> Self {
         let surfaces = scene.surfaces();
@@ -451,36 +442,47 @@ impl BeamTree {
         mut leaf: Option<(Vec3, &mut CandidateSet)>,
         progress: Progress<'_>,
     ) -> Result<(), TreeError> {
-        let parents = if depth == 1 {
-            (0, 0)
-        } else {
-            self.levels[depth - 2]
-        };
+        let materialised = leaf.is_none();
+        self.for_each_parent(prep, (depth, materialised), progress, |tree, p, bufs| {
+            let leaf = leaf.as_mut().map(|(rx, out)| (*rx, &mut **out));
+            tree.grow_children(prep, p, depth, scratch, leaf, bufs);
+        })
+    }
+
+    /// Run `grow(tree, p, bufs)` for every parent `p` of depth `depth` (the root at depth 1),
+    /// in order, reporting to `progress` and checking the node budget after each; then close
+    /// the level (recorded when `materialised`). `bufs`: scratch for a parent's planes and
+    /// children, reused across parents.
+    fn for_each_parent(
+        &mut self,
+        prep: &Prepared<'_>,
+        (depth, materialised): (usize, bool),
+        progress: Progress<'_>,
+        mut grow: impl FnMut(&mut Self, u32, (&mut Vec<Plane>, &mut Vec<u32>)),
+    ) -> Result<(), TreeError> {
         let start = self.nodes.len();
-        let parent_ids: Vec<u32> = if depth == 1 {
-            vec![ROOT]
-        } else {
-            (parents.0 as u32..parents.1 as u32).collect()
+        let ids: Vec<u32> = match depth {
+            1 => vec![ROOT],
+            _ => {
+                let (lo, hi) = self.levels[depth - 2];
+                (lo as u32..hi as u32).collect()
+            }
         };
-        let mut children = Vec::new();
-        let mut plane_copy: Vec<Plane> = Vec::new();
-        let parents = parent_ids.len();
-        for (done, p) in parent_ids.into_iter().enumerate() {
+        let (mut planes, mut children) = (Vec::new(), Vec::new());
+        for (done, &p) in ids.iter().enumerate() {
             if done % PROGRESS_EVERY == 0 {
                 progress(BuildProgress {
                     depth,
                     max_order: prep.options.max_order,
                     parents_done: done,
-                    parents,
+                    parents: ids.len(),
                     nodes: self.nodes.len() as u64,
                 });
             }
-            let leaf = leaf.as_mut().map(|(rx, out)| (*rx, &mut **out));
-            let bufs = (&mut plane_copy, &mut children);
-            self.grow_children(prep, p, depth, scratch, leaf, bufs);
+            grow(self, p, (&mut planes, &mut children));
             self.check_budget(prep, depth)?;
         }
-        self.end_level(start, leaf.is_none());
+        self.end_level(start, materialised);
         Ok(())
     }
 
@@ -990,13 +992,13 @@ fn rx_visibility(
         .copied()
         .filter(|&s| visible[s as usize])
         .collect();
-    let boxes: Vec<Boxed> = ids
+    let polygons: Vec<&bt_geom::Polygon> = ids
         .iter()
-        .map(|&s| Boxed(prep.scene.surface(SurfaceId(s)).polygon.bounds()))
+        .map(|&s| &prep.scene.surface(SurfaceId(s)).polygon)
         .collect();
     RxVisible {
         visible,
-        bvh: bt_geom::bvh::Bvh::build(&boxes),
+        bvh: bt_geom::bvh::Bvh::build(&polygons),
         ids,
     }
 }

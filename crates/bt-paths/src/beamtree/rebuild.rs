@@ -10,8 +10,8 @@
 //! not applied to copied nodes: culling only removes work, never paths, so the rebuilt tree
 //! holds every node of a fresh build and may keep a few it would have culled.
 
-use super::{BeamTree, PROGRESS_EVERY, Prepared, ROOT, Scratch, TreeError};
-use crate::beamtree::{BuildProgress, Progress};
+use super::{BeamTree, Prepared, ROOT, Scratch, TreeError};
+use crate::beamtree::Progress;
 use bt_geom::Plane;
 use bt_geom::bvh::box_meets_halfspaces;
 use bt_scene::{Scene, SurfaceId};
@@ -56,7 +56,6 @@ impl BeamTree {
         moved: &[SurfaceId],
         progress: Progress<'_>,
     ) -> Result<(BeamTree, RebuildStats), TreeError> {
-        let prep = Prepared::new(scene, self.options);
         if !self.reusable(scene, moved) {
             let tree = BeamTree::build_with_progress(scene, self.options, progress)?;
             let built = tree.len() as u64;
@@ -67,6 +66,7 @@ impl BeamTree {
             };
             return Ok((tree, stats));
         }
+        let prep = Prepared::new(scene, self.options);
         let mut is_moved = vec![false; self.surfaces];
         moved.iter().for_each(|id| is_moved[id.index()] = true);
         let mut reflectors: Vec<u32> = moved
@@ -88,13 +88,13 @@ impl BeamTree {
         // Per node of `tree`: its twin in `self` when copied.
         let mut origin: Vec<Option<u32>> = Vec::new();
         let children = self.child_ranges();
+        let ctx = Regrow {
+            old: &self,
+            children: &children,
+            moved: &moved,
+        };
         let mut scratch = Scratch::default();
         for depth in 1..=self.options.max_order {
-            let ctx = Regrow {
-                old: &self,
-                children: &children,
-                moved: &moved,
-            };
             tree.regrow_level(&prep, &ctx, depth, &mut origin, &mut scratch, progress)?;
         }
         tree.compact();
@@ -185,46 +185,20 @@ impl BeamTree {
         scratch: &mut Scratch,
         progress: Progress<'_>,
     ) -> Result<(), TreeError> {
-        let start = self.nodes.len();
-        let ids: Vec<u32> = match depth {
-            1 => vec![ROOT],
-            _ => {
-                let (lo, hi) = self.levels[depth - 2];
-                (lo as u32..hi as u32).collect()
-            }
-        };
-        let mut plane_copy: Vec<Plane> = Vec::new();
-        let mut children = Vec::new();
-        for (done, &p) in ids.iter().enumerate() {
-            if done % PROGRESS_EVERY == 0 {
-                progress(BuildProgress {
-                    depth,
-                    max_order: prep.options.max_order,
-                    parents_done: done,
-                    parents: ids.len(),
-                    nodes: self.nodes.len() as u64,
-                });
-            }
+        self.for_each_parent(prep, (depth, true), progress, |tree, p, bufs| {
             let twin = match p {
                 ROOT => Some(ROOT),
                 _ => origin[p as usize],
             };
-            let before = self.nodes.len();
             match twin {
-                Some(twin) => {
-                    self.merge_children(prep, ctx, (p, twin), origin, scratch, &mut plane_copy)
-                }
+                Some(twin) => tree.merge_children(prep, ctx, (p, twin), origin, scratch, bufs.0),
                 None => {
-                    let bufs = (&mut plane_copy, &mut children);
-                    self.grow_children(prep, p, depth, scratch, None, bufs);
-                    origin.resize(self.nodes.len(), None);
+                    tree.grow_children(prep, p, depth, scratch, None, bufs);
+                    origin.resize(tree.nodes.len(), None);
                 }
             }
-            debug_assert!(origin.len() == self.nodes.len() && self.nodes.len() >= before);
-            self.check_budget(prep, depth)?;
-        }
-        self.end_level(start, true);
-        Ok(())
+            debug_assert_eq!(origin.len(), tree.nodes.len());
+        })
     }
 
     /// The children of parent `p`, whose twin in the old tree is `twin`: the twin's children
