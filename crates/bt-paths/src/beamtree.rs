@@ -439,13 +439,12 @@ impl BeamTree {
         prep: &Prepared<'_>,
         depth: usize,
         scratch: &mut Scratch,
-        mut leaf: Option<(Vec3, &mut CandidateSet)>,
+        mut leaf: Option<&mut Leaf<'_>>,
         progress: Progress<'_>,
     ) -> Result<(), TreeError> {
         let materialised = leaf.is_none();
         self.for_each_parent(prep, (depth, materialised), progress, |tree, p, bufs| {
-            let leaf = leaf.as_mut().map(|(rx, out)| (*rx, &mut **out));
-            tree.grow_children(prep, p, depth, scratch, leaf, bufs);
+            tree.grow_children(prep, p, depth, scratch, leaf.as_deref_mut(), bufs);
         })
     }
 
@@ -496,7 +495,7 @@ impl BeamTree {
         p: u32,
         depth: usize,
         scratch: &mut Scratch,
-        mut leaf: Option<(Vec3, &mut CandidateSet)>,
+        mut leaf: Option<&mut Leaf<'_>>,
         (plane_copy, children): (&mut Vec<Plane>, &mut Vec<u32>),
     ) {
         let mut parent = self.parent_view(prep, p, plane_copy);
@@ -515,7 +514,7 @@ impl BeamTree {
         for &s in children.iter() {
             self.stats.tested += 1;
             match leaf.as_mut() {
-                Some((rx, out)) => self.leaf_child(prep, &parent, s, *rx, out, scratch),
+                Some(leaf) => self.leaf_child(prep, &parent, s, leaf),
                 None => self.child(prep, &parent, s, scratch),
             }
         }
@@ -588,10 +587,15 @@ impl BeamTree {
         if self.stats.occluder_clips == clips {
             return Cull::Kept;
         }
-        let planes = beam_planes(prep.plane(node.surface), node.image, &scratch.a);
+        let planes = beam_planes(
+            prep.plane(node.surface),
+            node.image,
+            &scratch.a,
+            &mut self.planes,
+        );
         let n = &mut self.nodes[i as usize];
         n.window = push_range(&mut self.verts, &scratch.a);
-        n.planes = push_range(&mut self.planes, &planes);
+        n.planes = planes;
         Cull::Clipped
     }
 
@@ -614,6 +618,15 @@ impl BeamTree {
         // On the last level, only surfaces RX can see can end a valid path.
         let last = prep.rx_visible.as_ref().filter(|_| leaf_level);
         let may_end = |s: u32| last.is_none_or(|v| v.visible[s as usize]);
+        if prep.reflectors.len() <= LINEAR_SCAN && leaf_level && last.is_none() {
+            out.extend(
+                prep.reflectors
+                    .iter()
+                    .copied()
+                    .filter(|&s| Some(s) != parent.surface),
+            );
+            return;
+        }
         if prep.reflectors.len() <= LINEAR_SCAN {
             out.extend(prep.reflectors.iter().copied().filter(|&s| {
                 let (lo, hi) = prep.scene.surface(SurfaceId(s)).polygon.bounds();
@@ -666,9 +679,8 @@ impl BeamTree {
             return;
         }
         let image = plane.mirror(parent.apex);
-        let planes = beam_planes(&plane, image, &scratch.a);
+        let planes = beam_planes(&plane, image, &scratch.a, &mut self.planes);
         let window = push_range(&mut self.verts, &scratch.a);
-        let planes = push_range(&mut self.planes, &planes);
         self.nodes.push(Node {
             surface: s,
             parent: parent.index,
@@ -680,28 +692,25 @@ impl BeamTree {
     }
 
     /// The last level of a single-receiver trace: emit child `s` when RX lies in its beam,
-    /// without building its window (the image method's crossing point is tested instead).
+    /// without building its window. RX lies in the beam exactly when the image-method point
+    /// (where the ray from the parent's apex to RX's mirror image crosses `s`'s plane) lies in
+    /// the parent's beam and in `s`'s polygon; that point is also the IPC start on `s`.
     fn leaf_child(
         &mut self,
         prep: &Prepared<'_>,
         parent: &Parent<'_>,
         s: u32,
-        rx: Vec3,
-        out: &mut CandidateSet,
-        scratch: &mut Scratch,
+        leaf: &mut Leaf<'_>,
     ) {
-        let plane = *prep.plane(s);
+        let plane = prep.plane(s);
         let tol = prep.tol;
         let eps = EPS * tol;
         let d_apex = plane.signed_distance_unfused(parent.apex);
-        let d_rx = plane.signed_distance_unfused(rx);
+        let (d_rx, rx_image) = leaf.mirrored[s as usize];
         // RX must be on the apex's side of the plane (the reflected side) and off it.
         if d_apex.abs() <= tol || d_rx * d_apex.signum() < -eps {
             return;
         }
-        // The image-method point: where the ray from the apex to RX's mirror image crosses
-        // the plane (the same point as on the ray from the apex's image to RX).
-        let rx_image = rx - (2.0 * d_rx) * plane.normal;
         let t = d_apex / (d_apex + d_rx);
         if !t.is_finite() {
             return;
@@ -711,24 +720,48 @@ impl BeamTree {
             .planes
             .iter()
             .all(|p| p.signed_distance_unfused(x) >= -eps)
+            || !prep
+                .scene
+                .surface(SurfaceId(s))
+                .polygon
+                .contains(x, GROW * tol)
         {
             return;
         }
-        let polygon = &prep.scene.surface(SurfaceId(s)).polygon;
-        if !polygon.contains(x, GROW * tol) {
-            return;
+        self.prefix(parent.index, &mut leaf.seq, &mut leaf.starts);
+        leaf.seq.push(SurfaceId(s));
+        leaf.starts.push(x);
+        leaf.out.push_with_starts(&leaf.seq, &leaf.starts);
+    }
+}
+
+/// The last level of a single-receiver trace: RX, each surface's signed distance to RX and
+/// RX's mirror image in it (computed once, read by every leaf test), the candidates emitted.
+struct Leaf<'o> {
+    /// Per surface: (signed distance of RX, m; RX mirrored through the plane).
+    mirrored: Vec<(Real, Vec3)>,
+    out: &'o mut CandidateSet,
+    /// Scratch for one candidate's sequence and start points.
+    seq: Vec<SurfaceId>,
+    starts: Vec<Vec3>,
+}
+
+impl<'o> Leaf<'o> {
+    fn new(prep: &Prepared<'_>, rx: Vec3, out: &'o mut CandidateSet) -> Self {
+        let mirrored = prep
+            .planes
+            .iter()
+            .map(|pl| {
+                let d = pl.signed_distance_unfused(rx);
+                (d, rx - (2.0 * d) * pl.normal)
+            })
+            .collect();
+        Leaf {
+            mirrored,
+            out,
+            seq: Vec::new(),
+            starts: Vec::new(),
         }
-        let mut seq = Vec::with_capacity(self.max_order);
-        let mut starts = Vec::with_capacity(self.max_order);
-        self.prefix(parent.index, &mut seq, &mut starts);
-        seq.push(SurfaceId(s));
-        window_in_beam(prep, parent, s, scratch);
-        starts.push(if scratch.a.len() >= 3 {
-            convex::vertex_mean(&scratch.a)
-        } else {
-            polygon.centroid()
-        });
-        out.push_with_starts(&seq, &starts);
     }
 }
 
@@ -738,8 +771,7 @@ fn window_in_beam(prep: &Prepared<'_>, parent: &Parent<'_>, s: u32, scratch: &mu
     scratch.a.clear();
     scratch.a.extend_from_slice(prep.hull(s));
     for pl in parent.planes {
-        convex::clip(&scratch.a, pl, EPS * prep.tol, &mut scratch.b);
-        std::mem::swap(&mut scratch.a, &mut scratch.b);
+        convex::clip_in_place(&mut scratch.a, pl, EPS * prep.tol, &mut scratch.b);
         if scratch.a.len() < 3 {
             break;
         }
@@ -752,11 +784,12 @@ fn push_range<T: Copy>(arena: &mut Vec<T>, items: &[T]) -> (u32, u32) {
     (lo, arena.len() as u32)
 }
 
-/// The beam of rays from `apex` through the convex `window` lying in `plane`: the near plane
-/// (oriented away from the apex) and one side plane per edge (oriented inward). Side planes that
-/// degenerate (apex on the edge's line) are left out, which only widens the beam.
-fn beam_planes(plane: &Plane, apex: Vec3, window: &[Vec3]) -> Vec<Plane> {
-    let mut out = Vec::with_capacity(window.len() + 1);
+/// The beam of rays from `apex` through the convex `window` lying in `plane`, appended to the
+/// arena `out`: the near plane (oriented away from the apex) and one side plane per edge
+/// (oriented inward); returns their range in `out`. Side planes that degenerate (apex on the
+/// edge's line) are left out, which only widens the beam.
+fn beam_planes(plane: &Plane, apex: Vec3, window: &[Vec3], out: &mut Vec<Plane>) -> (u32, u32) {
+    let lo = out.len() as u32;
     let near = if plane.signed_distance_unfused(apex) > 0.0 {
         flip(*plane)
     } else {
@@ -765,25 +798,34 @@ fn beam_planes(plane: &Plane, apex: Vec3, window: &[Vec3]) -> Vec<Plane> {
     out.push(near);
     let inner = convex::vertex_mean(window);
     let n = window.len();
-    for i in 0..n {
-        let (a, b) = (window[i], window[(i + 1) % n]);
-        let normal = (a - apex).cross(b - apex);
-        let len = normal.length();
-        if !spans_a_plane(len, (a - apex).length() * (b - apex).length()) {
-            continue;
+    // One square root per edge: the degeneracy test compares squares.
+    let mut a = window[0] - apex;
+    let mut a2 = a.length_squared();
+    for i in 1..=n {
+        let b = window[i % n] - apex;
+        let b2 = b.length_squared();
+        let normal = a.cross(b);
+        let len2 = normal.length_squared();
+        if spans_a_plane_squared(len2, a2 * b2) {
+            out.push(orient_towards(
+                Plane::from_point_normal(apex, normal / len2.sqrt()),
+                inner,
+            ));
         }
-        out.push(orient_towards(
-            Plane::from_point_normal(apex, normal / len),
-            inner,
-        ));
+        (a, a2) = (b, b2);
     }
-    out
+    (lo, out.len() as u32)
 }
 
 /// Whether a cross product of length `len` from two vectors whose lengths multiply to `scale`
 /// spans a plane: false for (nearly) parallel vectors, and for NaN.
 fn spans_a_plane(len: Real, scale: Real) -> bool {
     len > 1e-12 * scale
+}
+
+/// [`spans_a_plane`] on squares: `len2 = len²`, `scale2 = scale²`.
+fn spans_a_plane_squared(len2: Real, scale2: Real) -> bool {
+    len2 > 1e-24 * scale2
 }
 
 /// Occlusion culling of the window in `scratch.a` (child `s` of `parent`): returns true when a
@@ -1025,7 +1067,8 @@ pub fn candidates_with_progress(
             if worth_rx_visibility(&prep, &tree) {
                 prep.rx_visible = Some(rx_visibility(&prep, rx, &mut scratch, &mut tree.stats));
             }
-            tree.grow_level(&prep, depth, &mut scratch, Some((rx, &mut last)), progress)?;
+            let mut leaf = Leaf::new(&prep, rx, &mut last);
+            tree.grow_level(&prep, depth, &mut scratch, Some(&mut leaf), progress)?;
         } else {
             tree.grow_level(&prep, depth, &mut scratch, None, progress)?;
         }

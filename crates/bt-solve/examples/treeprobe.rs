@@ -43,6 +43,20 @@ fn run(what: &str, scene: &Scene, i: usize, tree: &BeamTree) -> usize {
             scene,
             &trace_options(Solver::Image, CandidateMode::BeamTree),
         ),
+        "report" => {
+            let traced = trace_scene(
+                scene,
+                &trace_options(Solver::Image, CandidateMode::BeamTree),
+            )
+            .unwrap();
+            bt_beams::report(
+                scene,
+                &traced.result.paths,
+                &bt_beams::RadioOptions::default(),
+            )
+            .unwrap()
+            .len()
+        }
         "exh" => traced_paths(
             scene,
             &trace_options(Solver::Image, CandidateMode::Exhaustive),
