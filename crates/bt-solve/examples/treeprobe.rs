@@ -88,6 +88,19 @@ fn main() {
         .unwrap()
         .unwrap();
     let tree = BeamTree::build(&scene, TreeOptions::new(3)).unwrap();
+    if std::env::var_os("TREEPROBE_TIME").is_some() {
+        // Wall clock: the best of 20 batches of `n` calls, per call.
+        let best = (0..20)
+            .map(|_| {
+                let t = std::time::Instant::now();
+                let total: usize = (0..n).map(|i| run(what, &scene, i, &tree)).sum();
+                std::hint::black_box(total);
+                t.elapsed().as_secs_f64() / n as f64
+            })
+            .fold(f64::INFINITY, f64::min);
+        println!("{what}: {:.1} µs per call (best of 20 batches of {n})", best * 1e6);
+        return;
+    }
     let total: usize = (0..n).map(|i| run(what, &scene, i, &tree)).sum();
     println!("{total}");
 }
