@@ -73,7 +73,10 @@ pub fn grown_hull(polygon: &Polygon, margin: Real) -> Vec<Vec3> {
     let n = hull.len();
     let mut out = Vec::with_capacity(n);
     for i in 0..n {
-        let (a, b, c) = (hull[(i + n - 1) % n], hull[i], hull[(i + 1) % n]);
+        // Neighbours without `%` (an integer division per vertex on a hot path).
+        let prev = if i == 0 { n - 1 } else { i - 1 };
+        let next = if i + 1 == n { 0 } else { i + 1 };
+        let (a, b, c) = (hull[prev], hull[i], hull[next]);
         let n1 = outward_normal(a, b);
         let n2 = outward_normal(b, c);
         // Mitre: the point whose distance to both moved edges' lines is `margin`.

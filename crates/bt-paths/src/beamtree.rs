@@ -619,12 +619,11 @@ impl BeamTree {
         let last = prep.rx_visible.as_ref().filter(|_| leaf_level);
         let may_end = |s: u32| last.is_none_or(|v| v.visible[s as usize]);
         if prep.reflectors.len() <= LINEAR_SCAN && leaf_level && last.is_none() {
-            out.extend(
-                prep.reflectors
-                    .iter()
-                    .copied()
-                    .filter(|&s| Some(s) != parent.surface),
-            );
+            // Every reflector but the parent's own (`reflectors` is ascending).
+            out.extend_from_slice(&prep.reflectors);
+            if let Some(own) = parent.surface.and_then(|p| out.binary_search(&p).ok()) {
+                out.remove(own);
+            }
             return;
         }
         if prep.reflectors.len() <= LINEAR_SCAN {
@@ -797,18 +796,17 @@ fn beam_planes(plane: &Plane, apex: Vec3, window: &[Vec3], out: &mut Vec<Plane>)
     };
     out.push(near);
     let inner = convex::vertex_mean(window);
-    let n = window.len();
     // One square root per edge: the degeneracy test compares squares.
     let mut a = window[0] - apex;
     let mut a2 = a.length_squared();
-    for i in 1..=n {
-        let b = window[i % n] - apex;
+    for &v in window[1..].iter().chain(&window[..1]) {
+        let b = v - apex;
         let b2 = b.length_squared();
         let normal = a.cross(b);
-        let len2 = normal.length_squared();
-        if spans_a_plane_squared(len2, a2 * b2) {
+        if spans_a_plane_squared(normal.length_squared(), a2 * b2) {
+            // `from_point_normal` normalises (one square root and one division per edge).
             out.push(orient_towards(
-                Plane::from_point_normal(apex, normal / len2.sqrt()),
+                Plane::from_point_normal(apex, normal),
                 inner,
             ));
         }
@@ -956,7 +954,7 @@ fn shadow(occluder: &bt_geom::Polygon, apex: Vec3, window: &[Vec3], margin: Real
     let normal = occluder.plane().normal;
     let mut open: Option<Plane> = None;
     for i in 0..n {
-        let (a, b) = (v[i], v[(i + 1) % n]);
+        let (a, b) = (v[i], v[if i + 1 == n { 0 } else { i + 1 }]);
         let dir = b - a;
         let mut inward = normal.cross(dir).normalize_or_zero();
         if (occluder.centroid() - a).dot(inward) < 0.0 {

@@ -98,7 +98,10 @@ fn main() {
                 t.elapsed().as_secs_f64() / n as f64
             })
             .fold(f64::INFINITY, f64::min);
-        println!("{what}: {:.1} µs per call (best of 20 batches of {n})", best * 1e6);
+        println!(
+            "{what}: {:.1} µs per call (best of 20 batches of {n})",
+            best * 1e6
+        );
         return;
     }
     let total: usize = (0..n).map(|i| run(what, &scene, i, &tree)).sum();
