@@ -65,6 +65,13 @@ fn run(what: &str, scene: &Scene, i: usize, tree: &BeamTree) -> usize {
             let ipc = Solver::Ipc(IpcOptions::for_scene(scene, UpdateOrder::GaussSeidel));
             traced_paths(scene, &trace_options(ipc, CandidateMode::BeamTree))
         }
+        "ipc-newton" => {
+            let ipc = IpcOptions {
+                acceleration: bt_solve::Acceleration::Newton,
+                ..IpcOptions::for_scene(scene, UpdateOrder::GaussSeidel)
+            };
+            traced_paths(scene, &trace_options(Solver::Ipc(ipc), CandidateMode::BeamTree))
+        }
         "walk" => tree.candidates(moved_rx(scene, i)).len(),
         "newrx" => {
             let rx = moved_rx(scene, i);
