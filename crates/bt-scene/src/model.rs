@@ -4,6 +4,7 @@ use crate::material::Material;
 use bt_geom::{Bvh, Polygon, Real, Vec3};
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
+use std::sync::Arc;
 
 /// Index of a surface in [`Scene::surfaces`].
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
@@ -50,13 +51,15 @@ pub struct Surface {
 pub struct Scene {
     pub(crate) name: String,
     pub(crate) origin: Vec3,
-    pub(crate) surfaces: Vec<Surface>,
+    /// Shared between a scene and its copies with other terminals or frequency
+    /// ([`Scene::with_receiver`]): a sweep's receivers do not copy the geometry.
+    pub(crate) surfaces: Arc<Vec<Surface>>,
     pub(crate) tx: Vec3,
     pub(crate) rx: Vec3,
     pub(crate) frequency_hz: Real,
-    pub(crate) materials: BTreeMap<String, Material>,
+    pub(crate) materials: Arc<BTreeMap<String, Material>>,
     pub(crate) extent: Real,
-    pub(crate) bvh: Bvh,
+    pub(crate) bvh: Arc<Bvh>,
 }
 
 impl Scene {
@@ -291,7 +294,7 @@ impl Scene {
         radio: bt_channel::RadioMaterial,
     ) -> Result<Scene, crate::SceneError> {
         let mut scene = self.clone();
-        for m in scene.materials.values_mut() {
+        for m in Arc::make_mut(&mut scene.materials).values_mut() {
             m.radio = Some(radio);
         }
         let problems =

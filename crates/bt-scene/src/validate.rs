@@ -283,13 +283,13 @@ impl Scene {
         Scene {
             name,
             origin,
-            surfaces,
+            surfaces: surfaces.into(),
             tx,
             rx,
             frequency_hz,
-            materials,
+            materials: materials.into(),
             extent,
-            bvh,
+            bvh: bvh.into(),
         }
     }
 }

@@ -70,7 +70,10 @@ fn run(what: &str, scene: &Scene, i: usize, tree: &BeamTree) -> usize {
                 acceleration: bt_solve::Acceleration::Newton,
                 ..IpcOptions::for_scene(scene, UpdateOrder::GaussSeidel)
             };
-            traced_paths(scene, &trace_options(Solver::Ipc(ipc), CandidateMode::BeamTree))
+            traced_paths(
+                scene,
+                &trace_options(Solver::Ipc(ipc), CandidateMode::BeamTree),
+            )
         }
         "walk" => tree.candidates(moved_rx(scene, i)).len(),
         "newrx" => {
