@@ -467,6 +467,9 @@ impl BeamTree {
                 (lo as u32..hi as u32).collect()
             }
         };
+        if materialised {
+            self.reserve_level(prep, ids.len());
+        }
         let (mut planes, mut children) = (Vec::new(), Vec::new());
         for (done, &p) in ids.iter().enumerate() {
             if done % PROGRESS_EVERY == 0 {
@@ -518,6 +521,21 @@ impl BeamTree {
                 None => self.child(prep, &parent, s, scratch),
             }
         }
+    }
+
+    /// In small scenes, room for the level's nodes at most (every parent times every
+    /// reflector, within the budget), so that the arenas grow once instead of doubling; large
+    /// scenes keep growing as they go (their bound is far above what culling leaves).
+    fn reserve_level(&mut self, prep: &Prepared<'_>, parents: usize) {
+        if prep.reflectors.len() > LINEAR_SCAN {
+            return;
+        }
+        let room = (parents * prep.reflectors.len()).min(prep.options.max_nodes as usize);
+        self.nodes.reserve(room);
+        // A window has a hull's vertices plus at most one per clipping plane; a beam one plane
+        // more than its window has edges. Typical room windows have 4-6.
+        self.verts.reserve(room * 6);
+        self.planes.reserve(room * 7);
     }
 
     /// Stop with [`TreeError::Budget`] once the tree holds more nodes than the budget.
