@@ -725,7 +725,8 @@ impl BeamTree {
         let d_apex = plane.signed_distance_unfused(parent.apex);
         let (d_rx, rx_image) = leaf.mirrored[s as usize];
         // RX must be on the apex's side of the plane (the reflected side) and off it.
-        if d_apex.abs() <= tol || d_rx * d_apex.signum() < -eps {
+        let d_rx_same_side = if d_apex > 0.0 { d_rx } else { -d_rx };
+        if d_apex.abs() <= tol || d_rx_same_side < -eps {
             return;
         }
         let t = d_apex / (d_apex + d_rx);
