@@ -498,27 +498,35 @@ impl BeamTree {
         p: u32,
         depth: usize,
         scratch: &mut Scratch,
-        mut leaf: Option<&mut Leaf<'_>>,
+        leaf: Option<&mut Leaf<'_>>,
         (plane_copy, children): (&mut Vec<Plane>, &mut Vec<u32>),
     ) {
-        let mut parent = self.parent_view(prep, p, plane_copy);
         let leaf_level = leaf.is_some();
-        self.child_candidates(prep, &parent, leaf_level, children);
+        self.child_candidates(prep, &self.parent_ref(prep, p), leaf_level, children);
         if p != ROOT && worth_culling(prep, children.len(), depth) {
             match self.cull(prep, p, scratch) {
                 Cull::Removed => return,
                 Cull::Kept => {}
                 Cull::Clipped => {
-                    parent = self.parent_view(prep, p, plane_copy);
-                    self.child_candidates(prep, &parent, leaf_level, children);
+                    self.child_candidates(prep, &self.parent_ref(prep, p), leaf_level, children);
                 }
             }
         }
-        for &s in children.iter() {
-            self.stats.tested += 1;
-            match leaf.as_mut() {
-                Some(leaf) => self.leaf_child(prep, &parent, s, leaf),
-                None => self.child(prep, &parent, s, scratch),
+        self.stats.tested += children.len() as u64;
+        match leaf {
+            // Leaves only read the tree: the parent's planes are borrowed in place.
+            Some(leaf) => {
+                let parent = self.parent_ref(prep, p);
+                for &s in children.iter() {
+                    self.leaf_child(prep, &parent, s, leaf);
+                }
+            }
+            // Children grow the arenas: the parent's planes are copied out first.
+            None => {
+                let parent = self.parent_view(prep, p, plane_copy);
+                for &s in children.iter() {
+                    self.child(prep, &parent, s, scratch);
+                }
             }
         }
     }
@@ -564,18 +572,34 @@ impl BeamTree {
     }
 
     /// Node `p` (or the root) as a parent, its beam planes copied into `planes`.
+    /// Node `p` (or the root) as a parent, its beam planes borrowed from the arena.
+    fn parent_ref(&self, prep: &Prepared<'_>, p: u32) -> Parent<'_> {
+        let (apex, surface, range) = self.parent_parts(prep, p);
+        Parent {
+            index: p,
+            surface,
+            apex,
+            planes: &self.planes[range.0 as usize..range.1 as usize],
+        }
+    }
+
+    /// Apex, surface and beam-plane range of node `p` (the root: TX, none, empty).
+    fn parent_parts(&self, prep: &Prepared<'_>, p: u32) -> (Vec3, Option<u32>, (u32, u32)) {
+        if p == ROOT {
+            (prep.scene.tx(), None, (0, 0))
+        } else {
+            let n = &self.nodes[p as usize];
+            (n.image, Some(n.surface), n.planes)
+        }
+    }
+
     fn parent_view<'b>(
         &self,
         prep: &Prepared<'_>,
         p: u32,
         planes: &'b mut Vec<Plane>,
     ) -> Parent<'b> {
-        let (apex, surface, range) = if p == ROOT {
-            (prep.scene.tx(), None, (0u32, 0u32))
-        } else {
-            let n = &self.nodes[p as usize];
-            (n.image, Some(n.surface), n.planes)
-        };
+        let (apex, surface, range) = self.parent_parts(prep, p);
         planes.clear();
         planes.extend_from_slice(&self.planes[range.0 as usize..range.1 as usize]);
         Parent {
@@ -712,13 +736,7 @@ impl BeamTree {
     /// without building its window. RX lies in the beam exactly when the image-method point
     /// (where the ray from the parent's apex to RX's mirror image crosses `s`'s plane) lies in
     /// the parent's beam and in `s`'s polygon; that point is also the IPC start on `s`.
-    fn leaf_child(
-        &mut self,
-        prep: &Prepared<'_>,
-        parent: &Parent<'_>,
-        s: u32,
-        leaf: &mut Leaf<'_>,
-    ) {
+    fn leaf_child(&self, prep: &Prepared<'_>, parent: &Parent<'_>, s: u32, leaf: &mut Leaf<'_>) {
         let plane = prep.plane(s);
         let tol = prep.tol;
         let eps = EPS * tol;
