@@ -66,7 +66,7 @@ fn main() {
 
 /// Rounds spent per outcome kind (for docs/performance.md).
 fn stats(scene: &bt_scene::Scene, candidates: &bt_paths::CandidateSet, solver: &Solver) {
-    use bt_solve::{CandidateOutcome, IpcOutcome, solve_candidate};
+    use bt_solve::{CandidateOutcome, solve_candidate};
     use std::collections::BTreeMap;
     let mut by_kind: BTreeMap<&str, (u64, u64, u32)> = BTreeMap::new();
     for seq in candidates.iter() {
@@ -86,17 +86,12 @@ fn stats(scene: &bt_scene::Scene, candidates: &bt_paths::CandidateSet, solver: &
                 ipc,
             ),
             CandidateOutcome::LeftPolygon(o) => ("left-polygon", Some(o)),
+            CandidateOutcome::Blocked(o) => ("stopped-blocked", Some(o)),
             CandidateOutcome::Degenerate(o) => ("degenerate", Some(o)),
             CandidateOutcome::NotConverged(o) => ("not-converged", Some(o)),
             _ => ("other", None),
         };
-        let rounds = match ipc {
-            Some(IpcOutcome::Converged { iterations, .. })
-            | Some(IpcOutcome::NotConverged { iterations, .. })
-            | Some(IpcOutcome::LeftPolygon { iterations, .. })
-            | Some(IpcOutcome::Degenerate { iterations, .. }) => iterations,
-            None => 0,
-        };
+        let rounds = ipc.map_or(0, |o| o.iterations());
         let e = by_kind.entry(kind).or_default();
         e.0 += 1;
         e.1 += rounds as u64 * n as u64;

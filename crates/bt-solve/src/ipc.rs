@@ -63,7 +63,11 @@ pub struct IpcOptions {
     /// Early stopping of paths that clearly tend to be invalid (the paper, section VI): stop
     /// a run when a point lies outside its polygon by more than [`EARLY_REJECT_MARGIN`] times
     /// the distance it can still move at the measured contraction rate. The run ends as
-    /// [`IpcOutcome::LeftPolygon`]; such a path could not have become valid.
+    /// [`IpcOutcome::LeftPolygon`]; such a path could not have become valid. Likewise when
+    /// every point is inside its polygon and on the reflecting side by more than that reach
+    /// and a segment crosses another surface well inside it
+    /// ([`crate::validate::blocked_for_good`]): the run ends as [`IpcOutcome::Blocked`], the
+    /// verdict validation would give the converged path.
     pub early_reject: bool,
     /// Acceleration after the paper's rounds (default none: the paper's IPC as it is).
     #[serde(default)]
@@ -153,6 +157,17 @@ pub enum IpcOutcome {
         /// Rounds run.
         iterations: u32,
     },
+    /// Early stopping: segment `segment` crosses surface `by` so far inside it, and every point
+    /// lies so far inside its polygon and off its plane, that no movement the run can still
+    /// make changes it: the converged path would be valid but for this blocked segment.
+    Blocked {
+        /// Segment index, 0-based from TX.
+        segment: usize,
+        /// The occluding surface.
+        by: SurfaceId,
+        /// Rounds run.
+        iterations: u32,
+    },
     /// The update is undefined or meaningless for this candidate.
     Degenerate {
         /// What went wrong.
@@ -162,6 +177,19 @@ pub enum IpcOutcome {
         /// Rounds run before it was detected.
         iterations: u32,
     },
+}
+
+impl IpcOutcome {
+    /// Rounds (plus Newton steps) the run took, whatever its end.
+    pub fn iterations(&self) -> u32 {
+        match *self {
+            IpcOutcome::Converged { iterations, .. }
+            | IpcOutcome::NotConverged { iterations, .. }
+            | IpcOutcome::LeftPolygon { iterations, .. }
+            | IpcOutcome::Blocked { iterations, .. }
+            | IpcOutcome::Degenerate { iterations, .. } => iterations,
+        }
+    }
 }
 
 /// Kinds of degenerate IPC candidates.
@@ -347,6 +375,16 @@ fn run(
                 iterations: rounds + newton_steps,
             };
         }
+        let block_check = reach.filter(|_| rounds.is_multiple_of(EARLY_BLOCK_EVERY));
+        if let Some((segment, by)) = block_check.and_then(|reach| {
+            crate::validate::blocked_for_good(scene, seq, (tx, rx), points, reach)
+        }) {
+            return IpcOutcome::Blocked {
+                segment,
+                by,
+                iterations: rounds + newton_steps,
+            };
+        }
         rule.record(rounds, moved);
     }
     let iterations = rounds + newton_steps;
@@ -366,6 +404,11 @@ fn run(
 
 /// Early rejection looks at the points every this many rounds (a divisor of [`RATE_WINDOW`]).
 pub const EARLY_REJECT_EVERY: u32 = 8;
+
+/// Early stopping looks for a segment blocked for good every this many rounds (a multiple of
+/// [`EARLY_REJECT_EVERY`]): the test walks the BVH along every segment, about as much work as
+/// 30 rounds of a third-order chain, and it only pays on the long runs.
+pub const EARLY_BLOCK_EVERY: u32 = 64;
 
 /// Rounds over which early rejection measures the contraction rate; [`EARLY_REJECT_FROM`]
 /// leaves at least this much history.

@@ -73,6 +73,8 @@ pub enum CandidateOutcome {
     Degenerate(IpcOutcome),
     /// IPC stopped early: a point was leaving its polygon for good.
     LeftPolygon(IpcOutcome),
+    /// IPC stopped early: a segment was blocked for good (counted as blocked).
+    Blocked(IpcOutcome),
     /// SBR: no launched ray reached RX through this sequence.
     Missed,
 }
@@ -115,6 +117,7 @@ impl OutcomeCounts {
             }
             CandidateOutcome::NotConverged(_) => self.not_converged += 1,
             CandidateOutcome::LeftPolygon(_) => self.outside_polygon += 1,
+            CandidateOutcome::Blocked(_) => self.blocked += 1,
             CandidateOutcome::Missed => self.missed += 1,
         }
     }
@@ -188,6 +191,7 @@ pub fn solve_candidate_from(
                 IpcOutcome::NotConverged { .. } => return CandidateOutcome::NotConverged(outcome),
                 IpcOutcome::Degenerate { .. } => return CandidateOutcome::Degenerate(outcome),
                 IpcOutcome::LeftPolygon { .. } => return CandidateOutcome::LeftPolygon(outcome),
+                IpcOutcome::Blocked { .. } => return CandidateOutcome::Blocked(outcome),
             }
         }
         Solver::Sbr(options) => match sbr::solve_sequence(scene, seq, options) {

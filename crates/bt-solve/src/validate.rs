@@ -102,3 +102,66 @@ pub fn blocker(
         })
         .map(SurfaceId)
 }
+
+/// Early stopping of IPC (`IpcOptions::early_reject`): the first segment of the path TX ->
+/// `points` -> RX that stays blocked, with its blocker, when every point may still move by up
+/// to `reach` metres — or `None` when that is not certain. Certain means: every point lies
+/// inside its polygon by more than `reach` plus the tolerance and both its neighbours lie off
+/// its plane, on its side, by as much (so validation reaches the blocking test whatever the
+/// final points), and the segment's crossing with the blocker stays strictly inside it. For a
+/// segment `a -> b` at distances `da`, `db` from the blocker's plane on either side
+/// (`S = |da| + |db|`, length `L`), moving both ends by up to `r` moves the crossing point by
+/// at most `r (1 + L / (S - 2r))` (its parameter moves by at most `r / (S - 2r)`).
+#[inline(always)]
+pub fn blocked_for_good(
+    scene: &Scene,
+    seq: &[SurfaceId],
+    (tx, rx): (Vec3, Vec3),
+    points: &[Vec3],
+    reach: Real,
+) -> Option<(usize, SurfaceId)> {
+    let tol = scene.length_tolerance();
+    let margin = reach + tol;
+    let n = seq.len();
+    let at = |k: usize| match k {
+        0 => tx,
+        k if k == n + 1 => rx,
+        k => points[k - 1],
+    };
+    for k in 0..n {
+        let polygon = &scene.surface(seq[k]).polygon;
+        let (a, b) = (
+            polygon.plane().signed_distance(at(k)),
+            polygon.plane().signed_distance(at(k + 2)),
+        );
+        let sides = (a > margin && b > margin) || (a < -margin && b < -margin);
+        if !sides || polygon.signed_boundary_distance(points[k]) <= margin {
+            return None;
+        }
+    }
+    (0..=n).find_map(|segment| {
+        let (a, b) = (at(segment), at(segment + 1));
+        let from = segment.checked_sub(1).map(|k| seq[k]);
+        let to = (segment < n).then(|| seq[segment]);
+        let length = a.distance(b);
+        let by = scene.bvh().any_hit(a, b, |i| {
+            let id = SurfaceId(i);
+            if Some(id) == from || Some(id) == to {
+                return false;
+            }
+            let polygon = &scene.surface(id).polygon;
+            let (da, db) = (
+                polygon.plane().signed_distance(a),
+                polygon.plane().signed_distance(b),
+            );
+            let span = da.abs() + db.abs();
+            if (da > 0.0) == (db > 0.0) || da.abs() <= margin || db.abs() <= margin {
+                return false;
+            }
+            let crossing = a + (da / (da - db)) * (b - a);
+            let shift = reach * (1.0 + length / (span - 2.0 * reach));
+            polygon.signed_boundary_distance(crossing) > tol + shift
+        });
+        by.map(|i| (segment, SurfaceId(i)))
+    })
+}

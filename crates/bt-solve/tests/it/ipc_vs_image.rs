@@ -2,8 +2,43 @@
 //! 1e-9 m, and every reported path obeys the law of reflection and lies inside its polygons.
 
 use crate::common::*;
-use bt_solve::{Solver, UpdateOrder};
+use bt_paths::beamtree::{TreeOptions, candidates};
+use bt_scene::Scene;
+use bt_solve::{CandidateOutcome, Solver, UpdateOrder, Validity, solve_candidate_from};
 use proptest::prelude::*;
+
+/// Early stopping for blocked segments: every candidate IPC stops as blocked is one the image
+/// method's path is blocked on (the verdict validation gives it). Returns how many stopped.
+fn early_blocks_agree_with_the_image_method(scene: &Scene) -> Result<usize, String> {
+    let set = candidates(scene, TreeOptions::new(3)).map_err(|e| e.to_string())?;
+    let gs = ipc(scene, UpdateOrder::GaussSeidel);
+    let mut stopped = 0;
+    for i in 0..set.len() {
+        let seq = set.get(i);
+        let mut points = vec![bt_geom::Vec3::ZERO; seq.len()];
+        let mut scratch = points.clone();
+        let outcome =
+            solve_candidate_from(scene, seq, &gs, set.start(i), &mut points, &mut scratch);
+        if !matches!(outcome, CandidateOutcome::Blocked(_)) {
+            continue;
+        }
+        stopped += 1;
+        let image =
+            solve_candidate_from(scene, seq, &Solver::Image, None, &mut points, &mut scratch);
+        if !matches!(
+            image,
+            CandidateOutcome::Solved {
+                validity: Validity::Blocked { .. },
+                ..
+            }
+        ) {
+            return Err(format!(
+                "{seq:?}: IPC stopped as blocked, the image method gives {image:?}"
+            ));
+        }
+    }
+    Ok(stopped)
+}
 
 proptest! {
     #![proptest_config(random_scene_config())]
@@ -18,6 +53,8 @@ proptest! {
             let d = max_point_distance(&paths, &reference);
             prop_assert!(d < 1e-9, "{:?}: points differ by {} m", order, d);
         }
+        let agree = early_blocks_agree_with_the_image_method(&scene);
+        prop_assert!(agree.is_ok(), "{:?}", agree);
         let tol = scene.length_tolerance();
         let direct = scene.tx().distance(scene.rx());
         for p in &reference {
@@ -47,4 +84,14 @@ fn builtin_living_room_ipc_equals_image_method() {
         let d = max_point_distance(&paths, &reference);
         assert!(d < 1e-9, "{order:?}: {d}");
     }
+}
+
+#[test]
+fn living_room_early_blocked_stops_agree_with_the_image_method() {
+    let scene = bt_scene::builtin_scene("living-room", Default::default())
+        .unwrap()
+        .unwrap();
+    // wall-north > window > wall-north alone ran 3,636 rounds to a blocked path.
+    let stopped = early_blocks_agree_with_the_image_method(&scene).unwrap();
+    assert!(stopped >= 1, "no run stopped early as blocked");
 }
