@@ -1,8 +1,9 @@
 //! Beam-tree benchmarks, single-threaded, figures as ratios inside one run
 //! (`cargo bench -p bt-solve --bench beamtree`; docs/performance.md):
-//! - living room, order <= 3: candidates only, whole traces (candidates + solver + validation +
-//!   report) with the beam tree and with exhaustive enumeration, IPC Gauss-Seidel, a new RX
-//!   answered by a kept tree;
+//! - living room, order <= 3: candidates only; whole traces as the issue defines them
+//!   (candidates + solver + validation) with the beam tree and with exhaustive enumeration,
+//!   IPC Gauss-Seidel (the paper's rounds, and with Newton polish); the image-method trace
+//!   followed by the per-path report (gains, angles, names); a new RX answered by a kept tree;
 //! - the built-in city (39,692 triangles): orders 1, 2 and 3.
 
 use bt_paths::beamtree::{BeamTree, TreeOptions};
@@ -23,7 +24,17 @@ fn options(order: usize, mode: CandidateMode, solver: Solver) -> TraceOptions {
     }
 }
 
+/// Candidates, solver and validation: the valid paths.
 fn whole_trace(scene: &Scene, options: &TraceOptions) -> usize {
+    trace_scene(scene, options)
+        .expect("trace runs")
+        .result
+        .paths
+        .len()
+}
+
+/// [`whole_trace`] and the per-path report the CLI prints (gains, angles, names).
+fn trace_and_report(scene: &Scene, options: &TraceOptions) -> usize {
     let traced = trace_scene(scene, options).expect("trace runs");
     bt_beams::report(
         scene,
@@ -38,7 +49,12 @@ fn living_room(c: &mut Criterion) {
     let scene = bt_scene::builtin_scene("living-room", Terminals::default())
         .unwrap()
         .unwrap();
-    let gs = Solver::Ipc(IpcOptions::for_scene(&scene, UpdateOrder::GaussSeidel));
+    let gs_options = IpcOptions::for_scene(&scene, UpdateOrder::GaussSeidel);
+    let gs = Solver::Ipc(gs_options);
+    let gs_newton = Solver::Ipc(IpcOptions {
+        acceleration: bt_solve::Acceleration::Newton,
+        ..gs_options
+    });
     let mut group = c.benchmark_group("living-room-order3");
     group.bench_function("beam-tree-candidates", |b| {
         b.iter(|| bt_paths::beamtree::candidates(black_box(&scene), TreeOptions::new(3)))
@@ -55,11 +71,20 @@ fn living_room(c: &mut Criterion) {
             Solver::Image,
         ),
         ("trace-ipc-gs-beam-tree", CandidateMode::BeamTree, gs),
+        (
+            "trace-ipc-gs-newton-beam-tree",
+            CandidateMode::BeamTree,
+            gs_newton,
+        ),
         ("trace-ipc-gs-exhaustive", CandidateMode::Exhaustive, gs),
     ] {
         let opts = options(3, mode, solver);
         group.bench_function(name, |b| b.iter(|| whole_trace(black_box(&scene), &opts)));
     }
+    let opts = options(3, CandidateMode::BeamTree, Solver::Image);
+    group.bench_function("trace-image-beam-tree-and-report", |b| {
+        b.iter(|| trace_and_report(black_box(&scene), &opts))
+    });
     // Fixed TX, moving RX: the tree is kept; each new RX is a walk plus the image method.
     let tree = BeamTree::build(&scene, TreeOptions::new(3)).unwrap();
     let receivers: Vec<Vec3> = (0..16)
