@@ -710,7 +710,7 @@ impl BeamTree {
             self.stats.empty += 1;
             return;
         }
-        window_in_beam(prep, parent, s, scratch);
+        window_in_beam(prep, parent, s, (&mut scratch.a, &mut scratch.b));
         if scratch.a.len() < 3 {
             self.stats.empty += 1;
             return;
@@ -735,7 +735,10 @@ impl BeamTree {
     /// The last level of a single-receiver trace: emit child `s` when RX lies in its beam,
     /// without building its window. RX lies in the beam exactly when the image-method point
     /// (where the ray from the parent's apex to RX's mirror image crosses `s`'s plane) lies in
-    /// the parent's beam and in `s`'s polygon; that point is also the IPC start on `s`.
+    /// the parent's beam and in `s`'s polygon. Only an emitted child's window is clipped: its
+    /// centre is the IPC start on `s`, like every other window's. (The image-method point
+    /// itself, though inside the window, is a worse start for the accelerator's Jacobi
+    /// rounds: a third-order path of the dynamic living room then missed its 256-round cap.)
     fn leaf_child(&self, prep: &Prepared<'_>, parent: &Parent<'_>, s: u32, leaf: &mut Leaf<'_>) {
         let plane = prep.plane(s);
         let tol = prep.tol;
@@ -766,7 +769,12 @@ impl BeamTree {
         }
         self.prefix(parent.index, &mut leaf.seq, &mut leaf.starts);
         leaf.seq.push(SurfaceId(s));
-        leaf.starts.push(x);
+        window_in_beam(prep, parent, s, (&mut leaf.window, &mut leaf.tmp));
+        leaf.starts.push(if leaf.window.len() >= 3 {
+            convex::vertex_mean(&leaf.window)
+        } else {
+            prep.scene.surface(SurfaceId(s)).polygon.centroid()
+        });
         leaf.out.push_with_starts(&leaf.seq, &leaf.starts);
     }
 }
@@ -777,9 +785,11 @@ struct Leaf<'o> {
     /// Per surface: (signed distance of RX, m; RX mirrored through the plane).
     mirrored: Vec<(Real, Vec3)>,
     out: &'o mut CandidateSet,
-    /// Scratch for one candidate's sequence and start points.
+    /// Scratch for one candidate's sequence, start points and last window.
     seq: Vec<SurfaceId>,
     starts: Vec<Vec3>,
+    window: Vec<Vec3>,
+    tmp: Vec<Vec3>,
 }
 
 impl<'o> Leaf<'o> {
@@ -797,18 +807,25 @@ impl<'o> Leaf<'o> {
             out,
             seq: Vec::new(),
             starts: Vec::new(),
+            window: Vec::new(),
+            tmp: Vec::new(),
         }
     }
 }
 
-/// Child `s`'s window, its grown hull clipped by `parent`'s beam planes, into `scratch.a`
-/// (fewer than 3 vertices: empty).
-fn window_in_beam(prep: &Prepared<'_>, parent: &Parent<'_>, s: u32, scratch: &mut Scratch) {
-    scratch.a.clear();
-    scratch.a.extend_from_slice(prep.hull(s));
+/// Child `s`'s window, its grown hull clipped by `parent`'s beam planes, into `window`
+/// (`tmp`: scratch; fewer than 3 vertices: empty).
+fn window_in_beam(
+    prep: &Prepared<'_>,
+    parent: &Parent<'_>,
+    s: u32,
+    (window, tmp): (&mut Vec<Vec3>, &mut Vec<Vec3>),
+) {
+    window.clear();
+    window.extend_from_slice(prep.hull(s));
     for pl in parent.planes {
-        convex::clip_in_place(&mut scratch.a, pl, EPS * prep.tol, &mut scratch.b);
-        if scratch.a.len() < 3 {
+        convex::clip_in_place(window, pl, EPS * prep.tol, tmp);
+        if window.len() < 3 {
             break;
         }
     }
