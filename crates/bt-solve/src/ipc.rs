@@ -180,6 +180,18 @@ pub enum IpcOutcome {
 }
 
 impl IpcOutcome {
+    /// The same outcome after `n` rounds (plus Newton steps).
+    fn with_iterations(mut self, n: u32) -> Self {
+        match &mut self {
+            IpcOutcome::Converged { iterations, .. }
+            | IpcOutcome::NotConverged { iterations, .. }
+            | IpcOutcome::LeftPolygon { iterations, .. }
+            | IpcOutcome::Blocked { iterations, .. }
+            | IpcOutcome::Degenerate { iterations, .. } => *iterations = n,
+        }
+        self
+    }
+
     /// Rounds (plus Newton steps) the run took, whatever its end.
     pub fn iterations(&self) -> u32 {
         match *self {
@@ -367,23 +379,11 @@ fn run(
             .early_reject
             .then(|| rule.early_reject_reach(rounds, moved, scene.length_tolerance()))
             .flatten();
-        if let Some(index) = reach.and_then(|reach| {
-            (0..n).find(|&k| !scene.surface(seq[k]).polygon.contains(points[k], reach))
+        if let Some(stop) = reach.and_then(|reach| {
+            early_stop(scene, seq, (tx, rx), points, (rounds, reach))
+                .map(|stop| stop.with_iterations(rounds + newton_steps))
         }) {
-            return IpcOutcome::LeftPolygon {
-                index,
-                iterations: rounds + newton_steps,
-            };
-        }
-        let block_check = reach.filter(|_| rounds.is_multiple_of(EARLY_BLOCK_EVERY));
-        if let Some((segment, by)) = block_check.and_then(|reach| {
-            crate::validate::blocked_for_good(scene, seq, (tx, rx), points, reach)
-        }) {
-            return IpcOutcome::Blocked {
-                segment,
-                by,
-                iterations: rounds + newton_steps,
-            };
+            return stop;
         }
         rule.record(rounds, moved);
     }
@@ -400,6 +400,38 @@ fn run(
             Real::MAX
         },
     }
+}
+
+/// Early stopping at round `rounds` when the points can still move by up to `reach` metres:
+/// a point outside its polygon by more than that ([`IpcOutcome::LeftPolygon`]), or, every
+/// [`EARLY_BLOCK_EVERY`] rounds, a segment blocked for good ([`IpcOutcome::Blocked`]). The
+/// outcomes' `iterations` are left at 0 for the caller.
+#[inline(always)]
+fn early_stop(
+    scene: &Scene,
+    seq: &[SurfaceId],
+    (tx, rx): (Vec3, Vec3),
+    points: &[Vec3],
+    (rounds, reach): (u32, Real),
+) -> Option<IpcOutcome> {
+    let outside =
+        (0..seq.len()).find(|&k| !scene.surface(seq[k]).polygon.contains(points[k], reach));
+    if let Some(index) = outside {
+        return Some(IpcOutcome::LeftPolygon {
+            index,
+            iterations: 0,
+        });
+    }
+    if !rounds.is_multiple_of(EARLY_BLOCK_EVERY) {
+        return None;
+    }
+    crate::validate::blocked_for_good(scene, seq, (tx, rx), points, reach).map(|(segment, by)| {
+        IpcOutcome::Blocked {
+            segment,
+            by,
+            iterations: 0,
+        }
+    })
 }
 
 /// Early rejection looks at the points every this many rounds (a divisor of [`RATE_WINDOW`]).
