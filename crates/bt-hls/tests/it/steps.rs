@@ -1,13 +1,11 @@
 //! One platform, several time steps: the host loads each step's schedule, start points and
 //! TX/RX over the bus and the RTL matches the model bit for bit in every run (Verilator).
 
-mod common;
-
 use std::path::PathBuf;
 
+use crate::common::*;
 use bt_hls::{Platform, StepWork};
 use bt_schedule::{Budget, schedule_list};
-use common::*;
 
 fn list_work(input: bt_hls::HlsInput) -> StepWork {
     let problem = input.problem().unwrap();

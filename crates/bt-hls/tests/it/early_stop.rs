@@ -1,11 +1,9 @@
 //! The small scene with early stopping: paths whose point leaves its wall's box are frozen
 //! (`left_bounds`) in the model and in the RTL, bit for bit, and free their schedule slots.
 
-mod common;
-
 use std::path::PathBuf;
 
-use common::*;
+use crate::common::*;
 
 #[test]
 fn early_stopping_is_bit_exact_and_shortens_the_schedule() {

@@ -1,5 +1,4 @@
 // The small test scene shared by the bt-hls integration tests.
-#![allow(dead_code)]
 
 use std::path::PathBuf;
 use std::sync::OnceLock;

@@ -1,10 +1,8 @@
 //! The small scene end to end: lint, co-simulation, golden files, synthesis.
 
-mod common;
-
 use std::sync::OnceLock;
 
-use common::*;
+use crate::common::*;
 
 fn sim() -> &'static bt_hls::SimReport {
     static S: OnceLock<bt_hls::SimReport> = OnceLock::new();

@@ -2,13 +2,11 @@
 //! (`testdata/rtl/small_scene/<module>.v`), and with early stopping, which adds the box logic
 //! to `bt_top` only (`testdata/rtl/small_scene_early/bt_top.v`; its PEs must equal the plain
 //! design's).
-//! A change of the generated Verilog fails here; `UPDATE_GOLDEN=1 cargo test -p bt-hls --test
+//! A change of the generated Verilog fails here; `UPDATE_GOLDEN=1 cargo test -p bt-hls --test it
 //! golden_rtl` rewrites the files after a deliberate change (review the diff).
 
-mod common;
-
+use crate::common::*;
 use bt_hls::{HlsInput, Platform, StepWork};
-use common::*;
 
 fn modules(input: HlsInput) -> Vec<(String, String)> {
     let schedule = small_schedule(&input);

@@ -1,12 +1,10 @@
 //! Golden files, determinism and a synthesis smoke test.
 
-mod common;
-
 use std::path::PathBuf;
 
+use crate::common::*;
 use bt_hls::{HlsInput, PlaneSpec};
 use bt_schedule::{Budget, schedule_list};
-use common::*;
 
 #[test]
 fn golden_cycle_count() {
