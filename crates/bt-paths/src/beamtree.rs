@@ -443,6 +443,14 @@ impl BeamTree {
         progress: Progress<'_>,
     ) -> Result<(), TreeError> {
         let materialised = leaf.is_none();
+        if materialised {
+            // A fresh level (a rebuild instead keeps the old tree's arenas, already sized).
+            let parents = match depth {
+                1 => 1,
+                _ => self.levels[depth - 2].1 - self.levels[depth - 2].0,
+            };
+            self.reserve_level(prep, parents);
+        }
         self.for_each_parent(prep, (depth, materialised), progress, |tree, p, bufs| {
             tree.grow_children(prep, p, depth, scratch, leaf.as_deref_mut(), bufs);
         })
@@ -467,9 +475,6 @@ impl BeamTree {
                 (lo as u32..hi as u32).collect()
             }
         };
-        if materialised {
-            self.reserve_level(prep, ids.len());
-        }
         let (mut planes, mut children) = (Vec::new(), Vec::new());
         for (done, &p) in ids.iter().enumerate() {
             if done % PROGRESS_EVERY == 0 {
