@@ -576,7 +576,6 @@ impl BeamTree {
         }
     }
 
-    /// Node `p` (or the root) as a parent, its beam planes copied into `planes`.
     /// Node `p` (or the root) as a parent, its beam planes borrowed from the arena.
     fn parent_ref(&self, prep: &Prepared<'_>, p: u32) -> Parent<'_> {
         let (apex, surface, range) = self.parent_parts(prep, p);
@@ -598,6 +597,8 @@ impl BeamTree {
         }
     }
 
+    /// Node `p` (or the root) as a parent, its beam planes copied into `planes` (for growing
+    /// levels, which push to the arena while the parent is in use).
     fn parent_view<'b>(
         &self,
         prep: &Prepared<'_>,
