@@ -863,7 +863,7 @@ fn beam_planes(plane: &Plane, apex: Vec3, window: &[Vec3], out: &mut Vec<Plane>)
         let b = v - apex;
         let b2 = b.length_squared();
         let normal = a.cross(b);
-        if spans_a_plane_squared(normal.length_squared(), a2 * b2) {
+        if spans_a_plane(normal.length_squared(), a2 * b2) {
             // `from_point_normal` normalises (one square root and one division per edge).
             out.push(orient_towards(
                 Plane::from_point_normal(apex, normal),
@@ -875,14 +875,10 @@ fn beam_planes(plane: &Plane, apex: Vec3, window: &[Vec3], out: &mut Vec<Plane>)
     (lo, out.len() as u32)
 }
 
-/// Whether a cross product of length `len` from two vectors whose lengths multiply to `scale`
-/// spans a plane: false for (nearly) parallel vectors, and for NaN.
-fn spans_a_plane(len: Real, scale: Real) -> bool {
-    len > 1e-12 * scale
-}
-
-/// [`spans_a_plane`] on squares: `len2 = len²`, `scale2 = scale²`.
-fn spans_a_plane_squared(len2: Real, scale2: Real) -> bool {
+/// Whether a cross product of squared length `len2` from two vectors whose squared lengths
+/// multiply to `scale2` spans a plane (its length above 1e-12 times the lengths' product):
+/// false for (nearly) parallel vectors, and for NaN. Squares spare the square roots.
+fn spans_a_plane(len2: Real, scale2: Real) -> bool {
     len2 > 1e-24 * scale2
 }
 
@@ -1022,11 +1018,12 @@ fn shadow(occluder: &bt_geom::Polygon, apex: Vec3, window: &[Vec3], margin: Real
         }
         let moved = a + margin * inward;
         let pn = (moved - apex).cross(dir);
-        let len = pn.length();
-        if !spans_a_plane(len, (moved - apex).length() * dir.length()) {
+        let scale2 = (moved - apex).length_squared() * dir.length_squared();
+        if !spans_a_plane(pn.length_squared(), scale2) {
             return Shadow::None;
         }
-        let plane = orient_towards(Plane::from_point_normal(apex, pn / len), moved + inward);
+        // `from_point_normal` normalises.
+        let plane = orient_towards(Plane::from_point_normal(apex, pn), moved + inward);
         if window
             .iter()
             .all(|q| plane.signed_distance_unfused(*q) > 0.0)

@@ -180,18 +180,6 @@ pub enum IpcOutcome {
 }
 
 impl IpcOutcome {
-    /// The same outcome after `n` rounds (plus Newton steps).
-    fn with_iterations(mut self, n: u32) -> Self {
-        match &mut self {
-            IpcOutcome::Converged { iterations, .. }
-            | IpcOutcome::NotConverged { iterations, .. }
-            | IpcOutcome::LeftPolygon { iterations, .. }
-            | IpcOutcome::Blocked { iterations, .. }
-            | IpcOutcome::Degenerate { iterations, .. } => *iterations = n,
-        }
-        self
-    }
-
     /// Rounds (plus Newton steps) the run took, whatever its end.
     pub fn iterations(&self) -> u32 {
         match *self {
@@ -379,10 +367,10 @@ fn run(
             .early_reject
             .then(|| rule.early_reject_reach(rounds, moved, scene.length_tolerance()))
             .flatten();
-        if let Some(stop) = reach.and_then(|reach| {
-            early_stop(scene, seq, (tx, rx), points, (rounds, reach))
-                .map(|stop| stop.with_iterations(rounds + newton_steps))
-        }) {
+        let iterations = rounds + newton_steps;
+        if let Some(stop) = reach
+            .and_then(|reach| early_stop(scene, seq, (tx, rx), points, (rounds, iterations, reach)))
+        {
             return stop;
         }
         rule.record(rounds, moved);
@@ -404,23 +392,20 @@ fn run(
 
 /// Early stopping at round `rounds` when the points can still move by up to `reach` metres:
 /// a point outside its polygon by more than that ([`IpcOutcome::LeftPolygon`]), or, every
-/// [`EARLY_BLOCK_EVERY`] rounds, a segment blocked for good ([`IpcOutcome::Blocked`]). The
-/// outcomes' `iterations` are left at 0 for the caller.
+/// [`EARLY_BLOCK_EVERY`] rounds, a segment blocked for good ([`IpcOutcome::Blocked`]), after
+/// `iterations` rounds plus Newton steps.
 #[inline(always)]
 fn early_stop(
     scene: &Scene,
     seq: &[SurfaceId],
     (tx, rx): (Vec3, Vec3),
     points: &[Vec3],
-    (rounds, reach): (u32, Real),
+    (rounds, iterations, reach): (u32, u32, Real),
 ) -> Option<IpcOutcome> {
     let outside =
         (0..seq.len()).find(|&k| !scene.surface(seq[k]).polygon.contains(points[k], reach));
     if let Some(index) = outside {
-        return Some(IpcOutcome::LeftPolygon {
-            index,
-            iterations: 0,
-        });
+        return Some(IpcOutcome::LeftPolygon { index, iterations });
     }
     if !rounds.is_multiple_of(EARLY_BLOCK_EVERY) {
         return None;
@@ -429,7 +414,7 @@ fn early_stop(
         IpcOutcome::Blocked {
             segment,
             by,
-            iterations: 0,
+            iterations,
         }
     })
 }

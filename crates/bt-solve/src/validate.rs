@@ -51,10 +51,7 @@ pub fn validate(scene: &Scene, seq: &[SurfaceId], tx: Vec3, rx: Vec3, points: &[
         }
     }
     for k in 0..n {
-        let plane = scene.surface(seq[k]).polygon.plane();
-        let prev = if k == 0 { tx } else { points[k - 1] };
-        let next = if k + 1 == n { rx } else { points[k + 1] };
-        let (a, b) = (plane.signed_distance(prev), plane.signed_distance(next));
+        let (a, b) = neighbour_distances(scene, seq, (tx, rx), points, k);
         if a.abs() <= tol || b.abs() <= tol {
             return Validity::Grazing { index: k };
         }
@@ -63,21 +60,71 @@ pub fn validate(scene: &Scene, seq: &[SurfaceId], tx: Vec3, rx: Vec3, points: &[
         }
     }
     for segment in 0..=n {
-        let (a, from) = if segment == 0 {
-            (tx, None)
-        } else {
-            (points[segment - 1], Some(seq[segment - 1]))
-        };
-        let (b, to) = if segment == n {
-            (rx, None)
-        } else {
-            (points[segment], Some(seq[segment]))
-        };
+        let ((a, from), (b, to)) = segment_ends(seq, (tx, rx), points, segment);
         if let Some(by) = blocker(scene, a, b, from, to, tol) {
             return Validity::Blocked { segment, by };
         }
     }
     Validity::Valid
+}
+
+/// Signed distances (m) of point `k`'s two neighbours on the path TX -> `points` -> RX (TX or
+/// the previous point, RX or the next) from its surface's plane.
+#[inline(always)]
+fn neighbour_distances(
+    scene: &Scene,
+    seq: &[SurfaceId],
+    (tx, rx): (Vec3, Vec3),
+    points: &[Vec3],
+    k: usize,
+) -> (Real, Real) {
+    let plane = scene.surface(seq[k]).polygon.plane();
+    let prev = if k == 0 { tx } else { points[k - 1] };
+    let next = if k + 1 == seq.len() {
+        rx
+    } else {
+        points[k + 1]
+    };
+    (plane.signed_distance(prev), plane.signed_distance(next))
+}
+
+/// The ends of segment `segment` (0 = TX to the first point) of the path TX -> `points` -> RX
+/// over `seq`, each with the surface it lies on (`None` for TX and RX).
+#[inline(always)]
+fn segment_ends(
+    seq: &[SurfaceId],
+    (tx, rx): (Vec3, Vec3),
+    points: &[Vec3],
+    segment: usize,
+) -> ((Vec3, Option<SurfaceId>), (Vec3, Option<SurfaceId>)) {
+    let n = seq.len();
+    let start = match segment {
+        0 => (tx, None),
+        _ => (points[segment - 1], Some(seq[segment - 1])),
+    };
+    let end = match segment {
+        s if s == n => (rx, None),
+        _ => (points[segment], Some(seq[segment])),
+    };
+    (start, end)
+}
+
+/// The first surface, other than the segment's own end surfaces `from` and `to`, whose box the
+/// segment `a -> b` touches and whose polygon passes `blocks`.
+#[inline(always)]
+fn first_blocking(
+    scene: &Scene,
+    (a, b): (Vec3, Vec3),
+    (from, to): (Option<SurfaceId>, Option<SurfaceId>),
+    mut blocks: impl FnMut(&bt_geom::Polygon) -> bool,
+) -> Option<SurfaceId> {
+    scene
+        .bvh()
+        .any_hit(a, b, |i| {
+            let id = SurfaceId(i);
+            Some(id) != from && Some(id) != to && blocks(&scene.surface(id).polygon)
+        })
+        .map(SurfaceId)
 }
 
 /// The first surface (other than the segment's own end surfaces) crossing the segment `a -> b`.
@@ -92,15 +139,9 @@ pub fn blocker(
 ) -> Option<SurfaceId> {
     let length = a.distance(b);
     let t_min = tol / length.max(tol);
-    scene
-        .bvh()
-        .any_hit(a, b, |i| {
-            let id = SurfaceId(i);
-            Some(id) != from
-                && Some(id) != to
-                && scene.surface(id).polygon.blocks_segment(a, b, t_min, tol)
-        })
-        .map(SurfaceId)
+    first_blocking(scene, (a, b), (from, to), |polygon| {
+        polygon.blocks_segment(a, b, t_min, tol)
+    })
 }
 
 /// Early stopping of IPC (`IpcOptions::early_reject`): the first segment of the path TX ->
@@ -123,33 +164,18 @@ pub fn blocked_for_good(
     let tol = scene.length_tolerance();
     let margin = reach + tol;
     let n = seq.len();
-    let at = |k: usize| match k {
-        0 => tx,
-        k if k == n + 1 => rx,
-        k => points[k - 1],
-    };
     for k in 0..n {
-        let polygon = &scene.surface(seq[k]).polygon;
-        let (a, b) = (
-            polygon.plane().signed_distance(at(k)),
-            polygon.plane().signed_distance(at(k + 2)),
-        );
+        let (a, b) = neighbour_distances(scene, seq, (tx, rx), points, k);
         let sides = (a > margin && b > margin) || (a < -margin && b < -margin);
+        let polygon = &scene.surface(seq[k]).polygon;
         if !sides || polygon.signed_boundary_distance(points[k]) <= margin {
             return None;
         }
     }
     (0..=n).find_map(|segment| {
-        let (a, b) = (at(segment), at(segment + 1));
-        let from = segment.checked_sub(1).map(|k| seq[k]);
-        let to = (segment < n).then(|| seq[segment]);
+        let ((a, from), (b, to)) = segment_ends(seq, (tx, rx), points, segment);
         let length = a.distance(b);
-        let by = scene.bvh().any_hit(a, b, |i| {
-            let id = SurfaceId(i);
-            if Some(id) == from || Some(id) == to {
-                return false;
-            }
-            let polygon = &scene.surface(id).polygon;
+        let by = first_blocking(scene, (a, b), (from, to), |polygon| {
             let (da, db) = (
                 polygon.plane().signed_distance(a),
                 polygon.plane().signed_distance(b),
@@ -162,6 +188,6 @@ pub fn blocked_for_good(
             let shift = reach * (1.0 + length / (span - 2.0 * reach));
             polygon.signed_boundary_distance(crossing) > tol + shift
         });
-        by.map(|i| (segment, SurfaceId(i)))
+        by.map(|by| (segment, by))
     })
 }
