@@ -277,6 +277,34 @@ impl Polygon {
         false
     }
 
+    /// Whether the projection of `p` onto the plane lies inside the polygon by more than
+    /// `margin` metres (`margin >= 0`): `signed_boundary_distance(p) > margin` up to rounding,
+    /// without square roots, and without looking at the edges for points within `margin` of
+    /// the polygon's 2-D bounding box (a ray from such a point to the box meets the boundary
+    /// within `margin`).
+    #[inline]
+    pub fn inside_by(&self, p: Vec3, margin: Real) -> bool {
+        let q = self.to_local(p);
+        if q.x - self.local_min.x <= margin
+            || self.local_max.x - q.x <= margin
+            || q.y - self.local_min.y <= margin
+            || self.local_max.y - q.y <= margin
+            || !poly2::contains(&self.local, q)
+        {
+            return false;
+        }
+        let n = self.local.len();
+        let margin2 = margin * margin;
+        let mut j = n - 1;
+        for i in 0..n {
+            if segment_distance_sq(q, self.local[j], self.local[i]) <= margin2 {
+                return false;
+            }
+            j = i;
+        }
+        true
+    }
+
     /// Whether the open segment `a -> b` passes through the polygon: it crosses the plane at a
     /// parameter `t` in `[t_min, 1 - t_min]` at a point inside the polygon or within `tol` of
     /// its boundary (grazing an edge counts as blocked: the conservative choice for occlusion).
@@ -349,6 +377,28 @@ mod tests {
         assert!((l.area() - 3.0).abs() < 1e-12);
         assert!(l.contains(Vec3::new(0.5, 1.5, 0.), 1e-9));
         assert!(!l.contains(Vec3::new(1.5, 1.5, 0.), 1e-9));
+    }
+
+    #[test]
+    fn inside_by_agrees_with_the_boundary_distance() {
+        // An L (concave) in a tilted plane, points on a grid around it, several margins.
+        let l = [(0., 0.), (3., 0.), (3., 1.), (1., 1.), (1., 2.5), (0., 2.5)];
+        let tilt = |x: Real, y: Real| Vec3::new(x, y * 0.6, y * 0.8);
+        let p = Polygon::new(l.iter().map(|&(x, y)| tilt(x, y)).collect()).unwrap();
+        let mut checked = 0;
+        for i in -10..=80 {
+            for j in -10..=70 {
+                let q = tilt(i as Real * 0.05, j as Real * 0.05) + 0.3 * p.plane().normal;
+                let d = p.signed_boundary_distance(q);
+                for margin in [0.0, 0.01, 0.1, 0.3, 0.55] {
+                    if (d - margin).abs() > 1e-9 {
+                        assert_eq!(p.inside_by(q, margin), d > margin, "{q} {margin} {d}");
+                        checked += 1;
+                    }
+                }
+            }
+        }
+        assert!(checked > 30_000);
     }
 
     #[test]

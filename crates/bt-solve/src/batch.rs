@@ -4,7 +4,11 @@
 //! else the candidate set's window start, else the centroids) and the per-candidate buffers.
 //! [`found_path`] turns a valid outcome into a [`FoundPath`].
 
-use crate::{CandidateOutcome, FoundPath, IpcOutcome, Solver, Validity, solve_candidate_from};
+use crate::ipc::IpcOptions;
+use crate::{
+    CandidateOutcome, FoundPath, IpcOutcome, Solver, Validity, ipc_verdict, lanes,
+    solve_candidate_from,
+};
 use bt_geom::Vec3;
 use bt_paths::CandidateSet;
 use bt_scene::{Scene, SurfaceId};
@@ -136,6 +140,9 @@ where
             solver,
             ..
         } = *self.batch;
+        if let Solver::Ipc(options) = solver {
+            return self.run_ipc(range, options);
+        }
         let mut acc = R::default();
         let mut stack_points = [Vec3::ZERO; STACK_ORDER];
         let mut stack_scratch = [Vec3::ZERO; STACK_ORDER];
@@ -155,6 +162,68 @@ where
             let start = (self.warm)(i).or_else(|| candidates.start(i));
             let outcome = solve_candidate_from(scene, seq, solver, start, points, scratch);
             (self.each)(&mut acc, i, seq, &outcome, points);
+        }
+        acc
+    }
+}
+
+impl<'w, W, F> Chunk<'_, W, F>
+where
+    W: Fn(usize) -> Option<&'w [Vec3]>,
+{
+    /// [`Chunk::run_impl`] for IPC: the candidates of each order up to
+    /// [`lanes::MAX_ORDER`] run [`lanes::LANES`] at a time ([`lanes::solve_group`]); longer
+    /// ones, and Newton acceleration, take the one-by-one path. The outcomes are kept and
+    /// folded in `todo` order at the end, so the accumulator sees exactly what the one-by-one
+    /// loop gives.
+    #[inline(always)]
+    fn run_ipc<R: Default>(&self, range: std::ops::Range<usize>, options: &IpcOptions) -> R
+    where
+        F: Fn(&mut R, usize, &[SurfaceId], &CandidateOutcome, &[Vec3]),
+    {
+        let (scene, candidates) = (self.batch.scene, self.batch.candidates);
+        let index = |k: usize| self.todo.index(range.start + k);
+        let seq_at = |k: usize| candidates.get(index(k));
+        let start_at = |k: usize| (self.warm)(index(k)).or_else(|| candidates.start(index(k)));
+        let len = range.len();
+        // Each candidate's points at `offsets[k]..offsets[k + 1]` of `points`.
+        let mut offsets = Vec::with_capacity(len + 1);
+        offsets.push(0);
+        for k in 0..len {
+            offsets.push(offsets[k] + seq_at(k).len());
+        }
+        let mut points = vec![Vec3::ZERO; offsets[len]];
+        let mut outcomes: Vec<Option<CandidateOutcome>> = vec![None; len];
+        let mut by_order: Vec<usize> = (0..len).collect();
+        by_order.sort_by_key(|&k| seq_at(k).len());
+        let lanes = lanes::handles(options);
+        for group in by_order.chunk_by(|&a, &b| seq_at(a).len() == seq_at(b).len()) {
+            let n = seq_at(group[0]).len();
+            if lanes && n <= lanes::MAX_ORDER {
+                let items = group.iter().map(|&k| (k, seq_at(k), start_at(k)));
+                lanes::solve_group(scene, options, n, items, |k, seq, outcome, solved| {
+                    let out = &mut points[offsets[k]..offsets[k + 1]];
+                    out.copy_from_slice(solved);
+                    outcomes[k] = Some(ipc_verdict(scene, seq, outcome, out));
+                });
+                continue;
+            }
+            let solver = Solver::Ipc(*options);
+            let mut scratch = vec![Vec3::ZERO; n];
+            for &k in group {
+                let out = &mut points[offsets[k]..offsets[k + 1]];
+                let outcome =
+                    solve_candidate_from(scene, seq_at(k), &solver, start_at(k), out, &mut scratch);
+                outcomes[k] = Some(outcome);
+            }
+        }
+        let mut acc = R::default();
+        for (k, outcome) in outcomes.iter().enumerate() {
+            let outcome = outcome
+                .as_ref()
+                .expect("every candidate of the chunk was solved");
+            let solved = &points[offsets[k]..offsets[k + 1]];
+            (self.each)(&mut acc, index(k), seq_at(k), outcome, solved);
         }
         acc
     }

@@ -264,7 +264,7 @@ pub fn solve(
 /// point to its successor; Jacobi computes every point from the previous round, in place: the
 /// old value of point k - 1 is kept in a register, point k + 1 is not yet overwritten.
 #[inline(always)]
-fn round<const JACOBI: bool>(
+pub(crate) fn round<const JACOBI: bool>(
     planes: &[Plane],
     tx: Vec3,
     rx: Vec3,
@@ -294,6 +294,13 @@ fn mean_displacement(sum: Real, n: usize) -> Real {
     if n == 0 { 0.0 } else { sum / n as Real }
 }
 
+/// The smallest summed distance (m) of a point's neighbours from its plane for which
+/// Algorithm 2's update is defined in `scene` (below it the run ends as degenerate).
+#[inline(always)]
+pub(crate) fn min_sum(scene: &Scene) -> Real {
+    scene.length_tolerance() * 1e-3
+}
+
 // Inlined so that the FMA-compiled candidate loop (`run_range_fma`) compiles it with FMA:
 // a call would run every `mul_add` of the rounds through the software fallback.
 #[inline(always)]
@@ -306,87 +313,227 @@ fn run(
     options: &IpcOptions,
     points: &mut [Vec3],
 ) -> IpcOutcome {
-    let n = seq.len();
-    let min_sum = scene.length_tolerance() * 1e-3;
-    // Newton is tried at most twice: after NEWTON_PATIENCE rounds and at the switch point.
-    let newton = options.acceleration == Acceleration::Newton;
-    let (mut switch_pending, mut patience_pending) = (newton, newton);
-    let newton_switch = NEWTON_SWITCH_REL * scene.extent().max(1.0) * n as Real;
-    let mut newton_steps = 0;
-    let mut rule = StoppingRule::new(options, n);
-    let mut rounds = 0;
-    while rounds < options.max_iterations {
-        rounds += 1;
-        let round = match options.order {
-            UpdateOrder::GaussSeidel => round::<false>(planes, tx, rx, points, min_sum),
-            UpdateOrder::Jacobi => round::<true>(planes, tx, rx, points, min_sum),
+    let mut run = IpcRun::new(scene, seq, (tx, rx), options);
+    loop {
+        if let Some(outcome) = run.step(planes, points) {
+            return outcome;
+        }
+    }
+}
+
+/// One IPC run that advances a round at a time ([`IpcRun::step`]), so that a batch can
+/// interleave independent runs: a Gauss-Seidel round is one long chain of dependent
+/// operations, and the CPU overlaps the chains of different runs. A run's arithmetic does not
+/// depend on what it is interleaved with: its outcome and points are bit for bit those of
+/// [`solve`].
+pub struct IpcRun<'a> {
+    scene: &'a Scene,
+    seq: &'a [SurfaceId],
+    tx: Vec3,
+    rx: Vec3,
+    options: &'a IpcOptions,
+    /// Below this summed distance of a point's neighbours from its plane the update is
+    /// undefined (m).
+    min_sum: Real,
+    /// Newton is tried at most twice: after NEWTON_PATIENCE rounds and at the switch point.
+    switch_pending: bool,
+    patience_pending: bool,
+    /// Summed displacement of a round (m) at which Newton takes over.
+    newton_switch: Real,
+    newton_steps: u32,
+    rule: StoppingRule,
+    rounds: u32,
+}
+
+impl<'a> IpcRun<'a> {
+    /// A run of `options` on `seq` between `tx` and `rx`, before its first round.
+    #[inline(always)]
+    pub fn new(
+        scene: &'a Scene,
+        seq: &'a [SurfaceId],
+        (tx, rx): (Vec3, Vec3),
+        options: &'a IpcOptions,
+    ) -> Self {
+        let n = seq.len();
+        let newton = options.acceleration == Acceleration::Newton;
+        IpcRun {
+            scene,
+            seq,
+            tx,
+            rx,
+            options,
+            min_sum: min_sum(scene),
+            switch_pending: newton,
+            patience_pending: newton,
+            newton_switch: NEWTON_SWITCH_REL * scene.extent().max(1.0) * n as Real,
+            newton_steps: 0,
+            rule: StoppingRule::new(options, n),
+            rounds: 0,
+        }
+    }
+
+    /// One round and the checks after it, on `points` (the run's points, updated in place)
+    /// with `planes` (the planes of its sequence): the outcome once the run has ended.
+    #[inline(always)]
+    pub fn step(&mut self, planes: &[Plane], points: &mut [Vec3]) -> Option<IpcOutcome> {
+        if self.at_cap() {
+            return Some(self.not_settled(planes, points));
+        }
+        self.rounds += 1;
+        let (tx, rx) = (self.tx, self.rx);
+        let round = match self.options.order {
+            UpdateOrder::GaussSeidel => round::<false>(planes, tx, rx, points, self.min_sum),
+            UpdateOrder::Jacobi => round::<true>(planes, tx, rx, points, self.min_sum),
         };
+        self.end_round(planes, points, round)
+    }
+
+    /// Whether the run has used its round cap (it then ends with [`IpcRun::not_settled`]).
+    #[inline(always)]
+    pub(crate) fn at_cap(&self) -> bool {
+        self.rounds >= self.options.max_iterations
+    }
+
+    /// Counts a round about to run (below the cap).
+    #[inline(always)]
+    pub(crate) fn count_round(&mut self) {
+        self.rounds += 1;
+    }
+
+    /// Whether the round just run, which moved the points by `moved` in sum, is a quiet one:
+    /// no check after it would look at the points or end the run. A quiet round is recorded;
+    /// any other goes through [`IpcRun::end_round`]. Lets a caller that keeps the points
+    /// elsewhere ([`crate::lanes`]) hand them over only when they are needed.
+    #[inline(always)]
+    pub(crate) fn quiet_round(&mut self, moved: Real) -> bool {
+        let rounds = self.rounds;
+        let looks = self.options.early_reject
+            && rounds as usize >= EARLY_REJECT_FROM
+            && rounds.is_multiple_of(EARLY_REJECT_EVERY);
+        let quiet = moved.is_finite()
+            && moved > self.rule.limit
+            && !self.switch_pending
+            && !self.patience_pending
+            && !looks
+            && !rounds.is_multiple_of(STALL_WINDOW);
+        if quiet {
+            self.rule.record(rounds, moved);
+        }
+        quiet
+    }
+
+    /// The checks after a round whose result was `round` (the summed displacement, or the
+    /// index of a point whose neighbours both lie on its plane): the outcome once the run has
+    /// ended.
+    #[inline(always)]
+    pub(crate) fn end_round(
+        &mut self,
+        planes: &[Plane],
+        points: &mut [Vec3],
+        round: Result<Real, usize>,
+    ) -> Option<IpcOutcome> {
+        let rounds = self.rounds;
+        let (tx, rx) = (self.tx, self.rx);
         let moved = match round {
             Ok(moved) => moved,
             Err(index) => {
-                return IpcOutcome::Degenerate {
+                return Some(IpcOutcome::Degenerate {
                     kind: DegenerateKind::NeighboursOnPlane,
                     index,
-                    iterations: rounds + newton_steps,
-                };
+                    iterations: rounds + self.newton_steps,
+                });
             }
         };
         if !moved.is_finite() {
-            break;
+            return Some(self.not_settled(planes, points));
         }
-        let at_switch = switch_pending && moved <= newton_switch;
-        let at_patience = patience_pending && rounds >= NEWTON_PATIENCE;
-        if at_switch || at_patience {
-            switch_pending &= !at_switch;
-            patience_pending = false;
-            match crate::newton::polish(planes, tx, rx, points, options.threshold) {
-                crate::newton::Polish::Converged { steps, last_step } => {
-                    let residual = mean_displacement(last_step, n);
-                    return converged(scene, planes, tx, rx, points, rounds + steps, residual);
-                }
-                // The points are unchanged; the paper's rounds carry on.
-                crate::newton::Polish::Failed { steps } => newton_steps += steps,
-            }
+        if let Some(outcome) = self.newton(planes, points, moved) {
+            return Some(outcome);
         }
-        if rule.settled(rounds, moved) {
-            let residual = mean_displacement(moved, n);
-            return converged(
-                scene,
-                planes,
-                tx,
-                rx,
-                points,
-                rounds + newton_steps,
-                residual,
-            );
+        let scene = self.scene;
+        if self.rule.settled(rounds, moved) {
+            let residual = mean_displacement(moved, planes.len());
+            let iterations = rounds + self.newton_steps;
+            return Some(converged(
+                scene, planes, tx, rx, points, iterations, residual,
+            ));
         }
-        if rule.stalled(rounds, moved) {
-            break;
+        if self.rule.stalled(rounds, moved) {
+            return Some(self.not_settled(planes, points));
         }
-        let reach = options
+        let reach = self
+            .options
             .early_reject
-            .then(|| rule.early_reject_reach(rounds, moved, scene.length_tolerance()))
+            .then(|| {
+                self.rule
+                    .early_reject_reach(rounds, moved, scene.length_tolerance())
+            })
             .flatten();
-        let iterations = rounds + newton_steps;
-        if let Some(stop) = reach
-            .and_then(|reach| early_stop(scene, seq, (tx, rx), points, (rounds, iterations, reach)))
-        {
+        let iterations = rounds + self.newton_steps;
+        let stop = reach.and_then(|reach| {
+            early_stop(
+                scene,
+                self.seq,
+                (tx, rx),
+                points,
+                (rounds, iterations, reach),
+            )
+        });
+        if stop.is_some() {
             return stop;
         }
-        rule.record(rounds, moved);
+        self.rule.record(rounds, moved);
+        None
     }
-    let iterations = rounds + newton_steps;
-    let residual = mean_displacement(rule.last, n);
-    if rule.rule_met && residual.is_finite() {
-        return converged(scene, planes, tx, rx, points, iterations, residual);
+
+    /// Newton acceleration after a round that moved the points by `moved` in sum: at the
+    /// switch point or after [`NEWTON_PATIENCE`] rounds, the outcome if Newton converged.
+    #[inline(always)]
+    fn newton(&mut self, planes: &[Plane], points: &mut [Vec3], moved: Real) -> Option<IpcOutcome> {
+        let at_switch = self.switch_pending && moved <= self.newton_switch;
+        let at_patience = self.patience_pending && self.rounds >= NEWTON_PATIENCE;
+        if !(at_switch || at_patience) {
+            return None;
+        }
+        self.switch_pending &= !at_switch;
+        self.patience_pending = false;
+        let (tx, rx) = (self.tx, self.rx);
+        match crate::newton::polish(planes, tx, rx, points, self.options.threshold) {
+            crate::newton::Polish::Converged { steps, last_step } => {
+                let residual = mean_displacement(last_step, planes.len());
+                let iterations = self.rounds + steps;
+                Some(converged(
+                    self.scene, planes, tx, rx, points, iterations, residual,
+                ))
+            }
+            // The points are unchanged; the paper's rounds carry on.
+            crate::newton::Polish::Failed { steps } => {
+                self.newton_steps += steps;
+                None
+            }
+        }
     }
-    IpcOutcome::NotConverged {
-        iterations,
-        residual: if residual.is_finite() {
-            residual
-        } else {
-            Real::MAX
-        },
+
+    /// The end of a run that stopped without its rule holding in the last round (round cap,
+    /// stall, non-finite displacement): converged if the paper's rule held in some round,
+    /// else not converged.
+    #[cold]
+    pub(crate) fn not_settled(&self, planes: &[Plane], points: &[Vec3]) -> IpcOutcome {
+        let iterations = self.rounds + self.newton_steps;
+        let residual = mean_displacement(self.rule.last, planes.len());
+        if self.rule.rule_met && residual.is_finite() {
+            return converged(
+                self.scene, planes, self.tx, self.rx, points, iterations, residual,
+            );
+        }
+        IpcOutcome::NotConverged {
+            iterations,
+            residual: if residual.is_finite() {
+                residual
+            } else {
+                Real::MAX
+            },
+        }
     }
 }
 
@@ -501,7 +648,7 @@ impl StoppingRule {
     fn stalled(&mut self, rounds: u32, moved: Real) -> bool {
         let window_end = rounds.is_multiple_of(STALL_WINDOW);
         if window_end && rounds > STALL_WINDOW {
-            let rate = (moved / self.window_start).powf(1.0 / STALL_WINDOW as Real);
+            let rate = root_of_power_of_two(moved / self.window_start, STALL_WINDOW);
             let remaining = (self.max_iterations - rounds) as Real;
             let needed = if rate < 1.0 {
                 (self.limit / moved).ln() / rate.ln()
@@ -530,7 +677,7 @@ impl StoppingRule {
             return None;
         }
         let base = self.recent[(rounds as usize - EARLY_REJECT_SPAN) % RATE_WINDOW];
-        let rate = (moved / base).powf(1.0 / EARLY_REJECT_SPAN as Real);
+        let rate = root_of_power_of_two(moved / base, EARLY_REJECT_SPAN as u32);
         (rate < 1.0).then(|| EARLY_REJECT_MARGIN * moved * rate / (1.0 - rate) + length_tolerance)
     }
 
@@ -541,6 +688,16 @@ impl StoppingRule {
         self.last = moved;
     }
 }
+
+/// `x^(1/span)` for a power of two `span`, by repeated square roots: several times cheaper
+/// than `powf`, and as good for the rates it measures (estimates used with a wide margin).
+#[inline(always)]
+fn root_of_power_of_two(x: Real, span: u32) -> Real {
+    debug_assert!(span.is_power_of_two());
+    (0..span.trailing_zeros()).fold(x, |r, _| r.sqrt())
+}
+
+const _: () = assert!(EARLY_REJECT_SPAN.is_power_of_two() && STALL_WINDOW.is_power_of_two());
 
 /// The outcome of a run whose stopping rule held: converged, unless some point ends with its
 /// neighbours on opposite sides of its plane (a transmission, not a reflection).

@@ -13,6 +13,7 @@
 pub mod batch;
 pub mod image;
 pub mod ipc;
+mod lanes;
 mod newton;
 pub mod pipeline;
 pub mod sbr;
@@ -169,42 +170,64 @@ pub fn solve_candidate_from(
     scratch: &mut [Vec3],
 ) -> CandidateOutcome {
     let (tx, rx) = (scene.tx(), scene.rx());
-    let ipc = match solver {
+    match solver {
         Solver::Image => {
             if let Err(e) = image::solve(scene, seq, tx, rx, points) {
                 return CandidateOutcome::ImageDegenerate(e);
             }
-            None
         }
         Solver::Ipc(options) => {
-            match warm {
-                Some(warm) => points.copy_from_slice(warm),
-                None => {
-                    for (p, id) in points.iter_mut().zip(seq) {
-                        *p = scene.surface(*id).polygon.centroid();
-                    }
-                }
-            }
+            ipc_start(scene, seq, warm, points);
             let outcome = ipc::solve(scene, seq, tx, rx, options, points, scratch);
-            match outcome {
-                IpcOutcome::Converged { .. } => Some(outcome),
-                IpcOutcome::NotConverged { .. } => return CandidateOutcome::NotConverged(outcome),
-                IpcOutcome::Degenerate { .. } => return CandidateOutcome::Degenerate(outcome),
-                IpcOutcome::LeftPolygon { .. } => return CandidateOutcome::LeftPolygon(outcome),
-                IpcOutcome::Blocked { .. } => return CandidateOutcome::Blocked(outcome),
-            }
+            return ipc_verdict(scene, seq, outcome, points);
         }
         Solver::Sbr(options) => match sbr::solve_sequence(scene, seq, options) {
-            Some(path) => {
-                points.copy_from_slice(&path.points);
-                None
-            }
+            Some(path) => points.copy_from_slice(&path.points),
             None => return CandidateOutcome::Missed,
         },
-    };
+    }
     CandidateOutcome::Solved {
         validity: validate::validate(scene, seq, tx, rx, points),
-        ipc,
+        ipc: None,
+    }
+}
+
+/// IPC's start points for `seq` into `points`: `warm` when given, else the polygon centroids.
+#[inline(always)]
+pub(crate) fn ipc_start(
+    scene: &Scene,
+    seq: &[SurfaceId],
+    warm: Option<&[Vec3]>,
+    points: &mut [Vec3],
+) {
+    match warm {
+        Some(warm) => points.copy_from_slice(warm),
+        None => {
+            for (p, id) in points.iter_mut().zip(seq) {
+                *p = scene.surface(*id).polygon.centroid();
+            }
+        }
+    }
+}
+
+/// The candidate outcome of an IPC run on `seq` that ended as `outcome` with `points`: a
+/// converged run is validated, any other end is the outcome itself.
+#[inline(always)]
+pub(crate) fn ipc_verdict(
+    scene: &Scene,
+    seq: &[SurfaceId],
+    outcome: IpcOutcome,
+    points: &[Vec3],
+) -> CandidateOutcome {
+    match outcome {
+        IpcOutcome::Converged { .. } => CandidateOutcome::Solved {
+            validity: validate::validate(scene, seq, scene.tx(), scene.rx(), points),
+            ipc: Some(outcome),
+        },
+        IpcOutcome::NotConverged { .. } => CandidateOutcome::NotConverged(outcome),
+        IpcOutcome::Degenerate { .. } => CandidateOutcome::Degenerate(outcome),
+        IpcOutcome::LeftPolygon { .. } => CandidateOutcome::LeftPolygon(outcome),
+        IpcOutcome::Blocked { .. } => CandidateOutcome::Blocked(outcome),
     }
 }
 

@@ -168,7 +168,7 @@ pub fn blocked_for_good(
         let (a, b) = neighbour_distances(scene, seq, (tx, rx), points, k);
         let sides = (a > margin && b > margin) || (a < -margin && b < -margin);
         let polygon = &scene.surface(seq[k]).polygon;
-        if !sides || polygon.signed_boundary_distance(points[k]) <= margin {
+        if !sides || !polygon.inside_by(points[k], margin) {
             return None;
         }
     }
@@ -176,9 +176,11 @@ pub fn blocked_for_good(
         let ((a, from), (b, to)) = segment_ends(seq, (tx, rx), points, segment);
         let length = a.distance(b);
         let by = first_blocking(scene, (a, b), (from, to), |polygon| {
+            // Unfused: the margins are far above its round-off, and the closure may be compiled
+            // without the FMA feature (a software `fma` per call).
             let (da, db) = (
-                polygon.plane().signed_distance(a),
-                polygon.plane().signed_distance(b),
+                polygon.plane().signed_distance_unfused(a),
+                polygon.plane().signed_distance_unfused(b),
             );
             let span = da.abs() + db.abs();
             if (da > 0.0) == (db > 0.0) || da.abs() <= margin || db.abs() <= margin {
@@ -186,7 +188,7 @@ pub fn blocked_for_good(
             }
             let crossing = a + (da / (da - db)) * (b - a);
             let shift = reach * (1.0 + length / (span - 2.0 * reach));
-            polygon.signed_boundary_distance(crossing) > tol + shift
+            polygon.inside_by(crossing, tol + shift)
         });
         by.map(|by| (segment, by))
     })

@@ -6,5 +6,6 @@ mod analytic;
 mod beamtree;
 mod common;
 mod ipc_vs_image;
+mod lanes;
 mod newton;
 mod translation;

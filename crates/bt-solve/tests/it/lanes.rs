@@ -1,0 +1,147 @@
+//! IPC runs four at a time in a batch (`solve_batch`), one by one in `solve_candidate_from`:
+//! the two must agree bit for bit, whatever the outcome.
+
+use crate::common::{random_scene, scene_from_json};
+use bt_geom::Vec3;
+use bt_paths::{AllVisible, CandidateSet, enumerate};
+use bt_scene::{Scene, SurfaceId};
+use bt_solve::{
+    Batch, CandidateOutcome, IpcOptions, Solver, Todo, UpdateOrder, solve_batch,
+    solve_candidate_from,
+};
+
+type Solved = Vec<(usize, CandidateOutcome, Vec<Vec3>)>;
+
+/// Every candidate's outcome and points through the batch (`parallel` as given).
+fn batched(scene: &Scene, set: &CandidateSet, solver: &Solver, parallel: bool) -> Solved {
+    let batch = Batch {
+        scene,
+        candidates: set,
+        solver,
+        parallel,
+    };
+    let keep = |acc: &mut Solved, i: usize, _: &[SurfaceId], o: &CandidateOutcome, p: &[Vec3]| {
+        acc.push((i, *o, p.to_vec()))
+    };
+    solve_batch(&batch, Todo::All, |_| None, keep)
+        .into_iter()
+        .flatten()
+        .collect()
+}
+
+/// Every candidate's outcome and points, one by one.
+fn one_by_one(scene: &Scene, set: &CandidateSet, solver: &Solver) -> Solved {
+    (0..set.len())
+        .map(|i| {
+            let seq = set.get(i);
+            let mut points = vec![Vec3::ZERO; seq.len()];
+            let mut scratch = points.clone();
+            let start = set.start(i);
+            let outcome =
+                solve_candidate_from(scene, seq, solver, start, &mut points, &mut scratch);
+            (i, outcome, points)
+        })
+        .collect()
+}
+
+/// Bit-for-bit equality (points by their bits, so that NaN equals NaN); returns how many
+/// candidates ended in each kind of outcome.
+fn assert_bitwise_equal(a: &Solved, b: &Solved) -> std::collections::BTreeMap<String, usize> {
+    assert_eq!(a.len(), b.len());
+    let mut kinds = std::collections::BTreeMap::new();
+    for ((i, oa, pa), (j, ob, pb)) in a.iter().zip(b) {
+        assert_eq!(i, j);
+        assert_eq!(format!("{oa:?}"), format!("{ob:?}"), "candidate {i}");
+        let bits = |p: &[Vec3]| {
+            p.iter()
+                .flat_map(|v| v.to_array().map(f64::to_bits))
+                .collect::<Vec<_>>()
+        };
+        assert_eq!(bits(pa), bits(pb), "candidate {i}: points differ");
+        let kind = format!("{oa:?}")
+            .split(['(', ' ', '{'])
+            .next()
+            .unwrap()
+            .to_string();
+        *kinds.entry(kind).or_insert(0) += 1;
+    }
+    kinds
+}
+
+fn solvers(scene: &Scene) -> Vec<Solver> {
+    [UpdateOrder::GaussSeidel, UpdateOrder::Jacobi]
+        .into_iter()
+        .flat_map(|order| {
+            let options = IpcOptions::for_scene(scene, order);
+            [
+                Solver::Ipc(options),
+                // A tight round cap: runs end at the cap, in lanes and alone.
+                Solver::Ipc(IpcOptions {
+                    max_iterations: 40,
+                    ..options
+                }),
+            ]
+        })
+        .collect()
+}
+
+#[test]
+fn lanes_equal_one_by_one_on_the_living_room() {
+    let scene = bt_scene::builtin_scene("living-room", bt_scene::Terminals::default())
+        .unwrap()
+        .unwrap();
+    // Exhaustive candidates from the centroids: every kind of ending, many of each order.
+    let set = enumerate(&scene, 3, &AllVisible);
+    let mut kinds = std::collections::BTreeMap::new();
+    for solver in solvers(&scene) {
+        let reference = one_by_one(&scene, &set, &solver);
+        for parallel in [false, true] {
+            for (k, n) in
+                assert_bitwise_equal(&batched(&scene, &set, &solver, parallel), &reference)
+            {
+                *kinds.entry(k).or_insert(0) += n;
+            }
+        }
+    }
+    for kind in ["Solved", "LeftPolygon", "Blocked", "NotConverged"] {
+        assert!(
+            kinds.get(kind).copied().unwrap_or(0) > 0,
+            "no {kind} outcome: {kinds:?}"
+        );
+    }
+}
+
+#[test]
+fn lanes_equal_one_by_one_where_ipc_degenerates() {
+    // The floor's centroid lies in the wall's plane: from the centroids, IPC on wall -> floor
+    // meets a point whose neighbours both lie on its plane (the lanes rerun that lane alone).
+    let scene = scene_from_json(
+        r#"{ "tx": [-0.3, -1.4, 2.3], "rx": [-0.9, 0.6, 0.9], "surfaces": [
+            { "name": "floor", "vertices": [[-2,-2,0],[2,-2,0],[2,2,0],[-2,2,0]] },
+            { "name": "wall", "vertices": [[0,-1.75,0.9],[0,1.75,0.9],[0,1.75,2.9],[0,-1.75,2.9]] } ] }"#,
+    );
+    let set = enumerate(&scene, 3, &AllVisible);
+    let mut degenerate = 0;
+    for solver in solvers(&scene) {
+        let kinds = assert_bitwise_equal(
+            &batched(&scene, &set, &solver, false),
+            &one_by_one(&scene, &set, &solver),
+        );
+        degenerate += kinds.get("Degenerate").copied().unwrap_or(0);
+    }
+    assert!(degenerate > 0, "no degenerate run");
+}
+
+#[test]
+fn lanes_equal_one_by_one_on_random_scenes() {
+    for seed in 0..12 {
+        let scene = random_scene(seed, 2 + (seed as usize % 5));
+        let set = enumerate(&scene, 3, &AllVisible);
+        for solver in solvers(&scene) {
+            assert_bitwise_equal(
+                &batched(&scene, &set, &solver, false),
+                &one_by_one(&scene, &set, &solver),
+            );
+        }
+    }
+}
