@@ -203,11 +203,7 @@ fn ipc_finds_the_wall_floor_path_that_centroid_starts_missed() {
     // The floor's centroid lies in the wall's plane: IPC from centroids settled on the planes'
     // shared line. Started inside the beam tree's windows it converges to the image method's
     // wall -> floor path of 3.960 m.
-    let scene = scene_from_json(
-        r#"{ "tx": [-0.3, -1.4, 2.3], "rx": [-0.9, 0.6, 0.9], "surfaces": [
-            { "name": "floor", "vertices": [[-2,-2,0],[2,-2,0],[2,2,0],[-2,2,0]] },
-            { "name": "wall", "vertices": [[0,-1.75,0.9],[0,1.75,0.9],[0,1.75,2.9],[0,-1.75,2.9]] } ] }"#,
-    );
+    let scene = crate::common::wall_floor_scene();
     let image = paths(&scene, 2, CandidateMode::Exhaustive);
     let ipc = trace_scene(
         &scene,

@@ -1,7 +1,7 @@
 //! IPC runs four at a time in a batch (`solve_batch`), one by one in `solve_candidate_from`:
 //! the two must agree bit for bit, whatever the outcome.
 
-use crate::common::{random_scene, scene_from_json};
+use crate::common::random_scene;
 use bt_geom::Vec3;
 use bt_paths::{AllVisible, CandidateSet, enumerate};
 use bt_scene::{Scene, SurfaceId};
@@ -115,11 +115,7 @@ fn lanes_equal_one_by_one_on_the_living_room() {
 fn lanes_equal_one_by_one_where_ipc_degenerates() {
     // The floor's centroid lies in the wall's plane: from the centroids, IPC on wall -> floor
     // meets a point whose neighbours both lie on its plane (the lanes rerun that lane alone).
-    let scene = scene_from_json(
-        r#"{ "tx": [-0.3, -1.4, 2.3], "rx": [-0.9, 0.6, 0.9], "surfaces": [
-            { "name": "floor", "vertices": [[-2,-2,0],[2,-2,0],[2,2,0],[-2,2,0]] },
-            { "name": "wall", "vertices": [[0,-1.75,0.9],[0,1.75,0.9],[0,1.75,2.9],[0,-1.75,2.9]] } ] }"#,
-    );
+    let scene = crate::common::wall_floor_scene();
     let set = enumerate(&scene, 3, &AllVisible);
     let mut degenerate = 0;
     for solver in solvers(&scene) {
