@@ -75,6 +75,8 @@ struct Job<'s> {
 struct Group<'s> {
     n: usize,
     points: [Points; MAX_ORDER],
+    /// The points before the current round (for [`Group::rerun`]).
+    before: [Points; MAX_ORDER],
     planes: [Planes; MAX_ORDER],
     jobs: [Option<Job<'s>>; LANES],
 }
@@ -95,6 +97,7 @@ pub(crate) fn solve_group<'s>(
     let mut group = Group {
         n,
         points: [Points::default(); MAX_ORDER],
+        before: [Points::default(); MAX_ORDER],
         planes: [Planes::default(); MAX_ORDER],
         jobs: std::array::from_fn(|_| None),
     };
@@ -225,8 +228,6 @@ impl<'s> Group<'s> {
         min_sum: Real,
     ) -> [Result<Real, usize>; LANES] {
         let n = self.n;
-        let mut before = [Points::default(); MAX_ORDER];
-        before[..n].copy_from_slice(&self.points[..n]);
         let mut moved = [0.0; LANES];
         let mut flat = [false; LANES];
         let mut prev = Points::splat(tx);
@@ -237,6 +238,7 @@ impl<'s> Group<'s> {
                 self.points[k + 1]
             };
             let old = self.points[k];
+            self.before[k] = old;
             let new = update(
                 &self.planes[k],
                 (&prev, &next, &old),
@@ -248,16 +250,15 @@ impl<'s> Group<'s> {
         }
         std::array::from_fn(|l| match flat[l] {
             false => Ok(moved[l]),
-            true => self.rerun::<JACOBI>(l, &before, (tx, rx), min_sum),
+            true => self.rerun::<JACOBI>(l, (tx, rx), min_sum),
         })
     }
 
-    /// Lane `l`'s round rerun by the scalar round from its points `before` it.
+    /// Lane `l`'s round rerun by the scalar round from its points before it.
     #[cold]
     fn rerun<const JACOBI: bool>(
         &mut self,
         l: usize,
-        before: &[Points; MAX_ORDER],
         (tx, rx): (Vec3, Vec3),
         min_sum: Real,
     ) -> Result<Real, usize> {
@@ -267,7 +268,7 @@ impl<'s> Group<'s> {
         };
         let mut points = [Vec3::ZERO; MAX_ORDER];
         for (i, p) in points[..n].iter_mut().enumerate() {
-            *p = before[i].get(l);
+            *p = self.before[i].get(l);
         }
         let round =
             crate::ipc::round::<JACOBI>(&job.planes[..n], tx, rx, &mut points[..n], min_sum);
