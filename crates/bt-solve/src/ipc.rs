@@ -343,6 +343,10 @@ pub struct IpcRun<'a> {
     newton_steps: u32,
     rule: StoppingRule,
     rounds: u32,
+    /// Summed displacement (m) since every point was last found inside its polygon (infinite
+    /// before that): while it is at most early rejection's reach, no point can lie outside by
+    /// more than the reach, and the test is skipped.
+    inside_moved: Real,
 }
 
 impl<'a> IpcRun<'a> {
@@ -369,6 +373,7 @@ impl<'a> IpcRun<'a> {
             newton_steps: 0,
             rule: StoppingRule::new(options, n),
             rounds: 0,
+            inside_moved: Real::INFINITY,
         }
     }
 
@@ -417,6 +422,7 @@ impl<'a> IpcRun<'a> {
             && !looks
             && !rounds.is_multiple_of(STALL_WINDOW);
         if quiet {
+            self.inside_moved += moved;
             self.rule.record(rounds, moved);
         }
         quiet
@@ -447,6 +453,7 @@ impl<'a> IpcRun<'a> {
         if !moved.is_finite() {
             return Some(self.not_settled(planes, points));
         }
+        self.inside_moved += moved;
         if let Some(outcome) = self.newton(planes, points, moved) {
             return Some(outcome);
         }
@@ -470,15 +477,7 @@ impl<'a> IpcRun<'a> {
             })
             .flatten();
         let iterations = rounds + self.newton_steps;
-        let stop = reach.and_then(|reach| {
-            early_stop(
-                scene,
-                self.seq,
-                (tx, rx),
-                points,
-                (rounds, iterations, reach),
-            )
-        });
+        let stop = reach.and_then(|reach| self.early_stop(points, (rounds, iterations, reach)));
         if stop.is_some() {
             return stop;
         }
@@ -514,6 +513,50 @@ impl<'a> IpcRun<'a> {
         }
     }
 
+    /// Early stopping at round `rounds` when the points can still move by up to `reach` metres:
+    /// a point outside its polygon by more than that ([`IpcOutcome::LeftPolygon`]), or, every
+    /// [`EARLY_BLOCK_EVERY`] rounds, a segment blocked for good ([`IpcOutcome::Blocked`]), after
+    /// `iterations` rounds plus Newton steps.
+    #[inline(always)]
+    fn early_stop(
+        &mut self,
+        points: &[Vec3],
+        (rounds, iterations, reach): (u32, u32, Real),
+    ) -> Option<IpcOutcome> {
+        let (scene, seq) = (self.scene, self.seq);
+        if self.inside_moved > reach {
+            // A point inside its polygon needs no margin; one outside is rejected beyond `reach`.
+            let mut inside = true;
+            for (k, id) in seq.iter().enumerate() {
+                let polygon = &scene.surface(*id).polygon;
+                if polygon.contains(points[k], 0.0) {
+                    continue;
+                }
+                if !polygon.contains(points[k], reach) {
+                    return Some(IpcOutcome::LeftPolygon {
+                        index: k,
+                        iterations,
+                    });
+                }
+                inside = false;
+            }
+            if inside {
+                self.inside_moved = 0.0;
+            }
+        }
+        if !rounds.is_multiple_of(EARLY_BLOCK_EVERY) {
+            return None;
+        }
+        let (tx, rx) = (self.tx, self.rx);
+        crate::validate::blocked_for_good(scene, seq, (tx, rx), points, reach).map(
+            |(segment, by)| IpcOutcome::Blocked {
+                segment,
+                by,
+                iterations,
+            },
+        )
+    }
+
     /// The end of a run that stopped without its rule holding in the last round (round cap,
     /// stall, non-finite displacement): converged if the paper's rule held in some round,
     /// else not converged.
@@ -535,35 +578,6 @@ impl<'a> IpcRun<'a> {
             },
         }
     }
-}
-
-/// Early stopping at round `rounds` when the points can still move by up to `reach` metres:
-/// a point outside its polygon by more than that ([`IpcOutcome::LeftPolygon`]), or, every
-/// [`EARLY_BLOCK_EVERY`] rounds, a segment blocked for good ([`IpcOutcome::Blocked`]), after
-/// `iterations` rounds plus Newton steps.
-#[inline(always)]
-fn early_stop(
-    scene: &Scene,
-    seq: &[SurfaceId],
-    (tx, rx): (Vec3, Vec3),
-    points: &[Vec3],
-    (rounds, iterations, reach): (u32, u32, Real),
-) -> Option<IpcOutcome> {
-    let outside =
-        (0..seq.len()).find(|&k| !scene.surface(seq[k]).polygon.contains(points[k], reach));
-    if let Some(index) = outside {
-        return Some(IpcOutcome::LeftPolygon { index, iterations });
-    }
-    if !rounds.is_multiple_of(EARLY_BLOCK_EVERY) {
-        return None;
-    }
-    crate::validate::blocked_for_good(scene, seq, (tx, rx), points, reach).map(|(segment, by)| {
-        IpcOutcome::Blocked {
-            segment,
-            by,
-            iterations,
-        }
-    })
 }
 
 /// Early rejection looks at the points every this many rounds (a divisor of [`RATE_WINDOW`]).
