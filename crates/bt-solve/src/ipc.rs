@@ -219,7 +219,21 @@ pub fn intersection_point(plane: &Plane, prev: Vec3, next: Vec3, min_sum: Real) 
 }
 
 /// Chains up to this order keep a copy of their planes on the stack (longer ones on the heap).
-const LOCAL_PLANES: usize = 8;
+pub(crate) const LOCAL_PLANES: usize = 8;
+
+/// The planes of `seq` (at most [`LOCAL_PLANES`] long), contiguous and on the stack: the rounds
+/// touch nothing else of the scene. Entries past `seq.len()` are unused.
+#[inline(always)]
+pub(crate) fn local_planes(scene: &Scene, seq: &[SurfaceId]) -> [Plane; LOCAL_PLANES] {
+    let mut planes = [Plane {
+        normal: Vec3::ZERO,
+        offset: 0.0,
+    }; LOCAL_PLANES];
+    for (plane, id) in planes.iter_mut().zip(seq) {
+        *plane = *scene.surface(*id).polygon.plane();
+    }
+    planes
+}
 
 /// Run IPC on `seq` between `tx` and `rx`. `points` holds the initial points on entry (one per
 /// surface) and the final ones on return; `scratch` (same length) is kept for API stability
@@ -240,15 +254,8 @@ pub fn solve(
     let n = seq.len();
     debug_assert!(points.len() == n && scratch.len() == n);
     let _ = scratch;
-    // The planes of this chain, contiguous: the rounds touch nothing else of the scene.
     if n <= LOCAL_PLANES {
-        let mut planes = [Plane {
-            normal: Vec3::ZERO,
-            offset: 0.0,
-        }; LOCAL_PLANES];
-        for (plane, id) in planes.iter_mut().zip(seq) {
-            *plane = *scene.surface(*id).polygon.plane();
-        }
+        let planes = local_planes(scene, seq);
         run(scene, seq, &planes[..n], tx, rx, options, points)
     } else {
         let planes: Vec<Plane> = seq
@@ -384,7 +391,7 @@ impl<'a> IpcRun<'a> {
         if self.at_cap() {
             return Some(self.not_settled(planes, points));
         }
-        self.rounds += 1;
+        self.count_round();
         let (tx, rx) = (self.tx, self.rx);
         let round = match self.options.order {
             UpdateOrder::GaussSeidel => round::<false>(planes, tx, rx, points, self.min_sum),
@@ -412,9 +419,7 @@ impl<'a> IpcRun<'a> {
     #[inline(always)]
     pub(crate) fn quiet_round(&mut self, moved: Real) -> bool {
         let rounds = self.rounds;
-        let looks = self.options.early_reject
-            && rounds as usize >= EARLY_REJECT_FROM
-            && rounds.is_multiple_of(EARLY_REJECT_EVERY);
+        let looks = self.options.early_reject && early_reject_looks(rounds);
         let quiet = moved.is_finite()
             && moved > self.rule.limit
             && !self.switch_pending
@@ -580,6 +585,12 @@ impl<'a> IpcRun<'a> {
     }
 }
 
+/// Whether early rejection looks at the points after round `rounds` (from 1).
+#[inline(always)]
+fn early_reject_looks(rounds: u32) -> bool {
+    rounds as usize >= EARLY_REJECT_FROM && rounds.is_multiple_of(EARLY_REJECT_EVERY)
+}
+
 /// Early rejection looks at the points every this many rounds (a divisor of [`RATE_WINDOW`]).
 pub const EARLY_REJECT_EVERY: u32 = 8;
 
@@ -685,9 +696,7 @@ impl StoppingRule {
     /// on other rounds and while the displacement is not shrinking.
     #[inline(always)]
     fn early_reject_reach(&self, rounds: u32, moved: Real, length_tolerance: Real) -> Option<Real> {
-        let looks =
-            rounds as usize >= EARLY_REJECT_FROM && rounds.is_multiple_of(EARLY_REJECT_EVERY);
-        if !looks {
+        if !early_reject_looks(rounds) {
             return None;
         }
         let base = self.recent[(rounds as usize - EARLY_REJECT_SPAN) % RATE_WINDOW];

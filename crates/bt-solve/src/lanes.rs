@@ -16,8 +16,9 @@ use bt_scene::{Scene, SurfaceId};
 /// Runs advanced together.
 pub(crate) const LANES: usize = 4;
 
-/// Longest chain run in lanes; longer ones take the scalar path.
-pub(crate) const MAX_ORDER: usize = 8;
+/// Longest chain run in lanes (the scalar run's stack copy of its planes); longer ones take
+/// the scalar path.
+pub(crate) const MAX_ORDER: usize = crate::ipc::LOCAL_PLANES;
 
 type Lanes = [Real; LANES];
 
@@ -102,6 +103,7 @@ pub(crate) fn solve_group<'s>(
         jobs: std::array::from_fn(|_| None),
     };
     let (tx, rx) = (scene.tx(), scene.rx());
+    let min_sum = crate::ipc::min_sum(scene);
     let mut out = [Vec3::ZERO; MAX_ORDER];
     loop {
         for l in 0..LANES {
@@ -115,7 +117,6 @@ pub(crate) fn solve_group<'s>(
             return;
         }
         group.open_rounds(&mut out, &mut done);
-        let min_sum = crate::ipc::min_sum(scene);
         let rounds = match options.order {
             UpdateOrder::GaussSeidel => group.round::<false>((tx, rx), min_sum),
             UpdateOrder::Jacobi => group.round::<true>((tx, rx), min_sum),
@@ -134,15 +135,10 @@ impl<'s> Group<'s> {
         (k, seq, start): (usize, &'s [SurfaceId], Option<&'s [Vec3]>),
     ) {
         let n = self.n;
-        let mut planes = [Plane {
-            normal: Vec3::ZERO,
-            offset: 0.0,
-        }; MAX_ORDER];
+        let planes = crate::ipc::local_planes(scene, seq);
         let mut points = [Vec3::ZERO; MAX_ORDER];
         crate::ipc_start(scene, seq, start, &mut points[..n]);
-        for i in 0..n {
-            let plane = *scene.surface(seq[i]).polygon.plane();
-            planes[i] = plane;
+        for (i, plane) in planes[..n].iter().enumerate() {
             let lane = &mut self.planes[i];
             (lane.x[l], lane.y[l], lane.z[l]) = (plane.normal.x, plane.normal.y, plane.normal.z);
             lane.offset[l] = plane.offset;
