@@ -262,19 +262,7 @@ impl Polygon {
         {
             return false;
         }
-        if poly2::contains(&self.local, q) {
-            return true;
-        }
-        let n = self.local.len();
-        let tol2 = tol * tol;
-        let mut j = n - 1;
-        for i in 0..n {
-            if segment_distance_sq(q, self.local[j], self.local[i]) <= tol2 {
-                return true;
-            }
-            j = i;
-        }
-        false
+        poly2::contains(&self.local, q) || self.near_boundary(q, tol)
     }
 
     /// Whether the projection of `p` onto the plane lies inside the polygon by more than
@@ -293,16 +281,21 @@ impl Polygon {
         {
             return false;
         }
+        !self.near_boundary(q, margin)
+    }
+
+    /// Whether the in-plane point `q` lies within `dist` metres of an edge (squared distances,
+    /// no square root).
+    #[inline]
+    fn near_boundary(&self, q: Vec2, dist: Real) -> bool {
+        let dist2 = dist * dist;
         let n = self.local.len();
-        let margin2 = margin * margin;
         let mut j = n - 1;
-        for i in 0..n {
-            if segment_distance_sq(q, self.local[j], self.local[i]) <= margin2 {
-                return false;
-            }
+        (0..n).any(|i| {
+            let near = segment_distance_sq(q, self.local[j], self.local[i]) <= dist2;
             j = i;
-        }
-        true
+            near
+        })
     }
 
     /// Whether the open segment `a -> b` passes through the polygon: it crosses the plane at a
