@@ -2,7 +2,7 @@
 
 use crate::{
     FineCoord, FinePoint, FixedError, FixedPlane, FixedPoint, dequantize_fine_point,
-    displacement_linf, intersection_point, quantize_fine_point, quantize_point,
+    Widths, displacement_linf, intersection_point_in, quantize_fine_point, quantize_point,
 };
 
 /// A plane at the boundary, in metres: `normal · x = offset_m`, `normal` unit.
@@ -195,6 +195,8 @@ pub struct FixedIpc {
     threshold_lsb: u32,
     max_rounds: u32,
     early_stop: Option<(EarlyStop, Vec<FineBox>)>,
+    /// Width of the coordinate word, bits ([`crate::Widths`]; 40 unless narrowed).
+    coord_bits: u32,
 }
 
 impl FixedIpc {
@@ -263,6 +265,71 @@ impl FixedIpc {
             threshold_lsb,
             max_rounds,
             early_stop: None,
+            coord_bits: FineCoord::BITS,
+        })
+    }
+
+    /// Narrows the coordinate word to `bits` ([`crate::Widths`]; a room needs far fewer than
+    /// 40): points saturate there, raising the overflow flag. Refused, naming each value, when
+    /// a plane offset or start point does not fit, or `bits` is outside
+    /// [`crate::Widths::MIN_COORD`]..=40.
+    pub fn with_coord_bits(mut self, bits: u32) -> Result<FixedIpc, FixedError> {
+        let mut problems = Vec::new();
+        if !(Widths::MIN_COORD..=FineCoord::BITS).contains(&bits) {
+            problems.push(format!(
+                "coordinate word of {bits} bits: must be {}..={}",
+                Widths::MIN_COORD,
+                FineCoord::BITS
+            ));
+            return Err(FixedError::InvalidInput { problems });
+        }
+        let range = Widths::for_coord(bits).coord_range();
+        let fits = |v: i64| (range.0..=range.1).contains(&v);
+        let limit_m = FineCoord(range.1).dequantize();
+        for (i, p) in self.planes.iter().enumerate() {
+            if !fits(p.offset.0) {
+                problems.push(format!(
+                    "plane {i}: offset {} m is outside the {bits}-bit coordinate range (±{limit_m} m)",
+                    p.offset.dequantize()
+                ));
+            }
+        }
+        for (p, path) in self.paths.iter().enumerate() {
+            for (i, q) in path.init.iter().enumerate() {
+                if !q.iter().all(|c| fits(c.0)) {
+                    problems.push(format!(
+                        "path {p} initial point {i}: {:?} m is outside the {bits}-bit coordinate range (±{limit_m} m)",
+                        dequantize_fine_point(*q)
+                    ));
+                }
+            }
+        }
+        if !problems.is_empty() {
+            return Err(FixedError::InvalidInput { problems });
+        }
+        self.coord_bits = bits;
+        Ok(self)
+    }
+
+    /// Width of the coordinate word, bits.
+    pub fn coord_bits(&self) -> u32 {
+        self.coord_bits
+    }
+
+    /// Whether TX or RX `point` (bus words) fits the coordinate word; the error names it.
+    pub fn check_terminal(&self, name: &str, point: FixedPoint) -> Result<(), FixedError> {
+        let range = Widths::for_coord(self.coord_bits).coord_range();
+        let fine = point.map(FineCoord::from_coord);
+        if fine.iter().all(|c| (range.0..=range.1).contains(&c.0)) {
+            return Ok(());
+        }
+        Err(FixedError::InvalidInput {
+            problems: vec![format!(
+                "{name} {:?} m is outside the {}-bit coordinate range (±{} m)",
+                dequantize_fine_point(fine),
+                self.coord_bits,
+                FineCoord(range.1).dequantize()
+            )],
         })
     }
 
@@ -361,10 +428,13 @@ impl FixedIpc {
     pub fn run(&self, tx_m: [f64; 3], rx_m: [f64; 3]) -> Result<Vec<PathResult>, FixedError> {
         let tx = quantize_point(tx_m)?;
         let rx = quantize_point(rx_m)?;
+        self.check_terminal("TX", tx)?;
+        self.check_terminal("RX", rx)?;
         Ok(self.run_fixed(tx, rx, None))
     }
 
-    /// Runs every path with TX/RX as millimetre bus words; `budgets[p]` overrides the round budget of path
+    /// Runs every path with TX/RX as millimetre bus words (which must fit the coordinate word:
+    /// [`FixedIpc::check_terminal`]); `budgets[p]` overrides the round budget of path
     /// `p` (the accelerator's budget is the number of rounds its schedule holds for `p`).
     pub fn run_fixed(
         &self,
@@ -411,7 +481,7 @@ impl FixedIpc {
                 let prev = if i == 0 { tx } else { points[i - 1] };
                 let follow = if i + 1 == n { rx } else { points[i + 1] };
                 let plane = &self.planes[path.planes[i] as usize];
-                let trace = intersection_point(plane, prev, follow);
+                let trace = intersection_point_in(plane, prev, follow, self.coord_bits);
                 result.zero_sum |= trace.proportion.zero_sum;
                 result.overflow |= trace.overflow;
                 disp = disp.max(displacement_linf(trace.point, points[i]));

@@ -50,6 +50,7 @@ pub use ipc::{
 };
 pub use normal::{FixedPlane, NORMAL_FRAC, NormalComponent, UNIT_NORMAL_TOLERANCE};
 pub use ops::{
-    GUARD_BITS, PROPORTION_ITERATIONS, PeTrace, Proportion, displacement_linf, halving_proportion,
-    intersection_point, project, signed_distance, width,
+    COORD_HEADROOM_BITS, GUARD_BITS, PROPORTION_ITERATIONS, PeTrace, Proportion, Widths,
+    coord_bits_for, displacement_linf, halving_proportion, intersection_point,
+    intersection_point_in, project, signed_distance, width,
 };

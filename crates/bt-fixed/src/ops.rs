@@ -72,6 +72,100 @@ pub mod width {
     }
 }
 
+/// The datapath widths of one design whose coordinate word has `coord` bits instead of
+/// [`width::COORD`] (40): every intermediate of Algorithm 2 and 3 is a fixed combination of
+/// coordinates and plane offsets (sums, projections with ‖n‖ ≤ 1, halvings), so its bound
+/// scales with theirs and each width shrinks by the same `40 − coord` bits. A room a few tens
+/// of metres across needs about 24 bits (`bt_accel` sizes it from the room's extent,
+/// [`coord_bits_for`]): about a third less logic per PE. Valid when every coordinate and
+/// plane offset fits `coord` bits ([`crate::FixedIpc::with_coord_bits`] checks);
+/// `tests/it/widths.rs` and `tests/it/rtl_form.rs` prove it for several `coord`.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+#[allow(missing_docs)] // one field per constant of [`width`], documented there
+pub struct Widths {
+    pub coord: u32,
+    pub dot_acc: u32,
+    pub distance: u32,
+    pub proj_acc: u32,
+    pub projection: u32,
+    pub delta: u32,
+    pub abs_distance: u32,
+    pub distance_sum: u32,
+    pub half_sum: u32,
+    pub search: u32,
+    pub half_delta: u32,
+    pub acc_delta: u32,
+    pub offset: u32,
+    pub sum_point: u32,
+    pub displacement: u32,
+    pub search_diff: u32,
+    pub point_acc: u32,
+}
+
+impl Widths {
+    /// The full 40-bit design: exactly the constants of [`width`].
+    pub const FULL: Widths = Widths::for_coord(width::COORD);
+
+    /// Narrowest coordinate word accepted, bits (the bus reads `point[coord-1:8]`, and the
+    /// early-stopping comparisons are 48 bits wide).
+    pub const MIN_COORD: u32 = 16;
+
+    /// The widths for a `coord`-bit coordinate word ([`Widths::MIN_COORD`] ≤ `coord` ≤
+    /// [`width::COORD`]; other values are clamped into that range).
+    pub const fn for_coord(coord: u32) -> Widths {
+        let coord = if coord < Self::MIN_COORD {
+            Self::MIN_COORD
+        } else if coord > width::COORD {
+            width::COORD
+        } else {
+            coord
+        };
+        let s = width::COORD - coord;
+        Widths {
+            coord,
+            dot_acc: width::DOT_ACC - s,
+            distance: width::DISTANCE - s,
+            proj_acc: width::PROJ_ACC - s,
+            projection: width::PROJECTION - s,
+            delta: width::DELTA - s,
+            abs_distance: width::ABS_DISTANCE - s,
+            distance_sum: width::DISTANCE_SUM - s,
+            half_sum: width::HALF_SUM - s,
+            search: width::SEARCH - s,
+            half_delta: width::HALF_DELTA - s,
+            acc_delta: width::ACC_DELTA - s,
+            offset: width::OFFSET - s,
+            sum_point: width::SUM_POINT - s,
+            displacement: width::DISPLACEMENT - s,
+            search_diff: width::SEARCH_DIFF - s,
+            point_acc: width::POINT_ACC - s,
+        }
+    }
+
+    /// Smallest and largest value of the coordinate word, fine LSB.
+    pub const fn coord_range(&self) -> (i64, i64) {
+        (-(1 << (self.coord - 1)), (1 << (self.coord - 1)) - 1)
+    }
+}
+
+/// Bits of headroom [`coord_bits_for`] keeps above a room's extent: IPC points may wander
+/// this far (4×) outside before the coordinate saturates and the path is dropped as degenerate.
+pub const COORD_HEADROOM_BITS: u32 = 2;
+
+/// The coordinate word for a room whose coordinates, plane offsets, terminals and start points
+/// all lie within `max_abs_m` metres of the origin: their magnitude in fine LSB, a sign bit and
+/// [`COORD_HEADROOM_BITS`], clamped to [`Widths::MIN_COORD`]..=[`width::COORD`]. A non-finite
+/// or out-of-range extent gives the full width.
+pub fn coord_bits_for(max_abs_m: f64) -> u32 {
+    match FineCoord::quantize(max_abs_m.abs()) {
+        Ok(fine) => {
+            let magnitude = 64 - (fine.0.unsigned_abs()).leading_zeros();
+            (magnitude + 1 + COORD_HEADROOM_BITS).clamp(Widths::MIN_COORD, width::COORD)
+        }
+        Err(_) => width::COORD,
+    }
+}
+
 use width::fits_signed;
 
 /// Signed distance of `s` to the plane in fine units (mm × 2^8): `round_half_up((Σ n_k·s_k − offset·2^30) / 2^30)`,
@@ -213,7 +307,7 @@ pub struct PeTrace {
     pub proportion: Proportion,
     /// `t_prev + offset` before saturation, fine LSB.
     pub unsaturated: [i64; 3],
-    /// The new intersection point (saturated to 40 bits).
+    /// The new intersection point (saturated to the coordinate word, 40 bits by default).
     pub point: FinePoint,
     /// Some component did not fit 40 bits and was saturated.
     pub overflow: bool,
@@ -226,6 +320,17 @@ pub struct PeTrace {
 /// Verilog twin: one `bt_pe_<i>` evaluation (`load`, `start` → `s_sum`, `zero_sum`) followed by
 /// `bt_top`'s saturation after its PE select (`sat_{x,y,z}`, `pe_sel_ov`).
 pub fn intersection_point(plane: &FixedPlane, prev: FinePoint, next: FinePoint) -> PeTrace {
+    intersection_point_in(plane, prev, next, width::COORD)
+}
+
+/// [`intersection_point`] of a design with a `coord_bits`-bit coordinate word ([`Widths`]):
+/// the point saturates (and `overflow` is raised) at that width instead of 40 bits.
+pub fn intersection_point_in(
+    plane: &FixedPlane,
+    prev: FinePoint,
+    next: FinePoint,
+    coord_bits: u32,
+) -> PeTrace {
     let d_prev = signed_distance(plane, prev);
     let d_next = signed_distance(plane, next);
     let t_prev = project(plane, prev, d_prev);
@@ -236,8 +341,9 @@ pub fn intersection_point(plane: &FixedPlane, prev: FinePoint, next: FinePoint) 
     let proportion = halving_proportion(m, n, delta);
     let unsaturated: [i64; 3] = std::array::from_fn(|k| t_prev[k] + proportion.offset[k]);
     let mut overflow = false;
+    let (lo, hi) = Widths::for_coord(coord_bits).coord_range();
     let point = unsaturated.map(|v| {
-        let clamped = v.clamp(FineCoord::MIN.0, FineCoord::MAX.0);
+        let clamped = v.clamp(lo, hi);
         overflow |= clamped != v;
         FineCoord(clamped)
     });

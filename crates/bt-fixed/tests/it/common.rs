@@ -26,7 +26,12 @@ pub fn unit_normal() -> impl Strategy<Value = [f64; 3]> {
 
 /// Any plane: unit normal and any 40-bit offset word.
 pub fn any_plane() -> impl Strategy<Value = FixedPlane> {
-    (unit_normal(), any_coord()).prop_map(|(n, off)| {
+    any_plane_in(FineCoord::BITS)
+}
+
+/// Any plane of a design with `bits`-bit coordinate words ([`bt_fixed::Widths`]).
+pub fn any_plane_in(bits: u32) -> impl Strategy<Value = FixedPlane> {
+    (unit_normal(), any_coord_in(bits)).prop_map(|(n, off)| {
         let mut p = FixedPlane::quantize(n, 0.0).unwrap();
         p.offset = off;
         p
@@ -35,17 +40,37 @@ pub fn any_plane() -> impl Strategy<Value = FixedPlane> {
 
 /// Any 40-bit fine coordinate word, biased towards the extremes and indoor scale.
 pub fn any_coord() -> impl Strategy<Value = FineCoord> {
-    let (min, max) = (FineCoord::MIN.0, FineCoord::MAX.0);
+    any_coord_in(FineCoord::BITS)
+}
+
+/// Any `bits`-bit fine coordinate word, biased towards the extremes and indoor scale.
+pub fn any_coord_in(bits: u32) -> impl Strategy<Value = FineCoord> {
+    let (min, max) = bt_fixed::Widths::for_coord(bits).coord_range();
+    let indoor = 5_120_000i64.min(max);
     prop_oneof![
         (min..=max).prop_map(FineCoord),
         prop::sample::select(vec![min, min + 1, -1, 0, 1, max - 1, max]).prop_map(FineCoord),
-        (-5_120_000i64..5_120_000).prop_map(FineCoord),
+        (-indoor..indoor).prop_map(FineCoord),
     ]
 }
 
 /// Any point of 40-bit words.
 pub fn any_point() -> impl Strategy<Value = FinePoint> {
-    [any_coord(), any_coord(), any_coord()]
+    any_point_in(FineCoord::BITS)
+}
+
+/// Any point of `bits`-bit words.
+pub fn any_point_in(bits: u32) -> impl Strategy<Value = FinePoint> {
+    [any_coord_in(bits), any_coord_in(bits), any_coord_in(bits)]
+}
+
+/// Coordinate widths the width proofs run at: the full word and narrowed room designs.
+pub const COORD_BITS: [u32; 5] = [40, 32, 24, 20, 16];
+
+/// A coordinate width of [`COORD_BITS`] with a plane and two points of that width.
+pub fn any_case() -> impl Strategy<Value = (u32, FixedPlane, FinePoint, FinePoint)> {
+    prop::sample::select(COORD_BITS.to_vec())
+        .prop_flat_map(|b| (Just(b), any_plane_in(b), any_point_in(b), any_point_in(b)))
 }
 
 /// `round_half_up(num / 2^shift)` computed by exact Euclidean division (the oracle).

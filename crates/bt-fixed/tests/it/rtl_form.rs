@@ -4,7 +4,7 @@
 //! * one CSD network per normal component, shared by `d_prev`, `d_next`, `t_prev`, `t_next`
 //!   (the products are exact whatever the order, so sharing cannot change a bit);
 //! * `E = B − m·2^G` instead of `B`, `m·2^G` and a comparator (`B < m·2^G` ⇔ `E < 0`);
-//! * `A = t_prev·2^G + 2^(G−1) + B_p` kept modulo 2^[`width::POINT_ACC`] instead of `B_p`,
+//! * `A = t_prev·2^G + 2^(G−1) + B_p` kept modulo 2^[`w.point_acc`] instead of `B_p`,
 //!   the rounding adder and `t_prev + offset`: `A >> G` is the unsaturated point.
 //!
 //! This file emulates those registers in i128 with the RTL's widths (wrapping where the RTL
@@ -12,8 +12,8 @@
 
 use crate::common::*;
 use bt_fixed::{
-    FinePoint, FixedPlane, GUARD_BITS, NORMAL_FRAC, PROPORTION_ITERATIONS, intersection_point,
-    width,
+    FinePoint, FixedPlane, GUARD_BITS, NORMAL_FRAC, PROPORTION_ITERATIONS, Widths,
+    intersection_point_in, width,
 };
 use proptest::prelude::*;
 
@@ -25,7 +25,7 @@ fn wrap(v: i128, bits: u32) -> i128 {
 }
 
 /// The unsaturated point as the PE's registers compute it.
-fn rtl_pe(plane: &FixedPlane, prev: FinePoint, next: FinePoint) -> ([i128; 3], bool) {
+fn rtl_pe(plane: &FixedPlane, prev: FinePoint, next: FinePoint, w: Widths) -> ([i128; 3], bool) {
     let g = GUARD_BITS;
     let nf = NORMAL_FRAC;
     let net = |k: usize, x: i128| -> i128 { plane.normal[k].csd().mul(x as i64) };
@@ -33,14 +33,14 @@ fn rtl_pe(plane: &FixedPlane, prev: FinePoint, next: FinePoint) -> ([i128; 3], b
         let acc: i128 = (0..3).map(|k| net(k, i128::from(s[k].0))).sum::<i128>()
             + (1i128 << (nf - 1))
             - (i128::from(plane.offset.0) << nf);
-        wrap(wrap(acc, width::DOT_ACC) >> nf, width::DISTANCE)
+        wrap(wrap(acc, w.dot_acc) >> nf, w.distance)
     };
     let d_prev = dot(prev);
     let d_next = dot(next);
     let proj = |s: FinePoint, d: i128| -> [i128; 3] {
         std::array::from_fn(|k| {
-            let p = wrap(net(k, d) + (1i128 << (nf - 1)), width::PROJ_ACC) >> nf;
-            wrap(i128::from(s[k].0) - p, width::PROJECTION)
+            let p = wrap(net(k, d) + (1i128 << (nf - 1)), w.proj_acc) >> nf;
+            wrap(i128::from(s[k].0) - p, w.projection)
         })
     };
     let t_prev = proj(prev, d_prev);
@@ -51,7 +51,7 @@ fn rtl_pe(plane: &FixedPlane, prev: FinePoint, next: FinePoint) -> ([i128; 3], b
     let mut e = (n - m) << (g - 1);
     let mut lp: [i128; 3] = std::array::from_fn(|k| (t_next[k] - t_prev[k]) << (g - 1));
     let mut a: [i128; 3] =
-        std::array::from_fn(|k| wrap((t_prev[k] + t_next[k] + 1) << (g - 1), width::POINT_ACC));
+        std::array::from_fn(|k| wrap((t_prev[k] + t_next[k] + 1) << (g - 1), w.point_acc));
     for _ in 0..PROPORTION_ITERATIONS {
         if big_l == 0 {
             continue;
@@ -62,20 +62,20 @@ fn rtl_pe(plane: &FixedPlane, prev: FinePoint, next: FinePoint) -> ([i128; 3], b
             lp[k] >>= 1;
             a[k] = wrap(
                 if up { a[k] + lp[k] } else { a[k] - lp[k] },
-                width::POINT_ACC,
+                w.point_acc,
             );
         }
         e = if up { e + big_l } else { e - big_l };
-        assert!(width::fits_signed(e, width::SEARCH_DIFF), "E = {e}");
-        assert!(width::fits_unsigned(big_l, width::HALF_SUM));
-        assert!(lp.iter().all(|&v| width::fits_signed(v, width::HALF_DELTA)));
+        assert!(width::fits_signed(e, w.search_diff), "E = {e}");
+        assert!(width::fits_unsigned(big_l, w.half_sum));
+        assert!(lp.iter().all(|&v| width::fits_signed(v, w.half_delta)));
     }
     (a.map(|v| v >> g), sum == 0)
 }
 
-fn check(plane: &FixedPlane, prev: FinePoint, next: FinePoint) {
-    let model = intersection_point(plane, prev, next);
-    let (rtl, zero_sum) = rtl_pe(plane, prev, next);
+fn check(plane: &FixedPlane, prev: FinePoint, next: FinePoint, bits: u32) {
+    let model = intersection_point_in(plane, prev, next, bits);
+    let (rtl, zero_sum) = rtl_pe(plane, prev, next, Widths::for_coord(bits));
     let unsat = model.unsaturated.map(i128::from);
     assert_eq!(rtl, unsat, "plane {plane:?} prev {prev:?} next {next:?}");
     assert_eq!(zero_sum, model.proportion.zero_sum);
@@ -85,8 +85,8 @@ proptest! {
     #![proptest_config(ProptestConfig::with_cases(3000))]
 
     #[test]
-    fn register_form_equals_model(plane in any_plane(), prev in any_point(), next in any_point()) {
-        check(&plane, prev, next);
+    fn register_form_equals_model((bits, plane, prev, next) in any_case()) {
+        check(&plane, prev, next, bits);
     }
 }
 
@@ -94,22 +94,25 @@ proptest! {
 fn register_form_equals_model_at_the_corners() {
     use bt_fixed::FineCoord;
     let r3 = 1.0 / 3f64.sqrt();
-    let corners = [FineCoord::MIN, FineCoord::MAX, FineCoord(0)];
-    for normal in [
-        [r3, r3, r3],
-        [-r3, r3, -r3],
-        [1.0, 0.0, 0.0],
-        [0.6, -0.8, 0.0],
-    ] {
-        for offset in corners {
-            let mut plane = FixedPlane::quantize(normal, 0.0).unwrap();
-            plane.offset = offset;
-            for bits_prev in 0..27u32 {
-                for bits_next in 0..27u32 {
-                    let pt = |bits: u32| -> FinePoint {
-                        std::array::from_fn(|k| corners[((bits / 3u32.pow(k as u32)) % 3) as usize])
-                    };
-                    check(&plane, pt(bits_prev), pt(bits_next));
+    for bits in COORD_BITS {
+        let (min, max) = Widths::for_coord(bits).coord_range();
+        let corners = [FineCoord(min), FineCoord(max), FineCoord(0)];
+        for normal in [
+            [r3, r3, r3],
+            [-r3, r3, -r3],
+            [1.0, 0.0, 0.0],
+            [0.6, -0.8, 0.0],
+        ] {
+            for offset in corners {
+                let mut plane = FixedPlane::quantize(normal, 0.0).unwrap();
+                plane.offset = offset;
+                for bits_prev in 0..27u32 {
+                    for bits_next in 0..27u32 {
+                        let pt = |b: u32| -> FinePoint {
+                            std::array::from_fn(|k| corners[((b / 3u32.pow(k as u32)) % 3) as usize])
+                        };
+                        check(&plane, pt(bits_prev), pt(bits_next), bits);
+                    }
                 }
             }
         }
