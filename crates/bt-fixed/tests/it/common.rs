@@ -38,11 +38,6 @@ pub fn any_plane_in(bits: u32) -> impl Strategy<Value = FixedPlane> {
     })
 }
 
-/// Any 40-bit fine coordinate word, biased towards the extremes and indoor scale.
-pub fn any_coord() -> impl Strategy<Value = FineCoord> {
-    any_coord_in(FineCoord::BITS)
-}
-
 /// Any `bits`-bit fine coordinate word, biased towards the extremes and indoor scale.
 pub fn any_coord_in(bits: u32) -> impl Strategy<Value = FineCoord> {
     let (min, max) = bt_fixed::Widths::for_coord(bits).coord_range();
@@ -54,7 +49,7 @@ pub fn any_coord_in(bits: u32) -> impl Strategy<Value = FineCoord> {
     ]
 }
 
-/// Any point of 40-bit words.
+/// Any point of 40-bit words (biased towards the extremes and indoor scale).
 pub fn any_point() -> impl Strategy<Value = FinePoint> {
     any_point_in(FineCoord::BITS)
 }
