@@ -125,7 +125,7 @@ pub struct StepInput {
 /// `planes[i]`), `candidates` the step's candidate sequences (empty ones skipped); a
 /// candidate through a surface not in `planes` goes to the host. `threshold_lsb` in 1/256 mm,
 /// `max_rounds` the round cap; early stopping ([`EarlyStop::default`]) on every plane's
-/// polygon bounding box.
+/// polygon bounding box; the coordinate word sized from the planes ([`platform_extent_m`]).
 pub fn step_input(
     scene: &Scene,
     planes: &[SurfaceId],
@@ -159,7 +159,7 @@ pub fn step_input(
         });
         sequences.push(seq.to_vec());
     }
-    let planes = planes
+    let planes: Vec<PlaneSpec> = planes
         .iter()
         .map(|id| {
             let s = scene.surface(*id);
@@ -173,6 +173,7 @@ pub fn step_input(
             }
         })
         .collect();
+    let coord_bits = bt_fixed::coord_bits_for(platform_extent_m(&planes));
     let input = HlsInput {
         planes,
         paths,
@@ -183,12 +184,28 @@ pub fn step_input(
         max_rounds,
         test_vectors: Vec::new(),
         early_stop: Some(EarlyStop::default()),
+        coord_bits,
     };
     StepInput {
         input,
         sequences,
         host_sequences,
     }
+}
+
+/// How far the platform's planes reach from the origin, metres: the largest |coordinate| of
+/// their polygons' boxes and |offset|. It sizes the accelerator's coordinate word
+/// ([`bt_fixed::coord_bits_for`], 4× headroom), so it depends on the static planes only and
+/// every step of a stream gets the same word; terminals and start points must fit it (the
+/// model refuses, naming the value, when one does not).
+pub fn platform_extent_m(planes: &[PlaneSpec]) -> f64 {
+    planes
+        .iter()
+        .flat_map(|p| {
+            let corners = p.bounds_m.into_iter().flatten().flatten();
+            corners.chain([p.offset_m]).map(f64::abs)
+        })
+        .fold(0.0, f64::max)
 }
 
 /// The HLS input of a scene: one plane per reflector (PE `bt_pe_<i>` for the `i`-th

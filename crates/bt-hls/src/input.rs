@@ -45,6 +45,15 @@ pub struct HlsInput {
     /// Early stopping on the planes' `bounds_m` ([`EarlyStop`]); `None`: off.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub early_stop: Option<EarlyStop>,
+    /// Width of the coordinate word, bits ([`bt_fixed::Widths`]; 40 = the full design, a room
+    /// needs about 24: [`bt_fixed::coord_bits_for`]). Every datapath narrows with it.
+    #[serde(default = "full_coord_bits")]
+    pub coord_bits: u32,
+}
+
+/// The full 40-bit coordinate word (inputs written before narrowing existed).
+pub fn full_coord_bits() -> u32 {
+    bt_fixed::width::COORD
 }
 
 impl HlsInput {
@@ -64,7 +73,8 @@ impl HlsInput {
             &self.init_points,
             self.threshold_lsb,
             self.max_rounds,
-        )?;
+        )?
+        .with_coord_bits(self.coord_bits)?;
         Ok(match self.early_stop {
             Some(stop) => {
                 let bounds: Vec<Option<BoundsM>> = self.planes.iter().map(|p| p.bounds_m).collect();
@@ -185,6 +195,9 @@ pub struct Platform {
     /// needs more is refused. Default: the EP4CE115's [`EP4CE115_M9K_BLOCKS`].
     #[serde(default = "default_m9k_budget")]
     pub m9k_budget: u32,
+    /// Width of the coordinate word, bits ([`HlsInput::coord_bits`]; every step's must equal it).
+    #[serde(default = "full_coord_bits")]
+    pub coord_bits: u32,
 }
 
 fn default_m9k_budget() -> u32 {
@@ -250,6 +263,7 @@ impl Platform {
             instances,
             capacity,
             m9k_budget: EP4CE115_M9K_BLOCKS,
+            coord_bits: work.iter().map(|w| w.input.coord_bits).max().unwrap_or(first.input.coord_bits),
         })
     }
 }
@@ -333,7 +347,8 @@ impl Layout {
             )));
         }
         let sw = sched_entry_bits(path_bits, point_bits, inst_bits);
-        let blocks = 2 * m9k_blocks(1 << (point_bits + 1), crate::pe::POINT_BITS.into())
+        let word = crate::pe::point_bits(bt_fixed::Widths::for_coord(platform.coord_bits));
+        let blocks = 2 * m9k_blocks(1 << (point_bits + 1), word.into())
             + m9k_blocks(1 << entry_bits, sw.into());
         if blocks > platform.m9k_budget.into() {
             return Err(HlsError::TooLarge(format!(
@@ -432,6 +447,7 @@ pub(crate) fn platform_model(platform: &Platform) -> Result<FixedIpc, HlsError> 
         max_rounds: 1,
         test_vectors: Vec::new(),
         early_stop: platform.early_stop,
+        coord_bits: platform.coord_bits,
     };
     input.model()
 }
@@ -453,13 +469,24 @@ fn step_design(platform: &Platform, k: usize, w: &StepWork) -> Result<StepDesign
             "step {k}: threshold or early stopping differs from the platform's"
         ));
     }
-    if let Err(e) = input.vectors() {
+    if input.coord_bits != platform.coord_bits {
+        problems.push(format!(
+            "step {k}: its coordinate word ({} bits) differs from the platform's ({} bits)",
+            input.coord_bits, platform.coord_bits
+        ));
+    }
+    let vectors = input.vectors();
+    if let Err(e) = &vectors {
         problems.push(format!("step {k} test vector: {e}"));
     }
     if !problems.is_empty() {
         return Err(HlsError::InvalidInput { problems });
     }
     let model = input.model()?;
+    for [tx, rx] in vectors? {
+        model.check_terminal("TX", tx)?;
+        model.check_terminal("RX", rx)?;
+    }
     let mut budgets = vec![0u32; input.paths.len()];
     for row in &schedule.slots {
         for job in row.iter().flatten() {

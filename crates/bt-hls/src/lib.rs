@@ -34,7 +34,7 @@ pub use bt_fixed::{BoundsM, EarlyStop, FixedOutcome, PathResult};
 pub use error::HlsError;
 pub use input::{Capacity, EP4CE115_M9K_BLOCKS, MAX_ADDRESS_BITS, MIN_ADDRESS_BITS, m9k_blocks};
 pub use input::{HlsInput, PE_LATENCY, PlaneSpec, Platform, StepWork};
-pub use pe::{POINT_BITS, pe_module_name};
+pub use pe::{pe_module_name, point_bits, sum_bits};
 pub use plan::{
     Plan, PlanOptions, ScheduleKind, plan, plan_on, run_cycles, schedule_entries, slot_cycles,
 };
@@ -411,7 +411,8 @@ fn rtl_of(
     let mut out = Vec::new();
     for p in planes {
         let spec = &platform.planes[p as usize];
-        let m = pe::pe_module(p as usize, &spec.name, &model.planes()[p as usize])?;
+        let wd = bt_fixed::Widths::for_coord(model.coord_bits());
+        let m = pe::pe_module(p as usize, &spec.name, &model.planes()[p as usize], wd)?;
         out.push((m.name.clone(), verilog::print_module(&m)));
     }
     let top = top::top_module(&top::TopParams::of(platform, model)?);

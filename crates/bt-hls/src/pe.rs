@@ -1,16 +1,20 @@
 //! `bt_pe_<i>`: one processing element per plane (Algorithm 2 with Algorithm 3 inside), the
 //! plane's constants baked in as CSD shift-add networks. Twin of `bt_fixed::intersection_point`.
 
-use bt_fixed::{FixedPlane, GUARD_BITS, NORMAL_FRAC, PROPORTION_ITERATIONS, width};
+use bt_fixed::{FixedPlane, GUARD_BITS, NORMAL_FRAC, PROPORTION_ITERATIONS, Widths};
 
 use crate::HlsError;
 use crate::verilog::{BinaryOp, Direction, Expr, Item, Module, Port, Signal, Stmt, UnaryOp};
 
-/// Width of a packed point `{z, y, x}` of fine words.
-pub const POINT_BITS: u32 = 3 * width::COORD;
+/// Width of a packed point `{z, y, x}` of fine words in a design of widths `wd`.
+pub fn point_bits(wd: Widths) -> u32 {
+    3 * wd.coord
+}
 
-/// Width of a PE's packed unsaturated result `{z, y, x}` ([`width::SUM_POINT`] bits each).
-pub const SUM_BITS: u32 = 3 * width::SUM_POINT;
+/// Width of a PE's packed unsaturated result `{z, y, x}` (`wd.sum_point` bits each).
+pub fn sum_bits(wd: Widths) -> u32 {
+    3 * wd.sum_point
+}
 
 const AXES: [&str; 3] = ["x", "y", "z"];
 
@@ -132,14 +136,15 @@ pub(crate) fn pe_module(
     index: usize,
     plane_name: &str,
     plane: &FixedPlane,
+    wd: Widths,
 ) -> Result<Module, HlsError> {
-    debug_assert_eq!(width::PROJECTION, XW);
+    debug_assert_eq!(wd.projection, wd.distance);
     let mut items = Vec::new();
     let mut unused = Vec::new();
     let csd: Vec<bt_fixed::Csd> = plane.normal.iter().map(|n| n.csd()).collect();
-    let regs = pe_state(index, plane_name, plane, &csd, &mut items);
+    let regs = pe_state((index, plane_name, plane), &csd, wd, &mut items);
     let nets = csd_networks(&regs, &csd, &mut items)?;
-    let d_new = signed_distance(plane, &nets, &mut items, &mut unused)?;
+    let d_new = signed_distance(plane, &nets, wd, &mut items, &mut unused)?;
     let t = projections(index, &regs, &nets, &mut items, &mut unused)?;
     let setup = setup_values(&regs, &mut items, &mut unused);
     let halving = halving_step(&regs, &mut items, &mut unused);
@@ -151,11 +156,8 @@ pub(crate) fn pe_module(
         Expr::id("bt_unused_ok"),
         Expr::Unary(UnaryOp::ReduceAnd, Box::new(Expr::concat(unused))),
     ));
-    Ok(pe_shell(index, plane_name, items))
+    Ok(pe_shell(index, plane_name, wd, items))
 }
-
-/// Network input width: s (40 bits, sign-extended), d or t (42 bits).
-const XW: u32 = width::DISTANCE;
 
 /// The PE's registers (see the step table of [`pe_module`]).
 struct PeRegs {
@@ -171,14 +173,15 @@ struct PeRegs {
     a: Vec<Signal>,
     /// Per axis: `s_next`, `t_next`, then `L_p`.
     b: Vec<Signal>,
+    /// The design's datapath widths.
+    wd: Widths,
 }
 
 /// The plane's header comment and the PE's registers.
 fn pe_state(
-    index: usize,
-    plane_name: &str,
-    plane: &FixedPlane,
+    (index, plane_name, plane): (usize, &str, &FixedPlane),
     csd: &[bt_fixed::Csd],
+    wd: Widths,
     items: &mut Vec<Item>,
 ) -> PeRegs {
     items.push(Item::Comment(format!(
@@ -197,12 +200,12 @@ fn pe_state(
     )));
     let step = Signal::reg(items, "step", step_bits());
     let zs = Signal::reg(items, "zs", 1);
-    let r_e = Signal::reg(items, "r_e", width::SEARCH_DIFF);
-    let r_l = Signal::reg(items, "r_l", width::HALF_SUM);
+    let r_e = Signal::reg(items, "r_e", wd.search_diff);
+    let r_l = Signal::reg(items, "r_l", wd.half_sum);
     let (mut a, mut b) = (Vec::new(), Vec::new());
     for axis in AXES {
-        a.push(Signal::reg(items, format!("a_{axis}"), width::POINT_ACC));
-        b.push(Signal::reg(items, format!("b_{axis}"), width::HALF_DELTA));
+        a.push(Signal::reg(items, format!("a_{axis}"), wd.point_acc));
+        b.push(Signal::reg(items, format!("b_{axis}"), wd.half_delta));
     }
     PeRegs {
         step,
@@ -211,6 +214,7 @@ fn pe_state(
         r_l,
         a,
         b,
+        wd,
     }
 }
 
@@ -222,9 +226,10 @@ fn step_bits() -> u32 {
     64 - u64::from(last_step()).leading_zeros()
 }
 
-/// The low [`XW`] bits of a register (the network input).
-fn low(s: &Signal) -> Expr {
-    s.slice(XW - 1, 0)
+/// The low `xw` bits of a register (the network input: `wd.distance` bits; the coordinate
+/// `s` sign-extended, or `d` or `t`).
+fn low(s: &Signal, xw: u32) -> Expr {
+    s.slice(xw - 1, 0)
 }
 
 /// One shared CSD network: `net = x_in · n_k / 2^base`.
@@ -242,6 +247,7 @@ fn csd_networks(
     csd: &[bt_fixed::Csd],
     items: &mut Vec<Item>,
 ) -> Result<Vec<Option<Network>>, HlsError> {
+    let wd = r.wd;
     items.push(Item::Comment(
         "one CSD network per non-zero normal component, shared by d_prev, d_next, t_prev, t_next"
             .into(),
@@ -256,14 +262,14 @@ fn csd_networks(
         let xin = Signal::assigned(
             items,
             format!("x_in_{axis}"),
-            XW,
+            wd.distance,
             Expr::mux(
                 s1.clone(),
-                Expr::mux(s0.clone(), low(&r.r_l), low(&r.r_e)),
-                Expr::mux(s0.clone(), low(&r.b[k]), low(&r.a[k])),
+                Expr::mux(s0.clone(), low(&r.r_l, wd.distance), low(&r.r_e, wd.distance)),
+                Expr::mux(s0.clone(), low(&r.b[k], wd.distance), low(&r.a[k], wd.distance)),
             ),
         );
-        let nw = width::DOT_ACC - bk;
+        let nw = wd.dot_acc - bk;
         items.push(Item::Comment(format!(
             "net_{axis} = x_in_{axis} * n_{axis} / 2^{bk} ({} digits)",
             csd[k].digits.len()
@@ -272,7 +278,7 @@ fn csd_networks(
             items,
             format!("net_{axis}"),
             nw,
-            csd_sum(xin.name(), XW, &csd[k], bk, nw)?,
+            csd_sum(xin.name(), wd.distance, &csd[k], bk, nw)?,
         );
         nets.push(Some(Network { base: bk, net }));
     }
@@ -284,10 +290,11 @@ fn csd_networks(
 fn signed_distance(
     plane: &FixedPlane,
     nets: &[Option<Network>],
+    wd: Widths,
     items: &mut Vec<Item>,
     unused: &mut Vec<Expr>,
 ) -> Result<Signal, HlsError> {
-    let accw = width::DOT_ACC;
+    let accw = wd.dot_acc;
     let nf = NORMAL_FRAC;
     let sd = nets
         .iter()
@@ -313,7 +320,7 @@ fn signed_distance(
     Ok(Signal::assigned(
         items,
         "d_new",
-        XW,
+        wd.distance,
         dot.slice(dw - 1, nf - sd),
     ))
 }
@@ -326,12 +333,13 @@ fn projections(
     items: &mut Vec<Item>,
     unused: &mut Vec<Expr>,
 ) -> Result<Vec<Signal>, HlsError> {
+    let wd = r.wd;
     let nf = NORMAL_FRAC;
     let s0 = r.step.bit(0);
     let mut ts = Vec::new();
     for (k, axis) in AXES.iter().enumerate() {
-        let pbase = Expr::mux(s0.clone(), low(&r.b[k]), low(&r.a[k]));
-        let t = Signal::wire(items, format!("t_{axis}"), XW);
+        let pbase = Expr::mux(s0.clone(), low(&r.b[k], wd.distance), low(&r.a[k], wd.distance));
+        let t = Signal::wire(items, format!("t_{axis}"), wd.distance);
         let Some(Network { base: bk, net }) = &nets[k] else {
             items.push(Item::Assign(t.e(), pbase));
             ts.push(t);
@@ -372,22 +380,23 @@ struct SetupValues {
 
 /// Step 4: m, n, delta, and the Algorithm 3 initial values.
 fn setup_values(r: &PeRegs, items: &mut Vec<Item>, unused: &mut Vec<Expr>) -> SetupValues {
-    let (deltaw, sumw) = (width::DELTA, width::DISTANCE_SUM);
+    let wd = r.wd;
+    let (deltaw, sumw) = (wd.delta, wd.distance_sum);
     let abs = |items: &mut Vec<Item>, name: &str, reg: &Signal| {
         Signal::assigned(
             items,
             name,
-            XW,
+            wd.distance,
             Expr::mux(
-                reg.bit(XW - 1),
-                low(reg).inv().plus(Expr::lit(XW, 1)),
-                low(reg),
+                reg.bit(wd.distance - 1),
+                low(reg, wd.distance).inv().plus(Expr::lit(wd.distance, 1)),
+                low(reg, wd.distance),
             ),
         )
     };
     let m = abs(items, "m_dist", &r.r_e);
     let n = abs(items, "n_dist", &r.r_l);
-    debug_assert_eq!(sumw, XW);
+    debug_assert_eq!(sumw, wd.distance);
     let dist_sum = Signal::assigned(items, "dist_sum", sumw, m.e().plus(n.e()));
     let dist_diff = Signal::assigned(
         items,
@@ -403,15 +412,15 @@ fn setup_values(r: &PeRegs, items: &mut Vec<Item>, unused: &mut Vec<Expr>) -> Se
             items,
             format!("delta_{axis}"),
             deltaw,
-            sext_slice(b, XW - 1, 0, deltaw).minus(sext_slice(a, XW - 1, 0, deltaw)),
+            sext_slice(b, wd.distance - 1, 0, deltaw).minus(sext_slice(a, wd.distance - 1, 0, deltaw)),
         ));
         // t_prev + t_next + 1 as one adder: {b, 1} + {a, 1} = 2·(a + b + 1).
         let ts = Signal::assigned(
             items,
             format!("tsum_{axis}"),
             deltaw + 1,
-            Expr::concat(vec![sext_slice(b, XW - 1, 0, deltaw), Expr::lit(1, 1)]).plus(
-                Expr::concat(vec![sext_slice(a, XW - 1, 0, deltaw), Expr::lit(1, 1)]),
+            Expr::concat(vec![sext_slice(b, wd.distance - 1, 0, deltaw), Expr::lit(1, 1)]).plus(
+                Expr::concat(vec![sext_slice(a, wd.distance - 1, 0, deltaw), Expr::lit(1, 1)]),
             ),
         );
         unused.push(ts.bit(0));
@@ -437,12 +446,13 @@ struct Halving {
 
 /// One halving step (the sign of `E` decides the direction).
 fn halving_step(r: &PeRegs, items: &mut Vec<Item>, unused: &mut Vec<Expr>) -> Halving {
+    let wd = r.wd;
     let g = GUARD_BITS;
     let (lw, ew, lpw, aw) = (
-        width::HALF_SUM,
-        width::SEARCH_DIFF,
-        width::HALF_DELTA,
-        width::POINT_ACC,
+        wd.half_sum,
+        wd.search_diff,
+        wd.half_delta,
+        wd.point_acc,
     );
     items.push(Item::Comment(format!(
         "Algorithm 3 on {g} guard bits, {PROPORTION_ITERATIONS} steps frozen once L = 0; E = B - m*2^{g} replaces B, m and the comparator"
@@ -487,12 +497,13 @@ fn halving_step(r: &PeRegs, items: &mut Vec<Item>, unused: &mut Vec<Expr>) -> Ha
 
 /// Output: the unsaturated point t_prev + round(B_p / 2^G) = a >> G, and the zero flag.
 fn pe_outputs(r: &PeRegs, items: &mut Vec<Item>) {
-    let (g, aw) = (GUARD_BITS, width::POINT_ACC);
+    let wd = r.wd;
+    let (g, aw) = (GUARD_BITS, wd.point_acc);
     let mut sum_parts = Vec::new();
     for a in &r.a {
         sum_parts.insert(0, a.slice(aw - 1, g));
     }
-    debug_assert_eq!(aw - g, width::SUM_POINT);
+    debug_assert_eq!(aw - g, wd.sum_point);
     items.push(Item::Assign(Expr::id("s_sum"), Expr::concat(sum_parts)));
     items.push(Item::Assign(Expr::id("zero_sum"), r.zs.e()));
 }
@@ -509,7 +520,8 @@ fn goto(r: &PeRegs, value: u32) -> Stmt {
 
 /// Idle: on `start` latch `d_prev` and go to step 1; on `load` latch the operands.
 fn seq_idle(r: &PeRegs, d_new: &Signal) -> Vec<Stmt> {
-    let (cw, aw, lpw) = (width::COORD, width::POINT_ACC, width::HALF_DELTA);
+    let wd = r.wd;
+    let (cw, aw, lpw) = (wd.coord, wd.point_acc, wd.half_delta);
     let mut load = Vec::new();
     for k in 0..AXES.len() {
         let (hi, lo) = (cw * (k as u32 + 1) - 1, cw * k as u32);
@@ -519,7 +531,7 @@ fn seq_idle(r: &PeRegs, d_new: &Signal) -> Vec<Stmt> {
     vec![Stmt::If(
         Expr::id("start"),
         vec![
-            nb(&r.r_e, sext(d_new.name(), XW, width::SEARCH_DIFF)),
+            nb(&r.r_e, sext(d_new.name(), wd.distance, wd.search_diff)),
             goto(r, 1),
         ],
         vec![Stmt::If(Expr::id("load"), load, vec![])],
@@ -528,12 +540,13 @@ fn seq_idle(r: &PeRegs, d_new: &Signal) -> Vec<Stmt> {
 
 /// Step 4: the Algorithm 3 initial values.
 fn seq_setup(r: &PeRegs, s: &SetupValues) -> Vec<Stmt> {
+    let wd = r.wd;
     let g = GUARD_BITS;
     let (deltaw, sumw, ew, aw) = (
-        width::DELTA,
-        width::DISTANCE_SUM,
-        width::SEARCH_DIFF,
-        width::POINT_ACC,
+        wd.delta,
+        wd.distance_sum,
+        wd.search_diff,
+        wd.point_acc,
     );
     let mut setup = vec![
         nb(
@@ -550,8 +563,8 @@ fn seq_setup(r: &PeRegs, s: &SetupValues) -> Vec<Stmt> {
         ),
         nb(&r.zs, s.dist_sum.e().eq(Expr::lit(sumw, 0))),
     ];
-    debug_assert_eq!(width::HALF_SUM, sumw + g - 1);
-    debug_assert_eq!(width::HALF_DELTA, deltaw + g - 1);
+    debug_assert_eq!(wd.half_sum, sumw + g - 1);
+    debug_assert_eq!(wd.half_delta, deltaw + g - 1);
     for k in 0..AXES.len() {
         setup.push(nb(
             &r.b[k],
@@ -574,7 +587,8 @@ fn seq_setup(r: &PeRegs, s: &SetupValues) -> Vec<Stmt> {
 
 /// Steps 5 ..: one halving step while `L ≠ 0`, back to idle after the last.
 fn seq_iterate(r: &PeRegs, h: &Halving) -> Vec<Stmt> {
-    let (lw, stepw) = (width::HALF_SUM, step_bits());
+    let wd = r.wd;
+    let (lw, stepw) = (wd.half_sum, step_bits());
     let mut iterate = vec![
         nb(
             &r.r_l,
@@ -609,8 +623,9 @@ fn sequencer(
     h: &Halving,
     items: &mut Vec<Item>,
 ) {
-    let (stepw, xw) = (step_bits(), XW);
-    let (aw, lpw) = (width::POINT_ACC, width::HALF_DELTA);
+    let wd = r.wd;
+    let (stepw, xw) = (step_bits(), wd.distance);
+    let (aw, lpw) = (wd.point_acc, wd.half_delta);
     let mut proj_prev: Vec<Stmt> = (0..AXES.len())
         .map(|k| nb(&r.a[k], sext(t[k].name(), xw, aw)))
         .collect();
@@ -631,7 +646,7 @@ fn sequencer(
                     vec![
                         nb(
                             &r.r_l,
-                            Expr::concat(vec![Expr::lit(width::HALF_SUM - xw, 0), d_new.e()]),
+                            Expr::concat(vec![Expr::lit(wd.half_sum - xw, 0), d_new.e()]),
                         ),
                         goto(r, 2),
                     ],
@@ -646,8 +661,8 @@ fn sequencer(
 }
 
 /// The `bt_pe_<index>` module around `items`: header and ports.
-fn pe_shell(index: usize, plane_name: &str, items: Vec<Item>) -> Module {
-    let spw = width::SUM_POINT;
+fn pe_shell(index: usize, plane_name: &str, wd: Widths, items: Vec<Item>) -> Module {
+    let spw = wd.sum_point;
     Module {
         name: pe_module_name(index),
         header: vec![
@@ -659,7 +674,8 @@ fn pe_shell(index: usize, plane_name: &str, items: Vec<Item>) -> Module {
                 crate::PE_LATENCY
             ),
             format!(
-                "Operands are {{z, y, x}} of 40-bit words, s_sum {{z, y, x}} of {spw}-bit words, mm x 2^8."
+                "Operands are {{z, y, x}} of {}-bit words, s_sum {{z, y, x}} of {spw}-bit words, mm x 2^8.",
+                wd.coord
             ),
         ],
         ports: vec![
@@ -667,9 +683,9 @@ fn pe_shell(index: usize, plane_name: &str, items: Vec<Item>) -> Module {
             port("rst_n", Direction::Input, 1),
             port("load", Direction::Input, 1),
             port("start", Direction::Input, 1),
-            port("s_prev", Direction::Input, POINT_BITS),
-            port("s_next", Direction::Input, POINT_BITS),
-            port("s_sum", Direction::Output, SUM_BITS),
+            port("s_prev", Direction::Input, point_bits(wd)),
+            port("s_next", Direction::Input, point_bits(wd)),
+            port("s_sum", Direction::Output, sum_bits(wd)),
             port("zero_sum", Direction::Output, 1),
         ],
         items,
@@ -677,7 +693,7 @@ fn pe_shell(index: usize, plane_name: &str, items: Vec<Item>) -> Module {
 }
 
 /// `name[hi:lo]` sign-extended to `total` bits.
-fn sext_slice(name: &str, hi: u32, lo: u32, total: u32) -> Expr {
+pub(crate) fn sext_slice(name: &str, hi: u32, lo: u32, total: u32) -> Expr {
     let w = hi - lo + 1;
     if total == w {
         Expr::slice(name, hi, lo)

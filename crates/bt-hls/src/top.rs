@@ -1,10 +1,9 @@
 //! `bt_top`: PE matrix, scheduler ROM, coordinate updater-buffer, convergence flags and the
 //! Avalon-MM slave. Twin of `bt_fixed::FixedIpc::run_fixed` with the schedule's budgets.
 
-use bt_fixed::width;
 
 use crate::input::{Layout, PE_LATENCY, bits_for, sched_entry_bits};
-use crate::pe::{POINT_BITS, SUM_BITS, pe_module_name, port};
+use crate::pe::{pe_module_name, point_bits, port, sext_slice, sum_bits};
 use crate::verilog::{BinaryOp, Direction, Expr, Item, Module, Signal, Stmt, UnaryOp};
 
 /// FSM state encodings.
@@ -57,6 +56,23 @@ impl<'a> TopParams<'a> {
     }
 }
 
+/// How many bits of a 32-bit millimetre bus word a fine coordinate of widths `wd` keeps.
+fn mm_width(wd: bt_fixed::Widths) -> u32 {
+    (wd.coord - bt_fixed::POINT_FRAC).min(32)
+}
+
+/// The low bits of the 32-bit millimetre bus word `name` that a fine coordinate of the
+/// design's width keeps above its 8 fraction bits (all 32 in the full 40-bit design; the host
+/// writes only values that fit, [`bt_fixed::FixedIpc::check_terminal`]).
+fn mm_bits(name: &str, wd: bt_fixed::Widths) -> Expr {
+    let keep = mm_width(wd);
+    if keep >= 32 {
+        id(name)
+    } else {
+        Expr::slice(name, keep - 1, 0)
+    }
+}
+
 /// `name` (`from` bits) as an `to`-bit unsigned value: zero-extended or truncated.
 fn zero_extend(name: &str, from: u32, to: u32) -> Expr {
     match from.cmp(&to) {
@@ -86,6 +102,8 @@ struct Dims<'a> {
     ab: u32,
     /// Early stopping rule and the widened box of every plane, when enabled.
     early: Option<(bt_fixed::EarlyStop, Vec<bt_fixed::FineBox>)>,
+    /// Datapath widths (the model's coordinate word).
+    wd: bt_fixed::Widths,
 }
 
 impl<'a> Dims<'a> {
@@ -103,6 +121,7 @@ impl<'a> Dims<'a> {
             cnt_bits: bits_for(u64::from((l.num_instances + 2).max(PE_LATENCY)) + 1),
             ab: l.address_bits,
             early: p.model.early_stop().map(|(s, b)| (*s, b.to_vec())),
+            wd: bt_fixed::Widths::for_coord(p.model.coord_bits()),
         }
     }
 }
@@ -145,9 +164,9 @@ fn declare_state(t: &Dims<'_>, items: &mut Vec<Item>) -> Vec<PeWires> {
         ("rx_x", 32),
         ("rx_y", 32),
         ("rx_z", 32),
-        ("st_x", 32),
-        ("st_y", 32),
-        ("st_z", 32),
+        ("st_x", mm_width(t.wd)),
+        ("st_y", mm_width(t.wd)),
+        ("st_z", mm_width(t.wd)),
         ("cur", np2),
         ("conv", np2),
         ("dz", np2),
@@ -155,8 +174,8 @@ fn declare_state(t: &Dims<'_>, items: &mut Vec<Item>) -> Vec<PeWires> {
         ("pbig", np2),
         ("pdz", np2),
         ("pov", np2),
-        ("rd_a", POINT_BITS),
-        ("rd_b", POINT_BITS),
+        ("rd_a", point_bits(t.wd)),
+        ("rd_b", point_bits(t.wd)),
         ("sched_q", sched_entry_bits(pb, ptb, ib)),
         ("sq_ok", 1),
         ("seen_tail", 1),
@@ -187,12 +206,12 @@ fn declare_state(t: &Dims<'_>, items: &mut Vec<Item>) -> Vec<PeWires> {
     // Two copies of the point memory (one per read port, both written): each is a plain
     // 1-write 1-read array with a registered read, which Yosys maps to M9K blocks.
     let depth = 1u32 << (ptb + 1);
-    items.push(Item::Memory("pm_a".into(), POINT_BITS, depth));
-    items.push(Item::Memory("pm_b".into(), POINT_BITS, depth));
+    items.push(Item::Memory("pm_a".into(), point_bits(t.wd), depth));
+    items.push(Item::Memory("pm_b".into(), point_bits(t.wd), depth));
     (0..k)
         .map(|j| PeWires {
             load: Signal::wire(items, format!("pe_load_{j}"), 1),
-            sum: Signal::wire(items, format!("pe_sum_{j}"), SUM_BITS),
+            sum: Signal::wire(items, format!("pe_sum_{j}"), sum_bits(t.wd)),
             zs: Signal::wire(items, format!("pe_zs_{j}"), 1),
         })
         .collect()
@@ -396,7 +415,7 @@ fn updater_read_ports(
     let rb_addr = Signal::reg(items, "rb_addr", ptb + 1);
     let wr_addr = Signal::reg(items, "wr_addr", ptb + 1);
     let wr_en = Signal::reg(items, "wr_en", 1);
-    let wr_data = Signal::reg(items, "wr_data", POINT_BITS);
+    let wr_data = Signal::reg(items, "wr_data", point_bits(t.wd));
     let one_pt = lit(ptb, 1);
     items.push(Item::AlwaysComb(vec![
         Stmt::Blocking(ra_addr.e(), bus_cell(bus)),
@@ -441,8 +460,8 @@ struct Selected {
 
 /// Write-back, PE output select and saturation (twin of the model's `saturate`).
 fn pe_output_select(t: &Dims<'_>, pe: &[PeWires], items: &mut Vec<Item>) -> Selected {
-    let cw = width::COORD;
-    let sel_sum = Signal::reg(items, "pe_sel_sum", SUM_BITS);
+    let cw = t.wd.coord;
+    let sel_sum = Signal::reg(items, "pe_sel_sum", sum_bits(t.wd));
     let zs = Signal::reg(items, "pe_sel_zs", 1);
     let sel_arms = pe
         .iter()
@@ -458,7 +477,7 @@ fn pe_output_select(t: &Dims<'_>, pe: &[PeWires], items: &mut Vec<Item>) -> Sele
         })
         .collect();
     let sel_default = vec![
-        Stmt::Blocking(sel_sum.e(), lit(SUM_BITS, 0)),
+        Stmt::Blocking(sel_sum.e(), lit(sum_bits(t.wd), 0)),
         Stmt::Blocking(zs.e(), lit(1, 0)),
     ];
     items.push(Item::AlwaysComb(vec![Stmt::Case(
@@ -466,7 +485,7 @@ fn pe_output_select(t: &Dims<'_>, pe: &[PeWires], items: &mut Vec<Item>) -> Sele
         sel_arms,
         sel_default,
     )]));
-    let spw = width::SUM_POINT;
+    let spw = t.wd.sum_point;
     let mut sat_parts = Vec::new();
     let mut ovf_terms = Vec::new();
     for (a, axis) in ["x", "y", "z"].iter().enumerate() {
@@ -505,7 +524,7 @@ fn pe_output_select(t: &Dims<'_>, pe: &[PeWires], items: &mut Vec<Item>) -> Sele
         sat_parts.insert(0, sat.e());
         ovf_terms.push(ovf.e());
     }
-    let point = Signal::assigned(items, "pe_sel", POINT_BITS, Expr::concat(sat_parts));
+    let point = Signal::assigned(items, "pe_sel", point_bits(t.wd), Expr::concat(sat_parts));
     let ov = Signal::assigned(
         items,
         "pe_sel_ov",
@@ -527,7 +546,7 @@ struct Displacement {
 
 /// Write-back displacement: per-axis |new − old| and the threshold test.
 fn displacement(t: &Dims<'_>, sel: &Selected, items: &mut Vec<Item>) -> Displacement {
-    let cw = width::COORD;
+    let cw = t.wd.coord;
     let dispw = cw + 1;
     let (mut new, mut adiff, mut big_terms) = (Vec::new(), Vec::new(), Vec::new());
     for (a, axis) in ["x", "y", "z"].iter().enumerate() {
@@ -626,12 +645,14 @@ fn writeback_flags(
 /// Coordinate updater-buffer, write side: the host's point writes while idle, the selected
 /// PE's result into the other bank at write-back; both memory copies take every write.
 fn updater_write_port(
+    t: &Dims<'_>,
     bus: &Decode,
     ports: &UpdaterPorts,
     sel: &Selected,
     flags: &WritebackFlags,
     items: &mut Vec<Item>,
 ) {
+    // `st_<axis>` hold the millimetre words' kept bits already (`mm_width`).
     let host_point = Expr::concat(vec![
         id("st_z"),
         Expr::slice("avs_writedata", 23, 16),
@@ -686,19 +707,19 @@ fn pe_matrix(t: &Dims<'_>, pe: &[PeWires], items: &mut Vec<Item>) {
     );
     // The operand wires follow the instances in the file: build them aside first.
     let mut operands = Vec::new();
-    let fine = |n: &str| Expr::concat(vec![id(n), lit(8, 0)]);
+    let fine = |n: &str| Expr::concat(vec![mm_bits(n, t.wd), lit(8, 0)]);
     let tx_fine = Expr::concat(vec![fine("tx_z"), fine("tx_y"), fine("tx_x")]);
     let rx_fine = Expr::concat(vec![fine("rx_z"), fine("rx_y"), fine("rx_x")]);
     let prev = Signal::assigned(
         &mut operands,
         "opnd_prev",
-        POINT_BITS,
+        point_bits(t.wd),
         Expr::mux(id("ld_q_first"), tx_fine, id("rd_a")),
     );
     let next = Signal::assigned(
         &mut operands,
         "opnd_next",
-        POINT_BITS,
+        point_bits(t.wd),
         Expr::mux(id("ld_q_last"), rx_fine, id("rd_b")),
     );
     for (j, (inst, w)) in t.p.platform.instances.iter().zip(pe).enumerate() {
@@ -983,9 +1004,9 @@ fn register_writes(t: &Dims<'_>, bus: &Decode, items: &mut Vec<Item>) {
                     vec![Stmt::Case(
                         Expr::slice("avs_address", 1, 0),
                         vec![
-                            (lit(2, 0), vec![nb(id("st_x"), id("avs_writedata"))]),
-                            (lit(2, 1), vec![nb(id("st_y"), id("avs_writedata"))]),
-                            (lit(2, 2), vec![nb(id("st_z"), id("avs_writedata"))]),
+                            (lit(2, 0), vec![nb(id("st_x"), mm_bits("avs_writedata", t.wd))]),
+                            (lit(2, 1), vec![nb(id("st_y"), mm_bits("avs_writedata", t.wd))]),
+                            (lit(2, 2), vec![nb(id("st_z"), mm_bits("avs_writedata", t.wd))]),
                         ],
                         vec![],
                     )],
@@ -1064,13 +1085,13 @@ fn control_read_arms(t: &Dims<'_>, mux: &Signal) -> Vec<(Expr, Vec<Stmt>)> {
 /// The read multiplexer: control registers, a path's status word, or a point's words (three
 /// integer words, then the packed fractions).
 fn read_mux(t: &Dims<'_>, mux: &Signal, items: &mut Vec<Item>) {
-    let cw = width::COORD;
+    let cw = t.wd.coord;
     let set = |value: Expr| vec![Stmt::Blocking(mux.e(), value)];
     let rqp = |v: &str| Expr::id(v).at(id("rq_path"));
     let point_arms = vec![
-        (lit(2, 0), set(Expr::slice("rd_a", cw - 1, 8))),
-        (lit(2, 1), set(Expr::slice("rd_a", 2 * cw - 1, cw + 8))),
-        (lit(2, 2), set(Expr::slice("rd_a", 3 * cw - 1, 2 * cw + 8))),
+        (lit(2, 0), set(sext_slice("rd_a", cw - 1, 8, 32))),
+        (lit(2, 1), set(sext_slice("rd_a", 2 * cw - 1, cw + 8, 32))),
+        (lit(2, 2), set(sext_slice("rd_a", 3 * cw - 1, 2 * cw + 8, 32))),
     ];
     let frac_word = Expr::concat(vec![
         lit(8, 0),
@@ -1169,7 +1190,7 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
         .as_ref()
         .map(|(stop, boxes)| early_stop_logic(d, stop, boxes, &disp, &mut items));
     let flags = writeback_flags(&sel, &disp, wb_lb, &mut items);
-    updater_write_port(&bus, &ports, &sel, &flags, &mut items);
+    updater_write_port(&t, &bus, &ports, &sel, &flags, &mut items);
     pe_matrix(&t, &pe, &mut items);
     controller(&t, &rom, &flags, &mut items);
     register_writes(&t, &bus, &mut items);
@@ -1248,7 +1269,8 @@ fn early_stop_logic(
     let w = BOX_BITS;
     let axes = ["x", "y", "z"];
     let bx = instance_box(d, boxes, items);
-    let dispw = width::COORD + 1;
+    let cw = d.model.coord_bits();
+    let dispw = cw + 1;
     let mvw = w - bt_fixed::EarlyStop::MAX_SHIFT;
     let zext = |s: &Signal| Expr::concat(vec![lit(mvw - dispw, 0), s.e()]);
     items.push(Item::Wire("mv_l1".into(), mvw));
@@ -1271,7 +1293,7 @@ fn early_stop_logic(
         items.push(Item::Wire(pw.clone(), w));
         items.push(Item::Assign(
             id(&pw),
-            crate::pe::sext(new.name(), width::COORD, w),
+            crate::pe::sext(new.name(), cw, w),
         ));
         for (side, expr) in [
             ("lo", id(&pw).plus(id("slack"))),

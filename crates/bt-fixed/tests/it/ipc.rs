@@ -175,3 +175,30 @@ fn early_stopping_settings_are_validated() {
     };
     assert_eq!(problems.len(), 4, "{problems:?}");
 }
+
+/// A narrowed coordinate word (a room's 24 bits: ±32.8 m) gives the full word's answer inside
+/// its range and refuses what does not fit, naming the value. (Saturation at each width is
+/// exercised by `widths::widths_hold_at_the_corners`.)
+#[test]
+fn a_narrow_coordinate_word_agrees_inside_refuses_outside_and_saturates() {
+    let ipc = || FixedIpc::new(&[floor()], &[vec![0]], &[vec![[0.5, 0.5, 0.0]]], 16, 50).unwrap();
+    let narrow = ipc().with_coord_bits(24).unwrap();
+    assert_eq!(narrow.coord_bits(), 24);
+    let (tx, rx) = ([0.0, 0.0, 1.0], [3.0, 0.0, 2.0]);
+    assert_eq!(narrow.run(tx, rx).unwrap(), ipc().run(tx, rx).unwrap());
+    // TX 40 m away does not fit.
+    let err = narrow.run([40.0, 0.0, 1.0], rx).unwrap_err().to_string();
+    assert!(err.contains("TX") && err.contains("24-bit"), "{err}");
+    // A plane 40 m out and a start point 50 m out are refused, each named.
+    let far = PlaneInput {
+        normal: [1.0, 0.0, 0.0],
+        offset_m: 40.0,
+    };
+    let err = FixedIpc::new(&[floor(), far], &[vec![0]], &[vec![[50.0, 0.0, 0.0]]], 16, 50)
+        .unwrap()
+        .with_coord_bits(24)
+        .unwrap_err()
+        .to_string();
+    assert!(err.contains("plane 1") && err.contains("initial point 0"), "{err}");
+    assert!(ipc().with_coord_bits(12).is_err());
+}

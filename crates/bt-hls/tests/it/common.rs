@@ -82,6 +82,8 @@ pub fn small_scene() -> HlsInput {
             [[2.5, 2.0, 1.0], [2.6, 2.1, 2.0]],
         ],
         early_stop: None,
+        // The room's 5 m extent: a 24-bit coordinate word, as `bt_accel` sizes a room.
+        coord_bits: bt_fixed::coord_bits_for(5.0),
     }
 }
 

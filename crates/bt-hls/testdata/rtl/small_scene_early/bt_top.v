@@ -27,9 +27,9 @@ module bt_top (
   reg [31:0] rx_x;
   reg [31:0] rx_y;
   reg [31:0] rx_z;
-  reg [31:0] st_x;
-  reg [31:0] st_y;
-  reg [31:0] st_z;
+  reg [15:0] st_x;
+  reg [15:0] st_y;
+  reg [15:0] st_z;
   reg [31:0] cur;
   reg [31:0] conv;
   reg [31:0] dz;
@@ -37,8 +37,8 @@ module bt_top (
   reg [31:0] pbig;
   reg [31:0] pdz;
   reg [31:0] pov;
-  reg [119:0] rd_a;
-  reg [119:0] rd_b;
+  reg [71:0] rd_a;
+  reg [71:0] rd_b;
   reg [18:0] sched_q;
   reg sq_ok;
   reg seen_tail;
@@ -61,31 +61,31 @@ module bt_top (
   reg [31:0] lb;
   reg [31:0] plb;
   reg [15:0] rounds [0:31];
-  reg [119:0] pm_a [0:127];
-  reg [119:0] pm_b [0:127];
+  reg [71:0] pm_a [0:127];
+  reg [71:0] pm_b [0:127];
   wire pe_load_0;
-  wire [131:0] pe_sum_0;
+  wire [83:0] pe_sum_0;
   wire pe_zs_0;
   wire pe_load_1;
-  wire [131:0] pe_sum_1;
+  wire [83:0] pe_sum_1;
   wire pe_zs_1;
   wire pe_load_2;
-  wire [131:0] pe_sum_2;
+  wire [83:0] pe_sum_2;
   wire pe_zs_2;
   wire pe_load_3;
-  wire [131:0] pe_sum_3;
+  wire [83:0] pe_sum_3;
   wire pe_zs_3;
   wire pe_load_4;
-  wire [131:0] pe_sum_4;
+  wire [83:0] pe_sum_4;
   wire pe_zs_4;
   wire pe_load_5;
-  wire [131:0] pe_sum_5;
+  wire [83:0] pe_sum_5;
   wire pe_zs_5;
   wire pe_load_6;
-  wire [131:0] pe_sum_6;
+  wire [83:0] pe_sum_6;
   wire pe_zs_6;
   wire pe_load_7;
-  wire [131:0] pe_sum_7;
+  wire [83:0] pe_sum_7;
   wire pe_zs_7;
   wire idle;
   assign idle = (state == 3'd0);
@@ -137,7 +137,7 @@ module bt_top (
   reg [6:0] rb_addr;
   reg [6:0] wr_addr;
   reg wr_en;
-  reg [119:0] wr_data;
+  reg [71:0] wr_data;
   always @* begin
     ra_addr = {bus_point, avs_address[2]};
     if ((state == 3'd2)) begin
@@ -149,7 +149,7 @@ module bt_top (
     end
     rb_addr = {(rom_point + 6'd1), cur[rom_path]};
   end
-  reg [131:0] pe_sel_sum;
+  reg [83:0] pe_sel_sum;
   reg pe_sel_zs;
   always @* begin
     case (wb_q_inst)
@@ -186,60 +186,60 @@ module bt_top (
         pe_sel_zs = pe_zs_7;
       end
       default: begin
-        pe_sel_sum = 132'h0;
+        pe_sel_sum = 84'h0;
         pe_sel_zs = 1'd0;
       end
     endcase
   end
-  wire [43:0] sum_x;
-  assign sum_x = pe_sel_sum[43:0];
+  wire [27:0] sum_x;
+  assign sum_x = pe_sel_sum[27:0];
   wire ovf_x;
-  assign ovf_x = ((sum_x[43:39] != 5'd0) && (sum_x[43:39] != 5'd31));
-  wire [39:0] sat_x;
-  assign sat_x = (ovf_x ? (sum_x[43] ? 40'h8000000000 : 40'h7fffffffff) : sum_x[39:0]);
-  wire [43:0] sum_y;
-  assign sum_y = pe_sel_sum[87:44];
+  assign ovf_x = ((sum_x[27:23] != 5'd0) && (sum_x[27:23] != 5'd31));
+  wire [23:0] sat_x;
+  assign sat_x = (ovf_x ? (sum_x[27] ? 24'h800000 : 24'h7fffff) : sum_x[23:0]);
+  wire [27:0] sum_y;
+  assign sum_y = pe_sel_sum[55:28];
   wire ovf_y;
-  assign ovf_y = ((sum_y[43:39] != 5'd0) && (sum_y[43:39] != 5'd31));
-  wire [39:0] sat_y;
-  assign sat_y = (ovf_y ? (sum_y[43] ? 40'h8000000000 : 40'h7fffffffff) : sum_y[39:0]);
-  wire [43:0] sum_z;
-  assign sum_z = pe_sel_sum[131:88];
+  assign ovf_y = ((sum_y[27:23] != 5'd0) && (sum_y[27:23] != 5'd31));
+  wire [23:0] sat_y;
+  assign sat_y = (ovf_y ? (sum_y[27] ? 24'h800000 : 24'h7fffff) : sum_y[23:0]);
+  wire [27:0] sum_z;
+  assign sum_z = pe_sel_sum[83:56];
   wire ovf_z;
-  assign ovf_z = ((sum_z[43:39] != 5'd0) && (sum_z[43:39] != 5'd31));
-  wire [39:0] sat_z;
-  assign sat_z = (ovf_z ? (sum_z[43] ? 40'h8000000000 : 40'h7fffffffff) : sum_z[39:0]);
-  wire [119:0] pe_sel;
+  assign ovf_z = ((sum_z[27:23] != 5'd0) && (sum_z[27:23] != 5'd31));
+  wire [23:0] sat_z;
+  assign sat_z = (ovf_z ? (sum_z[27] ? 24'h800000 : 24'h7fffff) : sum_z[23:0]);
+  wire [71:0] pe_sel;
   assign pe_sel = {sat_z, sat_y, sat_x};
   wire pe_sel_ov;
   assign pe_sel_ov = ((ovf_x | ovf_y) | ovf_z);
-  wire [39:0] new_x;
-  assign new_x = pe_sel[39:0];
-  wire [39:0] old_x;
-  assign old_x = rd_a[39:0];
-  wire [40:0] diff_x;
-  assign diff_x = ({{1{new_x[39]}}, new_x} - {{1{old_x[39]}}, old_x});
-  wire [40:0] adiff_x;
-  assign adiff_x = (diff_x[40] ? (~(diff_x) + 41'h1) : diff_x);
-  wire [39:0] new_y;
-  assign new_y = pe_sel[79:40];
-  wire [39:0] old_y;
-  assign old_y = rd_a[79:40];
-  wire [40:0] diff_y;
-  assign diff_y = ({{1{new_y[39]}}, new_y} - {{1{old_y[39]}}, old_y});
-  wire [40:0] adiff_y;
-  assign adiff_y = (diff_y[40] ? (~(diff_y) + 41'h1) : diff_y);
-  wire [39:0] new_z;
-  assign new_z = pe_sel[119:80];
-  wire [39:0] old_z;
-  assign old_z = rd_a[119:80];
-  wire [40:0] diff_z;
-  assign diff_z = ({{1{new_z[39]}}, new_z} - {{1{old_z[39]}}, old_z});
-  wire [40:0] adiff_z;
-  assign adiff_z = (diff_z[40] ? (~(diff_z) + 41'h1) : diff_z);
+  wire [23:0] new_x;
+  assign new_x = pe_sel[23:0];
+  wire [23:0] old_x;
+  assign old_x = rd_a[23:0];
+  wire [24:0] diff_x;
+  assign diff_x = ({{1{new_x[23]}}, new_x} - {{1{old_x[23]}}, old_x});
+  wire [24:0] adiff_x;
+  assign adiff_x = (diff_x[24] ? (~(diff_x) + 25'h1) : diff_x);
+  wire [23:0] new_y;
+  assign new_y = pe_sel[47:24];
+  wire [23:0] old_y;
+  assign old_y = rd_a[47:24];
+  wire [24:0] diff_y;
+  assign diff_y = ({{1{new_y[23]}}, new_y} - {{1{old_y[23]}}, old_y});
+  wire [24:0] adiff_y;
+  assign adiff_y = (diff_y[24] ? (~(diff_y) + 25'h1) : diff_y);
+  wire [23:0] new_z;
+  assign new_z = pe_sel[71:48];
+  wire [23:0] old_z;
+  assign old_z = rd_a[71:48];
+  wire [24:0] diff_z;
+  assign diff_z = ({{1{new_z[23]}}, new_z} - {{1{old_z[23]}}, old_z});
+  wire [24:0] adiff_z;
+  assign adiff_z = (diff_z[24] ? (~(diff_z) + 25'h1) : diff_z);
   // wb_big: L-infinity displacement of the written point exceeds the threshold
   wire wb_big;
-  assign wb_big = (((adiff_x > 41'h10) | (adiff_y > 41'h10)) | (adiff_z > 41'h10));
+  assign wb_big = (((adiff_x > 25'h10) | (adiff_y > 25'h10)) | (adiff_z > 25'h10));
   reg [47:0] box_lo_x;
   reg [47:0] box_hi_x;
   reg [47:0] box_lo_y;
@@ -324,23 +324,23 @@ module bt_top (
     endcase
   end
   wire [43:0] mv_l1;
-  assign mv_l1 = (({3'd0, adiff_x} + {3'd0, adiff_y}) + {3'd0, adiff_z});
+  assign mv_l1 = (({19'h0, adiff_x} + {19'h0, adiff_y}) + {19'h0, adiff_z});
   wire [47:0] slack;
   assign slack = {2'd0, mv_l1, 2'd0};
   wire [47:0] bp_x;
-  assign bp_x = {{8{new_x[39]}}, new_x};
+  assign bp_x = {{24{new_x[23]}}, new_x};
   wire [47:0] bq_lo_x;
   assign bq_lo_x = (bp_x + slack);
   wire [47:0] bq_hi_x;
   assign bq_hi_x = (bp_x - slack);
   wire [47:0] bp_y;
-  assign bp_y = {{8{new_y[39]}}, new_y};
+  assign bp_y = {{24{new_y[23]}}, new_y};
   wire [47:0] bq_lo_y;
   assign bq_lo_y = (bp_y + slack);
   wire [47:0] bq_hi_y;
   assign bq_hi_y = (bp_y - slack);
   wire [47:0] bp_z;
-  assign bp_z = {{8{new_z[39]}}, new_z};
+  assign bp_z = {{24{new_z[23]}}, new_z};
   wire [47:0] bq_lo_z;
   assign bq_lo_z = (bp_z + slack);
   wire [47:0] bq_hi_z;
@@ -463,10 +463,10 @@ module bt_top (
     .s_sum(pe_sum_7),
     .zero_sum(pe_zs_7)
   );
-  wire [119:0] opnd_prev;
-  assign opnd_prev = (ld_q_first ? {{tx_z, 8'd0}, {tx_y, 8'd0}, {tx_x, 8'd0}} : rd_a);
-  wire [119:0] opnd_next;
-  assign opnd_next = (ld_q_last ? {{rx_z, 8'd0}, {rx_y, 8'd0}, {rx_x, 8'd0}} : rd_b);
+  wire [71:0] opnd_prev;
+  assign opnd_prev = (ld_q_first ? {{tx_z[15:0], 8'd0}, {tx_y[15:0], 8'd0}, {tx_x[15:0], 8'd0}} : rd_a);
+  wire [71:0] opnd_next;
+  assign opnd_next = (ld_q_last ? {{rx_z[15:0], 8'd0}, {rx_y[15:0], 8'd0}, {rx_x[15:0], 8'd0}} : rd_b);
   assign pe_load_0 = (((state == 3'd2) && ld_q_en) && (ld_q_inst == 3'd0));
   assign pe_load_1 = (((state == 3'd2) && ld_q_en) && (ld_q_inst == 3'd1));
   assign pe_load_2 = (((state == 3'd2) && ld_q_en) && (ld_q_inst == 3'd2));
@@ -652,13 +652,13 @@ module bt_top (
         if (is_point) begin
           case (avs_address[1:0])
             2'd0: begin
-              st_x <= avs_writedata;
+              st_x <= avs_writedata[15:0];
             end
             2'd1: begin
-              st_y <= avs_writedata;
+              st_y <= avs_writedata[15:0];
             end
             2'd2: begin
-              st_z <= avs_writedata;
+              st_z <= avs_writedata[15:0];
             end
             default: begin
             end
@@ -732,16 +732,16 @@ module bt_top (
       2'd3: begin
         case (rq_word)
           2'd0: begin
-            read_mux = rd_a[39:8];
+            read_mux = {{16{rd_a[23]}}, rd_a[23:8]};
           end
           2'd1: begin
-            read_mux = rd_a[79:48];
+            read_mux = {{16{rd_a[47]}}, rd_a[47:32]};
           end
           2'd2: begin
-            read_mux = rd_a[119:88];
+            read_mux = {{16{rd_a[71]}}, rd_a[71:56]};
           end
           default: begin
-            read_mux = {8'd0, rd_a[87:80], rd_a[47:40], rd_a[7:0]};
+            read_mux = {8'd0, rd_a[55:48], rd_a[31:24], rd_a[7:0]};
           end
         endcase
       end
