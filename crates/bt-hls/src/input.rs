@@ -588,6 +588,7 @@ mod tests {
                 entries,
             },
             m9k_budget,
+            coord_bits: full_coord_bits(),
         }
     }
 

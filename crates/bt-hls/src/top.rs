@@ -645,7 +645,6 @@ fn writeback_flags(
 /// Coordinate updater-buffer, write side: the host's point writes while idle, the selected
 /// PE's result into the other bank at write-back; both memory copies take every write.
 fn updater_write_port(
-    t: &Dims<'_>,
     bus: &Decode,
     ports: &UpdaterPorts,
     sel: &Selected,
@@ -1190,7 +1189,7 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
         .as_ref()
         .map(|(stop, boxes)| early_stop_logic(d, stop, boxes, &disp, &mut items));
     let flags = writeback_flags(&sel, &disp, wb_lb, &mut items);
-    updater_write_port(&t, &bus, &ports, &sel, &flags, &mut items);
+    updater_write_port(&bus, &ports, &sel, &flags, &mut items);
     pe_matrix(&t, &pe, &mut items);
     controller(&t, &rom, &flags, &mut items);
     register_writes(&t, &bus, &mut items);
