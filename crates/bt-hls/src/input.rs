@@ -452,9 +452,10 @@ pub(crate) fn platform_model(platform: &Platform) -> Result<FixedIpc, HlsError> 
     input.model()
 }
 
-fn step_design(platform: &Platform, k: usize, w: &StepWork) -> Result<StepDesign, HlsError> {
-    let input = &w.input;
-    let schedule = &w.schedule;
+/// Step `k`'s work against the platform: its planes, threshold, early stopping and coordinate
+/// word must be the platform's, and its TX/RX vectors must fit. Every problem at once; returns
+/// the step's model.
+fn check_step(platform: &Platform, k: usize, input: &HlsInput) -> Result<FixedIpc, HlsError> {
     let mut problems = Vec::new();
     if input.paths.is_empty() {
         problems.push(format!("step {k}: no candidate path"));
@@ -487,6 +488,13 @@ fn step_design(platform: &Platform, k: usize, w: &StepWork) -> Result<StepDesign
         model.check_terminal("TX", tx)?;
         model.check_terminal("RX", rx)?;
     }
+    Ok(model)
+}
+
+fn step_design(platform: &Platform, k: usize, w: &StepWork) -> Result<StepDesign, HlsError> {
+    let input = &w.input;
+    let schedule = &w.schedule;
+    let model = check_step(platform, k, input)?;
     let mut budgets = vec![0u32; input.paths.len()];
     for row in &schedule.slots {
         for job in row.iter().flatten() {
