@@ -1,8 +1,8 @@
 //! The IPC loop (Algorithm 1) in fixed point, with the accelerator's Jacobi update.
 
 use crate::{
-    FineCoord, FinePoint, FixedError, FixedPlane, FixedPoint, dequantize_fine_point,
-    Widths, displacement_linf, intersection_point_in, quantize_fine_point, quantize_point,
+    FineCoord, FinePoint, FixedError, FixedPlane, FixedPoint, Widths, dequantize_fine_point,
+    displacement_linf, intersection_point_in, quantize_fine_point, quantize_point,
 };
 
 /// A plane at the boundary, in metres: `normal · x = offset_m`, `normal` unit.
@@ -179,6 +179,15 @@ struct FixedPath {
     init: Vec<FinePoint>,
 }
 
+/// "the `bits`-bit coordinate range (±L m)", for errors.
+fn range_text(bits: u32) -> String {
+    let (_, hi) = Widths::for_coord(bits).coord_range();
+    format!(
+        "the {bits}-bit coordinate range (±{} m)",
+        FineCoord(hi).dequantize()
+    )
+}
+
 /// The fixed-point IPC model: validated, quantised scene plus candidate paths.
 ///
 /// Semantics (identical in `bt_top`): each round is a Jacobi update, every point of a path
@@ -283,23 +292,23 @@ impl FixedIpc {
             ));
             return Err(FixedError::InvalidInput { problems });
         }
-        let range = Widths::for_coord(bits).coord_range();
-        let fits = |v: i64| (range.0..=range.1).contains(&v);
-        let limit_m = FineCoord(range.1).dequantize();
+        let wd = Widths::for_coord(bits);
         for (i, p) in self.planes.iter().enumerate() {
-            if !fits(p.offset.0) {
+            if !wd.holds(&[p.offset]) {
                 problems.push(format!(
-                    "plane {i}: offset {} m is outside the {bits}-bit coordinate range (±{limit_m} m)",
-                    p.offset.dequantize()
+                    "plane {i}: offset {} m is outside {}",
+                    p.offset.dequantize(),
+                    range_text(bits)
                 ));
             }
         }
         for (p, path) in self.paths.iter().enumerate() {
             for (i, q) in path.init.iter().enumerate() {
-                if !q.iter().all(|c| fits(c.0)) {
+                if !wd.holds(q) {
                     problems.push(format!(
-                        "path {p} initial point {i}: {:?} m is outside the {bits}-bit coordinate range (±{limit_m} m)",
-                        dequantize_fine_point(*q)
+                        "path {p} initial point {i}: {:?} m is outside {}",
+                        dequantize_fine_point(*q),
+                        range_text(bits)
                     ));
                 }
             }
@@ -318,17 +327,15 @@ impl FixedIpc {
 
     /// Whether TX or RX `point` (bus words) fits the coordinate word; the error names it.
     pub fn check_terminal(&self, name: &str, point: FixedPoint) -> Result<(), FixedError> {
-        let range = Widths::for_coord(self.coord_bits).coord_range();
         let fine = point.map(FineCoord::from_coord);
-        if fine.iter().all(|c| (range.0..=range.1).contains(&c.0)) {
+        if Widths::for_coord(self.coord_bits).holds(&fine) {
             return Ok(());
         }
         Err(FixedError::InvalidInput {
             problems: vec![format!(
-                "{name} {:?} m is outside the {}-bit coordinate range (±{} m)",
+                "{name} {:?} m is outside {}",
                 dequantize_fine_point(fine),
-                self.coord_bits,
-                FineCoord(range.1).dequantize()
+                range_text(self.coord_bits)
             )],
         })
     }

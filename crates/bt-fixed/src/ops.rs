@@ -146,6 +146,12 @@ impl Widths {
     pub const fn coord_range(&self) -> (i64, i64) {
         (-(1 << (self.coord - 1)), (1 << (self.coord - 1)) - 1)
     }
+
+    /// Whether every component of `p` fits the coordinate word.
+    pub fn holds(&self, p: &[FineCoord]) -> bool {
+        let (lo, hi) = self.coord_range();
+        p.iter().all(|c| (lo..=hi).contains(&c.0))
+    }
 }
 
 /// Bits of headroom [`coord_bits_for`] keeps above a room's extent: IPC points may wander
@@ -309,7 +315,7 @@ pub struct PeTrace {
     pub unsaturated: [i64; 3],
     /// The new intersection point (saturated to the coordinate word, 40 bits by default).
     pub point: FinePoint,
-    /// Some component did not fit 40 bits and was saturated.
+    /// Some component did not fit the coordinate word and was saturated.
     pub overflow: bool,
 }
 

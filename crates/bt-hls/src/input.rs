@@ -215,8 +215,8 @@ pub struct StepWork {
 }
 
 impl Platform {
-    /// The smallest platform that runs every step of `work`: the planes, threshold and early
-    /// stopping of the first step, one PE per plane (more where a step's schedule duplicates
+    /// The smallest platform that runs every step of `work`: the planes, threshold, early
+    /// stopping and coordinate word of the first step, one PE per plane (more where a step's schedule duplicates
     /// it), and RAMs for the largest step.
     pub fn fitting(work: &[StepWork]) -> Result<Platform, HlsError> {
         let Some(first) = work.first() else {
@@ -263,7 +263,7 @@ impl Platform {
             instances,
             capacity,
             m9k_budget: EP4CE115_M9K_BLOCKS,
-            coord_bits: work.iter().map(|w| w.input.coord_bits).max().unwrap_or(first.input.coord_bits),
+            coord_bits: first.input.coord_bits,
         })
     }
 }

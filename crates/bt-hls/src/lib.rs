@@ -408,10 +408,10 @@ fn rtl_of(
 ) -> Result<Vec<(String, String)>, HlsError> {
     let planes: std::collections::BTreeSet<u32> =
         platform.instances.iter().map(|i| i.plane).collect();
+    let wd = bt_fixed::Widths::for_coord(model.coord_bits());
     let mut out = Vec::new();
     for p in planes {
         let spec = &platform.planes[p as usize];
-        let wd = bt_fixed::Widths::for_coord(model.coord_bits());
         let m = pe::pe_module(p as usize, &spec.name, &model.planes()[p as usize], wd)?;
         out.push((m.name.clone(), verilog::print_module(&m)));
     }

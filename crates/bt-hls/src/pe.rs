@@ -226,10 +226,12 @@ fn step_bits() -> u32 {
     64 - u64::from(last_step()).leading_zeros()
 }
 
-/// The low `xw` bits of a register (the network input: `wd.distance` bits; the coordinate
-/// `s` sign-extended, or `d` or `t`).
-fn low(s: &Signal, xw: u32) -> Expr {
-    s.slice(xw - 1, 0)
+impl PeRegs {
+    /// The low `wd.distance` bits of a register (the network input: the coordinate `s`
+    /// sign-extended, or `d` or `t`).
+    fn low(&self, s: &Signal) -> Expr {
+        s.slice(self.wd.distance - 1, 0)
+    }
 }
 
 /// One shared CSD network: `net = x_in · n_k / 2^base`.
@@ -265,8 +267,8 @@ fn csd_networks(
             wd.distance,
             Expr::mux(
                 s1.clone(),
-                Expr::mux(s0.clone(), low(&r.r_l, wd.distance), low(&r.r_e, wd.distance)),
-                Expr::mux(s0.clone(), low(&r.b[k], wd.distance), low(&r.a[k], wd.distance)),
+                Expr::mux(s0.clone(), r.low(&r.r_l), r.low(&r.r_e)),
+                Expr::mux(s0.clone(), r.low(&r.b[k]), r.low(&r.a[k])),
             ),
         );
         let nw = wd.dot_acc - bk;
@@ -338,7 +340,7 @@ fn projections(
     let s0 = r.step.bit(0);
     let mut ts = Vec::new();
     for (k, axis) in AXES.iter().enumerate() {
-        let pbase = Expr::mux(s0.clone(), low(&r.b[k], wd.distance), low(&r.a[k], wd.distance));
+        let pbase = Expr::mux(s0.clone(), r.low(&r.b[k]), r.low(&r.a[k]));
         let t = Signal::wire(items, format!("t_{axis}"), wd.distance);
         let Some(Network { base: bk, net }) = &nets[k] else {
             items.push(Item::Assign(t.e(), pbase));
@@ -389,8 +391,8 @@ fn setup_values(r: &PeRegs, items: &mut Vec<Item>, unused: &mut Vec<Expr>) -> Se
             wd.distance,
             Expr::mux(
                 reg.bit(wd.distance - 1),
-                low(reg, wd.distance).inv().plus(Expr::lit(wd.distance, 1)),
-                low(reg, wd.distance),
+                r.low(reg).inv().plus(Expr::lit(wd.distance, 1)),
+                r.low(reg),
             ),
         )
     };
@@ -412,16 +414,26 @@ fn setup_values(r: &PeRegs, items: &mut Vec<Item>, unused: &mut Vec<Expr>) -> Se
             items,
             format!("delta_{axis}"),
             deltaw,
-            sext_slice(b, wd.distance - 1, 0, deltaw).minus(sext_slice(a, wd.distance - 1, 0, deltaw)),
+            sext_slice(b, wd.distance - 1, 0, deltaw).minus(sext_slice(
+                a,
+                wd.distance - 1,
+                0,
+                deltaw,
+            )),
         ));
         // t_prev + t_next + 1 as one adder: {b, 1} + {a, 1} = 2·(a + b + 1).
         let ts = Signal::assigned(
             items,
             format!("tsum_{axis}"),
             deltaw + 1,
-            Expr::concat(vec![sext_slice(b, wd.distance - 1, 0, deltaw), Expr::lit(1, 1)]).plus(
-                Expr::concat(vec![sext_slice(a, wd.distance - 1, 0, deltaw), Expr::lit(1, 1)]),
-            ),
+            Expr::concat(vec![
+                sext_slice(b, wd.distance - 1, 0, deltaw),
+                Expr::lit(1, 1),
+            ])
+            .plus(Expr::concat(vec![
+                sext_slice(a, wd.distance - 1, 0, deltaw),
+                Expr::lit(1, 1),
+            ])),
         );
         unused.push(ts.bit(0));
         tsum.push(ts);
@@ -448,12 +460,7 @@ struct Halving {
 fn halving_step(r: &PeRegs, items: &mut Vec<Item>, unused: &mut Vec<Expr>) -> Halving {
     let wd = r.wd;
     let g = GUARD_BITS;
-    let (lw, ew, lpw, aw) = (
-        wd.half_sum,
-        wd.search_diff,
-        wd.half_delta,
-        wd.point_acc,
-    );
+    let (lw, ew, lpw, aw) = (wd.half_sum, wd.search_diff, wd.half_delta, wd.point_acc);
     items.push(Item::Comment(format!(
         "Algorithm 3 on {g} guard bits, {PROPORTION_ITERATIONS} steps frozen once L = 0; E = B - m*2^{g} replaces B, m and the comparator"
     )));
@@ -542,12 +549,7 @@ fn seq_idle(r: &PeRegs, d_new: &Signal) -> Vec<Stmt> {
 fn seq_setup(r: &PeRegs, s: &SetupValues) -> Vec<Stmt> {
     let wd = r.wd;
     let g = GUARD_BITS;
-    let (deltaw, sumw, ew, aw) = (
-        wd.delta,
-        wd.distance_sum,
-        wd.search_diff,
-        wd.point_acc,
-    );
+    let (deltaw, sumw, ew, aw) = (wd.delta, wd.distance_sum, wd.search_diff, wd.point_acc);
     let mut setup = vec![
         nb(
             &r.r_e,

@@ -1,7 +1,6 @@
 //! `bt_top`: PE matrix, scheduler ROM, coordinate updater-buffer, convergence flags and the
 //! Avalon-MM slave. Twin of `bt_fixed::FixedIpc::run_fixed` with the schedule's budgets.
 
-
 use crate::input::{Layout, PE_LATENCY, bits_for, sched_entry_bits};
 use crate::pe::{pe_module_name, point_bits, port, sext_slice, sum_bits};
 use crate::verilog::{BinaryOp, Direction, Expr, Item, Module, Signal, Stmt, UnaryOp};
@@ -1003,9 +1002,18 @@ fn register_writes(t: &Dims<'_>, bus: &Decode, items: &mut Vec<Item>) {
                     vec![Stmt::Case(
                         Expr::slice("avs_address", 1, 0),
                         vec![
-                            (lit(2, 0), vec![nb(id("st_x"), mm_bits("avs_writedata", t.wd))]),
-                            (lit(2, 1), vec![nb(id("st_y"), mm_bits("avs_writedata", t.wd))]),
-                            (lit(2, 2), vec![nb(id("st_z"), mm_bits("avs_writedata", t.wd))]),
+                            (
+                                lit(2, 0),
+                                vec![nb(id("st_x"), mm_bits("avs_writedata", t.wd))],
+                            ),
+                            (
+                                lit(2, 1),
+                                vec![nb(id("st_y"), mm_bits("avs_writedata", t.wd))],
+                            ),
+                            (
+                                lit(2, 2),
+                                vec![nb(id("st_z"), mm_bits("avs_writedata", t.wd))],
+                            ),
                         ],
                         vec![],
                     )],
@@ -1090,7 +1098,10 @@ fn read_mux(t: &Dims<'_>, mux: &Signal, items: &mut Vec<Item>) {
     let point_arms = vec![
         (lit(2, 0), set(sext_slice("rd_a", cw - 1, 8, 32))),
         (lit(2, 1), set(sext_slice("rd_a", 2 * cw - 1, cw + 8, 32))),
-        (lit(2, 2), set(sext_slice("rd_a", 3 * cw - 1, 2 * cw + 8, 32))),
+        (
+            lit(2, 2),
+            set(sext_slice("rd_a", 3 * cw - 1, 2 * cw + 8, 32)),
+        ),
     ];
     let frac_word = Expr::concat(vec![
         lit(8, 0),
@@ -1290,10 +1301,7 @@ fn early_stop_logic(
     for (a, (axis, new)) in axes.iter().zip(&disp.new).enumerate() {
         let pw = format!("bp_{axis}");
         items.push(Item::Wire(pw.clone(), w));
-        items.push(Item::Assign(
-            id(&pw),
-            crate::pe::sext(new.name(), cw, w),
-        ));
+        items.push(Item::Assign(id(&pw), crate::pe::sext(new.name(), cw, w)));
         for (side, expr) in [
             ("lo", id(&pw).plus(id("slack"))),
             ("hi", id(&pw).minus(id("slack"))),

@@ -194,11 +194,20 @@ fn a_narrow_coordinate_word_agrees_inside_refuses_outside_and_saturates() {
         normal: [1.0, 0.0, 0.0],
         offset_m: 40.0,
     };
-    let err = FixedIpc::new(&[floor(), far], &[vec![0]], &[vec![[50.0, 0.0, 0.0]]], 16, 50)
-        .unwrap()
-        .with_coord_bits(24)
-        .unwrap_err()
-        .to_string();
-    assert!(err.contains("plane 1") && err.contains("initial point 0"), "{err}");
+    let err = FixedIpc::new(
+        &[floor(), far],
+        &[vec![0]],
+        &[vec![[50.0, 0.0, 0.0]]],
+        16,
+        50,
+    )
+    .unwrap()
+    .with_coord_bits(24)
+    .unwrap_err()
+    .to_string();
+    assert!(
+        err.contains("plane 1") && err.contains("initial point 0"),
+        "{err}"
+    );
     assert!(ipc().with_coord_bits(12).is_err());
 }

@@ -60,10 +60,7 @@ fn rtl_pe(plane: &FixedPlane, prev: FinePoint, next: FinePoint, w: Widths) -> ([
         let up = e < 0;
         for k in 0..3 {
             lp[k] >>= 1;
-            a[k] = wrap(
-                if up { a[k] + lp[k] } else { a[k] - lp[k] },
-                w.point_acc,
-            );
+            a[k] = wrap(if up { a[k] + lp[k] } else { a[k] - lp[k] }, w.point_acc);
         }
         e = if up { e + big_l } else { e - big_l };
         assert!(width::fits_signed(e, w.search_diff), "E = {e}");
@@ -109,7 +106,9 @@ fn register_form_equals_model_at_the_corners() {
                 for bits_prev in 0..27u32 {
                     for bits_next in 0..27u32 {
                         let pt = |b: u32| -> FinePoint {
-                            std::array::from_fn(|k| corners[((b / 3u32.pow(k as u32)) % 3) as usize])
+                            std::array::from_fn(|k| {
+                                corners[((b / 3u32.pow(k as u32)) % 3) as usize]
+                            })
                         };
                         check(&plane, pt(bits_prev), pt(bits_next), bits);
                     }

@@ -38,23 +38,14 @@ fn check(plane: &FixedPlane, prev: FinePoint, next: FinePoint, bits: u32) -> PeT
             2 * lp0.abs() + 64 + (1 << (GUARD_BITS - 1)),
             w.acc_delta
         ));
-        assert!(width::fits_signed(
-            t.proportion.offset[k].into(),
-            w.offset
-        ));
-        assert!(width::fits_signed(
-            t.unsaturated[k].into(),
-            w.sum_point
-        ));
+        assert!(width::fits_signed(t.proportion.offset[k].into(), w.offset));
+        assert!(width::fits_signed(t.unsaturated[k].into(), w.sum_point));
     }
     assert!(width::fits_unsigned(t.m.into(), w.abs_distance));
     assert!(width::fits_unsigned(t.n.into(), w.abs_distance));
     let sum = i128::from(t.m) + i128::from(t.n);
     assert!(width::fits_unsigned(sum, w.distance_sum));
-    assert!(width::fits_unsigned(
-        sum << (GUARD_BITS - 1),
-        w.half_sum
-    ));
+    assert!(width::fits_unsigned(sum << (GUARD_BITS - 1), w.half_sum));
     assert!(width::fits_unsigned(sum << GUARD_BITS, w.search));
     assert!(width::fits_unsigned(
         i128::from(t.m) << GUARD_BITS,

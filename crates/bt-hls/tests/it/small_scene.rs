@@ -54,7 +54,10 @@ fn the_full_width_design_is_bit_exact_and_agrees_with_the_narrow_one() {
     let schedule = small_schedule(&full);
     bt_hls::generate(&full, &schedule, &dir).expect("generate");
     let top = std::fs::read_to_string(dir.join("rtl/bt_top.v")).unwrap();
-    assert!(top.contains("[119:0] pm_a"), "40-bit points: three 40-bit words");
+    assert!(
+        top.contains("[119:0] pm_a"),
+        "40-bit points: three 40-bit words"
+    );
     let lint = bt_hls::lint(&dir).expect("lint");
     assert!(lint.warnings.is_empty(), "{}", lint.warnings.join("\n"));
     let s = bt_hls::simulate(&dir).expect("simulate");
