@@ -109,6 +109,9 @@ pub struct StudyLivingRoomArgs {
     /// points the previous step converged to.
     #[arg(long)]
     pub cold_start: bool,
+    /// Update order of the accelerator's rounds.
+    #[arg(long, value_enum, default_value_t = RoundOrderArg::RedBlack)]
+    pub round_order: RoundOrderArg,
 }
 
 /// The budgets both studies check before any work.
@@ -815,6 +818,23 @@ impl SimulatorArg {
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
+pub enum RoundOrderArg {
+    /// Every point from the previous round (the paper's PE matrix).
+    Jacobi,
+    /// Even points, then odd points from them: about half the rounds, each in two phases.
+    RedBlack,
+}
+
+impl RoundOrderArg {
+    pub fn order(self) -> bt_hls::RoundOrder {
+        match self {
+            RoundOrderArg::Jacobi => bt_hls::RoundOrder::Jacobi,
+            RoundOrderArg::RedBlack => bt_hls::RoundOrder::RedBlack,
+        }
+    }
+}
+
+#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
 pub enum ScheduleArg {
     /// Genetic algorithm + PE duplication + ASAP fill (the paper's three passes).
     Ga,
@@ -868,6 +888,9 @@ pub struct HlsGenArgs {
     /// points the previous step converged to.
     #[arg(long)]
     pub cold_start: bool,
+    /// Update order of the accelerator's rounds.
+    #[arg(long, value_enum, default_value_t = RoundOrderArg::RedBlack)]
+    pub round_order: RoundOrderArg,
     /// Model and schedule only (cycle counts, errors): skip writing RTL (for large scenes).
     #[arg(long)]
     pub plan_only: bool,

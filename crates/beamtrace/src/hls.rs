@@ -268,6 +268,7 @@ fn step_options(args: &HlsGenArgs) -> bt_accel::StepOptions {
             },
         },
         warm_start: !args.cold_start,
+        round_order: args.round_order.order(),
     }
 }
 

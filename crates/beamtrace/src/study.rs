@@ -64,6 +64,7 @@ pub fn run_living_room(args: &StudyLivingRoomArgs) -> anyhow::Result<ExitCode> {
         ga_generations: args.ga_generations,
         pe_budget: args.pe_budget,
         warm_start: !args.cold_start,
+        round_order: args.round_order.order(),
     };
     let problems = config.problems();
     if !problems.is_empty() {

@@ -185,6 +185,8 @@ pub fn step_input(
         test_vectors: Vec::new(),
         early_stop: Some(EarlyStop::default()),
         coord_bits,
+        // The paper's order; `plan_step` sets the order a stream runs with.
+        round_order: bt_hls::RoundOrder::Jacobi,
     };
     StepInput {
         input,

@@ -53,6 +53,8 @@ pub struct StepOptions {
     pub plan: PlanOptions,
     /// Start paths the previous step converged on from its points ([`warm_start`]).
     pub warm_start: bool,
+    /// Update order of the accelerator's rounds (red-black: about half Jacobi's rounds).
+    pub round_order: bt_fixed::RoundOrder,
 }
 
 /// One step planned on the host.
@@ -112,6 +114,7 @@ pub fn plan_step(
         options.threshold_lsb,
         options.max_rounds,
     );
+    step.input.round_order = options.round_order;
     let warm_started = match previous {
         Some(p) if options.warm_start => warm_start(&mut step, &p.step, &p.results),
         _ => 0,

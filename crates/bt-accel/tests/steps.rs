@@ -21,6 +21,7 @@ fn options(max_order: usize, warm_start: bool) -> StepOptions {
             ga: GaParams::default(),
         },
         warm_start,
+        round_order: bt_fixed::RoundOrder::RedBlack,
     }
 }
 
@@ -146,4 +147,40 @@ fn a_pe_budget_sizes_the_copies_once_for_every_step() {
     let platform = bt_hls::Platform::fitting(&work).unwrap();
     let extra: u32 = copies.iter().map(|&c| c.saturating_sub(1)).sum();
     assert_eq!(platform.instances.len() as u32, planes.len() as u32 + extra);
+}
+
+#[test]
+fn red_black_rounds_halve_the_cold_start_and_keep_every_path() {
+    // Step 0 at order 3 (no warm start): the same candidates, starts and PEs under both
+    // orders; red-black needs about half the PE jobs and no exact path is missed or spurious.
+    let scene = builtin_dynamic_scene("living-room-dynamic", Terminals::default())
+        .unwrap()
+        .unwrap();
+    let steps = scene.scenes();
+    let planes = static_reflectors(steps);
+    let plan = |order| {
+        let o = StepOptions {
+            round_order: order,
+            ..options(3, true)
+        };
+        plan_step(&steps[0], &planes, 0, &o, None).unwrap()
+    };
+    let jacobi = plan(bt_hls::RoundOrder::Jacobi);
+    let red_black = plan(bt_hls::RoundOrder::RedBlack);
+    assert_eq!(jacobi.step.sequences, red_black.step.sequences);
+    for p in [&jacobi, &red_black] {
+        assert_eq!((p.fixed.missed, p.fixed.spurious), (0, 0), "{:?}", p.fixed);
+    }
+    let jobs = |p: &PlannedStep| p.plan.stats.jobs;
+    assert!(
+        10 * jobs(&red_black) < 6 * jobs(&jacobi),
+        "{} vs {}",
+        jobs(&red_black),
+        jobs(&jacobi)
+    );
+    let cycles = |p: &PlannedStep| bt_hls::run_cycles(&p.plan.schedule);
+    assert!(10 * cycles(&red_black) < 6 * cycles(&jacobi));
+    // Every path the host accepts under Jacobi it accepts under red-black.
+    let converged = |p: &PlannedStep| p.results.iter().filter(|r| r.converged).count();
+    assert!(converged(&red_black) >= converged(&jacobi));
 }

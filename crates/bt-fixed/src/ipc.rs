@@ -1,4 +1,4 @@
-//! The IPC loop (Algorithm 1) in fixed point, with the accelerator's Jacobi update.
+//! The IPC loop (Algorithm 1) in fixed point, with the accelerator's Jacobi or red-black update.
 
 use crate::{
     FineCoord, FinePoint, FixedError, FixedPlane, FixedPoint, Widths, dequantize_fine_point,
@@ -78,6 +78,36 @@ impl FineBox {
     pub fn outside(&self, point: FinePoint, move_l1: u64, shift: u32) -> bool {
         let slack = (move_l1 << shift) as i64;
         (0..3).any(|a| point[a].0 + slack < self.lo[a] || point[a].0 - slack > self.hi[a])
+    }
+}
+
+/// The order in which a round updates a path's points (Algorithm 1's loop over the points).
+///
+/// Both orders apply the same Algorithm 2 to every point once per round; they differ in which
+/// neighbour values a point reads. A chain's update couples each point to its two neighbours
+/// only, so the points of even index (TX side first, 0-based) depend on odd ones alone and
+/// vice versa: updating one colour from the other is Gauss-Seidel's convergence (locally
+/// ρ_Jacobi², half the rounds for the same displacement) with every phase still parallel.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum RoundOrder {
+    /// Every point from the previous round's values (the paper's PE matrix): one phase.
+    #[default]
+    Jacobi,
+    /// Red-black: first the points of even index from the previous round's values, then the
+    /// points of odd index from the even points just computed: two phases, the second reading
+    /// the round's new values (the schedule's `late` jobs in `bt_top`).
+    RedBlack,
+}
+
+impl RoundOrder {
+    /// Phases of a round: point `i` is updated in phase `i % phases`, a phase after the one
+    /// before it has been written.
+    pub const fn phases(self) -> u32 {
+        match self {
+            RoundOrder::Jacobi => 1,
+            RoundOrder::RedBlack => 2,
+        }
     }
 }
 
@@ -190,8 +220,9 @@ fn range_text(bits: u32) -> String {
 
 /// The fixed-point IPC model: validated, quantised scene plus candidate paths.
 ///
-/// Semantics (identical in `bt_top`): each round is a Jacobi update, every point of a path
-/// computed by [`intersection_point`] from the previous round's values (TX and RX fixed);
+/// Semantics (identical in `bt_top`): each round updates every point of a path once by
+/// [`intersection_point`] (TX and RX fixed), in the [`RoundOrder`]: Jacobi (every point from
+/// the previous round's values) or red-black (even points first, then odd points from them);
 /// the round's displacement is the maximum over the path's points of the L∞ norm of the
 /// point's move, in fine LSB (1/256 mm). After committing round `r`: if a degenerate flag was raised the path
 /// freezes as degenerate, else if early stopping is on, `r ≥ min_rounds` and a point of the
@@ -206,6 +237,8 @@ pub struct FixedIpc {
     early_stop: Option<(EarlyStop, Vec<FineBox>)>,
     /// Width of the coordinate word, bits ([`crate::Widths`]; 40 unless narrowed).
     coord_bits: u32,
+    /// Update order of a round (Jacobi unless set).
+    order: RoundOrder,
 }
 
 impl FixedIpc {
@@ -275,6 +308,7 @@ impl FixedIpc {
             max_rounds,
             early_stop: None,
             coord_bits: FineCoord::BITS,
+            order: RoundOrder::Jacobi,
         })
     }
 
@@ -318,6 +352,17 @@ impl FixedIpc {
         }
         self.coord_bits = bits;
         Ok(self)
+    }
+
+    /// Sets the update order of a round (default [`RoundOrder::Jacobi`]).
+    pub fn with_round_order(mut self, order: RoundOrder) -> FixedIpc {
+        self.order = order;
+        self
+    }
+
+    /// Update order of a round.
+    pub fn round_order(&self) -> RoundOrder {
+        self.order
     }
 
     /// Width of the coordinate word, bits.
@@ -476,17 +521,29 @@ impl FixedIpc {
             overflow: false,
             left_bounds: false,
         };
+        let phases = self.order.phases() as usize;
         for _ in 0..budget {
-            let mut next = Vec::with_capacity(n);
+            // Phase h updates points h, h + phases, ...: from the values of the round so far
+            // (`next`), whose points are the previous round's until their phase comes.
+            let mut next = points.clone();
             let mut disp = 0;
             let mut outside = false;
             let check = self
                 .early_stop
                 .as_ref()
                 .filter(|(s, _)| result.rounds + 1 >= s.min_rounds);
-            for i in 0..n {
-                let prev = if i == 0 { tx } else { points[i - 1] };
-                let follow = if i + 1 == n { rx } else { points[i + 1] };
+            for i in (0..phases).flat_map(|h| (h..n).step_by(phases)) {
+                // A phase's points are not neighbours of each other (Jacobi: the one phase
+                // reads the previous round), so the neighbours' values are those before it.
+                let neighbour = |j: usize| {
+                    if j % phases == i % phases {
+                        points[j]
+                    } else {
+                        next[j]
+                    }
+                };
+                let prev = if i == 0 { tx } else { neighbour(i - 1) };
+                let follow = if i + 1 == n { rx } else { neighbour(i + 1) };
                 let plane = &self.planes[path.planes[i] as usize];
                 let trace = intersection_point_in(plane, prev, follow, self.coord_bits);
                 result.zero_sum |= trace.proportion.zero_sum;
@@ -502,7 +559,7 @@ impl FixedIpc {
                         stop.displacement_shift,
                     );
                 }
-                next.push(trace.point);
+                next[i] = trace.point;
             }
             points = next;
             result.rounds += 1;

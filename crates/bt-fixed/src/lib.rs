@@ -47,6 +47,7 @@ pub use csd::{Csd, CsdDigit, round_shift};
 pub use error::FixedError;
 pub use ipc::{
     BoundsM, DegenerateKind, EarlyStop, FineBox, FixedIpc, FixedOutcome, PathResult, PlaneInput,
+    RoundOrder,
 };
 pub use normal::{FixedPlane, NORMAL_FRAC, NormalComponent, UNIT_NORMAL_TOLERANCE};
 pub use ops::{

@@ -2,7 +2,7 @@
 
 use bt_fixed::{
     BoundsM, EarlyStop, FixedIpc, FixedPoint, PROPORTION_ITERATIONS, PathResult, PlaneInput,
-    quantize_point,
+    RoundOrder, quantize_point,
 };
 use bt_schedule::{PathJob, PeInstance, Problem, Schedule};
 
@@ -49,6 +49,11 @@ pub struct HlsInput {
     /// needs about 24: [`bt_fixed::coord_bits_for`]). Every datapath narrows with it.
     #[serde(default = "full_coord_bits")]
     pub coord_bits: u32,
+    /// Update order of a round ([`RoundOrder`]; inputs written before it existed: Jacobi).
+    /// Red-black runs a round in two phases, the second reading the first's new points (the
+    /// schedule's `late` jobs); the platform runs either.
+    #[serde(default)]
+    pub round_order: RoundOrder,
 }
 
 /// The full 40-bit coordinate word (inputs written before narrowing existed).
@@ -74,7 +79,8 @@ impl HlsInput {
             self.threshold_lsb,
             self.max_rounds,
         )?
-        .with_coord_bits(self.coord_bits)?;
+        .with_coord_bits(self.coord_bits)?
+        .with_round_order(self.round_order);
         Ok(match self.early_stop {
             Some(stop) => {
                 let bounds: Vec<Option<BoundsM>> = self.planes.iter().map(|p| p.bounds_m).collect();
@@ -106,6 +112,7 @@ impl HlsInput {
                 .map(|(planes, r)| PathJob {
                     planes: planes.clone(),
                     rounds: r.rounds.max(1),
+                    phases: self.round_order.phases(),
                 })
                 .collect(),
         }
@@ -387,7 +394,7 @@ impl Layout {
 /// Schedule-entry fields: `{column, tail, end, last, first, point, path, valid}` from bit 0
 /// up (`tail` marks a slot's last entry, `column` the PE).
 pub(crate) fn sched_entry_bits(path_bits: u32, point_bits: u32, inst_bits: u32) -> u32 {
-    5 + path_bits + point_bits + inst_bits
+    6 + path_bits + point_bits + inst_bits
 }
 
 impl Design {
@@ -448,6 +455,7 @@ pub(crate) fn platform_model(platform: &Platform) -> Result<FixedIpc, HlsError> 
         test_vectors: Vec::new(),
         early_stop: platform.early_stop,
         coord_bits: platform.coord_bits,
+        round_order: RoundOrder::Jacobi,
     };
     input.model()
 }
@@ -512,6 +520,7 @@ fn step_design(platform: &Platform, k: usize, w: &StepWork) -> Result<StepDesign
             .map(|(planes, &rounds)| PathJob {
                 planes: planes.clone(),
                 rounds,
+                phases: input.round_order.phases(),
             })
             .collect(),
     };

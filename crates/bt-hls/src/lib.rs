@@ -30,7 +30,7 @@ use bt_fixed::FixedPoint;
 pub use bt_output::OutputDir;
 use bt_schedule::Schedule;
 
-pub use bt_fixed::{BoundsM, EarlyStop, FixedOutcome, PathResult};
+pub use bt_fixed::{BoundsM, EarlyStop, FixedOutcome, PathResult, RoundOrder};
 pub use error::HlsError;
 pub use input::{Capacity, EP4CE115_M9K_BLOCKS, MAX_ADDRESS_BITS, MIN_ADDRESS_BITS, m9k_blocks};
 pub use input::{HlsInput, PE_LATENCY, PlaneSpec, Platform, StepWork};
@@ -175,7 +175,7 @@ fn schedule_writes(d: &Design, s: &StepDesign, ops: &mut Vec<BusOp>) {
             last_of_round.insert((job.path, job.round), (t, e));
         }
     }
-    let tail_bit = 1u32 << (4 + pb + ptb);
+    let tail_bit = 1u32 << (5 + pb + ptb);
     let mut entry = 0u32;
     for (t, jobs) in rows.iter().enumerate() {
         let mut words: Vec<u32> = jobs
@@ -185,12 +185,15 @@ fn schedule_writes(d: &Design, s: &StepDesign, ops: &mut Vec<BusOp>) {
                 let n = s.input.paths[job.path as usize].len() as u32;
                 let point = s.first_point[job.path as usize] + job.point;
                 let end = last_of_round[&(job.path, job.round)] == (t, e);
+                // A job after its round's first phase reads its neighbours' new points.
+                let late = job.point % s.input.round_order.phases() != 0;
                 1 | job.path << 1
                     | point << (1 + pb)
                     | u32::from(job.point == 0) << (1 + pb + ptb)
                     | u32::from(job.point + 1 == n) << (2 + pb + ptb)
                     | u32::from(end) << (3 + pb + ptb)
-                    | col << (5 + pb + ptb)
+                    | u32::from(late) << (4 + pb + ptb)
+                    | col << (6 + pb + ptb)
             })
             .collect();
         if words.is_empty() {

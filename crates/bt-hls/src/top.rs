@@ -13,7 +13,7 @@ const S_WB: u128 = 4;
 const STATE_BITS: u32 = 3;
 
 /// Register-map version reported in `INFO[15:8]`.
-pub const MAP_VERSION: u32 = 4;
+pub const MAP_VERSION: u32 = 5;
 
 /// Width of the early-stopping comparisons (`bt_fixed::FineBox::outside`): a 40-bit point
 /// plus or minus `(L1 move) << 4` and the ±2^41 box bounds fit in 48 signed bits.
@@ -303,6 +303,9 @@ struct ScheduleRead {
     last: Signal,
     /// The job closes its path's round.
     end: Signal,
+    /// The job runs after its round's first phase (red-black): its neighbours' points are
+    /// read from the bank the round writes, not the committed one.
+    late: Signal,
 }
 
 /// Schedule memory (M9K): the jobs packed slot after slot (ascending PE column, each slot's
@@ -314,7 +317,7 @@ fn schedule_memory(t: &Dims<'_>, bus: &Decode, items: &mut Vec<Item>) -> Schedul
     let (pb, ptb, ib, eb, cnt_bits) = (t.pb, t.ptb, t.ib, t.eb, t.cnt_bits);
     let sw = sched_entry_bits(pb, ptb, ib);
     items.push(Item::Comment(format!(
-        "PE schedule memory, written per step by the host: entry -> {{column, tail, end, last, first, point, path, valid}} ({sw} bits)"
+        "PE schedule memory, written per step by the host: entry -> {{column, tail, late, end, last, first, point, path, valid}} ({sw} bits)"
     )));
     let sched_addr = Signal::assigned(
         items,
@@ -326,7 +329,7 @@ fn schedule_memory(t: &Dims<'_>, bus: &Decode, items: &mut Vec<Item>) -> Schedul
         items,
         "rom_tail",
         1,
-        Expr::bit("sched_q", 4 + pb + ptb).and(id("sq_ok")),
+        Expr::bit("sched_q", 5 + pb + ptb).and(id("sq_ok")),
     );
     let stop = Signal::assigned(items, "stop", 1, or(id("seen_tail"), tail.e()));
     items.push(Item::Memory("sched".into(), sw, 1 << eb));
@@ -362,10 +365,11 @@ fn schedule_memory(t: &Dims<'_>, bus: &Decode, items: &mut Vec<Item>) -> Schedul
     };
     let path = field(items, "rom_path", pb, 1);
     let point = field(items, "rom_point", ptb, 1 + pb);
-    let inst = field(items, "rom_inst", ib, 5 + pb + ptb);
+    let inst = field(items, "rom_inst", ib, 6 + pb + ptb);
     let first = field(items, "rom_first", 1, 1 + pb + ptb);
     let last = field(items, "rom_last", 1, 2 + pb + ptb);
     let end = field(items, "rom_end", 1, 3 + pb + ptb);
+    let late = field(items, "rom_late", 1, 4 + pb + ptb);
     ScheduleRead {
         valid,
         tail,
@@ -376,6 +380,7 @@ fn schedule_memory(t: &Dims<'_>, bus: &Decode, items: &mut Vec<Item>) -> Schedul
         first,
         last,
         end,
+        late,
     }
 }
 
@@ -410,6 +415,8 @@ fn updater_read_ports(
             .into(),
     ));
     let rom_bank = Expr::id("cur").at(rom.path.e());
+    // Neighbours: the committed bank, or for a late job the bank its round writes.
+    let nb_bank = Expr::bin(BinaryOp::Xor, rom_bank.clone(), rom.late.e());
     let ra_addr = Signal::reg(items, "ra_addr", ptb + 1);
     let rb_addr = Signal::reg(items, "rb_addr", ptb + 1);
     let wr_addr = Signal::reg(items, "wr_addr", ptb + 1);
@@ -422,7 +429,7 @@ fn updater_read_ports(
             state_is(S_LOAD),
             vec![Stmt::Blocking(
                 ra_addr.e(),
-                Expr::concat(vec![rom.point.e().minus(one_pt.clone()), rom_bank.clone()]),
+                Expr::concat(vec![rom.point.e().minus(one_pt.clone()), nb_bank.clone()]),
             )],
             vec![Stmt::If(
                 state_is(S_WB),
@@ -435,7 +442,7 @@ fn updater_read_ports(
         ),
         Stmt::Blocking(
             rb_addr.e(),
-            Expr::concat(vec![rom.point.e().plus(one_pt), rom_bank]),
+            Expr::concat(vec![rom.point.e().plus(one_pt), nb_bank]),
         ),
     ]));
     UpdaterPorts {

@@ -4,40 +4,46 @@ use crate::decode::{self, Fitness, Positions};
 use crate::occupancy::{self, FreeSlots, Occupancy};
 use crate::problem::{InstanceSet, Prepared};
 
-/// Moves jobs into earlier empty cells where the Jacobi order allows, then (implicitly, as
+/// Moves jobs into earlier empty cells where the phase order allows, then (implicitly, as
 /// the makespan is recomputed) drops empty trailing slots.
 ///
-/// Rounds are visited in order of their current first slot, so a round's predecessor has
-/// already moved and its new end gives the earliest legal slot. Each round is taken out and
-/// put back in the best of three ways, compared by (round end, round spread): where it was,
-/// all jobs in one slot, or ending at the earliest possible slot with every job at the latest
-/// free cell before it. The old cells are one of the
-/// options and the round's predecessor never ends later, so no round ends later than before
-/// and the makespan never grows; a round's spread (its share of the latency factor) only
-/// grows when that makes the round end earlier.
+/// Units (phases of path rounds) are visited in order of their current first slot, so a
+/// unit's predecessor has already moved and its new end gives the earliest legal slot. Each
+/// unit is taken out and put back in the best of three ways, compared by (unit end, unit
+/// spread): where it was, all jobs in one slot, or ending at the earliest possible slot with
+/// every job at the latest free cell before it. The old cells are one of the
+/// options and the unit's predecessor never ends later, so no unit ends later than before
+/// and the makespan never grows; a unit's spread (its share of the latency factor) only
+/// grows when that makes the unit end earlier.
 pub(crate) fn asap_fill(prep: &Prepared<'_>, inst: &InstanceSet, pos: &mut Positions) -> Fitness {
     let horizon = decode::measure(prep, pos).makespan;
     let mut free = FreeSlots::all_free(inst.len(), horizon);
     for &(slot, col) in pos.iter() {
         free.take(col as usize, slot);
     }
-    let mut rounds = Vec::with_capacity(prep.total_rounds());
-    decode::for_each_round(prep, |path, round, jobs| {
-        let start = pos[jobs].iter().map(|&(s, _)| s).min().unwrap_or(0);
-        rounds.push((start, path, round));
+    let mut units = Vec::with_capacity(prep.total_units());
+    decode::for_each_unit(prep, |path, _, unit, jobs| {
+        let start = pos[jobs.clone()].iter().map(|&(s, _)| s).min().unwrap_or(0);
+        let p = path as usize;
+        let phase = (unit - prep.unit_offset[p] as usize) as u32 % prep.phases(p);
+        units.push((start, path, unit as u32, phase, jobs.start as u32));
     });
-    rounds.sort_unstable();
+    units.sort_unstable();
 
-    let mut new_end = vec![0u32; prep.total_rounds()];
+    let mut new_end = vec![0u32; prep.total_units()];
     let mut cursors = Vec::new();
     let mut cells = Vec::new();
-    for (start, p, r) in rounds {
-        let path = &prep.problem.paths[p as usize];
-        let k = path.planes.len();
-        let first = prep.job_offset[p as usize] as usize + r as usize * k;
-        let jobs = first..first + k;
-        let ro = (prep.round_offset[p as usize] + r) as usize;
-        let earliest = if r == 0 { 0 } else { new_end[ro - 1] + 1 };
+    for (start, p, unit, phase, first) in units {
+        let planes = prep.phase_planes(p as usize, phase);
+        let needs = prep.needs(p as usize, phase);
+        let first = first as usize;
+        let jobs = first..first + planes.len();
+        let ro = unit as usize;
+        let earliest = if ro == prep.unit_offset[p as usize] as usize {
+            0
+        } else {
+            new_end[ro - 1] + 1
+        };
         let old_end = pos[jobs.clone()]
             .iter()
             .map(|&(s, _)| s)
@@ -52,49 +58,35 @@ pub(crate) fn asap_fill(prep: &Prepared<'_>, inst: &InstanceSet, pos: &mut Posit
             free.give(col as usize, slot);
         }
 
-        let ind_end = prep
-            .needs(p as usize)
+        let ind_end = needs
             .iter()
             .map(|&(plane, n)| {
                 occupancy::nth_free_cell(&mut free, inst, plane, earliest, n, &mut cursors)
             })
             .max()
             .unwrap_or(earliest);
-        debug_assert!(ind_end <= old_end, "the round's own old cells are free");
+        debug_assert!(ind_end <= old_end, "the unit's own old cells are free");
         cells.clear();
-        occupancy::place_latest(&mut free, inst, &path.planes, earliest, ind_end, &mut cells);
+        occupancy::place_latest(&mut free, inst, planes, earliest, ind_end, &mut cells);
         let ind_start = cells.iter().map(|&(s, _)| s).min().unwrap_or(earliest);
         for &(slot, col) in &cells {
             free.give(col as usize, slot);
         }
-        let aligned = occupancy::aligned_slot(
-            &mut free,
-            inst,
-            prep.needs(p as usize),
-            ind_end,
-            old_end,
-            &mut cursors,
-        );
+        let aligned =
+            occupancy::aligned_slot(&mut free, inst, needs, ind_end, old_end, &mut cursors);
 
         let old_key = (old_end, old_end - start);
         let ind_key = (ind_end, ind_end - ind_start);
         let end = match aligned {
             Some(t) if (t, 0) < old_key && (t, 0) <= ind_key => {
                 cells.clear();
-                occupancy::place_aligned(&mut free, inst, &path.planes, t, &mut cells);
+                occupancy::place_aligned(&mut free, inst, planes, t, &mut cells);
                 pos[jobs].copy_from_slice(&cells);
                 t
             }
             _ if ind_key < old_key => {
                 cells.clear();
-                occupancy::place_latest(
-                    &mut free,
-                    inst,
-                    &path.planes,
-                    earliest,
-                    ind_end,
-                    &mut cells,
-                );
+                occupancy::place_latest(&mut free, inst, planes, earliest, ind_end, &mut cells);
                 pos[jobs].copy_from_slice(&cells);
                 ind_end
             }
@@ -116,12 +108,15 @@ mod tests {
     use crate::decode::Placement;
     use crate::synthetic;
 
-    /// The ASAP pass keeps schedules legal and never delays a round, from both decoders and
-    /// with duplicates.
+    /// The ASAP pass keeps schedules legal and never delays a unit, from both decoders, with
+    /// duplicates and with red-black paths.
     #[test]
     fn asap_fill_is_legal_and_never_later() {
         for seed in 0..24 {
-            let problem = synthetic::living_room(seed, 2 + (seed % 5) as u32, 40);
+            let mut problem = synthetic::living_room(seed, 2 + (seed % 5) as u32, 40);
+            for path in problem.paths.iter_mut().skip(seed as usize % 2) {
+                path.phases = 2;
+            }
             let prep = Prepared::new(&problem).unwrap();
             let mut copies = prep.base_copies();
             copies[0] += (seed % 3) as u32;
@@ -143,7 +138,7 @@ mod tests {
 
     fn round_ends(prep: &Prepared<'_>, pos: &Positions) -> Vec<u32> {
         let mut ends = Vec::new();
-        decode::for_each_round(prep, |_, _, jobs| {
+        decode::for_each_unit(prep, |_, _, _, jobs| {
             ends.push(pos[jobs].iter().map(|&(s, _)| s).max().unwrap_or(0));
         });
         ends

@@ -12,10 +12,11 @@ use crate::{Job, Problem, Schedule};
 pub struct ScheduleStats {
     /// Slots up to and including the last one holding a job.
     pub makespan: u32,
-    /// Latency factor after eq. 14, in slots: the sum over paths **and rounds** of (latest
-    /// slot - earliest slot) of that round's jobs. The paper sums over paths only; a path spans
-    /// all its rounds, so we take each round on its own, which is 0 exactly when every round
-    /// runs all its PEs in one slot (the paper's goal).
+    /// Latency factor after eq. 14, in slots: the sum over paths **and units** (phases of
+    /// rounds; a Jacobi round is one unit) of (latest slot - earliest slot) of that unit's
+    /// jobs. The paper sums over paths only; a path spans all its rounds, so we take each
+    /// unit on its own, which is 0 exactly when every unit runs all its PEs in one slot (the
+    /// paper's goal).
     pub latency_factor: u64,
     /// Busy cells / (instances x makespan), in [0, 1]; 0 for an empty schedule.
     pub utilisation: f64,
@@ -26,7 +27,7 @@ pub struct ScheduleStats {
     /// Jobs placed (cells holding a job).
     pub jobs: u64,
     /// A lower bound on the makespan with these instances, in slots: the larger of the
-    /// busiest plane's jobs per copy and, over paths, rounds x slots one round needs.
+    /// busiest plane's jobs per copy and, over paths, rounds x slots one round's phases need.
     pub makespan_lower_bound: u32,
 }
 
@@ -34,9 +35,9 @@ impl Schedule {
     /// Verifies the schedule is legal for `problem` and reports every violation at once:
     /// each job `(path, round < rounds, point)` appears exactly once; it runs on an instance of
     /// the plane of its point; instances are distinct and of existing planes; every slot row
-    /// has one entry per instance (so an instance runs at most one job per slot); and Jacobi
-    /// order: every job of round `r` of a path is in a slot strictly later than every job of
-    /// round `r - 1` of that path.
+    /// has one entry per instance (so an instance runs at most one job per slot); and phase
+    /// order: every job of a unit (phase of a round) of a path is in a slot strictly later
+    /// than every job of the unit before it of that path.
     pub fn check(&self, problem: &Problem) -> Result<(), ScheduleError> {
         let prep = Prepared::new(problem)?;
         let mut report = Report::new();
@@ -138,24 +139,17 @@ impl Schedule {
             jobs as f64 / cells as f64
         };
 
-        // First path-round index of each path; out-of-range jobs are skipped.
-        let mut round_offset = Vec::with_capacity(problem.paths.len() + 1);
-        let mut total = 0usize;
-        for path in &problem.paths {
-            round_offset.push(total);
-            total += path.rounds as usize;
-        }
-        let mut span = vec![(u32::MAX, 0u32); total];
+        // Span of every unit; jobs that are not part of the problem are skipped.
+        let prep = Prepared::new(problem).ok();
+        let mut span = vec![(u32::MAX, 0u32); prep.as_ref().map_or(0, |p| p.total_units())];
         for (t, row) in self.slots.iter().enumerate() {
             for job in row.iter().flatten() {
-                let Some(path) = problem.paths.get(job.path as usize) else {
+                let Some(unit) = prep.as_ref().and_then(|p| unit_index(p, *job)) else {
                     continue;
                 };
-                if job.round < path.rounds {
-                    let s = &mut span[round_offset[job.path as usize] + job.round as usize];
-                    s.0 = s.0.min(to_u32(t));
-                    s.1 = s.1.max(to_u32(t));
-                }
+                let s = &mut span[unit];
+                s.0 = s.0.min(to_u32(t));
+                s.1 = s.1.max(to_u32(t));
             }
         }
         let latency_factor = span
@@ -193,21 +187,26 @@ pub(crate) fn lower_bound(problem: &Problem, copies: &[u32]) -> u32 {
     let mut chain = 0u64;
     let mut counts: Vec<(u32, u64)> = Vec::new();
     for path in &problem.paths {
-        counts.clear();
-        for &plane in &path.planes {
-            if let Some(l) = load.get_mut(plane as usize) {
-                *l += u64::from(path.rounds);
+        let order = path.planes.len();
+        let phases = (path.phases as usize).clamp(1, order.max(1));
+        let mut per_round = 0;
+        for h in 0..phases {
+            counts.clear();
+            for &plane in path.planes.iter().skip(h).step_by(phases) {
+                if let Some(l) = load.get_mut(plane as usize) {
+                    *l += u64::from(path.rounds);
+                }
+                match counts.iter_mut().find(|(q, _)| *q == plane) {
+                    Some((_, n)) => *n += 1,
+                    None => counts.push((plane, 1)),
+                }
             }
-            match counts.iter_mut().find(|(q, _)| *q == plane) {
-                Some((_, n)) => *n += 1,
-                None => counts.push((plane, 1)),
-            }
+            per_round += counts
+                .iter()
+                .map(|&(q, n)| per_copy(n, q))
+                .max()
+                .unwrap_or(0);
         }
-        let per_round = counts
-            .iter()
-            .map(|&(q, n)| per_copy(n, q))
-            .max()
-            .unwrap_or(0);
         chain = chain.max(per_round * u64::from(path.rounds));
     }
     let load_bound = (0..problem.num_planes)
@@ -217,48 +216,52 @@ pub(crate) fn lower_bound(problem: &Problem, copies: &[u32]) -> u32 {
     u32::try_from(load_bound.max(chain)).unwrap_or(u32::MAX)
 }
 
-/// Every job of every round is placed, and (Jacobi order) each round of a path starts after
-/// the previous round's last job; `at` is the slot of each job by index.
+/// Every job of every round is placed, and (phase order) each unit of a path starts after the
+/// unit before it has ended; `at` is the slot of each job by index.
 fn check_rounds(
     problem: &Problem,
     prep: &Prepared<'_>,
     at: &[u32],
     report: &mut Report<ScheduleViolation>,
 ) {
-    for (p, path) in problem.paths.iter().enumerate() {
-        let k = path.planes.len();
-        let base = prep.job_offset[p] as usize;
-        let mut previous_end = None;
-        for round in 0..path.rounds {
-            let first = base + round as usize * k;
-            let (mut start, mut end) = (None::<u32>, None::<u32>);
-            for (point, &slot) in at[first..first + k].iter().enumerate() {
-                if slot == NONE {
-                    report.push(ScheduleViolation::MissingJob {
-                        job: Job {
-                            path: p as u32,
-                            round,
-                            point: point as u32,
-                        },
-                    });
-                } else {
-                    start = Some(start.map_or(slot, |s| s.min(slot)));
-                    end = Some(end.map_or(slot, |e| e.max(slot)));
-                }
-            }
-            if let (Some(start), Some(previous_end)) = (start, previous_end) {
-                if start <= previous_end {
-                    report.push(ScheduleViolation::Dependency {
-                        path: p as u32,
-                        round,
-                        start,
-                        previous_end,
-                    });
-                }
-            }
-            previous_end = end.or(previous_end);
+    let mut previous_end: Option<u32> = None;
+    let mut current_path = u32::MAX;
+    crate::decode::for_each_unit(prep, |p, round, unit, jobs| {
+        if p != current_path {
+            (current_path, previous_end) = (p, None);
         }
-    }
+        let phase = (unit - prep.unit_offset[p as usize] as usize) as u32 % prep.phases(p as usize);
+        let round_base = prep.job_offset[p as usize] as usize
+            + round as usize * problem.paths[p as usize].planes.len();
+        let (mut start, mut end) = (None::<u32>, None::<u32>);
+        for j in jobs {
+            let slot = at[j];
+            if slot == NONE {
+                report.push(ScheduleViolation::MissingJob {
+                    job: Job {
+                        path: p,
+                        round,
+                        point: prep.point_of_rank(p as usize, j - round_base),
+                    },
+                });
+            } else {
+                start = Some(start.map_or(slot, |s| s.min(slot)));
+                end = Some(end.map_or(slot, |e| e.max(slot)));
+            }
+        }
+        if let (Some(start), Some(previous_end)) = (start, previous_end) {
+            if start <= previous_end {
+                report.push(ScheduleViolation::Dependency {
+                    path: p,
+                    round,
+                    phase,
+                    start,
+                    previous_end,
+                });
+            }
+        }
+        previous_end = end.or(previous_end);
+    });
 }
 
 /// Job index of a job of the problem, `None` if out of range.
@@ -270,8 +273,16 @@ fn job_index(prep: &Prepared<'_>, job: Job) -> Option<usize> {
     Some(
         prep.job_offset[job.path as usize] as usize
             + job.round as usize * path.planes.len()
-            + job.point as usize,
+            + prep.rank_of_point(job.path as usize, job.point),
     )
+}
+
+/// Unit index (phase of a round) of a job of the problem, `None` if out of range.
+fn unit_index(prep: &Prepared<'_>, job: Job) -> Option<usize> {
+    job_index(prep, job)?;
+    let p = job.path as usize;
+    let phases = prep.phases(p);
+    Some(prep.unit_offset[p] as usize + (job.round * phases + job.point % phases) as usize)
 }
 
 fn to_u32(n: usize) -> u32 {

@@ -64,6 +64,12 @@ pub enum ProblemIssue {
         /// Offending path.
         path: u32,
     },
+    /// A path whose rounds have zero phases.
+    #[error("path {path}: zero phases per round")]
+    ZeroPhases {
+        /// Offending path.
+        path: u32,
+    },
     /// A point on a plane index `>= num_planes`.
     #[error("path {path} point {point} lies on plane {plane}, but there are {num_planes} planes")]
     PlaneOutOfRange {
@@ -172,19 +178,21 @@ pub enum ScheduleViolation {
         /// The job.
         job: Job,
     },
-    /// Jacobi order broken: round `round` starts no later than round `round - 1` ends.
+    /// Phase order broken: phase `phase` of round `round` starts no later than the phase
+    /// before it (of this round, or the last one of the previous round) ends.
     #[error(
-        "path {path} round {round} starts in slot {start}, not after round {} ending in slot {previous_end}",
-        round - 1
+        "path {path} round {round} phase {phase} starts in slot {start}, not after the phase before it ending in slot {previous_end}"
     )]
     Dependency {
         /// Path.
         path: u32,
-        /// Round (>= 1) that starts too early.
+        /// Round of the phase that starts too early.
         round: u32,
-        /// Earliest slot of `round`.
+        /// Phase (0 for Jacobi paths) that starts too early.
+        phase: u32,
+        /// Earliest slot of that phase.
         start: u32,
-        /// Latest slot of `round - 1`.
+        /// Latest slot of the phase before it.
         previous_end: u32,
     },
 }

@@ -3,8 +3,10 @@
 //! CONTRACT (written before the implementation; `bt-hls` codes against these types):
 //! A *job* is one evaluation of Algorithm 2 for one point of one candidate path in one IPC
 //! round. It runs on a processing element (PE) instance of the plane that point lies on and
-//! takes exactly one *slot*. Jacobi order: every job of round `r` of a path must be in a slot
-//! strictly after every job of round `r - 1` of the same path.
+//! takes exactly one *slot*. A path's round runs in [`PathJob::phases`] *phases* (1: Jacobi,
+//! 2: red-black), point `i` in phase `i % phases`: every job of a phase must be in a slot
+//! strictly after every job of the phase before it (the previous phase of the same round, or
+//! the last phase of the previous round) of the same path.
 //!
 //! # Entry points
 //! - [`Problem::validate`] checks the input at the boundary (every problem reported at once).
@@ -45,6 +47,27 @@ pub struct PathJob {
     pub planes: Vec<u32>,
     /// IPC rounds this path needs (from the fixed-point model; early stopping frees the PEs).
     pub rounds: u32,
+    /// Phases of a round (≥ 1): point `i` is updated in phase `i % phases`, after the phase
+    /// before it. 1 = Jacobi (every point from the previous round), 2 = red-black (even points,
+    /// then odd points from them: `bt_fixed::RoundOrder`). More phases than points count as
+    /// one per point.
+    #[serde(default = "one_phase")]
+    pub phases: u32,
+}
+
+impl PathJob {
+    /// A path of `planes` running `rounds` Jacobi rounds (one phase).
+    pub fn jacobi(planes: Vec<u32>, rounds: u32) -> PathJob {
+        PathJob {
+            planes,
+            rounds,
+            phases: 1,
+        }
+    }
+}
+
+fn one_phase() -> u32 {
+    1
 }
 
 /// The whole scheduling problem of one time step.

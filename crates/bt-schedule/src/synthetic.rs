@@ -39,10 +39,7 @@ pub fn living_room(seed: u64, num_planes: u32, num_paths: u32) -> Problem {
                     planes.push(q);
                 }
             }
-            PathJob {
-                planes,
-                rounds: rng.random_range(5..=60),
-            }
+            PathJob::jacobi(planes, rng.random_range(5..=60))
         })
         .collect();
     Problem { num_planes, paths }

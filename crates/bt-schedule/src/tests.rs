@@ -6,10 +6,7 @@ use crate::{
 };
 
 fn path(planes: &[u32], rounds: u32) -> PathJob {
-    PathJob {
-        planes: planes.to_vec(),
-        rounds,
-    }
+    PathJob::jacobi(planes.to_vec(), rounds)
 }
 
 fn small_ga() -> GaParams {
@@ -18,6 +15,18 @@ fn small_ga() -> GaParams {
         generations: 4,
         ..GaParams::default()
     }
+}
+
+/// The list and GA schedules of `problem` within `budget`, both checked legal.
+fn list_and_ga(problem: &Problem, budget: &Budget) -> [Schedule; 2] {
+    let schedules = [
+        schedule_list(problem, budget).unwrap(),
+        schedule_ga(problem, budget, &small_ga()).unwrap(),
+    ];
+    for schedule in &schedules {
+        schedule.check(problem).unwrap();
+    }
+    schedules
 }
 
 fn job(path: u32, round: u32, point: u32) -> Job {
@@ -32,11 +41,7 @@ fn disjoint_paths_run_in_parallel() {
     };
     let budget = Budget::originals_only(&problem);
     assert_eq!(budget.max_instances, 4);
-    for schedule in [
-        schedule_list(&problem, &budget).unwrap(),
-        schedule_ga(&problem, &budget, &small_ga()).unwrap(),
-    ] {
-        schedule.check(&problem).unwrap();
+    for schedule in list_and_ga(&problem, &budget) {
         let stats = schedule.stats(&problem);
         assert_eq!(stats.makespan, 3);
         assert_eq!(stats.latency_factor, 0);
@@ -55,11 +60,7 @@ fn a_b_a_needs_two_slots_per_round_without_duplicate() {
         paths: vec![path(&[0, 1, 0], 3)],
     };
     let budget = Budget::originals_only(&problem);
-    for schedule in [
-        schedule_list(&problem, &budget).unwrap(),
-        schedule_ga(&problem, &budget, &small_ga()).unwrap(),
-    ] {
-        schedule.check(&problem).unwrap();
+    for schedule in list_and_ga(&problem, &budget) {
         let stats = schedule.stats(&problem);
         assert_eq!(stats.makespan, 6);
         assert_eq!(stats.latency_factor, 3);
@@ -282,6 +283,7 @@ fn check_rejects_a_dependency_violation() {
         vec![ScheduleViolation::Dependency {
             path: 0,
             round: 1,
+            phase: 0,
             start: 0,
             previous_end: 2
         }]
@@ -303,6 +305,7 @@ fn check_rejects_same_slot_rounds() {
         vec![ScheduleViolation::Dependency {
             path: 0,
             round: 1,
+            phase: 0,
             start: 1,
             previous_end: 1
         }]
@@ -420,4 +423,79 @@ fn the_duplicating_list_scheduler_is_legal_and_never_slower_on_synthetic_rooms()
             stats.makespan
         );
     }
+}
+
+fn red_black(planes: &[u32], rounds: u32) -> PathJob {
+    PathJob {
+        phases: 2,
+        ..path(planes, rounds)
+    }
+}
+
+#[test]
+fn a_red_black_round_runs_its_two_phases_one_after_the_other() {
+    // A-B-A: phase 0 = points 0 and 2 (both on A: two slots with one PE of A), phase 1 =
+    // point 1 (B) after it: 3 slots a round, where Jacobi packs a round into 2.
+    let problem = Problem {
+        num_planes: 2,
+        paths: vec![red_black(&[0, 1, 0], 3)],
+    };
+    let budget = Budget::originals_only(&problem);
+    for schedule in list_and_ga(&problem, &budget) {
+        let stats = schedule.stats(&problem);
+        assert_eq!(stats.makespan, 9);
+        assert_eq!(stats.makespan_lower_bound, 9);
+        // Phase 0 spreads over 2 slots each round, phase 1 takes one.
+        assert_eq!(stats.latency_factor, 3);
+        for round in 0..3 {
+            let slot_of = |point| {
+                schedule
+                    .slots
+                    .iter()
+                    .position(|row| row.contains(&Some(job(0, round, point))))
+                    .unwrap()
+            };
+            assert!(slot_of(1) > slot_of(0).max(slot_of(2)), "round {round}");
+        }
+    }
+    // A second PE of A runs phase 0 in one slot: 2 slots a round.
+    let schedule = schedule_ga(&problem, &Budget { max_instances: 3 }, &small_ga()).unwrap();
+    schedule.check(&problem).unwrap();
+    assert_eq!(schedule.stats(&problem).makespan, 6);
+    assert_eq!(schedule.stats(&problem).latency_factor, 0);
+}
+
+#[test]
+fn check_rejects_a_second_phase_next_to_the_first() {
+    // A-B red-black, one round: point 1 must run after point 0, not beside it.
+    let problem = Problem {
+        num_planes: 2,
+        paths: vec![red_black(&[0, 1], 1)],
+    };
+    let mut schedule = schedule_list(&problem, &Budget::originals_only(&problem)).unwrap();
+    assert_eq!(schedule.makespan(), 2);
+    schedule.slots[0][1] = schedule.slots[1][1].take();
+    let v = violations(&problem, &schedule);
+    assert_eq!(
+        v,
+        vec![ScheduleViolation::Dependency {
+            path: 0,
+            round: 0,
+            phase: 1,
+            start: 0,
+            previous_end: 0
+        }]
+    );
+    // Zero phases is refused at the boundary.
+    let bad = Problem {
+        num_planes: 2,
+        paths: vec![PathJob {
+            phases: 0,
+            ..path(&[0, 1], 1)
+        }],
+    };
+    assert!(matches!(
+        bad.validate(),
+        Err(ScheduleError::InvalidProblem(r)) if r.items == vec![ProblemIssue::ZeroPhases { path: 0 }]
+    ));
 }

@@ -5,11 +5,15 @@ use bt_schedule::{Budget, GaParams, PathJob, Problem, schedule_ga, schedule_list
 use proptest::prelude::*;
 
 /// Random valid problems: 1-5 planes, 0-10 paths of order 1-4 (no plane twice in a row),
-/// 1-6 rounds each.
+/// 1-6 rounds of 1-3 phases each.
 fn problems() -> impl Strategy<Value = Problem> {
     (1u32..=5).prop_flat_map(|num_planes| {
-        let path = (prop::collection::vec(0..num_planes, 1..=4), 1u32..=6).prop_map(
-            move |(mut planes, rounds)| {
+        let path = (
+            prop::collection::vec(0..num_planes, 1..=4),
+            1u32..=6,
+            1u32..=3,
+        )
+            .prop_map(move |(mut planes, rounds, phases)| {
                 // Shift a repeat to the next plane; with one plane keep a single point.
                 for i in 1..planes.len() {
                     if planes[i] == planes[i - 1] {
@@ -19,9 +23,12 @@ fn problems() -> impl Strategy<Value = Problem> {
                 if num_planes == 1 {
                     planes.truncate(1);
                 }
-                PathJob { planes, rounds }
-            },
-        );
+                PathJob {
+                    planes,
+                    rounds,
+                    phases,
+                }
+            });
         prop::collection::vec(path, 0..=10).prop_map(move |paths| Problem { num_planes, paths })
     })
 }

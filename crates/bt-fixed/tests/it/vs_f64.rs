@@ -12,7 +12,7 @@
 //! TX and RX lie on the millimetre grid (the bus format), so the comparison measures the
 //! arithmetic, not the quantisation of the terminals.
 
-use bt_fixed::{FixedIpc, FixedOutcome, PlaneInput, dequantize_point, quantize_point};
+use bt_fixed::{FixedIpc, FixedOutcome, PlaneInput, RoundOrder, dequantize_point, quantize_point};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -161,7 +161,24 @@ fn valid_reflection(planes: &[PlaneInput], path: &[u32], pts: &[V], tx: V, rx: V
 }
 
 #[test]
-fn fixed_ipc_matches_f64_within_budget() {
+fn fixed_ipc_matches_f64_within_budget_and_red_black_saves_rounds() {
+    let jacobi = matches_f64_within_budget(RoundOrder::Jacobi);
+    let red_black = matches_f64_within_budget(RoundOrder::RedBlack);
+    // The same paths converge under both orders; red-black's rate is about Jacobi's squared,
+    // so it needs about half the rounds (measured 16.1 vs 30.8 mean).
+    assert_eq!(red_black.0, jacobi.0);
+    let mean = |(paths, rounds): (usize, u64)| rounds as f64 / paths as f64;
+    assert!(
+        mean(red_black) < 0.6 * mean(jacobi),
+        "mean rounds: red-black {} vs Jacobi {}",
+        mean(red_black),
+        mean(jacobi)
+    );
+}
+
+/// Paths compared and their rounds summed, after checking every converged fixed-point path of
+/// `order` against the f64 reference.
+fn matches_f64_within_budget(order: RoundOrder) -> (usize, u64) {
     let mut rng = ChaCha8Rng::seed_from_u64(SEED);
     let (mut compared, mut max_point_mm, mut max_angle_deg) = (0usize, 0f64, 0f64);
     let (mut fixed_not_converged, mut rounds_sum) = (0usize, 0u64);
@@ -173,7 +190,9 @@ fn fixed_ipc_matches_f64_within_budget() {
             .iter()
             .map(|p| p.iter().map(|&i| room.centroids[i as usize]).collect())
             .collect();
-        let ipc = FixedIpc::new(&room.planes, &paths, &init, THRESHOLD_LSB, MAX_ROUNDS).unwrap();
+        let ipc = FixedIpc::new(&room.planes, &paths, &init, THRESHOLD_LSB, MAX_ROUNDS)
+            .unwrap()
+            .with_round_order(order);
         for _pair in 0..3 {
             let inside = |rng: &mut ChaCha8Rng| -> V {
                 std::array::from_fn(|k| rng.random_range(0.3..room.size[k] - 0.3))
@@ -187,19 +206,21 @@ fn fixed_ipc_matches_f64_within_budget() {
                 else {
                     continue;
                 };
-                if !valid_reflection(&room.planes, path, &reference, tx, rx) {
+                // Corner-hugging paths contract so slowly (ρ near 1) that even f64 Jacobi needs
+                // more rounds than the budget: the stopping rule leaves them up to
+                // threshold·ρ/(1−ρ) from the fixed point, outside the error budget. Jacobi's
+                // fixed point does not converge on them; red-black's may.
+                if !valid_reflection(&room.planes, path, &reference, tx, rx)
+                    || f64_rounds > MAX_ROUNDS
+                {
                     continue;
                 }
                 let result = &fixed[p];
                 match result.outcome() {
                     FixedOutcome::Converged { rounds } => rounds_sum += u64::from(rounds),
                     other => {
-                        // Corner-hugging paths contract so slowly that even f64 needs more
-                        // rounds than the budget; anything else must converge.
-                        if f64_rounds <= MAX_ROUNDS {
-                            fixed_not_converged += 1;
-                            eprintln!("path {path:?}: fixed {other:?}, f64 rounds {f64_rounds}");
-                        }
+                        fixed_not_converged += 1;
+                        eprintln!("path {path:?}: fixed {other:?}, f64 rounds {f64_rounds}");
                         continue;
                     }
                 }
@@ -224,7 +245,7 @@ fn fixed_ipc_matches_f64_within_budget() {
         }
     }
     eprintln!(
-        "compared {compared} paths: point error max {max_point_mm:.3} mm mean {:.3} mm, max angle \
+        "{order:?}: compared {compared} paths: point error max {max_point_mm:.3} mm mean {:.3} mm, max angle \
          error {max_angle_deg:.5} deg, mean rounds {:.1}, fixed not converged {fixed_not_converged}",
         sum_point_mm / num_points.max(1) as f64,
         rounds_sum as f64 / compared.max(1) as f64
@@ -239,4 +260,5 @@ fn fixed_ipc_matches_f64_within_budget() {
         "angle error {max_angle_deg} deg"
     );
     assert_eq!(fixed_not_converged, 0);
+    (compared, rounds_sum)
 }

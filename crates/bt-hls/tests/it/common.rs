@@ -84,6 +84,7 @@ pub fn small_scene() -> HlsInput {
         early_stop: None,
         // The room's 5 m extent: a 24-bit coordinate word, as `bt_accel` sizes a room.
         coord_bits: bt_fixed::coord_bits_for(5.0),
+        round_order: bt_hls::RoundOrder::Jacobi,
     }
 }
 

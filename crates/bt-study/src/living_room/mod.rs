@@ -67,12 +67,14 @@ pub struct LivingRoomConfig {
     pub pe_budget: Option<u32>,
     /// Start each step from the points the previous step converged to ([`fpga::warm_start`]).
     pub warm_start: bool,
+    /// Update order of the accelerator's rounds.
+    pub round_order: bt_hls::RoundOrder,
 }
 
 impl Default for LivingRoomConfig {
     /// The paper's setting: third order, 1° SBR sphere, the `hls gen --steps` defaults
     /// (beam-tree candidates, threshold 16/256 mm, 256 rounds, the list scheduler per step,
-    /// warm start); with `schedule: Ga` a small GA (population 4, 2 generations, seed 1).
+    /// warm start, red-black rounds); with `schedule: Ga` a small GA (population 4, 2 generations, seed 1).
     fn default() -> Self {
         Self {
             scene: "builtin:living-room-dynamic".into(),
@@ -86,6 +88,7 @@ impl Default for LivingRoomConfig {
             ga_generations: 2,
             pe_budget: None,
             warm_start: true,
+            round_order: bt_hls::RoundOrder::RedBlack,
         }
     }
 }
@@ -120,6 +123,7 @@ impl LivingRoomConfig {
             max_rounds: self.max_rounds,
             plan: self.plan_options(),
             warm_start: self.warm_start,
+            round_order: self.round_order,
         }
     }
 

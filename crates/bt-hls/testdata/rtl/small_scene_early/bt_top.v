@@ -39,7 +39,7 @@ module bt_top (
   reg [31:0] pov;
   reg [71:0] rd_a;
   reg [71:0] rd_b;
-  reg [18:0] sched_q;
+  reg [19:0] sched_q;
   reg sq_ok;
   reg seen_tail;
   reg ld_q_en;
@@ -103,17 +103,17 @@ module bt_top (
   assign host_wr = (avs_write && idle);
   wire pt_we;
   assign pt_we = ((host_wr && is_point) && (avs_address[1:0] == 2'd3));
-  // PE schedule memory, written per step by the host: entry -> {column, tail, end, last, first, point, path, valid} (19 bits)
+  // PE schedule memory, written per step by the host: entry -> {column, tail, late, end, last, first, point, path, valid} (20 bits)
   wire [9:0] sched_addr;
   assign sched_addr = (sbase + {4'd0, cnt});
   wire rom_tail;
-  assign rom_tail = (sched_q[15] && sq_ok);
+  assign rom_tail = (sched_q[16] && sq_ok);
   wire stop;
   assign stop = (seen_tail | rom_tail);
-  reg [18:0] sched [0:1023];
+  reg [19:0] sched [0:1023];
   always @(posedge clk) begin
     if ((host_wr && is_sched)) begin
-      sched[avs_address[9:0]] <= avs_writedata[18:0];
+      sched[avs_address[9:0]] <= avs_writedata[19:0];
     end
     sched_q <= sched[sched_addr];
     sq_ok <= ((((state == 3'd2) | (state == 3'd4)) && (cnt < 6'd8)) && !(stop));
@@ -125,13 +125,15 @@ module bt_top (
   wire [5:0] rom_point;
   assign rom_point = sched_q[11:6];
   wire [2:0] rom_inst;
-  assign rom_inst = sched_q[18:16];
+  assign rom_inst = sched_q[19:17];
   wire rom_first;
   assign rom_first = sched_q[12];
   wire rom_last;
   assign rom_last = sched_q[13];
   wire rom_end;
   assign rom_end = sched_q[14];
+  wire rom_late;
+  assign rom_late = sched_q[15];
   // coordinate updater-buffer: address {point, bank}; cur[path] = bank of the committed round
   reg [6:0] ra_addr;
   reg [6:0] rb_addr;
@@ -141,13 +143,13 @@ module bt_top (
   always @* begin
     ra_addr = {bus_point, avs_address[2]};
     if ((state == 3'd2)) begin
-      ra_addr = {(rom_point - 6'd1), cur[rom_path]};
+      ra_addr = {(rom_point - 6'd1), (cur[rom_path] ^ rom_late)};
     end else begin
       if ((state == 3'd4)) begin
         ra_addr = {rom_point, cur[rom_path]};
       end
     end
-    rb_addr = {(rom_point + 6'd1), cur[rom_path]};
+    rb_addr = {(rom_point + 6'd1), (cur[rom_path] ^ rom_late)};
   end
   reg [83:0] pe_sel_sum;
   reg pe_sel_zs;
@@ -695,7 +697,7 @@ module bt_top (
             read_mux = cycles;
           end
           4'd2: begin
-            read_mux = 32'h804001a;
+            read_mux = 32'h805001a;
           end
           4'd3: begin
             read_mux = 32'h10;
