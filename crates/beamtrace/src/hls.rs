@@ -141,7 +141,7 @@ pub struct HlsSummary {
     pub list_makespan: u32,
     /// PE instances of the platform (the one design all steps run on).
     pub platform_instances: u32,
-    /// Mean cycles of a slot (`2·(jobs + 2) + PE_LATENCY` per slot; idle PEs cost nothing).
+    /// Mean cycles of a slot (`2·(jobs + 2) + pe_latency` per slot; idle PEs cost nothing).
     pub mean_cycles_per_slot: f64,
     pub predicted_cycles: u64,
     pub latency_s_at_50mhz: f64,

@@ -131,14 +131,15 @@ pub fn plan_step(
         .run(step.input.tx, step.input.rx)
         .map_err(|e| hardware(e.into()))?;
     let problem = step.input.problem_for(&results);
+    let latency = step.input.pe_latency();
     let t2 = Instant::now();
     let plan = match previous {
         // Copies sized once, at the first step, within the PE budget; every later step is
         // scheduled onto them, so that one design runs the whole stream.
         Some(p) if fixed_copies(&options.plan) => {
-            bt_hls::plan_on(&problem, &options.plan, &p.plan.schedule.copies())
+            bt_hls::plan_on(&problem, &options.plan, &p.plan.schedule.copies(), latency)
         }
-        _ => bt_hls::plan(&problem, &options.plan),
+        _ => bt_hls::plan(&problem, &options.plan, latency),
     }
     .map_err(hardware)?;
     let t3 = Instant::now();

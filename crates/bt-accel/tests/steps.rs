@@ -178,7 +178,7 @@ fn red_black_rounds_halve_the_cold_start_and_keep_every_path() {
         jobs(&red_black),
         jobs(&jacobi)
     );
-    let cycles = |p: &PlannedStep| bt_hls::run_cycles(&p.plan.schedule);
+    let cycles = |p: &PlannedStep| bt_hls::run_cycles(&p.plan.schedule, p.step.input.pe_latency());
     assert!(10 * cycles(&red_black) < 6 * cycles(&jacobi));
     // Every path the host accepts under Jacobi it accepts under red-black.
     let converged = |p: &PlannedStep| p.results.iter().filter(|r| r.converged).count();

@@ -52,6 +52,6 @@ pub use ipc::{
 pub use normal::{FixedPlane, NORMAL_FRAC, NormalComponent, UNIT_NORMAL_TOLERANCE};
 pub use ops::{
     COORD_HEADROOM_BITS, GUARD_BITS, PROPORTION_ITERATIONS, PeTrace, Proportion, Widths,
-    coord_bits_for, displacement_linf, halving_proportion, intersection_point,
-    intersection_point_in, project, signed_distance, width,
+    coord_bits_for, displacement_linf, halving_proportion, halving_proportion_in,
+    intersection_point, intersection_point_in, project, signed_distance, width,
 };

@@ -10,9 +10,10 @@ use crate::{FineCoord, FinePoint, FixedPlane, NORMAL_FRAC, round_shift};
 /// m + n = 1 m. (All Algorithm 3 quantities are in fine LSB = 1/256 mm.)
 pub const GUARD_BITS: u32 = 16;
 
-/// Maximal number of halving iterations of Algorithm 3 (the hardware always spends this many
-/// cycles; iterations after `L` reaches 0 are frozen, as the paper's `while L > 0`). The
-/// ratio resolution is then `2^-(PROPORTION_ITERATIONS+1)` ≈ 1.2e-10 when `m + n` is large.
+/// Maximal number of halving iterations of Algorithm 3 in the full 40-bit design (the hardware
+/// always spends this many cycles; iterations after `L` reaches 0 are frozen, as the paper's
+/// `while L > 0`). The ratio resolution is then `2^-(PROPORTION_ITERATIONS+1)` ≈ 1.2e-10 when
+/// `m + n` is large. A narrower coordinate word needs fewer ([`Widths::iterations`]).
 pub const PROPORTION_ITERATIONS: u32 = 32;
 
 /// Bit widths of every intermediate, shared with the RTL generator (`bt-hls` declares its wires
@@ -100,6 +101,11 @@ pub struct Widths {
     pub displacement: u32,
     pub search_diff: u32,
     pub point_acc: u32,
+    /// Halving iterations of Algorithm 3: `min(PROPORTION_ITERATIONS, coord)`. After `i`
+    /// iterations the search leaves an error of at most `|l|·2^-(i+1)` in the offset, and a
+    /// `coord`-bit word bounds `|l| = |t_next − t_prev| < 2^coord`: `coord` iterations give
+    /// the word's resolution (≤ ½ LSB), more would refine below it.
+    pub iterations: u32,
 }
 
 impl Widths {
@@ -139,6 +145,11 @@ impl Widths {
             displacement: width::DISPLACEMENT - s,
             search_diff: width::SEARCH_DIFF - s,
             point_acc: width::POINT_ACC - s,
+            iterations: if coord < PROPORTION_ITERATIONS {
+                coord
+            } else {
+                PROPORTION_ITERATIONS
+            },
         }
     }
 
@@ -252,6 +263,13 @@ pub struct Proportion {
 /// [`width::POINT_ACC`]), one iteration per clock; `tests/it/rtl_form.rs` proves the re-arrangement
 /// exact.
 pub fn halving_proportion(m: u64, n: u64, l: [i64; 3]) -> Proportion {
+    halving_proportion_in(m, n, l, PROPORTION_ITERATIONS)
+}
+
+/// [`halving_proportion`] with at most `iterations` halving steps (a narrower design's
+/// [`Widths::iterations`]); the bound above holds with `i` ≤ `iterations`.
+pub fn halving_proportion_in(m: u64, n: u64, l: [i64; 3], iterations: u32) -> Proportion {
+    let max_iterations = iterations;
     let sum = u128::from(m) + u128::from(n);
     let mut big_l: u128 = sum << (GUARD_BITS - 1);
     let mut b = big_l;
@@ -259,7 +277,7 @@ pub fn halving_proportion(m: u64, n: u64, l: [i64; 3]) -> Proportion {
     let mut lp: [i128; 3] = l.map(|x| i128::from(x) << (GUARD_BITS - 1));
     let mut bp = lp;
     let mut iterations = 0;
-    for _ in 0..PROPORTION_ITERATIONS {
+    for _ in 0..max_iterations {
         if big_l == 0 {
             break;
         }
@@ -344,10 +362,11 @@ pub fn intersection_point_in(
     let m = d_prev.unsigned_abs();
     let n = d_next.unsigned_abs();
     let delta: [i64; 3] = std::array::from_fn(|k| t_next[k] - t_prev[k]);
-    let proportion = halving_proportion(m, n, delta);
+    let wd = Widths::for_coord(coord_bits);
+    let proportion = halving_proportion_in(m, n, delta, wd.iterations);
     let unsaturated: [i64; 3] = std::array::from_fn(|k| t_prev[k] + proportion.offset[k]);
     let mut overflow = false;
-    let (lo, hi) = Widths::for_coord(coord_bits).coord_range();
+    let (lo, hi) = wd.coord_range();
     let point = unsaturated.map(|v| {
         let clamped = v.clamp(lo, hi);
         overflow |= clamped != v;

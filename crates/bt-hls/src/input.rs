@@ -1,8 +1,7 @@
 //! The generator's input, its validation, and the derived design parameters.
 
 use bt_fixed::{
-    BoundsM, EarlyStop, FixedIpc, FixedPoint, PROPORTION_ITERATIONS, PathResult, PlaneInput,
-    RoundOrder, quantize_point,
+    BoundsM, EarlyStop, FixedIpc, FixedPoint, PathResult, PlaneInput, RoundOrder, quantize_point,
 };
 use bt_schedule::{PathJob, PeInstance, Problem, Schedule};
 
@@ -127,11 +126,21 @@ impl HlsInput {
     }
 }
 
-/// Latency of one PE evaluation in cycles, from `start` to a valid `s_sum`: `d_prev`,
-/// `d_next`, `t_prev`, `t_next` through the shared CSD networks (4), Algorithm 3 set-up (1),
-/// [`PROPORTION_ITERATIONS`] halving steps. The result is combinational from the registers,
-/// so no output cycle.
-pub const PE_LATENCY: u32 = 5 + PROPORTION_ITERATIONS;
+/// Latency of one PE evaluation in cycles for a `coord_bits`-bit coordinate word, from `start`
+/// to a valid `s_sum`: `d_prev`, `d_next`, `t_prev`, `t_next` through the shared CSD networks
+/// (4), Algorithm 3 set-up (1), [`bt_fixed::Widths::iterations`] halving steps (32 at 40 bits,
+/// 24 at a room's 24 bits). The result is combinational from the registers, so no output
+/// cycle.
+pub fn pe_latency(coord_bits: u32) -> u32 {
+    5 + bt_fixed::Widths::for_coord(coord_bits).iterations
+}
+
+impl HlsInput {
+    /// The PE latency of this input's design, cycles ([`pe_latency`]).
+    pub fn pe_latency(&self) -> u32 {
+        pe_latency(self.coord_bits)
+    }
+}
 
 /// Narrowest Avalon word address of a design, bits: the control, status, point and schedule
 /// regions of [`Layout::of`] take what they need above it (the port is

@@ -33,7 +33,7 @@ use bt_schedule::Schedule;
 pub use bt_fixed::{BoundsM, EarlyStop, FixedOutcome, PathResult, RoundOrder};
 pub use error::HlsError;
 pub use input::{Capacity, EP4CE115_M9K_BLOCKS, MAX_ADDRESS_BITS, MIN_ADDRESS_BITS, m9k_blocks};
-pub use input::{HlsInput, PE_LATENCY, PlaneSpec, Platform, StepWork};
+pub use input::{HlsInput, PlaneSpec, Platform, StepWork, pe_latency};
 pub use pe::{pe_module_name, point_bits, sum_bits};
 pub use plan::{
     Plan, PlanOptions, ScheduleKind, plan, plan_on, run_cycles, schedule_entries, slot_cycles,
@@ -78,7 +78,7 @@ pub struct Report {
     /// Schedule makespan of each step, slots.
     pub makespans: Vec<u32>,
     /// Predicted `CYCLES` register value of every run (steps in order, each step's vectors in
-    /// order): the sum over the step's slots of `2·(jobs + 2) + PE_LATENCY`.
+    /// order): the sum over the step's slots of `2·(jobs + 2) + pe_latency`.
     pub run_cycles: Vec<u64>,
     /// Predicted testbench clock edges for the whole bus program (1 per write, 2 per read,
     /// 1 + CYCLES per start).
@@ -237,7 +237,7 @@ fn run_ops(
     for (k, c) in rx.iter().enumerate() {
         ops.push(BusOp::Write(regs::RX + k as u32, c.0 as u32));
     }
-    let cycles = crate::plan::run_cycles(&s.schedule);
+    let cycles = crate::plan::run_cycles(&s.schedule, pe_latency(d.platform.coord_bits));
     ops.push(BusOp::Start(cycles));
     let paths = s.model.run_fixed(tx, rx, Some(&s.budgets));
     let mut reads = vec![(regs::CYCLES, cycles as u32)];
@@ -347,7 +347,7 @@ fn register_map(d: &Design) -> String {
         d.point_base
     ));
     s.push_str(&format!(
-        "| 0x{:04x} + j | W | SCHED[j] | schedule entry j (the jobs of slot 0, then slot 1, ..., each slot's in ascending PE column): `{{column[{}:0], tail, end, last, first, point[{}:0], path[{}:0], valid}}` from bit 0 up, `tail` on a slot's last entry, j < {}, slots < {} |\n\n",
+        "| 0x{:04x} + j | W | SCHED[j] | schedule entry j (the jobs of slot 0, then slot 1, ..., each slot's in ascending PE column): `{{column[{}:0], tail, late, end, last, first, point[{}:0], path[{}:0], valid}}`, `valid` at bit 0, `tail` on a slot's last entry, `late` on a job that reads its round's new points (red-black), j < {}, slots < {} |\n\n",
         d.sched_base,
         d.inst_bits - 1,
         d.point_bits - 1,
@@ -377,8 +377,12 @@ fn register_map(d: &Design) -> String {
     );
     s.push_str("## Cycle formulas (exact, checked by co-simulation)\n\n");
     s.push_str(&format!(
-        "* CYCLES = sum over slots of (2 x (jobs + 2) + PE_LATENCY), PE_LATENCY = {PE_LATENCY} \
-         (an empty slot counts as 1 job); idle PEs cost nothing\n"
+        "* CYCLES = sum over slots of (2 x (jobs + 2) + PE_LATENCY), PE_LATENCY = {} \
+         (5 + {} halving steps of Algorithm 3 at the {}-bit coordinate word; an empty slot \
+         counts as 1 job); idle PEs cost nothing\n",
+        pe_latency(d.platform.coord_bits),
+        bt_fixed::Widths::for_coord(d.platform.coord_bits).iterations,
+        d.platform.coord_bits
     ));
     s.push_str(
         "* testbench edges: 1 per write, 2 per read, 1 + CYCLES per start\n\
@@ -519,7 +523,7 @@ pub fn generate_steps_into(
         platform.capacity.paths,
         platform.capacity.points,
         platform.capacity.slots,
-        PE_LATENCY,
+        pe_latency(platform.coord_bits),
         d.steps.len(),
         runs.len(),
         report.makespans

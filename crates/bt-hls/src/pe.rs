@@ -1,7 +1,7 @@
 //! `bt_pe_<i>`: one processing element per plane (Algorithm 2 with Algorithm 3 inside), the
 //! plane's constants baked in as CSD shift-add networks. Twin of `bt_fixed::intersection_point`.
 
-use bt_fixed::{FixedPlane, GUARD_BITS, NORMAL_FRAC, PROPORTION_ITERATIONS, Widths};
+use bt_fixed::{FixedPlane, GUARD_BITS, NORMAL_FRAC, Widths};
 
 use crate::HlsError;
 use crate::verilog::{BinaryOp, Direction, Expr, Item, Module, Port, Signal, Stmt, UnaryOp};
@@ -130,7 +130,7 @@ const FIRST_ITERATION_STEP: u32 = 5;
 /// | 4 | - | `b_k ← L_p0 = δ_k·2^15`, `a_k ← (t_prev+t_next)·2^15 + 2^15` (= `t_prev·2^16 + 2^15 + B_p0`), `r_e ← E = (n−m)·2^15`, `r_l ← L = (m+n)·2^15` |
 /// | 5 .. 36 | - | one halving step: `r_l ← L/2`, `b_k ← L_p/2`, `E ± L/2`, `a_k ± L_p/2` (sign of `E` decides) |
 ///
-/// `s_sum_k = a_k >> 16 = t_prev_k + round(B_p/2^16)`, valid from [`crate::PE_LATENCY`] cycles
+/// `s_sum_k = a_k >> 16 = t_prev_k + round(B_p/2^16)`, valid from [`crate::pe_latency`] cycles
 /// after `start` until the next `load`.
 pub(crate) fn pe_module(
     index: usize,
@@ -198,7 +198,7 @@ fn pe_state(
         csd[1].digits.len(),
         csd[2].digits.len()
     )));
-    let step = Signal::reg(items, "step", step_bits());
+    let step = Signal::reg(items, "step", step_bits(wd));
     let zs = Signal::reg(items, "zs", 1);
     let r_e = Signal::reg(items, "r_e", wd.search_diff);
     let r_l = Signal::reg(items, "r_l", wd.half_sum);
@@ -218,12 +218,13 @@ fn pe_state(
     }
 }
 
-/// The last step of the PE's counter and the counter's width.
-fn last_step() -> u32 {
-    FIRST_ITERATION_STEP + PROPORTION_ITERATIONS - 1
+/// The last step of the PE's counter (after `wd.iterations` halving steps) and the counter's
+/// width.
+fn last_step(wd: Widths) -> u32 {
+    FIRST_ITERATION_STEP + wd.iterations - 1
 }
-fn step_bits() -> u32 {
-    64 - u64::from(last_step()).leading_zeros()
+fn step_bits(wd: Widths) -> u32 {
+    64 - u64::from(last_step(wd)).leading_zeros()
 }
 
 impl PeRegs {
@@ -462,7 +463,8 @@ fn halving_step(r: &PeRegs, items: &mut Vec<Item>, unused: &mut Vec<Expr>) -> Ha
     let g = GUARD_BITS;
     let (lw, ew, lpw, aw) = (wd.half_sum, wd.search_diff, wd.half_delta, wd.point_acc);
     items.push(Item::Comment(format!(
-        "Algorithm 3 on {g} guard bits, {PROPORTION_ITERATIONS} steps frozen once L = 0; E = B - m*2^{g} replaces B, m and the comparator"
+        "Algorithm 3 on {g} guard bits, {} steps frozen once L = 0; E = B - m*2^{g} replaces B, m and the comparator",
+        wd.iterations
     )));
     let go_up = Signal::assigned(items, "go_up", 1, r.r_e.bit(ew - 1));
     let l_half = Expr::concat(vec![Expr::lit(ew - lw + 1, 0), r.r_l.slice(lw - 1, 1)]);
@@ -522,7 +524,7 @@ fn nb(reg: &Signal, value: Expr) -> Stmt {
 
 /// `step <= value;`
 fn goto(r: &PeRegs, value: u32) -> Stmt {
-    nb(&r.step, Expr::lit(step_bits(), value.into()))
+    nb(&r.step, Expr::lit(step_bits(r.wd), value.into()))
 }
 
 /// Idle: on `start` latch `d_prev` and go to step 1; on `load` latch the operands.
@@ -590,7 +592,7 @@ fn seq_setup(r: &PeRegs, s: &SetupValues) -> Vec<Stmt> {
 /// Steps 5 ..: one halving step while `L ≠ 0`, back to idle after the last.
 fn seq_iterate(r: &PeRegs, h: &Halving) -> Vec<Stmt> {
     let wd = r.wd;
-    let (lw, stepw) = (wd.half_sum, step_bits());
+    let (lw, stepw) = (wd.half_sum, step_bits(wd));
     let mut iterate = vec![
         nb(
             &r.r_l,
@@ -609,7 +611,7 @@ fn seq_iterate(r: &PeRegs, h: &Halving) -> Vec<Stmt> {
             vec![],
         ),
         Stmt::If(
-            r.step.e().eq(Expr::lit(stepw, last_step().into())),
+            r.step.e().eq(Expr::lit(stepw, last_step(wd).into())),
             vec![goto(r, 0)],
             vec![nb(&r.step, r.step.e().plus(Expr::lit(stepw, 1)))],
         ),
@@ -626,7 +628,7 @@ fn sequencer(
     items: &mut Vec<Item>,
 ) {
     let wd = r.wd;
-    let (stepw, xw) = (step_bits(), wd.distance);
+    let (stepw, xw) = (step_bits(wd), wd.distance);
     let (aw, lpw) = (wd.point_acc, wd.half_delta);
     let mut proj_prev: Vec<Stmt> = (0..AXES.len())
         .map(|k| nb(&r.a[k], sext(t[k].name(), xw, aw)))
@@ -673,7 +675,7 @@ fn pe_shell(index: usize, plane_name: &str, wd: Widths, items: Vec<Item>) -> Mod
             ),
             format!(
                 "`load` latches the operands; `s_sum` valid {} cycles after `start`; twin of bt_fixed::intersection_point before saturation.",
-                crate::PE_LATENCY
+                crate::pe_latency(wd.coord)
             ),
             format!(
                 "Operands are {{z, y, x}} of {}-bit words, s_sum {{z, y, x}} of {spw}-bit words, mm x 2^8.",

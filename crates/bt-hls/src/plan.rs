@@ -4,7 +4,6 @@
 use bt_schedule::{Budget, GaParams, Problem, Schedule, ScheduleStats};
 
 use crate::HlsError;
-use crate::input::PE_LATENCY;
 
 /// Which scheduler places the jobs.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -60,11 +59,12 @@ pub struct Plan {
 }
 
 /// Cycles of one schedule slot holding `jobs` jobs: load operands (jobs + 2: the schedule
-/// memory's registered read adds one), run the PEs ([`PE_LATENCY`]), write back (jobs + 2).
+/// memory's registered read adds one), run the PEs (`latency`, [`crate::pe_latency`]), write
+/// back (jobs + 2).
 /// The slot's jobs are packed in the schedule memory, so idle PEs cost nothing; an empty slot
 /// counts as one job (its one entry only marks the slot's end).
-pub fn slot_cycles(jobs: u32) -> u64 {
-    2 * (u64::from(jobs.max(1)) + 2) + u64::from(PE_LATENCY)
+pub fn slot_cycles(jobs: u32, latency: u32) -> u64 {
+    2 * (u64::from(jobs.max(1)) + 2) + u64::from(latency)
 }
 
 /// Schedule-memory entries of `schedule`: its jobs packed slot after slot up to the makespan,
@@ -80,34 +80,42 @@ pub fn schedule_entries(schedule: &Schedule) -> u32 {
 
 /// Cycles of one accelerator run of `schedule` (the `CYCLES` register): [`slot_cycles`] of
 /// every slot up to the makespan (the host writes the start points before the start command).
-/// Independent of how many PEs the platform has.
-pub fn run_cycles(schedule: &Schedule) -> u64 {
+/// Independent of how many PEs the platform has; `latency` is the design's PE latency
+/// ([`crate::pe_latency`]).
+pub fn run_cycles(schedule: &Schedule, latency: u32) -> u64 {
     schedule
         .slots
         .iter()
         .take(schedule.makespan() as usize)
-        .map(|row| slot_cycles(row.iter().flatten().count() as u32))
+        .map(|row| slot_cycles(row.iter().flatten().count() as u32, latency))
         .sum()
 }
 
 /// Schedule `problem` (from [`crate::HlsInput::problem`] or
-/// [`crate::HlsInput::problem_for`]) and predict the run's cycles. Deterministic for the
-/// options (the GA is seeded).
-pub fn plan(problem: &Problem, options: &PlanOptions) -> Result<Plan, HlsError> {
-    plan_with(problem, options, None)
+/// [`crate::HlsInput::problem_for`]) and predict the run's cycles on a design whose PE takes
+/// `latency` cycles ([`crate::HlsInput::pe_latency`]). Deterministic for the options (the GA
+/// is seeded).
+pub fn plan(problem: &Problem, options: &PlanOptions, latency: u32) -> Result<Plan, HlsError> {
+    plan_with(problem, options, None, latency)
 }
 
 /// [`plan`] with the list scheduler onto a platform sized beforehand: `copies[p]` PEs of
 /// plane `p` ([`bt_schedule::schedule_list_on`]), e.g. the copies the first time step chose
 /// within the PE budget, so that every step runs on the same design.
-pub fn plan_on(problem: &Problem, options: &PlanOptions, copies: &[u32]) -> Result<Plan, HlsError> {
-    plan_with(problem, options, Some(copies))
+pub fn plan_on(
+    problem: &Problem,
+    options: &PlanOptions,
+    copies: &[u32],
+    latency: u32,
+) -> Result<Plan, HlsError> {
+    plan_with(problem, options, Some(copies), latency)
 }
 
 fn plan_with(
     problem: &Problem,
     options: &PlanOptions,
     copies: Option<&[u32]>,
+    latency: u32,
 ) -> Result<Plan, HlsError> {
     let planes_used = {
         let mut used: Vec<u32> = problem
@@ -147,8 +155,9 @@ fn plan_with(
     let pe_budget = budget.max_instances.max(schedule.instances.len() as u32);
     let points: u64 = problem.paths.iter().map(|p| p.planes.len() as u64).sum();
     Ok(Plan {
-        predicted_cycles: run_cycles(&schedule),
-        mean_cycles_per_slot: run_cycles(&schedule) as f64 / f64::from(stats.makespan.max(1)),
+        predicted_cycles: run_cycles(&schedule, latency),
+        mean_cycles_per_slot: run_cycles(&schedule, latency) as f64
+            / f64::from(stats.makespan.max(1)),
         schedule,
         stats,
         list_makespan,

@@ -1,7 +1,7 @@
 //! `bt_top`: PE matrix, scheduler ROM, coordinate updater-buffer, convergence flags and the
 //! Avalon-MM slave. Twin of `bt_fixed::FixedIpc::run_fixed` with the schedule's budgets.
 
-use crate::input::{Layout, PE_LATENCY, bits_for, sched_entry_bits};
+use crate::input::{Layout, bits_for, pe_latency, sched_entry_bits};
 use crate::pe::{pe_module_name, point_bits, port, sext_slice, sum_bits};
 use crate::verilog::{BinaryOp, Direction, Expr, Item, Module, Signal, Stmt, UnaryOp};
 
@@ -106,6 +106,11 @@ struct Dims<'a> {
 }
 
 impl<'a> Dims<'a> {
+    /// Cycles of one PE evaluation in this design.
+    fn latency(&self) -> u32 {
+        pe_latency(self.wd.coord)
+    }
+
     fn of(p: &'a TopParams<'a>) -> Self {
         let l = &p.layout;
         Dims {
@@ -117,7 +122,9 @@ impl<'a> Dims<'a> {
             sb: l.slot_bits,
             eb: l.entry_bits,
             np2: 1u32 << l.path_bits,
-            cnt_bits: bits_for(u64::from((l.num_instances + 2).max(PE_LATENCY)) + 1),
+            cnt_bits: bits_for(
+                u64::from((l.num_instances + 2).max(pe_latency(p.model.coord_bits()))) + 1,
+            ),
             ab: l.address_bits,
             early: p.model.early_stop().map(|(s, b)| (*s, b.to_vec())),
             wd: bt_fixed::Widths::for_coord(p.model.coord_bits()),
@@ -146,7 +153,7 @@ fn declare_state(t: &Dims<'_>, items: &mut Vec<Item>) -> Vec<PeWires> {
         cap.paths,
         cap.points,
         cap.slots,
-        PE_LATENCY,
+        t.latency(),
         t.p.platform.threshold_lsb
     )));
     for (n, w) in [
@@ -311,7 +318,7 @@ struct ScheduleRead {
 /// Schedule memory (M9K): the jobs packed slot after slot (ascending PE column, each slot's
 /// last one flagged `tail`), written by the host, read one cycle after the address
 /// sbase + cnt (sbase = the slot's first entry): entry cnt - 1 is in sched_q. Entries after
-/// the tail are never used (`stop`), so a slot takes 2 x (jobs + 2) + PE_LATENCY cycles
+/// the tail are never used (`stop`), so a slot takes 2 x (jobs + 2) + pe_latency cycles
 /// whatever the PE count.
 fn schedule_memory(t: &Dims<'_>, bus: &Decode, items: &mut Vec<Item>) -> ScheduleRead {
     let (pb, ptb, ib, eb, cnt_bits) = (t.pb, t.ptb, t.ib, t.eb, t.cnt_bits);
@@ -810,10 +817,10 @@ fn fsm_load(t: &Dims<'_>, rom: &ScheduleRead) -> Vec<Stmt> {
     ]
 }
 
-/// EXEC: wait `PE_LATENCY` cycles for every PE of the slot, then WB.
+/// EXEC: wait the PE latency ([`pe_latency`]) for every PE of the slot, then WB.
 fn fsm_exec(t: &Dims<'_>) -> Vec<Stmt> {
     vec![Stmt::If(
-        id("cnt").eq(lit(t.cnt_bits, u128::from(PE_LATENCY - 1))),
+        id("cnt").eq(lit(t.cnt_bits, u128::from(t.latency() - 1))),
         vec![
             nb(id("state"), lit(STATE_BITS, S_WB)),
             nb(id("cnt"), lit(t.cnt_bits, 0)),
@@ -920,7 +927,8 @@ fn fsm_writeback(t: &Dims<'_>, rom: &ScheduleRead, f: &WritebackFlags) -> Vec<St
 fn controller(t: &Dims<'_>, rom: &ScheduleRead, f: &WritebackFlags, items: &mut Vec<Item>) {
     let cnt_bits = t.cnt_bits;
     items.push(Item::Comment(format!(
-        "main FSM: IDLE -> per slot LOAD (jobs + 2) EXEC ({PE_LATENCY}) WB (jobs + 2) -> IDLE with done after SLOTS slots"
+        "main FSM: IDLE -> per slot LOAD (jobs + 2) EXEC ({}) WB (jobs + 2) -> IDLE with done after SLOTS slots",
+        t.latency()
     )));
     let start_req = Signal::assigned(
         items,

@@ -1,6 +1,8 @@
 //! Algorithm 3 (halving comparison) at its boundaries and against the exact ratio.
 
-use bt_fixed::{GUARD_BITS, PROPORTION_ITERATIONS, halving_proportion, width};
+use bt_fixed::{
+    GUARD_BITS, PROPORTION_ITERATIONS, Widths, halving_proportion, halving_proportion_in, width,
+};
 use proptest::prelude::*;
 
 /// Largest |d| the PE can produce (34-bit signed distance, |d| < 2^32.45).
@@ -139,6 +141,32 @@ proptest! {
         check_bound(m, n, l, p.offset[0], p.iterations);
         check_bound(m, n, -l, p.offset[1], p.iterations);
         check_bound(m, n, l / 2, p.offset[2], p.iterations);
+    }
+
+    /// A `c`-bit design stops after `Widths::iterations` = min(32, c) halving steps: the
+    /// documented bound still holds, and against the 32 steps of the full design the result
+    /// moves by at most 1 LSB (the skipped steps add at most |l|·2^-(c+1) < ½ before the one
+    /// rounding), since |l| = |t_next − t_prev| < 2^c in a `c`-bit word.
+    #[test]
+    fn fewer_iterations_for_a_narrow_word_cost_at_most_one_lsb(
+        c in Widths::MIN_COORD..=40u32,
+        m_frac in 0.0f64..1.0,
+        n_frac in prop_oneof![0.0f64..1.0, 0.0f64..1e-6],
+        l_frac in -1.0f64..1.0,
+    ) {
+        let wd = Widths::for_coord(c);
+        // |d| < 2^(c+1) (the narrowed ABS_DISTANCE), |l| < 2^c.
+        let m = (m_frac * ((1u64 << wd.abs_distance) - 1) as f64) as u64;
+        let n = (n_frac * ((1u64 << wd.abs_distance) - 1) as f64) as u64;
+        let l = (l_frac * ((1i64 << c) - 1) as f64) as i64;
+        let narrow = halving_proportion_in(m, n, [l, -l, l / 3], wd.iterations);
+        let full = halving_proportion(m, n, [l, -l, l / 3]);
+        prop_assert!(narrow.iterations <= wd.iterations);
+        for k in 0..3 {
+            prop_assert!((narrow.offset[k] - full.offset[k]).abs() <= 1, "{narrow:?} vs {full:?}");
+        }
+        check_bound(m, n, l, narrow.offset[0], narrow.iterations);
+        check_bound(m, n, -l, narrow.offset[1], narrow.iterations);
     }
 
     /// Indoor-scale inputs (distances 0.5–20 m, |l| ≤ 20 m): the result is within 0.6 mm

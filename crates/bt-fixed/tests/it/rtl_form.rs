@@ -12,8 +12,7 @@
 
 use crate::common::*;
 use bt_fixed::{
-    FinePoint, FixedPlane, GUARD_BITS, NORMAL_FRAC, PROPORTION_ITERATIONS, Widths,
-    intersection_point_in, width,
+    FinePoint, FixedPlane, GUARD_BITS, NORMAL_FRAC, Widths, intersection_point_in, width,
 };
 use proptest::prelude::*;
 
@@ -52,7 +51,7 @@ fn rtl_pe(plane: &FixedPlane, prev: FinePoint, next: FinePoint, w: Widths) -> ([
     let mut lp: [i128; 3] = std::array::from_fn(|k| (t_next[k] - t_prev[k]) << (g - 1));
     let mut a: [i128; 3] =
         std::array::from_fn(|k| wrap((t_prev[k] + t_next[k] + 1) << (g - 1), w.point_acc));
-    for _ in 0..PROPORTION_ITERATIONS {
+    for _ in 0..w.iterations {
         if big_l == 0 {
             continue;
         }

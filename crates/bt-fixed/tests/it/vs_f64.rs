@@ -12,7 +12,10 @@
 //! TX and RX lie on the millimetre grid (the bus format), so the comparison measures the
 //! arithmetic, not the quantisation of the terminals.
 
-use bt_fixed::{FixedIpc, FixedOutcome, PlaneInput, RoundOrder, dequantize_point, quantize_point};
+use bt_fixed::{
+    FixedIpc, FixedOutcome, PlaneInput, RoundOrder, coord_bits_for, dequantize_point,
+    quantize_point,
+};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 
@@ -162,8 +165,11 @@ fn valid_reflection(planes: &[PlaneInput], path: &[u32], pts: &[V], tx: V, rx: V
 
 #[test]
 fn fixed_ipc_matches_f64_within_budget_and_red_black_saves_rounds() {
-    let jacobi = matches_f64_within_budget(RoundOrder::Jacobi);
-    let red_black = matches_f64_within_budget(RoundOrder::RedBlack);
+    let jacobi = matches_f64_within_budget(RoundOrder::Jacobi, 40);
+    let red_black = matches_f64_within_budget(RoundOrder::RedBlack, 40);
+    // The accelerator as deployed in a room: a 24-bit word (24 halving steps), red-black.
+    let deployed = matches_f64_within_budget(RoundOrder::RedBlack, coord_bits_for(8.0));
+    assert_eq!(deployed.0, red_black.0);
     // The same paths converge under both orders; red-black's rate is about Jacobi's squared,
     // so it needs about half the rounds (measured 16.1 vs 30.8 mean).
     assert_eq!(red_black.0, jacobi.0);
@@ -177,8 +183,8 @@ fn fixed_ipc_matches_f64_within_budget_and_red_black_saves_rounds() {
 }
 
 /// Paths compared and their rounds summed, after checking every converged fixed-point path of
-/// `order` against the f64 reference.
-fn matches_f64_within_budget(order: RoundOrder) -> (usize, u64) {
+/// `order` on a `coord_bits`-bit word against the f64 reference.
+fn matches_f64_within_budget(order: RoundOrder, coord_bits: u32) -> (usize, u64) {
     let mut rng = ChaCha8Rng::seed_from_u64(SEED);
     let (mut compared, mut max_point_mm, mut max_angle_deg) = (0usize, 0f64, 0f64);
     let (mut fixed_not_converged, mut rounds_sum) = (0usize, 0u64);
@@ -192,7 +198,9 @@ fn matches_f64_within_budget(order: RoundOrder) -> (usize, u64) {
             .collect();
         let ipc = FixedIpc::new(&room.planes, &paths, &init, THRESHOLD_LSB, MAX_ROUNDS)
             .unwrap()
-            .with_round_order(order);
+            .with_round_order(order)
+            .with_coord_bits(coord_bits)
+            .unwrap();
         for _pair in 0..3 {
             let inside = |rng: &mut ChaCha8Rng| -> V {
                 std::array::from_fn(|k| rng.random_range(0.3..room.size[k] - 0.3))
@@ -245,7 +253,7 @@ fn matches_f64_within_budget(order: RoundOrder) -> (usize, u64) {
         }
     }
     eprintln!(
-        "{order:?}: compared {compared} paths: point error max {max_point_mm:.3} mm mean {:.3} mm, max angle \
+        "{order:?}, {coord_bits} bits: compared {compared} paths: point error max {max_point_mm:.3} mm mean {:.3} mm, max angle \
          error {max_angle_deg:.5} deg, mean rounds {:.1}, fixed not converged {fixed_not_converged}",
         sum_point_mm / num_points.max(1) as f64,
         rounds_sum as f64 / compared.max(1) as f64

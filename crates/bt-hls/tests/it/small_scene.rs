@@ -37,8 +37,9 @@ fn cosimulation_is_bit_exact_and_cycles_match() {
 }
 
 /// The full 40-bit datapath (inputs written before narrowing) stays lint-clean and bit-exact,
-/// and on this room it gives the narrowed design's results: the room's points never come near
-/// the narrow word's ±32 m.
+/// and on this room it gives the narrowed design's results but for the last bit: the room's
+/// points never come near the narrow word's ±32 m, and the narrow PE's 24 halving steps (32 at
+/// 40 bits) move an offset by at most 1 LSB (`bt-fixed/tests/it/algorithm3.rs`).
 #[test]
 fn the_full_width_design_is_bit_exact_and_agrees_with_the_narrow_one() {
     let narrow = small_scene();
@@ -48,7 +49,27 @@ fn the_full_width_design_is_bit_exact_and_agrees_with_the_narrow_one() {
     };
     assert!(narrow.coord_bits < full.coord_bits);
     let run = |input: &bt_hls::HlsInput| input.model().unwrap().run(input.tx, input.rx).unwrap();
-    assert_eq!(run(&narrow), run(&full));
+    let (narrow_runs, full_runs) = (run(&narrow), run(&full));
+    let mut largest = 0;
+    for (a, b) in narrow_runs.iter().zip(&full_runs) {
+        assert_eq!(
+            (a.converged, a.zero_sum, a.overflow, a.left_bounds),
+            (b.converged, b.zero_sum, b.overflow, b.left_bounds)
+        );
+        if a.converged {
+            assert!(a.rounds.abs_diff(b.rounds) <= 1, "{a:?} vs {b:?}");
+            for (p, q) in a.points.iter().zip(&b.points) {
+                for k in 0..3 {
+                    largest = largest.max((p[k].0 - q[k].0).abs());
+                }
+            }
+        }
+    }
+    // 1/64 mm: a few LSB where the last-bit differences feed later rounds.
+    assert!(
+        largest <= 4,
+        "converged points differ by {largest} fine LSB"
+    );
     let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("bt_hls_small_scene_full");
     let _ = std::fs::remove_dir_all(&dir);
     let schedule = small_schedule(&full);

@@ -214,7 +214,7 @@ pub struct FpgaStep {
     pub utilisation: Real,
     /// PE instances of the one platform every step runs on.
     pub platform_instances: u32,
-    /// Mean cycles of a schedule slot (`2·(jobs + 2) + PE_LATENCY`; idle PEs cost nothing).
+    /// Mean cycles of a schedule slot (`2·(jobs + 2) + pe_latency`; idle PEs cost nothing).
     pub mean_cycles_per_slot: Real,
     /// Predicted `CYCLES` of the run on that platform (exact; co-simulation checks it).
     pub cycles: u64,

@@ -13,9 +13,9 @@ module bt_top (
   output reg  avs_readdatavalid,
   output wire ins_irq
 );
-  // 8 PE instances, capacity 26 paths, 46 points, 135 slots; 2 x (jobs + 2) + 37 cycles per slot, threshold 16 fine LSB
+  // 8 PE instances, capacity 26 paths, 46 points, 135 slots; 2 x (jobs + 2) + 29 cycles per slot, threshold 16 fine LSB
   reg [2:0] state;
-  reg [5:0] cnt;
+  reg [4:0] cnt;
   reg [7:0] slot;
   reg [9:0] sbase;
   reg [8:0] slots_r;
@@ -105,7 +105,7 @@ module bt_top (
   assign pt_we = ((host_wr && is_point) && (avs_address[1:0] == 2'd3));
   // PE schedule memory, written per step by the host: entry -> {column, tail, late, end, last, first, point, path, valid} (20 bits)
   wire [9:0] sched_addr;
-  assign sched_addr = (sbase + {4'd0, cnt});
+  assign sched_addr = (sbase + {5'd0, cnt});
   wire rom_tail;
   assign rom_tail = (sched_q[16] && sq_ok);
   wire stop;
@@ -116,7 +116,7 @@ module bt_top (
       sched[avs_address[9:0]] <= avs_writedata[19:0];
     end
     sched_q <= sched[sched_addr];
-    sq_ok <= ((((state == 3'd2) | (state == 3'd4)) && (cnt < 6'd8)) && !(stop));
+    sq_ok <= ((((state == 3'd2) | (state == 3'd4)) && (cnt < 5'd8)) && !(stop));
   end
   wire rom_valid;
   assign rom_valid = (sched_q[0] && sq_ok);
@@ -384,7 +384,7 @@ module bt_top (
     rd_b <= pm_b[rb_addr];
   end
   wire pe_start;
-  assign pe_start = ((state == 3'd3) && (cnt == 6'd0));
+  assign pe_start = ((state == 3'd3) && (cnt == 5'd0));
   bt_pe_0 u_pe_0 (
     .clk(clk),
     .rst_n(rst_n),
@@ -477,13 +477,13 @@ module bt_top (
   assign pe_load_5 = (((state == 3'd2) && ld_q_en) && (ld_q_inst == 3'd5));
   assign pe_load_6 = (((state == 3'd2) && ld_q_en) && (ld_q_inst == 3'd6));
   assign pe_load_7 = (((state == 3'd2) && ld_q_en) && (ld_q_inst == 3'd7));
-  // main FSM: IDLE -> per slot LOAD (jobs + 2) EXEC (37) WB (jobs + 2) -> IDLE with done after SLOTS slots
+  // main FSM: IDLE -> per slot LOAD (jobs + 2) EXEC (29) WB (jobs + 2) -> IDLE with done after SLOTS slots
   wire start_req;
   assign start_req = (((avs_write && (avs_address == 16'h0)) && avs_writedata[0]) && (state == 3'd0));
   always @(posedge clk) begin
     if (!(rst_n)) begin
       state <= 3'd0;
-      cnt <= 6'd0;
+      cnt <= 5'd0;
       slot <= 8'd0;
       cycles <= 32'h0;
       done <= 1'd0;
@@ -500,7 +500,7 @@ module bt_top (
         3'd0: begin
           if (start_req) begin
             state <= ((slots_r == 9'h0) ? 3'd0 : 3'd2);
-            cnt <= 6'd0;
+            cnt <= 5'd0;
             slot <= 8'd0;
             sbase <= 10'h0;
             cycles <= 32'h0;
@@ -556,19 +556,19 @@ module bt_top (
           ld_q_inst <= rom_inst;
           if (ld_q_tail) begin
             state <= 3'd3;
-            cnt <= 6'd0;
+            cnt <= 5'd0;
             seen_tail <= 1'd0;
           end else begin
-            cnt <= (cnt + 6'd1);
+            cnt <= (cnt + 5'd1);
             seen_tail <= stop;
           end
         end
         3'd3: begin
-          if ((cnt == 6'd36)) begin
+          if ((cnt == 5'd28)) begin
             state <= 3'd4;
-            cnt <= 6'd0;
+            cnt <= 5'd0;
           end else begin
-            cnt <= (cnt + 6'd1);
+            cnt <= (cnt + 5'd1);
           end
         end
         3'd4: begin
@@ -598,9 +598,9 @@ module bt_top (
             end
           end
           if (wb_q_tail) begin
-            cnt <= 6'd0;
+            cnt <= 5'd0;
             seen_tail <= 1'd0;
-            sbase <= ((sbase + {4'd0, cnt}) - 10'h1);
+            sbase <= ((sbase + {5'd0, cnt}) - 10'h1);
             if ((({1'd0, slot} + 9'h1) == slots_r)) begin
               state <= 3'd0;
               done <= 1'd1;
@@ -609,7 +609,7 @@ module bt_top (
               slot <= (slot + 8'd1);
             end
           end else begin
-            cnt <= (cnt + 6'd1);
+            cnt <= (cnt + 5'd1);
             seen_tail <= stop;
           end
         end
