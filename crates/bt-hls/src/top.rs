@@ -201,6 +201,8 @@ fn declare_state(t: &Dims<'_>, items: &mut Vec<Item>) -> Vec<PeWires> {
         ("rq_reg", 4),
         ("rq_word", 2),
         ("rq_path", pb),
+        ("rounds_q", 16),
+        ("rvalid", np2),
     ] {
         items.push(Item::Reg(n.into(), w));
     }
@@ -208,6 +210,8 @@ fn declare_state(t: &Dims<'_>, items: &mut Vec<Item>) -> Vec<PeWires> {
         items.push(Item::Reg("lb".into(), np2));
         items.push(Item::Reg("plb".into(), np2));
     }
+    // Rounds per path in a RAM (M9K), not 16 registers a path: `rvalid` marks the paths that
+    // committed a round since the start (the RAM cannot be cleared in one cycle).
     items.push(Item::Memory("rounds".into(), 16, np2));
     // Two copies of the point memory (one per read port, both written): each is a plain
     // 1-write 1-read array with a registered read, which Yosys maps to M9K blocks.
@@ -405,6 +409,53 @@ struct UpdaterPorts {
 /// `{bus_point, avs_address[2]}`: the memory cell a point-window bus access addresses.
 fn bus_cell(bus: &Decode) -> Expr {
     Expr::concat(vec![bus.bus_point.e(), Expr::bit("avs_address", 2)])
+}
+
+/// Rounds memory, read side: `rounds_q` <= rounds[addr] every cycle, the address being the
+/// schedule entry's path at write-back (so `rounds_q` holds rounds[wb_q_path] when the entry
+/// commits: a path's jobs in a slot belong to one round, so no commit of the same path sits
+/// between) and the bus address otherwise (a PATH_STATUS read while idle).
+/// `rounds_cur` = the rounds `wb_q_path` has committed since the start.
+fn rounds_read(t: &Dims<'_>, rom: &ScheduleRead, items: &mut Vec<Item>) {
+    items.push(Item::Comment(
+        "rounds memory (M9K): read at the write-back entry's path, or the bus address".into(),
+    ));
+    let addr = Signal::assigned(
+        items,
+        "rounds_ra",
+        t.pb,
+        Expr::mux(
+            state_is(S_WB),
+            rom.path.e(),
+            Expr::slice("avs_address", t.pb - 1, 0),
+        ),
+    );
+    items.push(Item::AlwaysFf(vec![nb(
+        id("rounds_q"),
+        Expr::id("rounds").at(addr.e()),
+    )]));
+    Signal::assigned(
+        items,
+        "rounds_cur",
+        16,
+        Expr::mux(
+            Expr::id("rvalid").at(id("wb_q_path")),
+            id("rounds_q"),
+            lit(16, 0),
+        ),
+    );
+}
+
+/// Rounds memory, write side: a committed round's end writes rounds_cur + 1.
+fn rounds_write(f: &WritebackFlags, items: &mut Vec<Item>) {
+    items.push(Item::AlwaysFf(vec![Stmt::If(
+        f.go.e().and(id("wb_q_end")),
+        vec![nb(
+            Expr::id("rounds").at(id("wb_q_path")),
+            id("rounds_cur").plus(lit(16, 1)),
+        )],
+        vec![],
+    )]));
 }
 
 /// Coordinate updater-buffer, read side: two banks per point, bank = cur[path] holds the last
@@ -791,9 +842,7 @@ fn fsm_on_start(t: &Dims<'_>) -> Vec<Stmt> {
         on_start.push(nb(id("lb"), all_zero.clone()));
         on_start.push(nb(id("plb"), all_zero.clone()));
     }
-    for p in 0..t.np2 {
-        on_start.push(nb(Expr::id("rounds").at(lit(t.pb, p.into())), lit(16, 0)));
-    }
+    on_start.push(nb(id("rvalid"), all_zero));
     on_start
 }
 
@@ -854,10 +903,7 @@ fn path_commit(f: &WritebackFlags) -> Vec<Stmt> {
         id("wb_q_end"),
         vec![
             nb(wbp("cur"), wbp("cur").inv()),
-            nb(
-                Expr::id("rounds").at(id("wb_q_path")),
-                Expr::id("rounds").at(id("wb_q_path")).plus(lit(16, 1)),
-            ),
+            nb(wbp("rvalid"), lit(1, 1)),
             nb(wbp("dz"), f.any_dz.e()),
             nb(wbp("ov"), f.any_ov.e()),
             nb(wbp("conv"), conv_next),
@@ -952,6 +998,7 @@ fn controller(t: &Dims<'_>, rom: &ScheduleRead, f: &WritebackFlags, items: &mut 
             nb(id("wb_q_en"), lit(1, 0)),
             nb(id("wb_q_tail"), lit(1, 0)),
             nb(id("seen_tail"), lit(1, 0)),
+            nb(id("rvalid"), lit(t.np2, 0)),
         ],
         vec![
             Stmt::If(
@@ -1125,7 +1172,12 @@ fn read_mux(t: &Dims<'_>, mux: &Signal, items: &mut Vec<Item>) {
         Expr::slice("rd_a", 7, 0),
     ]);
     let status_word = Expr::concat(vec![
-        Expr::id("rounds").at(id("rq_path")),
+        // `rounds_q` holds rounds[rq_path]: read with the request's address while idle.
+        Expr::mux(
+            Expr::id("rvalid").at(id("rq_path")),
+            id("rounds_q"),
+            lit(16, 0),
+        ),
         lit(12, 0),
         if t.early.is_some() {
             rqp("lb")
@@ -1207,6 +1259,7 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
     let pe = declare_state(&t, &mut items);
     let bus = bus_decode(&t, &mut items);
     let rom = schedule_memory(&t, &bus, &mut items);
+    rounds_read(&t, &rom, &mut items);
     let ports = updater_read_ports(&t, &bus, &rom, &mut items);
     let sel = pe_output_select(&t, &pe, &mut items);
     let disp = displacement(&t, &sel, &mut items);
@@ -1215,6 +1268,7 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
         .as_ref()
         .map(|(stop, boxes)| early_stop_logic(d, stop, boxes, &disp, &mut items));
     let flags = writeback_flags(&sel, &disp, wb_lb, &mut items);
+    rounds_write(&flags, &mut items);
     updater_write_port(&bus, &ports, &sel, &flags, &mut items);
     pe_matrix(&t, &pe, &mut items);
     controller(&t, &rom, &flags, &mut items);
@@ -1338,7 +1392,7 @@ fn early_stop_logic(
     let late = if stop.min_rounds >= 2 {
         Expr::bin(
             BinaryOp::Gt,
-            Expr::id("rounds").at(id("wb_q_path")),
+            id("rounds_cur"),
             lit(16, u128::from(stop.min_rounds - 2)),
         )
     } else {

@@ -58,6 +58,8 @@ module bt_top (
   reg [3:0] rq_reg;
   reg [1:0] rq_word;
   reg [4:0] rq_path;
+  reg [15:0] rounds_q;
+  reg [31:0] rvalid;
   reg [15:0] rounds [0:31];
   reg [71:0] pm_a [0:127];
   reg [71:0] pm_b [0:127];
@@ -129,6 +131,14 @@ module bt_top (
   assign rom_end = sched_q[14];
   wire rom_late;
   assign rom_late = sched_q[15];
+  // rounds memory (M9K): read at the write-back entry's path, or the bus address
+  wire [4:0] rounds_ra;
+  assign rounds_ra = ((state == 3'd4) ? rom_path : avs_address[4:0]);
+  always @(posedge clk) begin
+    rounds_q <= rounds[rounds_ra];
+  end
+  wire [15:0] rounds_cur;
+  assign rounds_cur = (rvalid[wb_q_path] ? rounds_q : 16'h0);
   // coordinate updater-buffer: address {point, bank}; cur[path] = bank of the committed round
   reg [6:0] ra_addr;
   reg [6:0] rb_addr;
@@ -243,6 +253,11 @@ module bt_top (
   assign any_dz = (pdz[wb_q_path] | pe_sel_zs);
   wire any_ov;
   assign any_ov = (pov[wb_q_path] | pe_sel_ov);
+  always @(posedge clk) begin
+    if ((wb_go && wb_q_end)) begin
+      rounds[wb_q_path] <= (rounds_cur + 16'h1);
+    end
+  end
   always @* begin
     wr_en = (pt_we || wb_go);
     wr_addr = {bus_point, avs_address[2]};
@@ -362,6 +377,7 @@ module bt_top (
       wb_q_en <= 1'd0;
       wb_q_tail <= 1'd0;
       seen_tail <= 1'd0;
+      rvalid <= 32'h0;
     end else begin
       if ((state != 3'd0)) begin
         cycles <= (cycles + 32'h1);
@@ -382,38 +398,7 @@ module bt_top (
             pbig <= 32'h0;
             pdz <= 32'h0;
             pov <= 32'h0;
-            rounds[5'd0] <= 16'h0;
-            rounds[5'd1] <= 16'h0;
-            rounds[5'd2] <= 16'h0;
-            rounds[5'd3] <= 16'h0;
-            rounds[5'd4] <= 16'h0;
-            rounds[5'd5] <= 16'h0;
-            rounds[5'd6] <= 16'h0;
-            rounds[5'd7] <= 16'h0;
-            rounds[5'd8] <= 16'h0;
-            rounds[5'd9] <= 16'h0;
-            rounds[5'd10] <= 16'h0;
-            rounds[5'd11] <= 16'h0;
-            rounds[5'd12] <= 16'h0;
-            rounds[5'd13] <= 16'h0;
-            rounds[5'd14] <= 16'h0;
-            rounds[5'd15] <= 16'h0;
-            rounds[5'd16] <= 16'h0;
-            rounds[5'd17] <= 16'h0;
-            rounds[5'd18] <= 16'h0;
-            rounds[5'd19] <= 16'h0;
-            rounds[5'd20] <= 16'h0;
-            rounds[5'd21] <= 16'h0;
-            rounds[5'd22] <= 16'h0;
-            rounds[5'd23] <= 16'h0;
-            rounds[5'd24] <= 16'h0;
-            rounds[5'd25] <= 16'h0;
-            rounds[5'd26] <= 16'h0;
-            rounds[5'd27] <= 16'h0;
-            rounds[5'd28] <= 16'h0;
-            rounds[5'd29] <= 16'h0;
-            rounds[5'd30] <= 16'h0;
-            rounds[5'd31] <= 16'h0;
+            rvalid <= 32'h0;
           end
         end
         3'd2: begin
@@ -449,7 +434,7 @@ module bt_top (
           if (wb_go) begin
             if (wb_q_end) begin
               cur[wb_q_path] <= ~(cur[wb_q_path]);
-              rounds[wb_q_path] <= (rounds[wb_q_path] + 16'h1);
+              rvalid[wb_q_path] <= 1'd1;
               dz[wb_q_path] <= any_dz;
               ov[wb_q_path] <= any_ov;
               conv[wb_q_path] <= ((!(any_big) && !(any_dz)) && !(any_ov));
@@ -594,7 +579,7 @@ module bt_top (
         endcase
       end
       2'd2: begin
-        read_mux = {rounds[rq_path], 12'h0, 1'd0, ov[rq_path], dz[rq_path], conv[rq_path]};
+        read_mux = {(rvalid[rq_path] ? rounds_q : 16'h0), 12'h0, 1'd0, ov[rq_path], dz[rq_path], conv[rq_path]};
       end
       2'd3: begin
         case (rq_word)
