@@ -374,9 +374,9 @@ impl Layout {
                 cap.paths, cap.points, cap.entries, cap.slots, num_instances, platform.m9k_budget
             )));
         }
-        if sw > 32 {
+        if sw > 64 {
             return Err(HlsError::TooLarge(format!(
-                "a schedule entry for {} paths and {} points exceeds one 32-bit word",
+                "a schedule entry for {} paths and {} points exceeds two 32-bit words",
                 cap.paths, cap.points
             )));
         }

@@ -64,6 +64,9 @@ pub mod regs {
     pub const RX: u32 = 8;
     /// RW: slots of the loaded schedule (the run's makespan).
     pub const SLOTS: u32 = 12;
+    /// W: the bits above 32 of the schedule entries written after it (only in designs whose
+    /// entries are wider than 32 bits: many paths, points and PEs).
+    pub const SCHED_HI: u32 = 13;
 }
 
 /// What [`generate`] produced.
@@ -175,10 +178,12 @@ fn schedule_writes(d: &Design, s: &StepDesign, ops: &mut Vec<BusOp>) {
             last_of_round.insert((job.path, job.round), (t, e));
         }
     }
-    let tail_bit = 1u32 << (5 + pb + ptb);
+    let tail_bit = 1u64 << (5 + pb + ptb);
+    let wide = crate::input::sched_entry_bits(pb, ptb, d.inst_bits) > 32;
+    let mut high = None;
     let mut entry = 0u32;
     for (t, jobs) in rows.iter().enumerate() {
-        let mut words: Vec<u32> = jobs
+        let mut words: Vec<u64> = jobs
             .iter()
             .enumerate()
             .map(|(e, &(col, job))| {
@@ -187,13 +192,13 @@ fn schedule_writes(d: &Design, s: &StepDesign, ops: &mut Vec<BusOp>) {
                 let end = last_of_round[&(job.path, job.round)] == (t, e);
                 // A job after its round's first phase reads its neighbours' new points.
                 let late = job.point % s.input.round_order.phases() != 0;
-                1 | job.path << 1
-                    | point << (1 + pb)
-                    | u32::from(job.point == 0) << (1 + pb + ptb)
-                    | u32::from(job.point + 1 == n) << (2 + pb + ptb)
-                    | u32::from(end) << (3 + pb + ptb)
-                    | u32::from(late) << (4 + pb + ptb)
-                    | col << (6 + pb + ptb)
+                1 | u64::from(job.path) << 1
+                    | u64::from(point) << (1 + pb)
+                    | u64::from(job.point == 0) << (1 + pb + ptb)
+                    | u64::from(job.point + 1 == n) << (2 + pb + ptb)
+                    | u64::from(end) << (3 + pb + ptb)
+                    | u64::from(late) << (4 + pb + ptb)
+                    | u64::from(col) << (6 + pb + ptb)
             })
             .collect();
         if words.is_empty() {
@@ -203,7 +208,13 @@ fn schedule_writes(d: &Design, s: &StepDesign, ops: &mut Vec<BusOp>) {
             *last |= tail_bit;
         }
         for word in words {
-            ops.push(BusOp::Write(d.sched_base + entry, word));
+            // A wide entry's high bits go to SCHED_HI first, when they change.
+            let hi = (word >> 32) as u32;
+            if wide && high != Some(hi) {
+                ops.push(BusOp::Write(regs::SCHED_HI, hi));
+                high = Some(hi);
+            }
+            ops.push(BusOp::Write(d.sched_base + entry, word as u32));
             entry += 1;
         }
     }

@@ -206,6 +206,11 @@ fn declare_state(t: &Dims<'_>, items: &mut Vec<Item>) -> Vec<PeWires> {
     ] {
         items.push(Item::Reg(n.into(), w));
     }
+    let sw = sched_entry_bits(pb, ptb, ib);
+    if sw > 32 {
+        // Entries wider than the bus word: the host writes their high bits first.
+        items.push(Item::Reg("sched_hi".into(), sw - 32));
+    }
     if t.early.is_some() {
         items.push(Item::Reg("lb".into(), np2));
         items.push(Item::Reg("plb".into(), np2));
@@ -344,12 +349,17 @@ fn schedule_memory(t: &Dims<'_>, bus: &Decode, items: &mut Vec<Item>) -> Schedul
     );
     let stop = Signal::assigned(items, "stop", 1, or(id("seen_tail"), tail.e()));
     items.push(Item::Memory("sched".into(), sw, 1 << eb));
+    let entry = if sw > 32 {
+        Expr::concat(vec![id("sched_hi"), id("avs_writedata")])
+    } else {
+        Expr::slice("avs_writedata", sw - 1, 0)
+    };
     items.push(Item::AlwaysFf(vec![
         Stmt::If(
             bus.host_wr.e().and(bus.is_sched.e()),
             vec![nb(
                 Expr::id("sched").at(Expr::slice("avs_address", eb - 1, 0)),
-                Expr::slice("avs_writedata", sw - 1, 0),
+                entry,
             )],
             vec![],
         ),
@@ -1124,6 +1134,22 @@ fn read_pipeline(t: &Dims<'_>, bus: &Decode, items: &mut Vec<Item>) -> Signal {
     read_mux
 }
 
+/// SCHED_HI: the high bits of wide schedule entries, written by the host before the entries
+/// (only in designs whose entries exceed 32 bits).
+fn sched_hi_register(t: &Dims<'_>, bus: &Decode, items: &mut Vec<Item>) {
+    let sw = sched_entry_bits(t.pb, t.ptb, t.ib);
+    if sw <= 32 {
+        return;
+    }
+    items.push(Item::AlwaysFf(vec![Stmt::If(
+        bus.host_wr
+            .e()
+            .and(id("avs_address").eq(lit(t.ab, crate::regs::SCHED_HI.into()))),
+        vec![nb(id("sched_hi"), Expr::slice("avs_writedata", sw - 33, 0))],
+        vec![],
+    )]));
+}
+
 /// The control registers' read values by word address (register map in `docs/hardware.md`).
 fn control_read_arms(t: &Dims<'_>, mux: &Signal) -> Vec<(Expr, Vec<Stmt>)> {
     let platform = t.p.platform;
@@ -1273,6 +1299,7 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
     pe_matrix(&t, &pe, &mut items);
     controller(&t, &rom, &flags, &mut items);
     register_writes(&t, &bus, &mut items);
+    sched_hi_register(&t, &bus, &mut items);
     let mux = read_pipeline(&t, &bus, &mut items);
     read_mux(&t, &mux, &mut items);
     interrupt_and_unused(&mut items);
