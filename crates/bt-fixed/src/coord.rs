@@ -3,24 +3,12 @@ use crate::FixedError;
 /// Millimetres per metre: the decimal scale of [`Coord`].
 pub const MM_PER_M: i64 = 1000;
 
-/// A coordinate or length word: 32-bit signed, value = metres × 1000 (1 LSB = 1 mm).
-///
-/// Verilog twin: a `signed [31:0]` field of the 96-bit point word `{z, y, x}` in `bt_top`.
-#[derive(
-    Debug,
-    Clone,
-    Copy,
-    PartialEq,
-    Eq,
-    PartialOrd,
-    Ord,
-    Hash,
-    Default,
-    serde::Serialize,
-    serde::Deserialize,
-)]
-#[serde(transparent)]
-pub struct Coord(pub i32);
+fixed_word! {
+    /// A coordinate or length word: 32-bit signed, value = metres × 1000 (1 LSB = 1 mm).
+    ///
+    /// Verilog twin: a `signed [31:0]` field of the 96-bit point word `{z, y, x}` in `bt_top`.
+    Coord(i32)
+}
 
 /// A point in millimetre words, `[x, y, z]`.
 pub type FixedPoint = [Coord; 3];
@@ -56,26 +44,14 @@ impl Coord {
 /// 0.003 degree. The bus keeps the paper's 32-bit millimetre words.
 pub const POINT_FRAC: u32 = 8;
 
-/// The iterated coordinate word: 40-bit signed, value = millimetres × 2^[`POINT_FRAC`]
-/// (decimal millimetre scale with 8 binary fraction bits; range ±2^31 mm like [`Coord`]).
-///
-/// Verilog twin: a `signed [39:0]` field of the 120-bit point word `{z, y, x}` in `bt_top`'s
-/// point memory and the PE ports.
-#[derive(
-    Debug,
-    Clone,
-    Copy,
-    PartialEq,
-    Eq,
-    PartialOrd,
-    Ord,
-    Hash,
-    Default,
-    serde::Serialize,
-    serde::Deserialize,
-)]
-#[serde(transparent)]
-pub struct FineCoord(pub i64);
+fixed_word! {
+    /// The iterated coordinate word: 40-bit signed, value = millimetres × 2^[`POINT_FRAC`]
+    /// (decimal millimetre scale with 8 binary fraction bits; range ±2^31 mm like [`Coord`]).
+    ///
+    /// Verilog twin: a `signed [39:0]` field of the 120-bit point word `{z, y, x}` in `bt_top`'s
+    /// point memory and the PE ports.
+    FineCoord(i64)
+}
 
 /// A point in [`FineCoord`] words, `[x, y, z]`.
 pub type FinePoint = [FineCoord; 3];

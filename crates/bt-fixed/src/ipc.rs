@@ -221,7 +221,7 @@ fn range_text(bits: u32) -> String {
 /// The fixed-point IPC model: validated, quantised scene plus candidate paths.
 ///
 /// Semantics (identical in `bt_top`): each round updates every point of a path once by
-/// [`intersection_point`] (TX and RX fixed), in the [`RoundOrder`]: Jacobi (every point from
+/// [`crate::intersection_point`] (TX and RX fixed), in the [`RoundOrder`]: Jacobi (every point from
 /// the previous round's values) or red-black (even points first, then odd points from them);
 /// the round's displacement is the maximum over the path's points of the L∞ norm of the
 /// point's move, in fine LSB (1/256 mm). After committing round `r`: if a degenerate flag was raised the path

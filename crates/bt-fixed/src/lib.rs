@@ -32,6 +32,20 @@
 
 #![warn(missing_docs)]
 
+/// Declares a fixed-point word: a transparent newtype over its raw integer with the derives
+/// every word shares (ordering, hashing, serde as the bare integer).
+macro_rules! fixed_word {
+    ($(#[$doc:meta])* $name:ident($raw:ty)) => {
+        $(#[$doc])*
+        #[derive(
+            Debug, Clone, Copy, PartialEq, Eq, PartialOrd, Ord, Hash, Default,
+            serde::Serialize, serde::Deserialize,
+        )]
+        #[serde(transparent)]
+        pub struct $name(pub $raw);
+    };
+}
+
 mod coord;
 mod csd;
 mod error;

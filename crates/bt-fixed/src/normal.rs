@@ -9,24 +9,12 @@ pub const NORMAL_FRAC: u32 = 30;
 /// [`crate::width`] (which assumes ‖n‖ ≤ 1 + 1e-6 after quantisation) holds.
 pub const UNIT_NORMAL_TOLERANCE: f64 = 1e-7;
 
-/// One component of a unit normal in Q2.30: value = raw / 2^30, raw ∈ [-2^30, 2^30].
-///
-/// Verilog twin: not a wire but a constant baked into `bt_pe_<i>` as its [`Csd`] network.
-#[derive(
-    Debug,
-    Clone,
-    Copy,
-    PartialEq,
-    Eq,
-    PartialOrd,
-    Ord,
-    Hash,
-    Default,
-    serde::Serialize,
-    serde::Deserialize,
-)]
-#[serde(transparent)]
-pub struct NormalComponent(pub i32);
+fixed_word! {
+    /// One component of a unit normal in Q2.30: value = raw / 2^30, raw ∈ [-2^30, 2^30].
+    ///
+    /// Verilog twin: not a wire but a constant baked into `bt_pe_<i>` as its [`Csd`] network.
+    NormalComponent(i32)
+}
 
 impl NormalComponent {
     /// Quantises `value` (unitless, |value| ≤ 1) to Q2.30, ties away from zero on the exact f64.

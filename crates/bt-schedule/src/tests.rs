@@ -29,6 +29,24 @@ fn list_and_ga(problem: &Problem, budget: &Budget) -> [Schedule; 2] {
     schedules
 }
 
+/// The violation of phase `phase` of round `round` of `path` starting in slot `start`, not
+/// after the phase before it (ending in `previous_end`).
+fn dependency(
+    path: u32,
+    round: u32,
+    phase: u32,
+    start: u32,
+    previous_end: u32,
+) -> ScheduleViolation {
+    ScheduleViolation::Dependency {
+        path,
+        round,
+        phase,
+        start,
+        previous_end,
+    }
+}
+
 fn job(path: u32, round: u32, point: u32) -> Job {
     Job { path, round, point }
 }
@@ -278,16 +296,7 @@ fn check_rejects_a_dependency_violation() {
     schedule.slots[0][0] = Some(job(0, 1, 0));
     schedule.slots[2][0] = Some(job(0, 0, 0));
     let v = violations(&problem, &schedule);
-    assert_eq!(
-        v,
-        vec![ScheduleViolation::Dependency {
-            path: 0,
-            round: 1,
-            phase: 0,
-            start: 0,
-            previous_end: 2
-        }]
-    );
+    assert_eq!(v, vec![dependency(0, 1, 0, 0, 2)]);
 }
 
 #[test]
@@ -300,16 +309,7 @@ fn check_rejects_same_slot_rounds() {
     schedule.slots[1][1] = Some(job(0, 0, 1));
     schedule.slots[0][1] = Some(job(1, 0, 0));
     let v = violations(&problem, &schedule);
-    assert_eq!(
-        v,
-        vec![ScheduleViolation::Dependency {
-            path: 0,
-            round: 1,
-            phase: 0,
-            start: 1,
-            previous_end: 1
-        }]
-    );
+    assert_eq!(v, vec![dependency(0, 1, 0, 1, 1)]);
 }
 
 #[test]
@@ -476,16 +476,7 @@ fn check_rejects_a_second_phase_next_to_the_first() {
     assert_eq!(schedule.makespan(), 2);
     schedule.slots[0][1] = schedule.slots[1][1].take();
     let v = violations(&problem, &schedule);
-    assert_eq!(
-        v,
-        vec![ScheduleViolation::Dependency {
-            path: 0,
-            round: 0,
-            phase: 1,
-            start: 0,
-            previous_end: 0
-        }]
-    );
+    assert_eq!(v, vec![dependency(0, 0, 1, 0, 0)]);
     // Zero phases is refused at the boundary.
     let bad = Problem {
         num_planes: 2,
