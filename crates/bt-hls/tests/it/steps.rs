@@ -14,9 +14,10 @@ fn list_work(input: bt_hls::HlsInput) -> StepWork {
 }
 
 /// Step 0: the small scene (Jacobi rounds). Step 1: other TX/RX, every second candidate, start
-/// points moved 0.3 m, red-black rounds. Step 2: four paths only (a shorter schedule than the
-/// ones loaded before it, so stale entries would show), red-black, one of them of order 3
-/// with both ends on the floor (its first phase takes the floor's PE twice).
+/// points moved 0.3 m, red-black rounds. Step 2: five paths only (a shorter schedule than the
+/// ones loaded before it, so stale entries would show), red-black, one of order 3 with both
+/// ends on the floor (its first phase takes the floor's PE twice) and one of order 4 (two
+/// points in each phase).
 fn three_steps() -> Vec<StepWork> {
     let s0 = small_scene();
     let mut s1 = small_scene();
@@ -36,12 +37,24 @@ fn three_steps() -> Vec<StepWork> {
     s1.test_vectors = vec![[[1.5, 1.5, 1.5], [3.5, 2.5, 1.0]]];
     s1.round_order = bt_hls::RoundOrder::RedBlack;
     let mut s2 = small_scene();
-    s2.paths = vec![vec![4], vec![1, 4], vec![2], vec![4, 5, 4]];
+    s2.paths = vec![
+        vec![4],
+        vec![1, 4],
+        vec![2],
+        vec![4, 5, 4],
+        vec![2, 4, 3, 5],
+    ];
     s2.init_points = vec![
         vec![[2.5, 2.0, 0.0]],
         vec![[5.0, 2.0, 1.5], [2.5, 2.0, 0.0]],
         vec![[2.5, 0.0, 1.5]],
         vec![[2.0, 1.8, 0.0], [2.5, 2.0, 3.0], [3.0, 2.2, 0.0]],
+        vec![
+            [1.5, 0.0, 1.0],
+            [2.0, 1.0, 0.0],
+            [2.5, 4.0, 1.5],
+            [3.0, 2.5, 3.0],
+        ],
     ];
     s2.test_vectors.clear();
     s2.round_order = bt_hls::RoundOrder::RedBlack;
