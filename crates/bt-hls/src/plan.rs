@@ -11,10 +11,11 @@ use crate::HlsError;
 pub enum ScheduleKind {
     /// The paper's three passes: GA, PE duplication, ASAP fill ([`bt_schedule::schedule_ga`]).
     Ga,
-    /// The list scheduler, paths with the most jobs first ([`bt_schedule::schedule_list_on`]):
-    /// one PE per plane, or, with a [`PlanOptions::pe_budget`] above the planes used, the extra
-    /// PEs as copies of the busiest planes ([`bt_schedule::schedule_list_duplicated`]). (The
-    /// index-order list schedule stays the baseline, [`Plan::list_makespan`].)
+    /// The list scheduler: one PE per plane, paths with the most jobs first
+    /// ([`bt_schedule::schedule_list_on`]) or in index order ([`bt_schedule::schedule_list`],
+    /// the baseline [`Plan::list_makespan`]), whichever is shorter; or, with a
+    /// [`PlanOptions::pe_budget`] above the planes used, the extra PEs as copies of the busiest
+    /// planes ([`bt_schedule::schedule_list_duplicated`]).
     List,
 }
 
@@ -149,9 +150,17 @@ fn plan_with(
         (None, ScheduleKind::List, Some(b)) if b > planes_used => {
             bt_schedule::schedule_list_duplicated(problem, &budget)?
         }
-        // Most jobs first: the long paths' chains start at once (living room step 0: 1,115 ->
-        // 1,013 slots, the busiest plane's load being 1,007).
-        (None, ScheduleKind::List, _) => bt_schedule::schedule_list_on(problem, &[])?,
+        // Most jobs first, the long paths' chains starting at once (living room step 0: 1,115
+        // -> 1,013 slots, the busiest plane's load being 1,008), unless the index order is
+        // shorter: the two list schedules cost microseconds.
+        (None, ScheduleKind::List, _) => {
+            let longest_first = bt_schedule::schedule_list_on(problem, &[])?;
+            if longest_first.makespan() <= list.makespan() {
+                longest_first
+            } else {
+                list
+            }
+        }
         (None, ScheduleKind::Ga, _) => bt_schedule::schedule_ga(problem, &budget, &options.ga)?,
     };
     schedule.check(problem)?;

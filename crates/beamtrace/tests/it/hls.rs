@@ -121,7 +121,8 @@ fn ga_is_never_longer_than_list_and_duplication_helps() {
         makespan(&d),
         makespan(&g)
     );
-    assert_eq!(l["list_makespan"], l["stats"]["makespan"]);
+    // The list scheduler keeps the shorter of most-jobs-first and the index-order baseline.
+    assert!(makespan(&l) <= l["list_makespan"].as_u64().unwrap(), "{l}");
     std::fs::remove_dir_all(root).ok();
 }
 
