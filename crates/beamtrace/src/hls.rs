@@ -56,8 +56,8 @@ pub fn run(args: &HlsArgs) -> anyhow::Result<ExitCode> {
             );
             for b in &r.blocks {
                 println!(
-                    "  {:<16} {:>8} logic cells {:>7} registers {:>3} M9K",
-                    b.module, b.logic_cells, b.registers, b.m9k_blocks
+                    "  {:<16} {:>3} x {:>8} logic cells {:>7} registers {:>3} M9K",
+                    b.module, b.instances, b.logic_cells, b.registers, b.m9k_blocks
                 );
             }
             println!(

@@ -34,7 +34,7 @@ pub use bt_fixed::{BoundsM, EarlyStop, FixedOutcome, PathResult, RoundOrder};
 pub use error::HlsError;
 pub use input::{Capacity, EP4CE115_M9K_BLOCKS, MAX_ADDRESS_BITS, MIN_ADDRESS_BITS, m9k_blocks};
 pub use input::{HlsInput, PlaneSpec, Platform, StepWork, pe_latency};
-pub use pe::{pe_module_name, point_bits, sum_bits};
+pub use pe::{PE_CORE_MODULE, pe_module_name, point_bits, sum_bits};
 pub use plan::{
     Plan, PlanOptions, ScheduleKind, plan, plan_on, run_cycles, schedule_entries, slot_cycles,
 };
@@ -413,8 +413,8 @@ fn write(
     Ok(())
 }
 
-/// The generated modules (PEs of the platform's planes, then `bt_top`), as
-/// `(module name, Verilog text)`. Pure function of the inputs.
+/// The generated modules (the PEs' shared core, the PEs of the platform's planes, then
+/// `bt_top`), as `(module name, Verilog text)`. Pure function of the inputs.
 pub fn rtl_modules(platform: &Platform) -> Result<Vec<(String, String)>, HlsError> {
     let model = input::platform_model(platform)?;
     rtl_of(platform, &model)
@@ -427,7 +427,8 @@ fn rtl_of(
     let planes: std::collections::BTreeSet<u32> =
         platform.instances.iter().map(|i| i.plane).collect();
     let wd = bt_fixed::Widths::for_coord(model.coord_bits());
-    let mut out = Vec::new();
+    let core = pe::pe_core_module(wd);
+    let mut out = vec![(core.name.clone(), verilog::print_module(&core))];
     for p in planes {
         let spec = &platform.planes[p as usize];
         let m = pe::pe_module(p as usize, &spec.name, &model.planes()[p as usize], wd)?;

@@ -451,16 +451,20 @@ pub struct SynthReport {
     pub blocks: Vec<BlockArea>,
 }
 
-/// Cells of one module of a hierarchical synthesis ([`SynthOptions::per_block`]).
+/// Cells of one module of a hierarchical synthesis ([`SynthOptions::per_block`]), per
+/// instance: a module's own cells, without those of the modules it instantiates.
 #[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
 pub struct BlockArea {
-    /// Module name (`bt_top`: controller, memories, write-back; `bt_pe_<i>`: plane i's PE).
+    /// Module name (`bt_top`: controller, memories, write-back; `bt_pe_core`: the registers,
+    /// Algorithm 3 and sequencer every PE holds; `bt_pe_<i>`: plane i's constant networks).
     pub module: String,
-    /// `cycloneive_lcell_comb` cells.
+    /// Instances in the design (PE copies and the core in every PE count).
+    pub instances: u64,
+    /// `cycloneive_lcell_comb` cells of one instance.
     pub logic_cells: u64,
-    /// `dffeas` cells.
+    /// `dffeas` cells of one instance.
     pub registers: u64,
-    /// `altsyncram` cells (M9K blocks).
+    /// `altsyncram` cells (M9K blocks) of one instance.
     pub m9k_blocks: u64,
 }
 
@@ -565,28 +569,41 @@ pub fn synthesize_rtl(
         return Ok(synth_report(parse_stat(&stat), parse_bram_bits(&log)));
     }
     let modules = parse_module_stats(&stat);
+    let is_module = |k: &str| modules.iter().any(|(name, _)| name == k);
     let mut cells = BTreeMap::new();
-    for (_, m) in &modules {
-        for (k, v) in m {
-            if !modules.iter().any(|(name, _)| name == k) {
-                *cells.entry(k.clone()).or_insert(0) += v;
-            }
+    let mut blocks = Vec::new();
+    for (module, m) in &modules {
+        let instances = instance_count(&modules, top, module);
+        for (k, v) in m.iter().filter(|(k, _)| !is_module(k)) {
+            *cells.entry(k.clone()).or_insert(0) += v * instances;
         }
+        let r = synth_report(m.clone(), 0);
+        blocks.push(BlockArea {
+            module: module.clone(),
+            instances,
+            logic_cells: r.logic_cells,
+            registers: r.registers,
+            m9k_blocks: r.m9k_blocks,
+        });
     }
     let mut report = synth_report(cells, parse_bram_bits(&log));
-    report.blocks = modules
-        .iter()
-        .map(|(module, m)| {
-            let r = synth_report(m.clone(), 0);
-            BlockArea {
-                module: module.clone(),
-                logic_cells: r.logic_cells,
-                registers: r.registers,
-                m9k_blocks: r.m9k_blocks,
-            }
-        })
-        .collect();
+    report.blocks = blocks;
     Ok(report)
+}
+
+/// How many times `module` is instantiated below `top` in a hierarchical `stat` (`top`
+/// itself: once): a module's section lists the modules it instantiates among its cells.
+fn instance_count(modules: &[(String, BTreeMap<String, u64>)], top: &str, module: &str) -> u64 {
+    if module == top {
+        return 1;
+    }
+    modules
+        .iter()
+        .filter_map(|(parent, cells)| {
+            let n = cells.get(module)?;
+            Some(n * instance_count(modules, top, parent))
+        })
+        .sum()
 }
 
 /// Each module's section (`=== name ===`) of a hierarchical `stat`, `bt_top` first.
@@ -599,8 +616,15 @@ fn parse_module_stats(stat: &str) -> Vec<(String, BTreeMap<String, u64>)> {
             (name != "design hierarchy").then(|| (name.to_string(), parse_stat(body)))
         })
         .collect();
-    // bt_top, then the PEs in plane order (bt_pe_2 before bt_pe_10).
-    out.sort_by_key(|(name, _)| (name != "bt_top", name.len(), name.clone()));
+    // bt_top, the PEs' core, then the PEs in plane order (bt_pe_2 before bt_pe_10).
+    out.sort_by_key(|(name, _)| {
+        (
+            name != "bt_top",
+            name != crate::PE_CORE_MODULE,
+            name.len(),
+            name.clone(),
+        )
+    });
     out
 }
 
@@ -623,12 +647,16 @@ pub fn area_markdown(r: &SynthReport, options: &SynthOptions) -> String {
         r.logic_cells, r.registers, r.m9k_blocks, r.memory_bits, r.percent_of_ep4ce115
     );
     if !r.blocks.is_empty() {
-        md.push_str("\n| block | logic cells | registers | M9K | share of logic cells |\n|---|---:|---:|---:|---:|\n");
+        md.push_str(
+            "\n| block | instances | logic cells (each) | registers (each) | M9K (each) | share of logic cells |\n\
+             |---|---:|---:|---:|---:|---:|\n",
+        );
         for b in &r.blocks {
-            let share = 100.0 * b.logic_cells as f64 / r.logic_cells.max(1) as f64;
+            let all = b.logic_cells * b.instances;
+            let share = 100.0 * all as f64 / r.logic_cells.max(1) as f64;
             md.push_str(&format!(
-                "| `{}` | {} | {} | {} | {share:.1} % |\n",
-                b.module, b.logic_cells, b.registers, b.m9k_blocks
+                "| `{}` | {} | {} | {} | {} | {share:.1} % |\n",
+                b.module, b.instances, b.logic_cells, b.registers, b.m9k_blocks
             ));
         }
     }
@@ -799,6 +827,28 @@ mod tests {
         assert_eq!(names, ["bt_top", "bt_pe_0"]);
         assert_eq!(m[0].1["cycloneive_lcell_comb"], 3);
         assert_eq!(m[1].1["dffeas"], 1);
+    }
+
+    #[test]
+    fn counts_instances_through_the_hierarchy() {
+        // bt_top holds PE 0 twice (a copy) and PE 10 once; every PE holds one core.
+        let stat = "=== bt_pe_10 ===\n   Number of cells:   2\n     bt_pe_core    1\n     cycloneive_lcell_comb    1\n\n\
+                    === bt_pe_0 ===\n   Number of cells:   2\n     bt_pe_core    1\n     cycloneive_lcell_comb    1\n\n\
+                    === bt_pe_core ===\n   Number of cells:   5\n     cycloneive_lcell_comb    4\n     dffeas    1\n\n\
+                    === bt_top ===\n   Number of cells:   4\n     bt_pe_0    2\n     bt_pe_10    1\n     dffeas    1\n\n";
+        let m = super::parse_module_stats(stat);
+        let names: Vec<&str> = m.iter().map(|(n, _)| n.as_str()).collect();
+        assert_eq!(names, ["bt_top", "bt_pe_core", "bt_pe_0", "bt_pe_10"]);
+        let count = |name| super::instance_count(&m, "bt_top", name);
+        assert_eq!(
+            [
+                count("bt_top"),
+                count("bt_pe_core"),
+                count("bt_pe_0"),
+                count("bt_pe_10")
+            ],
+            [1, 3, 2, 1]
+        );
     }
 
     #[test]

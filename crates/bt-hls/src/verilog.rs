@@ -179,6 +179,14 @@ impl Signal {
         items.push(Item::Assign(s.e(), value));
         s
     }
+    /// A handle on a port of the module being built (declared by its port list, not in
+    /// `items`).
+    pub fn port(name: impl Into<String>, width: u32) -> Signal {
+        Signal {
+            name: name.into(),
+            width,
+        }
+    }
     /// Declares `reg [width-1:0] name;` in `items`.
     pub fn reg(items: &mut Vec<Item>, name: impl Into<String>, width: u32) -> Signal {
         let s = Signal {

@@ -3,7 +3,7 @@
 use std::path::PathBuf;
 
 use crate::common::*;
-use bt_hls::{HlsInput, PlaneSpec};
+use bt_hls::{HlsInput, PlaneSpec, Platform, StepWork};
 use bt_schedule::{Budget, schedule_list};
 
 #[test]
@@ -109,6 +109,55 @@ fn synthesis_reports_cell_counts_and_its_netlist_is_bit_exact() {
     assert!(synth.m9k_blocks > 0, "{synth:?}");
     assert_eq!(input.coord_bits, 24);
     assert_eq!(synth.memory_bits, 2 * 8 * (3 * 24) + 32 * 11, "{synth:?}");
+    per_block_counts_every_instance(&input, &schedule, &dir, &synth);
+}
+
+/// The hierarchical run (`--per-block`) of the tiny design: one row per module with its
+/// instance count taken from the platform (the shared `bt_pe_core` once per PE), totals that
+/// count every instance, and those totals near the flat run's (the hierarchy only forgoes
+/// optimisation across the PE ports; counting the core once would lose most of the PEs).
+fn per_block_counts_every_instance(
+    input: &HlsInput,
+    schedule: &bt_schedule::Schedule,
+    dir: &std::path::Path,
+    flat: &bt_hls::SynthReport,
+) {
+    let work = [StepWork {
+        input: input.clone(),
+        schedule: schedule.clone(),
+    }];
+    let platform = Platform::fitting(&work).unwrap();
+    let options = bt_hls::SynthOptions {
+        per_block: true,
+        ..Default::default()
+    };
+    let tree = bt_hls::synthesize_with(dir, &options).unwrap();
+    let names: Vec<&str> = tree.blocks.iter().map(|b| b.module.as_str()).collect();
+    assert_eq!(names[..2], ["bt_top", bt_hls::PE_CORE_MODULE], "{names:?}");
+    let pes = platform.instances.len() as u64;
+    assert_eq!(tree.blocks[0].instances, 1);
+    assert_eq!(tree.blocks[1].instances, pes, "{tree:#?}");
+    for b in &tree.blocks[2..] {
+        let plane: u32 = b.module.strip_prefix("bt_pe_").unwrap().parse().unwrap();
+        let copies = platform
+            .instances
+            .iter()
+            .filter(|i| i.plane == plane)
+            .count();
+        assert_eq!(b.instances, copies as u64, "{}", b.module);
+    }
+    let sum = |f: fn(&bt_hls::BlockArea) -> u64| -> u64 {
+        tree.blocks.iter().map(|b| b.instances * f(b)).sum()
+    };
+    assert_eq!(tree.logic_cells, sum(|b| b.logic_cells));
+    assert_eq!(tree.registers, sum(|b| b.registers));
+    let core = &tree.blocks[1];
+    assert!(core.registers * pes > tree.registers / 2, "{tree:#?}");
+    let ratio = tree.logic_cells as f64 / flat.logic_cells as f64;
+    assert!(
+        (0.9..1.2).contains(&ratio),
+        "hierarchical {tree:#?} vs flat {flat:#?}"
+    );
 }
 
 /// Arithmetic the accelerator uses, each output one case of the carry-chain map: unsigned and
