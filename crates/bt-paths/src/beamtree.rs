@@ -522,6 +522,7 @@ impl BeamTree {
             // Leaves only read the tree: the parent's planes are borrowed in place.
             Some(leaf) => {
                 let parent = self.parent_ref(prep, p);
+                leaf.apex_distances(&parent);
                 for &s in children.iter() {
                     self.leaf_child(prep, &parent, s, leaf);
                 }
@@ -756,20 +757,27 @@ impl BeamTree {
         if d_apex.abs() <= tol || d_rx_same_side < -eps {
             return;
         }
-        let t = d_apex / (d_apex + d_rx);
+        // The point is x = apex + t·(rx_image − apex) with t = num / den > 0 (den > 0: |d_apex|
+        // > tol ≥ eps ≥ −d_rx_same_side). A beam plane's distance is affine along the line,
+        // d(x) = a + t·(r − a) for a = d(apex), r = d(rx_image), so d(x) ≥ −eps is tested as
+        // a·den + num·(r − a) ≥ −eps·den: no division for the pairs the beam rejects.
+        let (num, den) = (d_apex.abs(), d_apex.abs() + d_rx_same_side);
+        if !parent.planes.iter().zip(&leaf.apex_d).all(|(p, &a)| {
+            let r = p.signed_distance_unfused(rx_image);
+            a * den + num * (r - a) >= -eps * den
+        }) {
+            return;
+        }
+        let t = num / den;
         if !t.is_finite() {
             return;
         }
         let x = parent.apex + t * (rx_image - parent.apex);
-        if !parent
-            .planes
-            .iter()
-            .all(|p| p.signed_distance_unfused(x) >= -eps)
-            || !prep
-                .scene
-                .surface(SurfaceId(s))
-                .polygon
-                .contains(x, GROW * tol)
+        if !prep
+            .scene
+            .surface(SurfaceId(s))
+            .polygon
+            .contains(x, GROW * tol)
         {
             return;
         }
@@ -790,6 +798,9 @@ impl BeamTree {
 struct Leaf<'o> {
     /// Per surface: (signed distance of RX, m; RX mirrored through the plane).
     mirrored: Vec<(Real, Vec3)>,
+    /// The current parent's apex's signed distance to each of its beam planes, m (read by
+    /// each of its leaf tests).
+    apex_d: Vec<Real>,
     out: &'o mut CandidateSet,
     /// Scratch for one candidate's sequence, start points and last window.
     seq: Vec<SurfaceId>,
@@ -799,6 +810,17 @@ struct Leaf<'o> {
 }
 
 impl<'o> Leaf<'o> {
+    /// Prepare the leaf tests of `parent`'s children ([`Leaf::apex_d`]).
+    fn apex_distances(&mut self, parent: &Parent<'_>) {
+        self.apex_d.clear();
+        self.apex_d.extend(
+            parent
+                .planes
+                .iter()
+                .map(|p| p.signed_distance_unfused(parent.apex)),
+        );
+    }
+
     fn new(prep: &Prepared<'_>, rx: Vec3, out: &'o mut CandidateSet) -> Self {
         let mirrored = prep
             .planes
@@ -810,6 +832,7 @@ impl<'o> Leaf<'o> {
             .collect();
         Leaf {
             mirrored,
+            apex_d: Vec::new(),
             out,
             seq: Vec::new(),
             starts: Vec::new(),
