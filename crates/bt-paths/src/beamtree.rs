@@ -39,6 +39,10 @@ pub struct TreeOptions {
     pub max_nodes: u64,
     /// When to remove or shrink windows covered by convex occluders (exact either way).
     pub culling: Culling,
+    /// Give each candidate its IPC start points (the centres of its windows). Solvers that do
+    /// not read them (the image method) turn this off: a single-receiver trace then does not
+    /// clip the last window of each candidate it emits.
+    pub starts: bool,
 }
 
 /// When the tree tests its nodes for occlusion ([`occlude`]). Culling never changes the paths
@@ -66,6 +70,7 @@ impl TreeOptions {
             max_order,
             max_nodes: 2_000_000,
             culling: Culling::Auto { min_work: 64 },
+            starts: true,
         }
     }
 }
@@ -310,6 +315,46 @@ struct Scratch {
     hits: Vec<(Real, u32)>,
 }
 
+/// The arenas of a tree (nodes, window vertices, beam planes), kept per thread between
+/// single-receiver traces ([`candidates`]): a stream of traces (receivers, time steps,
+/// benchmarks) reuses them instead of allocating them afresh, which with glibc can mean a
+/// page fault per touched page of every call. Only arenas of at most [`POOLED_BYTES`] are
+/// kept, so a city-sized tree's memory is returned.
+#[derive(Default)]
+struct Arenas {
+    nodes: Vec<Node>,
+    verts: Vec<Vec3>,
+    planes: Vec<Plane>,
+}
+
+/// The largest arenas a thread keeps between traces, bytes.
+const POOLED_BYTES: usize = 4 << 20;
+
+thread_local! {
+    static POOL: std::cell::Cell<Option<Arenas>> = const { std::cell::Cell::new(None) };
+}
+
+impl Arenas {
+    /// This thread's kept arenas (empty), or new ones.
+    fn take() -> Arenas {
+        let mut a = POOL.take().unwrap_or_default();
+        a.nodes.clear();
+        a.verts.clear();
+        a.planes.clear();
+        a
+    }
+
+    /// Keep `self` for this thread's next trace, unless too large.
+    fn give_back(self) {
+        let bytes = self.nodes.capacity() * size_of::<Node>()
+            + self.verts.capacity() * size_of::<Vec3>()
+            + self.planes.capacity() * size_of::<Plane>();
+        if bytes <= POOLED_BYTES {
+            POOL.set(Some(self));
+        }
+    }
+}
+
 /// A parent's view for generating children: apex, near plane and beam planes.
 struct Parent<'n> {
     index: u32,
@@ -379,7 +424,8 @@ impl BeamTree {
     }
 
     /// The candidates for a receiver at `rx`: line of sight and every sequence whose beam holds
-    /// `rx`, by order then lexicographically, with IPC start points inside the windows.
+    /// `rx`, by order then lexicographically, with IPC start points inside the windows (when
+    /// the tree's options ask for them).
     pub fn candidates(&self, rx: Vec3) -> CandidateSet {
         let mut set = CandidateSet::with_starts();
         set.push_with_starts(&[], &[]);
@@ -389,7 +435,7 @@ impl BeamTree {
             for i in lo..hi {
                 if self.nodes[i].live && self.holds(i, rx) {
                     self.prefix(i as u32, &mut seq, &mut starts);
-                    set.push_with_starts(&seq, &starts);
+                    push(&mut set, &seq, &starts);
                 }
             }
         }
@@ -417,15 +463,18 @@ impl BeamTree {
             .all(|pl| pl.signed_distance_unfused(p) >= -eps)
     }
 
-    /// The surface sequence and window centres of node `i`, TX side first.
+    /// The surface sequence and, when the options ask for start points, the window centres of
+    /// node `i`, TX side first.
     fn prefix(&self, mut i: u32, seq: &mut Vec<SurfaceId>, starts: &mut Vec<Vec3>) {
         seq.clear();
         starts.clear();
         while i != ROOT {
             let node = &self.nodes[i as usize];
             seq.push(SurfaceId(node.surface));
-            let (lo, hi) = node.window;
-            starts.push(convex::vertex_mean(&self.verts[lo as usize..hi as usize]));
+            if self.options.starts {
+                let (lo, hi) = node.window;
+                starts.push(convex::vertex_mean(&self.verts[lo as usize..hi as usize]));
+            }
             i = node.parent;
         }
         seq.reverse();
@@ -783,13 +832,15 @@ impl BeamTree {
         }
         self.prefix(parent.index, &mut leaf.seq, &mut leaf.starts);
         leaf.seq.push(SurfaceId(s));
-        window_in_beam(prep, parent, s, (&mut leaf.window, &mut leaf.tmp));
-        leaf.starts.push(if leaf.window.len() >= 3 {
-            convex::vertex_mean(&leaf.window)
-        } else {
-            prep.scene.surface(SurfaceId(s)).polygon.centroid()
-        });
-        leaf.out.push_with_starts(&leaf.seq, &leaf.starts);
+        if prep.options.starts {
+            window_in_beam(prep, parent, s, (&mut leaf.window, &mut leaf.tmp));
+            leaf.starts.push(if leaf.window.len() >= 3 {
+                convex::vertex_mean(&leaf.window)
+            } else {
+                prep.scene.surface(SurfaceId(s)).polygon.centroid()
+            });
+        }
+        push(leaf.out, &leaf.seq, &leaf.starts);
     }
 }
 
@@ -857,6 +908,16 @@ fn window_in_beam(
         if window.len() < 3 {
             break;
         }
+    }
+}
+
+/// Append candidate `seq` to `set` with its start points (`starts`, empty when the options
+/// ask for none: the set then has no start points).
+fn push(set: &mut CandidateSet, seq: &[SurfaceId], starts: &[Vec3]) {
+    if starts.len() == seq.len() {
+        set.push_with_starts(seq, starts);
+    } else {
+        set.push(seq);
     }
 }
 
@@ -1137,6 +1198,8 @@ pub fn candidates_with_progress(
 ) -> Result<CandidateSet, TreeError> {
     let mut prep = Prepared::new(scene, options);
     let mut tree = BeamTree::empty(&prep);
+    let arenas = Arenas::take();
+    (tree.nodes, tree.verts, tree.planes) = (arenas.nodes, arenas.verts, arenas.planes);
     let mut scratch = Scratch::default();
     let rx = scene.rx();
     let mut last = CandidateSet::with_starts();
@@ -1153,9 +1216,15 @@ pub fn candidates_with_progress(
     }
     let mut set = tree.candidates(rx);
     for i in 0..last.len() {
-        set.push_with_starts(last.get(i), last.start(i).unwrap_or(&[]));
+        push(&mut set, last.get(i), last.start(i).unwrap_or(&[]));
     }
     set.stats = tree.candidate_stats(set.len() as u64);
     set.tree = Some(tree.stats.clone());
+    Arenas {
+        nodes: tree.nodes,
+        verts: tree.verts,
+        planes: tree.planes,
+    }
+    .give_back();
     Ok(set)
 }

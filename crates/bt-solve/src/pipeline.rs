@@ -118,11 +118,21 @@ pub fn candidates_with_progress(
     options: &TraceOptions,
     progress: Progress<'_>,
 ) -> Result<CandidateSet, TraceError> {
+    generate(scene, options, tree_options(options), progress)
+}
+
+/// The candidates of `options.candidates`, the beam tree built with `tree`.
+fn generate(
+    scene: &Scene,
+    options: &TraceOptions,
+    tree: TreeOptions,
+    progress: Progress<'_>,
+) -> Result<CandidateSet, TraceError> {
     check_budget(scene, options)?;
     Ok(match options.candidates {
         CandidateMode::Exhaustive => bt_paths::enumerate(scene, options.max_order, &AllVisible),
         CandidateMode::BeamTree => {
-            bt_paths::beamtree::candidates_with_progress(scene, tree_options(options), progress)?
+            bt_paths::beamtree::candidates_with_progress(scene, tree, progress)?
         }
         CandidateMode::Wvrn => {
             let wvrn = bt_paths::wvrn::Wvrn::build(scene);
@@ -189,7 +199,12 @@ pub fn trace_scene_with_progress(
     progress: Progress<'_>,
 ) -> Result<Traced, TraceError> {
     let t0 = Instant::now();
-    let set = candidates_with_progress(scene, options, progress)?;
+    // Start points only for the solver that reads them.
+    let tree = TreeOptions {
+        starts: matches!(options.solver, Solver::Ipc(_)),
+        ..tree_options(options)
+    };
+    let set = generate(scene, options, tree, progress)?;
     let t1 = Instant::now();
     Ok(solve_set(scene, set, options, t1 - t0))
 }

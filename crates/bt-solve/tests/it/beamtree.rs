@@ -179,6 +179,41 @@ fn living_room_same_paths_and_few_candidates() {
     }
 }
 
+/// The image method's trace asks the tree for no start points: the same candidates, none
+/// carrying starts; with starts (IPC), every candidate has one per surface, inside its polygon
+/// (the grown window's centre, within the margin).
+#[test]
+fn start_points_only_when_asked_for_and_the_same_candidates_either_way() {
+    let scene = bt_scene::builtin_scene("living-room", Terminals::default())
+        .unwrap()
+        .unwrap();
+    let with = bt_paths::beamtree::candidates(&scene, TreeOptions::new(3)).unwrap();
+    let without = bt_paths::beamtree::candidates(
+        &scene,
+        TreeOptions {
+            starts: false,
+            ..TreeOptions::new(3)
+        },
+    )
+    .unwrap();
+    let seqs =
+        |set: &bt_paths::CandidateSet| -> Vec<Vec<_>> { set.iter().map(<[_]>::to_vec).collect() };
+    assert_eq!(seqs(&with), seqs(&without));
+    assert!(with.len() > 50);
+    let tol = scene.length_tolerance();
+    for i in 0..with.len() {
+        assert!(without.start(i).is_none());
+        let starts = with.start(i).expect("starts asked for");
+        assert_eq!(starts.len(), with.get(i).len());
+        for (id, p) in with.get(i).iter().zip(starts) {
+            assert!(
+                scene.surface(*id).polygon.contains(*p, 8.0 * tol),
+                "{i}: {p}"
+            );
+        }
+    }
+}
+
 #[test]
 fn full_tree_walk_equals_the_single_receiver_trace() {
     let scene = bt_scene::builtin_scene("living-room", Terminals::default())
