@@ -194,6 +194,7 @@ where
         }
         let mut points = vec![Vec3::ZERO; offsets[len]];
         let mut outcomes: Vec<Option<CandidateOutcome>> = vec![None; len];
+        let mut ends: Vec<Option<crate::IpcOutcome>> = vec![None; len];
         let mut by_order: Vec<usize> = (0..len).collect();
         by_order.sort_by_key(|&k| seq_at(k).len());
         let lanes = lanes::handles(options);
@@ -201,11 +202,18 @@ where
             let n = seq_at(group[0]).len();
             if lanes && n <= lanes::MAX_ORDER {
                 let items = group.iter().map(|&k| (k, seq_at(k), start_at(k)));
-                lanes::solve_group(scene, options, n, items, |k, seq, outcome, solved| {
-                    let out = &mut points[offsets[k]..offsets[k + 1]];
-                    out.copy_from_slice(solved);
-                    outcomes[k] = Some(ipc_verdict(scene, seq, outcome, out));
+                // The callback only records each run's end: a closure is compiled without the
+                // FMA feature of this function, so validation (whose fused plane distances
+                // would each be a software `fma` call there) runs below, in this body.
+                lanes::solve_group(scene, options, n, items, |k, _, end, solved| {
+                    points[offsets[k]..offsets[k + 1]].copy_from_slice(solved);
+                    ends[k] = Some(end);
                 });
+                for &k in group {
+                    let end = ends[k].take().expect("every run of the group ended");
+                    let solved = &points[offsets[k]..offsets[k + 1]];
+                    outcomes[k] = Some(ipc_verdict(scene, seq_at(k), end, solved));
+                }
                 continue;
             }
             let solver = Solver::Ipc(*options);

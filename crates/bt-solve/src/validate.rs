@@ -172,7 +172,8 @@ pub fn blocked_for_good(
             return None;
         }
     }
-    (0..=n).find_map(|segment| {
+    // A loop, not `find_map`: a closure would be compiled apart from the caller's FMA body.
+    for segment in 0..=n {
         let ((a, from), (b, to)) = segment_ends(seq, (tx, rx), points, segment);
         let length = a.distance(b);
         let by = first_blocking(scene, (a, b), (from, to), |polygon| {
@@ -190,6 +191,9 @@ pub fn blocked_for_good(
             let shift = reach * (1.0 + length / (span - 2.0 * reach));
             polygon.inside_by(crossing, tol + shift)
         });
-        by.map(|by| (segment, by))
-    })
+        if let Some(by) = by {
+            return Some((segment, by));
+        }
+    }
+    None
 }
