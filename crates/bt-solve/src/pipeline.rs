@@ -149,6 +149,15 @@ pub fn tree_options(options: &TraceOptions) -> TreeOptions {
     }
 }
 
+/// [`tree_options`] for a trace that solves the candidates itself: start points only for the
+/// solver that reads them (IPC).
+fn solver_tree_options(options: &TraceOptions) -> TreeOptions {
+    TreeOptions {
+        starts: matches!(options.solver, Solver::Ipc(_)),
+        ..tree_options(options)
+    }
+}
+
 /// Check the budget before enumerating: the exhaustive and WVRN generators are refused when
 /// the sequence count [`exhaustive_count`] exceeds it (the beam tree counts its nodes as it
 /// builds them instead).
@@ -199,12 +208,7 @@ pub fn trace_scene_with_progress(
     progress: Progress<'_>,
 ) -> Result<Traced, TraceError> {
     let t0 = Instant::now();
-    // Start points only for the solver that reads them.
-    let tree = TreeOptions {
-        starts: matches!(options.solver, Solver::Ipc(_)),
-        ..tree_options(options)
-    };
-    let set = generate(scene, options, tree, progress)?;
+    let set = generate(scene, options, solver_tree_options(options), progress)?;
     let t1 = Instant::now();
     Ok(solve_set(scene, set, options, t1 - t0))
 }
@@ -260,7 +264,7 @@ pub fn trace_each_receiver(
     // Fixed TX: one beam tree answers every receiver by a walk.
     let tree = match options.candidates {
         CandidateMode::BeamTree if receivers.len() > 1 => {
-            match BeamTree::build(scene, tree_options(options)) {
+            match BeamTree::build(scene, solver_tree_options(options)) {
                 Ok(tree) => Some(tree),
                 Err(e) => return receivers.iter().map(|_| Err(e.clone().into())).collect(),
             }
