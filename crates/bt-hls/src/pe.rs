@@ -156,7 +156,7 @@ pub(crate) fn pe_module(
     let nets = csd_networks(&link, &csd, wd, &mut items)?;
     signed_distance(plane, &nets, (&link.d_new, wd), &mut items, &mut unused)?;
     projections(index, &link, &nets, &mut items, &mut unused)?;
-    items.push(link.core_instance());
+    items.push(link.core_instance(wd));
     unused_ok(&mut items, unused);
     Ok(pe_shell(index, plane_name, wd, items))
 }
@@ -274,12 +274,12 @@ impl Link {
         items.push(Item::Assign(self.l.e(), r.low(&r.r_l)));
     }
 
-    /// In the front end: the core instance, every port by name.
-    fn core_instance(&self) -> Item {
-        let mut ports: Vec<(String, Expr)> = ["clk", "rst_n", "load", "start", "s_prev", "s_next"]
+    /// In the front end: the core instance, every port by name (the PE's own ports, which the
+    /// core shares, passed through).
+    fn core_instance(&self, wd: Widths) -> Item {
+        let mut ports: Vec<(String, Expr)> = pe_ports(wd)
             .into_iter()
-            .chain(["s_sum", "zero_sum"])
-            .map(|p| (p.to_string(), Expr::id(p)))
+            .map(|p| (p.name.clone(), Expr::id(p.name)))
             .collect();
         ports.extend(
             self.outputs()
