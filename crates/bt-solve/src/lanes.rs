@@ -76,8 +76,6 @@ struct Job<'s> {
 struct Group<'s> {
     n: usize,
     points: [Points; MAX_ORDER],
-    /// The points before the current round (for [`Group::rerun`]).
-    before: [Points; MAX_ORDER],
     planes: [Planes; MAX_ORDER],
     jobs: [Option<Job<'s>>; LANES],
 }
@@ -98,7 +96,6 @@ pub(crate) fn solve_group<'s>(
     let mut group = Group {
         n,
         points: [Points::default(); MAX_ORDER],
-        before: [Points::default(); MAX_ORDER],
         planes: [Planes::default(); MAX_ORDER],
         jobs: std::array::from_fn(|_| None),
     };
@@ -118,8 +115,8 @@ pub(crate) fn solve_group<'s>(
         }
         group.open_rounds(&mut out, &mut done);
         let rounds = match options.order {
-            UpdateOrder::GaussSeidel => group.round::<false>((tx, rx), min_sum),
-            UpdateOrder::Jacobi => group.round::<true>((tx, rx), min_sum),
+            UpdateOrder::GaussSeidel => group.round_of::<false>((tx, rx), min_sum),
+            UpdateOrder::Jacobi => group.round_of::<true>((tx, rx), min_sum),
         };
         group.close_rounds(rounds, &mut out, &mut done);
     }
@@ -213,19 +210,38 @@ impl<'s> Group<'s> {
         }
     }
 
-    /// One round in every lane (free lanes compute on stale values, never read): the summed
-    /// displacement per lane, or for a lane where some point's neighbours both lie on its
-    /// plane, that point's index. Such a lane (rare) is rerun by the scalar round from its
-    /// points before the round, which leaves them exactly as the scalar run would.
+    /// One round in every lane, the chain length made a constant for the common orders (the
+    /// round's loop then unrolls and its points stay in registers).
     #[inline(always)]
-    fn round<const JACOBI: bool>(
+    fn round_of<const JACOBI: bool>(
+        &mut self,
+        ends: (Vec3, Vec3),
+        min_sum: Real,
+    ) -> [Result<Real, usize>; LANES] {
+        match self.n {
+            1 => self.round::<1, JACOBI>(ends, min_sum),
+            2 => self.round::<2, JACOBI>(ends, min_sum),
+            3 => self.round::<3, JACOBI>(ends, min_sum),
+            _ => self.round::<MAX_ORDER, JACOBI>(ends, min_sum),
+        }
+    }
+
+    /// One round in every lane (free lanes compute on stale values, never read) of a chain of
+    /// `self.n` ≤ `N` points: the summed displacement per lane, or for a lane where some point's
+    /// neighbours both lie on its plane, that point's index. Such a lane (rare) is rerun by the
+    /// scalar round from its points before the round, which leaves them exactly as the scalar
+    /// run would: the new points are written back only after the round, so the lanes still
+    /// hold them.
+    #[inline(always)]
+    fn round<const N: usize, const JACOBI: bool>(
         &mut self,
         (tx, rx): (Vec3, Vec3),
         min_sum: Real,
     ) -> [Result<Real, usize>; LANES] {
-        let n = self.n;
+        let n = self.n.min(N);
         let mut moved = [0.0; LANES];
         let mut flat = [false; LANES];
+        let mut new = [Points::default(); N];
         let mut prev = Points::splat(tx);
         for k in 0..n {
             let next = if k + 1 == n {
@@ -234,23 +250,46 @@ impl<'s> Group<'s> {
                 self.points[k + 1]
             };
             let old = self.points[k];
-            self.before[k] = old;
-            let new = update(
+            new[k] = update(
                 &self.planes[k],
                 (&prev, &next, &old),
                 min_sum,
                 (&mut flat, &mut moved),
             );
-            self.points[k] = new;
-            prev = if JACOBI { old } else { new };
+            prev = if JACOBI { old } else { new[k] };
         }
-        std::array::from_fn(|l| match flat[l] {
-            false => Ok(moved[l]),
-            true => self.rerun::<JACOBI>(l, (tx, rx), min_sum),
-        })
+        if flat.iter().any(|&f| f) {
+            return self.rerun_flat::<JACOBI>(&new[..n], flat, moved, (tx, rx), min_sum);
+        }
+        self.points[..n].copy_from_slice(&new[..n]);
+        moved.map(Ok)
     }
 
-    /// Lane `l`'s round rerun by the scalar round from its points before it.
+    /// The end of a round in which some lanes were `flat`: those are rerun by the scalar round
+    /// from their points before it (still in the lanes), the others take their `new` points.
+    #[cold]
+    fn rerun_flat<const JACOBI: bool>(
+        &mut self,
+        new: &[Points],
+        flat: [bool; LANES],
+        moved: Lanes,
+        ends: (Vec3, Vec3),
+        min_sum: Real,
+    ) -> [Result<Real, usize>; LANES] {
+        let rounds = std::array::from_fn(|l| match flat[l] {
+            false => Ok(moved[l]),
+            true => self.rerun::<JACOBI>(l, ends, min_sum),
+        });
+        for (k, points) in new.iter().enumerate() {
+            for l in (0..LANES).filter(|&l| !flat[l]) {
+                self.points[k].set(l, points.get(l));
+            }
+        }
+        rounds
+    }
+
+    /// Lane `l`'s round rerun by the scalar round from its points before it (still in the
+    /// lanes: [`Group::round`] writes the new points back after the reruns).
     #[cold]
     fn rerun<const JACOBI: bool>(
         &mut self,
@@ -264,7 +303,7 @@ impl<'s> Group<'s> {
         };
         let mut points = [Vec3::ZERO; MAX_ORDER];
         for (i, p) in points[..n].iter_mut().enumerate() {
-            *p = self.before[i].get(l);
+            *p = self.points[i].get(l);
         }
         let round =
             crate::ipc::round::<JACOBI>(&job.planes[..n], tx, rx, &mut points[..n], min_sum);
