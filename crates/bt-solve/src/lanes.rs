@@ -243,6 +243,8 @@ impl<'s> Group<'s> {
         let mut flat = [false; LANES];
         let mut new = [Points::default(); N];
         let mut prev = Points::splat(tx);
+        // `k` indexes the points, their successors and the planes alike.
+        #[allow(clippy::needless_range_loop)]
         for k in 0..n {
             let next = if k + 1 == n {
                 Points::splat(rx)
