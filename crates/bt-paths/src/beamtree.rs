@@ -211,10 +211,8 @@ struct Prepared<'a> {
     tol: Real,
     /// Each surface's plane, contiguous (the leaf test reads one per child).
     planes: Vec<Plane>,
-    /// Grown convex hull of each reflector (empty for blockers), once asked for.
-    hulls: Vec<OnceCell<Vec<Vec3>>>,
-    /// Whether each surface is convex (only convex surfaces cull), once asked for.
-    convex: Vec<OnceCell<bool>>,
+    /// Hulls and convexity, kept for the thread's next build of the same geometry.
+    shapes: Shapes,
     reflectors: Vec<u32>,
     /// Whether each surface reflects (children are reflectors only).
     is_reflector: Vec<bool>,
@@ -244,10 +242,10 @@ impl<'a> Prepared<'a> {
             Culling::Always => true,
             Culling::Auto { .. } => reflectors.len() > LINEAR_SCAN,
         };
+        let tol = scene.length_tolerance();
         Prepared {
             planes: surfaces.iter().map(|s| *s.polygon.plane()).collect(),
-            hulls: surfaces.iter().map(|_| OnceCell::new()).collect(),
-            convex: surfaces.iter().map(|_| OnceCell::new()).collect(),
+            shapes: Shapes::take(scene, GROW * tol),
             is_reflector: surfaces
                 .iter()
                 .map(|s| s.kind == SurfaceKind::Reflector)
@@ -255,7 +253,7 @@ impl<'a> Prepared<'a> {
             cull_at_build,
             rx_visible: None,
             scene,
-            tol: scene.length_tolerance(),
+            tol,
             reflectors,
             options,
         }
@@ -267,10 +265,10 @@ impl<'a> Prepared<'a> {
 
     /// The grown convex hull of surface `s` (empty for a blocker).
     fn hull(&self, s: u32) -> &[Vec3] {
-        self.hulls[s as usize].get_or_init(|| {
+        self.shapes.hulls[s as usize].get_or_init(|| {
             let surface = self.scene.surface(SurfaceId(s));
             match surface.kind {
-                SurfaceKind::Reflector => convex::grown_hull(&surface.polygon, GROW * self.tol),
+                SurfaceKind::Reflector => convex::grown_hull(&surface.polygon, self.shapes.margin),
                 SurfaceKind::Blocker => Vec::new(),
             }
         })
@@ -278,8 +276,55 @@ impl<'a> Prepared<'a> {
 
     /// Whether surface `s` is convex.
     fn is_convex(&self, s: u32) -> bool {
-        *self.convex[s as usize]
+        *self.shapes.convex[s as usize]
             .get_or_init(|| convex::is_convex(&self.scene.surface(SurfaceId(s)).polygon))
+    }
+}
+
+impl Drop for Prepared<'_> {
+    fn drop(&mut self) {
+        std::mem::take(&mut self.shapes).give_back();
+    }
+}
+
+/// Per-surface shapes derived from the geometry alone: each reflector's convex hull grown by
+/// `margin` (m) and each surface's convexity, computed on first use. A thread keeps the last
+/// build's for its next one of the same geometry ([`bt_scene::GeometryKey`]: a stream of
+/// receivers, a sweep, a benchmark), so that hulls are not rebuilt every trace.
+#[derive(Default)]
+struct Shapes {
+    geometry: Option<bt_scene::GeometryKey>,
+    margin: Real,
+    hulls: Vec<OnceCell<Vec<Vec3>>>,
+    convex: Vec<OnceCell<bool>>,
+}
+
+thread_local! {
+    static SHAPES: std::cell::RefCell<Shapes> = std::cell::RefCell::new(Shapes::default());
+}
+
+impl Shapes {
+    /// The thread's kept shapes when they are `scene`'s with the same `margin`, else fresh ones.
+    fn take(scene: &Scene, margin: Real) -> Shapes {
+        let kept = SHAPES.with(|s| std::mem::take(&mut *s.borrow_mut()));
+        let n = scene.surfaces().len();
+        if kept.margin == margin
+            && kept.hulls.len() == n
+            && kept.geometry.as_ref().is_some_and(|g| g.matches(scene))
+        {
+            return kept;
+        }
+        Shapes {
+            geometry: Some(scene.geometry_key()),
+            margin,
+            hulls: (0..n).map(|_| OnceCell::new()).collect(),
+            convex: (0..n).map(|_| OnceCell::new()).collect(),
+        }
+    }
+
+    /// Keep these shapes for the thread's next build.
+    fn give_back(self) {
+        SHAPES.with(|s| *s.borrow_mut() = self);
     }
 }
 

@@ -21,7 +21,7 @@ pub use description::{BoxDesc, MaterialDesc, SceneDescription, SurfaceDesc};
 pub use frame::RECENTRE_RATIO;
 pub use io::{LoadOptions, Loaded, Source, load, load_dynamic, load_with_progress};
 pub use material::{DEFAULT_MATERIAL, Material, default_materials};
-pub use model::{Scene, Surface, SurfaceId, SurfaceKind};
+pub use model::{GeometryKey, Scene, Surface, SurfaceId, SurfaceKind};
 pub use validate::{DEFAULT_FREQUENCY_HZ, Problem, SceneError, Terminals};
 
 /// Re-exported so users of the scene need not depend on the geometry crate for the basics.

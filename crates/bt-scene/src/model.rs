@@ -62,6 +62,19 @@ pub struct Scene {
     pub(crate) bvh: Arc<Bvh>,
 }
 
+/// The identity of a scene's surfaces ([`Scene::geometry_key`]). It holds no strong reference:
+/// the surfaces are freed with their last scene, while the key keeps their address from being
+/// reused, so a key never matches other geometry. Surfaces are never changed in place.
+#[derive(Debug, Clone)]
+pub struct GeometryKey(std::sync::Weak<Vec<Surface>>);
+
+impl GeometryKey {
+    /// Whether `scene` has exactly the surfaces this key was taken from.
+    pub fn matches(&self, scene: &Scene) -> bool {
+        self.0.strong_count() > 0 && std::ptr::eq(self.0.as_ptr(), Arc::as_ptr(&scene.surfaces))
+    }
+}
+
 impl Scene {
     /// Scene name.
     pub fn name(&self) -> &str {
@@ -70,6 +83,12 @@ impl Scene {
     /// All surfaces, reflectors and blockers; indexed by [`SurfaceId`].
     pub fn surfaces(&self) -> &[Surface] {
         &self.surfaces
+    }
+    /// The identity of this scene's surface geometry, shared by its copies with another
+    /// receiver, terminals or frequency ([`GeometryKey::matches`]): lets a caller keep data
+    /// derived from the surfaces alone across traces of the same geometry.
+    pub fn geometry_key(&self) -> GeometryKey {
+        GeometryKey(Arc::downgrade(&self.surfaces))
     }
     /// The surface with id `id`.
     #[inline]

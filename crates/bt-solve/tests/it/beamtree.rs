@@ -378,3 +378,50 @@ fn the_swinging_door_rebuilds_only_its_subtrees() {
     }
     assert!(reused > 0);
 }
+
+/// A set's sequences with their start points, for exact comparison.
+fn listing(set: &bt_paths::CandidateSet) -> Vec<(Vec<bt_scene::SurfaceId>, Option<Vec<Vec3>>)> {
+    (0..set.len())
+        .map(|i| (set.get(i).to_vec(), set.start(i).map(<[Vec3]>::to_vec)))
+        .collect()
+}
+
+/// A thread keeps the grown hulls of the geometry it last traced for its next trace of the same
+/// geometry: traces of other scenes in between (two steps of the dynamic living room: the same
+/// surfaces but the door moved), and copies of a scene with another receiver, give exactly the
+/// candidates (and start points) of a thread that starts afresh.
+#[test]
+fn kept_hulls_give_the_candidates_of_a_fresh_thread() {
+    let dynamic =
+        bt_scene::dynamic::builtin_dynamic_scene("living-room-dynamic", Terminals::default())
+            .unwrap()
+            .unwrap();
+    let (closed, open) = (dynamic.step(0), dynamic.step(dynamic.len() - 1));
+    assert_eq!(closed.surfaces().len(), open.surfaces().len());
+    let moved = closed
+        .with_receiver(closed.to_world(closed.rx() + Vec3::new(0.4, -0.3, 0.2)))
+        .unwrap();
+    let other = (0..50)
+        .find_map(|seed| nasty_scene(seed, 10, 0))
+        .expect("a scene");
+    let options = TreeOptions {
+        starts: true,
+        ..TreeOptions::new(3)
+    };
+    let fresh = |scene: &Scene| {
+        let scene = scene.clone();
+        std::thread::spawn(move || {
+            listing(&bt_paths::beamtree::candidates(&scene, options).unwrap())
+        })
+        .join()
+        .unwrap()
+    };
+    for (i, scene) in [closed, open, closed, &moved, &other, closed, open]
+        .into_iter()
+        .enumerate()
+    {
+        let here = listing(&bt_paths::beamtree::candidates(scene, options).unwrap());
+        assert!(here.len() > 1);
+        assert!(here == fresh(scene), "trace {i}: candidates differ");
+    }
+}
