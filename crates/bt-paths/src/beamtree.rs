@@ -372,6 +372,10 @@ struct Arenas {
     planes: Vec<Plane>,
 }
 
+/// Candidates a walk makes room for at once (a room at order 3 has about a hundred): the set
+/// then grows once or not at all instead of doubling from one.
+const RESERVED_CANDIDATES: usize = 256;
+
 /// The largest arenas a thread keeps between traces, bytes.
 const POOLED_BYTES: usize = 4 << 20;
 
@@ -473,6 +477,11 @@ impl BeamTree {
     /// the tree's options ask for them).
     pub fn candidates(&self, rx: Vec3) -> CandidateSet {
         let mut set = CandidateSet::with_starts();
+        set.reserve(
+            RESERVED_CANDIDATES,
+            RESERVED_CANDIDATES * self.max_order,
+            self.options.starts,
+        );
         set.push_with_starts(&[], &[]);
         let mut seq = Vec::with_capacity(self.max_order);
         let mut starts = Vec::with_capacity(self.max_order);
@@ -1247,21 +1256,24 @@ pub fn candidates_with_progress(
     (tree.nodes, tree.verts, tree.planes) = (arenas.nodes, arenas.verts, arenas.planes);
     let mut scratch = Scratch::default();
     let rx = scene.rx();
-    let mut last = CandidateSet::with_starts();
-    for depth in 1..=options.max_order {
-        if depth == options.max_order {
-            if worth_rx_visibility(&prep, &tree) {
-                prep.rx_visible = Some(rx_visibility(&prep, rx, &mut scratch, &mut tree.stats));
-            }
-            let mut leaf = Leaf::new(&prep, rx, &mut last);
-            tree.grow_level(&prep, depth, &mut scratch, Some(&mut leaf), progress)?;
-        } else {
-            tree.grow_level(&prep, depth, &mut scratch, None, progress)?;
-        }
+    for depth in 1..options.max_order {
+        tree.grow_level(&prep, depth, &mut scratch, None, progress)?;
     }
+    // The materialised levels' candidates first, then the last level's, tested against RX
+    // without being materialised, straight into the same set.
     let mut set = tree.candidates(rx);
-    for i in 0..last.len() {
-        push(&mut set, last.get(i), last.start(i).unwrap_or(&[]));
+    if options.max_order > 0 {
+        if worth_rx_visibility(&prep, &tree) {
+            prep.rx_visible = Some(rx_visibility(&prep, rx, &mut scratch, &mut tree.stats));
+        }
+        let mut leaf = Leaf::new(&prep, rx, &mut set);
+        tree.grow_level(
+            &prep,
+            options.max_order,
+            &mut scratch,
+            Some(&mut leaf),
+            progress,
+        )?;
     }
     set.stats = tree.candidate_stats(set.len() as u64);
     set.tree = Some(tree.stats.clone());

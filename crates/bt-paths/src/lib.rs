@@ -103,6 +103,15 @@ impl CandidateSet {
             ..CandidateSet::default()
         }
     }
+    /// Make room for `candidates` more candidates of `surfaces` surfaces in all, and for their
+    /// start points when `starts`.
+    pub fn reserve(&mut self, candidates: usize, surfaces: usize, starts: bool) {
+        self.offsets.reserve(candidates);
+        self.ids.reserve(surfaces);
+        if starts {
+            self.starts.reserve(surfaces);
+        }
+    }
     /// Append a candidate with its start points (`starts.len() == seq.len()`).
     pub fn push_with_starts(&mut self, seq: &[SurfaceId], starts: &[bt_geom::Vec3]) {
         debug_assert_eq!(seq.len(), starts.len());
