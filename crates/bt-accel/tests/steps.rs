@@ -6,7 +6,7 @@ use bt_accel::{
 };
 use bt_hls::{PlanOptions, ScheduleKind};
 use bt_scene::Terminals;
-use bt_scene::dynamic::builtin_dynamic_scene;
+use bt_scene::dynamic::{DynamicScene, builtin_dynamic_scene};
 use bt_schedule::GaParams;
 use bt_solve::pipeline::TraceOptions;
 
@@ -25,15 +25,20 @@ fn options(max_order: usize, warm_start: bool) -> StepOptions {
     }
 }
 
+/// The built-in dynamic living room with its own terminals.
+fn living_room() -> DynamicScene {
+    builtin_dynamic_scene("living-room-dynamic", Terminals::default())
+        .unwrap()
+        .unwrap()
+}
+
 fn rounds(p: &PlannedStep) -> u32 {
     p.results.iter().map(|r| r.rounds).sum()
 }
 
 #[test]
 fn warm_start_keeps_every_path_and_saves_rounds() {
-    let scene = builtin_dynamic_scene("living-room-dynamic", Terminals::default())
-        .unwrap()
-        .unwrap();
+    let scene = living_room();
     let steps = scene.scenes();
     let planes = static_reflectors(steps);
     // The door moves: it is no platform plane.
@@ -82,9 +87,7 @@ fn warm_start_keeps_every_path_and_saves_rounds() {
 fn a_ray_slipping_past_an_edge_is_decided_on_the_exact_points() {
     // Step 2 at order 3: two fixed-point paths pass 0.15 mm beside a blocker's edge that the
     // exact ray hits (ceiling, wall-south, ...); without the exact re-check they were spurious.
-    let scene = builtin_dynamic_scene("living-room-dynamic", Terminals::default())
-        .unwrap()
-        .unwrap();
+    let scene = living_room();
     let steps = scene.scenes();
     let planes = static_reflectors(steps);
     let p = plan_step(&steps[2], &planes, 2, &options(3, false), None).unwrap();
@@ -105,9 +108,7 @@ fn a_pe_budget_sizes_the_copies_once_for_every_step() {
     // With the list scheduler and a PE budget, the first step picks the copies (its busiest
     // planes) and the later steps are scheduled onto the same PEs: one platform, and no
     // later step slower than on a platform without copies.
-    let scene = builtin_dynamic_scene("living-room-dynamic", Terminals::default())
-        .unwrap()
-        .unwrap();
+    let scene = living_room();
     let steps = &scene.scenes()[..4];
     let planes = static_reflectors(scene.scenes());
     let mut with_copies = options(2, true);
@@ -153,9 +154,7 @@ fn a_pe_budget_sizes_the_copies_once_for_every_step() {
 fn red_black_rounds_halve_the_cold_start_and_keep_every_path() {
     // Step 0 at order 3 (no warm start): the same candidates, starts and PEs under both
     // orders; red-black needs about half the PE jobs and no exact path is missed or spurious.
-    let scene = builtin_dynamic_scene("living-room-dynamic", Terminals::default())
-        .unwrap()
-        .unwrap();
+    let scene = living_room();
     let steps = scene.scenes();
     let planes = static_reflectors(steps);
     let plan = |order| {

@@ -2,7 +2,7 @@
 
 use bt_geom::{Real, Vec3};
 use std::collections::HashMap;
-use std::hash::{BuildHasherDefault, Hasher};
+use std::hash::{BuildHasherDefault, Hash, Hasher};
 
 use rayon::prelude::*;
 
@@ -12,7 +12,25 @@ use rayon::prelude::*;
 pub(crate) struct VoxelIndex {
     cell: Real,
     order: Vec<u32>,
-    ranges: HashMap<[i64; 3], (u32, u32), BuildHasherDefault<KeyHasher>>,
+    ranges: KeyRanges<[i64; 3]>,
+}
+
+/// Where each key's run lies in a slice sorted by key: `key -> (start, end)`, end exclusive.
+pub(crate) type KeyRanges<K> = HashMap<K, (u32, u32), BuildHasherDefault<KeyHasher>>;
+
+/// The runs of equal keys in `keyed`, which must be sorted by key (the bucket index of a
+/// spatial hash: the items of one cell are `keyed[start..end]`).
+pub(crate) fn key_ranges<K: Copy + Ord + Hash>(keyed: &[(K, u32)]) -> KeyRanges<K> {
+    debug_assert!(keyed.is_sorted_by(|a, b| a.0 <= b.0));
+    let mut ranges = KeyRanges::default();
+    let mut start = 0;
+    for i in 1..=keyed.len() {
+        if i == keyed.len() || keyed[i].0 != keyed[start].0 {
+            ranges.insert(keyed[start].0, (start as u32, i as u32));
+            start = i;
+        }
+    }
+    ranges
 }
 
 /// Multiply-rotate hasher for voxel keys: lookups dominate neighbour queries and the
@@ -55,18 +73,10 @@ impl VoxelIndex {
             .map(|(i, p)| (voxel_key(*p, cell), i as u32))
             .collect();
         keyed.par_sort_unstable();
-        let mut ranges = HashMap::default();
-        let mut start = 0;
-        for i in 1..=keyed.len() {
-            if i == keyed.len() || keyed[i].0 != keyed[start].0 {
-                ranges.insert(keyed[start].0, (start as u32, i as u32));
-                start = i;
-            }
-        }
         Self {
             cell,
+            ranges: key_ranges(&keyed),
             order: keyed.into_iter().map(|(_, i)| i).collect(),
-            ranges,
         }
     }
 

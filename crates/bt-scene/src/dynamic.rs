@@ -744,6 +744,15 @@ mod tests {
         assert_eq!(moved_surfaces(d.step(0), &s), Some(vec![]));
     }
 
+    /// Every problem `desc` is refused with, as printed.
+    fn problem_texts(desc: &SceneDescription) -> Vec<String> {
+        let err = DynamicScene::from_description(desc, "t", Terminals::default()).unwrap_err();
+        let SceneError::Invalid { problems, .. } = &err else {
+            panic!("{err}")
+        };
+        problems.iter().map(|p| p.to_string()).collect()
+    }
+
     #[test]
     fn problems_are_all_reported() {
         let mut desc = door_scene(
@@ -751,11 +760,7 @@ mod tests {
         );
         desc.objects.get_mut("door").unwrap().keyframes[1].step = 7;
         desc.tx_steps = Some(vec![[1.0, 1.0, 1.0]]);
-        let err = DynamicScene::from_description(&desc, "t", Terminals::default()).unwrap_err();
-        let SceneError::Invalid { problems, .. } = err else {
-            panic!()
-        };
-        let text: Vec<String> = problems.iter().map(|p| p.to_string()).collect();
+        let text = problem_texts(&desc);
         let has = |s: &str| text.iter().any(|t| t.contains(s));
         assert!(has("tx_steps: has 1 positions"), "{text:#?}");
         assert!(has("objects.door.keyframes[1].step: is 7"), "{text:#?}");
@@ -764,11 +769,7 @@ mod tests {
         desc.objects.get_mut("door").unwrap().keyframes[1].step = 3;
         desc.objects.get_mut("spin").unwrap().pivot = Some([0.0; 3]);
         desc.tx_steps = None;
-        let err = DynamicScene::from_description(&desc, "t", Terminals::default()).unwrap_err();
-        let SceneError::Invalid { problems, .. } = err else {
-            panic!()
-        };
-        let text: Vec<String> = problems.iter().map(|p| p.to_string()).collect();
+        let text = problem_texts(&desc);
         let has = |s: &str| text.iter().any(|t| t.contains(s));
         assert!(has("objects.ghost: has no members"), "{text:#?}");
         assert!(

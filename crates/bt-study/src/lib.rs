@@ -68,3 +68,14 @@ pub enum StudyError {
         message: String,
     },
 }
+
+impl StudyError {
+    /// Refuses settings with any problem, naming every one (both studies' `problems()`).
+    pub(crate) fn check_settings(problems: Vec<String>) -> Result<(), StudyError> {
+        if problems.is_empty() {
+            Ok(())
+        } else {
+            Err(StudyError::Config(problems.join("; ")))
+        }
+    }
+}

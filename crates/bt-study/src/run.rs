@@ -389,10 +389,7 @@ pub fn run(
     config: &StudyConfig,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<StudyResults, StudyError> {
-    let problems = config.problems();
-    if !problems.is_empty() {
-        return Err(StudyError::Config(problems.join("; ")));
-    }
+    StudyError::check_settings(config.problems())?;
     let total = config.rooms * config.steps;
     let mut rows = Vec::with_capacity(total * StudySolver::ALL.len());
     let mut drawings = Vec::new();

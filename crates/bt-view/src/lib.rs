@@ -1,5 +1,5 @@
 //! A 3-D viewer of a scene and its paths as ONE self-contained HTML page: three.js (vendored,
-//! `assets/`) and the viewer script are inlined, the data is a JSON document inside
+//! `vendor/`) and the viewer script are inlined, the data is a JSON document inside
 //! `<script type="application/json">` read with `textContent` — names from the scene are data
 //! and never reach HTML markup (the script writes them with `textContent` only).
 //!
@@ -13,7 +13,7 @@ use bt_geom::Real;
 use bt_scene::{Scene, SurfaceKind};
 use serde::{Deserialize, Serialize};
 
-const THREE: &str = include_str!("../assets/three.bundle.min.js");
+const THREE: &str = include_str!("../vendor/three.bundle.min.js");
 const VIEWER: &str = include_str!("../assets/viewer.js");
 const TEMPLATE: &str = include_str!("../assets/page.html");
 

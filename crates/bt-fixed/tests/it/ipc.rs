@@ -9,9 +9,14 @@ fn floor() -> PlaneInput {
     }
 }
 
+/// One path bouncing once off the floor from `start`, 16 LSB threshold.
+fn floor_bounce(start: [f64; 3], max_rounds: u32) -> FixedIpc {
+    FixedIpc::new(&[floor()], &[vec![0]], &[vec![start]], 16, max_rounds).unwrap()
+}
+
 #[test]
 fn single_floor_bounce_converges_to_the_mirror_point() {
-    let ipc = FixedIpc::new(&[floor()], &[vec![0]], &[vec![[0.5, 0.5, 0.0]]], 16, 50).unwrap();
+    let ipc = floor_bounce([0.5, 0.5, 0.0], 50);
     let r = &ipc.run([0.0, 0.0, 1.0], [3.0, 0.0, 2.0]).unwrap()[0];
     assert!(
         matches!(r.outcome(), FixedOutcome::Converged { rounds: 1 | 2 }),
@@ -24,7 +29,7 @@ fn single_floor_bounce_converges_to_the_mirror_point() {
 
 #[test]
 fn zero_budget_returns_the_initial_points() {
-    let ipc = FixedIpc::new(&[floor()], &[vec![0]], &[vec![[0.5, 0.5, 0.0]]], 16, 0).unwrap();
+    let ipc = floor_bounce([0.5, 0.5, 0.0], 0);
     let r = &ipc.run([0.0, 0.0, 1.0], [3.0, 0.0, 2.0]).unwrap()[0];
     assert_eq!(
         r.outcome(),
@@ -38,7 +43,7 @@ fn zero_budget_returns_the_initial_points() {
 
 #[test]
 fn terminals_on_the_plane_are_degenerate_not_a_panic() {
-    let ipc = FixedIpc::new(&[floor()], &[vec![0]], &[vec![[0.5, 0.5, 0.0]]], 16, 50).unwrap();
+    let ipc = floor_bounce([0.5, 0.5, 0.0], 50);
     let r = &ipc.run([0.0, 0.0, 0.0], [1.0, 0.0, 0.0]).unwrap()[0];
     assert_eq!(
         r.outcome(),
@@ -118,7 +123,7 @@ fn validation_reports_every_problem() {
 #[test]
 fn early_stopping_freezes_a_point_outside_its_box_and_nothing_else() {
     // The mirror point is x = 1 m; a floor patch x in [0, 0.5] m does not hold it.
-    let ipc = || FixedIpc::new(&[floor()], &[vec![0]], &[vec![[0.25, 0.0, 0.0]]], 16, 50).unwrap();
+    let ipc = || floor_bounce([0.25, 0.0, 0.0], 50);
     let stop = EarlyStop {
         min_rounds: 1,
         ..EarlyStop::default()
@@ -161,7 +166,7 @@ fn early_stopping_freezes_a_point_outside_its_box_and_nothing_else() {
 
 #[test]
 fn early_stopping_settings_are_validated() {
-    let ipc = FixedIpc::new(&[floor()], &[vec![0]], &[vec![[0.5, 0.5, 0.0]]], 16, 50).unwrap();
+    let ipc = floor_bounce([0.5, 0.5, 0.0], 50);
     let bad = EarlyStop {
         min_rounds: 0,
         displacement_shift: 5,
@@ -181,7 +186,7 @@ fn early_stopping_settings_are_validated() {
 /// exercised by `widths::widths_hold_at_the_corners`.)
 #[test]
 fn a_narrow_coordinate_word_agrees_inside_refuses_outside_and_saturates() {
-    let ipc = || FixedIpc::new(&[floor()], &[vec![0]], &[vec![[0.5, 0.5, 0.0]]], 16, 50).unwrap();
+    let ipc = || floor_bounce([0.5, 0.5, 0.0], 50);
     let narrow = ipc().with_coord_bits(24).unwrap();
     assert_eq!(narrow.coord_bits(), 24);
     let (tx, rx) = ([0.0, 0.0, 1.0], [3.0, 0.0, 2.0]);

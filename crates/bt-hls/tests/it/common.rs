@@ -129,14 +129,15 @@ pub fn generated() -> &'static Generated {
     })
 }
 
-/// `crates/bt-hls/testdata`.
-pub fn testdata() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("testdata")
+/// `testdata/golden/rtl` at the repository root: the generator's golden outputs.
+pub fn golden_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../testdata/golden/rtl")
 }
 
-/// Compares `actual` with the golden file `testdata/<name>`; `UPDATE_GOLDEN=1` rewrites it.
+/// Compares `actual` with the golden file `testdata/golden/rtl/<name>`; `UPDATE_GOLDEN=1`
+/// rewrites it.
 pub fn golden(name: &str, actual: &str) {
-    let path = testdata().join(name);
+    let path = golden_dir().join(name);
     if std::env::var_os("UPDATE_GOLDEN").is_some() {
         if let Some(dir) = path.parent() {
             std::fs::create_dir_all(dir).unwrap();

@@ -1,6 +1,6 @@
 //! A golden file for every module the generator emits: the small scene's PEs and `bt_top`
-//! (`testdata/rtl/small_scene/<module>.v`), and with early stopping, which adds the box logic
-//! to `bt_top` only (`testdata/rtl/small_scene_early/bt_top.v`; its PEs must equal the plain
+//! (`testdata/golden/rtl/small_scene/<module>.v`), and with early stopping, which adds the box logic
+//! to `bt_top` only (`testdata/golden/rtl/small_scene_early/bt_top.v`; its PEs must equal the plain
 //! design's).
 //! A change of the generated Verilog fails here; `UPDATE_GOLDEN=1 cargo test -p bt-hls --test it
 //! golden_rtl` rewrites the files after a deliberate change (review the diff).
@@ -14,12 +14,12 @@ fn modules(input: HlsInput) -> Vec<(String, String)> {
     bt_hls::rtl_modules(&platform).unwrap()
 }
 
-/// Golden-checks `modules` in `testdata/rtl/<design>/` and that no golden file is stale.
+/// Golden-checks `modules` in `testdata/golden/rtl/<design>/` and that no golden file is stale.
 fn check_design(design: &str, modules: &[(String, String)]) {
     for (name, text) in modules {
-        golden(&format!("rtl/{design}/{name}.v"), text);
+        golden(&format!("{design}/{name}.v"), text);
     }
-    let dir = testdata().join("rtl").join(design);
+    let dir = golden_dir().join(design);
     for entry in std::fs::read_dir(&dir).unwrap() {
         let file = entry.unwrap().file_name().into_string().unwrap();
         let stem = file.strip_suffix(".v").unwrap_or(&file);

@@ -9,6 +9,7 @@
 //! simplicity is checked and falls back to the previous, valid polygon.
 
 use crate::tol;
+use bt_geom::convex::hull_2d;
 pub(crate) use bt_geom::poly2::{is_simple, signed_area};
 use bt_geom::{Real, Vec2};
 
@@ -20,35 +21,6 @@ const MAX_CELLS: Real = 4.0e6;
 pub(crate) struct Line2 {
     pub p: Vec2,
     pub d: Vec2,
-}
-
-/// Convex hull (Andrew's monotone chain), counter-clockwise, without collinear points.
-pub(crate) fn convex_hull(points: &[Vec2]) -> Vec<Vec2> {
-    let mut p: Vec<Vec2> = points.to_vec();
-    p.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
-    p.dedup();
-    if p.len() < 3 {
-        return p;
-    }
-    let mut h: Vec<Vec2> = Vec::with_capacity(2 * p.len());
-    for pass in 0..2 {
-        let start = h.len();
-        let iter: Box<dyn Iterator<Item = &Vec2>> = if pass == 0 {
-            Box::new(p.iter())
-        } else {
-            Box::new(p.iter().rev())
-        };
-        for &q in iter {
-            while h.len() >= start + 2
-                && (h[h.len() - 1] - h[h.len() - 2]).perp_dot(q - h[h.len() - 2]) <= 0.0
-            {
-                h.pop();
-            }
-            h.push(q);
-        }
-        h.pop();
-    }
-    h
 }
 
 /// Minimum-area enclosing rectangle of a convex hull: `(angle_rad, width, length)` where
@@ -219,7 +191,7 @@ fn simplify_closed(poly: &[Vec2], tolerance: Real) -> Vec<Vec2> {
 /// Boundary of the points `pts` (patch frame, metres): a simple counter-clockwise polygon,
 /// or `None` if the points do not cover at least one raster cell's worth of area.
 pub(crate) fn patch_boundary(pts: &[Vec2], cell: Real, simplify_tol: Real) -> Option<Vec<Vec2>> {
-    let hull = convex_hull(pts);
+    let hull = hull_2d(pts);
     if hull.len() < 3 {
         return None;
     }
@@ -614,7 +586,7 @@ mod tests {
             Vec2::new(0.0, 1.0),
             Vec2::new(1.0, 0.5),
         ];
-        let h = convex_hull(&pts);
+        let h = hull_2d(&pts);
         assert_eq!(h.len(), 4);
         assert!(signed_area(&h) > 0.0);
         let (_, w, l) = min_area_rect(&h);

@@ -19,12 +19,12 @@
 //! (uncontested) side of each layer. Otherwise both patches stay as RANSAC left them.
 
 use bt_geom::{Real, Vec2, Vec3};
-use std::collections::HashMap;
 
 use rayon::prelude::*;
 
 use super::{RawPatch, frame};
 use crate::linalg::fit_plane;
+use crate::spatial::{KeyRanges, key_ranges};
 use crate::tol;
 
 /// Rounds of assignment and refit per pair.
@@ -384,7 +384,7 @@ fn outer_sigma(
 struct Grid {
     radius: Real,
     keyed: Vec<((i64, i64), u32)>,
-    cells: HashMap<(i64, i64), (usize, usize)>,
+    cells: KeyRanges<(i64, i64)>,
 }
 
 impl Grid {
@@ -399,18 +399,10 @@ impl Grid {
             .map(|(k, p)| (Self::key(*p, radius), k as u32))
             .collect();
         keyed.sort_unstable();
-        let mut cells = HashMap::new();
-        let mut s = 0;
-        for k in 1..=keyed.len() {
-            if k == keyed.len() || keyed[k].0 != keyed[s].0 {
-                cells.insert(keyed[s].0, (s, k));
-                s = k;
-            }
-        }
         Self {
             radius,
+            cells: key_ranges(&keyed),
             keyed,
-            cells,
         }
     }
 
@@ -422,7 +414,7 @@ impl Grid {
         for di in -1..=1 {
             for dj in -1..=1 {
                 if let Some(&(s, e)) = self.cells.get(&(ci + di, cj + dj)) {
-                    for &(_, m) in &self.keyed[s..e] {
+                    for &(_, m) in &self.keyed[s as usize..e as usize] {
                         if m as usize != k && flat[m as usize].distance_squared(q) <= r2 {
                             f(m);
                         }

@@ -34,7 +34,8 @@ use crate::error::PointCloudError;
 use crate::linalg::fit_plane;
 use crate::spatial::VoxelIndex;
 use crate::tol;
-use boundary::{convex_hull, min_area_rect, patch_boundary, signed_area};
+use boundary::{min_area_rect, patch_boundary, signed_area};
+use bt_geom::convex::hull_2d;
 use snap::PatchGeom;
 
 /// Parameters of [`extract_planes`]. Lengths in metres, angles in degrees. The defaults
@@ -758,7 +759,7 @@ fn finish_planes(
     let mut planes = Vec::new();
     for ((g, poly), (count, rms, plane)) in geoms.iter().zip(snapped).zip(meta) {
         let area = signed_area(&poly);
-        let (_, width, _) = min_area_rect(&convex_hull(&poly));
+        let (_, width, _) = min_area_rect(&hull_2d(&poly));
         if !(area > 0.0 && area.is_finite()) || width < params.min_patch_width_m {
             dropped.add(count);
             continue;

@@ -3,7 +3,7 @@
 
 use bt_scene::dynamic::{DynamicScene, MAX_STEPS, MAX_SURFACE_STEPS};
 use bt_scene::io::parse_json;
-use bt_scene::{SceneError, Terminals};
+use bt_scene::{SceneDescription, SceneError, Terminals};
 
 fn regression(name: &str) -> String {
     let path = format!(
@@ -13,22 +13,26 @@ fn regression(name: &str) -> String {
     std::fs::read_to_string(&path).unwrap_or_else(|e| panic!("{path}: {e}"))
 }
 
-/// A 150-byte file with `"steps": 4000000000` made `DynamicScene::from_description` reserve
-/// one `Scene` per step up front: a 735 GB allocation and an abort.
-#[test]
-fn huge_step_count_is_a_problem_not_an_allocation() {
-    let desc = parse_json(&regression("huge-steps.json"), "huge-steps.json").unwrap();
-    let err =
-        DynamicScene::from_description(&desc, "huge-steps.json", Terminals::default()).unwrap_err();
+/// `desc` is refused with a problem at `steps` that names `limit`.
+fn assert_steps_refused(desc: &SceneDescription, file: &str, limit: impl std::fmt::Display) {
+    let err = DynamicScene::from_description(desc, file, Terminals::default()).unwrap_err();
     let SceneError::Invalid { problems, .. } = &err else {
         panic!("{err}")
     };
     assert!(
         problems
             .iter()
-            .any(|p| p.location == "steps" && p.message.contains(&MAX_STEPS.to_string())),
+            .any(|p| p.location == "steps" && p.message.contains(&limit.to_string())),
         "{err}"
     );
+}
+
+/// A 150-byte file with `"steps": 4000000000` made `DynamicScene::from_description` reserve
+/// one `Scene` per step up front: a 735 GB allocation and an abort.
+#[test]
+fn huge_step_count_is_a_problem_not_an_allocation() {
+    let desc = parse_json(&regression("huge-steps.json"), "huge-steps.json").unwrap();
+    assert_steps_refused(&desc, "huge-steps.json", MAX_STEPS);
 }
 
 #[test]
@@ -45,18 +49,7 @@ fn step_count_at_the_limit_is_accepted() {
 fn many_surfaces_times_many_steps_is_a_problem_not_an_allocation() {
     let text = regression("many-surface-steps.json");
     let desc = parse_json(&text, "many-surface-steps.json").unwrap();
-    let err =
-        DynamicScene::from_description(&desc, "many-surface-steps.json", Terminals::default())
-            .unwrap_err();
-    let SceneError::Invalid { problems, .. } = &err else {
-        panic!("{err}")
-    };
-    assert!(
-        problems
-            .iter()
-            .any(|p| p.location == "steps" && p.message.contains(&MAX_SURFACE_STEPS.to_string())),
-        "{err}"
-    );
+    assert_steps_refused(&desc, "many-surface-steps.json", MAX_SURFACE_STEPS);
     // The same boxes over fewer steps are fine.
     let mut desc = desc;
     desc.steps = Some(10);

@@ -415,10 +415,7 @@ pub fn run(
     config: &LivingRoomConfig,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<LivingRoomResults, StudyError> {
-    let problems = config.problems();
-    if !problems.is_empty() {
-        return Err(StudyError::Config(problems.join("; ")));
-    }
+    StudyError::check_settings(config.problems())?;
     let solver_config = config.solver_config();
     let steps = scene.len();
     let drawn = drawn_steps(steps);

@@ -66,6 +66,19 @@ pub fn assert_refused_writing_nothing(args: &[&str], out: &Path, needles: &[&str
     assert!(!out.exists(), "{args:?} wrote {}", out.display());
 }
 
+/// A clear refusal ([`assert_refused`]) of a run that left `file` byte for byte as it was
+/// (an input it was asked to overwrite).
+pub fn assert_refused_keeping(args: &[&str], file: &Path, needles: &[&str]) {
+    let before = std::fs::read(file).unwrap();
+    assert_refused(&beamtrace(args), needles);
+    assert_eq!(
+        std::fs::read(file).unwrap(),
+        before,
+        "{args:?} changed {}",
+        file.display()
+    );
+}
+
 pub fn assert_ok(o: &Output) {
     assert!(o.status.success(), "exit {:?}:\n{}", o.status, text(o));
 }

@@ -84,23 +84,26 @@ fn sampled_cloud(dir: &std::path::Path) -> std::path::PathBuf {
 fn extract_refuses_to_overwrite_its_input() {
     let dir = scratch("extract-same");
     let cloud = sampled_cloud(&dir);
-    let before = std::fs::read(&cloud).unwrap();
     let c = cloud.to_str().unwrap();
-    let r = beamtrace(&["extract", c, "-o", c]);
-    assert_refused(&r, &["refusing to write", "it is the input"]);
-    assert_eq!(std::fs::read(&cloud).unwrap(), before);
+    assert_refused_keeping(
+        &["extract", c, "-o", c],
+        &cloud,
+        &["refusing to write", "it is the input"],
+    );
     // Another spelling of the same file.
     let other = dir.join(".").join("room.ply");
-    let r = beamtrace(&[
-        "extract",
-        c,
-        "--report",
-        other.to_str().unwrap(),
-        "-o",
-        dir.join("s.json").to_str().unwrap(),
-    ]);
-    assert_refused(&r, &["it is the input"]);
-    assert_eq!(std::fs::read(&cloud).unwrap(), before);
+    assert_refused_keeping(
+        &[
+            "extract",
+            c,
+            "--report",
+            other.to_str().unwrap(),
+            "-o",
+            dir.join("s.json").to_str().unwrap(),
+        ],
+        &cloud,
+        &["it is the input"],
+    );
 }
 
 #[test]
@@ -143,10 +146,8 @@ fn trace_out_refuses_the_scene_file_and_other_formats() {
     let dir = scratch("trace-out");
     let scene = dir.join("scene.json");
     std::fs::copy(one_wall(), &scene).unwrap();
-    let before = std::fs::read(&scene).unwrap();
     let s = scene.to_str().unwrap();
-    assert_refused(&beamtrace(&["trace", s, "--out", s]), &["it is the input"]);
-    assert_eq!(std::fs::read(&scene).unwrap(), before);
+    assert_refused_keeping(&["trace", s, "--out", s], &scene, &["it is the input"]);
     let csv = dir.join("paths.csv");
     assert_refused_writing_nothing(
         &["trace", s, "--out", csv.to_str().unwrap()],
@@ -162,10 +163,8 @@ fn trace_out_refuses_the_scene_file_and_other_formats() {
 fn sample_refuses_to_overwrite_its_input_and_leaves_no_temporary() {
     let dir = scratch("sample-same");
     let cloud = sampled_cloud(&dir);
-    let before = std::fs::read(&cloud).unwrap();
     let c = cloud.to_str().unwrap();
-    assert_refused(&beamtrace(&["sample", c, "-o", c]), &["it is the input"]);
-    assert_eq!(std::fs::read(&cloud).unwrap(), before);
+    assert_refused_keeping(&["sample", c, "-o", c], &cloud, &["it is the input"]);
     assert_eq!(tree(&dir), ["room.ply"]);
 }
 
