@@ -131,13 +131,12 @@ impl Bvh {
 #[inline]
 pub fn box_meets_halfspaces(min: Vec3, max: Vec3, planes: &[crate::Plane], eps: Real) -> bool {
     planes.iter().all(|p| {
-        // the box corner furthest along the normal
-        let far = Vec3::new(
-            if p.normal.x >= 0.0 { max.x } else { min.x },
-            if p.normal.y >= 0.0 { max.y } else { min.y },
-            if p.normal.z >= 0.0 { max.z } else { min.z },
-        );
-        p.signed_distance_unfused(far) >= -eps
+        // The distance of the box corner furthest along the normal, without branching on the
+        // normal's signs: per axis the larger of the two products is the far corner's (a
+        // product with a non-negative factor is monotone under rounding), summed in
+        // `dot`'s order, so the value is exactly `signed_distance_unfused(far)`.
+        let far = (p.normal * min).max(p.normal * max);
+        far.x + far.y + far.z - p.offset >= -eps
     })
 }
 
