@@ -290,7 +290,8 @@ impl Drop for Prepared<'_> {
 /// Per-surface shapes derived from the geometry alone: each reflector's convex hull grown by
 /// `margin` (m) and each surface's convexity, computed on first use. A thread keeps the last
 /// build's for its next one of the same geometry ([`bt_scene::GeometryKey`]: a stream of
-/// receivers, a sweep, a benchmark), so that hulls are not rebuilt every trace.
+/// receivers, a sweep, a benchmark), so that hulls are not rebuilt every trace. Unlike the
+/// [`Arenas`], they are kept whatever their size: they grow with the scene, not with a tree.
 #[derive(Default)]
 struct Shapes {
     geometry: Option<bt_scene::GeometryKey>,
@@ -300,13 +301,13 @@ struct Shapes {
 }
 
 thread_local! {
-    static SHAPES: std::cell::RefCell<Shapes> = std::cell::RefCell::new(Shapes::default());
+    static SHAPES: std::cell::Cell<Shapes> = std::cell::Cell::new(Shapes::default());
 }
 
 impl Shapes {
     /// The thread's kept shapes when they are `scene`'s with the same `margin`, else fresh ones.
     fn take(scene: &Scene, margin: Real) -> Shapes {
-        let kept = SHAPES.with(|s| std::mem::take(&mut *s.borrow_mut()));
+        let kept = SHAPES.take();
         let n = scene.surfaces().len();
         if kept.margin == margin
             && kept.hulls.len() == n
@@ -324,7 +325,7 @@ impl Shapes {
 
     /// Keep these shapes for the thread's next build.
     fn give_back(self) {
-        SHAPES.with(|s| *s.borrow_mut() = self);
+        SHAPES.set(self);
     }
 }
 
