@@ -238,7 +238,10 @@ impl<'s> Group<'s> {
         (tx, rx): (Vec3, Vec3),
         min_sum: Real,
     ) -> [Result<Real, usize>; LANES] {
-        let n = self.n.min(N);
+        // The common orders run with `N` = the chain length, a constant: the loop unrolls and
+        // the points are written back without a call to `memcpy`.
+        let n = if N < MAX_ORDER { N } else { self.n };
+        debug_assert_eq!(n, self.n);
         let mut moved = [0.0; LANES];
         let mut flat = [false; LANES];
         let mut new = [Points::default(); N];
@@ -263,7 +266,9 @@ impl<'s> Group<'s> {
         if flat.iter().any(|&f| f) {
             return self.rerun_flat::<JACOBI>(&new[..n], flat, moved, (tx, rx), min_sum);
         }
-        self.points[..n].copy_from_slice(&new[..n]);
+        for (k, points) in new[..n].iter().enumerate() {
+            self.points[k] = *points;
+        }
         moved.map(Ok)
     }
 
