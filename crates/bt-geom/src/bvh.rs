@@ -58,13 +58,23 @@ impl Bvh {
         Self { nodes, order }
     }
 
-    /// Calls `hit(item)` for every item whose box the segment `a -> b` touches, stopping at and
-    /// returning the first item for which `hit` returns true.
+    /// Calls `hit(item)` for every item whose box, grown by `margin` metres on every side, the
+    /// segment `a -> b` touches, stopping at and returning the first item for which `hit`
+    /// returns true. Exact tests that accept points within a tolerance of a polygon (such as
+    /// [`crate::Polygon::blocks_segment`]) need a margin of at least that tolerance: their
+    /// hits may lie outside the polygon's box. (The growth is folded into the segment's start,
+    /// so it costs nothing per box; it is exact up to one rounding of `a ± margin`, so pass
+    /// some slack, e.g. twice the tolerance.)
     #[inline(always)]
-    pub fn any_hit(&self, a: Vec3, b: Vec3, hit: impl FnMut(u32) -> bool) -> Option<u32> {
-        let d = b - a;
-        let inv = Vec3::new(1.0 / d.x, 1.0 / d.y, 1.0 / d.z);
-        self.walk(|min, max| segment_hits_box(a, inv, min, max), hit)
+    pub fn any_hit(
+        &self,
+        a: Vec3,
+        b: Vec3,
+        margin: Real,
+        hit: impl FnMut(u32) -> bool,
+    ) -> Option<u32> {
+        let slab = Slab::new(a, b, margin);
+        self.walk(|min, max| slab.hits_box(min, max), hit)
     }
 
     /// The one traversal: descend into nodes whose box passes `box_test`, call `hit` on the
@@ -117,12 +127,12 @@ impl Bvh {
         });
     }
 
-    /// Calls `visit(item)` for every item whose box the segment `a -> b` touches.
+    /// Calls `visit(item)` for every item whose box, grown by `margin` metres, the segment
+    /// `a -> b` touches (see [`Bvh::any_hit`]).
     #[inline]
-    pub fn visit_segment(&self, a: Vec3, b: Vec3, visit: impl FnMut(u32)) {
-        let d = b - a;
-        let inv = Vec3::new(1.0 / d.x, 1.0 / d.y, 1.0 / d.z);
-        self.visit(|min, max| segment_hits_box(a, inv, min, max), visit);
+    pub fn visit_segment(&self, a: Vec3, b: Vec3, margin: Real, visit: impl FnMut(u32)) {
+        let slab = Slab::new(a, b, margin);
+        self.visit(|min, max| slab.hits_box(min, max), visit);
     }
 }
 
@@ -183,16 +193,42 @@ fn build_node(
     index
 }
 
-#[inline]
-fn segment_hits_box(a: Vec3, inv: Vec3, min: Vec3, max: Vec3) -> bool {
-    let t0 = (min - a) * inv;
-    let t1 = (max - a) * inv;
-    let lo = t0.min(t1);
-    let hi = t0.max(t1);
-    // NaN (0 * inf on a box face) is treated as "no constraint" by max/min with the bounds.
-    let enter = lo.x.max(lo.y).max(lo.z).max(0.0 as Real);
-    let exit = hi.x.min(hi.y).min(hi.z).min(1.0);
-    enter <= exit
+/// The slab test of a segment against boxes grown by a margin.
+struct Slab {
+    /// The segment's start moved by `+margin` and `-margin` on every axis: a box face at `min`
+    /// grown to `min - margin` is crossed where `min - (a + margin)` is, and likewise for `max`.
+    from_min: Vec3,
+    from_max: Vec3,
+    /// 1 / (b - a) per axis (infinite on axes the segment does not move along).
+    inv: Vec3,
+}
+
+impl Slab {
+    #[inline(always)]
+    fn new(a: Vec3, b: Vec3, margin: Real) -> Self {
+        let d = b - a;
+        let m = Vec3::splat(margin);
+        Slab {
+            from_min: a + m,
+            from_max: a - m,
+            inv: Vec3::new(1.0 / d.x, 1.0 / d.y, 1.0 / d.z),
+        }
+    }
+
+    /// Whether the segment touches the box `min..max` grown by the margin (inclusive).
+    #[inline(always)]
+    fn hits_box(&self, min: Vec3, max: Vec3) -> bool {
+        let t0 = (min - self.from_min) * self.inv;
+        let t1 = (max - self.from_max) * self.inv;
+        let lo = t0.min(t1);
+        let hi = t0.max(t1);
+        // NaN (0 * inf: a segment that runs exactly in the plane of a grown face) is dropped by
+        // min/max, and the box is missed: the segment then lies exactly the margin away from
+        // the box, beyond any tolerance the margin covers.
+        let enter = lo.x.max(lo.y).max(lo.z).max(0.0 as Real);
+        let exit = hi.x.min(hi.y).min(hi.z).min(1.0);
+        enter <= exit
+    }
 }
 
 #[cfg(test)]
@@ -210,6 +246,23 @@ mod tests {
         .unwrap()
     }
 
+    /// The walls `blocks_segment` (tolerance `tol`) accepts for `a -> b`: all of them, and
+    /// those the BVH with a margin of twice the tolerance offers.
+    fn brute_and_bvh(walls: &[Polygon], bvh: &Bvh, (a, b): (Vec3, Vec3)) -> (Vec<u32>, Vec<u32>) {
+        let tol = 1e-9;
+        let blocks = |i: u32| walls[i as usize].blocks_segment(a, b, tol, tol);
+        let brute: Vec<u32> = (0..walls.len() as u32).filter(|&i| blocks(i)).collect();
+        let mut seen = Vec::new();
+        bvh.any_hit(a, b, 2.0 * tol, |i| {
+            if blocks(i) {
+                seen.push(i);
+            }
+            false
+        });
+        seen.sort();
+        (brute, seen)
+    }
+
     #[test]
     fn finds_the_same_hits_as_brute_force() {
         let walls: Vec<Polygon> = (0..37).map(|i| quad(i as Real * 0.5)).collect();
@@ -217,19 +270,31 @@ mod tests {
         for k in 0..50 {
             let a = Vec3::new(k as Real * 0.37 - 1.0, 0.5, 0.5);
             let b = a + Vec3::new(0.9, 0.1, 0.05);
-            let mut brute: Vec<u32> = (0..walls.len() as u32)
-                .filter(|&i| walls[i as usize].blocks_segment(a, b, 1e-9, 1e-9))
-                .collect();
-            let mut seen = Vec::new();
-            bvh.any_hit(a, b, |i| {
-                if walls[i as usize].blocks_segment(a, b, 1e-9, 1e-9) {
-                    seen.push(i);
-                }
-                false
-            });
-            brute.sort();
-            seen.sort();
+            let (brute, seen) = brute_and_bvh(&walls, &bvh, (a, b));
             assert_eq!(brute, seen, "segment {k}");
+        }
+    }
+
+    #[test]
+    fn finds_hits_within_the_tolerance_outside_the_boxes() {
+        // Segments that pass just outside the walls' edges (inside the tolerance, so
+        // `blocks_segment` accepts them), along an edge and obliquely, and ones just beyond it.
+        let walls: Vec<Polygon> = (0..37).map(|i| quad(i as Real * 0.5)).collect();
+        let bvh = Bvh::build(&walls);
+        for off in [0.0, 0.5e-9, 0.99e-9, 1.5e-9, 3e-9] {
+            let along = (
+                Vec3::new(0.1, 1.0 + off, 0.5),
+                Vec3::new(17.9, 1.0 + off, 0.5),
+            );
+            let oblique = (
+                Vec3::new(0.2, 0.9 + off, -0.2),
+                Vec3::new(0.8, 1.1 + off, 1.0 + off),
+            );
+            for (what, seg) in [("along", along), ("oblique", oblique)] {
+                let (brute, seen) = brute_and_bvh(&walls, &bvh, seg);
+                assert_eq!(brute, seen, "{what} segment at {off} m beyond the edge");
+                assert_eq!(brute.is_empty(), off > 1e-9, "{what} segment at {off} m");
+            }
         }
     }
 }

@@ -1075,7 +1075,7 @@ fn occlude(
     'rays: for k in 0..rays {
         let (a, q) = (starts[k], window_rays[k]);
         hits.clear();
-        scene.bvh().visit_segment(a, q, |item| {
+        scene.bvh().visit_segment(a, q, prep.tol, |item| {
             if Some(item) == parent.surface
                 || item == s
                 || !prep.is_convex(item)

@@ -524,7 +524,8 @@ impl<'a> Tracer<'a> {
         let far = origin + self.reach * dir;
         let mut best_t = self.reach;
         let mut best = None;
-        self.scene.bvh().any_hit(origin, far, |i| {
+        // Boxes grown by twice the tolerance: `contains` accepts hits that far outside.
+        self.scene.bvh().any_hit(origin, far, 2.0 * self.tol, |i| {
             let id = SurfaceId(i);
             if Some(id) == leaving {
                 return false;

@@ -109,8 +109,9 @@ fn segment_ends(
     (start, end)
 }
 
-/// The first surface, other than the segment's own end surfaces `from` and `to`, whose box the
-/// segment `a -> b` touches and whose polygon passes `blocks`.
+/// The first surface, other than the segment's own end surfaces `from` and `to`, whose box
+/// grown by twice the scene's length tolerance (`blocks` may accept crossings within the
+/// tolerance outside a polygon) the segment `a -> b` touches and whose polygon passes `blocks`.
 #[inline(always)]
 fn first_blocking(
     scene: &Scene,
@@ -118,9 +119,10 @@ fn first_blocking(
     (from, to): (Option<SurfaceId>, Option<SurfaceId>),
     mut blocks: impl FnMut(&bt_geom::Polygon) -> bool,
 ) -> Option<SurfaceId> {
+    let margin = 2.0 * scene.length_tolerance();
     scene
         .bvh()
-        .any_hit(a, b, |i| {
+        .any_hit(a, b, margin, |i| {
             let id = SurfaceId(i);
             Some(id) != from && Some(id) != to && blocks(&scene.surface(id).polygon)
         })

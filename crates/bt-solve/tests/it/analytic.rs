@@ -135,3 +135,51 @@ fn a_path_through_a_room_edge_is_reported_as_grazing() {
     assert_eq!(result.counts.grazing, 6);
     assert_eq!(result.paths.len(), 63 - 3);
 }
+
+#[test]
+fn a_segment_passing_within_the_tolerance_of_a_blockers_edge_is_blocked() {
+    // Validation counts a segment that passes within the length tolerance of a polygon's
+    // boundary as blocked (grazing an edge is occlusion). The BVH that finds the candidates
+    // must then reach polygons the segment misses by less than the tolerance: their exact
+    // boxes do not hold the crossing point.
+    let json = |tx: Vec3, rx: Vec3| {
+        format!(
+            r#"{{ "tx": [{}, {}, {}], "rx": [{}, {}, {}], "surfaces": [
+                 {{ "name": "screen", "kind": "blocker",
+                    "vertices": [[1, -1, 0], [1, 1, 0], [1, 1, 1], [1, -1, 1]] }} ] }}"#,
+            tx.x, tx.y, tx.z, rx.x, rx.y, rx.z
+        )
+    };
+    let tol = scene_from_json(&json(Vec3::new(0.0, 0.0, 0.5), Vec3::new(2.0, 0.0, 0.5)))
+        .length_tolerance();
+    let d = 0.5 * tol;
+    for (what, tx, rx) in [
+        // Level with the top edge, half a tolerance above it (parallel to the box's faces).
+        (
+            "over the top",
+            Vec3::new(0.0, 0.0, 1.0 + d),
+            Vec3::new(2.0, 0.0, 1.0 + d),
+        ),
+        // Crossing the screen's plane half a tolerance beside its side edge, obliquely.
+        (
+            "past the side",
+            Vec3::new(0.0, 0.9 + d, 0.5),
+            Vec3::new(2.0, 1.1 + d, 0.6),
+        ),
+    ] {
+        let scene = scene_from_json(&json(tx, rx));
+        let tol = scene.length_tolerance();
+        assert!(d < 0.6 * tol, "{what}");
+        let by_rule = scene.surfaces().iter().any(|s| {
+            let t_min = tol / tx.distance(rx);
+            s.polygon.blocks_segment(tx, rx, t_min, tol)
+        });
+        assert!(by_rule, "{what}: the rule says blocked");
+        let found = bt_solve::validate::blocker(&scene, tx, rx, None, None, tol);
+        assert!(found.is_some(), "{what}: validation missed the blocker");
+        assert!(
+            run(&scene, 1, Solver::Image).is_empty(),
+            "{what}: a blocked path was reported"
+        );
+    }
+}
