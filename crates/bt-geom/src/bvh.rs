@@ -42,9 +42,24 @@ struct Node {
 pub struct Bvh {
     nodes: Vec<Node>,
     order: Vec<u32>,
+    /// Small sets ([`SCAN_UP_TO`] items or fewer): every item's box, for segment queries that
+    /// test them all in index order instead of walking the tree.
+    boxes: Option<Boxes>,
 }
 
 const LEAF_SIZE: usize = 4;
+
+/// Up to this many items, a segment query tests every item's box in turn: in a room a walk
+/// visits a third of the nodes anyway, one box at a time, while the boxes stored as arrays
+/// are tested several at once by the CPU's vector units.
+pub const SCAN_UP_TO: usize = 64;
+
+/// Item boxes as arrays, by bound and coordinate (m).
+#[derive(Debug, Clone, Default)]
+struct Boxes {
+    min: [Vec<Real>; 3],
+    max: [Vec<Real>; 3],
+}
 
 impl Bvh {
     /// Build over the bounding boxes of `items` (median split on the longest axis).
@@ -55,7 +70,16 @@ impl Bvh {
         if !items.is_empty() {
             build_node(&boxes, &mut order, 0, items.len(), &mut nodes);
         }
-        Self { nodes, order }
+        let axis = |f: fn(&(Vec3, Vec3)) -> Vec3, k: usize| boxes.iter().map(|b| f(b)[k]).collect();
+        let scan = (boxes.len() <= SCAN_UP_TO).then(|| Boxes {
+            min: std::array::from_fn(|k| axis(|b| b.0, k)),
+            max: std::array::from_fn(|k| axis(|b| b.1, k)),
+        });
+        Self {
+            nodes,
+            order,
+            boxes: scan,
+        }
     }
 
     /// Calls `hit(item)` for every item whose box, grown by `margin` metres on every side, the
@@ -74,7 +98,10 @@ impl Bvh {
         hit: impl FnMut(u32) -> bool,
     ) -> Option<u32> {
         let slab = Slab::new(a, b, margin);
-        self.walk(|min, max| slab.hits_box(min, max), hit)
+        match &self.boxes {
+            Some(boxes) => boxes.scan(&slab, hit),
+            None => self.walk(|min, max| slab.hits_box(min, max), hit),
+        }
     }
 
     /// The one traversal: descend into nodes whose box passes `box_test`, call `hit` on the
@@ -193,6 +220,25 @@ fn build_node(
     index
 }
 
+impl Boxes {
+    /// [`Bvh::any_hit`] by testing every box: `hit` on the items whose box `slab` touches, in
+    /// index order, up to the first it accepts.
+    #[inline(always)]
+    fn scan(&self, slab: &Slab, mut hit: impl FnMut(u32) -> bool) -> Option<u32> {
+        let n = self.min[0].len().min(SCAN_UP_TO);
+        let [x0, y0, z0] = [&self.min[0][..n], &self.min[1][..n], &self.min[2][..n]];
+        let [x1, y1, z1] = [&self.max[0][..n], &self.max[1][..n], &self.max[2][..n]];
+        let mut touched = [false; SCAN_UP_TO];
+        for (j, t) in touched[..n].iter_mut().enumerate() {
+            *t = slab.hits_box(
+                Vec3::new(x0[j], y0[j], z0[j]),
+                Vec3::new(x1[j], y1[j], z1[j]),
+            );
+        }
+        (0..n as u32).find(|&j| touched[j as usize] && hit(j))
+    }
+}
+
 /// The slab test of a segment against boxes grown by a margin.
 struct Slab {
     /// The segment's start moved by `+margin` and `-margin` on every axis: a box face at `min`
@@ -263,15 +309,23 @@ mod tests {
         (brute, seen)
     }
 
+    /// Walls at x = 0, 0.5, 1, ...: few enough to be scanned, and too many (the tree is walked).
+    fn wall_sets() -> [Vec<Polygon>; 2] {
+        let walls = |n: usize| (0..n).map(|i| quad(i as Real * 0.5)).collect::<Vec<_>>();
+        [walls(37), walls(SCAN_UP_TO + 37)]
+    }
+
     #[test]
     fn finds_the_same_hits_as_brute_force() {
-        let walls: Vec<Polygon> = (0..37).map(|i| quad(i as Real * 0.5)).collect();
-        let bvh = Bvh::build(&walls);
-        for k in 0..50 {
-            let a = Vec3::new(k as Real * 0.37 - 1.0, 0.5, 0.5);
-            let b = a + Vec3::new(0.9, 0.1, 0.05);
-            let (brute, seen) = brute_and_bvh(&walls, &bvh, (a, b));
-            assert_eq!(brute, seen, "segment {k}");
+        for walls in wall_sets() {
+            let bvh = Bvh::build(&walls);
+            assert_eq!(bvh.boxes.is_some(), walls.len() <= SCAN_UP_TO);
+            for k in 0..50 {
+                let a = Vec3::new(k as Real * 0.37 - 1.0, 0.5, 0.5);
+                let b = a + Vec3::new(0.9, 0.1, 0.05);
+                let (brute, seen) = brute_and_bvh(&walls, &bvh, (a, b));
+                assert_eq!(brute, seen, "segment {k} among {} walls", walls.len());
+            }
         }
     }
 
@@ -279,8 +333,13 @@ mod tests {
     fn finds_hits_within_the_tolerance_outside_the_boxes() {
         // Segments that pass just outside the walls' edges (inside the tolerance, so
         // `blocks_segment` accepts them), along an edge and obliquely, and ones just beyond it.
-        let walls: Vec<Polygon> = (0..37).map(|i| quad(i as Real * 0.5)).collect();
-        let bvh = Bvh::build(&walls);
+        for walls in wall_sets() {
+            hits_within_the_tolerance(&walls);
+        }
+    }
+
+    fn hits_within_the_tolerance(walls: &[Polygon]) {
+        let bvh = Bvh::build(walls);
         for off in [0.0, 0.5e-9, 0.99e-9, 1.5e-9, 3e-9] {
             let along = (
                 Vec3::new(0.1, 1.0 + off, 0.5),
@@ -291,7 +350,7 @@ mod tests {
                 Vec3::new(0.8, 1.1 + off, 1.0 + off),
             );
             for (what, seg) in [("along", along), ("oblique", oblique)] {
-                let (brute, seen) = brute_and_bvh(&walls, &bvh, seg);
+                let (brute, seen) = brute_and_bvh(walls, &bvh, seg);
                 assert_eq!(brute, seen, "{what} segment at {off} m beyond the edge");
                 assert_eq!(brute.is_empty(), off > 1e-9, "{what} segment at {off} m");
             }
