@@ -5,6 +5,7 @@ use crate::args::{SceneArgs, Study2dArgs, StudyLivingRoomArgs};
 use bt_study::living_room::{self, LivingRoomConfig};
 use bt_study::{StudyConfig, report};
 use std::io::Write;
+use std::path::PathBuf;
 use std::process::ExitCode;
 
 pub fn run_2d(args: &Study2dArgs) -> anyhow::Result<ExitCode> {
@@ -32,10 +33,7 @@ pub fn run_2d(args: &Study2dArgs) -> anyhow::Result<ExitCode> {
     bar.finish_and_clear();
     let files = bt_study::io::write_outputs(&args.out, &results)?;
     let r = report::ratios(&results);
-    // Written, not println!: a closed pipe (`| head`) must not panic.
-    let mut stdout = std::io::stdout().lock();
-    let _ = writeln!(
-        stdout,
+    let headline = format!(
         "{} rooms × {} steps, seed {}: SBR/IPC time {:.3}, SBR error {:.3e}°, IPC error {:.3e}° (ratio {:.2e})",
         config.rooms,
         config.steps,
@@ -45,10 +43,18 @@ pub fn run_2d(args: &Study2dArgs) -> anyhow::Result<ExitCode> {
         r.ipc_error_deg,
         r.sbr_over_ipc_error
     );
+    print_headline_and_files(&headline, &files);
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Prints a study's one-line `headline` and the `files` it wrote. Written, not println!: a
+/// closed pipe (`| head`) must not panic.
+fn print_headline_and_files(headline: &str, files: &[PathBuf]) {
+    let mut stdout = std::io::stdout().lock();
+    let _ = writeln!(stdout, "{headline}");
     for f in files {
         let _ = writeln!(stdout, "wrote {}", f.display());
     }
-    Ok(ExitCode::SUCCESS)
 }
 
 pub fn run_living_room(args: &StudyLivingRoomArgs) -> anyhow::Result<ExitCode> {
@@ -87,9 +93,7 @@ pub fn run_living_room(args: &StudyLivingRoomArgs) -> anyhow::Result<ExitCode> {
     bar.finish_and_clear();
     let files = bt_study::io::write_living_room(&args.out, &results)?;
     let h = living_room::report::headline(&results);
-    let mut stdout = std::io::stdout().lock();
-    let _ = writeln!(
-        stdout,
+    let headline = format!(
         "{} × {} steps, order <= {}: FPGA IPC error {:.3e}° / {:.3e}° (TX / RX), SBR {:.3e}° / {:.3e}° (ratio {:.2e}); FPGA {:.3} ms per step at 50 MHz; SBR/IPC CPU time {:.3}",
         results.scene_name,
         results.steps,
@@ -102,8 +106,6 @@ pub fn run_living_room(args: &StudyLivingRoomArgs) -> anyhow::Result<ExitCode> {
         h.fpga_mean_latency_s * 1e3,
         h.sbr_over_ipc_time
     );
-    for f in files {
-        let _ = writeln!(stdout, "wrote {}", f.display());
-    }
+    print_headline_and_files(&headline, &files);
     Ok(ExitCode::SUCCESS)
 }

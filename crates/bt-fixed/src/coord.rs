@@ -104,13 +104,19 @@ impl FineCoord {
     }
 }
 
+/// Quantises the axes of `p` (metres) with `quantize`, x first; the first axis out of range
+/// is the error.
+fn quantize_axes<T>(
+    p: [f64; 3],
+    quantize: impl Fn(f64) -> Result<T, FixedError>,
+) -> Result<[T; 3], FixedError> {
+    let [x, y, z] = p;
+    Ok([quantize(x)?, quantize(y)?, quantize(z)?])
+}
+
 /// Quantises a point given in metres to [`FineCoord`] words.
 pub fn quantize_fine_point(p: [f64; 3]) -> Result<FinePoint, FixedError> {
-    Ok([
-        FineCoord::quantize(p[0])?,
-        FineCoord::quantize(p[1])?,
-        FineCoord::quantize(p[2])?,
-    ])
+    quantize_axes(p, FineCoord::quantize)
 }
 
 /// Dequantises a [`FinePoint`] to metres.
@@ -120,16 +126,12 @@ pub fn dequantize_fine_point(p: FinePoint) -> [f64; 3] {
 
 /// Quantises a point given in metres; see [`Coord::quantize`].
 pub fn quantize_point(p: [f64; 3]) -> Result<FixedPoint, FixedError> {
-    Ok([
-        Coord::quantize(p[0])?,
-        Coord::quantize(p[1])?,
-        Coord::quantize(p[2])?,
-    ])
+    quantize_axes(p, Coord::quantize)
 }
 
 /// Dequantises a point to metres; see [`Coord::dequantize`].
 pub fn dequantize_point(p: FixedPoint) -> [f64; 3] {
-    [p[0].dequantize(), p[1].dequantize(), p[2].dequantize()]
+    p.map(Coord::dequantize)
 }
 
 /// `round_half_away_from_zero(x * mul * 2^pow2)` on the exact value of `x`, as an `i128`.

@@ -7,6 +7,13 @@ fn scratch(name: &str) -> PathBuf {
     dir
 }
 
+/// A fresh scratch folder `name` and the output folder `out` to be built in it (not created).
+fn scratch_out(name: &str) -> (PathBuf, PathBuf) {
+    let root = scratch(name);
+    let dir = root.join("out");
+    (root, dir)
+}
+
 fn listing(dir: &Path) -> Vec<String> {
     let mut v: Vec<String> = std::fs::read_dir(dir)
         .unwrap()
@@ -14,6 +21,27 @@ fn listing(dir: &Path) -> Vec<String> {
         .collect();
     v.sort();
     v
+}
+
+/// The file `name` holding `old` in a fresh scratch folder `dir`.
+fn old_file(dir: &str, name: &str) -> PathBuf {
+    let f = scratch(dir).join(name);
+    write_atomic(&f, b"old").unwrap();
+    f
+}
+
+/// What a writer returns when it fails half-way (after writing part of its output).
+fn simulated_failure() -> Result<(), OutputError> {
+    Err(OutputError::BadRelative("simulated".into()))
+}
+
+/// One build of the output folder `dir` that writes `files` (path, contents) and commits.
+fn commit_files(dir: &Path, files: &[(&str, &[u8])]) {
+    let mut out = OutputDir::begin(dir, &[]).unwrap();
+    for (path, contents) in files {
+        out.write(path, contents).unwrap();
+    }
+    out.commit().unwrap();
 }
 
 /// `file` holds `content` and is the only entry of its directory (no temporary file left).
@@ -34,12 +62,10 @@ fn atomic_write_replaces_and_leaves_no_temporary() {
 
 #[test]
 fn failed_fill_keeps_the_old_file() {
-    let dir = scratch("fail");
-    let f = dir.join("a.csv");
-    write_atomic(&f, b"old").unwrap();
-    let r: Result<(), OutputError> = write_atomic_with(&f, |w| {
+    let f = old_file("fail", "a.csv");
+    let r = write_atomic_with(&f, |w| {
         w.write_all(b"half").unwrap();
-        Err(OutputError::BadRelative("simulated".into()))
+        simulated_failure()
     });
     assert!(r.is_err());
     assert_alone(&f, b"old");
@@ -47,14 +73,12 @@ fn failed_fill_keeps_the_old_file() {
 
 #[test]
 fn path_writer_sees_the_extension_and_a_failure_keeps_the_old_file() {
-    let dir = scratch("via");
-    let f = dir.join("fig.png");
-    write_atomic(&f, b"old").unwrap();
-    let r: Result<(), OutputError> = write_atomic_via(&f, |tmp| {
+    let f = old_file("via", "fig.png");
+    let r = write_atomic_via(&f, |tmp| {
         assert_eq!(tmp.extension().unwrap(), "png");
         assert_eq!(tmp.parent(), f.parent());
         std::fs::write(tmp, b"half").unwrap();
-        Err(OutputError::BadRelative("simulated".into()))
+        simulated_failure()
     });
     assert!(r.is_err());
     assert_alone(&f, b"old");
@@ -97,8 +121,7 @@ fn extension_chooses_or_refuses() {
 
 #[test]
 fn new_directory_is_swapped_in_whole() {
-    let root = scratch("new");
-    let dir = root.join("out");
+    let (root, dir) = scratch_out("new");
     let mut out = OutputDir::begin(&dir, &[]).unwrap();
     out.write("rtl/a.v", b"module a; endmodule").unwrap();
     out.write("summary.json", b"{}").unwrap();
@@ -110,16 +133,10 @@ fn new_directory_is_swapped_in_whole() {
 
 #[test]
 fn user_files_survive_and_only_our_stale_files_go() {
-    let root = scratch("keep");
-    let dir = root.join("out");
-    let mut out = OutputDir::begin(&dir, &[]).unwrap();
-    out.write("rtl/a.v", b"1").unwrap();
-    out.write("rtl/b.v", b"1").unwrap();
-    out.commit().unwrap();
+    let (_, dir) = scratch_out("keep");
+    commit_files(&dir, &[("rtl/a.v", b"1"), ("rtl/b.v", b"1")]);
     std::fs::write(dir.join("rtl/mine.v"), b"user").unwrap();
-    let mut out = OutputDir::begin(&dir, &[]).unwrap();
-    out.write("rtl/a.v", b"2").unwrap();
-    out.commit().unwrap();
+    commit_files(&dir, &[("rtl/a.v", b"2")]);
     assert_eq!(listing(&dir.join("rtl")), ["a.v", "mine.v"]);
     assert_eq!(std::fs::read(dir.join("rtl/a.v")).unwrap(), b"2");
     assert_eq!(std::fs::read(dir.join("rtl/mine.v")).unwrap(), b"user");
@@ -127,8 +144,7 @@ fn user_files_survive_and_only_our_stale_files_go() {
 
 #[test]
 fn abandoned_build_leaves_nothing() {
-    let root = scratch("abandon");
-    let dir = root.join("out");
+    let (root, dir) = scratch_out("abandon");
     {
         let mut out = OutputDir::begin(&dir, &[]).unwrap();
         out.write("a.txt", b"x").unwrap();
@@ -138,8 +154,7 @@ fn abandoned_build_leaves_nothing() {
 
 #[test]
 fn commit_refuses_to_replace_an_input() {
-    let root = scratch("protect");
-    let dir = root.join("out");
+    let (root, dir) = scratch_out("protect");
     std::fs::create_dir_all(&dir).unwrap();
     let input = dir.join("summary.json");
     std::fs::write(&input, b"precious").unwrap();

@@ -11,13 +11,10 @@ fn f(v: &Value) -> f64 {
 
 #[test]
 fn trace_json_reports_gains_and_received_power() {
-    let doc = run_json(&[
-        "trace",
-        "builtin:living-room",
-        "--json",
-        "--tx-power-dbm",
-        "23",
-    ]);
+    let doc = run_json(&cli(
+        "trace builtin:living-room --json --tx-power-dbm 23",
+        &[],
+    ));
     let paths = doc["paths"].as_array().unwrap();
     let mut sum = 0.0;
     for p in paths {
@@ -46,21 +43,11 @@ fn a_perfect_conductor_mesh_keeps_every_reflection_at_full_strength() {
         .join("testdata/scenes/box-room.obj")
         .display()
         .to_string();
-    let doc = run_json(&[
-        "trace",
-        &mesh,
-        "--tx",
-        "1,1,1.5",
-        "--rx",
-        "4,3,1.2",
-        "--max-order",
-        "2",
-        "--json",
-        "--material",
-        "custom:1,1e12",
-        "--frequency",
-        "5e9",
-    ]);
+    let doc = run_json(&cli(
+        "trace {} --tx 1,1,1.5 --rx 4,3,1.2 --max-order 2 --json \
+         --material custom:1,1e12 --frequency 5e9",
+        &[&mesh],
+    ));
     assert_eq!(doc["frequency_hz"], 5e9);
     let paths = doc["paths"].as_array().unwrap();
     assert!(paths.len() > 10);
@@ -166,19 +153,11 @@ fn channel_writes_cir_cfr_and_the_pdp_plot() {
 #[test]
 fn beams_finds_the_best_pair_and_keeps_the_paper_ranking() {
     let sweep = |extra: &[&str]| {
-        let mut args = vec![
-            "beams",
-            "builtin:living-room",
-            "--tx-array",
-            "1x8",
-            "--rx-array",
-            "1x8",
-            "--tx-orientation",
-            "180,0,0",
-            "--json",
-            "--max-order",
-            "2",
-        ];
+        let mut args = cli(
+            "beams builtin:living-room --tx-array 1x8 --rx-array 1x8 \
+             --tx-orientation 180,0,0 --json --max-order 2",
+            &[],
+        );
         args.extend_from_slice(extra);
         run_json(&args)
     };
@@ -214,17 +193,10 @@ fn beams_finds_the_best_pair_and_keeps_the_paper_ranking() {
 
 #[test]
 fn near_field_is_clamped_and_warned() {
-    let o = run_ok(&[
-        "trace",
-        "builtin:living-room",
-        "--tx",
-        "3,2,1",
-        "--rx",
-        "3.0005,2,1",
-        "--max-order",
-        "0",
-        "--json",
-    ]);
+    let o = run_ok(&cli(
+        "trace builtin:living-room --tx 3,2,1 --rx 3.0005,2,1 --max-order 0 --json",
+        &[],
+    ));
     let doc: Value = serde_json::from_slice(&o.stdout).unwrap();
     let los = &doc["paths"][0];
     assert!(f(&los["free_space_loss_db"]) >= 0.0 && f(&los["gain_db"]) <= 0.0);
@@ -236,30 +208,19 @@ fn near_field_is_clamped_and_warned() {
 /// carrier is still refused, naming it.
 #[test]
 fn overrides_apply_to_every_step_of_a_dynamic_scene() {
-    let o = beamtrace(&[
-        "trace",
-        "builtin:living-room-dynamic",
-        "--steps",
-        "--max-order",
-        "1",
-        "--frequency",
-        "60e9",
-        "--json",
-    ]);
+    let o = beamtrace(&cli(
+        "trace builtin:living-room-dynamic --steps --max-order 1 --frequency 60e9 --json",
+        &[],
+    ));
     assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
     let doc: Value = serde_json::from_slice(&o.stdout).unwrap();
     assert_eq!(doc["frequency_hz"].as_f64(), Some(60e9));
     assert_eq!(doc["steps"].as_array().unwrap().len(), 10);
     assert_clear_error(
-        &[
-            "trace",
-            "builtin:living-room-dynamic",
-            "--steps",
-            "--frequency",
-            "60e9",
-            "--material",
-            "itu:brick",
-        ],
+        &cli(
+            "trace builtin:living-room-dynamic --steps --frequency 60e9 --material itu:brick",
+            &[],
+        ),
         &["brick"],
     );
 }

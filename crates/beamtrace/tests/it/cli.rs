@@ -80,13 +80,10 @@ fn json_document_has_the_documented_fields() {
 fn ipc_orders_agree_with_the_image_method_through_the_cli() {
     let image = trace_json(&["builtin:living-room"]);
     for order in ["gauss-seidel", "jacobi"] {
-        let ipc = trace_json(&[
-            "builtin:living-room",
-            "--solver",
-            "ipc",
-            "--ipc-order",
-            order,
-        ]);
+        let ipc = trace_json(&cli(
+            "builtin:living-room --solver ipc --ipc-order {}",
+            &[order],
+        ));
         let (a, b) = (
             image["paths"].as_array().unwrap(),
             ipc["paths"].as_array().unwrap(),
@@ -213,14 +210,10 @@ fn bad_inputs_give_clear_errors() {
         &["garbage.obj", "line 1"],
     );
     assert_clear_error(
-        &[
-            "trace",
-            &testdata("huge-claim.ply"),
-            "--tx",
-            "0,0,1",
-            "--rx",
-            "1,1,1",
-        ],
+        &cli(
+            "trace {} --tx 0,0,1 --rx 1,1,1",
+            &[&testdata("huge-claim.ply")],
+        ),
         &["huge-claim.ply", "3000000000"],
     );
     assert_clear_error(&["trace", &testdata("box-room.obj")], &["--tx"]);
@@ -295,15 +288,10 @@ fn xml_scene_traces_like_its_json_twin() {
     let expected = (9.0f64 + 4.0 + 3.2 * 3.2).sqrt();
     assert!((floor["length_m"].as_f64().unwrap() - expected).abs() < 1e-9);
     // The glass pane (Sionna 0.x style id) and the custom wall keep their own materials.
-    let check = run_ok(&[
-        "scene",
-        "check",
-        &testdata("sionna/room.xml"),
-        "--tx",
-        tx,
-        "--rx",
-        rx,
-    ]);
+    let check = run_ok(&cli(
+        "scene check {} --tx {} --rx {}",
+        &[&testdata("sionna/room.xml"), tx, rx],
+    ));
     assert!(
         stdout(&check).contains("3 surfaces (3 reflectors"),
         "{}",

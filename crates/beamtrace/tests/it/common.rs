@@ -20,6 +20,23 @@ pub fn testdata(name: &str) -> String {
         .to_string()
 }
 
+/// A command line written as one string: its words split at white space, each `{}` word
+/// replaced by the next of `values` (paths, passed apart so that a space in one stays in it).
+pub fn cli<'a>(line: &'a str, values: &[&'a str]) -> Vec<&'a str> {
+    let mut values = values.iter();
+    let args = line
+        .split_whitespace()
+        .map(|w| match w {
+            "{}" => *values
+                .next()
+                .unwrap_or_else(|| panic!("{line:?}: too few values")),
+            _ => w,
+        })
+        .collect();
+    assert!(values.next().is_none(), "{line:?}: too many values");
+    args
+}
+
 /// Runs the binary with `args`.
 pub fn beamtrace(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_beamtrace"))
@@ -75,6 +92,14 @@ pub fn read_json(path: &Path) -> Value {
     let text =
         std::fs::read_to_string(path).unwrap_or_else(|e| panic!("reading {}: {e}", path.display()));
     serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
+}
+
+/// The largest TX angle error, degrees, of the fixed-point model against f64 in the summary
+/// `hls gen` writes for a design or a step.
+pub fn fixed_point_tx_error_deg(summary: &Value) -> f64 {
+    summary["fixed_vs_f64"]["max_angle_error_tx_deg"]
+        .as_f64()
+        .expect("max_angle_error_tx_deg")
 }
 
 /// A fresh, empty folder for the files of one test. All tests share one process (one pid in

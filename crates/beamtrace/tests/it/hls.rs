@@ -4,34 +4,37 @@
 
 use crate::common::*;
 use serde_json::Value;
+use std::path::PathBuf;
+
+/// `hls gen` with the arguments `line` and `values` (see [`cli`]) followed by `-o` into a fresh
+/// folder named `name`, then `hls sim` of the design, which must report no mismatch and every
+/// run as predicted: the scratch folder, the design's folder in it and the simulator's report.
+fn generate_and_cosimulate(name: &str, line: &str, values: &[&str]) -> (PathBuf, PathBuf, String) {
+    let root = scratch(name);
+    let dir = root.join("out");
+    let mut args = cli(line, values);
+    args.extend(["-o", dir.to_str().unwrap()]);
+    run_ok(&[&["hls", "gen"][..], &args].concat());
+    let out = text(&run_ok(&["hls", "sim", dir.to_str().unwrap()]));
+    assert!(out.contains(" 0 mismatches"), "{out}");
+    assert!(out.contains("runs as predicted: true"), "{out}");
+    (root, dir, out)
+}
 
 /// CI's multi-step co-simulation: the 10 steps of the dynamic living room (order 1) on ONE
 /// design, each step's schedule, start points and TX/RX loaded over the bus, Verilator.
 #[test]
 fn living_room_steps_run_on_one_design_bit_exact() {
-    let root = scratch("hls-steps");
-    let dir = root.join("out");
-    run_ok(&[
-        "hls",
-        "gen",
-        "builtin:living-room-dynamic",
-        "--steps",
-        "--max-order",
-        "1",
-        "-o",
-        dir.to_str().unwrap(),
-    ]);
+    let (root, dir, out) = generate_and_cosimulate(
+        "hls-steps",
+        "builtin:living-room-dynamic --steps --max-order 1",
+        &[],
+    );
     let doc = read_json(&dir.join("steps.json"));
     let steps = doc["steps"].as_array().unwrap();
     assert_eq!(steps.len(), 10);
     for s in steps {
-        assert!(
-            s["fixed_vs_f64"]["max_angle_error_tx_deg"]
-                .as_f64()
-                .unwrap()
-                < 0.1,
-            "{s}"
-        );
+        assert!(fixed_point_tx_error_deg(s) < 0.1, "{s}");
         assert_eq!(s["fixed_vs_f64"]["spurious"], 0, "{s}");
     }
     assert!(dir.join("rtl/bt_top.v").exists());
@@ -39,10 +42,7 @@ fn living_room_steps_run_on_one_design_bit_exact() {
         !dir.join("step-0/rtl").exists(),
         "one design, not one per step"
     );
-    let out = text(&run_ok(&["hls", "sim", dir.to_str().unwrap()]));
     assert!(out.contains("verilator (10 steps, 10 runs)"), "{out}");
-    assert!(out.contains(" 0 mismatches"), "{out}");
-    assert!(out.contains("runs as predicted: true"), "{out}");
     let predicted = steps[0]["predicted_cycles"].as_u64().unwrap();
     assert!(
         out.contains(&format!(
@@ -58,27 +58,16 @@ fn living_room_steps_run_on_one_design_bit_exact() {
 /// co-simulates bit for bit in Verilator in seconds (it ran for over 20 minutes in Icarus).
 #[test]
 fn the_street_of_37_planes_cosimulates_with_wide_schedule_entries() {
-    let root = scratch("hls-street");
-    let dir = root.join("out");
-    run_ok(&[
-        "hls",
-        "gen",
-        &testdata("street-37.json"),
-        "--max-order",
-        "2",
-        "--candidates",
-        "exhaustive",
-        "-o",
-        dir.to_str().unwrap(),
-    ]);
+    let (root, dir, _) = generate_and_cosimulate(
+        "hls-street",
+        "{} --max-order 2 --candidates exhaustive",
+        &[&testdata("street-37.json")],
+    );
     let summary = read_json(&dir.join("summary.json"));
     assert_eq!(summary["planes"], 37, "{summary}");
     assert_eq!(summary["paths"], 683, "{summary}");
     let top = std::fs::read_to_string(dir.join("rtl/bt_top.v")).unwrap();
     assert!(top.contains("sched_hi"), "entries wider than 32 bits");
-    let out = text(&run_ok(&["hls", "sim", dir.to_str().unwrap()]));
-    assert!(out.contains(" 0 mismatches"), "{out}");
-    assert!(out.contains("runs as predicted: true"), "{out}");
     std::fs::remove_dir_all(&root).ok();
 }
 
@@ -91,16 +80,10 @@ fn ga_is_never_longer_than_list_and_duplication_helps() {
         (&dup, vec!["--schedule", "ga", "--pe-budget", "40"]),
         (&list, vec!["--schedule", "list"]),
     ] {
-        let mut args = vec![
-            "hls",
-            "gen",
-            "builtin:living-room",
-            "--max-order",
-            "2",
-            "--plan-only",
-            "-o",
-            dir.to_str().unwrap(),
-        ];
+        let mut args = cli(
+            "hls gen builtin:living-room --max-order 2 --plan-only -o {}",
+            &[dir.to_str().unwrap()],
+        );
         args.extend(extra);
         run_ok(&args);
     }
@@ -134,15 +117,11 @@ fn hls_errors_are_clear() {
         !ok && out.contains("/no/such/dir") && !out.contains("panicked"),
         "{out}"
     );
-    let o = beamtrace(&[
-        "hls",
-        "gen",
-        "builtin:living-room",
-        "--max-order",
-        "0",
-        "-o",
-        scratch("hls-errors").join("x").to_str().unwrap(),
-    ]);
+    let out = scratch("hls-errors").join("x");
+    let o = beamtrace(&cli(
+        "hls gen builtin:living-room --max-order 0 -o {}",
+        &[out.to_str().unwrap()],
+    ));
     let (ok, out) = (o.status.success(), text(&o));
     assert!(!ok && out.contains("--max-order"), "{out}");
 }

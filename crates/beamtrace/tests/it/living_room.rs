@@ -33,18 +33,10 @@ fn study_living_room_writes_consistent_csv_and_figures() {
     let out = dir.join("out");
     // The short study into `out` (a fast SBR and order 2).
     let study = |out: &Path| {
-        run_ok(&[
-            "study",
-            "living-room",
-            "--out",
-            out.to_str().unwrap(),
-            "--steps-from",
-            &scene,
-            "--sbr-step-deg",
-            "5",
-            "--max-order",
-            "2",
-        ])
+        run_ok(&cli(
+            "study living-room --out {} --steps-from {} --sbr-step-deg 5 --max-order 2",
+            &[out.to_str().unwrap(), &scene],
+        ))
     };
     let stdout = stdout(&study(&out));
     assert!(stdout.contains("FPGA IPC error"), "{stdout}");
@@ -201,17 +193,10 @@ fn hls_gen_steps_plans_every_step() {
     let dir = scratch("living-room-hls");
     let scene = short_living_room(&dir, 3);
     let out = dir.join("out");
-    let stdout = stdout(&run_ok(&[
-        "hls",
-        "gen",
-        &scene,
-        "--steps",
-        "--plan-only",
-        "--max-order",
-        "2",
-        "-o",
-        out.to_str().unwrap(),
-    ]));
+    let stdout = stdout(&run_ok(&cli(
+        "hls gen {} --steps --plan-only --max-order 2 -o {}",
+        &[&scene, out.to_str().unwrap()],
+    )));
     let doc = read_json(&out.join("steps.json"));
     let steps = doc["steps"].as_array().expect("steps");
     assert_eq!(steps.len(), 3, "{doc}");
@@ -222,13 +207,7 @@ fn hls_gen_steps_plans_every_step() {
         let cycles = s["predicted_cycles"].as_u64().expect("cycles");
         assert!(cycles > 0, "{s}");
         assert_eq!(doc["cycles"][k], cycles);
-        assert!(
-            s["fixed_vs_f64"]["max_angle_error_tx_deg"]
-                .as_f64()
-                .unwrap()
-                < 0.1,
-            "{s}"
-        );
+        assert!(fixed_point_tx_error_deg(s) < 0.1, "{s}");
         let step_dir = out.join(format!("step-{k}"));
         assert!(!out.join("rtl").exists());
         let own = read_json(&step_dir.join("summary.json"));

@@ -37,26 +37,15 @@ fn polygons(doc: &Value) -> Vec<(String, String, Vec<Vec3>)> {
 fn extraction_recovers_the_living_room_and_its_paths() {
     let dir = scratch("pointcloud-extract");
     let (cloud, scene) = (dir.join("living-room.ply"), dir.join("extracted.json"));
-    run_ok(&[
-        "sample",
-        "builtin:living-room",
-        "-o",
-        cloud.to_str().unwrap(),
-        "--density",
-        "2000",
-        "--noise",
-        "0.005",
-        "--seed",
-        "3",
-    ]);
-    run_ok(&[
-        "extract",
-        cloud.to_str().unwrap(),
-        "-o",
-        scene.to_str().unwrap(),
-        "--seed",
-        "1",
-    ]);
+    let c = cloud.to_str().unwrap();
+    run_ok(&cli(
+        "sample builtin:living-room -o {} --density 2000 --noise 0.005 --seed 3",
+        &[c],
+    ));
+    run_ok(&cli(
+        "extract {} -o {} --seed 1",
+        &[c, scene.to_str().unwrap()],
+    ));
 
     let original: Value =
         serde_json::from_str(bt_scene::builtin_json("living-room").unwrap()).unwrap();
@@ -109,15 +98,10 @@ fn extraction_recovers_the_living_room_and_its_paths() {
     // Tracing the extracted scene gives the same paths: same count per order, lengths within
     // 1 cm, departure directions within 1°.
     let trace = |s: &str| -> Vec<Value> {
-        let v = run_json(&[
-            "trace",
-            s,
-            "--tx",
-            "5.6,0.6,2.2",
-            "--rx",
-            "2.3,2.1,0.72",
-            "--json",
-        ]);
+        let v = run_json(&cli(
+            "trace {} --tx 5.6,0.6,2.2 --rx 2.3,2.1,0.72 --json",
+            &[s],
+        ));
         v["paths"].as_array().unwrap().clone()
     };
     let a = trace("builtin:living-room");
@@ -158,25 +142,12 @@ fn extraction_recovers_the_living_room_and_its_paths() {
 fn a_point_cloud_traces_directly_and_bad_clouds_are_reported() {
     let dir = scratch("pointcloud-trace");
     let cloud = dir.join("box.pcd");
-    run_ok(&[
-        "sample",
-        &testdata("one-wall.json"),
-        "-o",
-        cloud.to_str().unwrap(),
-        "--density",
-        "3000",
-        "--noise",
-        "0.002",
-    ]);
-    let v = run_json(&[
-        "trace",
-        cloud.to_str().unwrap(),
-        "--tx",
-        "-1.5,1,2",
-        "--rx",
-        "2,2,1",
-        "--json",
-    ]);
+    let c = cloud.to_str().unwrap();
+    run_ok(&cli(
+        "sample {} -o {} --density 3000 --noise 0.002",
+        &[&testdata("one-wall.json"), c],
+    ));
+    let v = run_json(&cli("trace {} --tx -1.5,1,2 --rx 2,2,1 --json", &[c]));
     assert_eq!(
         v["paths"].as_array().unwrap().len(),
         2,
@@ -185,12 +156,13 @@ fn a_point_cloud_traces_directly_and_bad_clouds_are_reported() {
     let truncated = dir.join("truncated.pcd");
     let bytes = std::fs::read(&cloud).unwrap();
     std::fs::write(&truncated, &bytes[..bytes.len() / 3]).unwrap();
-    let bad = beamtrace(&[
-        "extract",
-        truncated.to_str().unwrap(),
-        "-o",
-        dir.join("x.json").to_str().unwrap(),
-    ]);
+    let bad = beamtrace(&cli(
+        "extract {} -o {}",
+        &[
+            truncated.to_str().unwrap(),
+            dir.join("x.json").to_str().unwrap(),
+        ],
+    ));
     let msg = stderr(&bad);
     assert_eq!(bad.status.code(), Some(2), "{msg}");
     assert!(msg.contains("truncated.pcd"), "{msg}");

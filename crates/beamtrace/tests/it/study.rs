@@ -8,20 +8,10 @@ use serde_json::Value;
 fn study_2d_writes_csv_summary_and_figures() {
     let dir = scratch("study-2d");
     let out = dir.join("out");
-    let stdout = stdout(&run_ok(&[
-        "study",
-        "2d",
-        "--rooms",
-        "4",
-        "--steps",
-        "2",
-        "--sbr-step-deg",
-        "2",
-        "--seed",
-        "5",
-        "--out",
-        out.to_str().unwrap(),
-    ]));
+    let stdout = stdout(&run_ok(&cli(
+        "study 2d --rooms 4 --steps 2 --sbr-step-deg 2 --seed 5 --out {}",
+        &[out.to_str().unwrap()],
+    )));
     assert!(stdout.contains("seed 5"), "{stdout}");
     let csv = std::fs::read_to_string(out.join("results.csv")).unwrap();
     // Header plus 4 rooms × 2 steps × 4 solvers.
@@ -41,14 +31,10 @@ fn study_2d_writes_csv_summary_and_figures() {
 #[test]
 fn study_rejects_bad_settings() {
     let out = scratch("study-bad").join("out");
-    let run = beamtrace(&[
-        "study",
-        "2d",
-        "--rooms",
-        "0",
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let run = beamtrace(&cli(
+        "study 2d --rooms 0 --out {}",
+        &[out.to_str().unwrap()],
+    ));
     assert!(!run.status.success());
     assert!(stderr(&run).contains("rooms must be at least 1"));
 }

@@ -21,16 +21,10 @@ fn sweep(grid: &str, extra: &[&str], name: &str) -> (PathBuf, String) {
 /// `trace --json` of the living room at order 2 to the receiver of a CSV row's fields.
 fn trace_at(fields: &[&str]) -> Value {
     let rx = format!("{},{},{}", fields[0], fields[1], fields[2]);
-    let args = [
-        "trace",
-        "builtin:living-room",
-        "--rx",
-        &rx,
-        "--max-order",
-        "2",
-        "--json",
-    ];
-    run_json(&args)
+    run_json(&cli(
+        "trace builtin:living-room --rx {} --max-order 2 --json",
+        &[&rx],
+    ))
 }
 
 #[test]
@@ -128,29 +122,20 @@ fn bad_grids_are_refused_with_the_field_named() {
     ];
     let dir = scratch("sweep-bad").join("out");
     for (grid, message) in cases {
-        let o = beamtrace(&[
-            "sweep",
-            "builtin:living-room",
-            "--grid",
-            grid,
-            "--out",
-            &dir.display().to_string(),
-        ]);
+        let out = dir.display().to_string();
+        let o = beamtrace(&cli(
+            "sweep builtin:living-room --grid {} --out {}",
+            &[grid, &out],
+        ));
         let err = stderr(&o);
         assert_eq!(o.status.code(), Some(2), "{grid}: {err}");
         assert!(err.contains(message), "{grid}: {err}");
         assert!(!dir.exists(), "{grid}: wrote output");
     }
-    let o = beamtrace(&[
-        "sweep",
-        "builtin:living-room",
-        "--grid",
-        "0:1:1,0:1:1,1",
-        "--rx",
-        "1,1,1",
-        "--out",
-        "x",
-    ]);
+    let o = beamtrace(&cli(
+        "sweep builtin:living-room --grid 0:1:1,0:1:1,1 --rx 1,1,1 --out x",
+        &[],
+    ));
     assert!(stderr(&o).contains("--rx is not used"));
 }
 

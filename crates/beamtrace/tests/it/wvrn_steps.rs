@@ -1,6 +1,6 @@
 //! CLI integration tests of `beamtrace wvrn` and `beamtrace trace --steps`.
 
-use crate::common::run_ok;
+use crate::common::{cli, run_json, run_ok};
 use std::collections::BTreeSet;
 
 /// Standard output of a successful run.
@@ -33,22 +33,12 @@ fn check_dot(dot: &str) -> (usize, usize) {
 
 #[test]
 fn wvrn_dot_and_json_describe_the_same_graph() {
-    let dot = beamtrace(&[
-        "wvrn",
-        "builtin:living-room-dynamic",
-        "--step",
-        "3",
-        "--dot",
-    ]);
+    let dot = beamtrace(&cli("wvrn builtin:living-room-dynamic --step 3 --dot", &[]));
     let (nodes, edges) = check_dot(&dot);
-    let json: serde_json::Value = serde_json::from_str(&beamtrace(&[
-        "wvrn",
-        "builtin:living-room-dynamic",
-        "--step",
-        "3",
-        "--json",
-    ]))
-    .unwrap();
+    let json = run_json(&cli(
+        "wvrn builtin:living-room-dynamic --step 3 --json",
+        &[],
+    ));
     assert_eq!(json["nodes"].as_array().unwrap().len(), nodes);
     assert_eq!(json["edges"].as_array().unwrap().len(), edges);
     assert!(dot.contains("color=red") && dot.contains("color=green"));
@@ -124,19 +114,11 @@ fn trace_steps_json_and_jsonl() {
 
 #[test]
 fn wvrn_flag_changes_candidates_not_paths() {
-    let on: serde_json::Value = serde_json::from_str(&beamtrace(&[
-        "trace",
-        "builtin:living-room-dynamic",
-        "--json",
-    ]))
-    .unwrap();
-    let off: serde_json::Value = serde_json::from_str(&beamtrace(&[
-        "trace",
-        "builtin:living-room-dynamic",
-        "--json",
-        "--no-wvrn",
-    ]))
-    .unwrap();
+    let on = run_json(&cli("trace builtin:living-room-dynamic --json", &[]));
+    let off = run_json(&cli(
+        "trace builtin:living-room-dynamic --json --no-wvrn",
+        &[],
+    ));
     assert_eq!(on["paths"], off["paths"]);
     assert_eq!(off["stats"]["candidates"]["pruned_visibility"], 0);
 }

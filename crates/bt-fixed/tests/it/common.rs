@@ -68,6 +68,38 @@ pub fn any_case() -> impl Strategy<Value = (u32, FixedPlane, FinePoint, FinePoin
         .prop_flat_map(|b| (Just(b), any_plane_in(b), any_point_in(b), any_point_in(b)))
 }
 
+/// The planes of the corner tests at `bits`-bit coordinates: four unit normals (diagonal,
+/// anti-diagonal, axis, 3-4-5 in the xy plane), each with its offset at the coordinate range's
+/// minimum, its maximum and zero.
+pub fn corner_planes(bits: u32) -> Vec<FixedPlane> {
+    let (min, max) = bt_fixed::Widths::for_coord(bits).coord_range();
+    let r3 = 1.0 / 3f64.sqrt();
+    let normals = [
+        [r3, r3, r3],
+        [-r3, r3, -r3],
+        [1.0, 0.0, 0.0],
+        [0.6, -0.8, 0.0],
+    ];
+    let offsets = [min, max, 0].map(FineCoord);
+    let mut planes = Vec::new();
+    for normal in normals {
+        for offset in offsets {
+            let mut plane = FixedPlane::quantize(normal, 0.0).unwrap();
+            plane.offset = offset;
+            planes.push(plane);
+        }
+    }
+    planes
+}
+
+/// Every point whose three axes take values of `values`, x varying fastest.
+pub fn grid_points(values: &[FineCoord]) -> Vec<FinePoint> {
+    let n = values.len();
+    (0..n.pow(3))
+        .map(|b| std::array::from_fn(|k| values[(b / n.pow(k as u32)) % n]))
+        .collect()
+}
+
 /// `round_half_up(num / 2^shift)` computed by exact Euclidean division (the oracle).
 pub fn oracle_round(num: i128, shift: u32) -> i128 {
     if shift == 0 {

@@ -89,28 +89,13 @@ proptest! {
 #[test]
 fn register_form_equals_model_at_the_corners() {
     use bt_fixed::FineCoord;
-    let r3 = 1.0 / 3f64.sqrt();
     for bits in COORD_BITS {
         let (min, max) = Widths::for_coord(bits).coord_range();
-        let corners = [FineCoord(min), FineCoord(max), FineCoord(0)];
-        for normal in [
-            [r3, r3, r3],
-            [-r3, r3, -r3],
-            [1.0, 0.0, 0.0],
-            [0.6, -0.8, 0.0],
-        ] {
-            for offset in corners {
-                let mut plane = FixedPlane::quantize(normal, 0.0).unwrap();
-                plane.offset = offset;
-                for bits_prev in 0..27u32 {
-                    for bits_next in 0..27u32 {
-                        let pt = |b: u32| -> FinePoint {
-                            std::array::from_fn(|k| {
-                                corners[((b / 3u32.pow(k as u32)) % 3) as usize]
-                            })
-                        };
-                        check(&plane, pt(bits_prev), pt(bits_next), bits);
-                    }
+        let points = grid_points(&[min, max, 0].map(FineCoord));
+        for plane in corner_planes(bits) {
+            for &prev in &points {
+                for &next in &points {
+                    check(&plane, prev, next, bits);
                 }
             }
         }

@@ -65,28 +65,14 @@ proptest! {
 
 #[test]
 fn widths_hold_at_the_corners() {
-    let r3 = 1.0 / 3f64.sqrt();
     for bits in COORD_BITS {
         let (min, max) = Widths::for_coord(bits).coord_range();
-        let corners = [FineCoord(min), FineCoord(max)];
+        let points = grid_points(&[FineCoord(min), FineCoord(max)]);
         let mut saw_overflow = false;
-        for normal in [
-            [r3, r3, r3],
-            [-r3, r3, -r3],
-            [1.0, 0.0, 0.0],
-            [0.6, -0.8, 0.0],
-        ] {
-            for offset in [corners[0], corners[1], FineCoord(0)] {
-                let mut plane = FixedPlane::quantize(normal, 0.0).unwrap();
-                plane.offset = offset;
-                for bits_prev in 0..8u32 {
-                    for bits_next in 0..8u32 {
-                        let pt = |b: u32| -> FinePoint {
-                            std::array::from_fn(|k| corners[((b >> k) & 1) as usize])
-                        };
-                        let t = check(&plane, pt(bits_prev), pt(bits_next), bits);
-                        saw_overflow |= t.overflow;
-                    }
+        for plane in corner_planes(bits) {
+            for &prev in &points {
+                for &next in &points {
+                    saw_overflow |= check(&plane, prev, next, bits).overflow;
                 }
             }
         }

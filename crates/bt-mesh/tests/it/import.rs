@@ -194,21 +194,28 @@ fn l_shaped_room_gives_concave_floor_and_ceiling() {
     assert_eq!(import.surfaces[1].vertices.len(), 6);
 }
 
-#[test]
-fn ring_with_hole_keeps_outer_loop_and_warns() {
-    // 3 x 3 unit grid without its centre cell.
-    let vertices: Vec<DVec3> = (0..16)
-        .map(|k| DVec3::new((k % 4) as f64, (k / 4) as f64, 1.0))
+/// A 3 x 3 grid of unit quads in the plane at height `z`, without the cells `(i, j)` of
+/// `missing`: the grid's 16 vertices and the quads, counter-clockwise seen from +z.
+fn unit_grid_without(z: f64, missing: &[(usize, usize)]) -> (Vec<DVec3>, Vec<Vec<usize>>) {
+    let vertices = (0..16)
+        .map(|k| DVec3::new((k % 4) as f64, (k / 4) as f64, z))
         .collect();
     let mut faces = Vec::new();
     for j in 0..3 {
         for i in 0..3 {
-            if (i, j) != (1, 1) {
+            if !missing.contains(&(i, j)) {
                 let k = j * 4 + i;
                 faces.push(vec![k, k + 1, k + 5, k + 4]);
             }
         }
     }
+    (vertices, faces)
+}
+
+#[test]
+fn ring_with_hole_keeps_outer_loop_and_warns() {
+    // 3 x 3 unit grid without its centre cell.
+    let (vertices, faces) = unit_grid_without(1.0, &[(1, 1)]);
     let text = format!("o floor\n{}", obj_text(&vertices, &faces));
     let import = read_obj(text.as_bytes(), Some("ring.obj"), &opts()).unwrap();
     assert_surfaces(&import, &[(DVec3::Z, 9.0)], TOL);
@@ -227,18 +234,7 @@ fn ring_with_hole_keeps_outer_loop_and_warns() {
 fn hole_touching_the_outline_at_a_vertex_is_separated() {
     // 3 x 3 unit grid without the centre cell (1, 1) and the corner cell (2, 2): the hole and
     // the outer boundary meet at the vertex (2, 2).
-    let vertices: Vec<DVec3> = (0..16)
-        .map(|k| DVec3::new((k % 4) as f64, (k / 4) as f64, 0.0))
-        .collect();
-    let mut faces = Vec::new();
-    for j in 0..3 {
-        for i in 0..3 {
-            if (i, j) != (1, 1) && (i, j) != (2, 2) {
-                let k = j * 4 + i;
-                faces.push(vec![k, k + 1, k + 5, k + 4]);
-            }
-        }
-    }
+    let (vertices, faces) = unit_grid_without(0.0, &[(1, 1), (2, 2)]);
     let import = read_obj(
         obj_text(&vertices, &triangulate(&faces)).as_bytes(),
         None,
@@ -354,10 +350,10 @@ fn invalid_options_are_rejected() {
         angle_tol_deg: f64::NAN,
         ..MergeOptions::default()
     };
-    assert!(matches!(
+    assert_matches!(
         read_obj(b"", None, &bad),
         Err(MeshError::InvalidOptions { .. })
-    ));
+    );
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -374,15 +370,12 @@ fn ply_error(bytes: &[u8]) -> MeshError {
 #[test]
 fn malformed_obj_line() {
     let e = obj_error("v 0 0 0\nv 1 0 0\nv 1 abc 0\nf 1 2 3\n");
-    assert!(
-        matches!(
-            &e,
-            MeshError::Syntax {
-                position: Position::Line(3),
-                ..
-            }
-        ),
-        "{e:?}"
+    assert_matches!(
+        e,
+        MeshError::Syntax {
+            position: Position::Line(3),
+            ..
+        }
     );
     let message = e.to_string();
     assert!(
@@ -390,111 +383,87 @@ fn malformed_obj_line() {
         "{message}"
     );
     let e = obj_error("v 0 0 0\nv 1 0 0\nv 1 1 0\nf 1 2/x 3\n");
-    assert!(
-        matches!(
-            &e,
-            MeshError::Syntax {
-                position: Position::Line(4),
-                ..
-            }
-        ),
-        "{e:?}"
+    assert_matches!(
+        e,
+        MeshError::Syntax {
+            position: Position::Line(4),
+            ..
+        }
     );
 }
 
 #[test]
 fn obj_index_out_of_range() {
     let e = obj_error("v 0 0 0\nv 1 0 0\nv 1 1 0\n\nf 1 2 4\n");
-    assert!(
-        matches!(
-            &e,
-            MeshError::IndexOutOfRange {
-                position: Position::Line(5),
-                index: 4,
-                vertex_count: 3,
-                ..
-            }
-        ),
-        "{e:?}"
+    assert_matches!(
+        e,
+        MeshError::IndexOutOfRange {
+            position: Position::Line(5),
+            index: 4,
+            vertex_count: 3,
+            ..
+        }
     );
     assert!(e.to_string().contains("bad.obj: line 5"), "{e}");
     let e = obj_error("v 0 0 0\nv 1 0 0\nf 1 2 -3\n");
-    assert!(
-        matches!(&e, MeshError::IndexOutOfRange { index: -3, .. }),
-        "{e:?}"
-    );
+    assert_matches!(e, MeshError::IndexOutOfRange { index: -3, .. });
     let e = obj_error("v 0 0 0\nv 1 0 0\nf 0 1 2\n");
-    assert!(
-        matches!(&e, MeshError::IndexOutOfRange { index: 0, .. }),
-        "{e:?}"
-    );
+    assert_matches!(e, MeshError::IndexOutOfRange { index: 0, .. });
 }
 
 #[test]
 fn obj_face_with_two_vertices() {
     let e = obj_error("v 0 0 0\nv 1 0 0\nf 1 2\n");
-    assert!(
-        matches!(
-            &e,
-            MeshError::FaceTooSmall {
-                position: Position::Line(3),
-                count: 2,
-                ..
-            }
-        ),
-        "{e:?}"
+    assert_matches!(
+        e,
+        MeshError::FaceTooSmall {
+            position: Position::Line(3),
+            count: 2,
+            ..
+        }
     );
 }
 
 #[test]
 fn obj_nan_vertex() {
     let e = obj_error("v 0 0 0\nv 1 NaN 0\n");
-    assert!(
-        matches!(
-            &e,
-            MeshError::NonFiniteCoordinate {
-                position: Position::Line(2),
-                axis: 'y',
-                ..
-            }
-        ),
-        "{e:?}"
+    assert_matches!(
+        e,
+        MeshError::NonFiniteCoordinate {
+            position: Position::Line(2),
+            axis: 'y',
+            ..
+        }
     );
     assert!(e.to_string().contains("line 2"));
-    assert!(matches!(
+    assert_matches!(
         obj_error("v inf 0 0\n"),
         MeshError::NonFiniteCoordinate { .. }
-    ));
+    );
 }
 
 #[test]
 fn ply_with_three_billion_claimed_vertices_is_rejected_before_allocating() {
     let text = "ply\nformat binary_little_endian 1.0\nelement vertex 3000000000\nproperty float x\nproperty float y\nproperty float z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n\0\0\0\0";
     let e = ply_error(text.as_bytes());
-    assert!(
-        matches!(
-            &e,
-            MeshError::CountTooLarge {
-                count: 3_000_000_000,
-                body_bytes: 4,
-                ..
-            }
-        ),
-        "{e:?}"
+    assert_matches!(
+        e,
+        MeshError::CountTooLarge {
+            count: 3_000_000_000,
+            body_bytes: 4,
+            ..
+        }
     );
     assert!(e.to_string().contains("\"vertex\""), "{e}");
     let ascii = text.replace("binary_little_endian", "ascii");
-    assert!(matches!(
-        ply_error(ascii.as_bytes()),
-        MeshError::CountTooLarge { .. }
-    ));
+    assert_matches!(ply_error(ascii.as_bytes()), MeshError::CountTooLarge { .. });
     // Lists with a huge count in a small body end in truncation, not allocation.
     let mut huge_list = ply_binary_le(&box_vertices(), &[vec![0, 1, 2]]);
     let n = huge_list.len();
     huge_list.truncate(n - 13);
     huge_list.extend_from_slice(&[0xff; 1]);
     huge_list.extend_from_slice(&[0; 4]);
-    assert!(matches!(ply_error(&huge_list), MeshError::Truncated { .. }));
+    assert_matches!(ply_error(&huge_list), MeshError::Truncated { .. });
 }
 
 #[test]
@@ -502,13 +471,10 @@ fn truncated_binary_ply() {
     let mut bytes = ply_binary_le(&box_vertices(), &triangulate(&box_quads()));
     bytes.truncate(bytes.len() - 5);
     let e = ply_error(&bytes);
-    assert!(
-        matches!(
-            &e,
-            MeshError::Truncated { position: Position::Element { element, index: 11, line: None }, .. }
-                if element == "face"
-        ),
-        "{e:?}"
+    assert_matches!(
+        e,
+        MeshError::Truncated { position: Position::Element { element, index: 11, line: None }, .. }
+            if element == "face"
     );
     assert!(e.to_string().contains("face 11"), "{e}");
     // The count check catches a body too short for the declared element counts outright.
@@ -518,7 +484,7 @@ fn truncated_binary_ply() {
         .unwrap()
         + 11;
     bytes.truncate(header + 100);
-    assert!(matches!(ply_error(&bytes), MeshError::CountTooLarge { .. }));
+    assert_matches!(ply_error(&bytes), MeshError::CountTooLarge { .. });
 }
 
 #[test]
@@ -526,65 +492,53 @@ fn ply_nan_vertex_and_bad_index() {
     let mut vertices = box_vertices();
     vertices[5].z = f64::NAN;
     let e = ply_error(&ply_binary_le(&vertices, &triangulate(&box_quads())));
-    assert!(
-        matches!(
-            &e,
-            MeshError::NonFiniteCoordinate {
-                position: Position::Element { index: 5, .. },
-                axis: 'z',
-                ..
-            }
-        ),
-        "{e:?}"
+    assert_matches!(
+        e,
+        MeshError::NonFiniteCoordinate {
+            position: Position::Element { index: 5, .. },
+            axis: 'z',
+            ..
+        }
     );
     let text = ply_ascii(&box_vertices(), &[vec![0, 1, 2], vec![0, 1, 8]]);
     let e = ply_error(text.as_bytes());
-    assert!(
-        matches!(
-            &e,
-            MeshError::IndexOutOfRange {
-                position: Position::Element {
-                    index: 1,
-                    line: Some(20),
-                    ..
-                },
-                index: 8,
+    assert_matches!(
+        e,
+        MeshError::IndexOutOfRange {
+            position: Position::Element {
+                index: 1,
+                line: Some(20),
                 ..
-            }
-        ),
-        "{e:?}"
+            },
+            index: 8,
+            ..
+        }
     );
     assert!(e.to_string().contains("face 1 (line 20)"), "{e}");
     let text = ply_ascii(&box_vertices(), &[vec![0, 1]]);
-    assert!(matches!(
+    assert_matches!(
         ply_error(text.as_bytes()),
         MeshError::FaceTooSmall { count: 2, .. }
-    ));
+    );
 }
 
 #[test]
 fn unsupported_ply_formats() {
     let text = ply_ascii(&box_vertices(), &box_quads()).replace("ascii", "binary_middle_endian");
     let e = ply_error(text.as_bytes());
-    assert!(matches!(&e, MeshError::Unsupported { .. }), "{e:?}");
+    assert_matches!(e, MeshError::Unsupported { .. });
     assert!(e.to_string().contains("binary_middle_endian"));
-    assert!(matches!(
-        ply_error(b"solid stl\n"),
-        MeshError::Syntax { .. }
-    ));
+    assert_matches!(ply_error(b"solid stl\n"), MeshError::Syntax { .. });
     let no_faces = "ply\nformat ascii 1.0\nelement vertex 1\nproperty float x\nproperty float y\nproperty float z\nend_header\n0 0 0\n";
-    assert!(matches!(
+    assert_matches!(
         ply_error(no_faces.as_bytes()),
         MeshError::Unsupported { .. }
-    ));
+    );
     let header_only = "ply\nformat ascii 1.0\nelement vertex 1\n";
-    assert!(matches!(
+    assert_matches!(
         ply_error(header_only.as_bytes()),
         MeshError::Truncated { .. }
-    ));
+    );
     let bad_value = ply_ascii(&box_vertices(), &box_quads()).replace("\n0 5 0\n", "\n0 zero 0\n");
-    assert!(matches!(
-        ply_error(bad_value.as_bytes()),
-        MeshError::Syntax { .. }
-    ));
+    assert_matches!(ply_error(bad_value.as_bytes()), MeshError::Syntax { .. });
 }

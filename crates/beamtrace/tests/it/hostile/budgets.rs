@@ -21,13 +21,10 @@ fn wvrn_at_order_10_is_held_by_the_budget_under_a_memory_limit() {
 
 #[test]
 fn dynamic_steps_respect_the_candidate_budget() {
-    let r = beamtrace(&[
-        "trace",
-        "builtin:living-room-dynamic",
-        "--steps",
-        "--max-order",
-        "40",
-    ]);
+    let r = beamtrace(&cli(
+        "trace builtin:living-room-dynamic --steps --max-order 40",
+        &[],
+    ));
     assert_refused(&r, &["candidate budget exceeded", "--max-candidates"]);
 }
 
@@ -35,47 +32,26 @@ fn dynamic_steps_respect_the_candidate_budget() {
 fn hls_and_study_respect_the_candidate_budget() {
     let dir = scratch("budget-hls");
     let out = dir.join("a");
+    let o = out.to_str().unwrap();
     assert_refused_writing_nothing(
-        &[
-            "hls",
-            "gen",
-            "builtin:living-room",
-            "--max-order",
-            "30",
-            "-o",
-            out.to_str().unwrap(),
-        ],
+        &cli("hls gen builtin:living-room --max-order 30 -o {}", &[o]),
         &out,
         &["candidate budget exceeded", "--max-candidates"],
     );
     assert_refused_writing_nothing(
-        &[
-            "study",
-            "living-room",
-            "--max-order",
-            "3",
-            "--max-candidates",
-            "100",
-            "--out",
-            out.to_str().unwrap(),
-        ],
+        &cli(
+            "study living-room --max-order 3 --max-candidates 100 --out {}",
+            &[o],
+        ),
         &out,
         &["candidate budget exceeded", "budget 100"],
     );
     // The 2-D study accepted --max-candidates and ignored it.
     assert_refused_writing_nothing(
-        &[
-            "study",
-            "2d",
-            "--rooms",
-            "1",
-            "--steps",
-            "1",
-            "--max-candidates",
-            "3",
-            "--out",
-            out.to_str().unwrap(),
-        ],
+        &cli(
+            "study 2d --rooms 1 --steps 1 --max-candidates 3 --out {}",
+            &[o],
+        ),
         &out,
         &["room-0-step-0", "--max-candidates"],
     );
@@ -83,28 +59,21 @@ fn hls_and_study_respect_the_candidate_budget() {
 
 #[test]
 fn sbr_grids_beyond_the_ray_budget_are_refused_not_answered_with_zero_paths() {
+    let wall = one_wall();
     for step in ["1e-20", "1e-5"] {
-        let r = beamtrace(&[
-            "trace",
-            &one_wall(),
-            "--solver",
-            "sbr",
-            "--sbr-step-deg",
-            step,
-        ]);
+        let r = beamtrace(&cli(
+            "trace {} --solver sbr --sbr-step-deg {}",
+            &[&wall, step],
+        ));
         assert_refused(&r, &["sbr ray budget exceeded", "--max-rays"]);
     }
-    let r = beamtrace(&[
-        "trace",
-        &one_wall(),
-        "--solver",
-        "sbr",
-        "--sbr-rays",
-        "1000000000",
-    ]);
+    let r = beamtrace(&cli(
+        "trace {} --solver sbr --sbr-rays 1000000000",
+        &[&wall],
+    ));
     assert_refused(&r, &["1.000e9 rays", "--max-rays"]);
     // Within the budget SBR still finds the wall's reflection.
-    let r = beamtrace(&["trace", &one_wall(), "--solver", "sbr", "--json"]);
+    let r = beamtrace(&cli("trace {} --solver sbr --json", &[&wall]));
     assert_ok(&r);
     let v: serde_json::Value = serde_json::from_slice(&r.stdout).unwrap();
     assert!(v["stats"]["valid_paths"].as_u64().unwrap() >= 2, "{v}");
@@ -115,14 +84,10 @@ fn sampling_beyond_the_point_budget_is_refused_before_allocating() {
     let dir = scratch("budget-sample");
     let out = dir.join("c.ply");
     assert_refused_writing_nothing(
-        &[
-            "sample",
-            "builtin:living-room",
-            "--density",
-            "1e12",
-            "-o",
-            out.to_str().unwrap(),
-        ],
+        &cli(
+            "sample builtin:living-room --density 1e12 -o {}",
+            &[out.to_str().unwrap()],
+        ),
         &out,
         &["point budget exceeded", "--max-points"],
     );
@@ -182,7 +147,7 @@ fn meshes_beyond_the_element_budget_stop_early_naming_count_budget_and_option() 
     }
     let obj = scene_with(&dir, "cube.obj", &obj);
     let ply = scene_with(&dir, "cube.ply", &ply);
-    let terminals = ["--tx", "2,2,2", "--rx", "3,2,2"];
+    let check_line = "scene check {} --max-mesh-elements {} --tx 2,2,2 --rx 3,2,2";
     for (file, budget, needle) in [
         (
             &obj,
@@ -197,20 +162,11 @@ fn meshes_beyond_the_element_budget_stop_early_naming_count_budget_and_option() 
         (&ply, "10", "12 faces, more than the budget of 10 faces"),
         (&ply, "7", "8 vertices, more than the budget of 7 vertices"),
     ] {
-        let mut args = vec![
-            "scene",
-            "check",
-            file.as_str(),
-            "--max-mesh-elements",
-            budget,
-        ];
-        args.extend(terminals);
-        assert_refused(&beamtrace(&args), &[needle, "--max-mesh-elements"]);
+        let check = cli(check_line, &[file.as_str(), budget]);
+        assert_refused(&beamtrace(&check), &[needle, "--max-mesh-elements"]);
     }
     for file in [&obj, &ply] {
-        let mut args = vec!["scene", "check", file.as_str(), "--max-mesh-elements", "12"];
-        args.extend(terminals);
-        assert_ok(&beamtrace(&args));
+        assert_ok(&beamtrace(&cli(check_line, &[file.as_str(), "12"])));
     }
 }
 
@@ -222,14 +178,10 @@ fn saturated_estimates_print_as_a_bound_not_as_u64_max() {
     // Grid: 1e600 points per axis.
     let out = dir.join("sweep");
     let grid = "0:1e300:1e-300,0:1e300:1e-300,1";
-    let sweep = beamtrace(&[
-        "sweep",
-        "builtin:living-room",
-        "--grid",
-        grid,
-        "--out",
-        out.to_str().unwrap(),
-    ]);
+    let sweep = beamtrace(&cli(
+        "sweep builtin:living-room --grid {} --out {}",
+        &[grid, out.to_str().unwrap()],
+    ));
     // PLY: a vertex count whose byte size overflows u64.
     let header = "ply\nformat binary_little_endian 1.0\nelement vertex 18446744073709551615\n\
                   property float x\nproperty float y\nproperty float z\nelement face 1\n\

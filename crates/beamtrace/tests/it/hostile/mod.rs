@@ -6,7 +6,7 @@ mod names;
 mod outputs;
 mod small;
 
-pub use crate::common::{scratch, text};
+pub use crate::common::{cli, scratch, text};
 use std::path::Path;
 use std::process::{Command, Output};
 

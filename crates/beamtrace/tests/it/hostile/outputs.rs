@@ -2,46 +2,49 @@
 
 use super::*;
 
+/// Writes the user's `files` (path in `out`, contents) into the output folder `out` in `dir`,
+/// then runs the command `line` (its `{}` is `out`) `runs` times, each run succeeding: the
+/// files are still there unchanged, and nothing but `out` is left in `dir` (no staging
+/// folders beside it).
+fn assert_runs_keep_users_files(
+    dir: &Path,
+    out: &Path,
+    files: &[(&str, &str)],
+    line: &str,
+    runs: usize,
+) {
+    for (name, contents) in files {
+        let path = out.join(name);
+        std::fs::create_dir_all(path.parent().unwrap()).unwrap();
+        std::fs::write(path, contents).unwrap();
+    }
+    for _ in 0..runs {
+        assert_ok(&beamtrace(&cli(line, &[out.to_str().unwrap()])));
+    }
+    for (name, contents) in files {
+        let kept = std::fs::read_to_string(out.join(name));
+        assert_eq!(kept.unwrap(), *contents, "{name}");
+    }
+    let siblings = std::fs::read_dir(dir).unwrap().count();
+    assert_eq!(siblings, 1, "no staging left");
+}
+
 #[test]
 fn hls_gen_keeps_the_users_files_and_replaces_its_own() {
     let dir = scratch("hls-keep");
     let out = dir.join("accel");
-    std::fs::create_dir_all(out.join("rtl")).unwrap();
-    std::fs::write(
-        out.join("rtl/my_wrapper.v"),
-        "module my_wrapper; endmodule\n",
-    )
-    .unwrap();
-    std::fs::write(out.join("notes.txt"), "mine").unwrap();
-    let o = out.to_str().unwrap();
-    for _ in 0..2 {
-        let r = beamtrace(&[
-            "hls",
-            "gen",
-            "builtin:living-room",
-            "--max-order",
-            "1",
-            "-o",
-            o,
-        ]);
-        assert_ok(&r);
-    }
-    assert_eq!(
-        std::fs::read_to_string(out.join("rtl/my_wrapper.v")).unwrap(),
-        "module my_wrapper; endmodule\n"
-    );
-    assert_eq!(
-        std::fs::read_to_string(out.join("notes.txt")).unwrap(),
-        "mine"
-    );
+    let mine = [
+        ("rtl/my_wrapper.v", "module my_wrapper; endmodule\n"),
+        ("notes.txt", "mine"),
+    ];
+    // The second run replaces what the first wrote.
+    let line = "hls gen builtin:living-room --max-order 1 -o {}";
+    assert_runs_keep_users_files(&dir, &out, &mine, line, 2);
     assert!(out.join("rtl/bt_top.v").exists());
     assert!(out.join("summary.json").exists());
     let manifest = std::fs::read_to_string(out.join(".beamtrace-manifest")).unwrap();
     assert!(manifest.contains("rtl/bt_top.v") && manifest.contains("summary.json"));
     assert!(!manifest.contains("my_wrapper") && !manifest.contains("notes.txt"));
-    // Nothing left beside the directory (no staging directories).
-    let siblings: Vec<_> = std::fs::read_dir(&dir).unwrap().collect();
-    assert_eq!(siblings.len(), 1);
 }
 
 #[test]
@@ -49,17 +52,10 @@ fn hls_gen_that_cannot_fit_fails_fast_and_creates_nothing() {
     let dir = scratch("hls-fail");
     let out = dir.join("accel");
     assert_refused_writing_nothing(
-        &[
-            "hls",
-            "gen",
-            "builtin:living-room",
-            "--max-order",
-            "1",
-            "--m9k-budget",
-            "4",
-            "-o",
-            out.to_str().unwrap(),
-        ],
+        &cli(
+            "hls gen builtin:living-room --max-order 1 --m9k-budget 4 -o {}",
+            &[out.to_str().unwrap()],
+        ),
         &out,
         &["M9K blocks", "budget of 4", "--max-order"],
     );
@@ -68,14 +64,10 @@ fn hls_gen_that_cannot_fit_fails_fast_and_creates_nothing() {
 
 fn sampled_cloud(dir: &std::path::Path) -> std::path::PathBuf {
     let cloud = dir.join("room.ply");
-    let r = beamtrace(&[
-        "sample",
-        &one_wall(),
-        "-o",
-        cloud.to_str().unwrap(),
-        "--density",
-        "2000",
-    ]);
+    let r = beamtrace(&cli(
+        "sample {} -o {} --density 2000",
+        &[&one_wall(), cloud.to_str().unwrap()],
+    ));
     assert_ok(&r);
     cloud
 }
@@ -92,15 +84,12 @@ fn extract_refuses_to_overwrite_its_input() {
     );
     // Another spelling of the same file.
     let other = dir.join(".").join("room.ply");
+    let report = other.to_str().unwrap();
     assert_refused_keeping(
-        &[
-            "extract",
-            c,
-            "--report",
-            other.to_str().unwrap(),
-            "-o",
-            dir.join("s.json").to_str().unwrap(),
-        ],
+        &cli(
+            "extract {} --report {} -o {}",
+            &[c, report, dir.join("s.json").to_str().unwrap()],
+        ),
         &cloud,
         &["it is the input"],
     );
@@ -117,14 +106,10 @@ fn extract_writes_the_format_its_extension_names_or_refuses() {
     let text = std::fs::read_to_string(&toml).unwrap();
     assert!(text.contains("[[surfaces]]"), "not TOML:\n{text}");
     // trace reads it back (as TOML, by extension).
-    let r = beamtrace(&[
-        "trace",
-        toml.to_str().unwrap(),
-        "--tx",
-        "-1.5,1,2",
-        "--rx",
-        "2,2,1",
-    ]);
+    let r = beamtrace(&cli(
+        "trace {} --tx -1.5,1,2 --rx 2,2,1",
+        &[toml.to_str().unwrap()],
+    ));
     assert_ok(&r);
     let json = dir.join("room.json");
     assert_ok(&beamtrace(&["extract", c, "-o", json.to_str().unwrap()]));
@@ -172,30 +157,8 @@ fn sample_refuses_to_overwrite_its_input_and_leaves_no_temporary() {
 fn study_keeps_files_it_did_not_write() {
     let dir = scratch("study");
     let out = dir.join("study");
-    std::fs::create_dir_all(&out).unwrap();
-    std::fs::write(out.join("README.txt"), "mine").unwrap();
-    let o = out.to_str().unwrap();
-    let r = beamtrace(&[
-        "study",
-        "2d",
-        "--rooms",
-        "1",
-        "--steps",
-        "1",
-        "--max-order",
-        "1",
-        "--out",
-        o,
-    ]);
-    assert_ok(&r);
-    assert_eq!(
-        std::fs::read_to_string(out.join("README.txt")).unwrap(),
-        "mine"
-    );
+    let mine = [("README.txt", "mine")];
+    let line = "study 2d --rooms 1 --steps 1 --max-order 1 --out {}";
+    assert_runs_keep_users_files(&dir, &out, &mine, line, 1);
     assert!(out.join("results.csv").exists());
-    assert_eq!(
-        std::fs::read_dir(&dir).unwrap().count(),
-        1,
-        "no staging left"
-    );
 }

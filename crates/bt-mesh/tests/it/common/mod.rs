@@ -1,6 +1,16 @@
 //! Small mesh builders shared by the integration tests. All lengths in metres.
 
 use bt_mesh::{MeshImport, MeshSurface};
+
+/// Asserts that `value` matches `pattern` (with an optional `if` guard), printing the value
+/// when it does not: `assert!(matches!(..))` says only that it failed, and the standard
+/// library's `assert_matches!` is not stable yet.
+macro_rules! assert_matches {
+    ($value:expr, $pattern:pat $(if $guard:expr)?) => {{
+        let value = &$value;
+        assert!(matches!(value, $pattern $(if $guard)?), "{value:?}");
+    }};
+}
 use glam::DVec3;
 
 /// Room size of the test box: 4 x 5 x 2.6 m.
