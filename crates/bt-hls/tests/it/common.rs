@@ -11,44 +11,33 @@ use bt_schedule::{Budget, GaParams, Schedule, schedule_ga};
 /// between two walls or a wall and the floor (orders <= 2).
 pub fn small_scene() -> HlsInput {
     let tilt = [0.995_037_190_209_989_1, 0.099_503_719_020_998_92, 0.0];
-    let planes = vec![
-        PlaneSpec {
-            name: "wall_west_tilted".into(),
-            normal: tilt,
-            offset_m: tilt[1] * 2.0,
-            bounds_m: Some([[-0.2, 0.0, 0.0], [0.2, 4.0, 3.0]]),
-        },
-        PlaneSpec {
-            name: "wall_east".into(),
-            normal: [-1.0, 0.0, 0.0],
-            offset_m: -5.0,
-            bounds_m: Some([[5.0, 0.0, 0.0], [5.0, 4.0, 3.0]]),
-        },
-        PlaneSpec {
-            name: "wall_south".into(),
-            normal: [0.0, 1.0, 0.0],
-            offset_m: 0.0,
-            bounds_m: Some([[0.0, 0.0, 0.0], [5.0, 0.0, 3.0]]),
-        },
-        PlaneSpec {
-            name: "wall_north".into(),
-            normal: [0.0, -1.0, 0.0],
-            offset_m: -4.0,
-            bounds_m: Some([[0.0, 4.0, 0.0], [5.0, 4.0, 3.0]]),
-        },
-        PlaneSpec {
-            name: "floor".into(),
-            normal: [0.0, 0.0, 1.0],
-            offset_m: 0.0,
-            bounds_m: Some([[0.0, 0.0, 0.0], [5.0, 4.0, 0.0]]),
-        },
-        PlaneSpec {
-            name: "ceiling".into(),
-            normal: [0.0, 0.0, -1.0],
-            offset_m: -3.0,
-            bounds_m: Some([[0.0, 0.0, 3.0], [5.0, 4.0, 3.0]]),
-        },
-    ];
+    let mut planes = vec![PlaneSpec {
+        name: "wall_west_tilted".into(),
+        normal: tilt,
+        offset_m: tilt[1] * 2.0,
+        bounds_m: Some([[-0.2, 0.0, 0.0], [0.2, 4.0, 3.0]]),
+    }];
+    // The other five faces, axis-aligned: (name, axis, on the far side of the room).
+    let room = [5.0, 4.0, 3.0];
+    for (name, axis, far) in [
+        ("wall_east", 0, true),
+        ("wall_south", 1, false),
+        ("wall_north", 1, true),
+        ("floor", 2, false),
+        ("ceiling", 2, true),
+    ] {
+        let at = if far { room[axis] } else { 0.0 };
+        let mut normal = [0.0; 3];
+        normal[axis] = if far { -1.0 } else { 1.0 };
+        let (mut lo, mut hi) = ([0.0; 3], room);
+        (lo[axis], hi[axis]) = (at, at);
+        planes.push(PlaneSpec {
+            name: name.into(),
+            normal,
+            offset_m: normal[axis] * at,
+            bounds_m: Some([lo, hi]),
+        });
+    }
     let centroids = [
         [0.0, 2.0, 1.5],
         [5.0, 2.0, 1.5],
