@@ -1,7 +1,9 @@
 //! Property tests: IPC (both update orders) finds exactly the image method's valid paths, to
-//! 1e-9 m, and every reported path obeys the law of reflection and lies inside its polygons.
+//! 1e-9 m (1e-11 m with Newton acceleration), and every reported path obeys the law of
+//! reflection and lies inside its polygons.
 
 use crate::common::*;
+use crate::newton::{check_agreement, newton};
 use bt_paths::beamtree::{TreeOptions, candidates};
 use bt_scene::Scene;
 use bt_solve::{CandidateOutcome, Solver, UpdateOrder, Validity, solve_candidate_from};
@@ -52,6 +54,11 @@ proptest! {
             prop_assert_eq!(sequences(&paths), sequences(&reference), "{:?}", order);
             let d = max_point_distance(&paths, &reference);
             prop_assert!(d < 1e-9, "{:?}: points differ by {} m", order, d);
+            let polished = run(&scene, 3, newton(&scene, order));
+            check_agreement(&reference, &polished, &format!("{order:?} with Newton"))?;
+            for p in &polished {
+                prop_assert!(p.points.iter().all(|q| q.is_finite()));
+            }
         }
         let agree = early_blocks_agree_with_the_image_method(&scene);
         prop_assert!(agree.is_ok(), "{:?}", agree);

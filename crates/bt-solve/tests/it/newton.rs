@@ -1,6 +1,7 @@
-//! Newton-accelerated IPC against the image method: the same valid paths, to 1e-11 m, on the
-//! random scenes of `ipc_vs_image.rs` and on corner reflectors whose bounce points lie
-//! within 0.1-10 mm of the edge (where the paper's rounds converge sublinearly).
+//! Newton-accelerated IPC against the image method: the same valid paths, to 1e-11 m, on
+//! corner reflectors whose bounce points lie within 0.1-10 mm of the edge (where the paper's
+//! rounds converge sublinearly). The random scenes' check runs with plain IPC's in
+//! `ipc_vs_image.rs`.
 
 use crate::common::*;
 use bt_geom::Real;
@@ -12,14 +13,16 @@ use proptest::prelude::*;
 /// Agreement promised by Newton acceleration, metres.
 const NEWTON_AGREEMENT: Real = 1e-11;
 
-fn newton(scene: &Scene, order: UpdateOrder) -> Solver {
+pub(crate) fn newton(scene: &Scene, order: UpdateOrder) -> Solver {
     Solver::Ipc(IpcOptions {
         acceleration: Acceleration::Newton,
         ..IpcOptions::for_scene(scene, order)
     })
 }
 
-fn check_agreement(
+/// Newton's paths against the image method's: the same sequences, points within
+/// [`NEWTON_AGREEMENT`].
+pub(crate) fn check_agreement(
     reference: &[FoundPath],
     paths: &[FoundPath],
     what: &str,
@@ -28,24 +31,6 @@ fn check_agreement(
     let d = max_point_distance(paths, reference);
     prop_assert!(d <= NEWTON_AGREEMENT, "{}: points differ by {} m", what, d);
     Ok(())
-}
-
-proptest! {
-    #![proptest_config(random_scene_config())]
-
-    /// The scenes of `ipc_equals_image_method_on_random_scenes`, with Newton after both orders.
-    #[test]
-    fn newton_equals_image_method_on_random_scenes(seed in 0u64..1_000_000, n in 1usize..6) {
-        let scene = random_scene(seed, n);
-        let reference = run(&scene, 3, Solver::Image);
-        for order in [UpdateOrder::GaussSeidel, UpdateOrder::Jacobi] {
-            let paths = run(&scene, 3, newton(&scene, order));
-            check_agreement(&reference, &paths, &format!("{order:?}"))?;
-            for p in &paths {
-                prop_assert!(p.points.iter().all(|q| q.is_finite()));
-            }
-        }
-    }
 }
 
 proptest! {
