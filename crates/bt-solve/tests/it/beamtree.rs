@@ -234,6 +234,31 @@ fn full_tree_walk_equals_the_single_receiver_trace() {
 }
 
 #[test]
+fn ipc_finds_corner_paths_whose_rounds_stall() {
+    // A nasty scene (found by the property test below under another seed): the paths that
+    // reflect on two walls 14 and 98 µm from their common edge. The paper's rounds converge
+    // sublinearly there and stalled after ~85,000 rounds tens of nanometres off; Newton steps
+    // from where they stalled finish them, so IPC reports the image method's paths.
+    let scene = nasty_scene(327_569, 4, 0).expect("the scene builds");
+    let image = paths(&scene, 3, CandidateMode::Exhaustive);
+    let gs = crate::common::ipc(&scene, UpdateOrder::GaussSeidel);
+    let ipc = trace_scene(&scene, &options(3, CandidateMode::BeamTree, gs))
+        .unwrap()
+        .result
+        .paths;
+    assert_eq!(sequences(&ipc), sequences(&image));
+    assert!(max_point_distance(&ipc, &image) < 1e-8);
+    let corner = ipc
+        .iter()
+        .filter(|p| p.iterations.is_some_and(|i| i > 50_000));
+    assert_eq!(
+        corner.count(),
+        2,
+        "the two stalled corner paths are among them"
+    );
+}
+
+#[test]
 fn ipc_finds_the_wall_floor_path_that_centroid_starts_missed() {
     // The floor's centroid lies in the wall's plane: IPC from centroids settled on the planes'
     // shared line. Started inside the beam tree's windows it converges to the image method's
