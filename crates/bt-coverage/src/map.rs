@@ -4,7 +4,7 @@
 
 use crate::{Grid, PointStatus, Row};
 use bt_geom::Real;
-use bt_plot::{FAMILY, blank, fail};
+use bt_plot::{FAMILY, blank, fail, mesh};
 use bt_scene::{Scene, SurfaceKind};
 use plotters::coord::Shift;
 use plotters::prelude::*;
@@ -121,13 +121,8 @@ impl HeatMap<'_> {
             .y_label_area_size(50)
             .build_cartesian_2d(x0..x1, y0..y1)
             .map_err(fail)?;
-        chart
-            .configure_mesh()
+        mesh(&mut chart, ("x (m)", "y (m)"), (12, 14))
             .disable_mesh()
-            .x_desc("x (m)")
-            .y_desc("y (m)")
-            .label_style((FAMILY, 12))
-            .axis_desc_style((FAMILY, 14))
             .draw()
             .map_err(fail)?;
         let (hx, hy) = (self.grid.x.step / 2.0, self.grid.y.step / 2.0);

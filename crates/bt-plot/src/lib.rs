@@ -7,6 +7,8 @@
 
 #![warn(missing_docs)]
 
+use plotters::chart::MeshStyle;
+use plotters::coord::ranged1d::{Ranged, ValueFormatter};
 use plotters::coord::{CoordTranslate, Shift};
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
@@ -52,6 +54,27 @@ pub fn legend<'a, DB: DrawingBackend + 'a, CT: CoordTranslate>(
         .border_style(BLACK)
         .draw()
         .map_err(fail)
+}
+
+/// Start the mesh of a 2-D chart with axis titles `x_desc` and `y_desc` in the shipped font:
+/// tick labels at `sizes.0` points and axis titles at `sizes.1` points. The caller adds what
+/// its chart needs (label counts, formatters, `disable_mesh`) and draws it.
+pub fn mesh<'a, 'b, DB, X, Y, XT, YT>(
+    chart: &'b mut ChartContext<'a, DB, Cartesian2d<X, Y>>,
+    (x_desc, y_desc): (&str, &str),
+    sizes: (u32, u32),
+) -> MeshStyle<'a, 'b, X, Y, DB>
+where
+    DB: DrawingBackend,
+    X: Ranged<ValueType = XT> + ValueFormatter<XT>,
+    Y: Ranged<ValueType = YT> + ValueFormatter<YT>,
+{
+    let mut mesh = chart.configure_mesh();
+    mesh.x_desc(x_desc)
+        .y_desc(y_desc)
+        .label_style((FAMILY, sizes.0))
+        .axis_desc_style((FAMILY, sizes.1));
+    mesh
 }
 
 /// A figure that can draw itself on any plotters backend.

@@ -18,7 +18,7 @@ pub const ERROR_FLOOR_DEG: Real = 1e-15;
 pub const TIME_FLOOR_S: Real = 1e-7;
 
 pub use bt_plot::register_font;
-pub(crate) use bt_plot::{FAMILY, blank, fail, legend};
+pub(crate) use bt_plot::{FAMILY, blank, fail, legend, mesh};
 
 /// Colour of a solver in every figure.
 pub fn colour(solver: StudySolver) -> RGBColor {
@@ -85,15 +85,10 @@ pub(crate) fn panel<DB: DrawingBackend>(
             (y_lo..y_hi).log_scale(),
         )
         .map_err(fail)?;
-    chart
-        .configure_mesh()
-        .x_desc(x_desc)
-        .y_desc(y_desc)
+    mesh(&mut chart, (x_desc, y_desc), (12, 14))
         .x_labels((x_hi - x_lo + 1).min(12))
         .x_label_formatter(&|x| format!("{x:.0}"))
         .y_label_formatter(&|y| format!("{y:.0e}"))
-        .label_style((FAMILY, 12))
-        .axis_desc_style((FAMILY, 14))
         .draw()
         .map_err(fail)?;
     for s in series {
@@ -355,12 +350,7 @@ pub fn power_delay_profile<DB: DrawingBackend>(
         .y_label_area_size(60)
         .build_cartesian_2d(0.0..t_hi, p_lo..p_hi)
         .map_err(fail)?;
-    chart
-        .configure_mesh()
-        .x_desc("delay (ns)")
-        .y_desc("received power (dBm)")
-        .label_style((FAMILY, 12))
-        .axis_desc_style((FAMILY, 14))
+    mesh(&mut chart, ("delay (ns)", "received power (dBm)"), (12, 14))
         .draw()
         .map_err(fail)?;
     let max_order = finite().map(|t| t.order).max().unwrap_or(0);

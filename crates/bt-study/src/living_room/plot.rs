@@ -4,7 +4,9 @@
 
 use super::{LivingRoomResults, RayAngles, StepRays};
 use crate::StudySolver;
-use crate::plot::{FAMILY, Series, TIME_FLOOR_S, blank, colour, error_panel, fail, legend, panel};
+use crate::plot::{
+    FAMILY, Series, TIME_FLOOR_S, blank, colour, error_panel, fail, legend, mesh, panel,
+};
 use crate::run::Comparison;
 use bt_geom::Real;
 use plotters::coord::Shift;
@@ -125,16 +127,11 @@ pub fn ray_directions<DB: DrawingBackend>(
                 .y_label_area_size(50)
                 .build_cartesian_2d(-180.0..180.0, -90.0..90.0)
                 .map_err(fail)?;
-            chart
-                .configure_mesh()
-                .x_desc("azimuth (deg)")
-                .y_desc("elevation (deg)")
+            mesh(&mut chart, ("azimuth (deg)", "elevation (deg)"), (11, 13))
                 .x_labels(9)
                 .y_labels(7)
                 .x_label_formatter(&|x| format!("{x:.0}"))
                 .y_label_formatter(&|y| format!("{y:.0}"))
-                .label_style((FAMILY, 11))
-                .axis_desc_style((FAMILY, 13))
                 .draw()
                 .map_err(fail)?;
             chart
