@@ -2,6 +2,7 @@
 
 use anyhow::{Context, bail};
 use bt_geom::Vec3;
+use bt_solve::settings::{IpcSettings, Named, SbrSettings, SolveSettings};
 use clap::{Args, Parser, Subcommand, ValueEnum};
 use std::path::PathBuf;
 
@@ -494,12 +495,7 @@ pub enum CandidatesArg {
 impl CandidatesArg {
     /// The pipeline's candidate mode.
     pub fn mode(self) -> bt_solve::pipeline::CandidateMode {
-        use bt_solve::pipeline::CandidateMode;
-        match self {
-            CandidatesArg::BeamTree => CandidateMode::BeamTree,
-            CandidatesArg::Wvrn => CandidateMode::Wvrn,
-            CandidatesArg::Exhaustive => CandidateMode::Exhaustive,
-        }
+        by_name(self)
     }
 }
 
@@ -515,6 +511,36 @@ impl SolveArgs {
         }
         self.candidates.mode()
     }
+
+    /// The library's settings these arguments give (checked when they meet a scene).
+    pub fn settings(&self) -> SolveSettings {
+        SolveSettings {
+            max_order: self.max_order,
+            solver: by_name(self.solver),
+            ipc: IpcSettings {
+                order: by_name(self.ipc_order),
+                acceleration: by_name(self.ipc_accel),
+                threshold: self.ipc_threshold,
+                max_iterations: self.ipc_max_iterations,
+            },
+            sbr: SbrSettings {
+                step_deg: self.sbr_step_deg,
+                rays: self.sbr_rays,
+                planar: self.sbr_planar,
+                max_rays: self.max_rays,
+            },
+            candidates: self.candidate_mode(),
+            max_candidates: self.max_candidates,
+            parallel: !self.single_thread,
+        }
+    }
+}
+
+/// The library value a command-line value names: the flags' values are the library's names
+/// (`bt_solve::settings`), checked for every value by a test.
+fn by_name<T: Named>(value: impl ValueEnum) -> T {
+    let name = value.to_possible_value().expect("no value is skipped");
+    bt_solve::settings::parse(name.get_name()).expect("every flag value is a library name")
 }
 
 #[derive(Debug, Args, Clone)]
@@ -935,5 +961,27 @@ mod tests {
         );
         assert_eq!(a.max_mesh_elements, bt_mesh::DEFAULT_MAX_ELEMENTS);
         assert_eq!(a.max_cloud_points, bt_pointcloud::io::DEFAULT_MAX_POINTS);
+    }
+
+    #[test]
+    fn every_solver_flag_value_is_the_library_name_of_one_value() {
+        fn all_named<A: ValueEnum, T: Named + PartialEq + std::fmt::Debug>() {
+            let values: Vec<T> = A::value_variants()
+                .iter()
+                .map(|v| by_name(v.clone()))
+                .collect();
+            assert_eq!(values.len(), T::NAMES.len());
+            assert!(T::NAMES.iter().all(|(_, v)| values.contains(v)));
+        }
+        all_named::<SolverArg, bt_solve::settings::SolverKind>();
+        all_named::<IpcOrderArg, bt_solve::UpdateOrder>();
+        all_named::<IpcAccelArg, bt_solve::Acceleration>();
+        all_named::<CandidatesArg, bt_solve::pipeline::CandidateMode>();
+    }
+
+    #[test]
+    fn the_default_flags_are_the_library_defaults() {
+        let defaults = SolveArgs::with(3, SolverArg::Image);
+        assert_eq!(defaults.settings(), SolveSettings::default());
     }
 }

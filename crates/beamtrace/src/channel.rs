@@ -1,7 +1,7 @@
 //! `beamtrace channel` (CIR, CFR, power-delay profile) and `beamtrace beams` (codebook sweep).
 
 use crate::args::{BeamsArgs, ChannelArgs, PathArgs, RankingArg};
-use crate::trace::{load_scene, solver_for, trace_options, warn_near_field};
+use crate::trace::{load_scene, warn_near_field};
 use anyhow::{Context, bail};
 use bt_beams::{BeamRanking, PathReport, RadioOptions};
 use bt_scene::Scene;
@@ -21,9 +21,8 @@ fn traced_paths(args: &PathArgs) -> anyhow::Result<(Scene, Vec<PathReport>, Radi
     }
     let scene = loaded.scene;
     let trace_args = args.trace_args();
-    let solver = solver_for(&trace_args.solve, &scene)?;
-    let traced =
-        bt_solve::pipeline::trace_scene(&scene, &trace_options(&trace_args.solve, solver))?;
+    let options = trace_args.solve.settings().trace_options(&scene)?;
+    let traced = bt_solve::pipeline::trace_scene(&scene, &options)?;
     let radio = args.radio.options()?;
     let paths = bt_beams::report(&scene, &traced.result.paths, &radio)?;
     warn_near_field(&paths, &scene);

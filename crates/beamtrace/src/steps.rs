@@ -4,10 +4,10 @@
 
 use crate::args::{SceneArgs, TraceArgs};
 use crate::output::FORMAT_VERSION;
-use crate::trace::{load_options, solver_for};
+use crate::trace::load_options;
 use anyhow::Context;
 use bt_beams::PathReport;
-use bt_dynamic::{IncrementalTracer, StepOptions, UpdateStats, trace_scratch};
+use bt_dynamic::{IncrementalTracer, UpdateStats, trace_scratch};
 use bt_paths::CandidateStats;
 use bt_paths::wvrn::WvrnStats;
 use bt_scene::dynamic::DynamicScene;
@@ -69,14 +69,8 @@ pub fn load_dynamic(args: &SceneArgs) -> anyhow::Result<DynamicScene> {
 pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
     let dynamic = load_dynamic(&args.scene)?;
     let scene0 = dynamic.step(0);
-    let solver = solver_for(&args.solve, scene0)?;
-    let options = StepOptions {
-        max_order: args.solve.max_order,
-        solver,
-        candidates: args.solve.candidate_mode(),
-        max_candidates: args.solve.max_candidates,
-        parallel: !args.solve.single_thread,
-    };
+    let options = args.solve.settings().trace_options(scene0)?;
+    let solver = options.solver;
     let incremental = !args.from_scratch;
     let radio = args.radio.options()?;
     let mut tracer = IncrementalTracer::new(options);

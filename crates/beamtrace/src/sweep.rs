@@ -2,7 +2,7 @@
 //! coverage.csv and the heat map into the output directory.
 
 use crate::args::SweepArgs;
-use crate::trace::{load_scene, solver_for, trace_options};
+use crate::trace::load_scene;
 use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::process::ExitCode;
@@ -18,7 +18,7 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<ExitCode> {
         eprintln!("warning: {w}");
     }
     let scene = loaded.scene;
-    let options = trace_options(&args.solve, solver_for(&args.solve, &scene)?);
+    let options = args.solve.settings().trace_options(&scene)?;
     // indicatif draws to stderr and hides itself when stderr is not a terminal.
     let bar = ProgressBar::new(points.len() as u64);
     bar.set_style(

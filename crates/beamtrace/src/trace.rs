@@ -1,11 +1,10 @@
 //! `beamtrace trace`, `demo` and `scene check`.
 
-use crate::args::{IpcAccelArg, IpcOrderArg, SceneArgs, SolveArgs, SolverArg, TraceArgs};
+use crate::args::{SceneArgs, TraceArgs};
 use crate::output::{self, TraceDocument};
-use anyhow::{Context, bail};
+use anyhow::Context;
 use bt_scene::io::{LoadOptions, Loaded};
 use bt_scene::{Scene, SceneError, Terminals};
-use bt_solve::{Acceleration, IpcOptions, SbrOptions, Solver, UpdateOrder};
 use std::process::ExitCode;
 use std::time::Instant;
 
@@ -53,54 +52,6 @@ pub fn load_scene(args: &SceneArgs) -> anyhow::Result<Loaded> {
     Ok(loaded)
 }
 
-/// The solver the arguments select, with defaults scaled to the scene.
-pub fn solver_for(args: &SolveArgs, scene: &Scene) -> anyhow::Result<Solver> {
-    Ok(match args.solver {
-        SolverArg::Image => Solver::Image,
-        SolverArg::Ipc => {
-            let order = match args.ipc_order {
-                IpcOrderArg::GaussSeidel => UpdateOrder::GaussSeidel,
-                IpcOrderArg::Jacobi => UpdateOrder::Jacobi,
-            };
-            let mut options = IpcOptions::for_scene(scene, order);
-            if let Some(t) = args.ipc_threshold {
-                if !(t.is_finite() && t > 0.0) {
-                    bail!("--ipc-threshold must be a positive number of metres, got {t}");
-                }
-                options.threshold = t;
-            }
-            if args.ipc_max_iterations == 0 {
-                bail!("--ipc-max-iterations must be at least 1");
-            }
-            options.max_iterations = args.ipc_max_iterations;
-            options.acceleration = match args.ipc_accel {
-                IpcAccelArg::None => Acceleration::None,
-                IpcAccelArg::Newton => Acceleration::Newton,
-            };
-            Solver::Ipc(options)
-        }
-        SolverArg::Sbr => {
-            let options = SbrOptions::chosen(args.sbr_rays, args.sbr_step_deg, args.sbr_planar)
-                .map_err(anyhow::Error::msg)?;
-            if let Some(problem) = options.over_budget(args.max_rays) {
-                bail!("{problem}");
-            }
-            Solver::Sbr(options)
-        }
-    })
-}
-
-/// The pipeline options the arguments select.
-pub fn trace_options(args: &SolveArgs, solver: Solver) -> bt_solve::pipeline::TraceOptions {
-    bt_solve::pipeline::TraceOptions {
-        max_order: args.max_order,
-        solver,
-        candidates: args.candidate_mode(),
-        parallel: !args.single_thread,
-        max_candidates: args.max_candidates,
-    }
-}
-
 pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
     if args.steps {
         return crate::steps::run(args);
@@ -114,9 +65,9 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
     for w in scene.warnings() {
         eprintln!("warning: {w}");
     }
-    let solver = solver_for(&args.solve, &scene)?;
+    let options = args.solve.settings().trace_options(&scene)?;
+    let solver = options.solver;
     let t1 = Instant::now();
-    let options = trace_options(&args.solve, solver);
     let (bar, mut progress) = crate::progress::tree_progress();
     let traced = bt_solve::pipeline::trace_scene_with_progress(&scene, &options, &mut progress);
     bar.finish_and_clear();

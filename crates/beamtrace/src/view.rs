@@ -3,7 +3,6 @@
 
 use crate::args::ViewArgs;
 use crate::steps::load_dynamic;
-use crate::trace::{solver_for, trace_options};
 use anyhow::Context;
 use bt_view::StepPaths;
 use std::process::ExitCode;
@@ -20,7 +19,7 @@ pub fn run(args: &ViewArgs) -> anyhow::Result<ExitCode> {
             paths
         }
         None => {
-            let options = trace_options(&args.solve, solver_for(&args.solve, scenes[0])?);
+            let options = args.solve.settings().trace_options(scenes[0])?;
             let mut steps = Vec::with_capacity(scenes.len());
             for scene in &scenes {
                 let traced = bt_solve::pipeline::trace_scene(scene, &options)?;

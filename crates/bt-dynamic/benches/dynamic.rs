@@ -5,21 +5,21 @@
 //! `cargo bench -p bt-dynamic`; the reduction ratio and the incremental/scratch ratio of the
 //! mean step times are printed to stderr before the criterion groups run.
 
-use bt_dynamic::{IncrementalTracer, StepOptions, trace_scratch};
+use bt_dynamic::{IncrementalTracer, trace_scratch};
 use bt_paths::wvrn::Wvrn;
 use bt_paths::{AllVisible, enumerate};
 use bt_scene::Terminals;
 use bt_scene::dynamic::builtin_dynamic_scene;
 use bt_solve::Solver;
-use bt_solve::pipeline::CandidateMode;
+use bt_solve::pipeline::{CandidateMode, TraceOptions};
 use criterion::{BatchSize, Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
 use std::time::Instant;
 
 const ORDER: usize = 3;
 
-fn options(candidates: CandidateMode) -> StepOptions {
-    StepOptions {
+fn options(candidates: CandidateMode) -> TraceOptions {
+    TraceOptions {
         max_order: ORDER,
         solver: Solver::Image,
         candidates,

@@ -42,22 +42,6 @@ use bt_solve::{
 use serde::Serialize;
 use std::cmp::Ordering;
 
-/// What to trace at every step.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
-pub struct StepOptions {
-    /// Highest reflection order.
-    pub max_order: usize,
-    /// Path solver (IPC options are used as given; scale them to the scene yourself).
-    pub solver: Solver,
-    /// Candidate generator (the beam tree by default; the WVRN mode keeps its incremental
-    /// link update).
-    pub candidates: CandidateMode,
-    /// Budget on candidates (beam-tree nodes) per step.
-    pub max_candidates: u64,
-    /// Spread solving over rayon's pool (output identical either way).
-    pub parallel: bool,
-}
-
 /// What an incremental step recomputed.
 #[derive(Debug, Clone, Default, PartialEq, Serialize)]
 pub struct UpdateStats {
@@ -104,26 +88,26 @@ pub struct StepTrace {
     pub update: UpdateStats,
 }
 
-impl StepOptions {
-    fn trace_options(&self) -> TraceOptions {
-        TraceOptions {
-            max_order: self.max_order,
-            solver: self.solver,
-            candidates: self.candidates,
-            parallel: self.parallel,
-            max_candidates: self.max_candidates,
-        }
-    }
-
+/// How a step generates its candidates under the pipeline's options (the WVRN mode keeps its
+/// incremental link update; the beam tree is kept for the next steps).
+trait StepGeneration {
     /// The step's candidates: over `wvrn` when given (WVRN mode), else from the pipeline's
     /// generator (beam tree or exhaustive), under the budget.
+    fn candidates(&self, scene: &Scene, wvrn: Option<&Wvrn>) -> Result<CandidateSet, TraceError>;
+    /// The WVRN of `scene` in WVRN mode.
+    fn wvrn(&self, scene: &Scene) -> Option<Wvrn>;
+    /// A first step's generator and its candidates.
+    fn generate(&self, scene: &Scene) -> Result<(Generator, CandidateSet), TraceError>;
+}
+
+impl StepGeneration for TraceOptions {
     fn candidates(&self, scene: &Scene, wvrn: Option<&Wvrn>) -> Result<CandidateSet, TraceError> {
         match wvrn {
             Some(w) => {
-                bt_solve::pipeline::check_budget(scene, &self.trace_options())?;
+                bt_solve::pipeline::check_budget(scene, self)?;
                 Ok(bt_paths::enumerate(scene, self.max_order, w))
             }
-            None => bt_solve::pipeline::candidates(scene, &self.trace_options()),
+            None => bt_solve::pipeline::candidates(scene, self),
         }
     }
 
@@ -136,7 +120,7 @@ impl StepOptions {
     /// rebuilds only its subtrees), or exhaustive enumeration.
     fn generate(&self, scene: &Scene) -> Result<(Generator, CandidateSet), TraceError> {
         if self.candidates == CandidateMode::BeamTree {
-            let options = bt_solve::pipeline::tree_options(&self.trace_options());
+            let options = bt_solve::pipeline::tree_options(self);
             let tree = BeamTree::build(scene, options)?;
             let candidates = tree.candidates(scene.rx());
             let generator = Generator {
@@ -164,7 +148,7 @@ struct Generator {
 pub fn trace_scratch(
     scene: &Scene,
     step: usize,
-    options: &StepOptions,
+    options: &TraceOptions,
 ) -> Result<StepTrace, TraceError> {
     let wvrn = options.wvrn(scene);
     let candidates = options.candidates(scene, wvrn.as_ref())?;
@@ -185,7 +169,7 @@ pub fn trace_scratch(
 /// Trace every step of a dynamic scene, incrementally or each from scratch.
 pub fn trace_steps(
     dynamic: &DynamicScene,
-    options: &StepOptions,
+    options: &TraceOptions,
     incremental: bool,
 ) -> Result<Vec<StepTrace>, TraceError> {
     if incremental {
@@ -224,13 +208,13 @@ struct State {
 /// (to branch, or to time one step).
 #[derive(Clone)]
 pub struct IncrementalTracer {
-    options: StepOptions,
+    options: TraceOptions,
     state: Option<State>,
 }
 
 impl IncrementalTracer {
     /// A tracer with no previous step.
-    pub fn new(options: StepOptions) -> Self {
+    pub fn new(options: TraceOptions) -> Self {
         Self {
             options,
             state: None,
@@ -373,7 +357,7 @@ impl State {
 /// surfaces) and candidates: the previous ones while nothing they depend on moved, else
 /// generated anew (counted in `update`).
 fn next_candidates(
-    options: &StepOptions,
+    options: &TraceOptions,
     (generator, prev): (Generator, &State),
     scene: &Scene,
     moved: &[SurfaceId],
@@ -503,7 +487,7 @@ enum Plan {
 /// (and whether IPC was warm-started from the previous step) and their points, concatenated.
 fn solve_planned(
     scene: &Scene,
-    options: &StepOptions,
+    options: &TraceOptions,
     candidates: &CandidateSet,
     plans: &[Plan],
     prev: (&[Record], &[Vec3]),

@@ -1,108 +1,94 @@
 //! Python keyword arguments → the library's trace options, with the CLI's names and checks.
 
 use bt_scene::Scene;
-use bt_solve::pipeline::{CandidateMode, TraceOptions};
-use bt_solve::{Acceleration, IpcOptions, SbrOptions, Solver, UpdateOrder};
+use bt_solve::pipeline::TraceOptions;
+use bt_solve::settings::{IpcSettings, SbrSettings, SolveSettings, parse};
 
 /// The trace keywords of `Scene.trace` / `Scene.trace_many` (names and values as the CLI's
 /// `beamtrace trace` flags, e.g. `solver="ipc"`, `candidates="beam-tree"`), passed from the
-/// Python wrappers as one dict with every key.
+/// Python wrappers as one dict with every key, IPC's and SBR's in their own dicts.
 #[derive(Debug, Clone, pyo3::FromPyObject)]
 #[pyo3(from_item_all)]
 pub struct TraceKeywords {
+    /// Highest reflection order.
     pub max_order: usize,
+    /// Path solver: `image`, `ipc` or `sbr`.
     pub solver: String,
+    /// Candidate generator: `beam-tree`, `wvrn` or `exhaustive`.
     pub candidates: String,
+    /// Budget on candidates (beam-tree nodes).
     pub max_candidates: u64,
-    pub ipc_order: String,
-    pub ipc_accel: String,
-    pub sbr_step_deg: Option<f64>,
-    pub sbr_rays: Option<u32>,
-    pub sbr_planar: bool,
+    /// Solve on every core (the output is identical either way).
     pub parallel: bool,
+    /// `ipc_order` and `ipc_accel`.
+    pub ipc: IpcKeywords,
+    /// `sbr_step_deg`, `sbr_rays` and `sbr_planar`.
+    pub sbr: SbrKeywords,
 }
 
-/// Pick `value` from `choices` (name, meaning) or say which names are allowed.
-fn choose<T: Copy>(field: &str, value: &str, choices: &[(&str, T)]) -> Result<T, String> {
-    choices
-        .iter()
-        .find(|(name, _)| *name == value)
-        .map(|(_, v)| *v)
-        .ok_or_else(|| {
-            let names: Vec<_> = choices.iter().map(|(n, _)| format!("\"{n}\"")).collect();
-            format!("{field} must be one of {}, got {value:?}", names.join(", "))
-        })
+/// IPC's keywords (`ipc_order`, `ipc_accel` in Python).
+#[derive(Debug, Clone, pyo3::FromPyObject)]
+#[pyo3(from_item_all)]
+pub struct IpcKeywords {
+    /// Update order: `gauss-seidel` or `jacobi`.
+    pub order: String,
+    /// Acceleration: `none` or `newton`.
+    pub accel: String,
+}
+
+/// SBR's keywords (`sbr_step_deg`, `sbr_rays`, `sbr_planar` in Python).
+#[derive(Debug, Clone, pyo3::FromPyObject)]
+#[pyo3(from_item_all)]
+pub struct SbrKeywords {
+    /// Grid step, degrees (`None`: 1°, unless `rays`).
+    pub step_deg: Option<f64>,
+    /// Rays on a Fibonacci sphere instead of a grid.
+    pub rays: Option<u32>,
+    /// Launch only in the horizontal plane through TX.
+    pub planar: bool,
 }
 
 impl TraceKeywords {
-    /// The solver these keywords select, with defaults scaled to `scene` (as the CLI does).
-    pub fn solver(&self, scene: &Scene) -> Result<Solver, String> {
-        let kind = choose(
-            "solver",
-            &self.solver,
-            &[("image", 0), ("ipc", 1), ("sbr", 2)],
-        )?;
-        Ok(match kind {
-            0 => Solver::Image,
-            1 => {
-                let order = choose(
-                    "ipc_order",
-                    &self.ipc_order,
-                    &[
-                        ("gauss-seidel", UpdateOrder::GaussSeidel),
-                        ("jacobi", UpdateOrder::Jacobi),
-                    ],
-                )?;
-                let acceleration = choose(
-                    "ipc_accel",
-                    &self.ipc_accel,
-                    &[
-                        ("none", Acceleration::None),
-                        ("newton", Acceleration::Newton),
-                    ],
-                )?;
-                Solver::Ipc(IpcOptions {
-                    acceleration,
-                    ..IpcOptions::for_scene(scene, order)
-                })
-            }
-            _ => {
-                if self.sbr_step_deg.is_some() && self.sbr_rays.is_some() {
-                    return Err("give sbr_step_deg or sbr_rays, not both".into());
-                }
-                Solver::Sbr(SbrOptions::chosen(
-                    self.sbr_rays,
-                    self.sbr_step_deg,
-                    self.sbr_planar,
-                )?)
-            }
-        })
+    /// The library's settings these keywords name (the CLI's defaults for the rest: IPC's
+    /// threshold scaled to the scene, its round cap, SBR's ray budget).
+    pub fn settings(&self) -> Result<SolveSettings, String> {
+        let defaults = SolveSettings::default();
+        let named = || -> Result<SolveSettings, bt_solve::settings::SettingsError> {
+            Ok(SolveSettings {
+                max_order: self.max_order,
+                solver: parse(&self.solver)?,
+                ipc: IpcSettings {
+                    order: parse(&self.ipc.order)?,
+                    acceleration: parse(&self.ipc.accel)?,
+                    ..defaults.ipc
+                },
+                sbr: SbrSettings {
+                    step_deg: self.sbr.step_deg,
+                    rays: self.sbr.rays,
+                    planar: self.sbr.planar,
+                    ..defaults.sbr
+                },
+                candidates: parse(&self.candidates)?,
+                max_candidates: self.max_candidates,
+                parallel: self.parallel,
+            })
+        };
+        named().map_err(|e| e.to_string())
     }
 
     /// The pipeline options for `scene`.
     pub fn trace_options(&self, scene: &Scene) -> Result<TraceOptions, String> {
-        let candidates = choose(
-            "candidates",
-            &self.candidates,
-            &[
-                ("beam-tree", CandidateMode::BeamTree),
-                ("wvrn", CandidateMode::Wvrn),
-                ("exhaustive", CandidateMode::Exhaustive),
-            ],
-        )?;
-        Ok(TraceOptions {
-            max_order: self.max_order,
-            solver: self.solver(scene)?,
-            candidates,
-            parallel: self.parallel,
-            max_candidates: self.max_candidates,
-        })
+        self.settings()?
+            .trace_options(scene)
+            .map_err(|e| e.to_string())
     }
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use bt_solve::pipeline::CandidateMode;
+    use bt_solve::{Solver, UpdateOrder};
 
     fn keywords() -> TraceKeywords {
         TraceKeywords {
@@ -110,12 +96,16 @@ mod tests {
             solver: "image".into(),
             candidates: "beam-tree".into(),
             max_candidates: 10,
-            ipc_order: "gauss-seidel".into(),
-            ipc_accel: "none".into(),
-            sbr_step_deg: None,
-            sbr_rays: None,
-            sbr_planar: false,
             parallel: true,
+            ipc: IpcKeywords {
+                order: "gauss-seidel".into(),
+                accel: "none".into(),
+            },
+            sbr: SbrKeywords {
+                step_deg: None,
+                rays: None,
+                planar: false,
+            },
         }
     }
 
@@ -129,8 +119,11 @@ mod tests {
     fn names_map_to_the_cli_meanings() {
         let k = TraceKeywords {
             solver: "ipc".into(),
-            ipc_order: "jacobi".into(),
             candidates: "wvrn".into(),
+            ipc: IpcKeywords {
+                order: "jacobi".into(),
+                accel: "none".into(),
+            },
             ..keywords()
         };
         let o = k.trace_options(&scene()).unwrap();
@@ -152,7 +145,11 @@ mod tests {
         );
         let k = TraceKeywords {
             solver: "sbr".into(),
-            sbr_step_deg: Some(-1.0),
+            sbr: SbrKeywords {
+                step_deg: Some(-1.0),
+                rays: None,
+                planar: false,
+            },
             ..keywords()
         };
         assert!(k.trace_options(&scene()).unwrap_err().contains("sbr step"));

@@ -4,7 +4,8 @@
 //! - [`ipc`]: iterative path convergence (the paper's Algorithms 1-2), Gauss-Seidel or Jacobi,
 //!   optionally finished by Newton steps ([`Acceleration::Newton`]);
 //! - [`validate`]: the geometric checks every found path must pass;
-//! - [`sbr`]: shooting and bouncing rays, the baseline (whole-scene, not per candidate).
+//! - [`sbr`]: shooting and bouncing rays, the baseline (whole-scene, not per candidate);
+//! - [`settings`]: a trace's settings by name (the CLI's flags, Python's keywords) → options.
 //!
 //! [`trace`] runs a solver over a [`CandidateSet`] and returns the valid paths plus a count
 //! of every outcome; one bad candidate never aborts the batch.
@@ -17,6 +18,7 @@ mod lanes;
 mod newton;
 pub mod pipeline;
 pub mod sbr;
+pub mod settings;
 pub mod validate;
 
 use bt_geom::{Real, Vec3};

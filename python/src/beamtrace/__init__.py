@@ -222,22 +222,19 @@ class Scene:
         return [Paths(c) for c in results]
 
 
-_OPTION_NAMES = (
-    "max_order",
-    "solver",
-    "candidates",
-    "max_candidates",
-    "ipc_order",
-    "ipc_accel",
-    "sbr_step_deg",
-    "sbr_rays",
-    "sbr_planar",
-    "parallel",
-)
-
-
 def _options(arguments: Dict[str, Any]) -> Dict[str, Any]:
-    return {name: arguments[name] for name in _OPTION_NAMES}
+    """The trace keywords as the native module takes them: IPC's and SBR's in their own dicts."""
+    options = {
+        name: arguments[name]
+        for name in ("max_order", "solver", "candidates", "max_candidates", "parallel")
+    }
+    options["ipc"] = {"order": arguments["ipc_order"], "accel": arguments["ipc_accel"]}
+    options["sbr"] = {
+        "step_deg": arguments["sbr_step_deg"],
+        "rays": arguments["sbr_rays"],
+        "planar": arguments["sbr_planar"],
+    }
+    return options
 
 
 def load(

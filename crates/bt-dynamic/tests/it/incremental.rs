@@ -4,11 +4,11 @@
 
 use bt_testkit::partitioned as common;
 
-use bt_dynamic::{IncrementalTracer, StepOptions, StepTrace, max_point_distance, trace_scratch};
+use bt_dynamic::{IncrementalTracer, StepTrace, max_point_distance, trace_scratch};
 use bt_paths::wvrn::Wvrn;
 use bt_scene::Terminals;
 use bt_scene::dynamic::{DynamicScene, builtin_dynamic_scene, moved_surfaces};
-use bt_solve::pipeline::CandidateMode;
+use bt_solve::pipeline::{CandidateMode, TraceOptions};
 use bt_solve::{IpcOptions, Solver, UpdateOrder};
 
 fn living_room() -> DynamicScene {
@@ -18,8 +18,8 @@ fn living_room() -> DynamicScene {
 }
 
 /// The image method on `candidates` up to `max_order`, without a candidate budget.
-fn image(candidates: CandidateMode, max_order: usize, parallel: bool) -> StepOptions {
-    StepOptions {
+fn image(candidates: CandidateMode, max_order: usize, parallel: bool) -> TraceOptions {
+    TraceOptions {
         max_order,
         solver: Solver::Image,
         candidates,
@@ -30,7 +30,7 @@ fn image(candidates: CandidateMode, max_order: usize, parallel: bool) -> StepOpt
 
 /// Trace every step of `dynamic` incrementally, assert that each equals a from-scratch trace,
 /// and return the incremental steps.
-fn same_as_scratch(dynamic: &DynamicScene, options: &StepOptions) -> Vec<StepTrace> {
+fn same_as_scratch(dynamic: &DynamicScene, options: &TraceOptions) -> Vec<StepTrace> {
     let mut tracer = IncrementalTracer::new(*options);
     let mut steps = Vec::with_capacity(dynamic.len());
     for (k, scene) in dynamic.scenes().iter().enumerate() {
@@ -62,7 +62,7 @@ fn same_as_scratch(dynamic: &DynamicScene, options: &StepOptions) -> Vec<StepTra
 }
 
 /// [`same_as_scratch`], returning the candidates re-solved and all candidates over steps 1...
-fn assert_same_as_scratch(dynamic: &DynamicScene, options: &StepOptions) -> (usize, usize) {
+fn assert_same_as_scratch(dynamic: &DynamicScene, options: &TraceOptions) -> (usize, usize) {
     same_as_scratch(dynamic, options)
         .iter()
         .skip(1)
@@ -171,7 +171,7 @@ fn ipc_warm_start_agrees_with_the_image_method() {
     let scene0 = dynamic.step(0);
     let ipc = Solver::Ipc(IpcOptions::for_scene(scene0, UpdateOrder::GaussSeidel));
     let reference_options = image(CandidateMode::Wvrn, 2, true);
-    let mut tracer = IncrementalTracer::new(StepOptions {
+    let mut tracer = IncrementalTracer::new(TraceOptions {
         solver: ipc,
         ..reference_options
     });
