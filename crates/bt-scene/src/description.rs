@@ -7,20 +7,17 @@ use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
 /// A scene file as written by a user. Validate it with [`crate::Scene::from_description`].
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct SceneDescription {
     /// Scene name (optional; the file stem is used otherwise).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub name: Option<String>,
     /// Carrier frequency, Hz (default 28 GHz).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub frequency_hz: Option<Real>,
     /// Transmitter position `[x, y, z]`, metres.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tx: Option<[Real; 3]>,
     /// Receiver position `[x, y, z]`, metres.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rx: Option<[Real; 3]>,
     /// Extra or overriding materials by name (the built-ins are always available).
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
@@ -33,16 +30,13 @@ pub struct SceneDescription {
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub boxes: Vec<BoxDesc>,
     /// Dynamic scenes: number of time steps (default 1). See `docs/dynamic-scenes.md`.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub steps: Option<u32>,
     /// Dynamic scenes: moving objects by name (members and motion).
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
     pub objects: BTreeMap<String, crate::dynamic::ObjectDesc>,
     /// Dynamic scenes: TX position per step `[[x, y, z], ...]` (one per step), metres.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub tx_steps: Option<Vec<[Real; 3]>>,
     /// Dynamic scenes: RX position per step `[[x, y, z], ...]` (one per step), metres.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rx_steps: Option<Vec<[Real; 3]>>,
 }
 
@@ -61,57 +55,50 @@ impl SceneDescription {
 }
 
 /// A material entry: a constant loss, a radio model, or both (`docs/scene-format.md`).
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct MaterialDesc {
     /// Loss per reflection, dB (>= 0). Default with a radio model: its loss at normal
     /// incidence at the scene's frequency.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub reflection_loss_db: Option<Real>,
     /// An ITU-R P.2040-3 material name (`concrete`, `itu_glass`, `very_dry_ground`, ...).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub itu: Option<String>,
     /// Custom relative permittivity εr' (with `conductivity`, instead of `itu`).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub relative_permittivity: Option<Real>,
     /// Custom conductivity σ, S/m (with `relative_permittivity`).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub conductivity: Option<Real>,
     /// Slab thickness, metres (absent: a half-space).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub thickness: Option<Real>,
 }
 
 /// One planar polygon.
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct SurfaceDesc {
     /// Unique name.
     pub name: String,
     /// Material name (default `"default"`).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub material: Option<String>,
     /// `reflector` (default) or `blocker`.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub kind: Option<SurfaceKind>,
     /// Vertices `[[x, y, z], ...]` in order around the polygon (either winding), metres.
     pub vertices: Vec<[Real; 3]>,
     /// Dynamic scenes: the moving object this surface belongs to (a key of `objects`).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub object: Option<String>,
 }
 
 /// An axis-aligned box, expanded into up to six rectangular faces.
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct BoxDesc {
     /// Name prefix of the faces.
     pub name: String,
     /// Material name (default `"default"`).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub material: Option<String>,
     /// `reflector` (default) or `blocker`.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub kind: Option<SurfaceKind>,
     /// Minimum corner, metres.
     pub min: [Real; 3],
@@ -122,7 +109,6 @@ pub struct BoxDesc {
     #[serde(default)]
     pub omit: Vec<String>,
     /// Dynamic scenes: the moving object this box belongs to (a key of `objects`).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub object: Option<String>,
 }
 

@@ -34,6 +34,7 @@ pub const MAX_SURFACE_STEPS: usize = 250_000;
 /// A moving object as written in a scene file (an entry of `objects`).
 ///
 /// Give either a constant per-step motion (`translate` and/or `rotate_deg`) or `keyframes`.
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct ObjectDesc {
@@ -42,16 +43,12 @@ pub struct ObjectDesc {
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
     pub members: Vec<String>,
     /// Translation per step `[dx, dy, dz]`, metres.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub translate: Option<[Real; 3]>,
     /// Rotation per step about `axis` through `pivot`, degrees (right-hand rule).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rotate_deg: Option<Real>,
     /// Point on the rotation axis (a door's hinge), metres. Required when the object rotates.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub pivot: Option<[Real; 3]>,
     /// Rotation axis direction (any length > 0; default `[0, 0, 1]`, z up).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub axis: Option<[Real; 3]>,
     /// Poses at given steps, linearly interpolated in between.
     #[serde(default, skip_serializing_if = "Vec::is_empty")]
@@ -59,16 +56,15 @@ pub struct ObjectDesc {
 }
 
 /// The pose of an object at one step.
+#[serde_with::skip_serializing_none]
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
 #[serde(deny_unknown_fields)]
 pub struct KeyframeDesc {
     /// Time step (0-based, below `steps`; keyframes strictly increasing).
     pub step: u32,
     /// Translation from the file's geometry `[dx, dy, dz]`, metres (default zero).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub offset: Option<[Real; 3]>,
     /// Rotation about the object's axis through its pivot, degrees (default 0).
-    #[serde(default, skip_serializing_if = "Option::is_none")]
     pub angle_deg: Option<Real>,
 }
 
