@@ -239,11 +239,12 @@ mod tests {
     #[test]
     fn newell_is_twice_the_area_vector() {
         let sq = [
-            Vec3::new(5.0, 5.0, 7.0),
-            Vec3::new(6.0, 5.0, 7.0),
-            Vec3::new(6.0, 6.0, 7.0),
-            Vec3::new(5.0, 6.0, 7.0),
-        ];
+            [5.0, 5.0, 7.0],
+            [6.0, 5.0, 7.0],
+            [6.0, 6.0, 7.0],
+            [5.0, 6.0, 7.0],
+        ]
+        .map(Vec3::from);
         assert_eq!(newell(&sq), Vec3::new(0.0, 0.0, 2.0));
         assert_eq!(newell(&sq[..2]), Vec3::ZERO);
     }
