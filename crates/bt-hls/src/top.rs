@@ -271,9 +271,9 @@ fn bus_decode(t: &Dims<'_>, items: &mut Vec<Item>) -> Decode {
         1,
         Expr::slice("avs_address", hi, 4).eq(lit(ab - 4, 0)),
     );
-    let is_status = window(items, "is_status", l.status_base);
-    let is_point = window(items, "is_point", l.point_base);
-    let is_sched = window(items, "is_sched", l.sched_base);
+    let is_status = window(items, "is_status", l.map.status_base);
+    let is_point = window(items, "is_point", l.map.point_base);
+    let is_sched = window(items, "is_sched", l.map.sched_base);
     let bus_point = Signal::assigned(
         items,
         "bus_point",

@@ -15,9 +15,9 @@ fn golden_cycle_count() {
         "makespans": r.makespans,
         "run_cycles": r.run_cycles,
         "predicted_tb_cycles": r.predicted_tb_cycles,
-        "status_base": r.status_base,
-        "point_base": r.point_base,
-        "sched_base": r.sched_base,
+        "status_base": r.address_map.status_base,
+        "point_base": r.address_map.point_base,
+        "sched_base": r.address_map.sched_base,
     });
     golden(
         "small_scene_cycles.json",
