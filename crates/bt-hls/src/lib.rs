@@ -82,12 +82,9 @@ pub struct Report {
     pub capacity: Capacity,
     /// Schedule makespan of each step, slots.
     pub makespans: Vec<u32>,
-    /// Predicted `CYCLES` register value of every run (steps in order, each step's vectors in
-    /// order): the sum over the step's slots of `2·(jobs + 2) + pe_latency`.
-    pub run_cycles: Vec<u64>,
-    /// Predicted testbench clock edges for the whole bus program (1 per write, 2 per read,
-    /// 1 + CYCLES per start).
-    pub predicted_tb_cycles: u64,
+    /// The cycles the host program takes (JSON: `run_cycles`, `predicted_tb_cycles`).
+    #[serde(flatten)]
+    pub predicted: CyclePrediction,
     /// Bus writes the host makes to load every step's work (schedule, start points, TX/RX).
     pub load_writes: u64,
     /// Where the status, point and schedule regions start (JSON: `status_base`,
@@ -96,6 +93,30 @@ pub struct Report {
     pub address_map: AddressMap,
     /// Register map and cycle formulas (markdown), also in `report.md`.
     pub docs: String,
+}
+
+/// The cycle counts of a host program by the exact formulas (checked by co-simulation),
+/// computed once from the program: [`Report`] carries them, [`SimReport`] sets the measured
+/// counts beside them.
+#[derive(Debug, Clone, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+pub struct CyclePrediction {
+    /// `CYCLES` register value of every run (steps in order, each step's vectors in order),
+    /// clock cycles: the sum over the step's slots of `2·(jobs + 2) + pe_latency`.
+    pub run_cycles: Vec<u64>,
+    /// Testbench clock edges of the whole bus program (1 per write, 2 per read, 1 + CYCLES per
+    /// start).
+    #[serde(rename = "predicted_tb_cycles")]
+    pub tb_cycles: u64,
+}
+
+impl CyclePrediction {
+    /// The prediction of the bus program `ops` whose runs the model expects as `runs`.
+    fn of(ops: &[BusOp], runs: &[VectorExpectation]) -> CyclePrediction {
+        CyclePrediction {
+            run_cycles: runs.iter().map(|r| r.cycles).collect(),
+            tb_cycles: ops.iter().map(|o| o.tb_cycles()).sum(),
+        }
+    }
 }
 
 /// One bus operation of the host program (and of the testbench's stimulus).
@@ -514,8 +535,7 @@ pub fn generate_steps_into(
         num_instances: d.layout.num_instances,
         capacity: platform.capacity,
         makespans: d.steps.iter().map(|s| s.makespan).collect(),
-        run_cycles: runs.iter().map(|r| r.cycles).collect(),
-        predicted_tb_cycles: ops.iter().map(|o| o.tb_cycles()).sum(),
+        predicted: CyclePrediction::of(&ops, &runs),
         load_writes,
         address_map: d.layout.map,
         docs: docs.clone(),
