@@ -287,14 +287,15 @@ impl Platform {
 /// One step of a [`Design`]: the validated work and everything derived from it.
 #[derive(Debug, Clone)]
 pub(crate) struct StepDesign {
-    pub input: HlsInput,
+    /// The step's input and schedule, validated against the platform.
+    pub work: StepWork,
+    /// The fixed-point model of the step's paths, which computes the expected bus words.
     pub model: FixedIpc,
-    pub schedule: Schedule,
     /// Round budget of each path (rounds its schedule holds).
     pub budgets: Vec<u32>,
     /// Global index of the first point of each path.
     pub first_point: Vec<u32>,
-    pub num_paths: u32,
+    /// Slots of the schedule, at least 1.
     pub makespan: u32,
     /// Platform column of each schedule instance.
     pub columns: Vec<u32>,
@@ -584,12 +585,10 @@ fn step_design(platform: &Platform, k: usize, w: &StepWork) -> Result<StepDesign
         )));
     }
     Ok(StepDesign {
-        input: input.clone(),
+        work: w.clone(),
         model,
-        schedule: schedule.clone(),
         budgets,
         first_point,
-        num_paths,
         makespan,
         columns,
     })

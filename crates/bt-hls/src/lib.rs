@@ -176,7 +176,7 @@ pub fn status_word(r: &PathResult) -> u32 {
 fn schedule_writes(d: &Design, s: &StepDesign, ops: &mut Vec<BusOp>) {
     let (pb, ptb) = (d.layout.path_bits, d.layout.point_bits);
     // Each slot's jobs in write-back order (ascending column).
-    let rows: Vec<Vec<(u32, bt_schedule::Job)>> = s.schedule.slots[..s.makespan as usize]
+    let rows: Vec<Vec<(u32, bt_schedule::Job)>> = s.work.schedule.slots[..s.makespan as usize]
         .iter()
         .map(|row| {
             let mut jobs: Vec<(u32, bt_schedule::Job)> = row
@@ -203,11 +203,11 @@ fn schedule_writes(d: &Design, s: &StepDesign, ops: &mut Vec<BusOp>) {
             .iter()
             .enumerate()
             .map(|(e, &(col, job))| {
-                let n = s.input.paths[job.path as usize].len() as u32;
+                let n = s.work.input.paths[job.path as usize].len() as u32;
                 let point = s.first_point[job.path as usize] + job.point;
                 let end = last_of_round[&(job.path, job.round)] == (t, e);
                 // A job after its round's first phase reads its neighbours' new points.
-                let late = job.point % s.input.round_order.phases() != 0;
+                let late = job.point % s.work.input.round_order.phases() != 0;
                 1 | u64::from(job.path) << 1
                     | u64::from(point) << (1 + pb)
                     | u64::from(job.point == 0) << (1 + pb + ptb)
@@ -247,7 +247,7 @@ fn run_ops(
 ) -> (Vec<BusOp>, VectorExpectation) {
     let map = &d.layout.map;
     let mut ops = Vec::new();
-    for p in 0..s.num_paths as usize {
+    for p in 0..s.work.input.paths.len() {
         for (i, pt) in s.model.init_points(p).iter().enumerate() {
             let g = s.first_point[p] + i as u32;
             for (k, c) in pt.iter().enumerate() {
@@ -265,7 +265,7 @@ fn run_ops(
     for (k, c) in rx.iter().enumerate() {
         ops.push(BusOp::Write(regs::RX + k as u32, c.0 as u32));
     }
-    let cycles = crate::plan::run_cycles(&s.schedule, pe_latency(d.platform.coord_bits));
+    let cycles = crate::plan::run_cycles(&s.work.schedule, pe_latency(d.platform.coord_bits));
     ops.push(BusOp::Start(cycles));
     let paths = s.model.run_fixed(tx, rx, Some(&s.budgets));
     let mut reads = vec![(regs::CYCLES, cycles as u32)];
@@ -305,7 +305,7 @@ fn host_program(d: &Design) -> Result<(Vec<BusOp>, Vec<VectorExpectation>), HlsE
     let mut runs = Vec::new();
     for (k, s) in d.steps.iter().enumerate() {
         schedule_writes(d, s, &mut ops);
-        for v in s.input.vectors()? {
+        for v in s.work.input.vectors()? {
             let (o, e) = run_ops(d, s, k, v);
             ops.extend(o);
             runs.push(e);
