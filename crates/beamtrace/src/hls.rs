@@ -101,10 +101,10 @@ fn simulate(dir: &Path, simulator: bt_hls::Simulator) -> anyhow::Result<ExitCode
         r.words_compared,
         r.mismatches,
         r.cycles,
-        r.predicted_cycles,
-        r.irq_cycles == r.predicted_run_cycles,
+        r.predicted_cycles(),
+        r.irq_cycles == r.predicted.run_cycles,
         r.tb_cycles,
-        r.predicted_tb_cycles
+        r.predicted.tb_cycles
     );
     for m in r.mismatch_details.iter().take(20) {
         println!("  mismatch: {m}");

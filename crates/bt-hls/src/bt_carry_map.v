@@ -21,27 +21,16 @@
 
 (* techmap_celltype = "$alu" *)
 module _80_bt_cycloneive_alu (A, B, CI, BI, X, Y, CO);
-	parameter A_SIGNED = 0;
-	parameter B_SIGNED = 0;
-	parameter A_WIDTH = 1;
-	parameter B_WIDTH = 1;
-	parameter Y_WIDTH = 1;
-	parameter _TECHMAP_CONSTMSK_A_ = 0;
-	parameter _TECHMAP_CONSTVAL_A_ = 0;
-	parameter _TECHMAP_CONSTMSK_B_ = 0;
-	parameter _TECHMAP_CONSTVAL_B_ = 0;
-	parameter _TECHMAP_CONSTMSK_CI_ = 0;
-	parameter _TECHMAP_CONSTVAL_CI_ = 0;
-	parameter _TECHMAP_CONSTMSK_BI_ = 0;
-	parameter _TECHMAP_CONSTVAL_BI_ = 0;
+	parameter A_SIGNED = 0, B_SIGNED = 0, A_WIDTH = 1, B_WIDTH = 1, Y_WIDTH = 1;
+	parameter _TECHMAP_CONSTMSK_A_ = 0, _TECHMAP_CONSTVAL_A_ = 0;
+	parameter _TECHMAP_CONSTMSK_B_ = 0, _TECHMAP_CONSTVAL_B_ = 0;
+	parameter _TECHMAP_CONSTMSK_CI_ = 0, _TECHMAP_CONSTVAL_CI_ = 0;
+	parameter _TECHMAP_CONSTMSK_BI_ = 0, _TECHMAP_CONSTVAL_BI_ = 0;
 
-	(* force_downto *)
-	input [A_WIDTH-1:0] A;
-	(* force_downto *)
-	input [B_WIDTH-1:0] B;
+	(* force_downto *) input [A_WIDTH-1:0] A;
+	(* force_downto *) input [B_WIDTH-1:0] B;
 	input CI, BI;
-	(* force_downto *)
-	output [Y_WIDTH-1:0] X, Y, CO;
+	(* force_downto *) output [Y_WIDTH-1:0] X, Y, CO;
 
 	localparam CI_CONST = _TECHMAP_CONSTMSK_CI_ == 1;
 	localparam C0 = CI_CONST && _TECHMAP_CONSTVAL_CI_ == 1;
@@ -99,15 +88,13 @@ module _80_bt_cycloneive_alu (A, B, CI, BI, X, Y, CO);
 		end
 	endfunction
 
-	(* force_downto *)
-	wire [Y_WIDTH-1:0] A_buf, B_buf;
+	(* force_downto *) wire [Y_WIDTH-1:0] A_buf, B_buf;
 	\$pos #(.A_SIGNED(A_SIGNED), .A_WIDTH(A_WIDTH), .Y_WIDTH(Y_WIDTH)) A_conv (.A(A), .Y(A_buf));
 	\$pos #(.A_SIGNED(B_SIGNED), .A_WIDTH(B_WIDTH), .Y_WIDTH(Y_WIDTH)) B_conv (.A(B), .Y(B_buf));
 
 	// The B operand as the chain cells see it (before the masks' own inversion) and as X
 	// needs it (after BI).
-	(* force_downto *)
-	wire [Y_WIDTH-1:0] B_chain, B_eff;
+	(* force_downto *) wire [Y_WIDTH-1:0] B_chain, B_eff;
 	generate
 		if (BI_CONST) begin:const_bi
 			assign B_chain = B_buf;
@@ -119,8 +106,7 @@ module _80_bt_cycloneive_alu (A, B, CI, BI, X, Y, CO);
 	endgenerate
 
 	// C[i] is the carry into bit i on the chain (bits L and up).
-	(* force_downto *)
-	wire [Y_WIDTH:0] C;
+	(* force_downto *) wire [Y_WIDTH:0] C;
 	genvar i;
 	generate
 		for (i = 0; i < L; i = i + 1) begin:pass

@@ -6,8 +6,7 @@
 // follows the Cyclone IV E register: asynchronous clear (clrn) and preset (prn), clock enable,
 // synchronous clear and load. ff_map.v uses d, clk, clrn and ena.
 module dffeas (output reg q, input d, clk, clrn, prn, ena, asdata, aload, sclr, sload);
-	parameter power_up = "low";
-	parameter is_wysiwyg = "false";
+	parameter power_up = "low", is_wysiwyg = "false";
 	always @(posedge clk or negedge clrn or negedge prn)
 		if (!clrn) q <= 1'b0;
 		else if (!prn) q <= 1'b1;
@@ -20,19 +19,11 @@ endmodule
 module altsyncram (data_a, address_a, wren_a, rden_a, q_a, data_b, address_b, wren_b, rden_b,
 	q_b, clock0, clock1, clocken0, clocken1, clocken2, clocken3, aclr0, aclr1,
 	addressstall_a, addressstall_b);
-	parameter operation_mode = "DUAL_PORT";
-	parameter intended_device_family = "Cyclone IV E";
-	parameter ram_block_type = "M9K";
-	parameter lpm_type = "altsyncram";
-	parameter width_a = 1;
-	parameter widthad_a = 1;
-	parameter numwords_a = 0;
-	parameter width_b = 1;
-	parameter widthad_b = 1;
-	parameter numwords_b = 0;
-	parameter outdata_reg_b = "UNREGISTERED";
-	parameter power_up_uninitialized = "FALSE";
-	parameter init_type = "unused";
+	parameter operation_mode = "DUAL_PORT", intended_device_family = "Cyclone IV E";
+	parameter ram_block_type = "M9K", lpm_type = "altsyncram";
+	parameter width_a = 1, widthad_a = 1, numwords_a = 0;
+	parameter width_b = 1, widthad_b = 1, numwords_b = 0;
+	parameter outdata_reg_b = "UNREGISTERED", power_up_uninitialized = "FALSE", init_type = "unused";
 	input [width_a-1:0] data_a;
 	input [widthad_a-1:0] address_a;
 	input wren_a, rden_a;

@@ -287,14 +287,15 @@ impl Platform {
 /// One step of a [`Design`]: the validated work and everything derived from it.
 #[derive(Debug, Clone)]
 pub(crate) struct StepDesign {
-    pub input: HlsInput,
+    /// The step's input and schedule, validated against the platform.
+    pub work: StepWork,
+    /// The fixed-point model of the step's paths, which computes the expected bus words.
     pub model: FixedIpc,
-    pub schedule: Schedule,
     /// Round budget of each path (rounds its schedule holds).
     pub budgets: Vec<u32>,
     /// Global index of the first point of each path.
     pub first_point: Vec<u32>,
-    pub num_paths: u32,
+    /// Slots of the schedule, at least 1.
     pub makespan: u32,
     /// Platform column of each schedule instance.
     pub columns: Vec<u32>,
@@ -307,24 +308,34 @@ pub(crate) struct Design {
     /// Model of the platform's planes (early-stopping boxes included), for the PEs and boxes.
     pub model: FixedIpc,
     pub steps: Vec<StepDesign>,
-    pub num_instances: u32,
-    /// Bits of a path index, point index, instance index.
-    pub path_bits: u32,
-    pub point_bits: u32,
-    pub inst_bits: u32,
-    /// Width of `avs_address`, bits.
-    pub address_bits: u32,
-    /// Word address of the first path status, of the first point word, of the first
-    /// schedule entry.
+    /// Index widths and bus regions of the platform.
+    pub layout: Layout,
+}
+
+/// Where the platform-sized regions of the bus address map start: Avalon-MM word addresses
+/// (32-bit words), each a power of two above the fixed registers of [`crate::regs`].
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
+pub struct AddressMap {
+    /// Word address of path 0's status word (`PATH_STATUS[p]` at `status_base + p`).
     pub status_base: u32,
+    /// Word address of point 0's first word (8 words per point: 2 banks of X, Y, Z, FRAC).
     pub point_base: u32,
+    /// Word address of the first schedule entry (`SCHED[j]` at `sched_base + j`).
     pub sched_base: u32,
+}
+
+impl AddressMap {
+    /// Word address of word `word` (0-3: X, Y, Z, FRAC) of point `g` in `bank` (0 or 1).
+    pub fn point_word(&self, g: u32, bank: u32, word: u32) -> u32 {
+        self.point_base + 8 * g + 4 * bank + word
+    }
 }
 
 /// Index widths and bus regions of a platform.
 #[derive(Debug, Clone, Copy)]
 pub(crate) struct Layout {
     pub num_instances: u32,
+    /// Bits of a path index, point index, instance index, slot index.
     pub path_bits: u32,
     pub point_bits: u32,
     pub inst_bits: u32,
@@ -333,9 +344,8 @@ pub(crate) struct Layout {
     pub entry_bits: u32,
     /// Width of `avs_address`, bits.
     pub address_bits: u32,
-    pub status_base: u32,
-    pub point_base: u32,
-    pub sched_base: u32,
+    /// The status, point and schedule regions.
+    pub map: AddressMap,
 }
 
 impl Layout {
@@ -393,9 +403,11 @@ impl Layout {
             slot_bits,
             entry_bits,
             address_bits,
-            status_base: 1 << status_bits,
-            point_base: 1 << point_region_bits,
-            sched_base: 1 << sched_region_bits,
+            map: AddressMap {
+                status_base: 1 << status_bits,
+                point_base: 1 << point_region_bits,
+                sched_base: 1 << sched_region_bits,
+            },
         })
     }
 }
@@ -433,19 +445,11 @@ impl Design {
         for (k, w) in work.iter().enumerate() {
             steps.push(step_design(platform, k, w)?);
         }
-        let l = Layout::of(platform)?;
         Ok(Design {
             platform: platform.clone(),
             model,
             steps,
-            num_instances: l.num_instances,
-            path_bits: l.path_bits,
-            point_bits: l.point_bits,
-            inst_bits: l.inst_bits,
-            address_bits: l.address_bits,
-            status_base: l.status_base,
-            point_base: l.point_base,
-            sched_base: l.sched_base,
+            layout: Layout::of(platform)?,
         })
     }
 }
@@ -581,12 +585,10 @@ fn step_design(platform: &Platform, k: usize, w: &StepWork) -> Result<StepDesign
         )));
     }
     Ok(StepDesign {
-        input: input.clone(),
+        work: w.clone(),
         model,
-        schedule: schedule.clone(),
         budgets,
         first_point,
-        num_paths,
         makespan,
         columns,
     })
@@ -632,10 +634,13 @@ mod tests {
         // The living room at order 3: 104 paths, 270 points, ~12,000 packed schedule entries
         // (2^14): the schedule region 2^14 fits the 16-bit minimum.
         let l = Layout::of(&platform(104, 270, 12_000, 25, EP4CE115_M9K_BLOCKS)).unwrap();
-        assert_eq!((l.sched_base, l.address_bits), (1 << 14, MIN_ADDRESS_BITS));
+        assert_eq!(
+            (l.map.sched_base, l.address_bits),
+            (1 << 14, MIN_ADDRESS_BITS)
+        );
         // 70,000 entries (2^17) need 18 address bits instead of a refusal.
         let l = Layout::of(&platform(104, 270, 70_000, 25, EP4CE115_M9K_BLOCKS)).unwrap();
-        assert_eq!((l.sched_base, l.address_bits), (1 << 17, 18));
+        assert_eq!((l.map.sched_base, l.address_bits), (1 << 17, 18));
     }
 
     #[test]

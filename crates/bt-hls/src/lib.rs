@@ -32,7 +32,9 @@ use bt_schedule::Schedule;
 
 pub use bt_fixed::{BoundsM, EarlyStop, FixedOutcome, PathResult, RoundOrder};
 pub use error::HlsError;
-pub use input::{Capacity, EP4CE115_M9K_BLOCKS, MAX_ADDRESS_BITS, MIN_ADDRESS_BITS, m9k_blocks};
+pub use input::{
+    AddressMap, Capacity, EP4CE115_M9K_BLOCKS, MAX_ADDRESS_BITS, MIN_ADDRESS_BITS, m9k_blocks,
+};
 pub use input::{HlsInput, PlaneSpec, Platform, StepWork, pe_latency};
 pub use pe::{PE_CORE_MODULE, pe_module_name, point_bits, sum_bits};
 pub use plan::{
@@ -80,22 +82,41 @@ pub struct Report {
     pub capacity: Capacity,
     /// Schedule makespan of each step, slots.
     pub makespans: Vec<u32>,
-    /// Predicted `CYCLES` register value of every run (steps in order, each step's vectors in
-    /// order): the sum over the step's slots of `2·(jobs + 2) + pe_latency`.
-    pub run_cycles: Vec<u64>,
-    /// Predicted testbench clock edges for the whole bus program (1 per write, 2 per read,
-    /// 1 + CYCLES per start).
-    pub predicted_tb_cycles: u64,
+    /// The cycles the host program takes (JSON: `run_cycles`, `predicted_tb_cycles`).
+    #[serde(flatten)]
+    pub predicted: CyclePrediction,
     /// Bus writes the host makes to load every step's work (schedule, start points, TX/RX).
     pub load_writes: u64,
-    /// Word address of path 0's status word.
-    pub status_base: u32,
-    /// Word address of point 0's first word.
-    pub point_base: u32,
-    /// Word address of the first schedule entry.
-    pub sched_base: u32,
+    /// Where the status, point and schedule regions start (JSON: `status_base`,
+    /// `point_base`, `sched_base`).
+    #[serde(flatten)]
+    pub address_map: AddressMap,
     /// Register map and cycle formulas (markdown), also in `report.md`.
     pub docs: String,
+}
+
+/// The cycle counts of a host program by the exact formulas (checked by co-simulation),
+/// computed once from the program: [`Report`] carries them, [`SimReport`] sets the measured
+/// counts beside them.
+#[derive(Debug, Clone, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
+pub struct CyclePrediction {
+    /// `CYCLES` register value of every run (steps in order, each step's vectors in order),
+    /// clock cycles: the sum over the step's slots of `2·(jobs + 2) + pe_latency`.
+    pub run_cycles: Vec<u64>,
+    /// Testbench clock edges of the whole bus program (1 per write, 2 per read, 1 + CYCLES per
+    /// start).
+    #[serde(rename = "predicted_tb_cycles")]
+    pub tb_cycles: u64,
+}
+
+impl CyclePrediction {
+    /// The prediction of the bus program `ops` whose runs the model expects as `runs`.
+    fn of(ops: &[BusOp], runs: &[VectorExpectation]) -> CyclePrediction {
+        CyclePrediction {
+            run_cycles: runs.iter().map(|r| r.cycles).collect(),
+            tb_cycles: ops.iter().map(|o| o.tb_cycles()).sum(),
+        }
+    }
 }
 
 /// One bus operation of the host program (and of the testbench's stimulus).
@@ -148,19 +169,14 @@ pub fn status_word(r: &PathResult) -> u32 {
         | u32::from(r.converged)
 }
 
-/// Word address of word `word` (0-3) of point `g` in `bank`.
-fn point_addr(d: &Design, g: u32, bank: u32, word: u32) -> u32 {
-    d.point_base + 8 * g + 4 * bank + word
-}
-
 /// The schedule-memory writes of one step: slot after slot (`0..makespan`) its jobs in
 /// ascending PE column, packed from entry 0, each slot's last flagged `tail` (an empty slot
 /// gets one invalid tail entry), then `SLOTS`. Entries after a slot's tail are never read, so nothing of an earlier
 /// step needs clearing.
 fn schedule_writes(d: &Design, s: &StepDesign, ops: &mut Vec<BusOp>) {
-    let (pb, ptb) = (d.path_bits, d.point_bits);
+    let (pb, ptb) = (d.layout.path_bits, d.layout.point_bits);
     // Each slot's jobs in write-back order (ascending column).
-    let rows: Vec<Vec<(u32, bt_schedule::Job)>> = s.schedule.slots[..s.makespan as usize]
+    let rows: Vec<Vec<(u32, bt_schedule::Job)>> = s.work.schedule.slots[..s.makespan as usize]
         .iter()
         .map(|row| {
             let mut jobs: Vec<(u32, bt_schedule::Job)> = row
@@ -179,7 +195,7 @@ fn schedule_writes(d: &Design, s: &StepDesign, ops: &mut Vec<BusOp>) {
         }
     }
     let tail_bit = 1u64 << (5 + pb + ptb);
-    let wide = crate::input::sched_entry_bits(pb, ptb, d.inst_bits) > 32;
+    let wide = crate::input::sched_entry_bits(pb, ptb, d.layout.inst_bits) > 32;
     let mut high = None;
     let mut entry = 0u32;
     for (t, jobs) in rows.iter().enumerate() {
@@ -187,11 +203,11 @@ fn schedule_writes(d: &Design, s: &StepDesign, ops: &mut Vec<BusOp>) {
             .iter()
             .enumerate()
             .map(|(e, &(col, job))| {
-                let n = s.input.paths[job.path as usize].len() as u32;
+                let n = s.work.input.paths[job.path as usize].len() as u32;
                 let point = s.first_point[job.path as usize] + job.point;
                 let end = last_of_round[&(job.path, job.round)] == (t, e);
                 // A job after its round's first phase reads its neighbours' new points.
-                let late = job.point % s.input.round_order.phases() != 0;
+                let late = job.point % s.work.input.round_order.phases() != 0;
                 1 | u64::from(job.path) << 1
                     | u64::from(point) << (1 + pb)
                     | u64::from(job.point == 0) << (1 + pb + ptb)
@@ -214,7 +230,7 @@ fn schedule_writes(d: &Design, s: &StepDesign, ops: &mut Vec<BusOp>) {
                 ops.push(BusOp::Write(regs::SCHED_HI, hi));
                 high = Some(hi);
             }
-            ops.push(BusOp::Write(d.sched_base + entry, word as u32));
+            ops.push(BusOp::Write(d.layout.map.sched_base + entry, word as u32));
             entry += 1;
         }
     }
@@ -229,17 +245,18 @@ fn run_ops(
     step: usize,
     [tx, rx]: [FixedPoint; 2],
 ) -> (Vec<BusOp>, VectorExpectation) {
+    let map = &d.layout.map;
     let mut ops = Vec::new();
-    for p in 0..s.num_paths as usize {
+    for p in 0..s.work.input.paths.len() {
         for (i, pt) in s.model.init_points(p).iter().enumerate() {
             let g = s.first_point[p] + i as u32;
             for (k, c) in pt.iter().enumerate() {
                 ops.push(BusOp::Write(
-                    point_addr(d, g, 0, k as u32),
+                    map.point_word(g, 0, k as u32),
                     c.floor_mm().0 as u32,
                 ));
             }
-            ops.push(BusOp::Write(point_addr(d, g, 0, 3), frac_word(pt)));
+            ops.push(BusOp::Write(map.point_word(g, 0, 3), frac_word(pt)));
         }
     }
     for (k, c) in tx.iter().enumerate() {
@@ -248,21 +265,21 @@ fn run_ops(
     for (k, c) in rx.iter().enumerate() {
         ops.push(BusOp::Write(regs::RX + k as u32, c.0 as u32));
     }
-    let cycles = crate::plan::run_cycles(&s.schedule, pe_latency(d.platform.coord_bits));
+    let cycles = crate::plan::run_cycles(&s.work.schedule, pe_latency(d.platform.coord_bits));
     ops.push(BusOp::Start(cycles));
     let paths = s.model.run_fixed(tx, rx, Some(&s.budgets));
     let mut reads = vec![(regs::CYCLES, cycles as u32)];
     for (p, r) in paths.iter().enumerate() {
-        reads.push((d.status_base + p as u32, status_word(r)));
+        reads.push((map.status_base + p as u32, status_word(r)));
     }
     for (p, r) in paths.iter().enumerate() {
         for (i, pt) in r.points.iter().enumerate() {
             let g = s.first_point[p] + i as u32;
             let bank = r.rounds & 1;
             for (k, c) in pt.iter().enumerate() {
-                reads.push((point_addr(d, g, bank, k as u32), c.floor_mm().0 as u32));
+                reads.push((map.point_word(g, bank, k as u32), c.floor_mm().0 as u32));
             }
-            reads.push((point_addr(d, g, bank, 3), frac_word(pt)));
+            reads.push((map.point_word(g, bank, 3), frac_word(pt)));
         }
     }
     ops.extend(reads.iter().map(|&(a, v)| BusOp::Read(a, v)));
@@ -288,7 +305,7 @@ fn host_program(d: &Design) -> Result<(Vec<BusOp>, Vec<VectorExpectation>), HlsE
     let mut runs = Vec::new();
     for (k, s) in d.steps.iter().enumerate() {
         schedule_writes(d, s, &mut ops);
-        for v in s.input.vectors()? {
+        for v in s.work.input.vectors()? {
             let (o, e) = run_ops(d, s, k, v);
             ops.extend(o);
             runs.push(e);
@@ -316,7 +333,7 @@ fn stimulus(ops: &[BusOp]) -> Vec<u32> {
 pub const TB_PROGRAM_WORDS: usize = 1 << 22;
 
 fn register_map(d: &Design) -> String {
-    let cap = d.platform.capacity;
+    let (cap, l) = (d.platform.capacity, &d.layout);
     let mut s = String::new();
     s.push_str("# bt_top register map (Avalon-MM slave)\n\n");
     s.push_str(&format!(
@@ -325,7 +342,7 @@ fn register_map(d: &Design) -> String {
          interrupt `ins_irq` = done (level, cleared by the next start). Coordinates on the bus \
          are millimetre words (two's complement, metres x 1000). Writes other than CTRL are \
          ignored while busy.\n\n",
-        d.address_bits - 1
+        l.address_bits - 1
     ));
     s.push_str("| address | access | name | content |\n|---|---|---|---|\n");
     s.push_str("| 0x0000 | W | CTRL | bit 0 = 1 starts a run (ignored while busy) |\n");
@@ -333,7 +350,7 @@ fn register_map(d: &Design) -> String {
     s.push_str("| 0x0001 | R | CYCLES | clock cycles of the last run |\n");
     s.push_str(&format!(
         "| 0x0002 | R | INFO | `{{instances[7:0], version[7:0], path capacity[15:0]}}` = 0x{:08x} |\n",
-        (d.num_instances << 24) | (MAP_VERSION << 16) | (cap.paths & 0xffff)
+        (l.num_instances << 24) | (MAP_VERSION << 16) | (cap.paths & 0xffff)
     ));
     s.push_str(&format!(
         "| 0x0003 | R | THRESHOLD | {} fine LSB (1/256 mm) |\n",
@@ -347,22 +364,22 @@ fn register_map(d: &Design) -> String {
     ));
     s.push_str(&format!(
         "| 0x{:04x} + p | R | PATH_STATUS[p] | `{{rounds[15:0], 12'b0, left_bounds, overflow, zero_sum, converged}}`, p < {} |\n",
-        d.status_base, cap.paths
+        l.map.status_base, cap.paths
     ));
     s.push_str(&format!(
         "| 0x{:04x} + 8i + 4b + {{0,1,2}} | RW | POINT[i].X/Y/Z, bank b | floor(mm) of point i, i < {} |\n",
-        d.point_base, cap.points
+        l.map.point_base, cap.points
     ));
     s.push_str(&format!(
         "| 0x{:04x} + 8i + 4b + 3 | RW | POINT[i].FRAC, bank b | `{{8'b0, z_frac, y_frac, x_frac}}` (1/256 mm; value = mm + frac/256); a write stores the point (X, Y, Z written before) |\n",
-        d.point_base
+        l.map.point_base
     ));
     s.push_str(&format!(
         "| 0x{:04x} + j | W | SCHED[j] | schedule entry j (the jobs of slot 0, then slot 1, ..., each slot's in ascending PE column): `{{column[{}:0], tail, late, end, last, first, point[{}:0], path[{}:0], valid}}`, `valid` at bit 0, `tail` on a slot's last entry, `late` on a job that reads its round's new points (red-black), j < {}, slots < {} |\n\n",
-        d.sched_base,
-        d.inst_bits - 1,
-        d.point_bits - 1,
-        d.path_bits - 1,
+        l.map.sched_base,
+        l.inst_bits - 1,
+        l.point_bits - 1,
+        l.path_bits - 1,
         cap.entries,
         cap.slots
     ));
@@ -484,7 +501,6 @@ pub fn generate_steps_into(
             prog.len()
         )));
     }
-    let predicted_tb_cycles: u64 = ops.iter().map(|o| o.tb_cycles()).sum();
     let docs = register_map(&d);
     let mut files = Vec::new();
     for (name, text) in &modules {
@@ -516,21 +532,18 @@ pub fn generate_steps_into(
     let load_writes = ops.iter().filter(|o| matches!(o, BusOp::Write(..))).count() as u64;
     let report = Report {
         files: Vec::new(),
-        num_instances: d.num_instances,
+        num_instances: d.layout.num_instances,
         capacity: platform.capacity,
         makespans: d.steps.iter().map(|s| s.makespan).collect(),
-        run_cycles: runs.iter().map(|r| r.cycles).collect(),
-        predicted_tb_cycles,
+        predicted: CyclePrediction::of(&ops, &runs),
         load_writes,
-        status_base: d.status_base,
-        point_base: d.point_base,
-        sched_base: d.sched_base,
+        address_map: d.layout.map,
         docs: docs.clone(),
     };
     let mut md = docs;
     md.push_str(&format!(
         "\n## Design\n\n* {} PE instances ({} planes), capacity {} paths, {} points, {} slots\n* PE latency {} cycles\n* {} steps, {} runs; makespan per step {:?}\n",
-        d.num_instances,
+        d.layout.num_instances,
         modules.len() - 1,
         platform.capacity.paths,
         platform.capacity.points,

@@ -6,7 +6,7 @@ use std::path::Path;
 use std::process::{Command, Output};
 
 use crate::error::io_err;
-use crate::{BusOp, HlsError, VectorExpectation, recompute, rtl_files};
+use crate::{BusOp, CyclePrediction, HlsError, VectorExpectation, recompute, rtl_files};
 
 /// Runs `tool args` in `dir`; maps "not found" to [`HlsError::ToolMissing`].
 fn run(tool: &str, package: &str, args: &[String], dir: &Path) -> Result<Output, HlsError> {
@@ -148,16 +148,14 @@ pub struct SimReport {
     pub simulator: Simulator,
     /// `CYCLES` register read back after the first run.
     pub cycles: u64,
-    /// Its exact prediction `makespan · cycles_per_slot`.
-    pub predicted_cycles: u64,
     /// Testbench-measured edges from start to `ins_irq`, per run.
     pub irq_cycles: Vec<u64>,
-    /// Predicted `CYCLES` per run.
-    pub predicted_run_cycles: Vec<u64>,
     /// Testbench edges of the whole bus program.
     pub tb_cycles: u64,
-    /// Predicted testbench edges (1 per write, 2 per read, 1 + CYCLES per start).
-    pub predicted_tb_cycles: u64,
+    /// What the formulas predict for the measured counts above (the same as the generator's
+    /// [`crate::Report`]).
+    #[serde(flatten)]
+    pub predicted: CyclePrediction,
     /// Words that differ from the `bt-fixed` model (plus protocol errors).
     pub mismatches: usize,
     /// The first 50 mismatches, described.
@@ -174,8 +172,13 @@ impl SimReport {
     /// No mismatch, and every run's cycles and the program's edges as predicted.
     pub fn passed(&self) -> bool {
         self.mismatches == 0
-            && self.irq_cycles == self.predicted_run_cycles
-            && self.tb_cycles == self.predicted_tb_cycles
+            && self.irq_cycles == self.predicted.run_cycles
+            && self.tb_cycles == self.predicted.tb_cycles
+    }
+
+    /// The predicted `CYCLES` of the first run (what [`SimReport::cycles`] should read).
+    pub fn predicted_cycles(&self) -> u64 {
+        self.predicted.run_cycles.first().copied().unwrap_or(0)
     }
 }
 
@@ -351,11 +354,9 @@ fn compare(
     let mut report = SimReport {
         simulator,
         cycles: 0,
-        predicted_cycles: runs.first().map_or(0, |r| r.cycles),
         irq_cycles: Vec::new(),
-        predicted_run_cycles: runs.iter().map(|r| r.cycles).collect(),
         tb_cycles: 0,
-        predicted_tb_cycles: ops.iter().map(|o| o.tb_cycles()).sum(),
+        predicted: CyclePrediction::of(ops, runs),
         mismatches: 0,
         mismatch_details: Vec::new(),
         words_compared: 0,

@@ -34,6 +34,10 @@ fn state_is(s: u128) -> Expr {
 fn or(a: Expr, b: Expr) -> Expr {
     Expr::bin(BinaryOp::Or, a, b)
 }
+/// The per-axis `terms` or-ed left to right, `(a | b) | c ...` (at least one per axis).
+fn or_all(terms: Vec<Expr>) -> Expr {
+    terms.into_iter().reduce(or).expect("a term per axis")
+}
 
 /// The platform-derived sizes `bt_top` is built from.
 pub(crate) struct TopParams<'a> {
@@ -271,9 +275,9 @@ fn bus_decode(t: &Dims<'_>, items: &mut Vec<Item>) -> Decode {
         1,
         Expr::slice("avs_address", hi, 4).eq(lit(ab - 4, 0)),
     );
-    let is_status = window(items, "is_status", l.status_base);
-    let is_point = window(items, "is_point", l.point_base);
-    let is_sched = window(items, "is_sched", l.sched_base);
+    let is_status = window(items, "is_status", l.map.status_base);
+    let is_point = window(items, "is_point", l.map.point_base);
+    let is_sched = window(items, "is_sched", l.map.sched_base);
     let bus_point = Signal::assigned(
         items,
         "bus_point",
@@ -599,12 +603,7 @@ fn pe_output_select(t: &Dims<'_>, pe: &[PeWires], items: &mut Vec<Item>) -> Sele
         ovf_terms.push(ovf.e());
     }
     let point = Signal::assigned(items, "pe_sel", point_bits(t.wd), Expr::concat(sat_parts));
-    let ov = Signal::assigned(
-        items,
-        "pe_sel_ov",
-        1,
-        ovf_terms.into_iter().reduce(or).expect("3 axes"),
-    );
+    let ov = Signal::assigned(items, "pe_sel_ov", 1, or_all(ovf_terms));
     Selected { point, ov, zs }
 }
 
@@ -626,18 +625,11 @@ fn displacement(t: &Dims<'_>, sel: &Selected, items: &mut Vec<Item>) -> Displace
     for (a, axis) in ["x", "y", "z"].iter().enumerate() {
         let (hi, lo) = (cw * (a as u32 + 1) - 1, cw * a as u32);
         let nw = Signal::assigned(items, format!("new_{axis}"), cw, sel.point.slice(hi, lo));
-        let ow = Signal::assigned(
-            items,
-            format!("old_{axis}"),
-            cw,
-            Expr::slice("rd_a", hi, lo),
-        );
-        let diff = Signal::assigned(
-            items,
-            format!("diff_{axis}"),
-            dispw,
-            crate::pe::sext(nw.name(), cw, dispw).minus(crate::pe::sext(ow.name(), cw, dispw)),
-        );
+        let old = Expr::slice("rd_a", hi, lo);
+        let ow = Signal::assigned(items, format!("old_{axis}"), cw, old);
+        let wide = |s: &Signal| crate::pe::sext(s.name(), cw, dispw);
+        let delta = wide(&nw).minus(wide(&ow));
+        let diff = Signal::assigned(items, format!("diff_{axis}"), dispw, delta);
         let abs = Signal::assigned(
             items,
             format!("adiff_{axis}"),
@@ -659,12 +651,7 @@ fn displacement(t: &Dims<'_>, sel: &Selected, items: &mut Vec<Item>) -> Displace
     items.push(Item::Comment(
         "wb_big: L-infinity displacement of the written point exceeds the threshold".into(),
     ));
-    let big = Signal::assigned(
-        items,
-        "wb_big",
-        1,
-        big_terms.into_iter().reduce(or).expect("3 axes"),
-    );
+    let big = Signal::assigned(items, "wb_big", 1, or_all(big_terms));
     Displacement { new, adiff, big }
 }
 
@@ -783,18 +770,12 @@ fn pe_matrix(t: &Dims<'_>, pe: &[PeWires], items: &mut Vec<Item>) {
     let fine = |n: &str| Expr::concat(vec![mm_bits(n, t.wd), lit(8, 0)]);
     let tx_fine = Expr::concat(vec![fine("tx_z"), fine("tx_y"), fine("tx_x")]);
     let rx_fine = Expr::concat(vec![fine("rx_z"), fine("rx_y"), fine("rx_x")]);
-    let prev = Signal::assigned(
-        &mut operands,
-        "opnd_prev",
-        point_bits(t.wd),
-        Expr::mux(id("ld_q_first"), tx_fine, id("rd_a")),
-    );
-    let next = Signal::assigned(
-        &mut operands,
-        "opnd_next",
-        point_bits(t.wd),
-        Expr::mux(id("ld_q_last"), rx_fine, id("rd_b")),
-    );
+    let pw = point_bits(t.wd);
+    // A path's first point reads TX as its previous point, its last RX as its next.
+    let prev_or_tx = Expr::mux(id("ld_q_first"), tx_fine, id("rd_a"));
+    let prev = Signal::assigned(&mut operands, "opnd_prev", pw, prev_or_tx);
+    let next_or_rx = Expr::mux(id("ld_q_last"), rx_fine, id("rd_b"));
+    let next = Signal::assigned(&mut operands, "opnd_next", pw, next_or_rx);
     for (j, (inst, w)) in t.p.platform.instances.iter().zip(pe).enumerate() {
         items.push(Item::Instance {
             module: pe_module_name(inst.plane as usize),
@@ -1415,7 +1396,7 @@ fn early_stop_logic(
             terms.push(Expr::bin(op, flipped, bound.e()));
         }
     }
-    let outside = terms.into_iter().reduce(or).expect("3 axes");
+    let outside = or_all(terms);
     let late = if stop.min_rounds >= 2 {
         Expr::bin(
             BinaryOp::Gt,

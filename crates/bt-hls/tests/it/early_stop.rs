@@ -43,13 +43,13 @@ fn early_stopping_is_bit_exact_and_shortens_the_schedule() {
     let sim = bt_hls::simulate(&dir).unwrap();
     assert_eq!(sim.mismatches, 0, "{:#?}", sim.mismatch_details);
     assert!(sim.words_compared > 0);
-    assert_eq!(sim.cycles, sim.predicted_cycles);
-    assert_eq!(sim.cycles, report.run_cycles[0]);
+    assert_eq!(sim.cycles, sim.predicted_cycles());
+    assert_eq!(sim.cycles, report.predicted.run_cycles[0]);
     assert!(sim.passed());
-    assert_eq!(sim.tb_cycles, sim.predicted_tb_cycles);
+    assert_eq!(sim.tb_cycles, sim.predicted.tb_cycles);
     eprintln!(
         "small scene with early stopping: {frozen} paths frozen, {} cycles (plain: {})",
-        report.run_cycles[0],
-        generated().report.run_cycles[0]
+        report.predicted.run_cycles[0],
+        generated().report.predicted.run_cycles[0]
     );
 }

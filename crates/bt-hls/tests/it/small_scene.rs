@@ -28,10 +28,10 @@ fn cosimulation_is_bit_exact_and_cycles_match() {
     eprintln!("{s:#?}");
     assert_eq!(s.mismatches, 0, "{:#?}", s.mismatch_details);
     assert!(s.words_compared > 0);
-    assert_eq!(s.cycles, s.predicted_cycles);
-    assert_eq!(s.cycles, g.report.run_cycles[0]);
-    assert_eq!(s.irq_cycles, s.predicted_run_cycles);
-    assert_eq!(s.tb_cycles, s.predicted_tb_cycles);
+    assert_eq!(s.cycles, s.predicted_cycles());
+    assert_eq!(s.cycles, g.report.predicted.run_cycles[0]);
+    assert_eq!(s.irq_cycles, s.predicted.run_cycles);
+    assert_eq!(s.tb_cycles, s.predicted.tb_cycles);
     assert!(s.passed());
     assert_eq!(s.vectors, 3);
 }
@@ -83,6 +83,6 @@ fn the_full_width_design_is_bit_exact_and_agrees_with_the_narrow_one() {
     assert!(lint.warnings.is_empty(), "{}", lint.warnings.join("\n"));
     let s = bt_hls::simulate(&dir).expect("simulate");
     assert_eq!(s.mismatches, 0, "{:#?}", s.mismatch_details);
-    assert_eq!(s.cycles, s.predicted_cycles);
+    assert_eq!(s.cycles, s.predicted_cycles());
     assert!(s.passed());
 }

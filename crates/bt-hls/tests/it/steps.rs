@@ -79,7 +79,7 @@ fn one_design_runs_every_step_bit_exact() {
     assert!(sim.passed());
     assert_eq!(sim.steps, 3);
     assert_eq!(sim.vectors, 3 + 2 + 1);
-    assert_eq!(sim.irq_cycles, report.run_cycles);
+    assert_eq!(sim.irq_cycles, report.predicted.run_cycles);
     // The steps' schedules differ, so do their run times.
     assert!(report.makespans[2] < report.makespans[1] && report.makespans[1] < report.makespans[0]);
     assert_eq!(

@@ -13,11 +13,11 @@ fn golden_cycle_count() {
     let pinned = serde_json::json!({
         "instances": r.num_instances,
         "makespans": r.makespans,
-        "run_cycles": r.run_cycles,
-        "predicted_tb_cycles": r.predicted_tb_cycles,
-        "status_base": r.status_base,
-        "point_base": r.point_base,
-        "sched_base": r.sched_base,
+        "run_cycles": r.predicted.run_cycles,
+        "predicted_tb_cycles": r.predicted.tb_cycles,
+        "status_base": r.address_map.status_base,
+        "point_base": r.address_map.point_base,
+        "sched_base": r.address_map.sched_base,
     });
     golden(
         "small_scene_cycles.json",
@@ -87,7 +87,7 @@ fn synthesis_reports_cell_counts_and_its_netlist_is_bit_exact() {
     // Icarus stays an option (`hls sim --simulator icarus`): it runs the same testbench.
     let sim = bt_hls::simulate_with(&dir, bt_hls::Simulator::Icarus, &mut |_| {}).unwrap();
     assert_eq!(sim.mismatches, 0, "{:#?}", sim.mismatch_details);
-    assert_eq!(sim.cycles, sim.predicted_cycles);
+    assert_eq!(sim.cycles, sim.predicted_cycles());
     assert!(sim.passed());
     let options = bt_hls::SynthOptions {
         netlist: true,
