@@ -261,6 +261,16 @@ fn violations(problem: &Problem, schedule: &Schedule) -> Vec<ScheduleViolation> 
     }
 }
 
+/// The violations of [`tiny`]'s schedule after `slots[slot][instance] = cell` for each
+/// `(slot, instance, cell)` of `edits`, in order.
+fn tiny_violations(edits: &[(usize, usize, Option<Job>)]) -> Vec<ScheduleViolation> {
+    let (problem, mut schedule) = tiny();
+    for &(slot, instance, cell) in edits {
+        schedule.slots[slot][instance] = cell;
+    }
+    violations(&problem, &schedule)
+}
+
 #[test]
 fn check_accepts_the_hand_schedule_and_stats_measure_it() {
     let (problem, schedule) = tiny();
@@ -275,38 +285,31 @@ fn check_accepts_the_hand_schedule_and_stats_measure_it() {
 
 #[test]
 fn check_rejects_a_dependency_violation() {
-    let (problem, mut schedule) = tiny();
     // Plane 0 runs round 1 of path 0 before round 0.
-    schedule.slots[0][0] = Some(job(0, 1, 0));
-    schedule.slots[2][0] = Some(job(0, 0, 0));
-    let v = violations(&problem, &schedule);
+    let v = tiny_violations(&[(0, 0, Some(job(0, 1, 0))), (2, 0, Some(job(0, 0, 0)))]);
     assert_eq!(v, vec![dependency(0, 1, 0, 0, 2)]);
 }
 
 #[test]
 fn check_rejects_same_slot_rounds() {
-    let (problem, mut schedule) = tiny();
     // Round 1's plane-0 job moved up next to round 0's jobs: same slot is not "strictly later".
-    schedule.slots[2][0] = None;
-    schedule.slots[1][0] = Some(job(0, 1, 0));
-    schedule.slots[0][0] = Some(job(0, 0, 0));
-    schedule.slots[1][1] = Some(job(0, 0, 1));
-    schedule.slots[0][1] = Some(job(1, 0, 0));
-    let v = violations(&problem, &schedule);
+    let v = tiny_violations(&[
+        (2, 0, None),
+        (1, 0, Some(job(0, 1, 0))),
+        (0, 0, Some(job(0, 0, 0))),
+        (1, 1, Some(job(0, 0, 1))),
+        (0, 1, Some(job(1, 0, 0))),
+    ]);
     assert_eq!(v, vec![dependency(0, 1, 0, 1, 1)]);
 }
 
 #[test]
 fn check_rejects_missing_duplicate_unknown_and_misplaced_jobs() {
-    let (problem, mut schedule) = tiny();
-    schedule.slots[1][1] = None;
-    let v = violations(&problem, &schedule);
+    let v = tiny_violations(&[(1, 1, None)]);
     assert_eq!(v, vec![ScheduleViolation::MissingJob { job: job(1, 0, 0) }]);
 
-    let (problem, mut schedule) = tiny();
-    schedule.slots[1][0] = Some(job(0, 0, 0));
     assert_eq!(
-        violations(&problem, &schedule),
+        tiny_violations(&[(1, 0, Some(job(0, 0, 0)))]),
         vec![ScheduleViolation::DuplicateJob {
             job: job(0, 0, 0),
             first: 0,
@@ -314,10 +317,8 @@ fn check_rejects_missing_duplicate_unknown_and_misplaced_jobs() {
         }]
     );
 
-    let (problem, mut schedule) = tiny();
-    schedule.slots[1][0] = Some(job(1, 1, 0));
     assert_eq!(
-        violations(&problem, &schedule),
+        tiny_violations(&[(1, 0, Some(job(1, 1, 0)))]),
         vec![ScheduleViolation::UnknownJob {
             slot: 1,
             instance: 0,
@@ -325,11 +326,8 @@ fn check_rejects_missing_duplicate_unknown_and_misplaced_jobs() {
         }]
     );
 
-    let (problem, mut schedule) = tiny();
-    schedule.slots[1][1] = None;
-    schedule.slots[1][0] = Some(job(1, 0, 0));
     assert_eq!(
-        violations(&problem, &schedule),
+        tiny_violations(&[(1, 1, None), (1, 0, Some(job(1, 0, 0)))]),
         vec![ScheduleViolation::WrongPlane {
             job: job(1, 0, 0),
             instance: 0,
