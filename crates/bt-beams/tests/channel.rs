@@ -93,16 +93,10 @@ fn reciprocity_in_the_living_room() {
     let scene = bt_scene::builtin_scene("living-room", Terminals::default())
         .unwrap()
         .unwrap();
-    let a = Antenna {
-        pattern: Pattern::Tr38901,
-        polarization: Polarization::Plus45,
-        orientation: Orientation::from_degrees(160.0, -15.0, 0.0),
-    };
-    let b = Antenna {
-        pattern: Pattern::Isotropic,
-        polarization: Polarization::H,
-        orientation: Orientation::from_degrees(-30.0, 10.0, 20.0),
-    };
+    let facing_a = Orientation::from_degrees(160.0, -15.0, 0.0);
+    let facing_b = Orientation::from_degrees(-30.0, 10.0, 20.0);
+    let a = Antenna::new(Pattern::Tr38901, Polarization::Plus45, facing_a);
+    let b = Antenna::new(Pattern::Isotropic, Polarization::H, facing_b);
     let forward = trace(
         &scene,
         2,

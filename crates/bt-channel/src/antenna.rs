@@ -139,6 +139,15 @@ impl Pattern {
 }
 
 impl Antenna {
+    /// An element with the given pattern, polarisation and world-frame orientation.
+    pub fn new(pattern: Pattern, polarization: Polarization, orientation: Orientation) -> Self {
+        Antenna {
+            pattern,
+            polarization,
+            orientation,
+        }
+    }
+
     /// The field vector (world frame, dimensionless, |·|² = G) towards the world unit direction
     /// `direction` (departure for a transmitter, the direction the wave comes from for a
     /// receiver).

@@ -262,16 +262,10 @@ mod tests {
             normal: -Vec3::X,
             response: SurfaceResponse::Radio(RadioMaterial::itu("glass", Some(0.01)).unwrap()),
         };
-        let a = Antenna {
-            pattern: Pattern::Tr38901,
-            polarization: Polarization::Plus45,
-            orientation: Orientation::from_degrees(20.0, -10.0, 5.0),
-        };
-        let b = Antenna {
-            pattern: Pattern::Isotropic,
-            polarization: Polarization::H,
-            orientation: Orientation::from_degrees(-150.0, 0.0, 30.0),
-        };
+        let facing_a = Orientation::from_degrees(20.0, -10.0, 5.0);
+        let facing_b = Orientation::from_degrees(-150.0, 0.0, 30.0);
+        let a = Antenna::new(Pattern::Tr38901, Polarization::Plus45, facing_a);
+        let b = Antenna::new(Pattern::Isotropic, Polarization::H, facing_b);
         let forward = path_gain(tx, &[p1, p2], rx, &[floor, wall], (&a, &b), F).unwrap();
         let backward = path_gain(rx, &[p2, p1], tx, &[wall, floor], (&b, &a), F).unwrap();
         assert!(forward.norm() > 1e-6);

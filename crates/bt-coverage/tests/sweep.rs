@@ -8,7 +8,7 @@ use bt_scene::Scene;
 use bt_solve::pipeline::TraceOptions;
 
 fn box_room(size: [f64; 3], tx: [f64; 3]) -> Scene {
-    bt_testkit::box_room(size.into(), tx.into(), Vec3::splat(0.5))
+    bt_testkit::box_room(size, tx, Vec3::splat(0.5))
 }
 
 /// Paths of order ≤ `max` in an empty box: one per lattice image with |a|+|b|+|c| ≤ max.

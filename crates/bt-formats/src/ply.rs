@@ -270,45 +270,23 @@ mod tests {
 
     #[test]
     fn every_error_names_its_line() {
+        // One case per line: (header, line the error names, error).
+        #[rustfmt::skip]
         let cases: &[(&[u8], usize, K)] = &[
-            (b"plx\n", 1, K::NotPly),
-            (b"ply\nformat ascii 1.0\n", 3, K::NoEndHeader),
-            (b"ply\n\xff\n", 2, K::NotText),
-            (b"ply\nend_header\n", 2, K::NoFormat),
-            (
-                b"ply\nformat middle 1.0\n",
-                2,
-                K::UnknownFormat("middle".into()),
-            ),
-            (
-                b"ply\nformat ascii 2.0\n",
-                2,
-                K::UnsupportedVersion("2.0".into()),
-            ),
-            (
-                b"ply\nformat ascii\n",
-                2,
-                K::Malformed("format ascii".into()),
-            ),
-            (b"ply\nelement vertex -3\n", 2, K::BadCount("-3".into())),
-            (b"ply\nproperty float x\n", 2, K::PropertyBeforeElement),
-            (
-                b"ply\nelement v 1\nproperty quad x\n",
-                3,
-                K::UnknownType("quad".into()),
-            ),
-            (
-                b"ply\nelement v 1\nproperty list float int f\n",
-                3,
-                K::NonIntegerListCount("f".into()),
-            ),
-            (
-                b"ply\nelement v 1\nproperty float x\nproperty int x\n",
-                4,
-                K::DuplicateProperty("x".into()),
-            ),
-            (b"ply\nelement v\n", 2, K::Malformed("element v".into())),
-            (b"ply\nvertex 3\n", 2, K::Malformed("vertex 3".into())),
+            (b"plx\n",                                                1, K::NotPly),
+            (b"ply\nformat ascii 1.0\n",                              3, K::NoEndHeader),
+            (b"ply\n\xff\n",                                          2, K::NotText),
+            (b"ply\nend_header\n",                                    2, K::NoFormat),
+            (b"ply\nformat middle 1.0\n",                             2, K::UnknownFormat("middle".into())),
+            (b"ply\nformat ascii 2.0\n",                              2, K::UnsupportedVersion("2.0".into())),
+            (b"ply\nformat ascii\n",                                  2, K::Malformed("format ascii".into())),
+            (b"ply\nelement vertex -3\n",                             2, K::BadCount("-3".into())),
+            (b"ply\nproperty float x\n",                              2, K::PropertyBeforeElement),
+            (b"ply\nelement v 1\nproperty quad x\n",                  3, K::UnknownType("quad".into())),
+            (b"ply\nelement v 1\nproperty list float int f\n",        3, K::NonIntegerListCount("f".into())),
+            (b"ply\nelement v 1\nproperty float x\nproperty int x\n", 4, K::DuplicateProperty("x".into())),
+            (b"ply\nelement v\n",                                     2, K::Malformed("element v".into())),
+            (b"ply\nvertex 3\n",                                      2, K::Malformed("vertex 3".into())),
         ];
         for (bytes, line, kind) in cases {
             let e = PlyHeader::parse(bytes).unwrap_err();

@@ -285,15 +285,10 @@ impl Dfs<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use bt_geom::Vec3;
     use bt_testkit::scene_from_json;
 
     fn box_room() -> Scene {
-        bt_testkit::box_room(
-            Vec3::new(4.0, 3.0, 2.5),
-            Vec3::new(1.0, 1.0, 1.0),
-            Vec3::new(3.0, 2.0, 1.5),
-        )
+        bt_testkit::box_room([4.0, 3.0, 2.5], [1.0, 1.0, 1.0], [3.0, 2.0, 1.5])
     }
 
     #[test]

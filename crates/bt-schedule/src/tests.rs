@@ -5,6 +5,10 @@ use crate::{
     Budget, GaParams, Job, PathJob, PeInstance, Problem, Schedule, schedule_ga, schedule_list,
 };
 
+fn problem(num_planes: u32, paths: Vec<PathJob>) -> Problem {
+    Problem { num_planes, paths }
+}
+
 fn path(planes: &[u32], rounds: u32) -> PathJob {
     PathJob::jacobi(planes.to_vec(), rounds)
 }
@@ -25,6 +29,22 @@ fn list_and_ga(problem: &Problem, budget: &Budget) -> [Schedule; 2] {
     ];
     for schedule in &schedules {
         schedule.check(problem).unwrap();
+    }
+    schedules
+}
+
+/// The list and GA schedules of `problem` with one PE per plane (both checked legal), each
+/// asserted to have the `expected` (makespan, latency factor, makespan lower bound).
+fn originals_only_list_and_ga(problem: &Problem, expected: (u32, u64, u32)) -> [Schedule; 2] {
+    let schedules = list_and_ga(problem, &Budget::originals_only(problem));
+    for schedule in &schedules {
+        let stats = schedule.stats(problem);
+        let measured = (
+            stats.makespan,
+            stats.latency_factor,
+            stats.makespan_lower_bound,
+        );
+        assert_eq!(measured, expected, "{stats:?}");
     }
     schedules
 }
@@ -53,45 +73,24 @@ fn job(path: u32, round: u32, point: u32) -> Job {
 
 #[test]
 fn disjoint_paths_run_in_parallel() {
-    let problem = Problem {
-        num_planes: 4,
-        paths: vec![path(&[0, 1], 3), path(&[2, 3], 3)],
-    };
-    let budget = Budget::originals_only(&problem);
-    assert_eq!(budget.max_instances, 4);
-    for schedule in list_and_ga(&problem, &budget) {
+    let problem = problem(4, vec![path(&[0, 1], 3), path(&[2, 3], 3)]);
+    assert_eq!(Budget::originals_only(&problem).max_instances, 4);
+    for schedule in originals_only_list_and_ga(&problem, (3, 0, 3)) {
         let stats = schedule.stats(&problem);
-        assert_eq!(stats.makespan, 3);
-        assert_eq!(stats.latency_factor, 0);
-        assert_eq!(stats.instances, 4);
-        assert_eq!(stats.duplicates, 0);
-        assert_eq!(stats.jobs, 12);
+        assert_eq!((stats.instances, stats.duplicates, stats.jobs), (4, 0, 12));
         assert_eq!(stats.utilisation, 1.0);
-        assert_eq!(stats.makespan_lower_bound, 3);
     }
 }
 
 #[test]
 fn a_b_a_needs_two_slots_per_round_without_duplicate() {
-    let problem = Problem {
-        num_planes: 2,
-        paths: vec![path(&[0, 1, 0], 3)],
-    };
-    let budget = Budget::originals_only(&problem);
-    for schedule in list_and_ga(&problem, &budget) {
-        let stats = schedule.stats(&problem);
-        assert_eq!(stats.makespan, 6);
-        assert_eq!(stats.latency_factor, 3);
-        assert_eq!(stats.makespan_lower_bound, 6);
-    }
+    let problem = problem(2, vec![path(&[0, 1, 0], 3)]);
+    originals_only_list_and_ga(&problem, (6, 3, 6));
 }
 
 #[test]
 fn a_b_a_takes_one_slot_per_round_with_a_duplicate_of_a() {
-    let problem = Problem {
-        num_planes: 2,
-        paths: vec![path(&[0, 1, 0], 3)],
-    };
+    let problem = problem(2, vec![path(&[0, 1, 0], 3)]);
     let schedule = schedule_ga(&problem, &Budget { max_instances: 3 }, &small_ga()).unwrap();
     schedule.check(&problem).unwrap();
     let stats = schedule.stats(&problem);
@@ -114,10 +113,7 @@ fn a_b_a_takes_one_slot_per_round_with_a_duplicate_of_a() {
 #[test]
 fn shared_plane_is_the_bottleneck_and_a_duplicate_halves_it() {
     // Plane 0 carries 2 x 4 jobs; plane 1 and 2 four each.
-    let problem = Problem {
-        num_planes: 3,
-        paths: vec![path(&[0, 1], 4), path(&[0, 2], 4)],
-    };
+    let problem = problem(3, vec![path(&[0, 1], 4), path(&[0, 2], 4)]);
     let list = schedule_list(&problem, &Budget::originals_only(&problem)).unwrap();
     list.check(&problem).unwrap();
     assert_eq!(list.stats(&problem).makespan, 8);
@@ -138,10 +134,7 @@ fn shared_plane_is_the_bottleneck_and_a_duplicate_halves_it() {
 fn ga_aligns_rounds_where_the_list_scheduler_spreads_them() {
     // List order puts path 0 on plane 0 first, so path 1's plane-0 job of each round lags
     // behind its plane-1 job; the GA finds an order with the same makespan and less spread.
-    let problem = Problem {
-        num_planes: 3,
-        paths: vec![path(&[0], 4), path(&[1, 0], 4), path(&[2], 8)],
-    };
+    let problem = problem(3, vec![path(&[0], 4), path(&[1, 0], 4), path(&[2], 8)]);
     let budget = Budget::originals_only(&problem);
     let list = schedule_list(&problem, &budget).unwrap();
     let ga = schedule_ga(&problem, &budget, &small_ga()).unwrap();
@@ -156,10 +149,7 @@ fn ga_aligns_rounds_where_the_list_scheduler_spreads_them() {
 
 #[test]
 fn empty_problem_gives_empty_schedule() {
-    let problem = Problem {
-        num_planes: 5,
-        paths: vec![],
-    };
+    let problem = problem(5, vec![]);
     let budget = Budget::originals_only(&problem);
     assert_eq!(budget.max_instances, 0);
     for schedule in [
@@ -176,15 +166,15 @@ fn empty_problem_gives_empty_schedule() {
 
 #[test]
 fn validate_reports_every_issue_at_once() {
-    let problem = Problem {
-        num_planes: 2,
-        paths: vec![
+    let problem = problem(
+        2,
+        vec![
             path(&[], 3),
             path(&[0, 5], 2),
             path(&[1, 1], 0),
             path(&[0, 1, 0], 1),
         ],
-    };
+    );
     let Err(ScheduleError::InvalidProblem(report)) = problem.validate() else {
         panic!("problem should be invalid");
     };
@@ -217,10 +207,7 @@ fn validate_reports_every_issue_at_once() {
 
 #[test]
 fn budget_and_parameters_are_checked() {
-    let problem = Problem {
-        num_planes: 3,
-        paths: vec![path(&[0, 2], 1)],
-    };
+    let problem = problem(3, vec![path(&[0, 2], 1)]);
     assert_eq!(
         schedule_list(&problem, &Budget { max_instances: 1 }),
         Err(ScheduleError::BudgetTooSmall {
@@ -252,10 +239,7 @@ fn budget_and_parameters_are_checked() {
 
 /// Path 0 = [0, 1] x 2 rounds, path 1 = [1] x 1 round, on instances (0,0), (1,0).
 fn tiny() -> (Problem, Schedule) {
-    let problem = Problem {
-        num_planes: 2,
-        paths: vec![path(&[0, 1], 2), path(&[1], 1)],
-    };
+    let problem = problem(2, vec![path(&[0, 1], 2), path(&[1], 1)]);
     let schedule = Schedule {
         instances: vec![
             PeInstance { plane: 0, copy: 0 },
@@ -277,6 +261,16 @@ fn violations(problem: &Problem, schedule: &Schedule) -> Vec<ScheduleViolation> 
     }
 }
 
+/// The violations of [`tiny`]'s schedule after `slots[slot][instance] = cell` for each
+/// `(slot, instance, cell)` of `edits`, in order.
+fn tiny_violations(edits: &[(usize, usize, Option<Job>)]) -> Vec<ScheduleViolation> {
+    let (problem, mut schedule) = tiny();
+    for &(slot, instance, cell) in edits {
+        schedule.slots[slot][instance] = cell;
+    }
+    violations(&problem, &schedule)
+}
+
 #[test]
 fn check_accepts_the_hand_schedule_and_stats_measure_it() {
     let (problem, schedule) = tiny();
@@ -291,38 +285,31 @@ fn check_accepts_the_hand_schedule_and_stats_measure_it() {
 
 #[test]
 fn check_rejects_a_dependency_violation() {
-    let (problem, mut schedule) = tiny();
     // Plane 0 runs round 1 of path 0 before round 0.
-    schedule.slots[0][0] = Some(job(0, 1, 0));
-    schedule.slots[2][0] = Some(job(0, 0, 0));
-    let v = violations(&problem, &schedule);
+    let v = tiny_violations(&[(0, 0, Some(job(0, 1, 0))), (2, 0, Some(job(0, 0, 0)))]);
     assert_eq!(v, vec![dependency(0, 1, 0, 0, 2)]);
 }
 
 #[test]
 fn check_rejects_same_slot_rounds() {
-    let (problem, mut schedule) = tiny();
     // Round 1's plane-0 job moved up next to round 0's jobs: same slot is not "strictly later".
-    schedule.slots[2][0] = None;
-    schedule.slots[1][0] = Some(job(0, 1, 0));
-    schedule.slots[0][0] = Some(job(0, 0, 0));
-    schedule.slots[1][1] = Some(job(0, 0, 1));
-    schedule.slots[0][1] = Some(job(1, 0, 0));
-    let v = violations(&problem, &schedule);
+    let v = tiny_violations(&[
+        (2, 0, None),
+        (1, 0, Some(job(0, 1, 0))),
+        (0, 0, Some(job(0, 0, 0))),
+        (1, 1, Some(job(0, 0, 1))),
+        (0, 1, Some(job(1, 0, 0))),
+    ]);
     assert_eq!(v, vec![dependency(0, 1, 0, 1, 1)]);
 }
 
 #[test]
 fn check_rejects_missing_duplicate_unknown_and_misplaced_jobs() {
-    let (problem, mut schedule) = tiny();
-    schedule.slots[1][1] = None;
-    let v = violations(&problem, &schedule);
+    let v = tiny_violations(&[(1, 1, None)]);
     assert_eq!(v, vec![ScheduleViolation::MissingJob { job: job(1, 0, 0) }]);
 
-    let (problem, mut schedule) = tiny();
-    schedule.slots[1][0] = Some(job(0, 0, 0));
     assert_eq!(
-        violations(&problem, &schedule),
+        tiny_violations(&[(1, 0, Some(job(0, 0, 0)))]),
         vec![ScheduleViolation::DuplicateJob {
             job: job(0, 0, 0),
             first: 0,
@@ -330,10 +317,8 @@ fn check_rejects_missing_duplicate_unknown_and_misplaced_jobs() {
         }]
     );
 
-    let (problem, mut schedule) = tiny();
-    schedule.slots[1][0] = Some(job(1, 1, 0));
     assert_eq!(
-        violations(&problem, &schedule),
+        tiny_violations(&[(1, 0, Some(job(1, 1, 0)))]),
         vec![ScheduleViolation::UnknownJob {
             slot: 1,
             instance: 0,
@@ -341,11 +326,8 @@ fn check_rejects_missing_duplicate_unknown_and_misplaced_jobs() {
         }]
     );
 
-    let (problem, mut schedule) = tiny();
-    schedule.slots[1][1] = None;
-    schedule.slots[1][0] = Some(job(1, 0, 0));
     assert_eq!(
-        violations(&problem, &schedule),
+        tiny_violations(&[(1, 1, None), (1, 0, Some(job(1, 0, 0)))]),
         vec![ScheduleViolation::WrongPlane {
             job: job(1, 0, 0),
             instance: 0,
@@ -382,10 +364,7 @@ fn schedule_round_trips_through_json() {
 fn the_duplicating_list_scheduler_copies_the_busiest_plane() {
     // Plane 0 carries 2 x 4 jobs, planes 1 and 2 four each: the one extra PE goes to plane 0
     // and the makespan halves to 4 (the optimum: 16 jobs on 4 PEs).
-    let problem = Problem {
-        num_planes: 3,
-        paths: vec![path(&[0, 1], 4), path(&[0, 2], 4)],
-    };
+    let problem = problem(3, vec![path(&[0, 1], 4), path(&[0, 2], 4)]);
     let budget = Budget { max_instances: 4 };
     assert_eq!(
         crate::size_copies(&problem, &budget).unwrap(),
@@ -436,17 +415,10 @@ fn red_black(planes: &[u32], rounds: u32) -> PathJob {
 fn a_red_black_round_runs_its_two_phases_one_after_the_other() {
     // A-B-A: phase 0 = points 0 and 2 (both on A: two slots with one PE of A), phase 1 =
     // point 1 (B) after it: 3 slots a round, where Jacobi packs a round into 2.
-    let problem = Problem {
-        num_planes: 2,
-        paths: vec![red_black(&[0, 1, 0], 3)],
-    };
-    let budget = Budget::originals_only(&problem);
-    for schedule in list_and_ga(&problem, &budget) {
-        let stats = schedule.stats(&problem);
-        assert_eq!(stats.makespan, 9);
-        assert_eq!(stats.makespan_lower_bound, 9);
-        // Phase 0 spreads over 2 slots each round, phase 1 takes one.
-        assert_eq!(stats.latency_factor, 3);
+    let problem = problem(2, vec![red_black(&[0, 1, 0], 3)]);
+    // Makespan 9 = its lower bound; latency factor 3: phase 0 spreads over 2 slots each
+    // round, phase 1 takes one.
+    for schedule in originals_only_list_and_ga(&problem, (9, 3, 9)) {
         for round in 0..3 {
             let slot_of = |point| {
                 schedule
@@ -468,10 +440,7 @@ fn a_red_black_round_runs_its_two_phases_one_after_the_other() {
 #[test]
 fn check_rejects_a_second_phase_next_to_the_first() {
     // A-B red-black, one round: point 1 must run after point 0, not beside it.
-    let problem = Problem {
-        num_planes: 2,
-        paths: vec![red_black(&[0, 1], 1)],
-    };
+    let problem = problem(2, vec![red_black(&[0, 1], 1)]);
     let mut schedule = schedule_list(&problem, &Budget::originals_only(&problem)).unwrap();
     assert_eq!(schedule.makespan(), 2);
     schedule.slots[0][1] = schedule.slots[1][1].take();

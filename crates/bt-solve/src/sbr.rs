@@ -556,11 +556,7 @@ mod tests {
     use std::collections::BTreeSet;
 
     fn box_room() -> Scene {
-        bt_testkit::box_room(
-            Vec3::new(4.0, 3.0, 2.5),
-            Vec3::new(1.1, 0.9, 1.2),
-            Vec3::new(3.2, 2.1, 1.6),
-        )
+        bt_testkit::box_room([4.0, 3.0, 2.5], [1.1, 0.9, 1.2], [3.2, 2.1, 1.6])
     }
 
     fn angle_deg(a: Vec3, b: Vec3) -> Real {

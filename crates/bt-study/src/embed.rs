@@ -64,12 +64,7 @@ mod tests {
 
     #[test]
     fn square_room_paths_stay_in_the_plane() {
-        let contour = [
-            Vec2::new(1., 1.),
-            Vec2::new(6., 1.),
-            Vec2::new(6., 5.),
-            Vec2::new(1., 5.),
-        ];
+        let contour = [[1., 1.], [6., 1.], [6., 5.], [1., 5.]].map(Vec2::from);
         let scene = scene("square", &contour, Vec2::new(2., 2.), Vec2::new(4., 3.)).unwrap();
         assert_eq!(scene.find("wall-2").map(|id| id.0), Some(2));
         let candidates = enumerate(&scene, 2, &AllVisible);

@@ -26,8 +26,9 @@ pub fn scene_from_json(json: &str) -> Scene {
     Scene::from_description(&d, "test", Terminals::default()).expect("test scene is valid")
 }
 
-/// An empty box room `[0, size]` with TX and RX inside.
-pub fn box_room(size: Vec3, tx: Vec3, rx: Vec3) -> Scene {
+/// An empty box room `[0, size]` with TX and RX inside (each a `Vec3` or an `[x, y, z]`).
+pub fn box_room(size: impl Into<Vec3>, tx: impl Into<Vec3>, rx: impl Into<Vec3>) -> Scene {
+    let (size, tx, rx) = (size.into(), tx.into(), rx.into());
     scene_from_json(&format!(
         r#"{{ "tx": {:?}, "rx": {:?}, "boxes": [ {{ "name": "room", "min": [0, 0, 0], "max": {:?} }} ] }}"#,
         tx.to_array(),

@@ -100,6 +100,24 @@ pub fn grid_points(values: &[FineCoord]) -> Vec<FinePoint> {
         .collect()
 }
 
+/// The corner cases at `bits`-bit coordinates: every [`corner_planes`] plane with both points
+/// on the [`grid_points`] of the coordinate range's minimum and maximum (and zero if
+/// `with_zero`), planes outermost, then the previous point, then the next.
+pub fn corner_cases(bits: u32, with_zero: bool) -> Vec<(FixedPlane, FinePoint, FinePoint)> {
+    let (min, max) = bt_fixed::Widths::for_coord(bits).coord_range();
+    let values = [min, max, 0].map(FineCoord);
+    let points = grid_points(&values[..if with_zero { 3 } else { 2 }]);
+    let mut cases = Vec::new();
+    for plane in corner_planes(bits) {
+        for &prev in &points {
+            for &next in &points {
+                cases.push((plane, prev, next));
+            }
+        }
+    }
+    cases
+}
+
 /// `round_half_up(num / 2^shift)` computed by exact Euclidean division (the oracle).
 pub fn oracle_round(num: i128, shift: u32) -> i128 {
     if shift == 0 {

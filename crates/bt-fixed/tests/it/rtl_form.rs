@@ -88,16 +88,9 @@ proptest! {
 
 #[test]
 fn register_form_equals_model_at_the_corners() {
-    use bt_fixed::FineCoord;
     for bits in COORD_BITS {
-        let (min, max) = Widths::for_coord(bits).coord_range();
-        let points = grid_points(&[min, max, 0].map(FineCoord));
-        for plane in corner_planes(bits) {
-            for &prev in &points {
-                for &next in &points {
-                    check(&plane, prev, next, bits);
-                }
-            }
+        for (plane, prev, next) in corner_cases(bits, true) {
+            check(&plane, prev, next, bits);
         }
     }
 }

@@ -38,14 +38,14 @@ pub fn small_scene() -> HlsInput {
             bounds_m: Some([lo, hi]),
         });
     }
-    let centroids = [
-        [0.0, 2.0, 1.5],
-        [5.0, 2.0, 1.5],
-        [2.5, 0.0, 1.5],
-        [2.5, 4.0, 1.5],
-        [2.5, 2.0, 0.0],
-        [2.5, 2.0, 3.0],
-    ];
+    // Each plane's centre of its bounds (the tilted wall's too): the paths' initial points.
+    let centroids: Vec<[f64; 3]> = planes
+        .iter()
+        .map(|p| {
+            let [lo, hi] = p.bounds_m.unwrap();
+            [0, 1, 2].map(|k| (lo[k] + hi[k]) / 2.0)
+        })
+        .collect();
     let mut paths: Vec<Vec<u32>> = (0..6).map(|p| vec![p]).collect();
     for a in 0..5u32 {
         for b in 0..5u32 {

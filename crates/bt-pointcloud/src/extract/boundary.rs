@@ -579,13 +579,7 @@ mod tests {
 
     #[test]
     fn hull_and_rect() {
-        let pts = [
-            Vec2::new(0.0, 0.0),
-            Vec2::new(2.0, 0.0),
-            Vec2::new(2.0, 1.0),
-            Vec2::new(0.0, 1.0),
-            Vec2::new(1.0, 0.5),
-        ];
+        let pts = [[0.0, 0.0], [2.0, 0.0], [2.0, 1.0], [0.0, 1.0], [1.0, 0.5]].map(Vec2::from);
         let h = hull_2d(&pts);
         assert_eq!(h.len(), 4);
         assert!(signed_area(&h) > 0.0);

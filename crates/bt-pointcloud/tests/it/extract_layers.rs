@@ -3,13 +3,9 @@
 //! short of a wall, which must not be snapped onto the crease. A shelf that does touch the
 //! wall must still be snapped (it lost a band of points to the wall).
 
+use crate::common::room::rect;
 use bt_pointcloud::{ExtractParams, ExtractedPlane, extract_planes, sample_polygons};
 use glam::DVec3;
-
-fn rect(c: [f64; 3], e1: [f64; 3], e2: [f64; 3]) -> Vec<DVec3> {
-    let (c, a, b) = (DVec3::from(c), DVec3::from(e1), DVec3::from(e2));
-    vec![c, c + a, c + a + b, c + b]
-}
 
 /// Distance of `c` from the plane of `p`, metres.
 fn off(p: &ExtractedPlane, c: DVec3) -> f64 {

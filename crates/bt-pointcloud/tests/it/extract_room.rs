@@ -189,12 +189,7 @@ fn edge_cases_and_parameter_validation() {
     }
 
     // A single square: one reflector, counter-clockwise seen from its normal, progress reported.
-    let sq = vec![
-        DVec3::ZERO,
-        DVec3::new(1.0, 0.0, 0.0),
-        DVec3::new(1.0, 1.0, 0.0),
-        DVec3::new(0.0, 1.0, 0.0),
-    ];
+    let sq = vec![DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y];
     let cloud = sample_polygons(&[sq], 2000.0, 0.002, 3);
     let mut stages = Vec::new();
     let ex =

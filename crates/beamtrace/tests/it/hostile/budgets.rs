@@ -30,28 +30,20 @@ fn dynamic_steps_respect_the_candidate_budget() {
 
 #[test]
 fn hls_and_study_respect_the_candidate_budget() {
-    let dir = scratch("budget-hls");
-    let out = dir.join("a");
-    let o = out.to_str().unwrap();
-    assert_refused_writing_nothing(
-        &cli("hls gen builtin:living-room --max-order 30 -o {}", &[o]),
+    let out = scratch("budget-hls").join("a");
+    assert_line_refused_writing_nothing(
+        "hls gen builtin:living-room --max-order 30 -o {}",
         &out,
         &["candidate budget exceeded", "--max-candidates"],
     );
-    assert_refused_writing_nothing(
-        &cli(
-            "study living-room --max-order 3 --max-candidates 100 --out {}",
-            &[o],
-        ),
+    assert_line_refused_writing_nothing(
+        "study living-room --max-order 3 --max-candidates 100 --out {}",
         &out,
         &["candidate budget exceeded", "budget 100"],
     );
     // The 2-D study accepted --max-candidates and ignored it.
-    assert_refused_writing_nothing(
-        &cli(
-            "study 2d --rooms 1 --steps 1 --max-candidates 3 --out {}",
-            &[o],
-        ),
+    assert_line_refused_writing_nothing(
+        "study 2d --rooms 1 --steps 1 --max-candidates 3 --out {}",
         &out,
         &["room-0-step-0", "--max-candidates"],
     );
@@ -81,13 +73,9 @@ fn sbr_grids_beyond_the_ray_budget_are_refused_not_answered_with_zero_paths() {
 
 #[test]
 fn sampling_beyond_the_point_budget_is_refused_before_allocating() {
-    let dir = scratch("budget-sample");
-    let out = dir.join("c.ply");
-    assert_refused_writing_nothing(
-        &cli(
-            "sample builtin:living-room --density 1e12 -o {}",
-            &[out.to_str().unwrap()],
-        ),
+    let out = scratch("budget-sample").join("c.ply");
+    assert_line_refused_writing_nothing(
+        "sample builtin:living-room --density 1e12 -o {}",
         &out,
         &["point budget exceeded", "--max-points"],
     );

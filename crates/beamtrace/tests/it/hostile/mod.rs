@@ -66,6 +66,12 @@ pub fn assert_refused_writing_nothing(args: &[&str], out: &Path, needles: &[&str
     assert!(!out.exists(), "{args:?} wrote {}", out.display());
 }
 
+/// [`assert_refused_writing_nothing`] of the command `line` (a [`cli`] line) whose one `{}`
+/// word is `out`.
+pub fn assert_line_refused_writing_nothing(line: &str, out: &Path, needles: &[&str]) {
+    assert_refused_writing_nothing(&cli(line, &[out.to_str().unwrap()]), out, needles);
+}
+
 /// A clear refusal ([`assert_refused`]) of a run that left `file` byte for byte as it was
 /// (an input it was asked to overwrite).
 pub fn assert_refused_keeping(args: &[&str], file: &Path, needles: &[&str]) {

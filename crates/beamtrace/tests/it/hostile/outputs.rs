@@ -51,11 +51,8 @@ fn hls_gen_keeps_the_users_files_and_replaces_its_own() {
 fn hls_gen_that_cannot_fit_fails_fast_and_creates_nothing() {
     let dir = scratch("hls-fail");
     let out = dir.join("accel");
-    assert_refused_writing_nothing(
-        &cli(
-            "hls gen builtin:living-room --max-order 1 --m9k-budget 4 -o {}",
-            &[out.to_str().unwrap()],
-        ),
+    assert_line_refused_writing_nothing(
+        "hls gen builtin:living-room --max-order 1 --m9k-budget 4 -o {}",
         &out,
         &["M9K blocks", "budget of 4", "--max-order"],
     );
