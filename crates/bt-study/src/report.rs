@@ -16,10 +16,7 @@ pub const CSV_HEADER: &str = concat!(
 /// `results.csv`: a header and one line per row; floats in Rust's shortest round-trip
 /// scientific notation (`1.5e-13`).
 pub fn csv(results: &StudyResults) -> String {
-    let mut out = String::with_capacity(128 * (results.rows.len() + 1));
-    out.push_str(CSV_HEADER);
-    out.push('\n');
-    for r in &results.rows {
+    csv_table(CSV_HEADER, &results.rows, |out, r| {
         let _ = write!(
             out,
             "{},{},{},{},{},",
@@ -29,7 +26,21 @@ pub fn csv(results: &StudyResults) -> String {
             r.edges,
             r.step
         );
-        r.comparison.write_csv(&mut out);
+        r.comparison.write_csv(out);
+    })
+}
+
+/// A CSV text: `header`, then one line per row as `line` writes it (without the newline).
+pub(crate) fn csv_table<T>(
+    header: &str,
+    rows: &[T],
+    mut line: impl FnMut(&mut String, &T),
+) -> String {
+    let mut out = String::with_capacity((header.len() + 1) * (rows.len() + 1));
+    out.push_str(header);
+    out.push('\n');
+    for row in rows {
+        line(&mut out, row);
         out.push('\n');
     }
     out

@@ -3,7 +3,7 @@
 
 use super::{CLOCK_HZ, LivingRoomResults, Row, SOLVERS};
 use crate::StudySolver;
-use crate::report::pick;
+use crate::report::{csv_table, pick};
 use crate::run::{AngularErrors, Comparison};
 use bt_geom::Real;
 use std::collections::BTreeMap;
@@ -25,10 +25,7 @@ latency_factor,utilisation,platform_instances,mean_cycles_per_slot,cycles,latenc
 /// scientific notation. `fpga_cycles` and `fpga_latency_s` (the accelerator's predicted run,
 /// at 50 MHz) are filled on the `ipc-fixed-point` rows only.
 pub fn csv(results: &LivingRoomResults) -> String {
-    let mut out = String::with_capacity(160 * (results.rows.len() + 1));
-    out.push_str(CSV_HEADER);
-    out.push('\n');
-    for r in &results.rows {
+    csv_table(CSV_HEADER, &results.rows, |out, r| {
         let fpga = if r.comparison.solver == StudySolver::IpcFixedPoint {
             results
                 .fpga
@@ -40,20 +37,16 @@ pub fn csv(results: &LivingRoomResults) -> String {
             ",".into()
         };
         let _ = write!(out, "{},{},", results.scene_name, r.step);
-        r.comparison.write_csv(&mut out);
-        let _ = writeln!(out, ",{fpga}");
-    }
-    out
+        r.comparison.write_csv(out);
+        let _ = write!(out, ",{fpga}");
+    })
 }
 
 /// `fpga.csv`: the accelerator of every step (candidate paths, fixed-point outcomes, the PE
 /// schedule and its cycles on the one platform); `host_time_s` is the only varying column.
 pub fn fpga_csv(results: &LivingRoomResults) -> String {
-    let mut out = String::new();
-    out.push_str(FPGA_CSV_HEADER);
-    out.push('\n');
-    for f in &results.fpga {
-        let _ = writeln!(
+    csv_table(FPGA_CSV_HEADER, &results.fpga, |out, f| {
+        let _ = write!(
             out,
             "{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{},{:e},{},{:e},{},{:e},{:e}",
             results.scene_name,
@@ -82,8 +75,7 @@ pub fn fpga_csv(results: &LivingRoomResults) -> String {
             f.latency_s,
             f.host_time_s
         );
-    }
-    out
+    })
 }
 
 /// Totals of one solver over all steps.
