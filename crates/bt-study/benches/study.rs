@@ -5,8 +5,8 @@
 //! single-threaded, as in the study. Throughput: exact paths per second.
 
 use bt_paths::{AllVisible, enumerate};
-use bt_solve::{IpcOptions, SbrOptions, Solver, UpdateOrder, sbr, trace};
-use bt_study::{embed, room};
+use bt_solve::{SbrOptions, Solver, sbr, trace};
+use bt_study::{StudySolver, embed, room};
 use criterion::{BenchmarkId, Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
 
@@ -25,18 +25,15 @@ fn solvers(c: &mut Criterion) {
         let mut group =
             c.benchmark_group(format!("room-{index}-{}-{}-edges", r.shape.name(), r.edges));
         group.throughput(Throughput::Elements(exact.paths.len() as u64));
-        let exact_solvers = [
-            ("image", Solver::Image),
-            (
-                "ipc-gauss-seidel",
-                Solver::Ipc(IpcOptions::for_scene(&scene, UpdateOrder::GaussSeidel)),
-            ),
-            (
-                "ipc-jacobi",
-                Solver::Ipc(IpcOptions::for_scene(&scene, UpdateOrder::Jacobi)),
-            ),
-        ];
-        for (name, solver) in exact_solvers {
+        for study_solver in [
+            StudySolver::Image,
+            StudySolver::IpcGaussSeidel,
+            StudySolver::IpcJacobi,
+        ] {
+            let (name, solver) = (
+                study_solver.name(),
+                study_solver.exact_solver(&scene).unwrap(),
+            );
             group.bench_function(BenchmarkId::from_parameter(name), |b| {
                 b.iter(|| {
                     let candidates = enumerate(black_box(&scene), MAX_ORDER, &AllVisible);

@@ -118,6 +118,19 @@ impl StudySolver {
             StudySolver::IpcFixedPoint => "ipc-fixed-point",
         }
     }
+
+    /// The candidate solver of an exact host solver (image method, IPC Gauss-Seidel or Jacobi)
+    /// with IPC's defaults scaled to `scene`; `None` for SBR (it traces the whole scene) and
+    /// the fixed-point model (the accelerator's, per step).
+    pub fn exact_solver(self, scene: &Scene) -> Option<Solver> {
+        let ipc = |order| Solver::Ipc(IpcOptions::for_scene(scene, order));
+        match self {
+            StudySolver::Image => Some(Solver::Image),
+            StudySolver::IpcGaussSeidel => Some(ipc(UpdateOrder::GaussSeidel)),
+            StudySolver::IpcJacobi => Some(ipc(UpdateOrder::Jacobi)),
+            StudySolver::Sbr | StudySolver::IpcFixedPoint => None,
+        }
+    }
 }
 
 /// One room, time step and solver.
@@ -332,11 +345,9 @@ pub(crate) fn run_solver(
 ) -> Result<(PathMap, Real), StudyError> {
     let start = Instant::now();
     let s = match solver {
-        StudySolver::Image => Solver::Image,
-        StudySolver::IpcGaussSeidel => {
-            Solver::Ipc(IpcOptions::for_scene(scene, UpdateOrder::GaussSeidel))
+        StudySolver::Image | StudySolver::IpcGaussSeidel | StudySolver::IpcJacobi => {
+            solver.exact_solver(scene).expect("an exact host solver")
         }
-        StudySolver::IpcJacobi => Solver::Ipc(IpcOptions::for_scene(scene, UpdateOrder::Jacobi)),
         StudySolver::Sbr => {
             let result = sbr::trace_detailed(scene, &config.sbr_options(), config.max_order, false);
             let elapsed = start.elapsed().as_secs_f64();
