@@ -306,10 +306,9 @@ impl RadioArgs {
         if !self.tx_power_dbm.is_finite() {
             bail!("--tx-power-dbm must be a finite number of dBm");
         }
-        let antenna = |pattern, polarization, o: Vec3| bt_channel::Antenna {
-            pattern,
-            polarization,
-            orientation: bt_channel::Orientation::from_degrees(o.x, o.y, o.z),
+        let antenna = |pattern, polarization, o: Vec3| {
+            let orientation = bt_channel::Orientation::from_degrees(o.x, o.y, o.z);
+            bt_channel::Antenna::new(pattern, polarization, orientation)
         };
         Ok(bt_beams::RadioOptions {
             tx: antenna(self.tx_pattern, self.tx_polarization, self.tx_orientation),
