@@ -98,10 +98,13 @@ impl SbrOptions {
 
     /// The options a user chose (CLI flags, Python keywords): `rays` on a Fibonacci sphere if
     /// given, else a grid of `step_deg` (default 1°), optionally `planar`; checked with
-    /// [`SbrOptions::problem`].
+    /// [`SbrOptions::problem`]. Giving both a ray count and a step is refused.
     pub fn chosen(rays: Option<u32>, step_deg: Option<Real>, planar: bool) -> Result<Self, String> {
         let options = match (rays, step_deg) {
-            (Some(rays), _) => Self::fibonacci(rays),
+            (Some(_), Some(_)) => {
+                return Err("give an sbr step or an sbr ray count, not both".into());
+            }
+            (Some(rays), None) => Self::fibonacci(rays),
             (None, step) => Self::grid(step.unwrap_or(1.0)),
         };
         let options = Self { planar, ..options };

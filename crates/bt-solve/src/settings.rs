@@ -203,11 +203,6 @@ impl IpcSettings {
 impl SbrSettings {
     /// SBR's options, refused when invalid or over [`SbrSettings::max_rays`].
     pub fn options(&self) -> Result<SbrOptions, SettingsError> {
-        if self.step_deg.is_some() && self.rays.is_some() {
-            return Err(SettingsError::Sbr(
-                "give an sbr step or an sbr ray count, not both".into(),
-            ));
-        }
         let options = SbrOptions::chosen(self.rays, self.step_deg, self.planar)
             .map_err(SettingsError::Sbr)?;
         match options.over_budget(self.max_rays) {
