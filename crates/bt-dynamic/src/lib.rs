@@ -88,51 +88,46 @@ pub struct StepTrace {
     pub update: UpdateStats,
 }
 
-/// How a step generates its candidates under the pipeline's options (the WVRN mode keeps its
-/// incremental link update; the beam tree is kept for the next steps).
-trait StepGeneration {
-    /// The step's candidates: over `wvrn` when given (WVRN mode), else from the pipeline's
-    /// generator (beam tree or exhaustive), under the budget.
-    fn candidates(&self, scene: &Scene, wvrn: Option<&Wvrn>) -> Result<CandidateSet, TraceError>;
-    /// The WVRN of `scene` in WVRN mode.
-    fn wvrn(&self, scene: &Scene) -> Option<Wvrn>;
-    /// A first step's generator and its candidates.
-    fn generate(&self, scene: &Scene) -> Result<(Generator, CandidateSet), TraceError>;
+/// The step's candidates: over `wvrn` when given (WVRN mode, which keeps its incremental link
+/// update), else from the pipeline's generator (beam tree or exhaustive), under the budget.
+fn step_candidates(
+    options: &TraceOptions,
+    scene: &Scene,
+    wvrn: Option<&Wvrn>,
+) -> Result<CandidateSet, TraceError> {
+    match wvrn {
+        Some(w) => {
+            bt_solve::pipeline::check_budget(scene, options)?;
+            Ok(bt_paths::enumerate(scene, options.max_order, w))
+        }
+        None => bt_solve::pipeline::candidates(scene, options),
+    }
 }
 
-impl StepGeneration for TraceOptions {
-    fn candidates(&self, scene: &Scene, wvrn: Option<&Wvrn>) -> Result<CandidateSet, TraceError> {
-        match wvrn {
-            Some(w) => {
-                bt_solve::pipeline::check_budget(scene, self)?;
-                Ok(bt_paths::enumerate(scene, self.max_order, w))
-            }
-            None => bt_solve::pipeline::candidates(scene, self),
-        }
-    }
+/// The WVRN of `scene` in WVRN mode.
+fn step_wvrn(options: &TraceOptions, scene: &Scene) -> Option<Wvrn> {
+    (options.candidates == CandidateMode::Wvrn).then(|| Wvrn::build(scene))
+}
 
-    fn wvrn(&self, scene: &Scene) -> Option<Wvrn> {
-        (self.candidates == CandidateMode::Wvrn).then(|| Wvrn::build(scene))
+/// A first step's generator and candidates: the WVRN, or the beam tree materialised to the
+/// full order (kept for the next steps: a new RX is a walk, a moved reflector rebuilds only its
+/// subtrees), or exhaustive enumeration.
+fn generate(
+    options: &TraceOptions,
+    scene: &Scene,
+) -> Result<(Generator, CandidateSet), TraceError> {
+    if options.candidates == CandidateMode::BeamTree {
+        let tree = BeamTree::build(scene, bt_solve::pipeline::tree_options(options))?;
+        let candidates = tree.candidates(scene.rx());
+        let generator = Generator {
+            wvrn: None,
+            tree: Some(tree),
+        };
+        return Ok((generator, candidates));
     }
-
-    /// A first step's generator and candidates: the WVRN, or the beam tree materialised to
-    /// the full order (kept for the next steps: a new RX is a walk, a moved reflector
-    /// rebuilds only its subtrees), or exhaustive enumeration.
-    fn generate(&self, scene: &Scene) -> Result<(Generator, CandidateSet), TraceError> {
-        if self.candidates == CandidateMode::BeamTree {
-            let options = bt_solve::pipeline::tree_options(self);
-            let tree = BeamTree::build(scene, options)?;
-            let candidates = tree.candidates(scene.rx());
-            let generator = Generator {
-                wvrn: None,
-                tree: Some(tree),
-            };
-            return Ok((generator, candidates));
-        }
-        let wvrn = self.wvrn(scene);
-        let candidates = self.candidates(scene, wvrn.as_ref())?;
-        Ok((Generator { wvrn, tree: None }, candidates))
-    }
+    let wvrn = step_wvrn(options, scene);
+    let candidates = step_candidates(options, scene, wvrn.as_ref())?;
+    Ok((Generator { wvrn, tree: None }, candidates))
 }
 
 /// What the tracer keeps of a step's candidate generator: the WVRN (WVRN mode) or the beam
@@ -150,8 +145,8 @@ pub fn trace_scratch(
     step: usize,
     options: &TraceOptions,
 ) -> Result<StepTrace, TraceError> {
-    let wvrn = options.wvrn(scene);
-    let candidates = options.candidates(scene, wvrn.as_ref())?;
+    let wvrn = step_wvrn(options, scene);
+    let candidates = step_candidates(options, scene, wvrn.as_ref())?;
     let trace = bt_solve::trace(scene, &candidates, &options.solver, options.parallel);
     Ok(StepTrace {
         step,
@@ -310,7 +305,7 @@ impl IncrementalTracer {
 
     fn full(&mut self, scene: &Scene, step: usize) -> Result<StepTrace, TraceError> {
         let options = self.options;
-        let (generator, candidates) = options.generate(scene)?;
+        let (generator, candidates) = generate(&options, scene)?;
         let batch = Batch {
             scene,
             candidates: &candidates,
@@ -382,7 +377,7 @@ fn next_candidates(
     let generator = Generator { wvrn, tree: None };
     if everything || reflector_moved || links_changed {
         update.candidates_rederived = true;
-        let candidates = options.candidates(scene, generator.wvrn.as_ref())?;
+        let candidates = step_candidates(options, scene, generator.wvrn.as_ref())?;
         return Ok((generator, candidates));
     }
     Ok((generator, prev.candidates.clone()))
