@@ -982,5 +982,10 @@ mod tests {
     fn the_default_flags_are_the_library_defaults() {
         let defaults = SolveArgs::with(3, SolverArg::Image);
         assert_eq!(defaults.settings(), SolveSettings::default());
+        let parsed = Cli::try_parse_from(["beamtrace", "trace", "builtin:living-room"]).unwrap();
+        let Command::Trace(trace) = parsed.command else {
+            panic!("not the trace command")
+        };
+        assert_eq!(trace.solve.settings(), SolveSettings::default());
     }
 }
