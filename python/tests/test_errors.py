@@ -70,6 +70,8 @@ def test_budget_error_carries_the_cli_message(cli):
         ({"solver": "magic"}, "solver must be one of"),
         ({"candidates": "all"}, "candidates must be one of"),
         ({"solver": "sbr", "sbr_step_deg": 0.0}, "sbr step must be a positive"),
+        ({"solver": "sbr", "sbr_step_deg": 0.001}, "sbr ray budget exceeded"),
+        ({"solver": "sbr", "sbr_step_deg": 1.0, "sbr_rays": 10}, "not both"),
     ],
 )
 def test_bad_options_are_value_errors(options, message):
