@@ -925,7 +925,7 @@ pub struct HlsGenArgs {
     /// Every time step of a dynamic scene through ONE accelerator (synthesised once for the
     /// static planes; each step's candidates, start points and schedule are loaded over the
     /// bus): the design and the bus program of all steps into OUTPUT, per-step summaries into
-    /// OUTPUT/step-<k>/, the per-step table into OUTPUT/steps.json.
+    /// OUTPUT/step-K/, the per-step table into OUTPUT/steps.json.
     #[arg(long)]
     pub steps: bool,
 }
