@@ -215,6 +215,65 @@ const MAX_DAMPED_STEPS: u32 = 6;
 /// Damping attempts per Newton iteration (the damping grows 100-fold per attempt).
 const DAMPING_ATTEMPTS: u32 = 12;
 
+/// The line search of one Newton iteration: its damping and the path length it must not grow.
+struct Search {
+    /// Path length of the accepted points, metres.
+    length: Real,
+    /// Relative round-off allowed on the length.
+    slack: Real,
+    /// Levenberg-Marquardt damping (0: pure Newton).
+    mu: Real,
+    /// The damping a first damped attempt starts from (scaled to this iteration's system).
+    mu_min: Real,
+}
+
+impl Search {
+    /// Tries an undamped full step, an undamped half step, then growing damping, from `current`
+    /// into `points`; the first step that does not lengthen the path is kept. Returns the
+    /// step's total point displacement (metres) and whether it was a full undamped step, or
+    /// `None` when every attempt failed.
+    #[inline(always)]
+    fn step(
+        &mut self,
+        system: &System,
+        frames: &[(Vec3, Vec3)],
+        current: &[Vec3],
+        points: &mut [Vec3],
+        (tx, rx): (Vec3, Vec3),
+    ) -> Option<(Real, bool)> {
+        let n = points.len();
+        let mut step = [[0.0; 2]; MAX_ORDER];
+        for attempt in 0..DAMPING_ATTEMPTS {
+            let factor = if self.mu == 0.0 && attempt == 1 {
+                0.5
+            } else {
+                1.0
+            };
+            if self.mu == 0.0 && attempt >= 2 {
+                self.mu = self.mu_min;
+            }
+            if system.solve(n, self.mu, &mut step) {
+                let mut moved = 0.0;
+                for k in 0..n {
+                    let (u, v) = frames[k];
+                    let (dx, dy) = (factor * step[k][0], factor * step[k][1]);
+                    points[k] = current[k] + dx * u + dy * v;
+                    moved += (dx * dx + dy * dy).sqrt();
+                }
+                let new_length = path_length(tx, rx, points);
+                if moved.is_finite() && new_length <= self.length * (1.0 + self.slack) {
+                    self.length = new_length.min(self.length);
+                    return Some((moved, factor == 1.0 && self.mu == 0.0));
+                }
+            }
+            if self.mu > 0.0 {
+                self.mu *= 100.0;
+            }
+        }
+        None
+    }
+}
+
 /// Newton steps on ∇L = 0 for the chain `tx -> points -> rx` over `planes`, until a full step's
 /// mean point displacement is at most `threshold` metres. On `Failed` the points are restored.
 ///
@@ -248,13 +307,15 @@ pub fn polish(
         upper: [M2::default(); MAX_ORDER],
         rhs: [[0.0; 2]; MAX_ORDER],
     };
-    let mut step = [[0.0; 2]; MAX_ORDER];
     let mut current = [Vec3::ZERO; MAX_ORDER];
-    let mut length = path_length(tx, rx, points);
-    // Round-off of L: n + 1 square roots and sums, each within a few ulps.
-    let slack = 4.0 * (n + 1) as Real * Real::EPSILON;
+    let mut search = Search {
+        length: path_length(tx, rx, points),
+        // Round-off of L: n + 1 square roots and sums, each within a few ulps.
+        slack: 4.0 * (n + 1) as Real * Real::EPSILON,
+        mu: 0.0,
+        mu_min: 0.0,
+    };
     let mut last_full = Real::INFINITY;
-    let mut mu = 0.0;
     let (mut steps, mut damped) = (0, 0);
     let fail = |points: &mut [Vec3], steps| {
         points.copy_from_slice(&saved[..n]);
@@ -271,36 +332,9 @@ pub fn polish(
             }
         }
         let scale = system.assemble(&frames[..n], &dirs[..=n]);
-        let mu_min = 1e-9 * scale;
+        search.mu_min = 1e-9 * scale;
         current[..n].copy_from_slice(points);
-        // Try: undamped full step, undamped half step, then growing damping.
-        let mut accepted = None;
-        let mut attempt = 0;
-        while attempt < DAMPING_ATTEMPTS && accepted.is_none() {
-            let factor = if mu == 0.0 && attempt == 1 { 0.5 } else { 1.0 };
-            if mu == 0.0 && attempt >= 2 {
-                mu = mu_min;
-            }
-            attempt += 1;
-            if system.solve(n, mu, &mut step) {
-                let mut moved = 0.0;
-                for k in 0..n {
-                    let (u, v) = frames[k];
-                    let (dx, dy) = (factor * step[k][0], factor * step[k][1]);
-                    points[k] = current[k] + dx * u + dy * v;
-                    moved += (dx * dx + dy * dy).sqrt();
-                }
-                let new_length = path_length(tx, rx, points);
-                if moved.is_finite() && new_length <= length * (1.0 + slack) {
-                    length = new_length.min(length);
-                    accepted = Some((moved, factor == 1.0 && mu == 0.0));
-                    break;
-                }
-            }
-            if mu > 0.0 {
-                mu *= 100.0;
-            }
-        }
+        let accepted = search.step(&system, &frames[..n], &current[..n], points, (tx, rx));
         let Some((moved, full)) = accepted else {
             return fail(points, steps);
         };
@@ -310,9 +344,10 @@ pub fn polish(
                 return fail(points, steps);
             }
         }
-        if mu > 0.0 {
+        if search.mu > 0.0 {
             // Success: relax the damping, back to pure Newton once it is negligible.
-            mu = if mu / 1e4 < mu_min { 0.0 } else { mu / 1e4 };
+            let mu = search.mu / 1e4;
+            search.mu = if mu < search.mu_min { 0.0 } else { mu };
             continue;
         }
         if full {
