@@ -2,16 +2,14 @@
 //! default. Output: one JSON document `{ "steps": [ { "step", "paths", "stats" } ] }`, JSON
 //! lines (one step object per line) with `--jsonl`, or a per-step table.
 
-use crate::args::{SceneArgs, TraceArgs};
+use crate::args::TraceArgs;
+use crate::load::load_dynamic;
 use crate::output::FORMAT_VERSION;
-use crate::trace::load_options;
 use anyhow::Context;
 use bt_beams::PathReport;
-use bt_dynamic::{IncrementalTracer, UpdateStats, trace_scratch};
 use bt_paths::CandidateStats;
 use bt_paths::wvrn::WvrnStats;
-use bt_scene::dynamic::DynamicScene;
-use bt_solve::{OutcomeCounts, Solver};
+use bt_solve::{OutcomeCounts, Solver, UpdateStats};
 use serde::Serialize;
 use std::process::ExitCode;
 use std::time::Instant;
@@ -49,23 +47,6 @@ pub struct StepStats {
     pub time_s: f64,
 }
 
-/// Load a scene as a dynamic scene: JSON/TOML files and built-ins with their steps; meshes
-/// (and any other static source) as one step. Import warnings go to stderr.
-pub fn load_dynamic(args: &SceneArgs) -> anyhow::Result<DynamicScene> {
-    let options = load_options(args)?;
-    let (bar, mut progress) = crate::cloud::extraction_progress();
-    let loaded = bt_scene::load_dynamic(&args.scene, &options, &mut progress);
-    bar.finish_and_clear();
-    let (mut scene, warnings) = loaded?;
-    if let Some(f) = args.material.frequency {
-        scene = scene.with_frequency(f)?;
-    }
-    for w in &warnings {
-        eprintln!("warning: {w}");
-    }
-    Ok(scene)
-}
-
 pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
     let dynamic = load_dynamic(&args.scene)?;
     let scene0 = dynamic.step(0);
@@ -73,14 +54,14 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
     let solver = options.solver;
     let incremental = !args.from_scratch;
     let radio = args.radio.options()?;
-    let mut tracer = IncrementalTracer::new(options);
+    let mut tracer = bt_solve::Tracer::new(scene0.clone(), options);
     let mut steps = Vec::with_capacity(dynamic.len());
     for (k, scene) in dynamic.scenes().iter().enumerate() {
         let t0 = Instant::now();
         let result = if incremental {
-            tracer.step(scene)?
+            tracer.update(scene)?
         } else {
-            trace_scratch(scene, k, &options)?
+            tracer.update_from_scratch(scene)?
         };
         let time_s = t0.elapsed().as_secs_f64();
         let paths = bt_beams::report(scene, &result.trace.paths, &radio)?;
