@@ -2,8 +2,9 @@
 
 use crate::args::{SceneArgs, TraceArgs};
 use crate::load::load_scene;
-use crate::output::{self, TraceDocument};
+use crate::output;
 use anyhow::Context;
+use bt_beams::TraceDocument;
 use bt_scene::{Scene, SceneError};
 use std::process::ExitCode;
 use std::time::Instant;
@@ -22,7 +23,6 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
         eprintln!("warning: {w}");
     }
     let options = args.solve.settings().trace_options(&scene)?;
-    let solver = options.solver;
     let t1 = Instant::now();
     let (bar, mut progress) = crate::progress::tree_progress();
     let (tx, rx) = (scene.tx_world(), scene.rx_world());
@@ -31,20 +31,9 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
     bar.finish_and_clear();
     let traced = traced?;
     let scene = tracer.scene();
-    let t3 = Instant::now();
     let radio = args.radio.options()?;
-    let paths = bt_beams::report(scene, &traced.result.paths, &radio)?;
-    warn_near_field(&paths, scene);
-    let t4 = Instant::now();
-    let doc = TraceDocument::new(
-        scene,
-        &solver,
-        args.solve.max_order,
-        &radio,
-        paths,
-        (traced.candidates, traced.tree, traced.result.counts),
-        [t1 - t0, traced.time.candidates, traced.time.solve, t4 - t3],
-    );
+    let doc = TraceDocument::report(scene, &options, &traced, &radio, t1 - t0)?;
+    warn_near_field(&doc.paths, scene);
     let json = serde_json::to_string_pretty(&doc).context("serialising the trace")?;
     if let Some(path) = &args.out {
         let inputs = crate::inputs(&args.scene);

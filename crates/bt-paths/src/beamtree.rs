@@ -24,7 +24,7 @@ use crate::{CandidateSet, CandidateStats};
 use bt_geom::bvh::box_meets_halfspaces;
 use bt_geom::{Plane, Real, Vec3, convex};
 use bt_scene::{Scene, SurfaceId, SurfaceKind};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::cell::OnceCell;
 
 mod rebuild;
@@ -118,7 +118,7 @@ pub const PROGRESS_EVERY: usize = 256;
 pub type Progress<'p> = &'p mut dyn FnMut(BuildProgress);
 
 /// What the tree did, for `stats.tree` in the JSON output.
-#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct TreeStats {
     /// Materialised nodes per depth (index 0 = depth 1).
     pub nodes_per_depth: Vec<u64>,
@@ -292,9 +292,9 @@ impl Prepared<'_> {
 
 /// What the beam tree keeps between builds, only for speed, owned by the caller (the
 /// `bt_solve` tracer keeps one; a build given a fresh cache computes everything anew and gives
-/// bit-identical trees): the per-surface [`Shapes`] of the last geometry built, reused while
+/// bit-identical trees): the per-surface shapes (grown hulls, convexity) of the last geometry built, reused while
 /// [`bt_scene::GeometryKey`] says the next scene has the same surfaces (a stream of receivers,
-/// a sweep, a benchmark), and the [`Arenas`] of the last single-receiver walk
+/// a sweep, a benchmark), and the arenas (nodes, windows, beam planes) of the last single-receiver walk
 /// ([`candidates_in`]). Cloning gives an empty cache.
 #[derive(Default)]
 pub struct TreeCache {

@@ -28,7 +28,7 @@ pub mod validate;
 use bt_geom::{Real, Vec3};
 use bt_paths::CandidateSet;
 use bt_scene::{Scene, SurfaceId};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use batch::{Batch, Todo, found_path, solve_batch};
 pub use ipc::{Acceleration, DegenerateKind, IpcOptions, IpcOutcome, UpdateOrder};
@@ -38,7 +38,7 @@ pub use tracer::Tracer;
 pub use validate::Validity;
 
 /// Which solver computes the interaction points.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "solver", rename_all = "kebab-case")]
 pub enum Solver {
     /// The image method.
@@ -89,7 +89,7 @@ pub enum CandidateOutcome {
 }
 
 /// Counts of candidate outcomes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub struct OutcomeCounts {
     /// Valid paths.
     pub valid: u64,
