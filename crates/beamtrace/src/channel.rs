@@ -1,7 +1,8 @@
 //! `beamtrace channel` (CIR, CFR, power-delay profile) and `beamtrace beams` (codebook sweep).
 
 use crate::args::{BeamsArgs, ChannelArgs, PathArgs, RankingArg};
-use crate::trace::{load_scene, warn_near_field};
+use crate::load::load_scene;
+use crate::trace::warn_near_field;
 use anyhow::{Context, bail};
 use bt_beams::{BeamRanking, PathReport, RadioOptions};
 use bt_scene::Scene;
@@ -22,7 +23,8 @@ fn traced_paths(args: &PathArgs) -> anyhow::Result<(Scene, Vec<PathReport>, Radi
     let scene = loaded.scene;
     let trace_args = args.trace_args();
     let options = trace_args.solve.settings().trace_options(&scene)?;
-    let traced = bt_solve::pipeline::trace_scene(&scene, &options)?;
+    let (tx, rx) = (scene.tx_world(), scene.rx_world());
+    let traced = bt_solve::Tracer::new(scene.clone(), options).trace(tx, rx)?;
     let radio = args.radio.options()?;
     let paths = bt_beams::report(&scene, &traced.result.paths, &radio)?;
     warn_near_field(&paths, &scene);

@@ -4,27 +4,9 @@
 use crate::args::{ExtractArgs, SampleArgs};
 use anyhow::{Context, bail};
 use bt_pointcloud::io::ReadOptions;
-use bt_pointcloud::{ExtractParams, Extraction, PointCloud, Progress};
-use indicatif::ProgressBar;
+use bt_pointcloud::{ExtractParams, Extraction, PointCloud};
 use std::path::Path;
 use std::process::ExitCode;
-
-/// A progress bar for plane extraction on stderr, shown from the first report on, and the
-/// callback that feeds it.
-pub fn extraction_progress() -> (ProgressBar, impl FnMut(Progress)) {
-    let deferred = crate::progress::Deferred::new(
-        "{spinner} extracting planes {bar:30} {pos}/{len} points assigned, {msg} [{elapsed_precise}, ETA {eta}]",
-        std::time::Duration::ZERO,
-    );
-    let bar = deferred.bar();
-    let callback = move |p: Progress| {
-        let feed = deferred.show_after();
-        feed.set_length(p.points_total as u64);
-        feed.set_position(p.points_assigned as u64);
-        feed.set_message(format!("{} planes", p.ransac_planes));
-    };
-    (bar, callback)
-}
 
 /// Read a cloud and extract its planes, with a progress bar on stderr.
 fn extract_from(
@@ -37,7 +19,7 @@ fn extract_from(
         ..ReadOptions::default()
     };
     let loaded = bt_pointcloud::io::read_path(path, &read)?;
-    let (bar, mut progress) = extraction_progress();
+    let (bar, mut progress) = crate::progress::extraction_progress();
     let extraction =
         bt_pointcloud::extract_planes_with_progress(&loaded.cloud, params, &mut progress)
             .with_context(|| format!("extracting planes from {}", path.display()))?;
@@ -127,7 +109,7 @@ pub fn run_sample(args: &SampleArgs) -> anyhow::Result<ExitCode> {
     }
     bt_output::refuse_input(&args.output, &crate::inputs(&args.scene))?;
     bt_output::extension_in(&args.output, &["ply", "pcd"])?;
-    let loaded = crate::trace::load_scene(&args.scene)?;
+    let loaded = crate::load::load_scene(&args.scene)?;
     let polygons: Vec<Vec<glam::DVec3>> = loaded
         .scene
         .surfaces()

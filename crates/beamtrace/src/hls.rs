@@ -159,9 +159,9 @@ fn generate(args: &HlsGenArgs) -> anyhow::Result<ExitCode> {
         bail!("--max-order must be at least 1 (line of sight needs no accelerator)");
     }
     let scenes: Vec<Scene> = if args.steps {
-        crate::steps::load_dynamic(&args.scene)?.scenes().to_vec()
+        crate::load::load_dynamic(&args.scene)?.scenes().to_vec()
     } else {
-        vec![crate::trace::load_scene(&args.scene)?.scene]
+        vec![crate::load::load_scene(&args.scene)?.scene]
     };
     // The output directory is built aside and swapped in: a user's own files in it survive.
     let mut out = OutputDir::begin(&args.output, &crate::inputs(&args.scene))

@@ -6,6 +6,7 @@ mod channel;
 mod cloud;
 mod files;
 mod hls;
+mod load;
 mod output;
 mod progress;
 mod steps;

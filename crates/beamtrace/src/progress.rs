@@ -83,3 +83,20 @@ pub fn tree_progress() -> (ProgressBar, impl FnMut(bt_solve::pipeline::BuildProg
     };
     (bar, callback)
 }
+
+/// A progress bar for plane extraction on stderr, shown from the first report on, and the
+/// callback that feeds it.
+pub fn extraction_progress() -> (ProgressBar, impl FnMut(bt_pointcloud::Progress)) {
+    let deferred = Deferred::new(
+        "{spinner} extracting planes {bar:30} {pos}/{len} points assigned, {msg} [{elapsed_precise}, ETA {eta}]",
+        std::time::Duration::ZERO,
+    );
+    let bar = deferred.bar();
+    let callback = move |p: bt_pointcloud::Progress| {
+        let feed = deferred.show_after();
+        feed.set_length(p.points_total as u64);
+        feed.set_position(p.points_assigned as u64);
+        feed.set_message(format!("{} planes", p.ransac_planes));
+    };
+    (bar, callback)
+}

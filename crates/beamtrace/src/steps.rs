@@ -2,102 +2,29 @@
 //! default. Output: one JSON document `{ "steps": [ { "step", "paths", "stats" } ] }`, JSON
 //! lines (one step object per line) with `--jsonl`, or a per-step table.
 
-use crate::args::{SceneArgs, TraceArgs};
-use crate::output::FORMAT_VERSION;
-use crate::trace::load_options;
+use crate::args::TraceArgs;
+use crate::load::load_dynamic;
 use anyhow::Context;
-use bt_beams::PathReport;
-use bt_dynamic::{IncrementalTracer, UpdateStats, trace_scratch};
-use bt_paths::CandidateStats;
-use bt_paths::wvrn::WvrnStats;
-use bt_scene::dynamic::DynamicScene;
-use bt_solve::{OutcomeCounts, Solver};
-use serde::Serialize;
+use bt_beams::{StepDocument, StepsDocument};
 use std::process::ExitCode;
 use std::time::Instant;
-
-#[derive(Debug, Serialize)]
-pub struct StepsDocument {
-    pub format_version: u32,
-    pub scene: String,
-    pub frequency_hz: f64,
-    pub max_order: usize,
-    pub solver: Solver,
-    pub candidates: bt_solve::pipeline::CandidateMode,
-    pub incremental: bool,
-    pub steps: Vec<StepDocument>,
-}
-
-#[derive(Debug, Serialize)]
-pub struct StepDocument {
-    pub step: usize,
-    pub tx: [f64; 3],
-    pub rx: [f64; 3],
-    pub paths: Vec<PathReport>,
-    pub stats: StepStats,
-}
-
-#[derive(Debug, Serialize)]
-pub struct StepStats {
-    pub candidates: CandidateStats,
-    pub outcomes: OutcomeCounts,
-    pub valid_paths: usize,
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub wvrn: Option<WvrnStats>,
-    pub update: UpdateStats,
-    /// Wall-clock seconds of the step (WVRN, candidates, solving; the only varying field).
-    pub time_s: f64,
-}
-
-/// Load a scene as a dynamic scene: JSON/TOML files and built-ins with their steps; meshes
-/// (and any other static source) as one step. Import warnings go to stderr.
-pub fn load_dynamic(args: &SceneArgs) -> anyhow::Result<DynamicScene> {
-    let options = load_options(args)?;
-    let (bar, mut progress) = crate::cloud::extraction_progress();
-    let loaded = bt_scene::load_dynamic(&args.scene, &options, &mut progress);
-    bar.finish_and_clear();
-    let (mut scene, warnings) = loaded?;
-    if let Some(f) = args.material.frequency {
-        scene = scene.with_frequency(f)?;
-    }
-    for w in &warnings {
-        eprintln!("warning: {w}");
-    }
-    Ok(scene)
-}
 
 pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
     let dynamic = load_dynamic(&args.scene)?;
     let scene0 = dynamic.step(0);
     let options = args.solve.settings().trace_options(scene0)?;
-    let solver = options.solver;
     let incremental = !args.from_scratch;
     let radio = args.radio.options()?;
-    let mut tracer = IncrementalTracer::new(options);
+    let mut tracer = bt_solve::Tracer::new(scene0.clone(), options);
     let mut steps = Vec::with_capacity(dynamic.len());
-    for (k, scene) in dynamic.scenes().iter().enumerate() {
+    for scene in dynamic.scenes() {
         let t0 = Instant::now();
         let result = if incremental {
-            tracer.step(scene)?
+            tracer.update(scene)?
         } else {
-            trace_scratch(scene, k, &options)?
+            tracer.update_from_scratch(scene)?
         };
-        let time_s = t0.elapsed().as_secs_f64();
-        let paths = bt_beams::report(scene, &result.trace.paths, &radio)?;
-        let step = StepDocument {
-            step: k,
-            tx: scene.tx_world().to_array(),
-            rx: scene.rx_world().to_array(),
-            stats: StepStats {
-                candidates: result.candidates,
-                outcomes: result.trace.counts,
-                valid_paths: paths.len(),
-                wvrn: result.wvrn,
-                update: result.update,
-                time_s,
-            },
-            paths,
-        };
+        let step = StepDocument::report(scene, result, &radio, t0.elapsed())?;
         if args.jsonl {
             println!(
                 "{}",
@@ -106,16 +33,7 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
         }
         steps.push(step);
     }
-    let doc = StepsDocument {
-        format_version: FORMAT_VERSION,
-        scene: scene0.name().to_string(),
-        frequency_hz: scene0.frequency_hz(),
-        max_order: args.solve.max_order,
-        solver,
-        candidates: options.candidates,
-        incremental,
-        steps,
-    };
+    let doc = StepsDocument::new(scene0, &options, incremental, steps);
     if args.json || args.out.is_some() {
         let json = serde_json::to_string_pretty(&doc).context("serialising the steps")?;
         if let Some(path) = &args.out {

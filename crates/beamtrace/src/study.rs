@@ -76,7 +76,7 @@ pub fn run_living_room(args: &StudyLivingRoomArgs) -> anyhow::Result<ExitCode> {
     if !problems.is_empty() {
         anyhow::bail!("{}", problems.join("; "));
     }
-    let scene = crate::steps::load_dynamic(&SceneArgs::defaults_for(&args.steps_from))?;
+    let scene = crate::load::load_dynamic(&SceneArgs::defaults_for(&args.steps_from))?;
     if let Some(problem) =
         bt_solve::SbrOptions::grid(args.sbr_step_deg).over_budget(args.budgets.max_rays)
     {

@@ -2,7 +2,7 @@
 //! coverage.csv and the heat map into the output directory.
 
 use crate::args::SweepArgs;
-use crate::trace::load_scene;
+use crate::load::load_scene;
 use anyhow::{Context, bail};
 use indicatif::{ProgressBar, ProgressStyle};
 use std::process::ExitCode;

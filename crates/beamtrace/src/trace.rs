@@ -1,56 +1,13 @@
 //! `beamtrace trace`, `demo` and `scene check`.
 
 use crate::args::{SceneArgs, TraceArgs};
-use crate::output::{self, TraceDocument};
+use crate::load::load_scene;
+use crate::output;
 use anyhow::Context;
-use bt_scene::io::{LoadOptions, Loaded};
-use bt_scene::{Scene, SceneError, Terminals};
+use bt_beams::TraceDocument;
+use bt_scene::{Scene, SceneError};
 use std::process::ExitCode;
 use std::time::Instant;
-
-/// The load options the scene arguments select: `--material`/`--thickness` give every
-/// material of any source that radio model; `--frequency` is the carrier of sources that carry
-/// none (meshes, point clouds, XML scenes).
-pub fn load_options(args: &SceneArgs) -> anyhow::Result<LoadOptions> {
-    Ok(LoadOptions {
-        terminals: Terminals {
-            tx: args.tx,
-            rx: args.rx,
-        },
-        merge: bt_mesh::MergeOptions {
-            angle_tol_deg: args.merge_angle_deg,
-            dist_tol_m: args.merge_distance,
-            max_elements: args.max_mesh_elements,
-            ..bt_mesh::MergeOptions::default()
-        },
-        min_reflector_area_m2: args.min_reflector_area,
-        cloud: bt_pointcloud::io::ReadOptions {
-            max_points: args.max_cloud_points,
-            ..Default::default()
-        },
-        frequency_hz: args
-            .material
-            .frequency
-            .unwrap_or(bt_scene::DEFAULT_FREQUENCY_HZ),
-        radio: args.material.radio()?,
-        ..LoadOptions::default()
-    })
-}
-
-/// Load the scene named on the command line (a file or `builtin:NAME`), with a progress bar
-/// while a point cloud's planes are extracted, and `--frequency` applied to scene files and
-/// built-ins too.
-pub fn load_scene(args: &SceneArgs) -> anyhow::Result<Loaded> {
-    let options = load_options(args)?;
-    let (bar, mut progress) = crate::cloud::extraction_progress();
-    let loaded = bt_scene::load_with_progress(&args.scene, &options, &mut progress);
-    bar.finish_and_clear();
-    let mut loaded = loaded?;
-    if let Some(f) = args.material.frequency {
-        loaded.scene = loaded.scene.with_frequency(f)?;
-    }
-    Ok(loaded)
-}
 
 pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
     if args.steps {
@@ -66,26 +23,17 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
         eprintln!("warning: {w}");
     }
     let options = args.solve.settings().trace_options(&scene)?;
-    let solver = options.solver;
     let t1 = Instant::now();
     let (bar, mut progress) = crate::progress::tree_progress();
-    let traced = bt_solve::pipeline::trace_scene_with_progress(&scene, &options, &mut progress);
+    let (tx, rx) = (scene.tx_world(), scene.rx_world());
+    let mut tracer = bt_solve::Tracer::new(scene, options);
+    let traced = tracer.trace_with_progress(tx, rx, &mut progress);
     bar.finish_and_clear();
     let traced = traced?;
-    let t3 = Instant::now();
+    let scene = tracer.scene();
     let radio = args.radio.options()?;
-    let paths = bt_beams::report(&scene, &traced.result.paths, &radio)?;
-    warn_near_field(&paths, &scene);
-    let t4 = Instant::now();
-    let doc = TraceDocument::new(
-        &scene,
-        &solver,
-        args.solve.max_order,
-        &radio,
-        paths,
-        (traced.candidates, traced.tree, traced.result.counts),
-        [t1 - t0, traced.time.candidates, traced.time.solve, t4 - t3],
-    );
+    let doc = TraceDocument::report(scene, &options, &traced, &radio, t1 - t0)?;
+    warn_near_field(&doc.paths, scene);
     let json = serde_json::to_string_pretty(&doc).context("serialising the trace")?;
     if let Some(path) = &args.out {
         let inputs = crate::inputs(&args.scene);

@@ -2,7 +2,7 @@
 //! scene) and its paths, traced here or read from a `trace --json` document.
 
 use crate::args::ViewArgs;
-use crate::steps::load_dynamic;
+use crate::load::load_dynamic;
 use anyhow::Context;
 use bt_view::StepPaths;
 use std::process::ExitCode;
@@ -20,9 +20,11 @@ pub fn run(args: &ViewArgs) -> anyhow::Result<ExitCode> {
         }
         None => {
             let options = args.solve.settings().trace_options(scenes[0])?;
+            let mut tracer = bt_solve::Tracer::new(scenes[0].clone(), options);
             let mut steps = Vec::with_capacity(scenes.len());
             for scene in &scenes {
-                let traced = bt_solve::pipeline::trace_scene(scene, &options)?;
+                tracer.set_scene((*scene).clone());
+                let traced = tracer.trace(scene.tx_world(), scene.rx_world())?;
                 let reports = bt_beams::report(
                     scene,
                     &traced.result.paths,

@@ -2,7 +2,7 @@
 //! relationship network as a table, JSON or Graphviz DOT, with the candidate reduction it gives.
 
 use crate::args::WvrnArgs;
-use crate::steps::load_dynamic;
+use crate::load::load_dynamic;
 use anyhow::{Context, bail};
 use bt_paths::wvrn::{Link, Wvrn, WvrnStats};
 use bt_paths::{AllVisible, Node, enumerate};

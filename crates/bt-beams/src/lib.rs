@@ -8,15 +8,19 @@
 //! interaction point (or TX), i.e. where the wave comes from, as Sionna RT and MATLAB report it.
 #![warn(missing_docs)]
 
+pub mod document;
 pub mod sweep;
 
+pub use document::{
+    FORMAT_VERSION, Radio, StageTimes, Stats, StepDocument, StepStats, StepsDocument, TraceDocument,
+};
 pub use sweep::{BeamPair, BeamRanking, Sweep, sweep};
 
 use bt_channel::{Antenna, Bounce, Complex64, SurfaceResponse, Tap};
 use bt_geom::{Real, Vec3};
 use bt_scene::{Scene, SurfaceId};
 use bt_solve::FoundPath;
-use serde::{Deserialize, Serialize, Serializer};
+use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 /// Speed of light in vacuum, m/s.
 pub use bt_channel::{ChannelError, SPEED_OF_LIGHT};
@@ -69,8 +73,10 @@ impl Direction {
     }
 }
 
-/// Everything reported about one path.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+/// Everything reported about one path: the path record of every document ([`document`]).
+/// The fields marked `serde(skip)` serve the libraries and are not part of the document (read
+/// back, they are empty or zero).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct PathReport {
     /// 1-based rank by (order, length, largest incidence angle).
     pub rank: usize,
@@ -101,7 +107,10 @@ pub struct PathReport {
     pub loss_db: Real,
     /// Complex path gain [re, im] (antennas, polarisation, reflections, λ/(4π·length); no
     /// propagation phase).
-    #[serde(serialize_with = "complex_pair")]
+    #[serde(
+        serialize_with = "complex_pair",
+        deserialize_with = "complex_from_pair"
+    )]
     pub gain: Complex64,
     /// 20·log10|gain|, dB; `null` when the path carries no power.
     pub gain_db: Option<Real>,
@@ -126,6 +135,11 @@ pub struct PathReport {
 
 fn complex_pair<S: Serializer>(c: &Complex64, s: S) -> Result<S::Ok, S::Error> {
     [c.re, c.im].serialize(s)
+}
+
+fn complex_from_pair<'de, D: Deserializer<'de>>(d: D) -> Result<Complex64, D::Error> {
+    let [re, im] = <[Real; 2]>::deserialize(d)?;
+    Ok(Complex64::new(re, im))
 }
 
 /// Free-space path loss (Friis), dB, for `length` metres at `frequency_hz`. Friis holds in the

@@ -6,13 +6,15 @@ use bt_beams::{PathReport, RadioOptions, report};
 use bt_channel::{Antenna, Complex64, Orientation, Pattern, Polarization};
 use bt_scene::io::parse_json;
 use bt_scene::{Scene, Terminals};
-use bt_solve::pipeline::{TraceOptions, trace_scene};
+use bt_solve::Tracer;
+use bt_solve::pipeline::TraceOptions;
 use std::f64::consts::PI;
 
 const C: f64 = 299_792_458.0;
 
 fn trace(scene: &Scene, max_order: usize, radio: &RadioOptions) -> Vec<PathReport> {
-    let traced = trace_scene(scene, &TraceOptions::new(max_order)).unwrap();
+    let mut tracer = Tracer::new(scene.clone(), TraceOptions::new(max_order));
+    let traced = tracer.trace(scene.tx_world(), scene.rx_world()).unwrap();
     report(scene, &traced.result.paths, radio).unwrap()
 }
 

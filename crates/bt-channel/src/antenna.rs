@@ -5,12 +5,12 @@
 
 use crate::ChannelError;
 use bt_geom::{Real, Vec3};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::f64::consts::FRAC_PI_4;
 use std::str::FromStr;
 
 /// Power pattern of one element.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Pattern {
     /// G = 1 (0 dBi) in every direction.
@@ -21,7 +21,7 @@ pub enum Pattern {
 }
 
 /// Polarisation: the slant angle ζ of the field from θ̂ towards φ̂.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
 pub enum Polarization {
     /// Vertical, ζ = 0 (field along θ̂).
@@ -70,6 +70,25 @@ impl Serialize for Orientation {
     }
 }
 
+impl<'de> Deserialize<'de> for Orientation {
+    /// Reads what [`Orientation`]'s `Serialize` writes (degrees).
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        #[derive(Deserialize)]
+        #[serde(deny_unknown_fields)]
+        struct Degrees {
+            yaw_deg: Real,
+            pitch_deg: Real,
+            roll_deg: Real,
+        }
+        let a = Degrees::deserialize(d)?;
+        Ok(Orientation::from_degrees(
+            a.yaw_deg,
+            a.pitch_deg,
+            a.roll_deg,
+        ))
+    }
+}
+
 impl Orientation {
     /// From degrees.
     pub fn from_degrees(yaw: Real, pitch: Real, roll: Real) -> Orientation {
@@ -89,7 +108,7 @@ impl Orientation {
 }
 
 /// An antenna element.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Antenna {
     /// Power pattern.
     pub pattern: Pattern,

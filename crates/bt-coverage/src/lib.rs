@@ -2,8 +2,8 @@
 //! number of paths, the shortest delay, the strongest path (lowest loss) — as rows for a CSV
 //! file and a heat map over the floor plan.
 //!
-//! Tracing goes through `bt_solve::pipeline::trace_each_receiver` (the one many-receiver
-//! entry), in chunks so a caller can show progress. A grid point on a surface or at the TX is
+//! Tracing goes through one [`bt_solve::Tracer`] (`trace_each`: one beam tree of the TX, kept
+//! for every chunk), in chunks so a caller can show progress. A grid point on a surface or at the TX is
 //! a [`PointStatus::Skipped`] row, not a failure of the sweep; a candidate budget error is.
 
 #![warn(missing_docs)]
@@ -17,7 +17,8 @@ pub use map::{HeatMap, MapQuantity};
 use bt_beams::PathReport;
 use bt_geom::{Real, Vec3};
 use bt_scene::Scene;
-use bt_solve::pipeline::{TraceError, TraceOptions, trace_each_receiver};
+use bt_solve::Tracer;
+use bt_solve::pipeline::{TraceError, TraceOptions};
 
 /// Why a sweep could not run.
 #[derive(Debug, thiserror::Error)]
@@ -92,8 +93,10 @@ pub fn sweep(
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<Vec<Row>, CoverageError> {
     let mut rows = Vec::with_capacity(points.len());
+    let mut tracer = Tracer::new(scene.clone(), *options);
     for chunk in points.chunks(CHUNK) {
-        for (rx, outcome) in chunk.iter().zip(trace_each_receiver(scene, chunk, options)) {
+        let traced = tracer.trace_each(scene.tx_world(), chunk)?;
+        for (rx, outcome) in chunk.iter().zip(traced) {
             let status = match outcome {
                 Ok(traced) => {
                     let moved = scene.with_receiver(*rx).map_err(TraceError::from)?;

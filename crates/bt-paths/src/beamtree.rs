@@ -24,7 +24,7 @@ use crate::{CandidateSet, CandidateStats};
 use bt_geom::bvh::box_meets_halfspaces;
 use bt_geom::{Plane, Real, Vec3, convex};
 use bt_scene::{Scene, SurfaceId, SurfaceKind};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::cell::OnceCell;
 
 mod rebuild;
@@ -118,7 +118,7 @@ pub const PROGRESS_EVERY: usize = 256;
 pub type Progress<'p> = &'p mut dyn FnMut(BuildProgress);
 
 /// What the tree did, for `stats.tree` in the JSON output.
-#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize)]
+#[derive(Debug, Clone, Default, PartialEq, Eq, Serialize, Deserialize)]
 pub struct TreeStats {
     /// Materialised nodes per depth (index 0 = depth 1).
     pub nodes_per_depth: Vec<u64>,
@@ -211,7 +211,7 @@ struct Prepared<'a> {
     tol: Real,
     /// Each surface's plane, contiguous (the leaf test reads one per child).
     planes: Vec<Plane>,
-    /// Hulls and convexity, kept for the thread's next build of the same geometry.
+    /// Hulls and convexity, from and back to the caller's [`TreeCache`].
     shapes: Shapes,
     reflectors: Vec<u32>,
     /// Whether each surface reflects (children are reflectors only).
@@ -234,7 +234,9 @@ struct RxVisible {
 }
 
 impl<'a> Prepared<'a> {
-    fn new(scene: &'a Scene, options: TreeOptions) -> Self {
+    /// The data of one build, taking the shapes out of `cache` when they are `scene`'s (hand
+    /// them back with [`Prepared::keep_in`]).
+    fn new(scene: &'a Scene, options: TreeOptions, cache: &mut TreeCache) -> Self {
         let surfaces = scene.surfaces();
         let reflectors: Vec<u32> = scene.reflectors().map(|id| id.0).collect();
         let cull_at_build = match options.culling {
@@ -245,7 +247,7 @@ impl<'a> Prepared<'a> {
         let tol = scene.length_tolerance();
         Prepared {
             planes: surfaces.iter().map(|s| *s.polygon.plane()).collect(),
-            shapes: Shapes::take(scene, GROW * tol),
+            shapes: Shapes::take(&mut cache.shapes, scene, GROW * tol),
             is_reflector: surfaces
                 .iter()
                 .map(|s| s.kind == SurfaceKind::Reflector)
@@ -281,17 +283,45 @@ impl<'a> Prepared<'a> {
     }
 }
 
-impl Drop for Prepared<'_> {
-    fn drop(&mut self) {
-        std::mem::take(&mut self.shapes).give_back();
+impl Prepared<'_> {
+    /// Hand the shapes back to `cache` for its next build of the same geometry.
+    fn keep_in(self, cache: &mut TreeCache) {
+        cache.shapes = self.shapes;
+    }
+}
+
+/// What the beam tree keeps between builds, only for speed, owned by the caller (the
+/// `bt_solve` tracer keeps one; a build given a fresh cache computes everything anew and gives
+/// bit-identical trees): the per-surface shapes (grown hulls, convexity) of the last geometry built, reused while
+/// [`bt_scene::GeometryKey`] says the next scene has the same surfaces (a stream of receivers,
+/// a sweep, a benchmark), and the arenas (nodes, windows, beam planes) of the last single-receiver walk
+/// ([`candidates_in`]). Cloning gives an empty cache.
+#[derive(Default)]
+pub struct TreeCache {
+    shapes: Shapes,
+    arenas: Option<Arenas>,
+}
+
+impl Clone for TreeCache {
+    fn clone(&self) -> Self {
+        TreeCache::default()
+    }
+}
+
+impl std::fmt::Debug for TreeCache {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("TreeCache")
+            .field("shapes", &self.shapes.hulls.len())
+            .field("arenas", &self.arenas.is_some())
+            .finish()
     }
 }
 
 /// Per-surface shapes derived from the geometry alone: each reflector's convex hull grown by
-/// `margin` (m) and each surface's convexity, computed on first use. A thread keeps the last
-/// build's for its next one of the same geometry ([`bt_scene::GeometryKey`]: a stream of
-/// receivers, a sweep, a benchmark), so that hulls are not rebuilt every trace. Unlike the
-/// [`Arenas`], they are kept whatever their size: they grow with the scene, not with a tree.
+/// `margin` (m) and each surface's convexity, computed on first use. A [`TreeCache`] keeps the
+/// last build's for its next one of the same geometry, so that hulls are not rebuilt every
+/// trace. Unlike the [`Arenas`], they are kept whatever their size: they grow with the scene,
+/// not with a tree.
 #[derive(Default)]
 struct Shapes {
     geometry: Option<bt_scene::GeometryKey>,
@@ -300,14 +330,11 @@ struct Shapes {
     convex: Vec<OnceCell<bool>>,
 }
 
-thread_local! {
-    static SHAPES: std::cell::Cell<Shapes> = std::cell::Cell::new(Shapes::default());
-}
-
 impl Shapes {
-    /// The thread's kept shapes when they are `scene`'s with the same `margin`, else fresh ones.
-    fn take(scene: &Scene, margin: Real) -> Shapes {
-        let kept = SHAPES.take();
+    /// The `kept` shapes (taken out) when they are `scene`'s with the same `margin`, else
+    /// fresh ones.
+    fn take(kept: &mut Shapes, scene: &Scene, margin: Real) -> Shapes {
+        let kept = std::mem::take(kept);
         let n = scene.surfaces().len();
         if kept.margin == margin
             && kept.hulls.len() == n
@@ -321,11 +348,6 @@ impl Shapes {
             hulls: (0..n).map(|_| OnceCell::new()).collect(),
             convex: (0..n).map(|_| OnceCell::new()).collect(),
         }
-    }
-
-    /// Keep these shapes for the thread's next build.
-    fn give_back(self) {
-        SHAPES.set(self);
     }
 }
 
@@ -361,8 +383,8 @@ struct Scratch {
     hits: Vec<(Real, u32)>,
 }
 
-/// The arenas of a tree (nodes, window vertices, beam planes), kept per thread between
-/// single-receiver traces ([`candidates`]): a stream of traces (receivers, time steps,
+/// The arenas of a tree (nodes, window vertices, beam planes), kept in a [`TreeCache`] between
+/// single-receiver traces ([`candidates_in`]): a stream of traces (receivers, time steps,
 /// benchmarks) reuses them instead of allocating them afresh, which with glibc can mean a
 /// page fault per touched page of every call. Only arenas of at most [`POOLED_BYTES`] are
 /// kept, so a city-sized tree's memory is returned.
@@ -377,30 +399,26 @@ struct Arenas {
 /// then grows once or not at all instead of doubling from one.
 const RESERVED_CANDIDATES: usize = 256;
 
-/// The largest arenas a thread keeps between traces, bytes.
+/// The largest arenas a [`TreeCache`] keeps between traces, bytes.
 const POOLED_BYTES: usize = 4 << 20;
 
-thread_local! {
-    static POOL: std::cell::Cell<Option<Arenas>> = const { std::cell::Cell::new(None) };
-}
-
 impl Arenas {
-    /// This thread's kept arenas (empty), or new ones.
-    fn take() -> Arenas {
-        let mut a = POOL.take().unwrap_or_default();
+    /// The cache's kept arenas (empty), or new ones.
+    fn take(cache: &mut TreeCache) -> Arenas {
+        let mut a = cache.arenas.take().unwrap_or_default();
         a.nodes.clear();
         a.verts.clear();
         a.planes.clear();
         a
     }
 
-    /// Keep `self` for this thread's next trace, unless too large.
-    fn give_back(self) {
+    /// Keep `self` in `cache` for its next trace, unless too large.
+    fn give_back(self, cache: &mut TreeCache) {
         let bytes = self.nodes.capacity() * size_of::<Node>()
             + self.verts.capacity() * size_of::<Vec3>()
             + self.planes.capacity() * size_of::<Plane>();
         if bytes <= POOLED_BYTES {
-            POOL.set(Some(self));
+            cache.arenas = Some(self);
         }
     }
 }
@@ -443,12 +461,23 @@ impl BeamTree {
         options: TreeOptions,
         progress: Progress<'_>,
     ) -> Result<Self, TreeError> {
-        let prep = Prepared::new(scene, options);
+        Self::build_in(scene, options, &mut TreeCache::default(), progress)
+    }
+
+    /// [`BeamTree::build_with_progress`], reusing and refilling `cache`.
+    pub fn build_in(
+        scene: &Scene,
+        options: TreeOptions,
+        cache: &mut TreeCache,
+        progress: Progress<'_>,
+    ) -> Result<Self, TreeError> {
+        let prep = Prepared::new(scene, options, cache);
         let mut tree = BeamTree::empty(&prep);
         let mut scratch = Scratch::default();
         for depth in 1..=options.max_order {
             tree.grow_level(&prep, depth, &mut scratch, None, progress)?;
         }
+        prep.keep_in(cache);
         Ok(tree)
     }
 
@@ -1251,9 +1280,20 @@ pub fn candidates_with_progress(
     options: TreeOptions,
     progress: Progress<'_>,
 ) -> Result<CandidateSet, TreeError> {
-    let mut prep = Prepared::new(scene, options);
+    candidates_in(scene, options, &mut TreeCache::default(), progress)
+}
+
+/// [`candidates_with_progress`], reusing and refilling `cache` (the same set as with a fresh
+/// cache; a stream of traces of one geometry skips the hulls and the arenas' allocation).
+pub fn candidates_in(
+    scene: &Scene,
+    options: TreeOptions,
+    cache: &mut TreeCache,
+    progress: Progress<'_>,
+) -> Result<CandidateSet, TreeError> {
+    let mut prep = Prepared::new(scene, options, cache);
     let mut tree = BeamTree::empty(&prep);
-    let arenas = Arenas::take();
+    let arenas = Arenas::take(cache);
     (tree.nodes, tree.verts, tree.planes) = (arenas.nodes, arenas.verts, arenas.planes);
     let mut scratch = Scratch::default();
     let rx = scene.rx();
@@ -1283,6 +1323,7 @@ pub fn candidates_with_progress(
         verts: tree.verts,
         planes: tree.planes,
     }
-    .give_back();
+    .give_back(cache);
+    prep.keep_in(cache);
     Ok(set)
 }

@@ -16,7 +16,7 @@ pub mod wvrn;
 
 use bt_geom::{Plane, Polygon, Real, Side};
 use bt_scene::{Scene, SurfaceId};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// A node of the path graph: a terminal or a reflecting surface.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize)]
@@ -47,7 +47,7 @@ impl Visibility for AllVisible {
 }
 
 /// How many candidates each stage produced.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub struct CandidateStats {
     /// All sequences up to the maximum order with no surface twice in a row, plus LOS.
     pub generated: u64,

@@ -30,7 +30,7 @@ use crate::{Node, Visibility};
 use bt_geom::convex::is_strictly_convex;
 use bt_geom::{Polygon, Real, Vec3};
 use bt_scene::{Scene, SurfaceId, SurfaceKind};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// The state of a pair of nodes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
@@ -56,7 +56,7 @@ impl Link {
 }
 
 /// Counts over the unordered pairs of distinct nodes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub struct WvrnStats {
     /// Nodes: TX, RX and the reflectors.
     pub nodes: usize,

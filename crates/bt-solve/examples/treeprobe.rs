@@ -13,7 +13,8 @@
 
 use bt_paths::beamtree::{BeamTree, TreeOptions, candidates};
 use bt_scene::{Scene, Terminals, Vec3};
-use bt_solve::pipeline::{CandidateMode, TraceOptions, trace_scene};
+use bt_solve::Tracer;
+use bt_solve::pipeline::{CandidateMode, TraceOptions, Traced};
 use bt_solve::{IpcOptions, Solver, UpdateOrder};
 
 fn trace_options(solver: Solver, candidates: CandidateMode) -> TraceOptions {
@@ -26,8 +27,14 @@ fn trace_options(solver: Solver, candidates: CandidateMode) -> TraceOptions {
     }
 }
 
+/// `scene` traced between its own terminals by a tracer of its own.
+fn trace_scene(scene: &Scene, options: &TraceOptions) -> Traced {
+    let mut tracer = Tracer::new(scene.clone(), *options);
+    tracer.trace(scene.tx_world(), scene.rx_world()).unwrap()
+}
+
 fn traced_paths(scene: &Scene, options: &TraceOptions) -> usize {
-    trace_scene(scene, options).unwrap().result.paths.len()
+    trace_scene(scene, options).result.paths.len()
 }
 
 /// The RX of call `i` (scene-local frame): a few millimetres apart, so that no call repeats
@@ -47,8 +54,7 @@ fn run(what: &str, scene: &Scene, i: usize, tree: &BeamTree) -> usize {
             let traced = trace_scene(
                 scene,
                 &trace_options(Solver::Image, CandidateMode::BeamTree),
-            )
-            .unwrap();
+            );
             bt_beams::report(
                 scene,
                 &traced.result.paths,

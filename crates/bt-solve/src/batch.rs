@@ -1,5 +1,5 @@
 //! The one batch-solve loop: every consumer that solves many candidates (the static
-//! [`crate::trace`], the incremental tracer of `bt-dynamic`) goes through [`solve_batch`], which
+//! [`crate::trace`], the incremental steps of [`crate::Tracer`]) goes through [`solve_batch`], which
 //! owns the chunking and parallelism, the FMA dispatch, the start points (a caller's warm start,
 //! else the candidate set's window start, else the centroids) and the per-candidate buffers.
 //! [`found_path`] turns a valid outcome into a [`FoundPath`].
@@ -23,7 +23,7 @@ const STACK_ORDER: usize = 8;
 
 /// Which candidates of a set a batch solves.
 #[derive(Debug, Clone, Copy)]
-pub enum Todo<'t> {
+pub(crate) enum Todo<'t> {
     /// Every candidate, in set order.
     All,
     /// These indices into the set, in this order.
@@ -49,22 +49,27 @@ impl Todo<'_> {
 /// What a batch solves: the scene, its candidates and the solver; `parallel` spreads chunks
 /// over rayon's pool (the output is identical either way).
 #[derive(Clone, Copy)]
-pub struct Batch<'a> {
+pub(crate) struct Batch<'a> {
     /// The scene (TX, RX, surfaces).
-    pub scene: &'a Scene,
+    pub(crate) scene: &'a Scene,
     /// The candidate sequences (and their window start points, if any).
-    pub candidates: &'a CandidateSet,
+    pub(crate) candidates: &'a CandidateSet,
     /// The solver.
-    pub solver: &'a Solver,
+    pub(crate) solver: &'a Solver,
     /// Whether to use rayon's pool for large batches.
-    pub parallel: bool,
+    pub(crate) parallel: bool,
 }
 
 /// Solve the candidates of `todo`. IPC starts from `warm(i)` when it gives points for candidate
 /// `i`, else from the set's start points, else from the centroids. `each(acc, i, seq,
 /// outcome, points)` folds every candidate's result, in `todo` order within a chunk, into its chunk's
 /// accumulator (`R::default()` to begin); the accumulators come back in chunk order.
-pub fn solve_batch<'w, R, W, F>(batch: &Batch<'_>, todo: Todo<'_>, warm: W, each: F) -> Vec<R>
+pub(crate) fn solve_batch<'w, R, W, F>(
+    batch: &Batch<'_>,
+    todo: Todo<'_>,
+    warm: W,
+    each: F,
+) -> Vec<R>
 where
     R: Default + Send,
     W: Fn(usize) -> Option<&'w [Vec3]> + Sync,
@@ -259,7 +264,7 @@ const PARALLEL_COS: Real = 0.999;
 
 /// The path of a valid outcome (`None` for any other outcome): `seq` and its solved `points`,
 /// with IPC's rounds and residual when IPC converged.
-pub fn found_path(
+pub(crate) fn found_path(
     seq: &[SurfaceId],
     outcome: &CandidateOutcome,
     points: &[Vec3],
@@ -285,3 +290,6 @@ pub fn found_path(
         residual,
     })
 }
+
+#[cfg(test)]
+mod tests;

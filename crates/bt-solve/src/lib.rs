@@ -7,11 +7,13 @@
 //! - [`sbr`]: shooting and bouncing rays, the baseline (whole-scene, not per candidate);
 //! - [`settings`]: a trace's settings by name (the CLI's flags, Python's keywords) → options.
 //!
-//! [`trace`] runs a solver over a [`CandidateSet`] and returns the valid paths plus a count
-//! of every outcome; one bad candidate never aborts the batch.
+//! [`Tracer`] is the front door every consumer traces through: it holds a scene, the options,
+//! the kept beam tree, the previous time step ([`steps`]) and the caches. [`trace`] runs a
+//! solver over a [`CandidateSet`] and returns the valid paths plus a count of every outcome;
+//! one bad candidate never aborts the batch.
 #![warn(missing_docs)]
 
-pub mod batch;
+mod batch;
 pub mod image;
 pub mod ipc;
 mod lanes;
@@ -19,20 +21,24 @@ mod newton;
 pub mod pipeline;
 pub mod sbr;
 pub mod settings;
+pub mod steps;
+mod tracer;
 pub mod validate;
 
 use bt_geom::{Real, Vec3};
 use bt_paths::CandidateSet;
 use bt_scene::{Scene, SurfaceId};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
-pub use batch::{Batch, Todo, found_path, solve_batch};
+use batch::{Batch, Todo, found_path, solve_batch};
 pub use ipc::{Acceleration, DegenerateKind, IpcOptions, IpcOutcome, UpdateOrder};
 pub use sbr::{SbrLaunch, SbrOptions};
+pub use steps::{StepTrace, UpdateStats, max_point_distance};
+pub use tracer::Tracer;
 pub use validate::Validity;
 
 /// Which solver computes the interaction points.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(tag = "solver", rename_all = "kebab-case")]
 pub enum Solver {
     /// The image method.
@@ -83,7 +89,7 @@ pub enum CandidateOutcome {
 }
 
 /// Counts of candidate outcomes.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 pub struct OutcomeCounts {
     /// Valid paths.
     pub valid: u64,

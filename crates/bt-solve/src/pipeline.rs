@@ -1,21 +1,22 @@
-//! The one entry every consumer calls to trace a scene: candidates → solver → valid paths.
+//! The pipeline under the [`crate::Tracer`]: candidates → solver → valid paths, and the types
+//! every trace shares ([`TraceOptions`], [`Traced`], [`TraceError`]).
 //!
-//! `trace` (CLI), the coverage sweep, the Python package, the studies and the accelerator's
-//! host all go through [`trace_scene`] (one TX, one RX) or [`trace_receivers`] (one TX, many
-//! RX), so the candidate generator, its budget and the solver dispatch live in one place.
+//! Front ends trace through the `Tracer`; the candidate generator, its budget and the solver
+//! dispatch live here, in one place. [`candidates`] stays public for the accelerator's host and
+//! the studies, which solve the candidate set their own way.
 
 use crate::{Solver, TraceResult};
 use bt_geom::Vec3;
-use bt_paths::beamtree::{BeamTree, TreeOptions, TreeStats};
+use bt_paths::beamtree::{BeamTree, TreeCache, TreeOptions, TreeStats};
 pub use bt_paths::beamtree::{BuildProgress, Progress};
 use bt_paths::{AllVisible, CandidateSet, CandidateStats};
 use bt_scene::{Scene, SceneError};
 use rayon::prelude::*;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::time::{Duration, Instant};
 
 /// How candidate surface sequences are generated.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum CandidateMode {
     /// Visibility-driven generation (the default): only sequences geometry allows.
@@ -118,22 +119,22 @@ pub fn candidates_with_progress(
     options: &TraceOptions,
     progress: Progress<'_>,
 ) -> Result<CandidateSet, TraceError> {
-    generate(scene, options, tree_options(options), progress)
+    let tree = tree_options(options);
+    generate(scene, options, tree, &mut TreeCache::default(), progress)
 }
 
-/// The candidates of `options.candidates`, the beam tree built with `tree`.
+/// The candidates of `options.candidates`, the beam tree built with `tree` and `cache`.
 fn generate(
     scene: &Scene,
     options: &TraceOptions,
     tree: TreeOptions,
+    cache: &mut TreeCache,
     progress: Progress<'_>,
 ) -> Result<CandidateSet, TraceError> {
     check_budget(scene, options)?;
     Ok(match options.candidates {
         CandidateMode::Exhaustive => bt_paths::enumerate(scene, options.max_order, &AllVisible),
-        CandidateMode::BeamTree => {
-            bt_paths::beamtree::candidates_with_progress(scene, tree, progress)?
-        }
+        CandidateMode::BeamTree => bt_paths::beamtree::candidates_in(scene, tree, cache, progress)?,
         CandidateMode::Wvrn => {
             let wvrn = bt_paths::wvrn::Wvrn::build(scene);
             bt_paths::enumerate(scene, options.max_order, &wvrn)
@@ -142,7 +143,7 @@ fn generate(
 }
 
 /// The beam-tree options of a trace: its order, and its candidate budget as the node budget.
-pub fn tree_options(options: &TraceOptions) -> TreeOptions {
+pub(crate) fn tree_options(options: &TraceOptions) -> TreeOptions {
     TreeOptions {
         max_nodes: options.max_candidates,
         ..TreeOptions::new(options.max_order)
@@ -151,7 +152,7 @@ pub fn tree_options(options: &TraceOptions) -> TreeOptions {
 
 /// [`tree_options`] for a trace that solves the candidates itself: start points only for the
 /// solver that reads them (IPC).
-fn solver_tree_options(options: &TraceOptions) -> TreeOptions {
+pub(crate) fn solver_tree_options(options: &TraceOptions) -> TreeOptions {
     TreeOptions {
         starts: matches!(options.solver, Solver::Ipc(_)),
         ..tree_options(options)
@@ -161,7 +162,7 @@ fn solver_tree_options(options: &TraceOptions) -> TreeOptions {
 /// Check the budget before enumerating: the exhaustive and WVRN generators are refused when
 /// the sequence count [`exhaustive_count`] exceeds it (the beam tree counts its nodes as it
 /// builds them instead).
-pub fn check_budget(scene: &Scene, options: &TraceOptions) -> Result<(), TraceError> {
+pub(crate) fn check_budget(scene: &Scene, options: &TraceOptions) -> Result<(), TraceError> {
     if options.candidates == CandidateMode::BeamTree {
         return Ok(());
     }
@@ -196,25 +197,28 @@ pub fn exhaustive_count(n: u64, max_order: usize) -> u64 {
     total
 }
 
-/// Trace `scene` from its TX to its RX.
-pub fn trace_scene(scene: &Scene, options: &TraceOptions) -> Result<Traced, TraceError> {
-    trace_scene_with_progress(scene, options, &mut |_| {})
-}
-
-/// [`trace_scene`], reporting the candidate generation to `progress`.
-pub fn trace_scene_with_progress(
+/// Trace `scene` from its TX to its RX, the beam tree built with `cache`, reporting the
+/// candidate generation to `progress`.
+pub(crate) fn trace_scene_in(
     scene: &Scene,
     options: &TraceOptions,
+    cache: &mut TreeCache,
     progress: Progress<'_>,
 ) -> Result<Traced, TraceError> {
     let t0 = Instant::now();
-    let set = generate(scene, options, solver_tree_options(options), progress)?;
+    let set = generate(
+        scene,
+        options,
+        solver_tree_options(options),
+        cache,
+        progress,
+    )?;
     let t1 = Instant::now();
     Ok(solve_set(scene, set, options, t1 - t0))
 }
 
-/// Solve a generated candidate set (the second half of [`trace_scene`]).
-fn solve_set(
+/// Solve a generated candidate set (the second half of [`trace_scene_in`]).
+pub(crate) fn solve_set(
     scene: &Scene,
     set: CandidateSet,
     options: &TraceOptions,
@@ -234,53 +238,39 @@ fn solve_set(
     }
 }
 
-/// Trace `scene`'s TX to each of `receivers` (metres, world frame: converted into the scene's
-/// local frame here; the paths found are local, see [`Scene::to_world`]). Receivers
-/// run in parallel when `options.parallel`; each one's own trace is then single-threaded.
-/// A receiver on a surface or at the TX fails the whole call with that receiver's error
-/// (see [`trace_each_receiver`] for one result per receiver).
-pub fn trace_receivers(
-    scene: &Scene,
+/// Trace `base`'s TX to each of `receivers` (metres, world frame: converted into the scene's
+/// local frame here; the paths found are local, see [`Scene::to_world`]), one outcome per
+/// receiver: a receiver on a surface or at the TX gets its own [`TraceError::Scene`] and the
+/// others are still traced. Receivers run in parallel when `options.parallel`; each one's own
+/// trace is then single-threaded. `tree` is the beam tree of `base`'s TX when the caller has
+/// one (a fixed TX: every receiver is a walk); `cache` serves a single receiver's trace.
+pub(crate) fn trace_each_receiver(
+    base: &Scene,
     receivers: &[Vec3],
     options: &TraceOptions,
-) -> Result<Vec<Traced>, TraceError> {
-    trace_each_receiver(scene, receivers, options)
-        .into_iter()
-        .collect()
-}
-
-/// Like [`trace_receivers`], but one outcome per receiver: a receiver on a surface or at the
-/// TX gets its own [`TraceError::Scene`] and the others are still traced (coverage sweeps
-/// mark such grid points instead of failing). A budget error repeats for every receiver.
-pub fn trace_each_receiver(
-    scene: &Scene,
-    receivers: &[Vec3],
-    options: &TraceOptions,
+    tree: Option<&BeamTree>,
+    cache: &mut TreeCache,
 ) -> Vec<Result<Traced, TraceError>> {
     let inner = TraceOptions {
         parallel: false,
         ..*options
     };
-    // Fixed TX: one beam tree answers every receiver by a walk.
-    let tree = match options.candidates {
-        CandidateMode::BeamTree if receivers.len() > 1 => {
-            match BeamTree::build(scene, solver_tree_options(options)) {
-                Ok(tree) => Some(tree),
-                Err(e) => return receivers.iter().map(|_| Err(e.clone().into())).collect(),
-            }
-        }
-        _ => None,
-    };
+    if let ([rx], None) = (receivers, tree) {
+        let one = base.with_receiver(*rx).map_err(TraceError::from);
+        return vec![one.and_then(|moved| trace_scene_in(&moved, &inner, cache, &mut |_| {}))];
+    }
     let one = |rx: &Vec3| -> Result<Traced, TraceError> {
-        let moved = scene.with_receiver(*rx)?;
-        match &tree {
+        let moved = base.with_receiver(*rx)?;
+        match tree {
             // The tree's margins hold for receivers whose scene tolerance is no larger.
             Some(tree) if moved.length_tolerance() <= tree.tolerance() => {
                 let t0 = Instant::now();
                 let set = tree.candidates(moved.rx());
                 Ok(solve_set(&moved, set, &inner, t0.elapsed()))
             }
-            _ => trace_scene(&moved, &inner),
+            // Receivers traced in parallel cannot share one cache (`tree` is built in beam-tree
+            // mode, so this is a receiver that grows the scene, or another mode: no tree).
+            _ => trace_scene_in(&moved, &inner, &mut TreeCache::default(), &mut |_| {}),
         }
     };
     if options.parallel {
@@ -288,6 +278,12 @@ pub fn trace_each_receiver(
     } else {
         receivers.iter().map(one).collect()
     }
+}
+
+/// Whether a many-receiver trace of `receivers` under `options` walks one beam tree of the TX
+/// (beam-tree mode, more than one receiver) instead of tracing each receiver alone.
+pub(crate) fn walks_one_tree(options: &TraceOptions, receivers: &[Vec3]) -> bool {
+    options.candidates == CandidateMode::BeamTree && receivers.len() > 1
 }
 
 #[cfg(test)]

@@ -37,6 +37,17 @@ pub fn box_room(size: impl Into<Vec3>, tx: impl Into<Vec3>, rx: impl Into<Vec3>)
     ))
 }
 
+/// The issue's floor/wall case: a 4 m × 4 m floor at z = 0 and a 3.5 m × 2 m wall in the plane
+/// x = 0, whose shared line holds the floor's centroid (IPC from the centroids degenerates on
+/// wall -> floor; the image method finds it, 3.960 m).
+pub fn wall_floor_scene() -> Scene {
+    scene_from_json(
+        r#"{ "tx": [-0.3, -1.4, 2.3], "rx": [-0.9, 0.6, 0.9], "surfaces": [
+            { "name": "floor", "vertices": [[-2,-2,0],[2,-2,0],[2,2,0],[-2,2,0]] },
+            { "name": "wall", "vertices": [[0,-1.75,0.9],[0,1.75,0.9],[0,1.75,2.9],[0,-1.75,2.9]] } ] }"#,
+    )
+}
+
 /// A random furnished room: a box room with `n` random rectangles inside (random size,
 /// orientation and position, some reflectors, some blockers) and random TX/RX.
 pub fn random_scene(seed: u64, n: usize) -> Scene {

@@ -8,7 +8,7 @@
 
 #![warn(missing_docs)]
 
-use bt_beams::{Direction, PathReport};
+use bt_beams::{PathReport, StepsDocument, TraceDocument};
 use bt_geom::Real;
 use bt_scene::{Scene, SurfaceKind};
 use serde::{Deserialize, Serialize};
@@ -43,42 +43,6 @@ pub enum ViewError {
     },
 }
 
-/// One path as the viewer shows it (the fields of a trace document's path).
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub struct ViewPath {
-    /// Reflections (0 = line of sight).
-    pub order: usize,
-    /// Reflecting surfaces, TX side first.
-    pub surfaces: Vec<String>,
-    /// Interaction points, metres, TX side first.
-    pub points: Vec<[Real; 3]>,
-    /// Unfolded length, metres.
-    pub length_m: Real,
-    /// Delay, seconds.
-    pub delay_s: Real,
-    /// Departure direction (azimuth, elevation), degrees.
-    pub aod_deg: Direction,
-    /// Arrival direction (azimuth, elevation), degrees.
-    pub aoa_deg: Direction,
-    /// Total loss, dB.
-    pub loss_db: Real,
-}
-
-impl From<&PathReport> for ViewPath {
-    fn from(p: &PathReport) -> Self {
-        ViewPath {
-            order: p.order,
-            surfaces: p.surfaces.clone(),
-            points: p.points.clone(),
-            length_m: p.length_m,
-            delay_s: p.delay_s,
-            aod_deg: p.aod_deg,
-            aoa_deg: p.aoa_deg,
-            loss_db: p.loss_db,
-        }
-    }
-}
-
 /// The paths of one time step with the terminals they were traced for.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct StepPaths {
@@ -86,8 +50,8 @@ pub struct StepPaths {
     pub tx: [Real; 3],
     /// Receiver, metres.
     pub rx: [Real; 3],
-    /// The paths.
-    pub paths: Vec<ViewPath>,
+    /// The paths (the trace documents' record).
+    pub paths: Vec<PathReport>,
 }
 
 impl StepPaths {
@@ -96,16 +60,17 @@ impl StepPaths {
         StepPaths {
             tx: scene.tx_world().to_array(),
             rx: scene.rx_world().to_array(),
-            paths: paths.iter().map(ViewPath::from).collect(),
+            paths: paths.to_vec(),
         }
     }
 }
 
+/// A document `--paths` reads: a trace's or every step's.
 #[derive(Deserialize)]
 #[serde(untagged)]
 enum PathsDocument {
-    Steps { steps: Vec<StepPaths> },
-    One(StepPaths),
+    Steps(StepsDocument),
+    One(Box<TraceDocument>),
 }
 
 /// Read the paths of a `beamtrace trace --json` document (one step) or of a
@@ -116,8 +81,20 @@ pub fn read_paths(text: &str, path: &str) -> Result<Vec<StepPaths>, ViewError> {
         message: e.to_string(),
     })?;
     Ok(match doc {
-        PathsDocument::Steps { steps } => steps,
-        PathsDocument::One(step) => vec![step],
+        PathsDocument::Steps(doc) => doc
+            .steps
+            .into_iter()
+            .map(|s| StepPaths {
+                tx: s.tx,
+                rx: s.rx,
+                paths: s.paths,
+            })
+            .collect(),
+        PathsDocument::One(doc) => vec![StepPaths {
+            tx: doc.tx,
+            rx: doc.rx,
+            paths: doc.paths,
+        }],
     })
 }
 
@@ -153,7 +130,7 @@ struct StepDocument<'a> {
     surfaces: Vec<SurfaceDocument<'a>>,
     tx: [Real; 3],
     rx: [Real; 3],
-    paths: &'a [ViewPath],
+    paths: &'a [PathReport],
 }
 
 #[derive(Serialize)]

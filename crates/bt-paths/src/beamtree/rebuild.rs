@@ -10,7 +10,7 @@
 //! not applied to copied nodes: culling only removes work, never paths, so the rebuilt tree
 //! holds every node of a fresh build and may keep a few it would have culled.
 
-use super::{BeamTree, Prepared, ROOT, Scratch, TreeError};
+use super::{BeamTree, Prepared, ROOT, Scratch, TreeCache, TreeError};
 use crate::beamtree::Progress;
 use bt_geom::Plane;
 use bt_geom::bvh::box_meets_halfspaces;
@@ -66,7 +66,8 @@ impl BeamTree {
             };
             return Ok((tree, stats));
         }
-        let prep = Prepared::new(scene, self.options);
+        // The moved surfaces make this another geometry: no kept shapes would match.
+        let prep = Prepared::new(scene, self.options, &mut TreeCache::default());
         let mut is_moved = vec![false; self.surfaces];
         moved.iter().for_each(|id| is_moved[id.index()] = true);
         let mut reflectors: Vec<u32> = moved

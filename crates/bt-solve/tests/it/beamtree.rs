@@ -5,10 +5,11 @@
 //! windows finds what the image method finds.
 
 use crate::common::*;
+use crate::common::{trace_receivers, trace_scene};
 use bt_geom::{Real, Vec3};
 use bt_paths::beamtree::{BeamTree, Culling, TreeOptions};
 use bt_scene::{Scene, Terminals};
-use bt_solve::pipeline::{CandidateMode, TraceOptions, trace_receivers, trace_scene};
+use bt_solve::pipeline::{CandidateMode, TraceOptions};
 use bt_solve::{FoundPath, Solver, UpdateOrder};
 use bt_testkit::nasty_scene;
 use proptest::prelude::*;

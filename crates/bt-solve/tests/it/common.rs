@@ -3,9 +3,10 @@
 use bt_geom::{Real, Vec3};
 use bt_paths::{AllVisible, enumerate};
 use bt_scene::{Scene, SurfaceId};
-use bt_solve::{FoundPath, IpcOptions, Solver, UpdateOrder, trace};
+use bt_solve::pipeline::{TraceError, TraceOptions, Traced};
+use bt_solve::{FoundPath, IpcOptions, Solver, Tracer, UpdateOrder, trace};
 
-pub use bt_testkit::{box_room, random_scene, scene_from_json};
+pub use bt_testkit::{box_room, random_scene, scene_from_json, wall_floor_scene};
 
 pub fn run(scene: &Scene, max_order: usize, solver: Solver) -> Vec<FoundPath> {
     let candidates = enumerate(scene, max_order, &AllVisible);
@@ -61,13 +62,16 @@ pub fn random_scene_config() -> proptest::test_runner::Config {
     }
 }
 
-/// The issue's floor/wall case: a 4 m × 4 m floor at z = 0 and a 3.5 m × 2 m wall in the plane
-/// x = 0, whose shared line holds the floor's centroid (IPC from the centroids degenerates on
-/// wall -> floor; the image method finds it, 3.960 m).
-pub fn wall_floor_scene() -> Scene {
-    scene_from_json(
-        r#"{ "tx": [-0.3, -1.4, 2.3], "rx": [-0.9, 0.6, 0.9], "surfaces": [
-            { "name": "floor", "vertices": [[-2,-2,0],[2,-2,0],[2,2,0],[-2,2,0]] },
-            { "name": "wall", "vertices": [[0,-1.75,0.9],[0,1.75,0.9],[0,1.75,2.9],[0,-1.75,2.9]] } ] }"#,
-    )
+/// Trace `scene` between its own terminals with a fresh [`Tracer`].
+pub fn trace_scene(scene: &Scene, options: &TraceOptions) -> Result<Traced, TraceError> {
+    Tracer::new(scene.clone(), *options).trace(scene.tx_world(), scene.rx_world())
+}
+
+/// Trace `scene`'s TX to each of `receivers` (world frame) with a fresh [`Tracer`].
+pub fn trace_receivers(
+    scene: &Scene,
+    receivers: &[Vec3],
+    options: &TraceOptions,
+) -> Result<Vec<Traced>, TraceError> {
+    Tracer::new(scene.clone(), *options).trace_many(scene.tx_world(), receivers)
 }

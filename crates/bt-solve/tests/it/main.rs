@@ -5,7 +5,8 @@
 mod analytic;
 mod beamtree;
 mod common;
+mod incremental;
 mod ipc_vs_image;
-mod lanes;
 mod newton;
 mod translation;
+mod wvrn_completeness;

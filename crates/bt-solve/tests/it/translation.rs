@@ -3,10 +3,11 @@
 //! is the scene at the origin, traced on its own; the far scene is built by moving its file
 //! description (`bt_testkit::translated`), so the library sees world coordinates only.
 
+use crate::common::trace_scene;
 use bt_beams::{PathReport, RadioOptions, report};
 use bt_geom::{Real, Vec3};
 use bt_scene::{Scene, SceneDescription, Terminals};
-use bt_solve::pipeline::{CandidateMode, TraceOptions, trace_scene};
+use bt_solve::pipeline::{CandidateMode, TraceOptions};
 use bt_solve::{IpcOptions, Solver, UpdateOrder};
 
 const OFFSETS: [[Real; 3]; 4] = [

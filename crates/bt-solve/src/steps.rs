@@ -1,7 +1,8 @@
 //! Tracing dynamic scenes step by step, incrementally: between two time steps only what the
 //! moving objects can have changed is recomputed, and the result equals a from-scratch trace.
 //!
-//! One step of [`IncrementalTracer::step`]:
+//! The state lives in the [`crate::Tracer`] (its previous step); one step of
+//! [`crate::Tracer::update`]:
 //! 1. *Moved surfaces*: vertex lists compared exactly with the previous step
 //!    ([`bt_scene::dynamic::moved_surfaces`]); TX/RX compared too.
 //! 2. *WVRN*: [`Wvrn::update`] recomputes the pairs touching moved nodes and re-tests the other
@@ -26,24 +27,24 @@
 //!
 //! For the image method the incremental result is bit-identical to [`trace_scratch`]; for IPC
 //! reused and warm-started points agree with a cold start to the IPC threshold.
-#![warn(missing_docs)]
+//!
+//! (This was the crate bt-dynamic, a second pipeline beside bt-solve's; it is now the
+//! [`crate::Tracer`]'s time-step half.)
 
+use crate::batch::{Batch, Todo, found_path, solve_batch};
+use crate::pipeline::{CandidateMode, TraceError, TraceOptions};
+use crate::{CandidateOutcome, FoundPath, IpcOutcome, Solver, TraceResult, Validity};
 use bt_geom::{Real, Vec3};
-use bt_paths::beamtree::BeamTree;
+use bt_paths::beamtree::{BeamTree, TreeCache};
 use bt_paths::wvrn::{Wvrn, WvrnStats};
 use bt_paths::{CandidateSet, CandidateStats};
-use bt_scene::dynamic::{DynamicScene, moved_surfaces};
+use bt_scene::dynamic::moved_surfaces;
 use bt_scene::{Scene, SurfaceId};
-use bt_solve::pipeline::{CandidateMode, TraceError, TraceOptions};
-use bt_solve::{
-    Batch, CandidateOutcome, FoundPath, IpcOutcome, Solver, Todo, TraceResult, Validity,
-    found_path, solve_batch,
-};
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 use std::cmp::Ordering;
 
 /// What an incremental step recomputed.
-#[derive(Debug, Clone, Default, PartialEq, Serialize)]
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
 pub struct UpdateStats {
     /// Computed from scratch (first step, or the scene is not the next step of the previous).
     pub full: bool,
@@ -97,10 +98,10 @@ fn step_candidates(
 ) -> Result<CandidateSet, TraceError> {
     match wvrn {
         Some(w) => {
-            bt_solve::pipeline::check_budget(scene, options)?;
+            crate::pipeline::check_budget(scene, options)?;
             Ok(bt_paths::enumerate(scene, options.max_order, w))
         }
-        None => bt_solve::pipeline::candidates(scene, options),
+        None => crate::pipeline::candidates(scene, options),
     }
 }
 
@@ -115,9 +116,11 @@ fn step_wvrn(options: &TraceOptions, scene: &Scene) -> Option<Wvrn> {
 fn generate(
     options: &TraceOptions,
     scene: &Scene,
+    cache: &mut TreeCache,
 ) -> Result<(Generator, CandidateSet), TraceError> {
     if options.candidates == CandidateMode::BeamTree {
-        let tree = BeamTree::build(scene, bt_solve::pipeline::tree_options(options))?;
+        let tree_options = crate::pipeline::tree_options(options);
+        let tree = BeamTree::build_in(scene, tree_options, cache, &mut |_| {})?;
         let candidates = tree.candidates(scene.rx());
         let generator = Generator {
             wvrn: None,
@@ -138,8 +141,8 @@ struct Generator {
     tree: Option<BeamTree>,
 }
 
-/// Trace one scene from scratch: candidates ([`bt_solve::pipeline::candidates`], or the WVRN),
-/// then [`bt_solve::trace`]. The reference the incremental tracer must reproduce.
+/// Trace one scene from scratch: candidates ([`crate::pipeline::candidates`], or the WVRN),
+/// then [`crate::trace`]. The reference the incremental tracer must reproduce.
 pub fn trace_scratch(
     scene: &Scene,
     step: usize,
@@ -147,7 +150,7 @@ pub fn trace_scratch(
 ) -> Result<StepTrace, TraceError> {
     let wvrn = step_wvrn(options, scene);
     let candidates = step_candidates(options, scene, wvrn.as_ref())?;
-    let trace = bt_solve::trace(scene, &candidates, &options.solver, options.parallel);
+    let trace = crate::trace(scene, &candidates, &options.solver, options.parallel);
     Ok(StepTrace {
         step,
         trace,
@@ -159,25 +162,6 @@ pub fn trace_scratch(
             ..UpdateStats::default()
         },
     })
-}
-
-/// Trace every step of a dynamic scene, incrementally or each from scratch.
-pub fn trace_steps(
-    dynamic: &DynamicScene,
-    options: &TraceOptions,
-    incremental: bool,
-) -> Result<Vec<StepTrace>, TraceError> {
-    if incremental {
-        let mut tracer = IncrementalTracer::new(*options);
-        dynamic.scenes().iter().map(|s| tracer.step(s)).collect()
-    } else {
-        dynamic
-            .scenes()
-            .iter()
-            .enumerate()
-            .map(|(k, s)| trace_scratch(s, k, options))
-            .collect()
-    }
 }
 
 /// One candidate's outcome and the points its solver produced (meaningful when solved).
@@ -198,30 +182,26 @@ struct State {
     step: usize,
 }
 
-/// Traces the steps of a dynamic scene one after the other, reusing the previous step's WVRN,
-/// candidates and outcomes where the motion provably changed nothing. Cloning keeps the state
-/// (to branch, or to time one step).
-#[derive(Clone)]
-pub struct IncrementalTracer {
-    options: TraceOptions,
+/// The previous step of a [`crate::Tracer`]: its scene, WVRN or beam tree, candidates and
+/// outcomes, reused where the motion provably changed nothing. Cloning keeps the state (to
+/// branch, or to time one step).
+#[derive(Clone, Default)]
+pub(crate) struct Incremental {
     state: Option<State>,
 }
 
-impl IncrementalTracer {
-    /// A tracer with no previous step.
-    pub fn new(options: TraceOptions) -> Self {
-        Self {
-            options,
-            state: None,
-        }
-    }
-
-    /// Trace the next step. Scenes that are not a next step of the previous one (other
-    /// surfaces) are traced from scratch.
-    pub fn step(&mut self, scene: &Scene) -> Result<StepTrace, TraceError> {
-        let options = self.options;
+impl Incremental {
+    /// Trace `scene` as step `step`, the next step after the kept one. Scenes that are not a
+    /// next step of the previous one (other surfaces) are traced from scratch.
+    pub(crate) fn step(
+        &mut self,
+        options: &TraceOptions,
+        scene: &Scene,
+        step: usize,
+        cache: &mut TreeCache,
+    ) -> Result<StepTrace, TraceError> {
+        let options = *options;
         let prev = self.state.take();
-        let step = prev.as_ref().map_or(0, |p| p.step + 1);
         if matches!(options.solver, Solver::Sbr(_)) {
             // SBR traces the whole scene at once, not per candidate: nothing to reuse.
             let result = trace_scratch(scene, step, &options)?;
@@ -237,7 +217,8 @@ impl IncrementalTracer {
         }
         let moved = prev.as_ref().and_then(|p| moved_surfaces(&p.scene, scene));
         let (Some(mut prev), Some(moved)) = (prev, moved) else {
-            return self.full(scene, step);
+            let generated = generate(&options, scene, cache)?;
+            return Ok(self.full(&options, scene, step, generated));
         };
         let mut update = UpdateStats {
             moved_surfaces: moved.len(),
@@ -303,9 +284,14 @@ impl IncrementalTracer {
         result
     }
 
-    fn full(&mut self, scene: &Scene, step: usize) -> Result<StepTrace, TraceError> {
-        let options = self.options;
-        let (generator, candidates) = generate(&options, scene)?;
+    /// Step `step` solved in full over the candidates `generate` gave.
+    fn full(
+        &mut self,
+        options: &TraceOptions,
+        scene: &Scene,
+        step: usize,
+        (generator, candidates): (Generator, CandidateSet),
+    ) -> StepTrace {
         let batch = Batch {
             scene,
             candidates: &candidates,
@@ -325,7 +311,7 @@ impl IncrementalTracer {
             ..UpdateStats::default()
         };
         let solved = (candidates, records, points);
-        Ok(self.keep(scene, step, generator, solved, update))
+        self.keep(scene, step, generator, solved, update)
     }
 }
 

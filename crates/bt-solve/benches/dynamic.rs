@@ -5,13 +5,14 @@
 //! `cargo bench -p bt-dynamic`; the reduction ratio and the incremental/scratch ratio of the
 //! mean step times are printed to stderr before the criterion groups run.
 
-use bt_dynamic::{IncrementalTracer, trace_scratch};
 use bt_paths::wvrn::Wvrn;
 use bt_paths::{AllVisible, enumerate};
 use bt_scene::Terminals;
 use bt_scene::dynamic::builtin_dynamic_scene;
 use bt_solve::Solver;
+use bt_solve::Tracer;
 use bt_solve::pipeline::{CandidateMode, TraceOptions};
+use bt_solve::steps::trace_scratch;
 use criterion::{BatchSize, Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
 use std::time::Instant;
@@ -89,11 +90,11 @@ fn steps(c: &mut Criterion) {
     ] {
         let opts = options(mode);
         // Tracers positioned after step k - 1, to time step k alone.
-        let mut tracer = IncrementalTracer::new(opts);
-        let mut before: Vec<IncrementalTracer> = Vec::new();
+        let mut tracer = Tracer::new(dynamic.step(0).clone(), opts);
+        let mut before: Vec<Tracer> = Vec::new();
         for s in dynamic.scenes() {
             before.push(tracer.clone());
-            tracer.step(s).unwrap();
+            tracer.update(s).unwrap();
         }
         // Quick ratio over steps 1..n (mean of a few rounds), printed for the record.
         let rounds = 20;
@@ -108,7 +109,7 @@ fn steps(c: &mut Criterion) {
         for _ in 0..rounds {
             for (k, b) in before.iter().enumerate().skip(1) {
                 let mut t = b.clone();
-                black_box(t.step(dynamic.step(k)).unwrap());
+                black_box(t.update(dynamic.step(k)).unwrap());
             }
         }
         let incremental = t0.elapsed().as_secs_f64() / (rounds * (n - 1)) as f64;
@@ -145,7 +146,7 @@ fn steps(c: &mut Criterion) {
                 || before[1].clone(),
                 |mut t| {
                     (1..n)
-                        .map(|k| t.step(dynamic.step(k)).unwrap().trace.paths.len())
+                        .map(|k| t.update(dynamic.step(k)).unwrap().trace.paths.len())
                         .sum::<usize>()
                 },
                 BatchSize::SmallInput,

@@ -4,12 +4,13 @@
 
 use bt_testkit::partitioned as common;
 
-use bt_dynamic::{IncrementalTracer, StepTrace, max_point_distance, trace_scratch};
 use bt_paths::wvrn::Wvrn;
 use bt_scene::Terminals;
 use bt_scene::dynamic::{DynamicScene, builtin_dynamic_scene, moved_surfaces};
 use bt_solve::pipeline::{CandidateMode, TraceOptions};
+use bt_solve::steps::trace_scratch;
 use bt_solve::{IpcOptions, Solver, UpdateOrder};
+use bt_solve::{StepTrace, Tracer, max_point_distance};
 
 fn living_room() -> DynamicScene {
     builtin_dynamic_scene("living-room-dynamic", Terminals::default())
@@ -31,10 +32,10 @@ fn image(candidates: CandidateMode, max_order: usize, parallel: bool) -> TraceOp
 /// Trace every step of `dynamic` incrementally, assert that each equals a from-scratch trace,
 /// and return the incremental steps.
 fn same_as_scratch(dynamic: &DynamicScene, options: &TraceOptions) -> Vec<StepTrace> {
-    let mut tracer = IncrementalTracer::new(*options);
+    let mut tracer = Tracer::new(dynamic.step(0).clone(), *options);
     let mut steps = Vec::with_capacity(dynamic.len());
     for (k, scene) in dynamic.scenes().iter().enumerate() {
-        let inc = tracer.step(scene).unwrap();
+        let inc = tracer.update(scene).unwrap();
         let scratch = trace_scratch(scene, k, options).unwrap();
         assert_eq!(inc.step, k);
         if options.candidates == CandidateMode::BeamTree {
@@ -107,13 +108,16 @@ fn dynamic_living_room_matches_scratch_with_and_without_wvrn() {
 #[test]
 fn person_blocks_the_line_of_sight_at_steps_2_and_3() {
     let dynamic = living_room();
-    let mut tracer = IncrementalTracer::new(image(CandidateMode::Wvrn, 1, false));
+    let mut tracer = Tracer::new(
+        dynamic.step(0).clone(),
+        image(CandidateMode::Wvrn, 1, false),
+    );
     let los: Vec<bool> = dynamic
         .scenes()
         .iter()
         .map(|s| {
             tracer
-                .step(s)
+                .update(s)
                 .unwrap()
                 .trace
                 .paths
@@ -171,13 +175,16 @@ fn ipc_warm_start_agrees_with_the_image_method() {
     let scene0 = dynamic.step(0);
     let ipc = Solver::Ipc(IpcOptions::for_scene(scene0, UpdateOrder::GaussSeidel));
     let reference_options = image(CandidateMode::Wvrn, 2, true);
-    let mut tracer = IncrementalTracer::new(TraceOptions {
-        solver: ipc,
-        ..reference_options
-    });
+    let mut tracer = Tracer::new(
+        dynamic.step(0).clone(),
+        TraceOptions {
+            solver: ipc,
+            ..reference_options
+        },
+    );
     let mut warm = 0;
     for (k, scene) in dynamic.scenes().iter().enumerate() {
-        let inc = tracer.step(scene).unwrap();
+        let inc = tracer.update(scene).unwrap();
         warm += inc.update.warm_started;
         let reference = trace_scratch(scene, k, &reference_options).unwrap();
         let worst = max_point_distance(&inc.trace.paths, &reference.trace.paths)

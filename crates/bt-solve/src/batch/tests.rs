@@ -1,14 +1,12 @@
 //! IPC runs four at a time in a batch (`solve_batch`), one by one in `solve_candidate_from`:
-//! the two must agree bit for bit, whatever the outcome.
+//! the two must agree bit for bit, whatever the outcome. (A unit test: the batch is crate-private.)
 
-use crate::common::random_scene;
+use super::{Batch, Todo, solve_batch};
+use crate::{CandidateOutcome, IpcOptions, Solver, UpdateOrder, solve_candidate_from};
 use bt_geom::Vec3;
 use bt_paths::{AllVisible, CandidateSet, enumerate};
 use bt_scene::{Scene, SurfaceId};
-use bt_solve::{
-    Batch, CandidateOutcome, IpcOptions, Solver, Todo, UpdateOrder, solve_batch,
-    solve_candidate_from,
-};
+use bt_testkit::random_scene;
 
 type Solved = Vec<(usize, CandidateOutcome, Vec<Vec3>)>;
 
@@ -115,7 +113,7 @@ fn lanes_equal_one_by_one_on_the_living_room() {
 fn lanes_equal_one_by_one_where_ipc_degenerates() {
     // The floor's centroid lies in the wall's plane: from the centroids, IPC on wall -> floor
     // meets a point whose neighbours both lie on its plane (the lanes rerun that lane alone).
-    let scene = crate::common::wall_floor_scene();
+    let scene = bt_testkit::wall_floor_scene();
     let set = enumerate(&scene, 3, &AllVisible);
     let mut degenerate = 0;
     for solver in solvers(&scene) {

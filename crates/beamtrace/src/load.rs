@@ -1,0 +1,68 @@
+//! Loading the scene a command names: the one place the scene arguments become load options
+//! (every command that takes a scene loads through here).
+
+use crate::args::SceneArgs;
+use bt_scene::Terminals;
+use bt_scene::dynamic::DynamicScene;
+use bt_scene::io::{LoadOptions, Loaded};
+
+/// The load options the scene arguments select: `--material`/`--thickness` give every
+/// material of any source that radio model; `--frequency` is the carrier of sources that carry
+/// none (meshes, point clouds, XML scenes).
+pub fn load_options(args: &SceneArgs) -> anyhow::Result<LoadOptions> {
+    Ok(LoadOptions {
+        terminals: Terminals {
+            tx: args.tx,
+            rx: args.rx,
+        },
+        merge: bt_mesh::MergeOptions {
+            angle_tol_deg: args.merge_angle_deg,
+            dist_tol_m: args.merge_distance,
+            max_elements: args.max_mesh_elements,
+            ..bt_mesh::MergeOptions::default()
+        },
+        min_reflector_area_m2: args.min_reflector_area,
+        cloud: bt_pointcloud::io::ReadOptions {
+            max_points: args.max_cloud_points,
+            ..Default::default()
+        },
+        frequency_hz: args
+            .material
+            .frequency
+            .unwrap_or(bt_scene::DEFAULT_FREQUENCY_HZ),
+        radio: args.material.radio()?,
+        ..LoadOptions::default()
+    })
+}
+
+/// Load the scene named on the command line (a file or `builtin:NAME`), with a progress bar
+/// while a point cloud's planes are extracted, and `--frequency` applied to scene files and
+/// built-ins too.
+pub fn load_scene(args: &SceneArgs) -> anyhow::Result<Loaded> {
+    let options = load_options(args)?;
+    let (bar, mut progress) = crate::progress::extraction_progress();
+    let loaded = bt_scene::load_with_progress(&args.scene, &options, &mut progress);
+    bar.finish_and_clear();
+    let mut loaded = loaded?;
+    if let Some(f) = args.material.frequency {
+        loaded.scene = loaded.scene.with_frequency(f)?;
+    }
+    Ok(loaded)
+}
+
+/// Load a scene as a dynamic scene: JSON/TOML files and built-ins with their steps; meshes
+/// (and any other static source) as one step. Import warnings go to stderr.
+pub fn load_dynamic(args: &SceneArgs) -> anyhow::Result<DynamicScene> {
+    let options = load_options(args)?;
+    let (bar, mut progress) = crate::progress::extraction_progress();
+    let loaded = bt_scene::load_dynamic(&args.scene, &options, &mut progress);
+    bar.finish_and_clear();
+    let (mut scene, warnings) = loaded?;
+    if let Some(f) = args.material.frequency {
+        scene = scene.with_frequency(f)?;
+    }
+    for w in &warnings {
+        eprintln!("warning: {w}");
+    }
+    Ok(scene)
+}
