@@ -54,7 +54,7 @@ pub struct StepStats {
 pub fn load_dynamic(args: &SceneArgs) -> anyhow::Result<DynamicScene> {
     let options = load_options(args)?;
     let (bar, mut progress) = crate::cloud::extraction_progress();
-    let loaded = bt_scene::load_dynamic(&args.scene, &options, &mut progress);
+    let loaded = bt_import::load_dynamic(&args.scene, &options, &mut progress);
     bar.finish_and_clear();
     let (mut scene, warnings) = loaded?;
     if let Some(f) = args.material.frequency {

@@ -3,7 +3,7 @@
 use crate::args::{SceneArgs, TraceArgs};
 use crate::output::{self, TraceDocument};
 use anyhow::Context;
-use bt_scene::io::{LoadOptions, Loaded};
+use bt_import::{LoadOptions, Loaded};
 use bt_scene::{Scene, SceneError, Terminals};
 use std::process::ExitCode;
 use std::time::Instant;
@@ -24,7 +24,7 @@ pub fn load_options(args: &SceneArgs) -> anyhow::Result<LoadOptions> {
             ..bt_mesh::MergeOptions::default()
         },
         min_reflector_area_m2: args.min_reflector_area,
-        cloud: bt_pointcloud::io::ReadOptions {
+        cloud: bt_import::cloud::ReadOptions {
             max_points: args.max_cloud_points,
             ..Default::default()
         },
@@ -43,7 +43,7 @@ pub fn load_options(args: &SceneArgs) -> anyhow::Result<LoadOptions> {
 pub fn load_scene(args: &SceneArgs) -> anyhow::Result<Loaded> {
     let options = load_options(args)?;
     let (bar, mut progress) = crate::cloud::extraction_progress();
-    let loaded = bt_scene::load_with_progress(&args.scene, &options, &mut progress);
+    let loaded = bt_import::load_with_progress(&args.scene, &options, &mut progress);
     bar.finish_and_clear();
     let mut loaded = loaded?;
     if let Some(f) = args.material.frequency {
@@ -135,8 +135,8 @@ pub fn check(args: &SceneArgs) -> anyhow::Result<ExitCode> {
             );
             Ok(ExitCode::SUCCESS)
         }
-        Err(e) => match e.downcast::<SceneError>() {
-            Ok(e @ SceneError::Invalid { .. }) => {
+        Err(e) => match e.downcast::<bt_import::ImportError>() {
+            Ok(bt_import::ImportError::Scene(e @ SceneError::Invalid { .. })) => {
                 println!("{e}");
                 Ok(ExitCode::from(1))
             }

@@ -6,10 +6,10 @@
 //! mean step times are printed to stderr before the criterion groups run.
 
 use bt_dynamic::{IncrementalTracer, trace_scratch};
+use bt_import::builtin_dynamic_scene;
 use bt_paths::wvrn::Wvrn;
 use bt_paths::{AllVisible, enumerate};
 use bt_scene::Terminals;
-use bt_scene::dynamic::builtin_dynamic_scene;
 use bt_solve::Solver;
 use bt_solve::pipeline::{CandidateMode, TraceOptions};
 use criterion::{BatchSize, Criterion, Throughput, criterion_group, criterion_main};
@@ -29,7 +29,7 @@ fn options(candidates: CandidateMode) -> TraceOptions {
 }
 
 fn wvrn(c: &mut Criterion) {
-    let scene = bt_scene::builtin_scene("living-room", Terminals::default())
+    let scene = bt_import::builtin_scene("living-room", Terminals::default())
         .unwrap()
         .unwrap();
     let dynamic = builtin_dynamic_scene("living-room-dynamic", Terminals::default())

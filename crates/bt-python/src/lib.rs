@@ -11,7 +11,7 @@ mod columns;
 mod options;
 
 use bt_geom::Vec3;
-use bt_scene::io::LoadOptions;
+use bt_import::LoadOptions;
 use bt_scene::{Scene, SceneError, Terminals};
 use bt_solve::pipeline::TraceError;
 use numpy::PyReadonlyArray2;
@@ -40,8 +40,11 @@ fn vec3(v: [f64; 3]) -> Vec3 {
 
 /// Load any source the CLI reads (`builtin:NAME`, JSON/TOML, OBJ/PLY meshes, point clouds,
 /// Mitsuba XML): the library's one loading entry.
-fn load_scene(source: &str, options: &LoadOptions) -> Result<bt_scene::io::Loaded, SceneError> {
-    bt_scene::io::load(source, options)
+fn load_scene(
+    source: &str,
+    options: &LoadOptions,
+) -> Result<bt_import::Loaded, bt_import::ImportError> {
+    bt_import::load(source, options)
 }
 
 /// A validated scene, ready to trace from any TX to any RX.
@@ -156,7 +159,10 @@ impl PyScene {
             .trace_options(&scene)
             .map_err(PyValueError::new_err)?;
         let reports = py.detach(|| trace_and_report(&scene, &receivers, &options));
-        let reports = reports.map_err(|e| self.error(e))?;
+        let reports = reports.map_err(|e| match e {
+            Failure::Trace(e) => self.error(e),
+            Failure::Report(message) => error(format!("{}: {message}", scene.name())),
+        })?;
         let dicts = reports
             .iter()
             .map(|paths| columns::to_dict(py, paths))
@@ -181,21 +187,26 @@ fn receivers_of(array: &PyReadonlyArray2<'_, f64>) -> PyResult<Vec<Vec3>> {
         .collect())
 }
 
+/// Why [`trace_and_report`] failed: the trace, or a receiver's report (its message).
+enum Failure {
+    Trace(TraceError),
+    Report(String),
+}
+
 /// `bt_solve::pipeline::trace_receivers`, then each receiver's report (in parallel when asked).
 fn trace_and_report(
     scene: &Scene,
     receivers: &[Vec3],
     options: &bt_solve::pipeline::TraceOptions,
-) -> Result<Vec<Vec<bt_beams::PathReport>>, TraceError> {
-    let traced = bt_solve::pipeline::trace_receivers(scene, receivers, options)?;
+) -> Result<Vec<Vec<bt_beams::PathReport>>, Failure> {
+    let traced =
+        bt_solve::pipeline::trace_receivers(scene, receivers, options).map_err(Failure::Trace)?;
     let one = |(rx, t): (&Vec3, &bt_solve::pipeline::Traced)| {
-        let moved = scene.with_receiver(*rx)?;
-        bt_beams::report(&moved, &t.result.paths, &bt_beams::RadioOptions::default()).map_err(|e| {
-            TraceError::Scene(SceneError::Parse {
-                path: scene.name().to_string(),
-                message: e.to_string(),
-            })
-        })
+        let moved = scene
+            .with_receiver(*rx)
+            .map_err(|e| Failure::Trace(e.into()))?;
+        bt_beams::report(&moved, &t.result.paths, &bt_beams::RadioOptions::default())
+            .map_err(|e| Failure::Report(e.to_string()))
     };
     if options.parallel {
         receivers.par_iter().zip(&traced).map(one).collect()
@@ -241,7 +252,7 @@ fn load(
 /// Names of the built-in scenes (`load("builtin:NAME")`).
 #[pyfunction]
 fn builtin_names() -> Vec<&'static str> {
-    bt_scene::builtin_names().to_vec()
+    bt_import::builtin_names().to_vec()
 }
 
 #[pymodule]
