@@ -7,7 +7,7 @@ use libfuzzer_sys::fuzz_target;
 mod mesh_common;
 
 fuzz_target!(|data: &[u8]| {
-    mesh_common::check(bt_mesh::read_obj(
+    mesh_common::check(bt_import::mesh::read_obj(
         data,
         None,
         &bt_mesh::MergeOptions::default(),

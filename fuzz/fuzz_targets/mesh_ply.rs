@@ -8,7 +8,7 @@ use libfuzzer_sys::fuzz_target;
 mod mesh_common;
 
 fuzz_target!(|data: &[u8]| {
-    mesh_common::check(bt_mesh::read_ply(
+    mesh_common::check(bt_import::mesh::read_ply(
         data,
         None,
         &bt_mesh::MergeOptions::default(),

@@ -2,7 +2,7 @@
 //! finite points and normals, and allocation stays bounded by the input length.
 #![no_main]
 
-use bt_pointcloud::io::{NonFinitePolicy, ReadOptions, parse_any};
+use bt_import::cloud::{NonFinitePolicy, ReadOptions, parse_any};
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {

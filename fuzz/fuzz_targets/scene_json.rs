@@ -19,7 +19,7 @@ fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else {
         return;
     };
-    let Ok(desc) = bt_scene::io::parse_json(text, "fuzz.json") else {
+    let Ok(desc) = bt_import::parse_json(text, "fuzz.json") else {
         return;
     };
     if let Ok(scene) = Scene::from_description(&desc, "fuzz", Terminals::default()) {

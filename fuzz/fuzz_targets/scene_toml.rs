@@ -19,7 +19,7 @@ fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else {
         return;
     };
-    let Ok(desc) = bt_scene::io::parse_toml(text, "fuzz.toml") else {
+    let Ok(desc) = bt_import::parse_toml(text, "fuzz.toml") else {
         return;
     };
     if let Ok(scene) = Scene::from_description(&desc, "fuzz", Terminals::default()) {

@@ -9,7 +9,7 @@ fuzz_target!(|data: &[u8]| {
     let Ok(text) = std::str::from_utf8(data) else {
         return;
     };
-    let Ok(scene) = bt_scene::io::xml::parse_xml(text, "fuzz.xml") else {
+    let Ok(scene) = bt_import::xml::parse_xml(text, "fuzz.xml") else {
         return;
     };
     for shape in &scene.shapes {

@@ -186,7 +186,7 @@ pub struct SceneArgs {
     #[arg(long, default_value_t = bt_mesh::DEFAULT_MAX_ELEMENTS)]
     pub max_mesh_elements: u64,
     /// Point clouds: budget on the points a file declares; a larger cloud stops before reading.
-    #[arg(long, default_value_t = bt_pointcloud::io::DEFAULT_MAX_POINTS)]
+    #[arg(long, default_value_t = bt_import::cloud::DEFAULT_MAX_POINTS)]
     pub max_cloud_points: u64,
     #[command(flatten)]
     pub material: MaterialArgs,
@@ -763,7 +763,7 @@ pub struct ExtractArgs {
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
     pub rx: Option<Vec3>,
     /// Budget on the points the cloud declares; a larger cloud stops before reading.
-    #[arg(long, default_value_t = bt_pointcloud::io::DEFAULT_MAX_POINTS)]
+    #[arg(long, default_value_t = bt_import::cloud::DEFAULT_MAX_POINTS)]
     pub max_cloud_points: u64,
 }
 
@@ -959,7 +959,7 @@ mod tests {
             (0.25, 1.0, 1e-3)
         );
         assert_eq!(a.max_mesh_elements, bt_mesh::DEFAULT_MAX_ELEMENTS);
-        assert_eq!(a.max_cloud_points, bt_pointcloud::io::DEFAULT_MAX_POINTS);
+        assert_eq!(a.max_cloud_points, bt_import::cloud::DEFAULT_MAX_POINTS);
     }
 
     #[test]

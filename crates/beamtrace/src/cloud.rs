@@ -3,7 +3,7 @@
 
 use crate::args::{ExtractArgs, SampleArgs};
 use anyhow::{Context, bail};
-use bt_pointcloud::io::ReadOptions;
+use bt_import::cloud::ReadOptions;
 use bt_pointcloud::{ExtractParams, Extraction, PointCloud};
 use std::path::Path;
 use std::process::ExitCode;
@@ -18,7 +18,7 @@ fn extract_from(
         max_points,
         ..ReadOptions::default()
     };
-    let loaded = bt_pointcloud::io::read_path(path, &read)?;
+    let loaded = bt_import::cloud::read_path(path, &read)?;
     let (bar, mut progress) = crate::progress::extraction_progress();
     let extraction =
         bt_pointcloud::extract_planes_with_progress(&loaded.cloud, params, &mut progress)
@@ -60,14 +60,13 @@ pub fn run_extract(args: &ExtractArgs) -> anyhow::Result<ExitCode> {
         .file_stem()
         .and_then(|s| s.to_str())
         .unwrap_or("extracted");
-    let desc = bt_scene::io::cloud_description(
+    let desc = bt_import::cloud::cloud_description(
         &extraction,
         name,
         args.tx.map(|v| v.to_array()),
         args.rx.map(|v| v.to_array()),
     );
-    let text = desc
-        .to_text(format)
+    let text = bt_import::write_description(&desc, format)
         .map_err(|e| anyhow::anyhow!("{}: {e}", args.output.display()))?;
     crate::files::write(&args.output, text.as_bytes(), &inputs, &[format])?;
     let r = &extraction.report;
@@ -137,7 +136,7 @@ pub fn run_sample(args: &SampleArgs) -> anyhow::Result<ExitCode> {
     }
     let cloud: PointCloud =
         bt_pointcloud::sample_polygons(&polygons, args.density, args.noise, args.seed);
-    bt_pointcloud::io::write_path(&cloud, &args.output)
+    bt_import::cloud::write_path(&cloud, &args.output)
         .with_context(|| format!("writing {}", args.output.display()))?;
     println!(
         "{} points from {} surfaces ({} pts/m², noise σ {} m, seed {}) -> {}",

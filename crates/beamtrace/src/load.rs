@@ -2,9 +2,9 @@
 //! (every command that takes a scene loads through here).
 
 use crate::args::SceneArgs;
+use bt_import::{LoadOptions, Loaded};
 use bt_scene::Terminals;
 use bt_scene::dynamic::DynamicScene;
-use bt_scene::io::{LoadOptions, Loaded};
 
 /// The load options the scene arguments select: `--material`/`--thickness` give every
 /// material of any source that radio model; `--frequency` is the carrier of sources that carry
@@ -22,7 +22,7 @@ pub fn load_options(args: &SceneArgs) -> anyhow::Result<LoadOptions> {
             ..bt_mesh::MergeOptions::default()
         },
         min_reflector_area_m2: args.min_reflector_area,
-        cloud: bt_pointcloud::io::ReadOptions {
+        cloud: bt_import::cloud::ReadOptions {
             max_points: args.max_cloud_points,
             ..Default::default()
         },
@@ -41,7 +41,7 @@ pub fn load_options(args: &SceneArgs) -> anyhow::Result<LoadOptions> {
 pub fn load_scene(args: &SceneArgs) -> anyhow::Result<Loaded> {
     let options = load_options(args)?;
     let (bar, mut progress) = crate::progress::extraction_progress();
-    let loaded = bt_scene::load_with_progress(&args.scene, &options, &mut progress);
+    let loaded = bt_import::load_with_progress(&args.scene, &options, &mut progress);
     bar.finish_and_clear();
     let mut loaded = loaded?;
     if let Some(f) = args.material.frequency {
@@ -55,7 +55,7 @@ pub fn load_scene(args: &SceneArgs) -> anyhow::Result<Loaded> {
 pub fn load_dynamic(args: &SceneArgs) -> anyhow::Result<DynamicScene> {
     let options = load_options(args)?;
     let (bar, mut progress) = crate::progress::extraction_progress();
-    let loaded = bt_scene::load_dynamic(&args.scene, &options, &mut progress);
+    let loaded = bt_import::load_dynamic(&args.scene, &options, &mut progress);
     bar.finish_and_clear();
     let (mut scene, warnings) = loaded?;
     if let Some(f) = args.material.frequency {

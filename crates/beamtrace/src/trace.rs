@@ -83,8 +83,8 @@ pub fn check(args: &SceneArgs) -> anyhow::Result<ExitCode> {
             );
             Ok(ExitCode::SUCCESS)
         }
-        Err(e) => match e.downcast::<SceneError>() {
-            Ok(e @ SceneError::Invalid { .. }) => {
+        Err(e) => match e.downcast::<bt_import::ImportError>() {
+            Ok(bt_import::ImportError::Scene(e @ SceneError::Invalid { .. })) => {
                 println!("{e}");
                 Ok(ExitCode::from(1))
             }

@@ -229,7 +229,7 @@ pub fn hls_input(
     (s.input, s.sequences)
 }
 
-/// Warm start from the previous time step (as `bt-dynamic` warm-starts its IPC): every path of
+/// Warm start from the previous time step (as `bt_solve::steps` warm-starts its IPC): every path of
 /// `step` whose surface sequence the accelerator ran at the previous step and brought to
 /// convergence starts from the points it converged to there (`previous.sequences[p]` and
 /// `results[p]`, the accelerator's read-back), instead of the beam tree's window centres. The

@@ -5,8 +5,9 @@ use bt_accel::{
     HostRejection, PlannedStep, StepOptions, host_accepts, plan_step, static_reflectors,
 };
 use bt_hls::{PlanOptions, ScheduleKind};
+use bt_import::builtin_dynamic_scene;
 use bt_scene::Terminals;
-use bt_scene::dynamic::{DynamicScene, builtin_dynamic_scene};
+use bt_scene::dynamic::DynamicScene;
 use bt_schedule::GaParams;
 use bt_solve::pipeline::TraceOptions;
 

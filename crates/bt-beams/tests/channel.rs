@@ -4,7 +4,7 @@
 
 use bt_beams::{PathReport, RadioOptions, report};
 use bt_channel::{Antenna, Complex64, Orientation, Pattern, Polarization};
-use bt_scene::io::parse_json;
+use bt_import::parse_json;
 use bt_scene::{Scene, Terminals};
 use bt_solve::Tracer;
 use bt_solve::pipeline::TraceOptions;
@@ -92,7 +92,7 @@ fn two_ray_ground_reflection_gain_and_phase() {
 
 #[test]
 fn reciprocity_in_the_living_room() {
-    let scene = bt_scene::builtin_scene("living-room", Terminals::default())
+    let scene = bt_import::builtin_scene("living-room", Terminals::default())
         .unwrap()
         .unwrap();
     let facing_a = Orientation::from_degrees(160.0, -15.0, 0.0);

@@ -1,9 +1,9 @@
-//! Mesh files (Wavefront OBJ, PLY) to bounded planar polygon surfaces.
+//! Polygon soups to bounded planar polygon surfaces: vertex welding and coplanar merging.
 //!
-//! A room exported from a 3-D tool is a soup of triangles and polygons. [`read_obj`] and
-//! [`read_ply`] parse one from bytes, weld duplicated vertices, merge edge-connected coplanar
-//! faces into groups and trace each group's boundary into one polygon: a [`MeshSurface`].
-//! [`read_mesh_path`] reads a file and picks the reader by extension.
+//! A room exported from a 3-D tool is a soup of triangles and polygons. The readers of
+//! `bt-import` (OBJ, PLY) parse one into a [`RawMesh`]; [`merge_mesh`] welds duplicated
+//! vertices, merges edge-connected coplanar faces into groups and traces each group's boundary
+//! into one polygon: a [`MeshSurface`]. No file parsing and no I/O here.
 //!
 //! Units and frame: coordinates are taken as metres in the file's own frame (beamtrace uses
 //! z up; no axis swap is applied). Areas are m², angles in the options are degrees.
@@ -26,20 +26,26 @@
 
 use bt_geom::{Real, Vec3};
 
-mod error;
-mod io;
 mod merge;
-mod obj;
-mod ply;
 mod raw;
 pub mod tol;
 
 use serde::{Deserialize, Serialize};
 
-pub use error::{MeshError, Position};
-pub use io::read_mesh_path;
+pub use raw::RawMesh;
 
 pub use tol::{DEFAULT_ANGLE_TOL_DEG, DEFAULT_DIST_TOL_M, DEFAULT_WELD_TOL_M};
+
+/// The crate's one error: merge options out of range.
+#[derive(Debug, thiserror::Error)]
+pub enum MergeError {
+    /// The merge options are out of range (negative or non-finite tolerance, angle >= 90 deg).
+    #[error("invalid merge options: {detail}")]
+    InvalidOptions {
+        /// What is wrong.
+        detail: String,
+    },
+}
 
 /// Tolerances of the coplanar merge.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -81,8 +87,8 @@ impl Default for MergeOptions {
 
 impl MergeOptions {
     /// Checks that every tolerance is finite and in range.
-    pub fn validate(&self) -> Result<(), MeshError> {
-        let bad = |detail: String| Err(MeshError::InvalidOptions { detail });
+    pub fn validate(&self) -> Result<(), MergeError> {
+        let bad = |detail: String| Err(MergeError::InvalidOptions { detail });
         if !(self.angle_tol_deg >= 0.0 && self.angle_tol_deg < 90.0) {
             return bad(format!(
                 "angle_tol_deg {} must be in [0, 90)",
@@ -138,97 +144,20 @@ pub struct MeshImport {
     pub faces_read: usize,
 }
 
-/// The file name used in messages when none is given.
-const UNNAMED: &str = "<input>";
-
-/// Reads a Wavefront OBJ mesh from bytes and merges its faces into planar surfaces.
-/// `file` names the source in errors and warnings. `.mtl` libraries are not read; `usemtl`
-/// names are kept as [`MeshSurface::material`].
-pub fn read_obj(
-    bytes: &[u8],
-    file: Option<&str>,
+/// Welds and merges the faces of `raw` into planar surfaces (checks `opts` first). `file`
+/// names the source in warnings. The surfaces come in the order of their first face.
+pub fn merge_mesh(
+    raw: &RawMesh,
     opts: &MergeOptions,
-) -> Result<MeshImport, MeshError> {
-    read(bytes, MeshFormat::Obj, file, opts)
-}
-
-/// Reads a PLY mesh (ASCII, binary little or big endian) from bytes and merges its faces into
-/// planar surfaces. `file` names the source in errors and warnings.
-pub fn read_ply(
-    bytes: &[u8],
-    file: Option<&str>,
-    opts: &MergeOptions,
-) -> Result<MeshImport, MeshError> {
-    read(bytes, MeshFormat::Ply, file, opts)
-}
-
-/// [`read_obj`] or [`read_ply`] by `format`.
-fn read(
-    bytes: &[u8],
-    format: MeshFormat,
-    file: Option<&str>,
-    opts: &MergeOptions,
-) -> Result<MeshImport, MeshError> {
-    let file = file.unwrap_or(UNNAMED);
-    finish(parse(bytes, format, file, opts)?, opts, file)
-}
-
-/// Checks `opts` and parses `bytes` as `format` into the polygon soup the merge starts from.
-fn parse(
-    bytes: &[u8],
-    format: MeshFormat,
     file: &str,
-    opts: &MergeOptions,
-) -> Result<raw::RawMesh, MeshError> {
+) -> Result<MeshImport, MergeError> {
     opts.validate()?;
-    match format {
-        MeshFormat::Obj => obj::parse(bytes, file, opts.max_elements),
-        MeshFormat::Ply => ply::parse(bytes, file, opts.max_elements),
-    }
-}
-
-/// Mesh file formats, for callers that choose the reader themselves.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum MeshFormat {
-    /// Wavefront OBJ.
-    Obj,
-    /// PLY (ASCII, binary little or big endian).
-    Ply,
-}
-
-/// Reads a mesh from bytes like [`read_obj`] / [`read_ply`], but first maps every vertex
-/// through `to_world` (metres to metres), so that welding and the coplanar merge run in the
-/// world frame with their tolerances in world metres: the `to_world` transform of a shape in
-/// a Mitsuba scene. A vertex that the transform makes non-finite is an error.
-pub fn read_transformed(
-    bytes: &[u8],
-    format: MeshFormat,
-    file: Option<&str>,
-    opts: &MergeOptions,
-    to_world: &dyn Fn(Vec3) -> Vec3,
-) -> Result<MeshImport, MeshError> {
-    let file = file.unwrap_or(UNNAMED);
-    let mut raw = parse(bytes, format, file, opts)?;
-    for (vertex, p) in raw.positions.iter_mut().enumerate() {
-        *p = to_world(*p);
-        if !p.is_finite() {
-            return Err(MeshError::NonFiniteTransformed {
-                file: file.to_string(),
-                vertex,
-            });
-        }
-    }
-    finish(raw, opts, file)
-}
-
-fn finish(raw: raw::RawMesh, opts: &MergeOptions, file: &str) -> Result<MeshImport, MeshError> {
-    let merged = merge::merge(&raw, opts, file);
-    let faces_read = raw.face_count();
-    let mut warnings = raw.warnings;
+    let merged = merge::merge(raw, opts, file);
+    let mut warnings = raw.warnings.clone();
     warnings.extend(merged.warnings);
     Ok(MeshImport {
         surfaces: merged.surfaces,
         warnings,
-        faces_read,
+        faces_read: raw.face_count(),
     })
 }

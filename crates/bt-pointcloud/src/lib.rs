@@ -1,9 +1,10 @@
-//! Point clouds for beamtrace: reading and writing PLY / PCD, extracting the planar
-//! surfaces of a scanned scene, and generating synthetic scans.
+//! Point clouds for beamtrace: extracting the planar surfaces of a scanned scene, and
+//! generating synthetic scans. An algorithm crate: reading and writing PLY / PCD files is
+//! `bt-import`'s (`bt_import::cloud`).
 //!
 //! The paper's geometric preprocessing extracts planes from a 3-D point cloud (with Open3D);
 //! planes of at least 0.25 m² take part in reflection, smaller ones only block rays. This
-//! crate is that step: [`io`] reads a scan, [`extract_planes`] returns bounded planes
+//! crate is that step: [`extract_planes`] returns bounded planes
 //! ([`ExtractedPlane`]: unit normal, offset, boundary polygon, area, reflector flag) and an
 //! [`ExtractionReport`], and [`sample_polygons`] makes synthetic scans for tests and
 //! benchmarks.
@@ -16,7 +17,6 @@
 pub mod cloud;
 pub mod error;
 pub mod extract;
-pub mod io;
 mod linalg;
 mod spatial;
 pub mod synth;

@@ -11,7 +11,7 @@ mod columns;
 mod options;
 
 use bt_geom::Vec3;
-use bt_scene::io::LoadOptions;
+use bt_import::LoadOptions;
 use bt_scene::{Scene, SceneError, Terminals};
 use bt_solve::Tracer;
 use bt_solve::pipeline::{TraceError, TraceOptions, Traced};
@@ -41,8 +41,11 @@ fn vec3(v: [f64; 3]) -> Vec3 {
 
 /// Load any source the CLI reads (`builtin:NAME`, JSON/TOML, OBJ/PLY meshes, point clouds,
 /// Mitsuba XML): the library's one loading entry.
-fn load_scene(source: &str, options: &LoadOptions) -> Result<bt_scene::io::Loaded, SceneError> {
-    bt_scene::io::load(source, options)
+fn load_scene(
+    source: &str,
+    options: &LoadOptions,
+) -> Result<bt_import::Loaded, bt_import::ImportError> {
+    bt_import::load(source, options)
 }
 
 /// A validated scene, ready to trace from any TX to any RX.
@@ -180,12 +183,17 @@ impl PyScene {
             .trace_options(&scene)
             .map_err(PyValueError::new_err)?;
         let reports = py.detach(|| {
-            let traced = self.with_tracer(scene.clone(), options, |t| {
-                t.trace_many(scene.tx_world(), &receivers)
-            });
-            report_each(&scene, &receivers, &traced?, options.parallel)
+            let traced = self
+                .with_tracer(scene.clone(), options, |t| {
+                    t.trace_many(scene.tx_world(), &receivers)
+                })
+                .map_err(Failure::Trace)?;
+            report_each(&scene, &receivers, &traced, options.parallel)
         });
-        let reports = reports.map_err(|e| self.error(e))?;
+        let reports = reports.map_err(|e| match e {
+            Failure::Trace(e) => self.error(e),
+            Failure::Report(message) => error(format!("{}: {message}", scene.name())),
+        })?;
         let dicts = reports
             .iter()
             .map(|paths| columns::to_dict(py, paths))
@@ -210,21 +218,26 @@ fn receivers_of(array: &PyReadonlyArray2<'_, f64>) -> PyResult<Vec<Vec3>> {
         .collect())
 }
 
+/// Why [`report_each`] or the trace before it failed: the trace, or a receiver's report (its
+/// message).
+enum Failure {
+    Trace(TraceError),
+    Report(String),
+}
+
 /// Each receiver's report of its trace (in parallel when asked).
 fn report_each(
     scene: &Scene,
     receivers: &[Vec3],
     traced: &[Traced],
     parallel: bool,
-) -> Result<Vec<Vec<bt_beams::PathReport>>, TraceError> {
+) -> Result<Vec<Vec<bt_beams::PathReport>>, Failure> {
     let one = |(rx, t): (&Vec3, &Traced)| {
-        let moved = scene.with_receiver(*rx)?;
-        bt_beams::report(&moved, &t.result.paths, &bt_beams::RadioOptions::default()).map_err(|e| {
-            TraceError::Scene(SceneError::Parse {
-                path: scene.name().to_string(),
-                message: e.to_string(),
-            })
-        })
+        let moved = scene
+            .with_receiver(*rx)
+            .map_err(|e| Failure::Trace(e.into()))?;
+        bt_beams::report(&moved, &t.result.paths, &bt_beams::RadioOptions::default())
+            .map_err(|e| Failure::Report(e.to_string()))
     };
     if parallel {
         receivers.par_iter().zip(traced).map(one).collect()
@@ -273,7 +286,7 @@ fn load(
 /// Names of the built-in scenes (`load("builtin:NAME")`).
 #[pyfunction]
 fn builtin_names() -> Vec<&'static str> {
-    bt_scene::builtin_names().to_vec()
+    bt_import::builtin_names().to_vec()
 }
 
 #[pymodule]

@@ -110,7 +110,7 @@ mod tests {
     }
 
     fn scene() -> Scene {
-        bt_scene::builtin_scene("living-room", Default::default())
+        bt_import::builtin_scene("living-room", Default::default())
             .unwrap()
             .unwrap()
     }

@@ -1,7 +1,7 @@
 //! The scene file format (JSON or TOML), as parsed, before validation.
 //! Documented in `docs/scene-format.md`; unknown fields are errors.
 
-use crate::model::SurfaceKind;
+use crate::surface::SurfaceKind;
 use bt_geom::Real;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
@@ -33,25 +33,11 @@ pub struct SceneDescription {
     pub steps: Option<u32>,
     /// Dynamic scenes: moving objects by name (members and motion).
     #[serde(default, skip_serializing_if = "BTreeMap::is_empty")]
-    pub objects: BTreeMap<String, crate::dynamic::ObjectDesc>,
+    pub objects: BTreeMap<String, ObjectDesc>,
     /// Dynamic scenes: TX position per step `[[x, y, z], ...]` (one per step), metres.
     pub tx_steps: Option<Vec<[Real; 3]>>,
     /// Dynamic scenes: RX position per step `[[x, y, z], ...]` (one per step), metres.
     pub rx_steps: Option<Vec<[Real; 3]>>,
-}
-
-impl SceneDescription {
-    /// The description as a scene file in `format` (`json` or `toml`, as `io::load` reads
-    /// them); absent optional fields are left out, never written as `null`.
-    pub fn to_text(&self, format: &str) -> Result<String, String> {
-        match format {
-            "json" => serde_json::to_string_pretty(self)
-                .map(|s| s + "\n")
-                .map_err(|e| e.to_string()),
-            "toml" => toml::to_string_pretty(self).map_err(|e| e.to_string()),
-            other => Err(format!("no scene writer for .{other} (use .json or .toml)")),
-        }
-    }
 }
 
 /// A material entry: a constant loss, a radio model, or both (`docs/scene-format.md`).
@@ -121,3 +107,40 @@ pub(crate) const BOX_FACES: [(&str, usize, bool); 6] = [
     ("south", 1, false),
     ("north", 1, true),
 ];
+
+/// A moving object as written in a scene file (an entry of `objects`).
+///
+/// Give either a constant per-step motion (`translate` and/or `rotate_deg`) or `keyframes`.
+#[serde_with::skip_serializing_none]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct ObjectDesc {
+    /// Names of surfaces or boxes that belong to the object, in addition to those whose
+    /// `object` field names it (a box name covers all its faces).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub members: Vec<String>,
+    /// Translation per step `[dx, dy, dz]`, metres.
+    pub translate: Option<[Real; 3]>,
+    /// Rotation per step about `axis` through `pivot`, degrees (right-hand rule).
+    pub rotate_deg: Option<Real>,
+    /// Point on the rotation axis (a door's hinge), metres. Required when the object rotates.
+    pub pivot: Option<[Real; 3]>,
+    /// Rotation axis direction (any length > 0; default `[0, 0, 1]`, z up).
+    pub axis: Option<[Real; 3]>,
+    /// Poses at given steps, linearly interpolated in between.
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub keyframes: Vec<KeyframeDesc>,
+}
+
+/// The pose of an object at one step.
+#[serde_with::skip_serializing_none]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct KeyframeDesc {
+    /// Time step (0-based, below `steps`; keyframes strictly increasing).
+    pub step: u32,
+    /// Translation from the file's geometry `[dx, dy, dz]`, metres (default zero).
+    pub offset: Option<[Real; 3]>,
+    /// Rotation about the object's axis through its pivot, degrees (default 0).
+    pub angle_deg: Option<Real>,
+}

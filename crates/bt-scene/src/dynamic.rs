@@ -13,12 +13,14 @@
 //! across steps; TX and RX are fixed unless the file gives `tx_steps` / `rx_steps`.
 
 use crate::description::{BOX_FACES, SceneDescription};
+pub use crate::description::{KeyframeDesc, ObjectDesc};
 use crate::frame::to_local;
-use crate::model::{Scene, Surface, SurfaceId};
-use crate::validate::{Problem, SceneError, Terminals, check_terminals};
-use crate::{builtin_json, io::parse_json};
+use crate::model::Scene;
+use crate::problem::{Problem, SceneError};
+use crate::surface::{Surface, SurfaceId};
+use crate::validate::{Terminals, check_terminals};
 use bt_geom::{Polygon, Real, Vec3};
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 use std::collections::BTreeMap;
 
 /// Largest `steps` a scene file may ask for. Every step is a full [`Scene`] (surfaces copied,
@@ -30,43 +32,6 @@ pub const MAX_STEPS: u32 = 10_000;
 /// each with the per-step BVH), so a 3 KB file of 70 boxes cannot ask for 10 000 steps of 420
 /// surfaces (2.5 GB); the limit is about 150 MB.
 pub const MAX_SURFACE_STEPS: usize = 250_000;
-
-/// A moving object as written in a scene file (an entry of `objects`).
-///
-/// Give either a constant per-step motion (`translate` and/or `rotate_deg`) or `keyframes`.
-#[serde_with::skip_serializing_none]
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
-#[serde(deny_unknown_fields)]
-pub struct ObjectDesc {
-    /// Names of surfaces or boxes that belong to the object, in addition to those whose
-    /// `object` field names it (a box name covers all its faces).
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub members: Vec<String>,
-    /// Translation per step `[dx, dy, dz]`, metres.
-    pub translate: Option<[Real; 3]>,
-    /// Rotation per step about `axis` through `pivot`, degrees (right-hand rule).
-    pub rotate_deg: Option<Real>,
-    /// Point on the rotation axis (a door's hinge), metres. Required when the object rotates.
-    pub pivot: Option<[Real; 3]>,
-    /// Rotation axis direction (any length > 0; default `[0, 0, 1]`, z up).
-    pub axis: Option<[Real; 3]>,
-    /// Poses at given steps, linearly interpolated in between.
-    #[serde(default, skip_serializing_if = "Vec::is_empty")]
-    pub keyframes: Vec<KeyframeDesc>,
-}
-
-/// The pose of an object at one step.
-#[serde_with::skip_serializing_none]
-#[derive(Debug, Clone, PartialEq, Serialize, Deserialize, Default)]
-#[serde(deny_unknown_fields)]
-pub struct KeyframeDesc {
-    /// Time step (0-based, below `steps`; keyframes strictly increasing).
-    pub step: u32,
-    /// Translation from the file's geometry `[dx, dy, dz]`, metres (default zero).
-    pub offset: Option<[Real; 3]>,
-    /// Rotation about the object's axis through its pivot, degrees (default 0).
-    pub angle_deg: Option<Real>,
-}
 
 /// Pose of an object at one step: rotation about an axis through a pivot, then translation.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -257,27 +222,6 @@ pub fn moved_surfaces(prev: &Scene, next: &Scene) -> Option<Vec<SurfaceId>> {
         }
     }
     Some(moved)
-}
-
-/// Names accepted by [`builtin_dynamic_scene`].
-pub fn builtin_dynamic_names() -> &'static [&'static str] {
-    &["living-room-dynamic"]
-}
-
-/// A built-in dynamic scene by name: `living-room-dynamic` is the built-in living room over 10
-/// steps with a person (0.4 × 0.3 × 1.75 m blocker) walking across the room through the
-/// line of sight, and the door swinging open about its hinge from 0° to 90° (10° per step).
-/// Static built-in scenes are returned as one-step dynamic scenes.
-pub fn builtin_dynamic_scene(
-    name: &str,
-    terminals: Terminals,
-) -> Option<Result<DynamicScene, SceneError>> {
-    let json = builtin_json(name)?;
-    let source = format!("builtin:{name}");
-    Some(
-        parse_json(json, &source)
-            .and_then(|d| DynamicScene::from_description(&d, &source, terminals)),
-    )
 }
 
 type FieldProblems = Vec<(String, String)>;
@@ -728,16 +672,6 @@ mod tests {
         for k in 1..4 {
             assert_eq!(d.step(k).surfaces().len(), d.step(0).surfaces().len());
         }
-    }
-
-    #[test]
-    fn static_description_gives_one_step_equal_to_the_static_scene() {
-        let json = builtin_json("living-room").unwrap();
-        let desc = parse_json(json, "x").unwrap();
-        let d = DynamicScene::from_description(&desc, "x", Terminals::default()).unwrap();
-        let s = Scene::from_description(&desc, "x", Terminals::default()).unwrap();
-        assert_eq!(d.len(), 1);
-        assert_eq!(moved_surfaces(d.step(0), &s), Some(vec![]));
     }
 
     /// Every problem `desc` is refused with, as printed.

@@ -8,7 +8,7 @@
 //! a vertex or along a plane is discarded for the next direction. When no direction is clear the
 //! answer is "unknown" and nothing is warned about.
 
-use crate::model::{Surface, SurfaceId};
+use crate::surface::{Surface, SurfaceId};
 use bt_geom::{Real, Vec3};
 use std::collections::BTreeMap;
 

@@ -17,7 +17,8 @@
 //!   coordinate's ulp and the difference is smaller than the coordinate): the local geometry is
 //!   the world geometry to the bit, and `to_world(to_local(p)) == p`.
 
-use crate::validate::{ProblemSink, RawSurface};
+use crate::problem::ProblemSink;
+use crate::surface::RawSurface;
 use bt_geom::{Real, Vec3, tol};
 
 /// A scene is recentred when its bounding-box centre is more than this many extents (of at

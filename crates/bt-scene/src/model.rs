@@ -1,47 +1,13 @@
 //! The validated scene model.
 
 use crate::material::Material;
-use bt_geom::{Bvh, Polygon, Real, Vec3};
-use serde::{Deserialize, Serialize};
+use crate::surface::{Surface, SurfaceId, SurfaceKind};
+use bt_geom::{Bvh, Real, Vec3};
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
-/// Index of a surface in [`Scene::surfaces`].
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord, Serialize, Deserialize)]
-pub struct SurfaceId(pub u32);
-
-impl SurfaceId {
-    /// The index as `usize`.
-    #[inline]
-    pub fn index(self) -> usize {
-        self.0 as usize
-    }
-}
-
-/// What a surface does to a ray.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum SurfaceKind {
-    /// Reflects specularly from both sides, and occludes.
-    Reflector,
-    /// Only occludes (small objects, people).
-    Blocker,
-}
-
-/// A named bounded planar surface.
-#[derive(Debug, Clone, PartialEq)]
-pub struct Surface {
-    /// Unique name (from the scene file, or generated for meshes).
-    pub name: String,
-    /// Material name, a key of [`Scene::materials`].
-    pub material: String,
-    /// Reflector or blocker.
-    pub kind: SurfaceKind,
-    /// The validated polygon (metres, world frame).
-    pub polygon: Polygon,
-}
-
-/// A validated scene. Construct it with [`crate::io`] loaders or [`Scene::from_description`];
+/// A validated scene. Construct it with [`Scene::from_description`] or [`Scene::from_surfaces`] (importers: the
+/// `bt-import` crate);
 /// every surface is a valid planar polygon, TX and RX are finite, distinct and off every surface.
 ///
 /// Positions are stored in the scene-local frame (`local = world − origin()`, see
@@ -254,80 +220,7 @@ impl Scene {
         conflicts.chain(enclosed).collect()
     }
 
-    /// A copy with other TX/RX positions (metres, world frame, like the scene file's),
-    /// validated like the originals; the scene keeps its local frame.
-    pub fn with_terminals(&self, tx: Vec3, rx: Vec3) -> Result<Scene, crate::SceneError> {
-        let (tx, rx) = (self.to_local(tx), self.to_local(rx));
-        crate::validate::check_terminals(
-            &self.surfaces,
-            tx,
-            rx,
-            self.extent_with(tx, rx),
-            self.origin,
-        )
-        .map_err(|problems| crate::SceneError::Invalid {
-            source_name: self.name.clone(),
-            problems,
-        })?;
-        let mut scene = self.clone();
-        scene.tx = tx;
-        scene.rx = rx;
-        scene.extent = self.extent_with(tx, rx);
-        Ok(scene)
-    }
-
-    /// A copy with another RX (metres, world frame) and the same TX: the receiver of a sweep
-    /// grid point or of `trace_receivers`.
-    pub fn with_receiver(&self, rx: Vec3) -> Result<Scene, crate::SceneError> {
-        self.with_terminals(self.tx_world(), rx)
-    }
-
-    /// A copy at another carrier frequency (Hz), checked against the radio models of the
-    /// materials in use (ITU validity ranges).
-    pub fn with_frequency(&self, frequency_hz: Real) -> Result<Scene, crate::SceneError> {
-        let mut problems = Vec::new();
-        if !(frequency_hz.is_finite() && frequency_hz > 0.0) {
-            problems.push(crate::Problem {
-                location: "frequency_hz".into(),
-                message: format!("must be a positive finite number, got {frequency_hz}"),
-            });
-        } else {
-            problems =
-                crate::validate::radio_problems(&self.surfaces, &self.materials, frequency_hz);
-        }
-        if !problems.is_empty() {
-            return Err(crate::SceneError::Invalid {
-                source_name: self.name.clone(),
-                problems,
-            });
-        }
-        let mut scene = self.clone();
-        scene.frequency_hz = frequency_hz;
-        Ok(scene)
-    }
-
-    /// A copy in which every material has the radio model `radio` (CLI `--material`), checked
-    /// at the scene's frequency. The constant `reflection_loss_db` of each material stays.
-    pub fn with_radio_material(
-        &self,
-        radio: bt_channel::RadioMaterial,
-    ) -> Result<Scene, crate::SceneError> {
-        let mut scene = self.clone();
-        for m in Arc::make_mut(&mut scene.materials).values_mut() {
-            m.radio = Some(radio);
-        }
-        let problems =
-            crate::validate::radio_problems(&scene.surfaces, &scene.materials, scene.frequency_hz);
-        if !problems.is_empty() {
-            return Err(crate::SceneError::Invalid {
-                source_name: self.name.clone(),
-                problems,
-            });
-        }
-        Ok(scene)
-    }
-
-    fn extent_with(&self, tx: Vec3, rx: Vec3) -> Real {
+    pub(crate) fn extent_with(&self, tx: Vec3, rx: Vec3) -> Real {
         scene_extent(&self.surfaces, tx, rx)
     }
 }

@@ -3,13 +3,13 @@
 use crate::description::{BOX_FACES, SceneDescription};
 use crate::frame::{to_local, to_world};
 use crate::material::{DEFAULT_MATERIAL, Material, default_materials};
-use crate::model::{Scene, Surface, SurfaceKind, scene_extent};
+use crate::model::{Scene, scene_extent};
+use crate::problem::{Collector, Problem, ProblemSink, SceneError};
+use crate::surface::{RawSurface, Surface, SurfaceKind};
 use bt_channel::RadioMaterial;
 use bt_geom::{Bvh, Polygon, Real, Vec3};
-use serde::Serialize;
-use std::collections::BTreeSet;
-use std::fmt;
-use thiserror::Error;
+use std::collections::{BTreeMap, BTreeSet};
+use std::sync::Arc;
 
 /// Default carrier frequency when a scene names none: 28 GHz (FR2 mmWave).
 pub const DEFAULT_FREQUENCY_HZ: Real = 28e9;
@@ -20,101 +20,6 @@ pub const MIN_FREQUENCY_HZ: Real = 1e3;
 /// Highest carrier frequency accepted, Hz (1 PHz: beyond, Friis' 4π d f / c overflows for
 /// long paths and geometric optics is all that is left anyway).
 pub const MAX_FREQUENCY_HZ: Real = 1e15;
-
-/// One problem found in a scene, located by field path (e.g. `surfaces[3] "sofa.top"`).
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Problem {
-    /// Where: a field path into the scene description.
-    pub location: String,
-    /// What is wrong, lowercase.
-    pub message: String,
-}
-
-impl fmt::Display for Problem {
-    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-        write!(f, "{}: {}", self.location, self.message)
-    }
-}
-
-/// Errors of scene loading and validation.
-#[derive(Debug, Error)]
-pub enum SceneError {
-    /// The file could not be read.
-    #[error("{path}: {source}")]
-    Io {
-        /// File path.
-        path: String,
-        /// Underlying error.
-        source: std::io::Error,
-    },
-    /// The file is not valid JSON/TOML of the scene format.
-    #[error("{path}: {message}")]
-    Parse {
-        /// File path.
-        path: String,
-        /// Parser message with line and column.
-        message: String,
-    },
-    /// A mesh file could not be imported.
-    #[error(transparent)]
-    Mesh(#[from] bt_mesh::MeshError),
-    /// A point cloud could not be read, or its planes not extracted.
-    #[error(transparent)]
-    PointCloud(#[from] bt_pointcloud::PointCloudError),
-    /// The extension is not one of the supported formats.
-    #[error(
-        "{path}: unsupported scene format (expected .json, .toml, .xml, .obj, .ply, .pcd or builtin:NAME)"
-    )]
-    UnsupportedFormat {
-        /// File path.
-        path: String,
-    },
-    /// A Mitsuba/Sionna XML scene is malformed or uses what beamtrace does not support.
-    #[error("{path}: line {line}, column {column}: {message}")]
-    Xml {
-        /// File path.
-        path: String,
-        /// 1-based line of the offending element.
-        line: u32,
-        /// 1-based column.
-        column: u32,
-        /// What is wrong, naming the element.
-        message: String,
-    },
-    /// A directory was given where a scene file is expected.
-    #[error("{path}: is a directory, not a scene file")]
-    IsDirectory {
-        /// The directory's path.
-        path: String,
-    },
-    /// `builtin:NAME` names no built-in scene.
-    #[error("unknown built-in scene \"{name}\" (built-in scenes: {known})")]
-    UnknownBuiltin {
-        /// The name after `builtin:`.
-        name: String,
-        /// The known names, comma-separated.
-        known: String,
-    },
-    /// The scene has one or more problems; all are listed.
-    #[error("{source_name}: {} problem(s):\n{}", problems.len(), problems.iter().map(|p| format!("  - {p}")).collect::<Vec<_>>().join("\n"))]
-    Invalid {
-        /// File or scene name.
-        source_name: String,
-        /// Every problem found.
-        problems: Vec<Problem>,
-    },
-}
-
-struct Collector(Vec<Problem>);
-
-impl Collector {
-    fn push(&mut self, location: impl Into<String>, message: impl Into<String>) {
-        self.0.push(Problem {
-            location: location.into(),
-            message: message.into(),
-        });
-    }
-}
 
 /// Terminal positions given outside the description (CLI `--tx/--rx`, mesh import).
 #[derive(Debug, Clone, Copy, Default)]
@@ -178,22 +83,55 @@ impl Scene {
         if let Err(p) = check_terminals(&surfaces, tx, rx, extent, origin) {
             problems.0.extend(p);
         }
-        if !problems.0.is_empty() {
-            return Err(SceneError::Invalid {
-                source_name: source_name.to_string(),
-                problems: problems.0,
-            });
-        }
         let name = desc.name.clone().unwrap_or_else(|| source_name.to_string());
-        Ok(Scene::assemble(
-            name,
-            origin,
-            surfaces,
-            tx,
-            rx,
-            frequency_hz,
-            materials,
-        ))
+        conclude(source_name, problems.0, || {
+            Scene::assemble(name, origin, surfaces, tx, rx, frequency_hz, materials)
+        })
+    }
+}
+
+impl Scene {
+    /// Validate surfaces that an importer made (mesh faces, extracted planes) into a scene
+    /// named `name`: every problem is collected (names, materials, polygons, terminals, radio
+    /// models at `frequency_hz`) and reported under `source_name`. `raw` and `tx`/`rx` are in
+    /// the world frame (metres); the scene is recentred like a scene file.
+    pub fn from_surfaces(
+        name: &str,
+        source_name: &str,
+        mut raw: Vec<RawSurface>,
+        materials: BTreeMap<String, Material>,
+        (tx, rx): (Vec3, Vec3),
+        frequency_hz: Real,
+    ) -> Result<Scene, SceneError> {
+        let mut problems: Vec<Problem> = Vec::new();
+        let origin = crate::frame::recentre(&mut raw, [Some(tx), Some(rx)], &mut problems);
+        let surfaces = build_surfaces(raw, &materials, &mut problems);
+        let (tx, rx) = (to_local(tx, origin), to_local(rx, origin));
+        let extent = scene_extent(&surfaces, tx, rx);
+        if let Err(p) = check_terminals(&surfaces, tx, rx, extent, origin) {
+            problems.extend(p);
+        }
+        problems.extend(radio_problems(&surfaces, &materials, frequency_hz));
+        let name = name.to_string();
+        conclude(source_name, problems, || {
+            Scene::assemble(name, origin, surfaces, tx, rx, frequency_hz, materials)
+        })
+    }
+}
+
+/// The scene `assemble` builds when no problem was found, else every problem.
+fn conclude(
+    source_name: &str,
+    problems: Vec<Problem>,
+    assemble: impl FnOnce() -> Scene,
+) -> Result<Scene, SceneError> {
+    if problems.is_empty() {
+        Ok(assemble())
+    } else {
+        Err(SceneError::Invalid {
+            source_name: source_name.to_string(),
+            problems,
+        })
     }
 }
 
@@ -298,7 +236,7 @@ impl Scene {
 /// `frequency_hz` (when valid) derives a missing `reflection_loss_db` from the radio model.
 fn material_from_desc(
     location: &str,
-    m: &crate::MaterialDesc,
+    m: &crate::description::MaterialDesc,
     frequency_hz: Option<Real>,
     problems: &mut impl ProblemSink,
 ) -> Option<Material> {
@@ -410,14 +348,6 @@ pub(crate) fn radio_problems(
     problems
 }
 
-pub(crate) struct RawSurface {
-    pub location: String,
-    pub name: String,
-    pub material: Option<String>,
-    pub kind: SurfaceKind,
-    pub vertices: Vec<Vec3>,
-}
-
 pub(crate) fn build_surfaces(
     raw: Vec<RawSurface>,
     materials: &std::collections::BTreeMap<String, Material>,
@@ -455,34 +385,6 @@ pub(crate) fn build_surfaces(
         }
     }
     surfaces
-}
-
-/// Where validation problems go.
-pub(crate) trait ProblemSink {
-    fn report(&mut self, location: &str, message: impl Into<String>);
-    /// Problems reported so far.
-    fn count(&self) -> usize;
-}
-
-impl ProblemSink for Collector {
-    fn report(&mut self, location: &str, message: impl Into<String>) {
-        self.push(location, message);
-    }
-    fn count(&self) -> usize {
-        self.0.len()
-    }
-}
-
-impl ProblemSink for Vec<Problem> {
-    fn report(&mut self, location: &str, message: impl Into<String>) {
-        self.push(Problem {
-            location: location.to_string(),
-            message: message.into(),
-        });
-    }
-    fn count(&self) -> usize {
-        self.len()
-    }
 }
 
 fn terminal(field: &str, value: Option<Vec3>, problems: &mut Collector) -> Option<Vec3> {
@@ -567,4 +469,77 @@ fn box_face(lo: Vec3, hi: Vec3, axis: usize, is_max: bool) -> Vec<Vec3> {
         face.reverse();
     }
     face
+}
+
+impl Scene {
+    /// A copy with other TX/RX positions (metres, world frame, like the scene file's),
+    /// validated like the originals; the scene keeps its local frame.
+    pub fn with_terminals(&self, tx: Vec3, rx: Vec3) -> Result<Scene, crate::SceneError> {
+        let (tx, rx) = (self.to_local(tx), self.to_local(rx));
+        check_terminals(
+            &self.surfaces,
+            tx,
+            rx,
+            self.extent_with(tx, rx),
+            self.origin,
+        )
+        .map_err(|problems| crate::SceneError::Invalid {
+            source_name: self.name.clone(),
+            problems,
+        })?;
+        let mut scene = self.clone();
+        scene.tx = tx;
+        scene.rx = rx;
+        scene.extent = self.extent_with(tx, rx);
+        Ok(scene)
+    }
+
+    /// A copy with another RX (metres, world frame) and the same TX: the receiver of a sweep
+    /// grid point or of `trace_receivers`.
+    pub fn with_receiver(&self, rx: Vec3) -> Result<Scene, crate::SceneError> {
+        self.with_terminals(self.tx_world(), rx)
+    }
+
+    /// A copy at another carrier frequency (Hz), checked against the radio models of the
+    /// materials in use (ITU validity ranges).
+    pub fn with_frequency(&self, frequency_hz: Real) -> Result<Scene, crate::SceneError> {
+        let mut problems = Vec::new();
+        if !(frequency_hz.is_finite() && frequency_hz > 0.0) {
+            problems.push(crate::Problem {
+                location: "frequency_hz".into(),
+                message: format!("must be a positive finite number, got {frequency_hz}"),
+            });
+        } else {
+            problems = radio_problems(&self.surfaces, &self.materials, frequency_hz);
+        }
+        if !problems.is_empty() {
+            return Err(crate::SceneError::Invalid {
+                source_name: self.name.clone(),
+                problems,
+            });
+        }
+        let mut scene = self.clone();
+        scene.frequency_hz = frequency_hz;
+        Ok(scene)
+    }
+
+    /// A copy in which every material has the radio model `radio` (CLI `--material`), checked
+    /// at the scene's frequency. The constant `reflection_loss_db` of each material stays.
+    pub fn with_radio_material(
+        &self,
+        radio: bt_channel::RadioMaterial,
+    ) -> Result<Scene, crate::SceneError> {
+        let mut scene = self.clone();
+        for m in Arc::make_mut(&mut scene.materials).values_mut() {
+            m.radio = Some(radio);
+        }
+        let problems = radio_problems(&scene.surfaces, &scene.materials, scene.frequency_hz);
+        if !problems.is_empty() {
+            return Err(crate::SceneError::Invalid {
+                source_name: self.name.clone(),
+                problems,
+            });
+        }
+        Ok(scene)
+    }
 }

@@ -50,7 +50,7 @@ fn trace_and_report(tracer: &mut Tracer) -> usize {
 }
 
 fn living_room(c: &mut Criterion) {
-    let scene = bt_scene::builtin_scene("living-room", Terminals::default())
+    let scene = bt_import::builtin_scene("living-room", Terminals::default())
         .unwrap()
         .unwrap();
     let gs_options = IpcOptions::for_scene(&scene, UpdateOrder::GaussSeidel);
@@ -123,7 +123,7 @@ fn living_room(c: &mut Criterion) {
 }
 
 fn city(c: &mut Criterion) {
-    let scene = bt_scene::builtin_scene("city", Terminals::default())
+    let scene = bt_import::builtin_scene("city", Terminals::default())
         .unwrap()
         .unwrap();
     let mut group = c.benchmark_group("city");

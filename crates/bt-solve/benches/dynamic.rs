@@ -2,13 +2,13 @@
 //! living room, incremental vs from scratch, per candidate generator (single thread, image
 //! method, order 3).
 //!
-//! `cargo bench -p bt-dynamic`; the reduction ratio and the incremental/scratch ratio of the
+//! `cargo bench -p bt-solve --bench dynamic`; the reduction ratio and the incremental/scratch ratio of the
 //! mean step times are printed to stderr before the criterion groups run.
 
+use bt_import::builtin_dynamic_scene;
 use bt_paths::wvrn::Wvrn;
 use bt_paths::{AllVisible, enumerate};
 use bt_scene::Terminals;
-use bt_scene::dynamic::builtin_dynamic_scene;
 use bt_solve::Solver;
 use bt_solve::Tracer;
 use bt_solve::pipeline::{CandidateMode, TraceOptions};
@@ -30,7 +30,7 @@ fn options(candidates: CandidateMode) -> TraceOptions {
 }
 
 fn wvrn(c: &mut Criterion) {
-    let scene = bt_scene::builtin_scene("living-room", Terminals::default())
+    let scene = bt_import::builtin_scene("living-room", Terminals::default())
         .unwrap()
         .unwrap();
     let dynamic = builtin_dynamic_scene("living-room-dynamic", Terminals::default())

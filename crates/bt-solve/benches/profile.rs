@@ -9,7 +9,7 @@ use bt_solve::{Acceleration, IpcOptions, Solver, UpdateOrder, trace};
 use std::hint::black_box;
 
 fn main() {
-    let scene = bt_scene::builtin_scene("living-room", Default::default())
+    let scene = bt_import::builtin_scene("living-room", Default::default())
         .unwrap()
         .unwrap();
     let candidates = enumerate(&scene, 3, &AllVisible);

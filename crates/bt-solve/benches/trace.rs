@@ -7,7 +7,7 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use std::hint::black_box;
 
 fn living_room(c: &mut Criterion) {
-    let scene = bt_scene::builtin_scene("living-room", Default::default())
+    let scene = bt_import::builtin_scene("living-room", Default::default())
         .unwrap()
         .unwrap();
     let candidates = enumerate(&scene, 3, &AllVisible);

@@ -3,7 +3,7 @@ use bt_paths::beamtree::{TreeOptions, candidates};
 use bt_scene::Terminals;
 use bt_solve::{CandidateOutcome, IpcOptions, Solver, UpdateOrder};
 fn main() {
-    let scene = bt_scene::builtin_scene("living-room", Terminals::default())
+    let scene = bt_import::builtin_scene("living-room", Terminals::default())
         .unwrap()
         .unwrap();
     let set = candidates(&scene, TreeOptions::new(3)).unwrap();

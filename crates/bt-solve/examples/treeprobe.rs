@@ -100,7 +100,7 @@ fn main() {
         [_, what, n] => (what.as_str(), n.parse::<usize>().expect("N is a count")),
         _ => panic!("usage: treeprobe WHAT N"),
     };
-    let scene = bt_scene::builtin_scene("living-room", Terminals::default())
+    let scene = bt_import::builtin_scene("living-room", Terminals::default())
         .unwrap()
         .unwrap();
     let tree = BeamTree::build(&scene, TreeOptions::new(3)).unwrap();

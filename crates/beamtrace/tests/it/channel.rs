@@ -204,7 +204,7 @@ fn near_field_is_clamped_and_warned() {
 }
 
 /// `--frequency` and `--material` reach every step of a dynamic scene (they load through the
-/// same `bt_scene::load_dynamic` as every source); a material the table does not define at the
+/// same `bt_import::load_dynamic` as every source); a material the table does not define at the
 /// carrier is still refused, naming it.
 #[test]
 fn overrides_apply_to_every_step_of_a_dynamic_scene() {

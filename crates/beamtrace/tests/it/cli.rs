@@ -238,7 +238,7 @@ fn bad_inputs_give_clear_errors() {
     std::fs::remove_dir_all(&dir).ok();
 }
 
-/// Every command loads through `bt_scene::load`: an unknown built-in gives the same message
+/// Every command loads through `bt_import::load`: an unknown built-in gives the same message
 /// from the static, dynamic and WVRN paths.
 #[test]
 fn unknown_builtin_is_one_error_everywhere() {

@@ -13,7 +13,7 @@ use std::path::Path;
 /// opens by 10° per step.
 fn short_living_room(dir: &Path, steps: usize) -> String {
     let source =
-        Path::new(env!("CARGO_MANIFEST_DIR")).join("../bt-scene/scenes/living-room-dynamic.json");
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("../bt-import/scenes/living-room-dynamic.json");
     let mut scene: Value =
         serde_json::from_str(&std::fs::read_to_string(source).expect("built-in scene")).unwrap();
     scene["steps"] = steps.into();

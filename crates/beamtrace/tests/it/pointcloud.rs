@@ -48,7 +48,7 @@ fn extraction_recovers_the_living_room_and_its_paths() {
     ));
 
     let original: Value =
-        serde_json::from_str(bt_scene::builtin_json("living-room").unwrap()).unwrap();
+        serde_json::from_str(bt_import::builtin_json("living-room").unwrap()).unwrap();
     let extracted = read_json(&scene);
     let found = polygons(&extracted);
     let mut failures = Vec::new();

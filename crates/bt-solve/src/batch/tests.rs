@@ -85,7 +85,7 @@ fn solvers(scene: &Scene) -> Vec<Solver> {
 
 #[test]
 fn lanes_equal_one_by_one_on_the_living_room() {
-    let scene = bt_scene::builtin_scene("living-room", bt_scene::Terminals::default())
+    let scene = bt_import::builtin_scene("living-room", bt_scene::Terminals::default())
         .unwrap()
         .unwrap();
     // Exhaustive candidates from the centroids: every kind of ending, many of each order.

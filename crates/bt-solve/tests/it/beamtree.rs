@@ -51,15 +51,15 @@ fn traced_like_exhaustive(scene: &Scene, order: usize) -> bt_solve::pipeline::Tr
 
 /// The 6 × 6-lot city (about 180 surfaces), TX on a mast, RX in the street at `(y, z)`.
 fn small_city(rx_y: Real, rx_z: Real) -> Scene {
-    let city = bt_scene::city::CityOptions {
+    let city = bt_import::city::CityOptions {
         lots: 6,
-        ..bt_scene::city::CityOptions::default()
+        ..bt_import::city::CityOptions::default()
     };
     let terminals = Terminals {
         tx: Some(city.street_point(0, 60.0, 10.0)),
         rx: Some(city.street_point(0, rx_y, rx_z)),
     };
-    bt_scene::city::city_scene(&city, terminals).unwrap()
+    bt_import::city::city_scene(&city, terminals).unwrap()
 }
 
 fn assert_same(a: &[FoundPath], b: &[FoundPath]) -> Result<(), TestCaseError> {
@@ -164,7 +164,7 @@ fn random_furnished_rooms_agree_at_order_four() {
 
 #[test]
 fn living_room_same_paths_and_few_candidates() {
-    let scene = bt_scene::builtin_scene("living-room", Terminals::default())
+    let scene = bt_import::builtin_scene("living-room", Terminals::default())
         .unwrap()
         .unwrap();
     for order in 1..=4 {
@@ -185,7 +185,7 @@ fn living_room_same_paths_and_few_candidates() {
 /// (the grown window's centre, within the margin).
 #[test]
 fn start_points_only_when_asked_for_and_the_same_candidates_either_way() {
-    let scene = bt_scene::builtin_scene("living-room", Terminals::default())
+    let scene = bt_import::builtin_scene("living-room", Terminals::default())
         .unwrap()
         .unwrap();
     let with = bt_paths::beamtree::candidates(&scene, TreeOptions::new(3)).unwrap();
@@ -217,7 +217,7 @@ fn start_points_only_when_asked_for_and_the_same_candidates_either_way() {
 
 #[test]
 fn full_tree_walk_equals_the_single_receiver_trace() {
-    let scene = bt_scene::builtin_scene("living-room", Terminals::default())
+    let scene = bt_import::builtin_scene("living-room", Terminals::default())
         .unwrap()
         .unwrap();
     let tree = BeamTree::build(&scene, TreeOptions::new(3)).unwrap();
@@ -381,10 +381,9 @@ proptest! {
 /// built again, and every step's paths equal a fresh build's.
 #[test]
 fn the_swinging_door_rebuilds_only_its_subtrees() {
-    let dynamic =
-        bt_scene::dynamic::builtin_dynamic_scene("living-room-dynamic", Terminals::default())
-            .expect("builtin")
-            .expect("dynamic");
+    let dynamic = bt_import::builtin_dynamic_scene("living-room-dynamic", Terminals::default())
+        .expect("builtin")
+        .expect("dynamic");
     let scenes = dynamic.scenes();
     let opts = TreeOptions::new(3);
     let mut tree = BeamTree::build(&scenes[0], opts).expect("tree builds");
@@ -418,10 +417,9 @@ fn listing(set: &bt_paths::CandidateSet) -> Vec<(Vec<bt_scene::SurfaceId>, Optio
 /// candidates (and start points) of a thread that starts afresh.
 #[test]
 fn kept_hulls_give_the_candidates_of_a_fresh_thread() {
-    let dynamic =
-        bt_scene::dynamic::builtin_dynamic_scene("living-room-dynamic", Terminals::default())
-            .unwrap()
-            .unwrap();
+    let dynamic = bt_import::builtin_dynamic_scene("living-room-dynamic", Terminals::default())
+        .unwrap()
+        .unwrap();
     let (closed, open) = (dynamic.step(0), dynamic.step(dynamic.len() - 1));
     assert_eq!(closed.surfaces().len(), open.surfaces().len());
     let moved = closed

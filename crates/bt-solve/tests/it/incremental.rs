@@ -4,9 +4,10 @@
 
 use bt_testkit::partitioned as common;
 
+use bt_import::builtin_dynamic_scene;
 use bt_paths::wvrn::Wvrn;
 use bt_scene::Terminals;
-use bt_scene::dynamic::{DynamicScene, builtin_dynamic_scene, moved_surfaces};
+use bt_scene::dynamic::{DynamicScene, moved_surfaces};
 use bt_solve::pipeline::{CandidateMode, TraceOptions};
 use bt_solve::steps::trace_scratch;
 use bt_solve::{IpcOptions, Solver, UpdateOrder};
@@ -202,8 +203,8 @@ fn a_walking_person_keeps_the_beam_tree() {
     // The tree depends on reflectors and on the occluders that culled a node (none in the
     // living room): steps where only the person (a blocker) moves keep the candidates, and
     // their paths still equal a from-scratch trace. The door is held shut here.
-    let json = bt_scene::builtin_json("living-room-dynamic").unwrap();
-    let mut description = bt_scene::io::parse_json(json, "test").unwrap();
+    let json = bt_import::builtin_json("living-room-dynamic").unwrap();
+    let mut description = bt_import::parse_json(json, "test").unwrap();
     description
         .objects
         .remove("door")
@@ -253,8 +254,8 @@ fn the_swinging_door_rebuilds_only_the_subtrees_it_touches() {
 fn a_walking_handset_is_a_walk_of_the_kept_tree() {
     // RX moves 0.3 m per step through the living room while the door swings and the person
     // walks: every step equals a from-scratch trace.
-    let json = bt_scene::builtin_json("living-room-dynamic").unwrap();
-    let mut description = bt_scene::io::parse_json(json, "test").unwrap();
+    let json = bt_import::builtin_json("living-room-dynamic").unwrap();
+    let mut description = bt_import::parse_json(json, "test").unwrap();
     let rx = description.rx.expect("the living room has an RX");
     description.rx_steps = Some(
         (0..10)

@@ -80,7 +80,7 @@ proptest! {
 
 #[test]
 fn builtin_living_room_ipc_equals_image_method() {
-    let scene = bt_scene::builtin_scene("living-room", Default::default())
+    let scene = bt_import::builtin_scene("living-room", Default::default())
         .unwrap()
         .unwrap();
     let reference = run(&scene, 3, Solver::Image);
@@ -95,7 +95,7 @@ fn builtin_living_room_ipc_equals_image_method() {
 
 #[test]
 fn living_room_early_blocked_stops_agree_with_the_image_method() {
-    let scene = bt_scene::builtin_scene("living-room", Default::default())
+    let scene = bt_import::builtin_scene("living-room", Default::default())
         .unwrap()
         .unwrap();
     // wall-north > window > wall-north alone ran 3,740 rounds to a blocked path.

@@ -18,7 +18,7 @@ const OFFSETS: [[Real; 3]; 4] = [
 ];
 
 fn living_room() -> SceneDescription {
-    serde_json::from_str(bt_scene::builtin_json("living-room").unwrap()).unwrap()
+    serde_json::from_str(bt_import::builtin_json("living-room").unwrap()).unwrap()
 }
 
 fn paths(scene: &Scene, solver: Solver, order: usize) -> Vec<PathReport> {

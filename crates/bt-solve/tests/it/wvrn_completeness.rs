@@ -73,7 +73,7 @@ fn random_scenes_keep_every_path_and_lose_candidates_behind_occluders() {
 
 #[test]
 fn living_room_keeps_every_path() {
-    let scene = bt_scene::builtin_scene("living-room", Terminals::default())
+    let scene = bt_import::builtin_scene("living-room", Terminals::default())
         .unwrap()
         .unwrap();
     let (all, routed, valid) = compare(&scene, 3);

@@ -476,8 +476,8 @@ pub fn run(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use bt_import::builtin_dynamic_scene;
     use bt_scene::Terminals;
-    use bt_scene::dynamic::builtin_dynamic_scene;
 
     #[test]
     fn drawn_steps_are_the_papers_first_and_fifth() {

@@ -71,7 +71,7 @@ fn check(scene: &Scene, max_order: usize) -> Counts {
 
 #[test]
 fn living_room_keeps_every_valid_path() {
-    let scene = bt_scene::builtin_scene("living-room", Terminals::default())
+    let scene = bt_import::builtin_scene("living-room", Terminals::default())
         .unwrap()
         .unwrap();
     let c = check(&scene, 3);

@@ -183,7 +183,8 @@ fn shifted(value: &Value, offset: [f64; 3]) -> Value {
 #[test]
 fn a_scene_far_from_the_origin_traces_like_the_same_scene_at_it() {
     let dir = scratch("far");
-    let room: Value = serde_json::from_str(bt_scene::builtin_json("living-room").unwrap()).unwrap();
+    let room: Value =
+        serde_json::from_str(bt_import::builtin_json("living-room").unwrap()).unwrap();
     let near = scene_with(&dir, "near.json", &room.to_string());
     for offset in [[1e7, 1e7, 100.0], [-3.2e5, 2.7e6, -50.0]] {
         let far = scene_with(&dir, "far.json", &shifted(&room, offset).to_string());

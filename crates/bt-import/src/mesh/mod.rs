@@ -1,0 +1,144 @@
+//! Mesh files (Wavefront OBJ, PLY) to bounded planar polygon surfaces: the readers parse bytes
+//! into a [`bt_mesh::RawMesh`] (polygon soup) and `bt-mesh` welds and merges it
+//! ([`bt_mesh::merge_mesh`]). [`read_mesh_path`] reads a file and picks the reader by
+//! extension; [`scene`] turns the surfaces into a [`bt_scene::Scene`].
+//!
+//! Units and frame: coordinates are taken as metres in the file's own frame (beamtrace uses
+//! z up; no axis swap is applied).
+
+mod error;
+mod obj;
+mod ply;
+pub mod scene;
+
+use bt_geom::Vec3;
+use bt_mesh::{MergeOptions, MeshImport, RawMesh};
+use std::path::Path;
+
+pub use error::{MeshError, Position};
+
+/// The file name used in messages when none is given.
+const UNNAMED: &str = "<input>";
+
+/// Mesh file formats, for callers that choose the reader themselves.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MeshFormat {
+    /// Wavefront OBJ.
+    Obj,
+    /// PLY (ASCII, binary little or big endian).
+    Ply,
+}
+
+/// Reads a Wavefront OBJ mesh from bytes and merges its faces into planar surfaces.
+/// `file` names the source in errors and warnings. `.mtl` libraries are not read; `usemtl`
+/// names are kept as [`bt_mesh::MeshSurface::material`].
+pub fn read_obj(
+    bytes: &[u8],
+    file: Option<&str>,
+    opts: &MergeOptions,
+) -> Result<MeshImport, MeshError> {
+    read_transformed(bytes, MeshFormat::Obj, file, opts, &|p| p)
+}
+
+/// Reads a PLY mesh (ASCII, binary little or big endian) from bytes and merges its faces into
+/// planar surfaces. `file` names the source in errors and warnings.
+pub fn read_ply(
+    bytes: &[u8],
+    file: Option<&str>,
+    opts: &MergeOptions,
+) -> Result<MeshImport, MeshError> {
+    read_transformed(bytes, MeshFormat::Ply, file, opts, &|p| p)
+}
+
+/// Checks `opts` and parses `bytes` as `format` into the polygon soup the merge starts from.
+fn parse(
+    bytes: &[u8],
+    format: MeshFormat,
+    file: Option<&str>,
+    opts: &MergeOptions,
+) -> Result<RawMesh, MeshError> {
+    let file = file.unwrap_or(UNNAMED);
+    opts.validate()?;
+    match format {
+        MeshFormat::Obj => obj::parse(bytes, file, opts.max_elements),
+        MeshFormat::Ply => ply::parse(bytes, file, opts.max_elements),
+    }
+}
+
+/// Reads a mesh from bytes like [`read_obj`] / [`read_ply`], but first maps every vertex
+/// through `to_world` (metres to metres), so that welding and the coplanar merge run in the
+/// world frame with their tolerances in world metres: the `to_world` transform of a shape in
+/// a Mitsuba scene. A vertex that the transform makes non-finite is an error.
+pub fn read_transformed(
+    bytes: &[u8],
+    format: MeshFormat,
+    file: Option<&str>,
+    opts: &MergeOptions,
+    to_world: &dyn Fn(Vec3) -> Vec3,
+) -> Result<MeshImport, MeshError> {
+    let mut raw = parse(bytes, format, file, opts)?;
+    let file = file.unwrap_or(UNNAMED);
+    for (vertex, p) in raw.positions.iter_mut().enumerate() {
+        *p = to_world(*p);
+        if !p.is_finite() {
+            return Err(MeshError::NonFiniteTransformed {
+                file: file.to_string(),
+                vertex,
+            });
+        }
+    }
+    Ok(bt_mesh::merge_mesh(&raw, opts, file)?)
+}
+
+/// Reads the mesh file at `path` and merges its faces into planar surfaces, choosing the
+/// reader by extension (`.obj` or `.ply`, case-insensitive). Coordinates are in metres.
+pub fn read_mesh_path(path: &Path, opts: &MergeOptions) -> Result<MeshImport, MeshError> {
+    let file = path.display().to_string();
+    let extension = path
+        .extension()
+        .map(|e| e.to_string_lossy().to_ascii_lowercase())
+        .unwrap_or_default();
+    let format = match extension.as_str() {
+        "obj" => MeshFormat::Obj,
+        "ply" => MeshFormat::Ply,
+        _ => return Err(MeshError::UnsupportedExtension { file, extension }),
+    };
+    opts.validate()?;
+    let bytes = std::fs::read(path).map_err(|source| MeshError::Io {
+        file: file.clone(),
+        source,
+    })?;
+    read_transformed(&bytes, format, Some(&file), opts, &|p| p)
+}
+
+/// Returns the index of `name` in `table`, appending it when new. Linear search: files have a
+/// handful of objects and materials, and the reader caches the current one.
+fn intern(table: &mut Vec<String>, name: &str) -> u32 {
+    match table.iter().position(|n| n == name) {
+        Some(i) => i as u32,
+        None => {
+            table.push(name.to_owned());
+            (table.len() - 1) as u32
+        }
+    }
+}
+
+/// Refuse the next element of kind `element` (`vertices` or `faces`) of an OBJ file when
+/// `so_far` of them already fill the budget `max_elements`.
+fn check_budget(
+    file: &str,
+    element: &'static str,
+    so_far: usize,
+    max_elements: u64,
+    line: usize,
+) -> Result<(), MeshError> {
+    if (so_far as u64) < max_elements {
+        return Ok(());
+    }
+    Err(MeshError::Budget {
+        file: file.to_owned(),
+        element,
+        count: format!("at least {} (line {line})", max_elements.saturating_add(1)),
+        budget: max_elements,
+    })
+}

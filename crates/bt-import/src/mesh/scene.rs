@@ -1,0 +1,82 @@
+//! Mesh surfaces into a scene: small surfaces block, ITU material names get their radio model.
+
+use crate::{ImportError, LoadOptions, Loaded};
+use bt_scene::{
+    DEFAULT_MATERIAL, Material, Problem, RawSurface, Scene, SceneError, SurfaceKind,
+    default_materials,
+};
+
+/// Build a scene from imported mesh surfaces: surfaces below the area threshold become blockers,
+/// material names of the ITU table (`itu_concrete`, ...) get that material as a half-space,
+/// other unknown names the default loss and radio model (with a warning).
+pub fn from_mesh(
+    import: bt_mesh::MeshImport,
+    name: &str,
+    source: &str,
+    options: &LoadOptions,
+) -> Result<Loaded, ImportError> {
+    let mut warnings = import.warnings;
+    let mut materials = default_materials();
+    let default = materials[DEFAULT_MATERIAL].clone();
+    let mut raw = Vec::with_capacity(import.surfaces.len());
+    for (i, s) in import.surfaces.into_iter().enumerate() {
+        let material = s.material.map(|m| {
+            let lower = m.to_ascii_lowercase();
+            if materials.contains_key(&lower) {
+                lower
+            } else {
+                if !materials.contains_key(&m) {
+                    let material = match bt_channel::RadioMaterial::itu(&m, None) {
+                        Ok(radio) => Material {
+                            reflection_loss_db: radio
+                                .normal_loss_db(options.frequency_hz)
+                                .unwrap_or(default.reflection_loss_db),
+                            radio: Some(radio),
+                        },
+                        Err(_) => {
+                            warnings.push(format!(
+                                "material \"{m}\" is not known: using {} dB per reflection and the radio model of \"{DEFAULT_MATERIAL}\"",
+                                default.reflection_loss_db
+                            ));
+                            default.clone()
+                        }
+                    };
+                    materials.insert(m.clone(), material);
+                }
+                m
+            }
+        });
+        let kind = if s.area_m2 >= options.min_reflector_area_m2 {
+            SurfaceKind::Reflector
+        } else {
+            SurfaceKind::Blocker
+        };
+        raw.push(RawSurface {
+            location: format!("surface {i} \"{}\"", bt_scene::name::escape(&s.name)),
+            name: s.name,
+            material,
+            kind,
+            vertices: s.vertices,
+        });
+    }
+    let (tx, rx) = match (options.terminals.tx, options.terminals.rx) {
+        (Some(tx), Some(rx)) => (tx, rx),
+        (tx, rx) => {
+            let problems = [("tx", tx), ("rx", rx)]
+                .into_iter()
+                .filter(|(_, v)| v.is_none())
+                .map(|(field, _)| Problem {
+                    location: field.into(),
+                    message: format!("meshes carry no {field}: pass --{field} X,Y,Z"),
+                })
+                .collect();
+            return Err(SceneError::Invalid {
+                source_name: source.to_string(),
+                problems,
+            }
+            .into());
+        }
+    };
+    let scene = Scene::from_surfaces(name, source, raw, materials, (tx, rx), options.frequency_hz)?;
+    Ok(Loaded { scene, warnings })
+}

@@ -1,0 +1,251 @@
+//! The one loading entry: a source string (`builtin:NAME` or a file path) to a validated
+//! [`Scene`] or [`DynamicScene`]. Every command of the CLI loads through here, so every
+//! command accepts the same sources and gives the same errors.
+
+use crate::builtin::{builtin_json, builtin_names};
+use crate::mesh::scene::from_mesh;
+use crate::{ImportError, parse_json, parse_toml};
+use bt_geom::Real;
+use bt_scene::dynamic::DynamicScene;
+use bt_scene::{DEFAULT_FREQUENCY_HZ, Scene, SceneDescription, Terminals};
+use std::path::{Path, PathBuf};
+
+/// Options of scene loading.
+#[derive(Debug, Clone)]
+pub struct LoadOptions {
+    /// TX/RX overriding the file's (required for meshes, which carry none).
+    pub terminals: Terminals,
+    /// Coplanar-merge tolerances for meshes.
+    pub merge: bt_mesh::MergeOptions,
+    /// Mesh surfaces smaller than this (m²) become blockers (default 0.25 m², as the paper).
+    pub min_reflector_area_m2: Real,
+    /// Carrier frequency for meshes and point clouds, Hz (default 28 GHz).
+    pub frequency_hz: Real,
+    /// Plane-extraction parameters for point clouds (PLY without faces, PCD).
+    pub extract: bt_pointcloud::ExtractParams,
+    /// Point-cloud reading: budget on the points a file declares (`max_points`, CLI
+    /// `--max-cloud-points`) and the policy for non-finite points.
+    pub cloud: crate::cloud::ReadOptions,
+    /// A radio material for every surface (CLI `--material itu:NAME --thickness M`), replacing
+    /// the radio model of every material of the loaded scene, whatever its format.
+    pub radio: Option<bt_channel::RadioMaterial>,
+}
+
+impl Default for LoadOptions {
+    fn default() -> Self {
+        Self {
+            terminals: Terminals::default(),
+            merge: bt_mesh::MergeOptions::default(),
+            min_reflector_area_m2: 0.25,
+            frequency_hz: DEFAULT_FREQUENCY_HZ,
+            extract: bt_pointcloud::ExtractParams::default(),
+            cloud: crate::cloud::ReadOptions::default(),
+            radio: None,
+        }
+    }
+}
+
+/// A loaded scene and the non-fatal notes of the import (merged faces, holes dropped, ...).
+#[derive(Debug, Clone)]
+pub struct Loaded {
+    /// The validated scene.
+    pub scene: Scene,
+    /// Warnings for the user.
+    pub warnings: Vec<String>,
+}
+
+/// Where a scene comes from, parsed from the command-line spelling by [`Source::parse`].
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Source {
+    /// A scene shipped inside the library (`builtin:NAME`), see [`crate::builtin_names`].
+    Builtin(String),
+    /// A file; its [`Format`] is chosen by extension (and, for `.ply`, by its header).
+    File(PathBuf),
+}
+
+impl Source {
+    /// `builtin:NAME` is a built-in scene, anything else a file path.
+    pub fn parse(text: &str) -> Source {
+        match text.strip_prefix("builtin:") {
+            Some(name) => Source::Builtin(name.to_string()),
+            None => Source::File(PathBuf::from(text)),
+        }
+    }
+}
+
+/// File formats [`load`] understands.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Format {
+    /// The project's scene file, JSON (`.json`).
+    Json,
+    /// The project's scene file, TOML (`.toml`).
+    Toml,
+    /// A Wavefront OBJ mesh (`.obj`).
+    Obj,
+    /// A PLY mesh (`.ply` declaring faces).
+    PlyMesh,
+    /// A point cloud: `.pcd`, or `.ply` declaring no faces; planes are extracted.
+    PointCloud,
+    /// A Mitsuba 3 / Sionna RT scene (`.xml`) with PLY/OBJ shapes and radio bsdfs.
+    Xml,
+}
+
+impl Format {
+    /// The format of the file at `path`: by extension (any case); a `.ply` is a point cloud
+    /// when its header declares no faces. A directory is an error of its own, not an
+    /// "unsupported format".
+    pub fn of(path: &Path) -> Result<Format, ImportError> {
+        let display = path.display().to_string();
+        if path.is_dir() {
+            return Err(ImportError::IsDirectory { path: display });
+        }
+        let ext = path
+            .extension()
+            .and_then(|e| e.to_str())
+            .unwrap_or("")
+            .to_ascii_lowercase();
+        Ok(match ext.as_str() {
+            "json" => Format::Json,
+            "toml" => Format::Toml,
+            "obj" => Format::Obj,
+            "xml" => Format::Xml,
+            "pcd" => Format::PointCloud,
+            "ply" if crate::cloud::is_point_cloud(path) => Format::PointCloud,
+            "ply" => Format::PlyMesh,
+            _ => return Err(ImportError::UnsupportedFormat { path: display }),
+        })
+    }
+}
+
+/// Progress of a long load (plane extraction from a point cloud), for a progress bar.
+pub type LoadProgress = bt_pointcloud::Progress;
+
+/// Load the scene named by `source` (`builtin:NAME` or a file path), see [`Source`] and
+/// [`Format`]. A dynamic scene (JSON/TOML with `steps`, or `builtin:living-room-dynamic`)
+/// loads as its step 0; use [`load_dynamic`] for every step.
+pub fn load(source: &str, options: &LoadOptions) -> Result<Loaded, ImportError> {
+    load_with_progress(source, options, &mut |_| {})
+}
+
+/// [`load`], reporting the progress of point-cloud plane extraction to `progress`.
+/// `options.radio`, when set, replaces the radio model of every material, whatever the format.
+pub fn load_with_progress(
+    source: &str,
+    options: &LoadOptions,
+    progress: &mut dyn FnMut(LoadProgress),
+) -> Result<Loaded, ImportError> {
+    let mut loaded = load_any(source, options, progress)?;
+    if let Some(radio) = options.radio {
+        loaded.scene = loaded.scene.with_radio_material(radio)?;
+    }
+    Ok(loaded)
+}
+
+fn load_any(
+    source: &str,
+    options: &LoadOptions,
+    progress: &mut dyn FnMut(LoadProgress),
+) -> Result<Loaded, ImportError> {
+    let path = match Source::parse(source) {
+        Source::Builtin(name) => {
+            // Generated built-ins (the city) have no JSON: they build their own scene.
+            if builtin_json(&name).is_none()
+                && let Some(scene) = crate::builtin_scene(&name, options.terminals)
+            {
+                return Ok(Loaded {
+                    scene: scene?,
+                    warnings: Vec::new(),
+                });
+            }
+            let desc = builtin_description(&name)?;
+            let scene = Scene::from_description(&desc, source, options.terminals)?;
+            return Ok(Loaded {
+                scene,
+                warnings: Vec::new(),
+            });
+        }
+        Source::File(path) => path,
+    };
+    let display = path.display().to_string();
+    match Format::of(&path)? {
+        format @ (Format::Json | Format::Toml) => {
+            let desc = read_description(&path, format)?;
+            let scene = Scene::from_description(&desc, &display, options.terminals)?;
+            Ok(Loaded {
+                scene,
+                warnings: Vec::new(),
+            })
+        }
+        Format::Obj | Format::PlyMesh => {
+            let import = crate::mesh::read_mesh_path(&path, &options.merge)?;
+            from_mesh(import, &file_stem(&path, "mesh"), &display, options)
+        }
+        Format::PointCloud => crate::cloud::scene::load_cloud(&path, options, progress),
+        Format::Xml => crate::xml::load_xml(&path, options),
+    }
+}
+
+/// Load `source` as a scene over time steps: JSON/TOML files and built-ins with their
+/// `steps` and moving objects; every other source (meshes, point clouds) as one step.
+/// Warnings of the import come back beside the scene.
+pub fn load_dynamic(
+    source: &str,
+    options: &LoadOptions,
+    progress: &mut dyn FnMut(LoadProgress),
+) -> Result<(DynamicScene, Vec<String>), ImportError> {
+    let desc = match Source::parse(source) {
+        // A generated built-in (no JSON) is static: one step, loaded below.
+        Source::Builtin(name)
+            if builtin_json(&name).is_none() && builtin_names().contains(&name.as_str()) =>
+        {
+            None
+        }
+        Source::Builtin(name) => Some(builtin_description(&name)?),
+        Source::File(path) => match Format::of(&path)? {
+            format @ (Format::Json | Format::Toml) => Some(read_description(&path, format)?),
+            _ => None,
+        },
+    };
+    match desc {
+        Some(desc) => {
+            let mut scene = DynamicScene::from_description(&desc, source, options.terminals)?;
+            if let Some(radio) = options.radio {
+                scene = scene.with_radio_material(radio)?;
+            }
+            Ok((scene, Vec::new()))
+        }
+        None => {
+            let loaded = load_with_progress(source, options, progress)?;
+            Ok((DynamicScene::from_static(loaded.scene), loaded.warnings))
+        }
+    }
+}
+
+fn builtin_description(name: &str) -> Result<SceneDescription, ImportError> {
+    let json = builtin_json(name).ok_or_else(|| ImportError::UnknownBuiltin {
+        name: name.to_string(),
+        known: builtin_names().join(", "),
+    })?;
+    parse_json(json, &format!("builtin:{name}"))
+}
+
+fn read_description(path: &Path, format: Format) -> Result<SceneDescription, ImportError> {
+    let display = path.display().to_string();
+    let text = std::fs::read_to_string(path).map_err(|source| ImportError::Io {
+        path: display.clone(),
+        source,
+    })?;
+    if format == Format::Toml {
+        parse_toml(&text, &display)
+    } else {
+        parse_json(&text, &display)
+    }
+}
+
+/// The file name without extension, the scene's name for formats that carry none.
+pub(crate) fn file_stem(path: &Path, fallback: &str) -> String {
+    path.file_stem()
+        .and_then(|s| s.to_str())
+        .unwrap_or(fallback)
+        .to_string()
+}

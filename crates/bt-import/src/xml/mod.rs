@@ -1,0 +1,344 @@
+//! Mitsuba 3 / Sionna RT XML scenes (`docs/scene-format.md`, "Mitsuba / Sionna XML").
+//!
+//! Two stages: [`parse_xml`] turns the text into an [`XmlScene`] (bsdfs and shapes, every error
+//! with its line; no file access, fuzzed), then [`load_xml`] reads each shape's PLY/OBJ mesh
+//! relative to the XML's folder, maps it through its `to_world` before bt-mesh welds and merges
+//! it (so surfaces never merge across shapes, hence never across materials), and validates the
+//! result as a [`SceneDescription`] whose materials are the bsdfs, named by their ids.
+//!
+//! Mesh file names are resolved safely: only relative paths of plain components under the
+//! XML's folder (no absolute path, no `..`), each file at most [`MAX_MESH_FILE_BYTES`] and all
+//! of them at most [`MAX_MESH_TOTAL_BYTES`].
+
+mod parse;
+mod transform;
+
+pub use parse::{SIONNA_DEFAULT_THICKNESS_M, parse_xml};
+
+use crate::source::file_stem;
+use crate::{ImportError, LoadOptions, Loaded};
+use bt_channel::{ItuMaterial, RadioModel};
+use bt_geom::Real;
+use bt_scene::{
+    DEFAULT_MATERIAL, MaterialDesc, Problem, Scene, SceneDescription, SceneError, SurfaceDesc,
+    SurfaceKind, default_materials,
+};
+use glam::DMat4;
+use std::collections::BTreeMap;
+use std::path::{Component, Path, PathBuf};
+
+/// Largest XML file read, bytes (16 MiB: Sionna's city scenes are well under 1 MiB of XML).
+pub const MAX_XML_BYTES: u64 = 16 << 20;
+/// Largest number of XML nodes (elements, attributes' text, comments) parsed.
+pub const MAX_XML_NODES: u32 = 1_000_000;
+/// Largest number of `<shape>` elements.
+pub const MAX_XML_SHAPES: usize = 20_000;
+/// Largest number of `<bsdf>` elements.
+pub const MAX_XML_BSDFS: usize = 10_000;
+/// Largest mesh file a shape may name, bytes.
+pub const MAX_MESH_FILE_BYTES: u64 = 512 << 20;
+/// Largest total size of all mesh files of one scene, bytes.
+pub const MAX_MESH_TOTAL_BYTES: u64 = 2 << 30;
+
+/// A position in the XML text, 1-based.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct XmlPos {
+    /// Line.
+    pub line: u32,
+    /// Column (characters).
+    pub column: u32,
+}
+
+/// A scene as written in the XML, before any mesh is read.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct XmlScene {
+    /// The `<bsdf>` elements (top level and inline in shapes), ids unique.
+    pub bsdfs: Vec<XmlBsdf>,
+    /// The `<shape>` elements in document order.
+    pub shapes: Vec<XmlShape>,
+    /// Notes for the user (rendering-only elements skipped).
+    pub warnings: Vec<String>,
+}
+
+/// One `<bsdf>`: its id (the scene material's name) and radio meaning.
+#[derive(Debug, Clone, PartialEq)]
+pub struct XmlBsdf {
+    /// The `id` attribute (inline bsdfs without one: `<shape id>.bsdf`).
+    pub id: String,
+    /// What the bsdf says about radio propagation.
+    pub radio: XmlRadio,
+    /// Line of the element.
+    pub line: u32,
+}
+
+/// The radio meaning of a bsdf.
+#[derive(Debug, Clone, PartialEq)]
+pub enum XmlRadio {
+    /// `itu-radio-material`: an ITU-R P.2040-3 material by Sionna's name, as a slab.
+    Itu {
+        /// `concrete`, `itu_concrete`, `very_dry_ground`, ...
+        name: String,
+        /// Slab thickness, metres (Sionna's 0.1 m when not given).
+        thickness_m: Real,
+    },
+    /// `radio-material`: constant εr' and σ, as a slab.
+    Custom {
+        /// Relative permittivity εr' (Sionna's default 1).
+        relative_permittivity: Real,
+        /// Conductivity σ, S/m (Sionna's default 0).
+        conductivity: Real,
+        /// Slab thickness, metres (Sionna's 0.1 m when not given).
+        thickness_m: Real,
+    },
+    /// Any other (visual) Mitsuba bsdf: the radio material comes from the id as Sionna 0.x
+    /// names them (`mat-itu_concrete`, `itu_glass`: an ITU half-space), else the default.
+    Visual {
+        /// The bsdf type (`diffuse`, `twosided`, `principled`, ...).
+        kind: String,
+    },
+}
+
+/// Mesh formats a `<shape>` may load.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum MeshKind {
+    /// `<shape type="ply">`.
+    Ply,
+    /// `<shape type="obj">`.
+    Obj,
+}
+
+/// One `<shape type="ply|obj">`.
+#[derive(Debug, Clone, PartialEq)]
+pub struct XmlShape {
+    /// The `id` attribute, or `shape-<k>`; prefixes its surfaces' names.
+    pub name: String,
+    /// Mesh format.
+    pub kind: MeshKind,
+    /// The `filename` property as written (relative to the XML's folder).
+    pub filename: String,
+    /// The bsdf id it refers to (or defines inline) and where; `None`: material `default`.
+    pub bsdf: Option<(String, XmlPos)>,
+    /// `to_world`, metres to metres (identity when absent).
+    pub to_world: DMat4,
+    /// Where the element starts.
+    pub at: XmlPos,
+}
+
+/// Load a Mitsuba/Sionna XML scene: parse, read every shape's mesh (bounded, relative to the
+/// XML's folder), and validate as a scene with `options.terminals` (required: the XML has no
+/// transmitter or receiver) at `options.frequency_hz`.
+pub fn load_xml(path: &Path, options: &LoadOptions) -> Result<Loaded, ImportError> {
+    let display = path.display().to_string();
+    let text = read_bounded(path, MAX_XML_BYTES, &display)?;
+    let text = String::from_utf8(text).map_err(|e| ImportError::Parse {
+        path: display.clone(),
+        message: format!("not UTF-8 text: {e}"),
+    })?;
+    let xml = parse_xml(&text, &display)?;
+    let missing: Vec<Problem> = [("tx", options.terminals.tx), ("rx", options.terminals.rx)]
+        .into_iter()
+        .filter(|(_, v)| v.is_none())
+        .map(|(field, _)| Problem {
+            location: field.into(),
+            message: format!("XML scenes carry no {field}: pass --{field} X,Y,Z"),
+        })
+        .collect();
+    if !missing.is_empty() {
+        return Err(SceneError::Invalid {
+            source_name: display,
+            problems: missing,
+        }
+        .into());
+    }
+    let folder = path.parent().unwrap_or(Path::new("."));
+    let mut warnings = xml.warnings.clone();
+    let mut desc = SceneDescription {
+        name: Some(file_stem(path, "scene")),
+        frequency_hz: Some(options.frequency_hz),
+        materials: materials(&xml, &mut warnings),
+        ..SceneDescription::default()
+    };
+    let mut budget = MAX_MESH_TOTAL_BYTES;
+    for shape in &xml.shapes {
+        let import = read_shape(shape, folder, &display, options, &mut budget)?;
+        warnings.extend(import.warnings);
+        let material = shape.bsdf.as_ref().map(|(id, _)| id.clone());
+        if material.is_none() {
+            warnings.push(format!(
+                "{display}: line {}: <shape id=\"{}\"> has no bsdf: material \"{DEFAULT_MATERIAL}\"",
+                shape.at.line, shape.name
+            ));
+        }
+        desc.surfaces
+            .extend(import.surfaces.into_iter().map(|s| SurfaceDesc {
+                name: format!("{}.{}", shape.name, s.name),
+                material: material.clone(),
+                kind: Some(if s.area_m2 >= options.min_reflector_area_m2 {
+                    SurfaceKind::Reflector
+                } else {
+                    SurfaceKind::Blocker
+                }),
+                vertices: s.vertices.iter().map(|v| v.to_array()).collect(),
+                ..SurfaceDesc::default()
+            }));
+    }
+    let scene = Scene::from_description(&desc, &display, options.terminals)?;
+    Ok(Loaded { scene, warnings })
+}
+
+/// The scene materials of the bsdfs, by id.
+fn materials(xml: &XmlScene, warnings: &mut Vec<String>) -> BTreeMap<String, MaterialDesc> {
+    xml.bsdfs
+        .iter()
+        .map(|b| {
+            let desc = match &b.radio {
+                XmlRadio::Itu { name, thickness_m } => MaterialDesc {
+                    itu: Some(name.clone()),
+                    thickness: Some(*thickness_m),
+                    ..MaterialDesc::default()
+                },
+                XmlRadio::Custom {
+                    relative_permittivity,
+                    conductivity,
+                    thickness_m,
+                } => MaterialDesc {
+                    relative_permittivity: Some(*relative_permittivity),
+                    conductivity: Some(*conductivity),
+                    thickness: Some(*thickness_m),
+                    ..MaterialDesc::default()
+                },
+                XmlRadio::Visual { kind } => visual_material(b, kind, warnings),
+            };
+            (b.id.clone(), desc)
+        })
+        .collect()
+}
+
+/// A visual bsdf: an ITU half-space when its id names one the way Sionna 0.x does
+/// (`mat-itu_concrete`, `itu_wood`), otherwise a copy of the `default` material.
+fn visual_material(b: &XmlBsdf, kind: &str, warnings: &mut Vec<String>) -> MaterialDesc {
+    let stem = b.id.strip_prefix("mat-").unwrap_or(&b.id);
+    if stem.starts_with("itu") && ItuMaterial::parse(stem).is_ok() {
+        return MaterialDesc {
+            itu: Some(stem.to_string()),
+            ..MaterialDesc::default()
+        };
+    }
+    warnings.push(format!(
+        "line {}: <bsdf type=\"{kind}\" id=\"{}\"> is not a radio material: using material \"{DEFAULT_MATERIAL}\"'s properties",
+        b.line, b.id
+    ));
+    let default = &default_materials()[DEFAULT_MATERIAL];
+    let mut desc = MaterialDesc {
+        reflection_loss_db: Some(default.reflection_loss_db),
+        ..MaterialDesc::default()
+    };
+    if let Some(radio) = default.radio {
+        desc.thickness = radio.thickness;
+        match radio.model {
+            RadioModel::Itu(m) => desc.itu = Some(m.name().to_string()),
+            RadioModel::Custom {
+                relative_permittivity,
+                conductivity,
+            } => {
+                desc.relative_permittivity = Some(relative_permittivity);
+                desc.conductivity = Some(conductivity);
+            }
+        }
+    }
+    desc
+}
+
+/// Read one shape's mesh through its transform, charging its size to `budget`.
+fn read_shape(
+    shape: &XmlShape,
+    folder: &Path,
+    xml: &str,
+    options: &LoadOptions,
+    budget: &mut u64,
+) -> Result<bt_mesh::MeshImport, ImportError> {
+    let at = |message: String| ImportError::Xml {
+        path: xml.to_string(),
+        line: shape.at.line,
+        column: shape.at.column,
+        message,
+    };
+    let file = resolve(folder, &shape.filename).map_err(|why| {
+        at(format!(
+            "<shape id=\"{}\"> filename \"{}\": {why}",
+            shape.name,
+            shape.filename.escape_debug()
+        ))
+    })?;
+    let shown = file.display().to_string();
+    let size = std::fs::metadata(&file)
+        .map_err(|e| {
+            at(format!(
+                "<shape id=\"{}\"> mesh file {shown}: {e}",
+                shape.name
+            ))
+        })?
+        .len();
+    if size > MAX_MESH_FILE_BYTES || size > *budget {
+        return Err(at(format!(
+            "<shape id=\"{}\"> mesh file {shown} is {size} bytes: over the limit ({MAX_MESH_FILE_BYTES} bytes per file, {MAX_MESH_TOTAL_BYTES} for all meshes of a scene)",
+            shape.name
+        )));
+    }
+    *budget -= size;
+    let bytes = read_bounded(&file, MAX_MESH_FILE_BYTES, &shown)?;
+    let format = match shape.kind {
+        MeshKind::Ply => crate::mesh::MeshFormat::Ply,
+        MeshKind::Obj => crate::mesh::MeshFormat::Obj,
+    };
+    let to_world = shape.to_world;
+    Ok(crate::mesh::read_transformed(
+        &bytes,
+        format,
+        Some(&shown),
+        &options.merge,
+        &|p| to_world.transform_point3(p),
+    )?)
+}
+
+/// `name` under `folder`: relative, plain components only (no `..`, no root, no drive).
+fn resolve(folder: &Path, name: &str) -> Result<PathBuf, &'static str> {
+    let relative = Path::new(name);
+    if name.is_empty() {
+        return Err("is empty");
+    }
+    for c in relative.components() {
+        match c {
+            Component::Normal(_) | Component::CurDir => {}
+            Component::ParentDir => {
+                return Err("must stay under the XML's folder (no \"..\")");
+            }
+            Component::RootDir | Component::Prefix(_) => {
+                return Err("must be relative to the XML's folder (no absolute path)");
+            }
+        }
+    }
+    Ok(folder.join(relative))
+}
+
+/// Read at most `limit` bytes of `path`; a longer file is an error, not a truncation.
+fn read_bounded(path: &Path, limit: u64, display: &str) -> Result<Vec<u8>, ImportError> {
+    use std::io::Read;
+    let io = |source| ImportError::Io {
+        path: display.to_string(),
+        source,
+    };
+    let file = std::fs::File::open(path).map_err(io)?;
+    let mut bytes = Vec::new();
+    file.take(limit + 1).read_to_end(&mut bytes).map_err(io)?;
+    if bytes.len() as u64 > limit {
+        return Err(ImportError::Parse {
+            path: display.to_string(),
+            message: format!("file larger than {limit} bytes"),
+        });
+    }
+    Ok(bytes)
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,293 @@
+//! The XML reader: every error names the element and its line; transforms compose in Mitsuba's
+//! order (checked on hand-computed points); shapes never merge across each other.
+
+use super::*;
+use bt_geom::Vec3;
+use bt_scene::Terminals;
+
+fn err(xml: &str) -> String {
+    parse_xml(xml, "t.xml").unwrap_err().to_string()
+}
+
+fn one_shape(transform: &str) -> DMat4 {
+    let xml = format!(
+        r#"<scene><shape type="ply"><string name="filename" value="a.ply"/><transform name="to_world">{transform}</transform></shape></scene>"#
+    );
+    parse_xml(&xml, "t.xml").unwrap().shapes[0].to_world
+}
+
+fn close(a: Vec3, b: Vec3) -> bool {
+    (a - b).length() < 1e-12
+}
+
+/// Each document's error mentions every one of its needles.
+fn assert_errors_mention(cases: &[(&str, &[&str])]) {
+    for (xml, needles) in cases {
+        let e = err(xml);
+        for n in *needles {
+            assert!(e.contains(n), "{n:?} not in: {e}");
+        }
+    }
+}
+
+#[test]
+fn unsupported_elements_are_named_with_their_line() {
+    let e = err(
+        "<scene version=\"2.1.0\">\n  <bsdf type=\"diffuse\" id=\"a\"/>\n  <shapegroup id=\"g\"/>\n</scene>",
+    );
+    assert_eq!(
+        e,
+        "t.xml: line 3, column 3: unsupported element <shapegroup> in <scene>"
+    );
+    let sphere = "<scene>\n\n<shape type=\"sphere\"/></scene>";
+    assert!(
+        err(sphere).starts_with("t.xml: line 3, column 1: "),
+        "{}",
+        err(sphere)
+    );
+    assert_errors_mention(&[
+        (sphere, &["<shape type=\"sphere\"> is not supported"]),
+        (
+            "<scene><shape type=\"ply\">\n <string name=\"filename\" value=\"a.ply\"/>\n <float name=\"radius\" value=\"2\"/></shape></scene>",
+            &["line 3", "<float name=\"radius\">"],
+        ),
+        (
+            "<scene><shape type=\"ply\"><string name=\"filename\" value=\"a.ply\"/><transform name=\"to_world\">\n<lookat origin=\"0 0 0\" target=\"1 0 0\"/></transform></shape></scene>",
+            &["line 2", "<lookat>"],
+        ),
+        ("<mitsuba/>", &["expected <scene>"]),
+        (
+            "<scene>\n<shape type=\"ply\">\n</scene>",
+            &["line 3", "not well-formed"],
+        ),
+        // A DTD is refused.
+        (
+            "<!DOCTYPE scene [<!ENTITY a \"b\">]><scene/>",
+            &["not well-formed"],
+        ),
+    ]);
+}
+
+#[test]
+fn references_and_properties_are_checked() {
+    let e = err(
+        "<scene>\n<shape type=\"obj\" id=\"w\">\n<string name=\"filename\" value=\"w.obj\"/>\n<ref id=\"nope\"/></shape></scene>",
+    );
+    assert_eq!(
+        e,
+        "t.xml: line 4, column 1: <shape id=\"w\"> refers to bsdf \"nope\", which the file does not define"
+    );
+    assert_errors_mention(&[
+        (
+            "<scene><shape type=\"obj\"/></scene>",
+            &["needs <string name=\"filename\""],
+        ),
+        (
+            "<scene><bsdf type=\"itu-radio-material\" id=\"m\">\n<string name=\"type\" value=\"cheese\"/></bsdf></scene>",
+            &["line 1", "unknown ITU material \"cheese\""],
+        ),
+        (
+            "<scene><bsdf type=\"radio-material\" id=\"m\"><float name=\"relative_permittivity\" value=\"-2\"/></bsdf></scene>",
+            &["relative_permittivity"],
+        ),
+        (
+            "<scene><bsdf type=\"itu-radio-material\" id=\"m\"/></scene>",
+            &["needs <string name=\"type\""],
+        ),
+        (
+            "<scene><bsdf type=\"diffuse\" id=\"m\"/><bsdf type=\"diffuse\" id=\"m\"/></scene>",
+            &["defined twice"],
+        ),
+        (
+            "<scene><bsdf type=\"itu-radio-material\" id=\"m\"><string name=\"type\" value=\"wood\"/><float name=\"thickness\" value=\"$t\"/></bsdf></scene>",
+            &["undefined parameter $t"],
+        ),
+    ]);
+}
+
+#[test]
+fn bsdfs_become_radio_materials_as_sionna_names_them() {
+    let xml = r#"<scene>
+        <default name="t" value="0.25"/>
+        <bsdf type="itu-radio-material" id="a"><string name="type" value="very_dry_ground"/><float name="thickness" value="$t"/></bsdf>
+        <bsdf type="itu-radio-material" id="b"><string name="type" value="itu_glass"/></bsdf>
+        <bsdf type="radio-material" id="c"><float name="conductivity" value="2"/></bsdf>
+        <bsdf type="twosided" id="mat-itu_metal"><bsdf type="diffuse"/></bsdf>
+        <bsdf type="diffuse" id="paint"/>
+    </scene>"#;
+    let scene = parse_xml(xml, "t.xml").unwrap();
+    let radio: Vec<&XmlRadio> = scene.bsdfs.iter().map(|b| &b.radio).collect();
+    assert_eq!(
+        radio[0],
+        &XmlRadio::Itu {
+            name: "very_dry_ground".into(),
+            thickness_m: 0.25
+        }
+    );
+    assert_eq!(
+        radio[1],
+        &XmlRadio::Itu {
+            name: "itu_glass".into(),
+            thickness_m: SIONNA_DEFAULT_THICKNESS_M
+        }
+    );
+    assert_eq!(
+        radio[2],
+        &XmlRadio::Custom {
+            relative_permittivity: 1.0,
+            conductivity: 2.0,
+            thickness_m: SIONNA_DEFAULT_THICKNESS_M
+        }
+    );
+    let mut warnings = Vec::new();
+    let m = materials(&scene, &mut warnings);
+    assert_eq!(m["mat-itu_metal"].itu.as_deref(), Some("itu_metal"));
+    assert_eq!(
+        m["mat-itu_metal"].thickness, None,
+        "Sionna 0.x: a half-space"
+    );
+    assert_eq!(
+        m["paint"].itu.as_deref(),
+        Some("concrete"),
+        "the default's model"
+    );
+    assert_eq!(warnings.len(), 1);
+    assert!(warnings[0].contains("\"paint\""), "{warnings:?}");
+}
+
+#[test]
+fn transforms_compose_in_document_order() {
+    let p = Vec3::new(1.0, 0.0, 0.0);
+    // Rotate first, then translate: (1,0,0) -> (0,1,0) -> (1,1,0).
+    let a = one_shape(r#"<rotate z="1" angle="90"/><translate x="1"/>"#);
+    assert!(close(a.transform_point3(p), Vec3::new(1.0, 1.0, 0.0)));
+    // Translate first, then rotate: (1,0,0) -> (2,0,0) -> (0,2,0).
+    let b = one_shape(r#"<translate value="1, 0, 0"/><rotate value="0 0 1" angle="90"/>"#);
+    assert!(close(b.transform_point3(p), Vec3::new(0.0, 2.0, 0.0)));
+    // A matrix is read row by row: the last column is the translation.
+    let m = one_shape(r#"<matrix value="1 0 0 5  0 1 0 6  0 0 1 7  0 0 0 1"/>"#);
+    assert!(close(
+        m.transform_point3(Vec3::ZERO),
+        Vec3::new(5.0, 6.0, 7.0)
+    ));
+    let s = one_shape(r#"<scale value="2"/><scale y="3"/>"#);
+    assert!(close(
+        s.transform_point3(Vec3::ONE),
+        Vec3::new(2.0, 6.0, 2.0)
+    ));
+    // Right-handed: +90 degrees about x takes +y to +z.
+    let r = one_shape(r#"<rotate x="1" angle="90"/>"#);
+    assert!(close(r.transform_point3(Vec3::Y), Vec3::Z));
+    let e = err(
+        r#"<scene><shape type="ply"><string name="filename" value="a.ply"/><transform name="to_world"><scale z="0"/></transform></shape></scene>"#,
+    );
+    assert!(e.contains("singular"), "{e}");
+    let e = err(
+        r#"<scene><shape type="ply"><string name="filename" value="a.ply"/><transform name="to_world"><matrix value="1 2 3"/></transform></shape></scene>"#,
+    );
+    assert!(e.contains("16 or 9 numbers, got 3"), "{e}");
+    let e = err(
+        r#"<scene><shape type="ply"><string name="filename" value="a.ply"/><transform name="to_world"><rotate angle="10"/></transform></shape></scene>"#,
+    );
+    assert!(e.contains("axis"), "{e}");
+}
+
+#[test]
+fn counts_are_bounded() {
+    let shape = r#"<shape type="ply"><string name="filename" value="a.ply"/></shape>"#;
+    let xml = format!("<scene>{}</scene>", shape.repeat(MAX_XML_SHAPES + 1));
+    let e = err(&xml);
+    assert!(
+        e.contains(&format!("more than {MAX_XML_SHAPES} shapes")),
+        "{e}"
+    );
+}
+
+#[test]
+fn file_names_stay_under_the_xml_folder() {
+    let folder = Path::new("/data/scenes");
+    assert_eq!(
+        resolve(folder, "meshes/a.ply").unwrap(),
+        Path::new("/data/scenes/meshes/a.ply")
+    );
+    assert!(resolve(folder, "../secret.ply").unwrap_err().contains(".."));
+    assert!(resolve(folder, "meshes/../../x.ply").is_err());
+    assert!(
+        resolve(folder, "/etc/x.ply")
+            .unwrap_err()
+            .contains("absolute")
+    );
+    assert!(resolve(folder, "").is_err());
+}
+
+/// A scratch folder with an XML scene and its meshes.
+fn scratch(name: &str, files: &[(&str, &str)]) -> PathBuf {
+    let dir = std::env::temp_dir().join(format!("bt-xml-{name}-{}", std::process::id()));
+    std::fs::create_dir_all(dir.join("meshes")).unwrap();
+    for (file, text) in files {
+        std::fs::write(dir.join(file), text).unwrap();
+    }
+    dir
+}
+
+const HALF_FLOOR: &str = "o half\nv 0 0 0\nv 2 0 0\nv 2 2 0\nv 0 2 0\nf 1 2 3 4\n";
+
+fn options() -> LoadOptions {
+    LoadOptions {
+        terminals: Terminals {
+            tx: Some(Vec3::new(1.0, 1.0, 1.0)),
+            rx: Some(Vec3::new(3.0, 1.5, 1.5)),
+        },
+        ..LoadOptions::default()
+    }
+}
+
+#[test]
+fn shapes_never_merge_even_when_coplanar_and_adjacent() {
+    // Two halves of one floor, edge to edge in one plane, with different materials.
+    let xml = r#"<scene>
+        <bsdf type="itu-radio-material" id="wood"><string name="type" value="wood"/></bsdf>
+        <bsdf type="itu-radio-material" id="stone"><string name="type" value="marble"/></bsdf>
+        <shape type="obj" id="left"><string name="filename" value="meshes/half.obj"/><ref id="wood"/></shape>
+        <shape type="obj" id="right"><string name="filename" value="meshes/half.obj"/>
+            <transform name="to_world"><translate x="2"/></transform><ref id="stone"/></shape>
+    </scene>"#;
+    let dir = scratch("merge", &[("s.xml", xml), ("meshes/half.obj", HALF_FLOOR)]);
+    let loaded = load_xml(&dir.join("s.xml"), &options()).unwrap();
+    let s = &loaded.scene;
+    let names: Vec<(&str, &str)> = s
+        .surfaces()
+        .iter()
+        .map(|f| (f.name.as_str(), f.material.as_str()))
+        .collect();
+    assert_eq!(names, [("left.half_0", "wood"), ("right.half_0", "stone")]);
+    let right = &s.surfaces()[1];
+    assert!(right.polygon.vertices().iter().all(|v| v.x >= 2.0 - 1e-12));
+    assert!(s.materials()["stone"].radio.is_some());
+    std::fs::remove_dir_all(dir).ok();
+}
+
+#[test]
+fn missing_files_and_terminals_are_clear_errors() {
+    let xml = "<scene>\n<shape type=\"ply\" id=\"gone\"><string name=\"filename\" value=\"meshes/nowhere.ply\"/></shape></scene>";
+    let dir = scratch("missing", &[("s.xml", xml)]);
+    let e = load_xml(&dir.join("s.xml"), &options())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("line 2") && e.contains("gone") && e.contains("nowhere.ply"),
+        "{e}"
+    );
+    let e = load_xml(&dir.join("s.xml"), &LoadOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("XML scenes carry no tx: pass --tx X,Y,Z"), "{e}");
+    let escape =
+        "<scene><shape type=\"ply\"><string name=\"filename\" value=\"../s.xml\"/></shape></scene>";
+    std::fs::write(dir.join("escape.xml"), escape).unwrap();
+    let e = load_xml(&dir.join("escape.xml"), &options())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("must stay under the XML's folder"), "{e}");
+    std::fs::remove_dir_all(dir).ok();
+}

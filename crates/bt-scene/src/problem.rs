@@ -1,0 +1,108 @@
+//! Problems found in a scene and the crate's one error type.
+
+use serde::Serialize;
+use std::fmt;
+use thiserror::Error;
+
+/// One problem found in a scene, located by field path (e.g. `surfaces[3] "sofa.top"`).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Problem {
+    /// Where: a field path into the scene description.
+    pub location: String,
+    /// What is wrong, lowercase.
+    pub message: String,
+}
+
+impl fmt::Display for Problem {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        write!(f, "{}: {}", self.location, self.message)
+    }
+}
+
+/// Errors of scene validation (the importers' errors, files and formats, are `bt-import`'s).
+#[derive(Debug, Error)]
+#[non_exhaustive]
+pub enum SceneError {
+    /// The scene has one or more problems; all are listed.
+    #[error("{source_name}: {} problem(s):\n{}", problems.len(), problems.iter().map(|p| format!("  - {p}")).collect::<Vec<_>>().join("\n"))]
+    Invalid {
+        /// File or scene name.
+        source_name: String,
+        /// Every problem found.
+        problems: Vec<Problem>,
+    },
+    /// A trace needs a terminal the scene does not have (a bare mesh, XML or point cloud
+    /// loaded without `tx`/`rx`). Front ends word it with their own names (CLI `--tx`,
+    /// Python `tx=`); this message names only the terminals.
+    #[error("{source_name}: no {} given: a trace needs both terminals", missing.iter().map(|t| t.to_string()).collect::<Vec<_>>().join(" and "))]
+    MissingTerminal {
+        /// File or scene name.
+        source_name: String,
+        /// The missing terminals, TX first (never empty).
+        missing: Vec<Terminal>,
+    },
+}
+
+/// One of the two terminals of a trace.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, PartialOrd, Ord)]
+pub enum Terminal {
+    /// The transmitter.
+    Tx,
+    /// The receiver.
+    Rx,
+}
+
+impl Terminal {
+    /// `tx` or `rx`: the field name in scene files, and the root of every front end's name.
+    pub fn name(self) -> &'static str {
+        match self {
+            Terminal::Tx => "tx",
+            Terminal::Rx => "rx",
+        }
+    }
+}
+
+impl fmt::Display for Terminal {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+pub(crate) struct Collector(pub Vec<Problem>);
+
+impl Collector {
+    pub fn push(&mut self, location: impl Into<String>, message: impl Into<String>) {
+        self.0.push(Problem {
+            location: location.into(),
+            message: message.into(),
+        });
+    }
+}
+
+/// Where validation problems go.
+pub(crate) trait ProblemSink {
+    fn report(&mut self, location: &str, message: impl Into<String>);
+    /// Problems reported so far.
+    fn count(&self) -> usize;
+}
+
+impl ProblemSink for Collector {
+    fn report(&mut self, location: &str, message: impl Into<String>) {
+        self.push(location, message);
+    }
+    fn count(&self) -> usize {
+        self.0.len()
+    }
+}
+
+impl ProblemSink for Vec<Problem> {
+    fn report(&mut self, location: &str, message: impl Into<String>) {
+        self.push(Problem {
+            location: location.to_string(),
+            message: message.into(),
+        });
+    }
+    fn count(&self) -> usize {
+        self.len()
+    }
+}
