@@ -11,7 +11,7 @@
 //!   them as SVG and PNG.
 //!
 //! Units: metres, seconds; angles in degrees where the name says `_deg`; cycles of the
-//! accelerator's clock, [`CLOCK_HZ`]. `docs/study-living-room.md` has the measured numbers.
+//! accelerator's clock, [`bt_hls::CLOCK_HZ`]. `docs/study-living-room.md` has the measured numbers.
 
 pub mod plot;
 pub mod report;
@@ -22,16 +22,13 @@ use crate::run::{
 use crate::{StudyConfig, StudyError, StudySolver};
 use bt_accel as fpga;
 use bt_geom::{Real, Vec3};
-use bt_hls::{PlanOptions, ScheduleKind};
+use bt_hls::{CLOCK_HZ, PlanOptions, ScheduleKind};
 use bt_scene::Scene;
 use bt_scene::dynamic::DynamicScene;
 use bt_schedule::GaParams;
 use bt_solve::{SbrOptions, Validity, validate::validate};
 use serde::Serialize;
 use std::time::Instant;
-
-/// Clock of the paper's platform (Intel Cyclone IV E at 50 MHz), Hz.
-pub const CLOCK_HZ: Real = 50e6;
 
 /// The solvers of the living-room study, in output order.
 pub const SOLVERS: [StudySolver; 5] = [

@@ -80,7 +80,7 @@ pub fn run_time<DB: DrawingBackend>(
     })
     .collect();
     series.push(Series {
-        label: format!("ipc on the FPGA (cycles / {} MHz)", super::CLOCK_HZ / 1e6),
+        label: format!("ipc on the FPGA (cycles / {} MHz)", bt_hls::CLOCK_HZ / 1e6),
         colour: FPGA_COLOUR,
         points: results.fpga.iter().map(|f| (f.step, f.latency_s)).collect(),
     });
