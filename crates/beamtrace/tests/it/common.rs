@@ -54,6 +54,23 @@ pub fn run_ok(args: &[&str]) -> Output {
     o
 }
 
+/// Runs the binary with `args` in the folder `dir` (its working directory, against which
+/// relative paths in `args` resolve) and asserts it succeeded.
+pub fn run_ok_in(dir: &Path, args: &[&str]) -> Output {
+    let o = Command::new(env!("CARGO_BIN_EXE_beamtrace"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("binary runs");
+    assert!(
+        o.status.success(),
+        "{args:?} in {}: {}",
+        dir.display(),
+        stderr(&o)
+    );
+    o
+}
+
 /// Runs the binary, asserts it succeeded and parses its standard output as JSON.
 pub fn run_json(args: &[&str]) -> Value {
     serde_json::from_slice(&run_ok(args).stdout).expect("valid JSON")
