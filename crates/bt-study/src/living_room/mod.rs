@@ -4,7 +4,7 @@
 //! the sphere) and the accelerator's bit-exact fixed-point IPC model, with the accelerator's
 //! cycle count per step from a per-step PE schedule.
 //!
-//! - [`mod@run`] here: the study, one [`Row`] per step and solver, one [`FpgaStep`] per step,
+//! - [`run()`] here: the study, one [`Row`] per step and solver, one [`FpgaStep`] per step,
 //!   and the ray directions of Fig. 18 for two steps;
 //! - [`report`]: `results.csv`, `fpga.csv`, `summary.md`;
 //! - [`plot`]: Figs. 17-19 on any plotters backend; [`crate::io::write_living_room`] writes

@@ -31,7 +31,7 @@ fn per_step(
 
 /// Fig. 17: mean angular error per time step at TX (left) and RX (right), for IPC
 /// (Gauss-Seidel, Jacobi), the fixed-point model of the accelerator and SBR. Log y; errors
-/// below [`ERROR_FLOOR_DEG`] are drawn at it.
+/// below [`ERROR_FLOOR_DEG`](crate::plot::ERROR_FLOOR_DEG) are drawn at it.
 pub fn angular_error<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     results: &LivingRoomResults,
