@@ -119,9 +119,9 @@ pub fn run_channel(args: &ChannelArgs) -> anyhow::Result<ExitCode> {
         println!("{}: {} subcarriers", path.display(), args.subcarriers);
     }
     if let Some(stem) = &args.pdp {
-        let taps: Vec<bt_study::plot::PdpTap> = paths
+        let taps: Vec<bt_plot::PdpTap> = paths
             .iter()
-            .map(|p| bt_study::plot::PdpTap {
+            .map(|p| bt_plot::PdpTap {
                 delay_ns: p.delay_s * 1e9,
                 power_dbm: p.power_dbm.unwrap_or(f64::NEG_INFINITY),
                 order: p.order,
@@ -133,7 +133,7 @@ pub fn run_channel(args: &ChannelArgs) -> anyhow::Result<ExitCode> {
             carrier / 1e9,
             radio.tx_power_dbm
         );
-        for written in bt_study::io::write_power_delay_profile(stem, &title, &taps)? {
+        for written in bt_plot::write_power_delay_profile(stem, &title, &taps)? {
             println!("{}", written.display());
         }
     }

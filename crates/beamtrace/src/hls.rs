@@ -3,16 +3,13 @@
 
 use crate::args::{HlsArgs, HlsCommand, HlsGenArgs};
 use anyhow::{Context, bail};
-use bt_hls::{OutputDir, PlanOptions};
+use bt_hls::{CLOCK_HZ, OutputDir, PlanOptions};
 use bt_scene::Scene;
 use bt_schedule::GaParams;
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 use std::path::Path;
 use std::process::ExitCode;
-
-/// Clock of the paper's platform (Cyclone IV E at 50 MHz), Hz.
-pub const CLOCK_HZ: f64 = bt_study::living_room::CLOCK_HZ;
 
 pub fn run(args: &HlsArgs) -> anyhow::Result<ExitCode> {
     match &args.command {

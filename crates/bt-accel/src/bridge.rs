@@ -125,7 +125,7 @@ pub struct StepInput {
 /// `planes[i]`), `candidates` the step's candidate sequences (empty ones skipped); a
 /// candidate through a surface not in `planes` goes to the host. `threshold_lsb` in 1/256 mm,
 /// `max_rounds` the round cap; early stopping ([`EarlyStop::default`]) on every plane's
-/// polygon bounding box; the coordinate word sized from the planes ([`platform_extent_m`]).
+/// polygon bounding box; the coordinate word sized from the planes (`platform_extent_m`).
 pub fn step_input(
     scene: &Scene,
     planes: &[SurfaceId],

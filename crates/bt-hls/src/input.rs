@@ -143,7 +143,7 @@ impl HlsInput {
 }
 
 /// Narrowest Avalon word address of a design, bits: the control, status, point and schedule
-/// regions of [`Layout::of`] take what they need above it (the port is
+/// regions of `Layout::of` take what they need above it (the port is
 /// `avs_address[address_bits-1:0]`, at least 16 bits).
 pub const MIN_ADDRESS_BITS: u32 = 16;
 

@@ -50,6 +50,10 @@ pub use top::MAP_VERSION;
 use error::io_err;
 use input::{Design, StepDesign};
 
+/// Clock of the accelerator on the paper's platform (Intel Cyclone IV E at 50 MHz), Hz: a run
+/// takes its cycle count (the CYCLES register, [`run_cycles`]) over this, in seconds.
+pub const CLOCK_HZ: f64 = 50e6;
+
 /// Word addresses of the control registers (Avalon-MM, 32-bit words).
 pub mod regs {
     /// W: bit 0 = start (ignored while busy). R: bit 0 = busy, bit 1 = done.
@@ -412,10 +416,12 @@ fn register_map(d: &Design) -> String {
         bt_fixed::Widths::for_coord(d.platform.coord_bits).iterations,
         d.platform.coord_bits
     ));
-    s.push_str(
-        "* testbench edges: 1 per write, 2 per read, 1 + CYCLES per start\n\
-         * at 50 MHz (the paper's clock) one run takes CYCLES x 20 ns\n",
-    );
+    s.push_str("* testbench edges: 1 per write, 2 per read, 1 + CYCLES per start\n");
+    s.push_str(&format!(
+        "* at {} MHz (the paper's clock) one run takes CYCLES x {} ns\n",
+        CLOCK_HZ / 1e6,
+        1e9 / CLOCK_HZ
+    ));
     s
 }
 

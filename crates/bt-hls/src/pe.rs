@@ -113,7 +113,7 @@ pub fn pe_module_name(index: usize) -> String {
     format!("bt_pe_{index}")
 }
 
-/// Name of the plane-independent core that every `bt_pe_<i>` instantiates ([`pe_core_module`]).
+/// Name of the plane-independent core that every `bt_pe_<i>` instantiates (`pe_core_module`).
 pub const PE_CORE_MODULE: &str = "bt_pe_core";
 
 /// First iteration step of Algorithm 3 in the PE's step counter (see [`pe_module`]).

@@ -275,7 +275,10 @@ fn simulate_sources(
             if !out.status.success() {
                 return Err(failure("verilator", &out));
             }
+            // Absolute: the binary runs inside `tb/`, where a path relative to the caller's
+            // directory (`hls sim hw` gives `hw/tb/obj_dir/bt_sim`) names nothing.
             let exe = out_dir.join("tb/obj_dir/bt_sim");
+            let exe = std::path::absolute(&exe).map_err(io_err(&exe))?;
             (exe.display().to_string(), Vec::new())
         }
     };

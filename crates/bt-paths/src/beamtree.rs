@@ -45,7 +45,7 @@ pub struct TreeOptions {
     pub starts: bool,
 }
 
-/// When the tree tests its nodes for occlusion ([`occlude`]). Culling never changes the paths
+/// When the tree tests its nodes for occlusion (`occlude`). Culling never changes the paths
 /// found, only how much the tree and the solver do: in a room most windows are visible and the
 /// test costs more than the children it could save; in a city it removes most nodes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -1,11 +1,16 @@
 //! The chart setup every beamtrace figure shares: the shipped font, a white canvas, the legend
-//! style, and writing one figure as SVG and PNG (atomically: temp file + rename).
+//! style, and writing one figure as SVG and PNG (atomically: temp file + rename); and the
+//! figures that belong to no study: the power-delay profile of a trace ([`pdp`]).
 //!
 //! Text needs a font and the machines that draw figures may have none: DejaVu Sans (Bitstream
 //! Vera licence, `assets/DejaVuSans-LICENSE.txt`) is compiled in and registered as
 //! `sans-serif` by [`register_font`].
 
 #![warn(missing_docs)]
+
+pub mod pdp;
+
+pub use pdp::{PdpTap, power_delay_profile, write_power_delay_profile};
 
 use plotters::chart::MeshStyle;
 use plotters::coord::ranged1d::{Ranged, ValueFormatter};

@@ -53,27 +53,6 @@ fn plot_error(e: bt_plot::PlotError) -> StudyError {
     }
 }
 
-/// Write the power-delay profile of `taps` as `<stem>.svg` and `<stem>.png` (each to a temporary
-/// file in the same directory, then renamed into place). Returns the files written.
-pub fn write_power_delay_profile(
-    stem: &Path,
-    title: &str,
-    taps: &[plot::PdpTap],
-) -> Result<Vec<PathBuf>, StudyError> {
-    struct Pdp<'a>(&'a str, &'a [plot::PdpTap]);
-    impl bt_plot::Figure for Pdp<'_> {
-        fn draw<DB: DrawingBackend>(
-            &self,
-            root: &DrawingArea<DB, plotters::coord::Shift>,
-        ) -> Result<(), String> {
-            plot::power_delay_profile(root, (self.0, self.1))
-        }
-    }
-    let written =
-        bt_plot::write_svg_png(stem, (900, 500), &Pdp(title, taps)).map_err(plot_error)?;
-    Ok(written.to_vec())
-}
-
 /// Write every output of a study into `dir` (created if missing; built aside and swapped in,
 /// see `bt_output::OutputDir`); returns the files written.
 pub fn write_outputs(dir: &Path, results: &StudyResults) -> Result<Vec<PathBuf>, StudyError> {

@@ -7,12 +7,15 @@
 //!   panels, blockers, grazing terminals and paths through edges and corners;
 //! - [`corner_scene`]: two walls at a dihedral angle with a double bounce near the edge;
 //! - [`partitioned`]: a room split by a partition with a doorway, random boxes and tilted
-//!   quads, optionally moving over time steps.
+//!   quads, optionally moving over time steps;
+//! - [`golden`]: the golden-file check of every golden test, with its update switch
+//!   (`UPDATE_GOLDEN=1`).
 //!
 //! Same seed, same scene, on every platform (ChaCha8). Scenes are test input: the builders
 //! panic when a generated scene does not validate.
 #![warn(missing_docs)]
 
+pub mod golden;
 pub mod partitioned;
 
 use bt_geom::{Real, Vec3};

@@ -36,18 +36,7 @@ fn demo_prints_a_table_of_paths() {
 fn golden_json_of_the_builtin_scene() {
     let doc = without_timings(trace_json(&["builtin:living-room"]));
     let text = serde_json::to_string_pretty(&doc).unwrap() + "\n";
-    let golden = repo().join("testdata/golden/living-room-image.json");
-    if std::env::var_os("UPDATE_GOLDEN").is_some() {
-        std::fs::write(&golden, &text).unwrap();
-    }
-    let expected =
-        std::fs::read_to_string(&golden).expect("golden file exists (UPDATE_GOLDEN=1 writes it)");
-    assert_eq!(
-        text,
-        expected,
-        "output differs from {}; rerun with UPDATE_GOLDEN=1 if intended",
-        golden.display()
-    );
+    assert_golden(golden::dir().join("living-room-image.json"), text);
 }
 
 #[test]

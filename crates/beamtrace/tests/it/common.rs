@@ -6,6 +6,8 @@ use std::path::{Path, PathBuf};
 use std::process::{Command, Output};
 use std::sync::Mutex;
 
+pub use bt_testkit::golden::{self, assert_golden};
+
 /// The repository root (for `testdata/`).
 pub fn repo() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("../..")
@@ -49,6 +51,23 @@ pub fn beamtrace(args: &[&str]) -> Output {
 pub fn run_ok(args: &[&str]) -> Output {
     let o = beamtrace(args);
     assert!(o.status.success(), "{args:?}: {}", stderr(&o));
+    o
+}
+
+/// Runs the binary with `args` in the folder `dir` (its working directory, against which
+/// relative paths in `args` resolve) and asserts it succeeded.
+pub fn run_ok_in(dir: &Path, args: &[&str]) -> Output {
+    let o = Command::new(env!("CARGO_BIN_EXE_beamtrace"))
+        .args(args)
+        .current_dir(dir)
+        .output()
+        .expect("binary runs");
+    assert!(
+        o.status.success(),
+        "{args:?} in {}: {}",
+        dir.display(),
+        stderr(&o)
+    );
     o
 }
 

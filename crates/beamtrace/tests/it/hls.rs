@@ -71,6 +71,23 @@ fn the_street_of_37_planes_cosimulates_with_wide_schedule_entries() {
     std::fs::remove_dir_all(&root).ok();
 }
 
+/// The README's form, run in the folder that is to hold the design: `hls builtin:living-room
+/// --max-order 1 -o hw`, then `hls sim hw` with that relative name, in Verilator (whose
+/// binary runs inside `hw/tb/`, where a path relative to the caller's folder names nothing).
+#[test]
+fn hls_sim_takes_the_readmes_relative_directory() {
+    let root = scratch("hls-relative");
+    run_ok_in(
+        &root,
+        &cli("hls builtin:living-room --max-order 1 -o hw", &[]),
+    );
+    let out = text(&run_ok_in(&root, &["hls", "sim", "hw"]));
+    assert!(out.contains("hw: verilator ("), "{out}");
+    assert!(out.contains(" 0 mismatches"), "{out}");
+    assert!(out.contains("runs as predicted: true"), "{out}");
+    std::fs::remove_dir_all(&root).ok();
+}
+
 #[test]
 fn ga_is_never_longer_than_list_and_duplication_helps() {
     let root = scratch("hls-schedules");

@@ -85,13 +85,7 @@ fn every_point_equals_its_own_trace() {
 fn tiny_grid_matches_the_golden_csv_and_marks_the_tx() {
     // (5.6, 0.6, 2.2) is the living room's TX: skipped with empty fields, the rest traced.
     let (dir, csv) = sweep("5.0:5.6:0.3,0.6:1.2:0.6,2.2", &[], "golden");
-    let golden = repo().join("testdata/golden/sweep-living-room.csv");
-    if std::env::var_os("UPDATE_GOLDEN").is_some() {
-        std::fs::write(&golden, &csv).unwrap();
-    }
-    let expected =
-        std::fs::read_to_string(&golden).expect("golden file (UPDATE_GOLDEN=1 writes it)");
-    assert_eq!(csv, expected, "rerun with UPDATE_GOLDEN=1 if intended");
+    assert_golden(golden::dir().join("sweep-living-room.csv"), &csv);
     assert!(
         csv.contains(
             "5.600000,0.600000,2.200000,skipped,,,,,,,,tx and rx are at the same position"

@@ -120,25 +120,12 @@ pub fn generated() -> &'static Generated {
 
 /// `testdata/golden/rtl` at the repository root: the generator's golden outputs.
 pub fn golden_dir() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../testdata/golden/rtl")
+    bt_testkit::golden::dir().join("rtl")
 }
 
 /// Compares `actual` with the golden file `testdata/golden/rtl/<name>`; `UPDATE_GOLDEN=1`
-/// rewrites it.
+/// rewrites it (`bt_testkit::golden::assert_golden`).
+#[track_caller]
 pub fn golden(name: &str, actual: &str) {
-    let path = golden_dir().join(name);
-    if std::env::var_os("UPDATE_GOLDEN").is_some() {
-        if let Some(dir) = path.parent() {
-            std::fs::create_dir_all(dir).unwrap();
-        }
-        std::fs::write(&path, actual).unwrap();
-        return;
-    }
-    let expected = std::fs::read_to_string(&path)
-        .unwrap_or_else(|e| panic!("{}: {e} (UPDATE_GOLDEN=1 creates it)", path.display()));
-    assert!(
-        expected == actual,
-        "{} differs from the generated output (UPDATE_GOLDEN=1 to accept)",
-        path.display()
-    );
+    bt_testkit::golden::assert_golden(golden_dir().join(name), actual);
 }

@@ -351,10 +351,10 @@ pub(super) fn frame(n: Vec3) -> (Vec3, Vec3) {
 /// Like [`extract_planes`], calling `progress` after each stage and each RANSAC plane. The
 /// library never prints; wire the callback to a progress bar in the binary.
 ///
-/// Stages, one function each: normals, [`ransac_patches`] (planes and their connected
-/// components), [`separate_layers`] (parallel surfaces share their points), [`build_patch`]
-/// (refit, orient, boundary; in parallel), snapping of shared edges, [`finish_planes`] (area
-/// and width checks) and [`report`].
+/// Stages, one function each: normals, `ransac_patches` (planes and their connected
+/// components), `separate_layers` (parallel surfaces share their points), `build_patch`
+/// (refit, orient, boundary; in parallel), snapping of shared edges, `finish_planes` (area
+/// and width checks) and `report`.
 pub fn extract_planes_with_progress(
     cloud: &PointCloud,
     params: &ExtractParams,

@@ -4,14 +4,14 @@
 //! the sphere) and the accelerator's bit-exact fixed-point IPC model, with the accelerator's
 //! cycle count per step from a per-step PE schedule.
 //!
-//! - [`mod@run`] here: the study, one [`Row`] per step and solver, one [`FpgaStep`] per step,
+//! - [`run()`] here: the study, one [`Row`] per step and solver, one [`FpgaStep`] per step,
 //!   and the ray directions of Fig. 18 for two steps;
 //! - [`report`]: `results.csv`, `fpga.csv`, `summary.md`;
 //! - [`plot`]: Figs. 17-19 on any plotters backend; [`crate::io::write_living_room`] writes
 //!   them as SVG and PNG.
 //!
 //! Units: metres, seconds; angles in degrees where the name says `_deg`; cycles of the
-//! accelerator's clock, [`CLOCK_HZ`]. `docs/study-living-room.md` has the measured numbers.
+//! accelerator's clock, [`bt_hls::CLOCK_HZ`]. `docs/study-living-room.md` has the measured numbers.
 
 pub mod plot;
 pub mod report;
@@ -22,16 +22,13 @@ use crate::run::{
 use crate::{StudyConfig, StudyError, StudySolver};
 use bt_accel as fpga;
 use bt_geom::{Real, Vec3};
-use bt_hls::{PlanOptions, ScheduleKind};
+use bt_hls::{CLOCK_HZ, PlanOptions, ScheduleKind};
 use bt_scene::Scene;
 use bt_scene::dynamic::DynamicScene;
 use bt_schedule::GaParams;
 use bt_solve::{SbrOptions, Validity, validate::validate};
 use serde::Serialize;
 use std::time::Instant;
-
-/// Clock of the paper's platform (Intel Cyclone IV E at 50 MHz), Hz.
-pub const CLOCK_HZ: Real = 50e6;
 
 /// The solvers of the living-room study, in output order.
 pub const SOLVERS: [StudySolver; 5] = [

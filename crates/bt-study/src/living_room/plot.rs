@@ -31,7 +31,7 @@ fn per_step(
 
 /// Fig. 17: mean angular error per time step at TX (left) and RX (right), for IPC
 /// (Gauss-Seidel, Jacobi), the fixed-point model of the accelerator and SBR. Log y; errors
-/// below [`ERROR_FLOOR_DEG`] are drawn at it.
+/// below [`ERROR_FLOOR_DEG`](crate::plot::ERROR_FLOOR_DEG) are drawn at it.
 pub fn angular_error<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     results: &LivingRoomResults,
@@ -80,7 +80,7 @@ pub fn run_time<DB: DrawingBackend>(
     })
     .collect();
     series.push(Series {
-        label: format!("ipc on the FPGA (cycles / {} MHz)", super::CLOCK_HZ / 1e6),
+        label: format!("ipc on the FPGA (cycles / {} MHz)", bt_hls::CLOCK_HZ / 1e6),
         colour: FPGA_COLOUR,
         points: results.fpga.iter().map(|f| (f.step, f.latency_s)).collect(),
     });

@@ -1,11 +1,12 @@
 //! The living-room study's text outputs (`results.csv`, `fpga.csv`, `summary.md`) and the
 //! aggregates behind them. Pure functions of the results: writing files is [`crate::io`]'s job.
 
-use super::{CLOCK_HZ, LivingRoomResults, Row, SOLVERS};
+use super::{LivingRoomResults, Row, SOLVERS};
 use crate::StudySolver;
 use crate::report::{csv_table, pick};
 use crate::run::{AngularErrors, Comparison};
 use bt_geom::Real;
+use bt_hls::CLOCK_HZ;
 use std::collections::BTreeMap;
 use std::fmt::Write;
 
