@@ -839,22 +839,36 @@ fn fsm_on_start(t: &Dims<'_>) -> Vec<Stmt> {
 
 /// LOAD: register the schedule entry for the operand broadcast until the slot's tail, then EXEC.
 fn fsm_load(t: &Dims<'_>, rom: &ScheduleRead) -> Vec<Stmt> {
-    vec![
-        nb(id("ld_q_en"), rom.valid.e()),
-        nb(id("ld_q_tail"), rom.tail.e()),
-        nb(id("ld_q_first"), rom.first.e()),
-        nb(id("ld_q_last"), rom.last.e()),
-        nb(id("ld_q_inst"), rom.inst.e()),
-        Stmt::If(
-            id("ld_q_tail"),
-            vec![
-                nb(id("state"), lit(STATE_BITS, S_EXEC)),
-                nb(id("cnt"), lit(t.cnt_bits, 0)),
-                nb(id("seen_tail"), lit(1, 0)),
-            ],
-            vec![nb(id("cnt"), cnt_inc(t)), nb(id("seen_tail"), rom.stop.e())],
-        ),
-    ]
+    let mut stmts = register_entry(&[
+        ("ld_q_en", &rom.valid),
+        ("ld_q_tail", &rom.tail),
+        ("ld_q_first", &rom.first),
+        ("ld_q_last", &rom.last),
+        ("ld_q_inst", &rom.inst),
+    ]);
+    stmts.push(Stmt::If(
+        id("ld_q_tail"),
+        vec![
+            nb(id("state"), lit(STATE_BITS, S_EXEC)),
+            nb(id("cnt"), lit(t.cnt_bits, 0)),
+            nb(id("seen_tail"), lit(1, 0)),
+        ],
+        next_entry(t, rom),
+    ));
+    stmts
+}
+
+/// Registers the schedule entry's fields: one `register <= field` per pair, in order.
+fn register_entry(pairs: &[(&str, &Signal)]) -> Vec<Stmt> {
+    pairs
+        .iter()
+        .map(|(reg, field)| nb(id(reg), field.e()))
+        .collect()
+}
+
+/// Before the slot's tail: step to the next entry and note whether the tail was read.
+fn next_entry(t: &Dims<'_>, rom: &ScheduleRead) -> Vec<Stmt> {
+    vec![nb(id("cnt"), cnt_inc(t)), nb(id("seen_tail"), rom.stop.e())]
 }
 
 /// EXEC: wait the PE latency ([`pe_latency`]) for every PE of the slot, then WB.
@@ -920,13 +934,15 @@ fn path_commit(f: &WritebackFlags) -> Vec<Stmt> {
 /// slot's LOAD (or IDLE with done after the last slot).
 fn fsm_writeback(t: &Dims<'_>, rom: &ScheduleRead, f: &WritebackFlags) -> Vec<Stmt> {
     let (sb, eb, cnt_bits) = (t.sb, t.eb, t.cnt_bits);
-    vec![
-        nb(id("wb_q_en"), rom.valid.e()),
-        nb(id("wb_q_tail"), rom.tail.e()),
-        nb(id("wb_q_end"), rom.end.e()),
-        nb(id("wb_q_path"), rom.path.e()),
-        nb(id("wb_q_point"), rom.point.e()),
-        nb(id("wb_q_inst"), rom.inst.e()),
+    let mut stmts = register_entry(&[
+        ("wb_q_en", &rom.valid),
+        ("wb_q_tail", &rom.tail),
+        ("wb_q_end", &rom.end),
+        ("wb_q_path", &rom.path),
+        ("wb_q_point", &rom.point),
+        ("wb_q_inst", &rom.inst),
+    ]);
+    stmts.extend([
         Stmt::If(f.go.e(), path_commit(f), vec![]),
         Stmt::If(
             id("wb_q_tail"),
@@ -954,9 +970,10 @@ fn fsm_writeback(t: &Dims<'_>, rom: &ScheduleRead, f: &WritebackFlags) -> Vec<St
                     ],
                 ),
             ],
-            vec![nb(id("cnt"), cnt_inc(t)), nb(id("seen_tail"), rom.stop.e())],
+            next_entry(t, rom),
         ),
-    ]
+    ]);
+    stmts
 }
 
 /// The main FSM (controller): IDLE -> per slot LOAD, EXEC, WB -> IDLE with done, and the
