@@ -167,7 +167,7 @@ fn power_db(value: Real) -> Option<Real> {
     (value > 0.0).then(|| 10.0 * value.log10())
 }
 
-/// Describe one found path (rank 0 until [`rank`] runs).
+/// Describe one found path (rank 0 until [`report`] ranks it).
 pub fn describe(
     scene: &Scene,
     path: &FoundPath,
