@@ -9,6 +9,7 @@
 
 mod columns;
 mod options;
+mod record;
 
 use bt_geom::Vec3;
 use bt_import::LoadOptions;
@@ -292,7 +293,7 @@ fn builtin_names() -> Vec<&'static str> {
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("BeamtraceError", m.py().get_type::<BeamtraceError>())?;
-    m.add("PATH_COLUMNS", columns::names())?;
+    m.add("PATH_COLUMNS", columns::names()?)?;
     m.add(
         "DEFAULT_MAX_CANDIDATES",
         bt_solve::pipeline::DEFAULT_MAX_CANDIDATES,

@@ -40,7 +40,9 @@ class Paths:
 
     Per-path columns are NumPy arrays of length ``n = len(paths)``; per-reflection values are
     lists of ``n`` arrays. Every field of ``beamtrace trace --json``'s path objects is here
-    under the same name. ``iterations``/``residual_m`` exist for the IPC solver only.
+    under the same name, in the same order (``beamtrace._native.PATH_COLUMNS`` lists them all;
+    the columns come from the report record itself). ``iterations``/``residual_m`` exist for
+    the IPC solver only.
     """
 
     rank: npt.NDArray[np.int64]
