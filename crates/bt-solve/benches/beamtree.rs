@@ -6,7 +6,7 @@
 //!   followed by the per-path report (gains, angles, names); a new RX answered by a kept tree;
 //! - the built-in city (39,692 triangles): orders 1, 2 and 3.
 
-use bt_paths::beamtree::{BeamTree, TreeOptions};
+use bt_paths::beamtree::{BeamTree, TreeCache, TreeOptions, candidates_in};
 use bt_scene::{Scene, Terminals, Vec3};
 use bt_solve::pipeline::{CandidateMode, TraceOptions};
 use bt_solve::{IpcOptions, Solver, Tracer, UpdateOrder};
@@ -60,8 +60,13 @@ fn living_room(c: &mut Criterion) {
         ..gs_options
     });
     let mut group = c.benchmark_group("living-room-order3");
+    // A stream of candidate walks keeps its cache, as the tracer does.
+    let mut cache = TreeCache::default();
     group.bench_function("beam-tree-candidates", |b| {
-        b.iter(|| bt_paths::beamtree::candidates(black_box(&scene), TreeOptions::new(3)))
+        b.iter(|| {
+            let options = TreeOptions::new(3);
+            candidates_in(black_box(&scene), options, &mut cache, &mut |_| {})
+        })
     });
     for (name, mode, solver) in [
         (

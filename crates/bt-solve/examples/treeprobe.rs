@@ -11,7 +11,7 @@
 //! tree / exhaustive candidates), `ipc` (whole IPC Gauss-Seidel trace), `walk` (a new RX on a
 //! kept tree, walk only), `newrx` (walk + image method + validation).
 
-use bt_paths::beamtree::{BeamTree, TreeOptions, candidates};
+use bt_paths::beamtree::{BeamTree, TreeCache, TreeOptions, candidates_in};
 use bt_scene::{Scene, Terminals, Vec3};
 use bt_solve::Tracer;
 use bt_solve::pipeline::{CandidateMode, TraceOptions, Traced};
@@ -27,14 +27,24 @@ fn trace_options(solver: Solver, candidates: CandidateMode) -> TraceOptions {
     }
 }
 
-/// `scene` traced between its own terminals by a tracer of its own.
-fn trace_scene(scene: &Scene, options: &TraceOptions) -> Traced {
-    let mut tracer = Tracer::new(scene.clone(), *options);
+/// What the calls of one run keep, as a stream of traces does: the tracer (with its beam-tree
+/// caches) and the cache of the bare candidate walks.
+#[derive(Default)]
+struct Kept {
+    tracer: Option<Tracer>,
+    cache: TreeCache,
+}
+
+/// `scene` traced between its own terminals by the run's tracer (made on the first call).
+fn trace_scene(kept: &mut Kept, scene: &Scene, options: &TraceOptions) -> Traced {
+    let tracer = kept
+        .tracer
+        .get_or_insert_with(|| Tracer::new(scene.clone(), *options));
     tracer.trace(scene.tx_world(), scene.rx_world()).unwrap()
 }
 
-fn traced_paths(scene: &Scene, options: &TraceOptions) -> usize {
-    trace_scene(scene, options).result.paths.len()
+fn traced_paths(kept: &mut Kept, scene: &Scene, options: &TraceOptions) -> usize {
+    trace_scene(kept, scene, options).result.paths.len()
 }
 
 /// The RX of call `i` (scene-local frame): a few millimetres apart, so that no call repeats
@@ -43,15 +53,19 @@ fn moved_rx(scene: &Scene, i: usize) -> Vec3 {
     scene.rx() + Vec3::new(0.001 * (i % 7) as f64, 0.0, 0.0)
 }
 
-fn run(what: &str, scene: &Scene, i: usize, tree: &BeamTree) -> usize {
+fn run(what: &str, scene: &Scene, i: usize, tree: &BeamTree, kept: &mut Kept) -> usize {
     match what {
-        "cand" => candidates(scene, TreeOptions::new(3)).unwrap().len(),
+        "cand" => candidates_in(scene, TreeOptions::new(3), &mut kept.cache, &mut |_| {})
+            .unwrap()
+            .len(),
         "image" => traced_paths(
+            kept,
             scene,
             &trace_options(Solver::Image, CandidateMode::BeamTree),
         ),
         "report" => {
             let traced = trace_scene(
+                kept,
                 scene,
                 &trace_options(Solver::Image, CandidateMode::BeamTree),
             );
@@ -64,12 +78,13 @@ fn run(what: &str, scene: &Scene, i: usize, tree: &BeamTree) -> usize {
             .len()
         }
         "exh" => traced_paths(
+            kept,
             scene,
             &trace_options(Solver::Image, CandidateMode::Exhaustive),
         ),
         "ipc" => {
             let ipc = Solver::Ipc(IpcOptions::for_scene(scene, UpdateOrder::GaussSeidel));
-            traced_paths(scene, &trace_options(ipc, CandidateMode::BeamTree))
+            traced_paths(kept, scene, &trace_options(ipc, CandidateMode::BeamTree))
         }
         "ipc-newton" => {
             let ipc = IpcOptions {
@@ -77,6 +92,7 @@ fn run(what: &str, scene: &Scene, i: usize, tree: &BeamTree) -> usize {
                 ..IpcOptions::for_scene(scene, UpdateOrder::GaussSeidel)
             };
             traced_paths(
+                kept,
                 scene,
                 &trace_options(Solver::Ipc(ipc), CandidateMode::BeamTree),
             )
@@ -104,12 +120,13 @@ fn main() {
         .unwrap()
         .unwrap();
     let tree = BeamTree::build(&scene, TreeOptions::new(3)).unwrap();
+    let mut kept = Kept::default();
     if std::env::var_os("TREEPROBE_TIME").is_some() {
         // Wall clock: the best of 20 batches of `n` calls, per call.
         let best = (0..20)
             .map(|_| {
                 let t = std::time::Instant::now();
-                let total: usize = (0..n).map(|i| run(what, &scene, i, &tree)).sum();
+                let total: usize = (0..n).map(|i| run(what, &scene, i, &tree, &mut kept)).sum();
                 std::hint::black_box(total);
                 t.elapsed().as_secs_f64() / n as f64
             })
@@ -120,6 +137,6 @@ fn main() {
         );
         return;
     }
-    let total: usize = (0..n).map(|i| run(what, &scene, i, &tree)).sum();
+    let total: usize = (0..n).map(|i| run(what, &scene, i, &tree, &mut kept)).sum();
     println!("{total}");
 }
