@@ -169,14 +169,16 @@ impl HeatMap<'_> {
                 )))
                 .map_err(fail)?;
         }
-        let tx = self.scene.tx_world();
-        chart
-            .draw_series(std::iter::once(TriangleMarker::new(
-                (tx.x, tx.y),
-                8,
-                RED.filled(),
-            )))
-            .map_err(fail)?;
+        // A scene without a TX has no sweep to show, but draws its outline without a marker.
+        if let Some(tx) = self.scene.tx_world() {
+            chart
+                .draw_series(std::iter::once(TriangleMarker::new(
+                    (tx.x, tx.y),
+                    8,
+                    RED.filled(),
+                )))
+                .map_err(fail)?;
+        }
         Ok(())
     }
 

@@ -30,7 +30,9 @@ fn trace_options(solver: Solver, candidates: CandidateMode) -> TraceOptions {
 /// `scene` traced between its own terminals by a tracer of its own.
 fn trace_scene(scene: &Scene, options: &TraceOptions) -> Traced {
     let mut tracer = Tracer::new(scene.clone(), *options);
-    tracer.trace(scene.tx_world(), scene.rx_world()).unwrap()
+    tracer
+        .trace(scene.tx_world().unwrap(), scene.rx_world().unwrap())
+        .unwrap()
 }
 
 fn traced_paths(scene: &Scene, options: &TraceOptions) -> usize {
@@ -40,7 +42,7 @@ fn traced_paths(scene: &Scene, options: &TraceOptions) -> usize {
 /// The RX of call `i` (scene-local frame): a few millimetres apart, so that no call repeats
 /// the previous one.
 fn moved_rx(scene: &Scene, i: usize) -> Vec3 {
-    scene.rx() + Vec3::new(0.001 * (i % 7) as f64, 0.0, 0.0)
+    scene.rx().unwrap() + Vec3::new(0.001 * (i % 7) as f64, 0.0, 0.0)
 }
 
 fn run(what: &str, scene: &Scene, i: usize, tree: &BeamTree) -> usize {
@@ -87,6 +89,7 @@ fn run(what: &str, scene: &Scene, i: usize, tree: &BeamTree) -> usize {
             let set = tree.candidates(rx);
             let moved = scene.with_receiver(scene.to_world(rx)).unwrap();
             bt_solve::trace(&moved, &set, &Solver::Image, false)
+                .unwrap()
                 .paths
                 .len()
         }

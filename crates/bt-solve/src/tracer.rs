@@ -94,7 +94,7 @@ impl Tracer {
         rx: Vec3,
         progress: &mut dyn FnMut(BuildProgress),
     ) -> Result<Traced, TraceError> {
-        if tx == self.scene.tx_world() && rx == self.scene.rx_world() {
+        if Some(tx) == self.scene.tx_world() && Some(rx) == self.scene.rx_world() {
             return trace_scene_in(&self.scene, &self.options, &mut self.cache, progress);
         }
         let moved = self.scene.with_terminals(tx, rx)?;
@@ -124,7 +124,7 @@ impl Tracer {
         };
         let options = self.options;
         let walk = walks_one_tree(&options, receivers);
-        if tx != self.scene.tx_world() {
+        if Some(tx) != self.scene.tx_world() {
             let base = self.scene.with_terminals(tx, *first)?;
             let tree = match walk {
                 true => Some(BeamTree::build_in(
