@@ -169,7 +169,7 @@ impl HeatMap<'_> {
                 )))
                 .map_err(fail)?;
         }
-        // A scene without a TX has no sweep to show, but draws its outline without a marker.
+        // `sweep` refuses a scene without a TX; a map of one draws no marker, not a made-up one.
         if let Some(tx) = self.scene.tx_world() {
             chart
                 .draw_series(std::iter::once(TriangleMarker::new(
