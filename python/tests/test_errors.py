@@ -36,8 +36,16 @@ def test_invalid_scene_lists_every_problem_like_the_cli(cli):
 
 
 def test_mesh_without_terminals_says_what_is_missing():
-    with pytest.raises(beamtrace.BeamtraceError, match="meshes carry no tx"):
-        beamtrace.load(TESTDATA / "box-room.obj")
+    # A mesh loads as bare geometry; the trace that lacks a terminal names its keyword.
+    scene = beamtrace.load(TESTDATA / "box-room.obj")
+    assert scene.tx is None and scene.rx is None
+    with pytest.raises(ValueError, match=r"no tx and rx given: pass tx=\[x, y, z\] and rx=") as info:
+        scene.trace()
+    assert "--tx" not in str(info.value)
+    with pytest.raises(ValueError, match=r"no rx given: pass rx=\[x, y, z\]"):
+        scene.trace(tx=[1.0, 1.0, 1.0])
+    with pytest.raises(ValueError, match=r"no tx given: pass tx=\[x, y, z\]"):
+        scene.trace_many(None, np.array([[3.0, 2.0, 1.5]]))
 
 
 def test_unknown_builtin_lists_the_builtins():

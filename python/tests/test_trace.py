@@ -73,6 +73,20 @@ def test_mesh_with_terminals_matches_cli(cli_json):
     assert_same_as_cli(paths, doc)
 
 
+def test_bare_mesh_traces_with_terminals_per_call(cli_json):
+    # Terminals per trace: load the mesh bare, give tx/rx to each trace; the result is the
+    # CLI's for the mesh loaded with those terminals, to the last bit.
+    tx, rx = [1.0, 1.0, 1.5], [3.0, 2.0, 1.2]
+    mesh = TESTDATA / "box-room.obj"
+    scene = beamtrace.load(mesh)
+    assert scene.tx is None and scene.rx is None
+    paths = scene.trace(tx=tx, rx=rx, max_order=2)
+    doc = cli_json(str(mesh), "--tx", vec(tx), "--rx", vec(rx), "--max-order", "2")
+    assert_same_as_cli(paths, doc)
+    many = scene.trace_many(tx, np.array([rx, [2.0, 3.0, 1.0]]), max_order=2)
+    assert many[0].length_m.tolist() == paths.length_m.tolist()
+
+
 def test_scene_properties():
     scene = beamtrace.load("builtin:living-room")
     assert scene.name == "living-room"

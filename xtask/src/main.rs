@@ -39,8 +39,8 @@ struct Accuracy {
 }
 
 fn run(scene: &Scene, solver: &Solver) -> Vec<FoundPath> {
-    let candidates = enumerate(scene, 3, &AllVisible);
-    trace(scene, &candidates, solver, true).paths
+    let candidates = enumerate(scene, 3, &AllVisible).unwrap();
+    trace(scene, &candidates, solver, true).unwrap().paths
 }
 
 fn solvers(scene: &Scene) -> [(&'static str, Solver); 4] {

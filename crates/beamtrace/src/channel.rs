@@ -21,9 +21,9 @@ fn traced_paths(args: &PathArgs) -> anyhow::Result<(Scene, Vec<PathReport>, Radi
         eprintln!("warning: {w}");
     }
     let scene = loaded.scene;
+    let (tx, rx) = crate::load::terminals(&scene, &args.scene)?;
     let trace_args = args.trace_args();
     let options = trace_args.solve.settings().trace_options(&scene)?;
-    let (tx, rx) = (scene.tx_world(), scene.rx_world());
     let traced = bt_solve::Tracer::new(scene.clone(), options).trace(tx, rx)?;
     let radio = args.radio.options()?;
     let paths = bt_beams::report(&scene, &traced.result.paths, &radio)?;

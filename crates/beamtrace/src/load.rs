@@ -3,8 +3,8 @@
 
 use crate::args::SceneArgs;
 use bt_import::{LoadOptions, Loaded};
-use bt_scene::Terminals;
 use bt_scene::dynamic::DynamicScene;
+use bt_scene::{Scene, Terminal, Terminals, Vec3};
 
 /// The load options the scene arguments select: `--material`/`--thickness` give every
 /// material of any source that radio model; `--frequency` is the carrier of sources that carry
@@ -65,4 +65,36 @@ pub fn load_dynamic(args: &SceneArgs) -> anyhow::Result<DynamicScene> {
         eprintln!("warning: {w}");
     }
     Ok(scene)
+}
+
+/// Refuse a scene without the terminals a command needs (`which`), naming the flags that give
+/// them: meshes, XML scenes and point clouds carry none, and a scene file may leave them out.
+pub fn require_terminals(
+    scene: &Scene,
+    which: &[Terminal],
+    args: &SceneArgs,
+) -> anyhow::Result<()> {
+    let missing: Vec<Terminal> = which
+        .iter()
+        .copied()
+        .filter(|t| scene.terminal(*t).is_err())
+        .collect();
+    if missing.is_empty() {
+        return Ok(());
+    }
+    let names: Vec<&str> = missing.iter().map(|t| t.name()).collect();
+    let flags: Vec<String> = names.iter().map(|t| format!("--{t} X,Y,Z")).collect();
+    anyhow::bail!(
+        "{}: no {} given: pass {} (meshes, XML scenes and point clouds carry no terminals)",
+        args.scene,
+        names.join(" and "),
+        flags.join(" and ")
+    )
+}
+
+/// Both terminals of `scene`, metres, world frame, or the error of [`require_terminals`].
+pub fn terminals(scene: &Scene, args: &SceneArgs) -> anyhow::Result<(Vec3, Vec3)> {
+    require_terminals(scene, &[Terminal::Tx, Terminal::Rx], args)?;
+    let ends = scene.terminals()?;
+    Ok((scene.to_world(ends.tx), scene.to_world(ends.rx)))
 }

@@ -18,6 +18,7 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<ExitCode> {
         eprintln!("warning: {w}");
     }
     let scene = loaded.scene;
+    crate::load::require_terminals(&scene, &[bt_scene::Terminal::Tx], &args.scene)?;
     let options = args.solve.settings().trace_options(&scene)?;
     // indicatif draws to stderr and hides itself when stderr is not a terminal.
     let bar = ProgressBar::new(points.len() as u64);

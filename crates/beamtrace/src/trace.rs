@@ -22,10 +22,10 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
     for w in scene.warnings() {
         eprintln!("warning: {w}");
     }
+    let (tx, rx) = crate::load::terminals(&scene, &args.scene)?;
     let options = args.solve.settings().trace_options(&scene)?;
     let t1 = Instant::now();
     let (bar, mut progress) = crate::progress::tree_progress();
-    let (tx, rx) = (scene.tx_world(), scene.rx_world());
     let mut tracer = bt_solve::Tracer::new(scene, options);
     let traced = tracer.trace_with_progress(tx, rx, &mut progress);
     bar.finish_and_clear();
@@ -70,15 +70,19 @@ pub fn check(args: &SceneArgs) -> anyhow::Result<ExitCode> {
                 println!("warning: {w}");
             }
             let reflectors = scene.reflectors().count();
+            // Bare geometry (no terminal in the file or flags) says "none".
+            let at = |p: Option<bt_scene::Vec3>| {
+                p.map_or_else(|| "none".to_string(), |p| format!("{:?}", p.to_array()))
+            };
             println!(
-                "{}: ok: {} surfaces ({} reflectors, {} blockers), extent {:.2} m, tx {:?}, rx {:?}, {:.3} GHz",
+                "{}: ok: {} surfaces ({} reflectors, {} blockers), extent {:.2} m, tx {}, rx {}, {:.3} GHz",
                 args.scene,
                 scene.surfaces().len(),
                 reflectors,
                 scene.surfaces().len() - reflectors,
                 scene.extent(),
-                scene.tx_world().to_array(),
-                scene.rx_world().to_array(),
+                at(scene.tx_world()),
+                at(scene.rx_world()),
                 scene.frequency_hz() / 1e9
             );
             Ok(ExitCode::SUCCESS)

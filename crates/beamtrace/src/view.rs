@@ -23,8 +23,13 @@ pub fn run(args: &ViewArgs) -> anyhow::Result<ExitCode> {
             let mut tracer = bt_solve::Tracer::new(scenes[0].clone(), options);
             let mut steps = Vec::with_capacity(scenes.len());
             for scene in &scenes {
+                // Bare geometry (no TX or RX in the file or flags) is drawn without paths.
+                let Ok(ends) = scene.terminals() else {
+                    steps.push(StepPaths::none());
+                    continue;
+                };
                 tracer.set_scene((*scene).clone());
-                let traced = tracer.trace(scene.tx_world(), scene.rx_world())?;
+                let traced = tracer.trace(scene.to_world(ends.tx), scene.to_world(ends.rx))?;
                 let reports = bt_beams::report(
                     scene,
                     &traced.result.paths,

@@ -71,14 +71,17 @@ fn node_name(scene: &Scene, node: Node) -> String {
 }
 
 /// Pairs of node indices whose link state changes at some step, and nodes that move.
-fn dynamic_parts(dynamic: &DynamicScene, nodes: &[Node]) -> (BTreeSet<(usize, usize)>, Vec<bool>) {
+type DynamicParts = (BTreeSet<(usize, usize)>, Vec<bool>);
+
+/// [`DynamicParts`] of every step; fails on a step without both terminals.
+fn dynamic_parts(dynamic: &DynamicScene, nodes: &[Node]) -> anyhow::Result<DynamicParts> {
     let mut moving = vec![false; nodes.len()];
     let mut changing = BTreeSet::new();
     if dynamic.len() < 2 {
-        return (changing, moving);
+        return Ok((changing, moving));
     }
     let index = |n: Node| nodes.iter().position(|m| *m == n);
-    let mut w = Wvrn::build(dynamic.step(0));
+    let mut w = Wvrn::build(dynamic.step(0))?;
     for k in 1..dynamic.len() {
         let (prev, next) = (dynamic.step(k - 1), dynamic.step(k));
         let moved = moved_surfaces(prev, next).unwrap_or_default();
@@ -89,17 +92,20 @@ fn dynamic_parts(dynamic: &DynamicScene, nodes: &[Node]) -> (BTreeSet<(usize, us
         }
         moving[0] |= prev.tx() != next.tx();
         moving[1] |= prev.rx() != next.rx();
-        for (a, b, _) in w.update(next, &moved).changed {
+        for (a, b, _) in w.update(next, &moved)?.changed {
             if let (Some(i), Some(j)) = (index(a), index(b)) {
                 changing.insert((i.min(j), i.max(j)));
             }
         }
     }
-    (changing, moving)
+    Ok((changing, moving))
 }
 
 pub fn run(args: &WvrnArgs) -> anyhow::Result<ExitCode> {
     let dynamic = load_dynamic(&args.scene)?;
+    for scene in dynamic.scenes() {
+        crate::load::terminals(scene, &args.scene)?;
+    }
     if args.step >= dynamic.len() {
         bail!(
             "--step {} is out of range: the scene has {} step(s)",
@@ -110,12 +116,12 @@ pub fn run(args: &WvrnArgs) -> anyhow::Result<ExitCode> {
     let scene = dynamic.step(args.step);
     bt_solve::pipeline::exhaustive_budget(scene, args.max_order, args.max_candidates)?;
     let t0 = Instant::now();
-    let wvrn = Wvrn::build(scene);
+    let wvrn = Wvrn::build(scene)?;
     let build_time_s = t0.elapsed().as_secs_f64();
     let nodes = wvrn.nodes().to_vec();
-    let (changing, moving) = dynamic_parts(&dynamic, &nodes);
-    let exhaustive = enumerate(scene, args.max_order, &AllVisible).len();
-    let routed = enumerate(scene, args.max_order, &wvrn).len();
+    let (changing, moving) = dynamic_parts(&dynamic, &nodes)?;
+    let exhaustive = enumerate(scene, args.max_order, &AllVisible)?.len();
+    let routed = enumerate(scene, args.max_order, &wvrn)?.len();
     let index = |n: Node| {
         nodes
             .iter()

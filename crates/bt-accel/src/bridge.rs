@@ -4,7 +4,7 @@
 use bt_geom::{Real, Vec3};
 use bt_hls::{EarlyStop, HlsInput, PathResult, PlaneSpec};
 use bt_paths::{AllVisible, CandidateSet, enumerate};
-use bt_scene::{Scene, SurfaceId};
+use bt_scene::{Endpoints, Scene, SceneError, SurfaceId};
 use bt_solve::{Validity, image, validate::validate};
 
 /// Largest reflection-law error the host accepts on a fixed-point path, degrees: the angle
@@ -39,9 +39,11 @@ pub fn reflection_error_deg(
 
 /// The host's check of one accelerator result (the paper's post-processor): converged, valid
 /// in f64 (inside every polygon, same side, unblocked), obeying the reflection law within
-/// [`REFLECTION_TOLERANCE_DEG`], and not an edge case ([`HostRejection::EdgeCase`]).
+/// [`REFLECTION_TOLERANCE_DEG`], and not an edge case ([`HostRejection::EdgeCase`]). `ends`
+/// are the scene's terminals ([`Scene::terminals`]), local frame.
 pub fn host_accepts(
     scene: &Scene,
+    ends: Endpoints,
     seq: &[SurfaceId],
     result: &PathResult,
 ) -> Result<Vec<Vec3>, HostRejection> {
@@ -53,7 +55,7 @@ pub fn host_accepts(
         .iter()
         .map(|p| Vec3::from_array(*p))
         .collect();
-    let (tx, rx) = (scene.tx(), scene.rx());
+    let Endpoints { tx, rx } = ends;
     if validate(scene, seq, tx, rx, &points) != Validity::Valid {
         return Err(HostRejection::Invalid);
     }
@@ -126,13 +128,15 @@ pub struct StepInput {
 /// candidate through a surface not in `planes` goes to the host. `threshold_lsb` in 1/256 mm,
 /// `max_rounds` the round cap; early stopping ([`EarlyStop::default`]) on every plane's
 /// polygon bounding box; the coordinate word sized from the planes (`platform_extent_m`).
+/// A scene without both terminals fails ([`SceneError::MissingTerminal`]).
 pub fn step_input(
     scene: &Scene,
     planes: &[SurfaceId],
     candidates: &CandidateSet,
     threshold_lsb: u32,
     max_rounds: u32,
-) -> StepInput {
+) -> Result<StepInput, SceneError> {
+    let ends = scene.terminals()?;
     let mut plane_of = vec![u32::MAX; scene.surfaces().len()];
     for (i, id) in planes.iter().enumerate() {
         plane_of[id.0 as usize] = i as u32;
@@ -178,8 +182,8 @@ pub fn step_input(
         planes,
         paths,
         init_points,
-        tx: scene.tx().to_array(),
-        rx: scene.rx().to_array(),
+        tx: ends.tx.to_array(),
+        rx: ends.rx.to_array(),
         threshold_lsb,
         max_rounds,
         test_vectors: Vec::new(),
@@ -188,11 +192,11 @@ pub fn step_input(
         // The paper's order; `plan_step` sets the order a stream runs with.
         round_order: bt_hls::RoundOrder::Jacobi,
     };
-    StepInput {
+    Ok(StepInput {
         input,
         sequences,
         host_sequences,
-    }
+    })
 }
 
 /// How far the platform's planes reach from the origin, metres: the largest |coordinate| of
@@ -215,18 +219,19 @@ pub fn platform_extent_m(planes: &[PlaneSpec]) -> f64 {
 /// the side test, as the paper computes *all* paths on the FPGA), starting points at the
 /// polygon centroids; `threshold_lsb` in 1/256 mm, `max_rounds` the round cap; early stopping
 /// ([`EarlyStop::default`]) on every plane's polygon bounding box. Also returns
-/// the surface sequence of every input path (`input.paths[p]` is `sequences[p]`).
+/// the surface sequence of every input path (`input.paths[p]` is `sequences[p]`). A scene
+/// without both terminals fails ([`SceneError::MissingTerminal`]).
 pub fn hls_input(
     scene: &Scene,
     max_order: usize,
     threshold_lsb: u32,
     max_rounds: u32,
-) -> (HlsInput, Vec<Vec<SurfaceId>>) {
+) -> Result<(HlsInput, Vec<Vec<SurfaceId>>), SceneError> {
     let reflectors: Vec<SurfaceId> = scene.reflectors().collect();
-    let candidates = enumerate(scene, max_order, &AllVisible);
-    let s = step_input(scene, &reflectors, &candidates, threshold_lsb, max_rounds);
+    let candidates = enumerate(scene, max_order, &AllVisible)?;
+    let s = step_input(scene, &reflectors, &candidates, threshold_lsb, max_rounds)?;
     debug_assert!(s.host_sequences.is_empty());
-    (s.input, s.sequences)
+    Ok((s.input, s.sequences))
 }
 
 /// Warm start from the previous time step (as `bt_solve::steps` warm-starts its IPC): every path of

@@ -4,7 +4,7 @@
 use bt_geom::Vec3;
 use bt_hls::PathResult;
 use bt_paths::AllVisible;
-use bt_scene::Scene;
+use bt_scene::{Endpoints, Scene};
 use serde::Serialize;
 
 use crate::bridge::{HostRejection, StepInput, host_accepts};
@@ -39,21 +39,23 @@ pub struct FixedDeviation {
 
 /// Compare one step's accelerator results (`results[p]` of `step.sequences[p]`) with the
 /// image method over every sequence up to `max_order` (exhaustive enumeration, validated):
-/// the reference is independent of the candidate generator the step used.
+/// the reference is independent of the candidate generator the step used. A scene without
+/// both terminals fails ([`bt_scene::SceneError::MissingTerminal`]).
 pub fn fixed_deviation(
     scene: &Scene,
     step: &StepInput,
     results: &[PathResult],
     max_order: usize,
-) -> FixedDeviation {
-    let candidates = bt_paths::enumerate(scene, max_order, &AllVisible);
-    let reference = bt_solve::trace(scene, &candidates, &bt_solve::Solver::Image, true);
+) -> Result<FixedDeviation, bt_scene::SceneError> {
+    let ends = scene.terminals()?;
+    let candidates = bt_paths::enumerate(scene, max_order, &AllVisible)?;
+    let reference = bt_solve::trace(scene, &candidates, &bt_solve::Solver::Image, true)?;
     let mut err = FixedDeviation {
         left_bounds: results.iter().filter(|r| r.left_bounds).count(),
         ..FixedDeviation::default()
     };
     for (seq, r) in step.sequences.iter().zip(results) {
-        match host_accepts(scene, seq, r) {
+        match host_accepts(scene, ends, seq, r) {
             Ok(_) => {
                 if !reference.paths.iter().any(|p| p.surfaces == *seq) {
                     err.spurious += 1;
@@ -79,7 +81,7 @@ pub fn fixed_deviation(
         if !r.converged {
             err.not_converged += 1;
         }
-        if host_accepts(scene, &step.sequences[k], r).is_err() {
+        if host_accepts(scene, ends, &step.sequences[k], r).is_err() {
             err.missed += 1;
         }
         err.valid_paths_compared += 1;
@@ -90,7 +92,7 @@ pub fn fixed_deviation(
             count += 1;
         }
         let angle = |a: Vec3, b: Vec3| a.angle_between(b).to_degrees();
-        let (tx, rx) = (scene.tx(), scene.rx());
+        let Endpoints { tx, rx } = ends;
         let first = Vec3::from_array(r.points_m[0]);
         let last = Vec3::from_array(*r.points_m.last().expect("order >= 1"));
         err.max_angle_error_tx_deg = err
@@ -102,5 +104,5 @@ pub fn fixed_deviation(
         ));
     }
     err.mean_point_error_mm = if count > 0 { sum / count as f64 } else { 0.0 };
-    err
+    Ok(err)
 }

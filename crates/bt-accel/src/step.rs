@@ -102,18 +102,19 @@ pub fn plan_step(
         parallel: false,
         ..options.trace
     };
-    let candidates =
-        bt_solve::pipeline::candidates(scene, &trace).map_err(|source| AccelError::Candidates {
-            step: index,
-            source,
-        })?;
+    let candidates_failed = |source| AccelError::Candidates {
+        step: index,
+        source,
+    };
+    let candidates = bt_solve::pipeline::candidates(scene, &trace).map_err(candidates_failed)?;
     let mut step = step_input(
         scene,
         planes,
         &candidates,
         options.threshold_lsb,
         options.max_rounds,
-    );
+    )
+    .map_err(|e| candidates_failed(e.into()))?;
     step.input.round_order = options.round_order;
     let warm_started = match previous {
         Some(p) if options.warm_start => warm_start(&mut step, &p.step, &p.results),
@@ -143,7 +144,8 @@ pub fn plan_step(
     }
     .map_err(hardware)?;
     let t3 = Instant::now();
-    let fixed = fixed_deviation(scene, &step, &results, trace.max_order);
+    let fixed = fixed_deviation(scene, &step, &results, trace.max_order)
+        .map_err(|e| candidates_failed(e.into()))?;
     Ok(PlannedStep {
         index,
         step,

@@ -97,7 +97,10 @@ fn a_ray_slipping_past_an_edge_is_decided_on_the_exact_points() {
         .sequences
         .iter()
         .zip(&p.results)
-        .filter(|(seq, r)| host_accepts(&steps[2], seq, r) == Err(HostRejection::EdgeCase))
+        .filter(|(seq, r)| {
+            host_accepts(&steps[2], steps[2].terminals().unwrap(), seq, r)
+                == Err(HostRejection::EdgeCase)
+        })
         .count();
     assert!(edge >= 1, "{:?}", p.fixed);
     assert_eq!(p.fixed.spurious, 0, "{:?}", p.fixed);

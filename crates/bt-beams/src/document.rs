@@ -5,7 +5,7 @@
 //! so a new path field is one edit. The layout is `docs/output-format.md`; the bytes are
 //! pinned by the golden files (only the `time_s` fields vary between runs).
 
-use crate::{ChannelError, PathReport, RadioOptions};
+use crate::{PathReport, RadioOptions, ReportError};
 use bt_channel::Antenna;
 use bt_paths::CandidateStats;
 use bt_paths::beamtree::TreeStats;
@@ -96,15 +96,16 @@ impl TraceDocument {
         traced: &Traced,
         radio: &RadioOptions,
         load: Duration,
-    ) -> Result<Self, ChannelError> {
+    ) -> Result<Self, ReportError> {
         let t0 = Instant::now();
         let paths = crate::report(scene, &traced.result.paths, radio)?;
+        let ends = scene.terminals()?;
         let report = t0.elapsed();
         Ok(Self {
             format_version: FORMAT_VERSION,
             scene: scene.name().to_string(),
-            tx: scene.tx_world().to_array(),
-            rx: scene.rx_world().to_array(),
+            tx: scene.to_world(ends.tx).to_array(),
+            rx: scene.to_world(ends.rx).to_array(),
             frequency_hz: scene.frequency_hz(),
             max_order: options.max_order,
             solver: options.solver,
@@ -216,12 +217,13 @@ impl StepDocument {
         traced: StepTrace,
         radio: &RadioOptions,
         time: Duration,
-    ) -> Result<Self, ChannelError> {
+    ) -> Result<Self, ReportError> {
         let paths = crate::report(scene, &traced.trace.paths, radio)?;
+        let ends = scene.terminals()?;
         Ok(StepDocument {
             step: traced.step,
-            tx: scene.tx_world().to_array(),
-            rx: scene.rx_world().to_array(),
+            tx: scene.to_world(ends.tx).to_array(),
+            rx: scene.to_world(ends.rx).to_array(),
             stats: StepStats {
                 candidates: traced.candidates,
                 outcomes: traced.trace.counts,

@@ -25,6 +25,18 @@ use serde::{Deserialize, Deserializer, Serialize, Serializer};
 /// Speed of light in vacuum, m/s.
 pub use bt_channel::{ChannelError, SPEED_OF_LIGHT};
 
+/// Why paths could not be reported.
+#[derive(Debug, thiserror::Error)]
+pub enum ReportError {
+    /// A material has no radio model at the scene's frequency.
+    #[error(transparent)]
+    Channel(#[from] ChannelError),
+    /// The scene lacks a terminal the paths run between
+    /// ([`bt_scene::SceneError::MissingTerminal`]): paths belong to a scene with both.
+    #[error(transparent)]
+    Scene(#[from] bt_scene::SceneError),
+}
+
 /// The radio side of a report: antennas at both ends and the transmitted power.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct RadioOptions {
@@ -216,13 +228,14 @@ fn power_db(value: Real) -> Option<Real> {
     (value > 0.0).then(|| 10.0 * value.log10())
 }
 
-/// Describe one found path (rank 0 until [`report`] ranks it).
+/// Describe one found path (rank 0 until [`report`] ranks it); `scene` is the one it was
+/// found in, with both terminals.
 pub fn describe(
     scene: &Scene,
     path: &FoundPath,
     radio: &RadioOptions,
-) -> Result<PathReport, ChannelError> {
-    let (tx, rx) = (scene.tx(), scene.rx());
+) -> Result<PathReport, ReportError> {
+    let bt_scene::Endpoints { tx, rx } = scene.terminals()?;
     let mut vertices = Vec::with_capacity(path.points.len() + 2);
     vertices.push(tx);
     vertices.extend_from_slice(&path.points);
@@ -257,9 +270,9 @@ pub fn describe(
         })
         .collect();
     let gain = bt_channel::path_gain(
-        scene.tx(),
+        tx,
         &path.points,
-        scene.rx(),
+        rx,
         &bounces,
         (&radio.tx, &radio.rx),
         scene.frequency_hz(),
@@ -319,12 +332,12 @@ pub fn received_power_dbm(paths: &[PathReport], tx_power_dbm: Real) -> Option<Re
 /// Describe and rank all paths: by order, then length, then the largest incidence angle
 /// (closer to normal first), then surface ids — the paper's principles, made total. Fails only
 /// if a material has no radio model at the scene's frequency (scenes are validated against
-/// that).
+/// that) or the scene lacks a terminal (it cannot then have been traced).
 pub fn report(
     scene: &Scene,
     paths: &[FoundPath],
     radio: &RadioOptions,
-) -> Result<Vec<PathReport>, ChannelError> {
+) -> Result<Vec<PathReport>, ReportError> {
     let mut reports = paths
         .iter()
         .map(|p| describe(scene, p, radio))

@@ -14,7 +14,9 @@ const C: f64 = 299_792_458.0;
 
 fn trace(scene: &Scene, max_order: usize, radio: &RadioOptions) -> Vec<PathReport> {
     let mut tracer = Tracer::new(scene.clone(), TraceOptions::new(max_order));
-    let traced = tracer.trace(scene.tx_world(), scene.rx_world()).unwrap();
+    let traced = tracer
+        .trace(scene.tx_world().unwrap(), scene.rx_world().unwrap())
+        .unwrap();
     report(scene, &traced.result.paths, radio).unwrap()
 }
 
@@ -109,7 +111,7 @@ fn reciprocity_in_the_living_room() {
         },
     );
     let swapped = scene
-        .with_terminals(scene.rx_world(), scene.tx_world())
+        .with_terminals(scene.rx_world().unwrap(), scene.tx_world().unwrap())
         .unwrap();
     let backward = trace(
         &swapped,

@@ -31,7 +31,7 @@ pub enum CoverageError {
     Trace(#[from] TraceError),
     /// The path gains could not be computed (a material undefined at the carrier).
     #[error(transparent)]
-    Channel(#[from] bt_beams::ChannelError),
+    Report(#[from] bt_beams::ReportError),
     /// A figure could not be drawn or written.
     #[error(transparent)]
     Plot(#[from] bt_plot::PlotError),
@@ -85,17 +85,24 @@ pub struct Row {
 pub const CHUNK: usize = 256;
 
 /// Trace `scene`'s TX to every one of `points` (in order; rows come back in the same order,
-/// identical whatever the thread count). `progress(done, total)` runs after every chunk.
+/// identical whatever the thread count). `progress(done, total)` runs after every chunk. A
+/// scene without a TX fails as a whole ([`bt_scene::SceneError::MissingTerminal`]); the
+/// scene's RX, if any, is not used.
 pub fn sweep(
     scene: &Scene,
     points: &[Vec3],
     options: &TraceOptions,
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<Vec<Row>, CoverageError> {
+    let tx = scene.to_world(
+        scene
+            .terminal(bt_scene::Terminal::Tx)
+            .map_err(TraceError::from)?,
+    );
     let mut rows = Vec::with_capacity(points.len());
     let mut tracer = Tracer::new(scene.clone(), *options);
     for chunk in points.chunks(CHUNK) {
-        let traced = tracer.trace_each(scene.tx_world(), chunk)?;
+        let traced = tracer.trace_each(tx, chunk)?;
         for (rx, outcome) in chunk.iter().zip(traced) {
             let status = match outcome {
                 Ok(traced) => {

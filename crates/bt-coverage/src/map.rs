@@ -169,14 +169,16 @@ impl HeatMap<'_> {
                 )))
                 .map_err(fail)?;
         }
-        let tx = self.scene.tx_world();
-        chart
-            .draw_series(std::iter::once(TriangleMarker::new(
-                (tx.x, tx.y),
-                8,
-                RED.filled(),
-            )))
-            .map_err(fail)?;
+        // `sweep` refuses a scene without a TX; a map of one draws no marker, not a made-up one.
+        if let Some(tx) = self.scene.tx_world() {
+            chart
+                .draw_series(std::iter::once(TriangleMarker::new(
+                    (tx.x, tx.y),
+                    8,
+                    RED.filled(),
+                )))
+                .map_err(fail)?;
+        }
         Ok(())
     }
 

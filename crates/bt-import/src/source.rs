@@ -13,7 +13,8 @@ use std::path::{Path, PathBuf};
 /// Options of scene loading.
 #[derive(Debug, Clone)]
 pub struct LoadOptions {
-    /// TX/RX overriding the file's (required for meshes, which carry none).
+    /// TX/RX overriding the file's; formats that carry none (meshes, XML, point clouds)
+    /// without them load as bare geometry.
     pub terminals: Terminals,
     /// Coplanar-merge tolerances for meshes.
     pub merge: bt_mesh::MergeOptions,

@@ -76,8 +76,12 @@ impl TreeOptions {
 }
 
 /// Why the tree could not be built.
-#[derive(Debug, Clone, PartialEq, Eq, thiserror::Error)]
+#[derive(Debug, thiserror::Error)]
 pub enum TreeError {
+    /// The scene lacks the terminal the work needs: the TX for a build, both for
+    /// [`candidates`] ([`bt_scene::SceneError::MissingTerminal`]).
+    #[error(transparent)]
+    Scene(#[from] bt_scene::SceneError),
     /// More nodes than the budget.
     #[error(
         "candidate budget exceeded: the beam tree holds more than {budget} nodes by depth {depth} \
@@ -208,6 +212,8 @@ const LINEAR_SCAN: usize = 64;
 /// trace at order 1 tests 19,846 reflectors and needs the hull of a handful.
 struct Prepared<'a> {
     scene: &'a Scene,
+    /// The scene's TX (checked: a bare scene builds no tree), the root's apex.
+    tx: Vec3,
     tol: Real,
     /// Each surface's plane, contiguous (the leaf test reads one per child).
     planes: Vec<Plane>,
@@ -236,7 +242,13 @@ struct RxVisible {
 impl<'a> Prepared<'a> {
     /// The data of one build, taking the shapes out of `cache` when they are `scene`'s (hand
     /// them back with [`Prepared::keep_in`]).
-    fn new(scene: &'a Scene, options: TreeOptions, cache: &mut TreeCache) -> Self {
+    /// Fails when the scene has no TX.
+    fn new(
+        scene: &'a Scene,
+        options: TreeOptions,
+        cache: &mut TreeCache,
+    ) -> Result<Self, TreeError> {
+        let tx = scene.terminal(bt_scene::Terminal::Tx)?;
         let surfaces = scene.surfaces();
         let reflectors: Vec<u32> = scene.reflectors().map(|id| id.0).collect();
         let cull_at_build = match options.culling {
@@ -245,7 +257,7 @@ impl<'a> Prepared<'a> {
             Culling::Auto { .. } => reflectors.len() > LINEAR_SCAN,
         };
         let tol = scene.length_tolerance();
-        Prepared {
+        Ok(Prepared {
             planes: surfaces.iter().map(|s| *s.polygon.plane()).collect(),
             shapes: Shapes::take(&mut cache.shapes, scene, GROW * tol),
             is_reflector: surfaces
@@ -255,10 +267,11 @@ impl<'a> Prepared<'a> {
             cull_at_build,
             rx_visible: None,
             scene,
+            tx,
             tol,
             reflectors,
             options,
-        }
+        })
     }
 
     fn plane(&self, s: u32) -> &Plane {
@@ -439,7 +452,7 @@ impl BeamTree {
             max_order: prep.options.max_order,
             tol: prep.tol,
             options: prep.options,
-            tx: prep.scene.tx(),
+            tx: prep.tx,
             reflectors: prep.reflectors.clone(),
             surfaces: prep.planes.len(),
             nodes: Vec::new(),
@@ -450,7 +463,8 @@ impl BeamTree {
         }
     }
 
-    /// Build the tree of `scene`'s TX to `options.max_order`.
+    /// Build the tree of `scene`'s TX to `options.max_order`; a scene without a TX fails with
+    /// [`TreeError::Scene`].
     pub fn build(scene: &Scene, options: TreeOptions) -> Result<Self, TreeError> {
         Self::build_with_progress(scene, options, &mut |_| {})
     }
@@ -471,7 +485,7 @@ impl BeamTree {
         cache: &mut TreeCache,
         progress: Progress<'_>,
     ) -> Result<Self, TreeError> {
-        let prep = Prepared::new(scene, options, cache);
+        let prep = Prepared::new(scene, options, cache)?;
         let mut tree = BeamTree::empty(&prep);
         let mut scratch = Scratch::default();
         for depth in 1..=options.max_order {
@@ -724,7 +738,7 @@ impl BeamTree {
     /// Apex, surface and beam-plane range of node `p` (the root: TX, none, empty).
     fn parent_parts(&self, prep: &Prepared<'_>, p: u32) -> (Vec3, Option<u32>, (u32, u32)) {
         if p == ROOT {
-            (prep.scene.tx(), None, (0, 0))
+            (prep.tx, None, (0, 0))
         } else {
             let n = &self.nodes[p as usize];
             (n.image, Some(n.surface), n.planes)
@@ -1270,6 +1284,7 @@ fn rx_visibility(
 
 /// The candidates of `scene` for its own RX up to `options.max_order`: the tree is built to
 /// order `max_order - 1` and the last level is tested against RX without being materialised.
+/// A scene without both terminals fails ([`TreeError::Scene`]).
 pub fn candidates(scene: &Scene, options: TreeOptions) -> Result<CandidateSet, TreeError> {
     candidates_with_progress(scene, options, &mut |_| {})
 }
@@ -1291,12 +1306,12 @@ pub fn candidates_in(
     cache: &mut TreeCache,
     progress: Progress<'_>,
 ) -> Result<CandidateSet, TreeError> {
-    let mut prep = Prepared::new(scene, options, cache);
+    let rx = scene.terminals()?.rx;
+    let mut prep = Prepared::new(scene, options, cache)?;
     let mut tree = BeamTree::empty(&prep);
     let arenas = Arenas::take(cache);
     (tree.nodes, tree.verts, tree.planes) = (arenas.nodes, arenas.verts, arenas.planes);
     let mut scratch = Scratch::default();
-    let rx = scene.rx();
     for depth in 1..options.max_order {
         tree.grow_level(&prep, depth, &mut scratch, None, progress)?;
     }

@@ -161,7 +161,14 @@ fn polygon_mask(plane: &Plane, poly: &Polygon, tol: Real) -> SideMask {
 /// Enumerate candidates of order `0..=max_order` over the scene's reflectors.
 ///
 /// Order of the output: by order, then lexicographically by reflector index (deterministic).
-pub fn enumerate(scene: &Scene, max_order: usize, visibility: &dyn Visibility) -> CandidateSet {
+/// Candidates run from TX to RX: a scene without both fails
+/// ([`bt_scene::SceneError::MissingTerminal`]).
+pub fn enumerate(
+    scene: &Scene,
+    max_order: usize,
+    visibility: &dyn Visibility,
+) -> Result<CandidateSet, bt_scene::SceneError> {
+    let ends = scene.terminals()?;
     let refl: Vec<SurfaceId> = scene.reflectors().collect();
     let n = refl.len();
     let tol = scene.length_tolerance();
@@ -176,8 +183,8 @@ pub fn enumerate(scene: &Scene, max_order: usize, visibility: &dyn Visibility) -
                 masks[b * stride + a] = polygon_mask(plane, &scene.surface(sa).polygon, tol);
             }
         }
-        masks[b * stride + n] = point_mask(plane, scene.tx(), tol);
-        masks[b * stride + n + 1] = point_mask(plane, scene.rx(), tol);
+        masks[b * stride + n] = point_mask(plane, ends.tx, tol);
+        masks[b * stride + n + 1] = point_mask(plane, ends.rx, tol);
     }
     let node = |i: usize| {
         if i == n {
@@ -224,7 +231,7 @@ pub fn enumerate(scene: &Scene, max_order: usize, visibility: &dyn Visibility) -
     set.stats.candidates = set.len() as u64;
     set.stats.pruned_side =
         set.stats.generated - set.stats.candidates - set.stats.pruned_visibility;
-    set
+    Ok(set)
 }
 
 struct Dfs<'a> {
@@ -296,7 +303,7 @@ mod tests {
         // Inside a convex room every face sees every other, and no face is coplanar with
         // another, so only the "same surface twice in a row" rule removes sequences.
         let scene = box_room();
-        let set = enumerate(&scene, 3, &AllVisible);
+        let set = enumerate(&scene, 3, &AllVisible).unwrap();
         assert_eq!(set.len(), 1 + 6 + 6 * 5 + 6 * 5 * 5);
         assert_eq!(set.stats.generated, set.stats.candidates);
         assert_eq!(set.get(0), &[] as &[SurfaceId]);
@@ -311,7 +318,7 @@ mod tests {
               { "name": "a", "vertices": [[-1,-1,0],[1,-1,0],[1,1,0],[-1,1,0]] },
               { "name": "b", "vertices": [[-1,-1,2],[1,-1,2],[1,1,2],[-1,1,2]] } ] }"#;
         let scene = scene_from_json(json);
-        let set = enumerate(&scene, 2, &AllVisible);
+        let set = enumerate(&scene, 2, &AllVisible).unwrap();
         // First order: TX and RX lie on opposite sides of both plates: pruned (2).
         // a-b: TX below a, b above a -> opposite sides of a: pruned (1).
         // b-a passes: TX and a both below b; b and RX both above a (the segment TX -> b

@@ -29,7 +29,7 @@
 use crate::{Node, Visibility};
 use bt_geom::convex::is_strictly_convex;
 use bt_geom::{Polygon, Real, Vec3};
-use bt_scene::{Scene, SurfaceId, SurfaceKind};
+use bt_scene::{Endpoints, Scene, SceneError, SurfaceId, SurfaceKind};
 use serde::{Deserialize, Serialize};
 
 /// The state of a pair of nodes.
@@ -108,8 +108,10 @@ pub struct Wvrn {
 const NONE: u32 = u32::MAX;
 
 impl Wvrn {
-    /// Build the network of `scene`: O(nodes² × surfaces) pair tests.
-    pub fn build(scene: &Scene) -> Self {
+    /// Build the network of `scene`: O(nodes² × surfaces) pair tests. TX and RX are nodes: a
+    /// scene without both fails ([`SceneError::MissingTerminal`]).
+    pub fn build(scene: &Scene) -> Result<Self, SceneError> {
+        let Endpoints { tx, rx } = scene.terminals()?;
         let mut nodes = vec![Node::Tx, Node::Rx];
         let mut slot = vec![NONE; scene.surfaces().len()];
         for id in scene.reflectors() {
@@ -128,8 +130,8 @@ impl Wvrn {
                 .map(|s| is_strictly_convex(&s.polygon))
                 .collect(),
             sides: vec![(0, 0.0); n * m],
-            tx: scene.tx(),
-            rx: scene.rx(),
+            tx,
+            rx,
             tol: scene.length_tolerance(),
         };
         for node in 0..n {
@@ -143,14 +145,16 @@ impl Wvrn {
                 wvrn.set(a, b, link);
             }
         }
-        wvrn
+        Ok(wvrn)
     }
 
     /// Update the network after the surfaces `moved` (ids) of the previous step moved to their
     /// places in `scene`; TX/RX moves are detected here. The result equals
     /// [`Wvrn::build`]`(scene)` exactly. `scene` must be the next step of the scene this network
     /// was built for (same surfaces by id); otherwise the network is rebuilt.
-    pub fn update(&mut self, scene: &Scene, moved: &[SurfaceId]) -> WvrnDelta {
+    /// A scene without both terminals fails and leaves the network as it was.
+    pub fn update(&mut self, scene: &Scene, moved: &[SurfaceId]) -> Result<WvrnDelta, SceneError> {
+        let Endpoints { tx, rx } = scene.terminals()?;
         let same_surfaces = self.slot.len() == scene.surfaces().len()
             && scene
                 .surfaces()
@@ -158,7 +162,7 @@ impl Wvrn {
                 .enumerate()
                 .all(|(i, s)| (self.slot[i] != NONE) == (s.kind == SurfaceKind::Reflector));
         if !same_surfaces || self.tol != scene.length_tolerance() {
-            let old = std::mem::replace(self, Wvrn::build(scene));
+            let old = std::mem::replace(self, Wvrn::build(scene)?);
             let mut delta = WvrnDelta {
                 rebuilt: true,
                 recomputed_pairs: self.nodes.len() * (self.nodes.len() - 1) / 2,
@@ -167,14 +171,14 @@ impl Wvrn {
             if old.nodes == self.nodes {
                 self.diff_into(&old, &mut delta);
             }
-            return delta;
+            return Ok(delta);
         }
         let n = self.nodes.len();
         let mut dirty = vec![false; n];
-        dirty[0] = self.tx != scene.tx();
-        dirty[1] = self.rx != scene.rx();
-        self.tx = scene.tx();
-        self.rx = scene.rx();
+        dirty[0] = self.tx != tx;
+        dirty[1] = self.rx != rx;
+        self.tx = tx;
+        self.rx = rx;
         let mut moved_mask = vec![false; self.slot.len()];
         for id in moved {
             moved_mask[id.index()] = true;
@@ -236,7 +240,7 @@ impl Wvrn {
             }
         }
         self.diff_into(&old, &mut delta);
-        delta
+        Ok(delta)
     }
 
     /// The nodes: TX, RX, then the reflectors in scene order.
@@ -316,8 +320,8 @@ impl Wvrn {
 
     fn points<'s>(&self, scene: &'s Scene, i: usize) -> std::borrow::Cow<'s, [Vec3]> {
         match self.nodes[i] {
-            Node::Tx => std::borrow::Cow::Owned(vec![scene.tx()]),
-            Node::Rx => std::borrow::Cow::Owned(vec![scene.rx()]),
+            Node::Tx => std::borrow::Cow::Owned(vec![self.tx]),
+            Node::Rx => std::borrow::Cow::Owned(vec![self.rx]),
             Node::Surface(id) => std::borrow::Cow::Borrowed(scene.surface(id).polygon.vertices()),
         }
     }
@@ -543,7 +547,7 @@ mod tests {
               { "name": "shelf-e", "vertices": [[2.5, 0.5, 0.8], [3.5, 0.5, 0.8], [3.5, 1.5, 0.8], [2.5, 1.5, 0.8]] }
             ] }"#,
         );
-        let w = Wvrn::build(&s);
+        let w = Wvrn::build(&s).unwrap();
         let id = |n: &str| Node::Surface(s.find(n).unwrap());
         let partition = s.find("partition").unwrap();
         assert_eq!(w.link(Node::Tx, Node::Rx), Link::Occluded { by: partition });
@@ -563,8 +567,8 @@ mod tests {
         let stats = w.stats();
         assert_eq!(stats.pairs, stats.linked + stats.coplanar + stats.occluded);
         assert!(stats.occluded >= 4, "{stats:?}");
-        let all = enumerate(&s, 2, &AllVisible);
-        let routed = enumerate(&s, 2, &w);
+        let all = enumerate(&s, 2, &AllVisible).unwrap();
+        let routed = enumerate(&s, 2, &w).unwrap();
         assert!(routed.len() < all.len());
     }
 
@@ -583,7 +587,7 @@ mod tests {
             .iter()
             .map(|x| scene(&json(*x)))
             .collect();
-        let mut w = Wvrn::build(&steps[0]);
+        let mut w = Wvrn::build(&steps[0]).unwrap();
         for k in 1..steps.len() {
             let moved: Vec<SurfaceId> = (0..steps[k].surfaces().len() as u32)
                 .map(SurfaceId)
@@ -592,9 +596,9 @@ mod tests {
                         != steps[k - 1].surface(*id).polygon.vertices()
                 })
                 .collect();
-            let delta = w.update(&steps[k], &moved);
+            let delta = w.update(&steps[k], &moved).unwrap();
             assert!(!delta.rebuilt);
-            assert_eq!(w, Wvrn::build(&steps[k]), "step {k}");
+            assert_eq!(w, Wvrn::build(&steps[k]).unwrap(), "step {k}");
         }
     }
 }

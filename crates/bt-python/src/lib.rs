@@ -62,10 +62,25 @@ struct PyScene {
 }
 
 impl PyScene {
-    /// The scene with other terminals (the scene's own where `None`).
+    /// The scene with other terminals (the scene's own where `None`); a terminal neither
+    /// given nor in the scene (a mesh, XML or point cloud) is a `ValueError` naming the
+    /// Python keyword.
     fn moved(&self, tx: Option<[f64; 3]>, rx: Option<[f64; 3]>) -> PyResult<Scene> {
-        let tx = tx.map(vec3).unwrap_or(self.scene.tx_world());
-        let rx = rx.map(vec3).unwrap_or(self.scene.rx_world());
+        let tx = tx.map(vec3).or(self.scene.tx_world());
+        let rx = rx.map(vec3).or(self.scene.rx_world());
+        let (Some(tx), Some(rx)) = (tx, rx) else {
+            let missing: Vec<&str> = [("tx", tx), ("rx", rx)]
+                .into_iter()
+                .filter_map(|(name, p)| p.is_none().then_some(name))
+                .collect();
+            let keywords: Vec<String> = missing.iter().map(|k| format!("{k}=[x, y, z]")).collect();
+            return Err(PyValueError::new_err(format!(
+                "{}: no {} given: pass {} (meshes, XML scenes and point clouds carry no terminals)",
+                self.source,
+                missing.join(" and "),
+                keywords.join(" and ")
+            )));
+        };
         self.scene
             .with_terminals(tx, rx)
             .map_err(|e| self.error(TraceError::Scene(e)))
@@ -109,15 +124,15 @@ impl PyScene {
     fn name(&self) -> &str {
         self.scene.name()
     }
-    /// Transmitter position, metres.
+    /// Transmitter position, metres, world frame; `None` when the scene has none.
     #[getter]
-    fn tx(&self) -> [f64; 3] {
-        self.scene.tx_world().to_array()
+    fn tx(&self) -> Option<[f64; 3]> {
+        self.scene.tx_world().map(|p| p.to_array())
     }
-    /// Receiver position, metres.
+    /// Receiver position, metres, world frame; `None` when the scene has none.
     #[getter]
-    fn rx(&self) -> [f64; 3] {
-        self.scene.rx_world().to_array()
+    fn rx(&self) -> Option<[f64; 3]> {
+        self.scene.rx_world().map(|p| p.to_array())
     }
     /// Carrier frequency, Hz.
     #[getter]
@@ -151,7 +166,8 @@ impl PyScene {
         let options = keywords
             .trace_options(&scene)
             .map_err(PyValueError::new_err)?;
-        let (tx, rx) = (scene.tx_world(), scene.rx_world());
+        let ends = scene.terminals().map_err(error)?;
+        let (tx, rx) = (scene.to_world(ends.tx), scene.to_world(ends.rx));
         let paths = py.detach(|| {
             let traced = self.with_tracer(scene.clone(), options, |t| t.trace(tx, rx));
             traced.map(|traced| {
@@ -183,11 +199,10 @@ impl PyScene {
         let options = keywords
             .trace_options(&scene)
             .map_err(PyValueError::new_err)?;
+        let tx = scene.to_world(scene.terminals().map_err(error)?.tx);
         let reports = py.detach(|| {
             let traced = self
-                .with_tracer(scene.clone(), options, |t| {
-                    t.trace_many(scene.tx_world(), &receivers)
-                })
+                .with_tracer(scene.clone(), options, |t| t.trace_many(tx, &receivers))
                 .map_err(Failure::Trace)?;
             report_each(&scene, &receivers, &traced, options.parallel)
         });
@@ -247,7 +262,8 @@ fn report_each(
     }
 }
 
-/// Load a scene; `tx`/`rx` override the file's (meshes need both).
+/// Load a scene; `tx`/`rx` override the file's (meshes, XML and point clouds carry none: then
+/// each trace gives them).
 #[pyfunction]
 #[pyo3(signature = (source, *, tx=None, rx=None, min_reflector_area=0.25, merge_angle_deg=1.0,
                     merge_distance=1e-3))]

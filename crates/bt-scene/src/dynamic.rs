@@ -373,8 +373,8 @@ fn step_scene(
         }
     }
     let at = terminals.at(k);
-    let tx = at.tx.map_or(base.tx(), |p| to_local(p, origin));
-    let rx = at.rx.map_or(base.rx(), |p| to_local(p, origin));
+    let tx = at.tx.map(|p| to_local(p, origin)).or(base.tx());
+    let rx = at.rx.map(|p| to_local(p, origin)).or(base.rx());
     let extent = crate::model::scene_extent(&surfaces, tx, rx);
     if let Err(list) = check_terminals(&surfaces, tx, rx, extent, origin) {
         problems.extend(list.into_iter().map(|p| Problem {
@@ -636,8 +636,9 @@ mod tests {
         for k in 0..near.len() {
             let (a, b) = (near.step(k), far.step(k));
             assert_eq!(b.origin(), origin, "one frame for every step");
-            assert!(b.tx().abs().max_element() < 16.0, "local tx {}", b.tx());
-            assert_eq!(b.tx_world(), a.tx() + offset);
+            let tx = b.tx().unwrap();
+            assert!(tx.abs().max_element() < 16.0, "local tx {tx}");
+            assert_eq!(b.tx_world(), Some(a.tx().unwrap() + offset));
             for (s, t) in a.surfaces().iter().zip(b.surfaces()) {
                 for (p, q) in s.polygon.vertices().iter().zip(t.polygon.vertices()) {
                     let error = (b.to_world(*q) - (*p + offset)).abs().max_element();

@@ -145,6 +145,9 @@ mod tests {
         assert_eq!(inside([3.0, 1.5, 1.0]), Some(false));
         // in the plane of a face but outside the face: still decided
         assert_eq!(inside([4.0, 3.0, 1.0]), Some(false));
-        assert_eq!(encloses(s.surfaces(), &shells[0], s.tx(), eps), Some(true));
+        assert_eq!(
+            encloses(s.surfaces(), &shells[0], s.tx().unwrap(), eps),
+            Some(true)
+        );
     }
 }

@@ -25,7 +25,7 @@ pub use description::{
 };
 pub use frame::RECENTRE_RATIO;
 pub use material::{DEFAULT_MATERIAL, Material, default_materials};
-pub use model::{GeometryKey, Scene};
+pub use model::{Endpoints, GeometryKey, Scene};
 pub use problem::{Problem, SceneError, Terminal};
 pub use surface::{RawSurface, Surface, SurfaceId, SurfaceKind};
 pub use validate::{DEFAULT_FREQUENCY_HZ, Terminals};

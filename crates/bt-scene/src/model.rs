@@ -1,14 +1,17 @@
 //! The validated scene model.
 
 use crate::material::Material;
+use crate::problem::{SceneError, Terminal};
 use crate::surface::{Surface, SurfaceId, SurfaceKind};
 use bt_geom::{Bvh, Real, Vec3};
 use std::collections::BTreeMap;
 use std::sync::Arc;
 
-/// A validated scene. Construct it with [`Scene::from_description`] or [`Scene::from_surfaces`] (importers: the
-/// `bt-import` crate);
-/// every surface is a valid planar polygon, TX and RX are finite, distinct and off every surface.
+/// A validated scene: bare geometry, or geometry with its terminals. Construct it with
+/// [`Scene::from_description`] or [`Scene::from_surfaces`] (importers: the `bt-import` crate);
+/// every surface is a valid planar polygon; TX and RX, where the input gives them, are finite,
+/// distinct and off every surface. A trace needs both: [`Scene::terminals`] is the checked way
+/// to get them, and [`Scene::with_terminals`] places them on a bare scene.
 ///
 /// Positions are stored in the scene-local frame (`local = world − origin()`, see
 /// [`Scene::origin`]): [`Scene::tx`], [`Scene::rx`], the surfaces' polygons and every path point
@@ -20,8 +23,10 @@ pub struct Scene {
     /// Shared between a scene and its copies with other terminals or frequency
     /// ([`Scene::with_receiver`]): a sweep's receivers do not copy the geometry.
     pub(crate) surfaces: Arc<Vec<Surface>>,
-    pub(crate) tx: Vec3,
-    pub(crate) rx: Vec3,
+    /// `None` on bare geometry (a mesh, XML or point cloud loaded without a TX).
+    pub(crate) tx: Option<Vec3>,
+    /// `None` on bare geometry.
+    pub(crate) rx: Option<Vec3>,
     pub(crate) frequency_hz: Real,
     pub(crate) materials: Arc<BTreeMap<String, Material>>,
     pub(crate) extent: Real,
@@ -69,21 +74,50 @@ impl Scene {
             .filter(|(_, s)| s.kind == SurfaceKind::Reflector)
             .map(|(i, _)| SurfaceId(i as u32))
     }
-    /// Transmitter position, metres, scene-local frame.
-    pub fn tx(&self) -> Vec3 {
+    /// Both terminals, metres, scene-local frame: the checked value every trace starts from.
+    /// A bare scene (a mesh, XML or point cloud loaded without them) lacks one or both, and
+    /// the error, [`SceneError::MissingTerminal`], names which; [`Scene::with_terminals`] makes
+    /// it traceable.
+    pub fn terminals(&self) -> Result<Endpoints, SceneError> {
+        match (self.tx, self.rx) {
+            (Some(tx), Some(rx)) => Ok(Endpoints { tx, rx }),
+            (tx, rx) => Err(SceneError::MissingTerminal {
+                source_name: self.name.clone(),
+                missing: [(Terminal::Tx, tx), (Terminal::Rx, rx)]
+                    .into_iter()
+                    .filter(|(_, p)| p.is_none())
+                    .map(|(t, _)| t)
+                    .collect(),
+            }),
+        }
+    }
+    /// One terminal, metres, scene-local frame, or [`SceneError::MissingTerminal`] naming it:
+    /// for work that needs only one (a beam tree needs only the TX).
+    pub fn terminal(&self, which: Terminal) -> Result<Vec3, SceneError> {
+        let p = match which {
+            Terminal::Tx => self.tx,
+            Terminal::Rx => self.rx,
+        };
+        p.ok_or_else(|| SceneError::MissingTerminal {
+            source_name: self.name.clone(),
+            missing: vec![which],
+        })
+    }
+    /// Transmitter position, metres, scene-local frame, if the scene has one.
+    pub fn tx(&self) -> Option<Vec3> {
         self.tx
     }
-    /// Receiver position, metres, scene-local frame.
-    pub fn rx(&self) -> Vec3 {
+    /// Receiver position, metres, scene-local frame, if the scene has one.
+    pub fn rx(&self) -> Option<Vec3> {
         self.rx
     }
-    /// Transmitter position, metres, world frame (as given in the input).
-    pub fn tx_world(&self) -> Vec3 {
-        self.to_world(self.tx)
+    /// Transmitter position, metres, world frame (as given in the input), if the scene has one.
+    pub fn tx_world(&self) -> Option<Vec3> {
+        self.tx.map(|p| self.to_world(p))
     }
-    /// Receiver position, metres, world frame (as given in the input).
-    pub fn rx_world(&self) -> Vec3 {
-        self.to_world(self.rx)
+    /// Receiver position, metres, world frame (as given in the input), if the scene has one.
+    pub fn rx_world(&self) -> Option<Vec3> {
+        self.rx.map(|p| self.to_world(p))
     }
     /// World position of the scene-local frame's origin, metres: zero for scenes near the world
     /// origin, a power-of-two-grid point near the scene's centre for scenes far from it
@@ -112,7 +146,8 @@ impl Scene {
     pub fn material_of(&self, id: SurfaceId) -> &Material {
         &self.materials[&self.surface(id).material]
     }
-    /// Bounding-box diagonal of all surfaces, TX and RX, metres (scales length tolerances).
+    /// Bounding-box diagonal of all surfaces and of the terminals the scene has, metres (scales
+    /// length tolerances): a bare scene's comes from its surfaces alone.
     pub fn extent(&self) -> Real {
         self.extent
     }
@@ -171,19 +206,21 @@ impl Scene {
     /// mesh solid) that hold exactly one of TX and RX, with the terminal inside ("tx" or "rx"):
     /// no path can connect the two. A shell holding both (the room itself) is not listed, nor
     /// one whose sides cannot be told within the tolerance (the test only answers when sure).
+    /// Empty for a scene without both terminals.
     pub fn separating_shells(&self) -> Vec<(&'static str, Vec<SurfaceId>)> {
+        let Ok(Endpoints { tx, rx }) = self.terminals() else {
+            return Vec::new();
+        };
         let eps = self.length_tolerance();
         let inside =
             |shell: &[SurfaceId], p| crate::enclosure::encloses(&self.surfaces, shell, p, eps);
         crate::enclosure::closed_shells(&self.surfaces)
             .into_iter()
-            .filter_map(
-                |shell| match (inside(&shell, self.tx)?, inside(&shell, self.rx)?) {
-                    (true, false) => Some(("tx", shell)),
-                    (false, true) => Some(("rx", shell)),
-                    _ => None,
-                },
-            )
+            .filter_map(|shell| match (inside(&shell, tx)?, inside(&shell, rx)?) {
+                (true, false) => Some(("tx", shell)),
+                (false, true) => Some(("rx", shell)),
+                _ => None,
+            })
             .collect()
     }
 
@@ -221,17 +258,36 @@ impl Scene {
     }
 
     pub(crate) fn extent_with(&self, tx: Vec3, rx: Vec3) -> Real {
-        scene_extent(&self.surfaces, tx, rx)
+        scene_extent(&self.surfaces, Some(tx), Some(rx))
     }
 }
 
-/// Bounding-box diagonal of surfaces and terminals, metres.
-pub(crate) fn scene_extent(surfaces: &[Surface], tx: Vec3, rx: Vec3) -> Real {
-    let (mut lo, mut hi) = (tx.min(rx), tx.max(rx));
+/// The two terminals of a trace, metres, scene-local frame: what [`Scene::terminals`] gives
+/// once it has checked that the scene has both.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Endpoints {
+    /// Transmitter position.
+    pub tx: Vec3,
+    /// Receiver position.
+    pub rx: Vec3,
+}
+
+/// Bounding-box diagonal of the surfaces and the terminals given, metres (0 for nothing).
+/// With both terminals the box starts from them, as it always did: outputs of scenes with
+/// terminals stay bit-identical.
+pub(crate) fn scene_extent(surfaces: &[Surface], tx: Option<Vec3>, rx: Option<Vec3>) -> Real {
+    let (mut lo, mut hi) = match (tx, rx) {
+        (Some(tx), Some(rx)) => (tx.min(rx), tx.max(rx)),
+        (Some(p), None) | (None, Some(p)) => (p, p),
+        (None, None) => (Vec3::INFINITY, Vec3::NEG_INFINITY),
+    };
     for s in surfaces {
         let (a, b) = s.polygon.bounds();
         lo = lo.min(a);
         hi = hi.max(b);
+    }
+    if lo.cmpgt(hi).any() {
+        return 0.0;
     }
     (hi - lo).length()
 }

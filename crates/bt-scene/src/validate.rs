@@ -32,7 +32,8 @@ pub struct Terminals {
 
 impl Scene {
     /// Validate a description. `source_name` names the file in messages; `terminals` override
-    /// the file's TX/RX. Every problem is reported, not just the first.
+    /// the file's TX/RX. A terminal given by neither stays absent (bare geometry, see
+    /// [`Scene::terminals`]). Every problem is reported, not just the first.
     pub fn from_description(
         desc: &SceneDescription,
         source_name: &str,
@@ -70,15 +71,8 @@ impl Scene {
                 .extend(radio_problems(&surfaces, &materials, frequency_hz));
         }
 
-        let tx = terminal("tx", given[0], &mut problems);
-        let rx = terminal("rx", given[1], &mut problems);
-        let (Some(tx), Some(rx)) = (tx, rx) else {
-            return Err(SceneError::Invalid {
-                source_name: source_name.to_string(),
-                problems: problems.0,
-            });
-        };
-        let (tx, rx) = (to_local(tx, origin), to_local(rx, origin));
+        let tx = terminal("tx", given[0], &mut problems).map(|p| to_local(p, origin));
+        let rx = terminal("rx", given[1], &mut problems).map(|p| to_local(p, origin));
         let extent = scene_extent(&surfaces, tx, rx);
         if let Err(p) = check_terminals(&surfaces, tx, rx, extent, origin) {
             problems.0.extend(p);
@@ -94,19 +88,23 @@ impl Scene {
     /// Validate surfaces that an importer made (mesh faces, extracted planes) into a scene
     /// named `name`: every problem is collected (names, materials, polygons, terminals, radio
     /// models at `frequency_hz`) and reported under `source_name`. `raw` and `tx`/`rx` are in
-    /// the world frame (metres); the scene is recentred like a scene file.
+    /// the world frame (metres); the scene is recentred like a scene file. A terminal not given
+    /// stays absent (bare geometry, see [`Scene::terminals`]).
     pub fn from_surfaces(
         name: &str,
         source_name: &str,
         mut raw: Vec<RawSurface>,
         materials: BTreeMap<String, Material>,
-        (tx, rx): (Vec3, Vec3),
+        terminals: Terminals,
         frequency_hz: Real,
     ) -> Result<Scene, SceneError> {
-        let mut problems: Vec<Problem> = Vec::new();
-        let origin = crate::frame::recentre(&mut raw, [Some(tx), Some(rx)], &mut problems);
+        let mut problems = Collector(Vec::new());
+        let given = [terminals.tx, terminals.rx];
+        let origin = crate::frame::recentre(&mut raw, given, &mut problems);
         let surfaces = build_surfaces(raw, &materials, &mut problems);
-        let (tx, rx) = (to_local(tx, origin), to_local(rx, origin));
+        let tx = terminal("tx", given[0], &mut problems).map(|p| to_local(p, origin));
+        let rx = terminal("rx", given[1], &mut problems).map(|p| to_local(p, origin));
+        let mut problems = problems.0;
         let extent = scene_extent(&surfaces, tx, rx);
         if let Err(p) = check_terminals(&surfaces, tx, rx, extent, origin) {
             problems.extend(p);
@@ -210,8 +208,8 @@ impl Scene {
         name: String,
         origin: Vec3,
         surfaces: Vec<Surface>,
-        tx: Vec3,
-        rx: Vec3,
+        tx: Option<Vec3>,
+        rx: Option<Vec3>,
         frequency_hz: Real,
         materials: std::collections::BTreeMap<String, Material>,
     ) -> Scene {
@@ -387,51 +385,50 @@ pub(crate) fn build_surfaces(
     surfaces
 }
 
+/// A terminal given (world frame) when finite; not given is no problem (bare geometry).
 fn terminal(field: &str, value: Option<Vec3>, problems: &mut Collector) -> Option<Vec3> {
     match value {
-        None => {
-            problems.push(
-                field,
-                format!("missing: give \"{field}\": [x, y, z] in the scene or --{field} X,Y,Z"),
-            );
-            None
-        }
         Some(p) if !p.is_finite() => {
             problems.push(field, "coordinates must be finite numbers");
             None
         }
-        Some(p) => Some(p),
+        value => value,
     }
 }
 
-/// TX and RX must be distinct and must not lie on any surface. Surfaces and terminals are in the
-/// local frame whose origin is `origin` (world): the resolution check looks at the world
-/// coordinates.
+/// TX and RX, where given, must be finite, resolvable and off every surface, and distinct when
+/// both are. Surfaces and terminals are in the local frame whose origin is `origin` (world):
+/// the resolution check looks at the world coordinates.
 pub(crate) fn check_terminals(
     surfaces: &[Surface],
-    tx: Vec3,
-    rx: Vec3,
+    tx: Option<Vec3>,
+    rx: Option<Vec3>,
     extent: Real,
     origin: Vec3,
 ) -> Result<(), Vec<Problem>> {
     let mut problems = Vec::new();
     let eps = crate::frame::scene_tolerance(extent);
-    if !tx.is_finite() {
-        problems.report("tx", "coordinates must be finite numbers");
+    let given: Vec<(&str, Vec3)> = [("tx", tx), ("rx", rx)]
+        .into_iter()
+        .filter_map(|(field, p)| Some((field, p?)))
+        .collect();
+    for &(field, p) in &given {
+        if !p.is_finite() {
+            problems.report(field, "coordinates must be finite numbers");
+        }
     }
-    if !rx.is_finite() {
-        problems.report("rx", "coordinates must be finite numbers");
-    }
-    for (field, p) in [("tx", tx), ("rx", rx)] {
+    for &(field, p) in &given {
         let magnitude = to_world(p, origin).abs().max_element();
         if let Some(why) = crate::frame::unresolvable(magnitude, eps) {
             problems.report(field, why);
         }
     }
-    if problems.is_empty() && tx.distance(rx) <= eps {
+    if let (true, Some(tx), Some(rx)) = (problems.is_empty(), tx, rx)
+        && tx.distance(rx) <= eps
+    {
         problems.report("tx", "tx and rx are at the same position");
     }
-    for (field, p) in [("tx", tx), ("rx", rx)] {
+    for &(field, p) in &given {
         for s in surfaces {
             if s.polygon.plane().signed_distance(p).abs() <= eps && s.polygon.contains(p, eps) {
                 problems.report(
@@ -473,31 +470,41 @@ fn box_face(lo: Vec3, hi: Vec3, axis: usize, is_max: bool) -> Vec<Vec3> {
 
 impl Scene {
     /// A copy with other TX/RX positions (metres, world frame, like the scene file's),
-    /// validated like the originals; the scene keeps its local frame.
+    /// validated like the originals; on a bare scene this places its terminals.
+    ///
+    /// The copy keeps the local frame ([`Scene::origin`]); its extent, and with it
+    /// [`Scene::length_tolerance`] and every tolerance scaled from it, is recomputed from the
+    /// surfaces and the new terminals. So a bare scene plus terminals has the extent and
+    /// tolerances of the same file loaded with those terminals, and traces the same, whenever
+    /// the origin agrees: always for scenes near the world origin (origin zero). A far scene
+    /// (recentred) keeps the origin chosen from its surfaces alone, which terminals outside
+    /// the geometry could have moved at load time.
     pub fn with_terminals(&self, tx: Vec3, rx: Vec3) -> Result<Scene, crate::SceneError> {
         let (tx, rx) = (self.to_local(tx), self.to_local(rx));
-        check_terminals(
-            &self.surfaces,
-            tx,
-            rx,
-            self.extent_with(tx, rx),
-            self.origin,
-        )
-        .map_err(|problems| crate::SceneError::Invalid {
-            source_name: self.name.clone(),
-            problems,
-        })?;
+        let extent = self.extent_with(tx, rx);
+        check_terminals(&self.surfaces, Some(tx), Some(rx), extent, self.origin).map_err(
+            |problems| crate::SceneError::Invalid {
+                source_name: self.name.clone(),
+                problems,
+            },
+        )?;
         let mut scene = self.clone();
-        scene.tx = tx;
-        scene.rx = rx;
-        scene.extent = self.extent_with(tx, rx);
+        scene.tx = Some(tx);
+        scene.rx = Some(rx);
+        scene.extent = extent;
         Ok(scene)
     }
 
-    /// A copy with another RX (metres, world frame) and the same TX: the receiver of a sweep
-    /// grid point or of `trace_receivers`.
+    /// A copy with another RX (metres, world frame) and the scene's TX: the receiver of a
+    /// sweep grid point. A scene without a TX refuses ([`SceneError::MissingTerminal`]).
     pub fn with_receiver(&self, rx: Vec3) -> Result<Scene, crate::SceneError> {
-        self.with_terminals(self.tx_world(), rx)
+        let Some(tx) = self.tx_world() else {
+            return Err(SceneError::MissingTerminal {
+                source_name: self.name.clone(),
+                missing: vec![crate::Terminal::Tx],
+            });
+        };
+        self.with_terminals(tx, rx)
     }
 
     /// A copy at another carrier frequency (Hz), checked against the radio models of the

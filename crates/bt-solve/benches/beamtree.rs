@@ -28,7 +28,10 @@ fn options(order: usize, mode: CandidateMode, solver: Solver) -> TraceOptions {
 /// loop, keeps the beam tree's caches from one iteration to the next, as a stream of traces
 /// does).
 fn trace_own(tracer: &mut Tracer) -> bt_solve::pipeline::Traced {
-    let (tx, rx) = (tracer.scene().tx_world(), tracer.scene().rx_world());
+    let (tx, rx) = (
+        tracer.scene().tx_world().unwrap(),
+        tracer.scene().rx_world().unwrap(),
+    );
     tracer.trace(black_box(tx), rx).expect("trace runs")
 }
 
@@ -111,8 +114,9 @@ fn living_room(c: &mut Criterion) {
         let mut k = 0;
         b.iter(|| {
             k = (k + 1) % receivers.len();
-            let set = tree.candidates(moved[k].rx());
+            let set = tree.candidates(moved[k].rx().unwrap());
             bt_solve::trace(&moved[k], &set, &Solver::Image, false)
+                .unwrap()
                 .paths
                 .len()
         })
@@ -121,7 +125,7 @@ fn living_room(c: &mut Criterion) {
         let mut k = 0;
         b.iter(|| {
             k = (k + 1) % receivers.len();
-            tree.candidates(moved[k].rx()).len()
+            tree.candidates(moved[k].rx().unwrap()).len()
         })
     });
     group.finish();

@@ -36,10 +36,10 @@ fn wvrn(c: &mut Criterion) {
     let dynamic = builtin_dynamic_scene("living-room-dynamic", Terminals::default())
         .unwrap()
         .unwrap();
-    let w = Wvrn::build(&scene);
+    let w = Wvrn::build(&scene).unwrap();
     let (all, routed) = (
-        enumerate(&scene, ORDER, &AllVisible).len(),
-        enumerate(&scene, ORDER, &w).len(),
+        enumerate(&scene, ORDER, &AllVisible).unwrap().len(),
+        enumerate(&scene, ORDER, &w).unwrap().len(),
     );
     eprintln!(
         "living room order {ORDER}: {routed} of {all} candidates over the WVRN (ratio {:.3})",
@@ -47,8 +47,8 @@ fn wvrn(c: &mut Criterion) {
     );
     let (mut all_d, mut routed_d) = (0, 0);
     for s in dynamic.scenes() {
-        all_d += enumerate(s, ORDER, &AllVisible).len();
-        routed_d += enumerate(s, ORDER, &Wvrn::build(s)).len();
+        all_d += enumerate(s, ORDER, &AllVisible).unwrap().len();
+        routed_d += enumerate(s, ORDER, &Wvrn::build(s).unwrap()).unwrap().len();
     }
     eprintln!(
         "dynamic living room, 10 steps: {routed_d} of {all_d} candidates (ratio {:.3})",
@@ -57,10 +57,10 @@ fn wvrn(c: &mut Criterion) {
 
     let mut g = c.benchmark_group("wvrn");
     g.bench_function("build/living-room", |b| {
-        b.iter(|| Wvrn::build(black_box(&scene)))
+        b.iter(|| Wvrn::build(black_box(&scene)).unwrap())
     });
     let moved = bt_scene::dynamic::moved_surfaces(dynamic.step(4), dynamic.step(5)).unwrap();
-    let w4 = Wvrn::build(dynamic.step(4));
+    let w4 = Wvrn::build(dynamic.step(4)).unwrap();
     g.bench_function("update/living-room-dynamic-step-5", |b| {
         b.iter_batched(
             || w4.clone(),
@@ -70,10 +70,10 @@ fn wvrn(c: &mut Criterion) {
     });
     g.throughput(Throughput::Elements(all as u64));
     g.bench_function("enumerate-exhaustive/living-room", |b| {
-        b.iter(|| enumerate(&scene, ORDER, &AllVisible))
+        b.iter(|| enumerate(&scene, ORDER, &AllVisible).unwrap())
     });
     g.bench_function("enumerate-wvrn/living-room", |b| {
-        b.iter(|| enumerate(&scene, ORDER, &w))
+        b.iter(|| enumerate(&scene, ORDER, &w).unwrap())
     });
     g.finish();
 }

@@ -12,7 +12,7 @@ fn main() {
     let scene = bt_import::builtin_scene("living-room", Default::default())
         .unwrap()
         .unwrap();
-    let candidates = enumerate(&scene, 3, &AllVisible);
+    let candidates = enumerate(&scene, 3, &AllVisible).unwrap();
     let args: Vec<String> = std::env::args()
         .skip(1)
         .filter(|a| !a.starts_with("--"))
@@ -43,7 +43,7 @@ fn main() {
     }
     if wanted == Some("candidates") {
         for _ in 0..reps {
-            black_box(enumerate(black_box(&scene), 3, &AllVisible));
+            black_box(enumerate(black_box(&scene), 3, &AllVisible).unwrap());
         }
         return;
     }
@@ -54,6 +54,7 @@ fn main() {
         let mut valid = 0;
         for _ in 0..reps {
             valid = black_box(trace(black_box(&scene), &candidates, solver, false))
+                .unwrap()
                 .counts
                 .valid;
         }
@@ -69,11 +70,12 @@ fn stats(scene: &bt_scene::Scene, candidates: &bt_paths::CandidateSet, solver: &
     use bt_solve::{CandidateOutcome, solve_candidate};
     use std::collections::BTreeMap;
     let mut by_kind: BTreeMap<&str, (u64, u64, u32)> = BTreeMap::new();
+    let ends = scene.terminals().unwrap();
     for seq in candidates.iter() {
         let n = seq.len();
         let mut points = vec![bt_geom::Vec3::ZERO; n];
         let mut scratch = points.clone();
-        let outcome = solve_candidate(scene, seq, solver, &mut points, &mut scratch);
+        let outcome = solve_candidate(scene, ends, seq, solver, &mut points, &mut scratch);
         let (kind, ipc) = match outcome {
             CandidateOutcome::Solved { validity, ipc } => (
                 match validity {

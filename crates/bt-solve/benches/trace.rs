@@ -10,11 +10,11 @@ fn living_room(c: &mut Criterion) {
     let scene = bt_import::builtin_scene("living-room", Default::default())
         .unwrap()
         .unwrap();
-    let candidates = enumerate(&scene, 3, &AllVisible);
+    let candidates = enumerate(&scene, 3, &AllVisible).unwrap();
     let mut group = c.benchmark_group("living-room-order3");
     group.throughput(Throughput::Elements(candidates.len() as u64));
     group.bench_function("candidates", |b| {
-        b.iter(|| enumerate(black_box(&scene), 3, &AllVisible))
+        b.iter(|| enumerate(black_box(&scene), 3, &AllVisible).unwrap())
     });
     let solvers = [
         ("image", Solver::Image),
@@ -41,8 +41,8 @@ fn living_room(c: &mut Criterion) {
     }
     group.bench_function("full-image-trace", |b| {
         b.iter(|| {
-            let c = enumerate(black_box(&scene), 3, &AllVisible);
-            let r = trace(&scene, &c, &Solver::Image, false);
+            let c = enumerate(black_box(&scene), 3, &AllVisible).unwrap();
+            let r = trace(&scene, &c, &Solver::Image, false).unwrap();
             bt_beams::report(&scene, &r.paths, &bt_beams::RadioOptions::default())
         })
     });

@@ -10,12 +10,13 @@ fn main() {
     let opts = IpcOptions::for_scene(&scene, UpdateOrder::GaussSeidel);
     let solver = Solver::Ipc(opts);
     let (mut total, mut blocked_rounds) = (0u64, 0u64);
+    let ends = scene.terminals().unwrap();
     for i in 0..set.len() {
         let seq = set.get(i);
         let mut pts = vec![bt_geom::Vec3::ZERO; seq.len()];
         let mut scr = pts.clone();
-        let out =
-            bt_solve::solve_candidate_from(&scene, seq, &solver, set.start(i), &mut pts, &mut scr);
+        let (start, out) = (set.start(i), &mut pts);
+        let out = bt_solve::solve_candidate_from(&scene, ends, seq, &solver, start, out, &mut scr);
         let it = match &out {
             CandidateOutcome::Solved { ipc, .. } => ipc.map_or(0, |o| o.iterations()),
             CandidateOutcome::NotConverged(o)

@@ -40,7 +40,9 @@ fn trace_scene(kept: &mut Kept, scene: &Scene, options: &TraceOptions) -> Traced
     let tracer = kept
         .tracer
         .get_or_insert_with(|| Tracer::new(scene.clone(), *options));
-    tracer.trace(scene.tx_world(), scene.rx_world()).unwrap()
+    tracer
+        .trace(scene.tx_world().unwrap(), scene.rx_world().unwrap())
+        .unwrap()
 }
 
 fn traced_paths(kept: &mut Kept, scene: &Scene, options: &TraceOptions) -> usize {
@@ -50,7 +52,7 @@ fn traced_paths(kept: &mut Kept, scene: &Scene, options: &TraceOptions) -> usize
 /// The RX of call `i` (scene-local frame): a few millimetres apart, so that no call repeats
 /// the previous one.
 fn moved_rx(scene: &Scene, i: usize) -> Vec3 {
-    scene.rx() + Vec3::new(0.001 * (i % 7) as f64, 0.0, 0.0)
+    scene.rx().unwrap() + Vec3::new(0.001 * (i % 7) as f64, 0.0, 0.0)
 }
 
 fn run(what: &str, scene: &Scene, i: usize, tree: &BeamTree, kept: &mut Kept) -> usize {
@@ -103,6 +105,7 @@ fn run(what: &str, scene: &Scene, i: usize, tree: &BeamTree, kept: &mut Kept) ->
             let set = tree.candidates(rx);
             let moved = scene.with_receiver(scene.to_world(rx)).unwrap();
             bt_solve::trace(&moved, &set, &Solver::Image, false)
+                .unwrap()
                 .paths
                 .len()
         }

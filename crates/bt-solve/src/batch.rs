@@ -11,7 +11,7 @@ use crate::{
 };
 use bt_geom::{Real, Vec3};
 use bt_paths::CandidateSet;
-use bt_scene::{Scene, SurfaceId};
+use bt_scene::{Endpoints, Scene, SurfaceId};
 use rayon::prelude::*;
 
 /// Candidates per parallel chunk.
@@ -52,6 +52,8 @@ impl Todo<'_> {
 pub(crate) struct Batch<'a> {
     /// The scene (TX, RX, surfaces).
     pub(crate) scene: &'a Scene,
+    /// The scene's terminals, checked ([`Scene::terminals`]).
+    pub(crate) ends: Endpoints,
     /// The candidate sequences (and their window start points, if any).
     pub(crate) candidates: &'a CandidateSet,
     /// The solver.
@@ -141,6 +143,7 @@ where
     {
         let Batch {
             scene,
+            ends,
             candidates,
             solver,
             ..
@@ -165,7 +168,7 @@ where
                 (&mut heap_points[..], &mut heap_scratch[..])
             };
             let start = (self.warm)(i).or_else(|| candidates.start(i));
-            let outcome = solve_candidate_from(scene, seq, solver, start, points, scratch);
+            let outcome = solve_candidate_from(scene, ends, seq, solver, start, points, scratch);
             (self.each)(&mut acc, i, seq, &outcome, points);
         }
         acc
@@ -186,7 +189,8 @@ where
     where
         F: Fn(&mut R, usize, &[SurfaceId], &CandidateOutcome, &[Vec3]),
     {
-        let (scene, candidates) = (self.batch.scene, self.batch.candidates);
+        let (scene, terminals, candidates) =
+            (self.batch.scene, self.batch.ends, self.batch.candidates);
         let index = |k: usize| self.todo.index(range.start + k);
         let seq_at = |k: usize| candidates.get(index(k));
         let start_at = |k: usize| (self.warm)(index(k)).or_else(|| candidates.start(index(k)));
@@ -212,14 +216,20 @@ where
                 // The callback only records each run's end: a closure is compiled without the
                 // FMA feature of this function, so validation (whose fused plane distances
                 // would each be a software `fma` call there) runs below, in this body.
-                lanes::solve_group(scene, options, n, items, |k, _, end, solved| {
-                    points[offsets[k]..offsets[k + 1]].copy_from_slice(solved);
-                    ends[k] = Some(end);
-                });
+                lanes::solve_group(
+                    (scene, terminals),
+                    options,
+                    n,
+                    items,
+                    |k, _, end, solved| {
+                        points[offsets[k]..offsets[k + 1]].copy_from_slice(solved);
+                        ends[k] = Some(end);
+                    },
+                );
                 for &k in group {
                     let end = ends[k].take().expect("every run of the group ended");
                     let solved = &points[offsets[k]..offsets[k + 1]];
-                    outcomes[k] = Some(ipc_verdict(scene, seq_at(k), end, solved));
+                    outcomes[k] = Some(ipc_verdict(scene, terminals, seq_at(k), end, solved));
                 }
                 continue;
             }
@@ -227,8 +237,9 @@ where
             let mut scratch = vec![Vec3::ZERO; n];
             for &k in group {
                 let out = &mut points[offsets[k]..offsets[k + 1]];
+                let (seq, start) = (seq_at(k), start_at(k));
                 let outcome =
-                    solve_candidate_from(scene, seq_at(k), &solver, start_at(k), out, &mut scratch);
+                    solve_candidate_from(scene, terminals, seq, &solver, start, out, &mut scratch);
                 outcomes[k] = Some(outcome);
             }
         }

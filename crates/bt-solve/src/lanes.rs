@@ -11,7 +11,7 @@
 
 use crate::ipc::{Acceleration, IpcOptions, IpcOutcome, IpcRun, UpdateOrder};
 use bt_geom::{Plane, Real, Vec3};
-use bt_scene::{Scene, SurfaceId};
+use bt_scene::{Endpoints, Scene, SurfaceId};
 
 /// Runs advanced together.
 pub(crate) const LANES: usize = 4;
@@ -86,7 +86,7 @@ struct Group<'s> {
 /// end.
 #[inline(always)]
 pub(crate) fn solve_group<'s>(
-    scene: &'s Scene,
+    (scene, ends): (&'s Scene, Endpoints),
     options: &'s IpcOptions,
     n: usize,
     mut items: impl Iterator<Item = (usize, &'s [SurfaceId], Option<&'s [Vec3]>)>,
@@ -99,7 +99,7 @@ pub(crate) fn solve_group<'s>(
         planes: [Planes::default(); MAX_ORDER],
         jobs: std::array::from_fn(|_| None),
     };
-    let (tx, rx) = (scene.tx(), scene.rx());
+    let Endpoints { tx, rx } = ends;
     let min_sum = crate::ipc::min_sum(scene);
     let mut out = [Vec3::ZERO; MAX_ORDER];
     loop {
@@ -107,7 +107,7 @@ pub(crate) fn solve_group<'s>(
             if group.jobs[l].is_none()
                 && let Some((k, seq, start)) = items.next()
             {
-                group.load(scene, options, l, (k, seq, start));
+                group.load((scene, ends), options, l, (k, seq, start));
             }
         }
         if group.jobs.iter().all(Option::is_none) {
@@ -126,7 +126,7 @@ impl<'s> Group<'s> {
     /// Put candidate `(k, seq, start)` into lane `l`.
     fn load(
         &mut self,
-        scene: &'s Scene,
+        (scene, ends): (&'s Scene, Endpoints),
         options: &'s IpcOptions,
         l: usize,
         (k, seq, start): (usize, &'s [SurfaceId], Option<&'s [Vec3]>),
@@ -141,7 +141,7 @@ impl<'s> Group<'s> {
             lane.offset[l] = plane.offset;
             self.points[i].set(l, points[i]);
         }
-        let run = IpcRun::new(scene, seq, (scene.tx(), scene.rx()), options);
+        let run = IpcRun::new(scene, seq, (ends.tx, ends.rx), options);
         self.jobs[l] = Some(Job {
             k,
             seq,

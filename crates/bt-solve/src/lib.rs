@@ -27,7 +27,7 @@ pub mod validate;
 
 use bt_geom::{Real, Vec3};
 use bt_paths::CandidateSet;
-use bt_scene::{Scene, SurfaceId};
+use bt_scene::{Endpoints, Scene, SceneError, SurfaceId};
 use serde::{Deserialize, Serialize};
 
 use batch::{Batch, Todo, found_path, solve_batch};
@@ -153,17 +153,19 @@ pub struct TraceResult {
     pub counts: OutcomeCounts,
 }
 
-/// Solve and validate one candidate. `points` and `scratch` must have the sequence's length;
-/// on return `points` holds the solver's points (meaningful when `Solved`).
+/// Solve and validate one candidate from `ends.tx` to `ends.rx` (the scene's, from
+/// [`Scene::terminals`]). `points` and `scratch` must have the sequence's length; on return
+/// `points` holds the solver's points (meaningful when `Solved`).
 #[inline(always)]
 pub fn solve_candidate(
     scene: &Scene,
+    ends: Endpoints,
     seq: &[SurfaceId],
     solver: &Solver,
     points: &mut [Vec3],
     scratch: &mut [Vec3],
 ) -> CandidateOutcome {
-    solve_candidate_from(scene, seq, solver, None, points, scratch)
+    solve_candidate_from(scene, ends, seq, solver, None, points, scratch)
 }
 
 /// [`solve_candidate`], with IPC starting from `warm` (e.g. the previous time step's points)
@@ -171,13 +173,14 @@ pub fn solve_candidate(
 #[inline(always)]
 pub fn solve_candidate_from(
     scene: &Scene,
+    ends: Endpoints,
     seq: &[SurfaceId],
     solver: &Solver,
     warm: Option<&[Vec3]>,
     points: &mut [Vec3],
     scratch: &mut [Vec3],
 ) -> CandidateOutcome {
-    let (tx, rx) = (scene.tx(), scene.rx());
+    let Endpoints { tx, rx } = ends;
     match solver {
         Solver::Image => {
             if let Err(e) = image::solve(scene, seq, tx, rx, points) {
@@ -187,9 +190,9 @@ pub fn solve_candidate_from(
         Solver::Ipc(options) => {
             ipc_start(scene, seq, warm, points);
             let outcome = ipc::solve(scene, seq, tx, rx, options, points, scratch);
-            return ipc_verdict(scene, seq, outcome, points);
+            return ipc_verdict(scene, ends, seq, outcome, points);
         }
-        Solver::Sbr(options) => match sbr::solve_sequence(scene, seq, options) {
+        Solver::Sbr(options) => match sbr::solve_sequence(scene, ends, seq, options) {
             Some(path) => points.copy_from_slice(&path.points),
             None => return CandidateOutcome::Missed,
         },
@@ -223,13 +226,14 @@ pub(crate) fn ipc_start(
 #[inline(always)]
 pub(crate) fn ipc_verdict(
     scene: &Scene,
+    ends: Endpoints,
     seq: &[SurfaceId],
     outcome: IpcOutcome,
     points: &[Vec3],
 ) -> CandidateOutcome {
     match outcome {
         IpcOutcome::Converged { .. } => CandidateOutcome::Solved {
-            validity: validate::validate(scene, seq, scene.tx(), scene.rx(), points),
+            validity: validate::validate(scene, seq, ends.tx, ends.rx, points),
             ipc: Some(outcome),
         },
         IpcOutcome::NotConverged { .. } => CandidateOutcome::NotConverged(outcome),
@@ -253,19 +257,23 @@ fn keep_valid(
 }
 
 /// Run `solver` on every candidate. `parallel` spreads candidates over rayon's pool; the
-/// output is identical either way (order-preserving).
+/// output is identical either way (order-preserving). A scene without both terminals fails
+/// ([`SceneError::MissingTerminal`]).
 pub fn trace(
     scene: &Scene,
     candidates: &CandidateSet,
     solver: &Solver,
     parallel: bool,
-) -> TraceResult {
+) -> Result<TraceResult, SceneError> {
+    let ends = scene.terminals()?;
     if let Solver::Sbr(options) = solver {
         let max_order = candidates.iter().map(<[SurfaceId]>::len).max().unwrap_or(0);
-        return sbr::to_trace_result(&sbr::trace_detailed(scene, options, max_order, parallel));
+        let result = sbr::trace_detailed(scene, options, max_order, parallel)?;
+        return Ok(sbr::to_trace_result(&result));
     }
     let batch = Batch {
         scene,
+        ends,
         candidates,
         solver,
         parallel,
@@ -276,5 +284,5 @@ pub fn trace(
         out.paths.extend(part.paths);
         out.counts.merge(&part.counts);
     }
-    out
+    Ok(out)
 }

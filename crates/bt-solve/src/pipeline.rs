@@ -77,12 +77,22 @@ pub enum TraceError {
         /// The order asked for.
         max_order: usize,
     },
-    /// The beam tree ran out of its node budget.
+    /// The beam tree ran out of its node budget (a tree's scene error, such as a missing
+    /// terminal, converts to [`TraceError::Scene`] instead: one shape per cause).
     #[error(transparent)]
-    Tree(#[from] bt_paths::beamtree::TreeError),
+    Tree(bt_paths::beamtree::TreeError),
     /// A receiver (or transmitter) position is not valid in the scene.
     #[error(transparent)]
     Scene(#[from] SceneError),
+}
+
+impl From<bt_paths::beamtree::TreeError> for TraceError {
+    fn from(e: bt_paths::beamtree::TreeError) -> Self {
+        match e {
+            bt_paths::beamtree::TreeError::Scene(e) => TraceError::Scene(e),
+            e => TraceError::Tree(e),
+        }
+    }
 }
 
 /// Wall time of each stage of one trace.
@@ -107,7 +117,9 @@ pub struct Traced {
     pub time: StageTimes,
 }
 
-/// Generate the candidates of `scene` under `options` (with the budget checked).
+/// Generate the candidates of `scene` under `options` (with the budget checked). A scene
+/// without both terminals fails with [`TraceError::Scene`]
+/// ([`bt_scene::SceneError::MissingTerminal`] names the missing ones).
 pub fn candidates(scene: &Scene, options: &TraceOptions) -> Result<CandidateSet, TraceError> {
     candidates_with_progress(scene, options, &mut |_| {})
 }
@@ -131,13 +143,14 @@ fn generate(
     cache: &mut TreeCache,
     progress: Progress<'_>,
 ) -> Result<CandidateSet, TraceError> {
+    scene.terminals()?;
     check_budget(scene, options)?;
     Ok(match options.candidates {
-        CandidateMode::Exhaustive => bt_paths::enumerate(scene, options.max_order, &AllVisible),
+        CandidateMode::Exhaustive => bt_paths::enumerate(scene, options.max_order, &AllVisible)?,
         CandidateMode::BeamTree => bt_paths::beamtree::candidates_in(scene, tree, cache, progress)?,
         CandidateMode::Wvrn => {
-            let wvrn = bt_paths::wvrn::Wvrn::build(scene);
-            bt_paths::enumerate(scene, options.max_order, &wvrn)
+            let wvrn = bt_paths::wvrn::Wvrn::build(scene)?;
+            bt_paths::enumerate(scene, options.max_order, &wvrn)?
         }
     })
 }
@@ -214,7 +227,7 @@ pub(crate) fn trace_scene_in(
         progress,
     )?;
     let t1 = Instant::now();
-    Ok(solve_set(scene, set, options, t1 - t0))
+    solve_set(scene, set, options, t1 - t0)
 }
 
 /// Solve a generated candidate set (the second half of [`trace_scene_in`]).
@@ -223,11 +236,11 @@ pub(crate) fn solve_set(
     set: CandidateSet,
     options: &TraceOptions,
     generation: Duration,
-) -> Traced {
+) -> Result<Traced, TraceError> {
     let t1 = Instant::now();
-    let result = crate::trace(scene, &set, &options.solver, options.parallel);
+    let result = crate::trace(scene, &set, &options.solver, options.parallel)?;
     let t2 = Instant::now();
-    Traced {
+    Ok(Traced {
         candidates: set.stats,
         tree: set.tree,
         result,
@@ -235,7 +248,7 @@ pub(crate) fn solve_set(
             candidates: generation,
             solve: t2 - t1,
         },
-    }
+    })
 }
 
 /// Trace `base`'s TX to each of `receivers` (metres, world frame: converted into the scene's
@@ -265,8 +278,8 @@ pub(crate) fn trace_each_receiver(
             // The tree's margins hold for receivers whose scene tolerance is no larger.
             Some(tree) if moved.length_tolerance() <= tree.tolerance() => {
                 let t0 = Instant::now();
-                let set = tree.candidates(moved.rx());
-                Ok(solve_set(&moved, set, &inner, t0.elapsed()))
+                let set = tree.candidates(moved.terminals()?.rx);
+                solve_set(&moved, set, &inner, t0.elapsed())
             }
             // Receivers traced in parallel cannot share one cache (`tree` is built in beam-tree
             // mode, so this is a receiver that grows the scene, or another mode: no tree).

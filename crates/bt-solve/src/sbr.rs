@@ -22,7 +22,7 @@
 
 use crate::{FoundPath, OutcomeCounts, TraceResult};
 use bt_geom::{Real, Vec3};
-use bt_scene::{Scene, SurfaceId, SurfaceKind};
+use bt_scene::{Endpoints, Scene, SceneError, SurfaceId, SurfaceKind};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -296,9 +296,16 @@ pub struct SbrResult {
 }
 
 /// Run SBR up to `max_order` reflections in parallel and return the paths as [`FoundPath`]s
-/// (`counts.valid` = number of paths; SBR has no per-candidate outcomes).
-pub fn trace(scene: &Scene, options: &SbrOptions, max_order: usize) -> TraceResult {
-    to_trace_result(&trace_detailed(scene, options, max_order, true))
+/// (`counts.valid` = number of paths; SBR has no per-candidate outcomes). A scene without
+/// both terminals fails ([`SceneError::MissingTerminal`]).
+pub fn trace(
+    scene: &Scene,
+    options: &SbrOptions,
+    max_order: usize,
+) -> Result<TraceResult, SceneError> {
+    Ok(to_trace_result(&trace_detailed(
+        scene, options, max_order, true,
+    )?))
 }
 
 /// The [`TraceResult`] view of an [`SbrResult`].
@@ -313,14 +320,15 @@ pub fn to_trace_result(result: &SbrResult) -> TraceResult {
 }
 
 /// Run SBR up to `max_order` reflections, with the SBR-specific details of every path.
-/// `parallel` spreads rays over rayon's pool; the result is identical either way.
+/// `parallel` spreads rays over rayon's pool; the result is identical either way. A scene
+/// without both terminals fails ([`SceneError::MissingTerminal`]).
 pub fn trace_detailed(
     scene: &Scene,
     options: &SbrOptions,
     max_order: usize,
     parallel: bool,
-) -> SbrResult {
-    let tracer = Tracer::new(scene, options, max_order, None);
+) -> Result<SbrResult, SceneError> {
+    let tracer = Tracer::new((scene, scene.terminals()?), options, max_order, None);
     let total = options.ray_count();
     let chunks = total.div_ceil(CHUNK);
     let run = |c: usize| tracer.run(c * CHUNK..((c + 1) * CHUNK).min(total));
@@ -335,18 +343,24 @@ pub fn trace_detailed(
     }
     let mut paths = merged.paths;
     paths.sort_by(|a, b| (a.surfaces.len(), &a.surfaces).cmp(&(b.surfaces.len(), &b.surfaces)));
-    SbrResult {
+    Ok(SbrResult {
         paths,
         rays: total as u64,
         receptions: merged.receptions,
-    }
+    })
 }
 
 /// SBR for one surface sequence: shoot the whole pattern but follow a ray only while it hits
 /// the surfaces of `seq` in order; the closest ray caught after the whole sequence wins.
-/// Returns it, or `None` when no ray reached RX that way.
-pub fn solve_sequence(scene: &Scene, seq: &[SurfaceId], options: &SbrOptions) -> Option<SbrPath> {
-    let tracer = Tracer::new(scene, options, seq.len(), Some(seq));
+/// Returns it, or `None` when no ray reached RX that way. Rays leave `ends.tx` and are caught
+/// around `ends.rx` (the scene's, [`Scene::terminals`]).
+pub fn solve_sequence(
+    scene: &Scene,
+    ends: Endpoints,
+    seq: &[SurfaceId],
+    options: &SbrOptions,
+) -> Option<SbrPath> {
+    let tracer = Tracer::new((scene, ends), options, seq.len(), Some(seq));
     tracer.run(0..options.ray_count()).paths.into_iter().next()
 }
 
@@ -428,7 +442,7 @@ struct Catch {
 
 impl<'a> Tracer<'a> {
     fn new(
-        scene: &'a Scene,
+        (scene, ends): (&'a Scene, Endpoints),
         options: &'a SbrOptions,
         max_order: usize,
         target: Option<&'a [SurfaceId]>,
@@ -438,8 +452,8 @@ impl<'a> Tracer<'a> {
             options,
             max_order,
             target,
-            tx: scene.tx(),
-            rx: scene.rx(),
+            tx: ends.tx,
+            rx: ends.rx,
             capture: options.capture_factor(),
             tol: scene.length_tolerance(),
             // Every hit lies in the scene's bounding box, which contains the ray's origin.
@@ -567,26 +581,30 @@ mod tests {
     }
 
     fn image_paths(scene: &Scene, max_order: usize) -> Vec<FoundPath> {
-        let candidates = enumerate(scene, max_order, &AllVisible);
-        crate::trace(scene, &candidates, &Solver::Image, false).paths
+        let candidates = enumerate(scene, max_order, &AllVisible).unwrap();
+        crate::trace(scene, &candidates, &Solver::Image, false)
+            .unwrap()
+            .paths
     }
 
     /// Mean departure-angle error of SBR against the image method over matched paths, and the
     /// sequences only one of them found.
     fn compare(scene: &Scene, options: &SbrOptions, max_order: usize) -> (Real, usize, usize) {
         let exact = image_paths(scene, max_order);
-        let sbr = trace_detailed(scene, options, max_order, true);
+        let sbr = trace_detailed(scene, options, max_order, true).unwrap();
         let exact_seqs: BTreeSet<_> = exact.iter().map(|p| p.surfaces.clone()).collect();
         let sbr_seqs: BTreeSet<_> = sbr.paths.iter().map(|p| p.surfaces.clone()).collect();
         let mut sum = 0.0;
         let mut matched = 0;
         for p in &sbr.paths {
             if let Some(e) = exact.iter().find(|e| e.surfaces == p.surfaces) {
-                let first = e.points.first().copied().unwrap_or(scene.rx());
-                sum += angle_deg(p.departure, first - scene.tx());
-                let last = e.points.last().copied().unwrap_or(scene.tx());
-                let rx_err = angle_deg(p.arrival, last - scene.rx());
-                assert!((rx_err - angle_deg(p.departure, first - scene.tx())).abs() < 1e-6);
+                let first = e.points.first().copied().unwrap_or(scene.rx().unwrap());
+                sum += angle_deg(p.departure, first - scene.tx().unwrap());
+                let last = e.points.last().copied().unwrap_or(scene.tx().unwrap());
+                let rx_err = angle_deg(p.arrival, last - scene.rx().unwrap());
+                assert!(
+                    (rx_err - angle_deg(p.departure, first - scene.tx().unwrap())).abs() < 1e-6
+                );
                 matched += 1;
             }
         }
@@ -629,8 +647,8 @@ mod tests {
     fn serial_and_parallel_agree() {
         let scene = box_room();
         let options = SbrOptions::grid(2.0);
-        let a = trace_detailed(&scene, &options, 3, false);
-        let b = trace_detailed(&scene, &options, 3, true);
+        let a = trace_detailed(&scene, &options, 3, false).unwrap();
+        let b = trace_detailed(&scene, &options, 3, true).unwrap();
         assert_eq!(a.paths, b.paths);
         assert_eq!(a.receptions, b.receptions);
         assert_eq!(a.rays, 180 * 90);
@@ -658,7 +676,7 @@ mod tests {
         ] {
             assert!(bad.problem().is_some());
             assert_eq!(bad.ray_count(), 0);
-            assert!(trace(&box_room(), &bad, 2).paths.is_empty());
+            assert!(trace(&box_room(), &bad, 2).unwrap().paths.is_empty());
         }
     }
 
@@ -674,11 +692,32 @@ mod tests {
             .find(|s| exact_paths.iter().any(|p| p.surfaces == s))
             .unwrap();
         let other = [seq[1], seq[0]];
-        assert!(solve_sequence(&scene, &other, &SbrOptions::grid(0.5)).is_none());
-        let found = solve_sequence(&scene, &seq, &SbrOptions::grid(0.5)).expect("reached");
+        assert!(
+            solve_sequence(
+                &scene,
+                scene.terminals().unwrap(),
+                &other,
+                &SbrOptions::grid(0.5)
+            )
+            .is_none()
+        );
+        let found = solve_sequence(
+            &scene,
+            scene.terminals().unwrap(),
+            &seq,
+            &SbrOptions::grid(0.5),
+        )
+        .expect("reached");
         let mut exact = [Vec3::ZERO; 2];
-        image::solve(&scene, &seq, scene.tx(), scene.rx(), &mut exact).unwrap();
+        image::solve(
+            &scene,
+            &seq,
+            scene.tx().unwrap(),
+            scene.rx().unwrap(),
+            &mut exact,
+        )
+        .unwrap();
         assert!(found.points[0].distance(exact[0]) < 0.1);
-        assert!(angle_deg(found.departure, exact[0] - scene.tx()) < 0.5);
+        assert!(angle_deg(found.departure, exact[0] - scene.tx().unwrap()) < 0.5);
     }
 }

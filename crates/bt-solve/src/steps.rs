@@ -39,7 +39,7 @@ use bt_paths::beamtree::{BeamTree, TreeCache};
 use bt_paths::wvrn::{Wvrn, WvrnStats};
 use bt_paths::{CandidateSet, CandidateStats};
 use bt_scene::dynamic::moved_surfaces;
-use bt_scene::{Scene, SurfaceId};
+use bt_scene::{Endpoints, Scene, SurfaceId};
 use serde::{Deserialize, Serialize};
 use std::cmp::Ordering;
 
@@ -99,15 +99,18 @@ fn step_candidates(
     match wvrn {
         Some(w) => {
             crate::pipeline::check_budget(scene, options)?;
-            Ok(bt_paths::enumerate(scene, options.max_order, w))
+            Ok(bt_paths::enumerate(scene, options.max_order, w)?)
         }
         None => crate::pipeline::candidates(scene, options),
     }
 }
 
 /// The WVRN of `scene` in WVRN mode.
-fn step_wvrn(options: &TraceOptions, scene: &Scene) -> Option<Wvrn> {
-    (options.candidates == CandidateMode::Wvrn).then(|| Wvrn::build(scene))
+fn step_wvrn(options: &TraceOptions, scene: &Scene) -> Result<Option<Wvrn>, TraceError> {
+    Ok(match options.candidates {
+        CandidateMode::Wvrn => Some(Wvrn::build(scene)?),
+        _ => None,
+    })
 }
 
 /// A first step's generator and candidates: the WVRN, or the beam tree materialised to the
@@ -115,20 +118,20 @@ fn step_wvrn(options: &TraceOptions, scene: &Scene) -> Option<Wvrn> {
 /// subtrees), or exhaustive enumeration.
 fn generate(
     options: &TraceOptions,
-    scene: &Scene,
+    (scene, ends): (&Scene, Endpoints),
     cache: &mut TreeCache,
 ) -> Result<(Generator, CandidateSet), TraceError> {
     if options.candidates == CandidateMode::BeamTree {
         let tree_options = crate::pipeline::tree_options(options);
         let tree = BeamTree::build_in(scene, tree_options, cache, &mut |_| {})?;
-        let candidates = tree.candidates(scene.rx());
+        let candidates = tree.candidates(ends.rx);
         let generator = Generator {
             wvrn: None,
             tree: Some(tree),
         };
         return Ok((generator, candidates));
     }
-    let wvrn = step_wvrn(options, scene);
+    let wvrn = step_wvrn(options, scene)?;
     let candidates = step_candidates(options, scene, wvrn.as_ref())?;
     Ok((Generator { wvrn, tree: None }, candidates))
 }
@@ -142,15 +145,17 @@ struct Generator {
 }
 
 /// Trace one scene from scratch: candidates ([`crate::pipeline::candidates`], or the WVRN),
-/// then [`crate::trace`]. The reference the incremental tracer must reproduce.
+/// then [`crate::trace`]. The reference the incremental tracer must reproduce. A scene without
+/// both terminals fails ([`bt_scene::SceneError::MissingTerminal`]).
 pub fn trace_scratch(
     scene: &Scene,
     step: usize,
     options: &TraceOptions,
 ) -> Result<StepTrace, TraceError> {
-    let wvrn = step_wvrn(options, scene);
+    scene.terminals()?;
+    let wvrn = step_wvrn(options, scene)?;
     let candidates = step_candidates(options, scene, wvrn.as_ref())?;
-    let trace = crate::trace(scene, &candidates, &options.solver, options.parallel);
+    let trace = crate::trace(scene, &candidates, &options.solver, options.parallel)?;
     Ok(StepTrace {
         step,
         trace,
@@ -192,7 +197,8 @@ pub(crate) struct Incremental {
 
 impl Incremental {
     /// Trace `scene` as step `step`, the next step after the kept one. Scenes that are not a
-    /// next step of the previous one (other surfaces) are traced from scratch.
+    /// next step of the previous one (other surfaces) are traced from scratch. A scene without
+    /// both terminals fails and leaves the previous step kept.
     pub(crate) fn step(
         &mut self,
         options: &TraceOptions,
@@ -200,6 +206,7 @@ impl Incremental {
         step: usize,
         cache: &mut TreeCache,
     ) -> Result<StepTrace, TraceError> {
+        let ends = scene.terminals()?;
         let options = *options;
         let prev = self.state.take();
         if matches!(options.solver, Solver::Sbr(_)) {
@@ -217,8 +224,8 @@ impl Incremental {
         }
         let moved = prev.as_ref().and_then(|p| moved_surfaces(&p.scene, scene));
         let (Some(mut prev), Some(moved)) = (prev, moved) else {
-            let generated = generate(&options, scene, cache)?;
-            return Ok(self.full(&options, scene, step, generated));
+            let generated = generate(&options, (scene, ends), cache)?;
+            return Ok(self.full(&options, (scene, ends), step, generated));
         };
         let mut update = UpdateStats {
             moved_surfaces: moved.len(),
@@ -236,11 +243,11 @@ impl Incremental {
             everything,
             &mut update,
         )?;
-        let plans = plan(&prev, scene, &candidates, &moved, everything);
+        let plans = plan(&prev, (scene, ends), &candidates, &moved, everything);
 
         // Solve the affected candidates (in parallel, order preserved).
         let (solved, solved_points) = solve_planned(
-            scene,
+            (scene, ends),
             &options,
             &candidates,
             &plans,
@@ -288,12 +295,13 @@ impl Incremental {
     fn full(
         &mut self,
         options: &TraceOptions,
-        scene: &Scene,
+        (scene, ends): (&Scene, Endpoints),
         step: usize,
         (generator, candidates): (Generator, CandidateSet),
     ) -> StepTrace {
         let batch = Batch {
             scene,
+            ends,
             candidates: &candidates,
             solver: &options.solver,
             parallel: options.parallel,
@@ -351,7 +359,7 @@ fn next_candidates(
     let mut wvrn = generator.wvrn;
     let mut links_changed = false;
     if let Some(w) = &mut wvrn {
-        let delta = w.update(scene, moved);
+        let delta = w.update(scene, moved)?;
         update.wvrn_recomputed_pairs = delta.recomputed_pairs;
         update.wvrn_retested_pairs = delta.retested_pairs;
         update.wvrn_links_changed = delta.changed.len();
@@ -388,9 +396,10 @@ fn next_from_tree(
         update.tree_nodes_built = stats.built;
         (tree, true)
     };
-    let candidates = if rebuilt || scene.rx() != prev.scene.rx() {
+    let rx = scene.terminal(bt_scene::Terminal::Rx)?;
+    let candidates = if rebuilt || Some(rx) != prev.scene.rx() {
         update.candidates_rederived = true;
-        tree.candidates(scene.rx())
+        tree.candidates(rx)
     } else {
         prev.candidates.clone()
     };
@@ -408,7 +417,7 @@ fn next_from_tree(
 /// order (by length, then by ids).
 fn plan(
     prev: &State,
-    scene: &Scene,
+    (scene, ends): (&Scene, Endpoints),
     candidates: &CandidateSet,
     moved: &[SurfaceId],
     everything: bool,
@@ -430,7 +439,7 @@ fn plan(
         .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), (a, b)| {
             (lo.min(*a), hi.max(*b))
         });
-    let (tx, rx) = (scene.tx(), scene.rx());
+    let Endpoints { tx, rx } = ends;
     let mut plans = Vec::with_capacity(candidates.len());
     let mut j = 0;
     for seq in candidates.iter() {
@@ -467,7 +476,7 @@ enum Plan {
 /// Solve the candidates planned for solving, in parallel with order preserved: their outcomes
 /// (and whether IPC was warm-started from the previous step) and their points, concatenated.
 fn solve_planned(
-    scene: &Scene,
+    (scene, ends): (&Scene, Endpoints),
     options: &TraceOptions,
     candidates: &CandidateSet,
     plans: &[Plan],
@@ -494,6 +503,7 @@ fn solve_planned(
     let is_ipc = matches!(options.solver, Solver::Ipc(_));
     let batch = Batch {
         scene,
+        ends,
         candidates,
         solver: &options.solver,
         parallel: options.parallel,

@@ -19,7 +19,10 @@ use bt_scene::Scene;
 /// ([`Tracer::update`]).
 ///
 /// Terminals are given in the scene's input (world) frame, metres; paths come back in the
-/// scene-local frame ([`Scene::to_world`] converts). Cloning keeps the scene, the kept tree and
+/// scene-local frame ([`Scene::to_world`] converts). The scene may be bare geometry (no TX or
+/// RX): `trace`, `trace_many` and `trace_each` place the terminals of each call
+/// ([`Scene::with_terminals`]); `update` traces the step's own terminals and fails with
+/// [`TraceError::Scene`] ([`bt_scene::SceneError::MissingTerminal`]) when it lacks one. Cloning keeps the scene, the kept tree and
 /// the previous step (to branch, or to time one step) and starts with empty caches.
 #[derive(Clone)]
 pub struct Tracer {
@@ -94,7 +97,7 @@ impl Tracer {
         rx: Vec3,
         progress: &mut dyn FnMut(BuildProgress),
     ) -> Result<Traced, TraceError> {
-        if tx == self.scene.tx_world() && rx == self.scene.rx_world() {
+        if Some(tx) == self.scene.tx_world() && Some(rx) == self.scene.rx_world() {
             return trace_scene_in(&self.scene, &self.options, &mut self.cache, progress);
         }
         let moved = self.scene.with_terminals(tx, rx)?;
@@ -124,7 +127,7 @@ impl Tracer {
         };
         let options = self.options;
         let walk = walks_one_tree(&options, receivers);
-        if tx != self.scene.tx_world() {
+        if Some(tx) != self.scene.tx_world() {
             let base = self.scene.with_terminals(tx, *first)?;
             let tree = match walk {
                 true => Some(BeamTree::build_in(
@@ -178,7 +181,9 @@ impl Tracer {
         trace_scratch(scene, step, &self.options)
     }
 
-    /// Hold `scene` as the next step: the kept tree is dropped; returns the step's index.
+    /// Hold `scene` as the next step: the kept tree is dropped; returns the step's index. (A
+    /// step without terminals is held too; its trace fails and the last traced step stays the
+    /// one the next step is compared with.)
     fn advance(&mut self, scene: &Scene) -> usize {
         self.scene = scene.clone();
         self.kept = None;

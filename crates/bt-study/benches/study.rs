@@ -18,10 +18,11 @@ fn solvers(c: &mut Criterion) {
         let scene = embed::scene("bench", &r.contours[0], r.tx, r.rx).expect("room embeds");
         let exact = trace(
             &scene,
-            &enumerate(&scene, MAX_ORDER, &AllVisible),
+            &enumerate(&scene, MAX_ORDER, &AllVisible).unwrap(),
             &Solver::Image,
             false,
-        );
+        )
+        .unwrap();
         let mut group =
             c.benchmark_group(format!("room-{index}-{}-{}-edges", r.shape.name(), r.edges));
         group.throughput(Throughput::Elements(exact.paths.len() as u64));
@@ -36,8 +37,8 @@ fn solvers(c: &mut Criterion) {
             );
             group.bench_function(BenchmarkId::from_parameter(name), |b| {
                 b.iter(|| {
-                    let candidates = enumerate(black_box(&scene), MAX_ORDER, &AllVisible);
-                    trace(&scene, &candidates, &solver, false)
+                    let candidates = enumerate(black_box(&scene), MAX_ORDER, &AllVisible).unwrap();
+                    trace(&scene, &candidates, &solver, false).unwrap()
                 })
             });
         }
@@ -46,7 +47,9 @@ fn solvers(c: &mut Criterion) {
             ("sbr-1deg-sphere", SbrOptions::grid(1.0)),
         ] {
             group.bench_function(BenchmarkId::from_parameter(name), |b| {
-                b.iter(|| sbr::trace_detailed(black_box(&scene), &options, MAX_ORDER, false))
+                b.iter(|| {
+                    sbr::trace_detailed(black_box(&scene), &options, MAX_ORDER, false).unwrap()
+                })
             });
         }
         group.finish();

@@ -67,8 +67,10 @@ mod tests {
         let contour = [[1., 1.], [6., 1.], [6., 5.], [1., 5.]].map(Vec2::from);
         let scene = scene("square", &contour, Vec2::new(2., 2.), Vec2::new(4., 3.)).unwrap();
         assert_eq!(scene.find("wall-2").map(|id| id.0), Some(2));
-        let candidates = enumerate(&scene, 2, &AllVisible);
-        let paths = trace(&scene, &candidates, &Solver::Image, false).paths;
+        let candidates = enumerate(&scene, 2, &AllVisible).unwrap();
+        let paths = trace(&scene, &candidates, &Solver::Image, false)
+            .unwrap()
+            .paths;
         // LOS + 4 first order + 2 × 2 between parallel walls + 4 perpendicular pairs (one
         // order each).
         assert_eq!(paths.len(), 1 + 4 + 4 + 4);

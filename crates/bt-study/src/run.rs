@@ -5,7 +5,7 @@ use crate::room::{self, Room, Shape};
 use crate::{StudyError, embed};
 use bt_geom::{Real, Vec2, Vec3};
 use bt_paths::CandidateSet;
-use bt_scene::{Scene, SurfaceId};
+use bt_scene::{Endpoints, Scene, SurfaceId};
 use bt_solve::{IpcOptions, SbrOptions, Solver, UpdateOrder, sbr, trace};
 use serde::Serialize;
 use std::collections::BTreeMap;
@@ -316,9 +316,10 @@ pub(crate) struct Directions {
     pub(crate) arrival: Vec3,
 }
 
-/// Departure and arrival directions of a path through `points` between the scene's TX and RX.
-pub(crate) fn exact_directions(scene: &Scene, points: &[Vec3]) -> Directions {
-    let (tx, rx) = (scene.tx(), scene.rx());
+/// Departure and arrival directions of a path through `points` between the scene's TX and RX
+/// (`ends`, local frame).
+pub(crate) fn exact_directions(ends: Endpoints, points: &[Vec3]) -> Directions {
+    let Endpoints { tx, rx } = ends;
     let first = points.first().copied().unwrap_or(rx);
     let last = points.last().copied().unwrap_or(tx);
     Directions {
@@ -343,13 +344,15 @@ pub(crate) fn run_solver(
     solver: StudySolver,
     config: &StudyConfig,
 ) -> Result<(PathMap, Real), StudyError> {
+    let ends = scene.terminals().map_err(|e| scene_error(scene, e))?;
     let start = Instant::now();
     let s = match solver {
         StudySolver::Image | StudySolver::IpcGaussSeidel | StudySolver::IpcJacobi => {
             solver.exact_solver(scene).expect("an exact host solver")
         }
         StudySolver::Sbr => {
-            let result = sbr::trace_detailed(scene, &config.sbr_options(), config.max_order, false);
+            let result = sbr::trace_detailed(scene, &config.sbr_options(), config.max_order, false)
+                .map_err(|e| scene_error(scene, e))?;
             let elapsed = start.elapsed().as_secs_f64();
             let map = result
                 .paths
@@ -371,13 +374,13 @@ pub(crate) fn run_solver(
         }
     };
     let candidates = study_candidates(scene, config)?;
-    let result = trace(scene, &candidates, &s, false);
+    let result = trace(scene, &candidates, &s, false).map_err(|e| scene_error(scene, e))?;
     let elapsed = start.elapsed().as_secs_f64();
     let map = result
         .paths
         .into_iter()
         .map(|p| {
-            let d = exact_directions(scene, &p.points);
+            let d = exact_directions(ends, &p.points);
             (p.surfaces, d)
         })
         .collect();
@@ -466,10 +469,15 @@ fn study_candidates(scene: &Scene, config: &StudyConfig) -> Result<CandidateSet,
         max_candidates: config.max_candidates,
         ..bt_solve::pipeline::TraceOptions::new(config.max_order)
     };
-    bt_solve::pipeline::candidates(scene, &options).map_err(|e| StudyError::Scene {
+    bt_solve::pipeline::candidates(scene, &options).map_err(|e| scene_error(scene, e))
+}
+
+/// A study scene's error (a generator bug: every study scene has its terminals).
+pub(crate) fn scene_error(scene: &Scene, e: impl std::fmt::Display) -> StudyError {
+    StudyError::Scene {
         name: scene.name().to_string(),
         message: e.to_string(),
-    })
+    }
 }
 
 fn exact_polylines(
@@ -477,13 +485,15 @@ fn exact_polylines(
     config: &StudyConfig,
 ) -> Result<Vec<(usize, Vec<Vec2>)>, StudyError> {
     let candidates = study_candidates(scene, config)?;
+    let ends = scene.terminals().map_err(|e| scene_error(scene, e))?;
     Ok(trace(scene, &candidates, &Solver::Image, false)
+        .map_err(|e| scene_error(scene, e))?
         .paths
         .iter()
         .map(|p| {
-            let mut line = vec![scene.tx().truncate()];
+            let mut line = vec![ends.tx.truncate()];
             line.extend(p.points.iter().map(|q| q.truncate()));
-            line.push(scene.rx().truncate());
+            line.push(ends.rx.truncate());
             (p.surfaces.len(), line)
         })
         .collect())

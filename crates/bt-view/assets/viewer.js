@@ -120,8 +120,9 @@
       stepGroup.add(line);
       pathLines.push(line);
     });
-    stepGroup.add(marker(step.tx, 0xd62728, 0.06));
-    stepGroup.add(marker(step.rx, 0x1f77b4, 0.06));
+    // Bare geometry (a mesh without terminals) has no markers: tx and rx are null.
+    if (step.tx) { stepGroup.add(marker(step.tx, 0xd62728, 0.06)); }
+    if (step.rx) { stepGroup.add(marker(step.rx, 0x1f77b4, 0.06)); }
     state.step = k;
     state.pathLines = pathLines.length;
     state.paths = step.paths.length;

@@ -46,21 +46,30 @@ pub enum ViewError {
 /// The paths of one time step with the terminals they were traced for.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct StepPaths {
-    /// Transmitter, metres.
-    pub tx: [Real; 3],
-    /// Receiver, metres.
-    pub rx: [Real; 3],
+    /// Transmitter, metres, world frame; `None` for bare geometry (drawn without terminals).
+    pub tx: Option<[Real; 3]>,
+    /// Receiver, metres, world frame; `None` for bare geometry.
+    pub rx: Option<[Real; 3]>,
     /// The paths (the trace documents' record).
     pub paths: Vec<PathReport>,
 }
 
 impl StepPaths {
-    /// The ranked reports of a trace of `scene`.
+    /// The ranked reports of a trace of `scene`, with the terminals it has.
     pub fn from_reports(scene: &Scene, paths: &[PathReport]) -> Self {
         StepPaths {
-            tx: scene.tx_world().to_array(),
-            rx: scene.rx_world().to_array(),
+            tx: scene.tx_world().map(|p| p.to_array()),
+            rx: scene.rx_world().map(|p| p.to_array()),
             paths: paths.to_vec(),
+        }
+    }
+
+    /// Bare geometry: no terminal, no path.
+    pub fn none() -> Self {
+        StepPaths {
+            tx: None,
+            rx: None,
+            paths: Vec::new(),
         }
     }
 }
@@ -85,14 +94,14 @@ pub fn read_paths(text: &str, path: &str) -> Result<Vec<StepPaths>, ViewError> {
             .steps
             .into_iter()
             .map(|s| StepPaths {
-                tx: s.tx,
-                rx: s.rx,
+                tx: Some(s.tx),
+                rx: Some(s.rx),
                 paths: s.paths,
             })
             .collect(),
         PathsDocument::One(doc) => vec![StepPaths {
-            tx: doc.tx,
-            rx: doc.rx,
+            tx: Some(doc.tx),
+            rx: Some(doc.rx),
             paths: doc.paths,
         }],
     })
@@ -128,8 +137,9 @@ struct MaterialColour<'a> {
 #[derive(Serialize)]
 struct StepDocument<'a> {
     surfaces: Vec<SurfaceDocument<'a>>,
-    tx: [Real; 3],
-    rx: [Real; 3],
+    /// `null` on bare geometry: the viewer draws no marker.
+    tx: Option<[Real; 3]>,
+    rx: Option<[Real; 3]>,
     paths: &'a [PathReport],
 }
 

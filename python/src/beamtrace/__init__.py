@@ -125,7 +125,8 @@ def _receivers(rx: Any) -> npt.NDArray[np.float64]:
 
 
 class Scene:
-    """A validated scene (surfaces, materials, a default TX and RX), loaded by :func:`load`."""
+    """A validated scene (surfaces, materials and, when the file or :func:`load` gives them, a
+    default TX and RX), loaded by :func:`load`."""
 
     def __init__(self, native: Any) -> None:
         self._native = native
@@ -136,14 +137,16 @@ class Scene:
         return self._native.name
 
     @property
-    def tx(self) -> npt.NDArray[np.float64]:
-        """The scene's transmitter position, metres."""
-        return np.array(self._native.tx)
+    def tx(self) -> Optional[npt.NDArray[np.float64]]:
+        """The scene's transmitter position, metres; None when it has none (a mesh)."""
+        tx = self._native.tx
+        return None if tx is None else np.array(tx)
 
     @property
-    def rx(self) -> npt.NDArray[np.float64]:
-        """The scene's receiver position, metres."""
-        return np.array(self._native.rx)
+    def rx(self) -> Optional[npt.NDArray[np.float64]]:
+        """The scene's receiver position, metres; None when it has none (a mesh)."""
+        rx = self._native.rx
+        return None if rx is None else np.array(rx)
 
     @property
     def frequency_hz(self) -> float:
@@ -185,7 +188,8 @@ class Scene:
         ``candidates`` "beam-tree" | "wvrn" | "exhaustive", ``ipc_order`` "gauss-seidel" |
         "jacobi", ``ipc_accel`` "none" | "newton", ``sbr_step_deg`` or ``sbr_rays``. Raises
         :class:`BeamtraceError` when a position is invalid (on a surface, equal to the other
-        terminal) or the candidate budget is exceeded, ``ValueError`` on a bad option.
+        terminal) or the candidate budget is exceeded, ``ValueError`` on a bad option or when
+        a terminal is neither given nor in the scene (meshes, XML and point clouds have none).
         """
         columns = self._native.trace(
             _point(tx, "tx"),
@@ -250,7 +254,8 @@ def load(
 ) -> Scene:
     """Load a scene: a file the CLI reads (.json, .toml, .obj, .ply) or ``"builtin:NAME"``.
 
-    ``tx``/``rx`` override the file's terminals (meshes carry none: give both). The mesh
+    ``tx``/``rx`` override the file's terminals. Meshes, XML scenes and point clouds carry
+    none: load them bare and give ``tx``/``rx`` to each :meth:`Scene.trace`. The mesh
     options are ``beamtrace trace``'s ``--min-reflector-area`` (m²), ``--merge-angle-deg`` and
     ``--merge-distance`` (m). Raises :class:`BeamtraceError` with the CLI's message (naming the
     file, line or field) when the scene cannot be read or is invalid.

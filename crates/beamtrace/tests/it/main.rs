@@ -10,4 +10,5 @@ mod living_room;
 mod pointcloud;
 mod study;
 mod sweep;
+mod terminals;
 mod wvrn_steps;

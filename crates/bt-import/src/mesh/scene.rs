@@ -1,10 +1,7 @@
 //! Mesh surfaces into a scene: small surfaces block, ITU material names get their radio model.
 
 use crate::{ImportError, LoadOptions, Loaded};
-use bt_scene::{
-    DEFAULT_MATERIAL, Material, Problem, RawSurface, Scene, SceneError, SurfaceKind,
-    default_materials,
-};
+use bt_scene::{DEFAULT_MATERIAL, Material, RawSurface, Scene, SurfaceKind, default_materials};
 
 /// Build a scene from imported mesh surfaces: surfaces below the area threshold become blockers,
 /// material names of the ITU table (`itu_concrete`, ...) get that material as a half-space,
@@ -59,24 +56,13 @@ pub fn from_mesh(
             vertices: s.vertices,
         });
     }
-    let (tx, rx) = match (options.terminals.tx, options.terminals.rx) {
-        (Some(tx), Some(rx)) => (tx, rx),
-        (tx, rx) => {
-            let problems = [("tx", tx), ("rx", rx)]
-                .into_iter()
-                .filter(|(_, v)| v.is_none())
-                .map(|(field, _)| Problem {
-                    location: field.into(),
-                    message: format!("meshes carry no {field}: pass --{field} X,Y,Z"),
-                })
-                .collect();
-            return Err(SceneError::Invalid {
-                source_name: source.to_string(),
-                problems,
-            }
-            .into());
-        }
-    };
-    let scene = Scene::from_surfaces(name, source, raw, materials, (tx, rx), options.frequency_hz)?;
+    let scene = Scene::from_surfaces(
+        name,
+        source,
+        raw,
+        materials,
+        options.terminals,
+        options.frequency_hz,
+    )?;
     Ok(Loaded { scene, warnings })
 }

@@ -20,8 +20,8 @@ use crate::{ImportError, LoadOptions, Loaded};
 use bt_channel::{ItuMaterial, RadioModel};
 use bt_geom::Real;
 use bt_scene::{
-    DEFAULT_MATERIAL, MaterialDesc, Problem, Scene, SceneDescription, SceneError, SurfaceDesc,
-    SurfaceKind, default_materials,
+    DEFAULT_MATERIAL, MaterialDesc, Scene, SceneDescription, SurfaceDesc, SurfaceKind,
+    default_materials,
 };
 use glam::DMat4;
 use std::collections::BTreeMap;
@@ -125,8 +125,9 @@ pub struct XmlShape {
 }
 
 /// Load a Mitsuba/Sionna XML scene: parse, read every shape's mesh (bounded, relative to the
-/// XML's folder), and validate as a scene with `options.terminals` (required: the XML has no
-/// transmitter or receiver) at `options.frequency_hz`.
+/// XML's folder), and validate as a scene with `options.terminals` at `options.frequency_hz`.
+/// The XML has no transmitter or receiver: without `options.terminals` the scene is bare
+/// geometry, traced with terminals given per trace.
 pub fn load_xml(path: &Path, options: &LoadOptions) -> Result<Loaded, ImportError> {
     let display = path.display().to_string();
     let text = read_bounded(path, MAX_XML_BYTES, &display)?;
@@ -135,21 +136,6 @@ pub fn load_xml(path: &Path, options: &LoadOptions) -> Result<Loaded, ImportErro
         message: format!("not UTF-8 text: {e}"),
     })?;
     let xml = parse_xml(&text, &display)?;
-    let missing: Vec<Problem> = [("tx", options.terminals.tx), ("rx", options.terminals.rx)]
-        .into_iter()
-        .filter(|(_, v)| v.is_none())
-        .map(|(field, _)| Problem {
-            location: field.into(),
-            message: format!("XML scenes carry no {field}: pass --{field} X,Y,Z"),
-        })
-        .collect();
-    if !missing.is_empty() {
-        return Err(SceneError::Invalid {
-            source_name: display,
-            problems: missing,
-        }
-        .into());
-    }
     let folder = path.parent().unwrap_or(Path::new("."));
     let mut warnings = xml.warnings.clone();
     let mut desc = SceneDescription {

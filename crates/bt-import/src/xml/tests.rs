@@ -268,7 +268,7 @@ fn shapes_never_merge_even_when_coplanar_and_adjacent() {
 }
 
 #[test]
-fn missing_files_and_terminals_are_clear_errors() {
+fn missing_files_are_clear_errors() {
     let xml = "<scene>\n<shape type=\"ply\" id=\"gone\"><string name=\"filename\" value=\"meshes/nowhere.ply\"/></shape></scene>";
     let dir = scratch("missing", &[("s.xml", xml)]);
     let e = load_xml(&dir.join("s.xml"), &options())
@@ -278,10 +278,11 @@ fn missing_files_and_terminals_are_clear_errors() {
         e.contains("line 2") && e.contains("gone") && e.contains("nowhere.ply"),
         "{e}"
     );
+    // Without terminals the missing mesh is still the error: the terminals are not required.
     let e = load_xml(&dir.join("s.xml"), &LoadOptions::default())
         .unwrap_err()
         .to_string();
-    assert!(e.contains("XML scenes carry no tx: pass --tx X,Y,Z"), "{e}");
+    assert!(e.contains("nowhere.ply"), "{e}");
     let escape =
         "<scene><shape type=\"ply\"><string name=\"filename\" value=\"../s.xml\"/></shape></scene>";
     std::fs::write(dir.join("escape.xml"), escape).unwrap();
@@ -289,5 +290,33 @@ fn missing_files_and_terminals_are_clear_errors() {
         .unwrap_err()
         .to_string();
     assert!(e.contains("must stay under the XML's folder"), "{e}");
+    std::fs::remove_dir_all(dir).ok();
+}
+
+#[test]
+fn xml_without_terminals_loads_as_bare_geometry() {
+    let xml = r#"<scene><shape type="obj" id="floor"><string name="filename" value="meshes/half.obj"/></shape></scene>"#;
+    let dir = scratch("bare", &[("s.xml", xml), ("meshes/half.obj", HALF_FLOOR)]);
+    let scene = load_xml(&dir.join("s.xml"), &LoadOptions::default())
+        .unwrap()
+        .scene;
+    assert_eq!((scene.tx(), scene.rx()), (None, None));
+    assert!(
+        (scene.extent() - 8.0_f64.sqrt()).abs() < 1e-12,
+        "{}",
+        scene.extent()
+    );
+    let e = scene.terminals().unwrap_err();
+    assert!(
+        matches!(&e, bt_scene::SceneError::MissingTerminal { missing, .. }
+            if missing == &[bt_scene::Terminal::Tx, bt_scene::Terminal::Rx]),
+        "{e}"
+    );
+    let placed = scene
+        .with_terminals(Vec3::new(1.0, 1.0, 1.0), Vec3::new(3.0, 1.5, 1.5))
+        .unwrap();
+    let loaded = load_xml(&dir.join("s.xml"), &options()).unwrap().scene;
+    assert_eq!(placed.terminals().unwrap(), loaded.terminals().unwrap());
+    assert_eq!(placed.extent(), loaded.extent());
     std::fs::remove_dir_all(dir).ok();
 }

@@ -67,7 +67,7 @@ impl BeamTree {
             return Ok((tree, stats));
         }
         // The moved surfaces make this another geometry: no kept shapes would match.
-        let prep = Prepared::new(scene, self.options, &mut TreeCache::default());
+        let prep = Prepared::new(scene, self.options, &mut TreeCache::default())?;
         let mut is_moved = vec![false; self.surfaces];
         moved.iter().for_each(|id| is_moved[id.index()] = true);
         let mut reflectors: Vec<u32> = moved
@@ -113,7 +113,7 @@ impl BeamTree {
     /// their wider margins), and no moved surface culled or shrank a node.
     fn reusable(&self, scene: &Scene, moved: &[SurfaceId]) -> bool {
         scene.surfaces().len() == self.surfaces
-            && scene.tx() == self.tx
+            && scene.tx() == Some(self.tx)
             && scene.length_tolerance() <= self.tol
             && scene
                 .reflectors()

@@ -14,6 +14,7 @@ type Solved = Vec<(usize, CandidateOutcome, Vec<Vec3>)>;
 fn batched(scene: &Scene, set: &CandidateSet, solver: &Solver, parallel: bool) -> Solved {
     let batch = Batch {
         scene,
+        ends: scene.terminals().unwrap(),
         candidates: set,
         solver,
         parallel,
@@ -29,6 +30,7 @@ fn batched(scene: &Scene, set: &CandidateSet, solver: &Solver, parallel: bool) -
 
 /// Every candidate's outcome and points, one by one.
 fn one_by_one(scene: &Scene, set: &CandidateSet, solver: &Solver) -> Solved {
+    let ends = scene.terminals().unwrap();
     (0..set.len())
         .map(|i| {
             let seq = set.get(i);
@@ -36,7 +38,7 @@ fn one_by_one(scene: &Scene, set: &CandidateSet, solver: &Solver) -> Solved {
             let mut scratch = points.clone();
             let start = set.start(i);
             let outcome =
-                solve_candidate_from(scene, seq, solver, start, &mut points, &mut scratch);
+                solve_candidate_from(scene, ends, seq, solver, start, &mut points, &mut scratch);
             (i, outcome, points)
         })
         .collect()
@@ -89,7 +91,7 @@ fn lanes_equal_one_by_one_on_the_living_room() {
         .unwrap()
         .unwrap();
     // Exhaustive candidates from the centroids: every kind of ending, many of each order.
-    let set = enumerate(&scene, 3, &AllVisible);
+    let set = enumerate(&scene, 3, &AllVisible).unwrap();
     let mut kinds = std::collections::BTreeMap::new();
     for solver in solvers(&scene) {
         let reference = one_by_one(&scene, &set, &solver);
@@ -114,7 +116,7 @@ fn lanes_equal_one_by_one_where_ipc_degenerates() {
     // The floor's centroid lies in the wall's plane: from the centroids, IPC on wall -> floor
     // meets a point whose neighbours both lie on its plane (the lanes rerun that lane alone).
     let scene = bt_testkit::wall_floor_scene();
-    let set = enumerate(&scene, 3, &AllVisible);
+    let set = enumerate(&scene, 3, &AllVisible).unwrap();
     let mut degenerate = 0;
     for solver in solvers(&scene) {
         let kinds = assert_bitwise_equal(
@@ -130,7 +132,7 @@ fn lanes_equal_one_by_one_where_ipc_degenerates() {
 fn lanes_equal_one_by_one_on_random_scenes() {
     for seed in 0..12 {
         let scene = random_scene(seed, 2 + (seed as usize % 5));
-        let set = enumerate(&scene, 3, &AllVisible);
+        let set = enumerate(&scene, 3, &AllVisible).unwrap();
         for solver in solvers(&scene) {
             assert_bitwise_equal(
                 &batched(&scene, &set, &solver, false),

@@ -102,11 +102,11 @@ proptest! {
         let reference = paths(&scene, order, CandidateMode::Exhaustive);
         let set = bt_paths::beamtree::candidates(&scene, TreeOptions { culling, ..TreeOptions::new(order) })
             .expect("tree builds");
-        let tree = bt_solve::trace(&scene, &set, &Solver::Image, false).paths;
+        let tree = bt_solve::trace(&scene, &set, &Solver::Image, false).unwrap().paths;
         assert_same(&tree, &reference)?;
         let kept = BeamTree::build(&scene, TreeOptions { culling, ..TreeOptions::new(order) })
             .expect("tree builds");
-        let walked = bt_solve::trace(&scene, &kept.candidates(scene.rx()), &Solver::Image, false).paths;
+        let walked = bt_solve::trace(&scene, &kept.candidates(scene.rx().unwrap()), &Solver::Image, false).unwrap().paths;
         assert_same(&walked, &reference)?;
     }
 
@@ -221,7 +221,7 @@ fn full_tree_walk_equals_the_single_receiver_trace() {
         .unwrap()
         .unwrap();
     let tree = BeamTree::build(&scene, TreeOptions::new(3)).unwrap();
-    let walked = tree.candidates(scene.rx());
+    let walked = tree.candidates(scene.rx().unwrap());
     let single = bt_paths::beamtree::candidates(&scene, TreeOptions::new(3)).unwrap();
     let a: Vec<_> = walked.iter().map(<[_]>::to_vec).collect();
     let b: Vec<_> = single.iter().map(<[_]>::to_vec).collect();
@@ -229,8 +229,11 @@ fn full_tree_walk_equals_the_single_receiver_trace() {
     for s in &a {
         assert!(b.contains(s), "{s:?}");
     }
-    let solved =
-        |set: &bt_paths::CandidateSet| bt_solve::trace(&scene, set, &Solver::Image, false).paths;
+    let solved = |set: &bt_paths::CandidateSet| {
+        bt_solve::trace(&scene, set, &Solver::Image, false)
+            .unwrap()
+            .paths
+    };
     assert_eq!(sequences(&solved(&walked)), sequences(&solved(&single)));
 }
 
@@ -282,9 +285,9 @@ fn ipc_finds_the_wall_floor_path_that_centroid_starts_missed() {
         .iter()
         .find(|p| p.surfaces.len() == 2 && scene.surface(p.surfaces[0]).name == "wall")
         .expect("wall -> floor found");
-    let mut v = vec![scene.tx()];
+    let mut v = vec![scene.tx().unwrap()];
     v.extend_from_slice(&wall_floor.points);
-    v.push(scene.rx());
+    v.push(scene.rx().unwrap());
     let length: Real = v.windows(2).map(|w| w[0].distance(w[1])).sum();
     assert!((length - 3.960).abs() < 5e-4, "{length}");
 }
@@ -334,7 +337,14 @@ fn the_build_reports_progress_level_by_level() {
 
 /// The candidates of `tree` for `scene`'s RX, traced with the image method.
 fn walked_paths(scene: &Scene, tree: &BeamTree) -> Vec<FoundPath> {
-    bt_solve::trace(scene, &tree.candidates(scene.rx()), &Solver::Image, false).paths
+    bt_solve::trace(
+        scene,
+        &tree.candidates(scene.rx().unwrap()),
+        &Solver::Image,
+        false,
+    )
+    .unwrap()
+    .paths
 }
 
 proptest! {
@@ -365,7 +375,7 @@ proptest! {
             if culling == Culling::Off && same_tol {
                 prop_assert!(!stats.full);
                 prop_assert_eq!(rebuilt.len(), fresh.len());
-                let (a, b) = (rebuilt.candidates(pair[1].rx()), fresh.candidates(pair[1].rx()));
+                let (a, b) = (rebuilt.candidates(pair[1].rx().unwrap()), fresh.candidates(pair[1].rx().unwrap()));
                 prop_assert_eq!(a.iter().collect::<Vec<_>>(), b.iter().collect::<Vec<_>>());
             }
             let reference = paths(&pair[1], order, CandidateMode::Exhaustive);
@@ -423,7 +433,7 @@ fn kept_hulls_give_the_candidates_of_a_fresh_thread() {
     let (closed, open) = (dynamic.step(0), dynamic.step(dynamic.len() - 1));
     assert_eq!(closed.surfaces().len(), open.surfaces().len());
     let moved = closed
-        .with_receiver(closed.to_world(closed.rx() + Vec3::new(0.4, -0.3, 0.2)))
+        .with_receiver(closed.to_world(closed.rx().unwrap() + Vec3::new(0.4, -0.3, 0.2)))
         .unwrap();
     let other = (0..50)
         .find_map(|seed| nasty_scene(seed, 10, 0))

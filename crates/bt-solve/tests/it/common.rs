@@ -9,8 +9,8 @@ use bt_solve::{FoundPath, IpcOptions, Solver, Tracer, UpdateOrder, trace};
 pub use bt_testkit::{box_room, random_scene, scene_from_json, wall_floor_scene};
 
 pub fn run(scene: &Scene, max_order: usize, solver: Solver) -> Vec<FoundPath> {
-    let candidates = enumerate(scene, max_order, &AllVisible);
-    trace(scene, &candidates, &solver, true).paths
+    let candidates = enumerate(scene, max_order, &AllVisible).unwrap();
+    trace(scene, &candidates, &solver, true).unwrap().paths
 }
 
 pub fn ipc(scene: &Scene, order: UpdateOrder) -> Solver {
@@ -20,9 +20,9 @@ pub fn ipc(scene: &Scene, order: UpdateOrder) -> Solver {
 /// Largest deviation from the law of reflection over the path, radians: the outgoing direction
 /// must be the mirror of the incoming one.
 pub fn reflection_law_error(scene: &Scene, path: &FoundPath) -> Real {
-    let mut v = vec![scene.tx()];
+    let mut v = vec![scene.tx().unwrap()];
     v.extend_from_slice(&path.points);
-    v.push(scene.rx());
+    v.push(scene.rx().unwrap());
     let mut worst: Real = 0.0;
     for (k, id) in path.surfaces.iter().enumerate() {
         let n = scene.surface(*id).polygon.plane().normal;
@@ -64,7 +64,7 @@ pub fn random_scene_config() -> proptest::test_runner::Config {
 
 /// Trace `scene` between its own terminals with a fresh [`Tracer`].
 pub fn trace_scene(scene: &Scene, options: &TraceOptions) -> Result<Traced, TraceError> {
-    Tracer::new(scene.clone(), *options).trace(scene.tx_world(), scene.rx_world())
+    Tracer::new(scene.clone(), *options).trace(scene.tx_world().unwrap(), scene.rx_world().unwrap())
 }
 
 /// Trace `scene`'s TX to each of `receivers` (world frame) with a fresh [`Tracer`].
@@ -73,5 +73,5 @@ pub fn trace_receivers(
     receivers: &[Vec3],
     options: &TraceOptions,
 ) -> Result<Vec<Traced>, TraceError> {
-    Tracer::new(scene.clone(), *options).trace_many(scene.tx_world(), receivers)
+    Tracer::new(scene.clone(), *options).trace_many(scene.tx_world().unwrap(), receivers)
 }

@@ -140,14 +140,14 @@ fn random_motions_match_scratch() {
             same_as_scratch(&dynamic, &image(candidates, max_order, true));
         }
         // The WVRN update is exact too.
-        let mut w = Wvrn::build(dynamic.step(0));
+        let mut w = Wvrn::build(dynamic.step(0)).unwrap();
         for k in 1..dynamic.len() {
             let moved = moved_surfaces(dynamic.step(k - 1), dynamic.step(k)).unwrap();
             assert!(!moved.is_empty());
-            let delta = w.update(dynamic.step(k), &moved);
+            let delta = w.update(dynamic.step(k), &moved).unwrap();
             assert_eq!(
                 w,
-                Wvrn::build(dynamic.step(k)),
+                Wvrn::build(dynamic.step(k)).unwrap(),
                 "seed {used} step {k}: {delta:?}"
             );
         }
@@ -157,14 +157,14 @@ fn random_motions_match_scratch() {
 #[test]
 fn wvrn_update_on_the_living_room_equals_rebuild() {
     let dynamic = living_room();
-    let mut w = Wvrn::build(dynamic.step(0));
+    let mut w = Wvrn::build(dynamic.step(0)).unwrap();
     let mut changed = 0;
     for k in 1..dynamic.len() {
         let moved = moved_surfaces(dynamic.step(k - 1), dynamic.step(k)).unwrap();
         assert_eq!(moved.len(), 6, "person's five faces and the door");
-        let delta = w.update(dynamic.step(k), &moved);
+        let delta = w.update(dynamic.step(k), &moved).unwrap();
         changed += delta.changed.len();
-        assert_eq!(w, Wvrn::build(dynamic.step(k)), "step {k}");
+        assert_eq!(w, Wvrn::build(dynamic.step(k)).unwrap(), "step {k}");
     }
     // The LOS link flips twice (blocked at step 2, free at step 4).
     assert!(changed >= 2, "{changed}");

@@ -14,19 +14,34 @@ use proptest::prelude::*;
 fn early_blocks_agree_with_the_image_method(scene: &Scene) -> Result<usize, String> {
     let set = candidates(scene, TreeOptions::new(3)).map_err(|e| e.to_string())?;
     let gs = ipc(scene, UpdateOrder::GaussSeidel);
+    let ends = scene.terminals().unwrap();
     let mut stopped = 0;
     for i in 0..set.len() {
         let seq = set.get(i);
         let mut points = vec![bt_geom::Vec3::ZERO; seq.len()];
         let mut scratch = points.clone();
-        let outcome =
-            solve_candidate_from(scene, seq, &gs, set.start(i), &mut points, &mut scratch);
+        let outcome = solve_candidate_from(
+            scene,
+            ends,
+            seq,
+            &gs,
+            set.start(i),
+            &mut points,
+            &mut scratch,
+        );
         if !matches!(outcome, CandidateOutcome::Blocked(_)) {
             continue;
         }
         stopped += 1;
-        let image =
-            solve_candidate_from(scene, seq, &Solver::Image, None, &mut points, &mut scratch);
+        let image = solve_candidate_from(
+            scene,
+            ends,
+            seq,
+            &Solver::Image,
+            None,
+            &mut points,
+            &mut scratch,
+        );
         if !matches!(
             image,
             CandidateOutcome::Solved {
@@ -63,15 +78,15 @@ proptest! {
         let agree = early_blocks_agree_with_the_image_method(&scene);
         prop_assert!(agree.is_ok(), "{:?}", agree);
         let tol = scene.length_tolerance();
-        let direct = scene.tx().distance(scene.rx());
+        let direct = scene.tx().unwrap().distance(scene.rx().unwrap());
         for p in &reference {
             prop_assert!(reflection_law_error(&scene, p) < 1e-9);
             for (pt, id) in p.points.iter().zip(&p.surfaces) {
                 prop_assert!(scene.surface(*id).polygon.contains(*pt, tol));
             }
-            let mut v = vec![scene.tx()];
+            let mut v = vec![scene.tx().unwrap()];
             v.extend_from_slice(&p.points);
-            v.push(scene.rx());
+            v.push(scene.rx().unwrap());
             let length: f64 = v.windows(2).map(|w| w[0].distance(w[1])).sum();
             prop_assert!(length >= direct - 1e-12);
         }

@@ -8,5 +8,6 @@ mod common;
 mod incremental;
 mod ipc_vs_image;
 mod newton;
+mod terminals;
 mod translation;
 mod wvrn_completeness;

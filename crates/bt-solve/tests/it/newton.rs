@@ -59,7 +59,7 @@ proptest! {
         prop_assert!(reference.iter().any(|p| p.surfaces.len() == 2), "the constructed double bounce is found");
         for order in [UpdateOrder::GaussSeidel, UpdateOrder::Jacobi] {
             let paths = run(&scene, 3, newton(&scene, order));
-            check_agreement(&reference, &paths, &format!("{order:?} tx {} rx {}", scene.tx(), scene.rx()))?;
+            check_agreement(&reference, &paths, &format!("{order:?} tx {} rx {}", scene.tx().unwrap(), scene.rx().unwrap()))?;
         }
     }
 }

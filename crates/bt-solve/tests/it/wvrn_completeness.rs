@@ -20,11 +20,11 @@ fn random_scene(seed: u64) -> Scene {
 
 /// Candidates with and without the WVRN, asserting the same valid paths.
 fn compare(scene: &Scene, order: usize) -> (usize, usize, u64) {
-    let wvrn = Wvrn::build(scene);
-    let all = enumerate(scene, order, &AllVisible);
-    let routed = enumerate(scene, order, &wvrn);
-    let a = trace(scene, &all, &Solver::Image, true);
-    let b = trace(scene, &routed, &Solver::Image, true);
+    let wvrn = Wvrn::build(scene).unwrap();
+    let all = enumerate(scene, order, &AllVisible).unwrap();
+    let routed = enumerate(scene, order, &wvrn).unwrap();
+    let a = trace(scene, &all, &Solver::Image, true).unwrap();
+    let b = trace(scene, &routed, &Solver::Image, true).unwrap();
     assert_eq!(
         a.paths,
         b.paths,
@@ -82,6 +82,6 @@ fn living_room_keeps_every_path() {
         "living room, order 3: {routed} of {all} candidates kept ({:.3})",
         routed as f64 / all as f64
     );
-    let stats = Wvrn::build(&scene).stats();
+    let stats = Wvrn::build(&scene).unwrap().stats();
     eprintln!("living room WVRN: {stats:?}");
 }

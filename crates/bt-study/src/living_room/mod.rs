@@ -23,8 +23,8 @@ use crate::{StudyConfig, StudyError, StudySolver};
 use bt_accel as fpga;
 use bt_geom::{Real, Vec3};
 use bt_hls::{CLOCK_HZ, PlanOptions, ScheduleKind};
-use bt_scene::Scene;
 use bt_scene::dynamic::DynamicScene;
+use bt_scene::{Endpoints, Scene};
 use bt_schedule::GaParams;
 use bt_solve::{SbrOptions, Validity, validate::validate};
 use serde::Serialize;
@@ -322,17 +322,20 @@ fn fixed_point_step(
             }
         })?;
     let start = Instant::now();
-    let (tx, rx) = (scene.tx(), scene.rx());
+    let ends = scene
+        .terminals()
+        .map_err(|e| crate::run::scene_error(scene, e))?;
+    let Endpoints { tx, rx } = ends;
     let mut paths = PathMap::new();
     if validate(scene, &[], tx, rx, &[]) == Validity::Valid {
-        paths.insert(Vec::new(), exact_directions(scene, &[]));
+        paths.insert(Vec::new(), exact_directions(ends, &[]));
     }
     let mut reflection_rejected = 0;
     let s = &planned.step;
     for (seq, r) in s.sequences.iter().zip(&planned.results) {
-        match fpga::host_accepts(scene, seq, r) {
+        match fpga::host_accepts(scene, ends, seq, r) {
             Ok(points) => {
-                paths.insert(seq.clone(), exact_directions(scene, &points));
+                paths.insert(seq.clone(), exact_directions(ends, &points));
             }
             Err(fpga::HostRejection::ReflectionLaw) => reflection_rejected += 1,
             Err(_) => {}
@@ -343,7 +346,7 @@ fn fixed_point_step(
         if bt_solve::image::solve(scene, seq, tx, rx, &mut points).is_ok()
             && validate(scene, seq, tx, rx, &points) == Validity::Valid
         {
-            paths.insert(seq.clone(), exact_directions(scene, &points));
+            paths.insert(seq.clone(), exact_directions(ends, &points));
         }
     }
     let time_s = planned.host_time_s + planned.budget_model_time_s + start.elapsed().as_secs_f64();

@@ -24,7 +24,7 @@ struct Counts {
 }
 
 fn check(scene: &Scene, max_order: usize) -> Counts {
-    let (input, sequences) = hls_input(scene, max_order, 16, 256);
+    let (input, sequences) = hls_input(scene, max_order, 16, 256).unwrap();
     let early = input.model().unwrap().run(input.tx, input.rx).unwrap();
     let plain_input = bt_hls::HlsInput {
         early_stop: None,
@@ -35,8 +35,9 @@ fn check(scene: &Scene, max_order: usize) -> Counts {
         .unwrap()
         .run(input.tx, input.rx)
         .unwrap();
-    let candidates = enumerate(scene, max_order, &AllVisible);
-    let reference = bt_solve::trace(scene, &candidates, &bt_solve::Solver::Image, false);
+    let candidates = enumerate(scene, max_order, &AllVisible).unwrap();
+    let reference = bt_solve::trace(scene, &candidates, &bt_solve::Solver::Image, false).unwrap();
+    let ends = scene.terminals().unwrap();
     let mut c = Counts {
         frozen: early.iter().filter(|r| r.left_bounds).count(),
         rounds_early: early.iter().map(|r| u64::from(r.rounds.max(1))).sum(),
@@ -49,7 +50,7 @@ fn check(scene: &Scene, max_order: usize) -> Counts {
             .position(|s| *s == path.surfaces)
             .expect("every valid path is a candidate");
         c.valid += 1;
-        match host_accepts(scene, &sequences[k], &early[k]) {
+        match host_accepts(scene, ends, &sequences[k], &early[k]) {
             Ok(_) => {}
             Err(_) if early[k].left_bounds => c.lost_to_early_stop += 1,
             Err(HostRejection::ReflectionLaw) => c.lost_to_reflection_check += 1,
@@ -60,7 +61,7 @@ fn check(scene: &Scene, max_order: usize) -> Counts {
         }
     }
     for (seq, r) in sequences.iter().zip(&early) {
-        if host_accepts(scene, seq, r).is_ok()
+        if host_accepts(scene, ends, seq, r).is_ok()
             && !reference.paths.iter().any(|p| p.surfaces == *seq)
         {
             c.spurious += 1;
