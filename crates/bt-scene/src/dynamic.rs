@@ -395,8 +395,29 @@ fn step_scene(
 
 /// Poses of one object at steps `0..steps`.
 fn poses(object: &ObjectDesc, steps: usize) -> Result<Vec<Pose>, FieldProblems> {
+    let mut problems = motion_problems(object);
+    let rotates = keyframe_problems(object, steps, &mut problems)
+        || object.rotate_deg.is_some_and(|r| r != 0.0);
+    if rotates && object.pivot.is_none() {
+        problems.push((
+            ".pivot".into(),
+            "missing: a rotating object needs a pivot [x, y, z]".into(),
+        ));
+    }
+    if !problems.is_empty() {
+        return Err(problems);
+    }
+    Ok(interpolate(object, steps))
+}
+
+/// Whether every coordinate is a finite number.
+fn finite3(v: &[Real; 3]) -> bool {
+    v.iter().all(|x| x.is_finite())
+}
+
+/// The problems of an object's axis, pivot and per-step motion fields.
+fn motion_problems(object: &ObjectDesc) -> FieldProblems {
     let mut problems: FieldProblems = Vec::new();
-    let finite3 = |v: &[Real; 3]| v.iter().all(|x| x.is_finite());
     let axis = object.axis.unwrap_or([0.0, 0.0, 1.0]);
     let axis_v = Vec3::from_array(axis);
     if !finite3(&axis) || axis_v.length() == 0.0 || !axis_v.length().is_normal() {
@@ -424,7 +445,13 @@ fn poses(object: &ObjectDesc, steps: usize) -> Result<Vec<Pose>, FieldProblems> 
             "give either a per-step motion (translate, rotate_deg) or keyframes, not both".into(),
         ));
     }
-    let mut rotates = object.rotate_deg.is_some_and(|r| r != 0.0);
+    problems
+}
+
+/// Appends the problems of an object's keyframes (steps in range and increasing, finite
+/// values); returns whether a keyframe rotates the object.
+fn keyframe_problems(object: &ObjectDesc, steps: usize, problems: &mut FieldProblems) -> bool {
+    let mut rotates = false;
     for (i, k) in object.keyframes.iter().enumerate() {
         if k.step as usize >= steps {
             problems.push((
@@ -452,17 +479,14 @@ fn poses(object: &ObjectDesc, steps: usize) -> Result<Vec<Pose>, FieldProblems> 
         }
         rotates |= k.angle_deg.is_some_and(|a| a != 0.0);
     }
-    if rotates && object.pivot.is_none() {
-        problems.push((
-            ".pivot".into(),
-            "missing: a rotating object needs a pivot [x, y, z]".into(),
-        ));
-    }
-    if !problems.is_empty() {
-        return Err(problems);
-    }
+    rotates
+}
+
+/// The poses of a validated object at steps `0..steps`: its per-step motion times the step,
+/// or its keyframes interpolated linearly (held before the first and after the last).
+fn interpolate(object: &ObjectDesc, steps: usize) -> Vec<Pose> {
     let pivot = Vec3::from_array(object.pivot.unwrap_or([0.0; 3]));
-    let axis = axis_v.normalize();
+    let axis = Vec3::from_array(object.axis.unwrap_or([0.0, 0.0, 1.0])).normalize();
     let pose = |offset: Vec3, angle_deg: Real| Pose {
         offset,
         angle_deg,
@@ -480,7 +504,7 @@ fn poses(object: &ObjectDesc, steps: usize) -> Result<Vec<Pose>, FieldProblems> 
             )
         })
         .collect();
-    Ok((0..steps)
+    (0..steps)
         .map(|k| {
             let t = k as Real;
             if keys.is_empty() {
@@ -502,7 +526,7 @@ fn poses(object: &ObjectDesc, steps: usize) -> Result<Vec<Pose>, FieldProblems> 
             let f = (t - a.0) / (b.0 - a.0);
             pose(a.1 + (b.1 - a.1) * f, a.2 + (b.2 - a.2) * f)
         })
-        .collect())
+        .collect()
 }
 
 /// Surfaces of each object: from `object` fields of surfaces and boxes, and from `members`.
