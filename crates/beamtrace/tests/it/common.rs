@@ -96,6 +96,13 @@ pub fn stdout(o: &Output) -> String {
     String::from_utf8_lossy(&o.stdout).into_owned()
 }
 
+/// Asserts that `o`'s standard output contains `needle`, showing the output when not.
+#[track_caller]
+pub fn assert_stdout_has(o: &Output, needle: &str) {
+    let out = stdout(o);
+    assert!(out.contains(needle), "stdout lacks {needle:?}:\n{out}");
+}
+
 /// Standard error, lossy UTF-8.
 pub fn stderr(o: &Output) -> String {
     String::from_utf8_lossy(&o.stderr).into_owned()

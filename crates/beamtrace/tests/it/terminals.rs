@@ -14,11 +14,7 @@ fn scene_check_accepts_bare_meshes_and_xml() {
     }
     // One terminal given, the other still none.
     let o = run_ok(&["scene", "check", &testdata("box-room.obj"), "--tx", "1,1,1"]);
-    assert!(
-        stdout(&o).contains("tx [1.0, 1.0, 1.0], rx none"),
-        "{}",
-        stdout(&o)
-    );
+    assert_stdout_has(&o, "tx [1.0, 1.0, 1.0], rx none");
 }
 
 #[test]
@@ -27,7 +23,7 @@ fn view_draws_bare_geometry_without_terminals() {
     let html = dir.join("v.html");
     let html_arg = html.display().to_string();
     let o = run_ok(&["view", &testdata("box-room.obj"), "-o", &html_arg]);
-    assert!(stdout(&o).contains("0 paths"), "{}", stdout(&o));
+    assert_stdout_has(&o, "0 paths");
     let page = std::fs::read_to_string(&html).unwrap();
     assert!(
         page.contains(r#""tx":null,"rx":null"#),

@@ -14,10 +14,15 @@ fn floor_bounce(start: [f64; 3], max_rounds: u32) -> FixedIpc {
     FixedIpc::new(&[floor()], &[vec![0]], &[vec![start]], 16, max_rounds).unwrap()
 }
 
+/// The one path of [`floor_bounce`] from (0.5, 0.5, 0) run between `tx` and `rx` (metres).
+fn bounce_path(max_rounds: u32, tx: [f64; 3], rx: [f64; 3]) -> bt_fixed::PathResult {
+    let ipc = floor_bounce([0.5, 0.5, 0.0], max_rounds);
+    ipc.run(tx, rx).unwrap().swap_remove(0)
+}
+
 #[test]
 fn single_floor_bounce_converges_to_the_mirror_point() {
-    let ipc = floor_bounce([0.5, 0.5, 0.0], 50);
-    let r = &ipc.run([0.0, 0.0, 1.0], [3.0, 0.0, 2.0]).unwrap()[0];
+    let r = &bounce_path(50, [0.0, 0.0, 1.0], [3.0, 0.0, 2.0]);
     assert!(
         matches!(r.outcome(), FixedOutcome::Converged { rounds: 1 | 2 }),
         "{r:?}"
@@ -29,29 +34,23 @@ fn single_floor_bounce_converges_to_the_mirror_point() {
 
 #[test]
 fn zero_budget_returns_the_initial_points() {
-    let ipc = floor_bounce([0.5, 0.5, 0.0], 0);
-    let r = &ipc.run([0.0, 0.0, 1.0], [3.0, 0.0, 2.0]).unwrap()[0];
-    assert_eq!(
-        r.outcome(),
-        FixedOutcome::NotConverged {
-            rounds: 0,
-            displacement_lsb: 0
-        }
-    );
+    let r = &bounce_path(0, [0.0, 0.0, 1.0], [3.0, 0.0, 2.0]);
+    let expected = FixedOutcome::NotConverged {
+        rounds: 0,
+        displacement_lsb: 0,
+    };
+    assert_eq!(r.outcome(), expected);
     assert_eq!(r.points_m[0], [0.5, 0.5, 0.0]);
 }
 
 #[test]
 fn terminals_on_the_plane_are_degenerate_not_a_panic() {
-    let ipc = floor_bounce([0.5, 0.5, 0.0], 50);
-    let r = &ipc.run([0.0, 0.0, 0.0], [1.0, 0.0, 0.0]).unwrap()[0];
-    assert_eq!(
-        r.outcome(),
-        FixedOutcome::Degenerate {
-            kind: DegenerateKind::ZeroDistanceSum,
-            rounds: 1
-        }
-    );
+    let r = &bounce_path(50, [0.0, 0.0, 0.0], [1.0, 0.0, 0.0]);
+    let expected = FixedOutcome::Degenerate {
+        kind: DegenerateKind::ZeroDistanceSum,
+        rounds: 1,
+    };
+    assert_eq!(r.outcome(), expected);
     assert_eq!(r.points_m[0], [0.5, 0.0, 0.0]); // midpoint
 }
 

@@ -13,6 +13,19 @@ use bt_solve::steps::trace_scratch;
 const ROOM: &str = r#""boxes": [ { "name": "room", "min": [0, 0, 0], "max": [6, 5, 3] } ],
     "surfaces": [ { "name": "shelf", "vertices": [[1, 1, 1], [2, 1, 1], [2, 2, 1], [1, 2, 1]] } ]"#;
 
+/// `options` under each candidate generator.
+fn in_every_mode(options: TraceOptions) -> [TraceOptions; 3] {
+    [
+        CandidateMode::BeamTree,
+        CandidateMode::Wvrn,
+        CandidateMode::Exhaustive,
+    ]
+    .map(|candidates| TraceOptions {
+        candidates,
+        ..options
+    })
+}
+
 fn missing(e: &TraceError) -> Vec<Terminal> {
     match e {
         TraceError::Scene(SceneError::MissingTerminal { missing, .. }) => missing.clone(),
@@ -31,15 +44,8 @@ fn a_bare_scene_traces_like_the_scene_with_its_terminals() {
     // room) gives the loaded scene's extent and tolerance.
     assert_eq!(bare.extent(), full.extent());
     let (tx, rx) = (Vec3::new(1.0, 4.0, 2.0), Vec3::new(5.0, 1.0, 1.5));
-    for mode in [
-        CandidateMode::BeamTree,
-        CandidateMode::Wvrn,
-        CandidateMode::Exhaustive,
-    ] {
-        let options = TraceOptions {
-            candidates: mode,
-            ..TraceOptions::new(2)
-        };
+    for options in in_every_mode(TraceOptions::new(2)) {
+        let mode = options.candidates;
         let a = Tracer::new(bare.clone(), options).trace(tx, rx).unwrap();
         let b = Tracer::new(full.clone(), options).trace(tx, rx).unwrap();
         assert_eq!(a.result.paths, b.result.paths, "{mode:?}");
@@ -55,16 +61,8 @@ fn a_bare_scene_traces_like_the_scene_with_its_terminals() {
 fn entry_points_name_the_missing_terminal() {
     let bare = scene_from_json(&format!("{{ {ROOM} }}"));
     let rx_only = scene_from_json(&format!(r#"{{ "rx": [5, 1, 1.5], {ROOM} }}"#));
-    let options = TraceOptions::new(2);
-    for mode in [
-        CandidateMode::BeamTree,
-        CandidateMode::Wvrn,
-        CandidateMode::Exhaustive,
-    ] {
-        let options = TraceOptions {
-            candidates: mode,
-            ..options
-        };
+    for options in in_every_mode(TraceOptions::new(2)) {
+        let mode = options.candidates;
         let e = candidates(&bare, &options).unwrap_err();
         assert_eq!(missing(&e), [Terminal::Tx, Terminal::Rx], "{mode:?}");
         let e = candidates(&rx_only, &options).unwrap_err();
