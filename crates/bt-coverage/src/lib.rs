@@ -37,20 +37,6 @@ pub enum CoverageError {
     Plot(#[from] bt_plot::PlotError),
 }
 
-/// The strongest path at a point: the lowest total loss (free space + reflections); among
-/// equal losses the better ranked one (lower order, then shorter).
-#[derive(Debug, Clone, PartialEq)]
-pub struct Strongest {
-    /// Number of reflections.
-    pub order: usize,
-    /// Total loss, dB.
-    pub loss_db: Real,
-    /// Unfolded length, metres.
-    pub length_m: Real,
-    /// Reflecting surfaces, TX side first.
-    pub surfaces: Vec<String>,
-}
-
 /// What was found at one grid point.
 #[derive(Debug, Clone, PartialEq)]
 pub enum PointStatus {
@@ -60,8 +46,10 @@ pub enum PointStatus {
         paths: usize,
         /// Delay of the shortest path, seconds (`None` without paths).
         shortest_delay_s: Option<Real>,
-        /// The strongest path (`None` without paths).
-        strongest: Option<Strongest>,
+        /// The strongest path's record (`None` without paths): the lowest total loss (free
+        /// space + reflections); among equal losses the better ranked one (lower order, then
+        /// shorter).
+        strongest: Option<Box<PathReport>>,
         /// Total received power of all paths, dBm: `trace --json`'s `received_power_dbm`
         /// (`bt_beams::received_power_dbm`, isotropic antennas, 0 dBm transmitted; `None`
         /// without paths).
@@ -140,12 +128,7 @@ pub fn summarise(paths: &[PathReport], tx_power_dbm: Real) -> PointStatus {
     let strongest = paths
         .iter()
         .min_by(|a, b| a.loss_db.total_cmp(&b.loss_db))
-        .map(|p| Strongest {
-            order: p.order,
-            loss_db: p.loss_db,
-            length_m: p.length_m,
-            surfaces: p.surfaces.clone(),
-        });
+        .map(|p| Box::new(p.clone()));
     PointStatus::Traced {
         paths: paths.len(),
         shortest_delay_s,
