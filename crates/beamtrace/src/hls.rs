@@ -160,9 +160,7 @@ fn generate(args: &HlsGenArgs) -> anyhow::Result<ExitCode> {
     } else {
         vec![crate::load::load_scene(&args.scene)?.scene]
     };
-    for scene in &scenes {
-        crate::load::terminals(scene, &args.scene)?;
-    }
+    crate::load::require_every_step(&scenes, &args.scene)?;
     // The output directory is built aside and swapped in: a user's own files in it survive.
     let mut out = OutputDir::begin(&args.output, &crate::inputs(&args.scene))
         .with_context(|| format!("creating {}", args.output.display()))?;

@@ -82,14 +82,18 @@ pub fn require_terminals(
     if missing.is_empty() {
         return Ok(());
     }
-    let names: Vec<&str> = missing.iter().map(|t| t.name()).collect();
-    let flags: Vec<String> = names.iter().map(|t| format!("--{t} X,Y,Z")).collect();
     anyhow::bail!(
-        "{}: no {} given: pass {} (meshes, XML scenes and point clouds carry no terminals)",
-        args.scene,
-        names.join(" and "),
-        flags.join(" and ")
+        "{}",
+        Terminal::missing_message(&args.scene, &missing, |t| format!("--{t} X,Y,Z"))
     )
+}
+
+/// Refuse a dynamic scene any of whose `steps` lacks a terminal ([`terminals`]).
+pub fn require_every_step(steps: &[Scene], args: &SceneArgs) -> anyhow::Result<()> {
+    for scene in steps {
+        terminals(scene, args)?;
+    }
+    Ok(())
 }
 
 /// Both terminals of `scene`, metres, world frame, or the error of [`require_terminals`].

@@ -11,9 +11,7 @@ use std::time::Instant;
 
 pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
     let dynamic = load_dynamic(&args.scene)?;
-    for scene in dynamic.scenes() {
-        crate::load::terminals(scene, &args.scene)?;
-    }
+    crate::load::require_every_step(dynamic.scenes(), &args.scene)?;
     let scene0 = dynamic.step(0);
     let options = args.solve.settings().trace_options(scene0)?;
     let incremental = !args.from_scratch;

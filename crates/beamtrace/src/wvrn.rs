@@ -103,9 +103,7 @@ fn dynamic_parts(dynamic: &DynamicScene, nodes: &[Node]) -> anyhow::Result<Dynam
 
 pub fn run(args: &WvrnArgs) -> anyhow::Result<ExitCode> {
     let dynamic = load_dynamic(&args.scene)?;
-    for scene in dynamic.scenes() {
-        crate::load::terminals(scene, &args.scene)?;
-    }
+    crate::load::require_every_step(dynamic.scenes(), &args.scene)?;
     if args.step >= dynamic.len() {
         bail!(
             "--step {} is out of range: the scene has {} step(s)",

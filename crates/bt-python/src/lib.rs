@@ -13,7 +13,7 @@ mod record;
 
 use bt_geom::Vec3;
 use bt_import::LoadOptions;
-use bt_scene::{Scene, SceneError, Terminals};
+use bt_scene::{Scene, SceneError, Terminal, Terminals};
 use bt_solve::Tracer;
 use bt_solve::pipeline::{TraceError, TraceOptions, Traced};
 use numpy::PyReadonlyArray2;
@@ -69,16 +69,14 @@ impl PyScene {
         let tx = tx.map(vec3).or(self.scene.tx_world());
         let rx = rx.map(vec3).or(self.scene.rx_world());
         let (Some(tx), Some(rx)) = (tx, rx) else {
-            let missing: Vec<&str> = [("tx", tx), ("rx", rx)]
+            let missing: Vec<Terminal> = [(Terminal::Tx, tx), (Terminal::Rx, rx)]
                 .into_iter()
-                .filter_map(|(name, p)| p.is_none().then_some(name))
+                .filter_map(|(t, p)| p.is_none().then_some(t))
                 .collect();
-            let keywords: Vec<String> = missing.iter().map(|k| format!("{k}=[x, y, z]")).collect();
-            return Err(PyValueError::new_err(format!(
-                "{}: no {} given: pass {} (meshes, XML scenes and point clouds carry no terminals)",
-                self.source,
-                missing.join(" and "),
-                keywords.join(" and ")
+            return Err(PyValueError::new_err(Terminal::missing_message(
+                &self.source,
+                &missing,
+                |t| format!("{t}=[x, y, z]"),
             )));
         };
         self.scene

@@ -62,6 +62,25 @@ impl Terminal {
     }
 }
 
+impl Terminal {
+    /// The message every front end gives for `missing` terminals of the scene named `source`,
+    /// each spelled by `spell` as the front end takes it (CLI `--tx X,Y,Z`, Python
+    /// `tx=[x, y, z]`): `SOURCE: no tx and rx given: pass A and B (...)`.
+    pub fn missing_message(
+        source: &str,
+        missing: &[Terminal],
+        spell: impl Fn(Terminal) -> String,
+    ) -> String {
+        let names: Vec<&str> = missing.iter().map(|t| t.name()).collect();
+        let spelled: Vec<String> = missing.iter().map(|&t| spell(t)).collect();
+        format!(
+            "{source}: no {} given: pass {} (meshes, XML scenes and point clouds carry no terminals)",
+            names.join(" and "),
+            spelled.join(" and ")
+        )
+    }
+}
+
 impl fmt::Display for Terminal {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())
