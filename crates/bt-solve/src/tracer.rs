@@ -130,12 +130,7 @@ impl Tracer {
         if Some(tx) != self.scene.tx_world() {
             let base = self.scene.with_terminals(tx, *first)?;
             let tree = match walk {
-                true => Some(BeamTree::build_in(
-                    &base,
-                    solver_tree_options(&options),
-                    &mut self.cache,
-                    &mut |_| {},
-                )?),
+                true => Some(tx_tree(&base, &options, &mut self.cache)?),
                 false => None,
             };
             let cache = &mut self.cache;
@@ -148,9 +143,7 @@ impl Tracer {
             ));
         }
         if walk && self.kept.is_none() {
-            let tree_options = solver_tree_options(&options);
-            let tree = BeamTree::build_in(&self.scene, tree_options, &mut self.cache, &mut |_| {})?;
-            self.kept = Some(tree);
+            self.kept = Some(tx_tree(&self.scene, &options, &mut self.cache)?);
         }
         let tree = if walk { self.kept.as_ref() } else { None };
         Ok(trace_each_receiver(
@@ -190,4 +183,19 @@ impl Tracer {
         self.next_step += 1;
         self.next_step - 1
     }
+}
+
+/// The beam tree of `scene`'s TX that a many-receiver trace walks (the solver's tree options:
+/// IPC start points when IPC solves), built with `cache`.
+fn tx_tree(
+    scene: &Scene,
+    options: &TraceOptions,
+    cache: &mut TreeCache,
+) -> Result<BeamTree, TraceError> {
+    Ok(BeamTree::build_in(
+        scene,
+        solver_tree_options(options),
+        cache,
+        &mut |_| {},
+    )?)
 }
