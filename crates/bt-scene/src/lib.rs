@@ -6,11 +6,12 @@
 //! [`SceneDescription`] or [`RawSurface`]s validated here.
 //!
 //! Module order (each uses only those before it): `name`, `material`, `problem`, `surface` →
-//! `frame`, `enclosure` → `model` → `description` → `validate` → `dynamic`.
+//! `frame`, `enclosure` → `model` → `edges` → `description` → `validate` → `dynamic`.
 #![warn(missing_docs)]
 
 mod description;
 pub mod dynamic;
+pub mod edges;
 mod enclosure;
 mod frame;
 mod material;
@@ -23,6 +24,7 @@ mod validate;
 pub use description::{
     BoxDesc, KeyframeDesc, MaterialDesc, ObjectDesc, SceneDescription, SurfaceDesc,
 };
+pub use edges::{Edge, EdgeId, Edges};
 pub use frame::RECENTRE_RATIO;
 pub use material::{DEFAULT_MATERIAL, Material, default_materials};
 pub use model::{Endpoints, GeometryKey, Scene};

@@ -31,6 +31,8 @@ pub struct Scene {
     pub(crate) materials: Arc<BTreeMap<String, Material>>,
     pub(crate) extent: Real,
     pub(crate) bvh: Arc<Bvh>,
+    /// The diffracting edges, derived on first use and shared like `surfaces`.
+    pub(crate) edges: Arc<std::sync::OnceLock<crate::edges::Edges>>,
 }
 
 /// The identity of a scene's surfaces ([`Scene::geometry_key`]). It holds no strong reference:
@@ -158,6 +160,12 @@ impl Scene {
     /// BVH over all surfaces (for occlusion tests).
     pub fn bvh(&self) -> &Bvh {
         &self.bvh
+    }
+    /// The diffracting edges of the surfaces (wedges and free edges, [`crate::edges`]),
+    /// derived on the first call and shared by the scene's copies with other terminals.
+    pub fn edges(&self) -> &crate::edges::Edges {
+        self.edges
+            .get_or_init(|| crate::edges::Edges::build(&self.surfaces))
     }
     /// Look a surface up by name.
     pub fn find(&self, name: &str) -> Option<SurfaceId> {

@@ -226,6 +226,7 @@ impl Scene {
             materials: materials.into(),
             extent,
             bvh: bvh.into(),
+            edges: Default::default(),
         }
     }
 }
