@@ -420,6 +420,16 @@ pub struct SolveArgs {
     /// Budget: stop with an error rather than generate more candidates (beam-tree nodes).
     #[arg(long, default_value_t = bt_solve::pipeline::DEFAULT_MAX_CANDIDATES)]
     pub max_candidates: u64,
+    /// Edge diffraction: paths may diffract once, on a wedge or a free edge, anywhere in the
+    /// sequence (the diffraction counts in --max-order). Same as --max-diffractions 1.
+    #[arg(long)]
+    pub diffraction: bool,
+    /// Diffractions per path (0 or 1; overrides --diffraction).
+    #[arg(long)]
+    pub max_diffractions: Option<usize>,
+    /// Edges shorter than this (metres) do not diffract.
+    #[arg(long, default_value_t = 0.0)]
+    pub min_edge_length: f64,
 }
 
 #[derive(Debug, Args, Clone)]
@@ -531,6 +541,12 @@ impl SolveArgs {
             candidates: self.candidate_mode(),
             max_candidates: self.max_candidates,
             parallel: !self.single_thread,
+            diffraction: bt_solve::pipeline::DiffractionOptions {
+                max_diffractions: self
+                    .max_diffractions
+                    .unwrap_or(usize::from(self.diffraction)),
+                min_edge_length: self.min_edge_length,
+            },
         }
     }
 }
@@ -715,6 +731,9 @@ impl SolveArgs {
             wvrn: false,
             no_wvrn: false,
             max_candidates: bt_solve::pipeline::DEFAULT_MAX_CANDIDATES,
+            diffraction: false,
+            max_diffractions: None,
+            min_edge_length: 0.0,
         }
     }
 }

@@ -27,7 +27,9 @@ use bt_scene::{Scene, SurfaceId, SurfaceKind};
 use serde::{Deserialize, Serialize};
 use std::cell::OnceCell;
 
+mod diffraction;
 mod rebuild;
+pub use diffraction::join as join_diffracted;
 pub use rebuild::RebuildStats;
 
 /// How the tree is built.
@@ -96,6 +98,17 @@ pub enum TreeError {
         max_order: usize,
         /// The budget.
         budget: u64,
+    },
+    /// More diffracted candidates than the budget.
+    #[error(
+        "candidate budget exceeded: more than {budget} diffracted candidates at order {max_order}; \
+         lower the order, raise --min-edge-length or raise the budget with --max-candidates"
+    )]
+    DiffractedBudget {
+        /// The budget.
+        budget: u64,
+        /// The order asked for.
+        max_order: usize,
     },
 }
 
@@ -1306,6 +1319,20 @@ pub fn candidates_in(
     cache: &mut TreeCache,
     progress: Progress<'_>,
 ) -> Result<CandidateSet, TreeError> {
+    candidates_and_diffracted_in(scene, options, None, cache, progress)
+}
+
+/// [`candidates_in`], with `diffraction: Some(min_edge_length)` also the candidates with one
+/// diffraction on an edge at least that long (metres) in [`CandidateSet::diffracted`]: the TX
+/// tree's levels below the last are joined with a tree grown from RX
+/// ([`join_diffracted`]).
+pub fn candidates_and_diffracted_in(
+    scene: &Scene,
+    options: TreeOptions,
+    diffraction: Option<Real>,
+    cache: &mut TreeCache,
+    progress: Progress<'_>,
+) -> Result<CandidateSet, TreeError> {
     let rx = scene.terminals()?.rx;
     let mut prep = Prepared::new(scene, options, cache)?;
     let mut tree = BeamTree::empty(&prep);
@@ -1333,6 +1360,9 @@ pub fn candidates_in(
     }
     set.stats = tree.candidate_stats(set.len() as u64);
     set.tree = Some(tree.stats.clone());
+    if let Some(min_edge_length) = diffraction {
+        set.diffracted = diffracted(scene, &tree, options, min_edge_length)?;
+    }
     Arenas {
         nodes: tree.nodes,
         verts: tree.verts,
@@ -1341,4 +1371,37 @@ pub fn candidates_in(
     .give_back(cache);
     prep.keep_in(cache);
     Ok(set)
+}
+
+/// The diffracted candidates of `scene` (edges at least `min_edge_length` m long), the TX
+/// side from `tx` (materialised to depth `options.max_order − 1`), the RX side from a tree
+/// grown from RX to the same depth.
+fn diffracted(
+    scene: &Scene,
+    tx: &BeamTree,
+    options: TreeOptions,
+    min_edge_length: Real,
+) -> Result<crate::diffraction::DiffractedSet, TreeError> {
+    if options.max_order == 0 {
+        return Ok(Default::default());
+    }
+    let ends = scene.terminals()?;
+    let swapped = scene.with_terminals(scene.to_world(ends.rx), scene.to_world(ends.tx))?;
+    let depth = TreeOptions {
+        max_order: options.max_order - 1,
+        starts: false,
+        ..options
+    };
+    let rx = BeamTree::build(&swapped, depth)?;
+    let mut usable = vec![false; scene.edges().len()];
+    for e in crate::diffraction::usable_edges(scene, min_edge_length) {
+        usable[e.index()] = true;
+    }
+    diffraction::join(
+        scene,
+        (tx, &rx),
+        options.max_order,
+        &usable,
+        options.max_nodes,
+    )
 }

@@ -12,6 +12,7 @@
 #![warn(missing_docs)]
 
 pub mod beamtree;
+pub mod diffraction;
 pub mod wvrn;
 
 use bt_geom::{Plane, Polygon, Real, Side};
@@ -70,6 +71,8 @@ pub struct CandidateSet {
     pub stats: CandidateStats,
     /// What the beam tree did, when it generated the set.
     pub tree: Option<beamtree::TreeStats>,
+    /// Candidates with one diffraction (empty unless diffraction was asked for).
+    pub diffracted: diffraction::DiffractedSet,
 }
 
 impl CandidateSet {

@@ -24,6 +24,18 @@ pub struct TraceKeywords {
     pub ipc: IpcKeywords,
     /// `sbr_step_deg`, `sbr_rays` and `sbr_planar`.
     pub sbr: SbrKeywords,
+    /// `diffraction`/`max_diffractions` and `min_edge_length`.
+    pub diffraction: DiffractionKeywords,
+}
+
+/// Diffraction's keywords (`diffraction=True` is `max_diffractions=1` in Python).
+#[derive(Debug, Clone, pyo3::FromPyObject)]
+#[pyo3(from_item_all)]
+pub struct DiffractionKeywords {
+    /// Diffractions per path (0 or 1).
+    pub max_diffractions: usize,
+    /// Edges shorter than this (metres) do not diffract.
+    pub min_edge_length: f64,
 }
 
 /// IPC's keywords (`ipc_order`, `ipc_accel` in Python).
@@ -71,6 +83,10 @@ impl TraceKeywords {
                 candidates: parse(&self.candidates)?,
                 max_candidates: self.max_candidates,
                 parallel: self.parallel,
+                diffraction: bt_solve::pipeline::DiffractionOptions {
+                    max_diffractions: self.diffraction.max_diffractions,
+                    min_edge_length: self.diffraction.min_edge_length,
+                },
             })
         };
         named().map_err(|e| e.to_string())
@@ -105,6 +121,10 @@ mod tests {
                 step_deg: None,
                 rays: None,
                 planar: false,
+            },
+            diffraction: DiffractionKeywords {
+                max_diffractions: 0,
+                min_edge_length: 0.0,
             },
         }
     }

@@ -26,6 +26,7 @@ fn options(candidates: CandidateMode) -> TraceOptions {
         candidates,
         max_candidates: u64::MAX,
         parallel: false,
+        diffraction: Default::default(),
     }
 }
 

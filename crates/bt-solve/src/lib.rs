@@ -14,6 +14,7 @@
 #![warn(missing_docs)]
 
 mod batch;
+pub mod diffraction;
 pub mod image;
 pub mod ipc;
 mod lanes;
@@ -51,17 +52,53 @@ pub enum Solver {
     Sbr(SbrOptions),
 }
 
-/// A valid specular path found by a solver.
+/// A valid path found by a solver: specular, or with one edge diffraction.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FoundPath {
-    /// Reflecting surfaces, TX side first (empty: line of sight).
+    /// Reflecting surfaces, TX side first (empty: line of sight, or a lone diffraction). With
+    /// a diffraction, one fewer than the points: [`FoundPath::interactions`] aligns them.
     pub surfaces: Vec<SurfaceId>,
     /// Interaction points, TX side first, metres (TX and RX excluded).
     pub points: Vec<Vec3>,
+    /// The diffraction, when the path has one.
+    pub diffraction: Option<Diffraction>,
     /// IPC rounds used (IPC only).
     pub iterations: Option<u32>,
     /// Mean displacement of IPC's last round, metres (IPC only).
     pub residual: Option<Real>,
+}
+
+/// A path's diffraction: which of its points, on which edge.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct Diffraction {
+    /// Index of the diffraction point in [`FoundPath::points`].
+    pub index: usize,
+    /// The edge ([`Scene::edges`]).
+    pub edge: bt_scene::EdgeId,
+}
+
+/// One interaction of a path, aligned with its points.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub enum Interaction {
+    /// A specular reflection on a surface.
+    Reflection(SurfaceId),
+    /// A diffraction on an edge.
+    Diffraction(bt_scene::EdgeId),
+}
+
+impl FoundPath {
+    /// The interactions, aligned with [`FoundPath::points`].
+    pub fn interactions(&self) -> Vec<Interaction> {
+        let mut out: Vec<Interaction> = self
+            .surfaces
+            .iter()
+            .map(|s| Interaction::Reflection(*s))
+            .collect();
+        if let Some(d) = self.diffraction {
+            out.insert(d.index, Interaction::Diffraction(d.edge));
+        }
+        out
+    }
 }
 
 /// What happened to one candidate.
@@ -120,6 +157,8 @@ impl OutcomeCounts {
                 Validity::Grazing { .. } => self.grazing += 1,
                 Validity::Blocked { .. } => self.blocked += 1,
                 Validity::NonFinite => self.degenerate += 1,
+                Validity::OffEdge { .. } => self.outside_polygon += 1,
+                Validity::InsideWedge { .. } => self.opposite_sides += 1,
             },
             CandidateOutcome::ImageDegenerate(_) | CandidateOutcome::Degenerate(_) => {
                 self.degenerate += 1
@@ -284,5 +323,8 @@ pub fn trace(
         out.paths.extend(part.paths);
         out.counts.merge(&part.counts);
     }
+    let diffracted = diffraction::trace_set(scene, ends, &candidates.diffracted, solver, parallel);
+    out.paths.extend(diffracted.paths);
+    out.counts.merge(&diffracted.counts);
     Ok(out)
 }

@@ -45,6 +45,33 @@ pub struct TraceOptions {
     /// Budget: the trace stops with [`TraceError::Budget`] rather than generate more
     /// candidates (or beam-tree nodes) than this.
     pub max_candidates: u64,
+    /// Edge diffraction (default off).
+    pub diffraction: DiffractionOptions,
+}
+
+/// Which diffracted paths a trace looks for. A diffraction counts as one interaction of the
+/// order: a path has at most `max_order` interactions, at most `max_diffractions` of them
+/// diffractions.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
+pub struct DiffractionOptions {
+    /// Diffractions per path: 0 (off, the default) or 1.
+    pub max_diffractions: usize,
+    /// Edges shorter than this (metres) do not diffract (default 0: every edge).
+    pub min_edge_length: bt_geom::Real,
+}
+
+impl DiffractionOptions {
+    /// One diffraction per path on every edge.
+    pub fn first_order() -> Self {
+        DiffractionOptions {
+            max_diffractions: 1,
+            min_edge_length: 0.0,
+        }
+    }
+    /// The minimum edge length when diffraction is on.
+    pub fn enabled(&self) -> Option<bt_geom::Real> {
+        (self.max_diffractions > 0).then_some(self.min_edge_length)
+    }
 }
 
 impl TraceOptions {
@@ -56,6 +83,7 @@ impl TraceOptions {
             candidates: CandidateMode::default(),
             parallel: true,
             max_candidates: DEFAULT_MAX_CANDIDATES,
+            diffraction: DiffractionOptions::default(),
         }
     }
 }
@@ -145,14 +173,29 @@ fn generate(
 ) -> Result<CandidateSet, TraceError> {
     scene.terminals()?;
     check_budget(scene, options)?;
-    Ok(match options.candidates {
+    let diffraction = options.diffraction.enabled();
+    let mut set = match options.candidates {
         CandidateMode::Exhaustive => bt_paths::enumerate(scene, options.max_order, &AllVisible)?,
-        CandidateMode::BeamTree => bt_paths::beamtree::candidates_in(scene, tree, cache, progress)?,
+        CandidateMode::BeamTree => {
+            return Ok(bt_paths::beamtree::candidates_and_diffracted_in(
+                scene,
+                tree,
+                diffraction,
+                cache,
+                progress,
+            )?);
+        }
         CandidateMode::Wvrn => {
             let wvrn = bt_paths::wvrn::Wvrn::build(scene)?;
             bt_paths::enumerate(scene, options.max_order, &wvrn)?
         }
-    })
+    };
+    // The enumerating modes diffract blindly (the WVRN relates surfaces, not edges).
+    if let Some(min_edge_length) = diffraction {
+        set.diffracted =
+            bt_paths::diffraction::enumerate_diffracted(scene, options.max_order, min_edge_length);
+    }
+    Ok(set)
 }
 
 /// The beam-tree options of a trace: its order, and its candidate budget as the node budget.
@@ -179,7 +222,7 @@ pub(crate) fn check_budget(scene: &Scene, options: &TraceOptions) -> Result<(), 
     if options.candidates == CandidateMode::BeamTree {
         return Ok(());
     }
-    exhaustive_budget(scene, options.max_order, options.max_candidates)
+    options_budget(scene, options)
 }
 
 /// Stop before enumerating every sequence of `scene` up to `max_order` (no surface twice in a
@@ -188,6 +231,27 @@ pub(crate) fn check_budget(scene: &Scene, options: &TraceOptions) -> Result<(), 
 pub fn exhaustive_budget(scene: &Scene, max_order: usize, budget: u64) -> Result<(), TraceError> {
     let reflectors = scene.reflectors().count() as u64;
     let estimate = exhaustive_count(reflectors, max_order);
+    check_estimate(estimate, budget, max_order)
+}
+
+/// [`exhaustive_budget`] for the candidates of `options`: the sequences, and the diffracted
+/// ones when diffraction is on ([`bt_paths::diffraction::diffracted_count`]).
+fn options_budget(scene: &Scene, options: &TraceOptions) -> Result<(), TraceError> {
+    let reflectors = scene.reflectors().count() as u64;
+    let mut estimate = exhaustive_count(reflectors, options.max_order);
+    if let Some(min_edge_length) = options.diffraction.enabled() {
+        let edges = bt_paths::diffraction::usable_edges(scene, min_edge_length).count() as u64;
+        estimate = estimate.saturating_add(bt_paths::diffraction::diffracted_count(
+            reflectors,
+            edges,
+            options.max_order,
+        ));
+    }
+    check_estimate(estimate, options.max_candidates, options.max_order)
+}
+
+/// Refuse `estimate` candidates over `budget`.
+fn check_estimate(estimate: u64, budget: u64, max_order: usize) -> Result<(), TraceError> {
     if estimate > budget {
         return Err(TraceError::Budget {
             estimate,
@@ -296,7 +360,11 @@ pub(crate) fn trace_each_receiver(
 /// Whether a many-receiver trace of `receivers` under `options` walks one beam tree of the TX
 /// (beam-tree mode, more than one receiver) instead of tracing each receiver alone.
 pub(crate) fn walks_one_tree(options: &TraceOptions, receivers: &[Vec3]) -> bool {
-    options.candidates == CandidateMode::BeamTree && receivers.len() > 1
+    // The kept tree answers specular candidates only: with diffraction each receiver grows
+    // its own tree from RX.
+    options.candidates == CandidateMode::BeamTree
+        && receivers.len() > 1
+        && options.diffraction.enabled().is_none()
 }
 
 #[cfg(test)]

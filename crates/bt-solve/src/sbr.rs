@@ -277,6 +277,7 @@ impl SbrPath {
     pub fn to_found(&self) -> FoundPath {
         FoundPath {
             surfaces: self.surfaces.clone(),
+            diffraction: None,
             points: self.points.clone(),
             iterations: None,
             residual: None,

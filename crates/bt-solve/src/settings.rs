@@ -5,7 +5,7 @@
 //! for every front end, and [`SolveSettings::trace_options`] checks the values and scales the
 //! IPC defaults to the scene, so the CLI and the Python package cannot drift apart.
 
-use crate::pipeline::{CandidateMode, DEFAULT_MAX_CANDIDATES, TraceOptions};
+use crate::pipeline::{CandidateMode, DEFAULT_MAX_CANDIDATES, DiffractionOptions, TraceOptions};
 use crate::{Acceleration, IpcOptions, SbrOptions, Solver, UpdateOrder};
 use bt_geom::Real;
 use bt_scene::Scene;
@@ -67,6 +67,8 @@ pub struct SolveSettings {
     pub max_candidates: u64,
     /// Spread the work over every core (output identical either way).
     pub parallel: bool,
+    /// Edge diffraction (`--diffraction`, `--max-diffractions`, `--min-edge-length`).
+    pub diffraction: DiffractionOptions,
 }
 
 impl Default for SolveSettings {
@@ -90,6 +92,7 @@ impl Default for SolveSettings {
             candidates: CandidateMode::default(),
             max_candidates: DEFAULT_MAX_CANDIDATES,
             parallel: true,
+            diffraction: DiffractionOptions::default(),
         }
     }
 }
@@ -117,6 +120,17 @@ pub enum SettingsError {
     /// SBR's launch pattern is invalid or over its ray budget.
     #[error("{0}")]
     Sbr(String),
+    /// More diffractions per path than the tracer does.
+    #[error(
+        "--max-diffractions must be 0 or 1 (two diffractions per path are not supported yet), got {0}"
+    )]
+    MaxDiffractions(usize),
+    /// The minimum edge length is not a finite non-negative number of metres.
+    #[error("--min-edge-length must be a finite number of metres >= 0, got {0}")]
+    MinEdgeLength(Real),
+    /// SBR finds specular paths only.
+    #[error("--diffraction needs an exact solver (--solver image or ipc): sbr does not diffract")]
+    SbrDiffraction,
 }
 
 /// A setting chosen by name from a fixed list (the CLI's value names).
@@ -171,12 +185,23 @@ impl SolveSettings {
 
     /// The pipeline options for `scene`.
     pub fn trace_options(&self, scene: &Scene) -> Result<TraceOptions, SettingsError> {
+        let d = self.diffraction;
+        if d.max_diffractions > 1 {
+            return Err(SettingsError::MaxDiffractions(d.max_diffractions));
+        }
+        if !(d.min_edge_length.is_finite() && d.min_edge_length >= 0.0) {
+            return Err(SettingsError::MinEdgeLength(d.min_edge_length));
+        }
+        if d.max_diffractions > 0 && self.solver == SolverKind::Sbr {
+            return Err(SettingsError::SbrDiffraction);
+        }
         Ok(TraceOptions {
             max_order: self.max_order,
             solver: self.solver(scene)?,
             candidates: self.candidates,
             parallel: self.parallel,
             max_candidates: self.max_candidates,
+            diffraction: d,
         })
     }
 }

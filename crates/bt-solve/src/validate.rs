@@ -35,6 +35,17 @@ pub enum Validity {
     },
     /// A point is not finite (only reachable from a solver bug; never reported as valid).
     NonFinite,
+    /// The diffraction point `index` lies off its edge (beyond an end, or at a corner).
+    OffEdge {
+        /// Point index, 0-based from TX.
+        index: usize,
+    },
+    /// A neighbour of the diffraction point `index` lies inside the wedge or on a face: no
+    /// diffraction (counted with `opposite_sides`).
+    InsideWedge {
+        /// Point index, 0-based from TX.
+        index: usize,
+    },
 }
 
 /// Validate the path TX -> points -> RX over the surface sequence `seq`.
@@ -125,6 +136,30 @@ fn first_blocking(
         .any_hit(a, b, margin, |i| {
             let id = SurfaceId(i);
             Some(id) != from && Some(id) != to && blocks(&scene.surface(id).polygon)
+        })
+        .map(SurfaceId)
+}
+
+/// The first surface crossing the segment `a -> b` other than those its ends lie on (`from`,
+/// `to`: several at a diffraction point, which lies on every surface touching its edge).
+pub fn blocker_excluding(
+    scene: &Scene,
+    a: Vec3,
+    b: Vec3,
+    from: &[SurfaceId],
+    to: &[SurfaceId],
+    tol: Real,
+) -> Option<SurfaceId> {
+    let length = a.distance(b);
+    let t_min = tol / length.max(tol);
+    let margin = 2.0 * tol;
+    scene
+        .bvh()
+        .any_hit(a, b, margin, |i| {
+            let id = SurfaceId(i);
+            !from.contains(&id)
+                && !to.contains(&id)
+                && scene.surface(id).polygon.blocks_segment(a, b, t_min, tol)
         })
         .map(SurfaceId)
 }

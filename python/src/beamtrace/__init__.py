@@ -181,8 +181,13 @@ class Scene:
         sbr_rays: Optional[int] = None,
         sbr_planar: bool = False,
         parallel: bool = True,
+        diffraction: bool = False,
+        max_diffractions: Optional[int] = None,
+        min_edge_length: float = 0.0,
     ) -> Paths:
-        """Trace every specular path from ``tx`` to ``rx`` (metres; the scene's own if None).
+        """Trace every path from ``tx`` to ``rx`` (metres; the scene's own if None): specular,
+        and with ``diffraction=True`` (or ``max_diffractions=1``) those that diffract once on
+        an edge at least ``min_edge_length`` metres long.
 
         Options are ``beamtrace trace``'s flags: ``solver`` "image" | "ipc" | "sbr",
         ``candidates`` "beam-tree" | "wvrn" | "exhaustive", ``ipc_order`` "gauss-seidel" |
@@ -213,6 +218,9 @@ class Scene:
         sbr_rays: Optional[int] = None,
         sbr_planar: bool = False,
         parallel: bool = True,
+        diffraction: bool = False,
+        max_diffractions: Optional[int] = None,
+        min_edge_length: float = 0.0,
     ) -> List[Paths]:
         """Trace one ``tx`` to every row of ``rx`` (an (m, 3) array, metres): one
         :class:`Paths` per receiver, in order, equal to calling :meth:`trace` for each.
@@ -239,6 +247,11 @@ def _options(arguments: Dict[str, Any]) -> Dict[str, Any]:
         "step_deg": arguments["sbr_step_deg"],
         "rays": arguments["sbr_rays"],
         "planar": arguments["sbr_planar"],
+    }
+    maximum = arguments["max_diffractions"]
+    options["diffraction"] = {
+        "max_diffractions": int(arguments["diffraction"]) if maximum is None else maximum,
+        "min_edge_length": float(arguments["min_edge_length"]),
     }
     return options
 

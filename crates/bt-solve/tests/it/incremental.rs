@@ -27,6 +27,7 @@ fn image(candidates: CandidateMode, max_order: usize, parallel: bool) -> TraceOp
         candidates,
         max_candidates: u64::MAX,
         parallel,
+        diffraction: Default::default(),
     }
 }
 

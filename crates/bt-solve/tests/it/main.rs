@@ -5,6 +5,7 @@
 mod analytic;
 mod beamtree;
 mod common;
+mod diffraction;
 mod incremental;
 mod ipc_vs_image;
 mod newton;

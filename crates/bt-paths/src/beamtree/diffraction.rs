@@ -1,0 +1,178 @@
+//! Diffracted candidates from two beam trees, one grown from TX and one from RX.
+//!
+//! A diffracted path `s1..sp → D on edge E → s(p+1)..sk → RX` unfolds, through the planes of
+//! its reflections, into a straight line from the TX image `I` (TX mirrored through `s1..sp`)
+//! to `D`, and another from `D` to the RX image `J` (RX mirrored through `sk..s(p+1)`). So
+//! - `D` lies in the beam of the TX tree's node `s1..sp` (the root when p = 0): the segment
+//!   `I → D` crosses every window of the prefix. The part of `E` inside that beam is the
+//!   node's *reach* on `E` (an interval, the beam being convex);
+//! - likewise `D` lies in the reach of the RX tree's node `sk..s(p+1)`;
+//! - the segments next to `D` lie in the edge's exterior, and their directions are those of
+//!   `I − D` and `J − D`: `I` and `J` lie in the exterior sector (a test independent of `D`);
+//! - `D` is the Keller point of `I` and `J` on the edge line ([`bt_scene::Edge::keller`]).
+//!
+//! The join pairs, per edge, the TX reaches with the RX reaches whose depths fit the order,
+//! and keeps a pair when the Keller point lies in both reaches and on the edge. Every test
+//! keeps the tree's margins on the inclusive side, so no path validation accepts is lost
+//! (property tests against [`crate::diffraction::enumerate_diffracted`]).
+
+use super::{BeamTree, EPS, GROW, ROOT, TreeError};
+use crate::diffraction::DiffractedSet;
+use bt_geom::bvh::box_meets_halfspaces;
+use bt_geom::{Plane, Real, Vec3};
+use bt_scene::{Edge, EdgeId, Scene, SurfaceId};
+use std::f64::consts::PI;
+
+/// Angular slack (rad) of the exterior test on images: far above round-off, far below any
+/// sector a valid path could need.
+const EXTERIOR_SLACK_RAD: Real = 1e-6;
+
+/// The part of an edge a node's beam reaches.
+#[derive(Debug, Clone, Copy)]
+struct Reach {
+    node: u32,
+    depth: usize,
+    image: Vec3,
+    /// Parameter interval along the edge (m from its start).
+    lo: Real,
+    hi: Real,
+}
+
+impl BeamTree {
+    /// The nodes of depth ≤ `max_depth` (the root included) whose image lies in an edge's
+    /// exterior and whose beam reaches the edge, per edge of `usable` (`usable[e]`).
+    fn reaches(&self, scene: &Scene, usable: &[bool], max_depth: usize) -> Vec<Vec<Reach>> {
+        let edges = scene.edges();
+        let eps = EPS * self.tol;
+        let mut out: Vec<Vec<Reach>> = vec![Vec::new(); edges.len()];
+        for (e, edge) in edges.all().iter().enumerate() {
+            if usable[e] && in_sector(edge, self.tx) {
+                out[e].push(Reach {
+                    node: ROOT,
+                    depth: 0,
+                    image: self.tx,
+                    lo: 0.0,
+                    hi: edge.length,
+                });
+            }
+        }
+        for (d, &(lo, hi)) in self.levels.iter().enumerate().take(max_depth) {
+            for i in lo..hi {
+                let node = &self.nodes[i];
+                if !node.live {
+                    continue;
+                }
+                let planes = &self.planes[node.planes.0 as usize..node.planes.1 as usize];
+                let test = |min, max| box_meets_halfspaces(min, max, planes, eps);
+                edges.bvh().visit(test, |e| {
+                    let edge = &edges.all()[e as usize];
+                    if !usable[e as usize] || !in_sector(edge, node.image) {
+                        return;
+                    }
+                    if let Some((lo, hi)) = clip(edge, planes, eps) {
+                        out[e as usize].push(Reach {
+                            node: i as u32,
+                            depth: d + 1,
+                            image: node.image,
+                            lo,
+                            hi,
+                        });
+                    }
+                });
+            }
+        }
+        out
+    }
+
+    /// The surfaces of node `i`, root side first (empty for the root).
+    fn surfaces_of(&self, mut i: u32, out: &mut Vec<SurfaceId>) {
+        out.clear();
+        while i != ROOT {
+            let node = &self.nodes[i as usize];
+            out.push(SurfaceId(node.surface));
+            i = node.parent;
+        }
+        out.reverse();
+    }
+}
+
+/// Whether `p` lies in the edge's exterior sector, up to [`EXTERIOR_SLACK_RAD`] (points on
+/// the edge line are in no sector).
+fn in_sector(edge: &Edge, p: Vec3) -> bool {
+    if edge.perpendicular(p).length_squared() == 0.0 {
+        return false;
+    }
+    let phi = edge.angle(p);
+    let wedge = edge.n * PI;
+    phi < wedge + EXTERIOR_SLACK_RAD || phi > 2.0 * PI - EXTERIOR_SLACK_RAD
+}
+
+/// The parameter interval of `edge` inside every half-space `{x : plane(x) ≥ −eps}`, or
+/// `None` when empty.
+fn clip(edge: &Edge, planes: &[Plane], eps: Real) -> Option<(Real, Real)> {
+    let (mut lo, mut hi) = (0.0, edge.length);
+    for plane in planes {
+        let at_start = plane.signed_distance_unfused(edge.start) + eps;
+        let slope = plane.normal.dot(edge.direction);
+        if slope.abs() <= Real::EPSILON {
+            if at_start < 0.0 {
+                return None;
+            }
+            continue;
+        }
+        let t = -at_start / slope;
+        if slope > 0.0 {
+            lo = Real::max(lo, t);
+        } else {
+            hi = Real::min(hi, t);
+        }
+        if lo > hi {
+            return None;
+        }
+    }
+    Some((lo, hi))
+}
+
+/// The diffracted candidates of one TX and one RX up to `max_order` interactions, from the
+/// TX tree `tx` and the RX tree `rx` (each materialised to depth `max_order − 1` at least),
+/// over the edges `usable` allows. Stops with [`TreeError::Budget`] beyond `budget`.
+pub fn join(
+    scene: &Scene,
+    (tx, rx): (&BeamTree, &BeamTree),
+    max_order: usize,
+    usable: &[bool],
+    budget: u64,
+) -> Result<DiffractedSet, TreeError> {
+    let mut set = DiffractedSet::default();
+    if max_order == 0 {
+        return Ok(set);
+    }
+    let margin = GROW * tx.tol.max(rx.tol);
+    let from_tx = tx.reaches(scene, usable, max_order - 1);
+    let from_rx = rx.reaches(scene, usable, max_order - 1);
+    let (mut before, mut after) = (Vec::new(), Vec::new());
+    for (e, edge) in scene.edges().all().iter().enumerate() {
+        for a in &from_tx[e] {
+            for b in &from_rx[e] {
+                if a.depth + b.depth + 1 > max_order || a.lo.max(b.lo) > a.hi.min(b.hi) + margin {
+                    continue;
+                }
+                let Some(t) = edge.keller(a.image, b.image) else {
+                    continue;
+                };
+                let inside = |r: &Reach| t >= r.lo - margin && t <= r.hi + margin;
+                if inside(a) && inside(b) {
+                    tx.surfaces_of(a.node, &mut before);
+                    rx.surfaces_of(b.node, &mut after);
+                    after.reverse();
+                    set.push(&before, EdgeId(e as u32), &after);
+                    if set.len() as u64 > budget {
+                        return Err(TreeError::DiffractedBudget { budget, max_order });
+                    }
+                }
+            }
+        }
+    }
+    set.canonicalise();
+    Ok(set)
+}
