@@ -9,6 +9,7 @@
 #![warn(missing_docs)]
 
 pub mod document;
+mod gain;
 pub mod sweep;
 
 pub use document::{
@@ -16,10 +17,10 @@ pub use document::{
 };
 pub use sweep::{BeamPair, BeamRanking, Sweep, sweep};
 
-use bt_channel::{Antenna, Bounce, Complex64, SurfaceResponse, Tap};
+use bt_channel::{Antenna, Complex64, SurfaceResponse, Tap};
 use bt_geom::{Real, Vec3};
 use bt_scene::{Scene, SurfaceId};
-use bt_solve::FoundPath;
+use bt_solve::{FoundPath, Interaction};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 /// Speed of light in vacuum, m/s.
@@ -92,13 +93,20 @@ impl Direction {
 pub struct PathReport {
     /// 1-based rank by (order, length, largest incidence angle).
     pub rank: usize,
-    /// Number of reflections (0 = line of sight).
+    /// Number of interactions, `len(points)` (0 = line of sight).
     pub order: usize,
-    /// Names of the reflecting surfaces, TX side first.
+    /// What happens at each point, aligned with `points`: "reflection" or "diffraction"
+    /// (empty for line of sight).
+    pub interactions: Vec<InteractionKind>,
+    /// The surface of each interaction, aligned with `points`: a reflection's surface, a
+    /// wedge's two faces `"A|B"` (face 0, then face n), a free edge's face `"A"`.
     pub surfaces: Vec<String>,
-    /// Surface ids, TX side first.
+    /// The reflecting surfaces' ids, TX side first (the diffraction left out).
     #[serde(skip)]
     pub surface_ids: Vec<SurfaceId>,
+    /// The diffraction (which point, which edge), when the path has one.
+    #[serde(skip)]
+    pub diffraction: Option<bt_solve::Diffraction>,
     /// Interaction points, TX side first, metres (TX and RX excluded).
     pub points: Vec<[Real; 3]>,
     /// Total unfolded length, metres.
@@ -109,13 +117,18 @@ pub struct PathReport {
     pub aod_deg: Direction,
     /// Angle of arrival at RX (direction the wave comes from), degrees.
     pub aoa_deg: Direction,
-    /// Angle of incidence at each reflection, from the surface normal, degrees.
-    pub incidence_deg: Vec<Real>,
+    /// Angle of incidence at each point, from the surface normal, degrees, aligned with
+    /// `points`: `null` at a diffraction.
+    pub incidence_deg: Vec<Option<Real>>,
     /// Free-space path loss over the unfolded length at the scene's frequency, dB.
     pub free_space_loss_db: Real,
     /// Sum of the materials' per-reflection losses, dB.
     pub reflection_loss_db: Real,
-    /// Total loss: free space plus reflections, dB.
+    /// The diffraction's excess loss over free space along the unfolded length, dB (0 for a
+    /// specular path): −20·log10(max(|D_s|, |D_h|)·√(L/(s·s'))), the stronger polarisation's
+    /// UTD coefficient with the edge's spreading (docs/output-format.md).
+    pub diffraction_loss_db: Real,
+    /// Total loss: free space plus reflections plus the diffraction, dB.
     pub loss_db: Real,
     /// Complex path gain [re, im] (antennas, polarisation, reflections, λ/(4π·length); no
     /// propagation phase).
@@ -180,16 +193,19 @@ impl PathReport {
         Self {
             rank: 1,
             order: 1,
+            interactions: vec![InteractionKind::Reflection],
             surfaces: vec!["floor".to_string()],
             surface_ids: vec![SurfaceId(0)],
+            diffraction: None,
             points: vec![floor.to_array()],
             length_m,
             delay_s: length_m / SPEED_OF_LIGHT,
             aod_deg: Direction::of(floor - tx),
             aoa_deg: Direction::of(floor - rx),
-            incidence_deg: vec![(tx - floor).normalize().z.acos().to_degrees()],
+            incidence_deg: vec![Some((tx - floor).normalize().z.acos().to_degrees())],
             free_space_loss_db,
             reflection_loss_db,
+            diffraction_loss_db: 0.0,
             loss_db,
             gain,
             gain_db,
@@ -228,13 +244,35 @@ fn power_db(value: Real) -> Option<Real> {
     (value > 0.0).then(|| 10.0 * value.log10())
 }
 
-/// Describe one found path (rank 0 until [`report`] ranks it); `scene` is the one it was
-/// found in, with both terminals.
-pub fn describe(
-    scene: &Scene,
-    path: &FoundPath,
-    radio: &RadioOptions,
-) -> Result<PathReport, ReportError> {
+/// What a path does at one of its points (the document's `interactions`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum InteractionKind {
+    /// A specular reflection.
+    Reflection,
+    /// An edge diffraction.
+    Diffraction,
+}
+
+/// The name of a path's interaction in the document: the surface's name for a reflection,
+/// `"A|B"` (its two faces) for a wedge's diffraction, `"A"` for a free edge's.
+fn interaction_name(scene: &Scene, interaction: Interaction) -> String {
+    match interaction {
+        Interaction::Reflection(id) => scene.surface(id).name.clone(),
+        Interaction::Diffraction(e) => {
+            let edge = scene.edges().get(e);
+            let name = |id: SurfaceId| scene.surface(id).name.as_str();
+            if edge.is_free() {
+                name(edge.face0).to_string()
+            } else {
+                format!("{}|{}", name(edge.face0), name(edge.face_n))
+            }
+        }
+    }
+}
+
+/// The path's vertices TX → points → RX (local frame) and its unfolded length (m).
+fn vertices(scene: &Scene, path: &FoundPath) -> Result<(Vec<Vec3>, Real), ReportError> {
     let bt_scene::Endpoints { tx, rx } = scene.terminals()?;
     let mut vertices = Vec::with_capacity(path.points.len() + 2);
     vertices.push(tx);
@@ -244,14 +282,26 @@ pub fn describe(
         .windows(2)
         .map(|w| w[0].distance(w[1]))
         .fold(0.0, |a, b| a + b);
-    let incidence_deg = path
-        .surfaces
-        .iter()
-        .enumerate()
-        .map(|(k, id)| {
-            let normal = scene.surface(*id).polygon.plane().normal;
-            let incoming = (vertices[k] - vertices[k + 1]).normalize();
-            incoming.dot(normal).abs().min(1.0).acos().to_degrees()
+    Ok((vertices, length_m))
+}
+
+/// Describe one found path (rank 0 until [`report`] ranks it); `scene` is the one it was
+/// found in, with both terminals.
+pub fn describe(
+    scene: &Scene,
+    path: &FoundPath,
+    radio: &RadioOptions,
+) -> Result<PathReport, ReportError> {
+    let (vertices, length_m) = vertices(scene, path)?;
+    let interactions = path.interactions();
+    let incidence_deg = (interactions.iter().enumerate())
+        .map(|(k, it)| match it {
+            Interaction::Reflection(id) => {
+                let normal = scene.surface(*id).polygon.plane().normal;
+                let incoming = (vertices[k] - vertices[k + 1]).normalize();
+                Some(incoming.dot(normal).abs().min(1.0).acos().to_degrees())
+            }
+            Interaction::Diffraction(_) => None,
         })
         .collect();
     // Fold from +0.0: an empty f64 sum is -0.0, which would print as -0.0 for line of sight.
@@ -261,33 +311,23 @@ pub fn describe(
         .map(|id| scene.material_of(*id).reflection_loss_db)
         .fold(0.0, |a, b| a + b);
     let free_space_loss_db = free_space_loss_db(length_m, scene.frequency_hz());
-    let bounces: Vec<Bounce> = path
-        .surfaces
-        .iter()
-        .map(|id| Bounce {
-            normal: scene.surface(*id).polygon.plane().normal,
-            response: surface_response(scene, *id),
-        })
-        .collect();
-    let gain = bt_channel::path_gain(
-        tx,
-        &path.points,
-        rx,
-        &bounces,
-        (&radio.tx, &radio.rx),
-        scene.frequency_hz(),
-    )?;
+    let (gain, diffraction_loss_db) = gain::path_gain(scene, path, &interactions, radio)?;
     let gain_db = power_db(gain.norm_sqr());
     let n = vertices.len();
     Ok(PathReport {
         rank: 0,
-        order: path.surfaces.len(),
-        surfaces: path
-            .surfaces
-            .iter()
-            .map(|id| scene.surface(*id).name.clone())
+        order: path.points.len(),
+        interactions: (interactions.iter())
+            .map(|it| match it {
+                Interaction::Reflection(_) => InteractionKind::Reflection,
+                Interaction::Diffraction(_) => InteractionKind::Diffraction,
+            })
+            .collect(),
+        surfaces: (interactions.iter())
+            .map(|it| interaction_name(scene, *it))
             .collect(),
         surface_ids: path.surfaces.clone(),
+        diffraction: path.diffraction,
         points: path
             .points
             .iter()
@@ -300,7 +340,8 @@ pub fn describe(
         incidence_deg,
         free_space_loss_db,
         reflection_loss_db,
-        loss_db: free_space_loss_db + reflection_loss_db,
+        diffraction_loss_db,
+        loss_db: free_space_loss_db + reflection_loss_db + diffraction_loss_db,
         gain,
         gain_db,
         power_dbm: gain_db.map(|g| g + radio.tx_power_dbm),
@@ -342,13 +383,24 @@ pub fn report(
         .iter()
         .map(|p| describe(scene, p, radio))
         .collect::<Result<Vec<_>, _>>()?;
-    let key = |r: &PathReport| r.incidence_deg.iter().copied().fold(0.0, Real::max);
+    let key = |r: &PathReport| {
+        r.incidence_deg
+            .iter()
+            .flatten()
+            .copied()
+            .fold(0.0, Real::max)
+    };
     reports.sort_by(|a, b| {
         a.order
             .cmp(&b.order)
             .then(a.length_m.total_cmp(&b.length_m))
             .then(key(a).total_cmp(&key(b)))
             .then(a.surface_ids.cmp(&b.surface_ids))
+            .then(
+                a.diffraction
+                    .map(|d| (d.index, d.edge))
+                    .cmp(&b.diffraction.map(|d| (d.index, d.edge))),
+            )
     });
     for (i, r) in reports.iter_mut().enumerate() {
         r.rank = i + 1;
@@ -388,7 +440,7 @@ mod tests {
         let back: PathReport = serde_json::from_str(&json).unwrap();
         let keys = |p: &PathReport| serde_json::to_value(p).unwrap().as_object().unwrap().len();
         assert_eq!(keys(&back), keys(&example));
-        assert!((example.incidence_deg[0] - 53.130_102_354_155_98).abs() < 1e-9);
+        assert!((example.incidence_deg[0].unwrap() - 53.130_102_354_155_98).abs() < 1e-9);
     }
 
     #[test]

@@ -157,6 +157,99 @@ pub fn path_gain(
     Ok(received * free_space(length, frequency_hz).amplitude)
 }
 
+/// One interaction of a path for [`mixed_path_gain`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Interaction {
+    /// A specular reflection.
+    Reflection(Bounce),
+    /// An edge diffraction (at most one per path).
+    Diffraction(crate::diffraction::Wedge),
+}
+
+/// The gain of a path and, for a diffracted one, the diffraction's excess loss.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PathGain {
+    /// Complex gain (no propagation phase), as [`path_gain`].
+    pub gain: Complex64,
+    /// −20·log10(max(|D_s|, |D_h|)·√((s + s')/(s·s'))), dB: the diffraction's loss over free
+    /// space along the same unfolded length (0 without a diffraction).
+    pub diffraction_loss_db: Real,
+}
+
+/// [`path_gain`] for paths that may diffract once: reflections as there, the diffraction by
+/// [`crate::diffraction`]'s UTD, and the amplitude λ/(4π)·(1/s')·√(s'/(s(s'+s))) instead of
+/// λ/(4π·length) (s', s: unfolded lengths before and after the edge, each clamped to one
+/// wavelength as in [`free_space`]).
+pub fn mixed_path_gain(
+    tx: Vec3,
+    points: &[Vec3],
+    rx: Vec3,
+    interactions: &[Interaction],
+    antennas: (&Antenna, &Antenna),
+    frequency_hz: Real,
+) -> Result<PathGain, ChannelError> {
+    let at = interactions
+        .iter()
+        .position(|i| matches!(i, Interaction::Diffraction(_)));
+    let bounces = || {
+        interactions.iter().filter_map(|i| match i {
+            Interaction::Reflection(b) => Some(*b),
+            Interaction::Diffraction(_) => None,
+        })
+    };
+    let Some(at) = at else {
+        let bounces: Vec<Bounce> = bounces().collect();
+        let gain = path_gain(tx, points, rx, &bounces, antennas, frequency_hz)?;
+        return Ok(PathGain {
+            gain,
+            diffraction_loss_db: 0.0,
+        });
+    };
+    if points.len() != interactions.len() || bounces().count() + 1 != interactions.len() {
+        return Err(ChannelError::Invalid {
+            field: "interactions",
+            message: format!(
+                "{} points, {} interactions, at most one diffraction",
+                points.len(),
+                interactions.len()
+            ),
+        });
+    }
+    let mut vertices = vec![tx];
+    vertices.extend_from_slice(points);
+    vertices.push(rx);
+    let wavelength = crate::material::SPEED_OF_LIGHT / frequency_hz;
+    let segment = |k: usize| vertices[k].distance(vertices[k + 1]);
+    let s_in = (0..=at).map(segment).sum::<Real>().max(wavelength);
+    let s_out = (at + 1..vertices.len() - 1)
+        .map(segment)
+        .sum::<Real>()
+        .max(wavelength);
+    let mut k = (vertices[1] - vertices[0]).normalize();
+    let one = Complex64::new(1.0, 0.0);
+    let mut field = scaled(antennas.0.field(k), one);
+    let mut loss_db = 0.0;
+    for (i, interaction) in interactions.iter().enumerate() {
+        match interaction {
+            Interaction::Reflection(b) => (field, k) = reflect(field, k, b, frequency_hz)?,
+            Interaction::Diffraction(w) => {
+                let k_out = (vertices[i + 2] - vertices[i + 1]).normalize();
+                let d = w.coefficients((k, k_out), (s_in, s_out), frequency_hz)?;
+                let spread = ((s_in + s_out) / (s_in * s_out)).sqrt();
+                loss_db = -20.0 * (d.soft.norm().max(d.hard.norm()) * spread).log10();
+                field = crate::diffraction::diffract(field, (k, k_out), w.edge, d);
+                k = k_out;
+            }
+        }
+    }
+    let received = dot(&field, antennas.1.field(-k));
+    let amplitude = wavelength / (4.0 * PI) / s_in * (s_in / (s_out * (s_in + s_out))).sqrt();
+    Ok(PathGain {
+        gain: received * amplitude,
+        diffraction_loss_db: loss_db,
+    })
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -9,13 +9,18 @@
 
 pub mod antenna;
 pub mod codebook;
+pub mod diffraction;
 pub mod gain;
 pub mod material;
 pub mod response;
 
 pub use antenna::{Antenna, Orientation, Pattern, Polarization};
 pub use codebook::{Array, Beam, PathDirections, beam_pairs};
-pub use gain::{Bounce, FreeSpace, SurfaceResponse, free_space, path_gain};
+pub use diffraction::{Coefficients, Wedge};
+pub use gain::{
+    Bounce, FreeSpace, Interaction, PathGain, SurfaceResponse, free_space, mixed_path_gain,
+    path_gain,
+};
 pub use material::{
     ItuBand, ItuMaterial, RadioMaterial, RadioModel, Reflection, SPEED_OF_LIGHT,
     VACUUM_PERMITTIVITY,

@@ -97,11 +97,12 @@ fn step_candidates(
     wvrn: Option<&Wvrn>,
 ) -> Result<CandidateSet, TraceError> {
     match wvrn {
-        Some(w) => {
+        // The WVRN relates surfaces, not edges: with diffraction the pipeline enumerates.
+        Some(w) if options.diffraction.enabled().is_none() => {
             crate::pipeline::check_budget(scene, options)?;
             Ok(bt_paths::enumerate(scene, options.max_order, w)?)
         }
-        None => crate::pipeline::candidates(scene, options),
+        _ => crate::pipeline::candidates(scene, options),
     }
 }
 
@@ -209,8 +210,10 @@ impl Incremental {
         let ends = scene.terminals()?;
         let options = *options;
         let prev = self.state.take();
-        if matches!(options.solver, Solver::Sbr(_)) {
-            // SBR traces the whole scene at once, not per candidate: nothing to reuse.
+        if matches!(options.solver, Solver::Sbr(_)) || options.diffraction.enabled().is_some() {
+            // SBR traces the whole scene at once, not per candidate: nothing to reuse. The
+            // reuse of the steps covers specular candidates: with diffraction every step is
+            // traced in full (its edges derived from its own surfaces).
             let result = trace_scratch(scene, step, &options)?;
             self.state = Some(State {
                 scene: scene.clone(),
