@@ -130,8 +130,14 @@ impl ser::Serializer for ValueSerializer {
     fn serialize_unit_struct(self, name: &'static str) -> Result<Value> {
         Err(unsupported(name))
     }
-    fn serialize_unit_variant(self, name: &'static str, _: u32, _: &'static str) -> Result<Value> {
-        Err(unsupported(name))
+    fn serialize_unit_variant(
+        self,
+        _: &'static str,
+        _: u32,
+        variant: &'static str,
+    ) -> Result<Value> {
+        // A unit variant is written as its (serde-renamed) name, as JSON writes it.
+        Ok(Value::Text(variant.to_string()))
     }
     fn serialize_newtype_struct<T: Serialize + ?Sized>(
         self,

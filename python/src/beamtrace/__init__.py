@@ -36,7 +36,8 @@ Point = Union[Sequence[float], npt.NDArray[np.float64]]
 
 
 class Paths:
-    """The specular paths from one TX to one RX, ranked (order, then length, then angle).
+    """The paths from one TX to one RX, specular and diffracted, ranked (order, then length,
+    then angle).
 
     Per-path columns are NumPy arrays of length ``n = len(paths)``; per-reflection values are
     lists of ``n`` arrays. Every field of ``beamtrace trace --json``'s path objects is here
@@ -48,9 +49,12 @@ class Paths:
     rank: npt.NDArray[np.int64]
     """1-based rank, shape (n,)."""
     order: npt.NDArray[np.int64]
-    """Number of reflections (0 = line of sight), shape (n,)."""
+    """Number of interactions (0 = line of sight), shape (n,)."""
+    interactions: List[List[str]]
+    """What happens at each point of each path: "reflection" or "diffraction"."""
     surfaces: List[List[str]]
-    """Names of the reflecting surfaces of each path, TX side first."""
+    """The surface of each interaction, TX side first: "A|B" (a wedge's two faces) or "A" (a
+    free edge's face) at a diffraction."""
     points: List[npt.NDArray[np.float64]]
     """Interaction points of each path, (k, 3) metres, TX side first (TX and RX excluded)."""
     length_m: npt.NDArray[np.float64]
@@ -62,11 +66,14 @@ class Paths:
     aoa_deg: npt.NDArray[np.float64]
     """Angle of arrival (azimuth, elevation), degrees, shape (n, 2)."""
     incidence_deg: List[npt.NDArray[np.float64]]
-    """Angle of incidence at each reflection from the surface normal, degrees, (k,) each."""
+    """Angle of incidence at each point from the surface normal, degrees, (k,) each; −inf at a
+    diffraction (the document's null)."""
     free_space_loss_db: npt.NDArray[np.float64]
     """Friis free-space loss over the unfolded length, dB, shape (n,)."""
     reflection_loss_db: npt.NDArray[np.float64]
     """Sum of the materials' reflection losses, dB, shape (n,)."""
+    diffraction_loss_db: npt.NDArray[np.float64]
+    """The diffraction's excess loss over free space, dB (0 for specular paths), shape (n,)."""
     loss_db: npt.NDArray[np.float64]
     """Total loss, dB, shape (n,)."""
     gain: npt.NDArray[np.complex128]
