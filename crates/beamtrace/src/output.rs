@@ -52,8 +52,12 @@ pub fn print_table(doc: &TraceDocument) {
         );
     }
     let s = &doc.stats;
+    let diffracted = match s.candidates.diffracted {
+        0 => String::new(),
+        n => format!(" + {n} diffracted"),
+    };
     println!(
-        "{} valid paths from {} candidates ({} generated, {} pruned); candidates {:.3} ms, solve {:.3} ms",
+        "{} valid paths from {} candidates{diffracted} ({} generated, {} pruned); candidates {:.3} ms, solve {:.3} ms",
         s.valid_paths,
         s.candidates.candidates,
         s.candidates.generated,

@@ -562,6 +562,7 @@ impl BeamTree {
             pruned_visibility: generated.saturating_sub(candidates),
             pruned_side: 0,
             candidates,
+            diffracted: 0,
         }
     }
 
@@ -1362,6 +1363,7 @@ pub fn candidates_and_diffracted_in(
     set.tree = Some(tree.stats.clone());
     if let Some(min_edge_length) = diffraction {
         set.diffracted = diffracted(scene, &tree, options, min_edge_length)?;
+        set.stats.diffracted = set.diffracted.len() as u64;
     }
     Arenas {
         nodes: tree.nodes,

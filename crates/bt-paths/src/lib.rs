@@ -58,6 +58,9 @@ pub struct CandidateStats {
     pub pruned_side: u64,
     /// Candidates that survived every stage.
     pub candidates: u64,
+    /// Candidates with one diffraction, on top of `candidates` (0 without diffraction).
+    #[serde(default)]
+    pub diffracted: u64,
 }
 
 /// A set of candidate surface sequences, stored flat (no allocation per candidate).

@@ -194,6 +194,7 @@ fn generate(
     if let Some(min_edge_length) = diffraction {
         set.diffracted =
             bt_paths::diffraction::enumerate_diffracted(scene, options.max_order, min_edge_length);
+        set.stats.diffracted = set.diffracted.len() as u64;
     }
     Ok(set)
 }
