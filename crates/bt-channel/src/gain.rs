@@ -5,6 +5,7 @@
 
 use crate::ChannelError;
 use crate::antenna::Antenna;
+use crate::diffraction::{Legs, Wedge, diffract, spreading};
 use crate::material::{RadioMaterial, Reflection, SPEED_OF_LIGHT};
 use bt_geom::{Real, Vec3};
 use num_complex::Complex64;
@@ -78,17 +79,17 @@ pub fn free_space(length: Real, frequency_hz: Real) -> FreeSpace {
 }
 
 /// A complex 3-vector (a field transverse to the propagation direction).
-type Field = [Complex64; 3];
+pub(crate) type Field = [Complex64; 3];
 
-fn dot(field: &Field, v: Vec3) -> Complex64 {
+pub(crate) fn dot(field: &Field, v: Vec3) -> Complex64 {
     field[0] * v.x + field[1] * v.y + field[2] * v.z
 }
 
-fn scaled(v: Vec3, c: Complex64) -> Field {
+pub(crate) fn scaled(v: Vec3, c: Complex64) -> Field {
     [c * v.x, c * v.y, c * v.z]
 }
 
-fn add(a: Field, b: Field) -> Field {
+pub(crate) fn add(a: Field, b: Field) -> Field {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
 
@@ -101,7 +102,7 @@ fn any_perpendicular(k: Vec3) -> Vec3 {
 
 /// Apply one reflection to `field` travelling along unit `k`: returns the reflected field and
 /// direction. s = normalize(k × n), p = s × k before and p' = s × k' after the bounce.
-fn reflect(
+pub(crate) fn reflect(
     field: Field,
     k: Vec3,
     bounce: &Bounce,
@@ -125,6 +126,15 @@ fn reflect(
     Ok((reflected, k_out))
 }
 
+/// One interaction of a path with the scene.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Interaction {
+    /// A specular reflection.
+    Reflection(Bounce),
+    /// An edge diffraction (UTD); at most one per path.
+    Diffraction(Wedge),
+}
+
 /// Complex gain of the path TX → `points` → RX (world frame, metres) with one [`Bounce`] per
 /// point, at `frequency_hz`: (λ/(4π·length)) · f_RX(−k_last) · Π_bounces · f_TX(k_first).
 /// Without the propagation phase e^{−j2πf·τ}. `length` is clamped as in [`free_space`].
@@ -142,19 +152,84 @@ pub fn path_gain(
             message: format!("{} points but {} bounces", points.len(), bounces.len()),
         });
     }
+    let interactions: Vec<Interaction> = bounces
+        .iter()
+        .copied()
+        .map(Interaction::Reflection)
+        .collect();
+    path_gain_mixed(tx, points, rx, &interactions, antennas, frequency_hz)
+}
+
+/// Complex gain of a path of reflections and at most one edge diffraction: TX → `points` →
+/// RX (world frame, metres), one [`Interaction`] per point, at `frequency_hz`.
+///
+/// Without a diffraction it is [`path_gain`]'s value, bit for bit. With one at point Q, the
+/// Jones chain runs through the UTD step of [`Wedge`] and the spreading is UTD's for a point
+/// source, λ/(4π)·1/√(s'·s·(s' + s)) with s' and s the unfolded lengths TX → Q and Q → RX
+/// (each clamped to at least one wavelength), instead of λ/(4π·(s' + s)). No propagation
+/// phase. Errors: lengths differ, two or more diffractions, an invalid wedge, a ray along the
+/// edge or off Keller's cone, a ray inside the wedge (`docs/channel.md`).
+pub fn path_gain_mixed(
+    tx: Vec3,
+    points: &[Vec3],
+    rx: Vec3,
+    interactions: &[Interaction],
+    antennas: (&Antenna, &Antenna),
+    frequency_hz: Real,
+) -> Result<Complex64, ChannelError> {
+    if points.len() != interactions.len() {
+        return Err(ChannelError::Invalid {
+            field: "interactions",
+            message: format!(
+                "{} points but {} interactions",
+                points.len(),
+                interactions.len()
+            ),
+        });
+    }
+    let mut diffractions = interactions
+        .iter()
+        .enumerate()
+        .filter(|(_, i)| matches!(i, Interaction::Diffraction(_)))
+        .map(|(index, _)| index);
+    let diffraction = diffractions.next();
+    if diffractions.next().is_some() {
+        return Err(ChannelError::Invalid {
+            field: "interactions",
+            message: "more than one diffraction in a path (only first-order diffraction)".into(),
+        });
+    }
     let mut vertices = Vec::with_capacity(points.len() + 2);
     vertices.push(tx);
     vertices.extend_from_slice(points);
     vertices.push(rx);
-    let length: Real = vertices.windows(2).map(|w| w[0].distance(w[1])).sum();
+    let segments: Vec<Real> = vertices.windows(2).map(|w| w[0].distance(w[1])).collect();
+    let length: Real = segments.iter().sum();
+    let legs = |index: usize| Legs {
+        incident: segments[..=index].iter().sum(),
+        diffracted: segments[index + 1..].iter().sum(),
+    };
     let mut k = (vertices[1] - vertices[0]).normalize();
     let one = Complex64::new(1.0, 0.0);
     let mut field = scaled(antennas.0.field(k), one);
-    for bounce in bounces {
-        (field, k) = reflect(field, k, bounce, frequency_hz)?;
+    for (index, interaction) in interactions.iter().enumerate() {
+        match interaction {
+            Interaction::Reflection(bounce) => {
+                (field, k) = reflect(field, k, bounce, frequency_hz)?;
+            }
+            Interaction::Diffraction(wedge) => {
+                let k_out = (vertices[index + 2] - vertices[index + 1]).normalize();
+                field = diffract(field, (k, k_out), wedge, legs(index), frequency_hz)?;
+                k = k_out;
+            }
+        }
     }
     let received = dot(&field, antennas.1.field(-k));
-    Ok(received * free_space(length, frequency_hz).amplitude)
+    let amplitude = match diffraction {
+        None => free_space(length, frequency_hz).amplitude,
+        Some(index) => spreading(legs(index), frequency_hz),
+    };
+    Ok(received * amplitude)
 }
 
 #[cfg(test)]
