@@ -26,9 +26,11 @@ pub(crate) fn path_gain(
             }),
             Interaction::Diffraction(e) => {
                 let edge = scene.edges().get(e);
+                // The exterior lies from t0 towards e × t0: face 0's free-space side.
                 bt_channel::Interaction::Diffraction(Wedge {
                     edge: edge.direction,
                     face0: edge.t0,
+                    normal0: edge.direction.cross(edge.t0),
                     n: edge.n,
                     response0: surface_response(scene, edge.face0),
                     response_n: surface_response(scene, edge.face_n),
@@ -36,7 +38,7 @@ pub(crate) fn path_gain(
             }
         })
         .collect();
-    let g = bt_channel::mixed_path_gain(
+    let g = bt_channel::path_gain_detailed(
         ends.tx,
         &path.points,
         ends.rx,

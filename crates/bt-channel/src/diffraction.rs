@@ -1,212 +1,421 @@
-//! Edge diffraction: the uniform theory of diffraction (UTD) of Kouyoumjian and Pathak, with
-//! the finite-conductivity heuristic of Luebbers for lossy wedges, as Sionna RT documents it.
-//!
-//! For a wedge of exterior angle nπ, incidence angle β0 between the ray and the edge (the same
-//! before and after, Keller's law), angles φ' (towards the source) and φ (towards the observer)
-//! measured about the edge from face 0, and wavenumber k:
-//!
-//! ```text
-//! D_{s,h} = −e^{−jπ/4} / (2n √(2πk) sin β0) · [ cot((π+(φ−φ'))/2n) F(kL a⁺(φ−φ'))
-//!                                              + cot((π−(φ−φ'))/2n) F(kL a⁻(φ−φ'))
-//!                                   + R_0^{s,h} · cot((π−(φ+φ'))/2n) F(kL a⁻(φ+φ'))
-//!                                   + R_n^{s,h} · cot((π+(φ+φ'))/2n) F(kL a⁺(φ+φ')) ]
-//! ```
-//!
-//! with a±(β) = 2cos²((2nπN± − β)/2), N± the integers nearest to (β ± π)/(2nπ), the distance
-//! parameter L = s·s'·sin²β0/(s + s') of a spherical wave (s' from the source to the edge, s
-//! from the edge to the observer, both unfolded through reflections), and the transition
-//! function F(x) = 2j√x e^{jx} ∫_{√x}^∞ e^{−jτ²} dτ. R_0 and R_n are face 0's and face n's
-//! reflection coefficients (TE for the soft coefficient D_s, TM for the hard D_h) at the
-//! grazing angles φ' and nπ − φ. A perfect conductor (R_TE = −1, R_TM = +1) gives the exact
-//! UTD coefficients. The diffracted field, in the edge-fixed bases (β̂0', φ̂') before and
-//! (β̂0, φ̂) after the edge, is E_β0 = −D_s·E_β0', E_φ = −D_h·E_φ', spread by
-//! A = √(s'/(s(s'+s))) on top of the incident field's 1/s'. Derivation, frames and the
-//! comparison with Sionna RT: `docs/channel.md` §7.
+//! First-order edge diffraction (UTD): the wedge seen by one path, the Kouyoumjian–Pathak
+//! coefficient with Luebbers' finite-conductivity heuristic as Sionna RT documents it, and the
+//! Fresnel-integral transition function. Formulas, frames and where we differ from Sionna:
+//! `docs/channel.md`, section "Diffraction (UTD)".
 
 use crate::ChannelError;
-use crate::gain::SurfaceResponse;
+use crate::gain::{Bounce, Field, SurfaceResponse, add, dot, reflect, scaled};
+use crate::material::SPEED_OF_LIGHT;
 use bt_geom::{Real, Vec3};
 use num_complex::Complex64;
 use std::f64::consts::{FRAC_PI_4, PI};
 
-/// A diffracting wedge at one path's diffraction point (local to the path: directions only).
+/// How far from 1 the length of a unit vector of a [`Wedge`] may be, and how far from 0 the
+/// cosine between two of its vectors that must be perpendicular (dimensionless; loose enough
+/// for vectors derived from f64 scene geometry, tight enough to catch a wrong argument).
+pub const WEDGE_UNIT_TOLERANCE: Real = 1e-6;
+
+/// Smallest sin β0 (β0 = angle between the incident ray and the edge) for which a diffraction
+/// is evaluated: below it the ray runs along the edge, the edge-fixed basis is undefined and
+/// the gain is an error (dimensionless, ≈ 0.2″ of arc).
+pub const MIN_SIN_BETA: Real = 1e-6;
+
+/// How far the diffracted ray may leave Keller's cone: |ŝ·ê − ŝ'·ê| above this is an error
+/// (dimensionless cosine; a diffraction point found by an iterative solver is this close).
+pub const KELLER_COS_TOLERANCE: Real = 1e-6;
+
+/// How far (rad) a ray may point into the wedge's interior and still be taken as grazing the
+/// nearer face (then snapped onto it).
+pub const FACE_ANGLE_TOLERANCE: Real = 1e-9;
+
+/// Below this argument the transition function is summed from the power series of the
+/// Fresnel integral, above it from a continued fraction (both within 4e-15 there).
+const SERIES_LIMIT: Real = 4.0;
+
+/// Depth of the continued fraction of erfcx (converged to 2e-15 for x >= 4).
+const FRACTION_DEPTH: usize = 80;
+
+/// A diffracting wedge (or a free edge: a half-plane screen, n = 2), local to one path.
 ///
-/// Frame: `edge` = ê (unit), `face0` = t̂0 (unit, ⊥ ê, in face 0, from the edge into the
-/// face), ŷ0 = ê × t̂0. Angles about the edge are measured from t̂0 towards ŷ0; the exterior
-/// (free space) is (0, nπ), face 0 at 0 and face n at nπ. A free edge (a screen) is n = 2
-/// with both faces the screen.
+/// Frame (world frame, unit vectors): t0 = `face0` lies in face 0 and points from the edge
+/// into it; `normal0` is face 0's normal on its free-space side. The exterior angle φ is
+/// measured about ê = t0 × `normal0` (so that ê × t0 = `normal0`), from t0 (φ = 0, face 0)
+/// through `normal0` (φ = π/2) to face n at φ = nπ; free space is 0 < φ < nπ. Face n lies
+/// along cos(nπ)·t0 + sin(nπ)·`normal0`. `edge` is the edge line's direction in either sense:
+/// it is checked against ê and otherwise unused, so −`edge` gives the identical gain.
+///
+/// From two face half-planes meeting at an edge, [`Wedge::from_faces`] builds it; for a
+/// half-plane (n = 2, both faces the same half-plane) fill the fields directly: `normal0`
+/// picks which side is face 0 (`response0`), the other side is face n (`response_n`).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Wedge {
-    /// Unit edge direction ê.
+    /// Unit direction of the edge line, either sense.
     pub edge: Vec3,
-    /// Unit vector t̂0: in face 0, ⊥ ê, pointing from the edge into face 0.
+    /// Unit vector t0 ⊥ edge in face 0, pointing from the edge into face 0.
     pub face0: Vec3,
-    /// Exterior angle over π, in (1, 2].
+    /// Unit normal of face 0 on its exterior (free-space) side, ⊥ edge and t0.
+    pub normal0: Vec3,
+    /// Exterior angle / π, in [1, 2] (2 = a half-plane screen, 1.5 = a right-angled corner).
     pub n: Real,
-    /// How face 0 reflects.
+    /// How face 0 reflects (Luebbers' heuristic for lossy wedges).
     pub response0: SurfaceResponse,
     /// How face n reflects.
     pub response_n: SurfaceResponse,
 }
 
-/// The soft and hard diffraction coefficients of one diffraction, √m.
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct Coefficients {
-    /// Soft (E along β̂0; pairs with R_TE).
-    pub soft: Complex64,
-    /// Hard (E along φ̂; pairs with R_TM).
-    pub hard: Complex64,
+/// The wedge's validated orthonormal frame.
+struct Frame {
+    e: Vec3,
+    t0: Vec3,
+    n0: Vec3,
+    /// A unit normal of face n (its sign does not matter for reflection).
+    nn: Vec3,
+    n: Real,
+}
+
+fn invalid(message: String) -> ChannelError {
+    ChannelError::Invalid {
+        field: "wedge",
+        message,
+    }
+}
+
+fn is_unit(v: Vec3) -> bool {
+    v.is_finite() && (v.length() - 1.0).abs() <= WEDGE_UNIT_TOLERANCE
 }
 
 impl Wedge {
-    /// The angle (rad, [0, 2π)) about the edge of direction `d` (from the edge outwards).
-    fn angle(&self, d: Vec3) -> Real {
-        let y0 = self.edge.cross(self.face0);
-        let phi = d.dot(y0).atan2(d.dot(self.face0));
-        if phi < 0.0 { phi + 2.0 * PI } else { phi }
+    /// The wedge between two faces meeting at an edge: `face0` and `face_n` are unit vectors
+    /// ⊥ edge, each in its face and pointing from the edge into it (world frame). The interior
+    /// angle α = acos(face0·face_n) gives n = 2 − α/π, and `normal0` is the unit part of
+    /// −face_n ⊥ face0 (the exterior side of face 0). Errors when the faces are (anti)parallel
+    /// (α ≈ 0: a half-plane, build the struct directly; α ≈ π: a flat surface, no edge).
+    pub fn from_faces(
+        face0: Vec3,
+        face_n: Vec3,
+        response0: SurfaceResponse,
+        response_n: SurfaceResponse,
+    ) -> Result<Wedge, ChannelError> {
+        if !(is_unit(face0) && is_unit(face_n)) {
+            return Err(invalid(format!(
+                "face directions must be unit vectors, got {face0} and {face_n}"
+            )));
+        }
+        let cos = face0.dot(face_n).clamp(-1.0, 1.0);
+        let across = face_n - cos * face0;
+        if across.length() <= WEDGE_UNIT_TOLERANCE {
+            return Err(invalid(format!(
+                "faces {face0} and {face_n} are (anti)parallel: no wedge angle (a half-plane needs normal0)"
+            )));
+        }
+        let normal0 = -across.normalize();
+        let wedge = Wedge {
+            edge: face0.cross(normal0),
+            face0,
+            normal0,
+            n: 2.0 - cos.acos() / PI,
+            response0,
+            response_n,
+        };
+        wedge.frame()?;
+        Ok(wedge)
     }
 
-    /// The UTD coefficients for a ray arriving along unit `k_in` and leaving along unit
-    /// `k_out`, with unfolded lengths `s_in` (source to edge) and `s_out` (edge to observer),
-    /// metres, at `frequency_hz`.
-    pub fn coefficients(
-        &self,
-        (k_in, k_out): (Vec3, Vec3),
-        (s_in, s_out): (Real, Real),
-        frequency_hz: Real,
-    ) -> Result<Coefficients, ChannelError> {
-        let sin_beta = k_in.cross(self.edge).length();
-        if sin_beta <= 1e-12 {
-            return Err(ChannelError::Invalid {
-                field: "diffraction",
-                message: "the ray runs along the edge (sin β0 = 0)".into(),
-            });
+    /// Check the fields (units, orthogonality, n in [1, 2]) and build the frame.
+    fn frame(&self) -> Result<Frame, ChannelError> {
+        let (t0, n0) = (self.face0, self.normal0);
+        if !(is_unit(self.edge) && is_unit(t0) && is_unit(n0)) {
+            return Err(invalid(format!(
+                "edge, face0 and normal0 must be unit vectors, got {}, {t0} and {n0}",
+                self.edge
+            )));
         }
-        let k = 2.0 * PI * frequency_hz / crate::SPEED_OF_LIGHT;
-        let phi_in = self.angle(-k_in);
-        let phi_out = self.angle(k_out);
-        let l = s_in * s_out * sin_beta * sin_beta / (s_in + s_out);
-        let n = self.n;
-        let term = |sign: Real, beta: Real| cot_f(n, sign, beta, k * l);
-        let (d1, d2) = (term(1.0, phi_out - phi_in), term(-1.0, phi_out - phi_in));
-        let (d3, d4) = (term(-1.0, phi_out + phi_in), term(1.0, phi_out + phi_in));
-        let cos0 = phi_in.sin().abs().min(1.0);
-        let cos_n = (n * PI - phi_out).sin().abs().min(1.0);
-        let r0 = self.response0.reflection(frequency_hz, cos0)?;
-        let rn = self.response_n.reflection(frequency_hz, cos_n)?;
-        let scale =
-            -Complex64::from_polar(1.0, -FRAC_PI_4) / (2.0 * n * (2.0 * PI * k).sqrt() * sin_beta);
-        Ok(Coefficients {
-            soft: scale * (d1 + d2 + r0.te * d3 + rn.te * d4),
-            hard: scale * (d1 + d2 + r0.tm * d3 + rn.tm * d4),
+        if t0.dot(n0).abs() > WEDGE_UNIT_TOLERANCE || self.edge.dot(t0).abs() > WEDGE_UNIT_TOLERANCE
+        {
+            return Err(invalid(format!(
+                "face0 {t0} must be perpendicular to the edge {} and to normal0 {n0}",
+                self.edge
+            )));
+        }
+        let e = t0.cross(n0);
+        if self.edge.cross(e).length() > WEDGE_UNIT_TOLERANCE {
+            return Err(invalid(format!(
+                "the edge {} is not along face0 × normal0 = {e}",
+                self.edge
+            )));
+        }
+        if !(1.0..=2.0).contains(&self.n) {
+            return Err(invalid(format!(
+                "n (exterior angle / π) must lie in [1, 2], got {}",
+                self.n
+            )));
+        }
+        let (sin, cos) = (self.n * PI).sin_cos();
+        let tn = cos * t0 + sin * n0;
+        Ok(Frame {
+            e,
+            t0,
+            n0,
+            nn: e.cross(tn),
+            n: self.n,
         })
     }
 }
 
-/// `cot((π + sign·β)/2n) · F(kL·a^sign(β))`, with its finite limit at a shadow or reflection
-/// boundary (where the cotangent diverges and F vanishes).
-fn cot_f(n: Real, sign: Real, beta: Real, kl: Real) -> Complex64 {
-    let big_n = ((beta + sign * PI) / (2.0 * n * PI)).round();
-    let eps = PI + sign * beta - 2.0 * PI * n * big_n;
-    let arg = (PI + sign * beta) / (2.0 * n);
-    if arg.sin().abs() < 1e-9 {
-        // K-P eq. (29): cot(·)F(kLa) → n[√(2πkL) sgn ε − 2kLε e^{jπ/4}] e^{jπ/4}.
-        let j4 = Complex64::from_polar(1.0, FRAC_PI_4);
-        let sgn = if eps >= 0.0 { 1.0 } else { -1.0 };
-        return n * (Complex64::new((2.0 * PI * kl).sqrt() * sgn, 0.0) - 2.0 * kl * eps * j4) * j4;
-    }
-    let a = 2.0 * ((2.0 * n * PI * big_n - beta) / 2.0).cos().powi(2);
-    transition(kl * a) * (arg.cos() / arg.sin())
+/// Fresnel integrals C(ν) = ∫₀^ν cos(πt²/2) dt and S(ν) = ∫₀^ν sin(πt²/2) dt (odd in ν),
+/// to about 1e-14 absolute.
+pub fn fresnel_integrals(nu: Real) -> (Real, Real) {
+    let a = nu.abs();
+    let x = PI * a * a / 2.0;
+    let (c, s) = if x < SERIES_LIMIT {
+        let phi = fresnel_series(a);
+        (phi.re, phi.im)
+    } else {
+        // Auxiliary functions: G = √(2π)·(f + j·g); C = ½ + f sin x − g cos x,
+        // S = ½ − f cos x − g sin x.
+        let fg = transition_over_root(x) / (2.0 * PI).sqrt();
+        let (sin, cos) = x.sin_cos();
+        (
+            0.5 + fg.re * sin - fg.im * cos,
+            0.5 - fg.re * cos - fg.im * sin,
+        )
+    };
+    if nu < 0.0 { (-c, -s) } else { (c, s) }
 }
 
-/// The UTD transition function F(x) = 2j√x e^{jx} ∫_{√x}^∞ e^{−jτ²} dτ for x ≥ 0 (F(0) = 0,
-/// F → 1 as x → ∞).
+/// C(ν) + j·S(ν) = Σ (jπ/2)^m ν^(2m+1) / (m!·(2m+1)) for ν >= 0 with πν²/2 below
+/// [`SERIES_LIMIT`] (terms at most e⁴ ≈ 55 times the sum: 1e-14 relative).
+fn fresnel_series(nu: Real) -> Complex64 {
+    let step = Complex64::new(0.0, PI / 2.0 * nu * nu);
+    let mut power = Complex64::new(nu, 0.0);
+    let mut sum = power;
+    for m in 1..200 {
+        power = power * step / m as Real;
+        let term = power / (2 * m + 1) as Real;
+        sum += term;
+        if term.norm() <= 1e-17 * sum.norm() {
+            break;
+        }
+    }
+    sum
+}
+
+/// G(x) = F(x)/√x for x >= 0, finite at 0 (G(0) = √π·e^{jπ/4}) and ~ 1/√x for large x.
+/// G(x) = √π·e^{jπ/4}·erfcx(√x·e^{jπ/4}): the power series of C + jS below
+/// [`SERIES_LIMIT`], the Laplace continued fraction of erfcx above.
+fn transition_over_root(x: Real) -> Complex64 {
+    let x = x.max(0.0);
+    let rotation = Complex64::from_polar(1.0, FRAC_PI_4);
+    if x < SERIES_LIMIT {
+        // G = j·√(2π)·e^{jx}·[(1 − j)/2 − conj(C + jS)] at ν = √(2x/π).
+        let phi = fresnel_series((2.0 * x / PI).sqrt());
+        let bracket = Complex64::new(0.5, -0.5) - phi.conj();
+        Complex64::new(0.0, (2.0 * PI).sqrt()) * Complex64::from_polar(1.0, x) * bracket
+    } else {
+        // erfcx(z) = 1/(√π·(z + (1/2)/(z + (2/2)/(z + (3/2)/(z + …))))).
+        let z = x.sqrt() * rotation;
+        let mut t = z;
+        for m in (1..=FRACTION_DEPTH).rev() {
+            t = z + (m as Real / 2.0) / t;
+        }
+        rotation / t
+    }
+}
+
+/// The UTD transition function F(x) = 2j·√x·e^{jx}·∫_{√x}^∞ e^{−jτ²} dτ (Kouyoumjian–Pathak),
+/// x >= 0 (negative x is taken as 0): F(0) = 0, F(x) ≈ √(πx)·e^{jπ/4} for small x, F → 1
+/// for large x.
 pub fn transition(x: Real) -> Complex64 {
-    if x <= 0.0 {
-        return Complex64::new(0.0, 0.0);
-    }
-    let sqrt_x = x.sqrt();
-    // ∫_{√x}^∞ e^{−jτ²} dτ = √(π/2)·[(½ − C(u)) − j(½ − S(u))], u = √(2x/π).
-    let (c, s) = fresnel((2.0 * x / PI).sqrt());
-    let tail = (PI / 2.0).sqrt() * Complex64::new(0.5 - c, -(0.5 - s));
-    Complex64::new(0.0, 2.0 * sqrt_x) * Complex64::from_polar(1.0, x) * tail
+    let x = x.max(0.0);
+    transition_over_root(x) * x.sqrt()
 }
 
-/// The Fresnel integrals C(u) = ∫₀ᵘ cos(πt²/2) dt and S(u) = ∫₀ᵘ sin(πt²/2) dt for u ≥ 0, to
-/// about 1e-12: the power series below u = 1.5, a continued fraction (modified Lentz) above.
-pub fn fresnel(u: Real) -> (Real, Real) {
-    let x = u.abs();
-    if x < 1.5 {
-        return fresnel_series(x);
-    }
-    // erfc-like continued fraction for the auxiliary functions (Numerical Recipes §6.8).
-    let pix2 = PI * x * x;
-    let b0 = Complex64::new(1.0, -pix2);
-    let tiny = 1e-300;
-    let mut b = b0;
-    let mut c = Complex64::new(1.0 / tiny, 0.0);
-    let mut d = Complex64::new(1.0, 0.0) / b;
-    let mut h = d;
-    let mut n: i32 = -1;
-    for _ in 2..200 {
-        n += 2;
-        let a = -Real::from(n * (n + 1));
-        b += Complex64::new(4.0, 0.0);
-        d = Complex64::new(1.0, 0.0) / (a * d + b);
-        c = b + a / c;
-        let del = c * d;
-        h *= del;
-        if (del.re - 1.0).abs() + del.im.abs() < 1e-15 {
-            break;
-        }
-    }
-    h *= Complex64::new(x, -x);
-    let cs = Complex64::new(0.5, 0.5)
-        * (Complex64::new(1.0, 0.0) - Complex64::from_polar(1.0, 0.5 * pix2) * h);
-    (cs.re, cs.im)
+/// cot(w/(2n))·F(kL·a(w)) of one UTD term, w = π ± (φ ∓ φ'), with a(w) = 2cos²((2nπN − β)/2)
+/// written as 2 sin²(u/2), u = w − 2nπ·round(w/(2nπ)) ∈ [−nπ, nπ]. Its only pole is u = 0
+/// (a shadow or reflection boundary), where cot → ∞ and F → 0: the product is evaluated as
+/// cos(u/2n)·[√(2kL)·|sin(u/2)|/sin(u/2n)]·G(x), exact for every u ≠ 0 and, at u = 0, the
+/// limit from u > 0, which is the lit side for all four terms.
+fn cot_transition(w: Real, n: Real, kl: Real) -> Complex64 {
+    let period = 2.0 * n * PI;
+    let u = w - period * (w / period).round();
+    let half = (u / 2.0).sin();
+    let x = 2.0 * kl * half * half;
+    let root = (2.0 * kl).sqrt();
+    let ratio = if u == 0.0 {
+        n * root
+    } else {
+        root * half.abs() / (u / (2.0 * n)).sin()
+    };
+    (u / (2.0 * n)).cos() * ratio * transition_over_root(x)
 }
 
-/// Power series of the Fresnel integrals, for small `x`.
-fn fresnel_series(x: Real) -> (Real, Real) {
-    let t = PI * x * x / 2.0;
-    let (mut c, mut s) = (0.0, 0.0);
-    // C = Σ (−1)^m t^{2m} x / ((2m)! (4m+1)), S = Σ (−1)^m t^{2m+1} x / ((2m+1)! (4m+3)).
-    let mut term = x; // t^k x / k!
-    for k in 0..60 {
-        let kk = k as Real;
-        let sign = if (k / 2) % 2 == 0 { 1.0 } else { -1.0 };
-        if k % 2 == 0 {
-            c += sign * term / (2.0 * kk + 1.0);
-        } else {
-            s += sign * term / (2.0 * kk + 1.0);
-        }
-        term *= t / (kk + 1.0);
-        if term.abs() < 1e-17 {
-            break;
-        }
+/// φ of direction `d` about the edge (rad, in [0, nπ]), snapped onto a face within
+/// [`FACE_ANGLE_TOLERANCE`]; an error inside the wedge.
+fn exterior_angle(frame: &Frame, d: Vec3, what: &str) -> Result<Real, ChannelError> {
+    let mut phi = d.dot(frame.n0).atan2(d.dot(frame.t0));
+    if phi < 0.0 {
+        phi += 2.0 * PI;
     }
-    (c, s)
+    let limit = frame.n * PI;
+    if phi <= limit {
+        return Ok(phi);
+    }
+    if 2.0 * PI - phi <= FACE_ANGLE_TOLERANCE {
+        Ok(0.0)
+    } else if phi - limit <= FACE_ANGLE_TOLERANCE {
+        Ok(limit)
+    } else {
+        Err(invalid(format!(
+            "the {what} lies inside the wedge (φ = {phi} rad > nπ = {limit} rad)"
+        )))
+    }
 }
 
-/// Apply one diffraction to `field` (a complex 3-vector ⊥ `k_in`) arriving along unit `k_in`
-/// and leaving along unit `k_out`: E_β0 = −D_s·E_β0', E_φ = −D_h·E_φ' in the edge-fixed bases.
-pub(crate) fn diffract(
-    field: [Complex64; 3],
+/// Edge-fixed basis (φ̂', β̂0') of a ray arriving along `k`: φ̂' = k × ê/|k × ê|, β̂0' = φ̂' × k.
+fn incident_basis(k: Vec3, e: Vec3) -> (Vec3, Vec3) {
+    let phi = k.cross(e).normalize();
+    (phi, phi.cross(k))
+}
+
+/// Edge-fixed basis (φ̂, β̂0) of a ray leaving along `k`: φ̂ = ê × k/|ê × k|, β̂0 = φ̂ × k.
+fn outgoing_basis(k: Vec3, e: Vec3) -> (Vec3, Vec3) {
+    let phi = e.cross(k).normalize();
+    (phi, phi.cross(k))
+}
+
+type Matrix = [[Complex64; 2]; 2];
+
+/// Face ν's reflection as a 2×2 matrix from (φ̂', β̂0') of the incident ray to (φ̂, β̂0) of
+/// that face's specular direction, with the face's coefficients at the true incidence angle
+/// cos θ = |ŝ'·n̂ν| (Sionna RT 2.2's choice). The same numbers are then applied to the
+/// diffracted ray's basis (Sionna's "Hashimoto" basis). A perfect conductor gives exactly
+/// diag(−1, +1), i.e. Kouyoumjian–Pathak's soft/hard signs.
+fn face_matrix(
+    normal: Vec3,
+    response: SurfaceResponse,
+    k_in: Vec3,
+    e: Vec3,
+    frequency_hz: Real,
+) -> Result<Matrix, ChannelError> {
+    let bounce = Bounce { normal, response };
+    let one = Complex64::new(1.0, 0.0);
+    let (phi_in, beta_in) = incident_basis(k_in, e);
+    let mut m = [[Complex64::new(0.0, 0.0); 2]; 2];
+    for (column, v) in [phi_in, beta_in].into_iter().enumerate() {
+        let (out, k_out) = reflect(scaled(v, one), k_in, &bounce, frequency_hz)?;
+        let (phi_out, beta_out) = outgoing_basis(k_out, e);
+        m[0][column] = dot(&out, phi_out);
+        m[1][column] = dot(&out, beta_out);
+    }
+    Ok(m)
+}
+
+/// Lengths of the path on each side of the diffraction point, metres (unfolded through the
+/// reflections on that side).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Legs {
+    /// s': source to diffraction point.
+    pub incident: Real,
+    /// s: diffraction point to observer.
+    pub diffracted: Real,
+}
+
+/// UTD amplitude factor of a point source diffracted once: λ/(4π)·1/√(s'·s·(s' + s)) =
+/// λ/(4π)·(1/s')·√(s'/(s·(s' + s))), s' and s each clamped to at least one wavelength (the
+/// far-field floor of [`crate::free_space`]). Units: 1/m³ᐟ²·m, multiplied by D (√m).
+pub(crate) fn spreading(legs: Legs, frequency_hz: Real) -> Real {
+    let wavelength = SPEED_OF_LIGHT / frequency_hz;
+    let (s_i, s_d) = (
+        legs.incident.max(wavelength),
+        legs.diffracted.max(wavelength),
+    );
+    wavelength / (4.0 * PI) / (s_i * s_d * (s_i + s_d)).sqrt()
+}
+
+/// The diffraction's Jones matrix J = −[(D1 + D2)·I − D3·R_n − D4·R_0] from the incident
+/// ray's edge-fixed basis (φ̂', β̂0') to the diffracted ray's (φ̂, β̂0), √m (Sionna RT's
+/// documented form), for a ray arriving along unit `k_in` and leaving along unit `k_out`.
+pub(crate) fn jones(
     (k_in, k_out): (Vec3, Vec3),
-    edge: Vec3,
-    d: Coefficients,
-) -> [Complex64; 3] {
-    let phi_in = -(edge.cross(k_in)).normalize();
-    let beta_in = phi_in.cross(k_in);
-    let phi_out = edge.cross(k_out).normalize();
-    let beta_out = phi_out.cross(k_out);
-    let dot = |v: Vec3| field[0] * v.x + field[1] * v.y + field[2] * v.z;
-    let (e_beta, e_phi) = (-d.soft * dot(beta_in), -d.hard * dot(phi_in));
-    [
-        e_beta * beta_out.x + e_phi * phi_out.x,
-        e_beta * beta_out.y + e_phi * phi_out.y,
-        e_beta * beta_out.z + e_phi * phi_out.z,
+    wedge: &Wedge,
+    legs: Legs,
+    frequency_hz: Real,
+) -> Result<Matrix, ChannelError> {
+    let frame = wedge.frame()?;
+    let e = frame.e;
+    let sin_beta = k_in.cross(e).length();
+    if !(sin_beta.is_finite() && sin_beta >= MIN_SIN_BETA) {
+        return Err(invalid(format!(
+            "the incident ray runs along the edge (sin β0 = {sin_beta:e})"
+        )));
+    }
+    let keller = (k_out.dot(e) - k_in.dot(e)).abs();
+    if !(keller.is_finite() && keller <= KELLER_COS_TOLERANCE) {
+        return Err(invalid(format!(
+            "the diffracted ray leaves Keller's cone (|ŝ·ê − ŝ'·ê| = {keller:e})"
+        )));
+    }
+    let phi_i = exterior_angle(&frame, -k_in, "source side of the incident ray")?;
+    let phi = exterior_angle(&frame, k_out, "diffracted ray")?;
+    let wavelength = SPEED_OF_LIGHT / frequency_hz;
+    let k = 2.0 * PI / wavelength;
+    let (s_i, s_d) = (
+        legs.incident.max(wavelength),
+        legs.diffracted.max(wavelength),
+    );
+    let kl = k * s_i * s_d / (s_i + s_d) * sin_beta * sin_beta;
+    let n = frame.n;
+    let factor =
+        -Complex64::from_polar(1.0, -FRAC_PI_4) / (2.0 * n * (2.0 * PI * k).sqrt() * sin_beta);
+    let d = [
+        PI + (phi - phi_i),
+        PI - (phi - phi_i),
+        PI + (phi + phi_i),
+        PI - (phi + phi_i),
     ]
+    .map(|w| factor * cot_transition(w, n, kl));
+    let r0 = face_matrix(frame.n0, wedge.response0, k_in, e, frequency_hz)?;
+    let rn = face_matrix(frame.nn, wedge.response_n, k_in, e, frequency_hz)?;
+    let incident = d[0] + d[1];
+    let mut j = [[Complex64::new(0.0, 0.0); 2]; 2];
+    for (row, line) in j.iter_mut().enumerate() {
+        for (column, value) in line.iter_mut().enumerate() {
+            let identity = if row == column { incident } else { 0.0.into() };
+            *value = -(identity - d[2] * rn[row][column] - d[3] * r0[row][column]);
+        }
+    }
+    Ok(j)
+}
+
+/// Diffract `field` (travelling along unit `k_in`) at `wedge` into unit direction `k_out` by
+/// its [`jones`] matrix. Returns the diffracted field without the spreading factor (applied by
+/// the caller) and the matrix.
+pub(crate) fn diffract(
+    field: Field,
+    (k_in, k_out): (Vec3, Vec3),
+    wedge: &Wedge,
+    legs: Legs,
+    frequency_hz: Real,
+) -> Result<(Field, Matrix), ChannelError> {
+    let j = jones((k_in, k_out), wedge, legs, frequency_hz)?;
+    let e = wedge.frame()?.e;
+    let (phi_in, beta_in) = incident_basis(k_in, e);
+    let (phi_out, beta_out) = outgoing_basis(k_out, e);
+    let (ep, eb) = (dot(&field, phi_in), dot(&field, beta_in));
+    let out = add(
+        scaled(phi_out, j[0][0] * ep + j[0][1] * eb),
+        scaled(beta_out, j[1][0] * ep + j[1][1] * eb),
+    );
+    Ok((out, j))
+}
+
+/// The largest singular value of a 2×2 complex matrix: the gain of its strongest
+/// polarisation.
+pub(crate) fn largest_singular_value(m: &Matrix) -> Real {
+    // Eigenvalues of MᴴM: (t ± √(t² − 4·det)) / 2, t = ‖M‖²_F, det = |det M|².
+    let t: Real = m.iter().flatten().map(|c| c.norm_sqr()).sum();
+    let det = (m[0][0] * m[1][1] - m[0][1] * m[1][0]).norm_sqr();
+    (0.5 * (t + (t * t - 4.0 * det).max(0.0).sqrt())).sqrt()
 }
 
 #[cfg(test)]

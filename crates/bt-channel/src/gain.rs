@@ -5,6 +5,7 @@
 
 use crate::ChannelError;
 use crate::antenna::Antenna;
+use crate::diffraction::{Legs, Wedge, diffract, largest_singular_value, spreading};
 use crate::material::{RadioMaterial, Reflection, SPEED_OF_LIGHT};
 use bt_geom::{Real, Vec3};
 use num_complex::Complex64;
@@ -78,17 +79,17 @@ pub fn free_space(length: Real, frequency_hz: Real) -> FreeSpace {
 }
 
 /// A complex 3-vector (a field transverse to the propagation direction).
-type Field = [Complex64; 3];
+pub(crate) type Field = [Complex64; 3];
 
-fn dot(field: &Field, v: Vec3) -> Complex64 {
+pub(crate) fn dot(field: &Field, v: Vec3) -> Complex64 {
     field[0] * v.x + field[1] * v.y + field[2] * v.z
 }
 
-fn scaled(v: Vec3, c: Complex64) -> Field {
+pub(crate) fn scaled(v: Vec3, c: Complex64) -> Field {
     [c * v.x, c * v.y, c * v.z]
 }
 
-fn add(a: Field, b: Field) -> Field {
+pub(crate) fn add(a: Field, b: Field) -> Field {
     [a[0] + b[0], a[1] + b[1], a[2] + b[2]]
 }
 
@@ -101,7 +102,7 @@ fn any_perpendicular(k: Vec3) -> Vec3 {
 
 /// Apply one reflection to `field` travelling along unit `k`: returns the reflected field and
 /// direction. s = normalize(k × n), p = s × k before and p' = s × k' after the bounce.
-fn reflect(
+pub(crate) fn reflect(
     field: Field,
     k: Vec3,
     bounce: &Bounce,
@@ -125,6 +126,15 @@ fn reflect(
     Ok((reflected, k_out))
 }
 
+/// One interaction of a path with the scene.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Interaction {
+    /// A specular reflection.
+    Reflection(Bounce),
+    /// An edge diffraction (UTD); at most one per path.
+    Diffraction(Wedge),
+}
+
 /// Complex gain of the path TX → `points` → RX (world frame, metres) with one [`Bounce`] per
 /// point, at `frequency_hz`: (λ/(4π·length)) · f_RX(−k_last) · Π_bounces · f_TX(k_first).
 /// Without the propagation phase e^{−j2πf·τ}. `length` is clamped as in [`free_space`].
@@ -142,45 +152,48 @@ pub fn path_gain(
             message: format!("{} points but {} bounces", points.len(), bounces.len()),
         });
     }
-    let mut vertices = Vec::with_capacity(points.len() + 2);
-    vertices.push(tx);
-    vertices.extend_from_slice(points);
-    vertices.push(rx);
-    let length: Real = vertices.windows(2).map(|w| w[0].distance(w[1])).sum();
-    let mut k = (vertices[1] - vertices[0]).normalize();
-    let one = Complex64::new(1.0, 0.0);
-    let mut field = scaled(antennas.0.field(k), one);
-    for bounce in bounces {
-        (field, k) = reflect(field, k, bounce, frequency_hz)?;
-    }
-    let received = dot(&field, antennas.1.field(-k));
-    Ok(received * free_space(length, frequency_hz).amplitude)
+    let interactions: Vec<Interaction> = bounces
+        .iter()
+        .copied()
+        .map(Interaction::Reflection)
+        .collect();
+    path_gain_mixed(tx, points, rx, &interactions, antennas, frequency_hz)
 }
 
-/// One interaction of a path for [`mixed_path_gain`].
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub enum Interaction {
-    /// A specular reflection.
-    Reflection(Bounce),
-    /// An edge diffraction (at most one per path).
-    Diffraction(crate::diffraction::Wedge),
+/// [`path_gain_detailed`]'s gain alone.
+pub fn path_gain_mixed(
+    tx: Vec3,
+    points: &[Vec3],
+    rx: Vec3,
+    interactions: &[Interaction],
+    antennas: (&Antenna, &Antenna),
+    frequency_hz: Real,
+) -> Result<Complex64, ChannelError> {
+    path_gain_detailed(tx, points, rx, interactions, antennas, frequency_hz).map(|g| g.gain)
 }
 
 /// The gain of a path and, for a diffracted one, the diffraction's excess loss.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct PathGain {
-    /// Complex gain (no propagation phase), as [`path_gain`].
+    /// Complex gain (no propagation phase), as [`path_gain_mixed`].
     pub gain: Complex64,
-    /// −20·log10(max(|D_s|, |D_h|)·√((s + s')/(s·s'))), dB: the diffraction's loss over free
-    /// space along the same unfolded length (0 without a diffraction).
+    /// 0 without a diffraction; with one, −20·log10(σ_max(J)·A_UTD/A_Friis), dB: the
+    /// strongest polarisation's diffraction matrix J (its largest singular value, √m) with
+    /// UTD's spreading A_UTD = λ/(4π)/√(s'·s·(s' + s)), relative to free space over the same
+    /// unfolded length, A_Friis = λ/(4π·(s' + s)).
     pub diffraction_loss_db: Real,
 }
 
-/// [`path_gain`] for paths that may diffract once: reflections as there, the diffraction by
-/// [`crate::diffraction`]'s UTD, and the amplitude λ/(4π)·(1/s')·√(s'/(s(s'+s))) instead of
-/// λ/(4π·length) (s', s: unfolded lengths before and after the edge, each clamped to one
-/// wavelength as in [`free_space`]).
-pub fn mixed_path_gain(
+/// Complex gain of a path of reflections and at most one edge diffraction: TX → `points` →
+/// RX (world frame, metres), one [`Interaction`] per point, at `frequency_hz`.
+///
+/// Without a diffraction it is [`path_gain`]'s value, bit for bit. With one at point Q, the
+/// Jones chain runs through the UTD step of [`Wedge`] and the spreading is UTD's for a point
+/// source, λ/(4π)·1/√(s'·s·(s' + s)) with s' and s the unfolded lengths TX → Q and Q → RX
+/// (each clamped to at least one wavelength), instead of λ/(4π·(s' + s)). No propagation
+/// phase. Errors: lengths differ, two or more diffractions, an invalid wedge, a ray along the
+/// edge or off Keller's cone, a ray inside the wedge (`docs/channel.md`).
+pub fn path_gain_detailed(
     tx: Vec3,
     points: &[Vec3],
     rx: Vec3,
@@ -188,65 +201,68 @@ pub fn mixed_path_gain(
     antennas: (&Antenna, &Antenna),
     frequency_hz: Real,
 ) -> Result<PathGain, ChannelError> {
-    let at = interactions
-        .iter()
-        .position(|i| matches!(i, Interaction::Diffraction(_)));
-    let bounces = || {
-        interactions.iter().filter_map(|i| match i {
-            Interaction::Reflection(b) => Some(*b),
-            Interaction::Diffraction(_) => None,
-        })
-    };
-    let Some(at) = at else {
-        let bounces: Vec<Bounce> = bounces().collect();
-        let gain = path_gain(tx, points, rx, &bounces, antennas, frequency_hz)?;
-        return Ok(PathGain {
-            gain,
-            diffraction_loss_db: 0.0,
-        });
-    };
-    if points.len() != interactions.len() || bounces().count() + 1 != interactions.len() {
+    if points.len() != interactions.len() {
         return Err(ChannelError::Invalid {
             field: "interactions",
             message: format!(
-                "{} points, {} interactions, at most one diffraction",
+                "{} points but {} interactions",
                 points.len(),
                 interactions.len()
             ),
         });
     }
-    let mut vertices = vec![tx];
+    let mut diffractions = interactions
+        .iter()
+        .enumerate()
+        .filter(|(_, i)| matches!(i, Interaction::Diffraction(_)))
+        .map(|(index, _)| index);
+    let diffraction = diffractions.next();
+    if diffractions.next().is_some() {
+        return Err(ChannelError::Invalid {
+            field: "interactions",
+            message: "more than one diffraction in a path (only first-order diffraction)".into(),
+        });
+    }
+    let mut vertices = Vec::with_capacity(points.len() + 2);
+    vertices.push(tx);
     vertices.extend_from_slice(points);
     vertices.push(rx);
-    let wavelength = crate::material::SPEED_OF_LIGHT / frequency_hz;
-    let segment = |k: usize| vertices[k].distance(vertices[k + 1]);
-    let s_in = (0..=at).map(segment).sum::<Real>().max(wavelength);
-    let s_out = (at + 1..vertices.len() - 1)
-        .map(segment)
-        .sum::<Real>()
-        .max(wavelength);
+    let segments: Vec<Real> = vertices.windows(2).map(|w| w[0].distance(w[1])).collect();
+    let length: Real = segments.iter().sum();
+    let legs = |index: usize| Legs {
+        incident: segments[..=index].iter().sum(),
+        diffracted: segments[index + 1..].iter().sum(),
+    };
     let mut k = (vertices[1] - vertices[0]).normalize();
     let one = Complex64::new(1.0, 0.0);
     let mut field = scaled(antennas.0.field(k), one);
-    let mut loss_db = 0.0;
-    for (i, interaction) in interactions.iter().enumerate() {
+    let mut excess_db = 0.0;
+    for (index, interaction) in interactions.iter().enumerate() {
         match interaction {
-            Interaction::Reflection(b) => (field, k) = reflect(field, k, b, frequency_hz)?,
-            Interaction::Diffraction(w) => {
-                let k_out = (vertices[i + 2] - vertices[i + 1]).normalize();
-                let d = w.coefficients((k, k_out), (s_in, s_out), frequency_hz)?;
-                let spread = ((s_in + s_out) / (s_in * s_out)).sqrt();
-                loss_db = -20.0 * (d.soft.norm().max(d.hard.norm()) * spread).log10();
-                field = crate::diffraction::diffract(field, (k, k_out), w.edge, d);
+            Interaction::Reflection(bounce) => {
+                (field, k) = reflect(field, k, bounce, frequency_hz)?;
+            }
+            Interaction::Diffraction(wedge) => {
+                let k_out = (vertices[index + 2] - vertices[index + 1]).normalize();
+                let matrix;
+                (field, matrix) = diffract(field, (k, k_out), wedge, legs(index), frequency_hz)?;
+                // Excess over free space along the same length: the strongest polarisation's
+                // coefficient with the edge's spreading relative to λ/(4π·length).
+                let ratio = spreading(legs(index), frequency_hz)
+                    / free_space(length, frequency_hz).amplitude;
+                excess_db = -20.0 * (largest_singular_value(&matrix) * ratio).log10();
                 k = k_out;
             }
         }
     }
     let received = dot(&field, antennas.1.field(-k));
-    let amplitude = wavelength / (4.0 * PI) / s_in * (s_in / (s_out * (s_in + s_out))).sqrt();
+    let amplitude = match diffraction {
+        None => free_space(length, frequency_hz).amplitude,
+        Some(index) => spreading(legs(index), frequency_hz),
+    };
     Ok(PathGain {
         gain: received * amplitude,
-        diffraction_loss_db: loss_db,
+        diffraction_loss_db: excess_db,
     })
 }
 

@@ -1,6 +1,7 @@
 //! The radio channel of traced paths: ITU-R P.2040-3 materials and their reflection
 //! coefficients, antennas (pattern and polarisation), polarised complex path gains (Jones
-//! calculus), channel impulse and frequency responses, and beam codebooks.
+//! calculus) with first-order UTD edge diffraction, channel impulse and frequency responses,
+//! and beam codebooks.
 //!
 //! Frames and units: world frame of `docs/conventions.md` (metres, z up), Hz, radians inside
 //! the library. Every formula and sign convention: `docs/channel.md`.
@@ -16,10 +17,10 @@ pub mod response;
 
 pub use antenna::{Antenna, Orientation, Pattern, Polarization};
 pub use codebook::{Array, Beam, PathDirections, beam_pairs};
-pub use diffraction::{Coefficients, Wedge};
+pub use diffraction::{Wedge, fresnel_integrals, transition};
 pub use gain::{
-    Bounce, FreeSpace, Interaction, PathGain, SurfaceResponse, free_space, mixed_path_gain,
-    path_gain,
+    Bounce, FreeSpace, Interaction, PathGain, SurfaceResponse, free_space, path_gain,
+    path_gain_detailed, path_gain_mixed,
 };
 pub use material::{
     ItuBand, ItuMaterial, RadioMaterial, RadioModel, Reflection, SPEED_OF_LIGHT,

@@ -15,7 +15,8 @@
 //! **Validation.** Reflection points as for specular paths ([`crate::validate`]); the
 //! diffraction point strictly inside its edge (one length tolerance from either end: a corner
 //! is not an edge); both neighbours of `D` in the edge's exterior ([`bt_scene::Edge::in_exterior`]:
-//! a path on a face or inside the wedge does not diffract); no segment blocked (the segments
+//! a path on a face or inside the wedge does not diffract); the ray not along the edge (sin β0
+//! at least `bt_channel::diffraction::MIN_SIN_BETA`, where UTD holds); no segment blocked (the segments
 //! at `D` start on every surface touching the edge, which cannot block them).
 
 use crate::image::ImageFailure;
@@ -177,6 +178,11 @@ pub fn validate(
     }
     if !exterior(edge, vertex(c.position), tol) || !exterior(edge, vertex(c.position + 2), tol) {
         return Validity::InsideWedge { index: c.position };
+    }
+    // A ray (nearly) along the edge has no UTD coefficient (sin β0 → 0): grazing.
+    let incoming = (points[c.position] - vertex(c.position)).normalize();
+    if incoming.cross(edge.direction).length() < bt_channel::diffraction::MIN_SIN_BETA {
+        return Validity::Grazing { index: c.position };
     }
     blocked(scene, c, (vertex, n), edge)
 }

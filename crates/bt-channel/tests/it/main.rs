@@ -1,0 +1,3 @@
+//! Integration tests of bt-channel through its public API (one test binary).
+
+mod diffraction;
