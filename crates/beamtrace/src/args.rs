@@ -941,6 +941,10 @@ pub struct HlsGenArgs {
     /// Budget: stop before the work rather than enumerate more candidate paths than this.
     #[arg(long, default_value_t = bt_solve::pipeline::DEFAULT_MAX_CANDIDATES)]
     pub max_candidates: u64,
+    /// Refused with an error: the accelerator is reflection-only (diffracted paths are traced
+    /// on the host, `beamtrace trace --diffraction`).
+    #[arg(long)]
+    pub diffraction: bool,
     /// Every time step of a dynamic scene through ONE accelerator (synthesised once for the
     /// static planes; each step's candidates, start points and schedule are loaded over the
     /// bus): the design and the bus program of all steps into OUTPUT, per-step summaries into

@@ -253,6 +253,10 @@ fn step_options(args: &HlsGenArgs) -> bt_accel::StepOptions {
         trace: bt_solve::pipeline::TraceOptions {
             candidates: args.candidates.mode(),
             max_candidates: args.max_candidates,
+            diffraction: bt_solve::pipeline::DiffractionOptions {
+                max_diffractions: usize::from(args.diffraction),
+                ..Default::default()
+            },
             ..bt_solve::pipeline::TraceOptions::new(args.max_order)
         },
         threshold_lsb: args.threshold_lsb,

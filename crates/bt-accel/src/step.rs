@@ -29,6 +29,12 @@ pub enum AccelError {
         /// The order asked for.
         max_order: usize,
     },
+    /// Diffraction was asked for: the PEs solve reflections only.
+    #[error(
+        "the accelerator traces specular paths only (its PEs solve reflections, not diffractions); \
+         trace diffracted paths on the host with `beamtrace trace --diffraction`"
+    )]
+    Diffraction,
     /// The model or the scheduler refused the work.
     #[error("step {step}: {source}")]
     Hardware {
@@ -93,6 +99,9 @@ pub fn plan_step(
     options: &StepOptions,
     previous: Option<&PlannedStep>,
 ) -> Result<PlannedStep, AccelError> {
+    if options.trace.diffraction.enabled().is_some() {
+        return Err(AccelError::Diffraction);
+    }
     let hardware = |source| AccelError::Hardware {
         step: index,
         source,

@@ -4,6 +4,7 @@
 //!   (candidates + solver + validation) with the beam tree and with exhaustive enumeration,
 //!   IPC Gauss-Seidel (the paper's rounds, and with Newton polish); the image-method trace
 //!   followed by the per-path report (gains, angles, names); a new RX answered by a kept tree;
+//! - living room with one diffraction per path, order <= 3, beside the specular trace;
 //! - the built-in city (39,692 triangles): orders 1, 2 and 3.
 
 use bt_paths::beamtree::{BeamTree, TreeCache, TreeOptions, candidates_in};
@@ -148,5 +149,34 @@ fn city(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, living_room, city);
+/// First-order diffraction in the living room at order ≤ 3 (the issue's ≤ 1 ms target): the
+/// specular trace beside it, the trace with diffraction, and its candidates alone.
+fn living_room_diffraction(c: &mut Criterion) {
+    let scene = bt_import::builtin_scene("living-room", Terminals::default())
+        .unwrap()
+        .unwrap();
+    let mut group = c.benchmark_group("living-room-diffraction");
+    let specular = options(3, CandidateMode::BeamTree, Solver::Image);
+    let diffraction = TraceOptions {
+        diffraction: bt_solve::pipeline::DiffractionOptions::first_order(),
+        ..specular
+    };
+    let mut tracer = Tracer::new(scene.clone(), specular);
+    group.bench_function("trace-specular", |b| b.iter(|| whole_trace(&mut tracer)));
+    let mut tracer = Tracer::new(scene.clone(), diffraction);
+    group.bench_function("trace-one-diffraction", |b| {
+        b.iter(|| whole_trace(&mut tracer))
+    });
+    group.bench_function("candidates-one-diffraction", |b| {
+        b.iter(|| {
+            bt_solve::pipeline::candidates(black_box(&scene), &diffraction)
+                .unwrap()
+                .diffracted
+                .len()
+        })
+    });
+    group.finish();
+}
+
+criterion_group!(benches, living_room, living_room_diffraction, city);
 criterion_main!(benches);

@@ -134,11 +134,24 @@ fn hls_errors_are_clear() {
         !ok && out.contains("/no/such/dir") && !out.contains("panicked"),
         "{out}"
     );
-    let out = scratch("hls-errors").join("x");
+    let root = scratch("hls-errors");
+    let out = root.join("x");
     let o = beamtrace(&cli(
         "hls gen builtin:living-room --max-order 0 -o {}",
         &[out.to_str().unwrap()],
     ));
     let (ok, out) = (o.status.success(), text(&o));
     assert!(!ok && out.contains("--max-order"), "{out}");
+    // The accelerator is reflection-only: asked for diffraction, it says so and writes nothing.
+    let dir = root.join("diffraction");
+    let o = beamtrace(&cli(
+        "hls gen builtin:living-room --plan-only --diffraction -o {}",
+        &[dir.to_str().unwrap()],
+    ));
+    let (ok, out) = (o.status.success(), text(&o));
+    assert!(
+        !ok && out.contains("specular paths only") && out.contains("trace --diffraction"),
+        "{out}"
+    );
+    assert!(!dir.exists());
 }
