@@ -1,0 +1,310 @@
+#!/usr/bin/env python3
+"""Sionna RT 2.2's diffraction coefficient, re-done in numpy, next to Kouyoumjian-Pathak.
+
+Why: docs/sionna-diffraction-notes.md says what Sionna 2.2 computes for a
+diffracted path; this file is that statement in code, checked against
+Sionna's own numbers. ``--check`` takes every path in
+``testdata/sionna-reference/*.json`` that is a single diffraction (TX -> edge
+-> RX, no reflection), rebuilds the wedge from the scene mesh the way
+``sionna/rt/utils/wedges.py`` does, evaluates the Jones matrix the way
+``RadioMaterial._diffraction_matrix`` does, and prints the replica's ``a``
+beside Sionna's, and beside what Kouyoumjian-Pathak (PEC) and Luebbers
+(lossy, same ITU slab reflection coefficients) give for the same geometry and
+the same V-polarised antennas.
+
+``--boundaries`` puts the same formula on a PEC wedge and prints the total
+(GO + diffracted) field just before and after the reflection and incident
+shadow boundaries, for Sionna's formula and for Kouyoumjian-Pathak.
+
+Run (needs the venv of tools/sionna_reference.py, for loading the meshes):
+
+    /work/sionna-venv/bin/python tools/sionna_utd_replica.py --check
+    /work/sionna-venv/bin/python tools/sionna_utd_replica.py --boundaries
+
+Conventions (all in the notes): phi, phi' are measured from the 0-face through
+the exterior, the 0-face is the face whose outward normal faces the incident
+wave, e is oriented so that n0 x e runs along the 0-face away from the edge,
+and Sionna's Jones vectors are (E . s, E . (k x s)) with s = theta_hat(k).
+"""
+
+from __future__ import annotations
+
+import argparse
+import glob
+import json
+import os
+import sys
+from pathlib import Path
+
+import numpy as np
+from scipy.special import fresnel
+
+C0 = 299792458.0
+EPS0 = 8.8541878128e-12
+REPO = Path(__file__).resolve().parents[1]
+
+
+def nrm(v):
+    return v / np.linalg.norm(v)
+
+
+def F(x):
+    """UTD transition function F(x) = 2j sqrt(x) e^{jx} int_sqrt(x)^inf e^{-jt^2} dt."""
+    x = float(x)
+    u = np.sqrt(2 * x / np.pi)
+    S, C = fresnel(u)
+    tail = np.sqrt(np.pi / 2) * ((0.5 - C) - 1j * (0.5 - S))
+    return 2j * np.sqrt(x) * np.exp(1j * x) * tail
+
+
+def slab(cos, eta, d, lam):
+    """ITU-R P.2040 single-layer slab reflection coefficients (r_te, r_tm), as Sionna."""
+    a = np.sqrt(eta - (1 - cos**2) + 0j)
+    rte = (cos - a) / (cos + a)
+    rtm = (eta * cos - a) / (eta * cos + a)
+    e2 = np.exp(-2j * (2 * np.pi * d / lam) * a)
+    return rte * (1 - e2) / (1 - rte**2 * e2), rtm * (1 - e2) / (1 - rtm**2 * e2)
+
+
+def theta_hat(k):
+    th = np.arccos(np.clip(k[2], -1, 1))
+    ph = np.arctan2(k[1], k[0])
+    return np.array([np.cos(th) * np.cos(ph), np.cos(th) * np.sin(ph), -np.sin(th)])
+
+
+def rotator(k, s_cur, s_tgt):
+    """Sionna's jones_matrix_rotator: components in basis (s_cur, k x s_cur) -> (s_tgt, k x s_tgt)."""
+    c = s_cur @ s_tgt
+    s = k @ np.cross(s_cur, s_tgt)
+    return np.array([[c, s], [-s, c]])
+
+
+def utd_terms(phi, phip, n, k, L, beta0):
+    """D1..D4 of Kouyoumjian-Pathak, each with the factor -e^{-j pi/4} / (2 n sqrt(2 pi k) sin beta0)."""
+    ext = n * np.pi
+
+    def a_pm(beta):
+        n_p = np.round((beta + np.pi) / (2 * ext))
+        n_m = np.round((beta - np.pi) / (2 * ext))
+        return 2 * np.cos(ext * n_p - beta / 2) ** 2, 2 * np.cos(ext * n_m - beta / 2) ** 2
+
+    fac = -np.exp(-1j * np.pi / 4) / (2 * n * np.sqrt(2 * np.pi * k) * np.sin(beta0))
+    a1, a2 = a_pm(phi - phip)
+    a3, a4 = a_pm(phi + phip)
+    cot = lambda x: np.cos(x) / np.sin(x)  # noqa: E731
+    kl = k * L
+    d1 = fac * cot((np.pi + (phi - phip)) / (2 * n)) * F(kl * a1)
+    d2 = fac * cot((np.pi - (phi - phip)) / (2 * n)) * F(kl * a2)
+    d3 = fac * cot((np.pi + (phi + phip)) / (2 * n)) * F(kl * a3)
+    d4 = fac * cot((np.pi - (phi + phip)) / (2 * n)) * F(kl * a4)
+    return d1, d2, d3, d4
+
+
+def wedge(v0, v1, f0, fn, ki):
+    """Sionna's wedge_geometry + swap_faces: outward n0, nn, edge direction e.
+
+    v0, v1: edge endpoints; f0, fn: the two triangles (3x3 vertex arrays);
+    fn is None for a free edge (a screen: nn = -n0).
+    """
+    def normal(f):
+        return nrm(np.cross(f[1] - f[0], f[2] - f[0]))
+
+    c0 = f0.mean(0)
+    n0 = normal(f0)
+    if fn is None:
+        cn, nn = c0, -n0
+    else:
+        cn, nn = fn.mean(0), normal(fn)
+        if n0 @ (cn - v0) > 1e-6:
+            n0 = -n0
+        if nn @ (c0 - v0) > 1e-6:
+            nn = -nn
+    if ki @ n0 > 0:  # the 0-face is the one the incident wave sees
+        n0, nn, c0, cn = nn, n0, cn, c0
+    e = nrm(v1 - v0)
+    if np.cross(n0, e) @ (c0 - v0) < 0:
+        e = -e
+    return n0, nn, e
+
+
+def sionna_jones(ki, ko, s_prime, s, e, n0, nn, eta, thick, lam, scattering=0.0):
+    """Jones matrix of RadioMaterial._diffraction_matrix (sionna-rt 2.2), world implicit bases."""
+    k = 2 * np.pi / lam
+    ext = 2 * np.pi - np.arccos(np.clip(-(n0 @ nn), -1.0, 1.0))
+    n = ext / np.pi
+    beta0 = np.arccos(abs(ki @ e))
+    t0 = nrm(np.cross(n0, e))
+    kip = nrm(ki - (ki @ e) * e)
+    kop = nrm(ko - (ko @ e) * e)
+    phip = (np.pi - np.arccos(np.clip(-kip @ t0, -1, 1))) * -np.sign(-kip @ n0) + np.pi
+    phi = (np.pi - np.arccos(np.clip(kop @ t0, -1, 1))) * -np.sign(kop @ n0) + np.pi
+    L = s * s_prime / (s + s_prime) * np.sin(beta0) ** 2
+    d1, d2, d3, d4 = utd_terms(phi, phip, n, k, L, beta0)
+
+    k_sb0 = ki - 2 * (ki @ n0) * n0
+    k_sbn = ki - 2 * (ki @ nn) * nn
+    phi_hat_p = nrm(np.cross(ki, e))
+    phi_sb0 = -nrm(np.cross(k_sb0, e))
+    phi_sbn = -nrm(np.cross(k_sbn, e))
+    phi_hat = -nrm(np.cross(ko, e))
+    es0 = nrm(np.cross(ki, n0))
+    esn = nrm(np.cross(ki, nn))
+    red = np.sqrt(1 - scattering**2)
+    r0 = np.array(slab(abs(ki @ n0), eta, thick, lam)) * red
+    rn = np.array(slab(abs(ki @ nn), eta, thick, lam)) * red
+    R0 = rotator(k_sb0, es0, phi_sb0) @ np.diag(r0) @ rotator(ki, phi_hat_p, es0)
+    Rn = rotator(k_sbn, esn, phi_sbn) @ np.diag(rn) @ rotator(ki, phi_hat_p, esn)
+    if ext > np.pi + phip:  # n-face not lit by the incident wave
+        Rn = -np.eye(2)
+    J_edge = R0 * (d1 - d4) + Rn * (d2 - d3)
+    J = rotator(ko, phi_hat, theta_hat(ko)) @ J_edge @ rotator(ki, theta_hat(ki), phi_hat_p)
+    return J, dict(phi=phi, phip=phip, n=n, beta0=beta0, L=L, d=(d1, d2, d3, d4), R0=R0, Rn=Rn,
+                   phi_hat_p=phi_hat_p, phi_hat=phi_hat)
+
+
+def kp_luebbers_a(ki, ko, s_prime, s, e, n0, nn, eta, thick, lam, geo):
+    """a for V-pol iso antennas with KP (PEC) and Luebbers (ITU slab) coefficients.
+
+    Dyadic D = -beta'beta D_s - phi'phi D_h in KP's edge-fixed bases; E_d = D . E_i.
+    Luebbers: D_{s,h} = D1 + D2 + R_n^{s,h} D3 + R_0^{s,h} D4 with R^s = r_te, R^h = r_tm of
+    each face at its own grazing angle (0-face: phi', n-face: n pi - phi).
+    """
+    d1, d2, d3, d4 = geo["d"]
+    pref = lam / (4 * np.pi) / np.sqrt(s * s_prime * (s + s_prime))
+    # KP edge-fixed unit vectors: phi' = -(e x s')/|..| with s' = ki; beta0' = phi' x s'
+    phi_p = -nrm(np.cross(e, ki))
+    beta_p = np.cross(phi_p, ki)
+    phi_d = nrm(np.cross(e, ko))
+    beta_d = np.cross(phi_d, ko)
+    t_in, t_out = theta_hat(ki), theta_hat(ko)
+    n = geo["n"]
+    sb = np.sin(geo["beta0"])
+    r0 = slab(abs(np.sin(geo["phip"])) * sb, eta, thick, lam)
+    rn = slab(abs(np.sin(n * np.pi - geo["phi"])) * sb, eta, thick, lam)
+    out = {}
+    for name, Ds, Dh in [
+        ("kp_pec", d1 + d2 - (d3 + d4), d1 + d2 + (d3 + d4)),
+        ("luebbers", d1 + d2 + rn[0] * d3 + r0[0] * d4, d1 + d2 + rn[1] * d3 + r0[1] * d4),
+    ]:
+        # project: E_i = theta_hat(ki); E_d = -(beta' . E_i) beta D_s - (phi' . E_i) phi D_h; a = theta_hat(ko) . E_d
+        amp = -(beta_p @ t_in) * (beta_d @ t_out) * Ds - (phi_p @ t_in) * (phi_d @ t_out) * Dh
+        out[name] = pref * amp
+    return out
+
+
+def check(paths_glob):
+    os.environ.setdefault("DRJIT_LIBLLVM_PATH", "/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1")
+    import drjit as dr
+    import mitsuba as mi
+    import sionna.rt as rt
+
+    rows = []
+    scenes = {}
+    for fn in sorted(glob.glob(paths_glob)):
+        doc = json.load(open(fn))
+        sname = doc["scene"]["name"]
+        if sname not in scenes:
+            sc = rt.load_scene(str(REPO / doc["scene"]["xml"]), merge_shapes=False)
+            meshes = {}
+            for name, o in sc.objects.items():
+                m = o.mi_mesh
+                meshes[name] = (dr.unravel(mi.Point3u, m.faces_buffer()).numpy().T,
+                                dr.unravel(mi.Point3f, m.vertex_positions_buffer()).numpy().T.astype(float),
+                                o.radio_material.name)
+            scenes[sname] = meshes
+        meshes = scenes[sname]
+        lam = doc["wavelength_m"]
+        tx = np.array(doc["tx"]["position"], float)
+        for r in doc["receivers"]:
+            rx = np.array(r["position"], float)
+            for p in r["paths"]:
+                if p["kinds"] != ["diffraction"]:
+                    continue
+                faces, verts, mat = meshes[p["shapes"][0]]
+                ed = p["edges"][0]
+                q = np.array(p["vertices"][0], float)
+                ki = nrm(q - tx)
+                ko = nrm(rx - q)
+                f0 = verts[faces[ed["faces"][0]]]
+                fn_ = None if ed["free"] else verts[faces[ed["faces"][1]]]
+                n0, nn, e = wedge(np.array(ed["a"]), np.array(ed["b"]), f0, fn_, ki)
+                m = doc["scene"]["materials"][mat]
+                eta = m["relative_permittivity"] - 1j * m["conductivity_S_per_m"] / (2 * np.pi * doc["frequency_hz"] * EPS0)
+                sp, s = np.linalg.norm(q - tx), np.linalg.norm(rx - q)
+                J, geo = sionna_jones(ki, ko, sp, s, e, n0, nn, eta, m["thickness_m"], lam,
+                                      m["scattering_coefficient"])
+                pref = lam / (4 * np.pi) / np.sqrt(s * sp * (s + sp))
+                a_rep = pref * J[0, 0]
+                a_s = complex(*p["a"])
+                other = kp_luebbers_a(ki, ko, sp, s, e, n0, nn, eta, m["thickness_m"], lam, geo)
+                rows.append((Path(fn).stem, r["name"], p["shapes"][0], ed["free"], geo["n"],
+                             np.degrees(geo["phip"]), np.degrees(geo["phi"]), a_s, a_rep, other))
+    db = lambda a: 20 * np.log10(abs(a)) if a != 0 else float("-inf")  # noqa: E731
+    print(f"{'case':18s} {'rx':4s} {'shape':28s} {'free':5s} {'n':>6s} {'phi_p':>7s} {'phi':>7s} "
+          f"{'sionna dB':>10s} {'replica':>9s} {'|rel err|':>9s} {'KP-PEC':>8s} {'Luebbers':>8s}")
+    worst = 0.0
+    for case, rx, shape, free, n, php, ph, a_s, a_rep, other in rows:
+        rel = abs(a_rep - a_s) / abs(a_s)
+        worst = max(worst, rel) if np.isfinite(rel) else float("inf")
+        print(f"{case:18s} {rx:4s} {shape[:28]:28s} {str(free):5s} {n:6.3f} {php:7.2f} {ph:7.2f} "
+              f"{db(a_s):10.3f} {db(a_rep):9.3f} {rel:9.2e} {db(other['kp_pec']):8.2f} {db(other['luebbers']):8.2f}")
+    print(f"{len(rows)} single-diffraction paths; worst |a_replica - a_sionna| / |a_sionna| = {worst:.2e}")
+    return worst
+
+
+def boundaries():
+    """Continuity of GO + diffracted field across the shadow boundaries of a PEC wedge.
+
+    The simple_wedge geometry (90 degree wedge, n = 1.5) with ITU metal, TX at
+    phi' = 30 deg, 20 m from the edge, RX 15 m from the edge, all in one plane
+    (beta0 = 90 deg). The reflection boundary of the 0-face is at phi = 150 deg,
+    the incident shadow boundary at 210 deg. GO = LoS (phi < 210) + reflection
+    off the 0-face (phi < 150); the total GO + diffracted field must not jump
+    there. Soft = E along the edge (V-pol here), hard = E across it (H-pol).
+    """
+    f = 3.5e9
+    lam = C0 / f
+    k = 2 * np.pi / lam
+    eta = 1 - 1j * 1e7 / (2 * np.pi * f * EPS0)
+    tx = np.array([20 * np.cos(np.radians(30)), 20 * np.sin(np.radians(30)), 0.0])
+    n0, nn, e = np.array([0, 1.0, 0]), np.array([-1.0, 0, 0]), np.array([0, 0, 1.0])
+    print("|GO + diffracted| just before / after each boundary (a jump = a discontinuity)")
+    for label, slot, rsign in [("soft", 0, -1), ("hard", 1, 1)]:
+        for name, phib in [("RSB 0-face", 150.0), ("ISB", 210.0)]:
+            vals = {}
+            for side, phi_deg in [("before", phib - 5e-4), ("after", phib + 5e-4)]:
+                rx = np.array([15 * np.cos(np.radians(phi_deg)), 15 * np.sin(np.radians(phi_deg)), 0.0])
+                ki, ko = nrm(-tx), nrm(rx)
+                J, geo = sionna_jones(ki, ko, 20.0, 15.0, e, n0, nn, eta, 1.0, lam)
+                pref = lam / (4 * np.pi) / np.sqrt(15.0 * 20.0 * 35.0) * np.exp(-1j * k * 35.0)
+                d1, d2, d3, d4 = geo["d"]
+                kp = d1 + d2 - (d3 + d4) if slot == 0 else d1 + d2 + (d3 + d4)
+                dl = np.linalg.norm(rx - tx)
+                go = lam / (4 * np.pi * dl) * np.exp(-1j * k * dl) if phi_deg < 210 else 0
+                img = tx * np.array([1, -1, 1])
+                dr_ = np.linalg.norm(rx - img)
+                go += rsign * lam / (4 * np.pi * dr_) * np.exp(-1j * k * dr_) if phi_deg < 150 else 0
+                vals[side] = (abs(go + pref * J[slot, slot]), abs(go + pref * kp))
+            print(f"  {label} {name} (phi = {phib:.0f}): Sionna 2.2 {vals['before'][0]:.4e} / {vals['after'][0]:.4e}"
+                  f"   Kouyoumjian-Pathak {vals['before'][1]:.4e} / {vals['after'][1]:.4e}")
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
+    ap.add_argument("--check", action="store_true", help="compare with testdata/sionna-reference/*.json")
+    ap.add_argument("--boundaries", action="store_true",
+                    help="GO + diffracted field across a PEC wedge's shadow boundaries, Sionna vs KP")
+    ap.add_argument("--glob", default=str(REPO / "testdata" / "sionna-reference" / "*.json"))
+    args = ap.parse_args(argv)
+    if args.boundaries:
+        boundaries()
+    if args.check:
+        worst = check(args.glob)
+        return 0 if worst < 1e-3 else 1
+    if not args.boundaries:
+        ap.print_help()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
