@@ -9,6 +9,7 @@ mod diffraction;
 mod incremental;
 mod ipc_vs_image;
 mod newton;
+mod sionna;
 mod terminals;
 mod translation;
 mod wvrn_completeness;
