@@ -1,9 +1,11 @@
 """Browser test of `beamtrace view`: the page loads in headless Chromium (Debian's, driven by
 Playwright) without console errors, draws one line per path of the trace's JSON, its time-step
-slider switches the drawn step, and hostile names stay text.
+slider switches the drawn step, hostile names stay text, and a diffracting wedge shows its edges
+and its diffraction point.
 
 Run: target/ci-venv/bin/python -m pytest tests/browser (`.ci/run` sets the venv up).
-BEAMTRACE_BIN names the binary (default: target/debug/beamtrace, built when missing)."""
+BEAMTRACE_BIN names the binary (default: target/debug/beamtrace, built when missing);
+SCREENSHOT_DIR keeps the wedge's screenshot (default: the test's temporary folder)."""
 
 import json
 import os
