@@ -1,9 +1,11 @@
 """Browser test of `beamtrace view`: the page loads in headless Chromium (Debian's, driven by
 Playwright) without console errors, draws one line per path of the trace's JSON, its time-step
-slider switches the drawn step, and hostile names stay text.
+slider switches the drawn step, hostile names stay text, and a diffracting wedge shows its edges
+and its diffraction point.
 
 Run: target/ci-venv/bin/python -m pytest tests/browser (`.ci/run` sets the venv up).
-BEAMTRACE_BIN names the binary (default: target/debug/beamtrace, built when missing)."""
+BEAMTRACE_BIN names the binary (default: target/debug/beamtrace, built when missing);
+SCREENSHOT_DIR keeps the wedge's screenshot (default: the test's temporary folder)."""
 
 import json
 import os
@@ -135,4 +137,37 @@ def test_hostile_names_stay_text(beamtrace, browser, tmp_path):
     assert page.evaluate("window.pwned") is None
     assert page.locator("img").count() == 0
     assert page.locator("#title").text_content() == name
+    assert errors == []
+
+
+def test_wedge_diffraction_draws_edges_and_the_diffraction_point(beamtrace, browser, tmp_path):
+    # Sionna RT's wedge hides RX from TX: the one path diffracts on the wedge's edge.
+    wedge = REPO / "testdata/scenes/sionna-rt/simple_wedge/simple_wedge.xml"
+    html = tmp_path / "wedge.html"
+    beamtrace("view", wedge, "--tx=-10,-20,2", "--rx=20,5,1", "--diffraction", "-o", html)
+    page, errors = open_view(browser, html)
+    state = drawn(page)
+    assert state["edges"] > 0
+    assert state["diffractionPoints"] == 1
+    assert state["pathLines"] == 1
+    legend = page.locator("#legend-edges").text_content()
+    assert "diffracting edge" in legend and "diffraction point" in legend
+    assert "1 path, 1 diffraction point" in page.locator("#counts").text_content()
+    page.screenshot(path=str(Path(os.environ.get("SCREENSHOT_DIR", tmp_path)) / "wedge.png"))
+    # Hovering the path names the edge it diffracts on.
+    doc = json.loads(page.evaluate("document.getElementById('beamtrace-data').textContent"))
+    step = doc["steps"][0]
+    point = step["paths"][0]["points"][0]
+    mid = [(a + b) / 2 for a, b in zip(step["tx"], point)]
+    x, y = page.evaluate("p => window.beamtraceView.project(p)", mid)
+    page.mouse.move(x, y)
+    assert page.locator("#tip").text_content().startswith("order 1: edge ")
+    assert errors == []
+    # Without --diffraction the same page draws the edges but no diffraction point.
+    plain = tmp_path / "plain.html"
+    beamtrace("view", wedge, "--tx=-10,-20,2", "--rx=20,5,1", "-o", plain)
+    page, errors = open_view(browser, plain)
+    assert drawn(page)["edges"] == state["edges"]
+    assert drawn(page)["diffractionPoints"] == 0
+    assert "diffraction point" not in page.locator("#legend-edges").text_content()
     assert errors == []

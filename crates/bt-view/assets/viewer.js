@@ -1,5 +1,5 @@
-// beamtrace viewer: draws the embedded document (scene surfaces, TX/RX, paths per time step)
-// with the inlined three.js. Names are data: they reach the page only through textContent.
+// beamtrace viewer: draws the embedded document (scene surfaces, diffracting edges, TX/RX,
+// paths and their diffraction points per time step) with the inlined three.js. Names are data: they reach the page only through textContent.
 (function () {
   "use strict";
   var doc = JSON.parse(document.getElementById("beamtrace-data").textContent);
@@ -20,6 +20,10 @@
     var t = lossMax > lossMin ? (lossMax - p.loss_db) / (lossMax - lossMin) : 1;
     return VIRIDIS[Math.min(VIRIDIS.length - 1, Math.floor(t * VIRIDIS.length))];
   }
+  var EDGE_COLOUR = "#202020";       // a wedge (two faces)
+  var FREE_EDGE_COLOUR = "#6e6e6e";  // a free edge (a screen's boundary)
+  var DIFFRACTION_COLOUR = "#f0a000";
+  function counted(n, noun) { return n + " " + noun + (n === 1 ? "" : "s"); }
   function text(el, s) { el.textContent = s; return el; }
   function make(tag, s) { return text(document.createElement(tag), s); }
 
@@ -43,7 +47,8 @@
   var stepGroup = new THREE.Group();
   scene.add(stepGroup);
   var pathLines = [];
-  var state = { steps: doc.steps.length, step: 0, pathLines: 0, paths: 0, surfaces: 0, ready: false };
+  var state = { steps: doc.steps.length, step: 0, pathLines: 0, paths: 0, surfaces: 0,
+                edges: 0, diffractionPoints: 0, ready: false };
   window.beamtraceView = state;
 
   // A planar polygon as triangles: project on its plane (Newell normal) and triangulate, so
@@ -83,11 +88,53 @@
     return g;
   }
 
-  function marker(p, colour, radius) {
-    var m = new THREE.Mesh(new THREE.SphereGeometry(radius, 20, 14),
-                           new THREE.MeshLambertMaterial({ color: colour }));
+  // A sphere; with diamond set, four by two segments: an octahedron, flat-shaded.
+  function marker(p, colour, radius, diamond) {
+    var m = new THREE.Mesh(diamond ? new THREE.SphereGeometry(radius, 4, 2) : new THREE.SphereGeometry(radius, 20, 14),
+                           new THREE.MeshLambertMaterial({ color: colour, flatShading: !!diamond }));
     m.position.set(p[0], p[1], p[2]);
     return m;
+  }
+
+  // Markers scale with the step's size (0.6 % of its diagonal, at least 6 cm) so they stay
+  // visible on a street as in a room.
+  function markerRadius(step) {
+    var box = new THREE.Box3();
+    step.surfaces.forEach(function (s) {
+      s.vertices.forEach(function (v) { box.expandByPoint(new THREE.Vector3(v[0], v[1], v[2])); });
+    });
+    [step.tx, step.rx].forEach(function (v) { if (v) box.expandByPoint(new THREE.Vector3(v[0], v[1], v[2])); });
+    return box.isEmpty() ? 0.06 : Math.max(0.06, 0.006 * box.getSize(new THREE.Vector3()).length());
+  }
+
+  // three's LineSegments (many segments, one draw call) is not exported by the vendored
+  // bundle; GridHelper extends it, so it is taken from there (one Line per edge otherwise).
+  var LineSegments = Object.getPrototypeOf(THREE.GridHelper);
+  if (!LineSegments.prototype || !LineSegments.prototype.isLineSegments) LineSegments = null;
+
+  // The step's edges of one kind (free or wedge) as thin lines, drawn after the surfaces'
+  // outlines they lie on (renderOrder) so they show where they coincide.
+  function addEdges(edges, free, colour) {
+    var segments = edges.filter(function (e) { return e.free === free; }).map(function (e) { return e.segment; });
+    if (!segments.length) return;
+    var material = new THREE.LineBasicMaterial({ color: colour });
+    var lines = LineSegments
+      ? [new LineSegments(lineGeometry([].concat.apply([], segments)), material)]
+      : segments.map(function (s) { return new THREE.Line(lineGeometry(s), material); });
+    lines.forEach(function (l) { l.renderOrder = 1; stepGroup.add(l); });
+  }
+
+  // A diamond at each diffraction point of the step's paths; returns how many.
+  function addDiffractionPoints(paths, radius) {
+    var count = 0;
+    paths.forEach(function (p) {
+      (p.interactions || []).forEach(function (kind, i) {
+        if (kind !== "diffraction") return;
+        stepGroup.add(marker(p.points[i], DIFFRACTION_COLOUR, radius, true));
+        count++;
+      });
+    });
+    return count;
   }
 
   function clearGroup() {
@@ -112,6 +159,8 @@
                                     new THREE.LineBasicMaterial({ color: s.colour }));
       stepGroup.add(edge);
     });
+    addEdges(step.edges, false, EDGE_COLOUR);
+    addEdges(step.edges, true, FREE_EDGE_COLOUR);
     step.paths.forEach(function (p) {
       var pts = [step.tx].concat(p.points, [step.rx]);
       var line = new THREE.Line(lineGeometry(pts), new THREE.LineBasicMaterial({
@@ -120,15 +169,22 @@
       stepGroup.add(line);
       pathLines.push(line);
     });
+    var radius = markerRadius(step);
+    var diffractions = addDiffractionPoints(step.paths, 1.2 * radius);
     // Bare geometry (a mesh without terminals) has no markers: tx and rx are null.
-    if (step.tx) { stepGroup.add(marker(step.tx, 0xd62728, 0.06)); }
-    if (step.rx) { stepGroup.add(marker(step.rx, 0x1f77b4, 0.06)); }
+    if (step.tx) { stepGroup.add(marker(step.tx, 0xd62728, radius)); }
+    if (step.rx) { stepGroup.add(marker(step.rx, 0x1f77b4, radius)); }
     state.step = k;
     state.pathLines = pathLines.length;
     state.paths = step.paths.length;
     state.surfaces = step.surfaces.length;
+    state.edges = step.edges.length;
+    state.diffractionPoints = diffractions;
+    var edges = counted(step.edges.length, "diffracting edge") +
+      (step.edges.length < step.edge_count ? " (of " + step.edge_count + ")" : "");
     text(document.getElementById("counts"),
-         step.surfaces.length + " surfaces, " + step.paths.length + " paths" +
+         counted(step.surfaces.length, "surface") + ", " + edges + ", " +
+         counted(step.paths.length, "path") + ", " + counted(diffractions, "diffraction point") +
          (doc.steps.length > 1 ? " (step " + k + " of " + (doc.steps.length - 1) + ")" : ""));
     text(document.getElementById("step-label"), String(k));
   }
@@ -176,6 +232,21 @@
     el.appendChild(swatchRow("#e15759", "box", "blocker"));
   }
 
+  // Edge and diffraction rows, for what some step of the document has.
+  function edgeLegend() {
+    var el = document.getElementById("legend-edges");
+    var has = function (test) { return doc.steps.some(test); };
+    if (has(function (s) { return s.edges.some(function (e) { return !e.free; }); })) {
+      el.appendChild(swatchRow(EDGE_COLOUR, "line", "diffracting edge"));
+    }
+    if (has(function (s) { return s.edges.some(function (e) { return e.free; }); })) {
+      el.appendChild(swatchRow(FREE_EDGE_COLOUR, "line", "diffracting edge (free)"));
+    }
+    if (has(function (s) { return s.paths.some(function (p) { return (p.interactions || []).indexOf("diffraction") >= 0; }); })) {
+      el.appendChild(swatchRow(DIFFRACTION_COLOUR, "diamond", "diffraction point"));
+    }
+  }
+
   // Hover: the nearest path line under the pointer, its numbers in the tip.
   var raycaster = new THREE.Raycaster();
   var pointer = new THREE.Vector2();
@@ -184,7 +255,9 @@
   function describe(p) {
     var f = function (x, d) { return Number(x).toFixed(d); };
     return [
-      p.order === 0 ? "line of sight" : "order " + p.order + ": " + p.surfaces.join(" > "),
+      p.order === 0 ? "line of sight" : "order " + p.order + ": " + p.surfaces.map(function (s, i) {
+        return (p.interactions || [])[i] === "diffraction" ? "edge " + s : s;
+      }).join(" > "),
       "length " + f(p.length_m, 3) + " m, delay " + f(p.delay_s * 1e9, 3) + " ns",
       "AoD az " + f(p.aod_deg.azimuth, 2) + " deg, el " + f(p.aod_deg.elevation, 2) + " deg",
       "AoA az " + f(p.aoa_deg.azimuth, 2) + " deg, el " + f(p.aoa_deg.elevation, 2) + " deg",
@@ -221,6 +294,7 @@
   text(document.getElementById("title"), doc.scene);
   legend();
   surfaceLegend();
+  edgeLegend();
   document.getElementById("colour-by").addEventListener("change", function (e) {
     colourBy = e.target.value;
     pathLines.forEach(function (l) { l.material.color.set(pathColour(l.userData.path)); });

@@ -3,22 +3,36 @@
 //! `<script type="application/json">` read with `textContent` — names from the scene are data
 //! and never reach HTML markup (the script writes them with `textContent` only).
 //!
-//! The page exposes `window.beamtraceView = { steps, step, pathLines, paths, surfaces, ready }`
-//! so a browser test can check what was drawn.
+//! The page exposes `window.beamtraceView = { steps, step, pathLines, paths, surfaces, edges,
+//! diffractionPoints, ready }` so a browser test can check what was drawn.
+//!
+//! Each step carries the scene's diffracting edges (all of them up to [`ALL_EDGES_CAP`], else
+//! the ones a shown path diffracts on) as world-frame segments; the viewer marks each path's
+//! diffraction points from the paths' own `interactions` and `points`.
 
 #![warn(missing_docs)]
 
-use bt_beams::{PathReport, StepsDocument, TraceDocument};
-use bt_geom::Real;
-use bt_scene::{Scene, SurfaceKind};
+use bt_beams::{InteractionKind, PathReport, StepsDocument, TraceDocument};
+use bt_geom::{Real, Vec3};
+use bt_scene::{Edge, EdgeId, Scene, SurfaceKind};
 use serde::{Deserialize, Serialize};
+use std::collections::BTreeSet;
 
 const THREE: &str = include_str!("../vendor/three.bundle.min.js");
 const VIEWER: &str = include_str!("../assets/viewer.js");
 const TEMPLATE: &str = include_str!("../assets/page.html");
 
-/// Version of the embedded document's layout.
+/// Version of the embedded document's layout. Still 1 with the steps' `edges` and
+/// `edge_count`: fields were only added, and the document is read by the viewer script of its
+/// own page, never by another reader.
 pub const FORMAT_VERSION: u32 = 1;
+
+/// A time step whose scene has at most this many diffracting edges shows all of them; a larger
+/// one shows only the edges a shown path diffracts on. 5,000 edges are about 0.5 MB of JSON per
+/// step (the size of the inlined three.js) and one cheap line batch to draw, and as many edges
+/// as that still read as the outline of a building; a city mesh's 10⁵ edges would multiply the
+/// page's size and hide the paths in grey lines.
+pub const ALL_EDGES_CAP: usize = 5_000;
 
 /// Why a page could not be made.
 #[derive(Debug, thiserror::Error)]
@@ -141,6 +155,19 @@ struct StepDocument<'a> {
     tx: Option<[Real; 3]>,
     rx: Option<[Real; 3]>,
     paths: &'a [PathReport],
+    /// The diffracting edges drawn: all, or those a path diffracts on ([`ALL_EDGES_CAP`]),
+    /// ascending by edge id.
+    edges: Vec<EdgeDocument>,
+    /// How many diffracting edges the step's scene has (more than `edges` over the cap).
+    edge_count: usize,
+}
+
+#[derive(Serialize)]
+struct EdgeDocument {
+    /// Start and end, metres, world frame.
+    segment: [[Real; 3]; 2],
+    /// A free edge (a screen's boundary) rather than a wedge of two faces.
+    free: bool,
 }
 
 #[derive(Serialize)]
@@ -198,6 +225,11 @@ pub fn page(scenes: &[&Scene], paths: &[StepPaths]) -> String {
             tx: step.tx,
             rx: step.rx,
             paths: &step.paths,
+            edges: shown_edges(scene, &step.paths, ALL_EDGES_CAP)
+                .into_iter()
+                .map(|id| edge_document(scene, scene.edges().get(id)))
+                .collect(),
+            edge_count: scene.edges().len(),
         })
         .collect();
     let doc = Document {
@@ -222,6 +254,77 @@ pub fn page(scenes: &[&Scene], paths: &[StepPaths]) -> String {
             ("{{VIEWER}}", VIEWER),
         ],
     )
+}
+
+/// The edges of `scene` to draw with `paths`: every edge when there are at most `cap`, else
+/// those a path diffracts on; ascending by id (deterministic).
+fn shown_edges(scene: &Scene, paths: &[PathReport], cap: usize) -> Vec<EdgeId> {
+    let count = scene.edges().len();
+    if count <= cap {
+        return (0..count).map(|i| EdgeId(i as u32)).collect();
+    }
+    let ids: BTreeSet<EdgeId> = paths
+        .iter()
+        .flat_map(|p| diffracted_edges(scene, p))
+        .collect();
+    ids.into_iter().collect()
+}
+
+/// The edges `path` diffracts on: its edge id when it was traced here; for a path read from a
+/// trace document (which carries no ids), the edges through its diffraction point (within the
+/// edges' own matching tolerance, [`bt_scene::edges::REL_EDGE_MATCH`] of the scene's extent)
+/// whose faces have the names the path gives.
+fn diffracted_edges(scene: &Scene, path: &PathReport) -> Vec<EdgeId> {
+    let edges = scene.edges();
+    if let Some(d) = path.diffraction {
+        return (d.edge.index() < edges.len())
+            .then_some(d.edge)
+            .into_iter()
+            .collect();
+    }
+    let tol = bt_geom::tol::scaled(bt_scene::edges::REL_EDGE_MATCH, scene.extent());
+    let mut out = Vec::new();
+    let interactions = path
+        .interactions
+        .iter()
+        .zip(&path.points)
+        .zip(&path.surfaces);
+    for ((kind, point), faces) in interactions {
+        if *kind != InteractionKind::Diffraction {
+            continue;
+        }
+        let p = scene.to_local(Vec3::from_array(*point));
+        let near = |lo: Vec3, hi: Vec3| p.cmpge(lo - tol).all() && p.cmple(hi + tol).all();
+        edges.bvh().visit(near, |i| {
+            let edge = &edges.all()[i as usize];
+            let t = edge.parameter(p).clamp(0.0, edge.length);
+            if edge.point(t).distance(p) <= tol && face_names(scene, edge) == *faces {
+                out.push(EdgeId(i));
+            }
+        });
+    }
+    out
+}
+
+/// An edge's name in the trace documents' `surfaces`: `"A|B"` (face 0, face n) for a wedge,
+/// `"A"` for a free edge.
+fn face_names(scene: &Scene, edge: &Edge) -> String {
+    let face0 = &scene.surface(edge.face0).name;
+    if edge.is_free() {
+        face0.clone()
+    } else {
+        format!("{face0}|{}", scene.surface(edge.face_n).name)
+    }
+}
+
+fn edge_document(scene: &Scene, edge: &Edge) -> EdgeDocument {
+    EdgeDocument {
+        segment: [
+            scene.to_world(edge.start).to_array(),
+            scene.to_world(edge.end).to_array(),
+        ],
+        free: edge.is_free(),
+    }
 }
 
 /// Replace each placeholder of `template` once, in one pass over the template only: a value
@@ -321,6 +424,82 @@ mod tests {
     fn placeholders_inside_values_are_not_expanded() {
         let page = fill("a{{X}}b{{Y}}c", &[("{{X}}", "{{Y}}"), ("{{Y}}", "y")]);
         assert_eq!(page, "a{{Y}}byc");
+    }
+
+    /// A floating screen between TX and RX (no line of sight), traced with diffraction: a
+    /// path over each of its four free edges.
+    fn screen_and_paths() -> (Scene, Vec<PathReport>) {
+        let json = r#"{ "tx": [0.3, -3, 1.8], "rx": [-0.2, 3, 1.6],
+            "surfaces": [ { "name": "screen",
+                "vertices": [[-2, 0, 0], [2, 0, 0], [2, 0, 2], [-2, 0, 2]] } ] }"#;
+        let desc: bt_scene::SceneDescription = serde_json::from_str(json).unwrap();
+        let scene = Scene::from_description(&desc, "screen", Default::default()).unwrap();
+        let options = bt_solve::pipeline::TraceOptions {
+            parallel: false,
+            diffraction: bt_solve::pipeline::DiffractionOptions::first_order(),
+            ..bt_solve::pipeline::TraceOptions::new(1)
+        };
+        let ends = scene.terminals().unwrap();
+        let traced = bt_solve::Tracer::new(scene.clone(), options)
+            .trace(scene.to_world(ends.tx), scene.to_world(ends.rx))
+            .unwrap();
+        let reports = bt_beams::report(&scene, &traced.result.paths, &Default::default());
+        (scene, reports.unwrap())
+    }
+
+    /// The JSON document embedded in a page.
+    fn embedded(html: &str) -> serde_json::Value {
+        let start = html.find("id=\"beamtrace-data\">").unwrap() + "id=\"beamtrace-data\">".len();
+        let end = start + html[start..].find("</script>").unwrap();
+        serde_json::from_str(&html[start..end]).unwrap()
+    }
+
+    #[test]
+    fn a_screen_puts_its_free_edges_and_the_diffractions_in_the_document() {
+        let (scene, reports) = screen_and_paths();
+        let html = page(&[&scene], &[StepPaths::from_reports(&scene, &reports)]);
+        let step = &embedded(&html)["steps"][0];
+        assert_eq!(step["edge_count"], 4);
+        let edges = step["edges"].as_array().unwrap();
+        assert_eq!(edges.len(), 4, "a screen has four free edges");
+        assert!(edges.iter().all(|e| e["free"] == true));
+        let top = [[-2.0, 0.0, 2.0], [2.0, 0.0, 2.0]];
+        let segment = |e: &serde_json::Value| -> [[Real; 3]; 2] {
+            serde_json::from_value(e["segment"].clone()).unwrap()
+        };
+        assert!(
+            edges.iter().any(|e| {
+                let s = segment(e);
+                s == top || s == [top[1], top[0]]
+            }),
+            "the top edge, world frame: {edges:?}"
+        );
+        let paths = step["paths"].as_array().unwrap();
+        assert_eq!(paths.len(), 4, "one path over each edge: {paths:?}");
+        for p in paths {
+            assert_eq!(p["interactions"], serde_json::json!(["diffraction"]));
+            assert_eq!(p["surfaces"], serde_json::json!(["screen"]));
+        }
+    }
+
+    #[test]
+    fn over_the_cap_only_the_edges_of_the_shown_paths_are_drawn() {
+        let (scene, reports) = screen_and_paths();
+        assert_eq!(shown_edges(&scene, &reports, 4).len(), 4, "at the cap: all");
+        assert!(shown_edges(&scene, &[], 3).is_empty(), "no path, no edge");
+        let over = shown_edges(&scene, &reports[..1], 3);
+        assert_eq!(over, vec![reports[0].diffraction.unwrap().edge]);
+        // A path read back from a trace document has no edge id: found by its point and name.
+        let json = serde_json::to_string(&reports[..1]).unwrap();
+        let read: Vec<PathReport> = serde_json::from_str(&json).unwrap();
+        assert!(read[0].diffraction.is_none());
+        assert_eq!(shown_edges(&scene, &read, 3), over);
+        let mut renamed = read.clone();
+        renamed[0].surfaces = vec!["other".to_string()];
+        assert!(
+            shown_edges(&scene, &renamed, 3).is_empty(),
+            "faces must match"
+        );
     }
 
     #[test]
