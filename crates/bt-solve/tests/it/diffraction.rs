@@ -180,3 +180,17 @@ fn random_scenes_diffract_at_every_position() {
     assert!(positions.iter().all(|&n| n > 0), "{positions:?}");
     assert!(tree_candidates * 5 < blind, "{tree_candidates} of {blind}");
 }
+
+/// The join stops at the candidate budget with an error that names diffraction.
+#[test]
+fn the_diffracted_candidates_stop_at_the_budget() {
+    let scene = bt_import::builtin_scene("living-room", bt_scene::Terminals::default())
+        .unwrap()
+        .unwrap();
+    let options = TraceOptions {
+        max_candidates: 1000,
+        ..options(3, CandidateMode::BeamTree, Solver::Image)
+    };
+    let error = trace_scene(&scene, &options).unwrap_err().to_string();
+    assert!(error.contains("1000 diffracted candidates"), "{error}");
+}
