@@ -9,7 +9,8 @@
 //!
 //! WHAT: `cand` (beam-tree candidates), `image` / `exh` (whole image-method trace with the beam
 //! tree / exhaustive candidates), `ipc` (whole IPC Gauss-Seidel trace), `walk` (a new RX on a
-//! kept tree, walk only), `newrx` (walk + image method + validation).
+//! kept tree, walk only), `newrx` (walk + image method + validation), `diff` (candidates with
+//! one diffraction), `rxtree` (a tree materialised to depth 2, as the RX side of `diff`).
 
 use bt_paths::beamtree::{BeamTree, TreeCache, TreeOptions, candidates_in};
 use bt_scene::{Scene, Terminals, Vec3};
@@ -100,6 +101,17 @@ fn run(what: &str, scene: &Scene, i: usize, tree: &BeamTree, kept: &mut Kept) ->
             )
         }
         "walk" => tree.candidates(moved_rx(scene, i)).len(),
+        "diff" => bt_paths::beamtree::candidates_and_diffracted_in(
+            scene,
+            TreeOptions::new(3),
+            Some(0.0),
+            &mut kept.cache,
+            &mut |_| {},
+        )
+        .unwrap()
+        .diffracted
+        .len(),
+        "rxtree" => BeamTree::build(scene, TreeOptions::new(2)).unwrap().len(),
         "newrx" => {
             let rx = moved_rx(scene, i);
             let set = tree.candidates(rx);
@@ -109,7 +121,9 @@ fn run(what: &str, scene: &Scene, i: usize, tree: &BeamTree, kept: &mut Kept) ->
                 .paths
                 .len()
         }
-        other => panic!("unknown workload {other:?}: cand, image, exh, ipc, walk or newrx"),
+        other => {
+            panic!("unknown workload {other:?}: cand, image, exh, ipc, walk, newrx, diff or rxtree")
+        }
     }
 }
 

@@ -43,10 +43,11 @@ impl BeamTree {
     /// exterior and whose beam reaches the edge, per edge of `usable` (`usable[e]`).
     fn reaches(&self, scene: &Scene, usable: &[bool], max_depth: usize) -> Vec<Vec<Reach>> {
         let edges = scene.edges();
+        let sectors: Vec<Sector> = edges.all().iter().map(Sector::of).collect();
         let eps = EPS * self.tol;
         let mut out: Vec<Vec<Reach>> = vec![Vec::new(); edges.len()];
         for (e, edge) in edges.all().iter().enumerate() {
-            if usable[e] && in_sector(edge, self.tx) {
+            if usable[e] && sectors[e].holds(edge, self.tx) {
                 out[e].push(Reach {
                     node: ROOT,
                     depth: 0,
@@ -66,7 +67,7 @@ impl BeamTree {
                 let test = |min, max| box_meets_halfspaces(min, max, planes, eps);
                 edges.bvh().visit(test, |e| {
                     let edge = &edges.all()[e as usize];
-                    if !usable[e as usize] || !in_sector(edge, node.image) {
+                    if !usable[e as usize] || !sectors[e as usize].holds(edge, node.image) {
                         return;
                     }
                     if let Some((lo, hi)) = clip(edge, planes, eps) {
@@ -96,15 +97,37 @@ impl BeamTree {
     }
 }
 
-/// Whether `p` lies in the edge's exterior sector, up to [`EXTERIOR_SLACK_RAD`] (points on
-/// the edge line are in no sector).
-fn in_sector(edge: &Edge, p: Vec3) -> bool {
-    if edge.perpendicular(p).length_squared() == 0.0 {
-        return false;
+/// An edge's exterior sector in a form tested without trigonometry: `y0 = e × t0` and the
+/// in-plane direction of face n, `f_n = cos(nπ)·t0 + sin(nπ)·y0`.
+#[derive(Debug, Clone, Copy)]
+struct Sector {
+    y0: Vec3,
+    face_n: Vec3,
+}
+
+impl Sector {
+    fn of(edge: &Edge) -> Sector {
+        let y0 = edge.direction.cross(edge.t0);
+        let (sin, cos) = (edge.n * PI).sin_cos();
+        Sector {
+            y0,
+            face_n: cos * edge.t0 + sin * y0,
+        }
     }
-    let phi = edge.angle(p);
-    let wedge = edge.n * PI;
-    phi < wedge + EXTERIOR_SLACK_RAD || phi > 2.0 * PI - EXTERIOR_SLACK_RAD
+
+    /// Whether `p` lies in the edge's exterior, φ ∈ (0, nπ), up to [`EXTERIOR_SLACK_RAD`]
+    /// (points on the edge line are in no sector). With v = p's offset ⊥ the edge and r = |v|:
+    /// φ ∈ [−slack, π + slack] where v·y0 ≥ −slack·r; beyond a half-turn (n > 1), φ ≤ nπ +
+    /// slack where v turns counter-clockwise into f_n: (v × f_n)·e ≥ −slack·r.
+    fn holds(&self, edge: &Edge, p: Vec3) -> bool {
+        let v = edge.perpendicular(p);
+        let r = v.length();
+        if r == 0.0 {
+            return false;
+        }
+        let slack = EXTERIOR_SLACK_RAD * r;
+        v.dot(self.y0) >= -slack || v.cross(self.face_n).dot(edge.direction) >= -slack
+    }
 }
 
 /// The parameter interval of `edge` inside every half-space `{x : plane(x) ≥ −eps}`, or
