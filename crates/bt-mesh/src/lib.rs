@@ -142,6 +142,11 @@ pub struct MeshSurface {
     pub normal: Vec3,
     /// Area of the polygon `vertices` in m².
     pub area_m2: Real,
+    /// Area in m² of the whole coplanar region this surface outlines a part of: the sum of
+    /// `area_m2` over the surfaces of one group of merged faces (several when a region with
+    /// holes was split into pieces, or touches itself at a vertex). Importers judge a surface's
+    /// size by it, so that a piece of a large ground still reflects.
+    pub region_area_m2: Real,
     /// Number of faces of the file merged into this surface.
     pub source_faces: usize,
 }

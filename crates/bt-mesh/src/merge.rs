@@ -94,6 +94,7 @@ pub(crate) fn merge(mesh: &RawMesh, opts: &MergeOptions, file: &str) -> Merged {
             .0
             .map_or("face", |n| mesh.names[n as usize].as_str());
         let material = first.key.1.map(|m| mesh.materials[m as usize].clone());
+        let region_area: Real = outlines.iter().map(|o| o.area).sum();
         for Outline {
             points: outline,
             area,
@@ -107,6 +108,7 @@ pub(crate) fn merge(mesh: &RawMesh, opts: &MergeOptions, file: &str) -> Merged {
                 vertices: outline.into_iter().map(|p| frame.lift(p)).collect(),
                 normal: frame.normal,
                 area_m2: area,
+                region_area_m2: region_area,
                 source_faces,
             });
             *counter += 1;

@@ -158,6 +158,8 @@ fn ground_with_a_footprint_is_split_not_filled() {
     assert_eq!(import.surfaces.len(), 2, "{:#?}", import.surfaces);
     let total_sources: usize = import.surfaces.iter().map(|s| s.source_faces).sum();
     assert_eq!(total_sources, 8);
+    // Both pieces are judged by the ground's area: a small one still reflects.
+    assert!(import.surfaces.iter().all(|s| s.region_area_m2 == 8.0));
 }
 
 #[test]
@@ -293,6 +295,12 @@ fn ring_closed_by_a_t_junction_splits_where_it_touches() {
     let areas: Vec<Real> = import.surfaces.iter().map(|s| s.area_m2).collect();
     assert_eq!(areas.len(), 2, "{:#?}", import.surfaces);
     assert!((areas[0] - 6.0).abs() < 1e-12 && (areas[1] - 1.6).abs() < 1e-12);
+    assert!(
+        import
+            .surfaces
+            .iter()
+            .all(|s| (s.region_area_m2 - 7.6).abs() < 1e-12)
+    );
 }
 
 #[test]

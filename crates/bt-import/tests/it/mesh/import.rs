@@ -253,6 +253,33 @@ fn ring_with_hole_is_split_into_simple_pieces() {
 }
 
 #[test]
+fn pieces_of_a_large_region_reflect() {
+    // The ring's pieces are judged by the ring's area, 8 m², not by their own: a threshold
+    // above the smaller piece still makes every piece a reflector.
+    let (vertices, faces) = unit_grid_without(1.0, &[(1, 1)]);
+    let import = read_obj(obj_text(&vertices, &faces).as_bytes(), None, &opts()).unwrap();
+    let smallest = import
+        .surfaces
+        .iter()
+        .map(|s| s.area_m2)
+        .fold(f64::INFINITY, f64::min);
+    assert!(smallest < 7.5, "{:#?}", import.surfaces);
+    let options = bt_import::LoadOptions {
+        min_reflector_area_m2: smallest + 0.5,
+        ..Default::default()
+    };
+    let loaded = bt_import::mesh::scene::from_mesh(import, "ring", "ring.obj", &options).unwrap();
+    assert_eq!(loaded.scene.surfaces().len(), 2);
+    assert!(
+        loaded
+            .scene
+            .surfaces()
+            .iter()
+            .all(|s| s.kind == bt_scene::SurfaceKind::Reflector)
+    );
+}
+
+#[test]
 fn hole_touching_the_outline_at_a_vertex_is_kept_open() {
     // 3 x 3 unit grid without the centre cell (1, 1) and the corner cell (2, 2): the hole and
     // the outer boundary meet at the vertex (2, 2).
