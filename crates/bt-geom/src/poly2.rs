@@ -94,6 +94,74 @@ pub fn first_crossing(pts: &[Vec2]) -> Option<(usize, usize)> {
     None
 }
 
+/// First pair `(i, j)`, `i < j`, of edges that come within `eps` metres of each other where a
+/// polygon simple by a margin of `eps` has none: two non-adjacent edges closer than `eps` (or
+/// touching), or two adjacent edges where the far end of one lies within `eps` of the other (a
+/// fold back, or a corner sharper than the margin). Edge `i` runs from vertex `i` to vertex
+/// `i + 1`. With `eps = 0` the non-adjacent part is [`first_crossing`]'s test. The caller
+/// ensures at least three vertices and no zero-length edge (the distances assume it).
+///
+/// Edges are swept in the order of their smallest x, so polygons whose edges are short compared
+/// with their extent (outlines of merged mesh regions, thousands of vertices) cost about
+/// n log n instead of n² pairs.
+pub fn first_contact(pts: &[Vec2], eps: Real) -> Option<(usize, usize)> {
+    let n = pts.len();
+    let ends = |i: usize| (pts[i], pts[(i + 1) % n]);
+    // Whether the edges' bounding boxes, grown by `eps`, overlap; then the exact rule.
+    let near = |i: usize, j: usize| {
+        let ((a, b), (c, d)) = (ends(i), ends(j));
+        let apart = |lo1: Real, hi1: Real, lo2: Real, hi2: Real| lo2 > hi1 + eps || lo1 > hi2 + eps;
+        !apart(a.x.min(b.x), a.x.max(b.x), c.x.min(d.x), c.x.max(d.x))
+            && !apart(a.y.min(b.y), a.y.max(b.y), c.y.min(d.y), c.y.max(d.y))
+            && edges_in_contact(pts, (i.min(j), i.max(j)), eps)
+    };
+    // Most outlines are a few vertices: every pair, in order, costs less than sorting.
+    if n <= 16 {
+        return (0..n)
+            .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
+            .find(|&(i, j)| near(i, j));
+    }
+    let low_x = |i: usize| pts[i].x.min(pts[(i + 1) % n].x);
+    let mut order: Vec<usize> = (0..n).collect();
+    order.sort_by(|&a, &b| low_x(a).total_cmp(&low_x(b)).then(a.cmp(&b)));
+    let mut first: Option<(usize, usize)> = None;
+    for (k, &i) in order.iter().enumerate() {
+        let (a, b) = ends(i);
+        let high_x = a.x.max(b.x) + eps;
+        for &j in &order[k + 1..] {
+            if low_x(j) > high_x {
+                break;
+            }
+            let pair = (i.min(j), i.max(j));
+            if first.is_none_or(|f| pair < f) && near(i, j) {
+                first = Some(pair);
+            }
+        }
+    }
+    first
+}
+
+/// Whether edges `i < j` of the closed polygon `pts` are in contact by [`first_contact`]'s rule.
+fn edges_in_contact(pts: &[Vec2], (i, j): (usize, usize), eps: Real) -> bool {
+    let n = pts.len();
+    let eps2 = eps * eps;
+    let (a, b) = (pts[i], pts[(i + 1) % n]);
+    let (c, d) = (pts[j], pts[(j + 1) % n]);
+    if j == i + 1 {
+        // b == c: the far ends are a and d.
+        return segment_distance_sq(d, a, b) <= eps2 || segment_distance_sq(a, c, d) <= eps2;
+    }
+    if i == 0 && j == n - 1 {
+        // d == a: the far ends are b and c.
+        return segment_distance_sq(c, a, b) <= eps2 || segment_distance_sq(b, c, d) <= eps2;
+    }
+    segments_touch(a, b, c, d)
+        || segment_distance_sq(a, c, d) <= eps2
+        || segment_distance_sq(b, c, d) <= eps2
+        || segment_distance_sq(c, a, b) <= eps2
+        || segment_distance_sq(d, a, b) <= eps2
+}
+
 /// Whether the closed polygon is simple: at least three finite vertices, no zero-length edge, no
 /// two non-adjacent edges touching, and no two consecutive edges folding back onto each other.
 pub fn is_simple(pts: &[Vec2]) -> bool {
@@ -234,6 +302,75 @@ mod tests {
         assert!(!is_simple(&repeated));
         let nan = [v(0.0, 0.0), v(Real::NAN, 0.0), v(0.0, 1.0)];
         assert!(!is_simple(&nan));
+    }
+
+    #[test]
+    fn contact_within_a_margin() {
+        let sq = [v(0.0, 0.0), v(1.0, 0.0), v(1.0, 1.0), v(0.0, 1.0)];
+        assert_eq!(first_contact(&sq, 0.0), None);
+        assert_eq!(first_contact(&sq, 0.4), None);
+        // Adjacent edges' far ends are 1 m from the other edge.
+        assert_eq!(first_contact(&sq, 1.0), Some((0, 1)));
+        let bow = [v(0.0, 0.0), v(1.0, 1.0), v(1.0, 0.0), v(0.0, 1.0)];
+        assert_eq!(first_contact(&bow, 0.0), Some((0, 2)));
+        // A notch whose tip comes 1 mm from the opposite edge: simple, but not by 1 cm.
+        let notch = [
+            v(0.0, 0.0),
+            v(2.0, 0.0),
+            v(2.0, 1.0),
+            v(1.0, 1.0),
+            v(1.0, 0.001),
+            v(0.9, 1.0),
+            v(0.0, 1.0),
+        ];
+        assert_eq!(first_contact(&notch, 0.0), None);
+        assert_eq!(first_contact(&notch, 0.01), Some((0, 3)));
+        // A T-junction: vertex 4 lies on edge 0.
+        let touching = [
+            v(0.0, 0.0),
+            v(2.0, 0.0),
+            v(2.0, 1.0),
+            v(1.5, 1.0),
+            v(1.0, 0.0),
+            v(0.5, 1.0),
+            v(0.0, 1.0),
+        ];
+        assert_eq!(first_contact(&touching, 0.0), first_crossing(&touching));
+        assert!(first_contact(&touching, 0.0).is_some());
+        // The sweep for long outlines finds what checking every pair finds: a comb of 20 teeth
+        // (82 vertices) whose tips are 1 m above the base edge, then one tip 0.3 m above it,
+        // then one on it.
+        let brute = |pts: &[Vec2], eps: Real| {
+            let n = pts.len();
+            (0..n)
+                .flat_map(|i| (i + 1..n).map(move |j| (i, j)))
+                .find(|&pair| edges_in_contact(pts, pair, eps))
+        };
+        let mut comb = vec![v(0.0, 0.0), v(80.0, 0.0)];
+        for t in (0..20).rev() {
+            let x = 4.0 * Real::from(t);
+            comb.extend([
+                v(x + 4.0, 5.0),
+                v(x + 3.0, 5.0),
+                v(x + 2.0, 1.0),
+                v(x + 1.0, 5.0),
+            ]);
+        }
+        assert_eq!(comb.len(), 82);
+        for eps in [0.0, 0.5] {
+            assert_eq!(first_contact(&comb, eps), None);
+        }
+        comb[44].y = 0.3;
+        assert_eq!(first_contact(&comb, 0.0), None);
+        assert_eq!(first_contact(&comb, 0.5), Some((0, 43)));
+        comb[44].y = 0.0;
+        assert_eq!(first_contact(&comb, 0.0), first_crossing(&comb));
+        for eps in [0.0, 0.5, 0.99, 1.5] {
+            assert_eq!(first_contact(&comb, eps), brute(&comb, eps), "eps {eps}");
+        }
+        // A fold back: vertex 2 returns onto edge 0.
+        let fold = [v(0.0, 0.0), v(2.0, 0.0), v(1.0, 0.0), v(1.0, 1.0)];
+        assert_eq!(first_contact(&fold, 0.0), Some((0, 1)));
     }
 
     #[test]

@@ -18,7 +18,8 @@ pub struct LoadOptions {
     pub terminals: Terminals,
     /// Coplanar-merge tolerances for meshes.
     pub merge: bt_mesh::MergeOptions,
-    /// Mesh surfaces smaller than this (m²) become blockers (default 0.25 m², as the paper).
+    /// Mesh surfaces smaller than this (m²) become blockers (default 0.25 m², as the paper); the
+    /// pieces of a region split around holes count with the whole region's area.
     pub min_reflector_area_m2: Real,
     /// Carrier frequency for meshes and point clouds, Hz (default 28 GHz).
     pub frequency_hz: Real,

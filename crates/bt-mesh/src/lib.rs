@@ -2,23 +2,29 @@
 //!
 //! A room exported from a 3-D tool is a soup of triangles and polygons. The readers of
 //! `bt-import` (OBJ, PLY) parse one into a [`RawMesh`]; [`merge_mesh`] welds duplicated
-//! vertices, merges edge-connected coplanar faces into groups and traces each group's boundary
-//! into one polygon: a [`MeshSurface`]. No file parsing and no I/O here.
+//! vertices, merges edge-connected coplanar faces into groups and outlines each group by
+//! simple polygons: [`MeshSurface`]s. No file parsing and no I/O here.
 //!
 //! Units and frame: coordinates are taken as metres in the file's own frame (beamtrace uses
 //! z up; no axis swap is applied). Areas are m², angles in the options are degrees.
 //!
 //! Decisions and limits:
 //! - Faces merge only with faces of the same object/group name and the same material.
-//! - A group's boundary loops are split by orientation seen from the group normal: every
-//!   counter-clockwise loop becomes a surface (`<name>_<k>`, in discovery order); clockwise
-//!   loops are holes. Holes are not supported yet: the outer loop is kept (the hole is filled,
-//!   `area_m2` includes it) and a warning names the surface.
-//! - Non-manifold edges (used by more than two faces) do not merge across unless the faces
-//!   are coplanar; boundary chains that do not close are skipped with a warning.
+//! - Nothing is lost or filled: the surfaces' areas add up to the faces' (up to the removal of
+//!   collinear vertices within `weld_tol_m`). A group whose boundary is one or more simple
+//!   counter-clockwise loops (seen from the group normal) gives one surface per loop. A group
+//!   with holes (a ground with building footprints), open or non-manifold boundaries, or
+//!   faces overlapping in its plane is split into simple pieces made of its own faces, grown
+//!   greedily so that there are few (`split`); seams between pieces are coplanar. Surfaces are
+//!   named `<name>_<k>` in output order.
+//! - Every surface is simple with a margin of the weld tolerance (no two non-adjacent edges
+//!   closer, so rounding cannot make it touch itself in `bt_geom::Polygon`'s exact test) and
+//!   has at most `bt_geom::polygon::MAX_VERTICES` vertices; it need not be convex.
+//! - Coincident duplicate faces (the same welded vertices, either winding) are kept once and
+//!   counted in a warning.
 //! - Degenerate faces (fewer than three distinct welded vertices, or height under the weld
 //!   tolerance) are dropped and counted in a warning. Polygon faces that are not planar within
-//!   `dist_tol_m` are split into fan triangles with a warning.
+//!   `dist_tol_m`, or touch themselves, are split into fan triangles with a warning.
 //! - Output polygon vertices are projected onto the group's plane (moving them at most
 //!   `dist_tol_m`), so every surface is exactly planar up to rounding.
 
@@ -26,9 +32,15 @@
 
 use bt_geom::{Real, Vec3};
 
+mod edges;
 mod merge;
+mod outline;
 mod raw;
+mod split;
+#[cfg(test)]
+mod tests;
 pub mod tol;
+mod trace;
 
 use serde::{Deserialize, Serialize};
 
@@ -115,19 +127,26 @@ impl MergeOptions {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MeshSurface {
     /// `<object>_<k>` with the OBJ object/group name (`face_<k>` when the face has none, as in
-    /// every PLY file); `k` counts surfaces of that name from 0 in output order.
+    /// every PLY file); `k` counts surfaces of that name from 0 in output order (a group split
+    /// into pieces gives several).
     pub name: String,
     /// The OBJ `usemtl` material in effect for the faces, if any (no `.mtl` file is read).
     pub material: Option<String>,
-    /// Outer boundary in metres, counter-clockwise seen from `normal` (right-hand rule gives
-    /// `normal`), no repeated or collinear vertices, at least three, all on one plane.
+    /// Boundary in metres, counter-clockwise seen from `normal` (right-hand rule gives
+    /// `normal`), no repeated or collinear vertices, at least three, all on one plane; a
+    /// simple polygon (no hole).
     pub vertices: Vec<Vec3>,
     /// Unit normal: the area-weighted average of the merged faces' normals, following the
     /// faces' winding (usually pointing into the room for exported interiors — whatever the
     /// file says).
     pub normal: Vec3,
-    /// Area of the polygon `vertices` in m² (holes, if any, are included).
+    /// Area of the polygon `vertices` in m².
     pub area_m2: Real,
+    /// Area in m² of the whole coplanar region this surface outlines a part of: the sum of
+    /// `area_m2` over the surfaces of one group of merged faces (several when a region with
+    /// holes was split into pieces, or touches itself at a vertex). Importers judge a surface's
+    /// size by it, so that a piece of a large ground still reflects.
+    pub region_area_m2: Real,
     /// Number of faces of the file merged into this surface.
     pub source_faces: usize,
 }
@@ -137,8 +156,8 @@ pub struct MeshSurface {
 pub struct MeshImport {
     /// Surfaces in the order of their first face in the file.
     pub surfaces: Vec<MeshSurface>,
-    /// Human-readable notes about skipped or altered input (dropped faces, filled holes,
-    /// ignored statements), each starting with the file name.
+    /// Human-readable notes about altered input (degenerate faces dropped, duplicates merged,
+    /// faces split, ignored statements), each starting with the file name.
     pub warnings: Vec<String>,
     /// Number of faces in the file, before any was dropped or merged.
     pub faces_read: usize,

@@ -2,23 +2,23 @@
 //!
 //! 1. Weld positions closer than `weld_tol_m` (exporters duplicate vertices per face).
 //! 2. Per face: drop repeated vertices, compute the area vector (Newell), drop zero-area faces,
-//!    split faces that are not planar within `dist_tol_m` into fan triangles.
-//! 3. Region growing over the edge adjacency graph in file order: a face joins its neighbour's
+//!    split faces that are not planar within `dist_tol_m`, or not simple, into fan triangles.
+//! 3. Drop coincident duplicates (the same welded vertices, in either winding): one copy stays.
+//! 4. Region growing over the edge adjacency graph in file order: a face joins its neighbour's
 //!    group when it has the same object/group name and material, its normal is within
 //!    `angle_tol_deg` of the group's area-weighted normal and all its vertices are within
 //!    `dist_tol_m` of the group's plane. Checking against the group (not the neighbour) keeps
 //!    a finely tessellated curved surface from merging into one "plane" by drift.
-//! 4. Boundary: the group's edges used by exactly one of its faces, traced into loops keeping
-//!    the group's interior on the left (the sharpest right turn at vertices where several
-//!    boundary edges meet, so pinched regions give separate simple loops).
-//! 5. Loops are projected onto the group's plane, cleaned of collinear vertices; counter-
-//!    clockwise loops (seen from the normal) become surfaces, clockwise loops are holes, which
-//!    are filled with a warning.
+//! 5. Outlines in the group's plane: the whole traced boundary when it is one or more simple
+//!    loops without holes ([`crate::trace`]), otherwise simple pieces of the group's own faces
+//!    ([`crate::split`]). Either way every face's area is in exactly one surface.
 
-use bt_geom::poly2::{self, contains, signed_area};
+use bt_geom::poly2::{self, first_contact};
 use bt_geom::{Real, Vec2, Vec3};
 use std::collections::HashMap;
 
+use crate::edges::EdgeTable;
+use crate::outline::{Frame, Outline};
 use crate::raw::RawMesh;
 use crate::tol;
 use crate::{MergeOptions, MeshSurface};
@@ -30,19 +30,42 @@ pub(crate) struct Merged {
 }
 
 /// A planar face after welding, with its plane.
-struct Face {
-    /// Welded vertex ids, no two consecutive equal, at least three.
-    vertices: Vec<u32>,
+pub(crate) struct Face {
+    /// Welded vertex ids, distinct, at least three, a simple polygon in its plane.
+    pub vertices: Vec<u32>,
     /// Index of the face in the file.
-    source: usize,
+    pub source: usize,
     /// Object/group name and material (interned indices).
-    key: (Option<u32>, Option<u32>),
+    pub key: (Option<u32>, Option<u32>),
     /// Unit normal (right-hand rule on the vertex order).
-    normal: Vec3,
+    pub normal: Vec3,
     /// Area in m².
-    area: Real,
+    pub area: Real,
     /// Vertex average, a point on the face's plane.
-    centroid: Vec3,
+    pub centroid: Vec3,
+}
+
+/// A set of coplanar, edge-connected faces.
+pub(crate) struct Group {
+    /// Indices into the face list, ascending.
+    pub faces: Vec<usize>,
+    /// Number of distinct file faces.
+    pub source_faces: usize,
+}
+
+/// What became of the file's faces on the way to [`Face`]s, for the warnings.
+#[derive(Default)]
+struct FaceCounts {
+    /// Zero-area faces dropped.
+    degenerate: usize,
+    /// Polygon faces not planar within `dist_tol_m`, split into fan triangles.
+    non_planar: usize,
+    /// Polygon faces that touch or cross themselves, split into fan triangles.
+    non_simple: usize,
+    /// Faces coincident with an earlier one, dropped.
+    duplicates: usize,
+    /// Faces that are no valid polygon even alone (thinner than the tolerances), dropped.
+    unusable: usize,
 }
 
 /// Runs the whole merge. `opts` must be validated.
@@ -50,92 +73,79 @@ pub(crate) fn merge(mesh: &RawMesh, opts: &MergeOptions, file: &str) -> Merged {
     let extent = bounding_diagonal(&mesh.positions);
     let zero_length = opts.weld_tol_m.max(tol::REL_ZERO_LENGTH * extent.max(1.0));
     let (weld_map, points) = weld(&mesh.positions, opts.weld_tol_m);
-    let mut warnings = Vec::new();
-
-    let (faces, degenerate, split) = planar_faces(mesh, &weld_map, &points, opts, zero_length);
-    if degenerate > 0 {
-        warnings.push(format!(
-            "{file}: {degenerate} degenerate (zero-area) faces dropped"
-        ));
-    }
-    if split > 0 {
-        warnings.push(format!(
-            "{file}: {split} non-planar polygon faces split into fan triangles"
-        ));
-    }
-
-    let edges = edge_table(&faces);
-    let groups = grow_regions(&faces, &edges, &points, opts);
+    let mut counts = FaceCounts::default();
+    let faces = planar_faces(mesh, &weld_map, &points, opts, zero_length, &mut counts);
+    let faces = drop_duplicates(faces, &mut counts);
+    let groups = grow_regions(&faces, &points, opts);
 
     let mut surfaces = Vec::new();
     let mut name_counts: HashMap<String, usize> = HashMap::new();
-    let mut open_chains = 0usize;
-    let mut zero_loops = 0usize;
     for group in &groups {
-        let traced = trace_group(&faces, group, &points, zero_length);
-        open_chains += traced.open_chains;
-        zero_loops += traced.zero_loops;
+        let frame = Frame::of_faces(&faces, &group.faces);
+        let outlines = crate::trace::whole_outlines(&faces, group, &frame, &points, zero_length)
+            .unwrap_or_else(|| {
+                let split = crate::split::split_group(&faces, group, &frame, &points, zero_length);
+                counts.unusable += split.unusable;
+                split.outlines
+            });
         let first = &faces[group.faces[0]];
-        if traced.outer.is_empty() {
-            warnings.push(format!(
-                "{file}: faces starting at face {} gave no closed boundary and were skipped",
-                first.source
-            ));
-            continue;
-        }
         let base = first
             .key
             .0
             .map_or("face", |n| mesh.names[n as usize].as_str());
         let material = first.key.1.map(|m| mesh.materials[m as usize].clone());
-        // Holes belong to the outer loop that contains their first vertex.
-        let mut holes_of = vec![(0usize, 0.0f64); traced.outer.len()];
-        for hole in &traced.holes {
-            let owner = traced
-                .outer
-                .iter()
-                .position(|outer| contains(&outer.points, hole.points[0]))
-                .unwrap_or(0);
-            holes_of[owner].0 += 1;
-            holes_of[owner].1 += -hole.area;
-        }
-        for (outer, (hole_count, hole_area)) in traced.outer.iter().zip(holes_of) {
+        let region_area: Real = outlines.iter().map(|o| o.area).sum();
+        for Outline {
+            points: outline,
+            area,
+            source_faces,
+        } in outlines
+        {
             let counter = name_counts.entry(base.to_owned()).or_insert(0);
-            let name = format!("{base}_{counter}");
-            *counter += 1;
-            if hole_count > 0 {
-                warnings.push(format!(
-                    "{file}: surface {name}: {hole_count} hole(s) of {hole_area:.4} m² in total \
-                     filled (holes are not supported yet; area_m2 includes them)"
-                ));
-            }
-            let vertices = outer
-                .points
-                .iter()
-                .map(|p| traced.origin + traced.u * p.x + traced.v * p.y)
-                .collect();
             surfaces.push(MeshSurface {
-                name,
+                name: format!("{base}_{counter}"),
                 material: material.clone(),
-                vertices,
-                normal: traced.normal,
-                area_m2: outer.area,
-                source_faces: group.source_faces,
+                vertices: outline.into_iter().map(|p| frame.lift(p)).collect(),
+                normal: frame.normal,
+                area_m2: area,
+                region_area_m2: region_area,
+                source_faces,
             });
+            *counter += 1;
         }
     }
-    if open_chains > 0 {
-        warnings.push(format!(
-            "{file}: {open_chains} open boundary chains ignored (non-manifold or \
-             inconsistently oriented faces)"
-        ));
+    Merged {
+        surfaces,
+        warnings: warnings(file, &counts),
     }
-    if zero_loops > 0 {
-        warnings.push(format!(
-            "{file}: {zero_loops} zero-area boundary loops ignored"
-        ));
-    }
-    Merged { surfaces, warnings }
+}
+
+/// The notes about faces dropped or split on the way.
+fn warnings(file: &str, counts: &FaceCounts) -> Vec<String> {
+    let mut warnings = Vec::new();
+    let mut note = |count: usize, what: &str| {
+        if count > 0 {
+            warnings.push(format!("{file}: {count} {what}"));
+        }
+    };
+    note(counts.degenerate, "degenerate (zero-area) faces dropped");
+    note(
+        counts.non_planar,
+        "non-planar polygon faces split into fan triangles",
+    );
+    note(
+        counts.non_simple,
+        "self-touching polygon faces split into fan triangles",
+    );
+    note(
+        counts.duplicates,
+        "duplicate faces (the same vertices as an earlier face) merged into one copy",
+    );
+    note(
+        counts.unusable,
+        "faces too thin to form a valid polygon on their own dropped",
+    );
+    warnings
 }
 
 fn bounding_diagonal(points: &[Vec3]) -> Real {
@@ -203,18 +213,17 @@ fn weld(positions: &[Vec3], tol: Real) -> (Vec<u32>, Vec<Vec3>) {
     (map, welded)
 }
 
-/// Builds the planar faces; returns them with the counts of dropped degenerate faces and of
-/// non-planar faces split into triangles.
+/// Builds the planar, simple faces, counting in `counts` the faces dropped as degenerate and
+/// the polygon faces split into fan triangles (not planar, or not simple).
 fn planar_faces(
     mesh: &RawMesh,
     weld_map: &[u32],
     points: &[Vec3],
     opts: &MergeOptions,
     zero_length: Real,
-) -> (Vec<Face>, usize, usize) {
+    counts: &mut FaceCounts,
+) -> Vec<Face> {
     let mut faces = Vec::with_capacity(mesh.face_count());
-    let mut degenerate = 0usize;
-    let mut split = 0usize;
     let mut ids: Vec<u32> = Vec::new();
     for f in 0..mesh.face_count() {
         ids.clear();
@@ -228,30 +237,48 @@ fn planar_faces(
             ids.pop();
         }
         let key = (mesh.face_name[f], mesh.face_material[f]);
-        match make_face(&ids, f, key, points, zero_length) {
-            None => degenerate += 1,
-            Some(face) => {
-                let off_plane = face
-                    .vertices
-                    .iter()
-                    .map(|&v| (points[v as usize] - face.centroid).dot(face.normal).abs())
-                    .fold(0.0, Real::max);
-                if off_plane <= opts.dist_tol_m {
-                    faces.push(face);
-                } else {
-                    split += 1;
-                    for k in 1..ids.len() - 1 {
-                        let tri = [ids[0], ids[k], ids[k + 1]];
-                        match make_face(&tri, f, key, points, zero_length) {
-                            Some(t) => faces.push(t),
-                            None => degenerate += 1,
-                        }
-                    }
-                }
+        let Some(face) = make_face(&ids, f, key, points, zero_length) else {
+            counts.degenerate += 1;
+            continue;
+        };
+        let planar = face.vertices.iter().all(|&v| {
+            (points[v as usize] - face.centroid).dot(face.normal).abs() <= opts.dist_tol_m
+        });
+        let simple = ids.len() == 3 || (planar && is_simple_face(&face, points, zero_length));
+        if planar && simple {
+            faces.push(face);
+            continue;
+        }
+        if planar {
+            counts.non_simple += 1;
+        } else {
+            counts.non_planar += 1;
+        }
+        for k in 1..ids.len() - 1 {
+            let tri = [ids[0], ids[k], ids[k + 1]];
+            match make_face(&tri, f, key, points, zero_length) {
+                Some(t) => faces.push(t),
+                None => counts.degenerate += 1,
             }
         }
     }
-    (faces, degenerate, split)
+    faces
+}
+
+/// Whether a planar polygon face is simple in its plane by a margin of `eps` metres (no vertex
+/// used twice, no edges touching).
+fn is_simple_face(face: &Face, points: &[Vec3], eps: Real) -> bool {
+    let u = face.normal.any_orthonormal_vector();
+    let v = face.normal.cross(u);
+    let local: Vec<Vec2> = face
+        .vertices
+        .iter()
+        .map(|&i| {
+            let d = points[i as usize] - face.centroid;
+            Vec2::new(d.dot(u), d.dot(v))
+        })
+        .collect();
+    first_contact(&local, eps).is_none()
 }
 
 /// A face from welded ids, or `None` when it is degenerate: fewer than three distinct vertices,
@@ -286,49 +313,71 @@ fn make_face(
     })
 }
 
-fn edge_key(a: u32, b: u32) -> u64 {
-    let (lo, hi) = if a < b { (a, b) } else { (b, a) };
-    (u64::from(lo) << 32) | u64::from(hi)
-}
-
-/// Every (undirected edge, face) pair, sorted by edge then face: the adjacency graph without a
-/// hash map per edge.
-fn edge_table(faces: &[Face]) -> Vec<(u64, u32)> {
-    let mut table: Vec<(u64, u32)> = Vec::new();
-    for (f, face) in faces.iter().enumerate() {
-        let n = face.vertices.len();
-        for i in 0..n {
-            table.push((
-                edge_key(face.vertices[i], face.vertices[(i + 1) % n]),
-                f as u32,
-            ));
+/// The faces without coincident duplicates: a face whose welded vertices are those of an
+/// earlier face, in the same cyclic order either way round, is dropped (counted in `counts`).
+/// Faces are sorted by length and the start of their canonical cycle, then index (no hashing,
+/// no allocation per face); only faces agreeing there are compared in full, so each set of
+/// copies is one run led by its first face.
+fn drop_duplicates(faces: Vec<Face>, counts: &mut FaceCounts) -> Vec<Face> {
+    let cycle = |i: usize| {
+        let vs = &faces[i].vertices;
+        (0..vs.len()).map(canonical_cycle(vs))
+    };
+    let mut order: Vec<((usize, [u32; 3]), usize)> = (0..faces.len())
+        .map(|i| {
+            let mut head = cycle(i);
+            let mut next = || head.next().unwrap_or(u32::MAX);
+            ((faces[i].vertices.len(), [next(), next(), next()]), i)
+        })
+        .collect();
+    order.sort_unstable();
+    let mut duplicate = vec![false; faces.len()];
+    for run in order
+        .chunk_by(|a, b| a.0 == b.0)
+        .filter(|run| run.len() > 1)
+    {
+        let mut copies: Vec<usize> = run.iter().map(|&(_, i)| i).collect();
+        if run[0].0.0 > 3 {
+            // Polygons agreeing in their first three vertices: order by the whole cycle.
+            copies.sort_by(|&a, &b| cycle(a).cmp(cycle(b)).then(a.cmp(&b)));
+        }
+        for same in copies.chunk_by(|&a, &b| cycle(a).eq(cycle(b))) {
+            for &i in &same[1..] {
+                duplicate[i] = true;
+            }
         }
     }
-    table.sort_unstable();
-    table.dedup();
-    table
+    counts.duplicates += duplicate.iter().filter(|&&d| d).count();
+    faces
+        .into_iter()
+        .zip(duplicate)
+        .filter_map(|(face, d)| (!d).then_some(face))
+        .collect()
 }
 
-/// A set of coplanar, edge-connected faces.
-struct Group {
-    /// Indices into the face list, the first is the lowest.
-    faces: Vec<usize>,
-    /// Number of distinct file faces.
-    source_faces: usize,
+/// The vertex cycle as a function of position: from its smallest id, continuing towards the
+/// smaller of that id's two neighbours; the same for every rotation and both windings.
+fn canonical_cycle(vs: &[u32]) -> impl Fn(usize) -> u32 + '_ {
+    let n = vs.len();
+    let low = (0..n).min_by_key(|&i| vs[i]).unwrap_or(0);
+    let forward = vs[(low + 1) % n] <= vs[(low + n - 1) % n];
+    move |k| {
+        if forward {
+            vs[(low + k) % n]
+        } else {
+            vs[(low + n - k % n) % n]
+        }
+    }
 }
 
-fn grow_regions(
-    faces: &[Face],
-    edges: &[(u64, u32)],
-    points: &[Vec3],
-    opts: &MergeOptions,
-) -> Vec<Group> {
+/// The groups of coplanar, edge-connected faces with the same name and material, in the
+/// order of their first face.
+fn grow_regions(faces: &[Face], points: &[Vec3], opts: &MergeOptions) -> Vec<Group> {
     let cos_tol = opts.angle_tol_deg.to_radians().cos();
+    let mut edges = EdgeTable::new(faces.iter().map(|f| f.vertices.as_slice()));
     let mut group_of: Vec<Option<u32>> = vec![None; faces.len()];
     let mut groups = Vec::new();
     let mut queue = std::collections::VecDeque::new();
-    // skip[i], for i the first index of an edge's run in `edges`: where its ungrouped faces begin.
-    let mut skip = vec![0u32; edges.len()];
     for seed in 0..faces.len() {
         if group_of[seed].is_some() {
             continue;
@@ -344,23 +393,8 @@ fn grow_regions(
             let face = &faces[f];
             let n = face.vertices.len();
             for i in 0..n {
-                let key = edge_key(face.vertices[i], face.vertices[(i + 1) % n]);
-                let start = edges.partition_point(|&(k, _)| k < key);
-                // Skip the leading run of faces on this edge that already have a group, so
-                // many faces on one edge (duplicated triangles) cost linear, not quadratic, time.
-                let mut first = skip[start].max(start as u32) as usize;
-                while first < edges.len()
-                    && edges[first].0 == key
-                    && group_of[edges[first].1 as usize].is_some()
-                {
-                    first += 1;
-                }
-                skip[start] = first as u32;
-                for &(k, other) in &edges[first..] {
-                    if k != key {
-                        break;
-                    }
-                    let other = other as usize;
+                let key = crate::edges::edge_key(face.vertices[i], face.vertices[(i + 1) % n]);
+                for other in edges.unsettled(key, |g| group_of[g].is_some()) {
                     if group_of[other].is_some() || faces[other].key != face.key {
                         continue;
                     }
@@ -383,209 +417,14 @@ fn grow_regions(
             }
         }
         members.sort_unstable();
-        let mut source_faces = 0;
-        let mut last = usize::MAX;
-        for &m in &members {
-            if faces[m].source != last {
-                source_faces += 1;
-                last = faces[m].source;
-            }
-        }
+        let mut sources: Vec<usize> = members.iter().map(|&m| faces[m].source).collect();
+        sources.dedup();
         groups.push(Group {
+            source_faces: sources.len(),
             faces: members,
-            source_faces,
         });
     }
     groups
-}
-
-/// A closed boundary loop in the group's plane coordinates (metres).
-struct Loop {
-    points: Vec<Vec2>,
-    /// Signed area in m²: positive counter-clockwise seen from the group normal.
-    area: Real,
-}
-
-/// The traced boundary of one group, with the plane frame its 2-D coordinates live in.
-struct Traced {
-    normal: Vec3,
-    origin: Vec3,
-    u: Vec3,
-    v: Vec3,
-    outer: Vec<Loop>,
-    holes: Vec<Loop>,
-    open_chains: usize,
-    zero_loops: usize,
-}
-
-/// The area-weighted normal and centroid of a group's faces.
-fn group_plane(faces: &[Face], group: &Group) -> (Vec3, Vec3) {
-    let mut normal_sum = Vec3::ZERO;
-    let mut centroid_sum = Vec3::ZERO;
-    let mut area_sum = 0.0;
-    for &f in &group.faces {
-        normal_sum += faces[f].normal * faces[f].area;
-        centroid_sum += faces[f].centroid * faces[f].area;
-        area_sum += faces[f].area;
-    }
-    (normal_sum.normalize(), centroid_sum / area_sum)
-}
-
-/// The group's boundary as directed edges `(from, to)` in face order: the half-edges whose
-/// undirected edge the group uses once.
-fn boundary_edges(faces: &[Face], group: &Group) -> Vec<(u32, u32)> {
-    let mut half: Vec<(u64, u32, u32)> = Vec::new();
-    for &f in &group.faces {
-        let vs = &faces[f].vertices;
-        for i in 0..vs.len() {
-            let (a, b) = (vs[i], vs[(i + 1) % vs.len()]);
-            half.push((edge_key(a, b), a, b));
-        }
-    }
-    let mut by_key: Vec<usize> = (0..half.len()).collect();
-    by_key.sort_by_key(|&h| half[h].0);
-    let mut is_boundary = vec![false; half.len()];
-    for run in by_key.chunk_by(|&x, &y| half[x].0 == half[y].0) {
-        if run.len() == 1 {
-            is_boundary[run[0]] = true;
-        }
-    }
-    half.iter()
-        .zip(&is_boundary)
-        .filter(|(_, b)| **b)
-        .map(|(&(_, a, b), _)| (a, b))
-        .collect()
-}
-
-fn trace_group(faces: &[Face], group: &Group, points: &[Vec3], zero_length: Real) -> Traced {
-    let (normal, origin) = group_plane(faces, group);
-    let u = normal.any_orthonormal_vector();
-    let v = normal.cross(u);
-    let project = |id: u32| {
-        let d = points[id as usize] - origin;
-        Vec2::new(d.dot(u), d.dot(v))
-    };
-    let boundary = boundary_edges(faces, group);
-    let mut outgoing: HashMap<u32, Vec<usize>> = HashMap::new();
-    for (h, &(a, _)) in boundary.iter().enumerate() {
-        outgoing.entry(a).or_default().push(h);
-    }
-
-    let mut traced = Traced {
-        normal,
-        origin,
-        u,
-        v,
-        outer: Vec::new(),
-        holes: Vec::new(),
-        open_chains: 0,
-        zero_loops: 0,
-    };
-    let mut used = vec![false; boundary.len()];
-    for start in 0..boundary.len() {
-        if used[start] {
-            continue;
-        }
-        let mut ids = vec![boundary[start].0];
-        let mut current = start;
-        let closed = loop {
-            let (from, at) = boundary[current];
-            let incoming = project(at) - project(from);
-            // Where several boundary edges leave one vertex (the region touches itself
-            // there), take the sharpest right turn: it follows the exterior wedge, so the
-            // loops separate into simple ones (outline and hole) instead of one self-touching
-            // loop that would hide the hole.
-            let next = outgoing
-                .get(&at)
-                .into_iter()
-                .flatten()
-                .copied()
-                .filter(|&h| !used[h] && h != current)
-                .map(|h| {
-                    let out = project(boundary[h].1) - project(at);
-                    (incoming.perp_dot(out).atan2(incoming.dot(out)), h)
-                })
-                .fold(None, |best: Option<(Real, usize)>, (turn, h)| match best {
-                    Some((bt, _)) if bt <= turn => best,
-                    _ => Some((turn, h)),
-                });
-            match next {
-                None => break false,
-                Some((_, h)) if h == start => break true,
-                Some((_, h)) => {
-                    used[h] = true;
-                    ids.push(at);
-                    current = h;
-                }
-            }
-        };
-        used[start] = true;
-        if !closed {
-            traced.open_chains += 1;
-            continue;
-        }
-        let pts = simplify(ids.into_iter().map(project).collect(), zero_length);
-        let area = signed_area(&pts);
-        let perimeter: Real = (0..pts.len())
-            .map(|i| pts[i].distance(pts[(i + 1) % pts.len()]))
-            .sum();
-        if pts.len() < 3 || area.abs() <= 0.5 * zero_length * perimeter {
-            traced.zero_loops += 1;
-        } else if area > 0.0 {
-            traced.outer.push(Loop { points: pts, area });
-        } else {
-            traced.holes.push(Loop { points: pts, area });
-        }
-    }
-    traced
-}
-
-/// Whether `p` is redundant between `a` and `b`: within `eps` of the line through them, or `a`
-/// and `b` coincide (a spike).
-fn redundant(a: Vec2, p: Vec2, b: Vec2, eps: Real) -> bool {
-    let ab = b - a;
-    let len = ab.length();
-    len <= eps || ab.perp_dot(p - a).abs() <= eps * len
-}
-
-/// Removes repeated, collinear and spike vertices of a closed loop until none is left.
-fn simplify(mut pts: Vec<Vec2>, eps: Real) -> Vec<Vec2> {
-    loop {
-        let before = pts.len();
-        let mut out: Vec<Vec2> = Vec::with_capacity(before);
-        for &p in &pts {
-            if out.last().is_some_and(|q| q.distance(p) <= eps) {
-                continue;
-            }
-            out.push(p);
-            while out.len() >= 3 {
-                let n = out.len();
-                if redundant(out[n - 3], out[n - 2], out[n - 1], eps) {
-                    out.remove(n - 2);
-                } else {
-                    break;
-                }
-            }
-        }
-        // Close the loop: the seam between the last and the first vertex.
-        while out.len() >= 2 && out[0].distance(out[out.len() - 1]) <= eps {
-            out.pop();
-        }
-        while out.len() >= 3 {
-            let n = out.len();
-            if redundant(out[n - 2], out[n - 1], out[0], eps) {
-                out.pop();
-            } else if redundant(out[n - 1], out[0], out[1], eps) {
-                out.remove(0);
-            } else {
-                break;
-            }
-        }
-        if out.len() == before || out.len() < 3 {
-            return out;
-        }
-        pts = out;
-    }
 }
 
 #[cfg(test)]
@@ -609,27 +448,15 @@ mod tests {
     }
 
     #[test]
-    fn simplify_removes_collinear_and_spikes() {
-        let square = [
-            (0.0, 0.0),
-            (0.5, 0.0),
-            (1.0, 0.0),
-            (1.0, 1.0),
-            (1.0, 2.0),
-            (1.0, 1.0),
-            (0.0, 1.0),
-            (0.0, 0.5),
-        ]
-        .map(|(x, y)| Vec2::new(x, y));
-        let out = simplify(square.to_vec(), 1e-9);
-        assert_eq!(out.len(), 4, "{out:?}");
-        assert!((signed_area(&out) - 1.0).abs() < 1e-12);
-    }
-
-    #[test]
-    fn point_in_polygon() {
-        let square = [(0.0, 0.0), (2.0, 0.0), (2.0, 2.0), (0.0, 2.0)].map(|(x, y)| Vec2::new(x, y));
-        assert!(contains(&square, Vec2::new(1.0, 1.0)));
-        assert!(!contains(&square, Vec2::new(3.0, 1.0)));
+    fn canonical_cycle_ignores_rotation_and_winding() {
+        let canonical = |vs: &[u32]| {
+            let c = canonical_cycle(vs);
+            (0..vs.len()).map(c).collect::<Vec<u32>>()
+        };
+        let expected = vec![1, 5, 9, 7];
+        for cycle in [[1, 5, 9, 7], [9, 7, 1, 5], [7, 9, 5, 1], [5, 1, 7, 9]] {
+            assert_eq!(canonical(&cycle), expected, "{cycle:?}");
+        }
+        assert_ne!(canonical(&[1, 9, 5, 7]), expected);
     }
 }

@@ -17,3 +17,8 @@ pub const DEFAULT_WELD_TOL_M: Real = 1e-4;
 /// 1 m) below which lengths count as zero even when `weld_tol_m` is 0: a few hundred ulps of
 /// f64 coordinates.
 pub const REL_ZERO_LENGTH: Real = 1e-12;
+
+/// Relative difference (dimensionless, to the area) allowed between an outline's area and the
+/// area of the faces it stands for, beyond what removing collinear vertices explains: rounding
+/// of sums over thousands of faces (1e-9, far below any lost face).
+pub const REL_AREA_MATCH: Real = 1e-9;

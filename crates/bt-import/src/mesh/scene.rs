@@ -3,9 +3,10 @@
 use crate::{ImportError, LoadOptions, Loaded};
 use bt_scene::{DEFAULT_MATERIAL, Material, RawSurface, Scene, SurfaceKind, default_materials};
 
-/// Build a scene from imported mesh surfaces: surfaces below the area threshold become blockers,
-/// material names of the ITU table (`itu_concrete`, ...) get that material as a half-space,
-/// other unknown names the default loss and radio model (with a warning).
+/// Build a scene from imported mesh surfaces: surfaces whose coplanar region is below the area
+/// threshold become blockers, material names of the ITU table (`itu_concrete`, ...) get that
+/// material as a half-space, other unknown names the default loss and radio model (with a
+/// warning).
 pub fn from_mesh(
     import: bt_mesh::MeshImport,
     name: &str,
@@ -43,7 +44,7 @@ pub fn from_mesh(
                 m
             }
         });
-        let kind = if s.area_m2 >= options.min_reflector_area_m2 {
+        let kind = if s.region_area_m2 >= options.min_reflector_area_m2 {
             SurfaceKind::Reflector
         } else {
             SurfaceKind::Blocker

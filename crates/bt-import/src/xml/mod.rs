@@ -159,7 +159,7 @@ pub fn load_xml(path: &Path, options: &LoadOptions) -> Result<Loaded, ImportErro
             .extend(import.surfaces.into_iter().map(|s| SurfaceDesc {
                 name: format!("{}.{}", shape.name, s.name),
                 material: material.clone(),
-                kind: Some(if s.area_m2 >= options.min_reflector_area_m2 {
+                kind: Some(if s.region_area_m2 >= options.min_reflector_area_m2 {
                     SurfaceKind::Reflector
                 } else {
                     SurfaceKind::Blocker

@@ -2,7 +2,7 @@
 
 use crate::mesh::common::*;
 use bt_import::mesh::{MeshError, Position, read_mesh_path, read_obj, read_ply};
-use bt_mesh::{MergeError, MergeOptions};
+use bt_mesh::{MergeError, MergeOptions, MeshImport};
 use glam::{DVec2, DVec3};
 
 const TOL: f64 = 1e-9;
@@ -213,26 +213,74 @@ fn unit_grid_without(z: f64, missing: &[(usize, usize)]) -> (Vec<DVec3>, Vec<Vec
     (vertices, faces)
 }
 
+/// Checks that `import` has no warnings, its surfaces are consistent polygons in the plane
+/// z = `z` with normal +z holding `area` m² together, and the in-plane point `hole` lies in none.
+fn assert_holed_floor(import: &MeshImport, z: f64, area: f64, hole: DVec2) {
+    assert!(import.warnings.is_empty(), "{:?}", import.warnings);
+    let total: f64 = import.surfaces.iter().map(|s| s.area_m2).sum();
+    assert!((total - area).abs() < TOL, "area {total}, expected {area}");
+    for s in &import.surfaces {
+        assert_polygon_consistent(s, TOL);
+        assert!(s.normal.distance(DVec3::Z) < TOL);
+        assert!(s.vertices.iter().all(|v| (v.z - z).abs() < TOL));
+        let flat: Vec<DVec2> = s.vertices.iter().map(|v| v.truncate()).collect();
+        assert!(
+            !bt_geom::poly2::contains(&flat, hole),
+            "{} covers the hole",
+            s.name
+        );
+    }
+}
+
 #[test]
-fn ring_with_hole_keeps_outer_loop_and_warns() {
-    // 3 x 3 unit grid without its centre cell.
+fn ring_with_hole_is_split_into_simple_pieces() {
+    // 3 x 3 unit grid without its centre cell: a hole is no reflector, so the ring is cut into
+    // pieces of its own faces, none covering the hole.
     let (vertices, faces) = unit_grid_without(1.0, &[(1, 1)]);
     let text = format!("o floor\n{}", obj_text(&vertices, &faces));
     let import = read_obj(text.as_bytes(), Some("ring.obj"), &opts()).unwrap();
-    assert_surfaces(&import, &[(DVec3::Z, 9.0)], TOL);
-    assert_eq!(import.surfaces[0].vertices.len(), 4);
-    assert!(
+    assert_holed_floor(&import, 1.0, 8.0, DVec2::new(1.5, 1.5));
+    let names: Vec<&str> = import.surfaces.iter().map(|s| s.name.as_str()).collect();
+    assert_eq!(names, ["floor_0", "floor_1"]);
+    assert_eq!(
         import
-            .warnings
+            .surfaces
             .iter()
-            .any(|w| w.contains("floor_0") && w.contains("hole")),
-        "{:?}",
-        import.warnings
+            .map(|s| s.source_faces)
+            .sum::<usize>(),
+        8
     );
 }
 
 #[test]
-fn hole_touching_the_outline_at_a_vertex_is_separated() {
+fn pieces_of_a_large_region_reflect() {
+    // The ring's pieces are judged by the ring's area, 8 m², not by their own: a threshold
+    // above the smaller piece still makes every piece a reflector.
+    let (vertices, faces) = unit_grid_without(1.0, &[(1, 1)]);
+    let import = read_obj(obj_text(&vertices, &faces).as_bytes(), None, &opts()).unwrap();
+    let smallest = import
+        .surfaces
+        .iter()
+        .map(|s| s.area_m2)
+        .fold(f64::INFINITY, f64::min);
+    assert!(smallest < 7.5, "{:#?}", import.surfaces);
+    let options = bt_import::LoadOptions {
+        min_reflector_area_m2: smallest + 0.5,
+        ..Default::default()
+    };
+    let loaded = bt_import::mesh::scene::from_mesh(import, "ring", "ring.obj", &options).unwrap();
+    assert_eq!(loaded.scene.surfaces().len(), 2);
+    assert!(
+        loaded
+            .scene
+            .surfaces()
+            .iter()
+            .all(|s| s.kind == bt_scene::SurfaceKind::Reflector)
+    );
+}
+
+#[test]
+fn hole_touching_the_outline_at_a_vertex_is_kept_open() {
     // 3 x 3 unit grid without the centre cell (1, 1) and the corner cell (2, 2): the hole and
     // the outer boundary meet at the vertex (2, 2).
     let (vertices, faces) = unit_grid_without(0.0, &[(1, 1), (2, 2)]);
@@ -242,14 +290,8 @@ fn hole_touching_the_outline_at_a_vertex_is_separated() {
         &opts(),
     )
     .unwrap();
-    assert_surfaces(&import, &[(DVec3::Z, 8.0)], TOL);
-    assert_eq!(import.surfaces[0].vertices.len(), 6);
-    assert!(
-        import
-            .warnings
-            .iter()
-            .any(|w| w.contains("face_0") && w.contains("hole"))
-    );
+    assert_holed_floor(&import, 0.0, 7.0, DVec2::new(1.5, 1.5));
+    assert!(import.surfaces.len() <= 2, "{:#?}", import.surfaces);
 }
 
 #[test]

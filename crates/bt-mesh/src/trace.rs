@@ -1,0 +1,127 @@
+//! The whole-group outline: a group's boundary traced into loops, accepted when it is plain.
+//!
+//! Boundary edges are the half-edges whose undirected edge the group uses once; they are
+//! traced into loops keeping the group's interior on the left (the sharpest right turn at a
+//! vertex where several boundary edges meet, so a region that touches itself at a vertex gives
+//! separate simple loops). The group is plain when every chain closes, no loop is a hole
+//! (clockwise seen from the normal), each loop is an [`Outline`] and together they hold the
+//! faces' area. Anything else (holes, open or non-manifold boundaries, overlapping faces) is
+//! left to [`crate::split`], which loses nothing.
+
+use bt_geom::{Real, Vec2, Vec3};
+use std::collections::HashMap;
+
+use crate::edges::edge_key;
+use crate::merge::{Face, Group};
+use crate::outline::{Frame, Outline, area_matches, outline};
+
+/// The outlines of a plain group, in the order of their first boundary edge; `None` when the
+/// group is not plain and must be split.
+pub(crate) fn whole_outlines(
+    faces: &[Face],
+    group: &Group,
+    frame: &Frame,
+    points: &[Vec3],
+    eps: Real,
+) -> Option<Vec<Outline>> {
+    let loops = closed_loops(faces, group, frame, points)?;
+    let mut outlines = Vec::with_capacity(loops.len());
+    for ring in loops {
+        let cleaned = crate::outline::simplify(ring, eps);
+        let area = bt_geom::poly2::signed_area(&cleaned);
+        if cleaned.len() < 3 || area.abs() <= 0.5 * eps * crate::outline::perimeter(&cleaned) {
+            // A slit or a sliver of a loop: no area, nothing to keep (the area check below
+            // notices if it mattered).
+            continue;
+        }
+        outlines.push(outline(cleaned, group.source_faces, eps)?);
+    }
+    let expected = frame.projected_area(faces, &group.faces);
+    (!outlines.is_empty() && area_matches(&outlines, expected, eps)).then_some(outlines)
+}
+
+/// The group's boundary as directed edges `(from, to)` in face order: the half-edges whose
+/// undirected edge the group uses once.
+fn boundary_edges(faces: &[Face], group: &Group) -> Vec<(u32, u32)> {
+    let mut half: Vec<(u64, u32, u32)> = Vec::new();
+    for &f in &group.faces {
+        let vs = &faces[f].vertices;
+        for i in 0..vs.len() {
+            let (a, b) = (vs[i], vs[(i + 1) % vs.len()]);
+            half.push((edge_key(a, b), a, b));
+        }
+    }
+    let mut by_key: Vec<usize> = (0..half.len()).collect();
+    by_key.sort_by_key(|&h| half[h].0);
+    let mut is_boundary = vec![false; half.len()];
+    for run in by_key.chunk_by(|&x, &y| half[x].0 == half[y].0) {
+        if run.len() == 1 {
+            is_boundary[run[0]] = true;
+        }
+    }
+    half.iter()
+        .zip(&is_boundary)
+        .filter(|(_, b)| **b)
+        .map(|(&(_, a, b), _)| (a, b))
+        .collect()
+}
+
+/// Every boundary loop of the group in frame coordinates, or `None` when a chain does not
+/// close (non-manifold edges, overlapping faces).
+fn closed_loops(
+    faces: &[Face],
+    group: &Group,
+    frame: &Frame,
+    points: &[Vec3],
+) -> Option<Vec<Vec<Vec2>>> {
+    let project = |id: u32| frame.project(points[id as usize]);
+    let boundary = boundary_edges(faces, group);
+    let mut outgoing: HashMap<u32, Vec<usize>> = HashMap::new();
+    for (h, &(a, _)) in boundary.iter().enumerate() {
+        outgoing.entry(a).or_default().push(h);
+    }
+    let mut loops = Vec::new();
+    let mut used = vec![false; boundary.len()];
+    for start in 0..boundary.len() {
+        if used[start] {
+            continue;
+        }
+        used[start] = true;
+        let mut ids = vec![boundary[start].0];
+        let mut current = start;
+        loop {
+            let (from, at) = boundary[current];
+            let incoming = project(at) - project(from);
+            // Where several boundary edges leave one vertex (the region touches itself
+            // there), take the sharpest right turn: it follows the exterior wedge, so the
+            // loops separate into simple ones (outline and hole) instead of one self-touching
+            // loop that would hide the hole.
+            let next = outgoing
+                .get(&at)
+                .into_iter()
+                .flatten()
+                .copied()
+                .filter(|&h| !used[h] || h == start)
+                .filter(|&h| h != current)
+                .map(|h| {
+                    let out = project(boundary[h].1) - project(at);
+                    (incoming.perp_dot(out).atan2(incoming.dot(out)), h)
+                })
+                .fold(None, |best: Option<(Real, usize)>, (turn, h)| match best {
+                    Some((bt, _)) if bt <= turn => best,
+                    _ => Some((turn, h)),
+                });
+            match next {
+                None => return None,
+                Some((_, h)) if h == start => break,
+                Some((_, h)) => {
+                    used[h] = true;
+                    ids.push(at);
+                    current = h;
+                }
+            }
+        }
+        loops.push(ids.into_iter().map(project).collect());
+    }
+    Some(loops)
+}
