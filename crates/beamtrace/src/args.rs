@@ -172,7 +172,8 @@ pub struct SceneArgs {
     /// Receiver position X,Y,Z in metres (overrides the scene's).
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
     pub rx: Option<Vec3>,
-    /// Meshes: surfaces smaller than this (m²) only block.
+    /// Meshes: surfaces whose merged region (all its coplanar pieces together) is smaller
+    /// than this (m²) only block.
     #[arg(long, default_value_t = 0.25)]
     pub min_reflector_area: f64,
     /// Meshes: faces whose normals differ by less than this (degrees) merge into one surface.
