@@ -626,6 +626,9 @@ pub struct PathArgs {
     /// Path solver.
     #[arg(long, value_enum, default_value_t = SolverArg::Image)]
     pub solver: SolverArg,
+    /// Edge diffraction: paths may diffract once (as `trace --diffraction`).
+    #[arg(long)]
+    pub diffraction: bool,
 }
 
 impl PathArgs {
@@ -634,7 +637,10 @@ impl PathArgs {
         TraceArgs {
             scene: self.scene.clone(),
             radio: self.radio.clone(),
-            solve: SolveArgs::with(self.max_order, self.solver),
+            solve: SolveArgs {
+                diffraction: self.diffraction,
+                ..SolveArgs::with(self.max_order, self.solver)
+            },
             json: false,
             out: None,
             steps: false,

@@ -224,3 +224,46 @@ fn overrides_apply_to_every_step_of_a_dynamic_scene() {
         &["brick"],
     );
 }
+
+/// In the shadow of Sionna's wedge only diffraction reaches RX: `trace`, `beams` and `channel`
+/// take `--diffraction`, and the diffracted path is in the record, the sweep and the CIR.
+#[test]
+fn diffraction_reaches_the_shadow_in_trace_beams_and_channel() {
+    let wedge = testdata("sionna-rt/simple_wedge/simple_wedge.xml");
+    let at = ["--tx=-10,-20,2", "--rx", "20,5,1"];
+    let with = |command: &str, extra: &[&str]| {
+        let mut args = vec![command, wedge.as_str()];
+        args.extend_from_slice(&at);
+        args.extend_from_slice(extra);
+        args.iter().map(|s| s.to_string()).collect::<Vec<_>>()
+    };
+    let json = with("trace", &["--json"]);
+    let doc = run_json(&json.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_eq!(doc["paths"].as_array().unwrap().len(), 0, "RX is in shadow");
+    let json = with("trace", &["--json", "--diffraction"]);
+    let doc = run_json(&json.iter().map(String::as_str).collect::<Vec<_>>());
+    let paths = doc["paths"].as_array().unwrap();
+    assert_eq!(paths.len(), 1);
+    assert_eq!(paths[0]["interactions"][0], "diffraction");
+    assert_eq!(
+        paths[0]["surfaces"][0],
+        "mesh-wedge.face_0|mesh-wedge.face_1"
+    );
+    assert!(paths[0]["incidence_deg"][0].is_null());
+    let beams = with("beams", &["--diffraction"]);
+    let o = run_ok(&beams.iter().map(String::as_str).collect::<Vec<_>>());
+    assert_stdout_has(&o, "best pair");
+    let dir = scratch("diffraction-channel");
+    let cir = dir.join("cir.csv");
+    let channel = with(
+        "channel",
+        &["--diffraction", "--out", cir.to_str().unwrap()],
+    );
+    run_ok(&channel.iter().map(String::as_str).collect::<Vec<_>>());
+    let text = std::fs::read_to_string(&cir).unwrap();
+    assert!(
+        text.contains("mesh-wedge.face_0|mesh-wedge.face_1"),
+        "{text}"
+    );
+    std::fs::remove_dir_all(dir).ok();
+}
