@@ -89,12 +89,21 @@ impl DiffractedSet {
     /// Put the candidates in the canonical order and drop repeats.
     pub fn canonicalise(&mut self) {
         let mut order: Vec<usize> = (0..self.len()).collect();
-        let key = |i: usize| {
-            let c = self.get(i);
-            (c.order(), c.position, c.edge, c.reflections)
+        // (order, position, edge) packed into one integer, compared first; the reflections
+        // only on ties.
+        let packed: Vec<u64> = (0..self.len())
+            .map(|i| {
+                let c = self.get(i);
+                ((c.order() as u64) << 56) | ((c.position as u64) << 48) | u64::from(c.edge.0)
+            })
+            .collect();
+        let compare = |a: usize, b: usize| {
+            packed[a]
+                .cmp(&packed[b])
+                .then_with(|| self.get(a).reflections.cmp(self.get(b).reflections))
         };
-        order.sort_by(|&a, &b| key(a).cmp(&key(b)));
-        order.dedup_by(|a, b| key(*a) == key(*b));
+        order.sort_unstable_by(|&a, &b| compare(a, b));
+        order.dedup_by(|a, b| compare(*a, *b).is_eq());
         let mut sorted = DiffractedSet::default();
         for i in order {
             let c = self.get(i);

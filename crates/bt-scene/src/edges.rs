@@ -91,6 +91,7 @@ impl Edge {
     }
 
     /// The angle φ (rad, in [0, 2π)) of `p` about the edge, from face 0 (module docs).
+    #[inline]
     pub fn angle(&self, p: Vec3) -> Real {
         let v = self.perpendicular(p);
         let y0 = self.direction.cross(self.t0);
@@ -100,6 +101,7 @@ impl Edge {
 
     /// Whether `p` lies in the exterior (the free sector), more than `tol` metres from the edge
     /// line and from both faces' half-planes.
+    #[inline]
     pub fn in_exterior(&self, p: Vec3, tol: Real) -> bool {
         let r = self.perpendicular(p).length();
         if r <= tol {
@@ -117,6 +119,7 @@ impl Edge {
     /// from the start) where the path makes equal angles with the edge,
     /// `t* = (d_b·t_a + d_a·t_b) / (d_a + d_b)` with `d` the distances to the edge line and `t`
     /// the projections on it; `None` when both lie on the line.
+    #[inline]
     pub fn keller(&self, a: Vec3, b: Vec3) -> Option<Real> {
         let (da, db) = (
             self.perpendicular(a).length(),

@@ -10,7 +10,8 @@
 //! WHAT: `cand` (beam-tree candidates), `image` / `exh` (whole image-method trace with the beam
 //! tree / exhaustive candidates), `ipc` (whole IPC Gauss-Seidel trace), `walk` (a new RX on a
 //! kept tree, walk only), `newrx` (walk + image method + validation), `diff` (candidates with
-//! one diffraction), `rxtree` (a tree materialised to depth 2, as the RX side of `diff`).
+//! one diffraction), `rxtree` (a tree materialised to depth 2, as the RX side of `diff`), `diffimage` (the
+//! whole image-method trace with one diffraction).
 
 use bt_paths::beamtree::{BeamTree, TreeCache, TreeOptions, candidates_in};
 use bt_scene::{Scene, Terminals, Vec3};
@@ -65,6 +66,14 @@ fn run(what: &str, scene: &Scene, i: usize, tree: &BeamTree, kept: &mut Kept) ->
             kept,
             scene,
             &trace_options(Solver::Image, CandidateMode::BeamTree),
+        ),
+        "diffimage" => traced_paths(
+            kept,
+            scene,
+            &TraceOptions {
+                diffraction: bt_solve::pipeline::DiffractionOptions::first_order(),
+                ..trace_options(Solver::Image, CandidateMode::BeamTree)
+            },
         ),
         "report" => {
             let traced = trace_scene(
@@ -122,7 +131,9 @@ fn run(what: &str, scene: &Scene, i: usize, tree: &BeamTree, kept: &mut Kept) ->
                 .len()
         }
         other => {
-            panic!("unknown workload {other:?}: cand, image, exh, ipc, walk, newrx, diff or rxtree")
+            panic!(
+                "unknown workload {other:?}: cand, image, exh, ipc, walk, newrx, diff, rxtree or diffimage"
+            )
         }
     }
 }

@@ -30,6 +30,7 @@ use rayon::prelude::*;
 
 /// The interaction points of `c` by the image method into `points` (length `c.order()`,
 /// metres, TX side first, the diffraction point at index `c.position`).
+#[inline(always)]
 pub fn solve_image(
     scene: &Scene,
     ends: Endpoints,
@@ -127,6 +128,7 @@ pub fn ipc_start(scene: &Scene, c: DiffractedCandidate<'_>, points: &mut [Vec3])
 }
 
 /// The surface of interaction `k` (not the diffraction) of `c`.
+#[inline(always)]
 fn reflection_at(c: DiffractedCandidate<'_>, k: usize) -> SurfaceId {
     if k < c.position {
         c.reflections[k]
@@ -136,6 +138,7 @@ fn reflection_at(c: DiffractedCandidate<'_>, k: usize) -> SurfaceId {
 }
 
 /// Validate the path TX → `points` → RX of candidate `c` (module docs).
+#[inline(always)]
 pub fn validate(
     scene: &Scene,
     ends: Endpoints,
@@ -188,11 +191,13 @@ pub fn validate(
 }
 
 /// Whether `p`, a neighbour of the diffraction point, lies in the edge's exterior.
+#[inline(always)]
 fn exterior(edge: &Edge, p: Vec3, tol: Real) -> bool {
     edge.in_exterior(p, tol)
 }
 
 /// The blocking verdict of the segments of the path with vertices `vertex(0..=n + 1)`.
+#[inline(always)]
 fn blocked(
     scene: &Scene,
     c: DiffractedCandidate<'_>,
@@ -225,6 +230,7 @@ fn blocked(
 
 /// Solve and validate `c` with `solver` (the image method or IPC; SBR does not diffract and
 /// gives `Missed`). `points` must have `c.order()` entries.
+#[inline(always)]
 pub fn solve_candidate(
     scene: &Scene,
     ends: Endpoints,
@@ -268,21 +274,79 @@ pub fn trace_set(
     solver: &crate::Solver,
     parallel: bool,
 ) -> TraceResult {
-    let one = |i: usize| {
-        let c = set.get(i);
-        let mut points = vec![Vec3::ZERO; c.order()];
-        let outcome = solve_candidate(scene, ends, c, solver, &mut points);
-        (outcome, found(c, &outcome, points))
+    let chunks: Vec<std::ops::Range<usize>> = (0..set.len())
+        .step_by(CHUNK)
+        .map(|start| start..(start + CHUNK).min(set.len()))
+        .collect();
+    let run = |range: &std::ops::Range<usize>| {
+        solve_range(
+            &Work {
+                scene,
+                ends,
+                set,
+                solver,
+            },
+            range.clone(),
+        )
     };
-    let results: Vec<(CandidateOutcome, Option<FoundPath>)> = if parallel && set.len() >= 256 {
-        (0..set.len()).into_par_iter().map(one).collect()
+    let parts: Vec<TraceResult> = if parallel && set.len() >= 2 * CHUNK {
+        chunks.par_iter().map(run).collect()
     } else {
-        (0..set.len()).map(one).collect()
+        chunks.iter().map(run).collect()
     };
     let mut out = TraceResult::default();
-    for (outcome, path) in results {
+    for part in parts {
+        out.counts.merge(&part.counts);
+        out.paths.extend(part.paths);
+    }
+    out
+}
+
+/// Diffracted candidates per parallel chunk.
+const CHUNK: usize = 128;
+
+/// What [`trace_set`] solves.
+struct Work<'a> {
+    scene: &'a Scene,
+    ends: Endpoints,
+    set: &'a DiffractedSet,
+    solver: &'a crate::Solver,
+}
+
+/// Solve candidates `range` of the set: compiled with the `fma` target feature when the CPU
+/// has it (as the specular batch, `crate::batch`: the side and inside tests use `mul_add`,
+/// a software call without the feature; results are bit-identical either way).
+fn solve_range(work: &Work<'_>, range: std::ops::Range<usize>) -> TraceResult {
+    #[cfg(target_arch = "x86_64")]
+    if std::arch::is_x86_feature_detected!("fma") {
+        // SAFETY: the CPU supports FMA (checked just above).
+        return unsafe { solve_range_fma(work, range) };
+    }
+    solve_range_impl(work, range)
+}
+
+#[cfg(target_arch = "x86_64")]
+#[target_feature(enable = "fma")]
+fn solve_range_fma(work: &Work<'_>, range: std::ops::Range<usize>) -> TraceResult {
+    solve_range_impl(work, range)
+}
+
+#[inline(always)]
+fn solve_range_impl(work: &Work<'_>, range: std::ops::Range<usize>) -> TraceResult {
+    let mut out = TraceResult::default();
+    let mut buffer = [Vec3::ZERO; 8];
+    let mut heap = Vec::new();
+    for i in range {
+        let c = work.set.get(i);
+        let points: &mut [Vec3] = if c.order() <= buffer.len() {
+            &mut buffer[..c.order()]
+        } else {
+            heap.resize(c.order(), Vec3::ZERO);
+            &mut heap[..]
+        };
+        let outcome = solve_candidate(work.scene, work.ends, c, work.solver, points);
         out.counts.add(&outcome);
-        out.paths.extend(path);
+        out.paths.extend(found(c, &outcome, points));
     }
     out
 }
@@ -291,7 +355,7 @@ pub fn trace_set(
 fn found(
     c: DiffractedCandidate<'_>,
     outcome: &CandidateOutcome,
-    points: Vec<Vec3>,
+    points: &[Vec3],
 ) -> Option<FoundPath> {
     let CandidateOutcome::Solved {
         validity: Validity::Valid,
@@ -309,7 +373,7 @@ fn found(
     };
     Some(FoundPath {
         surfaces: c.reflections.to_vec(),
-        points,
+        points: points.to_vec(),
         diffraction: Some(Diffraction {
             index: c.position,
             edge: c.edge,

@@ -142,6 +142,7 @@ fn first_blocking(
 
 /// The first surface crossing the segment `a -> b` other than those its ends lie on (`from`,
 /// `to`: several at a diffraction point, which lies on every surface touching its edge).
+#[inline(always)]
 pub fn blocker_excluding(
     scene: &Scene,
     a: Vec3,
