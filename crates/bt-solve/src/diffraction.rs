@@ -161,9 +161,10 @@ pub fn validate(
         return Validity::OffEdge { index: c.position };
     }
     for k in (0..n).filter(|&k| k != c.position) {
-        let polygon = &scene.surface(reflection_at(c, k)).polygon;
-        if !polygon.contains(points[k], tol) {
-            return Validity::OutsidePolygon { index: k };
+        if let Some(verdict) =
+            validate::reflection_point(scene, reflection_at(c, k), points[k], tol, k)
+        {
+            return verdict;
         }
     }
     for k in (0..n).filter(|&k| k != c.position) {

@@ -57,8 +57,8 @@ pub fn validate(scene: &Scene, seq: &[SurfaceId], tx: Vec3, rx: Vec3, points: &[
         return Validity::NonFinite;
     }
     for k in 0..n {
-        if !scene.surface(seq[k]).polygon.contains(points[k], tol) {
-            return Validity::OutsidePolygon { index: k };
+        if let Some(verdict) = reflection_point(scene, seq[k], points[k], tol, k) {
+            return verdict;
         }
     }
     for k in 0..n {
@@ -77,6 +77,47 @@ pub fn validate(scene: &Scene, seq: &[SurfaceId], tx: Vec3, rx: Vec3, points: &[
         }
     }
     Validity::Valid
+}
+
+/// Why `p` is not a reflection point of surface `id` (point `index` of a path), or `None`
+/// when it is: outside the polygon by more than `tol` is [`Validity::OutsidePolygon`]; within
+/// `tol` of a diffracting edge of it (a wedge's or a free edge, [`bt_scene::Scene::edges`]) is
+/// [`Validity::Grazing`]. The one rule for points on a boundary: at an edge or a corner a path
+/// does not reflect (it touches the edge; with diffraction on, it is found as a diffraction,
+/// whose point lies strictly inside its edge); on a seam between coplanar faces, which is no
+/// edge, it reflects. The edges are looked at only for points within `tol` of the boundary.
+#[inline(always)]
+pub fn reflection_point(
+    scene: &Scene,
+    id: SurfaceId,
+    p: Vec3,
+    tol: Real,
+    index: usize,
+) -> Option<Validity> {
+    let polygon = &scene.surface(id).polygon;
+    if !polygon.contains(p, tol) {
+        return Some(Validity::OutsidePolygon { index });
+    }
+    (!polygon.inside_by(p, tol) && on_edge_of(scene, id, p, tol))
+        .then_some(Validity::Grazing { index })
+}
+
+/// Whether `p` lies within `tol` of a diffracting edge that surface `id` touches.
+#[inline(never)]
+fn on_edge_of(scene: &Scene, id: SurfaceId, p: Vec3, tol: Real) -> bool {
+    let edges = scene.edges();
+    let grow = Vec3::splat(2.0 * tol);
+    let (lo, hi) = (p - grow, p + grow);
+    let mut near = false;
+    edges.bvh().visit(
+        |min, max| min.cmple(hi).all() && max.cmpge(lo).all(),
+        |e| {
+            let edge = edges.get(bt_scene::EdgeId(e));
+            let t = edge.parameter(p).clamp(0.0, edge.length);
+            near |= edge.touching.contains(&id) && edge.point(t).distance(p) <= tol;
+        },
+    );
+    near
 }
 
 /// Signed distances (m) of point `k`'s two neighbours on the path TX -> `points` -> RX (TX or

@@ -194,3 +194,32 @@ fn the_diffracted_candidates_stop_at_the_budget() {
     let error = trace_scene(&scene, &options).unwrap_err().to_string();
     assert!(error.contains("1000 diffracted candidates"), "{error}");
 }
+
+/// The one rule for a reflection point on a boundary: at a wedge's edge it is no reflection
+/// (it touches the edge, counted as grazing), and with diffraction on, the path through that
+/// point is found as the diffraction it is.
+#[test]
+fn a_reflection_point_on_an_edge_is_a_diffraction_not_a_reflection() {
+    // Walls x = 0 (y in 0..5) and y = 0 (x in 0..5) meet at the z axis; TX and RX mirror each
+    // other through y = 0, so the mirror image through x = 0 puts the reflection point on the
+    // corner (0, 0, 1).
+    let scene = scene_from_json(
+        r#"{ "tx": [-2, -1, 1], "rx": [-2, 1, 1],
+            "surfaces": [
+              { "name": "wx", "vertices": [[0,0,0],[0,5,0],[0,5,3],[0,0,3]] },
+              { "name": "wy", "vertices": [[0,0,0],[5,0,0],[5,0,3],[0,0,3]] } ] }"#,
+    );
+    let corner = Vec3::new(0.0, 0.0, 1.0) - scene.origin();
+    let at_corner = |p: &FoundPath| p.points.iter().any(|q| q.distance(corner) < 1e-6);
+    let specular = TraceOptions {
+        diffraction: DiffractionOptions::default(),
+        ..options(1, CandidateMode::Exhaustive, Solver::Image)
+    };
+    let traced = trace_scene(&scene, &specular).unwrap();
+    assert!(!traced.result.paths.iter().any(at_corner), "{:?}", traced.result.paths);
+    assert!(traced.result.counts.grazing >= 1);
+    let found = paths(&scene, 1, CandidateMode::BeamTree, Solver::Image);
+    let through: Vec<&FoundPath> = found.iter().filter(|p| at_corner(p)).collect();
+    assert_eq!(through.len(), 1, "{found:?}");
+    assert!(through[0].diffraction.is_some());
+}
