@@ -216,7 +216,11 @@ fn a_reflection_point_on_an_edge_is_a_diffraction_not_a_reflection() {
         ..options(1, CandidateMode::Exhaustive, Solver::Image)
     };
     let traced = trace_scene(&scene, &specular).unwrap();
-    assert!(!traced.result.paths.iter().any(at_corner), "{:?}", traced.result.paths);
+    assert!(
+        !traced.result.paths.iter().any(at_corner),
+        "{:?}",
+        traced.result.paths
+    );
     assert!(traced.result.counts.grazing >= 1);
     let found = paths(&scene, 1, CandidateMode::BeamTree, Solver::Image);
     let through: Vec<&FoundPath> = found.iter().filter(|p| at_corner(p)).collect();
