@@ -36,15 +36,6 @@ fn write_text(path: &Path, text: &str, args: &PathArgs) -> anyhow::Result<()> {
     crate::files::write(path, text.as_bytes(), &crate::inputs(&args.scene), &[])
 }
 
-/// A CSV field: quoted, with quotes doubled, when it holds a comma, quote or line break.
-fn csv_field(s: &str) -> String {
-    if s.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
-    }
-}
-
 fn opt(v: Option<f64>) -> String {
     v.map_or_else(String::new, |v| format!("{v}"))
 }
@@ -74,7 +65,7 @@ fn cir_csv(paths: &[PathReport], carrier_hz: f64) -> String {
             opt(p.power_dbm),
             bb.re,
             bb.im,
-            csv_field(&p.surfaces.join(" > "))
+            bt_output::csv::text_field(&p.surfaces.join(" > "))
         );
     }
     out

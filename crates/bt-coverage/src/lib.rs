@@ -168,7 +168,7 @@ pub fn csv(rows: &[Row]) -> String {
                             s.order,
                             s.loss_db,
                             s.length_m,
-                            csv_field(&s.surfaces.join(" > "))
+                            bt_output::csv::text_field(&s.surfaces.join(" > "))
                         )
                     })
                     .unwrap_or_else(|| ",,,".to_string());
@@ -178,22 +178,16 @@ pub fn csv(rows: &[Row]) -> String {
                 format!("{coords},ok,{paths},{delay},{best},{power},")
             }
             PointStatus::Skipped(reason) => {
-                format!("{coords},skipped,,,,,,,,{}", csv_field(reason))
+                format!(
+                    "{coords},skipped,,,,,,,,{}",
+                    bt_output::csv::text_field(reason)
+                )
             }
         };
         out.push_str(&line);
         out.push('\n');
     }
     out
-}
-
-/// One CSV field, quoted (with doubled quotes) when it holds a comma, quote or line break.
-fn csv_field(s: &str) -> String {
-    if s.contains([',', '"', '\n', '\r']) {
-        format!("\"{}\"", s.replace('"', "\"\""))
-    } else {
-        s.to_string()
-    }
 }
 
 #[cfg(test)]
@@ -244,14 +238,6 @@ mod tests {
                 other => panic!("at {}: {other:?}", r.rx),
             }
         }
-    }
-
-    #[test]
-    fn csv_fields_with_separators_are_quoted() {
-        assert_eq!(csv_field("wall"), "wall");
-        assert_eq!(csv_field("a,b"), "\"a,b\"");
-        assert_eq!(csv_field("say \"hi\""), "\"say \"\"hi\"\"\"");
-        assert_eq!(csv_field("two\nlines"), "\"two\nlines\"");
     }
 
     #[test]

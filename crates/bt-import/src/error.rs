@@ -62,4 +62,14 @@ pub enum ImportError {
     /// The parsed scene is invalid (every problem listed), see [`bt_scene::SceneError`].
     #[error(transparent)]
     Scene(#[from] bt_scene::SceneError),
+    /// A load option is out of its range (NaN, infinite, negative).
+    #[error("{option} must be {range}, got {value}")]
+    Option {
+        /// The option, by its CLI flag.
+        option: &'static str,
+        /// The range it must lie in.
+        range: &'static str,
+        /// The value given.
+        value: bt_geom::Real,
+    },
 }

@@ -33,6 +33,22 @@ pub struct LoadOptions {
     pub radio: Option<bt_channel::RadioMaterial>,
 }
 
+impl LoadOptions {
+    /// Refuse a value no load can use: a minimum reflector area that is not a finite number
+    /// ≥ 0 (NaN would make every surface a blocker).
+    pub fn check(&self) -> Result<(), ImportError> {
+        let area = self.min_reflector_area_m2;
+        if !(area.is_finite() && area >= 0.0) {
+            return Err(ImportError::Option {
+                option: "--min-reflector-area",
+                range: "a finite number of m² >= 0",
+                value: area,
+            });
+        }
+        Ok(())
+    }
+}
+
 impl Default for LoadOptions {
     fn default() -> Self {
         Self {
@@ -119,6 +135,25 @@ impl Format {
     }
 }
 
+/// Refuse anything but a regular file (or a symlink to one) before opening `path`: opening a
+/// FIFO blocks until a writer comes, and a device can stream forever. The error is an I/O
+/// error of kind `InvalidInput`, so every reader reports it with its file's path.
+pub(crate) fn regular_file(path: &Path) -> std::io::Result<()> {
+    let kind = std::fs::metadata(path)?.file_type();
+    if kind.is_file() {
+        return Ok(());
+    }
+    let what = if kind.is_dir() {
+        "a directory"
+    } else {
+        "a FIFO, socket or device"
+    };
+    Err(std::io::Error::new(
+        std::io::ErrorKind::InvalidInput,
+        format!("not a regular file ({what}); give a scene file"),
+    ))
+}
+
 /// Progress of a long load (plane extraction from a point cloud), for a progress bar.
 pub type LoadProgress = bt_pointcloud::Progress;
 
@@ -136,6 +171,7 @@ pub fn load_with_progress(
     options: &LoadOptions,
     progress: &mut dyn FnMut(LoadProgress),
 ) -> Result<Loaded, ImportError> {
+    options.check()?;
     let mut loaded = load_any(source, options, progress)?;
     if let Some(radio) = options.radio {
         loaded.scene = loaded.scene.with_radio_material(radio)?;
@@ -195,6 +231,7 @@ pub fn load_dynamic(
     options: &LoadOptions,
     progress: &mut dyn FnMut(LoadProgress),
 ) -> Result<(DynamicScene, Vec<String>), ImportError> {
+    options.check()?;
     let desc = match Source::parse(source) {
         // A generated built-in (no JSON) is static: one step, loaded below.
         Source::Builtin(name)
@@ -233,10 +270,12 @@ fn builtin_description(name: &str) -> Result<SceneDescription, ImportError> {
 
 fn read_description(path: &Path, format: Format) -> Result<SceneDescription, ImportError> {
     let display = path.display().to_string();
-    let text = std::fs::read_to_string(path).map_err(|source| ImportError::Io {
-        path: display.clone(),
-        source,
-    })?;
+    let text = regular_file(path)
+        .and_then(|()| std::fs::read_to_string(path))
+        .map_err(|source| ImportError::Io {
+            path: display.clone(),
+            source,
+        })?;
     if format == Format::Toml {
         parse_toml(&text, &display)
     } else {

@@ -14,6 +14,8 @@
 
 #![warn(missing_docs)]
 
+pub mod csv;
+
 use std::collections::BTreeSet;
 use std::fs::File;
 use std::io::{BufWriter, Write};

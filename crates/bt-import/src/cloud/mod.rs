@@ -133,10 +133,12 @@ pub fn parse_any(bytes: &[u8], opts: &ReadOptions) -> Result<LoadedCloud, CloudE
 
 /// Read a `.ply` or `.pcd` file. Errors carry the path.
 pub fn read_path(path: &Path, opts: &ReadOptions) -> Result<LoadedCloud, CloudError> {
-    let bytes = std::fs::read(path).map_err(|source| CloudError::Io {
-        origin: Origin(Some(path.to_path_buf())),
-        source,
-    })?;
+    let bytes = crate::source::regular_file(path)
+        .and_then(|()| std::fs::read(path))
+        .map_err(|source| CloudError::Io {
+            origin: Origin(Some(path.to_path_buf())),
+            source,
+        })?;
     let result = match detect_format(Some(path), &bytes) {
         Some(CloudFormat::Ply) => parse_ply(&bytes, opts),
         Some(CloudFormat::Pcd) => parse_pcd(&bytes, opts),

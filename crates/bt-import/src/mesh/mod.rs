@@ -104,10 +104,12 @@ pub fn read_mesh_path(path: &Path, opts: &MergeOptions) -> Result<MeshImport, Me
         _ => return Err(MeshError::UnsupportedExtension { file, extension }),
     };
     opts.validate()?;
-    let bytes = std::fs::read(path).map_err(|source| MeshError::Io {
-        file: file.clone(),
-        source,
-    })?;
+    let bytes = crate::source::regular_file(path)
+        .and_then(|()| std::fs::read(path))
+        .map_err(|source| MeshError::Io {
+            file: file.clone(),
+            source,
+        })?;
     read_transformed(&bytes, format, Some(&file), opts, &|p| p)
 }
 

@@ -314,6 +314,7 @@ fn read_bounded(path: &Path, limit: u64, display: &str) -> Result<Vec<u8>, Impor
         path: display.to_string(),
         source,
     };
+    crate::source::regular_file(path).map_err(io)?;
     let file = std::fs::File::open(path).map_err(io)?;
     let mut bytes = Vec::new();
     file.take(limit + 1).read_to_end(&mut bytes).map_err(io)?;

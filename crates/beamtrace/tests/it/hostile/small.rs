@@ -294,3 +294,86 @@ fn a_terminal_shut_inside_a_closed_solid_is_warned_about() {
         text(&r)
     );
 }
+
+/// Round 2 (issue 27): a NaN or negative minimum reflector area is refused, naming the
+/// option, instead of turning every surface into a blocker.
+#[test]
+fn a_nan_minimum_reflector_area_is_refused() {
+    for value in ["nan", "-1", "inf"] {
+        crate::common::assert_clear_error(
+            &[
+                "trace",
+                "builtin:living-room",
+                &format!("--min-reflector-area={value}"),
+            ],
+            &["--min-reflector-area", "finite number"],
+        );
+    }
+}
+
+/// Round 2 (issue 27): a surface named like a spreadsheet formula is not a formula in the CSV.
+#[test]
+fn a_formula_name_is_escaped_in_the_csv() {
+    let dir = scratch("formula-csv");
+    let scene = dir.join("scene.json");
+    std::fs::write(
+        &scene,
+        r#"{ "tx": [0, 0, 1], "rx": [3, 0, 1], "surfaces": [ { "name": "=HYPERLINK(1)",
+            "vertices": [[-5, -5, 0], [5, -5, 0], [5, 5, 0], [-5, 5, 0]] } ] }"#,
+    )
+    .unwrap();
+    let cir = dir.join("cir.csv");
+    let o = beamtrace(&[
+        "channel",
+        scene.to_str().unwrap(),
+        "--out",
+        cir.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let csv = std::fs::read_to_string(&cir).unwrap();
+    assert!(csv.contains("\"'=HYPERLINK(1)\""), "{csv}");
+    assert!(!csv.contains(",=HYPERLINK"), "{csv}");
+    std::fs::remove_dir_all(dir).ok();
+}
+
+/// Round 2 (issue 27): a FIFO named as a mesh, or reached as an XML scene's mesh, is refused
+/// at once, naming it, instead of hanging the run.
+#[cfg(unix)]
+#[test]
+fn a_fifo_as_a_mesh_is_refused_not_waited_on() {
+    let dir = scratch("fifo-mesh");
+    let fifo = dir.join("room.obj");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    if !made.is_ok_and(|s| s.success()) {
+        return; // no mkfifo on this system
+    }
+    crate::common::assert_clear_error(
+        &[
+            "trace",
+            fifo.to_str().unwrap(),
+            "--tx",
+            "0,0,1",
+            "--rx",
+            "1,0,1",
+        ],
+        &["room.obj", "not a regular file"],
+    );
+    let xml = dir.join("scene.xml");
+    std::fs::write(
+        &xml,
+        r#"<scene version="2.1.0"><shape type="obj" id="room"><string name="filename" value="room.obj"/></shape></scene>"#,
+    )
+    .unwrap();
+    crate::common::assert_clear_error(
+        &[
+            "trace",
+            xml.to_str().unwrap(),
+            "--tx",
+            "0,0,1",
+            "--rx",
+            "1,0,1",
+        ],
+        &["room.obj", "not a regular file"],
+    );
+    std::fs::remove_dir_all(dir).ok();
+}
