@@ -218,14 +218,17 @@ fn to_dot(doc: &WvrnDocument, changing: &BTreeSet<(usize, usize)>, dynamic: bool
         ))
     );
     let _ = writeln!(out, "  node [fontsize=10];");
-    for n in &doc.nodes {
+    // Nodes are named by index and labelled with their names: a surface named "TX" stays
+    // apart from the transmitter, and two nodes never merge by name.
+    let id = |i: usize| quote(&format!("n{i}"));
+    for (i, n) in doc.nodes.iter().enumerate() {
         let style = match n.kind {
             "tx" => "shape=box, color=red",
             "rx" => "shape=box, color=blue",
             _ if n.moving => "shape=ellipse, style=filled, fillcolor=mistyrose",
             _ => "shape=ellipse",
         };
-        let _ = writeln!(out, "  {} [{style}];", quote(&n.name));
+        let _ = writeln!(out, "  {} [label={}, {style}];", id(i), quote(&n.name));
     }
     for [a, b] in &doc.edges {
         let color = if !dynamic {
@@ -235,12 +238,7 @@ fn to_dot(doc: &WvrnDocument, changing: &BTreeSet<(usize, usize)>, dynamic: bool
         } else {
             " [color=green]".to_string()
         };
-        let _ = writeln!(
-            out,
-            "  {} -- {}{color};",
-            quote(&doc.nodes[*a].name),
-            quote(&doc.nodes[*b].name)
-        );
+        let _ = writeln!(out, "  {} -- {}{color};", id(*a), id(*b));
     }
     let _ = writeln!(out, "}}");
     out

@@ -92,3 +92,25 @@ fn printable_unicode_names_pass_and_print_as_themselves() {
     assert_ok(&r);
     assert!(text(&r).contains("\"Wand \\\"Süd\\\" 壁\""), "{}", text(&r));
 }
+
+/// Round 2 (issue 27): surfaces named `TX` and `RX` stay apart from the terminals in
+/// `wvrn --dot`: nodes are named by index and labelled with their names.
+#[test]
+fn surfaces_named_like_the_terminals_stay_apart_in_dot() {
+    let dir = scratch("tx-named");
+    let scene = dir.join("scene.json");
+    std::fs::write(
+        &scene,
+        r#"{ "tx": [0, 0, 1], "rx": [3, 0, 1], "surfaces": [
+            { "name": "TX", "vertices": [[-5, -5, 0], [5, -5, 0], [5, 5, 0], [-5, 5, 0]] },
+            { "name": "RX", "vertices": [[-5, 5, 0], [5, 5, 0], [5, 5, 3], [-5, 5, 3]] } ] }"#,
+    )
+    .unwrap();
+    let r = beamtrace(&["wvrn", "--dot", scene.to_str().unwrap()]);
+    assert_ok(&r);
+    let dot = text(&r);
+    let declared = dot.lines().filter(|l| l.contains("[label=")).count();
+    assert_eq!(declared, 4, "{dot}");
+    assert_eq!(dot.matches("label=\"TX\"").count(), 2, "{dot}");
+    std::fs::remove_dir_all(dir).ok();
+}
