@@ -17,6 +17,18 @@ pub fn from_mesh(
     let mut materials = default_materials();
     let default = materials[DEFAULT_MATERIAL].clone();
     let mut raw = Vec::with_capacity(import.surfaces.len());
+    for s in &import.surfaces {
+        // Material names (OBJ `usemtl`, PLY and XML material ids) follow the name rule of
+        // every other name: no control characters reach messages or outputs.
+        if let Some(m) = &s.material
+            && let Err(e) = bt_scene::name::check(m)
+        {
+            return Err(ImportError::Parse {
+                path: source.to_string(),
+                message: format!("material {}: {e}", quoted(m)),
+            });
+        }
+    }
     for (i, s) in import.surfaces.into_iter().enumerate() {
         let material = s.material.map(|m| {
             let lower = m.to_ascii_lowercase();
@@ -33,7 +45,8 @@ pub fn from_mesh(
                         },
                         Err(_) => {
                             warnings.push(format!(
-                                "material \"{m}\" is not known: using {} dB per reflection and the radio model of \"{DEFAULT_MATERIAL}\"",
+                                "material {} is not known: using {} dB per reflection and the radio model of \"{DEFAULT_MATERIAL}\"",
+                                quoted(&m),
                                 default.reflection_loss_db
                             ));
                             default.clone()
@@ -66,4 +79,9 @@ pub fn from_mesh(
         options.frequency_hz,
     )?;
     Ok(Loaded { scene, warnings })
+}
+
+/// `name` in quotes, escaped by the name rule's printer (`bt_scene::name::escape`).
+fn quoted(name: &str) -> String {
+    format!("\"{}\"", bt_scene::name::escape(name))
 }

@@ -114,3 +114,27 @@ fn surfaces_named_like_the_terminals_stay_apart_in_dot() {
     assert_eq!(dot.matches("label=\"TX\"").count(), 2, "{dot}");
     std::fs::remove_dir_all(dir).ok();
 }
+
+/// Round 2 (issue 27): an OBJ `usemtl` name is held to the name rule: an escape sequence in it
+/// is refused, escaped in the message, and never reaches the terminal raw.
+#[test]
+fn obj_material_names_follow_the_name_rule() {
+    let dir = scratch("usemtl");
+    let obj = dir.join("room.obj");
+    std::fs::write(
+        &obj,
+        "v 0 0 0\nv 4 0 0\nv 4 4 0\nv 0 4 0\nusemtl evil\u{1b}[31mred\nf 1 2 3 4\n",
+    )
+    .unwrap();
+    let r = beamtrace(&[
+        "trace",
+        obj.to_str().unwrap(),
+        "--tx",
+        "1,1,1",
+        "--rx",
+        "2,2,1",
+    ]);
+    assert_refused(&r, &["room.obj", "material", "U+001B"]);
+    assert!(!text(&r).contains('\u{1b}'), "{:?}", text(&r));
+    std::fs::remove_dir_all(dir).ok();
+}
