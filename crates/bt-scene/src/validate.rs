@@ -424,6 +424,12 @@ pub(crate) fn check_terminals(
             problems.report(field, why);
         }
     }
+    far_terminals(surfaces, &given, &mut problems);
+    if !problems.is_empty() {
+        // A far or unresolvable terminal scales the tolerance: the tests below would blame
+        // the other terminal.
+        return Err(problems);
+    }
     if let (true, Some(tx), Some(rx)) = (problems.is_empty(), tx, rx)
         && tx.distance(rx) <= eps
     {
@@ -443,6 +449,36 @@ pub(crate) fn check_terminals(
         Ok(())
     } else {
         Err(problems)
+    }
+}
+
+/// A terminal may lie at most this many extents of the surfaces (of at least 1 m) from their
+/// bounding box: beyond it, the length tolerance, which scales with the extent of surfaces and
+/// terminals together, would grow past the size of the scene's details.
+pub const MAX_TERMINAL_DISTANCE_RATIO: Real = 10_000.0;
+
+/// Report each given terminal farther from the surfaces than [`MAX_TERMINAL_DISTANCE_RATIO`]
+/// extents, naming it (not the other terminal, whose checks the inflated tolerance would fail).
+fn far_terminals(surfaces: &[Surface], given: &[(&str, Vec3)], problems: &mut Vec<Problem>) {
+    let Some((lo, hi)) = surfaces
+        .iter()
+        .map(|s| s.polygon.bounds())
+        .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))
+    else {
+        return;
+    };
+    let limit = MAX_TERMINAL_DISTANCE_RATIO * (hi - lo).length().max(1.0);
+    for &(field, p) in given {
+        let distance = (p - p.clamp(lo, hi)).length();
+        if p.is_finite() && distance > limit {
+            problems.report(
+                field,
+                format!(
+                    "lies {distance:.3e} m from the scene's surfaces, beyond {MAX_TERMINAL_DISTANCE_RATIO} \
+                     times their extent ({limit:.3e} m): move it nearer"
+                ),
+            );
+        }
     }
 }
 

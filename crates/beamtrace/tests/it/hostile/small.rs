@@ -377,3 +377,18 @@ fn a_fifo_as_a_mesh_is_refused_not_waited_on() {
     );
     std::fs::remove_dir_all(dir).ok();
 }
+
+/// Round 2 (issue 27): a receiver 1e9 m away is reported as the receiver's problem, not as the
+/// transmitter lying on surfaces (the far terminal had scaled the tolerance to a metre).
+#[test]
+fn a_far_receiver_is_named_as_the_problem() {
+    crate::common::assert_clear_error(
+        &["trace", "builtin:living-room", "--rx", "1e9,0,1"],
+        &[
+            "rx: lies 1.000e9 m from the scene's surfaces",
+            "move it nearer",
+        ],
+    );
+    let o = beamtrace(&["trace", "builtin:living-room", "--rx", "1e9,0,1"]);
+    assert!(!text(&o).contains("tx:"), "{}", text(&o));
+}
