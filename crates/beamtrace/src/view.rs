@@ -16,6 +16,7 @@ pub fn run(args: &ViewArgs) -> anyhow::Result<ExitCode> {
             let text = std::fs::read_to_string(file).with_context(|| format!("reading {name}"))?;
             let paths = bt_view::read_paths(&text, &name)?;
             bt_view::check_steps(&paths, scenes.len(), &name)?;
+            bt_view::check_surfaces(&paths, &scenes, &name)?;
             paths
         }
         None => {

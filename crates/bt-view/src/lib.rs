@@ -55,6 +55,22 @@ pub enum ViewError {
         /// Steps of the scene.
         expected: usize,
     },
+    /// A path of the document names a surface the scene does not have: the document belongs
+    /// to another scene.
+    #[error(
+        "{path}: step {step}: a path names surface \"{surface}\", which scene {scene} does not have; \
+         give the document traced from this scene"
+    )]
+    ForeignDocument {
+        /// The file.
+        path: String,
+        /// Time step, from 0.
+        step: usize,
+        /// The unknown surface name (escaped).
+        surface: String,
+        /// The scene's name (escaped).
+        scene: String,
+    },
 }
 
 /// The paths of one time step with the terminals they were traced for.
@@ -119,6 +135,28 @@ pub fn read_paths(text: &str, path: &str) -> Result<Vec<StepPaths>, ViewError> {
             paths: doc.paths,
         }],
     })
+}
+
+/// Check that every surface the paths of `paths[k]` name (a diffraction's `"A|B"` names two)
+/// is a surface of `scenes[k]`: a document traced from another scene is refused.
+pub fn check_surfaces(paths: &[StepPaths], scenes: &[&Scene], path: &str) -> Result<(), ViewError> {
+    for (step, (step_paths, scene)) in paths.iter().zip(scenes).enumerate() {
+        let known = |name: &str| {
+            scene.find(name).is_some() || name.split('|').all(|n| scene.find(n).is_some())
+        };
+        let names = step_paths.paths.iter().flat_map(|p| p.surfaces.iter());
+        for name in names {
+            if !known(name) {
+                return Err(ViewError::ForeignDocument {
+                    path: path.to_string(),
+                    step,
+                    surface: bt_scene::name::escape(name),
+                    scene: bt_scene::name::escape(scene.name()),
+                });
+            }
+        }
+    }
+    Ok(())
 }
 
 /// Check that `paths` has one entry per scene step.

@@ -392,3 +392,33 @@ fn a_far_receiver_is_named_as_the_problem() {
     let o = beamtrace(&["trace", "builtin:living-room", "--rx", "1e9,0,1"]);
     assert!(!text(&o).contains("tx:"), "{}", text(&o));
 }
+
+/// Round 2 (issue 27): `view --paths` refuses a document traced from another scene, naming a
+/// surface the scene lacks, and writes nothing.
+#[test]
+fn view_refuses_paths_of_another_scene() {
+    let dir = scratch("foreign-paths");
+    let doc = dir.join("room.json");
+    let o = beamtrace(&[
+        "trace",
+        "builtin:living-room",
+        "--json",
+        "--out",
+        doc.to_str().unwrap(),
+    ]);
+    assert!(o.status.success(), "{}", text(&o));
+    let page = dir.join("view.html");
+    crate::common::assert_clear_error(
+        &[
+            "view",
+            &crate::common::testdata("sionna-rt/simple_wedge/simple_wedge.xml"),
+            "--paths",
+            doc.to_str().unwrap(),
+            "-o",
+            page.to_str().unwrap(),
+        ],
+        &["room.json", "which scene simple_wedge does not have"],
+    );
+    assert!(!page.exists());
+    std::fs::remove_dir_all(dir).ok();
+}
