@@ -180,7 +180,8 @@ pub fn validate(
             return Validity::OppositeSides { index: k };
         }
     }
-    if !exterior(edge, vertex(c.position), tol) || !exterior(edge, vertex(c.position + 2), tol) {
+    if !edge.in_exterior(vertex(c.position), tol) || !edge.in_exterior(vertex(c.position + 2), tol)
+    {
         return Validity::InsideWedge { index: c.position };
     }
     // A ray (nearly) along the edge has no UTD coefficient (sin β0 → 0): grazing.
@@ -189,12 +190,6 @@ pub fn validate(
         return Validity::Grazing { index: c.position };
     }
     blocked(scene, c, (vertex, n), edge)
-}
-
-/// Whether `p`, a neighbour of the diffraction point, lies in the edge's exterior.
-#[inline(always)]
-fn exterior(edge: &Edge, p: Vec3, tol: Real) -> bool {
-    edge.in_exterior(p, tol)
 }
 
 /// The blocking verdict of the segments of the path with vertices `vertex(0..=n + 1)`.
@@ -352,34 +347,18 @@ fn solve_range_impl(work: &Work<'_>, range: std::ops::Range<usize>) -> TraceResu
     out
 }
 
-/// The found path of a valid outcome.
+/// The found path of a valid outcome: the specular batch's ([`crate::batch::found_path`])
+/// with its diffraction.
 fn found(
     c: DiffractedCandidate<'_>,
     outcome: &CandidateOutcome,
     points: &[Vec3],
 ) -> Option<FoundPath> {
-    let CandidateOutcome::Solved {
-        validity: Validity::Valid,
-        ipc,
-    } = outcome
-    else {
-        return None;
-    };
-    let (iterations, residual) = match ipc {
-        Some(IpcOutcome::Converged {
-            iterations,
-            residual,
-        }) => (Some(*iterations), Some(*residual)),
-        _ => (None, None),
-    };
-    Some(FoundPath {
-        surfaces: c.reflections.to_vec(),
-        points: points.to_vec(),
+    crate::batch::found_path(c.reflections, outcome, points).map(|path| FoundPath {
         diffraction: Some(Diffraction {
             index: c.position,
             edge: c.edge,
         }),
-        iterations,
-        residual,
+        ..path
     })
 }
