@@ -83,7 +83,9 @@ struct Differences {
     no_edge: Vec<String>,
 }
 
-fn compare_case(case: &str, out: &mut Differences) {
+/// Reference case `case` and the scene it was traced in, loaded as Sionna sees it: at the
+/// case's frequency, every face a reflector.
+fn reference(case: &str) -> (Value, bt_scene::Scene) {
     let file = root().join(format!("testdata/sionna-reference/{case}.json"));
     let doc: Value = serde_json::from_str(&std::fs::read_to_string(&file).unwrap()).unwrap();
     let xml = root().join(doc["scene"]["xml"].as_str().unwrap());
@@ -97,6 +99,11 @@ fn compare_case(case: &str, out: &mut Differences) {
     let scene = bt_import::load(xml.to_str().unwrap(), &options)
         .unwrap()
         .scene;
+    (doc, scene)
+}
+
+fn compare_case(case: &str, out: &mut Differences) {
+    let (doc, scene) = reference(case);
     let trace = TraceOptions {
         diffraction: DiffractionOptions::first_order(),
         ..TraceOptions::new(doc["max_depth"].as_u64().unwrap() as usize)
@@ -193,20 +200,7 @@ fn every_sionna_path_is_found_with_its_gain() {
 /// coefficient: docs/sionna-diffraction-notes.md).
 #[test]
 fn a_metal_box_diffracts_as_kouyoumjian_pathak() {
-    let doc: Value = serde_json::from_str(
-        &std::fs::read_to_string(root().join("testdata/sionna-reference/box-edges-d2.json"))
-            .unwrap(),
-    )
-    .unwrap();
-    let xml = root().join(doc["scene"]["xml"].as_str().unwrap());
-    let options = bt_import::LoadOptions {
-        frequency_hz: 3.5e9,
-        min_reflector_area_m2: 0.0,
-        ..bt_import::LoadOptions::default()
-    };
-    let scene = bt_import::load(xml.to_str().unwrap(), &options)
-        .unwrap()
-        .scene;
+    let (_, scene) = reference("box-edges-d2");
     let trace = TraceOptions {
         diffraction: DiffractionOptions::first_order(),
         ..TraceOptions::new(1)
