@@ -95,11 +95,14 @@ pub fn reflection_point(
     index: usize,
 ) -> Option<Validity> {
     let polygon = &scene.surface(id).polygon;
+    // Most points lie well inside: one test decides them.
+    if polygon.inside_by(p, tol) {
+        return None;
+    }
     if !polygon.contains(p, tol) {
         return Some(Validity::OutsidePolygon { index });
     }
-    (!polygon.inside_by(p, tol) && on_edge_of(scene, id, p, tol))
-        .then_some(Validity::Grazing { index })
+    on_edge_of(scene, id, p, tol).then_some(Validity::Grazing { index })
 }
 
 /// Whether `p` lies within `tol` of a diffracting edge that surface `id` touches.
@@ -161,14 +164,16 @@ fn segment_ends(
     (start, end)
 }
 
-/// The first surface, other than the segment's own end surfaces `from` and `to`, whose box
-/// grown by twice the scene's length tolerance (`blocks` may accept crossings within the
-/// tolerance outside a polygon) the segment `a -> b` touches and whose polygon passes `blocks`.
+/// The first surface, other than those the segment's ends lie on (`from`, `to`: none for a
+/// terminal, one for a reflection point, every surface touching the edge for a diffraction
+/// point), whose box grown by twice the scene's length tolerance (`blocks` may accept
+/// crossings within the tolerance outside a polygon) the segment `a -> b` touches and whose
+/// polygon passes `blocks`.
 #[inline(always)]
 fn first_blocking(
     scene: &Scene,
     (a, b): (Vec3, Vec3),
-    (from, to): (Option<SurfaceId>, Option<SurfaceId>),
+    (from, to): (&[SurfaceId], &[SurfaceId]),
     mut blocks: impl FnMut(&bt_geom::Polygon) -> bool,
 ) -> Option<SurfaceId> {
     let margin = 2.0 * scene.length_tolerance();
@@ -176,7 +181,7 @@ fn first_blocking(
         .bvh()
         .any_hit(a, b, margin, |i| {
             let id = SurfaceId(i);
-            Some(id) != from && Some(id) != to && blocks(&scene.surface(id).polygon)
+            !from.contains(&id) && !to.contains(&id) && blocks(&scene.surface(id).polygon)
         })
         .map(SurfaceId)
 }
@@ -194,16 +199,9 @@ pub fn blocker_excluding(
 ) -> Option<SurfaceId> {
     let length = a.distance(b);
     let t_min = tol / length.max(tol);
-    let margin = 2.0 * tol;
-    scene
-        .bvh()
-        .any_hit(a, b, margin, |i| {
-            let id = SurfaceId(i);
-            !from.contains(&id)
-                && !to.contains(&id)
-                && scene.surface(id).polygon.blocks_segment(a, b, t_min, tol)
-        })
-        .map(SurfaceId)
+    first_blocking(scene, (a, b), (from, to), |polygon| {
+        polygon.blocks_segment(a, b, t_min, tol)
+    })
 }
 
 /// The first surface (other than the segment's own end surfaces) crossing the segment `a -> b`.
@@ -216,11 +214,7 @@ pub fn blocker(
     to: Option<SurfaceId>,
     tol: Real,
 ) -> Option<SurfaceId> {
-    let length = a.distance(b);
-    let t_min = tol / length.max(tol);
-    first_blocking(scene, (a, b), (from, to), |polygon| {
-        polygon.blocks_segment(a, b, t_min, tol)
-    })
+    blocker_excluding(scene, a, b, from.as_slice(), to.as_slice(), tol)
 }
 
 /// Early stopping of IPC (`IpcOptions::early_reject`): the first segment of the path TX ->
@@ -255,7 +249,7 @@ pub fn blocked_for_good(
     for segment in 0..=n {
         let ((a, from), (b, to)) = segment_ends(seq, (tx, rx), points, segment);
         let length = a.distance(b);
-        let by = first_blocking(scene, (a, b), (from, to), |polygon| {
+        let by = first_blocking(scene, (a, b), (from.as_slice(), to.as_slice()), |polygon| {
             // Unfused: the margins are far above its round-off, and the closure may be compiled
             // without the FMA feature (a software `fma` per call).
             let (da, db) = (
