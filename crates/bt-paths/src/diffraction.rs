@@ -88,25 +88,31 @@ impl DiffractedSet {
     }
     /// Put the candidates in the canonical order and drop repeats.
     pub fn canonicalise(&mut self) {
-        let mut order: Vec<usize> = (0..self.len()).collect();
-        // (order, position, edge) packed into one integer, compared first; the reflections
-        // only on ties.
-        let packed: Vec<u64> = (0..self.len())
+        // (order, position, edge, first two reflections) packed into one integer, which
+        // decides alone up to order 3; longer reflection lists only on ties.
+        let mut keyed: Vec<(u128, u32)> = (0..self.len())
             .map(|i| {
                 let c = self.get(i);
-                ((c.order() as u64) << 56) | ((c.position as u64) << 48) | u64::from(c.edge.0)
+                let id = |k: usize| c.reflections.get(k).map_or(0, |s| u128::from(s.0) + 1);
+                let key = ((c.order() as u128) << 120)
+                    | ((c.position as u128) << 112)
+                    | (u128::from(c.edge.0) << 80)
+                    | (id(0) << 40)
+                    | id(1);
+                (key, i as u32)
             })
             .collect();
-        let compare = |a: usize, b: usize| {
-            packed[a]
-                .cmp(&packed[b])
-                .then_with(|| self.get(a).reflections.cmp(self.get(b).reflections))
+        let compare = |a: &(u128, u32), b: &(u128, u32)| {
+            a.0.cmp(&b.0).then_with(|| {
+                let (x, y) = (self.get(a.1 as usize), self.get(b.1 as usize));
+                x.reflections.cmp(y.reflections)
+            })
         };
-        order.sort_unstable_by(|&a, &b| compare(a, b));
-        order.dedup_by(|a, b| compare(*a, *b).is_eq());
+        keyed.sort_unstable_by(compare);
+        keyed.dedup_by(|a, b| compare(a, b).is_eq());
         let mut sorted = DiffractedSet::default();
-        for i in order {
-            let c = self.get(i);
+        for (_, i) in keyed {
+            let c = self.get(i as usize);
             sorted.push(c.before(), c.edge, c.after());
         }
         *self = sorted;

@@ -60,6 +60,9 @@ pub struct Edge {
     /// Exterior angle over π, in (1, 2]: 2 for a free edge (a half-plane screen), 1.5 for a
     /// right-angled corner of a solid.
     pub n: Real,
+    /// Unit vector `tn = cos(nπ)·t0 + sin(nπ)·y0`: ⊥ `e`, in face n, from the edge into face n
+    /// (kept so that the exterior tests need no trigonometry).
+    pub tn: Vec3,
     /// Every reflector touching the edge (face 0 and face n among them), ascending: a path
     /// leaving the edge starts on all of them.
     pub touching: Vec<SurfaceId>,
@@ -103,16 +106,26 @@ impl Edge {
     /// line and from both faces' half-planes.
     #[inline]
     pub fn in_exterior(&self, p: Vec3, tol: Real) -> bool {
-        let r = self.perpendicular(p).length();
-        if r <= tol {
-            return false;
-        }
-        let phi = self.angle(p);
-        let wedge = self.n * PI;
+        let a = self.about(p);
         // Distance from the face at angle 0 (resp. nπ) is r·sin of the angle to it while that
-        // angle is below a quarter turn, r beyond.
-        let clear = |angle: Real| angle >= PI / 2.0 || r * angle.sin() > tol;
-        phi > 0.0 && phi < wedge && clear(phi) && clear(wedge - phi)
+        // angle is below a quarter turn (sine and cosine positive), r beyond.
+        let clear = |sin: Real, cos: Real| cos <= 0.0 || sin < 0.0 || sin > tol;
+        a.r > tol && a.in_sector(0.0) && clear(a.sin0, a.cos0) && clear(a.sin_n, a.cos_n)
+    }
+
+    /// Where `p` lies about the edge ([`About`]). Only `p`'s offset ⊥ the edge matters, and
+    /// the frame vectors are ⊥ the edge, so they are dotted with `p − start` directly.
+    #[inline]
+    pub fn about(&self, p: Vec3) -> About {
+        let v = p - self.start;
+        let (sin0, cos0) = (v.dot(self.direction.cross(self.t0)), v.dot(self.t0));
+        About {
+            sin0,
+            cos0,
+            sin_n: v.dot(self.tn.cross(self.direction)),
+            cos_n: v.dot(self.tn),
+            r: (sin0 * sin0 + cos0 * cos0).sqrt(),
+        }
     }
 
     /// The Keller point of the straight (unfolded) path `a → edge → b`: the parameter `t` (m
@@ -452,8 +465,41 @@ impl Around {
             },
             t0,
             n: gap / PI,
+            tn: face_direction(e, t0, gap),
             touching,
         })
+    }
+}
+
+/// The unit vector ⊥ `e` at angle `angle` (rad) from `t0` towards `e × t0`.
+fn face_direction(e: Vec3, t0: Vec3, angle: Real) -> Vec3 {
+    let (sin, cos) = angle.sin_cos();
+    cos * t0 + sin * e.cross(t0)
+}
+
+/// Where a point lies about an edge ([`Edge::about`]), without trigonometry: with `r` its
+/// distance from the edge line (m) and φ its angle from face 0 (module docs).
+#[derive(Debug, Clone, Copy)]
+pub struct About {
+    /// r·sin φ: the distance from face 0's plane, positive on the exterior side (m).
+    pub sin0: Real,
+    /// r·cos φ (m).
+    pub cos0: Real,
+    /// r·sin(nπ − φ): the distance from face n's plane, positive on the exterior side (m).
+    pub sin_n: Real,
+    /// r·cos(nπ − φ) (m).
+    pub cos_n: Real,
+    /// r (m).
+    pub r: Real,
+}
+
+impl About {
+    /// Whether the point lies in the closed sector φ ∈ [0, nπ] up to `slack` metres: within a
+    /// half-turn after face 0 or within a half-turn before face n (for n ∈ (1, 2] the two cover
+    /// the sector).
+    #[inline]
+    pub fn in_sector(&self, slack: Real) -> bool {
+        self.sin0 >= -slack || self.sin_n >= -slack
     }
 }
 

@@ -11,6 +11,10 @@
 //!   `I − D` and `J − D`: `I` and `J` lie in the exterior sector (a test independent of `D`);
 //! - `D` is the Keller point of `I` and `J` on the edge line ([`bt_scene::Edge::keller`]).
 //!
+//! - the reflection next to `D` is not on a surface whose plane holds the edge line: `D` would
+//!   lie on that plane, and validation calls such a path grazing
+//!   ([`plane_holds_edge`]; a third of the living room's candidates before this rule).
+//!
 //! The join pairs, per edge, the TX reaches with the RX reaches whose depths fit the order,
 //! and keeps a pair when the Keller point lies in both reaches and on the edge. Every test
 //! keeps the tree's margins on the inclusive side, so no path validation accepts is lost
@@ -21,7 +25,6 @@ use crate::diffraction::DiffractedSet;
 use bt_geom::bvh::box_meets_halfspaces;
 use bt_geom::{Plane, Real, Vec3};
 use bt_scene::{Edge, EdgeId, Scene, SurfaceId};
-use std::f64::consts::PI;
 
 /// Angular slack (rad) of the exterior test on images: far above round-off, far below any
 /// sector a valid path could need.
@@ -40,14 +43,19 @@ struct Reach {
 
 impl BeamTree {
     /// The nodes of depth ≤ `max_depth` (the root included) whose image lies in an edge's
-    /// exterior and whose beam reaches the edge, per edge of `usable` (`usable[e]`).
+    /// exterior and whose beam reaches the edge, per edge of `usable` (`usable[e]`), each
+    /// edge's in ascending depth.
     fn reaches(&self, scene: &Scene, usable: &[bool], max_depth: usize) -> Vec<Vec<Reach>> {
         let edges = scene.edges();
-        let sectors: Vec<Sector> = edges.all().iter().map(Sector::of).collect();
+        let in_plane: Vec<Vec<u32>> = edges
+            .all()
+            .iter()
+            .map(|edge| plane_holds_edge(scene, edge))
+            .collect();
         let eps = EPS * self.tol;
         let mut out: Vec<Vec<Reach>> = vec![Vec::new(); edges.len()];
         for (e, edge) in edges.all().iter().enumerate() {
-            if usable[e] && sectors[e].holds(edge, self.tx) {
+            if usable[e] && in_sector(edge, self.tx) {
                 out[e].push(Reach {
                     node: ROOT,
                     depth: 0,
@@ -67,7 +75,10 @@ impl BeamTree {
                 let test = |min, max| box_meets_halfspaces(min, max, planes, eps);
                 edges.bvh().visit(test, |e| {
                     let edge = &edges.all()[e as usize];
-                    if !usable[e as usize] || !sectors[e as usize].holds(edge, node.image) {
+                    if !usable[e as usize]
+                        || in_plane[e as usize].contains(&node.surface)
+                        || !in_sector(edge, node.image)
+                    {
                         return;
                     }
                     if let Some((lo, hi)) = clip(edge, planes, eps) {
@@ -97,37 +108,31 @@ impl BeamTree {
     }
 }
 
-/// An edge's exterior sector in a form tested without trigonometry: `y0 = e × t0` and the
-/// in-plane direction of face n, `f_n = cos(nπ)·t0 + sin(nπ)·y0`.
-#[derive(Debug, Clone, Copy)]
-struct Sector {
-    y0: Vec3,
-    face_n: Vec3,
+/// The surfaces touching `edge` whose plane holds its whole segment to half the scene's length
+/// tolerance. A reflection on one of them next to the diffraction point `D` (on the segment,
+/// so within that half tolerance of the plane, plus round-off) has a neighbour within the
+/// tolerance of its plane, and validation rejects it as grazing
+/// (`bt_solve::diffraction::validate`): no valid path starts or ends such a reach.
+fn plane_holds_edge(scene: &Scene, edge: &Edge) -> Vec<u32> {
+    let half = 0.5 * scene.length_tolerance();
+    edge.touching
+        .iter()
+        .filter(|id| {
+            let plane = scene.surface(**id).polygon.plane();
+            plane.signed_distance(edge.start).abs() <= half
+                && plane.signed_distance(edge.end).abs() <= half
+        })
+        .map(|id| id.0)
+        .collect()
 }
 
-impl Sector {
-    fn of(edge: &Edge) -> Sector {
-        let y0 = edge.direction.cross(edge.t0);
-        let (sin, cos) = (edge.n * PI).sin_cos();
-        Sector {
-            y0,
-            face_n: cos * edge.t0 + sin * y0,
-        }
-    }
-
-    /// Whether `p` lies in the edge's exterior, φ ∈ (0, nπ), up to [`EXTERIOR_SLACK_RAD`]
-    /// (points on the edge line are in no sector). With v = p's offset ⊥ the edge and r = |v|:
-    /// φ ∈ [−slack, π + slack] where v·y0 ≥ −slack·r; beyond a half-turn (n > 1), φ ≤ nπ +
-    /// slack where v turns counter-clockwise into f_n: (v × f_n)·e ≥ −slack·r.
-    fn holds(&self, edge: &Edge, p: Vec3) -> bool {
-        let v = edge.perpendicular(p);
-        let r = v.length();
-        if r == 0.0 {
-            return false;
-        }
-        let slack = EXTERIOR_SLACK_RAD * r;
-        v.dot(self.y0) >= -slack || v.cross(self.face_n).dot(edge.direction) >= -slack
-    }
+/// Whether `p` lies in `edge`'s exterior, φ ∈ (0, nπ), up to [`EXTERIOR_SLACK_RAD`] (as a
+/// distance: the slack times p's distance r from the edge line; points on the line are in no
+/// sector).
+#[inline]
+fn in_sector(edge: &Edge, p: Vec3) -> bool {
+    let about = edge.about(p);
+    about.r > 0.0 && about.in_sector(EXTERIOR_SLACK_RAD * about.r)
 }
 
 /// The parameter interval of `edge` inside every half-space `{x : plane(x) ≥ −eps}`, or
@@ -176,8 +181,10 @@ pub fn join(
     let (mut before, mut after) = (Vec::new(), Vec::new());
     for (e, edge) in scene.edges().all().iter().enumerate() {
         for a in &from_tx[e] {
-            for b in &from_rx[e] {
-                if a.depth + b.depth + 1 > max_order || a.lo.max(b.lo) > a.hi.min(b.hi) + margin {
+            // Reaches come in ascending depth: stop at the first too deep to fit the order.
+            let fits = |b: &&Reach| a.depth + b.depth < max_order;
+            for b in from_rx[e].iter().take_while(fits) {
+                if a.lo.max(b.lo) > a.hi.min(b.hi) + margin {
                     continue;
                 }
                 let Some(t) = edge.keller(a.image, b.image) else {

@@ -178,3 +178,46 @@ fn the_keller_point_makes_equal_angles() {
     let cos_out = (b - p).normalize().dot(e.direction);
     assert!((cos_in - cos_out).abs() < 1e-12, "{cos_in} {cos_out}");
 }
+
+/// The exterior test without trigonometry agrees with its definition by the angle φ
+/// (φ ∈ (0, nπ), more than `tol` from the edge line and from both faces' half-planes), on a
+/// deterministic spiral of points around wedges of several angles, away from the boundaries.
+#[test]
+fn the_exterior_test_agrees_with_the_angle_definition() {
+    let tol = 1e-3;
+    for gap_deg in [185.0_f64, 225.0, 270.0, 300.0, 360.0] {
+        let gap = gap_deg.to_radians();
+        let (e, t0) = (Vec3::Z, Vec3::X);
+        let edge = Edge {
+            start: Vec3::ZERO,
+            end: Vec3::Z,
+            direction: e,
+            length: 1.0,
+            face0: SurfaceId(0),
+            face_n: SurfaceId(1),
+            t0,
+            n: gap / PI,
+            tn: face_direction(e, t0, gap),
+            touching: vec![],
+        };
+        let mut checked = 0;
+        for k in 0..20_000 {
+            let phi = (k as Real * 0.618_033_988_75 % 1.0) * 2.0 * PI;
+            let r = 1e-4 + (k % 97) as Real * 0.01;
+            let p = Vec3::new(r * phi.cos(), r * phi.sin(), 0.3);
+            let clear = |angle: Real| angle >= PI / 2.0 || r * angle.sin() > tol;
+            let by_angle = r > tol && phi > 0.0 && phi < gap && clear(phi) && clear(gap - phi);
+            let near = |x: Real| (x.abs() - tol).abs() < 1e-9;
+            if near(r * phi.sin()) || near(r * (gap - phi).sin()) || near(r) {
+                continue;
+            }
+            assert_eq!(
+                edge.in_exterior(p, tol),
+                by_angle,
+                "gap {gap_deg}° φ {phi} r {r}"
+            );
+            checked += 1;
+        }
+        assert!(checked > 19_000);
+    }
+}
