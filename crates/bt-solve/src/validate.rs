@@ -2,7 +2,7 @@
 //! no segment blocked by another surface.
 
 use bt_geom::{Real, Vec3};
-use bt_scene::{Scene, SurfaceId};
+use bt_scene::{Scene, SurfaceId, SurfaceKind};
 use serde::Serialize;
 
 /// Verdict on a path's geometry.
@@ -85,7 +85,9 @@ pub fn validate(scene: &Scene, seq: &[SurfaceId], tx: Vec3, rx: Vec3, points: &[
 /// [`Validity::Grazing`]. The one rule for points on a boundary: at an edge or a corner a path
 /// does not reflect (it touches the edge; with diffraction on, it is found as a diffraction,
 /// whose point lies strictly inside its edge); on a seam between coplanar faces, which is no
-/// edge, it reflects. The edges are looked at only for points within `tol` of the boundary.
+/// edge, it reflects once, on the face of the lowest id that holds the point
+/// ([`seam_owner_below`]); for the other faces it is [`Validity::OutsidePolygon`]. Edges and
+/// seams are looked at only for points within `tol` of the boundary.
 #[inline(always)]
 pub fn reflection_point(
     scene: &Scene,
@@ -102,8 +104,40 @@ pub fn reflection_point(
     if !polygon.contains(p, tol) {
         return Some(Validity::OutsidePolygon { index });
     }
-    on_edge_of(scene, id, p, tol).then_some(Validity::Grazing { index })
+    if on_edge_of(scene, id, p, tol) {
+        return Some(Validity::Grazing { index });
+    }
+    seam_owner_below(scene, id, p, tol).then_some(Validity::OutsidePolygon { index })
 }
+
+/// Whether a reflector of lower id than `id`, parallel to it, holds `p` (within `tol` of its
+/// plane and of its polygon): `p` lies on a seam of coplanar faces, and that face reflects
+/// the path, so that it is found once.
+#[inline(never)]
+fn seam_owner_below(scene: &Scene, id: SurfaceId, p: Vec3, tol: Real) -> bool {
+    let normal = scene.surface(id).polygon.plane().normal;
+    let grow = Vec3::splat(2.0 * tol);
+    let (lo, hi) = (p - grow, p + grow);
+    let mut below = false;
+    scene.bvh().visit(
+        |min, max| min.cmple(hi).all() && max.cmpge(lo).all(),
+        |s| {
+            if below || s >= id.0 {
+                return;
+            }
+            let other = scene.surface(SurfaceId(s));
+            let plane = other.polygon.plane();
+            below = other.kind == SurfaceKind::Reflector
+                && plane.normal.dot(normal).abs() >= PARALLEL_COS
+                && plane.signed_distance(p).abs() <= tol
+                && other.polygon.contains(p, tol);
+        },
+    );
+    below
+}
+
+/// Faces whose normals' |cos| reaches this (1e-6 rad apart) are parallel for the seam rule.
+const PARALLEL_COS: Real = 1.0 - 5e-13;
 
 /// Whether `p` lies within `tol` of a diffracting edge that surface `id` touches.
 #[inline(never)]

@@ -5,7 +5,7 @@
 
 use crate::common::{angle_between, scene_from_json, trace_scene};
 use bt_geom::{Real, Vec3};
-use bt_scene::Scene;
+use bt_scene::{Scene, SurfaceId};
 use bt_solve::pipeline::{CandidateMode, DiffractionOptions, TraceOptions};
 use bt_solve::{FoundPath, Interaction, IpcOptions, Solver, UpdateOrder};
 use bt_testkit::nasty_scene;
@@ -226,4 +226,38 @@ fn a_reflection_point_on_an_edge_is_a_diffraction_not_a_reflection() {
     let through: Vec<&FoundPath> = found.iter().filter(|p| at_corner(p)).collect();
     assert_eq!(through.len(), 1, "{found:?}");
     assert!(through[0].diffraction.is_some());
+}
+
+/// The same rule on a seam between coplanar faces, which is no edge: the point reflects, once,
+/// on the face of the lowest id (before the rule both halves of a split floor reported it).
+#[test]
+fn a_reflection_point_on_a_seam_reflects_once() {
+    // A floor split at x = 0 into two coplanar halves; TX and RX mirror each other through
+    // x = 0, so the floor's reflection point lies on the seam (0, 0, 0).
+    let scene = scene_from_json(
+        r#"{ "tx": [-1, 0, 1], "rx": [1, 0, 1],
+            "surfaces": [
+              { "name": "east", "vertices": [[0,-2,0],[3,-2,0],[3,2,0],[0,2,0]] },
+              { "name": "west", "vertices": [[-3,-2,0],[0,-2,0],[0,2,0],[-3,2,0]] } ] }"#,
+    );
+    for mode in [CandidateMode::Exhaustive, CandidateMode::BeamTree] {
+        for diffraction in [
+            DiffractionOptions::default(),
+            DiffractionOptions::first_order(),
+        ] {
+            let options = TraceOptions {
+                diffraction,
+                ..options(1, mode, Solver::Image)
+            };
+            let traced = trace_scene(&scene, &options).unwrap();
+            let reflected: Vec<&FoundPath> = traced
+                .result
+                .paths
+                .iter()
+                .filter(|p| p.points.len() == 1 && p.diffraction.is_none())
+                .collect();
+            assert_eq!(reflected.len(), 1, "{mode:?}: {reflected:?}");
+            assert_eq!(reflected[0].surfaces, vec![SurfaceId(0)]);
+        }
+    }
 }
