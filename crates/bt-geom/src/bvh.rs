@@ -154,6 +154,14 @@ impl Bvh {
         });
     }
 
+    /// Calls `visit(item)` for every item whose box meets the cube of half-side `radius`
+    /// (metres) around `p`.
+    #[inline]
+    pub fn visit_near(&self, p: Vec3, radius: Real, visit: impl FnMut(u32)) {
+        let (lo, hi) = (p - Vec3::splat(radius), p + Vec3::splat(radius));
+        self.visit(|min, max| min.cmple(hi).all() && max.cmpge(lo).all(), visit);
+    }
+
     /// Calls `visit(item)` for every item whose box, grown by `margin` metres, the segment
     /// `a -> b` touches (see [`Bvh::any_hit`]).
     #[inline]

@@ -2,6 +2,7 @@
 //! no segment blocked by another surface.
 
 use bt_geom::{Real, Vec3};
+use bt_scene::edges::FLAT_WEDGE_RAD;
 use bt_scene::{Scene, SurfaceId, SurfaceKind};
 use serde::Serialize;
 
@@ -110,50 +111,38 @@ pub fn reflection_point(
     seam_owner_below(scene, id, p, tol).then_some(Validity::OutsidePolygon { index })
 }
 
-/// Whether a reflector of lower id than `id`, parallel to it, holds `p` (within `tol` of its
-/// plane and of its polygon): `p` lies on a seam of coplanar faces, and that face reflects
+/// Whether a reflector of lower id than `id`, parallel to it (normals within
+/// [`FLAT_WEDGE_RAD`], the junctions that are seams and not edges), holds `p` (within `tol` of
+/// its plane and of its polygon): `p` lies on a seam of coplanar faces, and that face reflects
 /// the path, so that it is found once.
 #[inline(never)]
 fn seam_owner_below(scene: &Scene, id: SurfaceId, p: Vec3, tol: Real) -> bool {
     let normal = scene.surface(id).polygon.plane().normal;
-    let grow = Vec3::splat(2.0 * tol);
-    let (lo, hi) = (p - grow, p + grow);
     let mut below = false;
-    scene.bvh().visit(
-        |min, max| min.cmple(hi).all() && max.cmpge(lo).all(),
-        |s| {
-            if below || s >= id.0 {
-                return;
-            }
-            let other = scene.surface(SurfaceId(s));
-            let plane = other.polygon.plane();
-            below = other.kind == SurfaceKind::Reflector
-                && plane.normal.dot(normal).abs() >= PARALLEL_COS
-                && plane.signed_distance(p).abs() <= tol
-                && other.polygon.contains(p, tol);
-        },
-    );
+    scene.bvh().visit_near(p, 2.0 * tol, |s| {
+        if below || s >= id.0 {
+            return;
+        }
+        let other = scene.surface(SurfaceId(s));
+        let plane = other.polygon.plane();
+        below = other.kind == SurfaceKind::Reflector
+            && plane.normal.dot(normal).abs() >= FLAT_WEDGE_RAD.cos()
+            && plane.signed_distance(p).abs() <= tol
+            && other.polygon.contains(p, tol);
+    });
     below
 }
-
-/// Faces whose normals' |cos| reaches this (1e-6 rad apart) are parallel for the seam rule.
-const PARALLEL_COS: Real = 1.0 - 5e-13;
 
 /// Whether `p` lies within `tol` of a diffracting edge that surface `id` touches.
 #[inline(never)]
 fn on_edge_of(scene: &Scene, id: SurfaceId, p: Vec3, tol: Real) -> bool {
     let edges = scene.edges();
-    let grow = Vec3::splat(2.0 * tol);
-    let (lo, hi) = (p - grow, p + grow);
     let mut near = false;
-    edges.bvh().visit(
-        |min, max| min.cmple(hi).all() && max.cmpge(lo).all(),
-        |e| {
-            let edge = edges.get(bt_scene::EdgeId(e));
-            let t = edge.parameter(p).clamp(0.0, edge.length);
-            near |= edge.touching.contains(&id) && edge.point(t).distance(p) <= tol;
-        },
-    );
+    edges.bvh().visit_near(p, 2.0 * tol, |e| {
+        let edge = edges.get(bt_scene::EdgeId(e));
+        let t = edge.parameter(p).clamp(0.0, edge.length);
+        near |= edge.touching.contains(&id) && edge.point(t).distance(p) <= tol;
+    });
     near
 }
 
