@@ -29,7 +29,7 @@ use std::cell::OnceCell;
 
 mod diffraction;
 mod rebuild;
-pub use diffraction::join as join_diffracted;
+pub use diffraction::{DiffractionSide, join as join_diffracted};
 pub use rebuild::RebuildStats;
 
 /// How the tree is built.
@@ -1376,13 +1376,24 @@ pub fn candidates_and_diffracted_in(
 }
 
 /// The diffracted candidates of `scene` (edges at least `min_edge_length` m long), the TX
-/// side from `tx` (materialised to depth `options.max_order − 1`), the RX side from a tree
-/// grown from RX to the same depth.
+/// side from `tx` (materialised to depth `options.max_order − 1`).
 fn diffracted(
     scene: &Scene,
     tx: &BeamTree,
     options: TreeOptions,
     min_edge_length: Real,
+) -> Result<crate::diffraction::DiffractedSet, TreeError> {
+    let side = DiffractionSide::of(scene, tx, options.max_order, min_edge_length);
+    diffracted_with(scene, (tx, &side), options)
+}
+
+/// The diffracted candidates of `scene`'s RX with a kept TX tree and its side
+/// ([`DiffractionSide::of`], same order): the RX side from a tree grown from RX to depth
+/// `options.max_order − 1`. Stops beyond `options.max_nodes` candidates.
+pub fn diffracted_with(
+    scene: &Scene,
+    tx: (&BeamTree, &DiffractionSide),
+    options: TreeOptions,
 ) -> Result<crate::diffraction::DiffractedSet, TreeError> {
     if options.max_order == 0 {
         return Ok(Default::default());
@@ -1395,15 +1406,5 @@ fn diffracted(
         ..options
     };
     let rx = BeamTree::build(&swapped, depth)?;
-    let mut usable = vec![false; scene.edges().len()];
-    for e in crate::diffraction::usable_edges(scene, min_edge_length) {
-        usable[e.index()] = true;
-    }
-    diffraction::join(
-        scene,
-        (tx, &rx),
-        options.max_order,
-        &usable,
-        options.max_nodes,
-    )
+    diffraction::join(scene, tx, &rx, options.max_nodes)
 }

@@ -7,7 +7,9 @@
 
 use crate::{Solver, TraceResult};
 use bt_geom::Vec3;
-use bt_paths::beamtree::{BeamTree, TreeCache, TreeOptions, TreeStats};
+use bt_paths::beamtree::{
+    BeamTree, DiffractionSide, TreeCache, TreeOptions, TreeStats, diffracted_with,
+};
 pub use bt_paths::beamtree::{BuildProgress, Progress};
 use bt_paths::{AllVisible, CandidateSet, CandidateStats};
 use bt_scene::{Scene, SceneError};
@@ -326,7 +328,7 @@ pub(crate) fn trace_each_receiver(
     base: &Scene,
     receivers: &[Vec3],
     options: &TraceOptions,
-    tree: Option<&BeamTree>,
+    tree: Option<&KeptTx>,
     cache: &mut TreeCache,
 ) -> Vec<Result<Traced, TraceError>> {
     let inner = TraceOptions {
@@ -341,9 +343,9 @@ pub(crate) fn trace_each_receiver(
         let moved = base.with_receiver(*rx)?;
         match tree {
             // The tree's margins hold for receivers whose scene tolerance is no larger.
-            Some(tree) if moved.length_tolerance() <= tree.tolerance() => {
+            Some(kept) if moved.length_tolerance() <= kept.tree.tolerance() => {
                 let t0 = Instant::now();
-                let set = tree.candidates(moved.terminals()?.rx);
+                let set = kept.candidates(&moved, &inner)?;
                 solve_set(&moved, set, &inner, t0.elapsed())
             }
             // Receivers traced in parallel cannot share one cache (`tree` is built in beam-tree
@@ -361,11 +363,48 @@ pub(crate) fn trace_each_receiver(
 /// Whether a many-receiver trace of `receivers` under `options` walks one beam tree of the TX
 /// (beam-tree mode, more than one receiver) instead of tracing each receiver alone.
 pub(crate) fn walks_one_tree(options: &TraceOptions, receivers: &[Vec3]) -> bool {
-    // The kept tree answers specular candidates only: with diffraction each receiver grows
-    // its own tree from RX.
-    options.candidates == CandidateMode::BeamTree
-        && receivers.len() > 1
-        && options.diffraction.enabled().is_none()
+    options.candidates == CandidateMode::BeamTree && receivers.len() > 1
+}
+
+/// The beam tree of a TX kept for many receivers ([`trace_each_receiver`]), with the reaches
+/// of its nodes on the edges when diffraction is on: each receiver then only grows its own
+/// side (a tree from RX) and joins it.
+#[derive(Clone)]
+pub(crate) struct KeptTx {
+    pub tree: BeamTree,
+    pub side: Option<DiffractionSide>,
+}
+
+impl KeptTx {
+    /// The tree of `scene`'s TX under `options` (the solver's tree options), built with
+    /// `cache`, and its diffraction side when `options` diffract.
+    pub fn build(
+        scene: &Scene,
+        options: &TraceOptions,
+        cache: &mut TreeCache,
+    ) -> Result<KeptTx, TraceError> {
+        let tree = BeamTree::build_in(scene, solver_tree_options(options), cache, &mut |_| {})?;
+        let side = options.diffraction.enabled().map(|min_edge_length| {
+            DiffractionSide::of(scene, &tree, options.max_order, min_edge_length)
+        });
+        Ok(KeptTx { tree, side })
+    }
+
+    /// The candidates of `scene`'s RX (`scene` has this tree's TX): a walk of the tree, and
+    /// the diffracted ones joined with a tree grown from RX.
+    fn candidates(
+        &self,
+        scene: &Scene,
+        options: &TraceOptions,
+    ) -> Result<CandidateSet, TraceError> {
+        let mut set = self.tree.candidates(scene.terminals()?.rx);
+        if let Some(side) = &self.side {
+            let tree_options = solver_tree_options(options);
+            set.diffracted = diffracted_with(scene, (&self.tree, side), tree_options)?;
+            set.stats.diffracted = set.diffracted.len() as u64;
+        }
+        Ok(set)
+    }
 }
 
 #[cfg(test)]

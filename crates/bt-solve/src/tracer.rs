@@ -6,12 +6,12 @@
 //! A cache only saves work; a fresh `Tracer` gives bit-identical results.
 
 use crate::pipeline::{
-    BuildProgress, TraceError, TraceOptions, Traced, solver_tree_options, trace_each_receiver,
-    trace_scene_in, walks_one_tree,
+    BuildProgress, KeptTx, TraceError, TraceOptions, Traced, trace_each_receiver, trace_scene_in,
+    walks_one_tree,
 };
 use crate::steps::{Incremental, StepTrace, trace_scratch};
 use bt_geom::Vec3;
-use bt_paths::beamtree::{BeamTree, TreeCache};
+use bt_paths::beamtree::TreeCache;
 use bt_scene::Scene;
 
 /// Traces one scene: one TX–RX pair ([`Tracer::trace`]), one TX to many receivers with one beam
@@ -32,9 +32,9 @@ pub struct Tracer {
     /// The beam tree's per-surface shapes and arenas, reused while the geometry stays.
     cache: TreeCache,
     /// The beam tree of `scene`'s own TX (built with the solver's tree options) that
-    /// [`Tracer::trace_many`] walks for every receiver; dropped when the scene or the options
-    /// change.
-    kept: Option<BeamTree>,
+    /// [`Tracer::trace_many`] walks for every receiver, with its diffraction side; dropped when
+    /// the scene or the options change.
+    kept: Option<KeptTx>,
     /// The previous time step, for [`Tracer::update`].
     previous: Incremental,
     /// Index of the next time step.
@@ -130,7 +130,7 @@ impl Tracer {
         if Some(tx) != self.scene.tx_world() {
             let base = self.scene.with_terminals(tx, *first)?;
             let tree = match walk {
-                true => Some(tx_tree(&base, &options, &mut self.cache)?),
+                true => Some(KeptTx::build(&base, &options, &mut self.cache)?),
                 false => None,
             };
             let cache = &mut self.cache;
@@ -143,7 +143,7 @@ impl Tracer {
             ));
         }
         if walk && self.kept.is_none() {
-            self.kept = Some(tx_tree(&self.scene, &options, &mut self.cache)?);
+            self.kept = Some(KeptTx::build(&self.scene, &options, &mut self.cache)?);
         }
         let tree = if walk { self.kept.as_ref() } else { None };
         Ok(trace_each_receiver(
@@ -183,19 +183,4 @@ impl Tracer {
         self.next_step += 1;
         self.next_step - 1
     }
-}
-
-/// The beam tree of `scene`'s TX that a many-receiver trace walks (the solver's tree options:
-/// IPC start points when IPC solves), built with `cache`.
-fn tx_tree(
-    scene: &Scene,
-    options: &TraceOptions,
-    cache: &mut TreeCache,
-) -> Result<BeamTree, TraceError> {
-    Ok(BeamTree::build_in(
-        scene,
-        solver_tree_options(options),
-        cache,
-        &mut |_| {},
-    )?)
 }

@@ -161,23 +161,52 @@ fn clip(edge: &Edge, planes: &[Plane], eps: Real) -> Option<(Real, Real)> {
     Some((lo, hi))
 }
 
-/// The diffracted candidates of one TX and one RX up to `max_order` interactions, from the
-/// TX tree `tx` and the RX tree `rx` (each materialised to depth `max_order − 1` at least),
-/// over the edges `usable` allows. Stops with [`TreeError::Budget`] beyond `budget`.
+/// What the diffracted candidates need of a TX tree, kept while only RX moves: its nodes'
+/// reaches on the usable edges (those at least the minimum edge length long).
+#[derive(Debug, Clone)]
+pub struct DiffractionSide {
+    reaches: Vec<Vec<Reach>>,
+    usable: Vec<bool>,
+    max_order: usize,
+}
+
+impl DiffractionSide {
+    /// The side of `tx` (materialised to depth `max_order − 1` at least) for paths of up to
+    /// `max_order` interactions over the edges at least `min_edge_length` metres long.
+    pub fn of(scene: &Scene, tx: &BeamTree, max_order: usize, min_edge_length: Real) -> Self {
+        let mut usable = vec![false; scene.edges().len()];
+        for e in crate::diffraction::usable_edges(scene, min_edge_length) {
+            usable[e.index()] = true;
+        }
+        let reaches = match max_order {
+            0 => vec![Vec::new(); usable.len()],
+            _ => tx.reaches(scene, &usable, max_order - 1),
+        };
+        DiffractionSide {
+            reaches,
+            usable,
+            max_order,
+        }
+    }
+}
+
+/// The diffracted candidates of one TX and one RX up to `side`'s order, from the TX tree `tx`
+/// with its `side` and the RX tree `rx` (materialised to depth `max_order − 1` at least).
+/// Stops with [`TreeError::Budget`] beyond `budget`.
 pub fn join(
     scene: &Scene,
-    (tx, rx): (&BeamTree, &BeamTree),
-    max_order: usize,
-    usable: &[bool],
+    (tx, side): (&BeamTree, &DiffractionSide),
+    rx: &BeamTree,
     budget: u64,
 ) -> Result<DiffractedSet, TreeError> {
     let mut set = DiffractedSet::default();
+    let max_order = side.max_order;
     if max_order == 0 {
         return Ok(set);
     }
     let margin = GROW * tx.tol.max(rx.tol);
-    let from_tx = tx.reaches(scene, usable, max_order - 1);
-    let from_rx = rx.reaches(scene, usable, max_order - 1);
+    let from_tx = &side.reaches;
+    let from_rx = rx.reaches(scene, &side.usable, max_order - 1);
     let (mut before, mut after) = (Vec::new(), Vec::new());
     for (e, edge) in scene.edges().all().iter().enumerate() {
         for a in &from_tx[e] {

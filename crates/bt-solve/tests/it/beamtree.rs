@@ -9,7 +9,7 @@ use crate::common::{trace_receivers, trace_scene};
 use bt_geom::{Real, Vec3};
 use bt_paths::beamtree::{BeamTree, Culling, TreeOptions};
 use bt_scene::{Scene, Terminals};
-use bt_solve::pipeline::{CandidateMode, TraceOptions};
+use bt_solve::pipeline::{CandidateMode, DiffractionOptions, TraceOptions};
 use bt_solve::{FoundPath, Solver, UpdateOrder};
 use bt_testkit::nasty_scene;
 use proptest::prelude::*;
@@ -136,6 +136,24 @@ proptest! {
             let moved = scene.with_receiver(*rx).unwrap();
             let reference = paths(&moved, 3, CandidateMode::Exhaustive);
             assert_same(&got.result.paths, &reference)?;
+        }
+        // With diffraction the kept tree also keeps its reaches on the edges; each receiver
+        // grows its own side and finds exhaustive enumeration's paths.
+        let diffraction = |mode| TraceOptions {
+            diffraction: DiffractionOptions::first_order(),
+            ..options(3, mode, Solver::Image)
+        };
+        let many = trace_receivers(&scene, &receivers, &diffraction(CandidateMode::BeamTree))
+            .expect("receivers trace");
+        for (rx, got) in receivers.iter().zip(&many) {
+            let moved = scene.with_receiver(*rx).unwrap();
+            let reference = trace_scene(&moved, &diffraction(CandidateMode::Exhaustive))
+                .expect("trace runs").result.paths;
+            let kinds = |paths: &[FoundPath]| -> Vec<_> {
+                paths.iter().map(|p| (p.surfaces.clone(), p.diffraction)).collect()
+            };
+            prop_assert_eq!(kinds(&got.result.paths), kinds(&reference));
+            prop_assert!(max_point_distance(&got.result.paths, &reference) < 1e-9);
         }
     }
 
