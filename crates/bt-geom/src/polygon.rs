@@ -313,6 +313,56 @@ impl Polygon {
             _ => false,
         }
     }
+
+    /// Whether `other` lies in this polygon's plane (every vertex within `tol` of it) and the
+    /// two interiors share a region of positive area: some point lies inside both by more
+    /// than `tol`. Witnesses, each checked in both polygons: a proper crossing of two edges, a
+    /// vertex of one strictly inside the other, and each edge's midpoint moved `4·tol` into
+    /// its own polygon (identical, nested, shifted and crossing polygons). No false positive:
+    /// every witness is a point inside both.
+    pub fn overlaps_coplanar(&self, other: &Polygon, tol: Real) -> bool {
+        if other
+            .vertices
+            .iter()
+            .any(|p| self.plane.signed_distance(*p).abs() > tol)
+        {
+            return false;
+        }
+        let (a, b) = (self, other);
+        let crossing = a.edges().any(|(p, q)| {
+            b.edges().any(|(r, s)| {
+                let (p2, q2, r2, s2) = (a.to_local(p), a.to_local(q), a.to_local(r), a.to_local(s));
+                poly2::segments_touch(p2, q2, r2, s2)
+                    && [r, s].iter().all(|x| !a.contains(*x, tol))
+                    && [p, q].iter().all(|x| !b.contains(*x, tol))
+            })
+        });
+        crossing || a.witness_inside(b, tol) || b.witness_inside(a, tol)
+    }
+
+    /// Whether a vertex of this polygon, or one of its edges' midpoints moved `4·tol` inwards,
+    /// lies inside both this polygon and `other` by more than `tol`.
+    fn witness_inside(&self, other: &Polygon, tol: Real) -> bool {
+        let ccw = poly2::signed_area(&self.local) > 0.0;
+        let inward = |p: Vec3, q: Vec3| {
+            let d = (self.to_local(q) - self.to_local(p)).normalize_or_zero();
+            let left = Vec2::new(-d.y, d.x);
+            self.from_local(
+                self.to_local(0.5 * (p + q)) + 4.0 * tol * if ccw { left } else { -left },
+            )
+        };
+        self.vertices.iter().any(|p| other.inside_by(*p, tol))
+            || self
+                .edges()
+                .map(|(p, q)| inward(p, q))
+                .any(|m| self.inside_by(m, tol) && other.inside_by(m, tol))
+    }
+
+    /// The edges `(vertex i, vertex i + 1)`, closing the loop.
+    fn edges(&self) -> impl Iterator<Item = (Vec3, Vec3)> + '_ {
+        let n = self.vertices.len();
+        (0..n).map(move |i| (self.vertices[i], self.vertices[(i + 1) % n]))
+    }
 }
 
 fn bounds(points: &[Vec3]) -> (Vec3, Vec3) {
@@ -341,6 +391,65 @@ fn area_centroid(local: &[Vec2], origin: Vec3, u: Vec3, v: Vec3) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Axis-aligned rectangle `x0..x1 × y0..y1` at height `z`, turned clockwise when `cw`.
+    fn rect(x0: Real, y0: Real, x1: Real, y1: Real, z: Real, cw: bool) -> Polygon {
+        let mut v = vec![
+            Vec3::new(x0, y0, z),
+            Vec3::new(x1, y0, z),
+            Vec3::new(x1, y1, z),
+            Vec3::new(x0, y1, z),
+        ];
+        if cw {
+            v.reverse();
+        }
+        Polygon::new(v).unwrap()
+    }
+
+    #[test]
+    fn coplanar_overlap_is_found_whatever_its_shape() {
+        let tol = 1e-9;
+        let base = rect(0., 0., 2., 2., 0., false);
+        let overlapping = [
+            ("identical", rect(0., 0., 2., 2., 0., false)),
+            (
+                "identical, turned the other way",
+                rect(0., 0., 2., 2., 0., true),
+            ),
+            ("shifted by half", rect(1., 0., 3., 2., 0., false)),
+            ("nested", rect(0.5, 0.5, 1.5, 1.5, 0., true)),
+            ("nested on a shared edge", rect(0., 0., 1., 2., 0., false)),
+            ("crossing like a plus", rect(0.5, -1., 1.5, 3., 0., false)),
+        ];
+        for (what, other) in &overlapping {
+            assert!(base.overlaps_coplanar(other, tol), "{what}");
+            assert!(other.overlaps_coplanar(&base, tol), "{what}, swapped");
+        }
+        let apart = [
+            ("sharing an edge", rect(2., 0., 4., 2., 0., false)),
+            ("sharing a corner", rect(2., 2., 4., 4., 0., true)),
+            ("beside it", rect(3., 0., 4., 2., 0., false)),
+            ("parallel, 1 m above", rect(0., 0., 2., 2., 1., false)),
+            (
+                "within a tolerance of the edge",
+                rect(2. - 0.5 * tol, 0., 4., 2., 0., false),
+            ),
+        ];
+        for (what, other) in &apart {
+            assert!(!base.overlaps_coplanar(other, tol), "{what}");
+            assert!(!other.overlaps_coplanar(&base, tol), "{what}, swapped");
+        }
+        // A square in the notch of an L touches it along two edges only.
+        let l = Polygon::new(
+            [[0., 0.], [2., 0.], [2., 1.], [1., 1.], [1., 2.], [0., 2.]]
+                .map(|[x, y]| Vec3::new(x, y, 0.))
+                .to_vec(),
+        )
+        .unwrap();
+        let notch = rect(1., 1., 2., 2., 0., false);
+        assert!(!l.overlaps_coplanar(&notch, tol) && !notch.overlaps_coplanar(&l, tol));
+        assert!(l.overlaps_coplanar(&rect(0.5, 0.5, 1.5, 1.5, 0., false), tol));
+    }
 
     fn square(z: Real) -> Vec<Vec3> {
         vec![

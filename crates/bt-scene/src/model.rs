@@ -175,39 +175,16 @@ impl Scene {
             .map(|i| SurfaceId(i as u32))
     }
 
-    /// Pairs of surfaces (lower id first) that lie in one plane and overlap (the centroid of
-    /// one inside the other) but name different materials: every path reflecting there is
-    /// found twice, with two losses. A warning, not an error (meshes can hold such faces).
-    /// Pairs are compared only when their bounding boxes meet (found through the BVH: a city
-    /// mesh has 20,000 surfaces, 200 million pairs).
+    /// Pairs of reflectors (lower id first) that lie in one plane and overlap
+    /// ([`bt_geom::Polygon::overlaps_coplanar`]) but name different materials: every path
+    /// reflecting there is found twice, with two losses. A warning for imported geometry (a
+    /// scene file refuses every overlapping pair).
     pub fn coplanar_conflicts(&self) -> Vec<(SurfaceId, SurfaceId)> {
-        let eps = self.length_tolerance();
-        let mut out = Vec::new();
-        let mut near = Vec::new();
-        for (i, a) in self.surfaces.iter().enumerate() {
-            let (alo, ahi) = a.polygon.bounds();
-            near.clear();
-            self.bvh.visit(
-                |lo, hi| (alo - hi).max_element() <= eps && (lo - ahi).max_element() <= eps,
-                |j| near.push(j as usize),
-            );
-            near.sort_unstable();
-            for &j in near.iter().filter(|&&j| j > i) {
-                let b = &self.surfaces[j];
-                if a.material == b.material {
-                    continue;
-                }
-                let (pa, pb) = (&a.polygon, &b.polygon);
-                let same_plane = pa.plane().normal.dot(pb.plane().normal).abs() > 1.0 - 1e-9
-                    && pa.plane().signed_distance(pb.centroid()).abs() <= eps;
-                if same_plane
-                    && (pa.contains(pb.centroid(), eps) || pb.contains(pa.centroid(), eps))
-                {
-                    out.push((SurfaceId(i as u32), SurfaceId(j as u32)));
-                }
-            }
-        }
-        out
+        crate::validate::coplanar_overlaps(&self.surfaces, self.length_tolerance())
+            .into_iter()
+            .filter(|&(i, j)| self.surfaces[i].material != self.surfaces[j].material)
+            .map(|(i, j)| (SurfaceId(i as u32), SurfaceId(j as u32)))
+            .collect()
     }
 
     /// Closed shells (watertight groups of surfaces, e.g. a box with all six faces or a closed
