@@ -23,3 +23,10 @@ pub fn write(path: &Path, bytes: &[u8], inputs: &[&Path], formats: &[&str]) -> a
     }
     bt_output::write_atomic(path, bytes).with_context(|| format!("writing {}", path.display()))
 }
+
+/// Print a warning for each file of an earlier run's manifest that a commit left in place.
+pub fn warn_left_alone(done: &bt_output::Committed) {
+    for left in &done.left_alone {
+        eprintln!("warning: {left}");
+    }
+}

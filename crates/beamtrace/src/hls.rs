@@ -161,7 +161,7 @@ fn generate(args: &HlsGenArgs) -> anyhow::Result<ExitCode> {
         vec![crate::load::load_scene(&args.scene)?.scene]
     };
     crate::load::require_every_step(&scenes, &args.scene)?;
-    // The output directory is built aside and swapped in: a user's own files in it survive.
+    // The output directory is locked, built aside and moved in: a user's own files survive.
     let mut out = OutputDir::begin(&args.output, &crate::inputs(&args.scene))
         .with_context(|| format!("creating {}", args.output.display()))?;
     // The platform: one PE per reflector that no step moves.
@@ -193,8 +193,10 @@ fn generate(args: &HlsGenArgs) -> anyhow::Result<ExitCode> {
         .collect();
     if args.steps {
         let doc = report_steps(args, summaries, &mut out)?;
-        out.commit()
+        let done = out
+            .commit()
             .with_context(|| format!("writing {}", args.output.display()))?;
+        crate::files::warn_left_alone(&done);
         print_steps(args, &doc);
     } else {
         let s = &summaries[0];
@@ -206,8 +208,10 @@ fn generate(args: &HlsGenArgs) -> anyhow::Result<ExitCode> {
                 &serde_json::to_string(&work[0].schedule)?,
             )?;
         }
-        out.commit()
+        let done = out
+            .commit()
             .with_context(|| format!("writing {}", args.output.display()))?;
+        crate::files::warn_left_alone(&done);
         print_summary(s, &args.output);
     }
     Ok(ExitCode::SUCCESS)
