@@ -77,7 +77,8 @@ pub fn run_living_room(args: &StudyLivingRoomArgs) -> anyhow::Result<ExitCode> {
     if !problems.is_empty() {
         anyhow::bail!("{}", problems.join("; "));
     }
-    let scene = crate::load::load_dynamic(&SceneArgs::defaults_for(&args.steps_from))?;
+    let loaded = crate::load::load_dynamic(&SceneArgs::defaults_for(&args.steps_from))?;
+    let scene = &loaded.scene;
     if let Some(problem) =
         bt_solve::SbrOptions::grid(args.sbr_step_deg).over_budget(args.budgets.max_rays)
     {
@@ -88,11 +89,10 @@ pub fn run_living_room(args: &StudyLivingRoomArgs) -> anyhow::Result<ExitCode> {
     }
     let bar = crate::progress::counter(scene.len() as u64, "time steps");
     bar.tick();
-    let results = bt_study::living_room::run(&scene, &config, &mut |done, _| {
-        bar.set_position(done as u64)
-    })?;
+    let results =
+        bt_study::living_room::run(scene, &config, &mut |done, _| bar.set_position(done as u64))?;
     bar.finish_and_clear();
-    let done = bt_study::io::write_living_room(&args.out, &results)?;
+    let done = bt_study::io::write_living_room(&args.out, &results, &loaded.sources)?;
     crate::files::warn_left_alone(&done);
     let h = living_room::report::headline(&results);
     let headline = format!(

@@ -81,7 +81,7 @@ impl OutputDir {
     /// it fails with [`OutputError::Busy`]), remove what a killed run left there, and open a
     /// staging directory. `protected` are the inputs of the run: a commit that would replace
     /// one of them fails before moving anything.
-    pub fn begin(dir: &Path, protected: &[&Path]) -> Result<OutputDir, OutputError> {
+    pub fn begin(dir: &Path, protected: &[PathBuf]) -> Result<OutputDir, OutputError> {
         let created = create(dir)?;
         let locked = DirLock::acquire(dir).and_then(|lock| {
             check_target(&dir.join(MANIFEST))?;
@@ -103,7 +103,7 @@ impl OutputDir {
             dir: dir.to_path_buf(),
             staging,
             written: BTreeSet::new(),
-            protected: protected.iter().map(|p| p.to_path_buf()).collect(),
+            protected: protected.to_vec(),
             prefix: String::new(),
             created,
             committed: false,
@@ -154,7 +154,6 @@ impl OutputDir {
     /// Refuse, before anything moves, a file of this run whose place in `dir` is reached
     /// through a symbolic link, holds a directory or special file, or is an input.
     fn check_places(&self) -> Result<(), OutputError> {
-        let inputs: Vec<&Path> = self.protected.iter().map(PathBuf::as_path).collect();
         for rel in &self.written {
             let to = self.dir.join(rel);
             if let Walk::Symlink(link) = manifest::walk(&self.dir, rel) {
@@ -164,7 +163,7 @@ impl OutputDir {
                 });
             }
             check_target(&to)?;
-            refuse_input(&to, &inputs)?;
+            refuse_input(&to, &self.protected)?;
         }
         Ok(())
     }

@@ -210,8 +210,10 @@ pub(crate) fn identity(path: &Path) -> Option<(u64, u64, PathBuf)> {
     }
 }
 
-/// Refuse `output` when it is (a link to, or another spelling of) one of `inputs`.
-pub fn refuse_input(output: &Path, inputs: &[&Path]) -> Result<(), OutputError> {
+/// Refuse `output` when it is (a link to, or another spelling of) one of `inputs`: the same
+/// file (device and inode), whatever the path. Inputs that do not exist are no file to
+/// protect.
+pub fn refuse_input(output: &Path, inputs: &[PathBuf]) -> Result<(), OutputError> {
     let Some(out) = identity(output) else {
         return Ok(()); // the output does not exist yet: it is no input
     };

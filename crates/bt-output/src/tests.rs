@@ -99,10 +99,10 @@ fn output_equal_to_input_is_refused_in_any_spelling() {
     std::fs::write(&f, b"ply").unwrap();
     let other = dir.join(".").join("cloud.ply");
     assert!(matches!(
-        refuse_input(&other, &[&f]),
+        refuse_input(&other, std::slice::from_ref(&f)),
         Err(OutputError::SameAsInput { .. })
     ));
-    assert!(refuse_input(&dir.join("scene.json"), &[&f]).is_ok());
+    assert!(refuse_input(&dir.join("scene.json"), &[f]).is_ok());
 }
 
 #[test]
@@ -161,7 +161,7 @@ fn commit_refuses_to_replace_an_input() {
     std::fs::create_dir_all(&dir).unwrap();
     let input = dir.join("summary.json");
     std::fs::write(&input, b"precious").unwrap();
-    let mut out = OutputDir::begin(&dir, &[&input]).unwrap();
+    let mut out = OutputDir::begin(&dir, std::slice::from_ref(&input)).unwrap();
     out.write("summary.json", b"{}").unwrap();
     assert!(matches!(out.commit(), Err(OutputError::SameAsInput { .. })));
     assert_eq!(std::fs::read(&input).unwrap(), b"precious");

@@ -6,7 +6,7 @@ use crate::run::{RoomDrawing, StudyResults};
 use crate::{StudyError, plot, report};
 use bt_output::{Committed, OutputDir};
 use plotters::prelude::*;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 
 /// Pixel size of Fig. 5 per drawn room and time step.
 const ROOM_CELL: u32 = 300;
@@ -98,9 +98,14 @@ pub fn write_outputs(dir: &Path, results: &StudyResults) -> Result<Committed, St
 /// Write every output of the living-room study into `dir` (created if missing; built aside and
 /// moved in):
 /// `results.csv`, `fpga.csv`, `summary.md`, `fig17-angular-error`, `fig18-ray-directions` and
-/// `fig19-run-time` as SVG and PNG. Returns the files written and those left alone.
-pub fn write_living_room(dir: &Path, results: &LivingRoomResults) -> Result<Committed, StudyError> {
-    let mut out = OutputDir::begin(dir, &[])?;
+/// `fig19-run-time` as SVG and PNG, refusing to replace any of `inputs` (the scene's files).
+/// Returns the files written and those left alone.
+pub fn write_living_room(
+    dir: &Path,
+    results: &LivingRoomResults,
+    inputs: &[PathBuf],
+) -> Result<Committed, StudyError> {
+    let mut out = OutputDir::begin(dir, inputs)?;
     write(&mut out, "results.csv", &living_room::report::csv(results))?;
     write(
         &mut out,
