@@ -1,4 +1,5 @@
 use super::*;
+use bt_testkit::special::{is_fifo, mkfifo};
 
 fn scratch(name: &str) -> PathBuf {
     let dir = std::env::temp_dir().join(format!("bt-output-{name}-{}", std::process::id()));
@@ -187,23 +188,6 @@ fn paths_outside_the_directory_are_refused() {
 
 /// A path no process can have (beyond Linux's `pid_max`, 2^22).
 const GONE_PID: u32 = 999_999_999;
-
-fn mkfifo(path: &Path) {
-    let ok = std::process::Command::new("mkfifo")
-        .arg(path)
-        .status()
-        .unwrap()
-        .success();
-    assert!(ok, "mkfifo {}", path.display());
-}
-
-fn is_fifo(path: &Path) -> bool {
-    use std::os::unix::fs::FileTypeExt;
-    std::fs::symlink_metadata(path)
-        .unwrap()
-        .file_type()
-        .is_fifo()
-}
 
 /// A committed output folder holding `a.txt` (ours) and a user's `notes.txt`, whose manifest
 /// is then replaced by `manifest` (a hand edit); the next commit writes only `b.txt`.
