@@ -8,14 +8,17 @@ use bt_beams::{BeamRanking, PathReport, RadioOptions};
 use bt_scene::Scene;
 use serde::Serialize;
 use std::fmt::Write as _;
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// Subcarriers × paths above which the frequency response is refused (a stated budget).
 const MAX_CFR_PRODUCTS: u64 = 500_000_000;
 
 /// Load, trace and report the paths the arguments select.
-fn traced_paths(args: &PathArgs) -> anyhow::Result<(Scene, Vec<PathReport>, RadioOptions)> {
+/// The files read come back too: the outputs must not replace them.
+fn traced_paths(
+    args: &PathArgs,
+) -> anyhow::Result<(Scene, Vec<PathReport>, RadioOptions, Vec<PathBuf>)> {
     let loaded = load_scene(&args.scene)?;
     for w in &loaded.warnings {
         eprintln!("warning: {w}");
@@ -28,12 +31,12 @@ fn traced_paths(args: &PathArgs) -> anyhow::Result<(Scene, Vec<PathReport>, Radi
     let radio = args.radio.options()?;
     let paths = bt_beams::report(&scene, &traced.result.paths, &radio)?;
     warn_near_field(&paths, &scene);
-    Ok((scene, paths, radio))
+    Ok((scene, paths, radio, loaded.sources))
 }
 
-/// Write `text` to `path` through the CLI's one writer (atomic, never over the scene file).
-fn write_text(path: &Path, text: &str, args: &PathArgs) -> anyhow::Result<()> {
-    crate::files::write(path, text.as_bytes(), &crate::inputs(&args.scene), &[])
+/// Write `text` to `path` through the CLI's one writer (atomic, never over an input).
+fn write_text(path: &Path, text: &str, inputs: &[PathBuf]) -> anyhow::Result<()> {
+    crate::files::write(path, text.as_bytes(), inputs, &[])
 }
 
 fn opt(v: Option<f64>) -> String {
@@ -101,12 +104,12 @@ fn cfr_csv(paths: &[PathReport], carrier_hz: f64, args: &ChannelArgs) -> anyhow:
 }
 
 pub fn run_channel(args: &ChannelArgs) -> anyhow::Result<ExitCode> {
-    let (scene, paths, radio) = traced_paths(&args.paths)?;
+    let (scene, paths, radio, inputs) = traced_paths(&args.paths)?;
     let carrier = scene.frequency_hz();
-    write_text(&args.out, &cir_csv(&paths, carrier), &args.paths)?;
+    write_text(&args.out, &cir_csv(&paths, carrier), &inputs)?;
     println!("{}: {} taps", args.out.display(), paths.len());
     if let Some(path) = &args.cfr {
-        write_text(path, &cfr_csv(&paths, carrier, args)?, &args.paths)?;
+        write_text(path, &cfr_csv(&paths, carrier, args)?, &inputs)?;
         println!("{}: {} subcarriers", path.display(), args.subcarriers);
     }
     if let Some(stem) = &args.pdp {
@@ -170,7 +173,7 @@ impl ArrayDoc {
 }
 
 pub fn run_beams(args: &BeamsArgs) -> anyhow::Result<ExitCode> {
-    let (scene, paths, radio) = traced_paths(&args.paths)?;
+    let (scene, paths, radio, inputs) = traced_paths(&args.paths)?;
     let array = |(rows, columns): (usize, usize), spacing: f64, which: &str, o| {
         bt_channel::Array::new(rows, columns, spacing, o)
             .with_context(|| format!("--{which}-array"))
@@ -200,7 +203,7 @@ pub fn run_beams(args: &BeamsArgs) -> anyhow::Result<ExitCode> {
     };
     let json = serde_json::to_string_pretty(&doc).context("serialising the beam sweep")?;
     if let Some(path) = &args.out {
-        write_text(path, &format!("{json}\n"), &args.paths)?;
+        write_text(path, &format!("{json}\n"), &inputs)?;
     }
     if args.json {
         println!("{json}");

@@ -5,7 +5,7 @@ use crate::args::{ExtractArgs, SampleArgs};
 use anyhow::{Context, bail};
 use bt_import::cloud::ReadOptions;
 use bt_pointcloud::{ExtractParams, Extraction, PointCloud};
-use std::path::Path;
+use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
 /// Read a cloud and extract its planes, with a progress bar on stderr.
@@ -41,7 +41,7 @@ pub fn run_extract(args: &ExtractArgs) -> anyhow::Result<ExitCode> {
         );
     }
     // Refuse a bad output before the (possibly long) extraction.
-    let inputs = [args.cloud.as_path()];
+    let inputs = [args.cloud.clone()];
     bt_output::refuse_input(&args.output, &inputs)?;
     let format = bt_output::extension_in(&args.output, &["json", "toml"])?;
     if let Some(report) = &args.report {
@@ -106,9 +106,12 @@ pub fn run_sample(args: &SampleArgs) -> anyhow::Result<ExitCode> {
             args.noise
         );
     }
-    bt_output::refuse_input(&args.output, &crate::inputs(&args.scene))?;
+    // The named scene before the load (a cloud's extraction can take long), every file the
+    // load read after it.
+    bt_output::refuse_input(&args.output, &[PathBuf::from(&args.scene.scene)])?;
     bt_output::extension_in(&args.output, &["ply", "pcd"])?;
     let loaded = crate::load::load_scene(&args.scene)?;
+    bt_output::refuse_input(&args.output, &loaded.sources)?;
     let polygons: Vec<Vec<glam::DVec3>> = loaded
         .scene
         .surfaces()

@@ -1,25 +1,29 @@
 //! Every file the CLI writes goes through here (atomic, never over an input, format from the
-//! extension); the rules live in `bt_output` (`docs/reliability.md`).
+//! extension); the rules live in `bt_output` (`docs/reliability.md`). The inputs of a run are
+//! the files its load read (`bt_import::Loaded::sources`: the scene file and the meshes an XML
+//! scene names) and any other file the command reads (`view --paths`).
 
-use crate::args::SceneArgs;
 use anyhow::Context;
-use std::path::Path;
-
-/// The input files of a run that names a scene (none for `builtin:NAME`).
-pub fn inputs(scene: &SceneArgs) -> Vec<&Path> {
-    if scene.scene.starts_with("builtin:") {
-        Vec::new()
-    } else {
-        vec![Path::new(&scene.scene)]
-    }
-}
+use std::path::{Path, PathBuf};
 
 /// Write `bytes` to `path` atomically after checking it is none of `inputs` and its extension
 /// is one of `formats` (lowercase, without dot; empty: any).
-pub fn write(path: &Path, bytes: &[u8], inputs: &[&Path], formats: &[&str]) -> anyhow::Result<()> {
+pub fn write(
+    path: &Path,
+    bytes: &[u8],
+    inputs: &[PathBuf],
+    formats: &[&str],
+) -> anyhow::Result<()> {
     bt_output::refuse_input(path, inputs)?;
     if !formats.is_empty() {
         bt_output::extension_in(path, formats)?;
     }
     bt_output::write_atomic(path, bytes).with_context(|| format!("writing {}", path.display()))
+}
+
+/// Print a warning for each file of an earlier run's manifest that a commit left in place.
+pub fn warn_left_alone(done: &bt_output::Committed) {
+    for left in &done.left_alone {
+        eprintln!("warning: {left}");
+    }
 }

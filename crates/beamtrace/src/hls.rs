@@ -155,17 +155,18 @@ fn generate(args: &HlsGenArgs) -> anyhow::Result<ExitCode> {
     if args.max_order == 0 {
         bail!("--max-order must be at least 1 (line of sight needs no accelerator)");
     }
-    let scenes: Vec<Scene> = if args.steps {
-        crate::load::load_dynamic(&args.scene)?.scenes().to_vec()
+    let loaded = if args.steps {
+        crate::load::load_dynamic(&args.scene)?.map(|d| d.scenes().to_vec())
     } else {
-        vec![crate::load::load_scene(&args.scene)?.scene]
+        crate::load::load_scene(&args.scene)?.map(|s| vec![s])
     };
-    crate::load::require_every_step(&scenes, &args.scene)?;
-    // The output directory is built aside and swapped in: a user's own files in it survive.
-    let mut out = OutputDir::begin(&args.output, &crate::inputs(&args.scene))
+    let scenes: &[Scene] = &loaded.scene;
+    crate::load::require_every_step(scenes, &args.scene)?;
+    // The output directory is locked, built aside and moved in: a user's own files survive.
+    let mut out = OutputDir::begin(&args.output, &loaded.sources)
         .with_context(|| format!("creating {}", args.output.display()))?;
     // The platform: one PE per reflector that no step moves.
-    let planes = bt_accel::static_reflectors(&scenes);
+    let planes = bt_accel::static_reflectors(scenes);
     let options = step_options(args);
     let mut planned: Vec<bt_accel::PlannedStep> = Vec::with_capacity(scenes.len());
     for (k, scene) in scenes.iter().enumerate() {
@@ -193,8 +194,10 @@ fn generate(args: &HlsGenArgs) -> anyhow::Result<ExitCode> {
         .collect();
     if args.steps {
         let doc = report_steps(args, summaries, &mut out)?;
-        out.commit()
+        let done = out
+            .commit()
             .with_context(|| format!("writing {}", args.output.display()))?;
+        crate::files::warn_left_alone(&done);
         print_steps(args, &doc);
     } else {
         let s = &summaries[0];
@@ -206,8 +209,10 @@ fn generate(args: &HlsGenArgs) -> anyhow::Result<ExitCode> {
                 &serde_json::to_string(&work[0].schedule)?,
             )?;
         }
-        out.commit()
+        let done = out
+            .commit()
             .with_context(|| format!("writing {}", args.output.display()))?;
+        crate::files::warn_left_alone(&done);
         print_summary(s, &args.output);
     }
     Ok(ExitCode::SUCCESS)

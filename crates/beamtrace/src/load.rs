@@ -51,20 +51,21 @@ pub fn load_scene(args: &SceneArgs) -> anyhow::Result<Loaded> {
 }
 
 /// Load a scene as a dynamic scene: JSON/TOML files and built-ins with their steps; meshes
-/// (and any other static source) as one step. Import warnings go to stderr.
-pub fn load_dynamic(args: &SceneArgs) -> anyhow::Result<DynamicScene> {
+/// (and any other static source) as one step. Import warnings go to stderr; the files read
+/// come back with the scene.
+pub fn load_dynamic(args: &SceneArgs) -> anyhow::Result<Loaded<DynamicScene>> {
     let options = load_options(args)?;
     let (bar, mut progress) = crate::progress::extraction_progress();
     let loaded = bt_import::load_dynamic(&args.scene, &options, &mut progress);
     bar.finish_and_clear();
-    let (mut scene, warnings) = loaded?;
+    let mut loaded = loaded?;
     if let Some(f) = args.material.frequency {
-        scene = scene.with_frequency(f)?;
+        loaded.scene = loaded.scene.with_frequency(f)?;
     }
-    for w in &warnings {
+    for w in &loaded.warnings {
         eprintln!("warning: {w}");
     }
-    Ok(scene)
+    Ok(loaded)
 }
 
 /// Refuse a scene without the terminals a command needs (`which`), naming the flags that give

@@ -19,8 +19,6 @@ mod wvrn;
 use clap::Parser;
 use std::process::ExitCode;
 
-pub use files::inputs;
-
 fn main() -> ExitCode {
     restore_default_sigpipe();
     exit_cleanly_when_stdout_fails();

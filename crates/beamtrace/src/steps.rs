@@ -10,7 +10,8 @@ use std::process::ExitCode;
 use std::time::Instant;
 
 pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
-    let dynamic = load_dynamic(&args.scene)?;
+    let loaded = load_dynamic(&args.scene)?;
+    let dynamic = &loaded.scene;
     crate::load::require_every_step(dynamic.scenes(), &args.scene)?;
     let scene0 = dynamic.step(0);
     let options = args.solve.settings().trace_options(scene0)?;
@@ -38,8 +39,8 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
     if args.json || args.out.is_some() {
         let json = serde_json::to_string_pretty(&doc).context("serialising the steps")?;
         if let Some(path) = &args.out {
-            let inputs = crate::inputs(&args.scene);
-            crate::files::write(path, format!("{json}\n").as_bytes(), &inputs, &["json"])?;
+            let inputs = &loaded.sources;
+            crate::files::write(path, format!("{json}\n").as_bytes(), inputs, &["json"])?;
         }
         if args.json && !args.jsonl {
             println!("{json}");

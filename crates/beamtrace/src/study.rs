@@ -31,7 +31,8 @@ pub fn run_2d(args: &Study2dArgs) -> anyhow::Result<ExitCode> {
     let bar = crate::progress::counter((config.rooms * config.steps) as u64, "room-steps");
     let results = bt_study::run(&config, &mut |done, _| bar.set_position(done as u64))?;
     bar.finish_and_clear();
-    let files = bt_study::io::write_outputs(&args.out, &results)?;
+    let done = bt_study::io::write_outputs(&args.out, &results)?;
+    crate::files::warn_left_alone(&done);
     let r = report::ratios(&results);
     let headline = format!(
         "{} rooms × {} steps, seed {}: SBR/IPC time {:.3}, SBR error {:.3e}°, IPC error {:.3e}° (ratio {:.2e})",
@@ -43,7 +44,7 @@ pub fn run_2d(args: &Study2dArgs) -> anyhow::Result<ExitCode> {
         r.ipc_error_deg,
         r.sbr_over_ipc_error
     );
-    print_headline_and_files(&headline, &files);
+    print_headline_and_files(&headline, &done.files);
     Ok(ExitCode::SUCCESS)
 }
 
@@ -76,7 +77,8 @@ pub fn run_living_room(args: &StudyLivingRoomArgs) -> anyhow::Result<ExitCode> {
     if !problems.is_empty() {
         anyhow::bail!("{}", problems.join("; "));
     }
-    let scene = crate::load::load_dynamic(&SceneArgs::defaults_for(&args.steps_from))?;
+    let loaded = crate::load::load_dynamic(&SceneArgs::defaults_for(&args.steps_from))?;
+    let scene = &loaded.scene;
     if let Some(problem) =
         bt_solve::SbrOptions::grid(args.sbr_step_deg).over_budget(args.budgets.max_rays)
     {
@@ -87,11 +89,11 @@ pub fn run_living_room(args: &StudyLivingRoomArgs) -> anyhow::Result<ExitCode> {
     }
     let bar = crate::progress::counter(scene.len() as u64, "time steps");
     bar.tick();
-    let results = bt_study::living_room::run(&scene, &config, &mut |done, _| {
-        bar.set_position(done as u64)
-    })?;
+    let results =
+        bt_study::living_room::run(scene, &config, &mut |done, _| bar.set_position(done as u64))?;
     bar.finish_and_clear();
-    let files = bt_study::io::write_living_room(&args.out, &results)?;
+    let done = bt_study::io::write_living_room(&args.out, &results, &loaded.sources)?;
+    crate::files::warn_left_alone(&done);
     let h = living_room::report::headline(&results);
     let headline = format!(
         "{} × {} steps, order <= {}: FPGA IPC error {:.3e}° / {:.3e}° (TX / RX), SBR {:.3e}° / {:.3e}° (ratio {:.2e}); FPGA {:.3} ms per step at 50 MHz; SBR/IPC CPU time {:.3}",
@@ -106,6 +108,6 @@ pub fn run_living_room(args: &StudyLivingRoomArgs) -> anyhow::Result<ExitCode> {
         h.fpga_mean_latency_s * 1e3,
         h.sbr_over_ipc_time
     );
-    print_headline_and_files(&headline, &files);
+    print_headline_and_files(&headline, &done.files);
     Ok(ExitCode::SUCCESS)
 }

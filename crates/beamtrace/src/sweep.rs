@@ -38,7 +38,7 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<ExitCode> {
     crate::files::write(
         &csv,
         bt_coverage::csv(&rows).as_bytes(),
-        &crate::inputs(&args.scene),
+        &loaded.sources,
         &[],
     )?;
     let map = bt_coverage::HeatMap {

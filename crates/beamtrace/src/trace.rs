@@ -36,8 +36,8 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
     warn_near_field(&doc.paths, scene);
     let json = serde_json::to_string_pretty(&doc).context("serialising the trace")?;
     if let Some(path) = &args.out {
-        let inputs = crate::inputs(&args.scene);
-        crate::files::write(path, format!("{json}\n").as_bytes(), &inputs, &["json"])?;
+        let inputs = &loaded.sources;
+        crate::files::write(path, format!("{json}\n").as_bytes(), inputs, &["json"])?;
     }
     if args.json {
         println!("{json}");

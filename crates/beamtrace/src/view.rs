@@ -8,8 +8,12 @@ use bt_view::StepPaths;
 use std::process::ExitCode;
 
 pub fn run(args: &ViewArgs) -> anyhow::Result<ExitCode> {
-    let dynamic = load_dynamic(&args.scene)?;
-    let scenes: Vec<&bt_scene::Scene> = dynamic.scenes().iter().collect();
+    let loaded = load_dynamic(&args.scene)?;
+    let scenes: Vec<&bt_scene::Scene> = loaded.scene.scenes().iter().collect();
+    // The inputs the page must not replace: every file the load read, and the paths document.
+    let mut inputs = loaded.sources.clone();
+    inputs.extend(args.paths.iter().cloned());
+    bt_output::refuse_input(&args.output, &inputs)?;
     let paths = match &args.paths {
         Some(file) => {
             let name = file.display().to_string();
@@ -42,12 +46,7 @@ pub fn run(args: &ViewArgs) -> anyhow::Result<ExitCode> {
         }
     };
     let html = bt_view::page(&scenes, &paths);
-    crate::files::write(
-        &args.output,
-        html.as_bytes(),
-        &crate::inputs(&args.scene),
-        &[],
-    )?;
+    crate::files::write(&args.output, html.as_bytes(), &inputs, &[])?;
     let total: usize = paths.iter().map(|s| s.paths.len()).sum();
     println!(
         "{}: {} time step(s), {} paths -> {} ({} KiB)",

@@ -102,7 +102,8 @@ fn dynamic_parts(dynamic: &DynamicScene, nodes: &[Node]) -> anyhow::Result<Dynam
 }
 
 pub fn run(args: &WvrnArgs) -> anyhow::Result<ExitCode> {
-    let dynamic = load_dynamic(&args.scene)?;
+    let loaded = load_dynamic(&args.scene)?;
+    let dynamic = &loaded.scene;
     crate::load::require_every_step(dynamic.scenes(), &args.scene)?;
     if args.step >= dynamic.len() {
         bail!(
@@ -117,7 +118,7 @@ pub fn run(args: &WvrnArgs) -> anyhow::Result<ExitCode> {
     let wvrn = Wvrn::build(scene)?;
     let build_time_s = t0.elapsed().as_secs_f64();
     let nodes = wvrn.nodes().to_vec();
-    let (changing, moving) = dynamic_parts(&dynamic, &nodes)?;
+    let (changing, moving) = dynamic_parts(dynamic, &nodes)?;
     let exhaustive = enumerate(scene, args.max_order, &AllVisible)?.len();
     let routed = enumerate(scene, args.max_order, &wvrn)?.len();
     let index = |n: Node| {
@@ -191,7 +192,7 @@ pub fn run(args: &WvrnArgs) -> anyhow::Result<ExitCode> {
             } else {
                 &["txt"]
             };
-            crate::files::write(path, text.as_bytes(), &crate::inputs(&args.scene), format)?
+            crate::files::write(path, text.as_bytes(), &loaded.sources, format)?
         }
         None => print!("{text}"),
     }

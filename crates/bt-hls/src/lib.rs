@@ -477,8 +477,10 @@ pub fn generate(input: &HlsInput, schedule: &Schedule, out_dir: &Path) -> Result
 /// `vectors/vector_<n>.json` (one per run), `platform.json`, `work.json`, `report.md`,
 /// `report.json`. Deterministic: same inputs, same bytes.
 ///
-/// The directory is built aside and swapped in (`bt_output::OutputDir`): files of the user's in
-/// `out_dir` are never touched, files of a previous run are replaced.
+/// The directory is locked, built aside and moved in (`bt_output::OutputDir`): files of the
+/// user's in `out_dir` are never touched, files of a previous run are replaced. Files of a
+/// previous run's manifest left alone are not reported here; a caller that prints them uses
+/// [`generate_steps_into`] and commits itself (as `beamtrace hls gen` does).
 pub fn generate_steps(
     platform: &Platform,
     work: &[StepWork],

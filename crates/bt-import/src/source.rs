@@ -63,13 +63,38 @@ impl Default for LoadOptions {
     }
 }
 
-/// A loaded scene and the non-fatal notes of the import (merged faces, holes dropped, ...).
+/// A loaded scene (a [`Scene`], or a [`DynamicScene`] from [`load_dynamic`]), the non-fatal
+/// notes of the import (merged faces, holes dropped, ...) and the files it read.
 #[derive(Debug, Clone)]
-pub struct Loaded {
+pub struct Loaded<S = Scene> {
     /// The validated scene.
-    pub scene: Scene,
+    pub scene: S,
     /// Warnings for the user.
     pub warnings: Vec<String>,
+    /// Every file the load read, as it opened them: the named file first, then each mesh an
+    /// XML scene names (once each); empty for a built-in scene. The inputs an output of the
+    /// same run must not replace (`bt_output::refuse_input`).
+    pub sources: Vec<PathBuf>,
+}
+
+impl<S> Loaded<S> {
+    /// A load that read no file (yet): the scene and its warnings.
+    pub(crate) fn new(scene: S, warnings: Vec<String>) -> Self {
+        Loaded {
+            scene,
+            warnings,
+            sources: Vec::new(),
+        }
+    }
+
+    /// The same load holding `scene` instead (the files read and warnings kept).
+    pub fn map<T>(self, f: impl FnOnce(S) -> T) -> Loaded<T> {
+        Loaded {
+            scene: f(self.scene),
+            warnings: self.warnings,
+            sources: self.sources,
+        }
+    }
 }
 
 /// Where a scene comes from, parsed from the command-line spelling by [`Source::parse`].
@@ -190,59 +215,54 @@ fn load_any(
             if builtin_json(&name).is_none()
                 && let Some(scene) = crate::builtin_scene(&name, options.terminals)
             {
-                return Ok(Loaded {
-                    scene: scene?,
-                    warnings: Vec::new(),
-                });
+                return Ok(Loaded::new(scene?, Vec::new()));
             }
             let desc = builtin_description(&name)?;
             let scene = Scene::from_description(&desc, source, options.terminals)?;
-            return Ok(Loaded {
-                scene,
-                warnings: Vec::new(),
-            });
+            return Ok(Loaded::new(scene, Vec::new()));
         }
         Source::File(path) => path,
     };
     let display = path.display().to_string();
-    match Format::of(&path)? {
+    let mut loaded = match Format::of(&path)? {
         format @ (Format::Json | Format::Toml) => {
             let desc = read_description(&path, format)?;
             let scene = Scene::from_description(&desc, &display, options.terminals)?;
-            Ok(Loaded {
-                scene,
-                warnings: Vec::new(),
-            })
+            Loaded::new(scene, Vec::new())
         }
         Format::Obj | Format::PlyMesh => {
             let import = crate::mesh::read_mesh_path(&path, &options.merge)?;
-            from_mesh(import, &file_stem(&path, "mesh"), &display, options)
+            from_mesh(import, &file_stem(&path, "mesh"), &display, options)?
         }
-        Format::PointCloud => crate::cloud::scene::load_cloud(&path, options, progress),
-        Format::Xml => crate::xml::load_xml(&path, options),
-    }
+        Format::PointCloud => crate::cloud::scene::load_cloud(&path, options, progress)?,
+        Format::Xml => crate::xml::load_xml(&path, options)?,
+    };
+    loaded.sources.insert(0, path);
+    Ok(loaded)
 }
 
 /// Load `source` as a scene over time steps: JSON/TOML files and built-ins with their
 /// `steps` and moving objects; every other source (meshes, point clouds) as one step.
-/// Warnings of the import come back beside the scene.
+/// Warnings of the import and the files read come back beside the scene.
 pub fn load_dynamic(
     source: &str,
     options: &LoadOptions,
     progress: &mut dyn FnMut(LoadProgress),
-) -> Result<(DynamicScene, Vec<String>), ImportError> {
+) -> Result<Loaded<DynamicScene>, ImportError> {
     options.check()?;
-    let desc = match Source::parse(source) {
+    let (desc, sources) = match Source::parse(source) {
         // A generated built-in (no JSON) is static: one step, loaded below.
         Source::Builtin(name)
             if builtin_json(&name).is_none() && builtin_names().contains(&name.as_str()) =>
         {
-            None
+            (None, Vec::new())
         }
-        Source::Builtin(name) => Some(builtin_description(&name)?),
+        Source::Builtin(name) => (Some(builtin_description(&name)?), Vec::new()),
         Source::File(path) => match Format::of(&path)? {
-            format @ (Format::Json | Format::Toml) => Some(read_description(&path, format)?),
-            _ => None,
+            format @ (Format::Json | Format::Toml) => {
+                (Some(read_description(&path, format)?), vec![path])
+            }
+            _ => (None, Vec::new()),
         },
     };
     match desc {
@@ -251,12 +271,12 @@ pub fn load_dynamic(
             if let Some(radio) = options.radio {
                 scene = scene.with_radio_material(radio)?;
             }
-            Ok((scene, Vec::new()))
+            Ok(Loaded {
+                sources,
+                ..Loaded::new(scene, Vec::new())
+            })
         }
-        None => {
-            let loaded = load_with_progress(source, options, progress)?;
-            Ok((DynamicScene::from_static(loaded.scene), loaded.warnings))
-        }
+        None => Ok(load_with_progress(source, options, progress)?.map(DynamicScene::from_static)),
     }
 }
 

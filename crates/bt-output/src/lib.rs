@@ -1,29 +1,44 @@
 //! Safe outputs: the one home of every write beamtrace makes.
 //!
-//! Rules (`docs/reliability.md`):
+//! Rules (`docs/reliability.md`, "Outputs never destroy data"):
 //! - a file is written to a temporary file in its target directory and renamed over the
 //!   target ([`write_atomic`], [`write_atomic_with`], [`write_atomic_via`]): a killed run
 //!   leaves the old file or the new one, never half of one;
-//! - an output directory is built aside in `DIR.tmp-<pid>-<n>` ([`OutputDir`]) and its files are
-//!   moved into `DIR` only when complete (the whole directory is renamed into place when `DIR`
-//!   does not exist yet); a failed run leaves `DIR` as it was and removes its staging directory;
-//! - nothing in `DIR` is deleted unless the program wrote it: `DIR/.beamtrace-manifest` lists
-//!   the files of the last run, and only those are replaced or removed;
-//! - an output that is one of the inputs is refused ([`refuse_input`]);
+//! - an output directory ([`OutputDir`]) is locked for the run (`DIR/.beamtrace-lock`, an
+//!   advisory lock the OS drops when the process dies): a second run into it is refused;
+//! - its files are built in `DIR/.beamtrace-staging-<pid>-<n>` and moved into `DIR` only when
+//!   complete; a failed run leaves `DIR` as it was and removes its staging directory;
+//! - nothing is deleted unless the program wrote it: `DIR/.beamtrace-manifest` lists the files
+//!   of the last run with the SHA-256 of what it wrote, and a listed file is removed only when
+//!   it is a plain file inside `DIR`, reached through no symbolic link, with that content;
+//!   anything else listed is left alone with a warning ([`LeftAlone`]);
+//! - an output that is one of the inputs is refused ([`refuse_input`]), and so is an output
+//!   path that holds a directory, FIFO, socket or device ([`OutputError::NotRegular`]);
+//! - temporary files and staging directories a killed run left are removed by the next run
+//!   that writes the same output (`stale`): only names of our exact pattern, only regular
+//!   files and real directories, only when their process is gone;
 //! - the format follows the extension or the output is refused ([`extension_in`]).
 
 #![warn(missing_docs)]
 
 pub mod csv;
+mod dir;
+mod lock;
+mod manifest;
+mod stale;
 
-use std::collections::BTreeSet;
+pub use dir::{Committed, LeftAlone, OutputDir};
+pub use manifest::manifest_files;
+
 use std::fs::File;
 use std::io::{BufWriter, Write};
-use std::path::{Component, Path, PathBuf};
+use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicU64, Ordering};
 
 /// Name of the manifest an [`OutputDir`] keeps in its directory.
 pub const MANIFEST: &str = ".beamtrace-manifest";
+/// Name of the lock file an [`OutputDir`] holds in its directory while a run writes into it.
+pub const LOCK: &str = ".beamtrace-lock";
 
 /// Why an output could not be written.
 #[derive(Debug, thiserror::Error)]
@@ -60,9 +75,30 @@ pub enum OutputError {
     /// A directory stands where a file of the output goes (or the reverse).
     #[error("{0}: exists and is a directory; it is not replaced")]
     IsDirectory(String),
+    /// A FIFO, socket or device stands where a file of the output goes.
+    #[error("{0}: exists and is not a regular file (a FIFO, socket or device); it is not replaced")]
+    NotRegular(String),
+    /// A file of an output directory would be reached through a symbolic link inside it.
+    #[error(
+        "{path}: reached through the symbolic link {link}; outputs go only into real directories"
+    )]
+    ThroughSymlink {
+        /// The output file.
+        path: String,
+        /// The link on its way.
+        link: String,
+    },
+    /// Another run holds the lock of the output directory.
+    #[error(
+        "{dir}: another beamtrace run is writing into this directory (it holds {dir}/{LOCK}); wait for it to end or choose another output directory"
+    )]
+    Busy {
+        /// The output directory.
+        dir: String,
+    },
 }
 
-fn io(path: &Path) -> impl FnOnce(std::io::Error) -> OutputError + '_ {
+pub(crate) fn io(path: &Path) -> impl FnOnce(std::io::Error) -> OutputError + '_ {
     move |source| OutputError::Io {
         path: path.display().to_string(),
         source,
@@ -72,7 +108,7 @@ fn io(path: &Path) -> impl FnOnce(std::io::Error) -> OutputError + '_ {
 static COUNTER: AtomicU64 = AtomicU64::new(0);
 
 /// A name for a sibling of `path` that no other process or call uses: `<stem><tag>-<pid>-<n>`.
-fn sibling(path: &Path, tag: &str) -> PathBuf {
+pub(crate) fn sibling(path: &Path, tag: &str) -> PathBuf {
     let n = COUNTER.fetch_add(1, Ordering::Relaxed);
     let name = path
         .file_name()
@@ -81,7 +117,7 @@ fn sibling(path: &Path, tag: &str) -> PathBuf {
     path.with_file_name(format!("{name}{tag}-{}-{n}", std::process::id()))
 }
 
-fn parent_of(path: &Path) -> &Path {
+pub(crate) fn parent_of(path: &Path) -> &Path {
     match path.parent() {
         Some(p) if !p.as_os_str().is_empty() => p,
         _ => Path::new("."),
@@ -119,13 +155,12 @@ pub fn write_atomic_via<E: From<OutputError>>(
     path: &Path,
     produce: impl FnOnce(&Path) -> Result<(), E>,
 ) -> Result<(), E> {
-    if path.is_dir() {
-        return Err(OutputError::IsDirectory(path.display().to_string()).into());
-    }
+    check_target(path)?;
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
+    stale::remove_stale_temporaries(parent_of(path), &name, path.extension());
     let mut tmp = sibling(&parent_of(path).join(format!(".{name}")), ".tmp");
     if let Some(ext) = path.extension() {
         tmp.as_mut_os_string().push(".");
@@ -138,8 +173,30 @@ pub fn write_atomic_via<E: From<OutputError>>(
     result
 }
 
+/// Refuse an output path that holds anything but a regular file (or a symbolic link to one, which
+/// the rename replaces, leaving its target alone): a directory, FIFO, socket or device would be
+/// replaced by a regular file. A path that does not exist yet is fine.
+pub fn check_target(path: &Path) -> Result<(), OutputError> {
+    let Ok(own) = std::fs::symlink_metadata(path) else {
+        return Ok(());
+    };
+    // A link is judged by what it points to (a dangling link is replaced like a missing file).
+    let kind = match std::fs::metadata(path) {
+        Ok(target) => target.file_type(),
+        Err(_) => own.file_type(),
+    };
+    let shown = || path.display().to_string();
+    if kind.is_dir() {
+        Err(OutputError::IsDirectory(shown()))
+    } else if kind.is_file() || kind.is_symlink() {
+        Ok(())
+    } else {
+        Err(OutputError::NotRegular(shown()))
+    }
+}
+
 /// The identity of an existing file (device and inode on Unix, the canonical path elsewhere).
-fn identity(path: &Path) -> Option<(u64, u64, PathBuf)> {
+pub(crate) fn identity(path: &Path) -> Option<(u64, u64, PathBuf)> {
     let canonical = path.canonicalize().ok()?;
     #[cfg(unix)]
     {
@@ -153,8 +210,10 @@ fn identity(path: &Path) -> Option<(u64, u64, PathBuf)> {
     }
 }
 
-/// Refuse `output` when it is (a link to, or another spelling of) one of `inputs`.
-pub fn refuse_input(output: &Path, inputs: &[&Path]) -> Result<(), OutputError> {
+/// Refuse `output` when it is (a link to, or another spelling of) one of `inputs`: the same
+/// file (device and inode), whatever the path. Inputs that do not exist are no file to
+/// protect.
+pub fn refuse_input(output: &Path, inputs: &[PathBuf]) -> Result<(), OutputError> {
     let Some(out) = identity(output) else {
         return Ok(()); // the output does not exist yet: it is no input
     };
@@ -190,172 +249,6 @@ pub fn extension_in<'a>(path: &Path, allowed: &[&'a str]) -> Result<&'a str, Out
             .collect::<Vec<_>>()
             .join(" or "),
     })
-}
-
-/// An output directory under construction: files are written into a staging directory beside
-/// `dir` and moved into `dir` by [`OutputDir::commit`]. Dropped without a commit, it removes
-/// its staging directory and leaves `dir` untouched.
-#[derive(Debug)]
-pub struct OutputDir {
-    dir: PathBuf,
-    staging: PathBuf,
-    written: BTreeSet<String>,
-    protected: Vec<PathBuf>,
-    prefix: String,
-    committed: bool,
-}
-
-fn check_relative(rel: &str) -> Result<(), OutputError> {
-    let p = Path::new(rel);
-    let ok = !rel.is_empty()
-        && rel != MANIFEST
-        && p.components().all(|c| matches!(c, Component::Normal(_)));
-    if ok {
-        Ok(())
-    } else {
-        Err(OutputError::BadRelative(rel.to_string()))
-    }
-}
-
-impl OutputDir {
-    /// Start building `dir` (whose parent is created if missing). `protected` are the inputs of
-    /// the run: a commit that would replace one of them fails before moving anything.
-    pub fn begin(dir: &Path, protected: &[&Path]) -> Result<OutputDir, OutputError> {
-        if dir.exists() && !dir.is_dir() {
-            return Err(OutputError::Io {
-                path: dir.display().to_string(),
-                source: std::io::Error::new(
-                    std::io::ErrorKind::AlreadyExists,
-                    "exists and is not a directory",
-                ),
-            });
-        }
-        let parent = parent_of(dir);
-        std::fs::create_dir_all(parent).map_err(io(parent))?;
-        let staging = sibling(dir, ".tmp");
-        std::fs::create_dir(&staging).map_err(io(&staging))?;
-        Ok(OutputDir {
-            dir: dir.to_path_buf(),
-            staging,
-            written: BTreeSet::new(),
-            protected: protected.iter().map(|p| p.to_path_buf()).collect(),
-            prefix: String::new(),
-            committed: false,
-        })
-    }
-
-    /// The final directory.
-    pub fn dir(&self) -> &Path {
-        &self.dir
-    }
-
-    /// Put every following file under `prefix` (`""`, or a relative directory ending in `/`),
-    /// so a writer of one directory can fill a subdirectory (`step-3/`) of this one.
-    pub fn set_prefix(&mut self, prefix: &str) -> Result<(), OutputError> {
-        if !prefix.is_empty() {
-            check_relative(prefix.trim_end_matches('/'))?;
-        }
-        self.prefix = prefix.to_string();
-        Ok(())
-    }
-
-    /// Reserve `rel` (a relative path with `/` separators, under the current prefix) and
-    /// return where to write it now, inside the staging directory (parents created). For
-    /// writers that need a path.
-    pub fn path(&mut self, rel: &str) -> Result<PathBuf, OutputError> {
-        check_relative(rel)?;
-        let rel = format!("{}{rel}", self.prefix);
-        let rel = rel.as_str();
-        let path = self.staging.join(rel);
-        let parent = parent_of(&path);
-        std::fs::create_dir_all(parent).map_err(io(parent))?;
-        self.written.insert(rel.to_string());
-        Ok(path)
-    }
-
-    /// Write `rel` with `bytes`.
-    pub fn write(&mut self, rel: &str, bytes: &[u8]) -> Result<(), OutputError> {
-        let path = self.path(rel)?;
-        std::fs::write(&path, bytes).map_err(io(&path))
-    }
-
-    /// The files written so far, relative to the directory, sorted.
-    pub fn files(&self) -> impl Iterator<Item = &str> {
-        self.written.iter().map(String::as_str)
-    }
-
-    /// Move the files into place; remove files the previous run listed in the manifest and
-    /// this run did not write; write the new manifest. Returns the final paths written.
-    pub fn commit(mut self) -> Result<Vec<PathBuf>, OutputError> {
-        let finals: Vec<PathBuf> = self.written.iter().map(|r| self.dir.join(r)).collect();
-        let manifest = manifest_text(&self.written);
-        if !self.dir.exists() {
-            std::fs::write(self.staging.join(MANIFEST), &manifest).map_err(io(&self.staging))?;
-            std::fs::rename(&self.staging, &self.dir).map_err(io(&self.dir))?;
-            self.committed = true;
-            return Ok(finals);
-        }
-        for f in &finals {
-            if f.is_dir() {
-                return Err(OutputError::IsDirectory(f.display().to_string()));
-            }
-            let inputs: Vec<&Path> = self.protected.iter().map(PathBuf::as_path).collect();
-            refuse_input(f, &inputs)?;
-        }
-        let previous = read_manifest(&self.dir);
-        for rel in &self.written {
-            let (from, to) = (self.staging.join(rel), self.dir.join(rel));
-            let parent = parent_of(&to);
-            std::fs::create_dir_all(parent).map_err(io(parent))?;
-            std::fs::rename(&from, &to).map_err(io(&to))?;
-        }
-        for rel in previous.difference(&self.written) {
-            if check_relative(rel).is_ok() {
-                let stale = self.dir.join(rel);
-                if stale.is_file() {
-                    std::fs::remove_file(&stale).map_err(io(&stale))?;
-                }
-            }
-        }
-        write_atomic(&self.dir.join(MANIFEST), manifest.as_bytes())?;
-        Ok(finals)
-    }
-}
-
-impl Drop for OutputDir {
-    fn drop(&mut self) {
-        if !self.committed {
-            // Only the staging directory, which this value created and filled.
-            let _ = std::fs::remove_dir_all(&self.staging);
-        }
-    }
-}
-
-fn manifest_text(files: &BTreeSet<String>) -> String {
-    let mut s = String::from(
-        "# files written by beamtrace into this directory (replaced on the next run; others are left alone)\n",
-    );
-    for f in files {
-        s.push_str(f);
-        s.push('\n');
-    }
-    s
-}
-
-fn read_manifest(dir: &Path) -> BTreeSet<String> {
-    manifest_files(dir).unwrap_or_default()
-}
-
-/// The files (relative, sorted) the last committed run wrote into `dir`, or `None` when `dir`
-/// has no manifest.
-pub fn manifest_files(dir: &Path) -> Option<BTreeSet<String>> {
-    let text = std::fs::read_to_string(dir.join(MANIFEST)).ok()?;
-    Some(
-        text.lines()
-            .filter(|l| !l.is_empty() && !l.starts_with('#'))
-            .map(str::to_string)
-            .collect(),
-    )
 }
 
 #[cfg(test)]

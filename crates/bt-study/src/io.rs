@@ -4,7 +4,7 @@
 use crate::living_room::{self, LivingRoomResults};
 use crate::run::{RoomDrawing, StudyResults};
 use crate::{StudyError, plot, report};
-use bt_output::OutputDir;
+use bt_output::{Committed, OutputDir};
 use plotters::prelude::*;
 use std::path::{Path, PathBuf};
 
@@ -53,9 +53,10 @@ fn plot_error(e: bt_plot::PlotError) -> StudyError {
     }
 }
 
-/// Write every output of a study into `dir` (created if missing; built aside and swapped in,
-/// see `bt_output::OutputDir`); returns the files written.
-pub fn write_outputs(dir: &Path, results: &StudyResults) -> Result<Vec<PathBuf>, StudyError> {
+/// Write every output of a study into `dir` (created if missing; built in it aside and moved
+/// in, see `bt_output::OutputDir`); returns the files written and the files of an earlier run
+/// left alone.
+pub fn write_outputs(dir: &Path, results: &StudyResults) -> Result<Committed, StudyError> {
     let mut out = OutputDir::begin(dir, &[])?;
     write(&mut out, "results.csv", &report::csv(results))?;
     write(&mut out, "summary.md", &report::summary(results))?;
@@ -95,14 +96,16 @@ pub fn write_outputs(dir: &Path, results: &StudyResults) -> Result<Vec<PathBuf>,
 }
 
 /// Write every output of the living-room study into `dir` (created if missing; built aside and
-/// swapped in):
+/// moved in):
 /// `results.csv`, `fpga.csv`, `summary.md`, `fig17-angular-error`, `fig18-ray-directions` and
-/// `fig19-run-time` as SVG and PNG. Returns the files written.
+/// `fig19-run-time` as SVG and PNG, refusing to replace any of `inputs` (the scene's files).
+/// Returns the files written and those left alone.
 pub fn write_living_room(
     dir: &Path,
     results: &LivingRoomResults,
-) -> Result<Vec<PathBuf>, StudyError> {
-    let mut out = OutputDir::begin(dir, &[])?;
+    inputs: &[PathBuf],
+) -> Result<Committed, StudyError> {
+    let mut out = OutputDir::begin(dir, inputs)?;
     write(&mut out, "results.csv", &living_room::report::csv(results))?;
     write(
         &mut out,

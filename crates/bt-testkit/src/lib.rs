@@ -9,7 +9,8 @@
 //! - [`partitioned`]: a room split by a partition with a doorway, random boxes and tilted
 //!   quads, optionally moving over time steps;
 //! - [`golden`]: the golden-file check of every golden test, with its update switch
-//!   (`UPDATE_GOLDEN=1`).
+//!   (`UPDATE_GOLDEN=1`);
+//! - [`special`]: FIFOs for the tests of outputs (Unix).
 //!
 //! Same seed, same scene, on every platform (ChaCha8). Scenes are test input: the builders
 //! panic when a generated scene does not validate.
@@ -17,6 +18,8 @@
 
 pub mod golden;
 pub mod partitioned;
+#[cfg(unix)]
+pub mod special;
 
 use bt_geom::{Real, Vec3};
 use bt_scene::{Scene, SceneDescription, Terminals};

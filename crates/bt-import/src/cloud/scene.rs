@@ -99,5 +99,5 @@ pub(crate) fn load_cloud(
         "{display}: point cloud: extracted {} planes ({} reflectors); `beamtrace extract` writes them as a scene file",
         extraction.report.planes_found, extraction.report.reflectors
     ));
-    Ok(Loaded { scene, warnings })
+    Ok(Loaded::new(scene, warnings))
 }

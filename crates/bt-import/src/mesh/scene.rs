@@ -78,7 +78,7 @@ pub fn from_mesh(
         options.terminals,
         options.frequency_hz,
     )?;
-    Ok(Loaded { scene, warnings })
+    Ok(Loaded::new(scene, warnings))
 }
 
 /// `name` in quotes, escaped by the name rule's printer (`bt_scene::name::escape`).

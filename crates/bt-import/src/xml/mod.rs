@@ -125,7 +125,7 @@ pub struct XmlShape {
 }
 
 /// Load a Mitsuba/Sionna XML scene: parse, read every shape's mesh (bounded, relative to the
-/// XML's folder), and validate as a scene with `options.terminals` at `options.frequency_hz`.
+/// XML's folder; their paths are the returned [`Loaded::sources`]), and validate as a scene with `options.terminals` at `options.frequency_hz`.
 /// The XML has no transmitter or receiver: without `options.terminals` the scene is bare
 /// geometry, traced with terminals given per trace.
 pub fn load_xml(path: &Path, options: &LoadOptions) -> Result<Loaded, ImportError> {
@@ -145,8 +145,12 @@ pub fn load_xml(path: &Path, options: &LoadOptions) -> Result<Loaded, ImportErro
         ..SceneDescription::default()
     };
     let mut budget = MAX_MESH_TOTAL_BYTES;
+    let mut meshes: Vec<PathBuf> = Vec::new();
     for shape in &xml.shapes {
-        let import = read_shape(shape, folder, &display, options, &mut budget)?;
+        let (file, import) = read_shape(shape, folder, &display, options, &mut budget)?;
+        if !meshes.contains(&file) {
+            meshes.push(file);
+        }
         warnings.extend(import.warnings);
         let material = shape.bsdf.as_ref().map(|(id, _)| id.clone());
         if material.is_none() {
@@ -169,7 +173,10 @@ pub fn load_xml(path: &Path, options: &LoadOptions) -> Result<Loaded, ImportErro
             }));
     }
     let scene = Scene::from_description(&desc, &display, options.terminals)?;
-    Ok(Loaded { scene, warnings })
+    Ok(Loaded {
+        sources: meshes,
+        ..Loaded::new(scene, warnings)
+    })
 }
 
 /// The scene materials of the bsdfs, by id.
@@ -235,14 +242,15 @@ fn visual_material(b: &XmlBsdf, kind: &str, warnings: &mut Vec<String>) -> Mater
     desc
 }
 
-/// Read one shape's mesh through its transform, charging its size to `budget`.
+/// Read one shape's mesh through its transform, charging its size to `budget`; the file read
+/// and the mesh.
 fn read_shape(
     shape: &XmlShape,
     folder: &Path,
     xml: &str,
     options: &LoadOptions,
     budget: &mut u64,
-) -> Result<bt_mesh::MeshImport, ImportError> {
+) -> Result<(PathBuf, bt_mesh::MeshImport), ImportError> {
     let at = |message: String| ImportError::Xml {
         path: xml.to_string(),
         line: shape.at.line,
@@ -278,13 +286,11 @@ fn read_shape(
         MeshKind::Obj => crate::mesh::MeshFormat::Obj,
     };
     let to_world = shape.to_world;
-    Ok(crate::mesh::read_transformed(
-        &bytes,
-        format,
-        Some(&shown),
-        &options.merge,
-        &|p| to_world.transform_point3(p),
-    )?)
+    let import =
+        crate::mesh::read_transformed(&bytes, format, Some(&shown), &options.merge, &|p| {
+            to_world.transform_point3(p)
+        })?;
+    Ok((file, import))
 }
 
 /// `name` under `folder`: relative, plain components only (no `..`, no root, no drive).

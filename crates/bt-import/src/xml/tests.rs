@@ -264,6 +264,12 @@ fn shapes_never_merge_even_when_coplanar_and_adjacent() {
     let right = &s.surfaces()[1];
     assert!(right.polygon.vertices().iter().all(|v| v.x >= 2.0 - 1e-12));
     assert!(s.materials()["stone"].radio.is_some());
+    // The files read: the mesh once, though two shapes name it; through `load`, the XML first.
+    let mesh = dir.join("meshes/half.obj");
+    assert_eq!(loaded.sources, std::slice::from_ref(&mesh));
+    let xml_path = dir.join("s.xml");
+    let through_load = crate::load(xml_path.to_str().unwrap(), &options()).unwrap();
+    assert_eq!(through_load.sources, [xml_path, mesh]);
     std::fs::remove_dir_all(dir).ok();
 }
 

@@ -165,15 +165,17 @@ fn one_loading_entry_for_every_source() {
     };
     assert_eq!(load(&ply, &boxed).unwrap().scene.surfaces().len(), 6);
 
-    let (steps, _) = load_dynamic("builtin:living-room-dynamic", &options, &mut |_| {}).unwrap();
-    assert_eq!(steps.len(), 10);
-    let (one, _) = load_dynamic(&ply, &boxed, &mut |_| {}).unwrap();
-    assert_eq!(one.len(), 1);
+    let steps = load_dynamic("builtin:living-room-dynamic", &options, &mut |_| {}).unwrap();
+    assert_eq!(steps.scene.len(), 10);
+    assert!(steps.sources.is_empty(), "a built-in reads no file");
+    let one = load_dynamic(&ply, &boxed, &mut |_| {}).unwrap();
+    assert_eq!(one.scene.len(), 1);
+    assert_eq!(one.sources, [std::path::PathBuf::from(&ply)]);
 
     let city = load("builtin:city", &options).unwrap().scene;
     assert!(city.surfaces().len() > 19_000, "{}", city.surfaces().len());
-    let (city_steps, _) = load_dynamic("builtin:city", &options, &mut |_| {}).unwrap();
-    assert_eq!(city_steps.len(), 1);
+    let city_steps = load_dynamic("builtin:city", &options, &mut |_| {}).unwrap();
+    assert_eq!(city_steps.scene.len(), 1);
 
     let unknown = load("builtin:attic", &options).unwrap_err().to_string();
     assert_eq!(

@@ -107,7 +107,7 @@ fn outputs_are_written() {
     };
     let results = run(&config, &mut |_, _| {}).unwrap();
     let dir = std::env::temp_dir().join(format!("bt-study-test-{}", std::process::id()));
-    let files = bt_study::io::write_outputs(&dir, &results).unwrap();
+    let files = bt_study::io::write_outputs(&dir, &results).unwrap().files;
     for name in [
         "results.csv",
         "summary.md",

@@ -4,6 +4,7 @@
 mod budgets;
 mod names;
 mod outputs;
+mod outputs2;
 mod small;
 
 pub use crate::common::{cli, scratch, text};
