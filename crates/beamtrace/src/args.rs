@@ -134,6 +134,9 @@ pub struct Study2dArgs {
     /// Time steps per room (the moving vertex advances once per step).
     #[arg(long, default_value_t = 10)]
     pub steps: usize,
+    /// Budget: refuse a study of more rooms × steps than this.
+    #[arg(long, default_value_t = bt_study::MAX_ROOM_STEPS.limit)]
+    pub max_room_steps: u64,
     /// Seed of the room generator (echoed into the outputs).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -182,13 +185,20 @@ pub struct SceneArgs {
     /// Meshes: faces whose planes differ by less than this (metres) merge into one surface.
     #[arg(long, default_value_t = 1e-3)]
     pub merge_distance: f64,
-    /// Meshes (also inside XML scenes): budget on vertices and on faces per file; a larger
-    /// mesh stops before the merge.
+    /// Meshes: budget on vertices and on faces of a mesh file, and of all the meshes of an XML
+    /// scene together; a larger mesh stops before the merge.
     #[arg(long, default_value_t = bt_mesh::DEFAULT_MAX_ELEMENTS)]
     pub max_mesh_elements: u64,
     /// Point clouds: budget on the points a file declares; a larger cloud stops before reading.
     #[arg(long, default_value_t = bt_import::cloud::DEFAULT_MAX_POINTS)]
     pub max_cloud_points: u64,
+    /// Budget on the size of every input file (scene, mesh, cloud), bytes; a larger file is
+    /// refused before it is read.
+    #[arg(long, default_value_t = bt_import::MAX_FILE_BYTES.limit)]
+    pub max_file_bytes: u64,
+    /// XML scenes: budget on the bytes all $parameter substitutions produce.
+    #[arg(long, default_value_t = bt_import::xml::MAX_XML_SUBSTITUTION.limit)]
+    pub max_xml_substitution: u64,
     #[command(flatten)]
     pub material: MaterialArgs,
 }
@@ -421,6 +431,10 @@ pub struct SolveArgs {
     /// Budget: stop with an error rather than generate more candidates (beam-tree nodes).
     #[arg(long, default_value_t = bt_solve::pipeline::DEFAULT_MAX_CANDIDATES)]
     pub max_candidates: u64,
+    /// Budget: with --candidates wvrn, refuse a network of more pair tests (node pairs ×
+    /// surfaces) than this.
+    #[arg(long, default_value_t = bt_solve::pipeline::DEFAULT_MAX_WVRN_TESTS)]
+    pub max_wvrn_tests: u64,
     /// Edge diffraction: paths may diffract once, on a wedge or a free edge, anywhere in the
     /// sequence (the diffraction counts in --max-order). Same as --max-diffractions 1.
     #[arg(long)]
@@ -541,6 +555,7 @@ impl SolveArgs {
             },
             candidates: self.candidate_mode(),
             max_candidates: self.max_candidates,
+            max_wvrn_tests: self.max_wvrn_tests,
             parallel: !self.single_thread,
             diffraction: bt_solve::pipeline::DiffractionOptions {
                 max_diffractions: self
@@ -581,6 +596,9 @@ pub struct WvrnArgs {
     /// Budget: stop before the work rather than enumerate more candidates than this.
     #[arg(long, default_value_t = bt_solve::pipeline::DEFAULT_MAX_CANDIDATES)]
     pub max_candidates: u64,
+    /// Budget: refuse a network of more pair tests (node pairs × surfaces) than this.
+    #[arg(long, default_value_t = bt_solve::pipeline::DEFAULT_MAX_WVRN_TESTS)]
+    pub max_wvrn_tests: u64,
 }
 
 #[derive(Debug, Args, Clone)]
@@ -666,6 +684,12 @@ pub struct ChannelArgs {
     /// Subcarrier spacing, Hz.
     #[arg(long, default_value_t = 120e3)]
     pub subcarrier_spacing: f64,
+    /// Budget: refuse a frequency response of more subcarriers than this.
+    #[arg(long, default_value_t = bt_channel::MAX_SUBCARRIERS.limit)]
+    pub max_subcarriers: u64,
+    /// Budget: refuse a frequency response of more subcarriers × paths than this.
+    #[arg(long, default_value_t = bt_channel::MAX_CFR_PRODUCTS.limit)]
+    pub max_cfr_products: u64,
     /// Power-delay-profile plot: writes STEM.svg and STEM.png.
     #[arg(long)]
     pub pdp: Option<PathBuf>,
@@ -699,6 +723,9 @@ pub struct BeamsArgs {
     /// Ranking of the beam pairs.
     #[arg(long, value_enum, default_value_t = RankingArg::Power)]
     pub ranking: RankingArg,
+    /// Budget: refuse a sweep of more beam pairs (TX beams × RX beams) than this.
+    #[arg(long, default_value_t = bt_channel::MAX_BEAM_PAIRS.limit)]
+    pub max_beam_pairs: u64,
     /// Print this many pairs of the ranked list (the JSON holds them all).
     #[arg(long, default_value_t = 10)]
     pub top: usize,
@@ -738,6 +765,7 @@ impl SolveArgs {
             wvrn: false,
             no_wvrn: false,
             max_candidates: bt_solve::pipeline::DEFAULT_MAX_CANDIDATES,
+            max_wvrn_tests: bt_solve::pipeline::DEFAULT_MAX_WVRN_TESTS,
             diffraction: false,
             max_diffractions: None,
             min_edge_length: 0.0,
@@ -791,6 +819,9 @@ pub struct ExtractArgs {
     /// Budget on the points the cloud declares; a larger cloud stops before reading.
     #[arg(long, default_value_t = bt_import::cloud::DEFAULT_MAX_POINTS)]
     pub max_cloud_points: u64,
+    /// Budget on the size of the cloud file, bytes; a larger file is refused before reading.
+    #[arg(long, default_value_t = bt_import::MAX_FILE_BYTES.limit)]
+    pub max_file_bytes: u64,
 }
 
 #[derive(Debug, Args, Clone)]

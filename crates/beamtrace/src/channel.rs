@@ -11,9 +11,6 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-/// Subcarriers × paths above which the frequency response is refused (a stated budget).
-const MAX_CFR_PRODUCTS: u64 = 500_000_000;
-
 /// Load, trace and report the paths the arguments select.
 /// The files read come back too: the outputs must not replace them.
 fn traced_paths(
@@ -76,12 +73,13 @@ fn cir_csv(paths: &[PathReport], carrier_hz: f64) -> String {
 
 fn cfr_csv(paths: &[PathReport], carrier_hz: f64, args: &ChannelArgs) -> anyhow::Result<String> {
     let n = args.subcarriers;
-    if n == 0 || (n as u64).saturating_mul(paths.len().max(1) as u64) > MAX_CFR_PRODUCTS {
-        bail!(
-            "--subcarriers {n} × {} paths: need at least 1 subcarrier and at most {MAX_CFR_PRODUCTS} products",
-            paths.len()
-        );
-    }
+    let budget = bt_channel::ResponseBudget {
+        max_subcarriers: args.max_subcarriers,
+        max_products: args.max_cfr_products,
+    };
+    budget
+        .check(n, paths.len())
+        .with_context(|| format!("--subcarriers {n} over {} paths", paths.len()))?;
     if !(args.subcarrier_spacing.is_finite() && args.subcarrier_spacing > 0.0) {
         bail!("--subcarrier-spacing must be a positive number of Hz");
     }
@@ -191,6 +189,7 @@ pub fn run_beams(args: &BeamsArgs) -> anyhow::Result<ExitCode> {
         scene.frequency_hz(),
         radio.tx_power_dbm,
         ranking,
+        args.max_beam_pairs,
     )?;
     let doc = BeamsDocument {
         scene: scene.name(),

@@ -12,13 +12,9 @@ use std::process::ExitCode;
 fn extract_from(
     path: &Path,
     params: &ExtractParams,
-    max_points: u64,
+    read: &ReadOptions,
 ) -> anyhow::Result<(Extraction, u64)> {
-    let read = ReadOptions {
-        max_points,
-        ..ReadOptions::default()
-    };
-    let loaded = bt_import::cloud::read_path(path, &read)?;
+    let loaded = bt_import::cloud::read_path(path, read)?;
     let (bar, mut progress) = crate::progress::extraction_progress();
     let extraction =
         bt_pointcloud::extract_planes_with_progress(&loaded.cloud, params, &mut progress)
@@ -54,7 +50,12 @@ pub fn run_extract(args: &ExtractArgs) -> anyhow::Result<ExitCode> {
         min_reflector_area_m2: args.min_reflector_area,
         ..ExtractParams::default()
     };
-    let (extraction, skipped) = extract_from(&args.cloud, &params, args.max_cloud_points)?;
+    let read = ReadOptions {
+        max_points: args.max_cloud_points,
+        max_file_bytes: args.max_file_bytes,
+        ..ReadOptions::default()
+    };
+    let (extraction, skipped) = extract_from(&args.cloud, &params, &read)?;
     let name = args
         .cloud
         .file_stem()

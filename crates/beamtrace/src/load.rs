@@ -24,8 +24,11 @@ pub fn load_options(args: &SceneArgs) -> anyhow::Result<LoadOptions> {
         min_reflector_area_m2: args.min_reflector_area,
         cloud: bt_import::cloud::ReadOptions {
             max_points: args.max_cloud_points,
+            max_file_bytes: args.max_file_bytes,
             ..Default::default()
         },
+        max_file_bytes: args.max_file_bytes,
+        max_xml_substitution: args.max_xml_substitution,
         frequency_hz: args
             .material
             .frequency

@@ -17,6 +17,7 @@ pub fn run_2d(args: &Study2dArgs) -> anyhow::Result<ExitCode> {
         sbr_step_deg: args.sbr_step_deg,
         sbr_sphere: args.sbr_sphere,
         max_candidates: args.budgets.max_candidates,
+        max_room_steps: args.max_room_steps,
     };
     let problems = config.problems();
     if !problems.is_empty() {
@@ -28,7 +29,10 @@ pub fn run_2d(args: &Study2dArgs) -> anyhow::Result<ExitCode> {
         anyhow::bail!("{problem}");
     }
     // indicatif draws to stderr and hides itself when stderr is not a terminal.
-    let bar = crate::progress::counter((config.rooms * config.steps) as u64, "room-steps");
+    let bar = crate::progress::counter(
+        (config.rooms as u64).saturating_mul(config.steps as u64),
+        "room-steps",
+    );
     let results = bt_study::run(&config, &mut |done, _| bar.set_position(done as u64))?;
     bar.finish_and_clear();
     let done = bt_study::io::write_outputs(&args.out, &results)?;

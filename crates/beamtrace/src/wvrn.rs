@@ -114,6 +114,9 @@ pub fn run(args: &WvrnArgs) -> anyhow::Result<ExitCode> {
     }
     let scene = dynamic.step(args.step);
     bt_solve::pipeline::exhaustive_budget(scene, args.max_order, args.max_candidates)?;
+    for step in dynamic.scenes() {
+        bt_solve::pipeline::wvrn_budget(step, args.max_wvrn_tests)?;
+    }
     let t0 = Instant::now();
     let wvrn = Wvrn::build(scene)?;
     let build_time_s = t0.elapsed().as_secs_f64();

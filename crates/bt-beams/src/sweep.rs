@@ -53,7 +53,9 @@ pub struct Sweep {
     pub pairs: Vec<BeamPair>,
 }
 
-/// Sweep the DFT codebooks of `tx` and `rx` over `paths` at `carrier_hz` with `tx_power_dbm`.
+/// Sweep the DFT codebooks of `tx` and `rx` over `paths` at `carrier_hz` with `tx_power_dbm`;
+/// more than `max_pairs` beam pairs ([`bt_channel::MAX_BEAM_PAIRS`], `--max-beam-pairs`) are
+/// refused before the codebooks are built.
 pub fn sweep(
     paths: &[PathReport],
     tx: &Array,
@@ -61,7 +63,9 @@ pub fn sweep(
     carrier_hz: Real,
     tx_power_dbm: Real,
     ranking: BeamRanking,
+    max_pairs: u64,
 ) -> Result<Sweep, ChannelError> {
+    bt_channel::check_beam_pairs(tx, rx, max_pairs)?;
     let (tx_book, rx_book) = (tx.dft_codebook(), rx.dft_codebook());
     let directions: Vec<PathDirections> = taps(paths)
         .into_iter()

@@ -166,25 +166,29 @@ fn beam_sweep_finds_the_line_of_sight_pair() {
     let rx_array =
         bt_channel::Array::new(1, 8, 0.5, Orientation::from_degrees(180.0, 0.0, 0.0)).unwrap();
     let expected = 20.0 + 20.0 * (paths[0].gain.norm() * 8.0).log10();
+    let sweep = |ranking, max_pairs| {
+        let f = scene.frequency_hz();
+        bt_beams::sweep(&paths, &tx, &rx_array, f, 20.0, ranking, max_pairs)
+    };
+    let max_pairs = bt_channel::MAX_BEAM_PAIRS.limit;
     for ranking in [bt_beams::BeamRanking::Power, bt_beams::BeamRanking::Paper] {
-        let s =
-            bt_beams::sweep(&paths, &tx, &rx_array, scene.frequency_hz(), 20.0, ranking).unwrap();
+        let s = sweep(ranking, max_pairs).unwrap();
         let best = &s.pairs[0];
         assert_eq!((best.tx_beam, best.rx_beam), (2, 2), "{ranking:?}");
         assert!((best.power_dbm.unwrap() - expected).abs() < 1e-9);
         let dir = best.tx_direction_deg.unwrap();
         assert!((dir.azimuth - 30.0).abs() < 1e-9, "{dir:?}");
     }
-    let all = bt_beams::sweep(
-        &paths,
-        &tx,
-        &rx_array,
-        scene.frequency_hz(),
-        20.0,
-        bt_beams::BeamRanking::Power,
-    )
-    .unwrap();
+    let all = sweep(bt_beams::BeamRanking::Power, max_pairs).unwrap();
     assert_eq!(all.pairs.len(), 64);
+    // 64 pairs over a budget of 63: refused, naming the option.
+    let e = sweep(bt_beams::BeamRanking::Power, 63)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("64 beam pairs") && e.contains("--max-beam-pairs"),
+        "{e}"
+    );
     assert!(
         all.pairs
             .windows(2)

@@ -11,6 +11,20 @@ use std::f64::consts::PI;
 /// Beam pairs × paths above which [`beam_pairs`] refuses to work (a stated budget).
 pub const MAX_PAIR_PATH_PRODUCTS: u64 = 2_000_000_000;
 
+/// Budget on the beam pairs of a sweep (TX beams × RX beams): each pair is a ranked record
+/// (~100 B) and a JSON object (~300 B), so the default of 1,000,000 pairs (two 32 × 32 UPAs)
+/// holds a sweep under ~0.5 GB; two 64 × 64 arrays (16.7 M pairs) are refused before the
+/// codebooks are built.
+pub const MAX_BEAM_PAIRS: bt_geom::Budget =
+    bt_geom::Budget::new("beam pairs", "--max-beam-pairs", 1_000_000);
+
+/// Refuse a sweep of `tx` × `rx` beams over `max_pairs` ([`MAX_BEAM_PAIRS`] with another
+/// limit), before any codebook is built.
+pub fn check_beam_pairs(tx: &Array, rx: &Array, max_pairs: u64) -> Result<(), ChannelError> {
+    let pairs = (tx.len() as u64).saturating_mul(rx.len() as u64);
+    Ok(MAX_BEAM_PAIRS.with_limit(max_pairs).check(pairs)?)
+}
+
 /// A uniform planar array in its local y-z plane (boresight local +x, as the element pattern):
 /// `columns` elements along local y, `rows` along local z, `spacing_wavelengths` apart. A ULA
 /// is one row.
@@ -219,6 +233,17 @@ mod tests {
 
     fn ula(n: usize) -> Array {
         Array::new(1, n, 0.5, Orientation::default()).unwrap()
+    }
+
+    #[test]
+    fn two_64_by_64_arrays_are_over_the_pair_budget() {
+        let upa = Array::new(64, 64, 0.5, Orientation::default()).unwrap();
+        let e = check_beam_pairs(&upa, &upa, MAX_BEAM_PAIRS.limit)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("16777216 beam pairs"), "{e}");
+        assert!(e.contains("--max-beam-pairs"), "{e}");
+        assert!(check_beam_pairs(&ula(8), &upa, MAX_BEAM_PAIRS.limit).is_ok());
     }
 
     #[test]

@@ -16,7 +16,7 @@ pub mod material;
 pub mod response;
 
 pub use antenna::{Antenna, Orientation, Pattern, Polarization};
-pub use codebook::{Array, Beam, PathDirections, beam_pairs};
+pub use codebook::{Array, Beam, MAX_BEAM_PAIRS, PathDirections, beam_pairs, check_beam_pairs};
 pub use diffraction::{Wedge, fresnel_integrals, transition};
 pub use gain::{
     Bounce, FreeSpace, Interaction, PathGain, SurfaceResponse, free_space, path_gain,
@@ -27,7 +27,10 @@ pub use material::{
     VACUUM_PERMITTIVITY,
 };
 pub use num_complex::Complex64;
-pub use response::{Tap, frequency_response, subcarriers, total_power};
+pub use response::{
+    MAX_CFR_PRODUCTS, MAX_SUBCARRIERS, ResponseBudget, Tap, frequency_response, subcarriers,
+    total_power,
+};
 
 use bt_geom::Real;
 use thiserror::Error;
@@ -56,6 +59,9 @@ pub enum ChannelError {
         /// The validity bands, as text.
         valid: String,
     },
+    /// Work or memory over its budget, estimated before the work.
+    #[error(transparent)]
+    Budget(#[from] bt_geom::OverBudget),
     /// A parameter out of its domain.
     #[error("{field}: {message}")]
     Invalid {

@@ -28,6 +28,58 @@ fn phase(cycles: Real) -> Complex64 {
     Complex64::from_polar(1.0, -2.0 * PI * x)
 }
 
+/// Budget on the subcarriers of a frequency response: each is an offset, a complex value and
+/// a CSV row (~100 B), so the default of 1,000,000 holds a response under ~150 MB.
+pub const MAX_SUBCARRIERS: bt_geom::Budget =
+    bt_geom::Budget::new("subcarriers", "--max-subcarriers", 1_000_000);
+
+/// Budget on subcarriers × paths of a frequency response (one complex exponential each,
+/// ~15 ns): the default of 100,000,000 is a few seconds of work.
+pub const MAX_CFR_PRODUCTS: bt_geom::Budget = bt_geom::Budget::new(
+    "subcarrier-path products",
+    "--max-cfr-products",
+    100_000_000,
+);
+
+/// The two budgets of a frequency response (limits of [`MAX_SUBCARRIERS`] and
+/// [`MAX_CFR_PRODUCTS`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct ResponseBudget {
+    /// Subcarriers at most.
+    pub max_subcarriers: u64,
+    /// Subcarriers × taps at most.
+    pub max_products: u64,
+}
+
+impl Default for ResponseBudget {
+    fn default() -> Self {
+        ResponseBudget {
+            max_subcarriers: MAX_SUBCARRIERS.limit,
+            max_products: MAX_CFR_PRODUCTS.limit,
+        }
+    }
+}
+
+impl ResponseBudget {
+    /// Refuse a response of `subcarriers` over `taps` (at least one subcarrier) beyond either
+    /// budget, before anything is allocated.
+    pub fn check(&self, subcarriers: usize, taps: usize) -> Result<(), crate::ChannelError> {
+        if subcarriers == 0 {
+            return Err(crate::ChannelError::Invalid {
+                field: "subcarriers",
+                message: "need at least 1 subcarrier".into(),
+            });
+        }
+        let n = subcarriers as u64;
+        MAX_SUBCARRIERS.with_limit(self.max_subcarriers).check(n)?;
+        let products = n.saturating_mul(taps.max(1) as u64);
+        MAX_CFR_PRODUCTS
+            .with_limit(self.max_products)
+            .check(products)?;
+        Ok(())
+    }
+}
+
 /// `n` subcarrier offsets spaced `spacing_hz` apart and centred on the carrier:
 /// (k − ⌊n/2⌋)·Δf for k = 0..n, Hz.
 pub fn subcarriers(n: usize, spacing_hz: Real) -> Vec<Real> {
@@ -59,6 +111,18 @@ pub fn total_power(taps: &[Tap]) -> Real {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn responses_beyond_either_budget_are_refused_before_allocating() {
+        let b = ResponseBudget::default();
+        assert!(b.check(64, 10).is_ok());
+        assert!(b.check(0, 10).is_err());
+        let e = b.check(usize::MAX, 1).unwrap_err().to_string();
+        assert!(e.contains("--max-subcarriers"), "{e}");
+        let e = b.check(1_000_000, 1_000).unwrap_err().to_string();
+        assert!(e.contains("1000000000 subcarrier-path products"), "{e}");
+        assert!(e.contains("--max-cfr-products"), "{e}");
+    }
 
     #[test]
     fn one_tap_response_is_a_linear_phase() {

@@ -16,7 +16,7 @@ pub mod tol;
 mod fixtures;
 
 pub use bvh::{Bvh, Occluder};
-pub use count::{AtLeast, Count};
+pub use count::{AtLeast, Budget, Count, OverBudget};
 pub use plane::{Plane, Side};
 pub use polygon::{Polygon, PolygonError};
 

@@ -27,5 +27,6 @@ pub use builtin::{
 pub use error::ImportError;
 pub use scene_file::{parse_json, parse_toml, write_description};
 pub use source::{
-    Format, LoadOptions, LoadProgress, Loaded, Source, load, load_dynamic, load_with_progress,
+    Format, LoadOptions, LoadProgress, Loaded, MAX_FILE_BYTES, Source, load, load_dynamic,
+    load_with_progress,
 };

@@ -31,7 +31,20 @@ pub struct LoadOptions {
     /// A radio material for every surface (CLI `--material itu:NAME --thickness M`), replacing
     /// the radio model of every material of the loaded scene, whatever its format.
     pub radio: Option<bt_channel::RadioMaterial>,
+    /// Budget: the largest input file read, bytes (CLI `--max-file-bytes`): scene files, meshes
+    /// (also those of an XML scene), point clouds. Checked against the file's size before it
+    /// is read ([`MAX_FILE_BYTES`]).
+    pub max_file_bytes: u64,
+    /// Budget: bytes an XML scene's `$parameter` substitutions may produce in all, checked
+    /// before each substitution (CLI `--max-xml-substitution`, [`crate::xml::MAX_XML_SUBSTITUTION`]).
+    pub max_xml_substitution: u64,
 }
+
+/// Budget on the size of one input file: the default of 256 MiB holds a binary cloud of the
+/// point budget (20 M points × 12 B), a mesh of the element budget, and keeps a JSON or TOML
+/// scene file's parse (a few times its size) under a 2 GB address space.
+pub const MAX_FILE_BYTES: bt_geom::Budget =
+    bt_geom::Budget::new("file bytes", "--max-file-bytes", 256 << 20);
 
 impl LoadOptions {
     /// Refuse a value no load can use: a minimum reflector area that is not a finite number
@@ -59,6 +72,8 @@ impl Default for LoadOptions {
             extract: bt_pointcloud::ExtractParams::default(),
             cloud: crate::cloud::ReadOptions::default(),
             radio: None,
+            max_file_bytes: MAX_FILE_BYTES.limit,
+            max_xml_substitution: crate::xml::MAX_XML_SUBSTITUTION.limit,
         }
     }
 }
@@ -179,6 +194,28 @@ pub(crate) fn regular_file(path: &Path) -> std::io::Result<()> {
     ))
 }
 
+/// The bytes of the regular file `path` ([`regular_file`]), refused before reading when its
+/// size exceeds `max_bytes` ([`MAX_FILE_BYTES`]); a file that grows while read is cut at
+/// `max_bytes + 1` and refused too. The refusal is an I/O error of kind `InvalidData` whose
+/// message names the size, the budget and `--max-file-bytes`.
+pub(crate) fn read_file(path: &Path, max_bytes: u64) -> std::io::Result<Vec<u8>> {
+    use std::io::Read;
+    regular_file(path)?;
+    let over = |size: u64| {
+        let budget = MAX_FILE_BYTES.with_limit(max_bytes);
+        budget
+            .check(size)
+            .map_err(|e| std::io::Error::new(std::io::ErrorKind::InvalidData, e))
+    };
+    over(std::fs::metadata(path)?.len())?;
+    let mut bytes = Vec::new();
+    std::fs::File::open(path)?
+        .take(max_bytes.saturating_add(1))
+        .read_to_end(&mut bytes)?;
+    over(bytes.len() as u64)?;
+    Ok(bytes)
+}
+
 /// Progress of a long load (plane extraction from a point cloud), for a progress bar.
 pub type LoadProgress = bt_pointcloud::Progress;
 
@@ -226,12 +263,13 @@ fn load_any(
     let display = path.display().to_string();
     let mut loaded = match Format::of(&path)? {
         format @ (Format::Json | Format::Toml) => {
-            let desc = read_description(&path, format)?;
+            let desc = read_description(&path, format, options.max_file_bytes)?;
             let scene = Scene::from_description(&desc, &display, options.terminals)?;
             Loaded::new(scene, Vec::new())
         }
         Format::Obj | Format::PlyMesh => {
-            let import = crate::mesh::read_mesh_path(&path, &options.merge)?;
+            let import =
+                crate::mesh::read_mesh_path(&path, &options.merge, options.max_file_bytes)?;
             from_mesh(import, &file_stem(&path, "mesh"), &display, options)?
         }
         Format::PointCloud => crate::cloud::scene::load_cloud(&path, options, progress)?,
@@ -260,7 +298,8 @@ pub fn load_dynamic(
         Source::Builtin(name) => (Some(builtin_description(&name)?), Vec::new()),
         Source::File(path) => match Format::of(&path)? {
             format @ (Format::Json | Format::Toml) => {
-                (Some(read_description(&path, format)?), vec![path])
+                let desc = read_description(&path, format, options.max_file_bytes)?;
+                (Some(desc), vec![path])
             }
             _ => (None, Vec::new()),
         },
@@ -288,14 +327,23 @@ fn builtin_description(name: &str) -> Result<SceneDescription, ImportError> {
     parse_json(json, &format!("builtin:{name}"))
 }
 
-fn read_description(path: &Path, format: Format) -> Result<SceneDescription, ImportError> {
+fn read_description(
+    path: &Path,
+    format: Format,
+    max_bytes: u64,
+) -> Result<SceneDescription, ImportError> {
     let display = path.display().to_string();
-    let text = regular_file(path)
-        .and_then(|()| std::fs::read_to_string(path))
-        .map_err(|source| ImportError::Io {
-            path: display.clone(),
-            source,
-        })?;
+    let io = |source| ImportError::Io {
+        path: display.clone(),
+        source,
+    };
+    let bytes = read_file(path, max_bytes).map_err(io)?;
+    let text = String::from_utf8(bytes).map_err(|_| {
+        io(std::io::Error::new(
+            std::io::ErrorKind::InvalidData,
+            "stream did not contain valid UTF-8",
+        ))
+    })?;
     if format == Format::Toml {
         parse_toml(&text, &display)
     } else {

@@ -161,6 +161,8 @@ pub struct MeshImport {
     pub warnings: Vec<String>,
     /// Number of faces in the file, before any was dropped or merged.
     pub faces_read: usize,
+    /// Number of vertices in the file, before any was welded.
+    pub vertices_read: usize,
 }
 
 /// Welds and merges the faces of `raw` into planar surfaces (checks `opts` first). `file`
@@ -178,5 +180,6 @@ pub fn merge_mesh(
         surfaces: merged.surfaces,
         warnings,
         faces_read: raw.face_count(),
+        vertices_read: raw.positions.len(),
     })
 }

@@ -28,9 +28,26 @@
 
 use crate::{Node, Visibility};
 use bt_geom::convex::is_strictly_convex;
-use bt_geom::{Polygon, Real, Vec3};
+use bt_geom::{Budget, Polygon, Real, Vec3};
 use bt_scene::{Endpoints, Scene, SceneError, SurfaceId, SurfaceKind};
 use serde::{Deserialize, Serialize};
+
+/// Budget on the pair tests of [`Wvrn::build`] ([`build_tests`]): each node pair is tested
+/// against every surface (~100-150 ns each, measured on random quads), so the default of
+/// 100,000,000 is ~10-15 s; it admits ~580 reflectors, and refuses Sionna's city scenes
+/// (5,000-15,000 reflectors: 1e11-1e12 tests and a 1-6 GB pair table), which the beam tree
+/// traces.
+pub const MAX_WVRN_TESTS: Budget =
+    Budget::new("visibility pair tests", "--max-wvrn-tests", 100_000_000);
+
+/// The pair tests of building the network of `scene` (before any allocation): the unordered
+/// pairs of its nodes (TX, RX and the reflectors) times its surfaces, saturating. It bounds the
+/// memory too: the pair table holds nodes² links and nodes × surfaces sides.
+pub fn build_tests(scene: &Scene) -> u64 {
+    let nodes = scene.reflectors().count() as u64 + 2;
+    let pairs = nodes.saturating_mul(nodes - 1) / 2;
+    pairs.saturating_mul(scene.surfaces().len() as u64)
+}
 
 /// The state of a pair of nodes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
@@ -530,6 +547,19 @@ mod tests {
         // Same side: never occluded.
         let below = quad([0., 0., -1.], [0.5, 0., 0.], [0., 0.5, 0.]);
         assert!(!occludes(&wall, &small, &below, 1e-9));
+    }
+
+    #[test]
+    fn build_tests_count_node_pairs_times_surfaces() {
+        // a box room: 6 reflectors, 8 nodes, 28 pairs, 6 surfaces
+        let s = scene(
+            r#"{ "tx": [1, 1, 1], "rx": [3, 1, 1.5],
+            "boxes": [ { "name": "room", "min": [0, 0, 0], "max": [4, 3, 2.5] } ] }"#,
+        );
+        assert_eq!(build_tests(&s), 28 * 6);
+        let e = MAX_WVRN_TESTS.with_limit(100).check(build_tests(&s));
+        let e = e.unwrap_err().to_string();
+        assert!(e.contains("168 visibility pair tests") && e.contains("--max-wvrn-tests"));
     }
 
     #[test]

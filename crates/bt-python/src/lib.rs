@@ -264,7 +264,9 @@ fn report_each(
 /// each trace gives them).
 #[pyfunction]
 #[pyo3(signature = (source, *, tx=None, rx=None, min_reflector_area=0.25, merge_angle_deg=1.0,
-                    merge_distance=1e-3))]
+                    merge_distance=1e-3, budgets=None))]
+// One argument per Python keyword: pyo3 maps them by name.
+#[allow(clippy::too_many_arguments)]
 fn load(
     py: Python<'_>,
     source: String,
@@ -273,7 +275,14 @@ fn load(
     min_reflector_area: f64,
     merge_angle_deg: f64,
     merge_distance: f64,
+    budgets: Option<options::LoadBudgets>,
 ) -> PyResult<PyScene> {
+    let defaults = LoadOptions::default();
+    let budgets = budgets.unwrap_or(options::LoadBudgets {
+        max_file_bytes: defaults.max_file_bytes,
+        max_xml_substitution: defaults.max_xml_substitution,
+        max_mesh_elements: defaults.merge.max_elements,
+    });
     let options = LoadOptions {
         terminals: Terminals {
             tx: tx.map(vec3),
@@ -282,10 +291,13 @@ fn load(
         merge: bt_mesh::MergeOptions {
             angle_tol_deg: merge_angle_deg,
             dist_tol_m: merge_distance,
+            max_elements: budgets.max_mesh_elements,
             ..bt_mesh::MergeOptions::default()
         },
         min_reflector_area_m2: min_reflector_area,
-        ..LoadOptions::default()
+        max_file_bytes: budgets.max_file_bytes,
+        max_xml_substitution: budgets.max_xml_substitution,
+        ..defaults
     };
     let loaded = py.detach(|| load_scene(&source, &options)).map_err(error)?;
     // The options are set by each trace (its keywords).
@@ -312,6 +324,16 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
         "DEFAULT_MAX_CANDIDATES",
         bt_solve::pipeline::DEFAULT_MAX_CANDIDATES,
     )?;
+    m.add(
+        "DEFAULT_MAX_WVRN_TESTS",
+        bt_solve::pipeline::DEFAULT_MAX_WVRN_TESTS,
+    )?;
+    m.add("DEFAULT_MAX_FILE_BYTES", bt_import::MAX_FILE_BYTES.limit)?;
+    m.add(
+        "DEFAULT_MAX_XML_SUBSTITUTION",
+        bt_import::xml::MAX_XML_SUBSTITUTION.limit,
+    )?;
+    m.add("DEFAULT_MAX_MESH_ELEMENTS", bt_mesh::DEFAULT_MAX_ELEMENTS)?;
     m.add_class::<PyScene>()?;
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(builtin_names, m)?)?;

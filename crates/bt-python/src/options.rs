@@ -18,6 +18,8 @@ pub struct TraceKeywords {
     pub candidates: String,
     /// Budget on candidates (beam-tree nodes).
     pub max_candidates: u64,
+    /// Budget on the WVRN's pair tests (`candidates="wvrn"`).
+    pub max_wvrn_tests: u64,
     /// Solve on every core (the output is identical either way).
     pub parallel: bool,
     /// `ipc_order` and `ipc_accel`.
@@ -26,6 +28,20 @@ pub struct TraceKeywords {
     pub sbr: SbrKeywords,
     /// `diffraction`/`max_diffractions` and `min_edge_length`.
     pub diffraction: DiffractionKeywords,
+}
+
+/// The load budgets of `load` (`max_file_bytes`, `max_xml_substitution`, `max_mesh_elements`
+/// in Python; the CLI's `--max-file-bytes`, `--max-xml-substitution`, `--max-mesh-elements`),
+/// passed from the Python wrapper as one dict.
+#[derive(Debug, Clone, Copy, pyo3::FromPyObject)]
+#[pyo3(from_item_all)]
+pub struct LoadBudgets {
+    /// Largest input file, bytes.
+    pub max_file_bytes: u64,
+    /// Bytes an XML scene's `$parameter` substitutions may produce.
+    pub max_xml_substitution: u64,
+    /// Vertices and faces of a mesh file, and of all meshes of an XML scene.
+    pub max_mesh_elements: u64,
 }
 
 /// Diffraction's keywords (`diffraction=True` is `max_diffractions=1` in Python).
@@ -82,6 +98,7 @@ impl TraceKeywords {
                 },
                 candidates: parse(&self.candidates)?,
                 max_candidates: self.max_candidates,
+                max_wvrn_tests: self.max_wvrn_tests,
                 parallel: self.parallel,
                 diffraction: bt_solve::pipeline::DiffractionOptions {
                     max_diffractions: self.diffraction.max_diffractions,
@@ -112,6 +129,7 @@ mod tests {
             solver: "image".into(),
             candidates: "beam-tree".into(),
             max_candidates: 10,
+            max_wvrn_tests: 10,
             parallel: true,
             ipc: IpcKeywords {
                 order: "gauss-seidel".into(),

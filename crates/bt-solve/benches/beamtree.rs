@@ -21,6 +21,7 @@ fn options(order: usize, mode: CandidateMode, solver: Solver) -> TraceOptions {
         candidates: mode,
         parallel: false,
         max_candidates: u64::MAX,
+        max_wvrn_tests: u64::MAX,
         ..TraceOptions::new(order)
     }
 }

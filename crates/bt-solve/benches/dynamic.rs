@@ -25,6 +25,7 @@ fn options(candidates: CandidateMode) -> TraceOptions {
         solver: Solver::Image,
         candidates,
         max_candidates: u64::MAX,
+        max_wvrn_tests: u64::MAX,
         parallel: false,
         diffraction: Default::default(),
     }

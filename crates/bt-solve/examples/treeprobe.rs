@@ -25,6 +25,7 @@ fn trace_options(solver: Solver, candidates: CandidateMode) -> TraceOptions {
         candidates,
         parallel: false,
         max_candidates: u64::MAX,
+        max_wvrn_tests: u64::MAX,
         ..TraceOptions::new(3)
     }
 }

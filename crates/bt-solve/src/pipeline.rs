@@ -33,6 +33,9 @@ pub enum CandidateMode {
 /// Default budget on candidate sequences (see [`TraceOptions::max_candidates`]).
 pub const DEFAULT_MAX_CANDIDATES: u64 = 2_000_000;
 
+/// Default budget on the WVRN's pair tests (see [`TraceOptions::max_wvrn_tests`]).
+pub const DEFAULT_MAX_WVRN_TESTS: u64 = bt_paths::wvrn::MAX_WVRN_TESTS.limit;
+
 /// What to trace and how.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct TraceOptions {
@@ -47,6 +50,9 @@ pub struct TraceOptions {
     /// Budget: the trace stops with [`TraceError::Budget`] rather than generate more
     /// candidates (or beam-tree nodes) than this.
     pub max_candidates: u64,
+    /// Budget: the WVRN generator stops with [`TraceError::OverBudget`] before building a
+    /// network of more pair tests than this ([`bt_paths::wvrn::build_tests`]).
+    pub max_wvrn_tests: u64,
     /// Edge diffraction (default off).
     pub diffraction: DiffractionOptions,
 }
@@ -85,6 +91,7 @@ impl TraceOptions {
             candidates: CandidateMode::default(),
             parallel: true,
             max_candidates: DEFAULT_MAX_CANDIDATES,
+            max_wvrn_tests: DEFAULT_MAX_WVRN_TESTS,
             diffraction: DiffractionOptions::default(),
         }
     }
@@ -107,6 +114,9 @@ pub enum TraceError {
         /// The order asked for.
         max_order: usize,
     },
+    /// Other work over its budget (the WVRN's pair tests).
+    #[error(transparent)]
+    OverBudget(#[from] bt_geom::OverBudget),
     /// The beam tree ran out of its node budget (a tree's scene error, such as a missing
     /// terminal, converts to [`TraceError::Scene`] instead: one shape per cause).
     #[error(transparent)]
@@ -188,6 +198,7 @@ fn generate(
             )?);
         }
         CandidateMode::Wvrn => {
+            wvrn_budget(scene, options.max_wvrn_tests)?;
             let wvrn = bt_paths::wvrn::Wvrn::build(scene)?;
             bt_paths::enumerate(scene, options.max_order, &wvrn)?
         }
@@ -235,6 +246,15 @@ pub fn exhaustive_budget(scene: &Scene, max_order: usize, budget: u64) -> Result
     let reflectors = scene.reflectors().count() as u64;
     let estimate = exhaustive_count(reflectors, max_order);
     check_estimate(estimate, budget, max_order)
+}
+
+/// Stop before building the WVRN of `scene` when its pair tests
+/// ([`bt_paths::wvrn::build_tests`]) exceed `budget` (`--max-wvrn-tests`).
+pub fn wvrn_budget(scene: &Scene, budget: u64) -> Result<(), TraceError> {
+    let tests = bt_paths::wvrn::build_tests(scene);
+    Ok(bt_paths::wvrn::MAX_WVRN_TESTS
+        .with_limit(budget)
+        .check(tests)?)
 }
 
 /// [`exhaustive_budget`] for the candidates of `options`: the sequences, and the diffracted

@@ -65,6 +65,8 @@ pub struct SolveSettings {
     pub candidates: CandidateMode,
     /// Budget on candidates (beam-tree nodes).
     pub max_candidates: u64,
+    /// Budget on the WVRN's pair tests (`--max-wvrn-tests`).
+    pub max_wvrn_tests: u64,
     /// Spread the work over every core (output identical either way).
     pub parallel: bool,
     /// Edge diffraction (`--diffraction`, `--max-diffractions`, `--min-edge-length`).
@@ -91,6 +93,7 @@ impl Default for SolveSettings {
             },
             candidates: CandidateMode::default(),
             max_candidates: DEFAULT_MAX_CANDIDATES,
+            max_wvrn_tests: crate::pipeline::DEFAULT_MAX_WVRN_TESTS,
             parallel: true,
             diffraction: DiffractionOptions::default(),
         }
@@ -201,6 +204,7 @@ impl SolveSettings {
             candidates: self.candidates,
             parallel: self.parallel,
             max_candidates: self.max_candidates,
+            max_wvrn_tests: self.max_wvrn_tests,
             diffraction: d,
         })
     }

@@ -109,7 +109,10 @@ fn step_candidates(
 /// The WVRN of `scene` in WVRN mode.
 fn step_wvrn(options: &TraceOptions, scene: &Scene) -> Result<Option<Wvrn>, TraceError> {
     Ok(match options.candidates {
-        CandidateMode::Wvrn => Some(Wvrn::build(scene)?),
+        CandidateMode::Wvrn => {
+            crate::pipeline::wvrn_budget(scene, options.max_wvrn_tests)?;
+            Some(Wvrn::build(scene)?)
+        }
         _ => None,
     })
 }

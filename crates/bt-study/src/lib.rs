@@ -22,7 +22,7 @@ pub mod room;
 pub mod run;
 
 pub use room::{Room, Shape};
-pub use run::{Row, StudyConfig, StudyResults, StudySolver, run};
+pub use run::{MAX_ROOM_STEPS, Row, StudyConfig, StudyResults, StudySolver, run};
 
 use thiserror::Error;
 

@@ -31,7 +31,17 @@ pub struct StudyConfig {
     /// exceed it stops the study with that error.
     #[serde(skip)]
     pub max_candidates: u64,
+    /// Budget on rooms × steps (`--max-room-steps`, [`MAX_ROOM_STEPS`]), checked before any
+    /// room is generated.
+    #[serde(skip)]
+    pub max_room_steps: u64,
 }
+
+/// Budget on a 2-D study's room-steps (rooms × steps): each holds a room's contour and four
+/// result rows and takes tens of milliseconds, so the default of 100,000 (100 times the
+/// paper's study) stays near 100 MB; `--rooms 1e18` is refused before anything is allocated.
+pub const MAX_ROOM_STEPS: bt_geom::Budget =
+    bt_geom::Budget::new("room-steps", "--max-room-steps", 100_000);
 
 impl Default for StudyConfig {
     /// The paper's study: 100 rooms, 10 steps, third order, 1° SBR in the plane.
@@ -44,6 +54,7 @@ impl Default for StudyConfig {
             sbr_step_deg: 1.0,
             sbr_sphere: false,
             max_candidates: bt_solve::pipeline::DEFAULT_MAX_CANDIDATES,
+            max_room_steps: MAX_ROOM_STEPS.limit,
         }
     }
 }
@@ -67,6 +78,13 @@ impl StudyConfig {
         p.extend(max_order_problem(self.max_order));
         if let Some(m) = self.sbr_options().problem() {
             p.push(m);
+        }
+        let room_steps = (self.rooms as u64).saturating_mul(self.steps as u64);
+        if let Err(e) = MAX_ROOM_STEPS
+            .with_limit(self.max_room_steps)
+            .check(room_steps)
+        {
+            p.push(e.to_string());
         }
         p
     }

@@ -182,6 +182,7 @@ class Scene:
         candidates: str = "beam-tree",
         *,
         max_candidates: int = _native.DEFAULT_MAX_CANDIDATES,
+        max_wvrn_tests: int = _native.DEFAULT_MAX_WVRN_TESTS,
         ipc_order: str = "gauss-seidel",
         ipc_accel: str = "none",
         sbr_step_deg: Optional[float] = None,
@@ -200,7 +201,8 @@ class Scene:
         ``candidates`` "beam-tree" | "wvrn" | "exhaustive", ``ipc_order`` "gauss-seidel" |
         "jacobi", ``ipc_accel`` "none" | "newton", ``sbr_step_deg`` or ``sbr_rays``. Raises
         :class:`BeamtraceError` when a position is invalid (on a surface, equal to the other
-        terminal) or the candidate budget is exceeded, ``ValueError`` on a bad option or when
+        terminal) or a budget is exceeded (``max_candidates``; ``max_wvrn_tests``, the WVRN's
+        node pairs × surfaces, with ``candidates="wvrn"``), ``ValueError`` on a bad option or when
         a terminal is neither given nor in the scene (meshes, XML and point clouds have none).
         """
         columns = self._native.trace(
@@ -219,6 +221,7 @@ class Scene:
         candidates: str = "beam-tree",
         *,
         max_candidates: int = _native.DEFAULT_MAX_CANDIDATES,
+        max_wvrn_tests: int = _native.DEFAULT_MAX_WVRN_TESTS,
         ipc_order: str = "gauss-seidel",
         ipc_accel: str = "none",
         sbr_step_deg: Optional[float] = None,
@@ -247,7 +250,14 @@ def _options(arguments: Dict[str, Any]) -> Dict[str, Any]:
     """The trace keywords as the native module takes them: IPC's and SBR's in their own dicts."""
     options = {
         name: arguments[name]
-        for name in ("max_order", "solver", "candidates", "max_candidates", "parallel")
+        for name in (
+            "max_order",
+            "solver",
+            "candidates",
+            "max_candidates",
+            "max_wvrn_tests",
+            "parallel",
+        )
     }
     options["ipc"] = {"order": arguments["ipc_order"], "accel": arguments["ipc_accel"]}
     options["sbr"] = {
@@ -271,13 +281,19 @@ def load(
     min_reflector_area: float = 0.25,
     merge_angle_deg: float = 1.0,
     merge_distance: float = 1e-3,
+    max_file_bytes: int = _native.DEFAULT_MAX_FILE_BYTES,
+    max_xml_substitution: int = _native.DEFAULT_MAX_XML_SUBSTITUTION,
+    max_mesh_elements: int = _native.DEFAULT_MAX_MESH_ELEMENTS,
 ) -> Scene:
     """Load a scene: a file the CLI reads (.json, .toml, .obj, .ply) or ``"builtin:NAME"``.
 
     ``tx``/``rx`` override the file's terminals. Meshes, XML scenes and point clouds carry
     none: load them bare and give ``tx``/``rx`` to each :meth:`Scene.trace`. The mesh
     options are ``beamtrace trace``'s ``--min-reflector-area`` (m²), ``--merge-angle-deg`` and
-    ``--merge-distance`` (m). Raises :class:`BeamtraceError` with the CLI's message (naming the
+    ``--merge-distance`` (m); the budgets are its ``--max-file-bytes`` (any input file),
+    ``--max-xml-substitution`` (bytes an XML scene's ``$parameters`` expand to) and
+    ``--max-mesh-elements`` (vertices and faces of a mesh, or of all meshes of an XML scene),
+    each checked before the work. Raises :class:`BeamtraceError` with the CLI's message (naming the
     file, line or field) when the scene cannot be read or is invalid.
     """
     native = _native.load(
@@ -287,6 +303,11 @@ def load(
         min_reflector_area=min_reflector_area,
         merge_angle_deg=merge_angle_deg,
         merge_distance=merge_distance,
+        budgets={
+            "max_file_bytes": max_file_bytes,
+            "max_xml_substitution": max_xml_substitution,
+            "max_mesh_elements": max_mesh_elements,
+        },
     )
     return Scene(native)
 

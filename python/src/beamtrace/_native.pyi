@@ -9,6 +9,10 @@ PATH_COLUMNS: List[str]
 """Every column a trace can give, in the order of ``beamtrace trace --json``'s path objects
 (derived from the report record; ``iterations``/``residual_m`` only for IPC)."""
 DEFAULT_MAX_CANDIDATES: int
+DEFAULT_MAX_WVRN_TESTS: int
+DEFAULT_MAX_FILE_BYTES: int
+DEFAULT_MAX_XML_SUBSTITUTION: int
+DEFAULT_MAX_MESH_ELEMENTS: int
 
 class BeamtraceError(Exception): ...
 
@@ -40,5 +44,6 @@ def load(
     min_reflector_area: float = 0.25,
     merge_angle_deg: float = 1.0,
     merge_distance: float = 1e-3,
+    budgets: Optional[Dict[str, int]] = None,
 ) -> Scene: ...
 def builtin_names() -> List[str]: ...

@@ -51,6 +51,9 @@ pub struct ReadOptions {
     /// Budget: the most points a file may declare (CLI `--max-cloud-points`), checked against
     /// the header before any point is stored; default [`DEFAULT_MAX_POINTS`].
     pub max_points: u64,
+    /// Budget: the largest file read, bytes (CLI `--max-file-bytes`), checked against the
+    /// file's size before reading; default [`crate::MAX_FILE_BYTES`].
+    pub max_file_bytes: u64,
 }
 
 /// Default of [`ReadOptions::max_points`]: 20 million points, the budget `sample` writes
@@ -62,6 +65,7 @@ impl Default for ReadOptions {
         ReadOptions {
             non_finite: NonFinitePolicy::default(),
             max_points: DEFAULT_MAX_POINTS,
+            max_file_bytes: crate::MAX_FILE_BYTES.limit,
         }
     }
 }
@@ -133,9 +137,8 @@ pub fn parse_any(bytes: &[u8], opts: &ReadOptions) -> Result<LoadedCloud, CloudE
 
 /// Read a `.ply` or `.pcd` file. Errors carry the path.
 pub fn read_path(path: &Path, opts: &ReadOptions) -> Result<LoadedCloud, CloudError> {
-    let bytes = crate::source::regular_file(path)
-        .and_then(|()| std::fs::read(path))
-        .map_err(|source| CloudError::Io {
+    let bytes =
+        crate::source::read_file(path, opts.max_file_bytes).map_err(|source| CloudError::Io {
             origin: Origin(Some(path.to_path_buf())),
             source,
         })?;

@@ -91,8 +91,13 @@ pub fn read_transformed(
 }
 
 /// Reads the mesh file at `path` and merges its faces into planar surfaces, choosing the
-/// reader by extension (`.obj` or `.ply`, case-insensitive). Coordinates are in metres.
-pub fn read_mesh_path(path: &Path, opts: &MergeOptions) -> Result<MeshImport, MeshError> {
+/// reader by extension (`.obj` or `.ply`, case-insensitive). Coordinates are in metres. A file
+/// larger than `max_file_bytes` ([`crate::MAX_FILE_BYTES`]) is refused before it is read.
+pub fn read_mesh_path(
+    path: &Path,
+    opts: &MergeOptions,
+    max_file_bytes: u64,
+) -> Result<MeshImport, MeshError> {
     let file = path.display().to_string();
     let extension = path
         .extension()
@@ -104,12 +109,10 @@ pub fn read_mesh_path(path: &Path, opts: &MergeOptions) -> Result<MeshImport, Me
         _ => return Err(MeshError::UnsupportedExtension { file, extension }),
     };
     opts.validate()?;
-    let bytes = crate::source::regular_file(path)
-        .and_then(|()| std::fs::read(path))
-        .map_err(|source| MeshError::Io {
-            file: file.clone(),
-            source,
-        })?;
+    let bytes = crate::source::read_file(path, max_file_bytes).map_err(|source| MeshError::Io {
+        file: file.clone(),
+        source,
+    })?;
     read_transformed(&bytes, format, Some(&file), opts, &|p| p)
 }
 

@@ -7,13 +7,15 @@
 //! result as a [`SceneDescription`] whose materials are the bsdfs, named by their ids.
 //!
 //! Mesh file names are resolved safely: only relative paths of plain components under the
-//! XML's folder (no absolute path, no `..`), each file at most [`MAX_MESH_FILE_BYTES`] and all
-//! of them at most [`MAX_MESH_TOTAL_BYTES`].
+//! XML's folder (no absolute path, no `..`), each file at most [`LoadOptions::max_file_bytes`]
+//! and all of them at most [`MAX_MESH_TOTAL_BYTES`]; the vertices and the faces of all shapes
+//! together are held to the mesh budget (`--max-mesh-elements`), which is per scene here, not
+//! per file.
 
 mod parse;
 mod transform;
 
-pub use parse::{SIONNA_DEFAULT_THICKNESS_M, parse_xml};
+pub use parse::{SIONNA_DEFAULT_THICKNESS_M, parse_xml, parse_xml_with};
 
 use crate::source::file_stem;
 use crate::{ImportError, LoadOptions, Loaded};
@@ -35,8 +37,10 @@ pub const MAX_XML_NODES: u32 = 1_000_000;
 pub const MAX_XML_SHAPES: usize = 20_000;
 /// Largest number of `<bsdf>` elements.
 pub const MAX_XML_BSDFS: usize = 10_000;
-/// Largest mesh file a shape may name, bytes.
-pub const MAX_MESH_FILE_BYTES: u64 = 512 << 20;
+/// Budget on the bytes all `$parameter` substitutions of one XML file produce: 16 MiB, the
+/// size of the largest XML file read; Sionna's scenes substitute nothing.
+pub const MAX_XML_SUBSTITUTION: bt_geom::Budget =
+    bt_geom::Budget::new("substituted bytes", "--max-xml-substitution", 16 << 20);
 /// Largest total size of all mesh files of one scene, bytes.
 pub const MAX_MESH_TOTAL_BYTES: u64 = 2 << 30;
 
@@ -130,12 +134,12 @@ pub struct XmlShape {
 /// geometry, traced with terminals given per trace.
 pub fn load_xml(path: &Path, options: &LoadOptions) -> Result<Loaded, ImportError> {
     let display = path.display().to_string();
-    let text = read_bounded(path, MAX_XML_BYTES, &display)?;
+    let text = read_bounded(path, MAX_XML_BYTES.min(options.max_file_bytes), &display)?;
     let text = String::from_utf8(text).map_err(|e| ImportError::Parse {
         path: display.clone(),
         message: format!("not UTF-8 text: {e}"),
     })?;
-    let xml = parse_xml(&text, &display)?;
+    let xml = parse_xml_with(&text, &display, options.max_xml_substitution)?;
     let folder = path.parent().unwrap_or(Path::new("."));
     let mut warnings = xml.warnings.clone();
     let mut desc = SceneDescription {
@@ -146,11 +150,13 @@ pub fn load_xml(path: &Path, options: &LoadOptions) -> Result<Loaded, ImportErro
     };
     let mut budget = MAX_MESH_TOTAL_BYTES;
     let mut meshes: Vec<PathBuf> = Vec::new();
+    let mut elements = SceneElements::default();
     for shape in &xml.shapes {
         let (file, import) = read_shape(shape, folder, &display, options, &mut budget)?;
         if !meshes.contains(&file) {
             meshes.push(file);
         }
+        elements.charge(&import, shape, &display, options.merge.max_elements)?;
         warnings.extend(import.warnings);
         let material = shape.bsdf.as_ref().map(|(id, _)| id.clone());
         if material.is_none() {
@@ -177,6 +183,46 @@ pub fn load_xml(path: &Path, options: &LoadOptions) -> Result<Loaded, ImportErro
         sources: meshes,
         ..Loaded::new(scene, warnings)
     })
+}
+
+/// The vertices and faces read so far from the meshes of one XML scene.
+#[derive(Debug, Default)]
+struct SceneElements {
+    vertices: u64,
+    faces: u64,
+}
+
+impl SceneElements {
+    /// Add `import`'s vertices and faces (as read, before merging) and refuse the scene when
+    /// either total exceeds `max_elements`: the budget holds for the whole scene, so twenty
+    /// shapes of one large mesh do not pass where one file of all of them would not.
+    fn charge(
+        &mut self,
+        import: &bt_mesh::MeshImport,
+        shape: &XmlShape,
+        xml: &str,
+        max_elements: u64,
+    ) -> Result<(), ImportError> {
+        self.vertices = self.vertices.saturating_add(import.vertices_read as u64);
+        self.faces = self.faces.saturating_add(import.faces_read as u64);
+        for (element, total) in [("vertices", self.vertices), ("faces", self.faces)] {
+            if total > max_elements {
+                return Err(ImportError::Xml {
+                    path: xml.to_string(),
+                    line: shape.at.line,
+                    column: shape.at.column,
+                    message: format!(
+                        "the meshes up to <shape id=\"{}\"> hold {}, more than the budget of \
+                         {max_elements} {element} for the whole scene; raise it with \
+                         --max-mesh-elements (load options: merge.max_elements)",
+                        shape.name,
+                        bt_geom::AtLeast(total).to_string() + " " + element
+                    ),
+                });
+            }
+        }
+        Ok(())
+    }
 }
 
 /// The scene materials of the bsdfs, by id.
@@ -273,14 +319,23 @@ fn read_shape(
             ))
         })?
         .len();
-    if size > MAX_MESH_FILE_BYTES || size > *budget {
+    if let Err(e) = crate::MAX_FILE_BYTES
+        .with_limit(options.max_file_bytes)
+        .check(size)
+    {
         return Err(at(format!(
-            "<shape id=\"{}\"> mesh file {shown} is {size} bytes: over the limit ({MAX_MESH_FILE_BYTES} bytes per file, {MAX_MESH_TOTAL_BYTES} for all meshes of a scene)",
+            "<shape id=\"{}\"> mesh file {shown}: {e}",
+            shape.name
+        )));
+    }
+    if size > *budget {
+        return Err(at(format!(
+            "<shape id=\"{}\"> mesh file {shown} is {size} bytes: over the limit ({MAX_MESH_TOTAL_BYTES} bytes for all meshes of a scene)",
             shape.name
         )));
     }
     *budget -= size;
-    let bytes = read_bounded(&file, MAX_MESH_FILE_BYTES, &shown)?;
+    let bytes = read_bounded(&file, options.max_file_bytes, &shown)?;
     let format = match shape.kind {
         MeshKind::Ply => crate::mesh::MeshFormat::Ply,
         MeshKind::Obj => crate::mesh::MeshFormat::Obj,
@@ -313,24 +368,12 @@ fn resolve(folder: &Path, name: &str) -> Result<PathBuf, &'static str> {
     Ok(folder.join(relative))
 }
 
-/// Read at most `limit` bytes of `path`; a longer file is an error, not a truncation.
+/// The bytes of `path`, at most `limit` ([`crate::source::read_file`]).
 fn read_bounded(path: &Path, limit: u64, display: &str) -> Result<Vec<u8>, ImportError> {
-    use std::io::Read;
-    let io = |source| ImportError::Io {
+    crate::source::read_file(path, limit).map_err(|source| ImportError::Io {
         path: display.to_string(),
         source,
-    };
-    crate::source::regular_file(path).map_err(io)?;
-    let file = std::fs::File::open(path).map_err(io)?;
-    let mut bytes = Vec::new();
-    file.take(limit + 1).read_to_end(&mut bytes).map_err(io)?;
-    if bytes.len() as u64 > limit {
-        return Err(ImportError::Parse {
-            path: display.to_string(),
-            message: format!("file larger than {limit} bytes"),
-        });
-    }
-    Ok(bytes)
+    })
 }
 
 #[cfg(test)]

@@ -3,13 +3,14 @@
 
 use super::transform::parse_transform;
 use super::{
-    MAX_XML_BSDFS, MAX_XML_NODES, MAX_XML_SHAPES, MeshKind, XmlBsdf, XmlPos, XmlRadio, XmlScene,
-    XmlShape,
+    MAX_XML_BSDFS, MAX_XML_NODES, MAX_XML_SHAPES, MAX_XML_SUBSTITUTION, MeshKind, XmlBsdf, XmlPos,
+    XmlRadio, XmlScene, XmlShape,
 };
 use crate::ImportError;
 use bt_geom::Real;
 use glam::DMat4;
 use roxmltree::{Document, Node, ParsingOptions};
+use std::cell::Cell;
 use std::collections::{BTreeMap, BTreeSet};
 
 /// Elements that only matter for rendering images: skipped with one warning each.
@@ -38,13 +39,16 @@ const IGNORED_RADIO_PROPERTIES: [&str; 7] = [
 pub const SIONNA_DEFAULT_THICKNESS_M: Real = 0.1;
 
 /// Parsing context: the text and its line starts (for positions), the file name, the
-/// `<default>`s and the bsdf ids seen.
+/// `<default>`s, the bsdf ids seen, and the bytes substituted for `$parameters` so far against
+/// their budget.
 pub(super) struct Ctx<'a> {
     text: &'a str,
     line_starts: Vec<usize>,
     file: &'a str,
     defaults: BTreeMap<String, String>,
     bsdf_ids: BTreeSet<String>,
+    substituted: Cell<u64>,
+    max_substituted: u64,
 }
 
 impl Ctx<'_> {
@@ -110,11 +114,31 @@ impl Ctx<'_> {
                     format!("<{}> {name}=: undefined parameter ${key}", tag(node)),
                 )
             })?;
+            self.charge(node, name, key, value.len())?;
             out.push_str(value);
             rest = &tail[len..];
         }
         out.push_str(rest);
         Ok(Some(out))
+    }
+
+    /// Count `bytes` substituted for `$key` in attribute `name` against the budget, before they
+    /// are copied: `<default>`s that expand each other grow exponentially (ten levels of ten
+    /// references make 10^10 copies from a 1 kB file).
+    fn charge(
+        &self,
+        node: Node<'_, '_>,
+        name: &str,
+        key: &str,
+        bytes: usize,
+    ) -> Result<(), ImportError> {
+        let total = self.substituted.get().saturating_add(bytes as u64);
+        MAX_XML_SUBSTITUTION
+            .with_limit(self.max_substituted)
+            .check(total)
+            .map_err(|e| self.error(node, format!("<{}> {name}=: ${key}: {e}", tag(node))))?;
+        self.substituted.set(total);
+        Ok(())
     }
 
     /// A required attribute.
@@ -159,8 +183,19 @@ pub(super) fn elements<'a, 'i>(node: Node<'a, 'i>) -> impl Iterator<Item = Node<
 }
 
 /// Parse Mitsuba XML `text` (named `file` in errors) into the intermediate form. Checks the
-/// element count ([`MAX_XML_NODES`]), the shape and bsdf counts and every reference.
+/// element count ([`MAX_XML_NODES`]), the shape and bsdf counts, every reference, and the bytes
+/// substituted for `$parameters` ([`MAX_XML_SUBSTITUTION`], default limit).
 pub fn parse_xml(text: &str, file: &str) -> Result<XmlScene, ImportError> {
+    parse_xml_with(text, file, MAX_XML_SUBSTITUTION.limit)
+}
+
+/// [`parse_xml`] with at most `max_substituted` bytes substituted for `$parameters` in all
+/// (CLI `--max-xml-substitution`).
+pub fn parse_xml_with(
+    text: &str,
+    file: &str,
+    max_substituted: u64,
+) -> Result<XmlScene, ImportError> {
     let options = ParsingOptions {
         allow_dtd: false,
         nodes_limit: MAX_XML_NODES,
@@ -184,6 +219,8 @@ pub fn parse_xml(text: &str, file: &str) -> Result<XmlScene, ImportError> {
         file,
         defaults: BTreeMap::new(),
         bsdf_ids: BTreeSet::new(),
+        substituted: Cell::new(0),
+        max_substituted,
     };
     let root = doc.root_element();
     if tag(root) != "scene" {

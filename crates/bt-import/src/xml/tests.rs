@@ -326,3 +326,149 @@ fn xml_without_terminals_loads_as_bare_geometry() {
     assert_eq!(placed.extent(), loaded.extent());
     std::fs::remove_dir_all(dir).ok();
 }
+
+/// Ten `<default>`s, each ten copies of the one before: 10^10 bytes from a ~1 kB file.
+fn default_bomb(levels: usize) -> String {
+    let mut xml = String::from("<scene>\n<default name=\"d0\" value=\"xxxxxxxxxx\"/>\n");
+    for k in 1..=levels {
+        let value = format!("${}", k - 1).replace('$', "$d").repeat(10);
+        xml.push_str(&format!("<default name=\"d{k}\" value=\"{value}\"/>\n"));
+    }
+    xml.push_str("</scene>\n");
+    xml
+}
+
+#[test]
+fn defaults_that_expand_each_other_stop_at_the_substitution_budget() {
+    let xml = default_bomb(10);
+    assert!(xml.len() < 2000, "{}", xml.len());
+    let e = err(&xml);
+    assert!(e.contains("substituted bytes budget exceeded"), "{e}");
+    assert!(e.contains("--max-xml-substitution"), "{e}");
+    assert!(
+        e.contains("line 9"),
+        "the first default over the budget: {e}"
+    );
+    // Three levels (100 + 1,000 + 10,000 bytes substituted) fit the default budget, not a
+    // budget of 11,099 bytes.
+    let small = default_bomb(3);
+    assert!(parse_xml(&small, "t.xml").is_ok());
+    assert!(parse_xml_with(&small, "t.xml", 11_100).is_ok());
+    let e = parse_xml_with(&small, "t.xml", 11_099).unwrap_err();
+    assert!(
+        e.to_string().contains("more than the budget of 11099"),
+        "{e}"
+    );
+}
+
+mod substitution {
+    use super::super::parse_xml_with;
+    use proptest::prelude::*;
+
+    /// A default's value: literal text and references to earlier defaults (indices below
+    /// its own), as (literal length, reference) pieces.
+    fn document() -> impl Strategy<Value = Vec<Vec<(usize, Option<usize>)>>> {
+        prop::collection::vec(
+            prop::collection::vec((0usize..8, prop::option::of(0usize..64)), 0..12),
+            1..24,
+        )
+    }
+
+    /// The XML of `defaults` and the bytes its substitutions produce (saturating).
+    fn render(defaults: &[Vec<(usize, Option<usize>)>]) -> (String, u64) {
+        let mut xml = String::from("<scene>");
+        let mut lengths: Vec<u64> = Vec::new();
+        let mut substituted = 0u64;
+        for (k, pieces) in defaults.iter().enumerate() {
+            let mut value = String::new();
+            let mut length = 0u64;
+            for (literal, reference) in pieces {
+                value.push_str(&"a".repeat(*literal));
+                length = length.saturating_add(*literal as u64);
+                if let Some(r) = reference.filter(|_| k > 0).map(|r| r % k) {
+                    // '-' ends the name ('_' would continue it).
+                    value.push_str(&format!("$d{r}-"));
+                    length = length.saturating_add(lengths[r]).saturating_add(1);
+                    substituted = substituted.saturating_add(lengths[r]);
+                }
+            }
+            lengths.push(length);
+            xml.push_str(&format!("<default name=\"d{k}\" value=\"{value}\"/>"));
+        }
+        xml.push_str("</scene>");
+        (xml, substituted)
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig::with_cases(256))]
+
+        /// Random nestings of defaults: the parse succeeds exactly when the bytes substituted
+        /// fit the budget, otherwise it names the option; it never panics, and it never copies
+        /// more than the budget (a refused document stops before its over-budget copy).
+        #[test]
+        fn nested_defaults_never_exceed_the_budget(
+            defaults in document(),
+            budget in 0u64..200_000,
+        ) {
+            let (xml, substituted) = render(&defaults);
+            match parse_xml_with(&xml, "t.xml", budget) {
+                Ok(_) => prop_assert!(substituted <= budget),
+                Err(e) => {
+                    prop_assert!(substituted > budget, "{e}");
+                    prop_assert!(e.to_string().contains("--max-xml-substitution"), "{e}");
+                }
+            }
+        }
+    }
+}
+
+#[test]
+fn the_mesh_budget_holds_for_all_shapes_of_a_scene() {
+    // Three shapes of one 4-vertex mesh: 12 vertices in all.
+    let shape = |id: &str, z: u32| {
+        format!(
+            r#"<shape type="obj" id="{id}"><string name="filename" value="meshes/half.obj"/><transform name="to_world"><translate z="{z}"/></transform></shape>"#
+        )
+    };
+    let xml = format!(
+        "<scene>\n{}\n{}\n{}\n</scene>",
+        shape("a", 0),
+        shape("b", 5),
+        shape("c", 6)
+    );
+    let dir = scratch(
+        "scene-budget",
+        &[("s.xml", &xml), ("meshes/half.obj", HALF_FLOOR)],
+    );
+    let with_budget = |max_elements| LoadOptions {
+        merge: bt_mesh::MergeOptions {
+            max_elements,
+            ..bt_mesh::MergeOptions::default()
+        },
+        ..options()
+    };
+    let loaded = load_xml(&dir.join("s.xml"), &with_budget(12));
+    assert!(loaded.is_ok(), "{:?}", loaded.err());
+    // Each file fits a budget of 11; the scene does not.
+    let e = load_xml(&dir.join("s.xml"), &with_budget(11))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("line 4") && e.contains("<shape id=\"c\">"),
+        "{e}"
+    );
+    assert!(e.contains("hold at least 12 vertices"), "{e}");
+    assert!(
+        e.contains("budget of 11 vertices for the whole scene"),
+        "{e}"
+    );
+    assert!(e.contains("--max-mesh-elements"), "{e}");
+    // A mesh file over the byte budget is refused from its size.
+    let tiny = LoadOptions {
+        max_file_bytes: 10,
+        ..options()
+    };
+    let e = load_xml(&dir.join("s.xml"), &tiny).unwrap_err().to_string();
+    assert!(e.contains("--max-file-bytes"), "{e}");
+    std::fs::remove_dir_all(dir).ok();
+}

@@ -30,6 +30,7 @@ fn pcd(d: PcdData) -> Vec<u8> {
 const OPTS: ReadOptions = ReadOptions {
     non_finite: NonFinitePolicy::Skip,
     max_points: bt_import::cloud::DEFAULT_MAX_POINTS,
+    max_file_bytes: bt_import::MAX_FILE_BYTES.limit,
 };
 
 #[test]

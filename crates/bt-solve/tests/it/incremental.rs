@@ -26,6 +26,7 @@ fn image(candidates: CandidateMode, max_order: usize, parallel: bool) -> TraceOp
         solver: Solver::Image,
         candidates,
         max_candidates: u64::MAX,
+        max_wvrn_tests: u64::MAX,
         parallel,
         diffraction: Default::default(),
     }

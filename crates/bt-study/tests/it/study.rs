@@ -15,6 +15,26 @@ fn tiny() -> StudyConfig {
 }
 
 #[test]
+fn room_steps_beyond_the_budget_are_refused_before_any_room() {
+    let config = StudyConfig {
+        rooms: usize::MAX,
+        steps: usize::MAX,
+        ..tiny()
+    };
+    let e = run(&config, &mut |_, _| panic!("no room may run"))
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("more than 1.8e19 room-steps"), "{e}");
+    assert!(e.contains("--max-room-steps"), "{e}");
+    let config = StudyConfig {
+        max_room_steps: 7,
+        ..tiny()
+    };
+    let e = run(&config, &mut |_, _| {}).unwrap_err().to_string();
+    assert!(e.contains("8 room-steps, more than the budget of 7"), "{e}");
+}
+
+#[test]
 fn tiny_study_is_consistent() {
     let mut calls = 0;
     let results = run(&tiny(), &mut |done, total| {

@@ -107,15 +107,7 @@ fn meshes_beyond_the_element_budget_stop_early_naming_count_budget_and_option() 
     let corners: Vec<[u8; 3]> = (0..8u8)
         .map(|v| [v & 1, (v >> 1) & 1, (v >> 2) & 1])
         .collect();
-    let quads = [
-        [0, 2, 3, 1],
-        [4, 5, 7, 6],
-        [0, 1, 5, 4],
-        [2, 6, 7, 3],
-        [0, 4, 6, 2],
-        [1, 3, 7, 5],
-    ];
-    let triangles: Vec<[usize; 3]> = quads
+    let triangles: Vec<[usize; 3]> = CUBE_QUADS
         .iter()
         .flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]])
         .collect();

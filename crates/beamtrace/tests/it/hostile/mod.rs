@@ -2,6 +2,7 @@
 //! files before and after, and memory held under a budget small enough for CI.
 
 mod budgets;
+mod growth;
 mod names;
 mod outputs;
 mod outputs2;
@@ -15,26 +16,42 @@ pub fn one_wall() -> String {
     crate::common::testdata("one-wall.json")
 }
 
+/// The faces of the unit cube whose vertex `v` is `(v & 1, v >> 1 & 1, v >> 2 & 1)`, as quads
+/// of vertex indices, outward.
+pub const CUBE_QUADS: [[usize; 4]; 6] = [
+    [0, 2, 3, 1],
+    [4, 5, 7, 6],
+    [0, 1, 5, 4],
+    [2, 6, 7, 3],
+    [0, 4, 6, 2],
+    [1, 3, 7, 5],
+];
+
 /// Address-space limit of every run: the runaway cases of the issue asked for 8 GB to 10 TB.
 const MEMORY_LIMIT_BYTES: u64 = 3 << 30;
 
 /// Runs the binary under the memory limit.
 pub fn beamtrace(args: &[&str]) -> Output {
+    beamtrace_within(args, MEMORY_LIMIT_BYTES)
+}
+
+/// Runs the binary under an address-space limit of `bytes`.
+pub fn beamtrace_within(args: &[&str], bytes: u64) -> Output {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_beamtrace"));
     cmd.args(args);
-    limit_memory(&mut cmd);
+    limit_memory(&mut cmd, bytes);
     cmd.output().expect("binary runs")
 }
 
 #[cfg(unix)]
-fn limit_memory(cmd: &mut Command) {
+fn limit_memory(cmd: &mut Command, bytes: u64) {
     use std::os::unix::process::CommandExt;
     // SAFETY: setrlimit is async-signal-safe; the closure allocates nothing.
     unsafe {
-        cmd.pre_exec(|| {
+        cmd.pre_exec(move || {
             let lim = libc::rlimit {
-                rlim_cur: MEMORY_LIMIT_BYTES as libc::rlim_t,
-                rlim_max: MEMORY_LIMIT_BYTES as libc::rlim_t,
+                rlim_cur: bytes as libc::rlim_t,
+                rlim_max: bytes as libc::rlim_t,
             };
             libc::setrlimit(libc::RLIMIT_AS, &lim);
             Ok(())
@@ -43,7 +60,7 @@ fn limit_memory(cmd: &mut Command) {
 }
 
 #[cfg(not(unix))]
-fn limit_memory(_: &mut Command) {}
+fn limit_memory(_: &mut Command, _: u64) {}
 
 /// A clear failure: exit code 1 or 2 (not success, not a panic, not a signal) and every needle
 /// in the output.

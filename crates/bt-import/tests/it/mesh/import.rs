@@ -370,21 +370,31 @@ fn non_planar_quad_is_split() {
     assert!(import.warnings.iter().any(|w| w.contains("non-planar")));
 }
 
+const MAX_BYTES: u64 = bt_import::MAX_FILE_BYTES.limit;
+
 #[test]
 fn read_mesh_path_dispatches_on_extension() {
     let dir = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("testdata");
-    let import = read_mesh_path(&dir.join("box_quads.OBJ"), &opts()).unwrap();
+    let import = read_mesh_path(&dir.join("box_quads.OBJ"), &opts(), MAX_BYTES).unwrap();
     assert_surfaces(&import, &box_expected(), TOL);
-    let import = read_mesh_path(&dir.join("box_triangles.ply"), &opts()).unwrap();
+    let import = read_mesh_path(&dir.join("box_triangles.ply"), &opts(), MAX_BYTES).unwrap();
     assert_surfaces(&import, &box_expected(), 1e-6);
-    match read_mesh_path(&dir.join("room.stl"), &opts()) {
+    match read_mesh_path(&dir.join("room.stl"), &opts(), MAX_BYTES) {
         Err(MeshError::UnsupportedExtension { extension, .. }) => assert_eq!(extension, "stl"),
         other => panic!("unexpected {other:?}"),
     }
-    match read_mesh_path(&dir.join("missing.obj"), &opts()) {
+    match read_mesh_path(&dir.join("missing.obj"), &opts(), MAX_BYTES) {
         Err(e @ MeshError::Io { .. }) => assert!(e.to_string().contains("missing.obj")),
         other => panic!("unexpected {other:?}"),
     }
+    // A file over the byte budget is refused from its size, before it is read.
+    let e = read_mesh_path(&dir.join("box_quads.OBJ"), &opts(), 10).unwrap_err();
+    let e = e.to_string();
+    assert!(
+        e.contains("box_quads.OBJ") && e.contains("more than the budget of 10"),
+        "{e}"
+    );
+    assert!(e.contains("--max-file-bytes"), "{e}");
 }
 
 #[test]
