@@ -340,6 +340,17 @@ impl Polygon {
         crossing || a.witness_inside(b, tol) || b.witness_inside(a, tol)
     }
 
+    /// Whether `other` is this polygon again: as many vertices, each within `tol` (metres) of
+    /// one of this polygon's and the other way round (any start, either winding), and the
+    /// interiors overlapping ([`Polygon::overlaps_coplanar`]).
+    pub fn coincides(&self, other: &Polygon, tol: Real) -> bool {
+        let near = |p: &Vec3, all: &[Vec3]| all.iter().any(|q| q.distance(*p) <= tol);
+        self.vertices.len() == other.vertices.len()
+            && self.vertices.iter().all(|p| near(p, &other.vertices))
+            && other.vertices.iter().all(|p| near(p, &self.vertices))
+            && self.overlaps_coplanar(other, tol)
+    }
+
     /// Whether a vertex of this polygon, or one of its edges' midpoints moved `4·tol` inwards,
     /// lies inside both this polygon and `other` by more than `tol`.
     fn witness_inside(&self, other: &Polygon, tol: Real) -> bool {
@@ -449,6 +460,13 @@ mod tests {
         let notch = rect(1., 1., 2., 2., 0., false);
         assert!(!l.overlaps_coplanar(&notch, tol) && !notch.overlaps_coplanar(&l, tol));
         assert!(l.overlaps_coplanar(&rect(0.5, 0.5, 1.5, 1.5, 0., false), tol));
+        // The same polygon again, whatever its winding: only the first two.
+        let same: Vec<bool> = overlapping
+            .iter()
+            .map(|(_, o)| base.coincides(o, tol))
+            .collect();
+        assert_eq!(same, [true, true, false, false, false, false]);
+        assert!(!base.coincides(&rect(0., 0., 2., 2., 1., false), tol));
     }
 
     fn square(z: Real) -> Vec<Vec3> {

@@ -265,7 +265,7 @@ fn load_any(
         format @ (Format::Json | Format::Toml) => {
             let desc = read_description(&path, format, options.max_file_bytes)?;
             let scene = Scene::from_description(&desc, &display, options.terminals)?;
-            Loaded::new(scene, Vec::new())
+            Loaded::new(scene.without_duplicates(&display)?, Vec::new())
         }
         Format::Obj | Format::PlyMesh => {
             let import =
@@ -307,6 +307,9 @@ pub fn load_dynamic(
     match desc {
         Some(desc) => {
             let mut scene = DynamicScene::from_description(&desc, source, options.terminals)?;
+            for step in 0..scene.len() {
+                scene.step(step).check_duplicates(source)?;
+            }
             if let Some(radio) = options.radio {
                 scene = scene.with_radio_material(radio)?;
             }

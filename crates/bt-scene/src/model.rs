@@ -1,7 +1,7 @@
 //! The validated scene model.
 
 use crate::material::Material;
-use crate::problem::{SceneError, Terminal};
+use crate::problem::{Problem, SceneError, Terminal};
 use crate::surface::{Surface, SurfaceId, SurfaceKind};
 use bt_geom::{Bvh, Real, Vec3};
 use std::collections::BTreeMap;
@@ -185,6 +185,48 @@ impl Scene {
             .filter(|&(i, j)| self.surfaces[i].material != self.surfaces[j].material)
             .map(|(i, j)| (SurfaceId(i as u32), SurfaceId(j as u32)))
             .collect()
+    }
+
+    /// Pairs of reflectors (lower id first) that are the same polygon twice: as many
+    /// vertices, each within the tolerance of one of the other's, overlapping in one plane
+    /// ([`bt_geom::Polygon::coincides`]). Every path reflecting there is found twice.
+    pub fn duplicates(&self) -> Vec<(SurfaceId, SurfaceId)> {
+        let tol = self.length_tolerance();
+        crate::validate::coplanar_overlaps(&self.surfaces, tol)
+            .into_iter()
+            .filter(|&(i, j)| (self.surfaces[i].polygon).coincides(&self.surfaces[j].polygon, tol))
+            .map(|(i, j)| (SurfaceId(i as u32), SurfaceId(j as u32)))
+            .collect()
+    }
+
+    /// The scene itself, or its [`Scene::duplicates`] as problems of the scene file
+    /// `source_name` ([`Scene::check_duplicates`]).
+    pub fn without_duplicates(self, source_name: &str) -> Result<Scene, SceneError> {
+        self.check_duplicates(source_name).map(|()| self)
+    }
+
+    /// The [`Scene::duplicates`] as problems of the scene file `source_name`, naming both
+    /// surfaces: a file written by hand must say which one it means (imported meshes merge
+    /// theirs instead).
+    pub fn check_duplicates(&self, source_name: &str) -> Result<(), SceneError> {
+        let name = |id: SurfaceId| crate::name::escape(&self.surface(id).name);
+        let problems: Vec<Problem> = (self.duplicates().into_iter())
+            .map(|(a, b)| Problem {
+                location: format!("surface \"{}\"", name(b)),
+                message: format!(
+                    "the same polygon as surface \"{}\": a path would reflect on both \
+                     (remove one)",
+                    name(a)
+                ),
+            })
+            .collect();
+        match problems.is_empty() {
+            true => Ok(()),
+            false => Err(SceneError::Invalid {
+                source_name: source_name.to_string(),
+                problems,
+            }),
+        }
     }
 
     /// Closed shells (watertight groups of surfaces, e.g. a box with all six faces or a closed

@@ -64,7 +64,6 @@ impl Scene {
             terminals.rx.or(desc.rx.map(Vec3::from_array)),
         ];
         let origin = crate::frame::recentre(&mut raw, given, &mut problems);
-        let locations: Vec<String> = raw.iter().map(|r| r.location.clone()).collect();
         let surfaces = build_surfaces(raw, &materials, &mut problems);
         if frequency_ok {
             problems
@@ -77,10 +76,6 @@ impl Scene {
         let extent = scene_extent(&surfaces, tx, rx);
         if let Err(p) = check_terminals(&surfaces, tx, rx, extent, origin) {
             problems.0.extend(p);
-        }
-        if problems.0.is_empty() {
-            let tol = crate::frame::scene_tolerance(extent);
-            problems.0.extend(coincident(&surfaces, &locations, tol));
         }
         let name = desc.name.clone().unwrap_or_else(|| source_name.to_string());
         conclude(source_name, problems.0, || {
@@ -145,23 +140,6 @@ pub(crate) fn coplanar_overlaps(surfaces: &[Surface], tol: Real) -> Vec<(usize, 
     }
     pairs.sort_unstable();
     pairs
-}
-
-/// Coincident reflectors as problems of a scene file (`locations[i]` names surface `i`;
-/// checked only when every surface was built): imported meshes merge their duplicates
-/// instead; a file written by hand must say which surface it means.
-fn coincident(surfaces: &[Surface], locations: &[String], tol: Real) -> Vec<Problem> {
-    coplanar_overlaps(surfaces, tol)
-        .into_iter()
-        .map(|(first, second)| Problem {
-            location: locations[second].clone(),
-            message: format!(
-                "overlaps {} in the same plane: a path would reflect on both (remove one, or \
-                 split them where they meet)",
-                locations[first]
-            ),
-        })
-        .collect()
 }
 
 /// The scene `assemble` builds when no problem was found, else every problem.

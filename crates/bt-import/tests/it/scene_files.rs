@@ -312,40 +312,20 @@ fn coplanar_conflicts_are_the_overlapping_pairs_with_other_materials() {
         r#"{{ "tx": [1, 0.5, 0.5], "rx": [2, 3.5, 0.5], "surfaces": [{}] }}"#,
         surfaces.join(",")
     );
-    // A scene file refuses every overlapping pair, naming both.
-    let err = scene(&json).unwrap_err().to_string();
-    for (a, b) in [(2, 10), (5, 11), (7, 12)] {
-        let needle = format!("surfaces[{b}] \"t{a}-glass\": overlaps surfaces[{a}]");
-        assert!(err.contains(&needle), "lacks {needle:?}:\n{err}");
-    }
-    assert_eq!(err.matches("overlaps").count(), 3, "{err}");
-    // Imported geometry loads, with the pairs as a warning.
-    let desc = parse_json(&json, "test.json").unwrap();
-    let raw: Vec<bt_scene::RawSurface> = desc
-        .surfaces
-        .iter()
-        .enumerate()
-        .map(|(i, s)| bt_scene::RawSurface {
-            location: format!("face {i}"),
-            name: s.name.clone(),
-            material: s.material.clone(),
-            kind: bt_scene::SurfaceKind::Reflector,
-            vertices: s.vertices.iter().map(|v| Vec3::from_array(*v)).collect(),
-        })
-        .collect();
-    let imported = Scene::from_surfaces(
-        "tiles",
-        "tiles.obj",
-        raw,
-        bt_scene::default_materials(),
-        Terminals::default(),
-        28e9,
-    )
-    .unwrap();
-    let found = imported.coplanar_conflicts();
+    let found = scene(&json).unwrap().coplanar_conflicts();
     let pairs: Vec<(u32, u32)> = found.iter().map(|(a, b)| (a.0, b.0)).collect();
     assert_eq!(pairs, [(2, 10), (5, 11), (7, 12)]);
-    assert_eq!(imported.warnings().len(), 3);
+    // The copies are the same polygons again: a scene file (checked as bt_import::load
+    // checks JSON and TOML) names each pair.
+    let err = scene(&json)
+        .unwrap()
+        .without_duplicates("test.json")
+        .unwrap_err()
+        .to_string();
+    for k in [2, 5, 7] {
+        let needle = format!("surface \"t{k}-glass\": the same polygon as surface \"t{k}-");
+        assert!(err.contains(&needle), "lacks {needle:?}:\n{err}");
+    }
 }
 
 /// A description without dynamic fields is one step, equal to the static scene (moved from
@@ -364,34 +344,30 @@ fn static_description_gives_one_step_equal_to_the_static_scene() {
     );
 }
 
-/// Two reflectors overlapping in one plane would each reflect the same path: a scene file is
-/// refused, naming both, while neighbours that only share an edge load.
+/// The same polygon twice would reflect every path there twice: a scene file is refused,
+/// naming both; a polygon overlapping another only in part (a door drawn on a wall) loads.
 #[test]
-fn coincident_surfaces_are_a_problem_naming_both() {
+fn duplicate_surfaces_are_a_problem_naming_both() {
     let wall = |name: &str, x0: i32, x1: i32| {
         format!(
             r#"{{ "name": "{name}", "vertices": [[{x0}, 0, 0], [{x1}, 0, 0], [{x1}, 0, 3], [{x0}, 0, 3]] }}"#
         )
     };
-    let file = |surfaces: &[String]| {
-        format!(
+    let checked = |surfaces: &[String]| {
+        let json = format!(
             r#"{{ "tx": [0, 2, 1], "rx": [3, 2, 1], "surfaces": [{}] }}"#,
             surfaces.join(",")
-        )
+        );
+        scene(&json).unwrap().without_duplicates("test.json")
     };
-    let err = scene(&file(&[wall("a", 0, 4), wall("b", 5, 6), wall("a2", 0, 4)]))
+    let err = checked(&[wall("a", 0, 4), wall("b", 5, 6), wall("a2", 4, 0)])
         .unwrap_err()
         .to_string();
     assert!(
-        err.contains("surfaces[2] \"a2\": overlaps surfaces[0] \"a\" in the same plane"),
+        err.contains("test.json")
+            && err.contains("surface \"a2\": the same polygon as surface \"a\""),
         "{err}"
     );
-    let err = scene(&file(&[wall("a", 0, 4), wall("half", 2, 6)]))
-        .unwrap_err()
-        .to_string();
-    assert!(
-        err.contains("surfaces[1] \"half\": overlaps surfaces[0] \"a\""),
-        "{err}"
-    );
-    assert!(scene(&file(&[wall("a", 0, 4), wall("next", 4, 6)])).is_ok());
+    assert!(checked(&[wall("a", 0, 4), wall("half", 2, 6)]).is_ok());
+    assert!(checked(&[wall("a", 0, 4), wall("next", 4, 6)]).is_ok());
 }

@@ -412,12 +412,11 @@ fn identical_coplanar_walls_are_refused_naming_both() {
     );
     let needles = [
         "twice.json",
-        "surfaces[1] \"wall-again\": overlaps surfaces[0] \"wall\" in the same plane",
+        "surface \"wall-again\": the same polygon as surface \"wall\"",
     ];
     assert_refused(&beamtrace(&["scene", "check", &scene]), &needles);
     assert_refused(&beamtrace(&["trace", &scene]), &needles);
-    // Other materials make no difference (they were a warning before): a scene file must say
-    // which one is meant. Imported meshes keep the warning (bt-import's scene_files tests).
+    // Another material makes no difference: a scene file must say which one is meant.
     let glass = scene_with(
         &dir,
         "glass.json",
