@@ -16,10 +16,16 @@ the same V-polarised antennas.
 (GO + diffracted) field just before and after the reflection and incident
 shadow boundaries, for Sionna's formula and for Kouyoumjian-Pathak.
 
+``--unit-cases`` prints, for a few synthetic wedges (the faces as triangles,
+swapped as Sionna does), the four V/H path gains the formula gives; these are
+the reference numbers of bt-channel's unit test
+``sionna_coefficient_matches_the_replica`` (numpy/scipy only, no Sionna).
+
 Run (needs the venv of tools/sionna_reference.py, for loading the meshes):
 
     /work/sionna-venv/bin/python tools/sionna_utd_replica.py --check
     /work/sionna-venv/bin/python tools/sionna_utd_replica.py --boundaries
+    /work/sionna-venv/bin/python tools/sionna_utd_replica.py --unit-cases
 
 Conventions (all in the notes): phi, phi' are measured from the 0-face through
 the exterior, the 0-face is the face whose outward normal faces the incident
@@ -289,13 +295,60 @@ def boundaries():
                   f"   Kouyoumjian-Pathak {vals['before'][1]:.4e} / {vals['after'][1]:.4e}")
 
 
+UNIT_CASES = [
+    # (name, interior face n direction or None for a screen, phi' deg, phi deg)
+    ("corner, face n unlit", (0.0, -1.0), 30.0, 200.0),
+    ("corner, face n unlit, lit region", (0.0, -1.0), 30.0, 100.0),
+    ("corner, both faces lit", (0.0, -1.0), 135.0, 60.0),
+    ("corner, face 0 unlit (swapped)", (0.0, -1.0), 240.0, 100.0),
+    ("screen, source behind face 0 (swapped)", None, 300.0, 100.0),
+    ("acute wedge n = 1.75", (np.sqrt(0.5), -np.sqrt(0.5)), 20.0, 250.0),
+]
+
+
+def unit_cases():
+    """V/H path gains of Sionna 2.2's formula for synthetic wedges about the z axis.
+
+    Face 0 lies along +x in the plane y = 0, face n along the given direction (a screen:
+    face 0 alone); phi is measured from +x towards +y. TX 20 m from the edge at phi', z = 1;
+    RX 15 m from it at phi, z = -2; the diffraction point on the edge by Keller's law. Faces:
+    eps_r = 5.24, sigma = 0.1234 S/m, a slab 0.2 m thick; 3.5 GHz. Printed: a = lambda/(4 pi)
+    / sqrt(s s' (s + s')) * J in the (theta_hat, phi_hat) bases, i.e. the path gain between
+    isotropic antennas of the polarisations RX/TX (V = theta_hat, H = phi_hat).
+    """
+    f = 3.5e9
+    lam = C0 / f
+    eta = 5.24 - 1j * 0.1234 / (2 * np.pi * f * EPS0)
+    v0, v1 = np.array([0, 0, -50.0]), np.array([0, 0, 50.0])
+    f0 = np.array([v0, v1, [5.0, 0, 0]])
+    print("name | a_VV (re, im) | a_VH | a_HV | a_HH   (a_RT: RX polarisation R, TX T)")
+    for name, face_n, php, ph in UNIT_CASES:
+        fn_ = None if face_n is None else np.array([v0, v1, [5 * face_n[0], 5 * face_n[1], 0]])
+        tx = np.array([20 * np.cos(np.radians(php)), 20 * np.sin(np.radians(php)), 1.0])
+        rx = np.array([15 * np.cos(np.radians(ph)), 15 * np.sin(np.radians(ph)), -2.0])
+        q = np.array([0, 0, tx[2] + (rx[2] - tx[2]) * 20 / 35])
+        ki, ko = nrm(q - tx), nrm(rx - q)
+        n0, nn, e = wedge(v0, v1, f0, fn_, ki)
+        sp, s = np.linalg.norm(q - tx), np.linalg.norm(rx - q)
+        J, _ = sionna_jones(ki, ko, sp, s, e, n0, nn, eta, 0.2, lam)
+        a = lam / (4 * np.pi) / np.sqrt(s * sp * (s + sp)) * J
+        cells = ", ".join(f"({a[i, j].real:.9e}, {a[i, j].imag:.9e})" for i, j in
+                          [(0, 0), (0, 1), (1, 0), (1, 1)])
+        print(f"{name} | {cells}")
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--check", action="store_true", help="compare with testdata/sionna-reference/*.json")
     ap.add_argument("--boundaries", action="store_true",
                     help="GO + diffracted field across a PEC wedge's shadow boundaries, Sionna vs KP")
+    ap.add_argument("--unit-cases", action="store_true",
+                    help="reference gains of synthetic wedges for bt-channel's unit test")
     ap.add_argument("--glob", default=str(REPO / "testdata" / "sionna-reference" / "*.json"))
     args = ap.parse_args(argv)
+    if args.unit_cases:
+        unit_cases()
+        return 0
     if args.boundaries:
         boundaries()
     if args.check:

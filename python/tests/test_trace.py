@@ -87,6 +87,30 @@ def test_bare_mesh_traces_with_terminals_per_call(cli_json):
     assert many[0].length_m.tolist() == paths.length_m.tolist()
 
 
+def test_diffraction_coefficient_matches_cli(cli_json):
+    # Sionna RT 2.2's coefficient changes a diffracted gain, as `--diffraction-coefficient`.
+    wedge = TESTDATA / "sionna-rt" / "simple_wedge" / "simple_wedge.xml"
+    tx, rx = [10.0, 5.0, 1.0], [-5.0, -10.0, 1.0]
+    scene = beamtrace.load(wedge)
+    options = dict(max_order=1, diffraction=True)
+    args = ["--tx", vec(tx), "--rx", vec(rx), "--max-order", "1", "--diffraction"]
+    utd = scene.trace(tx, rx, **options)
+    sionna = scene.trace(tx, rx, diffraction_coefficient="sionna-rt-2.2", **options)
+    assert abs(utd.gain_db[0] - sionna.gain_db[0]) > 0.5
+    for paths, name in [(utd, "utd"), (sionna, "sionna-rt-2.2")]:
+        doc = cli_json(str(wedge), *args, "--diffraction-coefficient", name)
+        assert doc["radio"]["diffraction_coefficient"] == name
+        [e] = doc["paths"]
+        assert paths.interactions[0] == e["interactions"] == ["diffraction"]
+        assert paths.points[0].tolist() == e["points"]
+        assert paths.gain[0] == complex(e["gain"][0], e["gain"][1])
+        assert paths.gain_db[0] == e["gain_db"]
+        assert paths.diffraction_loss_db[0] == e["diffraction_loss_db"]
+    many = scene.trace_many(tx, np.array([rx]), diffraction_coefficient="sionna-rt-2.2",
+                            **options)
+    assert many[0].gain.tolist() == sionna.gain.tolist()
+
+
 def test_scene_properties():
     scene = beamtrace.load("builtin:living-room")
     assert scene.name == "living-room"

@@ -301,6 +301,34 @@ pub struct RadioArgs {
     /// Transmitted power, dBm (for power_dbm).
     #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
     pub tx_power_dbm: f64,
+    #[command(flatten)]
+    pub coefficient: CoefficientArgs,
+}
+
+/// The diffraction coefficient of diffracted paths' gains (every command that reports gains).
+#[derive(Debug, Args, Clone, Copy)]
+pub struct CoefficientArgs {
+    /// Diffraction coefficient of diffracted paths: utd (Kouyoumjian-Pathak with Luebbers'
+    /// lossy faces, continuous at every boundary) or sionna-rt-2.2 (Sionna RT 2.2's
+    /// combination, to compare with Sionna). docs/channel.md §8.
+    #[arg(long, default_value = "utd", value_parser = parse_coefficient)]
+    pub diffraction_coefficient: bt_channel::DiffractionCoefficient,
+}
+
+impl CoefficientArgs {
+    /// Default radio options with this coefficient (commands without antenna options).
+    pub fn options(self) -> bt_beams::RadioOptions {
+        bt_beams::RadioOptions {
+            diffraction_coefficient: self.diffraction_coefficient,
+            ..bt_beams::RadioOptions::default()
+        }
+    }
+}
+
+fn parse_coefficient(
+    s: &str,
+) -> Result<bt_channel::DiffractionCoefficient, bt_channel::ChannelError> {
+    s.parse()
 }
 
 fn parse_pattern(s: &str) -> Result<bt_channel::Pattern, bt_channel::ChannelError> {
@@ -325,6 +353,7 @@ impl RadioArgs {
             tx: antenna(self.tx_pattern, self.tx_polarization, self.tx_orientation),
             rx: antenna(self.rx_pattern, self.rx_polarization, self.rx_orientation),
             tx_power_dbm: self.tx_power_dbm,
+            diffraction_coefficient: self.coefficient.diffraction_coefficient,
         })
     }
 }
@@ -466,6 +495,8 @@ pub struct SweepArgs {
     /// What the heat map shows.
     #[arg(long, value_enum, default_value_t = MapArg::Gain)]
     pub map: MapArg,
+    #[command(flatten)]
+    pub coefficient: CoefficientArgs,
 }
 
 fn parse_grid(s: &str) -> Result<bt_coverage::Grid, bt_coverage::GridError> {
@@ -504,6 +535,8 @@ pub struct ViewArgs {
     /// HTML file to write.
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,
+    #[command(flatten)]
+    pub coefficient: CoefficientArgs,
 }
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]

@@ -28,7 +28,8 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<ExitCode> {
         )
         .context("progress bar template")?,
     );
-    let rows = bt_coverage::sweep(&scene, &points, &options, &mut |done, _| {
+    let radio = args.coefficient.options();
+    let rows = bt_coverage::sweep(&scene, &points, (&options, &radio), &mut |done, _| {
         bar.set_position(done as u64)
     })?;
     bar.finish_and_clear();

@@ -35,11 +35,8 @@ pub fn run(args: &ViewArgs) -> anyhow::Result<ExitCode> {
                 };
                 tracer.set_scene((*scene).clone());
                 let traced = tracer.trace(scene.to_world(ends.tx), scene.to_world(ends.rx))?;
-                let reports = bt_beams::report(
-                    scene,
-                    &traced.result.paths,
-                    &bt_beams::RadioOptions::default(),
-                )?;
+                let radio = args.coefficient.options();
+                let reports = bt_beams::report(scene, &traced.result.paths, &radio)?;
                 steps.push(StepPaths::from_reports(scene, &reports));
             }
             steps

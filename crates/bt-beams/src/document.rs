@@ -6,7 +6,7 @@
 //! pinned by the golden files (only the `time_s` fields vary between runs).
 
 use crate::{PathReport, RadioOptions, ReportError};
-use bt_channel::Antenna;
+use bt_channel::{Antenna, DiffractionCoefficient};
 use bt_paths::CandidateStats;
 use bt_paths::beamtree::TreeStats;
 use bt_paths::wvrn::WvrnStats;
@@ -44,7 +44,7 @@ pub struct TraceDocument {
     pub stats: Stats,
 }
 
-/// Antennas and transmitted power of the gains.
+/// Antennas, transmitted power and diffraction coefficient of the gains.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Radio {
     /// Transmitting antenna.
@@ -53,6 +53,10 @@ pub struct Radio {
     pub rx_antenna: Antenna,
     /// Transmitted power, dBm.
     pub tx_power_dbm: f64,
+    /// The diffraction coefficient of diffracted paths' gains: `"utd"` or `"sionna-rt-2.2"`
+    /// (a document written before it existed reads as `"utd"`, what it used).
+    #[serde(default)]
+    pub diffraction_coefficient: DiffractionCoefficient,
 }
 
 /// What a trace counted, and how long its stages took.
@@ -113,6 +117,7 @@ impl TraceDocument {
                 tx_antenna: radio.tx,
                 rx_antenna: radio.rx,
                 tx_power_dbm: radio.tx_power_dbm,
+                diffraction_coefficient: radio.diffraction_coefficient,
             },
             stats: Stats {
                 candidates: traced.candidates,

@@ -45,6 +45,7 @@ pub(crate) fn path_gain(
         &channel,
         (&radio.tx, &radio.rx),
         scene.frequency_hz(),
+        radio.diffraction_coefficient,
     )?;
     Ok((g.gain, g.diffraction_loss_db))
 }

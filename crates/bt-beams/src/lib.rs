@@ -17,7 +17,7 @@ pub use document::{
 };
 pub use sweep::{BeamPair, BeamRanking, Sweep, sweep};
 
-use bt_channel::{Antenna, Complex64, SurfaceResponse, Tap};
+use bt_channel::{Antenna, Complex64, DiffractionCoefficient, SurfaceResponse, Tap};
 use bt_geom::{Real, Vec3};
 use bt_scene::{Scene, SurfaceId};
 use bt_solve::{FoundPath, Interaction};
@@ -38,7 +38,8 @@ pub enum ReportError {
     Scene(#[from] bt_scene::SceneError),
 }
 
-/// The radio side of a report: antennas at both ends and the transmitted power.
+/// The radio side of a report: antennas at both ends, the transmitted power and the
+/// diffraction coefficient of diffracted paths.
 #[derive(Debug, Clone, Copy, PartialEq, Default)]
 pub struct RadioOptions {
     /// Transmitting antenna (default: isotropic, vertical).
@@ -47,6 +48,9 @@ pub struct RadioOptions {
     pub rx: Antenna,
     /// Transmitted power, dBm (default 0).
     pub tx_power_dbm: Real,
+    /// How a diffraction's Jones matrix combines the UTD terms (default: UTD;
+    /// `docs/channel.md` §8).
+    pub diffraction_coefficient: DiffractionCoefficient,
 }
 
 /// A direction as azimuth and elevation, degrees (`docs/conventions.md`); also what the

@@ -57,7 +57,7 @@ fn two_ray_ground_reflection_gain_and_phase() {
         let radio = RadioOptions {
             tx: antenna,
             rx: antenna,
-            tx_power_dbm: 0.0,
+            ..RadioOptions::default()
         };
         let paths = trace(&scene, 1, &radio);
         assert_eq!(paths.len(), 2);
@@ -107,7 +107,7 @@ fn reciprocity_in_the_living_room() {
         &RadioOptions {
             tx: a,
             rx: b,
-            tx_power_dbm: 0.0,
+            ..RadioOptions::default()
         },
     );
     let swapped = scene
@@ -119,7 +119,7 @@ fn reciprocity_in_the_living_room() {
         &RadioOptions {
             tx: b,
             rx: a,
-            tx_power_dbm: 0.0,
+            ..RadioOptions::default()
         },
     );
     assert_eq!(forward.len(), backward.len());

@@ -1,5 +1,6 @@
 //! First-order edge diffraction (UTD): the wedge seen by one path, the Kouyoumjian–Pathak
-//! coefficient with Luebbers' finite-conductivity heuristic as Sionna RT documents it, and the
+//! coefficient with Luebbers' finite-conductivity heuristic as Sionna RT documents it (the
+//! default) or as Sionna RT 2.2's code combines it ([`DiffractionCoefficient`]), and the
 //! Fresnel-integral transition function. Formulas, frames and where we differ from Sionna:
 //! `docs/channel.md`, section "Diffraction (UTD)".
 
@@ -8,7 +9,10 @@ use crate::gain::{Bounce, Field, SurfaceResponse, add, dot, reflect, scaled};
 use crate::material::SPEED_OF_LIGHT;
 use bt_geom::{Real, Vec3};
 use num_complex::Complex64;
+use serde::{Deserialize, Serialize};
 use std::f64::consts::{FRAC_PI_4, PI};
+use std::fmt;
+use std::str::FromStr;
 
 /// How far from 1 the length of a unit vector of a [`Wedge`] may be, and how far from 0 the
 /// cosine between two of its vectors that must be perpendicular (dimensionless; loose enough
@@ -34,6 +38,62 @@ const SERIES_LIMIT: Real = 4.0;
 
 /// Depth of the continued fraction of erfcx (converged to 2e-15 for x >= 4).
 const FRACTION_DEPTH: usize = 80;
+
+/// Which diffraction coefficient a diffracted path's gain uses (`docs/channel.md` §8). Both
+/// share the wedge frame, the four Kouyoumjian–Pathak terms D1..D4 (units √m), the transition
+/// function and the faces' reflection matrices R_0, R_n in the edge-fixed bases; they differ in
+/// how these are combined into the Jones matrix J.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+pub enum DiffractionCoefficient {
+    /// `utd`: Kouyoumjian–Pathak with Luebbers' heuristic in Sionna RT's documented form,
+    /// J = −[(D1 + D2)·I − D3·R_n − D4·R_0]: exactly Kouyoumjian–Pathak for a conductor, and
+    /// the total field is continuous across every shadow and reflection boundary.
+    #[default]
+    #[serde(rename = "utd")]
+    Utd,
+    /// `sionna-rt-2.2`: Sionna RT 2.2's `RadioMaterial._diffraction_matrix`, for comparing
+    /// with Sionna: J = R_0·(D1 − D4) + R_n·(D2 − D3) after swapping the faces so that the
+    /// incident wave sees face 0, with R_n := −I when face n is not lit
+    /// (`docs/sionna-diffraction-notes.md` §4). Not continuous across face 0's reflection
+    /// boundary; for a conductor the hard component gets the soft coefficient.
+    #[serde(rename = "sionna-rt-2.2")]
+    SionnaRt22,
+}
+
+impl DiffractionCoefficient {
+    /// Every coefficient, default first.
+    pub const ALL: [DiffractionCoefficient; 2] = [
+        DiffractionCoefficient::Utd,
+        DiffractionCoefficient::SionnaRt22,
+    ];
+
+    /// The name users give it (CLI, Python, the report's `radio.diffraction_coefficient`).
+    pub fn name(self) -> &'static str {
+        match self {
+            DiffractionCoefficient::Utd => "utd",
+            DiffractionCoefficient::SionnaRt22 => "sionna-rt-2.2",
+        }
+    }
+}
+
+impl fmt::Display for DiffractionCoefficient {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for DiffractionCoefficient {
+    type Err = ChannelError;
+    fn from_str(s: &str) -> Result<Self, Self::Err> {
+        Self::ALL
+            .into_iter()
+            .find(|c| c.name() == s)
+            .ok_or_else(|| ChannelError::Invalid {
+                field: "diffraction coefficient",
+                message: format!("unknown coefficient \"{s}\" (expected utd or sionna-rt-2.2)"),
+            })
+    }
+}
 
 /// A diffracting wedge (or a free edge: a half-plane screen, n = 2), local to one path.
 ///
@@ -332,14 +392,15 @@ pub(crate) fn spreading(legs: Legs, frequency_hz: Real) -> Real {
     wavelength / (4.0 * PI) / (s_i * s_d * (s_i + s_d)).sqrt()
 }
 
-/// The diffraction's Jones matrix J = −[(D1 + D2)·I − D3·R_n − D4·R_0] from the incident
-/// ray's edge-fixed basis (φ̂', β̂0') to the diffracted ray's (φ̂, β̂0), √m (Sionna RT's
-/// documented form), for a ray arriving along unit `k_in` and leaving along unit `k_out`.
+/// The diffraction's Jones matrix J from the incident ray's edge-fixed basis (φ̂', β̂0') to the
+/// diffracted ray's (φ̂, β̂0), √m, for a ray arriving along unit `k_in` and leaving along unit
+/// `k_out`, combined as `coefficient` says ([`DiffractionCoefficient`]).
 pub(crate) fn jones(
     (k_in, k_out): (Vec3, Vec3),
     wedge: &Wedge,
     legs: Legs,
     frequency_hz: Real,
+    coefficient: DiffractionCoefficient,
 ) -> Result<Matrix, ChannelError> {
     let frame = wedge.frame()?;
     let e = frame.e;
@@ -376,28 +437,50 @@ pub(crate) fn jones(
     .map(|w| factor * cot_transition(w, n, kl));
     let r0 = face_matrix(frame.n0, wedge.response0, k_in, e, frequency_hz)?;
     let rn = face_matrix(frame.nn, wedge.response_n, k_in, e, frequency_hz)?;
-    let incident = d[0] + d[1];
+    Ok(match coefficient {
+        DiffractionCoefficient::Utd => combine(&[(MINUS_I2, d[0] + d[1]), (rn, d[2]), (r0, d[3])]),
+        DiffractionCoefficient::SionnaRt22 => {
+            // Sionna swaps the faces so that face 0 is lit, then takes R_n := −I when face n is
+            // not (nπ > π + φ'). The swap maps φ' → nπ − φ', φ → nπ − φ, which exchanges
+            // D1 ↔ D2, D3 ↔ D4 and R_0 ↔ R_n, leaving R_0(D1 − D4) + R_n(D2 − D3) unchanged; so
+            // in our labelling the rule is: the face the source is strictly behind gets −I.
+            let r0 = if phi_i > PI { MINUS_I2 } else { r0 };
+            let rn = if phi_i < (n - 1.0) * PI { MINUS_I2 } else { rn };
+            combine(&[(r0, d[0] - d[3]), (rn, d[1] - d[2])])
+        }
+    })
+}
+
+/// −I, the 2×2 matrix of a wave continuing straight on in the edge-fixed bases.
+const MINUS_I2: Matrix = [
+    [Complex64::new(-1.0, 0.0), Complex64::new(0.0, 0.0)],
+    [Complex64::new(0.0, 0.0), Complex64::new(-1.0, 0.0)],
+];
+
+/// Σ cᵢ·Mᵢ over (matrix, weight) pairs.
+fn combine(terms: &[(Matrix, Complex64)]) -> Matrix {
     let mut j = [[Complex64::new(0.0, 0.0); 2]; 2];
-    for (row, line) in j.iter_mut().enumerate() {
-        for (column, value) in line.iter_mut().enumerate() {
-            let identity = if row == column { incident } else { 0.0.into() };
-            *value = -(identity - d[2] * rn[row][column] - d[3] * r0[row][column]);
+    for (m, c) in terms {
+        for (row, line) in j.iter_mut().enumerate() {
+            for (column, value) in line.iter_mut().enumerate() {
+                *value += c * m[row][column];
+            }
         }
     }
-    Ok(j)
+    j
 }
 
 /// Diffract `field` (travelling along unit `k_in`) at `wedge` into unit direction `k_out` by
-/// its [`jones`] matrix. Returns the diffracted field without the spreading factor (applied by
+/// its [`jones`] matrix (`coefficient` at `frequency_hz`). Returns the diffracted field without the spreading factor (applied by
 /// the caller) and the matrix.
 pub(crate) fn diffract(
     field: Field,
     (k_in, k_out): (Vec3, Vec3),
     wedge: &Wedge,
     legs: Legs,
-    frequency_hz: Real,
+    (frequency_hz, coefficient): (Real, DiffractionCoefficient),
 ) -> Result<(Field, Matrix), ChannelError> {
-    let j = jones((k_in, k_out), wedge, legs, frequency_hz)?;
+    let j = jones((k_in, k_out), wedge, legs, frequency_hz, coefficient)?;
     let e = wedge.frame()?.e;
     let (phi_in, beta_in) = incident_basis(k_in, e);
     let (phi_out, beta_out) = outgoing_basis(k_out, e);

@@ -5,7 +5,9 @@
 
 use crate::ChannelError;
 use crate::antenna::Antenna;
-use crate::diffraction::{Legs, Wedge, diffract, largest_singular_value, spreading};
+use crate::diffraction::{
+    DiffractionCoefficient, Legs, Wedge, diffract, largest_singular_value, spreading,
+};
 use crate::material::{RadioMaterial, Reflection, SPEED_OF_LIGHT};
 use bt_geom::{Real, Vec3};
 use num_complex::Complex64;
@@ -160,7 +162,7 @@ pub fn path_gain(
     path_gain_mixed(tx, points, rx, &interactions, antennas, frequency_hz)
 }
 
-/// [`path_gain_detailed`]'s gain alone.
+/// [`path_gain_detailed`]'s gain alone, with the default [`DiffractionCoefficient::Utd`].
 pub fn path_gain_mixed(
     tx: Vec3,
     points: &[Vec3],
@@ -169,7 +171,17 @@ pub fn path_gain_mixed(
     antennas: (&Antenna, &Antenna),
     frequency_hz: Real,
 ) -> Result<Complex64, ChannelError> {
-    path_gain_detailed(tx, points, rx, interactions, antennas, frequency_hz).map(|g| g.gain)
+    let coefficient = DiffractionCoefficient::Utd;
+    path_gain_detailed(
+        tx,
+        points,
+        rx,
+        interactions,
+        antennas,
+        frequency_hz,
+        coefficient,
+    )
+    .map(|g| g.gain)
 }
 
 /// The gain of a path and, for a diffracted one, the diffraction's excess loss.
@@ -188,7 +200,8 @@ pub struct PathGain {
 /// RX (world frame, metres), one [`Interaction`] per point, at `frequency_hz`.
 ///
 /// Without a diffraction it is [`path_gain`]'s value, bit for bit. With one at point Q, the
-/// Jones chain runs through the UTD step of [`Wedge`] and the spreading is UTD's for a point
+/// Jones chain runs through the UTD step of [`Wedge`] with `coefficient`'s combination of the
+/// terms ([`DiffractionCoefficient`]) and the spreading is UTD's for a point
 /// source, λ/(4π)·1/√(s'·s·(s' + s)) with s' and s the unfolded lengths TX → Q and Q → RX
 /// (each clamped to at least one wavelength), instead of λ/(4π·(s' + s)). No propagation
 /// phase. Errors: lengths differ, two or more diffractions, an invalid wedge, a ray along the
@@ -200,6 +213,7 @@ pub fn path_gain_detailed(
     interactions: &[Interaction],
     antennas: (&Antenna, &Antenna),
     frequency_hz: Real,
+    coefficient: DiffractionCoefficient,
 ) -> Result<PathGain, ChannelError> {
     if points.len() != interactions.len() {
         return Err(ChannelError::Invalid {
@@ -245,7 +259,13 @@ pub fn path_gain_detailed(
             Interaction::Diffraction(wedge) => {
                 let k_out = (vertices[index + 2] - vertices[index + 1]).normalize();
                 let matrix;
-                (field, matrix) = diffract(field, (k, k_out), wedge, legs(index), frequency_hz)?;
+                (field, matrix) = diffract(
+                    field,
+                    (k, k_out),
+                    wedge,
+                    legs(index),
+                    (frequency_hz, coefficient),
+                )?;
                 // Excess over free space along the same length: the strongest polarisation's
                 // coefficient with the edge's spreading relative to λ/(4π·length).
                 let ratio = spreading(legs(index), frequency_hz)

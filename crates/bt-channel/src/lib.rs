@@ -17,7 +17,7 @@ pub mod response;
 
 pub use antenna::{Antenna, Orientation, Pattern, Polarization};
 pub use codebook::{Array, Beam, MAX_BEAM_PAIRS, PathDirections, beam_pairs, check_beam_pairs};
-pub use diffraction::{Wedge, fresnel_integrals, transition};
+pub use diffraction::{DiffractionCoefficient, Wedge, fresnel_integrals, transition};
 pub use gain::{
     Bounce, FreeSpace, Interaction, PathGain, SurfaceResponse, free_space, path_gain,
     path_gain_detailed, path_gain_mixed,

@@ -14,7 +14,7 @@ mod map;
 pub use grid::{Axis, DEFAULT_MAX_POINTS, Grid, GridError};
 pub use map::{HeatMap, MapQuantity};
 
-use bt_beams::PathReport;
+use bt_beams::{PathReport, RadioOptions};
 use bt_geom::{Real, Vec3};
 use bt_scene::Scene;
 use bt_solve::Tracer;
@@ -51,7 +51,7 @@ pub enum PointStatus {
         /// shorter).
         strongest: Option<Box<PathReport>>,
         /// Total received power of all paths, dBm: `trace --json`'s `received_power_dbm`
-        /// (`bt_beams::received_power_dbm`, isotropic antennas, 0 dBm transmitted; `None`
+        /// (`bt_beams::received_power_dbm` with the sweep's radio options; `None`
         /// without paths).
         received_power_dbm: Option<Real>,
     },
@@ -73,13 +73,13 @@ pub struct Row {
 pub const CHUNK: usize = 256;
 
 /// Trace `scene`'s TX to every one of `points` (in order; rows come back in the same order,
-/// identical whatever the thread count). `progress(done, total)` runs after every chunk. A
-/// scene without a TX fails as a whole ([`bt_scene::SceneError::MissingTerminal`]); the
-/// scene's RX, if any, is not used.
+/// identical whatever the thread count) with `options`, and report the paths with `radio`.
+/// `progress(done, total)` runs after every chunk. A scene without a TX fails as a whole
+/// ([`bt_scene::SceneError::MissingTerminal`]); the scene's RX, if any, is not used.
 pub fn sweep(
     scene: &Scene,
     points: &[Vec3],
-    options: &TraceOptions,
+    (options, radio): (&TraceOptions, &RadioOptions),
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<Vec<Row>, CoverageError> {
     let tx = scene.to_world(
@@ -95,8 +95,7 @@ pub fn sweep(
             let status = match outcome {
                 Ok(traced) => {
                     let moved = scene.with_receiver(*rx).map_err(TraceError::from)?;
-                    let radio = bt_beams::RadioOptions::default();
-                    let reports = bt_beams::report(&moved, &traced.result.paths, &radio)?;
+                    let reports = bt_beams::report(&moved, &traced.result.paths, radio)?;
                     summarise(&reports, radio.tx_power_dbm)
                 }
                 Err(TraceError::Scene(e)) => PointStatus::Skipped(skip_reason(&e)),
@@ -209,8 +208,9 @@ mod tests {
         points.push(Vec3::new(6.0, 20.0, 1.25));
         let moved: Vec<Vec3> = points.iter().map(|p| *p + offset).collect();
         let options = TraceOptions::new(2);
-        let a = sweep(&near, &points, &options, &mut |_, _| {}).unwrap();
-        let b = sweep(&far, &moved, &options, &mut |_, _| {}).unwrap();
+        let radio = RadioOptions::default();
+        let a = sweep(&near, &points, (&options, &radio), &mut |_, _| {}).unwrap();
+        let b = sweep(&far, &moved, (&options, &radio), &mut |_, _| {}).unwrap();
         assert!(
             matches!(a[12].status, PointStatus::Skipped(_)),
             "{:?}",

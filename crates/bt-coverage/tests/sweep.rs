@@ -37,7 +37,10 @@ fn box_room_sweep_matches_the_image_lattice_at_every_point() {
         let rows = sweep(
             &scene,
             &points,
-            &TraceOptions::new(max_order),
+            (
+                &TraceOptions::new(max_order),
+                &bt_beams::RadioOptions::default(),
+            ),
             &mut |d, t| calls.push((d, t)),
         )
         .unwrap();
@@ -79,7 +82,7 @@ fn points_on_a_wall_or_at_the_tx_are_skipped_and_the_rest_traced() {
     let rows = sweep(
         &scene,
         &grid.points(10).unwrap(),
-        &TraceOptions::new(1),
+        (&TraceOptions::new(1), &bt_beams::RadioOptions::default()),
         &mut |_, _| {},
     )
     .unwrap();

@@ -164,17 +164,12 @@ impl PyScene {
         let options = keywords
             .trace_options(&scene)
             .map_err(PyValueError::new_err)?;
+        let radio = keywords.radio().map_err(PyValueError::new_err)?;
         let ends = scene.terminals().map_err(error)?;
         let (tx, rx) = (scene.to_world(ends.tx), scene.to_world(ends.rx));
         let paths = py.detach(|| {
             let traced = self.with_tracer(scene.clone(), options, |t| t.trace(tx, rx));
-            traced.map(|traced| {
-                bt_beams::report(
-                    &scene,
-                    &traced.result.paths,
-                    &bt_beams::RadioOptions::default(),
-                )
-            })
+            traced.map(|traced| bt_beams::report(&scene, &traced.result.paths, &radio))
         });
         let paths = paths.map_err(|e| self.error(e))?.map_err(error)?;
         columns::to_dict(py, &paths)
@@ -197,12 +192,13 @@ impl PyScene {
         let options = keywords
             .trace_options(&scene)
             .map_err(PyValueError::new_err)?;
+        let radio = keywords.radio().map_err(PyValueError::new_err)?;
         let tx = scene.to_world(scene.terminals().map_err(error)?.tx);
         let reports = py.detach(|| {
             let traced = self
                 .with_tracer(scene.clone(), options, |t| t.trace_many(tx, &receivers))
                 .map_err(Failure::Trace)?;
-            report_each(&scene, &receivers, &traced, options.parallel)
+            report_each(&scene, &receivers, &traced, (&radio, options.parallel))
         });
         let reports = reports.map_err(|e| match e {
             Failure::Trace(e) => self.error(e),
@@ -239,19 +235,18 @@ enum Failure {
     Report(String),
 }
 
-/// Each receiver's report of its trace (in parallel when asked).
+/// Each receiver's report of its trace with `radio` (in parallel when asked).
 fn report_each(
     scene: &Scene,
     receivers: &[Vec3],
     traced: &[Traced],
-    parallel: bool,
+    (radio, parallel): (&bt_beams::RadioOptions, bool),
 ) -> Result<Vec<Vec<bt_beams::PathReport>>, Failure> {
     let one = |(rx, t): (&Vec3, &Traced)| {
         let moved = scene
             .with_receiver(*rx)
             .map_err(|e| Failure::Trace(e.into()))?;
-        bt_beams::report(&moved, &t.result.paths, &bt_beams::RadioOptions::default())
-            .map_err(|e| Failure::Report(e.to_string()))
+        bt_beams::report(&moved, &t.result.paths, radio).map_err(|e| Failure::Report(e.to_string()))
     };
     if parallel {
         receivers.par_iter().zip(traced).map(one).collect()

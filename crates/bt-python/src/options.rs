@@ -52,6 +52,9 @@ pub struct DiffractionKeywords {
     pub max_diffractions: usize,
     /// Edges shorter than this (metres) do not diffract.
     pub min_edge_length: f64,
+    /// The diffraction coefficient of the gains: `utd` or `sionna-rt-2.2`
+    /// (`diffraction_coefficient` in Python).
+    pub coefficient: String,
 }
 
 /// IPC's keywords (`ipc_order`, `ipc_accel` in Python).
@@ -109,6 +112,16 @@ impl TraceKeywords {
         named().map_err(|e| e.to_string())
     }
 
+    /// The report's radio options: the CLI's defaults with the diffraction coefficient named.
+    pub fn radio(&self) -> Result<bt_beams::RadioOptions, String> {
+        let coefficient = (self.diffraction.coefficient.parse())
+            .map_err(|e: bt_beams::ChannelError| e.to_string())?;
+        Ok(bt_beams::RadioOptions {
+            diffraction_coefficient: coefficient,
+            ..bt_beams::RadioOptions::default()
+        })
+    }
+
     /// The pipeline options for `scene`.
     pub fn trace_options(&self, scene: &Scene) -> Result<TraceOptions, String> {
         self.settings()?
@@ -143,6 +156,7 @@ mod tests {
             diffraction: DiffractionKeywords {
                 max_diffractions: 0,
                 min_edge_length: 0.0,
+                coefficient: "utd".into(),
             },
         }
     }

@@ -192,10 +192,13 @@ class Scene:
         diffraction: bool = False,
         max_diffractions: Optional[int] = None,
         min_edge_length: float = 0.0,
+        diffraction_coefficient: str = "utd",
     ) -> Paths:
         """Trace every path from ``tx`` to ``rx`` (metres; the scene's own if None): specular,
         and with ``diffraction=True`` (or ``max_diffractions=1``) those that diffract once on
-        an edge at least ``min_edge_length`` metres long.
+        an edge at least ``min_edge_length`` metres long, their gains with
+        ``diffraction_coefficient`` "utd" (default) or "sionna-rt-2.2" (Sionna RT 2.2's own
+        combination, for comparing with Sionna; docs/channel.md §8).
 
         Options are ``beamtrace trace``'s flags: ``solver`` "image" | "ipc" | "sbr",
         ``candidates`` "beam-tree" | "wvrn" | "exhaustive", ``ipc_order`` "gauss-seidel" |
@@ -231,6 +234,7 @@ class Scene:
         diffraction: bool = False,
         max_diffractions: Optional[int] = None,
         min_edge_length: float = 0.0,
+        diffraction_coefficient: str = "utd",
     ) -> List[Paths]:
         """Trace one ``tx`` to every row of ``rx`` (an (m, 3) array, metres): one
         :class:`Paths` per receiver, in order, equal to calling :meth:`trace` for each.
@@ -269,6 +273,7 @@ def _options(arguments: Dict[str, Any]) -> Dict[str, Any]:
     options["diffraction"] = {
         "max_diffractions": int(arguments["diffraction"]) if maximum is None else maximum,
         "min_edge_length": float(arguments["min_edge_length"]),
+        "coefficient": arguments["diffraction_coefficient"],
     }
     return options
 

@@ -2,9 +2,9 @@
 //! continuity of the total field across shadow and reflection boundaries, reciprocity.
 
 use bt_channel::{
-    Antenna, Bounce, ChannelError, Complex64, Interaction, Orientation, Pattern, Polarization,
-    RadioMaterial, SPEED_OF_LIGHT, SurfaceResponse, Wedge, fresnel_integrals, path_gain,
-    path_gain_mixed,
+    Antenna, Bounce, ChannelError, Complex64, DiffractionCoefficient, Interaction, Orientation,
+    Pattern, Polarization, RadioMaterial, SPEED_OF_LIGHT, SurfaceResponse, Wedge,
+    fresnel_integrals, path_gain, path_gain_mixed,
 };
 use bt_geom::{Real, Vec3};
 use std::f64::consts::PI;
@@ -457,6 +457,7 @@ fn the_diffraction_loss_is_the_strongest_polarisations_excess() {
             &[Interaction::Diffraction(wedge)],
             (&a, &a),
             F,
+            DiffractionCoefficient::Utd,
         )
         .unwrap();
         (-db(g.gain.norm() / friis), g.diffraction_loss_db)
@@ -468,6 +469,63 @@ fn the_diffraction_loss_is_the_strongest_polarisations_excess() {
         "V {v} H {h} loss {loss}"
     );
     let a = isotropic(Polarization::V);
-    let specular = bt_channel::path_gain_detailed(tx, &[], rx, &[], (&a, &a), F).unwrap();
+    let specular =
+        bt_channel::path_gain_detailed(tx, &[], rx, &[], (&a, &a), F, DiffractionCoefficient::Utd)
+            .unwrap();
     assert_eq!(specular.diffraction_loss_db, 0.0);
+}
+
+/// The Sionna RT 2.2 coefficient against an independent implementation of the same formula,
+/// `tools/sionna_utd_replica.py` (numpy/scipy; its `--check` reproduces Sionna's own numbers
+/// on the reference paths to 1e-4), on synthetic wedges: the gains a_RT (RX polarisation R,
+/// TX polarisation T) printed by
+///
+///     /work/sionna-venv/bin/python tools/sionna_utd_replica.py --unit-cases
+///
+/// (`UNIT_CASES` there: edge along z, face 0 along +x, TX 20 m from the edge at φ', z = 1, RX
+/// 15 m from it at φ, z = −2; ε_r = 5.24, σ = 0.1234 S/m, slab 0.2 m; 3.5 GHz). The cases
+/// cover face n unlit (R_n := −I), both faces lit, face 0 unlit (Sionna swaps the faces), a
+/// screen and n = 1.75; agreement to 1e-8 relative. An H antenna at RX receives along −φ̂(ŝ), Sionna's second Jones
+/// component is along φ̂(ŝ): the RX-H gains differ in sign only.
+#[test]
+fn sionna_coefficient_matches_the_replica() {
+    type Case = (Real, Real, Real, [(Real, Real); 4]);
+    // (n, φ' deg, φ deg, [a_VV, a_VH, a_HV, a_HH] as (re, im)).
+    // One row per case of `--unit-cases`, as printed.
+    #[rustfmt::skip]
+    let cases: [Case; 6] = [
+        (1.5, 30.0, 200.0, [(-1.259967961e-05, 1.123846711e-05), (5.247304600e-08, -5.195308040e-08), (-5.247304600e-08, 5.195308040e-08), (-1.399358971e-05, 1.282832290e-05)]),
+        (1.5, 30.0, 100.0, [(-2.546702570e-06, 2.651437527e-06), (-5.958211319e-08, 5.902294991e-08), (5.958211319e-08, -5.902294991e-08), (-9.640081104e-07, 8.452949848e-07)]),
+        (1.5, 135.0, 60.0, [(4.965759409e-06, -5.156863708e-06), (-1.937297729e-07, 1.820190112e-07), (1.937297729e-07, -1.820190112e-07), (-2.425600336e-06, 2.758259839e-06)]),
+        (1.5, 240.0, 100.0, [(-1.645176452e-08, -1.922305837e-07), (-1.542540613e-07, 1.493684314e-07), (1.542540613e-07, -1.493684314e-07), (-4.120880708e-06, 4.385551116e-06)]),
+        (2.0, 300.0, 100.0, [(6.255951800e-06, -6.126341231e-06), (-1.113035250e-08, 1.108614996e-08), (1.113035250e-08, -1.108614996e-08), (5.708463333e-06, -5.508513489e-06)]),
+        (1.75, 20.0, 250.0, [(2.643921723e-06, -2.673942984e-06), (2.427211820e-08, -2.413264452e-08), (-2.427211820e-08, 2.413264452e-08), (2.057884331e-06, -2.002245925e-06)]),
+    ];
+    let slab = SurfaceResponse::Radio(RadioMaterial::custom(5.24, 0.1234, Some(0.2)).unwrap());
+    let (v, h) = (isotropic(Polarization::V), isotropic(Polarization::H));
+    for (n, phi_i, phi, expected) in cases {
+        let wedge = Interaction::Diffraction(test_wedge(n, slab));
+        let tx = cylindrical(20.0, phi_i.to_radians(), 1.0);
+        let rx = cylindrical(15.0, phi.to_radians(), -2.0);
+        let q = keller_point(Vec3::ZERO, Vec3::Z, tx, rx);
+        let pairs = [(&v, &v, 1.0), (&h, &v, 1.0), (&v, &h, -1.0), (&h, &h, -1.0)];
+        for ((tx_antenna, rx_antenna, sign), (re, im)) in pairs.into_iter().zip(expected) {
+            let ours = bt_channel::path_gain_detailed(
+                tx,
+                &[q],
+                rx,
+                &[wedge],
+                (tx_antenna, rx_antenna),
+                F,
+                DiffractionCoefficient::SionnaRt22,
+            )
+            .unwrap()
+            .gain;
+            let reference = sign * Complex64::new(re, im);
+            assert!(
+                (ours - reference).norm() <= 1e-8 * reference.norm(),
+                "n {n}, φ' {phi_i}°, φ {phi}°: {ours} vs {reference}"
+            );
+        }
+    }
 }

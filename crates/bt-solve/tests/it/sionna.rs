@@ -6,6 +6,7 @@
 //! docs/sionna-diffraction-notes.md, docs/channel.md §8).
 
 use bt_beams::{InteractionKind, PathReport, RadioOptions};
+use bt_channel::DiffractionCoefficient;
 use bt_geom::{Real, Vec3};
 use bt_scene::Terminals;
 use bt_solve::Tracer;
@@ -73,11 +74,28 @@ fn matching<'a>(ours: &'a [PathReport], e: &Expected, tolerance: Real) -> Option
     })
 }
 
+/// One diffracted path found in both: ours − Sionna's gain (dB), and whether Sionna diffracts
+/// on a free edge (a screen, n = 2) where our edge is a wedge (n < 2): Florence's eaves, where
+/// Sionna sees a wall mesh and a roof mesh meeting, and we one wedge (docs/channel.md §8).
+#[derive(Clone, Copy)]
+struct Diffracted {
+    diff_db: Real,
+    screen_there_wedge_here: bool,
+    /// The path reflects after its diffraction.
+    reflected_after: bool,
+}
+
+/// Sionna's diffraction of `path` is on a free edge of a mesh (a screen).
+fn screen_there(path: &Value) -> bool {
+    let edges = path["edges"].as_array().unwrap();
+    edges.iter().any(|e| e["free"] == true)
+}
+
 /// Gain differences (ours − Sionna's, dB) of the specular and the diffracted paths.
 #[derive(Default)]
 struct Differences {
     specular: Vec<Real>,
-    diffracted: Vec<Real>,
+    diffracted: Vec<Diffracted>,
     missing: Vec<String>,
     /// Sionna paths diffracting where our scene has no edge.
     no_edge: Vec<String>,
@@ -102,7 +120,7 @@ fn reference(case: &str) -> (Value, bt_scene::Scene) {
     (doc, scene)
 }
 
-fn compare_case(case: &str, out: &mut Differences) {
+fn compare_case(case: &str, radio: &RadioOptions, out: &mut Differences) {
     let (doc, scene) = reference(case);
     let trace = TraceOptions {
         diffraction: DiffractionOptions::first_order(),
@@ -114,17 +132,20 @@ fn compare_case(case: &str, out: &mut Differences) {
         let rx = vec3(&receiver["position"]);
         let traced = tracer.trace(tx, rx).unwrap();
         let scene = tracer.scene().with_terminals(tx, rx).unwrap();
-        let ours =
-            bt_beams::report(&scene, &traced.result.paths, &RadioOptions::default()).unwrap();
+        let ours = bt_beams::report(&scene, &traced.result.paths, radio).unwrap();
         for path in receiver["paths"].as_array().unwrap() {
             let e = expected(path);
             match matching(&ours, &e, 0.01) {
                 Some(p) => {
-                    let diff = p.gain_db.unwrap() - e.gain_db;
-                    if e.kinds.contains(&InteractionKind::Diffraction) {
-                        out.diffracted.push(diff);
-                    } else {
-                        out.specular.push(diff);
+                    let diff_db = p.gain_db.unwrap() - e.gain_db;
+                    match p.diffraction {
+                        Some(d) => out.diffracted.push(Diffracted {
+                            diff_db,
+                            screen_there_wedge_here: screen_there(path)
+                                && scene.edges().get(d.edge).n < 2.0,
+                            reflected_after: d.index + 1 < p.points.len(),
+                        }),
+                        None => out.specular.push(diff_db),
                     }
                 }
                 None => {
@@ -156,32 +177,65 @@ fn compare_case(case: &str, out: &mut Differences) {
     }
 }
 
-#[test]
-fn every_sionna_path_is_found_with_its_gain() {
+/// How many of `paths` lie within `db` of Sionna's gain.
+fn within(paths: &[Diffracted], db: Real) -> usize {
+    paths.iter().filter(|p| p.diff_db.abs() <= db).count()
+}
+
+/// Compare every case with `coefficient`, printing per case how many diffracted gains lie
+/// within 0.1, 1, 3 and 6 dB of Sionna's (and of those on Sionna's screens that are our
+/// wedges, how many within 3 dB).
+fn compare_all(coefficient: DiffractionCoefficient) -> Differences {
+    let radio = RadioOptions {
+        diffraction_coefficient: coefficient,
+        ..RadioOptions::default()
+    };
     let mut d = Differences::default();
+    eprintln!("coefficient {coefficient}: diffracted gains within 0.1 / 1 / 3 / 6 dB of Sionna's");
     for case in CASES {
         let before = d.diffracted.len();
-        compare_case(case, &mut d);
+        compare_case(case, &radio, &mut d);
         let mine = &d.diffracted[before..];
+        let eaves: Vec<Diffracted> = (mine.iter().copied())
+            .filter(|p| p.screen_there_wedge_here)
+            .collect();
         eprintln!(
-            "{case}: diffracted {} mean diff {:.2} dB, worst {:.2}",
+            "  {case:17} {:3} paths: {:3} {:3} {:3} {:3}; mean diff {:6.2} dB, worst {:6.2}; \
+             screens there, wedges here: {} ({} within 3 dB)",
             mine.len(),
-            mine.iter().sum::<Real>() / mine.len().max(1) as Real,
-            mine.iter().fold(0.0, |a: Real, b| a.max(b.abs()))
+            within(mine, 0.1),
+            within(mine, 1.0),
+            within(mine, 3.0),
+            within(mine, 6.0),
+            mine.iter().map(|p| p.diff_db).sum::<Real>() / mine.len().max(1) as Real,
+            mine.iter().fold(0.0, |a: Real, p| a.max(p.diff_db.abs())),
+            eaves.len(),
+            within(&eaves, 3.0),
         );
     }
-    let within = |v: &[Real], db: Real| v.iter().filter(|x| x.abs() <= db).count();
+    let all = &d.diffracted;
+    eprintln!(
+        "  all               {:3} paths: {:3} {:3} {:3} {:3}",
+        all.len(),
+        within(all, 0.1),
+        within(all, 1.0),
+        within(all, 3.0),
+        within(all, 6.0),
+    );
+    d
+}
+
+#[test]
+fn every_sionna_path_is_found_with_its_gain() {
+    let d = compare_all(DiffractionCoefficient::Utd);
     eprintln!(
         "Sionna paths: {} specular, {} diffracted, {} missing, {} on junctions without an edge \
-         here; specular worst {:.4} dB; diffracted within 3 dB: {}/{}, within 6 dB: {}",
+         here; specular worst {:.4} dB",
         d.specular.len(),
         d.diffracted.len(),
         d.missing.len(),
         d.no_edge.len(),
         d.specular.iter().fold(0.0, |a: Real, b| a.max(b.abs())),
-        within(&d.diffracted, 3.0),
-        d.diffracted.len(),
-        within(&d.diffracted, 6.0),
     );
     assert!(d.missing.is_empty(), "missing: {:#?}", d.missing);
     assert!(
@@ -219,4 +273,37 @@ fn a_metal_box_diffracts_as_kouyoumjian_pathak() {
         let gain = ours[0].gain_db.unwrap();
         assert!((gain - expected_db).abs() < 0.01, "{gain} vs {expected_db}");
     }
+}
+
+/// With Sionna RT 2.2's own coefficient (`--diffraction-coefficient sionna-rt-2.2`), every
+/// diffracted path that does not reflect after its diffraction has Sionna's gain within 0.1 dB,
+/// except where Sionna diffracts on a screen (Florence's eaves: wall and roof are two meshes)
+/// and we on the wedge the two faces make. Paths that reflect after the diffraction come out
+/// 3-8 dB above Sionna's (cause not found yet: docs/channel.md §8), so issue 26's "90 % within
+/// 3 dB" is not reached: 211 of 308 (68 %); the floor below keeps that from regressing.
+#[test]
+fn with_sionnas_coefficient_diffracted_gains_are_sionnas() {
+    let d = compare_all(DiffractionCoefficient::SionnaRt22);
+    assert!(d.missing.is_empty(), "missing: {:#?}", d.missing);
+    let n = d.diffracted.len();
+    assert!(n > 200, "{n}");
+    let last: Vec<Diffracted> = (d.diffracted.iter().copied())
+        .filter(|p| !p.reflected_after && !p.screen_there_wedge_here)
+        .collect();
+    eprintln!(
+        "  diffraction last, not at an eave: {} of {} within 0.1 dB",
+        within(&last, 0.1),
+        last.len()
+    );
+    let after: Vec<Diffracted> = (d.diffracted.iter().copied())
+        .filter(|p| p.reflected_after && !p.screen_there_wedge_here)
+        .collect();
+    eprintln!(
+        "  reflecting after the diffraction, not at an eave: {} of {} within 3 dB",
+        within(&after, 3.0),
+        after.len()
+    );
+    assert!(last.len() >= 90 && within(&last, 0.1) == last.len());
+    let close = within(&d.diffracted, 3.0);
+    assert!(close >= 211, "{close} of {n} within 3 dB");
 }
