@@ -95,18 +95,6 @@ pub fn run_extract(args: &ExtractArgs) -> anyhow::Result<ExitCode> {
 }
 
 pub fn run_sample(args: &SampleArgs) -> anyhow::Result<ExitCode> {
-    if !(args.density > 0.0 && args.density.is_finite()) {
-        bail!(
-            "--density must be a positive number of points per m², got {}",
-            args.density
-        );
-    }
-    if !(args.noise >= 0.0 && args.noise.is_finite()) {
-        bail!(
-            "--noise must be a non-negative number of metres, got {}",
-            args.noise
-        );
-    }
     // The named scene before the load (a cloud's extraction can take long), every file the
     // load read after it.
     bt_output::refuse_input(&args.output, &[PathBuf::from(&args.scene.scene)])?;

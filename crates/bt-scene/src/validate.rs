@@ -21,6 +21,19 @@ pub const MIN_FREQUENCY_HZ: Real = 1e3;
 /// long paths and geometric optics is all that is left anyway).
 pub const MAX_FREQUENCY_HZ: Real = 1e15;
 
+/// What is wrong with a carrier frequency, if anything: the one range check of scene files,
+/// [`Scene::with_frequency`] and the CLI's `--frequency`, whatever the materials (a constant-loss
+/// material needs no frequency, Friis does). The number prints compactly (`1e300`).
+pub fn frequency_problem(frequency_hz: Real) -> Option<String> {
+    let ok = (MIN_FREQUENCY_HZ..=MAX_FREQUENCY_HZ).contains(&frequency_hz);
+    (!ok).then(|| {
+        format!(
+            "must be between {MIN_FREQUENCY_HZ:e} and {MAX_FREQUENCY_HZ:e} Hz (radio to optical; \
+             outside, losses overflow), got {frequency_hz:e}"
+        )
+    })
+}
+
 /// Terminal positions given outside the description (CLI `--tx/--rx`, mesh import).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Terminals {
@@ -46,16 +59,13 @@ impl Scene {
             problems.push("name", e);
         }
         let frequency_hz = desc.frequency_hz.unwrap_or(DEFAULT_FREQUENCY_HZ);
-        let frequency_ok = (MIN_FREQUENCY_HZ..=MAX_FREQUENCY_HZ).contains(&frequency_hz);
-        if !frequency_ok {
-            problems.push(
-                "frequency_hz",
-                format!(
-                    "must be between {MIN_FREQUENCY_HZ:e} and {MAX_FREQUENCY_HZ:e} Hz (radio to optical; \
-                     outside, losses overflow), got {frequency_hz}"
-                ),
-            );
-        }
+        let frequency_ok = match frequency_problem(frequency_hz) {
+            Some(problem) => {
+                problems.push("frequency_hz", problem);
+                false
+            }
+            None => true,
+        };
         let materials =
             described_materials(desc, frequency_ok.then_some(frequency_hz), &mut problems);
         let mut raw = raw_surfaces(desc, &mut problems);
@@ -595,10 +605,10 @@ impl Scene {
     /// materials in use (ITU validity ranges).
     pub fn with_frequency(&self, frequency_hz: Real) -> Result<Scene, crate::SceneError> {
         let mut problems = Vec::new();
-        if !(frequency_hz.is_finite() && frequency_hz > 0.0) {
+        if let Some(message) = frequency_problem(frequency_hz) {
             problems.push(crate::Problem {
                 location: "frequency_hz".into(),
-                message: format!("must be a positive finite number, got {frequency_hz}"),
+                message,
             });
         } else {
             problems = radio_problems(&self.surfaces, &self.materials, frequency_hz);
