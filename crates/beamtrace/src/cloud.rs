@@ -38,11 +38,11 @@ pub fn run_extract(args: &ExtractArgs) -> anyhow::Result<ExitCode> {
     }
     // Refuse a bad output before the (possibly long) extraction.
     let inputs = [args.cloud.clone()];
-    bt_output::refuse_input(&args.output, &inputs)?;
+    // Both outputs are checked before the work, so a bad --report leaves no scene behind.
+    crate::files::check(&args.output, &inputs, &["json", "toml"])?;
     let format = bt_output::extension_in(&args.output, &["json", "toml"])?;
     if let Some(report) = &args.report {
-        bt_output::refuse_input(report, &inputs)?;
-        bt_output::extension_in(report, &["json"])?;
+        crate::files::check(report, &inputs, &["json"])?;
     }
     let params = ExtractParams {
         seed: args.seed,
