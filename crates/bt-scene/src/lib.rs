@@ -28,7 +28,7 @@ pub use edges::{Edge, EdgeId, Edges};
 pub use frame::RECENTRE_RATIO;
 pub use material::{DEFAULT_MATERIAL, Material, default_materials};
 pub use model::{Endpoints, GeometryKey, Scene};
-pub use problem::{Problem, SceneError, Terminal};
+pub use problem::{MAX_PRINTED_PROBLEMS, Problem, SceneError, Terminal};
 pub use surface::{RawSurface, Surface, SurfaceId, SurfaceKind};
 pub use validate::{
     DEFAULT_FREQUENCY_HZ, MAX_FREQUENCY_HZ, MAX_TERMINAL_DISTANCE_RATIO, MIN_FREQUENCY_HZ,

@@ -202,7 +202,7 @@ fn described_materials(
         if let Err(e) = crate::name::check(name) {
             problems.push("materials", e);
         }
-        let location = format!("materials.{}", crate::name::escape(name));
+        let location = format!("materials.{}", crate::name::shown(name));
         if let Some(material) = material_from_desc(&location, m, frequency_hz, &mut *problems) {
             materials.insert(name.clone(), material);
         }
@@ -215,7 +215,7 @@ fn raw_surfaces(desc: &SceneDescription, problems: &mut Collector) -> Vec<RawSur
     let mut raw: Vec<RawSurface> = Vec::new();
     for (i, s) in desc.surfaces.iter().enumerate() {
         raw.push(RawSurface {
-            location: format!("surfaces[{i}] \"{}\"", crate::name::escape(&s.name)),
+            location: format!("surfaces[{i}] \"{}\"", crate::name::shown(&s.name)),
             name: s.name.clone(),
             material: s.material.clone(),
             kind: s.kind.unwrap_or(SurfaceKind::Reflector),
@@ -223,13 +223,14 @@ fn raw_surfaces(desc: &SceneDescription, problems: &mut Collector) -> Vec<RawSur
         });
     }
     for (i, b) in desc.boxes.iter().enumerate() {
-        let location = format!("boxes[{i}] \"{}\"", crate::name::escape(&b.name));
+        let location = format!("boxes[{i}] \"{}\"", crate::name::shown(&b.name));
         for o in &b.omit {
             if !BOX_FACES.iter().any(|(f, _, _)| f == o) {
                 problems.push(
                     format!("{location}.omit"),
                     format!(
-                        "unknown face \"{o}\" (expected top, bottom, west, east, south or north)"
+                        "unknown face \"{}\" (expected top, bottom, west, east, south or north)",
+                        crate::name::shown(o)
                     ),
                 );
             }
@@ -417,7 +418,7 @@ pub(crate) fn build_surfaces(
         } else if !names.insert(r.name.clone()) {
             problems.report(
                 &r.location,
-                format!("duplicate surface name \"{}\"", r.name),
+                format!("duplicate surface name \"{}\"", crate::name::shown(&r.name)),
             );
         }
         let material = r.material.unwrap_or_else(|| DEFAULT_MATERIAL.to_string());
@@ -426,7 +427,7 @@ pub(crate) fn build_surfaces(
                 &r.location,
                 format!(
                     "unknown material \"{}\" (add it under \"materials\")",
-                    crate::name::escape(&material)
+                    crate::name::shown(&material)
                 ),
             );
         }
@@ -497,7 +498,7 @@ pub(crate) fn check_terminals(
             if s.polygon.plane().signed_distance(p).abs() <= eps && s.polygon.contains(p, eps) {
                 problems.report(
                     field,
-                    format!("lies on surface \"{}\"", crate::name::escape(&s.name)),
+                    format!("lies on surface \"{}\"", crate::name::shown(&s.name)),
                 );
             }
         }

@@ -138,3 +138,31 @@ fn obj_material_names_follow_the_name_rule() {
     assert!(!text(&r).contains('\u{1b}'), "{:?}", text(&r));
     std::fs::remove_dir_all(dir).ok();
 }
+
+#[test]
+fn long_duplicate_names_make_short_error_text() {
+    let dir = scratch("long-duplicates");
+    let name = "n".repeat(1024);
+    let surfaces: Vec<serde_json::Value> = (0..10_000)
+        .map(|i| {
+            let x = f64::from(i) * 2.0;
+            serde_json::json!({ "name": name, "vertices":
+                [[x, 0, 0], [x + 1.0, 0, 0], [x + 1.0, 0, 1], [x, 0, 1]] })
+        })
+        .collect();
+    let desc =
+        serde_json::json!({ "tx": [0.5, 1, 0.5], "rx": [3.5, 1, 0.5], "surfaces": surfaces });
+    let scene = scene_with(&dir, "long.json", &desc.to_string());
+    let r = beamtrace(&["scene", "check", &scene]);
+    assert_refused(&r, &["10000 problem(s)", "…(1024 bytes)", "and 9000 more"]);
+    let t = text(&r);
+    assert!(t.len() < 1 << 20, "{} bytes of error text", t.len());
+    assert!(!t.contains(&"n".repeat(100)), "a name printed in full");
+    // Names within the rule, all duplicates: cut too.
+    let desc = desc.to_string().replace(&name, &"m".repeat(150));
+    let scene = scene_with(&dir, "dup.json", &desc);
+    let r = beamtrace(&["scene", "check", &scene]);
+    assert_refused(&r, &["duplicate surface name", "…(150 bytes)"]);
+    assert!(text(&r).len() < 1 << 20);
+    std::fs::remove_dir_all(dir).ok();
+}
