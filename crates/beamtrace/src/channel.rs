@@ -65,7 +65,7 @@ fn cir_csv(paths: &[PathReport], carrier_hz: f64) -> String {
             opt(p.power_dbm),
             bb.re,
             bb.im,
-            bt_output::csv::text_field(&p.surfaces.join(" > "))
+            bt_output::csv::text_field(&bt_scene::name::path(&p.surfaces))
         );
     }
     out

@@ -75,6 +75,19 @@ pub fn shown(name: &str) -> String {
     out
 }
 
+/// What separates the surface names of a path in one line or CSV cell (` > `).
+pub const PATH_SEPARATOR: &str = " > ";
+
+/// A path's surface names as one text (terminal tables, CSV cells): each name [`escape`]d, with
+/// a `>` inside a name written `\>`, so [`PATH_SEPARATOR`] only ever separates names: the
+/// names `a > b` and `c` give `a \> b > c`, never the path `a`, `b`, `c`.
+pub fn path<S: AsRef<str>>(names: &[S]) -> String {
+    let names: Vec<String> = (names.iter())
+        .map(|n| escape(n.as_ref()).replace('>', "\\>"))
+        .collect();
+    names.join(PATH_SEPARATOR)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -116,6 +129,14 @@ mod tests {
         let s = shown(&format!("{}\u{1b}", "x".repeat(MESSAGE_CHARS - 2)));
         assert!(s.ends_with("x…(63 bytes)"), "{s}");
         assert!(check(&long).unwrap_err().len() < 200);
+    }
+
+    #[test]
+    fn a_separator_inside_a_name_is_escaped_in_paths() {
+        assert_eq!(path(&["a > b", "c"]), "a \\> b > c");
+        assert_eq!(path(&["wall", "floor"]), "wall > floor");
+        assert_eq!(path::<&str>(&[]), "");
+        assert_eq!(path(&["x\\>"]), "x\\\\\\>");
     }
 
     #[test]
