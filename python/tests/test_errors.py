@@ -80,6 +80,9 @@ def test_budget_error_carries_the_cli_message(cli):
         ({"solver": "sbr", "sbr_step_deg": 0.0}, "sbr step must be a positive"),
         ({"solver": "sbr", "sbr_step_deg": 0.001}, "sbr ray budget exceeded"),
         ({"solver": "sbr", "sbr_step_deg": 1.0, "sbr_rays": 10}, "not both"),
+        # checked even when the solver chosen does not use it
+        ({"sbr_step_deg": float("nan")}, "sbr step must be a positive"),
+        ({"ipc_threshold": -1.0}, "ipc-threshold"),
     ],
 )
 def test_bad_options_are_value_errors(options, message):
