@@ -81,6 +81,9 @@ def test_budget_error_carries_the_cli_message(cli):
         ({"solver": "sbr", "sbr_step_deg": 0.001}, "sbr ray budget exceeded"),
         ({"solver": "sbr", "sbr_step_deg": 1.0, "sbr_rays": 10}, "not both"),
         ({"diffraction_coefficient": "sionna"}, "diffraction coefficient: unknown"),
+        # checked even when the solver chosen does not use it
+        ({"sbr_step_deg": float("nan")}, "sbr step must be a positive"),
+        ({"ipc_threshold": -1.0}, "ipc-threshold"),
     ],
 )
 def test_bad_options_are_value_errors(options, message):
@@ -93,3 +96,17 @@ def test_bad_point_shape_is_a_value_error():
     scene = beamtrace.load("builtin:living-room")
     with pytest.raises(ValueError, match="three numbers"):
         scene.trace([1.0, 2.0], None)
+
+
+@pytest.mark.parametrize(
+    "options, message",
+    [
+        ({"merge_angle_deg": float("nan")}, "angle_tol_deg"),
+        ({"merge_distance": -1.0}, "dist_tol_m"),
+        ({"min_reflector_area": float("inf")}, "min-reflector-area"),
+    ],
+)
+def test_load_options_are_checked_for_every_source(options, message):
+    # A built-in scene merges no mesh, but a NaN given is still refused, not ignored.
+    with pytest.raises(beamtrace.BeamtraceError, match=message):
+        beamtrace.load("builtin:living-room", **options)

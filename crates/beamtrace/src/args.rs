@@ -1,5 +1,6 @@
 //! Command-line arguments.
 
+use crate::numbers;
 use anyhow::{Context, bail};
 use bt_geom::Vec3;
 use bt_solve::settings::{IpcSettings, Named, SbrSettings, SolveSettings};
@@ -76,7 +77,7 @@ pub struct StudyLivingRoomArgs {
     #[arg(long, default_value = "builtin:living-room-dynamic")]
     pub steps_from: String,
     /// SBR grid step over the whole sphere, degrees (the paper: 1, i.e. 64,800 rays).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, value_parser = numbers::sbr_step_deg)]
     pub sbr_step_deg: f64,
     #[command(flatten)]
     pub budgets: StudyBudgetArgs,
@@ -144,7 +145,7 @@ pub struct Study2dArgs {
     #[arg(long)]
     pub out: PathBuf,
     /// SBR angular step, degrees (the paper: 1).
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, value_parser = numbers::sbr_step_deg)]
     pub sbr_step_deg: f64,
     #[command(flatten)]
     pub budgets: StudyBudgetArgs,
@@ -177,13 +178,13 @@ pub struct SceneArgs {
     pub rx: Option<Vec3>,
     /// Meshes: surfaces whose merged region (all its coplanar pieces together) is smaller
     /// than this (m²) only block.
-    #[arg(long, default_value_t = 0.25)]
+    #[arg(long, default_value_t = 0.25, value_parser = numbers::non_negative)]
     pub min_reflector_area: f64,
     /// Meshes: faces whose normals differ by less than this (degrees) merge into one surface.
-    #[arg(long, default_value_t = 1.0)]
+    #[arg(long, default_value_t = 1.0, value_parser = numbers::merge_angle_deg)]
     pub merge_angle_deg: f64,
     /// Meshes: faces whose planes differ by less than this (metres) merge into one surface.
-    #[arg(long, default_value_t = 1e-3)]
+    #[arg(long, default_value_t = 1e-3, value_parser = numbers::length_m)]
     pub merge_distance: f64,
     /// Meshes: budget on vertices and on faces of a mesh file, and of all the meshes of an XML
     /// scene together; a larger mesh stops before the merge.
@@ -223,14 +224,14 @@ impl SceneArgs {
 pub struct MaterialArgs {
     /// Carrier frequency, Hz (overrides the scene's, at every step with --steps; meshes, point
     /// clouds and XML scenes default to 28e9).
-    #[arg(long)]
+    #[arg(long, value_parser = numbers::frequency_hz)]
     pub frequency: Option<f64>,
     /// Radio material of every surface: itu:NAME (ITU-R P.2040-3, e.g. itu:concrete) or
     /// custom:EPS_R,SIGMA (relative permittivity, conductivity in S/m).
     #[arg(long, value_parser = parse_material)]
     pub material: Option<MaterialArg>,
     /// With --material: slab thickness in metres (default: a half-space).
-    #[arg(long, requires = "material", allow_hyphen_values = true)]
+    #[arg(long, requires = "material", allow_hyphen_values = true, value_parser = numbers::length_m)]
     pub thickness: Option<f64>,
 }
 
@@ -299,7 +300,7 @@ pub struct RadioArgs {
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true, default_value = "0,0,0")]
     pub rx_orientation: Vec3,
     /// Transmitted power, dBm (for power_dbm).
-    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true)]
+    #[arg(long, default_value_t = 0.0, allow_hyphen_values = true, value_parser = numbers::power_dbm)]
     pub tx_power_dbm: f64,
     #[command(flatten)]
     pub coefficient: CoefficientArgs,
@@ -342,9 +343,6 @@ fn parse_polarization(s: &str) -> Result<bt_channel::Polarization, bt_channel::C
 impl RadioArgs {
     /// The report's radio options.
     pub fn options(&self) -> anyhow::Result<bt_beams::RadioOptions> {
-        if !self.tx_power_dbm.is_finite() {
-            bail!("--tx-power-dbm must be a finite number of dBm");
-        }
         let antenna = |pattern, polarization, o: Vec3| {
             let orientation = bt_channel::Orientation::from_degrees(o.x, o.y, o.z);
             bt_channel::Antenna::new(pattern, polarization, orientation)
@@ -424,7 +422,7 @@ pub struct SolveArgs {
     pub ipc_order: IpcOrderArg,
     /// IPC convergence threshold on the mean displacement per round, metres
     /// (default 1e-13 × scene extent).
-    #[arg(long)]
+    #[arg(long, value_parser = numbers::positive_length_m)]
     pub ipc_threshold: Option<f64>,
     /// IPC round cap.
     #[arg(long, default_value_t = bt_solve::ipc::DEFAULT_MAX_ITERATIONS)]
@@ -433,7 +431,7 @@ pub struct SolveArgs {
     #[arg(long, value_enum, default_value_t = IpcAccelArg::None)]
     pub ipc_accel: IpcAccelArg,
     /// SBR: azimuth × elevation grid step, degrees (default 1, i.e. 360 × 180 rays).
-    #[arg(long, conflicts_with = "sbr_rays")]
+    #[arg(long, conflicts_with = "sbr_rays", value_parser = numbers::sbr_step_deg)]
     pub sbr_step_deg: Option<f64>,
     /// SBR: launch this many rays on a Fibonacci sphere instead of a grid.
     #[arg(long)]
@@ -472,7 +470,7 @@ pub struct SolveArgs {
     #[arg(long)]
     pub max_diffractions: Option<usize>,
     /// Edges shorter than this (metres) do not diffract.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, value_parser = numbers::length_m)]
     pub min_edge_length: f64,
 }
 
@@ -715,7 +713,7 @@ pub struct ChannelArgs {
     #[arg(long, default_value_t = 64)]
     pub subcarriers: usize,
     /// Subcarrier spacing, Hz.
-    #[arg(long, default_value_t = 120e3)]
+    #[arg(long, default_value_t = 120e3, value_parser = numbers::spacing_hz)]
     pub subcarrier_spacing: f64,
     /// Budget: refuse a frequency response of more subcarriers than this.
     #[arg(long, default_value_t = bt_channel::MAX_SUBCARRIERS.limit)]
@@ -748,10 +746,10 @@ pub struct BeamsArgs {
     #[arg(long, default_value = "1x8", value_parser = parse_array_shape)]
     pub rx_array: (usize, usize),
     /// TX element spacing, wavelengths.
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, default_value_t = 0.5, value_parser = numbers::spacing_wavelengths)]
     pub tx_spacing: f64,
     /// RX element spacing, wavelengths.
-    #[arg(long, default_value_t = 0.5)]
+    #[arg(long, default_value_t = 0.5, value_parser = numbers::spacing_wavelengths)]
     pub rx_spacing: f64,
     /// Ranking of the beam pairs.
     #[arg(long, value_enum, default_value_t = RankingArg::Power)]
@@ -838,10 +836,10 @@ pub struct ExtractArgs {
     #[arg(long, default_value_t = 0)]
     pub seed: u64,
     /// RANSAC inlier distance, metres (about 3 σ of the sensor noise).
-    #[arg(long, default_value_t = 0.015)]
+    #[arg(long, default_value_t = 0.015, value_parser = numbers::positive_length_m)]
     pub distance_threshold: f64,
     /// Planes of at least this area (m²) reflect; smaller ones only block (paper: 0.25).
-    #[arg(long, default_value_t = 0.25)]
+    #[arg(long, default_value_t = 0.25, value_parser = numbers::non_negative)]
     pub min_reflector_area: f64,
     /// TX X,Y,Z in metres to store in the scene (optional).
     #[arg(long, value_parser = parse_vec3, allow_hyphen_values = true)]
@@ -865,14 +863,14 @@ pub struct SampleArgs {
     #[arg(short = 'o', long = "output")]
     pub output: PathBuf,
     /// Points per square metre of surface.
-    #[arg(long, default_value_t = 2000.0)]
+    #[arg(long, default_value_t = 2000.0, value_parser = numbers::positive)]
     pub density: f64,
     /// Budget: stop before sampling rather than generate more points than this (estimated
     /// as surface area × density).
     #[arg(long, default_value_t = 20_000_000)]
     pub max_points: u64,
     /// Gaussian noise along the surface normal, metres (standard deviation).
-    #[arg(long, default_value_t = 0.005)]
+    #[arg(long, default_value_t = 0.005, value_parser = numbers::length_m)]
     pub noise: f64,
     /// Random seed.
     #[arg(long, default_value_t = 0)]

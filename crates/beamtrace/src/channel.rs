@@ -3,7 +3,7 @@
 use crate::args::{BeamsArgs, ChannelArgs, PathArgs, RankingArg};
 use crate::load::load_scene;
 use crate::trace::warn_near_field;
-use anyhow::{Context, bail};
+use anyhow::Context;
 use bt_beams::{BeamRanking, PathReport, RadioOptions};
 use bt_scene::Scene;
 use serde::Serialize;
@@ -65,7 +65,7 @@ fn cir_csv(paths: &[PathReport], carrier_hz: f64) -> String {
             opt(p.power_dbm),
             bb.re,
             bb.im,
-            bt_output::csv::text_field(&p.surfaces.join(" > "))
+            bt_output::csv::text_field(&bt_scene::name::path(&p.surfaces))
         );
     }
     out
@@ -80,9 +80,6 @@ fn cfr_csv(paths: &[PathReport], carrier_hz: f64, args: &ChannelArgs) -> anyhow:
     budget
         .check(n, paths.len())
         .with_context(|| format!("--subcarriers {n} over {} paths", paths.len()))?;
-    if !(args.subcarrier_spacing.is_finite() && args.subcarrier_spacing > 0.0) {
-        bail!("--subcarrier-spacing must be a positive number of Hz");
-    }
     let offsets = bt_channel::subcarriers(n, args.subcarrier_spacing);
     let h = bt_channel::frequency_response(&bt_beams::taps(paths), carrier_hz, &offsets);
     let mut out = String::from("subcarrier,offset_hz,frequency_hz,re,im,gain_db\n");
@@ -104,28 +101,34 @@ fn cfr_csv(paths: &[PathReport], carrier_hz: f64, args: &ChannelArgs) -> anyhow:
 pub fn run_channel(args: &ChannelArgs) -> anyhow::Result<ExitCode> {
     let (scene, paths, radio, inputs) = traced_paths(&args.paths)?;
     let carrier = scene.frequency_hz();
-    write_text(&args.out, &cir_csv(&paths, carrier), &inputs)?;
+    // Every output is computed and every output path checked before the first file is
+    // written: a refused later option (the CFR's budget, a PDP stem over an input) leaves no
+    // CIR behind.
+    let cir = cir_csv(&paths, carrier);
+    let cfr = match &args.cfr {
+        Some(path) => Some((path, cfr_csv(&paths, carrier, args)?)),
+        None => None,
+    };
+    let pdp = args
+        .pdp
+        .as_ref()
+        .map(|stem| (stem, pdp_figure(&scene, &paths, &radio)));
+    let mut outputs = vec![args.out.clone()];
+    outputs.extend(cfr.as_ref().map(|(path, _)| path.to_path_buf()));
+    if let Some((stem, _)) = &pdp {
+        outputs.extend(["svg", "png"].map(|e| stem.with_added_extension(e)));
+    }
+    for path in &outputs {
+        crate::files::check(path, &inputs, &[])?;
+    }
+    write_text(&args.out, &cir, &inputs)?;
     println!("{}: {} taps", args.out.display(), paths.len());
-    if let Some(path) = &args.cfr {
-        write_text(path, &cfr_csv(&paths, carrier, args)?, &inputs)?;
+    if let Some((path, text)) = &cfr {
+        write_text(path, text, &inputs)?;
         println!("{}: {} subcarriers", path.display(), args.subcarriers);
     }
-    if let Some(stem) = &args.pdp {
-        let taps: Vec<bt_plot::PdpTap> = paths
-            .iter()
-            .map(|p| bt_plot::PdpTap {
-                delay_ns: p.delay_s * 1e9,
-                power_dbm: p.power_dbm.unwrap_or(f64::NEG_INFINITY),
-                order: p.order,
-            })
-            .collect();
-        let title = format!(
-            "power-delay profile: {} at {:.3} GHz, {} dBm",
-            scene.name(),
-            carrier / 1e9,
-            radio.tx_power_dbm
-        );
-        for written in bt_plot::write_power_delay_profile(stem, &title, &taps)? {
+    if let Some((stem, (title, taps))) = &pdp {
+        for written in bt_plot::write_power_delay_profile(stem, title, taps)? {
             println!("{}", written.display());
         }
     }
@@ -137,6 +140,29 @@ pub fn run_channel(args: &ChannelArgs) -> anyhow::Result<ExitCode> {
         None => println!("no power received"),
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The power-delay profile's title and taps.
+fn pdp_figure(
+    scene: &Scene,
+    paths: &[PathReport],
+    radio: &RadioOptions,
+) -> (String, Vec<bt_plot::PdpTap>) {
+    let taps = paths
+        .iter()
+        .map(|p| bt_plot::PdpTap {
+            delay_ns: p.delay_s * 1e9,
+            power_dbm: p.power_dbm.unwrap_or(f64::NEG_INFINITY),
+            order: p.order,
+        })
+        .collect();
+    let title = format!(
+        "power-delay profile: {} at {:.3} GHz, {} dBm",
+        scene.name(),
+        scene.frequency_hz() / 1e9,
+        radio.tx_power_dbm
+    );
+    (title, taps)
 }
 
 #[derive(Debug, Serialize)]

@@ -38,11 +38,11 @@ pub fn run_extract(args: &ExtractArgs) -> anyhow::Result<ExitCode> {
     }
     // Refuse a bad output before the (possibly long) extraction.
     let inputs = [args.cloud.clone()];
-    bt_output::refuse_input(&args.output, &inputs)?;
+    // Both outputs are checked before the work, so a bad --report leaves no scene behind.
+    crate::files::check(&args.output, &inputs, &["json", "toml"])?;
     let format = bt_output::extension_in(&args.output, &["json", "toml"])?;
     if let Some(report) = &args.report {
-        bt_output::refuse_input(report, &inputs)?;
-        bt_output::extension_in(report, &["json"])?;
+        crate::files::check(report, &inputs, &["json"])?;
     }
     let params = ExtractParams {
         seed: args.seed,
@@ -95,18 +95,6 @@ pub fn run_extract(args: &ExtractArgs) -> anyhow::Result<ExitCode> {
 }
 
 pub fn run_sample(args: &SampleArgs) -> anyhow::Result<ExitCode> {
-    if !(args.density > 0.0 && args.density.is_finite()) {
-        bail!(
-            "--density must be a positive number of points per m², got {}",
-            args.density
-        );
-    }
-    if !(args.noise >= 0.0 && args.noise.is_finite()) {
-        bail!(
-            "--noise must be a non-negative number of metres, got {}",
-            args.noise
-        );
-    }
     // The named scene before the load (a cloud's extraction can take long), every file the
     // load read after it.
     bt_output::refuse_input(&args.output, &[PathBuf::from(&args.scene.scene)])?;

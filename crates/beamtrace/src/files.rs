@@ -14,11 +14,19 @@ pub fn write(
     inputs: &[PathBuf],
     formats: &[&str],
 ) -> anyhow::Result<()> {
+    check(path, inputs, formats)?;
+    bt_output::write_atomic(path, bytes).with_context(|| format!("writing {}", path.display()))
+}
+
+/// What [`write`] checks before writing `path`, for commands of several outputs to check them
+/// all before writing the first: a refusal then leaves no output behind.
+pub fn check(path: &Path, inputs: &[PathBuf], formats: &[&str]) -> anyhow::Result<()> {
     bt_output::refuse_input(path, inputs)?;
     if !formats.is_empty() {
         bt_output::extension_in(path, formats)?;
     }
-    bt_output::write_atomic(path, bytes).with_context(|| format!("writing {}", path.display()))
+    bt_output::check_target(path)?;
+    Ok(())
 }
 
 /// Print a warning for each file of an earlier run's manifest that a commit left in place.

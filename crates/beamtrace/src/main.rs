@@ -7,6 +7,7 @@ mod cloud;
 mod files;
 mod hls;
 mod load;
+mod numbers;
 mod output;
 mod progress;
 mod steps;

@@ -29,11 +29,7 @@ pub fn print_table(doc: &TraceDocument) {
         let names = if p.surfaces.is_empty() {
             "(line of sight)".to_string()
         } else {
-            p.surfaces
-                .iter()
-                .map(|n| bt_scene::name::escape(n))
-                .collect::<Vec<_>>()
-                .join(" > ")
+            bt_scene::name::path(&p.surfaces)
         };
         println!(
             "{:>4} {:>3} {:>8.3} {:>8.3} {:>8.2} {:>7.2} {:>8.2} {:>7.2} {:>7.2} {:>8}  {}",

@@ -78,7 +78,7 @@ fn print_table(doc: &StepsDocument) {
                 let names = if p.surfaces.is_empty() {
                     "(line of sight)".to_string()
                 } else {
-                    p.surfaces.join(" > ")
+                    bt_scene::name::path(&p.surfaces)
                 };
                 format!("{:.1} dB  {names}", p.loss_db)
             })

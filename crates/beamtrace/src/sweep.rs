@@ -20,6 +20,17 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<ExitCode> {
     let scene = loaded.scene;
     crate::load::require_terminals(&scene, &[bt_scene::Terminal::Tx], &args.scene)?;
     let options = args.solve.settings().trace_options(&scene)?;
+    // Every output checked before the work and the first write: a heat map that could not be
+    // written leaves no CSV behind.
+    let csv = args.out.join("coverage.csv");
+    let stem = args.out.join("coverage");
+    for path in [
+        csv.clone(),
+        stem.with_extension("svg"),
+        stem.with_extension("png"),
+    ] {
+        crate::files::check(&path, &loaded.sources, &[])?;
+    }
     // indicatif draws to stderr and hides itself when stderr is not a terminal.
     let bar = ProgressBar::new(points.len() as u64);
     bar.set_style(
@@ -35,7 +46,6 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<ExitCode> {
     bar.finish_and_clear();
     std::fs::create_dir_all(&args.out)
         .with_context(|| format!("creating {}", args.out.display()))?;
-    let csv = args.out.join("coverage.csv");
     crate::files::write(
         &csv,
         bt_coverage::csv(&rows).as_bytes(),
@@ -48,7 +58,7 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<ExitCode> {
         rows: &rows,
         quantity: args.map.quantity(),
     };
-    let [svg, png] = map.write(&args.out.join("coverage"))?;
+    let [svg, png] = map.write(&stem)?;
     let skipped = rows
         .iter()
         .filter(|r| matches!(r.status, bt_coverage::PointStatus::Skipped(_)))

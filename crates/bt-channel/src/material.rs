@@ -301,7 +301,7 @@ impl RadioMaterial {
         if !(frequency_hz.is_finite() && frequency_hz > 0.0) {
             return Err(ChannelError::Invalid {
                 field: "frequency_hz",
-                message: format!("must be a positive finite number, got {frequency_hz}"),
+                message: format!("must be a positive finite number, got {frequency_hz:e}"),
             });
         }
         let (eps, sigma) = self.properties(frequency_hz)?;

@@ -62,6 +62,10 @@ pub enum ImportError {
     /// The parsed scene is invalid (every problem listed), see [`bt_scene::SceneError`].
     #[error(transparent)]
     Scene(#[from] bt_scene::SceneError),
+    /// The mesh merge options are out of range, whatever the source (a built-in scene merges
+    /// nothing, but a NaN given is still a mistake to report).
+    #[error(transparent)]
+    MergeOptions(#[from] bt_mesh::MergeError),
     /// A load option is out of its range (NaN, infinite, negative).
     #[error("{option} must be {range}, got {value}")]
     Option {

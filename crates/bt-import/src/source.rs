@@ -48,8 +48,10 @@ pub const MAX_FILE_BYTES: bt_geom::Budget =
 
 impl LoadOptions {
     /// Refuse a value no load can use: a minimum reflector area that is not a finite number
-    /// ≥ 0 (NaN would make every surface a blocker).
+    /// ≥ 0 (NaN would make every surface a blocker), merge options out of range (checked for
+    /// every source, not only meshes: a value given and ignored is an error too).
     pub fn check(&self) -> Result<(), ImportError> {
+        self.merge.validate()?;
         let area = self.min_reflector_area_m2;
         if !(area.is_finite() && area >= 0.0) {
             return Err(ImportError::Option {

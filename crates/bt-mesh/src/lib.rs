@@ -79,6 +79,9 @@ pub struct MergeOptions {
     pub max_elements: u64,
 }
 
+/// Merge angles are below this, degrees: faces at right angles never merge.
+pub const MAX_ANGLE_TOL_DEG: Real = 90.0;
+
 /// Default of [`MergeOptions::max_elements`]: 5 million vertices and 5 million faces.
 pub const DEFAULT_MAX_ELEMENTS: u64 = 5_000_000;
 
@@ -101,9 +104,9 @@ impl MergeOptions {
     /// Checks that every tolerance is finite and in range.
     pub fn validate(&self) -> Result<(), MergeError> {
         let bad = |detail: String| Err(MergeError::InvalidOptions { detail });
-        if !(self.angle_tol_deg >= 0.0 && self.angle_tol_deg < 90.0) {
+        if !(self.angle_tol_deg >= 0.0 && self.angle_tol_deg < MAX_ANGLE_TOL_DEG) {
             return bad(format!(
-                "angle_tol_deg {} must be in [0, 90)",
+                "angle_tol_deg {} must be in [0, {MAX_ANGLE_TOL_DEG})",
                 self.angle_tol_deg
             ));
         }

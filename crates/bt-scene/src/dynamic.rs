@@ -571,7 +571,7 @@ fn members(
             let ids = base.find(&s.name).into_iter().collect();
             assign(
                 object,
-                format!("surfaces[{i}] \"{}\".object", crate::name::escape(&s.name)),
+                format!("surfaces[{i}] \"{}\".object", crate::name::shown(&s.name)),
                 ids,
                 problems,
             );

@@ -28,9 +28,12 @@ pub use edges::{Edge, EdgeId, Edges};
 pub use frame::RECENTRE_RATIO;
 pub use material::{DEFAULT_MATERIAL, Material, default_materials};
 pub use model::{Endpoints, GeometryKey, Scene};
-pub use problem::{Problem, SceneError, Terminal};
+pub use problem::{MAX_PRINTED_PROBLEMS, Problem, SceneError, Terminal};
 pub use surface::{RawSurface, Surface, SurfaceId, SurfaceKind};
-pub use validate::{DEFAULT_FREQUENCY_HZ, MAX_TERMINAL_DISTANCE_RATIO, Terminals};
+pub use validate::{
+    DEFAULT_FREQUENCY_HZ, MAX_FREQUENCY_HZ, MAX_TERMINAL_DISTANCE_RATIO, MIN_FREQUENCY_HZ,
+    Terminals, frequency_problem,
+};
 
 /// Re-exported so users of the scene need not depend on the geometry crate for the basics.
 pub use bt_geom::{Polygon, Real, Vec3};

@@ -256,7 +256,7 @@ impl Scene {
     pub fn warnings(&self) -> Vec<String> {
         let enclosed = self.separating_shells().into_iter().map(|(inside, shell)| {
             let names: Vec<String> = (shell.iter().take(3))
-                .map(|id| format!("\"{}\"", crate::name::escape(&self.surface(*id).name)))
+                .map(|id| format!("\"{}\"", crate::name::shown(&self.surface(*id).name)))
                 .collect();
             let more = if shell.len() > 3 { ", ..." } else { "" };
             let outside = if inside == "tx" { "rx" } else { "tx" };
@@ -275,10 +275,10 @@ impl Scene {
                 format!(
                     "surfaces \"{}\" ({}) and \"{}\" ({}) overlap in one plane with different materials: \
                      paths reflecting there are found twice",
-                    crate::name::escape(&a.name),
-                    crate::name::escape(&a.material),
-                    crate::name::escape(&b.name),
-                    crate::name::escape(&b.material)
+                    crate::name::shown(&a.name),
+                    crate::name::shown(&a.material),
+                    crate::name::shown(&b.name),
+                    crate::name::shown(&b.material)
                 )
             });
         conflicts.chain(enclosed).collect()

@@ -9,6 +9,10 @@
 /// Longest name accepted, in characters.
 pub const MAX_CHARS: usize = 200;
 
+/// Longest name a message prints, in characters of its escaped form: a 1 KB name repeated in
+/// 10,000 problems must not make megabytes of error text.
+pub const MESSAGE_CHARS: usize = 64;
+
 /// Whether `c` may appear in a name.
 fn allowed(c: char) -> bool {
     !(c.is_control()
@@ -25,14 +29,14 @@ pub fn check(name: &str) -> Result<(), String> {
     let count = name.chars().count();
     if count > MAX_CHARS {
         return Err(format!(
-            "name \"{}…\" has {count} characters (at most {MAX_CHARS})",
-            escape(&name.chars().take(40).collect::<String>())
+            "name \"{}\" has {count} characters (at most {MAX_CHARS})",
+            shown(name)
         ));
     }
     if let Some((i, c)) = name.chars().enumerate().find(|(_, c)| !allowed(*c)) {
         return Err(format!(
             "name \"{}\" contains the control character U+{:04X} at character {} (names must be printable)",
-            escape(name),
+            shown(name),
             c as u32,
             i + 1
         ));
@@ -52,6 +56,36 @@ pub fn escape(name: &str) -> String {
             }
         })
         .collect()
+}
+
+/// `name` as a message prints it: [`escape`]d, and cut after [`MESSAGE_CHARS`] characters
+/// with its length (`wallwall…(1024 bytes)`). Every error and warning that repeats a name from
+/// input prints it through here; outputs of valid names (tables, DOT) use [`escape`].
+pub fn shown(name: &str) -> String {
+    let mut out = String::new();
+    let mut count = 0;
+    for c in name.chars() {
+        let piece = escape(c.encode_utf8(&mut [0; 4]));
+        count += piece.chars().count();
+        if count > MESSAGE_CHARS {
+            return format!("{out}…({} bytes)", name.len());
+        }
+        out.push_str(&piece);
+    }
+    out
+}
+
+/// What separates the surface names of a path in one line or CSV cell (` > `).
+pub const PATH_SEPARATOR: &str = " > ";
+
+/// A path's surface names as one text (terminal tables, CSV cells): each name [`escape`]d, with
+/// a `>` inside a name written `\>`, so [`PATH_SEPARATOR`] only ever separates names: the
+/// names `a > b` and `c` give `a \> b > c`, never the path `a`, `b`, `c`.
+pub fn path<S: AsRef<str>>(names: &[S]) -> String {
+    let names: Vec<String> = (names.iter())
+        .map(|n| escape(n.as_ref()).replace('>', "\\>"))
+        .collect();
+    names.join(PATH_SEPARATOR)
 }
 
 #[cfg(test)]
@@ -83,6 +117,26 @@ mod tests {
         }
         assert!(check(&"x".repeat(MAX_CHARS)).is_ok());
         assert!(check(&"x".repeat(MAX_CHARS + 1)).is_err());
+    }
+
+    #[test]
+    fn messages_cut_long_names() {
+        let long = "n".repeat(1024);
+        let s = shown(&long);
+        assert_eq!(s, format!("{}…(1024 bytes)", "n".repeat(MESSAGE_CHARS)));
+        assert_eq!(shown("wall\n"), "wall\\n");
+        // An escape is never cut in half.
+        let s = shown(&format!("{}\u{1b}", "x".repeat(MESSAGE_CHARS - 2)));
+        assert!(s.ends_with("x…(63 bytes)"), "{s}");
+        assert!(check(&long).unwrap_err().len() < 200);
+    }
+
+    #[test]
+    fn a_separator_inside_a_name_is_escaped_in_paths() {
+        assert_eq!(path(&["a > b", "c"]), "a \\> b > c");
+        assert_eq!(path(&["wall", "floor"]), "wall > floor");
+        assert_eq!(path::<&str>(&[]), "");
+        assert_eq!(path(&["x\\>"]), "x\\\\\\>");
     }
 
     #[test]

@@ -24,7 +24,7 @@ impl fmt::Display for Problem {
 #[non_exhaustive]
 pub enum SceneError {
     /// The scene has one or more problems; all are listed.
-    #[error("{source_name}: {} problem(s):\n{}", problems.len(), problems.iter().map(|p| format!("  - {p}")).collect::<Vec<_>>().join("\n"))]
+    #[error("{source_name}: {} problem(s):\n{}", problems.len(), list(problems))]
     Invalid {
         /// File or scene name.
         source_name: String,
@@ -85,6 +85,24 @@ impl fmt::Display for Terminal {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         f.write_str(self.name())
     }
+}
+
+/// Most problems an error prints: 10,000 problems of one kind are read as their first ones and
+/// a count, not as megabytes of text.
+pub const MAX_PRINTED_PROBLEMS: usize = 1000;
+
+/// The problems one per line, at most [`MAX_PRINTED_PROBLEMS`] of them, then how many more.
+fn list(problems: &[Problem]) -> String {
+    let mut lines: Vec<String> = (problems.iter().take(MAX_PRINTED_PROBLEMS))
+        .map(|p| format!("  - {p}"))
+        .collect();
+    if problems.len() > MAX_PRINTED_PROBLEMS {
+        lines.push(format!(
+            "  ... and {} more",
+            problems.len() - MAX_PRINTED_PROBLEMS
+        ));
+    }
+    lines.join("\n")
 }
 
 pub(crate) struct Collector(pub Vec<Problem>);

@@ -21,6 +21,19 @@ pub const MIN_FREQUENCY_HZ: Real = 1e3;
 /// long paths and geometric optics is all that is left anyway).
 pub const MAX_FREQUENCY_HZ: Real = 1e15;
 
+/// What is wrong with a carrier frequency, if anything: the one range check of scene files,
+/// [`Scene::with_frequency`] and the CLI's `--frequency`, whatever the materials (a constant-loss
+/// material needs no frequency, Friis does). The number prints compactly (`1e300`).
+pub fn frequency_problem(frequency_hz: Real) -> Option<String> {
+    let ok = (MIN_FREQUENCY_HZ..=MAX_FREQUENCY_HZ).contains(&frequency_hz);
+    (!ok).then(|| {
+        format!(
+            "must be between {MIN_FREQUENCY_HZ:e} and {MAX_FREQUENCY_HZ:e} Hz (radio to optical; \
+             outside, losses overflow), got {frequency_hz:e}"
+        )
+    })
+}
+
 /// Terminal positions given outside the description (CLI `--tx/--rx`, mesh import).
 #[derive(Debug, Clone, Copy, Default)]
 pub struct Terminals {
@@ -46,16 +59,13 @@ impl Scene {
             problems.push("name", e);
         }
         let frequency_hz = desc.frequency_hz.unwrap_or(DEFAULT_FREQUENCY_HZ);
-        let frequency_ok = (MIN_FREQUENCY_HZ..=MAX_FREQUENCY_HZ).contains(&frequency_hz);
-        if !frequency_ok {
-            problems.push(
-                "frequency_hz",
-                format!(
-                    "must be between {MIN_FREQUENCY_HZ:e} and {MAX_FREQUENCY_HZ:e} Hz (radio to optical; \
-                     outside, losses overflow), got {frequency_hz}"
-                ),
-            );
-        }
+        let frequency_ok = match frequency_problem(frequency_hz) {
+            Some(problem) => {
+                problems.push("frequency_hz", problem);
+                false
+            }
+            None => true,
+        };
         let materials =
             described_materials(desc, frequency_ok.then_some(frequency_hz), &mut problems);
         let mut raw = raw_surfaces(desc, &mut problems);
@@ -170,7 +180,7 @@ fn described_materials(
         if let Err(e) = crate::name::check(name) {
             problems.push("materials", e);
         }
-        let location = format!("materials.{}", crate::name::escape(name));
+        let location = format!("materials.{}", crate::name::shown(name));
         if let Some(material) = material_from_desc(&location, m, frequency_hz, &mut *problems) {
             materials.insert(name.clone(), material);
         }
@@ -183,7 +193,7 @@ fn raw_surfaces(desc: &SceneDescription, problems: &mut Collector) -> Vec<RawSur
     let mut raw: Vec<RawSurface> = Vec::new();
     for (i, s) in desc.surfaces.iter().enumerate() {
         raw.push(RawSurface {
-            location: format!("surfaces[{i}] \"{}\"", crate::name::escape(&s.name)),
+            location: format!("surfaces[{i}] \"{}\"", crate::name::shown(&s.name)),
             name: s.name.clone(),
             material: s.material.clone(),
             kind: s.kind.unwrap_or(SurfaceKind::Reflector),
@@ -191,13 +201,14 @@ fn raw_surfaces(desc: &SceneDescription, problems: &mut Collector) -> Vec<RawSur
         });
     }
     for (i, b) in desc.boxes.iter().enumerate() {
-        let location = format!("boxes[{i}] \"{}\"", crate::name::escape(&b.name));
+        let location = format!("boxes[{i}] \"{}\"", crate::name::shown(&b.name));
         for o in &b.omit {
             if !BOX_FACES.iter().any(|(f, _, _)| f == o) {
                 problems.push(
                     format!("{location}.omit"),
                     format!(
-                        "unknown face \"{o}\" (expected top, bottom, west, east, south or north)"
+                        "unknown face \"{}\" (expected top, bottom, west, east, south or north)",
+                        crate::name::shown(o)
                     ),
                 );
             }
@@ -385,7 +396,7 @@ pub(crate) fn build_surfaces(
         } else if !names.insert(r.name.clone()) {
             problems.report(
                 &r.location,
-                format!("duplicate surface name \"{}\"", r.name),
+                format!("duplicate surface name \"{}\"", crate::name::shown(&r.name)),
             );
         }
         let material = r.material.unwrap_or_else(|| DEFAULT_MATERIAL.to_string());
@@ -394,7 +405,7 @@ pub(crate) fn build_surfaces(
                 &r.location,
                 format!(
                     "unknown material \"{}\" (add it under \"materials\")",
-                    crate::name::escape(&material)
+                    crate::name::shown(&material)
                 ),
             );
         }
@@ -465,7 +476,7 @@ pub(crate) fn check_terminals(
             if s.polygon.plane().signed_distance(p).abs() <= eps && s.polygon.contains(p, eps) {
                 problems.report(
                     field,
-                    format!("lies on surface \"{}\"", crate::name::escape(&s.name)),
+                    format!("lies on surface \"{}\"", crate::name::shown(&s.name)),
                 );
             }
         }
@@ -573,10 +584,10 @@ impl Scene {
     /// materials in use (ITU validity ranges).
     pub fn with_frequency(&self, frequency_hz: Real) -> Result<Scene, crate::SceneError> {
         let mut problems = Vec::new();
-        if !(frequency_hz.is_finite() && frequency_hz > 0.0) {
+        if let Some(message) = frequency_problem(frequency_hz) {
             problems.push(crate::Problem {
                 location: "frequency_hz".into(),
-                message: format!("must be a positive finite number, got {frequency_hz}"),
+                message,
             });
         } else {
             problems = radio_problems(&self.surfaces, &self.materials, frequency_hz);

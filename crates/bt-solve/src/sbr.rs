@@ -67,6 +67,9 @@ impl Default for SbrOptions {
     }
 }
 
+/// The coarsest grid step, degrees (two elevations, four azimuths).
+pub const MAX_STEP_DEG: Real = 90.0;
+
 /// Default budget on launched rays (`--max-rays`): about 160 MB of ray state; the paper's
 /// 1-degree grid launches 64,800.
 pub const DEFAULT_MAX_RAYS: u64 = 10_000_000;
@@ -121,8 +124,8 @@ impl SbrOptions {
             SbrLaunch::Grid { step_deg } if !(step_deg.is_finite() && step_deg > 0.0) => Some(
                 format!("sbr step must be a positive number of degrees, got {step_deg}"),
             ),
-            SbrLaunch::Grid { step_deg } if step_deg > 90.0 => Some(format!(
-                "sbr step must be at most 90 degrees, got {step_deg}"
+            SbrLaunch::Grid { step_deg } if step_deg > MAX_STEP_DEG => Some(format!(
+                "sbr step must be at most {MAX_STEP_DEG} degrees, got {step_deg}"
             )),
             SbrLaunch::Fibonacci { rays: 0 } => Some("sbr ray count must be at least 1".into()),
             _ => None,
@@ -130,7 +133,7 @@ impl SbrOptions {
     }
 
     fn grid_counts(step_deg: Real) -> (usize, usize) {
-        if !(step_deg.is_finite() && step_deg > 0.0 && step_deg <= 90.0) {
+        if !(step_deg.is_finite() && step_deg > 0.0 && step_deg <= MAX_STEP_DEG) {
             return (0, 0);
         }
         let azimuths = (360.0 / step_deg).round().max(1.0) as usize;

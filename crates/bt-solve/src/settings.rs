@@ -177,8 +177,13 @@ named!(CandidateMode, "candidates": "beam-tree" => BeamTree, "wvrn" => Wvrn, "ex
 
 impl SolveSettings {
     /// The solver these settings select, with IPC's defaults scaled to `scene`; checks the
-    /// values and SBR's ray budget.
+    /// values and SBR's ray budget. The values of the solvers not selected are checked too
+    /// (not their budget): a NaN given and ignored is a mistake all the same (Python's
+    /// `trace(sbr_step_deg=nan)` with the image solver).
     pub fn solver(&self, scene: &Scene) -> Result<Solver, SettingsError> {
+        self.ipc.check()?;
+        SbrOptions::chosen(self.sbr.rays, self.sbr.step_deg, self.sbr.planar)
+            .map_err(SettingsError::Sbr)?;
         Ok(match self.solver {
             SolverKind::Image => Solver::Image,
             SolverKind::Ipc => Solver::Ipc(self.ipc.options(scene)?),
@@ -213,19 +218,30 @@ impl SolveSettings {
 impl IpcSettings {
     /// IPC's options for `scene`.
     pub fn options(&self, scene: &Scene) -> Result<IpcOptions, SettingsError> {
+        self.check()?;
         let mut options = IpcOptions::for_scene(scene, self.order);
         if let Some(t) = self.threshold {
-            if !(t.is_finite() && t > 0.0) {
-                return Err(SettingsError::IpcThreshold(t));
-            }
             options.threshold = t;
-        }
-        if self.max_iterations == 0 {
-            return Err(SettingsError::IpcMaxIterations);
         }
         options.max_iterations = self.max_iterations;
         options.acceleration = self.acceleration;
         Ok(options)
+    }
+}
+
+impl IpcSettings {
+    /// The values' ranges, without a scene: a threshold that is a positive finite number of
+    /// metres, at least one round.
+    fn check(&self) -> Result<(), SettingsError> {
+        if let Some(t) = self.threshold
+            && !(t.is_finite() && t > 0.0)
+        {
+            return Err(SettingsError::IpcThreshold(t));
+        }
+        if self.max_iterations == 0 {
+            return Err(SettingsError::IpcMaxIterations);
+        }
+        Ok(())
     }
 }
 
@@ -247,6 +263,23 @@ mod tests {
 
     fn room() -> Scene {
         bt_testkit::random_scene(1, 4)
+    }
+
+    #[test]
+    fn values_of_a_solver_not_chosen_are_checked_too() {
+        let mut s = SolveSettings::default();
+        s.sbr.step_deg = Some(Real::NAN);
+        assert!(matches!(s.solver(&room()), Err(SettingsError::Sbr(_))));
+        let mut s = SolveSettings::default();
+        s.ipc.threshold = Some(-1.0);
+        assert!(matches!(
+            s.solver(&room()),
+            Err(SettingsError::IpcThreshold(_))
+        ));
+        // A budget belongs to the solver that launches: a fine grid is no error for the image method.
+        let mut s = SolveSettings::default();
+        s.sbr.step_deg = Some(1e-3);
+        assert!(s.solver(&room()).is_ok());
     }
 
     #[test]

@@ -169,7 +169,12 @@ fn read_keywords(bytes: &[u8]) -> Result<Keywords, CloudError> {
                     data_line: line_no,
                 });
             }
-            other => return Err(header_err(line_no, format!("unknown keyword '{other}'"))),
+            other => {
+                return Err(header_err(
+                    line_no,
+                    format!("unknown keyword '{}'", bt_scene::name::shown(other)),
+                ));
+            }
         }
     }
 }
@@ -179,7 +184,13 @@ fn ints(rest: &[&str], what: &str, line: usize) -> Result<Vec<u64>, CloudError> 
     rest.iter()
         .map(|t| {
             t.parse::<u64>().map_err(|_| {
-                header_err(line, format!("{what}: '{t}' is not a non-negative integer"))
+                header_err(
+                    line,
+                    format!(
+                        "{what}: '{}' is not a non-negative integer",
+                        bt_scene::name::shown(t)
+                    ),
+                )
             })
         })
         .collect()
@@ -207,7 +218,10 @@ fn type_letters(rest: &[&str], line: usize) -> Result<Vec<u8>, CloudError> {
     rest.iter()
         .map(|s| match *s {
             "F" | "I" | "U" => Ok(s.as_bytes()[0]),
-            _ => Err(header_err(line, format!("TYPE '{s}' is not F, I or U"))),
+            _ => Err(header_err(
+                line,
+                format!("TYPE '{}' is not F, I or U", bt_scene::name::shown(s)),
+            )),
         })
         .collect()
 }
@@ -224,7 +238,10 @@ fn data_is_binary(rest: &[&str], line: usize) -> Result<bool, CloudError> {
         }),
         _ => Err(header_err(
             line,
-            format!("unknown DATA encoding '{}'", rest.join(" ")),
+            format!(
+                "unknown DATA encoding '{}'",
+                bt_scene::name::shown(&rest.join(" "))
+            ),
         )),
     }
 }
@@ -264,7 +281,9 @@ fn fields(kw: &Keywords) -> Result<Vec<Field>, CloudError> {
                 data_line,
                 format!(
                     "field '{}': TYPE {} with SIZE {} is not valid",
-                    names[i], types[i] as char, sizes[i]
+                    bt_scene::name::shown(&names[i]),
+                    types[i] as char,
+                    sizes[i]
                 ),
             ));
         };
@@ -314,7 +333,11 @@ fn layout(fields: &[Field], data_line: usize) -> Result<Layout, CloudError> {
         match fields.iter().position(|f| f.name == name) {
             Some(i) if fields[i].count != 1 => Err(header_err(
                 data_line,
-                format!("field '{name}' has COUNT {}, expected 1", fields[i].count),
+                format!(
+                    "field '{}' has COUNT {}, expected 1",
+                    bt_scene::name::shown(name),
+                    fields[i].count
+                ),
             )),
             other => Ok(other),
         }
@@ -427,7 +450,8 @@ fn read_ascii_body(
             vals[slot] = parse_number(toks[c], fields[fi].scalar).ok_or_else(|| {
                 bad(format!(
                     "'{}' is not a number ('{}')",
-                    toks[c], fields[fi].name
+                    bt_scene::name::shown(toks[c]),
+                    bt_scene::name::shown(&fields[fi].name)
                 ))
             })?;
         }

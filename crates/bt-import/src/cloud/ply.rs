@@ -44,9 +44,12 @@ pub fn parse_ply(bytes: &[u8], opts: &ReadOptions) -> Result<LoadedCloud, CloudE
     let vertex = &h.elements[vi];
     let find = |n: &str| -> Result<Option<usize>, CloudError> {
         match vertex.properties.iter().position(|p| p.name == n) {
-            Some(i) if matches!(vertex.properties[i].kind, PropKind::List { .. }) => Err(
-                header_err(end_line, format!("vertex property '{n}' is a list")),
-            ),
+            Some(i) if matches!(vertex.properties[i].kind, PropKind::List { .. }) => {
+                Err(header_err(
+                    end_line,
+                    format!("vertex property '{}' is a list", bt_scene::name::shown(n)),
+                ))
+            }
             other => Ok(other),
         }
     };
@@ -59,7 +62,10 @@ pub fn parse_ply(bytes: &[u8], opts: &ReadOptions) -> Result<LoadedCloud, CloudE
         if e.properties.is_empty() && e.count > 0 {
             return Err(header_err(
                 end_line,
-                format!("element '{}' has no properties", e.name),
+                format!(
+                    "element '{}' has no properties",
+                    bt_scene::name::shown(&e.name)
+                ),
             ));
         }
         min_total += e.count as u128 * u128::from(e.min_bytes(h.format));
@@ -149,7 +155,10 @@ fn read_binary_element(
                             element: k,
                             line: None,
                         },
-                        reason: format!("negative list length {n} for '{}'", p.name),
+                        reason: format!(
+                            "negative list length {n} for '{}'",
+                            bt_scene::name::shown(&p.name)
+                        ),
                     });
                 }
                 let skip = n as u128 * item.size() as u128;
@@ -192,24 +201,39 @@ fn read_ascii_element(
     let text = std::str::from_utf8(text).map_err(|_| bad("line is not text".into()))?;
     let mut tok = text.split_ascii_whitespace();
     for (i, p) in e.properties.iter().enumerate() {
-        let t = tok
-            .next()
-            .ok_or_else(|| bad(format!("missing value for '{}'", p.name)))?;
+        let t = tok.next().ok_or_else(|| {
+            bad(format!(
+                "missing value for '{}'",
+                bt_scene::name::shown(&p.name)
+            ))
+        })?;
         match p.kind {
             PropKind::Scalar(ty) => {
-                let v = parse_number(t, ty)
-                    .ok_or_else(|| bad(format!("'{t}' is not a number ('{}')", p.name)))?;
+                let v = parse_number(t, ty).ok_or_else(|| {
+                    bad(format!(
+                        "'{}' is not a number ('{}')",
+                        bt_scene::name::shown(t),
+                        bt_scene::name::shown(&p.name)
+                    ))
+                })?;
                 if let Some(slot) = vals.get_mut(i) {
                     *slot = v;
                 }
             }
             PropKind::List { .. } => {
-                let n: usize = t
-                    .parse()
-                    .map_err(|_| bad(format!("'{t}' is not a list length ('{}')", p.name)))?;
+                let n: usize = t.parse().map_err(|_| {
+                    bad(format!(
+                        "'{}' is not a list length ('{}')",
+                        bt_scene::name::shown(t),
+                        bt_scene::name::shown(&p.name)
+                    ))
+                })?;
                 for _ in 0..n {
                     tok.next().ok_or_else(|| {
-                        bad(format!("list '{}' shorter than its length {n}", p.name))
+                        bad(format!(
+                            "list '{}' shorter than its length {n}",
+                            bt_scene::name::shown(&p.name)
+                        ))
                     })?;
                 }
             }

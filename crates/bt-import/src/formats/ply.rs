@@ -101,28 +101,28 @@ pub enum PlyHeaderErrorKind {
     NoFormat,
     /// A `format` line names an encoding other than the three of PLY (a valid-looking file
     /// this reader cannot read).
-    #[error("unknown PLY format {0:?}")]
+    #[error("unknown PLY format \"{}\"", bt_scene::name::shown(.0))]
     UnknownFormat(String),
     /// A `format` line names a version other than `1.0`.
-    #[error("unsupported PLY format version {0:?}")]
+    #[error("unsupported PLY format version \"{}\"", bt_scene::name::shown(.0))]
     UnsupportedVersion(String),
     /// An element count that is not a non-negative integer.
-    #[error("element count {0:?} is not a non-negative integer")]
+    #[error("element count \"{}\" is not a non-negative integer", bt_scene::name::shown(.0))]
     BadCount(String),
     /// A `property` line before the first `element` line.
     #[error("property declared before any element")]
     PropertyBeforeElement,
     /// A property type that PLY does not define.
-    #[error("unknown property type {0:?}")]
+    #[error("unknown property type \"{}\"", bt_scene::name::shown(.0))]
     UnknownType(String),
     /// A list whose count type is a floating-point type.
-    #[error("list {0:?} has a non-integer count type")]
+    #[error("list \"{}\" has a non-integer count type", bt_scene::name::shown(.0))]
     NonIntegerListCount(String),
     /// Two properties of one element with the same name.
-    #[error("duplicate property {0:?}")]
+    #[error("duplicate property \"{}\"", bt_scene::name::shown(.0))]
     DuplicateProperty(String),
     /// A line that does not fit the grammar (wrong number of words, unknown keyword).
-    #[error("unexpected header line {0:?}")]
+    #[error("unexpected header line \"{}\"", bt_scene::name::shown(.0))]
     Malformed(String),
 }
 

@@ -120,7 +120,8 @@ pub enum MeshError {
     /// A PLY header claims more elements than the body can possibly hold. Checked before any
     /// allocation, so a hostile header cannot exhaust memory.
     #[error(
-        "{file}: element {element:?} claims {count} entries, which need {} bytes, but the body has only {body_bytes} bytes",
+        "{file}: element \"{}\" claims {count} entries, which need {} bytes, but the body has only {body_bytes} bytes",
+        bt_scene::name::shown(.element),
         bt_geom::AtLeast(*.min_bytes)
     )]
     CountTooLarge {

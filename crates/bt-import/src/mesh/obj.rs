@@ -134,7 +134,8 @@ impl Line<'_> {
                 .ok_or_else(|| self.syntax(format!("vertex has no {axis} coordinate")))?;
             let value: Real = token.parse().map_err(|_| {
                 self.syntax(format!(
-                    "vertex {axis} coordinate {token:?} is not a number"
+                    "vertex {axis} coordinate \"{}\" is not a number",
+                    bt_scene::name::shown(token)
                 ))
             })?;
             if !value.is_finite() {
@@ -197,14 +198,20 @@ impl Line<'_> {
 fn parse_reference(token: &str) -> Result<i64, String> {
     let mut parts = token.split('/');
     let vertex = parts.next().unwrap_or("");
-    let index: i64 = vertex
-        .parse()
-        .map_err(|_| format!("vertex reference {token:?} does not start with an integer index"))?;
+    let index: i64 = vertex.parse().map_err(|_| {
+        format!(
+            "vertex reference \"{}\" does not start with an integer index",
+            bt_scene::name::shown(token)
+        )
+    })?;
     let mut extra = 0;
     for part in parts {
         extra += 1;
         if extra > 2 || (!part.is_empty() && part.parse::<i64>().is_err()) {
-            return Err(format!("vertex reference {token:?} is malformed"));
+            return Err(format!(
+                "vertex reference \"{}\" is malformed",
+                bt_scene::name::shown(token)
+            ));
         }
     }
     Ok(index)

@@ -213,7 +213,10 @@ fn check_counts(header: &Header, body_bytes: u64, file: &str) -> Result<(), Mesh
         if element.properties.is_empty() && element.count > 0 {
             return Err(MeshError::Unsupported {
                 file: file.to_owned(),
-                detail: format!("element {:?} has no properties", element.name),
+                detail: format!(
+                    "element \"{}\" has no properties",
+                    bt_scene::name::shown(&element.name)
+                ),
             });
         }
         let min_bytes = element
@@ -280,7 +283,10 @@ impl Reader<'_> {
                         return Err(MeshError::Syntax {
                             file: self.file.to_owned(),
                             position: at.clone(),
-                            detail: format!("list {:?} has negative length {n}", property.name),
+                            detail: format!(
+                                "list \"{}\" has negative length {n}",
+                                bt_scene::name::shown(&property.name)
+                            ),
                         });
                     }
                     let collect = indices == Some(slot);
@@ -315,7 +321,10 @@ impl Reader<'_> {
         let truncated = || MeshError::Truncated {
             file: self.file.to_owned(),
             position: at.clone(),
-            detail: format!("data ends while reading property {property:?}"),
+            detail: format!(
+                "data ends while reading property \"{}\"",
+                bt_scene::name::shown(property)
+            ),
         };
         match self.format {
             Format::Ascii => {
@@ -340,7 +349,11 @@ impl Reader<'_> {
                 value.ok_or_else(|| MeshError::Syntax {
                     file: self.file.to_owned(),
                     position: at.clone(),
-                    detail: format!("property {property:?}: {token:?} is not a valid {ty:?} value"),
+                    detail: format!(
+                        "property \"{}\": \"{}\" is not a valid {ty:?} value",
+                        bt_scene::name::shown(property),
+                        bt_scene::name::shown(&token)
+                    ),
                 })
             }
             Format::BinaryLittleEndian | Format::BinaryBigEndian => {

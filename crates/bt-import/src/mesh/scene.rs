@@ -63,7 +63,7 @@ pub fn from_mesh(
             SurfaceKind::Blocker
         };
         raw.push(RawSurface {
-            location: format!("surface {i} \"{}\"", bt_scene::name::escape(&s.name)),
+            location: format!("surface {i} \"{}\"", bt_scene::name::shown(&s.name)),
             name: s.name,
             material,
             kind,
@@ -81,7 +81,7 @@ pub fn from_mesh(
     Ok(Loaded::new(scene, warnings))
 }
 
-/// `name` in quotes, escaped by the name rule's printer (`bt_scene::name::escape`).
+/// `name` in quotes, as messages print it (`bt_scene::name::shown`).
 fn quoted(name: &str) -> String {
-    format!("\"{}\"", bt_scene::name::escape(name))
+    format!("\"{}\"", bt_scene::name::shown(name))
 }

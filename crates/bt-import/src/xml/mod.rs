@@ -162,7 +162,8 @@ pub fn load_xml(path: &Path, options: &LoadOptions) -> Result<Loaded, ImportErro
         if material.is_none() {
             warnings.push(format!(
                 "{display}: line {}: <shape id=\"{}\"> has no bsdf: material \"{DEFAULT_MATERIAL}\"",
-                shape.at.line, shape.name
+                shape.at.line,
+                bt_scene::name::shown(&shape.name)
             ));
         }
         desc.surfaces
@@ -215,7 +216,7 @@ impl SceneElements {
                         "the meshes up to <shape id=\"{}\"> hold {}, more than the budget of \
                          {max_elements} {element} for the whole scene; raise it with \
                          --max-mesh-elements (load options: merge.max_elements)",
-                        shape.name,
+                        bt_scene::name::shown(&shape.name),
                         bt_geom::AtLeast(total).to_string() + " " + element
                     ),
                 });
@@ -265,7 +266,8 @@ fn visual_material(b: &XmlBsdf, kind: &str, warnings: &mut Vec<String>) -> Mater
     }
     warnings.push(format!(
         "line {}: <bsdf type=\"{kind}\" id=\"{}\"> is not a radio material: using material \"{DEFAULT_MATERIAL}\"'s properties",
-        b.line, b.id
+        b.line,
+        bt_scene::name::shown(&b.id)
     ));
     let default = &default_materials()[DEFAULT_MATERIAL];
     let mut desc = MaterialDesc {
@@ -306,8 +308,8 @@ fn read_shape(
     let file = resolve(folder, &shape.filename).map_err(|why| {
         at(format!(
             "<shape id=\"{}\"> filename \"{}\": {why}",
-            shape.name,
-            shape.filename.escape_debug()
+            bt_scene::name::shown(&shape.name),
+            bt_scene::name::shown(&shape.filename)
         ))
     })?;
     let shown = file.display().to_string();
@@ -315,7 +317,7 @@ fn read_shape(
         .map_err(|e| {
             at(format!(
                 "<shape id=\"{}\"> mesh file {shown}: {e}",
-                shape.name
+                bt_scene::name::shown(&shape.name)
             ))
         })?
         .len();
@@ -325,13 +327,13 @@ fn read_shape(
     {
         return Err(at(format!(
             "<shape id=\"{}\"> mesh file {shown}: {e}",
-            shape.name
+            bt_scene::name::shown(&shape.name)
         )));
     }
     if size > *budget {
         return Err(at(format!(
             "<shape id=\"{}\"> mesh file {shown} is {size} bytes: over the limit ({MAX_MESH_TOTAL_BYTES} bytes for all meshes of a scene)",
-            shape.name
+            bt_scene::name::shown(&shape.name)
         )));
     }
     *budget -= size;

@@ -160,7 +160,7 @@ impl Ctx<'_> {
                 format!(
                     "<{}> {name}=\"{}\" is not a finite number",
                     tag(node),
-                    text.escape_debug()
+                    bt_scene::name::shown(&text)
                 ),
             )
         })
@@ -285,7 +285,10 @@ fn add_bsdf(
     if !ctx.bsdf_ids.insert(id.clone()) {
         return Err(ctx.error(
             node,
-            format!("<bsdf id=\"{}\"> is defined twice", id.escape_debug()),
+            format!(
+                "<bsdf id=\"{}\"> is defined twice",
+                bt_scene::name::shown(&id)
+            ),
         ));
     }
     let radio = parse_bsdf(ctx, node)?;
@@ -328,7 +331,7 @@ fn parse_bsdf(ctx: &Ctx<'_>, node: Node<'_, '_>) -> Result<XmlRadio, ImportError
                     child,
                     format!(
                         "unsupported property <{t} name=\"{}\"> in <bsdf type=\"{k}\">",
-                        n.escape_debug()
+                        bt_scene::name::shown(n)
                     ),
                 ));
             }
@@ -374,7 +377,7 @@ fn parse_shape(
                 node,
                 format!(
                     "<shape type=\"{}\"> is not supported (only ply and obj meshes)",
-                    other.escape_debug()
+                    bt_scene::name::shown(other)
                 ),
             ));
         }
@@ -430,14 +433,17 @@ fn shape_child(
                     child,
                     format!(
                         "unsupported property <boolean name=\"{}\"> in <shape>",
-                        name.escape_debug()
+                        bt_scene::name::shown(&name)
                     ),
                 ));
             }
             if !matches!(value.as_str(), "true" | "false") {
                 return Err(ctx.error(
                     child,
-                    format!("<boolean name=\"{name}\"> value must be true or false"),
+                    format!(
+                        "<boolean name=\"{}\"> value must be true or false",
+                        bt_scene::name::shown(&name)
+                    ),
                 ));
             }
         }
@@ -449,7 +455,7 @@ fn shape_child(
                     child,
                     format!(
                         "<ref name=\"{}\"> is not supported in <shape> (only bsdf)",
-                        name.escape_debug()
+                        bt_scene::name::shown(&name)
                     ),
                 ));
             }
@@ -471,7 +477,7 @@ fn shape_child(
                     child,
                     format!(
                         "<transform name=\"{}\"> is not supported in <shape> (only to_world)",
-                        name.escape_debug()
+                        bt_scene::name::shown(&name)
                     ),
                 ));
             }
@@ -484,7 +490,7 @@ fn shape_child(
                 child,
                 format!(
                     "unsupported element <{other} name=\"{}\"> in <shape>",
-                    name.escape_debug()
+                    bt_scene::name::shown(name)
                 ),
             ));
         }
@@ -518,8 +524,8 @@ fn check_refs(ctx: &Ctx<'_>, scene: &XmlScene) -> Result<(), ImportError> {
                 column: at.column,
                 message: format!(
                     "<shape id=\"{}\"> refers to bsdf \"{}\", which the file does not define",
-                    shape.name.escape_debug(),
-                    id.escape_debug()
+                    bt_scene::name::shown(&shape.name),
+                    bt_scene::name::shown(id)
                 ),
             });
         }

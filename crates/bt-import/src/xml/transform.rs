@@ -115,7 +115,7 @@ fn numbers(ctx: &Ctx<'_>, op: Node<'_, '_>, text: &str) -> Result<Vec<Real>, Imp
                     format!(
                         "<{}>: \"{}\" is not a finite number",
                         tag(op),
-                        t.escape_debug()
+                        bt_scene::name::shown(t)
                     ),
                 )
             })

@@ -371,3 +371,34 @@ fn duplicate_surfaces_are_a_problem_naming_both() {
     assert!(checked(&[wall("a", 0, 4), wall("half", 2, 6)]).is_ok());
     assert!(checked(&[wall("a", 0, 4), wall("next", 4, 6)]).is_ok());
 }
+
+#[test]
+fn frequencies_outside_the_range_are_refused_for_constant_loss_materials_too() {
+    let wall = r#""materials": { "flat": { "reflection_loss_db": 6 } },
+        "surfaces": [ { "name": "w", "material": "flat", "vertices": [[0,0,0],[1,0,0],[1,0,1],[0,0,1]] } ]"#;
+    let s = scene(&format!("{{ {wall} }}")).unwrap();
+    assert!(s.materials()["flat"].radio.is_none());
+    for f in [1e300, 1.0, 2e15] {
+        let err = s.with_frequency(f).unwrap_err().to_string();
+        assert!(err.contains(&format!("got {f:e}")), "{err}");
+    }
+    assert!(s.with_frequency(1e15).is_ok());
+    let err = scene(&format!("{{ \"frequency_hz\": 1e300, {wall} }}"))
+        .unwrap_err()
+        .to_string();
+    assert!(
+        err.contains("frequency_hz") && err.contains("got 1e300"),
+        "{err}"
+    );
+}
+
+#[test]
+fn merge_options_are_checked_for_every_source() {
+    let mut options = bt_import::LoadOptions::default();
+    options.merge.angle_tol_deg = f64::NAN;
+    let Err(err) = bt_import::load("builtin:living-room", &options) else {
+        panic!("a NaN merge angle is accepted");
+    };
+    let err = err.to_string();
+    assert!(err.contains("angle_tol_deg"), "{err}");
+}

@@ -4,6 +4,7 @@
 mod budgets;
 mod growth;
 mod names;
+mod numbers;
 mod outputs;
 mod outputs2;
 mod small;
@@ -40,6 +41,14 @@ pub fn beamtrace_within(args: &[&str], bytes: u64) -> Output {
     let mut cmd = Command::new(env!("CARGO_BIN_EXE_beamtrace"));
     cmd.args(args);
     limit_memory(&mut cmd, bytes);
+    cmd.output().expect("binary runs")
+}
+
+/// Runs the binary in the folder `dir` (relative paths resolve there) under the memory limit.
+pub fn beamtrace_in(dir: &Path, args: &[&str]) -> Output {
+    let mut cmd = Command::new(env!("CARGO_BIN_EXE_beamtrace"));
+    cmd.args(args).current_dir(dir);
+    limit_memory(&mut cmd, MEMORY_LIMIT_BYTES);
     cmd.output().expect("binary runs")
 }
 

@@ -1,6 +1,7 @@
 //! Names are data: checked at load, escaped wherever printed.
 
 use super::*;
+use crate::common::stdout;
 
 /// The issue's injection: a surface name that ends the Verilog comment and opens a module.
 const INJECTION: &str = "wall\nmodule pwn; initial $display(\"pwned\"); endmodule\n//";
@@ -137,4 +138,99 @@ fn obj_material_names_follow_the_name_rule() {
     assert_refused(&r, &["room.obj", "material", "U+001B"]);
     assert!(!text(&r).contains('\u{1b}'), "{:?}", text(&r));
     std::fs::remove_dir_all(dir).ok();
+}
+
+#[test]
+fn long_duplicate_names_make_short_error_text() {
+    let dir = scratch("long-duplicates");
+    let name = "n".repeat(1024);
+    let surfaces: Vec<serde_json::Value> = (0..10_000)
+        .map(|i| {
+            let x = f64::from(i) * 2.0;
+            serde_json::json!({ "name": name, "vertices":
+                [[x, 0, 0], [x + 1.0, 0, 0], [x + 1.0, 0, 1], [x, 0, 1]] })
+        })
+        .collect();
+    let desc =
+        serde_json::json!({ "tx": [0.5, 1, 0.5], "rx": [3.5, 1, 0.5], "surfaces": surfaces });
+    let scene = scene_with(&dir, "long.json", &desc.to_string());
+    let r = beamtrace(&["scene", "check", &scene]);
+    assert_refused(&r, &["10000 problem(s)", "…(1024 bytes)", "and 9000 more"]);
+    let t = text(&r);
+    assert!(t.len() < 1 << 20, "{} bytes of error text", t.len());
+    assert!(!t.contains(&"n".repeat(100)), "a name printed in full");
+    // Names within the rule, all duplicates: cut too.
+    let desc = desc.to_string().replace(&name, &"m".repeat(150));
+    let scene = scene_with(&dir, "dup.json", &desc);
+    let r = beamtrace(&["scene", "check", &scene]);
+    assert_refused(&r, &["duplicate surface name", "…(150 bytes)"]);
+    assert!(text(&r).len() < 1 << 20);
+    std::fs::remove_dir_all(dir).ok();
+}
+
+/// Files whose names and header words carry an escape sequence (ESC, or the C1 CSI in XML,
+/// where ESC is not a character), each with a word of the
+/// message that must name the place: no run may print the escape character itself.
+#[test]
+fn escape_sequences_in_any_input_never_reach_the_terminal() {
+    let dir = scratch("escapes-everywhere");
+    let quad = "v 0 0 0\nv 4 0 0\nv 4 4 0\nv 0 4 0\n";
+    let cases: [(&str, String, &str); 7] = [
+        (
+            "object.obj",
+            format!("o evil\u{1b}[31m\n{quad}f 1 2 3 4\n"),
+            "U+001B",
+        ),
+        (
+            "group.obj",
+            format!("{quad}g evil\u{1b}[31m\nf 1 2 3 4\n"),
+            "U+001B",
+        ),
+        ("token.obj", "v 0 0 \u{1b}[31m\n".to_string(), "\\u{1b}"),
+        (
+            "type.ply",
+            "ply\nformat ascii 1.0\nelement vertex 1\nproperty flo\u{1b}[31mat x\nend_header\n"
+                .to_string(),
+            "\\u{1b}",
+        ),
+        (
+            "field.pcd",
+            "VERSION .7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F \u{1b}[31m\n".to_string(),
+            "\\u{1b}",
+        ),
+        (
+            "id.xml",
+            "<scene version=\"2.1.0\"><shape type=\"ply\" id=\"evil\u{9b}31m\">\
+             <string name=\"filename\" value=\"missing.ply\"/></shape></scene>"
+                .to_string(),
+            "\\u{9b}",
+        ),
+        (
+            "usemtl.obj",
+            format!("{quad}usemtl evil\u{1b}[31m\nf 1 2 3 4\n"),
+            "U+001B",
+        ),
+    ];
+    for (file, content, needle) in cases {
+        let path = dir.join(file);
+        std::fs::write(&path, content).unwrap();
+        let r = beamtrace(&["scene", "check", path.to_str().unwrap()]);
+        let t = text(&r);
+        assert!(!t.contains(['\u{1b}', '\u{9b}']), "{file}: {t:?}");
+        assert_refused(&r, &[needle]);
+    }
+}
+
+#[test]
+fn a_name_holding_the_path_separator_stays_one_name_in_csv_and_tables() {
+    let dir = scratch("separator-name");
+    let scene = scene_named(&dir, "a > b", "brick");
+    let cir = dir.join("cir.csv");
+    let r = beamtrace(&["channel", &scene, "--out", cir.to_str().unwrap()]);
+    assert_ok(&r);
+    let csv = std::fs::read_to_string(&cir).unwrap();
+    assert!(csv.contains(",a \\> b\n"), "{csv}");
+    let r = beamtrace(&["trace", &scene]);
+    assert_ok(&r);
+    assert!(stdout(&r).contains("a \\> b"), "{}", stdout(&r));
 }

@@ -239,3 +239,49 @@ fn leftovers_of_killed_runs_are_cleaned_by_the_next_run() {
         [link_name.as_str(), "accel", "paths.json", "target.txt"]
     );
 }
+
+#[test]
+fn channel_checks_every_option_and_output_before_writing_its_cir() {
+    let dir = scratch("channel-late-refusal");
+    let cir = dir.join("cir.csv");
+    let cfr = dir.join("cfr.csv");
+    let (cir_s, cfr_s) = (cir.to_str().unwrap(), cfr.to_str().unwrap());
+    // The frequency response's budget is the last option checked.
+    assert_refused_writing_nothing(
+        &cli(
+            "channel builtin:living-room --max-order 1 --out {} --cfr {} --subcarriers 2000",
+            &[cir_s, cfr_s],
+        )
+        .into_iter()
+        .chain(["--max-subcarriers", "1000"])
+        .collect::<Vec<_>>(),
+        &cir,
+        &["--max-subcarriers"],
+    );
+    // A PDP figure that would replace a directory.
+    std::fs::create_dir(dir.join("pdp.svg")).unwrap();
+    let stem = dir.join("pdp");
+    assert_refused_writing_nothing(
+        &cli(
+            "channel builtin:living-room --max-order 1 --out {} --pdp {}",
+            &[cir_s, stem.to_str().unwrap()],
+        ),
+        &cir,
+        &["pdp.svg"],
+    );
+    assert!(!cfr.exists());
+}
+
+#[test]
+fn sweep_checks_its_heat_map_before_writing_its_csv() {
+    let dir = scratch("sweep-late-refusal");
+    std::fs::create_dir(dir.join("coverage.png")).unwrap();
+    assert_refused_writing_nothing(
+        &cli(
+            "sweep builtin:living-room --max-order 1 --grid 1:2:1,1:2:1,1.2 --out {}",
+            &[dir.to_str().unwrap()],
+        ),
+        &dir.join("coverage.csv"),
+        &["coverage.png"],
+    );
+}

@@ -84,7 +84,10 @@ fn nan_options_are_refused() {
         "-o",
         dir.join("x.json").to_str().unwrap(),
     ]);
-    assert_refused(&r, &["--min-reflector-area", "NaN"]);
+    assert_refused(
+        &r,
+        &["--min-reflector-area", "'nan'", "must be a finite number"],
+    );
 }
 
 #[test]
