@@ -18,7 +18,7 @@ pub fn write(
     bt_output::write_atomic(path, bytes).with_context(|| format!("writing {}", path.display()))
 }
 
-/// What [`write`] checks before writing `path`, for commands of several outputs to check them
+/// What [`write()`] checks before writing `path`, for commands of several outputs to check them
 /// all before writing the first: a refusal then leaves no output behind.
 pub fn check(path: &Path, inputs: &[PathBuf], formats: &[&str]) -> anyhow::Result<()> {
     bt_output::refuse_input(path, inputs)?;

@@ -87,7 +87,7 @@ pub fn validate(scene: &Scene, seq: &[SurfaceId], tx: Vec3, rx: Vec3, points: &[
 /// does not reflect (it touches the edge; with diffraction on, it is found as a diffraction,
 /// whose point lies strictly inside its edge); on a seam between coplanar faces, which is no
 /// edge, it reflects once, on the face of the lowest id that holds the point
-/// ([`seam_owner_below`]); for the other faces it is [`Validity::OutsidePolygon`]. Edges and
+/// (`seam_owner_below`); for the other faces it is [`Validity::OutsidePolygon`]. Edges and
 /// seams are looked at only for points within `tol` of the boundary.
 #[inline(always)]
 pub fn reflection_point(
