@@ -69,6 +69,20 @@ pub enum PolygonError {
 /// million-vertex polygon would take minutes (a budget, `docs/reliability.md`).
 pub const MAX_VERTICES: usize = 10_000;
 
+/// Most vertex pairs the simplicity tests of one scene may compare, Σ n² over its polygons
+/// (about 7 s at the 0.68 s measured for one 10,000-vertex polygon, release build): many
+/// polygons just under [`MAX_VERTICES`] stop before the work instead of running for minutes
+/// (a budget, `docs/reliability.md`).
+pub const MAX_VERTEX_PAIRS: u64 = 1_000_000_000;
+
+/// The vertex pairs the simplicity tests of polygons with `counts` vertices compare, Σ n²
+/// (saturating), to hold against [`MAX_VERTEX_PAIRS`] before building them.
+pub fn vertex_pairs(counts: impl IntoIterator<Item = usize>) -> u64 {
+    counts.into_iter().fold(0u64, |sum, n| {
+        sum.saturating_add((n as u64).saturating_mul(n as u64))
+    })
+}
+
 /// A validated simple planar polygon in 3-D.
 ///
 /// The normal follows the right-hand rule of the vertex order (counter-clockwise seen from the

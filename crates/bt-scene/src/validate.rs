@@ -390,6 +390,20 @@ pub(crate) fn build_surfaces(
 ) -> Vec<Surface> {
     let mut names = BTreeSet::new();
     let mut surfaces = Vec::with_capacity(raw.len());
+    let pairs = bt_geom::polygon::vertex_pairs(raw.iter().map(|r| r.vertices.len()));
+    if pairs > bt_geom::polygon::MAX_VERTEX_PAIRS {
+        problems.report(
+            "surfaces",
+            format!(
+                "the polygons' simplicity tests would compare {} vertex pairs (the sum of each \
+                 polygon's vertex count squared), more than the budget of {:e}: split the \
+                 largest polygons",
+                bt_geom::AtLeast(pairs),
+                bt_geom::polygon::MAX_VERTEX_PAIRS as f64
+            ),
+        );
+        return surfaces;
+    }
     for r in raw {
         if let Err(e) = crate::name::check(&r.name) {
             problems.report(&r.location, e);

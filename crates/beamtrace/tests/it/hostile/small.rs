@@ -431,3 +431,41 @@ fn identical_coplanar_walls_are_refused_naming_both() {
     assert_refused(&beamtrace(&["scene", "check", &glass]), &needles[1..]);
     std::fs::remove_dir_all(dir).ok();
 }
+
+/// Round 2 (issue 27): polygons just under the per-surface vertex limit are quadratic each, so
+/// eleven of them ran for seconds apiece; their sum of squared vertex counts is a scene budget
+/// checked before any is built.
+#[test]
+fn many_huge_polygons_stop_at_the_scene_budget() {
+    let dir = scratch("huge-polygons");
+    let circle = |k: usize| {
+        let n = 10_000;
+        let points: Vec<String> = (0..n)
+            .map(|i| {
+                let a = i as f64 * std::f64::consts::TAU / n as f64;
+                format!("[{:.9}, {:.9}, {k}]", a.cos(), a.sin())
+            })
+            .collect();
+        format!(
+            r#"{{ "name": "disc{k}", "vertices": [{}] }}"#,
+            points.join(",")
+        )
+    };
+    let surfaces: Vec<String> = (0..11).map(circle).collect();
+    let scene = scene_with(
+        &dir,
+        "discs.json",
+        &format!(
+            r#"{{ "tx": [0, 0, 0.5], "rx": [0, 0.1, 0.5], "surfaces": [{}] }}"#,
+            surfaces.join(",")
+        ),
+    );
+    let start = std::time::Instant::now();
+    let o = beamtrace_within(&["scene", "check", &scene], 2 << 30);
+    assert_refused(
+        &o,
+        &["discs.json", "1100000000 vertex pairs", "split the largest"],
+    );
+    assert!(start.elapsed() < std::time::Duration::from_secs(20));
+    std::fs::remove_dir_all(dir).ok();
+}
