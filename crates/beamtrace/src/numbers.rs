@@ -232,6 +232,49 @@ mod tests {
         assert!(sbr_step_deg("90").is_ok() && sbr_step_deg("90.5").is_err());
     }
 
+    /// Every parser of the flags, as the table-driven CLI test sees them.
+    const PARSERS: [fn(&str) -> Result<f64, String>; 10] = [
+        non_negative,
+        positive,
+        length_m,
+        positive_length_m,
+        sbr_step_deg,
+        merge_angle_deg,
+        frequency_hz,
+        spacing_hz,
+        power_dbm,
+        spacing_wavelengths,
+    ];
+
+    proptest::proptest! {
+        #![proptest_config(proptest::test_runner::Config {
+            rng_seed: proptest::test_runner::RngSeed::Fixed(0x0b_ad_f1a6),
+            ..proptest::test_runner::Config::default()
+        })]
+
+        /// Fuzzing the numeric flags: any text, or any number however written, never panics
+        /// and never yields a non-finite value; an accepted number is what was written.
+        #[test]
+        fn any_text_parses_to_a_finite_number_or_a_message(
+            text in "\\PC{0,40}",
+            x in proptest::num::f64::ANY,
+            exponent in proptest::bool::ANY,
+        ) {
+            let written = if exponent { format!("{x:e}") } else { format!("{x}") };
+            for parse in PARSERS {
+                for input in [text.as_str(), written.as_str()] {
+                    match parse(input) {
+                        Ok(v) => proptest::prop_assert!(v.is_finite(), "{input:?} gave {v}"),
+                        Err(message) => proptest::prop_assert!(message.contains("must be")),
+                    }
+                }
+                if let Ok(v) = parse(&written) {
+                    proptest::prop_assert_eq!(v.to_bits(), x.to_bits());
+                }
+            }
+        }
+    }
+
     #[test]
     fn ordinary_values_pass_unchanged() {
         assert_eq!(length_m("1e-3"), Ok(1e-3));
