@@ -232,8 +232,11 @@ mod tests {
         assert!(sbr_step_deg("90").is_ok() && sbr_step_deg("90.5").is_err());
     }
 
+    /// A flag's value parser.
+    type Parser = fn(&str) -> Result<f64, String>;
+
     /// Every parser of the flags, as the table-driven CLI test sees them.
-    const PARSERS: [fn(&str) -> Result<f64, String>; 10] = [
+    const PARSERS: [Parser; 10] = [
         non_negative,
         positive,
         length_m,
@@ -248,7 +251,7 @@ mod tests {
 
     proptest::proptest! {
         #![proptest_config(proptest::test_runner::Config {
-            rng_seed: proptest::test_runner::RngSeed::Fixed(0x0b_ad_f1a6),
+            rng_seed: proptest::test_runner::RngSeed::Fixed(0x0bad_f1a6),
             ..proptest::test_runner::Config::default()
         })]
 
