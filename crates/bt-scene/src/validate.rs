@@ -7,6 +7,7 @@ use crate::model::{Scene, scene_extent};
 use crate::problem::{Collector, Problem, ProblemSink, SceneError};
 use crate::surface::{RawSurface, Surface, SurfaceKind};
 use bt_channel::RadioMaterial;
+use bt_geom::polygon::MAX_VERTICES;
 use bt_geom::{Bvh, Polygon, Real, Vec3};
 use std::collections::{BTreeMap, BTreeSet};
 use std::sync::Arc;
@@ -390,7 +391,9 @@ pub(crate) fn build_surfaces(
 ) -> Vec<Surface> {
     let mut names = BTreeSet::new();
     let mut surfaces = Vec::with_capacity(raw.len());
-    let pairs = bt_geom::polygon::vertex_pairs(raw.iter().map(|r| r.vertices.len()));
+    // Polygons over the per-surface limit are refused by their own check, before any work.
+    let counts = raw.iter().map(|r| r.vertices.len());
+    let pairs = bt_geom::polygon::vertex_pairs(counts.filter(|&n| n <= MAX_VERTICES));
     if pairs > bt_geom::polygon::MAX_VERTEX_PAIRS {
         problems.report(
             "surfaces",
