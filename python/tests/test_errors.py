@@ -83,7 +83,6 @@ def test_budget_error_carries_the_cli_message(cli):
         ({"diffraction_coefficient": "sionna"}, "diffraction coefficient: unknown"),
         # checked even when the solver chosen does not use it
         ({"sbr_step_deg": float("nan")}, "sbr step must be a positive"),
-        ({"ipc_threshold": -1.0}, "ipc-threshold"),
     ],
 )
 def test_bad_options_are_value_errors(options, message):
