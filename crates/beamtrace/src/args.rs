@@ -99,13 +99,13 @@ pub struct StudyLivingRoomArgs {
     pub ga_generations: u32,
     /// Total PE instances per step: with the GA, default planes used + 25 % for duplicates;
     /// with the list scheduler, extra PEs become copies of the busiest planes (default none).
-    #[arg(long)]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub pe_budget: Option<u32>,
     /// Fixed-point convergence threshold on a round's largest displacement, in 1/256 mm.
     #[arg(long, default_value_t = 16)]
     pub threshold_lsb: u32,
-    /// Round cap of the fixed-point IPC.
-    #[arg(long, default_value_t = 256)]
+    /// Round cap of the fixed-point IPC (1 to 65536: each round is a pass over every path).
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=65536))]
     pub max_rounds: u32,
     /// Start every step's accelerator run from the beam tree's window centres instead of the
     /// points the previous step converged to.
@@ -982,7 +982,7 @@ pub struct HlsGenArgs {
     pub schedule: ScheduleArg,
     /// Total PE instances per step: with the GA, default planes used + 25 % for duplicates;
     /// with the list scheduler, extra PEs become copies of the busiest planes (default none).
-    #[arg(long)]
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub pe_budget: Option<u32>,
     /// GA seed.
     #[arg(long, default_value_t = 1)]
@@ -990,8 +990,8 @@ pub struct HlsGenArgs {
     /// Convergence threshold on a round's largest displacement, in 1/256 mm.
     #[arg(long, default_value_t = 16)]
     pub threshold_lsb: u32,
-    /// Round cap of the fixed-point IPC.
-    #[arg(long, default_value_t = 256)]
+    /// Round cap of the fixed-point IPC (1 to 65536: each round is a pass over every path).
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=65536))]
     pub max_rounds: u32,
     /// M9K blocks the point and schedule memories may take (default: the EP4CE115's 432);
     /// a design that needs more is refused.

@@ -64,6 +64,20 @@ impl GaParams {
         if self.elite > self.population {
             return bad("elite", "must not exceed the population");
         }
+        if self.population > MAX_GA_POPULATION {
+            return bad(
+                "population",
+                "must be at most 1000 (each chromosome holds every job)",
+            );
+        }
+        let decodes = u64::from(self.population) * (u64::from(self.generations) + 1);
+        if decodes > MAX_GA_DECODES {
+            return bad(
+                "population × (generations + 1)",
+                "must be at most 100000 schedule decodes, each O(jobs): a budget against runs \
+                 of hours",
+            );
+        }
         if !(0.0..=1.0).contains(&self.crossover_rate) {
             return bad("crossover_rate", "must be a probability in [0, 1]");
         }
@@ -73,6 +87,13 @@ impl GaParams {
         Ok(())
     }
 }
+
+/// Most chromosomes per generation (each holds every job: 1000 × 10,000 jobs is 40 MB).
+pub const MAX_GA_POPULATION: u32 = 1000;
+
+/// Most schedule decodes a GA run may make, population × (generations + 1), each O(jobs)
+/// (the defaults make 156).
+pub const MAX_GA_DECODES: u64 = 100_000;
 
 /// Duplication steps always evaluated; beyond them only steps that lower the makespan bound.
 const DENSE_DUPLICATION_STEPS: usize = 64;

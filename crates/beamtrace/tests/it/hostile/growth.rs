@@ -191,3 +191,35 @@ fn every_input_format_is_held_to_the_file_byte_budget() {
     refused(&args, &["budget of 10", "--max-file-bytes"]);
     assert!(!out.exists());
 }
+
+/// The study and accelerator sizes: a GA of four billion chromosomes, a round cap of four
+/// billion and as many PEs are refused before any work, naming the option.
+#[test]
+fn study_and_accelerator_sizes_are_bounded() {
+    let dir = scratch("sizes");
+    let out = dir.join("out");
+    let out = out.to_str().unwrap();
+    let ga = |extra: &[&str]| {
+        let mut args = vec!["study", "living-room", "--schedule", "ga", "--out", out];
+        args.extend_from_slice(extra);
+        beamtrace(&args)
+    };
+    let o = ga(&["--ga-population", "4000000000"]);
+    assert_refused(&o, &["population", "at most 1000"]);
+    let o = ga(&["--ga-population", "1000", "--ga-generations", "4000000000"]);
+    assert_refused(&o, &["population × (generations + 1)", "100000"]);
+    for flag in ["--max-rounds", "--pe-budget"] {
+        let o = beamtrace(&[
+            "hls",
+            "gen",
+            "builtin:living-room",
+            flag,
+            "4000000000",
+            "-o",
+            out,
+        ]);
+        assert_refused(&o, &[flag]);
+    }
+    assert!(!dir.join("out").exists());
+    std::fs::remove_dir_all(dir).ok();
+}
