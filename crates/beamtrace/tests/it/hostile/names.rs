@@ -99,15 +99,14 @@ fn printable_unicode_names_pass_and_print_as_themselves() {
 #[test]
 fn surfaces_named_like_the_terminals_stay_apart_in_dot() {
     let dir = scratch("tx-named");
-    let scene = dir.join("scene.json");
-    std::fs::write(
-        &scene,
+    let scene = scene_with(
+        &dir,
+        "scene.json",
         r#"{ "tx": [0, 0, 1], "rx": [3, 0, 1], "surfaces": [
             { "name": "TX", "vertices": [[-5, -5, 0], [5, -5, 0], [5, 5, 0], [-5, 5, 0]] },
             { "name": "RX", "vertices": [[-5, 5, 0], [5, 5, 0], [5, 5, 3], [-5, 5, 3]] } ] }"#,
-    )
-    .unwrap();
-    let r = beamtrace(&["wvrn", "--dot", scene.to_str().unwrap()]);
+    );
+    let r = beamtrace(&["wvrn", "--dot", &scene]);
     assert_ok(&r);
     let dot = text(&r);
     let declared = dot.lines().filter(|l| l.contains("[label=")).count();
@@ -121,20 +120,12 @@ fn surfaces_named_like_the_terminals_stay_apart_in_dot() {
 #[test]
 fn obj_material_names_follow_the_name_rule() {
     let dir = scratch("usemtl");
-    let obj = dir.join("room.obj");
-    std::fs::write(
-        &obj,
+    let obj = scene_with(
+        &dir,
+        "room.obj",
         "v 0 0 0\nv 4 0 0\nv 4 4 0\nv 0 4 0\nusemtl evil\u{1b}[31mred\nf 1 2 3 4\n",
-    )
-    .unwrap();
-    let r = beamtrace(&[
-        "trace",
-        obj.to_str().unwrap(),
-        "--tx",
-        "1,1,1",
-        "--rx",
-        "2,2,1",
-    ]);
+    );
+    let r = beamtrace(&["trace", &obj, "--tx", "1,1,1", "--rx", "2,2,1"]);
     assert_refused(&r, &["room.obj", "material", "U+001B"]);
     assert!(!text(&r).contains('\u{1b}'), "{:?}", text(&r));
     std::fs::remove_dir_all(dir).ok();

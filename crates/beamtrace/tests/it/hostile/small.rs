@@ -290,20 +290,14 @@ fn a_nan_minimum_reflector_area_is_refused() {
 #[test]
 fn a_formula_name_is_escaped_in_the_csv() {
     let dir = scratch("formula-csv");
-    let scene = dir.join("scene.json");
-    std::fs::write(
-        &scene,
+    let scene = scene_with(
+        &dir,
+        "scene.json",
         r#"{ "tx": [0, 0, 1], "rx": [3, 0, 1], "surfaces": [ { "name": "=HYPERLINK(1)",
             "vertices": [[-5, -5, 0], [5, -5, 0], [5, 5, 0], [-5, 5, 0]] } ] }"#,
-    )
-    .unwrap();
+    );
     let cir = dir.join("cir.csv");
-    let o = beamtrace(&[
-        "channel",
-        scene.to_str().unwrap(),
-        "--out",
-        cir.to_str().unwrap(),
-    ]);
+    let o = beamtrace(&["channel", &scene, "--out", cir.to_str().unwrap()]);
     assert!(o.status.success(), "{}", text(&o));
     let csv = std::fs::read_to_string(&cir).unwrap();
     assert!(csv.contains("\"'=HYPERLINK(1)\""), "{csv}");
@@ -318,10 +312,7 @@ fn a_formula_name_is_escaped_in_the_csv() {
 fn a_fifo_as_a_mesh_is_refused_not_waited_on() {
     let dir = scratch("fifo-mesh");
     let fifo = dir.join("room.obj");
-    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
-    if !made.is_ok_and(|s| s.success()) {
-        return; // no mkfifo on this system
-    }
+    bt_testkit::special::mkfifo(&fifo);
     crate::common::assert_clear_error(
         &[
             "trace",
@@ -333,21 +324,13 @@ fn a_fifo_as_a_mesh_is_refused_not_waited_on() {
         ],
         &["room.obj", "not a regular file"],
     );
-    let xml = dir.join("scene.xml");
-    std::fs::write(
-        &xml,
+    let xml = scene_with(
+        &dir,
+        "scene.xml",
         r#"<scene version="2.1.0"><shape type="obj" id="room"><string name="filename" value="room.obj"/></shape></scene>"#,
-    )
-    .unwrap();
+    );
     crate::common::assert_clear_error(
-        &[
-            "trace",
-            xml.to_str().unwrap(),
-            "--tx",
-            "0,0,1",
-            "--rx",
-            "1,0,1",
-        ],
+        &["trace", &xml, "--tx", "0,0,1", "--rx", "1,0,1"],
         &["room.obj", "not a regular file"],
     );
     std::fs::remove_dir_all(dir).ok();
