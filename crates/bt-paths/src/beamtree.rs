@@ -326,6 +326,7 @@ impl Prepared<'_> {
 pub struct TreeCache {
     shapes: Shapes,
     arenas: Option<Arenas>,
+    side: Option<KeptSide>,
 }
 
 impl Clone for TreeCache {
@@ -1361,10 +1362,8 @@ pub fn candidates_and_diffracted_in(
     }
     set.stats = tree.candidate_stats(set.len() as u64);
     set.tree = Some(tree.stats.clone());
-    if let Some(min_edge_length) = diffraction {
-        set.diffracted = diffracted(scene, &tree, options, min_edge_length)?;
-        set.stats.diffracted = set.diffracted.len() as u64;
-    }
+    let side =
+        diffraction.map(|min_edge_length| KeptSide::take(cache, scene, &tree, min_edge_length));
     Arenas {
         nodes: tree.nodes,
         verts: tree.verts,
@@ -1372,28 +1371,59 @@ pub fn candidates_and_diffracted_in(
     }
     .give_back(cache);
     prep.keep_in(cache);
+    if let Some(side) = side {
+        set.diffracted = diffracted_with(scene, &side.side, options, cache)?;
+        set.stats.diffracted = set.diffracted.len() as u64;
+        cache.side = Some(side);
+    }
     Ok(set)
 }
 
-/// The diffracted candidates of `scene` (edges at least `min_edge_length` m long), the TX
-/// side from `tx` (materialised to depth `options.max_order − 1`).
-fn diffracted(
-    scene: &Scene,
-    tx: &BeamTree,
+/// A TX tree's [`DiffractionSide`] kept in a [`TreeCache`] with what it was built from, so
+/// that the next trace from the same TX (a moving receiver) skips the TX side's reaches.
+struct KeptSide {
+    geometry: bt_scene::GeometryKey,
+    /// The TX (scene-local frame, m), the tree's options and tolerance, the minimum edge
+    /// length: equal bit for bit, or the side is built anew.
+    tx: Vec3,
     options: TreeOptions,
+    tol: Real,
     min_edge_length: Real,
-) -> Result<crate::diffraction::DiffractedSet, TreeError> {
-    let side = DiffractionSide::of(scene, tx, options.max_order, min_edge_length);
-    diffracted_with(scene, (tx, &side), options)
+    side: DiffractionSide,
 }
 
-/// The diffracted candidates of `scene`'s RX with a kept TX tree and its side
+impl KeptSide {
+    /// `cache`'s kept side when it was built for `tx`'s tree in `scene`, or a new one.
+    fn take(cache: &mut TreeCache, scene: &Scene, tx: &BeamTree, min_edge_length: Real) -> Self {
+        let same = |k: &KeptSide| {
+            k.geometry.matches(scene)
+                && k.tx == tx.tx
+                && k.options == tx.options
+                && k.tol == tx.tol
+                && k.min_edge_length == min_edge_length
+        };
+        match cache.side.take() {
+            Some(kept) if same(&kept) => kept,
+            _ => KeptSide {
+                geometry: scene.geometry_key(),
+                tx: tx.tx,
+                options: tx.options,
+                tol: tx.tol,
+                min_edge_length,
+                side: DiffractionSide::of(scene, tx, tx.options.max_order, min_edge_length),
+            },
+        }
+    }
+}
+
+/// The diffracted candidates of `scene`'s RX with a kept TX tree's side
 /// ([`DiffractionSide::of`], same order): the RX side from a tree grown from RX to depth
-/// `options.max_order − 1`. Stops beyond `options.max_nodes` candidates.
+/// `options.max_order − 1` with `cache`. Stops beyond `options.max_nodes` candidates.
 pub fn diffracted_with(
     scene: &Scene,
-    tx: (&BeamTree, &DiffractionSide),
+    tx: &DiffractionSide,
     options: TreeOptions,
+    cache: &mut TreeCache,
 ) -> Result<crate::diffraction::DiffractedSet, TreeError> {
     if options.max_order == 0 {
         return Ok(Default::default());
@@ -1405,6 +1435,6 @@ pub fn diffracted_with(
         starts: false,
         ..options
     };
-    let rx = BeamTree::build(&swapped, depth)?;
+    let rx = BeamTree::build_in(&swapped, depth, cache, &mut |_| {})?;
     diffraction::join(scene, tx, &rx, options.max_nodes)
 }

@@ -420,7 +420,9 @@ impl KeptTx {
         let mut set = self.tree.candidates(scene.terminals()?.rx);
         if let Some(side) = &self.side {
             let tree_options = solver_tree_options(options);
-            set.diffracted = diffracted_with(scene, (&self.tree, side), tree_options)?;
+            // Receivers in parallel cannot share one cache: each RX tree gets its own.
+            let cache = &mut TreeCache::default();
+            set.diffracted = diffracted_with(scene, side, tree_options, cache)?;
             set.stats.diffracted = set.diffracted.len() as u64;
         }
         Ok(set)

@@ -42,10 +42,11 @@ struct Reach {
 }
 
 impl BeamTree {
-    /// The nodes of depth ≤ `max_depth` (the root included) whose image lies in an edge's
-    /// exterior and whose beam reaches the edge, per edge of `usable` (`usable[e]`), each
-    /// edge's in ascending depth.
-    fn reaches(&self, scene: &Scene, usable: &[bool], max_depth: usize) -> Vec<Vec<Reach>> {
+    /// The nodes (the root included) whose image lies in an edge's exterior and whose beam
+    /// reaches the edge, per edge, each edge's in ascending depth: on edge `e` the nodes of
+    /// depth below `limit[e]` (none when 0).
+    fn reaches(&self, scene: &Scene, limit: &[usize]) -> Vec<Vec<Reach>> {
+        let max_depth = limit.iter().max().map_or(0, |m| m.saturating_sub(1));
         let edges = scene.edges();
         let in_plane: Vec<Vec<u32>> = edges
             .all()
@@ -55,7 +56,7 @@ impl BeamTree {
         let eps = EPS * self.tol;
         let mut out: Vec<Vec<Reach>> = vec![Vec::new(); edges.len()];
         for (e, edge) in edges.all().iter().enumerate() {
-            if usable[e] && in_sector(edge, self.tx) {
+            if limit[e] > 0 && in_sector(edge, self.tx) {
                 out[e].push(Reach {
                     node: ROOT,
                     depth: 0,
@@ -75,7 +76,7 @@ impl BeamTree {
                 let test = |min, max| box_meets_halfspaces(min, max, planes, eps);
                 edges.bvh().visit(test, |e| {
                     let edge = &edges.all()[e as usize];
-                    if !usable[e as usize]
+                    if d + 1 >= limit[e as usize]
                         || in_plane[e as usize].contains(&node.surface)
                         || !in_sector(edge, node.image)
                     {
@@ -96,16 +97,32 @@ impl BeamTree {
         out
     }
 
-    /// The surfaces of node `i`, root side first (empty for the root).
-    fn surfaces_of(&self, mut i: u32, out: &mut Vec<SurfaceId>) {
-        out.clear();
-        while i != ROOT {
-            let node = &self.nodes[i as usize];
-            out.push(SurfaceId(node.surface));
-            i = node.parent;
-        }
-        out.reverse();
+    /// Each node's (parent, surface) up to depth `max_depth` (node index order), what
+    /// [`surfaces_of`] needs of the tree.
+    fn prefixes(&self, max_depth: usize) -> Vec<(u32, u32)> {
+        let end = self
+            .levels
+            .iter()
+            .take(max_depth)
+            .map(|l| l.1)
+            .max()
+            .unwrap_or(0);
+        self.nodes[..end]
+            .iter()
+            .map(|n| (n.parent, n.surface))
+            .collect()
     }
+}
+/// The surfaces of node `i` of a tree whose node `k` has (parent, surface) `node(k)`, root
+/// side first (empty for the root).
+fn surfaces_of(node: impl Fn(u32) -> (u32, u32), mut i: u32, out: &mut Vec<SurfaceId>) {
+    out.clear();
+    while i != ROOT {
+        let (parent, surface) = node(i);
+        out.push(SurfaceId(surface));
+        i = parent;
+    }
+    out.reverse();
 }
 
 /// The surfaces touching `edge` whose plane holds its whole segment to half the scene's length
@@ -162,12 +179,17 @@ fn clip(edge: &Edge, planes: &[Plane], eps: Real) -> Option<(Real, Real)> {
 }
 
 /// What the diffracted candidates need of a TX tree, kept while only RX moves: its nodes'
-/// reaches on the usable edges (those at least the minimum edge length long).
+/// reaches on the usable edges (those at least the minimum edge length long) and the
+/// surfaces of those nodes. It holds no reference to the tree, so a trace can keep it
+/// after the tree's arenas went back to their cache.
 #[derive(Debug, Clone)]
 pub struct DiffractionSide {
     reaches: Vec<Vec<Reach>>,
-    usable: Vec<bool>,
     max_order: usize,
+    /// (parent, surface) of the tree's nodes to depth `max_order − 1`.
+    prefixes: Vec<(u32, u32)>,
+    /// The tree's length tolerance (m), for the join's margin.
+    tol: Real,
 }
 
 impl DiffractionSide {
@@ -178,24 +200,26 @@ impl DiffractionSide {
         for e in crate::diffraction::usable_edges(scene, min_edge_length) {
             usable[e.index()] = true;
         }
-        let reaches = match max_order {
-            0 => vec![Vec::new(); usable.len()],
-            _ => tx.reaches(scene, &usable, max_order - 1),
-        };
+        let limit: Vec<usize> = usable
+            .iter()
+            .map(|&u| if u { max_order } else { 0 })
+            .collect();
+        let reaches = tx.reaches(scene, &limit);
         DiffractionSide {
             reaches,
-            usable,
             max_order,
+            prefixes: tx.prefixes(max_order.saturating_sub(1)),
+            tol: tx.tol,
         }
     }
 }
 
-/// The diffracted candidates of one TX and one RX up to `side`'s order, from the TX tree `tx`
-/// with its `side` and the RX tree `rx` (materialised to depth `max_order − 1` at least).
+/// The diffracted candidates of one TX and one RX up to `side`'s order, from the TX tree's
+/// `side` and the RX tree `rx` (materialised to depth `max_order − 1` at least).
 /// Stops with [`TreeError::Budget`] beyond `budget`.
 pub fn join(
     scene: &Scene,
-    (tx, side): (&BeamTree, &DiffractionSide),
+    side: &DiffractionSide,
     rx: &BeamTree,
     budget: u64,
 ) -> Result<DiffractedSet, TreeError> {
@@ -204,9 +228,16 @@ pub fn join(
     if max_order == 0 {
         return Ok(set);
     }
-    let margin = GROW * tx.tol.max(rx.tol);
+    let margin = GROW * side.tol.max(rx.tol);
+    let tx_node = |k: u32| side.prefixes[k as usize];
+    let rx_node = |k: u32| (rx.nodes[k as usize].parent, rx.nodes[k as usize].surface);
     let from_tx = &side.reaches;
-    let from_rx = rx.reaches(scene, &side.usable, max_order - 1);
+    // An RX reach on an edge fits the order only with the shallowest TX reach there at most.
+    let limit: Vec<usize> = from_tx
+        .iter()
+        .map(|r| r.first().map_or(0, |a| max_order - a.depth))
+        .collect();
+    let from_rx = rx.reaches(scene, &limit);
     let (mut before, mut after) = (Vec::new(), Vec::new());
     for (e, edge) in scene.edges().all().iter().enumerate() {
         for a in &from_tx[e] {
@@ -221,8 +252,8 @@ pub fn join(
                 };
                 let inside = |r: &Reach| t >= r.lo - margin && t <= r.hi + margin;
                 if inside(a) && inside(b) {
-                    tx.surfaces_of(a.node, &mut before);
-                    rx.surfaces_of(b.node, &mut after);
+                    surfaces_of(tx_node, a.node, &mut before);
+                    surfaces_of(rx_node, b.node, &mut after);
                     after.reverse();
                     set.push(&before, EdgeId(e as u32), &after);
                     if set.len() as u64 > budget {

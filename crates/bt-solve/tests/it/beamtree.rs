@@ -10,7 +10,7 @@ use bt_geom::{Real, Vec3};
 use bt_paths::beamtree::{BeamTree, Culling, TreeOptions};
 use bt_scene::{Scene, Terminals};
 use bt_solve::pipeline::{CandidateMode, DiffractionOptions, TraceOptions};
-use bt_solve::{FoundPath, Solver, UpdateOrder};
+use bt_solve::{FoundPath, Solver, Tracer, UpdateOrder};
 use bt_testkit::nasty_scene;
 use proptest::prelude::*;
 use rand::{Rng, SeedableRng};
@@ -145,6 +145,7 @@ proptest! {
         };
         let many = trace_receivers(&scene, &receivers, &diffraction(CandidateMode::BeamTree))
             .expect("receivers trace");
+        let mut one_at_a_time = Tracer::new(scene.clone(), diffraction(CandidateMode::BeamTree));
         for (rx, got) in receivers.iter().zip(&many) {
             let moved = scene.with_receiver(*rx).unwrap();
             let reference = trace_scene(&moved, &diffraction(CandidateMode::Exhaustive))
@@ -154,6 +155,23 @@ proptest! {
             };
             prop_assert_eq!(kinds(&got.result.paths), kinds(&reference));
             prop_assert!(max_point_distance(&got.result.paths, &reference) < 1e-9);
+            // One tracer, one receiver at a time: from the second trace on it reuses the TX
+            // side kept in its cache, and must give a fresh tracer's paths, bit for bit.
+            let fresh = Tracer::new(scene.clone(), diffraction(CandidateMode::BeamTree))
+                .trace(scene.tx_world().unwrap(), *rx)
+                .expect("fresh trace");
+            let reused = one_at_a_time.trace(scene.tx_world().unwrap(), *rx).expect("trace");
+            prop_assert_eq!(&reused.result.paths, &fresh.result.paths);
+            prop_assert_eq!(reused.candidates.diffracted, fresh.candidates.diffracted);
+        }
+        // Another TX: the kept side is not reused.
+        if let [first, second, ..] = receivers.as_slice() {
+            let fresh = Tracer::new(scene.clone(), diffraction(CandidateMode::BeamTree))
+                .trace(*second, *first);
+            let reused = one_at_a_time.trace(*second, *first);
+            if let (Ok(fresh), Ok(reused)) = (fresh, reused) {
+                prop_assert_eq!(&reused.result.paths, &fresh.result.paths);
+            }
         }
     }
 
