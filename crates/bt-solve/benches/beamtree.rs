@@ -168,6 +168,24 @@ fn living_room_diffraction(c: &mut Criterion) {
     group.bench_function("trace-one-diffraction", |b| {
         b.iter(|| whole_trace(&mut tracer))
     });
+    // A fixed access point and a moving handset: the RX moves by a millimetre every trace,
+    // and the tracer's cache keeps the TX side's reaches.
+    let (tx, rx) = (scene.tx_world().unwrap(), scene.rx_world().unwrap());
+    let step = |i: usize| Vec3::new(0.001 * (i % 7) as f64, 0.0, 0.0);
+    let mut i = 0;
+    group.bench_function("trace-one-diffraction-moving-rx", |b| {
+        b.iter(|| {
+            i += 1;
+            tracer.trace(tx, rx + step(i)).unwrap().result.paths.len()
+        })
+    });
+    // The TX moves every trace too: nothing of the TX side can be kept.
+    group.bench_function("trace-one-diffraction-moving-tx", |b| {
+        b.iter(|| {
+            i += 1;
+            tracer.trace(tx + step(i), rx).unwrap().result.paths.len()
+        })
+    });
     group.bench_function("candidates-one-diffraction", |b| {
         b.iter(|| {
             bt_solve::pipeline::candidates(black_box(&scene), &diffraction)
