@@ -402,3 +402,23 @@ fn merge_options_are_checked_for_every_source() {
     let err = err.to_string();
     assert!(err.contains("angle_tol_deg"), "{err}");
 }
+
+/// The README's example room (`examples/`): its JSON and TOML files are one scene, and the OBJ
+/// mesh has one surface fewer (the screen, which only the scene files have) and the same area
+/// besides; it has no terminals.
+#[test]
+fn the_example_room_is_one_scene_in_every_format() {
+    let dir = concat!(env!("CARGO_MANIFEST_DIR"), "/../../examples/");
+    let options = bt_import::LoadOptions::default();
+    let load = |name: &str| bt_import::load(&format!("{dir}{name}"), &options).unwrap();
+    let (json, toml, obj) = (load("room.json"), load("room.toml"), load("room.obj"));
+    assert!(json.warnings.is_empty() && toml.warnings.is_empty() && obj.warnings.is_empty());
+    let (json, toml, obj) = (json.scene, toml.scene, obj.scene);
+    assert_eq!(json.name(), toml.name());
+    assert_eq!(json.surfaces(), toml.surfaces());
+    assert_eq!((json.tx(), json.rx()), (toml.tx(), toml.rx()));
+    let area = |s: &Scene| -> f64 { s.surfaces().iter().map(|f| f.polygon.area()).sum() };
+    let screen = json.surface(json.find("screen").unwrap()).polygon.area();
+    assert!((area(&json) - screen - area(&obj)).abs() < 1e-9);
+    assert_eq!(obj.surfaces().len() + 1, json.surfaces().len());
+}
