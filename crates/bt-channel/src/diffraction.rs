@@ -55,7 +55,9 @@ pub enum DiffractionCoefficient {
     /// with Sionna: J = R_0·(D1 − D4) + R_n·(D2 − D3) after swapping the faces so that the
     /// incident wave sees face 0, with R_n := −I when face n is not lit
     /// (`docs/sionna-diffraction-notes.md` §4). Not continuous across face 0's reflection
-    /// boundary; for a conductor the hard component gets the soft coefficient.
+    /// boundary; for a conductor the hard component gets the soft coefficient. The diffracted
+    /// leg s stays UTD's unfolded length; Sionna 2.2's, which depends on its solver's
+    /// `max_depth`, is [`crate::path_gain_sionna_rt22`]'s.
     #[serde(rename = "sionna-rt-2.2")]
     SionnaRt22,
 }

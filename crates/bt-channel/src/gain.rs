@@ -215,6 +215,24 @@ pub fn path_gain_detailed(
     frequency_hz: Real,
     coefficient: DiffractionCoefficient,
 ) -> Result<PathGain, ChannelError> {
+    let radio = (frequency_hz, coefficient);
+    path_gain_with_leg(tx, points, rx, interactions, antennas, radio, None)
+}
+
+/// [`path_gain_detailed`] (`radio` = (frequency, Hz; coefficient)), with the diffraction's
+/// diffracted leg s (metres; in the coefficient's distance parameter L and in the spreading)
+/// taken as `diffracted_leg` instead of the unfolded length from the diffraction point to RX
+/// when it is given (Sionna RT 2.2's, [`crate::sionna`]). The delay and the excess loss's
+/// free-space reference keep the path's own length.
+pub(crate) fn path_gain_with_leg(
+    tx: Vec3,
+    points: &[Vec3],
+    rx: Vec3,
+    interactions: &[Interaction],
+    antennas: (&Antenna, &Antenna),
+    (frequency_hz, coefficient): (Real, DiffractionCoefficient),
+    diffracted_leg: Option<Real>,
+) -> Result<PathGain, ChannelError> {
     if points.len() != interactions.len() {
         return Err(ChannelError::Invalid {
             field: "interactions",
@@ -245,7 +263,7 @@ pub fn path_gain_detailed(
     let length: Real = segments.iter().sum();
     let legs = |index: usize| Legs {
         incident: segments[..=index].iter().sum(),
-        diffracted: segments[index + 1..].iter().sum(),
+        diffracted: diffracted_leg.unwrap_or_else(|| segments[index + 1..].iter().sum()),
     };
     let mut k = (vertices[1] - vertices[0]).normalize();
     let one = Complex64::new(1.0, 0.0);

@@ -14,6 +14,7 @@ pub mod diffraction;
 pub mod gain;
 pub mod material;
 pub mod response;
+pub mod sionna;
 
 pub use antenna::{Antenna, Orientation, Pattern, Polarization};
 pub use codebook::{Array, Beam, MAX_BEAM_PAIRS, PathDirections, beam_pairs, check_beam_pairs};
@@ -31,6 +32,7 @@ pub use response::{
     MAX_CFR_PRODUCTS, MAX_SUBCARRIERS, ResponseBudget, Tap, frequency_response, subcarriers,
     total_power,
 };
+pub use sionna::{path_gain_sionna_rt22, sionna_rt22_diffracted_leg};
 
 use bt_geom::Real;
 use thiserror::Error;

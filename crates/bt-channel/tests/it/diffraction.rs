@@ -529,3 +529,58 @@ fn sionna_coefficient_matches_the_replica() {
         }
     }
 }
+
+/// Sionna RT 2.2's diffracted leg (`bt_channel::sionna`): TX → screen edge → floor → RX, the
+/// reverse of `screen_paths`' bounced path. Found by a solver of depth 2 (as many interactions
+/// as the path) the leg is the unfolded length and the gain `path_gain_detailed`'s, bit for
+/// bit; of depth 3 the leg is s − |RX − P| + |X − P| + |RX − X| (P the floor point, X the
+/// edge point mirrored in the floor), and the gain equals the plain UTD gain with RX moved on
+/// along its last segment by the extra length (same directions, s and so L and the spreading
+/// grown the same way). A path whose diffraction comes last ([R, D]) keeps its leg at any
+/// depth; a path longer than the depth is refused.
+#[test]
+fn sionnas_diffracted_leg_grows_with_its_solver_depth() {
+    let paths = screen_paths(concrete());
+    let (tx, rx) = (paths.rx, paths.tx);
+    let (points, interactions) = (reversed(&paths.bounced.0), reversed(&paths.bounced.1));
+    let a = isotropic(Polarization::V);
+    let sionna = |depth| {
+        bt_channel::path_gain_sionna_rt22(tx, &points, rx, &interactions, (&a, &a), F, depth)
+            .unwrap()
+    };
+    let plain = |rx: Vec3| {
+        let coefficient = DiffractionCoefficient::SionnaRt22;
+        bt_channel::path_gain_detailed(tx, &points, rx, &interactions, (&a, &a), F, coefficient)
+            .unwrap()
+    };
+    let leg =
+        |depth| bt_channel::sionna_rt22_diffracted_leg(&points, rx, &interactions, depth).unwrap();
+    let unfolded = polyline(&[points[0], points[1], rx]);
+    assert_eq!(leg(2), Some(unfolded));
+    assert_eq!(sionna(2), plain(rx));
+    let (q, p) = (points[0], points[1]);
+    let mirrored = Vec3::new(q.x, q.y, -q.z);
+    let grown = unfolded - p.distance(rx) + mirrored.distance(p) + rx.distance(mirrored);
+    let extra = grown - unfolded;
+    assert!(extra > 1.0, "{extra}");
+    assert!(
+        (leg(3).unwrap() - grown).abs() < 1e-12,
+        "{:?} vs {grown}",
+        leg(3)
+    );
+    assert_eq!(leg(3), leg(5));
+    let moved = plain(rx + (rx - p).normalize() * extra).gain;
+    let deep = sionna(3).gain;
+    assert!(
+        (deep - moved).norm() <= 1e-12 * moved.norm(),
+        "{deep} vs {moved}"
+    );
+    assert!(db(deep.norm() / plain(rx).gain.norm()) < -1.0);
+    let (before, before_kinds) = &paths.bounced;
+    let edge_last = |depth| {
+        bt_channel::sionna_rt22_diffracted_leg(before, paths.rx, before_kinds, depth).unwrap()
+    };
+    let (two, three) = (edge_last(2).unwrap(), edge_last(3).unwrap());
+    assert!((three - two).abs() < 1e-12, "{three} vs {two}");
+    assert!(bt_channel::sionna_rt22_diffracted_leg(&points, rx, &interactions, 1).is_err());
+}
