@@ -310,14 +310,16 @@ pub struct RadioArgs {
 #[derive(Debug, Args, Clone, Copy)]
 pub struct CoefficientArgs {
     /// Diffraction coefficient of diffracted paths: utd (Kouyoumjian-Pathak with Luebbers'
-    /// lossy faces, continuous at every boundary) or sionna-rt-2.2 (Sionna RT 2.2's
-    /// combination, to compare with Sionna). docs/channel.md §8.
+    /// lossy faces, continuous at every boundary) or sionna-rt-2.2 (Sionna RT 2.2's gains, to
+    /// compare with Sionna: its combination, and its diffracted leg for a PathSolver whose
+    /// max_depth is --max-order). docs/channel.md §8.
     #[arg(long, default_value = "utd", value_parser = parse_coefficient)]
     pub diffraction_coefficient: bt_channel::DiffractionCoefficient,
 }
 
 impl CoefficientArgs {
-    /// Default radio options with this coefficient (commands without antenna options).
+    /// Default radio options with this coefficient (commands without antenna options); the
+    /// caller sets the trace's order ([`bt_beams::RadioOptions::for_order`]).
     pub fn options(self) -> bt_beams::RadioOptions {
         bt_beams::RadioOptions {
             diffraction_coefficient: self.diffraction_coefficient,
@@ -341,7 +343,8 @@ fn parse_polarization(s: &str) -> Result<bt_channel::Polarization, bt_channel::C
 }
 
 impl RadioArgs {
-    /// The report's radio options.
+    /// The report's radio options; the caller sets the trace's order
+    /// ([`bt_beams::RadioOptions::for_order`]).
     pub fn options(&self) -> anyhow::Result<bt_beams::RadioOptions> {
         let antenna = |pattern, polarization, o: Vec3| {
             let orientation = bt_channel::Orientation::from_degrees(o.x, o.y, o.z);
@@ -352,6 +355,7 @@ impl RadioArgs {
             rx: antenna(self.rx_pattern, self.rx_polarization, self.rx_orientation),
             tx_power_dbm: self.tx_power_dbm,
             diffraction_coefficient: self.coefficient.diffraction_coefficient,
+            sionna_max_depth: None,
         })
     }
 }

@@ -25,7 +25,7 @@ fn traced_paths(
     let trace_args = args.trace_args();
     let options = trace_args.solve.settings().trace_options(&scene)?;
     let traced = bt_solve::Tracer::new(scene.clone(), options).trace(tx, rx)?;
-    let radio = args.radio.options()?;
+    let radio = args.radio.options()?.for_order(options.max_order);
     let paths = bt_beams::report(&scene, &traced.result.paths, &radio)?;
     warn_near_field(&paths, &scene);
     Ok((scene, paths, radio, loaded.sources))

@@ -16,7 +16,7 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
     let scene0 = dynamic.step(0);
     let options = args.solve.settings().trace_options(scene0)?;
     let incremental = !args.from_scratch;
-    let radio = args.radio.options()?;
+    let radio = args.radio.options()?.for_order(options.max_order);
     let mut tracer = bt_solve::Tracer::new(scene0.clone(), options);
     let mut steps = Vec::with_capacity(dynamic.len());
     for scene in dynamic.scenes() {

@@ -31,7 +31,7 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
     bar.finish_and_clear();
     let traced = traced?;
     let scene = tracer.scene();
-    let radio = args.radio.options()?;
+    let radio = args.radio.options()?.for_order(options.max_order);
     let doc = TraceDocument::report(scene, &options, &traced, &radio, t1 - t0)?;
     warn_near_field(&doc.paths, scene);
     let json = serde_json::to_string_pretty(&doc).context("serialising the trace")?;

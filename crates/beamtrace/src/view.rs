@@ -35,7 +35,10 @@ pub fn run(args: &ViewArgs) -> anyhow::Result<ExitCode> {
                 };
                 tracer.set_scene((*scene).clone());
                 let traced = tracer.trace(scene.to_world(ends.tx), scene.to_world(ends.rx))?;
-                let radio = args.coefficient.options();
+                let radio = args
+                    .coefficient
+                    .options()
+                    .for_order(tracer.options().max_order);
                 let reports = bt_beams::report(scene, &traced.result.paths, &radio)?;
                 steps.push(StepPaths::from_reports(scene, &reports));
             }

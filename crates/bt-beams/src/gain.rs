@@ -3,7 +3,7 @@
 //! its wedge's frame and faces.
 
 use crate::{RadioOptions, ReportError, surface_response};
-use bt_channel::{Bounce, Complex64, Wedge};
+use bt_channel::{Bounce, Complex64, DiffractionCoefficient, Wedge};
 use bt_geom::Real;
 use bt_scene::Scene;
 use bt_solve::{FoundPath, Interaction};
@@ -38,14 +38,26 @@ pub(crate) fn path_gain(
             }
         })
         .collect();
-    let g = bt_channel::path_gain_detailed(
-        ends.tx,
-        &path.points,
-        ends.rx,
-        &channel,
-        (&radio.tx, &radio.rx),
-        scene.frequency_hz(),
-        radio.diffraction_coefficient,
-    )?;
+    let antennas = (&radio.tx, &radio.rx);
+    let g = match (radio.diffraction_coefficient, radio.sionna_max_depth) {
+        (DiffractionCoefficient::SionnaRt22, Some(max_depth)) => bt_channel::path_gain_sionna_rt22(
+            ends.tx,
+            &path.points,
+            ends.rx,
+            &channel,
+            antennas,
+            scene.frequency_hz(),
+            max_depth,
+        )?,
+        (coefficient, _) => bt_channel::path_gain_detailed(
+            ends.tx,
+            &path.points,
+            ends.rx,
+            &channel,
+            antennas,
+            scene.frequency_hz(),
+            coefficient,
+        )?,
+    };
     Ok((g.gain, g.diffraction_loss_db))
 }

@@ -51,6 +51,24 @@ pub struct RadioOptions {
     /// How a diffraction's Jones matrix combines the UTD terms (default: UTD;
     /// `docs/channel.md` §8).
     pub diffraction_coefficient: DiffractionCoefficient,
+    /// With the `sionna-rt-2.2` coefficient, the `max_depth` (interactions) of the Sionna RT 2.2
+    /// `PathSolver` whose gains to reproduce: Sionna lengthens the diffracted leg of a path
+    /// that reflects after its edge and has fewer interactions than that
+    /// ([`bt_channel::path_gain_sionna_rt22`], docs/channel.md "Reflections after the edge in
+    /// Sionna RT 2.2"). The CLI and Python set it to the trace's maximum order. `None`, or the
+    /// `utd` coefficient: UTD's unfolded leg.
+    pub sionna_max_depth: Option<usize>,
+}
+
+impl RadioOptions {
+    /// These options for a trace of at most `max_order` interactions: with the `sionna-rt-2.2`
+    /// coefficient, Sionna's `PathSolver` of that `max_depth` ([`RadioOptions::sionna_max_depth`]).
+    pub fn for_order(self, max_order: usize) -> Self {
+        RadioOptions {
+            sionna_max_depth: Some(max_order),
+            ..self
+        }
+    }
 }
 
 /// A direction as azimuth and elevation, degrees (`docs/conventions.md`); also what the

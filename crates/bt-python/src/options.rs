@@ -116,10 +116,11 @@ impl TraceKeywords {
     pub fn radio(&self) -> Result<bt_beams::RadioOptions, String> {
         let coefficient = (self.diffraction.coefficient.parse())
             .map_err(|e: bt_beams::ChannelError| e.to_string())?;
-        Ok(bt_beams::RadioOptions {
+        let radio = bt_beams::RadioOptions {
             diffraction_coefficient: coefficient,
             ..bt_beams::RadioOptions::default()
-        })
+        };
+        Ok(radio.for_order(self.max_order))
     }
 
     /// The pipeline options for `scene`.

@@ -197,8 +197,9 @@ class Scene:
         """Trace every path from ``tx`` to ``rx`` (metres; the scene's own if None): specular,
         and with ``diffraction=True`` (or ``max_diffractions=1``) those that diffract once on
         an edge at least ``min_edge_length`` metres long, their gains with
-        ``diffraction_coefficient`` "utd" (default) or "sionna-rt-2.2" (Sionna RT 2.2's own
-        combination, for comparing with Sionna; docs/channel.md §8).
+        ``diffraction_coefficient`` "utd" (default) or "sionna-rt-2.2" (Sionna RT 2.2's gains,
+        for comparing with Sionna: its combination, and its diffracted leg for a PathSolver
+        whose ``max_depth`` is ``max_order``; docs/channel.md §8).
 
         Options are ``beamtrace trace``'s flags: ``solver`` "image" | "ipc" | "sbr",
         ``candidates`` "beam-tree" | "wvrn" | "exhaustive", ``ipc_order`` "gauss-seidel" |
