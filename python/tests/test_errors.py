@@ -80,7 +80,7 @@ def test_budget_error_carries_the_cli_message(cli):
         ({"solver": "sbr", "sbr_step_deg": 0.0}, "sbr step must be a positive"),
         ({"solver": "sbr", "sbr_step_deg": 0.001}, "sbr ray budget exceeded"),
         ({"solver": "sbr", "sbr_step_deg": 1.0, "sbr_rays": 10}, "not both"),
-        ({"diffraction_coefficient": "sionna"}, "diffraction coefficient: unknown"),
+        ({"diffraction_coefficient": "sionna"}, "diffraction_coefficient must be one of"),
         # checked even when the solver chosen does not use it
         ({"sbr_step_deg": float("nan")}, "sbr step must be a positive"),
     ],
@@ -89,6 +89,18 @@ def test_bad_options_are_value_errors(options, message):
     scene = beamtrace.load("builtin:living-room")
     with pytest.raises(ValueError, match=message):
         scene.trace(**options)
+
+
+@pytest.mark.parametrize(
+    "keyword", ["solver", "candidates", "ipc_order", "ipc_accel", "diffraction_coefficient"]
+)
+def test_a_long_bad_value_is_cut_in_the_message(keyword):
+    # As the CLI's messages: the value escaped and cut after 64 characters, with its length.
+    scene = beamtrace.load("builtin:living-room")
+    with pytest.raises(ValueError, match=f"{keyword} must be one of") as info:
+        scene.trace(**{keyword: "x" * 10_000})
+    assert str(info.value).endswith("x" * 64 + '…(10000 bytes)"')
+    assert len(str(info.value)) < 300
 
 
 def test_bad_point_shape_is_a_value_error():

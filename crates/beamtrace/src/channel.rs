@@ -11,11 +11,13 @@ use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-/// Load, trace and report the paths the arguments select.
+/// Load, trace and report the paths the arguments select, with `radio` (the arguments'
+/// radio options, read before: what they refuse stops the run before any trace).
 /// The files read come back too: the outputs must not replace them.
 fn traced_paths(
     args: &PathArgs,
-) -> anyhow::Result<(Scene, Vec<PathReport>, RadioOptions, Vec<PathBuf>)> {
+    radio: &RadioOptions,
+) -> anyhow::Result<(Scene, Vec<PathReport>, Vec<PathBuf>)> {
     let loaded = load_scene(&args.scene)?;
     for w in &loaded.warnings {
         eprintln!("warning: {w}");
@@ -25,10 +27,10 @@ fn traced_paths(
     let trace_args = args.trace_args();
     let options = trace_args.solve.settings().trace_options(&scene)?;
     let traced = bt_solve::Tracer::new(scene.clone(), options).trace(tx, rx)?;
-    let radio = args.radio.options()?.for_order(options.max_order);
+    let radio = radio.for_order(options.max_order);
     let paths = bt_beams::report(&scene, &traced.result.paths, &radio)?;
     warn_near_field(&paths, &scene);
-    Ok((scene, paths, radio, loaded.sources))
+    Ok((scene, paths, loaded.sources))
 }
 
 /// Write `text` to `path` through the CLI's one writer (atomic, never over an input).
@@ -71,13 +73,19 @@ fn cir_csv(paths: &[PathReport], carrier_hz: f64) -> String {
     out
 }
 
-fn cfr_csv(paths: &[PathReport], carrier_hz: f64, args: &ChannelArgs) -> anyhow::Result<String> {
-    let n = args.subcarriers;
-    let budget = bt_channel::ResponseBudget {
+/// The CFR's budgets from the arguments.
+fn response_budget(args: &ChannelArgs) -> bt_channel::ResponseBudget {
+    bt_channel::ResponseBudget {
         max_subcarriers: args.max_subcarriers,
         max_products: args.max_cfr_products,
-    };
-    budget
+    }
+}
+
+fn cfr_csv(paths: &[PathReport], carrier_hz: f64, args: &ChannelArgs) -> anyhow::Result<String> {
+    let n = args.subcarriers;
+    // The subcarriers alone were checked before the trace (`run_channel`); what depends on
+    // the paths found is checked now.
+    response_budget(args)
         .check(n, paths.len())
         .with_context(|| format!("--subcarriers {n} over {} paths", paths.len()))?;
     let offsets = bt_channel::subcarriers(n, args.subcarrier_spacing);
@@ -99,7 +107,14 @@ fn cfr_csv(paths: &[PathReport], carrier_hz: f64, args: &ChannelArgs) -> anyhow:
 }
 
 pub fn run_channel(args: &ChannelArgs) -> anyhow::Result<ExitCode> {
-    let (scene, paths, radio, inputs) = traced_paths(&args.paths)?;
+    let radio = args.paths.radio.options()?;
+    if args.cfr.is_some() {
+        // Known from the arguments: the subcarriers, and their products with at least one
+        // path, refused before the scene is loaded or traced.
+        let n = args.subcarriers;
+        (response_budget(args).check(n, 0)).with_context(|| format!("--subcarriers {n}"))?;
+    }
+    let (scene, paths, inputs) = traced_paths(&args.paths, &radio)?;
     let carrier = scene.frequency_hz();
     // Every output is computed and every output path checked before the first file is
     // written: a refused later option (the CFR's budget, a PDP stem over an input) leaves no
@@ -198,13 +213,17 @@ impl ArrayDoc {
 }
 
 pub fn run_beams(args: &BeamsArgs) -> anyhow::Result<ExitCode> {
-    let (scene, paths, radio, inputs) = traced_paths(&args.paths)?;
+    let radio = args.paths.radio.options()?;
     let array = |(rows, columns): (usize, usize), spacing: f64, which: &str, o| {
         bt_channel::Array::new(rows, columns, spacing, o)
             .with_context(|| format!("--{which}-array"))
     };
     let tx = array(args.tx_array, args.tx_spacing, "tx", radio.tx.orientation)?;
     let rx = array(args.rx_array, args.rx_spacing, "rx", radio.rx.orientation)?;
+    // The beam pairs follow from the arrays alone: refused before the scene is loaded or
+    // traced (the sweep checks them again, with the pairs × paths it depends on).
+    bt_channel::check_beam_pairs(&tx, &rx, args.max_beam_pairs)?;
+    let (scene, paths, inputs) = traced_paths(&args.paths, &radio)?;
     let ranking = match args.ranking {
         RankingArg::Power => BeamRanking::Power,
         RankingArg::Paper => BeamRanking::Paper,

@@ -17,7 +17,7 @@ use serde::{Deserialize, Serialize};
 use std::time::{Duration, Instant};
 
 /// Version of the documents' layout; bump on any incompatible change.
-pub const FORMAT_VERSION: u32 = 2;
+pub const FORMAT_VERSION: u32 = 3;
 
 /// The document of one trace (`beamtrace trace --json`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]

@@ -121,7 +121,8 @@ pub struct PathReport {
     /// (empty for line of sight).
     pub interactions: Vec<InteractionKind>,
     /// The surface of each interaction, aligned with `points`: a reflection's surface, a
-    /// wedge's two faces `"A|B"` (face 0, then face n), a free edge's face `"A"`.
+    /// wedge's two faces `"A|B"` (face 0, then face n), a free edge's face `"A"`; a diffraction's
+    /// names escaped (`\|`, `\\`) by [`bt_scene::name::edge`].
     pub surfaces: Vec<String>,
     /// The reflecting surfaces' ids, TX side first (the diffraction left out).
     #[serde(skip)]
@@ -277,19 +278,12 @@ pub enum InteractionKind {
 }
 
 /// The name of a path's interaction in the document: the surface's name for a reflection,
-/// `"A|B"` (its two faces) for a wedge's diffraction, `"A"` for a free edge's.
+/// the edge's ([`Scene::edge_name`]: `"A|B"`, its two faces escaped, or `"A"` for a free edge)
+/// for a diffraction.
 fn interaction_name(scene: &Scene, interaction: Interaction) -> String {
     match interaction {
         Interaction::Reflection(id) => scene.surface(id).name.clone(),
-        Interaction::Diffraction(e) => {
-            let edge = scene.edges().get(e);
-            let name = |id: SurfaceId| scene.surface(id).name.as_str();
-            if edge.is_free() {
-                name(edge.face0).to_string()
-            } else {
-                format!("{}|{}", name(edge.face0), name(edge.face_n))
-            }
-        }
+        Interaction::Diffraction(e) => scene.edge_name(scene.edges().get(e)),
     }
 }
 
@@ -489,5 +483,48 @@ mod tests {
         assert!(
             (free_space_loss_db(10.0, 28e9) - free_space_loss_db(1.0, 28e9) - 20.0).abs() < 1e-9
         );
+    }
+
+    /// A wall (`north|wall`) whose top edge meets a roof (`roof\tile`) on the far side: a wedge
+    /// between TX in front of the wall and RX above the roof, whose record names both faces
+    /// so that they split back apart, as do the free edges' single names.
+    #[test]
+    fn edge_names_holding_separators_split_back_into_their_faces() {
+        let (wall, roof) = ("north|wall", "roof\\tile");
+        let json = r#"{ "tx": [0.3, -3, 1.8], "rx": [-0.2, 3, 2.1], "surfaces": [
+            { "name": "north|wall", "vertices": [[-2, 0, 0], [2, 0, 0], [2, 0, 2], [-2, 0, 2]] },
+            { "name": "roof\\tile", "vertices": [[-2, 0, 2], [2, 0, 2], [2, 2, 2], [-2, 2, 2]] }
+        ] }"#;
+        let desc: bt_scene::SceneDescription = serde_json::from_str(json).unwrap();
+        let scene = Scene::from_description(&desc, "wedge", Default::default()).unwrap();
+        assert_eq!(scene.surface(SurfaceId(1)).name, roof);
+        let options = bt_solve::pipeline::TraceOptions {
+            diffraction: bt_solve::pipeline::DiffractionOptions::first_order(),
+            ..bt_solve::pipeline::TraceOptions::new(1)
+        };
+        let (tx, rx) = (scene.tx_world().unwrap(), scene.rx_world().unwrap());
+        let traced = bt_solve::Tracer::new(scene.clone(), options)
+            .trace(tx, rx)
+            .unwrap();
+        let reports = report(&scene, &traced.result.paths, &RadioOptions::default()).unwrap();
+        let json = serde_json::to_string(&reports).unwrap();
+        let read: Vec<PathReport> = serde_json::from_str(&json).unwrap();
+        let mut wedges = 0;
+        for p in &read {
+            let edges = (p.interactions.iter().zip(&p.surfaces))
+                .filter(|(kind, _)| **kind == InteractionKind::Diffraction);
+            for (_, name) in edges {
+                let (face0, face_n) = bt_scene::name::split_edge(name).unwrap();
+                match face_n {
+                    Some(face_n) => {
+                        assert_eq!(name, "north\\|wall|roof\\\\tile");
+                        assert_eq!((face0.as_str(), face_n.as_str()), (wall, roof));
+                        wedges += 1;
+                    }
+                    None => assert!([wall, roof].contains(&face0.as_str()), "{name}"),
+                }
+            }
+        }
+        assert_eq!(wedges, 1, "one path over the wedge: {json}");
     }
 }

@@ -70,7 +70,7 @@ impl DiffractionCoefficient {
     ];
 
     /// The name users give it (CLI, Python, the report's `radio.diffraction_coefficient`).
-    pub fn name(self) -> &'static str {
+    pub const fn name(self) -> &'static str {
         match self {
             DiffractionCoefficient::Utd => "utd",
             DiffractionCoefficient::SionnaRt22 => "sionna-rt-2.2",

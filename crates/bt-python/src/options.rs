@@ -112,10 +112,10 @@ impl TraceKeywords {
         named().map_err(|e| e.to_string())
     }
 
-    /// The report's radio options: the CLI's defaults with the diffraction coefficient named.
+    /// The report's radio options: the CLI's defaults with the diffraction coefficient named
+    /// (an unknown name refused as the settings' are, the value cut short).
     pub fn radio(&self) -> Result<bt_beams::RadioOptions, String> {
-        let coefficient = (self.diffraction.coefficient.parse())
-            .map_err(|e: bt_beams::ChannelError| e.to_string())?;
+        let coefficient = parse(&self.diffraction.coefficient).map_err(|e| e.to_string())?;
         let radio = bt_beams::RadioOptions {
             diffraction_coefficient: coefficient,
             ..bt_beams::RadioOptions::default()
@@ -206,5 +206,29 @@ mod tests {
             ..keywords()
         };
         assert!(k.trace_options(&scene()).unwrap_err().contains("sbr step"));
+    }
+
+    /// A 10 kB value of a keyword makes a message of a few lines naming the keyword, as the
+    /// CLI's (`bt_scene::name::shown`), not 10 kB of exception text.
+    #[test]
+    fn long_bad_values_are_cut_in_the_message() {
+        let long = "z".repeat(10_000);
+        let cut = format!("got \"{}…(10000 bytes)\"", "z".repeat(64));
+        let mut k = keywords();
+        k.ipc.order = long.clone();
+        let e = k.trace_options(&scene()).unwrap_err();
+        assert!(
+            e.starts_with("ipc_order must be one of") && e.ends_with(&cut),
+            "{e}"
+        );
+        assert!(e.len() < 200, "{} bytes", e.len());
+        let mut k = keywords();
+        k.diffraction.coefficient = long;
+        let e = k.radio().unwrap_err();
+        assert!(
+            e.starts_with("diffraction_coefficient must be one of"),
+            "{e}"
+        );
+        assert!(e.ends_with(&cut) && e.len() < 200, "{e}");
     }
 }

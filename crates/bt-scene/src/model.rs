@@ -167,6 +167,14 @@ impl Scene {
         self.edges
             .get_or_init(|| crate::edges::Edges::build(&self.surfaces))
     }
+    /// `edge`'s name in a path record's `surfaces`: its face's name for a free edge, both
+    /// faces' (face 0, then face n) for a wedge, escaped by [`crate::name::edge`] so that
+    /// [`crate::name::split_edge`] gives them back.
+    pub fn edge_name(&self, edge: &crate::edges::Edge) -> String {
+        let name = |id: SurfaceId| self.surface(id).name.as_str();
+        let face_n = (!edge.is_free()).then(|| name(edge.face_n));
+        crate::name::edge(name(edge.face0), face_n)
+    }
     /// Look a surface up by name.
     pub fn find(&self, name: &str) -> Option<SurfaceId> {
         self.surfaces

@@ -88,6 +88,42 @@ pub fn path<S: AsRef<str>>(names: &[S]) -> String {
     names.join(PATH_SEPARATOR)
 }
 
+/// What separates an edge's two face names in a path record's `surfaces` (`"A|B"`).
+pub const EDGE_SEPARATOR: char = '|';
+
+/// An edge's name in a path record: its face's name for a free edge, `face0|face_n` for a
+/// wedge, with `\` inside a name written `\\` and `|` written `\|`, so that [`split_edge`]
+/// gives back the two names whatever they hold: the faces `a|b` and `c` give `a\|b|c`, never
+/// the faces `a`, `b|c`. The one place an edge's name is made (reports, the viewer's matching).
+pub fn edge(face0: &str, face_n: Option<&str>) -> String {
+    let escaped = |name: &str| name.replace('\\', "\\\\").replace(EDGE_SEPARATOR, "\\|");
+    match face_n {
+        Some(face_n) => format!("{}{EDGE_SEPARATOR}{}", escaped(face0), escaped(face_n)),
+        None => escaped(face0),
+    }
+}
+
+/// The face names of an edge's name made by [`edge`]: `(face0, None)` for a free edge,
+/// `(face0, Some(face_n))` for a wedge; `None` for text [`edge`] never makes (a `\` before
+/// anything but `\` or `|`, a trailing `\`, more than one unescaped `|`).
+pub fn split_edge(text: &str) -> Option<(String, Option<String>)> {
+    let mut names = vec![String::new()];
+    let mut chars = text.chars();
+    while let Some(c) = chars.next() {
+        match c {
+            '\\' => match chars.next() {
+                Some(e @ ('\\' | EDGE_SEPARATOR)) => names.last_mut()?.push(e),
+                _ => return None,
+            },
+            EDGE_SEPARATOR if names.len() == 1 => names.push(String::new()),
+            EDGE_SEPARATOR => return None,
+            c => names.last_mut()?.push(c),
+        }
+    }
+    let mut names = names.into_iter();
+    Some((names.next()?, names.next()))
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -144,5 +180,29 @@ mod tests {
         let e = escape("a\"b\\c\n\u{1b}\0");
         assert_eq!(e, "a\\\"b\\\\c\\n\\u{1b}\\u{0}");
         assert_eq!(escape("sofa.top"), "sofa.top");
+    }
+
+    #[test]
+    fn edge_names_split_back_into_their_faces() {
+        let cases: [(&str, Option<&str>, &str); 6] = [
+            ("wall", Some("floor"), "wall|floor"),
+            ("screen", None, "screen"),
+            ("a|b", Some("c"), "a\\|b|c"),
+            ("a", Some("b|c"), "a|b\\|c"),
+            ("x\\", Some("|"), "x\\\\|\\|"),
+            ("free|edge\\", None, "free\\|edge\\\\"),
+        ];
+        for (face0, face_n, text) in cases {
+            assert_eq!(edge(face0, face_n), text);
+            let split = split_edge(text).unwrap();
+            assert_eq!(
+                (split.0.as_str(), split.1.as_deref()),
+                (face0, face_n),
+                "{text}"
+            );
+        }
+        for bad in ["a|b|c", "a\\", "a\\b", "\\"] {
+            assert_eq!(split_edge(bad), None, "{bad}");
+        }
     }
 }

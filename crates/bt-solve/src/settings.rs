@@ -105,11 +105,12 @@ impl Default for SolveSettings {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 pub enum SettingsError {
     /// A name that is not one of the choices.
-    #[error("{field} must be one of {choices}, got {got:?}")]
+    #[error("{field} must be one of {choices}, got \"{got}\"")]
     UnknownName {
         /// The setting (`solver`, `ipc_order`, ...).
         field: &'static str,
-        /// The name given.
+        /// The name given, as messages show it: escaped and cut after 64 characters
+        /// ([`bt_scene::name::shown`]), so a 10 kB value makes a short message.
         got: String,
         /// The allowed names, quoted and comma-separated.
         choices: String,
@@ -154,7 +155,7 @@ pub fn parse<T: Named>(name: &str) -> Result<T, SettingsError> {
             let quoted: Vec<_> = T::NAMES.iter().map(|(n, _)| format!("\"{n}\"")).collect();
             SettingsError::UnknownName {
                 field: T::FIELD,
-                got: name.to_string(),
+                got: bt_scene::name::shown(name),
                 choices: quoted.join(", "),
             }
         })
@@ -174,6 +175,16 @@ named!(SolverKind, "solver": "image" => Image, "ipc" => Ipc, "sbr" => Sbr);
 named!(UpdateOrder, "ipc_order": "gauss-seidel" => GaussSeidel, "jacobi" => Jacobi);
 named!(Acceleration, "ipc_accel": "none" => None, "newton" => Newton);
 named!(CandidateMode, "candidates": "beam-tree" => BeamTree, "wvrn" => Wvrn, "exhaustive" => Exhaustive);
+
+/// The diffraction coefficient of the gains (Python's `diffraction_coefficient`; the CLI's
+/// `--diffraction-coefficient`), by the names [`bt_channel::DiffractionCoefficient::name`] gives.
+impl Named for bt_channel::DiffractionCoefficient {
+    const FIELD: &'static str = "diffraction_coefficient";
+    const NAMES: &'static [(&'static str, Self)] = &[
+        (Self::Utd.name(), Self::Utd),
+        (Self::SionnaRt22.name(), Self::SionnaRt22),
+    ];
+}
 
 impl SolveSettings {
     /// The solver these settings select, with IPC's defaults scaled to `scene`; checks the
@@ -293,6 +304,9 @@ mod tests {
         round_trip::<UpdateOrder>();
         round_trip::<Acceleration>();
         round_trip::<CandidateMode>();
+        round_trip::<bt_channel::DiffractionCoefficient>();
+        let all = bt_channel::DiffractionCoefficient::ALL;
+        assert_eq!(all.len(), bt_channel::DiffractionCoefficient::NAMES.len());
     }
 
     #[test]
@@ -302,6 +316,17 @@ mod tests {
             e.to_string(),
             "solver must be one of \"image\", \"ipc\", \"sbr\", got \"magic\""
         );
+    }
+
+    #[test]
+    fn a_long_unknown_name_is_cut_in_the_message() {
+        let long = format!("x\"{}", "y".repeat(10_000));
+        let e = parse::<CandidateMode>(&long).unwrap_err().to_string();
+        assert!(e.starts_with("candidates must be one of"), "{e}");
+        // The quote escaped (2 characters), then as many as fit in 64.
+        let shown = format!("x\\\"{}…(10002 bytes)", "y".repeat(61));
+        assert!(e.ends_with(&format!("got \"{shown}\"")), "{e}");
+        assert!(e.len() < 200, "{} bytes", e.len());
     }
 
     #[test]

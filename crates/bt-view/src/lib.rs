@@ -137,22 +137,27 @@ pub fn read_paths(text: &str, path: &str) -> Result<Vec<StepPaths>, ViewError> {
     })
 }
 
-/// Check that every surface the paths of `paths[k]` name (a diffraction's `"A|B"` names two)
-/// is a surface of `scenes[k]`: a document traced from another scene is refused.
+/// Check that every surface the paths of `paths[k]` name (a diffraction's `"A|B"` names two,
+/// split by [`bt_scene::name::split_edge`]) is a surface of `scenes[k]`: a document traced from
+/// another scene is refused.
 pub fn check_surfaces(paths: &[StepPaths], scenes: &[&Scene], path: &str) -> Result<(), ViewError> {
     for (step, (step_paths, scene)) in paths.iter().zip(scenes).enumerate() {
-        let known = |name: &str| {
-            scene.find(name).is_some() || name.split('|').all(|n| scene.find(n).is_some())
+        let found = |name: &str| scene.find(name).is_some();
+        let known = |kind: Option<&InteractionKind>, name: &str| match kind {
+            Some(InteractionKind::Diffraction) => bt_scene::name::split_edge(name)
+                .is_some_and(|(face0, face_n)| found(&face0) && face_n.is_none_or(|f| found(&f))),
+            _ => found(name),
         };
-        let names = step_paths.paths.iter().flat_map(|p| p.surfaces.iter());
-        for name in names {
-            if !known(name) {
-                return Err(ViewError::ForeignDocument {
-                    path: path.to_string(),
-                    step,
-                    surface: bt_scene::name::escape(name),
-                    scene: bt_scene::name::escape(scene.name()),
-                });
+        for p in &step_paths.paths {
+            for (k, name) in p.surfaces.iter().enumerate() {
+                if !known(p.interactions.get(k), name) {
+                    return Err(ViewError::ForeignDocument {
+                        path: path.to_string(),
+                        step,
+                        surface: bt_scene::name::shown(name),
+                        scene: bt_scene::name::shown(scene.name()),
+                    });
+                }
             }
         }
     }
@@ -336,23 +341,12 @@ fn diffracted_edges(scene: &Scene, path: &PathReport) -> Vec<EdgeId> {
         edges.bvh().visit(near, |i| {
             let edge = &edges.all()[i as usize];
             let t = edge.parameter(p).clamp(0.0, edge.length);
-            if edge.point(t).distance(p) <= tol && face_names(scene, edge) == *faces {
+            if edge.point(t).distance(p) <= tol && scene.edge_name(edge) == *faces {
                 out.push(EdgeId(i));
             }
         });
     }
     out
-}
-
-/// An edge's name in the trace documents' `surfaces`: `"A|B"` (face 0, face n) for a wedge,
-/// `"A"` for a free edge.
-fn face_names(scene: &Scene, edge: &Edge) -> String {
-    let face0 = &scene.surface(edge.face0).name;
-    if edge.is_free() {
-        face0.clone()
-    } else {
-        format!("{face0}|{}", scene.surface(edge.face_n).name)
-    }
 }
 
 fn edge_document(scene: &Scene, edge: &Edge) -> EdgeDocument {
@@ -538,6 +532,42 @@ mod tests {
             shown_edges(&scene, &renamed, 3).is_empty(),
             "faces must match"
         );
+    }
+
+    /// A document's diffraction entries are split as `bt_scene::name::edge` wrote them: the
+    /// faces `a|b` and `c` (`a\|b|c`) are this scene's, the unescaped `a|b|c` is no edge name.
+    #[test]
+    fn edge_names_are_split_at_their_unescaped_separator() {
+        let json = r#"{ "surfaces": [
+            { "name": "a|b", "vertices": [[0, 0, 0], [1, 0, 0], [1, 0, 1], [0, 0, 1]] },
+            { "name": "c", "vertices": [[0, 2, 0], [1, 2, 0], [1, 2, 1], [0, 2, 1]] } ] }"#;
+        let desc: bt_scene::SceneDescription = serde_json::from_str(json).unwrap();
+        let scene = Scene::from_description(&desc, "pipes", Default::default()).unwrap();
+        let document = |kind: InteractionKind, surface: &str| {
+            let mut path = PathReport::example();
+            path.interactions = vec![kind];
+            path.surfaces = vec![surface.to_string()];
+            vec![StepPaths {
+                tx: None,
+                rx: None,
+                paths: vec![path],
+            }]
+        };
+        let check = |kind, surface| check_surfaces(&document(kind, surface), &[&scene], "p.json");
+        assert!(check(InteractionKind::Diffraction, "a\\|b|c").is_ok());
+        assert!(
+            check(InteractionKind::Diffraction, "a\\|b").is_ok(),
+            "a free edge"
+        );
+        assert!(check(InteractionKind::Reflection, "a|b").is_ok());
+        for (kind, surface) in [
+            (InteractionKind::Diffraction, "a|b|c"),
+            (InteractionKind::Diffraction, "a|b"),
+            (InteractionKind::Reflection, "a\\|b"),
+        ] {
+            let e = check(kind, surface).unwrap_err().to_string();
+            assert!(e.contains("a path names surface"), "{surface}: {e}");
+        }
     }
 
     #[test]

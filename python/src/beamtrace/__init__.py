@@ -54,7 +54,9 @@ class Paths:
     """What happens at each point of each path: "reflection" or "diffraction"."""
     surfaces: List[List[str]]
     """The surface of each interaction, TX side first: "A|B" (a wedge's two faces) or "A" (a
-    free edge's face) at a diffraction."""
+    free edge's face) at a diffraction, with ``\\`` and ``|`` inside a face name written
+    ``\\\\`` and ``\\|`` (docs/output-format.md, "Edge names"): split a diffraction's entry
+    only at an unescaped ``|``."""
     points: List[npt.NDArray[np.float64]]
     """Interaction points of each path, (k, 3) metres, TX side first (TX and RX excluded)."""
     length_m: npt.NDArray[np.float64]

@@ -33,6 +33,59 @@ fn a_sweep_of_two_64_by_64_arrays_is_over_the_beam_pair_budget() {
     refused(&cli(line, &[]), &["256 beam pairs", "--max-beam-pairs"]);
 }
 
+/// Arguments whose trace alone is refused, after seconds of work: order 10 in the living room
+/// is over the candidate budget (the beam tree passes 2,000,000 nodes at depth 9, ~7 s and
+/// 0.6 GB in the test build). A refusal naming another budget with them, in under 2 s and with
+/// nothing printed, was decided before any trace.
+const TRACE_REFUSED: &str = "builtin:living-room --max-order 10";
+
+/// Runs `args` and asserts a refusal naming `needles` that comes before the trace: nothing
+/// on stdout, no word of the candidate budget that the trace would have hit.
+fn refused_before_the_trace(args: &[&str], needles: &[&str]) {
+    let t0 = Instant::now();
+    let r = beamtrace_within(args, LIMIT_BYTES);
+    assert_refused(&r, needles);
+    assert!(r.stdout.is_empty(), "{}", text(&r));
+    assert!(!text(&r).contains("--max-candidates"), "{}", text(&r));
+    assert!(t0.elapsed() < Duration::from_secs(2), "{:?}", t0.elapsed());
+}
+
+#[test]
+fn budgets_known_from_the_arguments_are_refused_before_the_trace() {
+    // The trace of these arguments is refused by its own budget ...
+    let beams = format!("beams {TRACE_REFUSED}");
+    refused(&cli(&beams, &[]), &["--max-candidates"]);
+    // ... so a refusal naming the beam pairs was made before it.
+    let line = format!("{beams} --tx-array 64x64 --rx-array 64x64");
+    refused_before_the_trace(
+        &cli(&line, &[]),
+        &["16777216 beam pairs", "--max-beam-pairs"],
+    );
+    let dir = scratch("growth-before-trace");
+    let (cir, cfr) = (dir.join("c.csv"), dir.join("f.csv"));
+    let (cir, cfr) = (cir.to_str().unwrap(), cfr.to_str().unwrap());
+    let channel = format!("channel {TRACE_REFUSED} --out {{}} --cfr {{}} --subcarriers {{}}");
+    let subcarriers = cli(&channel, &[cir, cfr, "500000000"]);
+    refused_before_the_trace(
+        &subcarriers,
+        &["500000000 subcarriers", "--max-subcarriers"],
+    );
+    // 1000 subcarriers are 1000 products with a single path: over 999 whatever the trace finds.
+    let products = [
+        &cli(&channel, &[cir, cfr, "1000"])[..],
+        &["--max-cfr-products", "999"],
+    ];
+    refused_before_the_trace(&products.concat(), &["1000 subcarrier-path products"]);
+    // Within 1000, the products depend on the paths: the trace runs first (and is refused by
+    // its own budget, as any run of these arguments).
+    let products = [
+        &cli(&channel, &[cir, cfr, "1000"])[..],
+        &["--max-cfr-products", "1000"],
+    ];
+    refused(&products.concat(), &["--max-candidates"]);
+    assert!(!dir.join("c.csv").exists());
+}
+
 #[test]
 fn the_wvrn_of_the_city_is_over_the_pair_test_budget() {
     refused(
@@ -75,9 +128,10 @@ fn a_frequency_response_beyond_its_budgets_is_refused() {
         &cli(line, &[cir, cfr, "500000000"]),
         &["500000000 subcarriers", "--max-subcarriers"],
     );
+    // 1000 subcarriers over the living room's paths (more than two): after the trace.
     let args = [
         &cli(line, &[cir, cfr, "1000"])[..],
-        &["--max-cfr-products", "999"],
+        &["--max-cfr-products", "1999"],
     ]
     .concat();
     refused(&args, &["subcarrier-path products", "--max-cfr-products"]);
