@@ -17,8 +17,9 @@ pub struct Cli {
 
 #[derive(Debug, Subcommand)]
 pub enum Command {
-    /// Trace every specular path between TX and RX in a scene (JSON/TOML scene, Mitsuba/Sionna
-    /// XML scene, OBJ or PLY mesh, point cloud, or builtin:living-room).
+    /// Trace every specular path between TX and RX in a scene, and with --diffraction those
+    /// that diffract once on an edge (JSON/TOML scene, Mitsuba/Sionna XML scene, OBJ or PLY
+    /// mesh, point cloud, or builtin:NAME).
     Trace(TraceArgs),
     /// Extract planar surfaces from a point cloud (PLY or PCD) into a scene file.
     Extract(ExtractArgs),

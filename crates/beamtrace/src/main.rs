@@ -23,7 +23,10 @@ use std::process::ExitCode;
 fn main() -> ExitCode {
     restore_default_sigpipe();
     exit_cleanly_when_stdout_fails();
-    let cli = args::Cli::parse_from(args::with_default_subcommands(std::env::args_os()));
+    let cli = match args::Cli::try_parse_from(args::with_default_subcommands(std::env::args_os())) {
+        Ok(cli) => cli,
+        Err(e) => exit_with(e),
+    };
     match run(cli) {
         Ok(code) => code,
         Err(e) => {
@@ -31,6 +34,22 @@ fn main() -> ExitCode {
             ExitCode::from(2)
         }
     }
+}
+
+/// Print clap's error (or help, or version) and exit as clap does, with the value it refuses
+/// cut short as every other message cuts names ([`bt_scene::name::shown`]): a 10 kB argument
+/// is not echoed whole.
+fn exit_with(e: clap::Error) -> ! {
+    use clap::error::{ContextKind, ContextValue};
+    let Some(ContextValue::String(value)) = e.get(ContextKind::InvalidValue) else {
+        e.exit()
+    };
+    let text = e.render().to_string();
+    eprint!(
+        "{}",
+        text.replace(value.as_str(), &bt_scene::name::shown(value))
+    );
+    std::process::exit(e.exit_code())
 }
 
 /// The error and its causes joined by `: `, each cause printed once: library errors that show

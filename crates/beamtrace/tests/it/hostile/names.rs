@@ -159,6 +159,27 @@ fn long_duplicate_names_make_short_error_text() {
     std::fs::remove_dir_all(dir).ok();
 }
 
+/// A 10 kB value of an option clap refuses itself (a value enum, a value parser's error) is
+/// cut in the message as names are: the option named, the value not echoed whole.
+#[test]
+fn long_option_values_make_short_error_text() {
+    let long = "x".repeat(10_000);
+    for flag in [
+        "--diffraction-coefficient",
+        "--solver",
+        "--tx-pattern",
+        "--tx",
+    ] {
+        let r = beamtrace(&["trace", "builtin:living-room", flag, &long]);
+        assert_refused(&r, &[flag, "…(10000 bytes)"]);
+        assert!(
+            text(&r).len() < 2000,
+            "{flag}: {} bytes of error text",
+            text(&r).len()
+        );
+    }
+}
+
 /// Files whose names and header words carry an escape sequence (ESC, or the C1 CSI in XML,
 /// where ESC is not a character), each with a word of the
 /// message that must name the place: no run may print the escape character itself.
