@@ -398,7 +398,8 @@ pub struct TraceArgs {
     /// Print the JSON document instead of a table.
     #[arg(long)]
     pub json: bool,
-    /// Write the JSON document to this file (the table still goes to stdout unless --json).
+    /// Write the JSON document to this file instead of the terminal (which gets one line
+    /// saying where it went).
     #[arg(long)]
     pub out: Option<PathBuf>,
     /// Trace every time step of a dynamic scene (static scenes have one step).

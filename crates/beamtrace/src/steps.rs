@@ -41,12 +41,12 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
         if let Some(path) = &args.out {
             let inputs = &loaded.sources;
             crate::files::write(path, format!("{json}\n").as_bytes(), inputs, &["json"])?;
-        }
-        if args.json && !args.jsonl {
+            eprintln!("wrote {} ({} steps)", path.display(), doc.steps.len());
+        } else if args.json && !args.jsonl {
             println!("{json}");
         }
     }
-    if !args.json && !args.jsonl {
+    if args.out.is_none() && !args.json && !args.jsonl {
         print_table(&doc);
     }
     Ok(ExitCode::SUCCESS)

@@ -36,10 +36,11 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
     warn_near_field(&doc.paths, scene);
     let json = serde_json::to_string_pretty(&doc).context("serialising the trace")?;
     if let Some(path) = &args.out {
+        // The document went to the file: the terminal gets one line, not the document again.
         let inputs = &loaded.sources;
         crate::files::write(path, format!("{json}\n").as_bytes(), inputs, &["json"])?;
-    }
-    if args.json {
+        eprintln!("wrote {} ({} paths)", path.display(), doc.paths.len());
+    } else if args.json {
         println!("{json}");
     } else {
         output::print_table(&doc);

@@ -326,3 +326,45 @@ fn bad_xml_scenes_name_the_element_and_line() {
     run(&text, &["text.xml", "not well-formed XML"]);
     std::fs::remove_dir_all(&dir).ok();
 }
+
+/// `--out` keeps the terminal quiet: the document goes to the file only (with `--json` too),
+/// and one line on stderr says where; without `--out`, `--json` prints the same document.
+#[test]
+fn out_writes_the_document_instead_of_printing_it() {
+    let dir = scratch("out-quiet");
+    for (extra, what) in [(&[][..], "paths"), (&["--steps"][..], "steps")] {
+        let scene = if extra.is_empty() {
+            "builtin:living-room"
+        } else {
+            "builtin:living-room-dynamic"
+        };
+        let file = dir.join(format!("{what}.json"));
+        let mut args = vec!["trace", scene, "--json", "--out", file.to_str().unwrap()];
+        args.extend_from_slice(extra);
+        let o = run_ok(&args);
+        assert!(stdout(&o).is_empty(), "{}", stdout(&o));
+        assert!(stderr(&o).contains(&format!("wrote {}", file.display())));
+        let mut printed = vec!["trace", scene, "--json"];
+        printed.extend_from_slice(extra);
+        let mut a = read_json(&file);
+        let mut b = run_json(&printed);
+        // The run times differ; everything else is the same document.
+        for doc in [&mut a, &mut b] {
+            strip_times(doc);
+        }
+        assert_eq!(a, b);
+    }
+    std::fs::remove_dir_all(dir).ok();
+}
+
+/// Remove every `time_s` field (run times) from `v`, recursively.
+fn strip_times(v: &mut serde_json::Value) {
+    match v {
+        serde_json::Value::Object(map) => {
+            map.remove("time_s");
+            map.values_mut().for_each(strip_times);
+        }
+        serde_json::Value::Array(items) => items.iter_mut().for_each(strip_times),
+        _ => {}
+    }
+}
