@@ -262,7 +262,7 @@ pub fn run_beams(args: &BeamsArgs) -> anyhow::Result<ExitCode> {
 fn print_beams(doc: &BeamsDocument<'_>, top: usize) {
     let dir = |d: &Option<bt_beams::Direction>| {
         d.map_or_else(
-            || "invisible".to_string(),
+            || "no direction".to_string(),
             |d| format!("{:7.2} {:6.2}", d.azimuth, d.elevation),
         )
     };
@@ -297,12 +297,32 @@ fn print_beams(doc: &BeamsDocument<'_>, top: usize) {
                 .map_or_else(|| "-".to_string(), |r| r.to_string())
         );
     }
-    if let Some(best) = doc.sweep.pairs.first() {
+    let Some(first) = doc.sweep.pairs.first() else {
+        return;
+    };
+    let label = match doc.sweep.ranking {
+        bt_beams::BeamRanking::Power => "best pair (strongest received power)",
+        // The paper ranks paths, not powers: its first pair serves the best-ranked path
+        // (lowest order, then shortest), which need not be the strongest pair.
+        bt_beams::BeamRanking::Paper => {
+            "first pair (paper ranking: the pair for the best-ranked path, lowest order then \
+             shortest, not the strongest; --ranking power ranks by power)"
+        }
+    };
+    println!(
+        "{label}: tx beam {}, rx beam {} ({} pairs ranked)",
+        first.tx_beam,
+        first.rx_beam,
+        doc.sweep.pairs.len()
+    );
+    let shown = doc.sweep.pairs.iter().take(top);
+    if shown
+        .clone()
+        .any(|p| p.tx_direction_deg.is_none() || p.rx_direction_deg.is_none())
+    {
         println!(
-            "best pair: tx beam {}, rx beam {} ({} pairs ranked)",
-            best.tx_beam,
-            best.rx_beam,
-            doc.sweep.pairs.len()
+            "no direction: the beam's main lobe lies outside the visible region \
+             (docs/channel.md §7)"
         );
     }
 }

@@ -180,7 +180,27 @@ fn beams_finds_the_best_pair_and_keeps_the_paper_ranking() {
     let table =
         String::from_utf8_lossy(&run_ok(&["beams", "builtin:living-room", "--top", "3"]).stdout)
             .into_owned();
-    assert!(table.contains("best pair: tx beam"));
+    assert!(table.contains("best pair (strongest received power): tx beam"));
+    // The paper ranking says what it ranks by, and a beam without a main lobe is explained.
+    let paper_table = stdout(&run_ok(&[
+        "beams",
+        "builtin:living-room",
+        "--ranking",
+        "paper",
+    ]));
+    assert!(paper_table.contains("first pair (paper ranking: the pair for the best-ranked path"));
+    let upa = stdout(&run_ok(&[
+        "beams",
+        "builtin:living-room",
+        "--rx-array",
+        "2x4",
+        "--top",
+        "64",
+    ]));
+    assert!(
+        upa.contains("no direction") && upa.contains("outside the visible region"),
+        "{upa}"
+    );
     assert_clear_error(
         &["beams", "builtin:living-room", "--tx-array", "8"],
         &["ROWSxCOLUMNS"],
