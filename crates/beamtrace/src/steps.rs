@@ -66,7 +66,7 @@ fn print_table(doc: &StepsDocument) {
         }
     );
     println!(
-        "{:>4} {:>5} {:>6} {:>10} {:>6} {:>7} {:>7} {:>5} {:>8}  strongest path",
+        "{:>4} {:>5} {:>6} {:>10} {:>6} {:>7} {:>7} {:>5} {:>8}  least-loss path",
         "step", "moved", "paths", "candidates", "links", "solved", "reused", "los", "time_ms"
     );
     for s in &doc.steps {
@@ -80,7 +80,7 @@ fn print_table(doc: &StepsDocument) {
                 } else {
                     bt_scene::name::path(&p.surfaces)
                 };
-                format!("{:.1} dB  {names}", p.loss_db)
+                format!("loss {:.1} dB  {names}", p.loss_db)
             })
             .unwrap_or_else(|| "-".into());
         let u = &s.stats.update;
@@ -106,4 +106,11 @@ fn print_table(doc: &StepsDocument) {
             best
         );
     }
+    println!("{STEPS_LEGEND}");
 }
+
+/// What the steps table's columns mean (docs/dynamic-scenes.md).
+const STEPS_LEGEND: &str = "moved: surfaces moved since the previous step; links: WVRN links \
+re-tested that changed (-: the step was traced in full); solved / reused: candidates solved \
+anew / taken over from the previous step; los: a line-of-sight path exists; least-loss path: \
+the path of smallest loss_db (free space and the materials' constant losses) and its surfaces";
