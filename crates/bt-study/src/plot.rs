@@ -156,25 +156,25 @@ pub fn angular_error<DB: DrawingBackend>(
         (
             GroupBy::Step,
             Quantity::ErrorTx,
-            "(a) TX side vs dynamics",
+            "(a1) TX side vs dynamics",
             "time step",
         ),
         (
             GroupBy::Step,
             Quantity::ErrorRx,
-            "(a) RX side vs dynamics",
+            "(a2) RX side vs dynamics",
             "time step",
         ),
         (
             GroupBy::Edges,
             Quantity::ErrorTx,
-            "(b) TX side vs complexity",
+            "(b1) TX side vs complexity",
             "number of edges",
         ),
         (
             GroupBy::Edges,
             Quantity::ErrorRx,
-            "(b) RX side vs complexity",
+            "(b2) RX side vs complexity",
             "number of edges",
         ),
     ];
