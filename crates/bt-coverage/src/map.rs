@@ -7,6 +7,7 @@ use bt_geom::Real;
 use bt_plot::{FAMILY, blank, fail, mesh};
 use bt_scene::{Scene, SurfaceKind};
 use plotters::coord::Shift;
+use plotters::coord::types::RangedCoordf64;
 use plotters::prelude::*;
 use plotters::style::colors::colormaps::{ColorMap, ViridisRGB};
 
@@ -177,9 +178,52 @@ impl HeatMap<'_> {
                     8,
                     RED.filled(),
                 )))
-                .map_err(fail)?;
+                .map_err(fail)?
+                .label("TX")
+                .legend(|(x, y)| TriangleMarker::new((x + 5, y), 6, RED.filled()));
         }
-        Ok(())
+        self.draw_legend(&mut chart)
+    }
+
+    /// The legend of what the colour bar does not say: skipped points and points without a
+    /// path, each only when the map has one, and the TX.
+    fn draw_legend<'c, DB: DrawingBackend + 'c>(
+        &self,
+        chart: &mut ChartContext<'c, DB, Cartesian2d<RangedCoordf64, RangedCoordf64>>,
+    ) -> Result<(), String> {
+        let skipped = |r: &&Row| matches!(r.status, PointStatus::Skipped(_));
+        let no_path = |r: &&Row| !skipped(r) && self.quantity.value(&r.status).is_none();
+        let entries = [
+            (
+                self.rows.iter().any(|r| skipped(&r)),
+                SKIPPED,
+                "skipped: on a surface or at the TX",
+            ),
+            (
+                self.rows.iter().any(|r| no_path(&r)),
+                NO_PATH,
+                "traced, no path",
+            ),
+        ];
+        for (present, colour, text) in entries {
+            if present {
+                chart
+                    .draw_series(std::iter::empty::<Rectangle<(Real, Real)>>())
+                    .map_err(fail)?
+                    .label(text)
+                    .legend(move |(x, y)| {
+                        Rectangle::new([(x, y - 5), (x + 10, y + 5)], colour.filled())
+                    });
+            }
+        }
+        chart
+            .configure_series_labels()
+            .label_font((FAMILY, 12))
+            .background_style(WHITE.mix(0.85))
+            .border_style(BLACK)
+            .position(SeriesLabelPosition::LowerRight)
+            .draw()
+            .map_err(fail)
     }
 
     fn draw_bar<DB: DrawingBackend>(

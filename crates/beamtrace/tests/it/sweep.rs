@@ -91,6 +91,12 @@ fn tiny_grid_matches_the_golden_csv_and_marks_the_tx() {
             "5.600000,0.600000,2.200000,skipped,,,,,,,,tx and rx are at the same position"
         )
     );
+    // The heat map's legend says what the grey crossed cell is.
+    let svg = std::fs::read_to_string(dir.join("coverage.svg")).unwrap();
+    assert!(
+        svg.contains("skipped: on a surface or at the TX"),
+        "no legend"
+    );
     let (dir1, single) = sweep(
         "5.0:5.6:0.3,0.6:1.2:0.6,2.2",
         &["--single-thread"],
