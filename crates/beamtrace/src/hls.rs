@@ -30,8 +30,11 @@ pub fn run(args: &HlsArgs) -> anyhow::Result<ExitCode> {
                 netlist: false,
                 per_block: *per_block,
             };
-            let r = bt_hls::synthesize_with(dir, &options)
-                .with_context(|| format!("synthesising {}", dir.display()))?;
+            let bar =
+                crate::progress::spinner(&format!("synthesising {} with Yosys", dir.display()));
+            let r = bt_hls::synthesize_with(dir, &options);
+            bar.finish_and_clear();
+            let r = r.with_context(|| format!("synthesising {}", dir.display()))?;
             println!(
                 "{}: Yosys synth_intel -family cycloneive (EP4CE115, 114,480 LEs), adders {}",
                 dir.display(),
@@ -73,6 +76,7 @@ fn simulate(dir: &Path, simulator: bt_hls::Simulator) -> anyhow::Result<ExitCode
     let bar = ProgressBar::new_spinner();
     bar.set_message(format!("compiling with {}", simulator.name()));
     bar.enable_steady_tick(std::time::Duration::from_millis(200));
+    crate::progress::heartbeat(&bar, "hls sim");
     let mut on_progress = |p: bt_hls::SimProgress| match p {
         bt_hls::SimProgress::Compiling => {}
         bt_hls::SimProgress::Runs { done, total } => {

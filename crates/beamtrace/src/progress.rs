@@ -1,8 +1,58 @@
-//! Progress on stderr for jobs that can take more than a few seconds (hidden when stderr is
-//! not a terminal, as indicatif does).
+//! Progress on stderr for jobs that can take more than a few seconds: indicatif's bars on a
+//! terminal, and when stderr is not a terminal (piped, logged), where indicatif draws nothing,
+//! one plain line every few seconds from [`heartbeat`].
 
 use indicatif::{ProgressBar, ProgressStyle};
+use std::io::IsTerminal;
 use std::time::Duration;
+
+/// How often a piped run prints its progress line: every 5 s, or every
+/// `BEAMTRACE_HEARTBEAT_MS` milliseconds when that variable holds a number (tests).
+fn heartbeat_period() -> Duration {
+    std::env::var("BEAMTRACE_HEARTBEAT_MS")
+        .ok()
+        .and_then(|v| v.parse::<u64>().ok())
+        .map_or(Duration::from_secs(5), Duration::from_millis)
+}
+
+/// When stderr is not a terminal: a thread that prints `what` with `bar`'s position, length,
+/// message and elapsed time on stderr every [`heartbeat_period`], until the bar is finished or
+/// dropped. Nothing on a terminal, where the bar draws itself.
+pub fn heartbeat(bar: &ProgressBar, what: &str) {
+    if std::io::stderr().is_terminal() {
+        return;
+    }
+    let (weak, what, period) = (bar.downgrade(), what.to_string(), heartbeat_period());
+    std::thread::spawn(move || {
+        let tick = period.min(Duration::from_millis(200));
+        let mut waited = Duration::ZERO;
+        loop {
+            std::thread::sleep(tick);
+            waited += tick;
+            let Some(bar) = weak.upgrade() else { return };
+            if bar.is_finished() {
+                return;
+            }
+            if waited >= period {
+                waited = Duration::ZERO;
+                eprintln!("{}", heartbeat_line(&bar, &what));
+            }
+        }
+    });
+}
+
+/// `what: pos/len message (elapsed s)`, the parts the bar has.
+fn heartbeat_line(bar: &ProgressBar, what: &str) -> String {
+    let mut line = format!("{what}:");
+    if let Some(len) = bar.length() {
+        line.push_str(&format!(" {}/{len}", bar.position()));
+    }
+    let message = bar.message();
+    if !message.is_empty() {
+        line.push_str(&format!(" {message}"));
+    }
+    line + &format!(" ({:.0} s)", bar.elapsed().as_secs_f64())
+}
 
 /// A spinner with elapsed time for work whose length is not known in advance.
 pub fn spinner(what: &str) -> ProgressBar {
@@ -12,6 +62,7 @@ pub fn spinner(what: &str) -> ProgressBar {
             .expect("static template"),
     );
     bar.enable_steady_tick(Duration::from_millis(200));
+    heartbeat(&bar, what);
     bar
 }
 
@@ -25,6 +76,7 @@ pub fn counter(len: u64, units: &str) -> ProgressBar {
         ))
         .expect("static template"),
     );
+    heartbeat(&bar, units);
     bar
 }
 
@@ -37,10 +89,12 @@ pub struct Deferred {
 }
 
 impl Deferred {
-    /// A hidden bar with `template`, to be drawn once `delay` has passed.
-    pub fn new(template: &str, delay: Duration) -> Self {
+    /// A hidden bar with `template`, to be drawn once `delay` has passed (and, piped, a
+    /// [`heartbeat`] naming `what`).
+    pub fn new(template: &str, delay: Duration, what: &str) -> Self {
         let bar = ProgressBar::hidden();
         bar.set_style(ProgressStyle::with_template(template).expect("static template"));
+        heartbeat(&bar, what);
         Deferred {
             bar,
             start: std::time::Instant::now(),
@@ -70,6 +124,7 @@ pub fn tree_progress() -> (ProgressBar, impl FnMut(bt_solve::pipeline::BuildProg
     let deferred = Deferred::new(
         "{spinner} beam tree {msg} {bar:30} {pos}/{len} parents [{elapsed_precise}, ETA {eta}]",
         Duration::from_millis(500),
+        "beam tree",
     );
     let bar = deferred.bar();
     let callback = move |p: bt_solve::pipeline::BuildProgress| {
@@ -90,6 +145,7 @@ pub fn extraction_progress() -> (ProgressBar, impl FnMut(bt_pointcloud::Progress
     let deferred = Deferred::new(
         "{spinner} extracting planes {bar:30} {pos}/{len} points assigned, {msg} [{elapsed_precise}, ETA {eta}]",
         std::time::Duration::ZERO,
+        "extracting planes",
     );
     let bar = deferred.bar();
     let callback = move |p: bt_pointcloud::Progress| {

@@ -39,6 +39,7 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<ExitCode> {
         )
         .context("progress bar template")?,
     );
+    crate::progress::heartbeat(&bar, "sweep");
     let radio = args.coefficient.options().for_order(options.max_order);
     let rows = bt_coverage::sweep(&scene, &points, (&options, &radio), &mut |done, _| {
         bar.set_position(done as u64)

@@ -163,3 +163,25 @@ fn received_power_column_equals_trace_json_received_power() {
     }
     let _ = std::fs::remove_dir_all(dir.parent().unwrap());
 }
+
+/// Piped (stderr not a terminal), a long sweep still shows progress: a plain line every
+/// heartbeat period (5 s; 20 ms here, through `BEAMTRACE_HEARTBEAT_MS`).
+#[test]
+fn a_piped_sweep_prints_progress_lines() {
+    let dir = scratch("sweep-heartbeat").join("out");
+    let o = std::process::Command::new(env!("CARGO_BIN_EXE_beamtrace"))
+        .args(["sweep", "builtin:living-room", "--single-thread", "--out"])
+        .arg(&dir)
+        .args(["--grid", "0.25:5.75:0.125,0.25:4.25:0.125,1.2"])
+        .env("BEAMTRACE_HEARTBEAT_MS", "20")
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    let err = String::from_utf8_lossy(&o.stderr);
+    assert!(
+        err.lines()
+            .any(|l| l.starts_with("sweep: ") && l.contains("/1485")),
+        "{err}"
+    );
+    let _ = std::fs::remove_dir_all(dir.parent().unwrap());
+}
