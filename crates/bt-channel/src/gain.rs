@@ -8,7 +8,7 @@ use crate::antenna::Antenna;
 use crate::diffraction::{
     DiffractionCoefficient, Legs, Wedge, diffract, largest_singular_value, spreading,
 };
-use crate::material::{RadioMaterial, Reflection, SPEED_OF_LIGHT};
+use crate::material::{RadioMaterial, Reflection, SPEED_OF_LIGHT, Transmission};
 use bt_geom::{Real, Vec3};
 use num_complex::Complex64;
 use std::f64::consts::PI;
@@ -27,6 +27,25 @@ pub enum SurfaceResponse {
 }
 
 impl SurfaceResponse {
+    /// Transmission coefficients at `frequency_hz` and cos θ = `cos_incidence`: a radio
+    /// material's slab ([`RadioMaterial::transmission`]). A constant loss says nothing about
+    /// what passes through: an error naming the material's radio model.
+    pub fn transmission(
+        &self,
+        frequency_hz: Real,
+        cos_incidence: Real,
+    ) -> Result<Transmission, ChannelError> {
+        match self {
+            SurfaceResponse::Radio(m) => m.transmission(frequency_hz, cos_incidence),
+            SurfaceResponse::ConstantLoss { .. } => Err(ChannelError::Invalid {
+                field: "material",
+                message: "a material with only a reflection loss has no transmission: give it \
+                          a radio model (itu or permittivity and conductivity) and a thickness"
+                    .into(),
+            }),
+        }
+    }
+
     /// Reflection coefficients at `frequency_hz` and cos θ = `cos_incidence`.
     pub fn reflection(
         &self,
@@ -128,11 +147,38 @@ pub(crate) fn reflect(
     Ok((reflected, k_out))
 }
 
+/// Apply one slab crossing to `field` travelling along unit `k` (which it keeps): its s and p
+/// components (s = normalize(k × n), p = s × k, as for [`reflect`]) times T_TE and T_TM.
+pub(crate) fn transmit(
+    field: Field,
+    k: Vec3,
+    crossing: &Bounce,
+    frequency_hz: Real,
+) -> Result<Field, ChannelError> {
+    let n = crossing.normal;
+    let cos = k.dot(n).abs().min(1.0);
+    let t = crossing.response.transmission(frequency_hz, cos)?;
+    let cross = k.cross(n);
+    let s = if cross.length() > 1e-12 {
+        cross.normalize()
+    } else {
+        any_perpendicular(k)
+    };
+    let p = s.cross(k);
+    Ok(add(
+        scaled(s, t.te * dot(&field, s)),
+        scaled(p, t.tm * dot(&field, p)),
+    ))
+}
+
 /// One interaction of a path with the scene.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Interaction {
     /// A specular reflection.
     Reflection(Bounce),
+    /// A crossing of a slab (ITU-R P.2040 transmission, no deflection): the surface's normal
+    /// and response, as for a reflection.
+    Transmission(Bounce),
     /// An edge diffraction (UTD); at most one per path.
     Diffraction(Wedge),
 }
@@ -273,6 +319,9 @@ pub(crate) fn path_gain_with_leg(
         match interaction {
             Interaction::Reflection(bounce) => {
                 (field, k) = reflect(field, k, bounce, frequency_hz)?;
+            }
+            Interaction::Transmission(crossing) => {
+                field = transmit(field, k, crossing, frequency_hz)?;
             }
             Interaction::Diffraction(wedge) => {
                 let k_out = (vertices[index + 2] - vertices[index + 1]).normalize();

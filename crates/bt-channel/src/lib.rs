@@ -24,8 +24,8 @@ pub use gain::{
     path_gain_detailed, path_gain_mixed,
 };
 pub use material::{
-    ItuBand, ItuMaterial, RadioMaterial, RadioModel, Reflection, SPEED_OF_LIGHT,
-    VACUUM_PERMITTIVITY,
+    ItuBand, ItuMaterial, RadioMaterial, RadioModel, Reflection, SPEED_OF_LIGHT, Transmission,
+    VACUUM_PERMITTIVITY, slab_transmission,
 };
 pub use num_complex::Complex64;
 pub use response::{

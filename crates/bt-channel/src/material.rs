@@ -245,6 +245,17 @@ pub struct Reflection {
     pub tm: Complex64,
 }
 
+/// Transmission coefficients of a wave crossing a slab (no deflection: it leaves along the
+/// direction it came), for the TE (s) and TM (p) components in the plane-of-incidence basis,
+/// which the crossing leaves unchanged.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Transmission {
+    /// TE (s) coefficient.
+    pub te: Complex64,
+    /// TM (p) coefficient.
+    pub tm: Complex64,
+}
+
 impl RadioMaterial {
     /// A material of P.2040-3 Table 3 by name (see [`ItuMaterial::parse`]), as a half-space
     /// (`thickness = None`) or a slab of `thickness` metres.
@@ -326,6 +337,27 @@ impl RadioMaterial {
         })
     }
 
+    /// Transmission coefficients at `frequency_hz` for a wave crossing the surface with
+    /// `cos_incidence` = cos θ ([`slab_transmission`]). A half-space (no thickness) lets
+    /// nothing through to the far side: an error naming the thickness.
+    pub fn transmission(
+        &self,
+        frequency_hz: Real,
+        cos_incidence: Real,
+    ) -> Result<Transmission, ChannelError> {
+        let eta = self.permittivity(frequency_hz)?;
+        let wavelength = SPEED_OF_LIGHT / frequency_hz;
+        match self.thickness {
+            Some(d) => Ok(slab_transmission(eta, cos_incidence, d / wavelength)),
+            None => Err(ChannelError::Invalid {
+                field: "thickness",
+                message: "a half-space (no thickness) transmits nothing: give the material a \
+                          thickness to let waves through it"
+                    .into(),
+            }),
+        }
+    }
+
     /// Normal-incidence power loss of one reflection, dB (>= 0): −20·log10|R_TE(0°)|;
     /// infinite when nothing reflects.
     pub fn normal_loss_db(&self, frequency_hz: Real) -> Result<Real, ChannelError> {
@@ -388,6 +420,30 @@ pub fn slab(eta: Complex64, cos_incidence: Real, thickness_wavelengths: Real) ->
         }
     };
     Reflection {
+        te: layer(half.te),
+        tm: layer(half.tm),
+    }
+}
+
+/// Single-layer slab in vacuum, transmission (ITU-R P.2040-4 eq. 43b, as Sionna RT's thin
+/// slab): T = (1 − r²)·e^{−jq} / (1 − r²·e^{−j2q}) per polarisation, with r and q as in
+/// [`slab`]. The wave leaves undeflected; e^{−jq} is the phase across the slab relative to the
+/// unfolded path's own propagation phase, which the delay carries. `thickness_wavelengths`
+/// = d/λ.
+pub fn slab_transmission(
+    eta: Complex64,
+    cos_incidence: Real,
+    thickness_wavelengths: Real,
+) -> Transmission {
+    let cos = cos_incidence.clamp(0.0, 1.0);
+    let half = fresnel(eta, cos);
+    let q = transmitted_cos(eta, cos) * (2.0 * PI * thickness_wavelengths);
+    let (once, twice) = (
+        (Complex64::new(0.0, -1.0) * q).exp(),
+        (Complex64::new(0.0, -2.0) * q).exp(),
+    );
+    let layer = |r: Complex64| ratio((1.0 - r * r) * once, 1.0 - r * r * twice);
+    Transmission {
         te: layer(half.te),
         tm: layer(half.tm),
     }
