@@ -15,11 +15,28 @@ pub struct Cli {
     pub command: Command,
 }
 
+/// What the columns of `trace`'s table mean (docs/output-format.md has every JSON field).
+const TRACE_COLUMNS: &str = "Table columns: rank (by order, then length); ord: interactions \
+(0: line of sight); length_m: unfolded length, m; delay_ns; aod_az, aod_el: departure \
+direction at TX, degrees (azimuth from +x towards +y, elevation up); aoa_az, aoa_el: where the \
+wave arrives from at RX; loss_db: free space + the materials' constant reflection losses + a \
+diffraction's excess loss (the paper's ranking uses it); gain_db: the polarised complex gain \
+with the antennas and ITU materials, 20·log10|a|; surfaces: in order, an edge as A|B. \
+docs/output-format.md.";
+
+/// What the columns of `beams`' table mean.
+const BEAMS_COLUMNS: &str = "Table columns: rank; tx_beam, rx_beam: indices in the DFT \
+codebooks; tx_az/el, rx_az/el: the beams' main-lobe directions, degrees ('no direction': the \
+main lobe lies outside the visible region); power_dbm: received power with that pair, the \
+paths summed coherently at the carrier; path: with --ranking paper, the rank of the path the \
+pair was chosen for. docs/channel.md §7.";
+
 #[derive(Debug, Subcommand)]
 pub enum Command {
     /// Trace every specular path between TX and RX in a scene, and with --diffraction those
     /// that diffract once on an edge (JSON/TOML scene, Mitsuba/Sionna XML scene, OBJ or PLY
     /// mesh, point cloud, or builtin:NAME).
+    #[command(after_help = TRACE_COLUMNS)]
     Trace(TraceArgs),
     /// Extract planar surfaces from a point cloud (PLY or PCD) into a scene file.
     Extract(ExtractArgs),
@@ -44,6 +61,7 @@ pub enum Command {
     Channel(ChannelArgs),
     /// Beam sweep: received power of every TX/RX beam pair of DFT codebooks on ULA/UPA arrays,
     /// the best pair and the ranked list.
+    #[command(after_help = BEAMS_COLUMNS)]
     Beams(BeamsArgs),
     /// Scene utilities.
     Scene {
