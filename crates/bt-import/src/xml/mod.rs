@@ -133,8 +133,18 @@ pub struct XmlShape {
 /// The XML has no transmitter or receiver: without `options.terminals` the scene is bare
 /// geometry, traced with terminals given per trace.
 pub fn load_xml(path: &Path, options: &LoadOptions) -> Result<Loaded, ImportError> {
+    Ok(load_xml_read(path, options)?.0)
+}
+
+/// [`load_xml`], with the SHA-256 of the XML's bytes as parsed ([`Loaded::digests`] holds the
+/// meshes').
+pub(crate) fn load_xml_read(
+    path: &Path,
+    options: &LoadOptions,
+) -> Result<(Loaded, crate::source::Digest), ImportError> {
     let display = path.display().to_string();
     let text = read_bounded(path, MAX_XML_BYTES.min(options.max_file_bytes), &display)?;
+    let read = crate::source::digest(&text);
     let text = String::from_utf8(text).map_err(|e| ImportError::Parse {
         path: display.clone(),
         message: format!("not UTF-8 text: {e}"),
@@ -161,10 +171,13 @@ pub fn load_xml(path: &Path, options: &LoadOptions) -> Result<Loaded, ImportErro
         reading.round(round, &mut desc, &mut warnings)?;
     }
     let scene = Scene::from_description(&desc, &display, options.terminals)?;
-    Ok(Loaded {
-        sources: reading.meshes,
+    let (sources, digests) = reading.meshes.into_iter().unzip();
+    let loaded = Loaded {
+        sources,
+        digests,
         ..Loaded::new(scene, warnings)
-    })
+    };
+    Ok((loaded, read))
 }
 
 /// Shapes whose meshes are read and merged in parallel at a time. The budgets are charged in
@@ -180,8 +193,8 @@ struct Reading<'a> {
     /// Of [`MAX_MESH_TOTAL_BYTES`].
     bytes_left: u64,
     elements: SceneElements,
-    /// Every mesh file read, once each, in document order.
-    meshes: Vec<PathBuf>,
+    /// Every mesh file read, once each, in document order, with the SHA-256 of its bytes.
+    meshes: Vec<(PathBuf, crate::source::Digest)>,
     // A set beside `meshes`: comparing paths walks their components, and with one file per
     // shape (Sionna's cities: 2,367) `meshes.contains` was 40 % of the load.
     seen: std::collections::HashSet<PathBuf>,
@@ -216,14 +229,14 @@ impl Reading<'_> {
                 }
             }
         }
-        let imports: Vec<Result<bt_mesh::MeshImport, ImportError>> = (found.par_iter())
+        let imports: Vec<Result<_, ImportError>> = (found.par_iter())
             .map(|(shape, file)| read_shape(shape, file, self.options))
             .collect();
         for ((shape, file), import) in found.into_iter().zip(imports) {
-            let import = import?;
+            let (import, read) = import?;
             (self.elements).charge(&import, shape, self.xml, self.options.merge.max_elements)?;
             if self.seen.insert(file.clone()) {
-                self.meshes.push(file);
+                self.meshes.push((file, read));
             }
             add_shape(shape, import, self.xml, self.options, desc, warnings);
         }
@@ -418,12 +431,13 @@ fn find_shape(
     Ok(file)
 }
 
-/// Read `shape`'s mesh `file` (found by [`find_shape`]) and merge it through its transform.
+/// Read `shape`'s mesh `file` (found by [`find_shape`]) and merge it through its transform;
+/// the mesh and the SHA-256 of the bytes read.
 fn read_shape(
     shape: &XmlShape,
     file: &Path,
     options: &LoadOptions,
-) -> Result<bt_mesh::MeshImport, ImportError> {
+) -> Result<(bt_mesh::MeshImport, crate::source::Digest), ImportError> {
     let shown = file.display().to_string();
     let bytes = read_bounded(file, options.max_file_bytes, &shown)?;
     let format = match shape.kind {
@@ -435,7 +449,7 @@ fn read_shape(
         crate::mesh::read_transformed(&bytes, format, Some(&shown), &options.merge, &|p| {
             to_world.transform_point3(p)
         })?;
-    Ok(import)
+    Ok((import, crate::source::digest(&bytes)))
 }
 
 /// `name` under `folder`: relative, plain components only (no `..`, no root, no drive).
