@@ -83,38 +83,45 @@ impl LoadCache {
         source: &str,
         options: &LoadOptions,
         progress: &mut dyn FnMut(LoadProgress),
-    ) -> Result<Loaded<DynamicScene>, ImportError> {
+    ) -> Result<(Loaded<DynamicScene>, Vec<String>), ImportError> {
+        let one_step = |path: &Path| {
+            matches!(
+                Format::of(path),
+                Ok(Format::Obj | Format::PlyMesh | Format::Xml)
+            )
+        };
         match Source::parse(source) {
-            Source::File(path)
-                if matches!(
-                    Format::of(&path)?,
-                    Format::Obj | Format::PlyMesh | Format::Xml
-                ) =>
-            {
-                Ok(self
-                    .load(source, options, progress)?
-                    .map(DynamicScene::from_static))
+            Source::File(path) if one_step(&path) => {
+                let (loaded, notes) = self.load(source, options, progress)?;
+                Ok((loaded.map(DynamicScene::from_static), notes))
             }
-            _ => crate::load_dynamic(source, options, progress),
+            _ => Ok((crate::load_dynamic(source, options, progress)?, vec![])),
         }
     }
 
     /// [`crate::load_with_progress`] through the cache: the entry of these inputs and options
     /// when there is a sound one, else a fresh load, stored for the next time. Built-in scenes
-    /// and point clouds load without the cache. The result equals a fresh load's (scene,
-    /// warnings, files read); a warning is added when a damaged entry was replaced.
+    /// and point clouds load without the cache. The load equals a fresh load (scene, warnings,
+    /// files read); beside it come the cache's own warnings (`load cache: FILE: ...`: a
+    /// damaged entry replaced, an entry that could not be written), for stderr.
     pub fn load(
         &self,
         source: &str,
         options: &LoadOptions,
         progress: &mut dyn FnMut(LoadProgress),
-    ) -> Result<Loaded, ImportError> {
+    ) -> Result<(Loaded, Vec<String>), ImportError> {
         options.check()?;
+        let uncached = |progress| {
+            Ok((
+                crate::load_with_progress(source, options, progress)?,
+                vec![],
+            ))
+        };
         let Source::File(path) = Source::parse(source) else {
-            return crate::load_with_progress(source, options, progress);
+            return uncached(progress);
         };
         if Format::of(&path)? == Format::PointCloud {
-            return crate::load_with_progress(source, options, progress);
+            return uncached(progress);
         }
         let named = read_file(&path, options.max_file_bytes).map_err(|e| ImportError::Io {
             path: path.display().to_string(),
@@ -125,14 +132,14 @@ impl LoadCache {
         let file = self.dir.join(format!("{}.bin", hex(&key)));
         let mut notes = Vec::new();
         match self.lookup(&file, &key, &named, options.max_file_bytes) {
-            Lookup::Hit(loaded) => return Ok(*loaded),
+            Lookup::Hit(loaded) => return Ok((*loaded, notes)),
             Lookup::Miss => {}
             Lookup::Damaged(why) => notes.push(format!(
                 "load cache: {}: {why}: ignored and rebuilt",
                 file.display()
             )),
         }
-        let mut loaded = crate::load_with_progress(source, options, progress)?;
+        let loaded = crate::load_with_progress(source, options, progress)?;
         // Stored only when the named file the load parsed is the one keyed (it may have
         // changed since it was hashed above) and every file read has its digest.
         let complete = loaded.digests.len() == loaded.sources.len();
@@ -141,8 +148,7 @@ impl LoadCache {
                 notes.push(format!("load cache: {}: not written: {e}", file.display()));
             }
         }
-        loaded.warnings.extend(notes);
-        Ok(loaded)
+        Ok((loaded, notes))
     }
 
     /// The entry in `file`, if it is sound and its inputs are unchanged.

@@ -95,9 +95,11 @@ fn a_cached_load_equals_a_fresh_one_and_writes_only_its_entry() {
         ..LoadOptions::default()
     };
     let fresh = bt_import::load(&xml, &options).unwrap();
-    let first = cache.load(&xml, &options, &mut |_| {}).unwrap();
+    let (first, notes) = cache.load(&xml, &options, &mut |_| {}).unwrap();
+    assert_eq!(notes, Vec::<String>::new());
     let (_, written) = entry(&cache_dir);
-    let second = cache.load(&xml, &options, &mut |_| {}).unwrap();
+    let (second, notes) = cache.load(&xml, &options, &mut |_| {}).unwrap();
+    assert_eq!(notes, Vec::<String>::new());
     assert_eq!(
         entry(&cache_dir).1,
         written,
@@ -111,7 +113,7 @@ fn a_cached_load_equals_a_fresh_one_and_writes_only_its_entry() {
         min_reflector_area_m2: 1.0,
         ..options
     };
-    let third = cache.load(&xml, &other, &mut |_| {}).unwrap();
+    let (third, _) = cache.load(&xml, &other, &mut |_| {}).unwrap();
     assert_same(&bt_import::load(&xml, &other).unwrap(), &third);
     assert_eq!(std::fs::read_dir(&cache_dir).unwrap().count(), 2);
     assert_eq!(
@@ -132,7 +134,7 @@ fn one_changed_byte_of_a_mesh_misses() {
     let xml = xml.to_str().unwrap();
     let cache = LoadCache::at(&cache_dir);
     let options = LoadOptions::default();
-    let original = cache.load(xml, &options, &mut |_| {}).unwrap();
+    let (original, _) = cache.load(xml, &options, &mut |_| {}).unwrap();
     let (_, written) = entry(&cache_dir);
     // The lowest bit of the first vertex's x: a valid mesh, a vertex moved by one ulp.
     let mesh = scene_dir.join("meshes/building_1.ply");
@@ -146,10 +148,10 @@ fn one_changed_byte_of_a_mesh_misses() {
     std::fs::write(&mesh, &bytes).unwrap();
     let fresh = bt_import::load(xml, &options).unwrap();
     assert_ne!(fresh.scene.surfaces(), original.scene.surfaces());
-    let cached = cache.load(xml, &options, &mut |_| {}).unwrap();
+    let (cached, notes) = cache.load(xml, &options, &mut |_| {}).unwrap();
     assert_same(&fresh, &cached);
     assert_ne!(entry(&cache_dir).1, written, "the entry was rebuilt");
-    assert!(cached.warnings.iter().all(|w| !w.contains("load cache")));
+    assert_eq!(notes, Vec::<String>::new(), "a changed input is no damage");
     std::fs::remove_dir_all(dir).ok();
 }
 
@@ -179,23 +181,19 @@ fn a_damaged_entry_is_rebuilt_with_a_warning() {
     ];
     for (why, bytes) in damages {
         std::fs::write(&file, &bytes).unwrap();
-        let loaded = cache.load(xml, &options, &mut |_| {}).unwrap();
-        let (notes, rest): (Vec<String>, Vec<String>) =
-            (loaded.warnings.iter().cloned()).partition(|w| w.starts_with("load cache: "));
-        assert_eq!(notes.len(), 1, "{why}: {:?}", loaded.warnings);
+        let (loaded, notes) = cache.load(xml, &options, &mut |_| {}).unwrap();
+        assert_eq!(notes.len(), 1, "{why}: {notes:?}");
+        let named =
+            notes[0].starts_with("load cache: ") && notes[0].contains(&file.display().to_string());
+        assert!(named, "{notes:?}");
         assert!(
             notes[0].contains(why) && notes[0].contains("ignored and rebuilt"),
             "{notes:?}"
         );
-        assert_same(
-            &fresh,
-            &Loaded {
-                warnings: rest,
-                ..loaded
-            },
-        );
+        assert_same(&fresh, &loaded);
         // Rebuilt: the next load reads it without a warning.
-        let again = cache.load(xml, &options, &mut |_| {}).unwrap();
+        let (again, notes) = cache.load(xml, &options, &mut |_| {}).unwrap();
+        assert_eq!(notes, Vec::<String>::new());
         assert_same(&fresh, &again);
     }
     std::fs::remove_dir_all(cache_dir).ok();
