@@ -17,6 +17,7 @@ use crate::source::{Digest, Format, Source, digest, read_file};
 use crate::{ImportError, LoadOptions, LoadProgress, Loaded};
 use bt_scene::dynamic::DynamicScene;
 use bt_scene::{Scene, StoredScene};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 use std::path::{Path, PathBuf};
 
@@ -169,12 +170,13 @@ impl LoadCache {
         if first != named {
             return Lookup::Damaged("lists another named file".into());
         }
-        for (path, recorded) in others {
-            match read_file(path, max_bytes) {
-                Ok(bytes) if digest(&bytes) == *recorded => {}
-                // Changed or gone: a plain miss, the fresh load reports what is wrong.
-                _ => return Lookup::Miss,
-            }
+        // On all cores (Munich: 2,366 meshes, 11 MB). Changed or gone: a plain miss, the
+        // fresh load reports what is wrong.
+        let unchanged = |(path, recorded): &(PathBuf, Digest)| {
+            read_file(path, max_bytes).is_ok_and(|bytes| digest(&bytes) == *recorded)
+        };
+        if !others.par_iter().all(unchanged) {
+            return Lookup::Miss;
         }
         let source = file.display().to_string();
         let scene = match Scene::from_stored(entry.scene, &source) {

@@ -79,22 +79,24 @@ impl Scene {
         if !points.iter().flatten().all(finite) || !stored.frequency_hz.is_finite() {
             return Err(invalid("scene".into(), "a number is not finite".into()));
         }
-        let mut names = HashSet::with_capacity(stored.surfaces.len());
         let mut surfaces = Vec::with_capacity(stored.surfaces.len());
         for (i, s) in stored.surfaces.into_iter().enumerate() {
-            let location = format!("surfaces[{i}]");
-            if !stored.materials.contains_key(&s.material) || !names.insert(s.name.clone()) {
-                let message = "an unknown material or a repeated name".to_string();
-                return Err(invalid(location, message));
+            let location = || format!("surfaces[{i}]");
+            if !stored.materials.contains_key(&s.material) {
+                return Err(invalid(location(), "an unknown material".into()));
             }
             let vertices = s.vertices.iter().map(|v| Vec3::from_array(*v)).collect();
-            let polygon = Polygon::new(vertices).map_err(|e| invalid(location, e.to_string()))?;
+            let polygon = Polygon::new(vertices).map_err(|e| invalid(location(), e.to_string()))?;
             surfaces.push(Surface {
                 name: s.name,
                 material: s.material,
                 kind: s.kind,
                 polygon,
             });
+        }
+        let mut names = HashSet::with_capacity(surfaces.len());
+        if let Some(i) = surfaces.iter().position(|s| !names.insert(s.name.as_str())) {
+            return Err(invalid(format!("surfaces[{i}]"), "a repeated name".into()));
         }
         Ok(Scene::assemble(
             stored.name,
