@@ -54,6 +54,11 @@ pub fn escape(name: &str) -> String {
     out
 }
 
+/// Whether the byte `b` is a printable ASCII character [`escape`] writes as itself.
+fn plain_ascii(b: u8) -> bool {
+    matches!(b, b' '..=b'~') && b != b'"' && b != b'\\'
+}
+
 /// Whether `c` is printed as itself by [`escape`].
 fn plain(c: char) -> bool {
     c != '"' && c != '\\' && allowed(c)
@@ -77,6 +82,11 @@ fn push_escaped(out: &mut String, c: char) -> usize {
 /// with its length (`wallwall…(1024 bytes)`). Every error and warning that repeats a name from
 /// input prints it through here; outputs of valid names (tables, DOT) use [`escape`].
 pub fn shown(name: &str) -> String {
+    // Most names are short printable ASCII, shown as they are: one scan instead of a push per
+    // character (validation shows every surface's name in its location: 17,803 in Munich).
+    if name.len() <= MESSAGE_CHARS && name.bytes().all(plain_ascii) {
+        return name.to_string();
+    }
     let mut out = String::new();
     let mut count = 0;
     for c in name.chars() {
