@@ -219,6 +219,11 @@ pub struct SceneArgs {
     /// XML scenes: budget on the bytes all $parameter substitutions produce.
     #[arg(long, default_value_t = bt_import::xml::MAX_XML_SUBSTITUTION.limit)]
     pub max_xml_substitution: u64,
+    /// Keep the loaded scene in the user's cache ($BEAMTRACE_CACHE_DIR, else
+    /// $XDG_CACHE_HOME/beamtrace, else ~/.cache/beamtrace) and load it from there when the
+    /// files and these options are unchanged (XML scenes, meshes, scene files)
+    #[arg(long)]
+    pub cache: bool,
     #[command(flatten)]
     pub material: MaterialArgs,
 }

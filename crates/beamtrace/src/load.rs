@@ -2,6 +2,7 @@
 //! (every command that takes a scene loads through here).
 
 use crate::args::SceneArgs;
+use bt_import::cache::LoadCache;
 use bt_import::{LoadOptions, Loaded};
 use bt_scene::dynamic::DynamicScene;
 use bt_scene::{Scene, Terminal, Terminals, Vec3};
@@ -38,15 +39,39 @@ pub fn load_options(args: &SceneArgs) -> anyhow::Result<LoadOptions> {
     })
 }
 
+/// The user's load cache with `--cache`, else none.
+fn cache(args: &SceneArgs) -> anyhow::Result<Option<LoadCache>> {
+    Ok(match args.cache {
+        true => Some(LoadCache::user()?),
+        false => None,
+    })
+}
+
+/// A load without the cache: no cache warnings.
+fn uncached<S>(loaded: Loaded<S>) -> (Loaded<S>, Vec<String>) {
+    (loaded, Vec::new())
+}
+
+/// The load, its cache's warnings printed to stderr (the import's are the command's).
+fn cache_warnings<S>((loaded, notes): (Loaded<S>, Vec<String>)) -> Loaded<S> {
+    for note in notes {
+        eprintln!("warning: {note}");
+    }
+    loaded
+}
+
 /// Load the scene named on the command line (a file or `builtin:NAME`), with a progress bar
 /// while a point cloud's planes are extracted, and `--frequency` applied to scene files and
 /// built-ins too.
 pub fn load_scene(args: &SceneArgs) -> anyhow::Result<Loaded> {
     let options = load_options(args)?;
     let (bar, mut progress) = crate::progress::extraction_progress();
-    let loaded = bt_import::load_with_progress(&args.scene, &options, &mut progress);
+    let loaded = match cache(args)? {
+        Some(cache) => cache.load(&args.scene, &options, &mut progress),
+        None => bt_import::load_with_progress(&args.scene, &options, &mut progress).map(uncached),
+    };
     bar.finish_and_clear();
-    let mut loaded = loaded?;
+    let mut loaded = cache_warnings(loaded?);
     if let Some(f) = args.material.frequency {
         loaded.scene = loaded.scene.with_frequency(f)?;
     }
@@ -59,9 +84,12 @@ pub fn load_scene(args: &SceneArgs) -> anyhow::Result<Loaded> {
 pub fn load_dynamic(args: &SceneArgs) -> anyhow::Result<Loaded<DynamicScene>> {
     let options = load_options(args)?;
     let (bar, mut progress) = crate::progress::extraction_progress();
-    let loaded = bt_import::load_dynamic(&args.scene, &options, &mut progress);
+    let loaded = match cache(args)? {
+        Some(cache) => cache.load_dynamic(&args.scene, &options, &mut progress),
+        None => bt_import::load_dynamic(&args.scene, &options, &mut progress).map(uncached),
+    };
     bar.finish_and_clear();
-    let mut loaded = loaded?;
+    let mut loaded = cache_warnings(loaded?);
     if let Some(f) = args.material.frequency {
         loaded.scene = loaded.scene.with_frequency(f)?;
     }

@@ -66,6 +66,10 @@ pub enum ImportError {
     /// nothing, but a NaN given is still a mistake to report).
     #[error(transparent)]
     MergeOptions(#[from] bt_mesh::MergeError),
+    /// The load cache was asked for but has no directory (no `BEAMTRACE_CACHE_DIR`,
+    /// `XDG_CACHE_HOME` or `HOME`).
+    #[error("--cache: no cache directory: set BEAMTRACE_CACHE_DIR, XDG_CACHE_HOME or HOME")]
+    NoCacheDir,
     /// A load option is out of its range (NaN, infinite, negative).
     #[error("{option} must be {range}, got {value}")]
     Option {

@@ -12,6 +12,7 @@
 #![warn(missing_docs)]
 
 mod builtin;
+pub mod cache;
 pub mod city;
 pub mod cloud;
 mod error;
@@ -27,6 +28,6 @@ pub use builtin::{
 pub use error::ImportError;
 pub use scene_file::{parse_json, parse_toml, write_description};
 pub use source::{
-    Format, LoadOptions, LoadProgress, Loaded, MAX_FILE_BYTES, Source, load, load_dynamic,
+    Digest, Format, LoadOptions, LoadProgress, Loaded, MAX_FILE_BYTES, Source, load, load_dynamic,
     load_with_progress,
 };

@@ -92,6 +92,19 @@ pub struct Loaded<S = Scene> {
     /// XML scene names (once each); empty for a built-in scene. The inputs an output of the
     /// same run must not replace (`bt_output::refuse_input`).
     pub sources: Vec<PathBuf>,
+    /// The SHA-256 of each of [`Loaded::sources`] as the load read it (the bytes it parsed),
+    /// in the same order; empty when the format does not record them (point clouds). What the
+    /// load cache ([`crate::cache`]) keys and checks its entries by.
+    pub digests: Vec<Digest>,
+}
+
+/// A SHA-256 digest.
+pub type Digest = [u8; 32];
+
+/// The SHA-256 of `bytes`.
+pub(crate) fn digest(bytes: &[u8]) -> Digest {
+    use sha2::Digest as _;
+    sha2::Sha256::digest(bytes).into()
 }
 
 impl<S> Loaded<S> {
@@ -101,6 +114,7 @@ impl<S> Loaded<S> {
             scene,
             warnings,
             sources: Vec::new(),
+            digests: Vec::new(),
         }
     }
 
@@ -110,6 +124,7 @@ impl<S> Loaded<S> {
             scene: f(self.scene),
             warnings: self.warnings,
             sources: self.sources,
+            digests: self.digests,
         }
     }
 }
@@ -263,21 +278,33 @@ fn load_any(
         Source::File(path) => path,
     };
     let display = path.display().to_string();
-    let mut loaded = match Format::of(&path)? {
+    let (mut loaded, read) = match Format::of(&path)? {
         format @ (Format::Json | Format::Toml) => {
-            let desc = read_description(&path, format, options.max_file_bytes)?;
+            let (desc, read) = read_description(&path, format, options.max_file_bytes)?;
             let scene = Scene::from_description(&desc, &display, options.terminals)?;
-            Loaded::new(scene.without_duplicates(&display)?, Vec::new())
+            let loaded = Loaded::new(scene.without_duplicates(&display)?, Vec::new());
+            (loaded, Some(read))
         }
         Format::Obj | Format::PlyMesh => {
-            let import =
-                crate::mesh::read_mesh_path(&path, &options.merge, options.max_file_bytes)?;
-            from_mesh(import, &file_stem(&path, "mesh"), &display, options)?
+            let (import, read) =
+                crate::mesh::read_mesh_file(&path, &options.merge, options.max_file_bytes)?;
+            let name = file_stem(&path, "mesh");
+            (from_mesh(import, &name, &display, options)?, Some(read))
         }
-        Format::PointCloud => crate::cloud::scene::load_cloud(&path, options, progress)?,
-        Format::Xml => crate::xml::load_xml(&path, options)?,
+        Format::PointCloud => (
+            crate::cloud::scene::load_cloud(&path, options, progress)?,
+            None,
+        ),
+        Format::Xml => {
+            let (loaded, read) = crate::xml::load_xml_read(&path, options)?;
+            (loaded, Some(read))
+        }
     };
     loaded.sources.insert(0, path);
+    match read {
+        Some(read) => loaded.digests.insert(0, read),
+        None => loaded.digests.clear(),
+    }
     Ok(loaded)
 }
 
@@ -300,7 +327,7 @@ pub fn load_dynamic(
         Source::Builtin(name) => (Some(builtin_description(&name)?), Vec::new()),
         Source::File(path) => match Format::of(&path)? {
             format @ (Format::Json | Format::Toml) => {
-                let desc = read_description(&path, format, options.max_file_bytes)?;
+                let (desc, _) = read_description(&path, format, options.max_file_bytes)?;
                 (Some(desc), vec![path])
             }
             _ => (None, Vec::new()),
@@ -332,28 +359,31 @@ fn builtin_description(name: &str) -> Result<SceneDescription, ImportError> {
     parse_json(json, &format!("builtin:{name}"))
 }
 
+/// The description in the scene file `path` and the SHA-256 of the bytes it was parsed from.
 fn read_description(
     path: &Path,
     format: Format,
     max_bytes: u64,
-) -> Result<SceneDescription, ImportError> {
+) -> Result<(SceneDescription, Digest), ImportError> {
     let display = path.display().to_string();
     let io = |source| ImportError::Io {
         path: display.clone(),
         source,
     };
     let bytes = read_file(path, max_bytes).map_err(io)?;
+    let read = digest(&bytes);
     let text = String::from_utf8(bytes).map_err(|_| {
         io(std::io::Error::new(
             std::io::ErrorKind::InvalidData,
             "stream did not contain valid UTF-8",
         ))
     })?;
-    if format == Format::Toml {
+    let desc = if format == Format::Toml {
         parse_toml(&text, &display)
     } else {
         parse_json(&text, &display)
-    }
+    };
+    Ok((desc?, read))
 }
 
 /// The file name without extension, the scene's name for formats that carry none.

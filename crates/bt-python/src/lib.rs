@@ -41,12 +41,18 @@ fn vec3(v: [f64; 3]) -> Vec3 {
 }
 
 /// Load any source the CLI reads (`builtin:NAME`, JSON/TOML, OBJ/PLY meshes, point clouds,
-/// Mitsuba XML): the library's one loading entry.
+/// Mitsuba XML): the library's one loading entry, through the user's load cache when `cache`
+/// (as the CLI's `--cache`); beside the load, the cache's own warnings.
 fn load_scene(
     source: &str,
     options: &LoadOptions,
-) -> Result<bt_import::Loaded, bt_import::ImportError> {
-    bt_import::load(source, options)
+    cache: bool,
+) -> Result<(bt_import::Loaded, Vec<String>), bt_import::ImportError> {
+    if cache {
+        bt_import::cache::LoadCache::user()?.load(source, options, &mut |_| {})
+    } else {
+        Ok((bt_import::load(source, options)?, Vec::new()))
+    }
 }
 
 /// A validated scene, ready to trace from any TX to any RX.
@@ -56,6 +62,8 @@ struct PyScene {
     /// What `load` was given (file path or `builtin:NAME`): messages name it, as the CLI's do.
     source: String,
     warnings: Vec<String>,
+    /// The load cache's own warnings (a damaged entry replaced), for Python's `warnings`.
+    cache_warnings: Vec<String>,
     /// The scene's tracer, kept between calls for its caches (a stream of traces of one
     /// scene reuses the beam tree's hulls and arenas).
     tracer: Mutex<Tracer>,
@@ -150,6 +158,11 @@ impl PyScene {
     #[getter]
     fn warnings(&self) -> Vec<String> {
         self.warnings.clone()
+    }
+    /// The load cache's warnings of this load (`load cache: FILE: ...`), empty without one.
+    #[getter]
+    fn cache_warnings(&self) -> Vec<String> {
+        self.cache_warnings.clone()
     }
 
     /// Trace one TX → RX; returns the path columns as a dict (see `beamtrace.Paths`).
@@ -259,7 +272,7 @@ fn report_each(
 /// each trace gives them).
 #[pyfunction]
 #[pyo3(signature = (source, *, tx=None, rx=None, min_reflector_area=0.25, merge_angle_deg=1.0,
-                    merge_distance=1e-3, budgets=None))]
+                    merge_distance=1e-3, budgets=None, cache=false))]
 // One argument per Python keyword: pyo3 maps them by name.
 #[allow(clippy::too_many_arguments)]
 fn load(
@@ -271,6 +284,7 @@ fn load(
     merge_angle_deg: f64,
     merge_distance: f64,
     budgets: Option<options::LoadBudgets>,
+    cache: bool,
 ) -> PyResult<PyScene> {
     let defaults = LoadOptions::default();
     let budgets = budgets.unwrap_or(options::LoadBudgets {
@@ -294,7 +308,9 @@ fn load(
         max_xml_substitution: budgets.max_xml_substitution,
         ..defaults
     };
-    let loaded = py.detach(|| load_scene(&source, &options)).map_err(error)?;
+    let (loaded, cache_warnings) = py
+        .detach(|| load_scene(&source, &options, cache))
+        .map_err(error)?;
     // The options are set by each trace (its keywords).
     let tracer = Tracer::new(loaded.scene.clone(), TraceOptions::new(0));
     Ok(PyScene {
@@ -302,6 +318,7 @@ fn load(
         scene: Arc::new(loaded.scene),
         source,
         warnings: loaded.warnings,
+        cache_warnings,
     })
 }
 

@@ -18,6 +18,7 @@ mod material;
 mod model;
 pub mod name;
 mod problem;
+mod stored;
 mod surface;
 mod validate;
 
@@ -29,6 +30,7 @@ pub use frame::RECENTRE_RATIO;
 pub use material::{DEFAULT_MATERIAL, Material, default_materials};
 pub use model::{Endpoints, GeometryKey, Scene};
 pub use problem::{MAX_PRINTED_PROBLEMS, Problem, SceneError, Terminal};
+pub use stored::{StoredScene, StoredSurface};
 pub use surface::{RawSurface, Surface, SurfaceId, SurfaceKind};
 pub use validate::{
     DEFAULT_FREQUENCY_HZ, MAX_FREQUENCY_HZ, MAX_TERMINAL_DISTANCE_RATIO, MIN_FREQUENCY_HZ,

@@ -15,6 +15,7 @@ horizontal plane; the arrival direction points from RX towards where the wave co
 from __future__ import annotations
 
 import os
+import warnings
 from typing import Any, Dict, List, Optional, Sequence, Union
 
 import numpy as np
@@ -292,6 +293,7 @@ def load(
     max_file_bytes: int = _native.DEFAULT_MAX_FILE_BYTES,
     max_xml_substitution: int = _native.DEFAULT_MAX_XML_SUBSTITUTION,
     max_mesh_elements: int = _native.DEFAULT_MAX_MESH_ELEMENTS,
+    cache: bool = False,
 ) -> Scene:
     """Load a scene: a file the CLI reads (.json, .toml, .obj, .ply) or ``"builtin:NAME"``.
 
@@ -301,8 +303,12 @@ def load(
     ``--merge-distance`` (m); the budgets are its ``--max-file-bytes`` (any input file),
     ``--max-xml-substitution`` (bytes an XML scene's ``$parameters`` expand to) and
     ``--max-mesh-elements`` (vertices and faces of a mesh, or of all meshes of an XML scene),
-    each checked before the work. Raises :class:`BeamtraceError` with the CLI's message (naming the
-    file, line or field) when the scene cannot be read or is invalid.
+    each checked before the work. ``cache=True`` is ``--cache``: the loaded scene is kept in
+    the user's cache directory (``$BEAMTRACE_CACHE_DIR``, else ``$XDG_CACHE_HOME/beamtrace``,
+    else ``~/.cache/beamtrace``) and read from there while the files and options are unchanged;
+    a damaged entry is rebuilt with a :class:`RuntimeWarning`. Raises :class:`BeamtraceError`
+    with the CLI's message (naming the file, line or field) when the scene cannot be read or is
+    invalid.
     """
     native = _native.load(
         os.fspath(source),
@@ -316,7 +322,10 @@ def load(
             "max_xml_substitution": max_xml_substitution,
             "max_mesh_elements": max_mesh_elements,
         },
+        cache=bool(cache),
     )
+    for note in native.cache_warnings:
+        warnings.warn(note, RuntimeWarning, stacklevel=2)
     return Scene(native)
 
 

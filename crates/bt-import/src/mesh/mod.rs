@@ -98,6 +98,15 @@ pub fn read_mesh_path(
     opts: &MergeOptions,
     max_file_bytes: u64,
 ) -> Result<MeshImport, MeshError> {
+    Ok(read_mesh_file(path, opts, max_file_bytes)?.0)
+}
+
+/// [`read_mesh_path`], with the SHA-256 of the bytes it parsed.
+pub(crate) fn read_mesh_file(
+    path: &Path,
+    opts: &MergeOptions,
+    max_file_bytes: u64,
+) -> Result<(MeshImport, crate::source::Digest), MeshError> {
     let file = path.display().to_string();
     let extension = path
         .extension()
@@ -113,7 +122,8 @@ pub fn read_mesh_path(
         file: file.clone(),
         source,
     })?;
-    read_transformed(&bytes, format, Some(&file), opts, &|p| p)
+    let import = read_transformed(&bytes, format, Some(&file), opts, &|p| p)?;
+    Ok((import, crate::source::digest(&bytes)))
 }
 
 /// Returns the index of `name` in `table`, appending it when new. Linear search: files have a

@@ -472,3 +472,70 @@ fn the_mesh_budget_holds_for_all_shapes_of_a_scene() {
     assert!(e.contains("--max-file-bytes"), "{e}");
     std::fs::remove_dir_all(dir).ok();
 }
+
+/// `f` run on a rayon pool of `threads` threads.
+fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(threads)
+        .build()
+        .unwrap();
+    pool.install(f)
+}
+
+#[test]
+fn meshes_merged_in_parallel_give_the_scene_of_one_thread() {
+    // Etoile: 565 shapes, three rounds of SHAPES_PER_ROUND.
+    let xml = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../testdata/scenes/sionna-rt/etoile/etoile.xml");
+    let load = || load_xml(&xml, &LoadOptions::default()).unwrap();
+    let one = on_threads(1, load);
+    let three = on_threads(3, load);
+    assert!(one.scene.surfaces().len() > 1000);
+    assert_eq!(one.scene.surfaces(), three.scene.surfaces());
+    assert_eq!(one.scene.materials(), three.scene.materials());
+    assert_eq!(one.warnings, three.warnings);
+    assert_eq!(one.sources, three.sources);
+}
+
+#[test]
+fn the_first_problem_in_document_order_is_reported_whatever_the_threads() {
+    // 300 shapes (two rounds); shape 5 reads a broken mesh, shapes 7 and 290 name missing
+    // files: the broken mesh comes first in the document, so it is the error, though the
+    // missing files are found before any mesh is read.
+    let shapes: String = (0..300)
+        .map(|k| {
+            let file = match k {
+                5 => "meshes/broken.obj",
+                7 | 290 => "meshes/nowhere.obj",
+                _ => "meshes/half.obj",
+            };
+            format!(
+                "<shape type=\"obj\" id=\"s{k}\"><string name=\"filename\" value=\"{file}\"/></shape>\n"
+            )
+        })
+        .collect();
+    let xml = format!("<scene>\n{shapes}</scene>");
+    let dir = scratch(
+        "order",
+        &[
+            ("s.xml", &xml),
+            ("meshes/half.obj", HALF_FLOOR),
+            ("meshes/broken.obj", "v 0 0 0\nf 1 2 3\n"),
+        ],
+    );
+    for threads in [1, 3] {
+        let e = on_threads(threads, || load_xml(&dir.join("s.xml"), &options()))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("broken.obj") && !e.contains("nowhere"), "{e}");
+    }
+    // Without the broken mesh, the first missing file (shape 7, line 9) is the error.
+    std::fs::write(dir.join("meshes/broken.obj"), HALF_FLOOR).unwrap();
+    for threads in [1, 3] {
+        let e = on_threads(threads, || load_xml(&dir.join("s.xml"), &options()))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("line 9") && e.contains("\"s7\""), "{e}");
+    }
+    std::fs::remove_dir_all(dir).ok();
+}
