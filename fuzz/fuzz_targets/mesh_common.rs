@@ -2,10 +2,10 @@
 //! surfaces, and turning it into a scene (as `beamtrace trace room.obj --tx .. --rx ..` does)
 //! does not panic either.
 
-use bt_import::mesh::MeshError;
-use bt_mesh::MeshImport;
 use bt_import::LoadOptions;
+use bt_import::mesh::MeshError;
 use bt_import::mesh::scene::from_mesh;
+use bt_mesh::MeshImport;
 use bt_scene::{Terminals, Vec3};
 
 pub fn check(result: Result<MeshImport, MeshError>) {

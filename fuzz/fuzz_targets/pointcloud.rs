@@ -7,7 +7,11 @@ use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {
     for non_finite in [NonFinitePolicy::Skip, NonFinitePolicy::Reject] {
-        let Ok(loaded) = parse_any(data, &ReadOptions { non_finite }) else {
+        let options = ReadOptions {
+            non_finite,
+            ..ReadOptions::default()
+        };
+        let Ok(loaded) = parse_any(data, &options) else {
             continue;
         };
         let cloud = &loaded.cloud;

@@ -21,7 +21,12 @@ fuzz_target!(|data: &[u8]| {
         rx: Some([2.0, 2.0, 1.0]),
         surfaces: vec![SurfaceDesc {
             name: text.to_string(),
-            vertices: vec![[-5.0, 0.0, 0.0], [5.0, 0.0, 0.0], [5.0, 0.0, 3.0], [-5.0, 0.0, 3.0]],
+            vertices: vec![
+                [-5.0, 0.0, 0.0],
+                [5.0, 0.0, 0.0],
+                [5.0, 0.0, 3.0],
+                [-5.0, 0.0, 3.0],
+            ],
             ..Default::default()
         }],
         ..Default::default()
