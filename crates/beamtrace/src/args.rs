@@ -24,6 +24,11 @@ diffraction's excess loss (the paper's ranking uses it); gain_db: the polarised 
 with the antennas and ITU materials, 20·log10|a|; surfaces: in order, an edge as A|B. \
 docs/output-format.md.";
 
+/// What `wvrn`'s table says.
+const WVRN_TABLE: &str = "The table lists the pairs of surfaces the network does not link, \
+with why: coplanar (both in one plane: no ray leaves one and reaches the other), occluded \
+(other surfaces hide every segment from one to the other). Linked pairs are the rest. docs/wvrn.md.";
+
 /// What the columns of `beams`' table mean.
 const BEAMS_COLUMNS: &str = "Table columns: rank; tx_beam, rx_beam: indices in the DFT \
 codebooks; tx_az/el, rx_az/el: the beams' main-lobe directions, degrees ('no direction': the \
@@ -49,6 +54,7 @@ pub enum Command {
     Demo(DemoArgs),
     /// Build the weak visibility relationship network (WVRN) of a scene and export it as a
     /// table, JSON or Graphviz DOT.
+    #[command(after_help = WVRN_TABLE)]
     Wvrn(WvrnArgs),
     /// Coverage sweep: trace the TX to every point of a receiver grid; writes coverage.csv and
     /// a heat map (coverage.svg, coverage.png) over the floor plan into --out.
