@@ -261,12 +261,11 @@ impl Server {
         first: usize,
         field: &dyn Fn(usize) -> String,
     ) -> Result<Vec<Result<Answer, ServeError>>, ServeError> {
-        let Some(&rx0) = positions.first() else {
+        if positions.is_empty() {
             return Ok(Vec::new());
-        };
+        }
         if self.tracer.scene().tx_world() != Some(tx) {
-            let scene = self.tracer.scene().with_terminals(tx, rx0);
-            let scene = scene.map_err(|e| scene_error(&e, &field(first)))?;
+            let scene = self.with_transmitter(tx, positions, first, field)?;
             self.tracer.set_scene(scene);
         }
         let traced = self.tracer.trace_each(tx, positions);
@@ -277,6 +276,28 @@ impl Server {
                 self.trace_answer(tx, rx, &t)
             })
             .collect())
+    }
+
+    /// The scene held with the transmitter at `tx` and, as its receiver, the first of
+    /// `positions` the scene accepts (a bad receiver in a list fails alone, later); when none
+    /// is accepted, the first one's error.
+    fn with_transmitter(
+        &self,
+        tx: Vec3,
+        positions: &[Vec3],
+        first: usize,
+        field: &dyn Fn(usize) -> String,
+    ) -> Result<bt_scene::Scene, ServeError> {
+        let mut refusal = None;
+        for (i, &rx) in positions.iter().enumerate() {
+            match self.tracer.scene().with_terminals(tx, rx) {
+                Ok(scene) => return Ok(scene),
+                Err(e) => {
+                    refusal.get_or_insert_with(|| scene_error(&e, &field(first + i)));
+                }
+            }
+        }
+        Err(refusal.unwrap_or_else(|| ServeError::request("rx", "no receiver")))
     }
 
     /// The answer of a trace from `tx` to `rx`, reported by the one report of `trace --json`.

@@ -105,6 +105,35 @@ fn a_bad_receiver_in_a_list_fails_alone() {
 }
 
 #[test]
+fn a_bad_first_receiver_does_not_stop_a_transmitter_move() {
+    let mut server = server(
+        "builtin:living-room",
+        SolveSettings::default(),
+        Limits::default(),
+    );
+    let lines = [
+        json!({"id": 1, "tx": [3, 3, 2], "rx": [[3, 0, 1], [1, 1, 1]]}),
+        json!({"id": 2, "tx": [3, 0, 2], "rx": [[1, 1, 1], [2, 2, 1]]}),
+    ];
+    let answers = ask(&mut server, &lines.map(|l| l.to_string()));
+    let results = answers[0]["results"].as_array().unwrap();
+    let e = results[0]["error"].as_str().unwrap();
+    assert!(
+        e.starts_with("rx[0]: lies on surface \"wall-south\""),
+        "{e}"
+    );
+    assert_eq!(results[1]["tx"], json!([3.0, 3.0, 2.0]));
+    assert!(
+        results[1]["paths"]
+            .as_array()
+            .is_some_and(|p| !p.is_empty())
+    );
+    // A transmitter in a wall fails the whole request, naming it.
+    let e = error(&answers[1]);
+    assert!(e.starts_with("tx: lies on surface \"wall-south\""), "{e}");
+}
+
+#[test]
 fn bad_poses_name_the_object_and_change_nothing() {
     let s = SolveSettings::default();
     let mut server = server("builtin:living-room-dynamic", s, Limits::default());
