@@ -381,9 +381,10 @@ pub(crate) fn trace_each_receiver(
 }
 
 /// Whether a many-receiver trace of `receivers` under `options` walks one beam tree of the TX
-/// (beam-tree mode, more than one receiver) instead of tracing each receiver alone.
-pub(crate) fn walks_one_tree(options: &TraceOptions, receivers: &[Vec3]) -> bool {
-    options.candidates == CandidateMode::BeamTree && receivers.len() > 1
+/// (beam-tree mode, more than one receiver, or any number when the tree is `kept` for the
+/// next call) instead of tracing each receiver alone.
+pub(crate) fn walks_one_tree(options: &TraceOptions, receivers: &[Vec3], kept: bool) -> bool {
+    options.candidates == CandidateMode::BeamTree && (receivers.len() > 1 || kept)
 }
 
 /// The beam tree of a TX kept for many receivers ([`trace_each_receiver`]), with the reaches
