@@ -227,8 +227,13 @@ impl Server {
         for (name, desc) in &request.objects {
             let location = format!("objects.{}", bt_scene::name::shown(name));
             let Some(i) = objects.iter().position(|o| &o.name == name) else {
-                let names: Vec<String> =
-                    objects.iter().map(|o| format!("\"{}\"", o.name)).collect();
+                // Names from the scene file, escaped, and a few of them only.
+                let mut names: Vec<String> = (objects.iter().take(20))
+                    .map(|o| format!("\"{}\"", bt_scene::name::shown(&o.name)))
+                    .collect();
+                if objects.len() > 20 {
+                    names.push(format!("... ({} in all)", objects.len()));
+                }
                 let known = match names.is_empty() {
                     true => "the scene has no moving objects".to_string(),
                     false => format!("the scene's objects are {}", names.join(", ")),
