@@ -88,6 +88,23 @@ fn listening(child: &mut Child, kind: &str) -> String {
         .to_string()
 }
 
+/// Starts `serve builtin:living-room --max-order 1 --listen LISTEN` (`tcp:...` or
+/// `unix:...`) and returns it with the address it listens on.
+fn start(listen: &str) -> (Child, String) {
+    let kind = listen.split(':').next().unwrap_or_default();
+    let args = [
+        "serve",
+        "builtin:living-room",
+        "--max-order",
+        "1",
+        "--listen",
+        listen,
+    ];
+    let mut child = spawn(&args);
+    let address = listening(&mut child, kind);
+    (child, address)
+}
+
 /// Sends `requests` on a connection and reads every answer until the server closes it.
 fn round_trip<S: Read + Write>(
     mut stream: S,
@@ -103,15 +120,7 @@ fn round_trip<S: Read + Write>(
 
 #[test]
 fn a_tcp_client_gets_its_answers_and_the_next_client_a_new_session() {
-    let mut child = spawn(&[
-        "serve",
-        "builtin:living-room",
-        "--max-order",
-        "1",
-        "--listen",
-        "tcp:127.0.0.1:0",
-    ]);
-    let address = listening(&mut child, "tcp");
+    let (mut child, address) = start("tcp:127.0.0.1:0");
     let shut = |s: &std::net::TcpStream| s.shutdown(std::net::Shutdown::Write).unwrap();
     let first = "{\"id\": 1, \"tx\": [3, 3, 2], \"rx\": [1, 1, 1]}\n{\"id\": 2}\n";
     let a = round_trip(std::net::TcpStream::connect(&address).unwrap(), first, shut);
@@ -157,15 +166,7 @@ fn a_unix_socket_round_trip_and_a_users_file_is_never_replaced() {
 
     let socket = dir.join("serve.sock");
     let listen = format!("unix:{}", socket.display());
-    let mut child = spawn(&[
-        "serve",
-        "builtin:living-room",
-        "--max-order",
-        "1",
-        "--listen",
-        &listen,
-    ]);
-    let address = listening(&mut child, "unix");
+    let (mut child, address) = start(&listen);
     assert_eq!(address, socket.display().to_string());
     let shut = |s: &UnixStream| s.shutdown(std::net::Shutdown::Write).unwrap();
     let requests = "{\"id\": \"u\", \"rx\": [[1, 1, 1], [2, 2, 1]]}\n";
@@ -177,6 +178,13 @@ fn a_unix_socket_round_trip_and_a_users_file_is_never_replaced() {
         .unwrap();
     child.kill().unwrap();
     child.wait().unwrap();
+    // The killed server left its socket: the next one replaces it (a socket, no one's data).
+    let (mut next, relisten) = start(&listen);
+    let later = round_trip(UnixStream::connect(&socket).unwrap(), "{\"id\": 2}\n", shut);
+    next.kill().unwrap();
+    next.wait().unwrap();
+    assert_eq!(relisten, socket.display().to_string());
+    assert_eq!(later[0]["id"], 2);
     assert_eq!(got[0]["id"], "u");
     assert_eq!(got[0]["results"].as_array().map(Vec::len), Some(2));
     let err = String::from_utf8_lossy(&again.stderr);
