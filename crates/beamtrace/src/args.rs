@@ -69,6 +69,10 @@ pub enum Command {
     /// the best pair and the ranked list.
     #[command(after_help = BEAMS_COLUMNS)]
     Beams(BeamsArgs),
+    /// Serve traces: one JSON request per line (receiver, transmitter and object moves), one
+    /// JSON answer per line with the path records of `trace --json`, from one long-lived
+    /// tracer; stdin/stdout, or a TCP or Unix socket (docs/serve.md).
+    Serve(ServeArgs),
     /// Scene utilities.
     Scene {
         #[command(subcommand)]
@@ -440,6 +444,51 @@ pub struct TraceArgs {
     /// With --steps: trace each step from scratch instead of updating the previous one.
     #[arg(long, requires = "steps")]
     pub from_scratch: bool,
+}
+
+#[derive(Debug, Args, Clone)]
+pub struct ServeArgs {
+    #[command(flatten)]
+    pub scene: SceneArgs,
+    #[command(flatten)]
+    pub radio: RadioArgs,
+    #[command(flatten)]
+    pub solve: SolveArgs,
+    /// Where requests come from: tcp:HOST:PORT or unix:PATH (one stream per connection,
+    /// one connection after another); stdin/stdout when absent.
+    #[arg(long, value_parser = parse_listen)]
+    pub listen: Option<Listen>,
+    /// Budget: refuse a request line longer than this many bytes (answered with an error
+    /// line; the stream goes on).
+    #[arg(long, default_value_t = bt_serve::MAX_LINE_BYTES as u64,
+          value_parser = clap::value_parser!(u64).range(1..=1 << 30))]
+    pub max_line_bytes: u64,
+    /// Budget: refuse a request with more receivers than this.
+    #[arg(long, default_value_t = bt_serve::MAX_RECEIVERS as u64,
+          value_parser = clap::value_parser!(u64).range(1..=1 << 20))]
+    pub max_receivers: u64,
+}
+
+/// The transport of `serve --listen`.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub enum Listen {
+    /// `tcp:HOST:PORT` (port 0: any free port, printed on stderr).
+    Tcp(String),
+    /// `unix:PATH`.
+    Unix(PathBuf),
+}
+
+fn parse_listen(s: &str) -> Result<Listen, String> {
+    if let Some(address) = s.strip_prefix("tcp:") {
+        if !address.contains(':') {
+            return Err(format!("tcp:{address}: expected tcp:HOST:PORT"));
+        }
+        return Ok(Listen::Tcp(address.to_string()));
+    }
+    match s.strip_prefix("unix:") {
+        Some(path) if !path.is_empty() => Ok(Listen::Unix(PathBuf::from(path))),
+        _ => Err("expected tcp:HOST:PORT or unix:PATH".into()),
+    }
 }
 
 /// How to trace: order, solver and its options, candidate generator, budget, threads (shared

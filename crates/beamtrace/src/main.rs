@@ -10,6 +10,7 @@ mod load;
 mod numbers;
 mod output;
 mod progress;
+mod serve;
 mod steps;
 mod study;
 mod sweep;
@@ -78,6 +79,7 @@ fn run(cli: args::Cli) -> anyhow::Result<ExitCode> {
         args::Command::View(a) => view::run(&a),
         args::Command::Channel(a) => channel::run_channel(&a),
         args::Command::Beams(a) => channel::run_beams(&a),
+        args::Command::Serve(a) => serve::run(&a),
         args::Command::Extract(a) => cloud::run_extract(&a),
         args::Command::Hls(a) => hls::run(&a),
         args::Command::Sample(a) => cloud::run_sample(&a),

@@ -10,6 +10,7 @@
 mod columns;
 mod options;
 mod record;
+mod tracer;
 
 use bt_geom::Vec3;
 use bt_import::LoadOptions;
@@ -38,6 +39,14 @@ fn error(e: impl std::fmt::Display) -> PyErr {
 
 fn vec3(v: [f64; 3]) -> Vec3 {
     Vec3::from_array(v)
+}
+
+/// The terminals Python passes to a load (`tx=`, `rx=`), overriding the scene's.
+fn terminals(tx: Option<[f64; 3]>, rx: Option<[f64; 3]>) -> Terminals {
+    Terminals {
+        tx: tx.map(vec3),
+        rx: rx.map(vec3),
+    }
 }
 
 /// Load any source the CLI reads (`builtin:NAME`, JSON/TOML, OBJ/PLY meshes, point clouds,
@@ -139,6 +148,11 @@ impl PyScene {
     #[getter]
     fn rx(&self) -> Option<[f64; 3]> {
         self.scene.rx_world().map(|p| p.to_array())
+    }
+    /// What the scene was loaded from (a file path or `builtin:NAME`).
+    #[getter]
+    fn source(&self) -> &str {
+        &self.source
     }
     /// Carrier frequency, Hz.
     #[getter]
@@ -293,10 +307,7 @@ fn load(
         max_mesh_elements: defaults.merge.max_elements,
     });
     let options = LoadOptions {
-        terminals: Terminals {
-            tx: tx.map(vec3),
-            rx: rx.map(vec3),
-        },
+        terminals: terminals(tx, rx),
         merge: bt_mesh::MergeOptions {
             angle_tol_deg: merge_angle_deg,
             dist_tol_m: merge_distance,
@@ -347,6 +358,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     )?;
     m.add("DEFAULT_MAX_MESH_ELEMENTS", bt_mesh::DEFAULT_MAX_ELEMENTS)?;
     m.add_class::<PyScene>()?;
+    m.add_class::<tracer::PyTracer>()?;
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(builtin_names, m)?)?;
     Ok(())

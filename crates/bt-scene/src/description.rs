@@ -144,3 +144,26 @@ pub struct KeyframeDesc {
     /// Rotation about the object's axis through its pivot, degrees (default 0).
     pub angle_deg: Option<Real>,
 }
+
+impl KeyframeDesc {
+    /// The pose this keyframe gives (its offset and angle, without the step).
+    pub fn pose(&self) -> PoseDesc {
+        PoseDesc {
+            offset: self.offset,
+            angle_deg: self.angle_deg,
+        }
+    }
+}
+
+/// The pose of an object as a keyframe spells it, without the step: `{ "offset": [dx, dy,
+/// dz], "angle_deg": a }` from the file's geometry, about the object's pivot and axis (what
+/// `beamtrace serve` takes in a request's `objects`).
+#[serde_with::skip_serializing_none]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize, Default)]
+#[serde(deny_unknown_fields)]
+pub struct PoseDesc {
+    /// Translation from the file's geometry `[dx, dy, dz]`, metres (default zero).
+    pub offset: Option<[Real; 3]>,
+    /// Rotation about the object's axis through its pivot, degrees (default 0).
+    pub angle_deg: Option<Real>,
+}

@@ -13,7 +13,7 @@
 //! across steps; TX and RX are fixed unless the file gives `tx_steps` / `rx_steps`.
 
 use crate::description::{BOX_FACES, SceneDescription};
-pub use crate::description::{KeyframeDesc, ObjectDesc};
+pub use crate::description::{KeyframeDesc, ObjectDesc, PoseDesc};
 use crate::frame::to_local;
 use crate::model::Scene;
 use crate::problem::{Problem, SceneError};
@@ -79,12 +79,48 @@ pub struct DynamicObject {
     pub surfaces: Vec<SurfaceId>,
     /// Its pose at each step.
     pub poses: Vec<Pose>,
+    /// The pivot of its rotations as the file gives it (world frame, metres); `None` for an
+    /// object that only translates, which no pose may rotate.
+    pub pivot: Option<Vec3>,
+}
+
+impl DynamicObject {
+    /// The pose `desc` (an offset and angle from the file's geometry, about this object's
+    /// pivot and axis), or the problems of its fields, located at `location` (such as
+    /// `objects.door`): non-finite values, or a rotation of an object without a pivot.
+    pub fn pose(&self, desc: &PoseDesc, location: &str) -> Result<Pose, Vec<Problem>> {
+        let mut problems = pose_problems(desc);
+        if desc.angle_deg.is_some_and(|a| a != 0.0) && self.pivot.is_none() {
+            problems.push((
+                ".angle_deg".into(),
+                "the object has no pivot in the scene file, so it cannot rotate".into(),
+            ));
+        }
+        if !problems.is_empty() {
+            return Err(problems
+                .into_iter()
+                .map(|(field, message)| Problem {
+                    location: format!("{location}{field}"),
+                    message,
+                })
+                .collect());
+        }
+        let axis = self.poses.first().map_or(Vec3::Z, |p| p.axis);
+        Ok(Pose {
+            offset: Vec3::from_array(desc.offset.unwrap_or([0.0; 3])),
+            angle_deg: desc.angle_deg.unwrap_or(0.0),
+            pivot: self.pivot.unwrap_or(Vec3::ZERO),
+            axis,
+        })
+    }
 }
 
 /// A validated scene over time steps: one [`Scene`] per step, same surfaces (names, ids,
 /// kinds, materials) in each, only the geometry of moving objects and the terminals differ.
 #[derive(Debug, Clone)]
 pub struct DynamicScene {
+    /// The file's geometry (every object unmoved) with step 0's terminals: what poses apply to.
+    base: Scene,
     scenes: Vec<Scene>,
     objects: Vec<DynamicObject>,
 }
@@ -93,6 +129,7 @@ impl DynamicScene {
     /// A static scene as a one-step dynamic scene.
     pub fn from_static(scene: Scene) -> Self {
         Self {
+            base: scene.clone(),
             scenes: vec![scene],
             objects: Vec::new(),
         }
@@ -138,17 +175,27 @@ impl DynamicScene {
             .into_iter()
             .map(|(name, poses)| DynamicObject {
                 surfaces: members.get(&name).cloned().unwrap_or_default(),
+                pivot: desc.objects[&name].pivot.map(Vec3::from_array),
                 name,
                 poses,
             })
             .collect();
         let scenes = (0..steps)
-            .map(|k| step_scene(k, &base, &objects, &terminals, &mut problems))
+            .map(|k| {
+                let poses: Vec<Pose> = objects.iter().map(|o| o.poses[k]).collect();
+                let location = format!("steps[{k}] ");
+                let at = terminals.at(k);
+                posed_scene(&base, &objects, &poses, at, &location, &mut problems)
+            })
             .collect();
         if !problems.is_empty() {
             return Err(invalid(source_name, problems));
         }
-        Ok(Self { scenes, objects })
+        Ok(Self {
+            base,
+            scenes,
+            objects,
+        })
     }
 
     /// Number of time steps (at least 1).
@@ -183,6 +230,7 @@ impl DynamicScene {
         f: impl Fn(&Scene) -> Result<Scene, SceneError>,
     ) -> Result<Self, SceneError> {
         Ok(Self {
+            base: f(&self.base)?,
             scenes: self.scenes.iter().map(f).collect::<Result<_, _>>()?,
             objects: self.objects.clone(),
         })
@@ -201,6 +249,38 @@ impl DynamicScene {
     /// The moving objects, by name order.
     pub fn objects(&self) -> &[DynamicObject] {
         &self.objects
+    }
+
+    /// The scene with every object at its pose in `poses` (aligned with [`Self::objects`])
+    /// and the terminals `terminals` (world frame; an absent one is step 0's): a step of the
+    /// same surfaces that the file does not list, validated like its steps (a pose that
+    /// breaks a polygon, a terminal on a moved surface). Problems are located at the object
+    /// and surface, or at `tx` / `rx`.
+    pub fn posed(&self, poses: &[Pose], terminals: Terminals) -> Result<Scene, SceneError> {
+        let mut problems = Vec::new();
+        if poses.len() != self.objects.len() {
+            problems.push(Problem {
+                location: "objects".into(),
+                message: format!(
+                    "{} poses given for {} objects",
+                    poses.len(),
+                    self.objects.len()
+                ),
+            });
+            return Err(invalid(self.base.name(), problems));
+        }
+        let scene = posed_scene(
+            &self.base,
+            &self.objects,
+            poses,
+            terminals,
+            "",
+            &mut problems,
+        );
+        match problems.is_empty() {
+            true => Ok(scene),
+            false => Err(invalid(self.base.name(), problems)),
+        }
     }
 }
 
@@ -330,21 +410,23 @@ fn check_surface_copies(steps: usize, surfaces: usize, problems: &mut Vec<Proble
     }
 }
 
-/// Step `k`: the base scene with every object moved to its pose and the step's terminals;
-/// a polygon a pose breaks and a terminal check that fails are problems of the step.
-fn step_scene(
-    k: usize,
+/// The base scene with every object moved to its pose (`poses`, aligned with `objects`) and
+/// the terminals `at` (world frame; an absent one is the base scene's); a polygon a pose
+/// breaks and a terminal check that fails are problems, their locations prefixed with
+/// `location` (a step's `steps[k] `).
+fn posed_scene(
     base: &Scene,
     objects: &[DynamicObject],
-    terminals: &StepTerminals,
+    poses: &[Pose],
+    at: Terminals,
+    location: &str,
     problems: &mut Vec<Problem>,
 ) -> Scene {
     // Every step shares the base scene's local frame (warm starts and reuse compare positions
     // across steps): world inputs (pivots, terminals) are moved into it.
     let origin = base.origin();
     let mut surfaces: Vec<Surface> = base.surfaces().to_vec();
-    for object in objects {
-        let pose = object.poses[k];
+    for (object, &pose) in objects.iter().zip(poses) {
         if pose.is_identity() {
             continue;
         }
@@ -364,7 +446,7 @@ fn step_scene(
                 Ok(p) => s.polygon = p,
                 Err(e) => problems.push(Problem {
                     location: format!(
-                        "steps[{k}] object \"{}\" surface \"{}\"",
+                        "{location}object \"{}\" surface \"{}\"",
                         object.name, s.name
                     ),
                     message: e.to_string(),
@@ -372,13 +454,12 @@ fn step_scene(
             }
         }
     }
-    let at = terminals.at(k);
     let tx = at.tx.map(|p| to_local(p, origin)).or(base.tx());
     let rx = at.rx.map(|p| to_local(p, origin)).or(base.rx());
     let extent = crate::model::scene_extent(&surfaces, tx, rx);
     if let Err(list) = check_terminals(&surfaces, tx, rx, extent, origin) {
         problems.extend(list.into_iter().map(|p| Problem {
-            location: format!("steps[{k}] {}", p.location),
+            location: format!("{location}{}", p.location),
             message: p.message,
         }));
     }
@@ -448,6 +529,19 @@ fn motion_problems(object: &ObjectDesc) -> FieldProblems {
     problems
 }
 
+/// The problems of a pose's values (`.offset`, `.angle_deg`): one home for the keyframes of
+/// scene files and the poses of `beamtrace serve`.
+fn pose_problems(pose: &PoseDesc) -> FieldProblems {
+    let mut problems = FieldProblems::new();
+    if pose.offset.is_some_and(|o| !finite3(&o)) {
+        problems.push((".offset".into(), "must be three finite numbers".into()));
+    }
+    if pose.angle_deg.is_some_and(|a| !a.is_finite()) {
+        problems.push((".angle_deg".into(), "must be a finite number".into()));
+    }
+    problems
+}
+
 /// Appends the problems of an object's keyframes (steps in range and increasing, finite
 /// values); returns whether a keyframe rotates the object.
 fn keyframe_problems(object: &ObjectDesc, steps: usize, problems: &mut FieldProblems) -> bool {
@@ -465,17 +559,8 @@ fn keyframe_problems(object: &ObjectDesc, steps: usize, problems: &mut FieldProb
                 "keyframe steps must be strictly increasing".into(),
             ));
         }
-        if k.offset.is_some_and(|o| !finite3(&o)) {
-            problems.push((
-                format!(".keyframes[{i}].offset"),
-                "must be three finite numbers".into(),
-            ));
-        }
-        if k.angle_deg.is_some_and(|a| !a.is_finite()) {
-            problems.push((
-                format!(".keyframes[{i}].angle_deg"),
-                "must be a finite number".into(),
-            ));
+        for (field, message) in pose_problems(&k.pose()) {
+            problems.push((format!(".keyframes[{i}]{field}"), message));
         }
         rotates |= k.angle_deg.is_some_and(|a| a != 0.0);
     }
@@ -697,6 +782,52 @@ mod tests {
         for k in 1..4 {
             assert_eq!(d.step(k).surfaces().len(), d.step(0).surfaces().len());
         }
+    }
+
+    #[test]
+    fn posed_with_a_steps_poses_is_that_step_and_bad_poses_are_named() {
+        let d = DynamicScene::from_description(&door_scene(""), "t", Terminals::default()).unwrap();
+        for k in 0..d.len() {
+            let poses: Vec<Pose> = d.objects().iter().map(|o| o.poses[k]).collect();
+            let posed = d.posed(&poses, Terminals::default()).unwrap();
+            for (a, b) in posed.surfaces().iter().zip(d.step(k).surfaces()) {
+                assert_eq!(a.polygon.vertices(), b.polygon.vertices(), "step {k}");
+            }
+        }
+        let names: Vec<&str> = d.objects().iter().map(|o| o.name.as_str()).collect();
+        assert_eq!(names, ["crate", "door"]);
+        let (crate_, door) = (&d.objects()[0], &d.objects()[1]);
+        let turn = PoseDesc {
+            offset: None,
+            angle_deg: Some(45.0),
+        };
+        let err = crate_.pose(&turn, "objects.crate").unwrap_err();
+        assert_eq!(err[0].location, "objects.crate.angle_deg", "{err:?}");
+        assert!(err[0].message.contains("no pivot"), "{err:?}");
+        let bad = PoseDesc {
+            offset: Some([f64::NAN, 0.0, 0.0]),
+            angle_deg: Some(f64::INFINITY),
+        };
+        let err = door.pose(&bad, "objects.door").unwrap_err();
+        let located: Vec<&str> = err.iter().map(|p| p.location.as_str()).collect();
+        assert_eq!(located, ["objects.door.offset", "objects.door.angle_deg"]);
+        // The crate pushed onto the RX: a problem of the RX, not a panic.
+        let onto_rx = PoseDesc {
+            offset: Some([0.7, 1.6, 0.0]),
+            angle_deg: None,
+        };
+        let poses = [
+            crate_.pose(&onto_rx, "objects.crate").unwrap(),
+            door.poses[0],
+        ];
+        let rx = Some(Vec3::new(2.7, 2.0, 0.25));
+        let err = d.posed(&poses, Terminals { tx: None, rx }).unwrap_err();
+        assert!(err.to_string().contains("rx: lies on surface"), "{err}");
+        let err = d.posed(&poses[..1], Terminals::default()).unwrap_err();
+        assert!(
+            err.to_string().contains("1 poses given for 2 objects"),
+            "{err}"
+        );
     }
 
     /// Every problem `desc` is refused with, as printed.

@@ -23,7 +23,7 @@ mod surface;
 mod validate;
 
 pub use description::{
-    BoxDesc, KeyframeDesc, MaterialDesc, ObjectDesc, SceneDescription, SurfaceDesc,
+    BoxDesc, KeyframeDesc, MaterialDesc, ObjectDesc, PoseDesc, SceneDescription, SurfaceDesc,
 };
 pub use edges::{Edge, EdgeId, Edges};
 pub use frame::RECENTRE_RATIO;

@@ -373,7 +373,9 @@ pub(crate) fn trace_each_receiver(
             _ => trace_scene_in(&moved, &inner, &mut TreeCache::default(), &mut |_| {}),
         }
     };
-    if options.parallel {
+    // One receiver runs on the caller's thread: handing it to the pool only adds a wake-up
+    // (a whole scheduler slice, ~4 ms, when the cores are busy: serve's p99).
+    if options.parallel && receivers.len() > 1 {
         receivers.par_iter().map(one).collect()
     } else {
         receivers.iter().map(one).collect()
@@ -381,9 +383,10 @@ pub(crate) fn trace_each_receiver(
 }
 
 /// Whether a many-receiver trace of `receivers` under `options` walks one beam tree of the TX
-/// (beam-tree mode, more than one receiver) instead of tracing each receiver alone.
-pub(crate) fn walks_one_tree(options: &TraceOptions, receivers: &[Vec3]) -> bool {
-    options.candidates == CandidateMode::BeamTree && receivers.len() > 1
+/// (beam-tree mode, more than one receiver, or any number when the tree is `kept` for the
+/// next call) instead of tracing each receiver alone.
+pub(crate) fn walks_one_tree(options: &TraceOptions, receivers: &[Vec3], kept: bool) -> bool {
+    options.candidates == CandidateMode::BeamTree && (receivers.len() > 1 || kept)
 }
 
 /// The beam tree of a TX kept for many receivers ([`trace_each_receiver`]), with the reaches

@@ -114,7 +114,8 @@ impl Tracer {
     /// receiver on a surface or at the TX gets its own [`TraceError::Scene`] and the others are
     /// still traced (a coverage sweep marks such grid points). In beam-tree mode one tree of
     /// the TX answers every receiver by a walk; for the scene's own TX the tree is kept for the
-    /// next call (a sweep in chunks builds it once). Another TX is placed with the first
+    /// next call (a sweep in chunks builds it once), and walked even for a single receiver (a
+    /// stream of receiver moves, `beamtrace serve`). Another TX is placed with the first
     /// receiver ([`Scene::with_terminals`]). Fails as a whole when the TX is not valid or the
     /// tree exceeds its budget.
     pub fn trace_each(
@@ -126,8 +127,9 @@ impl Tracer {
             return Ok(Vec::new());
         };
         let options = self.options;
-        let walk = walks_one_tree(&options, receivers);
-        if Some(tx) != self.scene.tx_world() {
+        let own = Some(tx) == self.scene.tx_world();
+        let walk = walks_one_tree(&options, receivers, own);
+        if !own {
             let base = self.scene.with_terminals(tx, *first)?;
             let tree = match walk {
                 true => Some(KeptTx::build(&base, &options, &mut self.cache)?),

@@ -14,6 +14,8 @@ horizontal plane; the arrival direction points from RX towards where the wave co
 
 from __future__ import annotations
 
+import inspect
+import json
 import os
 import warnings
 from typing import Any, Dict, List, Optional, Sequence, Union
@@ -28,6 +30,7 @@ __all__ = [
     "BeamtraceError",
     "Paths",
     "Scene",
+    "Tracer",
     "builtin_names",
     "load",
 ]
@@ -147,6 +150,11 @@ class Scene:
         return self._native.name
 
     @property
+    def source(self) -> str:
+        """What the scene was loaded from: a file path or ``builtin:NAME``."""
+        return self._native.source
+
+    @property
     def tx(self) -> Optional[npt.NDArray[np.float64]]:
         """The scene's transmitter position, metres; None when it has none (a mesh)."""
         tx = self._native.tx
@@ -252,6 +260,106 @@ class Scene:
             _options(locals()),
         )
         return [Paths(c) for c in results]
+
+
+class Tracer:
+    """The real-time loop of ``beamtrace serve`` in Python: a scene kept loaded with one
+    tracer (its beam tree of the TX and its caches carry over from update to update), moved by
+    :meth:`update` (docs/serve.md).
+
+    >>> tracer = beamtrace.Tracer("builtin:living-room-dynamic", max_order=3)
+    >>> tracer.update(rx=[1.0, 2.0, 1.2])["paths"][0]["length_m"]
+    >>> tracer.update(objects={"person": {"offset": [0.5, 1.5, 0.0]}})
+
+    ``scene`` is a source (``builtin:NAME`` or a scene file, loaded with its time steps and
+    moving objects) or a :class:`Scene` (reloaded from its :attr:`Scene.source`, with its TX
+    and RX). ``tx`` overrides the scene's transmitter. ``options`` are :meth:`Scene.trace`'s
+    keywords with its defaults (``max_order=3``, ``solver``, ``diffraction``, ...); an unknown
+    one raises ``TypeError``, a bad value ``ValueError``, here.
+    """
+
+    def __init__(
+        self,
+        scene: Union[str, "os.PathLike[str]", Scene],
+        tx: Optional[Point] = None,
+        **options: Any,
+    ) -> None:
+        rx = None
+        if isinstance(scene, Scene):
+            source = scene.source
+            tx = scene.tx if tx is None else tx
+            rx = scene.rx
+        else:
+            source = os.fspath(scene)
+        keywords = _trace_keywords(options)
+        self._native = _native.Tracer(source, keywords, _point(tx, "tx"), _point(rx, "rx"))
+
+    def update(
+        self,
+        rx: Any = None,
+        tx: Optional[Point] = None,
+        objects: Optional[Dict[str, Dict[str, Any]]] = None,
+        step: Optional[int] = None,
+    ) -> Dict[str, Any]:
+        """Move what is given and trace: ``rx`` one receiver ``[x, y, z]`` or an (m, 3)
+        array of them (metres), ``tx`` the transmitter, ``objects`` poses by object name
+        (``{"door": {"angle_deg": 30}, "person": {"offset": [dx, dy, dz]}}``, as a dynamic
+        scene's keyframes spell them), ``step`` every object to its pose at that step of the
+        scene file. What is not given stays as the previous update left it.
+
+        Returns the answer of ``beamtrace serve`` as Python objects: for one receiver
+        ``{"id", "tx", "rx", "paths", "stats", "latency_us"}`` (``paths``: the records of
+        ``beamtrace trace --json``), for several ``{"id", "results": [...], "latency_us"}``,
+        one entry per receiver (an entry ``{"rx", "error"}`` for a receiver that cannot be
+        traced). Raises :class:`BeamtraceError` with serve's message, naming the field, when
+        the update cannot be traced; the tracer then stays as it was.
+        """
+        request: Dict[str, Any] = {}
+        if rx is not None:
+            request["rx"] = _request_receivers(rx)
+        if tx is not None:
+            request["tx"] = list(_point(tx, "tx") or ())
+            if not np.isfinite(request["tx"]).all():
+                raise ValueError("tx must be finite numbers (metres)")
+        if objects is not None:
+            request["objects"] = objects
+        if step is not None:
+            request["step"] = step
+        line = json.dumps(request, default=_plain, allow_nan=False)
+        answer = json.loads(self._native.answer(line))
+        if "error" in answer:
+            raise BeamtraceError(answer["error"])
+        return answer
+
+
+def _trace_keywords(options: Dict[str, Any]) -> Dict[str, Any]:
+    """``options`` as the native module takes them, each keyword absent taking
+    :meth:`Scene.trace`'s default (its signature is the one list of them)."""
+    parameters = inspect.signature(Scene.trace).parameters
+    names = [name for name in parameters if name not in ("self", "tx", "rx")]
+    unknown = sorted(set(options) - set(names))
+    if unknown:
+        raise TypeError(
+            f"unknown trace keyword(s) {', '.join(unknown)}; they are {', '.join(names)}"
+        )
+    return _options({name: options.get(name, parameters[name].default) for name in names})
+
+
+def _request_receivers(rx: Any) -> Any:
+    """One receiver as [x, y, z], several as [[x, y, z], ...] (the serve request's spelling)."""
+    a = np.asarray(rx, dtype=np.float64)
+    if a.shape != (3,) and (a.ndim != 2 or a.shape[1] != 3):
+        raise ValueError(f"rx must be [x, y, z] or have shape (m, 3), metres, got shape {a.shape}")
+    if not np.isfinite(a).all():
+        raise ValueError("rx must be finite numbers (metres)")
+    return a.tolist()
+
+
+def _plain(value: Any) -> Any:
+    """NumPy values in a pose as plain Python numbers and lists (for JSON)."""
+    if isinstance(value, (np.ndarray, np.generic)):
+        return value.tolist()
+    raise TypeError(f"{type(value).__name__} is not a number or a list of numbers")
 
 
 def _options(arguments: Dict[str, Any]) -> Dict[str, Any]:

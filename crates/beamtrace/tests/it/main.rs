@@ -9,6 +9,7 @@ mod hls;
 mod hostile;
 mod living_room;
 mod pointcloud;
+mod serve;
 mod study;
 mod sweep;
 mod terminals;

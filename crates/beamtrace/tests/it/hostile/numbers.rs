@@ -16,6 +16,7 @@ const VALUES: [&str; 4] = ["nan", "inf", "-1", "1e300"];
 const BASES: &[(&str, &str)] = &[
     ("trace", "trace builtin:living-room --max-order 1"),
     ("demo", "demo --max-order 1"),
+    ("serve", "serve builtin:living-room --max-order 1"),
     ("scene check", "scene check builtin:living-room"),
     ("wvrn", "wvrn builtin:living-room --max-order 1"),
     (
@@ -65,6 +66,8 @@ const NOT_NUMBERS: &[&str] = &[
     "report",
     "paths",
     "steps-from",
+    // a transport, tcp:HOST:PORT or unix:PATH
+    "listen",
     // X,Y,Z vectors (each coordinate checked finite by `parse_vec3`, tested in small.rs)
     "tx",
     "rx",

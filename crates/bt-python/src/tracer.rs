@@ -1,0 +1,61 @@
+//! `beamtrace.Tracer`: the loop of `beamtrace serve` in Python. One `bt_serve::Server` (one
+//! long-lived `Tracer`) per object; each update is one request line of the serve protocol,
+//! answered by the same code, so Python gets exactly what `serve` prints (`docs/serve.md`).
+
+use crate::options::TraceKeywords;
+use crate::{error, terminals};
+use bt_import::LoadOptions;
+use bt_serve::{Limits, Server};
+use pyo3::exceptions::PyValueError;
+use pyo3::prelude::*;
+use std::sync::Mutex;
+
+/// A scene kept loaded with one tracer, answering the requests of `beamtrace serve`.
+#[pyclass(frozen, module = "beamtrace._native", name = "Tracer")]
+pub struct PyTracer {
+    server: Mutex<Server>,
+}
+
+#[pymethods]
+impl PyTracer {
+    /// Load `source` with its time steps and objects (`builtin:NAME` or a file), `tx`/`rx`
+    /// overriding its terminals, and trace under `keywords` (the trace keywords of
+    /// `Scene.trace`).
+    #[new]
+    #[pyo3(signature = (source, keywords, tx, rx))]
+    fn new(
+        py: Python<'_>,
+        source: String,
+        keywords: TraceKeywords,
+        tx: Option<[f64; 3]>,
+        rx: Option<[f64; 3]>,
+    ) -> PyResult<Self> {
+        let options = LoadOptions {
+            terminals: terminals(tx, rx),
+            ..LoadOptions::default()
+        };
+        let loaded = py.detach(|| bt_import::load_dynamic(&source, &options, &mut |_| {}));
+        let dynamic = loaded.map_err(error)?.scene;
+        let trace_options = keywords
+            .trace_options(dynamic.step(0))
+            .map_err(PyValueError::new_err)?;
+        let radio = keywords.radio().map_err(PyValueError::new_err)?;
+        let server = Server::new(dynamic, trace_options, radio, Limits::default());
+        Ok(PyTracer {
+            server: Mutex::new(server),
+        })
+    }
+
+    /// Answer one request line of the serve protocol (JSON) with its answer line (JSON),
+    /// without the GIL; an error answer is `{"id", "error"}`, as `serve` prints it.
+    fn answer(&self, py: Python<'_>, line: &str) -> PyResult<String> {
+        py.detach(|| {
+            let mut server = self.server.lock().map_err(|_| {
+                error("the tracer was poisoned by a panic in another thread; make a new one")
+            })?;
+            let mut out = Vec::new();
+            server.answer_line(line.as_bytes(), &mut out);
+            String::from_utf8(out).map_err(error)
+        })
+    }
+}

@@ -1,0 +1,104 @@
+//! A probe of the serve loop in process: a seeded random walk of receivers in the living room
+//! (order 3 unless given), streamed through one `Server` as JSON lines from memory into
+//! memory, one receiver per request and then in requests of `--batch` receivers. Prints the
+//! throughput and the percentiles of `latency_us` (docs/performance.md).
+//!
+//! `cargo run --release -p bt-serve --example stream -- [MOVES] [MAX_ORDER] [BATCH]`
+
+use bt_beams::RadioOptions;
+use bt_serve::{Limits, Server};
+use bt_solve::settings::SolveSettings;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
+use std::time::Instant;
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let arg = |i: usize, default: usize| -> Result<usize, Box<dyn std::error::Error>> {
+        match std::env::args().nth(i) {
+            Some(v) => Ok(v
+                .parse()
+                .map_err(|e| format!("argument {i} ({v:?}): {e}"))?),
+            None => Ok(default),
+        }
+    };
+    let (moves, max_order, batch) = (arg(1, 10_000)?, arg(2, 3)?, arg(3, 100)?.max(1));
+    let walk = walk(30, moves);
+    let single: Vec<String> = (walk.iter().enumerate())
+        .map(|(i, p)| format!("{{\"id\":{i},\"rx\":[{},{},{}]}}", p[0], p[1], p[2]))
+        .collect();
+    let batched: Vec<String> = (walk.chunks(batch).enumerate())
+        .map(|(i, chunk)| {
+            let list: Vec<String> = chunk
+                .iter()
+                .map(|p| format!("[{},{},{}]", p[0], p[1], p[2]))
+                .collect();
+            format!("{{\"id\":{i},\"rx\":[{}]}}", list.join(","))
+        })
+        .collect();
+    println!("living room, order {max_order}, {moves} receiver moves (seed 30)");
+    for (name, lines) in [("1 per request", &single), ("batched", &batched)] {
+        let (seconds, latencies) = stream(max_order, lines)?;
+        let per_move = seconds / moves as f64 * 1e6;
+        let p = |q: f64| latencies[((latencies.len() - 1) as f64 * q) as usize];
+        println!(
+            "{name:>14}: {:>8.0} moves/s, {per_move:>6.1} us per move; latency_us per request \
+             p50 {:.1} p99 {:.1} max {:.1} ({} requests)",
+            moves as f64 / seconds,
+            p(0.5),
+            p(0.99),
+            p(1.0),
+            latencies.len()
+        );
+    }
+    Ok(())
+}
+
+/// Streams `lines` through a fresh server; the wall time of the whole stream and each
+/// answer's `latency_us`, sorted.
+fn stream(
+    max_order: usize,
+    lines: &[String],
+) -> Result<(f64, Vec<f64>), Box<dyn std::error::Error>> {
+    let options = bt_import::LoadOptions::default();
+    let dynamic = bt_import::load_dynamic("builtin:living-room", &options, &mut |_| {})?.scene;
+    let settings = SolveSettings {
+        max_order,
+        ..SolveSettings::default()
+    };
+    let options = settings.trace_options(dynamic.step(0))?;
+    let limits = Limits::default();
+    let mut server = Server::new(dynamic, options, RadioOptions::default(), limits);
+    let input = lines.join("\n");
+    let mut output = Vec::with_capacity(input.len() * 64);
+    let t0 = Instant::now();
+    let summary = server.serve(input.as_bytes(), &mut output)?;
+    let seconds = t0.elapsed().as_secs_f64();
+    // Receivers of the walk that lie on a surface (a seat, a shelf) get error lines.
+    println!(
+        "{:>14}  {} requests, {} error answers",
+        "", summary.requests, summary.errors
+    );
+    let mut latencies = Vec::new();
+    for line in output.split(|&b| b == b'\n').filter(|l| !l.is_empty()) {
+        let v: serde_json::Value = serde_json::from_slice(line)?;
+        latencies.extend(v["latency_us"].as_f64());
+    }
+    latencies.sort_by(f64::total_cmp);
+    Ok((seconds, latencies))
+}
+
+/// The seeded walk of the tests: 0.2 m steps on a millimetre grid, 0.3 m from the walls.
+fn walk(seed: u64, n: usize) -> Vec<[f64; 3]> {
+    let mut rng = ChaCha8Rng::seed_from_u64(seed);
+    let mut p: [f64; 3] = [2.3, 2.1, 0.72];
+    let bounds: [(f64, f64); 3] = [(0.3, 5.7), (0.3, 4.2), (0.3, 2.4)];
+    (0..n)
+        .map(|_| {
+            for (x, (lo, hi)) in p.iter_mut().zip(bounds) {
+                let next = (*x + rng.random_range(-0.2..0.2)).clamp(lo, hi);
+                *x = (next * 1e3).round() / 1e3;
+            }
+            p
+        })
+        .collect()
+}

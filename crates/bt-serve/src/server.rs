@@ -1,0 +1,390 @@
+//! The session state and the answer to one request.
+
+use crate::request::{self, Receivers, Request};
+use crate::{Limits, ServeError};
+use bt_beams::{PathReport, RadioOptions, StepDocument, StepStats, TraceDocument};
+use bt_geom::Vec3;
+use bt_scene::dynamic::{DynamicScene, Pose};
+use bt_scene::{SceneError, Terminals};
+use bt_solve::Tracer;
+use bt_solve::pipeline::{TraceError, TraceOptions, Traced};
+use serde::Serialize;
+use serde_json::Value;
+use std::io::Write;
+use std::time::{Duration, Instant};
+
+/// A long-lived tracer answering requests: one [`Tracer`] for the whole life of the server
+/// (its TX tree and caches carry over from request to request), the scene's objects and the
+/// session's transmitter, receivers and poses.
+pub struct Server {
+    tracer: Tracer,
+    dynamic: DynamicScene,
+    radio: RadioOptions,
+    limits: Limits,
+    /// The session's state when it starts ([`Server::end_session`] goes back to it).
+    initial: Session,
+    session: Session,
+    /// The object poses of the geometry the tracer holds (aligned with the objects).
+    held: Vec<Pose>,
+}
+
+/// What a request may leave out and take from the previous one.
+#[derive(Debug, Clone)]
+struct Session {
+    tx: Option<Vec3>,
+    rx: Option<Receivers>,
+    poses: Vec<Pose>,
+}
+
+/// The answer for one receiver: the fields of `trace --json` a receiver changes.
+#[derive(Serialize)]
+struct Answer {
+    tx: [f64; 3],
+    rx: [f64; 3],
+    paths: Vec<PathReport>,
+    stats: AnswerStats,
+}
+
+/// The stats of `trace --json` for a trace, or of a `--steps` step for a request that moved
+/// objects (its `update` counts say what the incremental update did).
+#[derive(Serialize)]
+#[serde(untagged)]
+enum AnswerStats {
+    Trace(bt_beams::Stats),
+    Step(StepStats),
+}
+
+#[derive(Serialize)]
+struct Reply<'a> {
+    id: &'a Value,
+    #[serde(flatten)]
+    body: Body,
+}
+
+#[derive(Serialize)]
+#[serde(untagged)]
+enum Body {
+    One(Box<Answer>),
+    Many { results: Vec<Entry> },
+}
+
+/// One entry of `results`: an answer, or the error of that receiver alone.
+#[derive(Serialize)]
+#[serde(untagged)]
+enum Entry {
+    Answer(Box<Answer>),
+    Error { rx: [f64; 3], error: String },
+}
+
+#[derive(Serialize)]
+struct ErrorLine<'a> {
+    id: &'a Value,
+    error: String,
+}
+
+impl Server {
+    /// A server tracing `dynamic` (a static scene is one step without objects) under
+    /// `options`, reporting with `radio`. The session starts with step 0: its terminals
+    /// (the scene's, or `--tx`/`--rx`) and its objects' poses.
+    pub fn new(
+        dynamic: DynamicScene,
+        options: TraceOptions,
+        radio: RadioOptions,
+        limits: Limits,
+    ) -> Self {
+        let scene0 = dynamic.step(0).clone();
+        let poses: Vec<Pose> = dynamic.objects().iter().map(|o| o.poses[0]).collect();
+        let initial = Session {
+            tx: scene0.tx_world(),
+            rx: scene0.rx_world().map(Receivers::One),
+            poses: poses.clone(),
+        };
+        Server {
+            tracer: Tracer::new(scene0, options),
+            dynamic,
+            radio,
+            limits,
+            session: initial.clone(),
+            initial,
+            held: poses,
+        }
+    }
+
+    /// The bounds of every request.
+    pub fn limits(&self) -> &Limits {
+        &self.limits
+    }
+
+    /// The tracer (its scene is the geometry of the last request that moved objects).
+    pub fn tracer(&self) -> &Tracer {
+        &self.tracer
+    }
+
+    /// End a client's session: the next request starts from step 0's terminals and poses
+    /// again (a new connection), while the tracer keeps its trees and caches.
+    pub fn end_session(&mut self) {
+        self.session = self.initial.clone();
+    }
+
+    /// Answer one request line into `out` (cleared first; one JSON object, no line break);
+    /// false when the answer is an error line.
+    pub fn answer_line(&mut self, line: &[u8], out: &mut Vec<u8>) -> bool {
+        out.clear();
+        let request = match request::parse(line, &self.limits) {
+            Ok(r) => r,
+            Err((id, e)) => {
+                self.write_error(&id, &e, out);
+                return false;
+            }
+        };
+        let t0 = Instant::now();
+        match self.answer(&request, t0, out) {
+            Ok(()) => true,
+            Err(e) => {
+                out.clear();
+                self.write_error(&request.id, &e, out);
+                false
+            }
+        }
+    }
+
+    /// The error line `{"id", "error"}` of `e` into `out`.
+    pub(crate) fn write_error(&self, id: &Value, e: &ServeError, out: &mut Vec<u8>) {
+        let line = ErrorLine {
+            id,
+            error: e.to_string(),
+        };
+        if serde_json::to_writer(&mut *out, &line).is_err() {
+            out.clear();
+            out.extend_from_slice(br#"{"id":null,"error":"the answer could not be written"}"#);
+        }
+    }
+
+    /// Trace `request` and write its answer; the session takes its positions and poses once
+    /// it is answered.
+    fn answer(
+        &mut self,
+        request: &Request,
+        t0: Instant,
+        out: &mut Vec<u8>,
+    ) -> Result<(), ServeError> {
+        let tx = request.tx.or(self.session.tx).ok_or_else(|| {
+            ServeError::request("tx", "no transmitter yet: give \"tx\": [x, y, z] (or --tx)")
+        })?;
+        let rx = request.rx.clone().or_else(|| self.session.rx.clone());
+        let rx = rx.ok_or_else(|| {
+            ServeError::request("rx", "no receiver yet: give \"rx\": [x, y, z] (or --rx)")
+        })?;
+        let poses = self.poses(request)?;
+        let field = |i: usize| match rx {
+            Receivers::One(_) => "rx".to_string(),
+            Receivers::Many(_) => format!("rx[{i}]"),
+        };
+        let positions = rx.positions();
+        let mut outcomes = match poses != self.held {
+            true => self.update_and_trace(tx, positions, &poses, &field)?,
+            false => self.trace(tx, positions, 0, &field)?,
+        };
+        let body = match rx {
+            Receivers::One(_) => Body::One(Box::new(outcomes.pop().unwrap_or_else(|| {
+                Err(ServeError::request("rx", "no answer for the receiver"))
+            })?)),
+            Receivers::Many(_) => Body::Many {
+                results: (positions.iter().zip(outcomes))
+                    .map(|(p, o)| match o {
+                        Ok(answer) => Entry::Answer(Box::new(answer)),
+                        Err(e) => Entry::Error {
+                            rx: p.to_array(),
+                            error: e.to_string(),
+                        },
+                    })
+                    .collect(),
+            },
+        };
+        self.session = Session {
+            tx: Some(tx),
+            rx: Some(rx),
+            poses,
+        };
+        write_reply(&request.id, body, t0, out)
+    }
+
+    /// The poses a request asks for: the session's, or step `step`'s, then `objects`'.
+    fn poses(&self, request: &Request) -> Result<Vec<Pose>, ServeError> {
+        let objects = self.dynamic.objects();
+        let mut poses = match request.step {
+            None => self.session.poses.clone(),
+            Some(k) if k < self.dynamic.len() => objects.iter().map(|o| o.poses[k]).collect(),
+            Some(k) => {
+                let message = format!(
+                    "is {k}; the scene has {} step(s), 0 to {}",
+                    self.dynamic.len(),
+                    self.dynamic.len() - 1
+                );
+                return Err(ServeError::request("step", message));
+            }
+        };
+        for (name, desc) in &request.objects {
+            let location = format!("objects.{}", bt_scene::name::shown(name));
+            let Some(i) = objects.iter().position(|o| &o.name == name) else {
+                // Names from the scene file, escaped, and a few of them only.
+                let mut names: Vec<String> = (objects.iter().take(20))
+                    .map(|o| format!("\"{}\"", bt_scene::name::shown(&o.name)))
+                    .collect();
+                if objects.len() > 20 {
+                    names.push(format!("... ({} in all)", objects.len()));
+                }
+                let known = match names.is_empty() {
+                    true => "the scene has no moving objects".to_string(),
+                    false => format!("the scene's objects are {}", names.join(", ")),
+                };
+                return Err(ServeError::request(
+                    location,
+                    format!("no such object; {known}"),
+                ));
+            };
+            poses[i] = objects[i].pose(desc, &location).map_err(|problems| {
+                ServeError::Scene(
+                    problems
+                        .iter()
+                        .map(|p| p.to_string())
+                        .collect::<Vec<_>>()
+                        .join("; "),
+                )
+            })?;
+        }
+        Ok(poses)
+    }
+
+    /// Trace `tx` to `positions` (the first of them at index `first` of the request) in the
+    /// geometry held, one outcome per receiver; the tracer's scene takes `tx` first, so its
+    /// tree is the one kept and reused.
+    fn trace(
+        &mut self,
+        tx: Vec3,
+        positions: &[Vec3],
+        first: usize,
+        field: &dyn Fn(usize) -> String,
+    ) -> Result<Vec<Result<Answer, ServeError>>, ServeError> {
+        if positions.is_empty() {
+            return Ok(Vec::new());
+        }
+        if self.tracer.scene().tx_world() != Some(tx) {
+            let scene = self.with_transmitter(tx, positions, first, field)?;
+            self.tracer.set_scene(scene);
+        }
+        let traced = self.tracer.trace_each(tx, positions);
+        let traced = traced.map_err(|e| trace_error(e, &field(first)))?;
+        Ok((traced.into_iter().zip(positions).enumerate())
+            .map(|(i, (t, &rx))| {
+                let t = t.map_err(|e| trace_error(e, &field(first + i)))?;
+                self.trace_answer(tx, rx, &t)
+            })
+            .collect())
+    }
+
+    /// The scene held with the transmitter at `tx` and, as its receiver, the first of
+    /// `positions` the scene accepts (a bad receiver in a list fails alone, later); when none
+    /// is accepted, the first one's error.
+    fn with_transmitter(
+        &self,
+        tx: Vec3,
+        positions: &[Vec3],
+        first: usize,
+        field: &dyn Fn(usize) -> String,
+    ) -> Result<bt_scene::Scene, ServeError> {
+        let mut refusal = None;
+        for (i, &rx) in positions.iter().enumerate() {
+            match self.tracer.scene().with_terminals(tx, rx) {
+                Ok(scene) => return Ok(scene),
+                Err(e) => {
+                    refusal.get_or_insert_with(|| scene_error(&e, &field(first + i)));
+                }
+            }
+        }
+        Err(refusal.unwrap_or_else(|| ServeError::request("rx", "no receiver")))
+    }
+
+    /// The answer of a trace from `tx` to `rx`, reported by the one report of `trace --json`.
+    fn trace_answer(&self, tx: Vec3, rx: Vec3, traced: &Traced) -> Result<Answer, ServeError> {
+        let scene = self.tracer.scene().with_terminals(tx, rx);
+        let scene = scene.map_err(|e| scene_error(&e, "rx"))?;
+        let options = self.tracer.options();
+        let doc = TraceDocument::report(&scene, options, traced, &self.radio, Duration::ZERO)?;
+        Ok(Answer {
+            tx: doc.tx,
+            rx: doc.rx,
+            paths: doc.paths,
+            stats: AnswerStats::Trace(doc.stats),
+        })
+    }
+
+    /// Move the objects to `poses` and trace the first receiver as the tracer's next time
+    /// step (incrementally, as `trace --steps`), the others in that geometry.
+    fn update_and_trace(
+        &mut self,
+        tx: Vec3,
+        positions: &[Vec3],
+        poses: &[Pose],
+        field: &dyn Fn(usize) -> String,
+    ) -> Result<Vec<Result<Answer, ServeError>>, ServeError> {
+        let Some(&rx0) = positions.first() else {
+            return Ok(Vec::new());
+        };
+        let terminals = Terminals {
+            tx: Some(tx),
+            rx: Some(rx0),
+        };
+        let scene = self.dynamic.posed(poses, terminals);
+        let scene = scene.map_err(|e| scene_error(&e, &field(0)))?;
+        self.held = poses.to_vec();
+        let t0 = Instant::now();
+        let step = self
+            .tracer
+            .update(&scene)
+            .map_err(|e| trace_error(e, &field(0)))?;
+        let doc = StepDocument::report(&scene, step, &self.radio, t0.elapsed())?;
+        let first = Answer {
+            tx: doc.tx,
+            rx: doc.rx,
+            paths: doc.paths,
+            stats: AnswerStats::Step(doc.stats),
+        };
+        let mut outcomes = vec![Ok(first)];
+        outcomes.extend(self.trace(tx, &positions[1..], 1, field)?);
+        Ok(outcomes)
+    }
+}
+
+/// The reply `{"id", ...body, "latency_us"}` into `out`: `latency_us` is the time from the
+/// parsed request (`t0`) to the serialised answer, written last.
+fn write_reply(id: &Value, body: Body, t0: Instant, out: &mut Vec<u8>) -> Result<(), ServeError> {
+    serde_json::to_writer(&mut *out, &Reply { id, body })?;
+    out.pop(); // the closing brace: `latency_us` goes last
+    let latency_us = t0.elapsed().as_nanos() as f64 / 1e3;
+    write!(out, ",\"latency_us\":{latency_us}}}").map_err(ServeError::Write)
+}
+
+/// A trace's error: the scene's problems with the receiver's field, or the trace's own.
+fn trace_error(e: TraceError, rx_field: &str) -> ServeError {
+    match e {
+        TraceError::Scene(e) => scene_error(&e, rx_field),
+        e => ServeError::Trace(e),
+    }
+}
+
+/// A scene's refusal of a position or pose, one `field: problem` each, the receiver's
+/// problems under `rx_field` (`rx[3]` in a list).
+fn scene_error(e: &SceneError, rx_field: &str) -> ServeError {
+    let SceneError::Invalid { problems, .. } = e else {
+        return ServeError::Scene(e.to_string());
+    };
+    let shown: Vec<String> = (problems.iter().take(bt_scene::MAX_PRINTED_PROBLEMS))
+        .map(|p| match p.location.as_str() {
+            "rx" => format!("{rx_field}: {}", p.message),
+            l if l.starts_with("object ") => format!("objects: {p}"),
+            _ => p.to_string(),
+        })
+        .collect();
+    ServeError::Scene(shown.join("; "))
+}

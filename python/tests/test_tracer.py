@@ -1,0 +1,99 @@
+"""beamtrace.Tracer: the loop of `beamtrace serve` in Python, answering what serve answers."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+
+import numpy as np
+import pytest
+
+import beamtrace
+from conftest import _cli_path
+
+
+def serve(requests, *args):
+    """The answers of `beamtrace serve builtin:living-room-dynamic ARGS` to `requests`."""
+    lines = "".join(json.dumps(r) + "\n" for r in requests)
+    done = subprocess.run(
+        [str(_cli_path()), "serve", "builtin:living-room-dynamic", *args],
+        input=lines, capture_output=True, text=True, check=True,
+    )
+    return [json.loads(line) for line in done.stdout.splitlines()]
+
+
+def without_times(answer):
+    """An answer without what varies between runs (latency_us, stats.time_s)."""
+    answer = dict(answer)
+    answer.pop("latency_us")
+    answer["stats"] = {k: v for k, v in answer["stats"].items() if k != "time_s"}
+    return answer
+
+
+def test_updates_answer_what_serve_answers():
+    requests = [
+        {"rx": [1.0, 1.0, 1.0]},
+        {"objects": {"person": {"offset": [0.5, 1.5, 0.0]}, "door": {"angle_deg": 30}}},
+        {"tx": [3.0, 3.5, 2.0], "rx": [2.0, 1.0, 1.2]},
+        {"step": 9},
+    ]
+    expected = serve(requests, "--max-order", "2")
+    tracer = beamtrace.Tracer("builtin:living-room-dynamic", max_order=2)
+    got = [tracer.update(**r) for r in requests]
+    assert len(got) == len(expected) == 4
+    for g, e in zip(got, expected):
+        assert without_times(g) == without_times(e)
+    assert len(got[0]["paths"]) > 5
+    assert "update" in got[1]["stats"], "moving objects is an incremental update"
+    assert got[3]["tx"] == [3.0, 3.5, 2.0], "the transmitter stays where the last update put it"
+
+
+def test_one_receiver_is_the_trace_of_the_scene():
+    scene = beamtrace.load("builtin:living-room")
+    tracer = beamtrace.Tracer(scene)
+    answer = tracer.update(rx=np.array([1.0, 2.0, 1.2]))
+    paths = scene.trace(rx=[1.0, 2.0, 1.2])
+    assert answer["tx"] == list(scene.tx)
+    assert [p["length_m"] for p in answer["paths"]] == list(paths.length_m)
+    assert [p["surfaces"] for p in answer["paths"]] == paths.surfaces
+
+
+def test_several_receivers_give_one_entry_each_and_a_bad_one_fails_alone():
+    tracer = beamtrace.Tracer("builtin:living-room", max_order=1)
+    answer = tracer.update(rx=np.array([[1.0, 1.0, 1.0], [3.0, 0.0, 1.0], [2.0, 3.0, 1.5]]))
+    results = answer["results"]
+    assert len(results) == 3
+    assert results[0]["paths"] and results[2]["paths"]
+    assert results[1]["error"].startswith('rx[1]: lies on surface "wall-south"')
+
+
+@pytest.mark.parametrize(
+    "update, message",
+    [
+        ({"rx": [3.0, 0.0, 1.0]}, 'rx: lies on surface "wall-south"'),
+        ({"objects": {"kitchen": {}}}, "objects.kitchen: no such object"),
+        ({"objects": {"person": {"angle_deg": 10}}}, "objects.person.angle_deg: the object has no pivot"),
+        ({"objects": {"door": {"spin": 1}}}, "objects.door: unknown field `spin`"),
+        ({"step": 99}, "step: is 99; the scene has 10 step(s)"),
+    ],
+)
+def test_errors_name_the_field_and_change_nothing(update, message):
+    tracer = beamtrace.Tracer("builtin:living-room-dynamic", max_order=1)
+    before = tracer.update(rx=[2.3, 2.1, 0.72])
+    with pytest.raises(beamtrace.BeamtraceError) as info:
+        tracer.update(**update)
+    assert str(info.value).startswith(message), str(info.value)
+    after = tracer.update()
+    assert without_times(after) == without_times(before)
+
+
+def test_bad_arguments_are_value_errors():
+    with pytest.raises(ValueError, match="solver"):
+        beamtrace.Tracer("builtin:living-room", solver="nope")
+    with pytest.raises(TypeError, match="unknown trace keyword.*max_ordr"):
+        beamtrace.Tracer("builtin:living-room", max_ordr=2)
+    tracer = beamtrace.Tracer("builtin:living-room", max_order=1)
+    with pytest.raises(ValueError, match="rx must be"):
+        tracer.update(rx=[1.0, 2.0])
+    with pytest.raises(ValueError, match="finite"):
+        tracer.update(rx=[1.0, float("nan"), 1.0])
