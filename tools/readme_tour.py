@@ -24,6 +24,10 @@ import time
 from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
+# A README line must end by itself: the tour's shell block (about 4 minutes in CI, most of it
+# `hls synth`) and each Python block stop with a failure beyond these.
+SH_TIMEOUT_S = 1200
+PY_TIMEOUT_S = 600
 
 
 def blocks(text, lang):
@@ -53,7 +57,11 @@ def run_sh(body):
         if line.strip():
             script.append(f"printf '%s\\n' {shell_quote('+ ' + line)} >&2")
         script.append(line)
-    return subprocess.run(["bash", "-c", "\n".join(script)], cwd=ROOT).returncode
+    try:
+        return subprocess.run(["bash", "-c", "\n".join(script)], cwd=ROOT, timeout=SH_TIMEOUT_S).returncode
+    except subprocess.TimeoutExpired:
+        print(f"the block ran over {SH_TIMEOUT_S} s: a line that never ends (a server?)", file=sys.stderr)
+        return 1
 
 
 def shell_quote(s):
@@ -63,7 +71,12 @@ def shell_quote(s):
 def run_python(body, python):
     """One Python block; its `print(...)  # Paths(...)` lines must print their comments."""
     expected = re.findall(r"^print\(.*\)\s+#\s*(Paths\(.*?\))\s*$", body, re.M)
-    done = subprocess.run([python, "-c", body], cwd=ROOT, capture_output=True, text=True)
+    try:
+        done = subprocess.run(
+            [python, "-c", body], cwd=ROOT, capture_output=True, text=True, timeout=PY_TIMEOUT_S
+        )
+    except subprocess.TimeoutExpired:
+        return f"ran over {PY_TIMEOUT_S} s"
     sys.stdout.write(done.stdout)
     sys.stderr.write(done.stderr)
     if done.returncode != 0:
