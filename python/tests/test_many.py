@@ -59,3 +59,50 @@ def test_trace_many_rejects_bad_shapes():
     scene = beamtrace.load("builtin:living-room")
     with pytest.raises(ValueError, match=r"shape \(m, 3\)"):
         scene.trace_many(None, np.zeros((4, 2)))
+
+
+def test_on_error_skip_keeps_one_entry_per_receiver():
+    scene = beamtrace.load("builtin:living-room")
+    # The second receiver lies on the floor, the fourth at the TX: neither can be traced.
+    points = np.array([[2.0, 2.0, 1.0], [2.0, 2.0, 0.0], [3.0, 1.5, 1.2], list(scene.tx)])
+    many = scene.trace_many(None, points, max_order=2, on_error="skip")
+    assert [p is None for p in many] == [False, True, False, True]
+    for k in (0, 2):
+        assert_equal(many[k], scene.trace(None, points[k], max_order=2))
+    # The first receiver may be the bad one: the others are still traced.
+    first_bad = scene.trace_many(None, points[[1, 0]], max_order=2, on_error="skip")
+    assert first_bad[0] is None
+    assert_equal(first_bad[1], many[0])
+
+
+def test_on_error_raise_names_the_receiver():
+    scene = beamtrace.load("builtin:living-room")
+    points = np.array([[2.0, 2.0, 1.0], [2.0, 2.0, 0.0], [3.0, 1.5, 1.2]])
+    with pytest.raises(beamtrace.BeamtraceError, match=r"receiver 1 \[2\.0, 2\.0, 0\.0\]: "):
+        scene.trace_many(None, points, max_order=2)
+    with pytest.raises(ValueError, match="on_error"):
+        scene.trace_many(None, points, on_error="ignore")
+
+
+def test_paths_index_and_iterate_as_path_records():
+    scene = beamtrace.load("builtin:living-room")
+    paths = scene.trace(max_order=2)
+    assert len(list(paths)) == len(paths)
+    last = paths[-1]
+    assert isinstance(last, beamtrace.Path)
+    assert last.rank == paths.rank[-1] and last.order == paths.order[-1]
+    assert np.array_equal(last.points, paths.points[-1])
+    assert last.surfaces == paths.surfaces[-1]
+    assert paths[0].order == 0 and "line of sight" in repr(paths[0])
+    with pytest.raises(IndexError):
+        paths[len(paths)]
+    with pytest.raises(TypeError):
+        paths["rank"]
+
+
+def test_the_namespace_lists_only_public_names():
+    names = dir(beamtrace)
+    for public in ("load", "Scene", "Paths", "Path", "Tracer", "BeamtraceError"):
+        assert public in names
+    for private in ("np", "os", "Any", "json", "warnings"):
+        assert private not in names

@@ -122,12 +122,18 @@ impl PyScene {
     /// A trace error as the exception, naming the scene's source like the CLI (which
     /// validates terminals while loading `SOURCE --tx .. --rx ..`).
     fn error(&self, e: TraceError) -> PyErr {
+        error(self.message(e))
+    }
+
+    /// The message of a trace error, a scene problem named after this scene's source.
+    fn message(&self, e: TraceError) -> String {
         match e {
-            TraceError::Scene(SceneError::Invalid { problems, .. }) => error(SceneError::Invalid {
+            TraceError::Scene(SceneError::Invalid { problems, .. }) => SceneError::Invalid {
                 source_name: self.source.clone(),
                 problems,
-            }),
-            e => error(e),
+            }
+            .to_string(),
+            e => e.to_string(),
         }
     }
 }
@@ -210,12 +216,24 @@ impl PyScene {
         tx: Option<[f64; 3]>,
         receivers: PyReadonlyArray2<'py, f64>,
         keywords: TraceKeywords,
+        skip_errors: bool,
     ) -> PyResult<Bound<'py, PyList>> {
         let receivers = receivers_of(&receivers)?;
-        let Some(first) = receivers.first() else {
+        if receivers.is_empty() {
             return Ok(PyList::empty(py));
+        }
+        // The scene with the TX and the first receiver it accepts (each receiver gets its own
+        // outcome below); when it accepts none, the first one's error.
+        let placed = |r: &Vec3| self.moved(tx, Some(r.to_array()));
+        let scene = match receivers.iter().find_map(|r| placed(r).ok()) {
+            Some(scene) => scene,
+            None => {
+                return Err(match placed(&receivers[0]) {
+                    Err(e) => e,
+                    Ok(_) => error("no receiver could be placed in the scene"),
+                });
+            }
         };
-        let scene = self.moved(tx, Some(first.to_array()))?;
         let options = keywords
             .trace_options(&scene)
             .map_err(PyValueError::new_err)?;
@@ -223,17 +241,32 @@ impl PyScene {
         let tx = scene.to_world(scene.terminals().map_err(error)?.tx);
         let reports = py.detach(|| {
             let traced = self
-                .with_tracer(scene.clone(), options, |t| t.trace_many(tx, &receivers))
-                .map_err(Failure::Trace)?;
-            report_each(&scene, &receivers, &traced, (&radio, options.parallel))
+                .with_tracer(scene.clone(), options, |t| t.trace_each(tx, &receivers))
+                .map_err(|e| (None, Failure::Trace(e)))?;
+            report_each(
+                &scene,
+                &receivers,
+                traced,
+                (&radio, options.parallel),
+                skip_errors,
+            )
         });
-        let reports = reports.map_err(|e| match e {
-            Failure::Trace(e) => self.error(e),
-            Failure::Report(message) => error(format!("{}: {message}", scene.name())),
+        let reports = reports.map_err(|(index, e)| {
+            let at = |message: String| match index {
+                Some(i) => format!("receiver {i} {:?}: {message}", receivers[i].to_array()),
+                None => message,
+            };
+            match e {
+                Failure::Trace(e) => error(at(self.message(e))),
+                Failure::Report(message) => error(at(format!("{}: {message}", scene.name()))),
+            }
         })?;
         let dicts = reports
             .iter()
-            .map(|paths| columns::to_dict(py, paths))
+            .map(|paths| match paths {
+                Some(paths) => Ok(Some(columns::to_dict(py, paths)?)),
+                None => Ok(None),
+            })
             .collect::<PyResult<Vec<_>>>()?;
         PyList::new(py, dicts)
     }
@@ -262,24 +295,39 @@ enum Failure {
     Report(String),
 }
 
-/// Each receiver's report of its trace with `radio` (in parallel when asked).
+/// Each receiver's report of its trace with `radio` (in parallel when asked). A receiver that
+/// could not be traced is `None` when `skip_errors`, else the first such fails the call with
+/// its index.
 fn report_each(
     scene: &Scene,
     receivers: &[Vec3],
-    traced: &[Traced],
+    traced: Vec<Result<Traced, TraceError>>,
     (radio, parallel): (&bt_beams::RadioOptions, bool),
-) -> Result<Vec<Vec<bt_beams::PathReport>>, Failure> {
-    let one = |(rx, t): (&Vec3, &Traced)| {
+    skip_errors: bool,
+) -> Result<Vec<Option<Vec<bt_beams::PathReport>>>, (Option<usize>, Failure)> {
+    let one = |(i, (rx, t)): (usize, (&Vec3, Result<Traced, TraceError>))| {
+        let t = match t {
+            Ok(t) => t,
+            Err(_) if skip_errors => return Ok(None),
+            Err(e) => return Err((Some(i), Failure::Trace(e))),
+        };
         let moved = scene
             .with_receiver(*rx)
-            .map_err(|e| Failure::Trace(e.into()))?;
-        bt_beams::report(&moved, &t.result.paths, radio).map_err(|e| Failure::Report(e.to_string()))
+            .map_err(|e| (Some(i), Failure::Trace(e.into())))?;
+        bt_beams::report(&moved, &t.result.paths, radio)
+            .map(Some)
+            .map_err(|e| (Some(i), Failure::Report(e.to_string())))
     };
-    if parallel {
-        receivers.par_iter().zip(traced).map(one).collect()
+    let pairs = receivers.iter().zip(traced);
+    // Each receiver's outcome in order, then the first failure in receiver order (a parallel
+    // collect into a Result would stop at whichever failure came first in time).
+    let outcomes: Vec<_> = if parallel {
+        let pairs: Vec<_> = pairs.collect();
+        pairs.into_par_iter().enumerate().map(one).collect()
     } else {
-        receivers.iter().zip(traced).map(one).collect()
-    }
+        pairs.enumerate().map(one).collect()
+    };
+    outcomes.into_iter().collect()
 }
 
 /// Load a scene; `tx`/`rx` override the file's (meshes, XML and point clouds carry none: then

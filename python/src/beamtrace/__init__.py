@@ -28,6 +28,7 @@ from ._native import BeamtraceError
 
 __all__ = [
     "BeamtraceError",
+    "Path",
     "Paths",
     "Scene",
     "Tracer",
@@ -101,6 +102,28 @@ class Paths:
     def __len__(self) -> int:
         return len(self._columns["order"])
 
+    def __getitem__(self, i: int) -> "Path":
+        """The ``i``-th path (ranked order; negative counts from the end) as a :class:`Path`."""
+        n = len(self)
+        if not isinstance(i, (int, np.integer)):
+            raise TypeError(f"path index must be an integer, got {type(i).__name__}")
+        k = int(i) + n if i < 0 else int(i)
+        if not 0 <= k < n:
+            raise IndexError(f"path index {i} out of range for {n} paths")
+        return Path({name: column[k] for name, column in self._columns.items()})
+
+    def __iter__(self):
+        return (self[k] for k in range(len(self)))
+
+    def to_pandas(self):
+        """The paths as a pandas DataFrame, one row per path and one column per field
+        (per-interaction fields hold arrays or lists); needs pandas installed."""
+        try:
+            import pandas
+        except ImportError as e:  # pragma: no cover - depends on the environment
+            raise ImportError("Paths.to_pandas needs pandas: pip install pandas") from e
+        return pandas.DataFrame({name: list(column) for name, column in self._columns.items()})
+
     def __repr__(self) -> str:
         orders = np.bincount(self._columns["order"]) if len(self) else []
         return f"Paths({len(self)} paths, per order {list(map(int, orders))})"
@@ -119,6 +142,23 @@ class Paths:
 
     def __setstate__(self, state: Dict[str, Any]) -> None:
         self.__init__(state)  # type: ignore[misc]
+
+
+class Path:
+    """One path of a :class:`Paths`: the same fields, each this path's value (``order`` an int,
+    ``points`` a (k, 3) array, ``aod_deg`` an (azimuth, elevation) array, ...)."""
+
+    def __init__(self, fields: Dict[str, Any]) -> None:
+        self._fields = dict(fields)
+        self.__dict__.update(self._fields)
+
+    def to_dict(self) -> Dict[str, Any]:
+        """The fields as a dict."""
+        return dict(self._fields)
+
+    def __repr__(self) -> str:
+        via = " > ".join(self._fields["surfaces"]) or "line of sight"
+        return f"Path(rank {self._fields['rank']}, order {self._fields['order']}, {via})"
 
 
 def _point(value: Optional[Point], name: str) -> Optional[tuple]:
@@ -247,19 +287,28 @@ class Scene:
         max_diffractions: Optional[int] = None,
         min_edge_length: float = 0.0,
         diffraction_coefficient: str = "utd",
-    ) -> List[Paths]:
+        on_error: str = "raise",
+    ) -> List[Optional[Paths]]:
         """Trace one ``tx`` to every row of ``rx`` (an (m, 3) array, metres): one
         :class:`Paths` per receiver, in order, equal to calling :meth:`trace` for each.
 
-        Receivers run in parallel on all cores with the GIL released. A receiver on a surface
-        or at the TX fails the call with :class:`BeamtraceError`.
+        Receivers run in parallel on all cores with the GIL released. A receiver that cannot be
+        traced (on a surface, at the TX): with ``on_error="raise"`` (default) the call raises
+        :class:`BeamtraceError` naming the first such receiver's index and position; with
+        ``on_error="skip"`` its entry is ``None`` and the others are traced, as the CLI's
+        ``sweep`` marks such grid points.
         """
+        if on_error not in ("raise", "skip"):
+            raise ValueError(f'on_error must be "raise" or "skip", got {on_error!r}')
+        arguments = dict(locals())
+        del arguments["on_error"]
         results = self._native.trace_many(
             _point(tx, "tx"),
             _receivers(rx),
-            _options(locals()),
+            _options(arguments),
+            on_error == "skip",
         )
-        return [Paths(c) for c in results]
+        return [None if c is None else Paths(c) for c in results]
 
 
 class Tracer:
@@ -440,3 +489,8 @@ def load(
 def builtin_names() -> List[str]:
     """Names of the built-in scenes, loadable as ``load("builtin:NAME")``."""
     return list(_native.builtin_names())
+
+
+def __dir__() -> List[str]:
+    """The public names only (not the modules this one imports)."""
+    return sorted(__all__ + ["distributed"])

@@ -37,8 +37,12 @@ class Scene:
     def cache_warnings(self) -> List[str]: ...
     def trace(self, tx: _Point, rx: _Point, keywords: Dict[str, Any]) -> Dict[str, Any]: ...
     def trace_many(
-        self, tx: _Point, receivers: npt.NDArray[np.float64], keywords: Dict[str, Any]
-    ) -> List[Dict[str, Any]]: ...
+        self,
+        tx: _Point,
+        receivers: npt.NDArray[np.float64],
+        keywords: Dict[str, Any],
+        skip_errors: bool,
+    ) -> List[Optional[Dict[str, Any]]]: ...
 
 class Tracer:
     def __init__(
