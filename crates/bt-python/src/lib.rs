@@ -295,6 +295,12 @@ enum Failure {
     Report(String),
 }
 
+/// One receiver's paths as the report gives them.
+type Report = Vec<bt_beams::PathReport>;
+
+/// Why a many-receiver call failed: the receiver's index (none: the call as a whole).
+type Failed = (Option<usize>, Failure);
+
 /// Each receiver's report of its trace with `radio` (in parallel when asked). A receiver that
 /// could not be traced is `None` when `skip_errors`, else the first such fails the call with
 /// its index.
@@ -304,7 +310,7 @@ fn report_each(
     traced: Vec<Result<Traced, TraceError>>,
     (radio, parallel): (&bt_beams::RadioOptions, bool),
     skip_errors: bool,
-) -> Result<Vec<Option<Vec<bt_beams::PathReport>>>, (Option<usize>, Failure)> {
+) -> Result<Vec<Option<Report>>, Failed> {
     let one = |(i, (rx, t)): (usize, (&Vec3, Result<Traced, TraceError>))| {
         let t = match t {
             Ok(t) => t,
