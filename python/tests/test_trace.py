@@ -117,3 +117,30 @@ def test_scene_properties():
     assert scene.frequency_hz == pytest.approx(28e9)
     assert len(scene.surface_names) == 31
     assert "living-room" in beamtrace.builtin_names()
+
+
+@pytest.mark.parametrize(
+    "material, thickness, frequency",
+    [("itu:concrete", 0.2, 3.5e9), ("custom:4.5,0.02", None, 28e9), ("itu:glass", 0.006, None)],
+)
+def test_radio_load_options_match_cli(cli_json, material, thickness, frequency):
+    """load(material=, thickness=, frequency=) is trace's --material/--thickness/--frequency:
+    every field of every path equal to the CLI's, on a mesh and a scene file."""
+    flags = ["--material", material]
+    flags += [] if thickness is None else ["--thickness", str(thickness)]
+    flags += [] if frequency is None else ["--frequency", str(frequency)]
+    for source in ("builtin:living-room", str(TESTDATA / "box-room.obj")):
+        terminals = [] if source.startswith("builtin") else ["--tx", "1,1,1.5", "--rx", "4,3,1.2"]
+        scene = beamtrace.load(source, material=material, thickness=thickness, frequency=frequency)
+        tx, rx = (None, None) if not terminals else ([1, 1, 1.5], [4, 3, 1.2])
+        paths = scene.trace(tx, rx, max_order=2)
+        assert_same_as_cli(paths, cli_json(source, "--max-order", "2", *terminals, *flags))
+
+
+def test_radio_load_options_are_checked():
+    with pytest.raises(ValueError, match="expected itu:NAME"):
+        beamtrace.load("builtin:living-room", material="concrete")
+    with pytest.raises(ValueError, match="thickness= needs material="):
+        beamtrace.load("builtin:living-room", thickness=0.2)
+    with pytest.raises(beamtrace.BeamtraceError, match="frequency"):
+        beamtrace.load("builtin:living-room", frequency=-1.0)

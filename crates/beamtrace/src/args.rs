@@ -263,53 +263,26 @@ pub struct MaterialArgs {
     /// Radio material of every surface: itu:NAME (ITU-R P.2040-3, e.g. itu:concrete) or
     /// custom:EPS_R,SIGMA (relative permittivity, conductivity in S/m).
     #[arg(long, value_parser = parse_material)]
-    pub material: Option<MaterialArg>,
+    pub material: Option<String>,
     /// With --material: slab thickness in metres (default: a half-space).
     #[arg(long, requires = "material", allow_hyphen_values = true, value_parser = numbers::length_m)]
     pub thickness: Option<f64>,
 }
 
-/// `--material` as given.
-#[derive(Debug, Clone, PartialEq)]
-pub enum MaterialArg {
-    /// `itu:NAME`.
-    Itu(String),
-    /// `custom:EPS_R,SIGMA`.
-    Custom(f64, f64),
-}
-
 impl MaterialArgs {
     /// The radio material `--material`/`--thickness` select, checked.
     pub fn radio(&self) -> anyhow::Result<Option<bt_channel::RadioMaterial>> {
-        let radio = match &self.material {
-            None => return Ok(None),
-            Some(MaterialArg::Itu(name)) => bt_channel::RadioMaterial::itu(name, self.thickness),
-            Some(MaterialArg::Custom(eps, sigma)) => {
-                bt_channel::RadioMaterial::custom(*eps, *sigma, self.thickness)
-            }
+        let Some(spec) = &self.material else {
+            return Ok(None);
         };
+        let radio = bt_channel::RadioMaterial::from_spec(spec, self.thickness);
         Ok(Some(radio.context("--material/--thickness")?))
     }
 }
 
-fn parse_material(s: &str) -> anyhow::Result<MaterialArg> {
-    if let Some(name) = s.strip_prefix("itu:") {
-        bt_channel::ItuMaterial::parse(name)?;
-        return Ok(MaterialArg::Itu(name.to_string()));
-    }
-    if let Some(values) = s.strip_prefix("custom:") {
-        let parts: Vec<&str> = values.split(',').map(str::trim).collect();
-        if let [eps, sigma] = parts[..] {
-            let eps: f64 = eps
-                .parse()
-                .with_context(|| format!("\"{eps}\" is not a number"))?;
-            let sigma: f64 = sigma
-                .parse()
-                .with_context(|| format!("\"{sigma}\" is not a number"))?;
-            return Ok(MaterialArg::Custom(eps, sigma));
-        }
-    }
-    bail!("expected itu:NAME (e.g. itu:concrete) or custom:EPS_R,SIGMA, got \"{s}\"")
+/// `--material` checked as [`bt_channel::RadioMaterial::from_spec`] reads it.
+fn parse_material(s: &str) -> Result<String, bt_channel::ChannelError> {
+    bt_channel::RadioMaterial::from_spec(s, None).map(|_| s.to_string())
 }
 
 /// Antennas at both ends and the transmitted power.

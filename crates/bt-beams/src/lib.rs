@@ -24,7 +24,7 @@ use bt_solve::{FoundPath, Interaction};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 /// Speed of light in vacuum, m/s.
-pub use bt_channel::{ChannelError, SPEED_OF_LIGHT};
+pub use bt_channel::{ChannelError, RadioMaterial, SPEED_OF_LIGHT};
 
 /// Why paths could not be reported.
 #[derive(Debug, thiserror::Error)]

@@ -337,6 +337,36 @@ impl RadioMaterial {
         })
     }
 
+    /// The material a user names as the CLI's `--material` and Python's `material=` spell it:
+    /// `itu:NAME` (P.2040-3 Table 3, [`ItuMaterial::parse`]) or `custom:EPS_R,SIGMA` (relative
+    /// permittivity, conductivity in S/m), a slab of `thickness` metres or a half-space.
+    /// Errors name the `material` (or the thickness) and what was expected.
+    pub fn from_spec(spec: &str, thickness: Option<Real>) -> Result<RadioMaterial, ChannelError> {
+        let invalid = |message: String| ChannelError::Invalid {
+            field: "material",
+            message,
+        };
+        if let Some(name) = spec.strip_prefix("itu:") {
+            return RadioMaterial::itu(name, thickness);
+        }
+        if let Some(values) = spec.strip_prefix("custom:") {
+            let number = |text: &str| {
+                (text.trim().parse::<Real>())
+                    .map_err(|_| invalid(format!("\"{}\" is not a number", text.trim())))
+            };
+            if let [eps, sigma] = values.split(',').collect::<Vec<_>>()[..] {
+                return RadioMaterial::custom(number(eps)?, number(sigma)?, thickness);
+            }
+        }
+        let got = match spec.chars().count() {
+            n if n <= 64 => format!("\"{}\"", spec.escape_default()),
+            _ => format!("{} bytes", spec.len()),
+        };
+        Err(invalid(format!(
+            "expected itu:NAME (e.g. itu:concrete) or custom:EPS_R,SIGMA, got {got}"
+        )))
+    }
+
     /// Transmission coefficients at `frequency_hz` for a wave crossing the surface with
     /// `cos_incidence` = cos θ ([`slab_transmission`]). A half-space (no thickness) lets
     /// nothing through to the far side: an error naming the thickness.

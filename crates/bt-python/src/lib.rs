@@ -340,7 +340,8 @@ fn report_each(
 /// each trace gives them).
 #[pyfunction]
 #[pyo3(signature = (source, *, tx=None, rx=None, min_reflector_area=0.25, merge_angle_deg=1.0,
-                    merge_distance=1e-3, budgets=None, cache=false))]
+                    merge_distance=1e-3, budgets=None, cache=false, frequency=None,
+                    material=None, thickness=None))]
 // One argument per Python keyword: pyo3 maps them by name.
 #[allow(clippy::too_many_arguments)]
 fn load(
@@ -353,8 +354,12 @@ fn load(
     merge_distance: f64,
     budgets: Option<options::LoadBudgets>,
     cache: bool,
+    frequency: Option<f64>,
+    material: Option<String>,
+    thickness: Option<f64>,
 ) -> PyResult<PyScene> {
     let defaults = LoadOptions::default();
+    let radio = options::radio_material(material.as_deref(), thickness)?;
     let budgets = budgets.unwrap_or(options::LoadBudgets {
         max_file_bytes: defaults.max_file_bytes,
         max_xml_substitution: defaults.max_xml_substitution,
@@ -371,11 +376,17 @@ fn load(
         min_reflector_area_m2: min_reflector_area,
         max_file_bytes: budgets.max_file_bytes,
         max_xml_substitution: budgets.max_xml_substitution,
+        frequency_hz: frequency.unwrap_or(bt_scene::DEFAULT_FREQUENCY_HZ),
+        radio,
         ..defaults
     };
-    let (loaded, cache_warnings) = py
+    let (mut loaded, cache_warnings) = py
         .detach(|| load_scene(&source, &options, cache))
         .map_err(error)?;
+    // As the CLI's `--frequency`: scene files and built-ins carry their own carrier, replaced.
+    if let Some(f) = frequency {
+        loaded.scene = loaded.scene.with_frequency(f).map_err(error)?;
+    }
     // The options are set by each trace (its keywords).
     let tracer = Tracer::new(loaded.scene.clone(), TraceOptions::new(0));
     Ok(PyScene {

@@ -44,6 +44,25 @@ pub struct LoadBudgets {
     pub max_mesh_elements: u64,
 }
 
+/// `load`'s `material=` and `thickness=` (the CLI's `--material`, `--thickness`): the radio
+/// material of every surface, or none; a thickness without a material is a `ValueError`, as
+/// the CLI requires `--material` with `--thickness`.
+pub fn radio_material(
+    material: Option<&str>,
+    thickness: Option<f64>,
+) -> pyo3::PyResult<Option<bt_beams::RadioMaterial>> {
+    let value_error = |e: String| pyo3::exceptions::PyValueError::new_err(e);
+    match (material, thickness) {
+        (None, None) => Ok(None),
+        (None, Some(_)) => Err(value_error(
+            "thickness= needs material= (the slab's material)".into(),
+        )),
+        (Some(spec), thickness) => bt_beams::RadioMaterial::from_spec(spec, thickness)
+            .map(Some)
+            .map_err(|e| value_error(e.to_string())),
+    }
+}
+
 /// Diffraction's keywords (`diffraction=True` is `max_diffractions=1` in Python).
 #[derive(Debug, Clone, pyo3::FromPyObject)]
 #[pyo3(from_item_all)]

@@ -451,6 +451,9 @@ def load(
     max_xml_substitution: int = _native.DEFAULT_MAX_XML_SUBSTITUTION,
     max_mesh_elements: int = _native.DEFAULT_MAX_MESH_ELEMENTS,
     cache: bool = False,
+    frequency: Optional[float] = None,
+    material: Optional[str] = None,
+    thickness: Optional[float] = None,
 ) -> Scene:
     """Load a scene: a file the CLI reads (.json, .toml, .obj, .ply) or ``"builtin:NAME"``.
 
@@ -463,7 +466,11 @@ def load(
     each checked before the work. ``cache=True`` is ``--cache``: the loaded scene is kept in
     the user's cache directory (``$BEAMTRACE_CACHE_DIR``, else ``$XDG_CACHE_HOME/beamtrace``,
     else ``~/.cache/beamtrace``) and read from there while the files and options are unchanged;
-    a damaged entry is rebuilt with a :class:`RuntimeWarning`. Raises :class:`BeamtraceError`
+    a damaged entry is rebuilt with a :class:`RuntimeWarning`. ``frequency`` (Hz),
+    ``material`` and ``thickness`` (m) are ``--frequency``, ``--material`` and ``--thickness``:
+    the carrier (replacing a scene file's), and every surface's radio material spelled
+    ``"itu:NAME"`` (e.g. ``"itu:concrete"``) or ``"custom:EPS_R,SIGMA"``, a slab of
+    ``thickness`` metres or a half-space; a bad value is a ``ValueError``. Raises :class:`BeamtraceError`
     with the CLI's message (naming the file, line or field) when the scene cannot be read or is
     invalid.
     """
@@ -480,6 +487,9 @@ def load(
             "max_mesh_elements": max_mesh_elements,
         },
         cache=bool(cache),
+        frequency=None if frequency is None else float(frequency),
+        material=material,
+        thickness=None if thickness is None else float(thickness),
     )
     for note in native.cache_warnings:
         warnings.warn(note, RuntimeWarning, stacklevel=2)

@@ -60,5 +60,8 @@ def load(
     merge_distance: float = 1e-3,
     budgets: Optional[Dict[str, int]] = None,
     cache: bool = False,
+    frequency: Optional[float] = None,
+    material: Optional[str] = None,
+    thickness: Optional[float] = None,
 ) -> Scene: ...
 def builtin_names() -> List[str]: ...
