@@ -144,3 +144,32 @@ def test_radio_load_options_are_checked():
         beamtrace.load("builtin:living-room", thickness=0.2)
     with pytest.raises(beamtrace.BeamtraceError, match="frequency"):
         beamtrace.load("builtin:living-room", frequency=-1.0)
+
+
+def test_antenna_keywords_match_cli(cli_json):
+    """tx_/rx_pattern, _polarization, _orientation and tx_power_dbm are trace's flags of those
+    names: every field of every path equal to the CLI's."""
+    scene = beamtrace.load("builtin:living-room")
+    paths = scene.trace(
+        max_order=2,
+        tx_pattern="tr38901",
+        rx_polarization="+45",
+        tx_orientation=[180, -10, 0],
+        rx_orientation=(30, 0, 5),
+        tx_power_dbm=20,
+    )
+    doc = cli_json(
+        "builtin:living-room", "--max-order", "2", "--tx-pattern", "tr38901",
+        "--rx-polarization", "+45", "--tx-orientation", "180,-10,0",
+        "--rx-orientation", "30,0,5", "--tx-power-dbm", "20",
+    )
+    assert_same_as_cli(paths, doc)
+    # Not the defaults' numbers: the options took effect.
+    plain = scene.trace(max_order=2)
+    assert not np.array_equal(plain.gain_db, paths.gain_db)
+    with pytest.raises(ValueError, match="tx_pattern"):
+        scene.trace(tx_pattern="dipole")
+    with pytest.raises(ValueError, match="tx_power_dbm"):
+        scene.trace(tx_power_dbm=float("nan"))
+    with pytest.raises(ValueError, match="rx_orientation"):
+        scene.trace(rx_orientation=[0, float("inf"), 0])

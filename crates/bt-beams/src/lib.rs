@@ -17,14 +17,14 @@ pub use document::{
 };
 pub use sweep::{BeamPair, BeamRanking, Sweep, sweep};
 
-use bt_channel::{Antenna, Complex64, DiffractionCoefficient, SurfaceResponse, Tap};
+use bt_channel::{Complex64, DiffractionCoefficient, SurfaceResponse, Tap};
 use bt_geom::{Real, Vec3};
 use bt_scene::{Scene, SurfaceId};
 use bt_solve::{FoundPath, Interaction};
 use serde::{Deserialize, Deserializer, Serialize, Serializer};
 
 /// Speed of light in vacuum, m/s.
-pub use bt_channel::{ChannelError, RadioMaterial, SPEED_OF_LIGHT};
+pub use bt_channel::{Antenna, ChannelError, Orientation, RadioMaterial, SPEED_OF_LIGHT};
 
 /// Why paths could not be reported.
 #[derive(Debug, thiserror::Error)]

@@ -28,6 +28,69 @@ pub struct TraceKeywords {
     pub sbr: SbrKeywords,
     /// `diffraction`/`max_diffractions` and `min_edge_length`.
     pub diffraction: DiffractionKeywords,
+    /// The antennas and the transmitted power.
+    pub antennas: AntennaKeywords,
+}
+
+/// The antennas at both ends and the transmitted power (`tx_pattern`, `rx_pattern`,
+/// `tx_polarization`, `rx_polarization`, `tx_orientation`, `rx_orientation`, `tx_power_dbm` in
+/// Python; the CLI's flags of those names, spelled as there).
+#[derive(Debug, Clone, pyo3::FromPyObject)]
+#[pyo3(from_item_all)]
+pub struct AntennaKeywords {
+    /// `iso` or `tr38901`, each end.
+    pub tx_pattern: String,
+    pub rx_pattern: String,
+    /// `V`, `H`, `+45` or `-45`, each end.
+    pub tx_polarization: String,
+    pub rx_polarization: String,
+    /// Yaw, pitch, roll, degrees, each end.
+    pub tx_orientation: [f64; 3],
+    pub rx_orientation: [f64; 3],
+    /// Transmitted power, dBm.
+    pub tx_power_dbm: f64,
+}
+
+/// The CLI's bound on `--tx-power-dbm`, dBm either way.
+const MAX_POWER_DBM: f64 = 300.0;
+
+impl AntennaKeywords {
+    /// The antennas (TX, RX) and the power, each value checked as the CLI checks it.
+    fn antennas(&self) -> Result<(bt_beams::Antenna, bt_beams::Antenna, f64), String> {
+        let end = |name: &str, pattern: &str, polarization: &str, o: [f64; 3]| {
+            let pattern = pattern
+                .parse()
+                .map_err(|e: bt_beams::ChannelError| format!("{name}_pattern: {e}"))?;
+            let polarization = (polarization.parse())
+                .map_err(|e: bt_beams::ChannelError| format!("{name}_polarization: {e}"))?;
+            if o.iter().any(|v| !v.is_finite()) {
+                return Err(format!(
+                    "{name}_orientation must be three finite angles in degrees, got {o:?}"
+                ));
+            }
+            let orientation = bt_beams::Orientation::from_degrees(o[0], o[1], o[2]);
+            Ok(bt_beams::Antenna::new(pattern, polarization, orientation))
+        };
+        let tx = end(
+            "tx",
+            &self.tx_pattern,
+            &self.tx_polarization,
+            self.tx_orientation,
+        )?;
+        let rx = end(
+            "rx",
+            &self.rx_pattern,
+            &self.rx_polarization,
+            self.rx_orientation,
+        )?;
+        let p = self.tx_power_dbm;
+        if !(p.is_finite() && p.abs() <= MAX_POWER_DBM) {
+            return Err(format!(
+                "tx_power_dbm must be a finite power within ±{MAX_POWER_DBM} dBm, got {p}"
+            ));
+        }
+        Ok((tx, rx, p))
+    }
 }
 
 /// The load budgets of `load` (`max_file_bytes`, `max_xml_substitution`, `max_mesh_elements`
@@ -135,7 +198,11 @@ impl TraceKeywords {
     /// (an unknown name refused as the settings' are, the value cut short).
     pub fn radio(&self) -> Result<bt_beams::RadioOptions, String> {
         let coefficient = parse(&self.diffraction.coefficient).map_err(|e| e.to_string())?;
+        let (tx, rx, tx_power_dbm) = self.antennas.antennas()?;
         let radio = bt_beams::RadioOptions {
+            tx,
+            rx,
+            tx_power_dbm,
             diffraction_coefficient: coefficient,
             ..bt_beams::RadioOptions::default()
         };
@@ -177,6 +244,15 @@ mod tests {
                 max_diffractions: 0,
                 min_edge_length: 0.0,
                 coefficient: "utd".into(),
+            },
+            antennas: AntennaKeywords {
+                tx_pattern: "iso".into(),
+                rx_pattern: "iso".into(),
+                tx_polarization: "V".into(),
+                rx_polarization: "V".into(),
+                tx_orientation: [0.0; 3],
+                rx_orientation: [0.0; 3],
+                tx_power_dbm: 0.0,
             },
         }
     }

@@ -244,6 +244,13 @@ class Scene:
         max_diffractions: Optional[int] = None,
         min_edge_length: float = 0.0,
         diffraction_coefficient: str = "utd",
+        tx_pattern: str = "iso",
+        rx_pattern: str = "iso",
+        tx_polarization: str = "V",
+        rx_polarization: str = "V",
+        tx_orientation: Point = (0.0, 0.0, 0.0),
+        rx_orientation: Point = (0.0, 0.0, 0.0),
+        tx_power_dbm: float = 0.0,
     ) -> Paths:
         """Trace every path from ``tx`` to ``rx`` (metres; the scene's own if None): specular,
         and with ``diffraction=True`` (or ``max_diffractions=1``) those that diffract once on
@@ -254,7 +261,11 @@ class Scene:
 
         Options are ``beamtrace trace``'s flags: ``solver`` "image" | "ipc" | "sbr",
         ``candidates`` "beam-tree" | "wvrn" | "exhaustive", ``ipc_order`` "gauss-seidel" |
-        "jacobi", ``ipc_accel`` "none" | "newton", ``sbr_step_deg`` or ``sbr_rays``. Raises
+        "jacobi", ``ipc_accel`` "none" | "newton", ``sbr_step_deg`` or ``sbr_rays``; the
+        antennas ``tx_pattern``/``rx_pattern`` "iso" | "tr38901", ``tx_polarization``/
+        ``rx_polarization`` "V" | "H" | "+45" | "-45", ``tx_orientation``/``rx_orientation``
+        (yaw, pitch, roll in degrees) and ``tx_power_dbm``, as ``beamtrace trace``'s flags of
+        those names (docs/channel.md §4). Raises
         :class:`BeamtraceError` when a position is invalid (on a surface, equal to the other
         terminal) or a budget is exceeded (``max_candidates``; ``max_wvrn_tests``, the WVRN's
         node pairs × surfaces, with ``candidates="wvrn"``), ``ValueError`` on a bad option or when
@@ -287,6 +298,13 @@ class Scene:
         max_diffractions: Optional[int] = None,
         min_edge_length: float = 0.0,
         diffraction_coefficient: str = "utd",
+        tx_pattern: str = "iso",
+        rx_pattern: str = "iso",
+        tx_polarization: str = "V",
+        rx_polarization: str = "V",
+        tx_orientation: Point = (0.0, 0.0, 0.0),
+        rx_orientation: Point = (0.0, 0.0, 0.0),
+        tx_power_dbm: float = 0.0,
         on_error: str = "raise",
     ) -> List[Optional[Paths]]:
         """Trace one ``tx`` to every row of ``rx`` (an (m, 3) array, metres): one
@@ -436,6 +454,13 @@ def _options(arguments: Dict[str, Any]) -> Dict[str, Any]:
         "min_edge_length": float(arguments["min_edge_length"]),
         "coefficient": arguments["diffraction_coefficient"],
     }
+    options["antennas"] = {
+        name: arguments[name]
+        for name in ("tx_pattern", "rx_pattern", "tx_polarization", "rx_polarization")
+    }
+    for name in ("tx_orientation", "rx_orientation"):
+        options["antennas"][name] = _point(arguments[name], name)
+    options["antennas"]["tx_power_dbm"] = float(arguments["tx_power_dbm"])
     return options
 
 
