@@ -57,3 +57,34 @@ def test_core_imports_without_ray():
     lines = done.stdout.splitlines()
     assert lines[0] == "45"
     assert lines[1].startswith("ImportError") and "[ray]" in lines[1]
+
+
+def test_a_loaded_scene_travels_without_its_file(ray_local, tmp_path):
+    """A Scene goes to the workers as data: its file is gone before the sweep starts, and the
+    workers run in a folder where its path does not exist either."""
+    import shutil
+    from beamtrace import distributed
+    from conftest import TESTDATA
+
+    copy = tmp_path / "room.obj"
+    shutil.copy(TESTDATA / "box-room.obj", copy)
+    scene = beamtrace.load(copy)
+    copy.unlink()
+    tx = [1.0, 1.0, 1.5]
+    points = np.array([[4.0, 3.0, 1.2], [2.5, 2.0, 2.0], [1.5, 3.0, 0.8]])
+    local = scene.trace_many(tx, points, max_order=2)
+    remote = distributed.sweep(scene, tx, points, chunks=3, max_order=2)
+    assert len(remote) == len(local) == 3
+    for a, b in zip(remote, local):
+        assert_equal(a, b)
+
+
+def test_a_scene_pickles_as_its_data():
+    import pickle
+
+    scene = beamtrace.load("builtin:living-room")
+    back = pickle.loads(pickle.dumps(scene))
+    assert back.name == scene.name and back.surface_names == scene.surface_names
+    assert_equal(back.trace(max_order=2), scene.trace(max_order=2))
+    with pytest.raises(beamtrace.BeamtraceError, match="not a pickled beamtrace scene"):
+        beamtrace._scene_from_bytes("bad", b"\xff\x00garbage")

@@ -140,6 +140,13 @@ impl PyScene {
 
 #[pymethods]
 impl PyScene {
+    /// The scene as bytes for [`scene_from_bytes`] (Python's pickling: Ray ships a loaded
+    /// scene to its workers this way, no file needed there): postcard of its stored form.
+    fn to_bytes<'py>(&self, py: Python<'py>) -> PyResult<Bound<'py, pyo3::types::PyBytes>> {
+        let bytes = postcard::to_allocvec(&self.scene.to_stored()).map_err(error)?;
+        Ok(pyo3::types::PyBytes::new(py, &bytes))
+    }
+
     /// Scene name (file stem, or the name inside the scene file).
     #[getter]
     fn name(&self) -> &str {
@@ -398,6 +405,24 @@ fn load(
     })
 }
 
+/// The scene `data` ([`PyScene::to_bytes`]) holds, named `source` in messages: every polygon
+/// rebuilt and checked ([`Scene::from_stored`]); bytes that are not such a scene are a
+/// `BeamtraceError` naming `source`.
+#[pyfunction]
+fn scene_from_bytes(source: String, data: &[u8]) -> PyResult<PyScene> {
+    let stored: bt_scene::StoredScene = postcard::from_bytes(data)
+        .map_err(|e| error(format!("{source}: not a pickled beamtrace scene: {e}")))?;
+    let scene = Scene::from_stored(stored, &source).map_err(error)?;
+    let tracer = Tracer::new(scene.clone(), TraceOptions::new(0));
+    Ok(PyScene {
+        tracer: Mutex::new(tracer),
+        scene: Arc::new(scene),
+        source,
+        warnings: Vec::new(),
+        cache_warnings: Vec::new(),
+    })
+}
+
 /// Names of the built-in scenes (`load("builtin:NAME")`).
 #[pyfunction]
 fn builtin_names() -> Vec<&'static str> {
@@ -426,5 +451,6 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<tracer::PyTracer>()?;
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(builtin_names, m)?)?;
+    m.add_function(wrap_pyfunction!(scene_from_bytes, m)?)?;
     Ok(())
 }

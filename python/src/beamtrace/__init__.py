@@ -161,6 +161,11 @@ class Path:
         return f"Path(rank {self._fields['rank']}, order {self._fields['order']}, {via})"
 
 
+def _scene_from_bytes(source: str, data: bytes) -> "Scene":
+    """A pickled :class:`Scene` back (``Scene.__reduce__``)."""
+    return Scene(_native.scene_from_bytes(source, data))
+
+
 def _point(value: Optional[Point], name: str) -> Optional[tuple]:
     if value is None:
         return None
@@ -220,6 +225,11 @@ class Scene:
     def warnings(self) -> List[str]:
         """Non-fatal notes of the import (merged faces, unknown materials, ...)."""
         return self._native.warnings
+
+    def __reduce__(self):
+        # Pickling (Ray, multiprocessing) ships the scene itself, not its path: the receiving
+        # process rebuilds it, every polygon checked, without reading any file.
+        return (_scene_from_bytes, (self._native.source, self._native.to_bytes()))
 
     def __repr__(self) -> str:
         return f"Scene({self.name!r}, {len(self.surface_names)} surfaces)"
