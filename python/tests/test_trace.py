@@ -173,3 +173,21 @@ def test_antenna_keywords_match_cli(cli_json):
         scene.trace(tx_power_dbm=float("nan"))
     with pytest.raises(ValueError, match="rx_orientation"):
         scene.trace(rx_orientation=[0, float("inf"), 0])
+
+
+def test_ipc_and_sbr_settings_match_cli(cli, cli_json):
+    """ipc_threshold, ipc_max_iterations and max_rays are trace's flags of those names."""
+    scene = beamtrace.load("builtin:living-room")
+    paths = scene.trace(max_order=2, solver="ipc", ipc_threshold=1e-7, ipc_max_iterations=40)
+    doc = cli_json("builtin:living-room", "--max-order", "2", "--solver", "ipc",
+                   "--ipc-threshold", "1e-7", "--ipc-max-iterations", "40")
+    assert_same_as_cli(paths, doc)
+    # The cap took effect: fewer rounds allowed than the default needs somewhere.
+    assert max(paths.iterations) <= 40
+    with pytest.raises(ValueError, match="ray budget exceeded") as info:
+        scene.trace(max_order=1, solver="sbr", max_rays=1000)
+    done = cli("trace", "builtin:living-room", "--max-order", "1", "--solver", "sbr",
+               "--max-rays", "1000")
+    assert done.returncode != 0 and str(info.value) in done.stderr
+    with pytest.raises(ValueError, match="ipc-threshold|ipc_threshold"):
+        scene.trace(solver="ipc", ipc_threshold=-1.0)

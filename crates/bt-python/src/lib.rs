@@ -443,6 +443,11 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     )?;
     m.add("DEFAULT_MAX_FILE_BYTES", bt_import::MAX_FILE_BYTES.limit)?;
     m.add(
+        "DEFAULT_IPC_MAX_ITERATIONS",
+        bt_solve::ipc::DEFAULT_MAX_ITERATIONS,
+    )?;
+    m.add("DEFAULT_MAX_RAYS", bt_solve::sbr::DEFAULT_MAX_RAYS)?;
+    m.add(
         "DEFAULT_MAX_XML_SUBSTITUTION",
         bt_import::xml::MAX_XML_SUBSTITUTION.limit,
     )?;

@@ -147,6 +147,10 @@ pub struct IpcKeywords {
     pub order: String,
     /// Acceleration: `none` or `newton`.
     pub accel: String,
+    /// Stopping threshold, metres (`None`: scaled to the scene), `ipc_threshold` in Python.
+    pub threshold: Option<f64>,
+    /// Round cap, `ipc_max_iterations` in Python.
+    pub max_iterations: u32,
 }
 
 /// SBR's keywords (`sbr_step_deg`, `sbr_rays`, `sbr_planar` in Python).
@@ -159,13 +163,13 @@ pub struct SbrKeywords {
     pub rays: Option<u32>,
     /// Launch only in the horizontal plane through TX.
     pub planar: bool,
+    /// Budget on the launched rays, `max_rays` in Python.
+    pub max_rays: u64,
 }
 
 impl TraceKeywords {
-    /// The library's settings these keywords name (the CLI's defaults for the rest: IPC's
-    /// threshold scaled to the scene, its round cap, SBR's ray budget).
+    /// The library's settings these keywords name (every one of the CLI's trace settings).
     pub fn settings(&self) -> Result<SolveSettings, String> {
-        let defaults = SolveSettings::default();
         let named = || -> Result<SolveSettings, bt_solve::settings::SettingsError> {
             Ok(SolveSettings {
                 max_order: self.max_order,
@@ -173,13 +177,14 @@ impl TraceKeywords {
                 ipc: IpcSettings {
                     order: parse(&self.ipc.order)?,
                     acceleration: parse(&self.ipc.accel)?,
-                    ..defaults.ipc
+                    threshold: self.ipc.threshold,
+                    max_iterations: self.ipc.max_iterations,
                 },
                 sbr: SbrSettings {
                     step_deg: self.sbr.step_deg,
                     rays: self.sbr.rays,
                     planar: self.sbr.planar,
-                    ..defaults.sbr
+                    max_rays: self.sbr.max_rays,
                 },
                 candidates: parse(&self.candidates)?,
                 max_candidates: self.max_candidates,
@@ -234,11 +239,14 @@ mod tests {
             ipc: IpcKeywords {
                 order: "gauss-seidel".into(),
                 accel: "none".into(),
+                threshold: None,
+                max_iterations: 256,
             },
             sbr: SbrKeywords {
                 step_deg: None,
                 rays: None,
                 planar: false,
+                max_rays: 1_000_000,
             },
             diffraction: DiffractionKeywords {
                 max_diffractions: 0,
@@ -271,6 +279,8 @@ mod tests {
             ipc: IpcKeywords {
                 order: "jacobi".into(),
                 accel: "none".into(),
+                threshold: None,
+                max_iterations: 256,
             },
             ..keywords()
         };
@@ -297,6 +307,7 @@ mod tests {
                 step_deg: Some(-1.0),
                 rays: None,
                 planar: false,
+                max_rays: 1_000_000,
             },
             ..keywords()
         };

@@ -246,9 +246,12 @@ class Scene:
         max_wvrn_tests: int = _native.DEFAULT_MAX_WVRN_TESTS,
         ipc_order: str = "gauss-seidel",
         ipc_accel: str = "none",
+        ipc_threshold: Optional[float] = None,
+        ipc_max_iterations: int = _native.DEFAULT_IPC_MAX_ITERATIONS,
         sbr_step_deg: Optional[float] = None,
         sbr_rays: Optional[int] = None,
         sbr_planar: bool = False,
+        max_rays: int = _native.DEFAULT_MAX_RAYS,
         parallel: bool = True,
         diffraction: bool = False,
         max_diffractions: Optional[int] = None,
@@ -271,7 +274,8 @@ class Scene:
 
         Options are ``beamtrace trace``'s flags: ``solver`` "image" | "ipc" | "sbr",
         ``candidates`` "beam-tree" | "wvrn" | "exhaustive", ``ipc_order`` "gauss-seidel" |
-        "jacobi", ``ipc_accel`` "none" | "newton", ``sbr_step_deg`` or ``sbr_rays``; the
+        "jacobi", ``ipc_accel`` "none" | "newton", ``ipc_threshold`` (m) and
+        ``ipc_max_iterations``, ``sbr_step_deg`` or ``sbr_rays`` and the ``max_rays`` budget; the
         antennas ``tx_pattern``/``rx_pattern`` "iso" | "tr38901", ``tx_polarization``/
         ``rx_polarization`` "V" | "H" | "+45" | "-45", ``tx_orientation``/``rx_orientation``
         (yaw, pitch, roll in degrees) and ``tx_power_dbm``, as ``beamtrace trace``'s flags of
@@ -300,9 +304,12 @@ class Scene:
         max_wvrn_tests: int = _native.DEFAULT_MAX_WVRN_TESTS,
         ipc_order: str = "gauss-seidel",
         ipc_accel: str = "none",
+        ipc_threshold: Optional[float] = None,
+        ipc_max_iterations: int = _native.DEFAULT_IPC_MAX_ITERATIONS,
         sbr_step_deg: Optional[float] = None,
         sbr_rays: Optional[int] = None,
         sbr_planar: bool = False,
+        max_rays: int = _native.DEFAULT_MAX_RAYS,
         parallel: bool = True,
         diffraction: bool = False,
         max_diffractions: Optional[int] = None,
@@ -452,11 +459,18 @@ def _options(arguments: Dict[str, Any]) -> Dict[str, Any]:
             "parallel",
         )
     }
-    options["ipc"] = {"order": arguments["ipc_order"], "accel": arguments["ipc_accel"]}
+    threshold = arguments["ipc_threshold"]
+    options["ipc"] = {
+        "order": arguments["ipc_order"],
+        "accel": arguments["ipc_accel"],
+        "threshold": None if threshold is None else float(threshold),
+        "max_iterations": arguments["ipc_max_iterations"],
+    }
     options["sbr"] = {
         "step_deg": arguments["sbr_step_deg"],
         "rays": arguments["sbr_rays"],
         "planar": arguments["sbr_planar"],
+        "max_rays": arguments["max_rays"],
     }
     maximum = arguments["max_diffractions"]
     options["diffraction"] = {

@@ -10,6 +10,8 @@ PATH_COLUMNS: List[str]
 (derived from the report record; ``iterations``/``residual_m`` only for IPC)."""
 DEFAULT_MAX_CANDIDATES: int
 DEFAULT_MAX_WVRN_TESTS: int
+DEFAULT_IPC_MAX_ITERATIONS: int
+DEFAULT_MAX_RAYS: int
 DEFAULT_MAX_FILE_BYTES: int
 DEFAULT_MAX_XML_SUBSTITUTION: int
 DEFAULT_MAX_MESH_ELEMENTS: int
