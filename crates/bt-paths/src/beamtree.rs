@@ -1383,11 +1383,10 @@ pub fn candidates_and_diffracted_in(
 /// that the next trace from the same TX (a moving receiver) skips the TX side's reaches.
 struct KeptSide {
     geometry: bt_scene::GeometryKey,
-    /// The TX (scene-local frame, m), the tree's options and tolerance, the minimum edge
-    /// length: equal bit for bit, or the side is built anew.
+    /// The TX (scene-local frame, m), the tree's options, the minimum edge length and (in
+    /// `side`) the tree's tolerance: equal bit for bit, or the side is built anew.
     tx: Vec3,
     options: TreeOptions,
-    tol: Real,
     min_edge_length: Real,
     side: DiffractionSide,
 }
@@ -1399,7 +1398,7 @@ impl KeptSide {
             k.geometry.matches(scene)
                 && k.tx == tx.tx
                 && k.options == tx.options
-                && k.tol == tx.tol
+                && k.side.tol == tx.tol
                 && k.min_edge_length == min_edge_length
         };
         match cache.side.take() {
@@ -1408,7 +1407,6 @@ impl KeptSide {
                 geometry: scene.geometry_key(),
                 tx: tx.tx,
                 options: tx.options,
-                tol: tx.tol,
                 min_edge_length,
                 side: DiffractionSide::of(scene, tx, tx.options.max_order, min_edge_length),
             },

@@ -188,8 +188,8 @@ pub struct DiffractionSide {
     max_order: usize,
     /// (parent, surface) of the tree's nodes to depth `max_order − 1`.
     prefixes: Vec<(u32, u32)>,
-    /// The tree's length tolerance (m), for the join's margin.
-    tol: Real,
+    /// The tree's length tolerance (m), for the join's margin (and the cache's key).
+    pub(super) tol: Real,
 }
 
 impl DiffractionSide {
