@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import beamtrace
-from conftest import TESTDATA, vec
+from conftest import REPO, TESTDATA, vec
 
 
 def assert_same_as_cli(paths: beamtrace.Paths, doc: dict) -> None:
@@ -28,7 +28,8 @@ def assert_same_as_cli(paths: beamtrace.Paths, doc: dict) -> None:
                 e[key]["elevation"],
             ]
         assert paths.incidence_deg[i].tolist() == e["incidence_deg"]
-        for key in ("free_space_loss_db", "reflection_loss_db", "loss_db"):
+        assert paths.interactions[i] == e["interactions"]
+        for key in ("free_space_loss_db", "reflection_loss_db", "transmission_loss_db", "loss_db"):
             assert paths.to_dict()[key][i] == e[key]
         assert paths.gain[i] == complex(e["gain"][0], e["gain"][1])
         for key in ("gain_db", "power_dbm"):
@@ -109,6 +110,27 @@ def test_diffraction_coefficient_matches_cli(cli_json):
     many = scene.trace_many(tx, np.array([rx]), diffraction_coefficient="sionna-rt-2.2",
                             **options)
     assert many[0].gain.tolist() == sionna.gain.tolist()
+
+
+def test_transmission_matches_cli(cli_json):
+    # Through the partition (plasterboard) with transmission=True, as `--transmission`; the
+    # curtain's material opens it either way.
+    two_rooms = str(REPO / "examples" / "two-rooms.json")
+    scene = beamtrace.load(two_rooms)
+    through = scene.trace(max_order=3, transmission=True)
+    assert_same_as_cli(through, cli_json(two_rooms, "--max-order", "3", "--transmission"))
+    crossed = {s for kinds, names in zip(through.interactions, through.surfaces)
+               for k, s in zip(kinds, names) if k == "transmission"}
+    assert {"partition", "curtain"} <= crossed
+    assert through.transmission_loss_db.max() > 0
+    plain = scene.trace(max_order=3)
+    assert_same_as_cli(plain, cli_json(two_rooms, "--max-order", "3"))
+    assert len(plain) < len(through)
+    many = scene.trace_many(scene.tx, np.array([scene.rx]), max_order=3, transmission=True)
+    assert many[0].gain.tolist() == through.gain.tolist()
+    tracer = beamtrace.Tracer(two_rooms, max_order=3, transmission=True)
+    answer = tracer.update(rx=list(scene.rx))
+    assert [p["gain"] for p in answer["paths"]] == [[g.real, g.imag] for g in through.gain]
 
 
 def test_scene_properties():

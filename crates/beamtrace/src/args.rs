@@ -529,6 +529,11 @@ pub struct SolveArgs {
     /// Edges shorter than this (metres) do not diffract.
     #[arg(long, default_value_t = 0.0, value_parser = numbers::length_m)]
     pub min_edge_length: f64,
+    /// Transmission: waves also cross every reflector whose material is a slab (ITU-R P.2040
+    /// thin slab, no deflection; each crossing counts in --max-order). Half-spaces stay
+    /// opaque; a material's "transmission": true does the same for that material alone.
+    #[arg(long)]
+    pub transmission: bool,
 }
 
 #[derive(Debug, Args, Clone)]
@@ -645,6 +650,7 @@ impl SolveArgs {
             max_candidates: self.max_candidates,
             max_wvrn_tests: self.max_wvrn_tests,
             parallel: !self.single_thread,
+            transmission: self.transmission,
             diffraction: bt_solve::pipeline::DiffractionOptions {
                 max_diffractions: self
                     .max_diffractions
@@ -735,6 +741,9 @@ pub struct PathArgs {
     /// Edge diffraction: paths may diffract once (as `trace --diffraction`).
     #[arg(long)]
     pub diffraction: bool,
+    /// Transmission through slab reflectors (as `trace --transmission`).
+    #[arg(long)]
+    pub transmission: bool,
 }
 
 impl PathArgs {
@@ -745,6 +754,7 @@ impl PathArgs {
             radio: self.radio.clone(),
             solve: SolveArgs {
                 diffraction: self.diffraction,
+                transmission: self.transmission,
                 ..SolveArgs::with(self.max_order, self.solver)
             },
             json: false,
@@ -857,6 +867,7 @@ impl SolveArgs {
             diffraction: false,
             max_diffractions: None,
             min_edge_length: 0.0,
+            transmission: false,
         }
     }
 }

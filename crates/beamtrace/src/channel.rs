@@ -25,7 +25,7 @@ fn traced_paths(
     let scene = loaded.scene;
     let (tx, rx) = crate::load::terminals(&scene, &args.scene)?;
     let trace_args = args.trace_args();
-    let options = trace_args.solve.settings().trace_options(&scene)?;
+    let options = crate::trace::options_for(&trace_args.solve, &scene)?;
     let traced = bt_solve::Tracer::new(scene.clone(), options).trace(tx, rx)?;
     let radio = radio.for_order(options.max_order);
     let paths = bt_beams::report(&scene, &traced.result.paths, &radio)?;
@@ -67,7 +67,7 @@ fn cir_csv(paths: &[PathReport], carrier_hz: f64) -> String {
             opt(p.power_dbm),
             bb.re,
             bb.im,
-            bt_output::csv::text_field(&bt_scene::name::path(&p.surfaces))
+            bt_output::csv::text_field(&p.route())
         );
     }
     out

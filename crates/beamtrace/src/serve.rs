@@ -15,7 +15,7 @@ pub fn run(args: &ServeArgs) -> anyhow::Result<ExitCode> {
     for w in dynamic.step(0).warnings() {
         eprintln!("warning: {w}");
     }
-    let options = args.solve.settings().trace_options(dynamic.step(0))?;
+    let options = crate::trace::options_for(&args.solve, dynamic.step(0))?;
     let radio = args.radio.options()?;
     let limits = Limits {
         max_line_bytes: usize::try_from(args.max_line_bytes).context("--max-line-bytes")?,

@@ -221,6 +221,14 @@ fn blocked(
             return Validity::Blocked { segment, by };
         }
     }
+    if scene.transmits() {
+        let path = validate::PathVertices {
+            vertex: &vertex,
+            on: &on,
+            points: n,
+        };
+        return validate::crossing_budget(scene, path, n);
+    }
     Validity::Valid
 }
 

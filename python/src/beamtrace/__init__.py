@@ -56,7 +56,8 @@ class Paths:
     order: npt.NDArray[np.int64]
     """Number of interactions (0 = line of sight), shape (n,)."""
     interactions: List[List[str]]
-    """What happens at each point of each path: "reflection" or "diffraction"."""
+    """What happens at each point of each path: "reflection", "diffraction" or "transmission"
+    (a crossing of a penetrable surface)."""
     surfaces: List[List[str]]
     """The surface of each interaction, TX side first: "A|B" (a wedge's two faces) or "A" (a
     free edge's face) at a diffraction, with ``\\`` and ``|`` inside a face name written
@@ -81,6 +82,8 @@ class Paths:
     """Sum of the materials' reflection losses, dB, shape (n,)."""
     diffraction_loss_db: npt.NDArray[np.float64]
     """The diffraction's excess loss over free space, dB (0 for specular paths), shape (n,)."""
+    transmission_loss_db: npt.NDArray[np.float64]
+    """The crossings' loss (ITU-R P.2040 slab transmission), dB (0 without), shape (n,)."""
     loss_db: npt.NDArray[np.float64]
     """Total loss, dB, shape (n,)."""
     gain: npt.NDArray[np.complex128]
@@ -257,6 +260,7 @@ class Scene:
         max_diffractions: Optional[int] = None,
         min_edge_length: float = 0.0,
         diffraction_coefficient: str = "utd",
+        transmission: bool = False,
         tx_pattern: str = "iso",
         rx_pattern: str = "iso",
         tx_polarization: str = "V",
@@ -270,7 +274,9 @@ class Scene:
         an edge at least ``min_edge_length`` metres long, their gains with
         ``diffraction_coefficient`` "utd" (default) or "sionna-rt-2.2" (Sionna RT 2.2's gains,
         for comparing with Sionna: its combination, and its diffracted leg for a PathSolver
-        whose ``max_depth`` is ``max_order``; docs/channel.md §8).
+        whose ``max_depth`` is ``max_order``; docs/channel.md §8). ``transmission=True`` is
+        ``--transmission``: waves also cross every reflector whose material is a slab (ITU-R
+        P.2040 thin-slab transmission, no deflection; each crossing counts in ``max_order``).
 
         Options are ``beamtrace trace``'s flags: ``solver`` "image" | "ipc" | "sbr",
         ``candidates`` "beam-tree" | "wvrn" | "exhaustive", ``ipc_order`` "gauss-seidel" |
@@ -315,6 +321,7 @@ class Scene:
         max_diffractions: Optional[int] = None,
         min_edge_length: float = 0.0,
         diffraction_coefficient: str = "utd",
+        transmission: bool = False,
         tx_pattern: str = "iso",
         rx_pattern: str = "iso",
         tx_polarization: str = "V",
@@ -457,6 +464,7 @@ def _options(arguments: Dict[str, Any]) -> Dict[str, Any]:
             "max_candidates",
             "max_wvrn_tests",
             "parallel",
+            "transmission",
         )
     }
     threshold = arguments["ipc_threshold"]
