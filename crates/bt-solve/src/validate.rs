@@ -73,13 +73,15 @@ pub fn validate(scene: &Scene, seq: &[SurfaceId], tx: Vec3, rx: Vec3, points: &[
             return Validity::OppositeSides { index: k };
         }
     }
+    let through = may_cross(scene, n);
     for segment in 0..=n {
         let ((a, from), (b, to)) = segment_ends(seq, (tx, rx), points, segment);
-        if let Some(by) = blocker(scene, a, b, from, to, tol) {
+        let ends = (from.as_slice(), to.as_slice());
+        if let Some(by) = blocker_excluding(scene, (a, b), ends, tol, through) {
             return Validity::Blocked { segment, by };
         }
     }
-    if scene.transmits() {
+    if through {
         let vertex = |k: usize| match k {
             0 => tx,
             k if k == n + 1 => rx,
@@ -314,8 +316,8 @@ fn segment_ends(
     (start, end)
 }
 
-/// The first opaque surface (penetrable ones are crossed, see [`walk_crossings`]), other than
-/// those the segment's ends lie on (`from`, `to`: none for a
+/// The first surface that blocks (an opaque one; a penetrable one too unless `through`: then it
+/// is crossed, see [`walk_crossings`]), other than those the segment's ends lie on (`from`, `to`: none for a
 /// terminal, one for a reflection point, every surface touching the edge for a diffraction
 /// point), whose box grown by twice the scene's length tolerance (`blocks` may accept
 /// crossings within the tolerance outside a polygon) the segment `a -> b` touches and whose
@@ -325,6 +327,7 @@ fn first_blocking(
     scene: &Scene,
     (a, b): (Vec3, Vec3),
     (from, to): (&[SurfaceId], &[SurfaceId]),
+    through: bool,
     mut blocks: impl FnMut(&bt_geom::Polygon) -> bool,
 ) -> Option<SurfaceId> {
     let margin = 2.0 * scene.length_tolerance();
@@ -332,33 +335,34 @@ fn first_blocking(
         .bvh()
         .any_hit(a, b, margin, |i| {
             let id = SurfaceId(i);
-            !from.contains(&id)
-                && !to.contains(&id)
-                && !scene.penetrable(id)
+            let crossed = through && scene.penetrable(id);
+            !(from.contains(&id) || to.contains(&id) || crossed)
                 && blocks(&scene.surface(id).polygon)
         })
         .map(SurfaceId)
 }
 
 /// The first surface crossing the segment `a -> b` other than those its ends lie on (`from`,
-/// `to`: several at a diffraction point, which lies on every surface touching its edge).
+/// `to`: several at a diffraction point, which lies on every surface touching its edge):
+/// opaque surfaces only when `through` (the path may still cross penetrable ones), every
+/// surface otherwise.
 #[inline(always)]
 pub fn blocker_excluding(
     scene: &Scene,
-    a: Vec3,
-    b: Vec3,
-    from: &[SurfaceId],
-    to: &[SurfaceId],
+    (a, b): (Vec3, Vec3),
+    (from, to): (&[SurfaceId], &[SurfaceId]),
     tol: Real,
+    through: bool,
 ) -> Option<SurfaceId> {
     let length = a.distance(b);
     let t_min = tol / length.max(tol);
-    first_blocking(scene, (a, b), (from, to), |polygon| {
+    first_blocking(scene, (a, b), (from, to), through, |polygon| {
         polygon.blocks_segment(a, b, t_min, tol)
     })
 }
 
-/// The first surface (other than the segment's own end surfaces) crossing the segment `a -> b`.
+/// The first opaque surface (other than the segment's own end surfaces) crossing the segment
+/// `a -> b`.
 #[inline(always)]
 pub fn blocker(
     scene: &Scene,
@@ -368,7 +372,15 @@ pub fn blocker(
     to: Option<SurfaceId>,
     tol: Real,
 ) -> Option<SurfaceId> {
-    blocker_excluding(scene, a, b, from.as_slice(), to.as_slice(), tol)
+    blocker_excluding(scene, (a, b), (from.as_slice(), to.as_slice()), tol, true)
+}
+
+/// Whether a path with `interactions` reflections and diffractions may still cross penetrable
+/// surfaces (the scene has some, and the interaction budget is not spent): if not, a
+/// penetrable surface blocks it like an opaque one, and one early-exit test decides.
+#[inline(always)]
+pub fn may_cross(scene: &Scene, interactions: usize) -> bool {
+    scene.transmits() && scene.max_interactions() > interactions
 }
 
 /// Early stopping of IPC (`IpcOptions::early_reject`): the first segment of the path TX ->
@@ -403,7 +415,8 @@ pub fn blocked_for_good(
     for segment in 0..=n {
         let ((a, from), (b, to)) = segment_ends(seq, (tx, rx), points, segment);
         let length = a.distance(b);
-        let by = first_blocking(scene, (a, b), (from.as_slice(), to.as_slice()), |polygon| {
+        let ends = (from.as_slice(), to.as_slice());
+        let by = first_blocking(scene, (a, b), ends, true, |polygon| {
             // Unfused: the margins are far above its round-off, and the closure may be compiled
             // without the FMA feature (a software `fma` per call).
             let (da, db) = (
