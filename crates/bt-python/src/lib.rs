@@ -215,6 +215,38 @@ impl PyScene {
         columns::to_dict(py, &paths)
     }
 
+    /// The viewer's page (`beamtrace view`: one offline HTML document, three.js inside) of the
+    /// scene with the paths traced from `tx` to `rx` under `keywords`; the geometry alone when
+    /// a terminal is neither given nor in the scene.
+    fn view(
+        &self,
+        py: Python<'_>,
+        tx: Option<[f64; 3]>,
+        rx: Option<[f64; 3]>,
+        keywords: TraceKeywords,
+    ) -> PyResult<String> {
+        let placed = tx.is_some() || self.scene.tx().is_some();
+        if !placed || (rx.is_none() && self.scene.rx().is_none()) {
+            return Ok(bt_view::page(&[&self.scene], &[bt_view::StepPaths::none()]));
+        }
+        let scene = self.moved(tx, rx)?;
+        let options = keywords
+            .trace_options(&scene)
+            .map_err(PyValueError::new_err)?;
+        let radio = keywords.radio().map_err(PyValueError::new_err)?;
+        let ends = scene.terminals().map_err(error)?;
+        let (tx, rx) = (scene.to_world(ends.tx), scene.to_world(ends.rx));
+        let page = py.detach(|| {
+            let traced = self.with_tracer(scene.clone(), options, |t| t.trace(tx, rx));
+            traced.map(|traced| {
+                let paths = bt_beams::report(&scene, &traced.result.paths, &radio)?;
+                let step = bt_view::StepPaths::from_reports(&scene, &paths);
+                Ok::<_, bt_beams::ReportError>(bt_view::page(&[&scene], &[step]))
+            })
+        });
+        page.map_err(|e| self.error(e))?.map_err(error)
+    }
+
     /// Trace one TX to each row of `receivers` (m × 3, metres) in parallel without the GIL;
     /// returns one column dict per receiver, in order.
     fn trace_many<'py>(

@@ -32,6 +32,7 @@ __all__ = [
     "Paths",
     "Scene",
     "Tracer",
+    "View",
     "builtin_names",
     "load",
 ]
@@ -351,6 +352,48 @@ class Scene:
             on_error == "skip",
         )
         return [None if c is None else Paths(c) for c in results]
+
+    def view(
+        self, tx: Optional[Point] = None, rx: Optional[Point] = None, **options: Any
+    ) -> "View":
+        """The 3-D view of ``beamtrace view``: the scene with the paths from ``tx`` to ``rx``
+        (metres; the scene's own if None) traced with :meth:`trace`'s keywords, or the
+        geometry alone when a terminal is neither given nor in the scene. A Jupyter cell
+        shows it inline; :meth:`View.save` writes the page.
+
+        >>> scene.view(max_order=2, diffraction=True)      # last line of a notebook cell
+        """
+        keywords = _trace_keywords(options)
+        return View(self._native.view(_point(tx, "tx"), _point(rx, "rx"), keywords))
+
+
+class View:
+    """One offline HTML page (three.js inside) showing a scene and its paths: inline in
+    Jupyter (``_repr_html_``), or written with :meth:`save` and opened in a browser."""
+
+    def __init__(self, html: str) -> None:
+        self.html = html
+        """The whole page, as ``beamtrace view`` writes it."""
+
+    def _repr_html_(self) -> str:
+        escaped = self.html.replace("&", "&amp;").replace('"', "&quot;")
+        return f'<iframe srcdoc="{escaped}" style="width:100%;height:520px;border:0"></iframe>'
+
+    def save(self, path: Union[str, "os.PathLike[str]"]) -> None:
+        """Write the page to ``path`` (a new file, or one this view wrote before: an existing
+        file is refused with ``FileExistsError`` unless it holds a beamtrace page)."""
+        path = os.fspath(path)
+        if os.path.exists(path):
+            with open(path, encoding="utf-8", errors="replace") as f:
+                if "<title>beamtrace view:" not in f.read(4096):
+                    raise FileExistsError(f"{path} exists and is not a beamtrace view: not replaced")
+        tmp = f"{path}.{os.getpid()}.tmp"
+        with open(tmp, "w", encoding="utf-8") as f:
+            f.write(self.html)
+        os.replace(tmp, path)
+
+    def __repr__(self) -> str:
+        return f"View({len(self.html) // 1024} KiB)"
 
 
 class Tracer:
