@@ -213,3 +213,18 @@ def test_ipc_and_sbr_settings_match_cli(cli, cli_json):
     assert done.returncode != 0 and str(info.value) in done.stderr
     with pytest.raises(ValueError, match="ipc-threshold|ipc_threshold"):
         scene.trace(solver="ipc", ipc_threshold=-1.0)
+
+
+def test_point_cloud_matches_cli(cli, cli_json, tmp_path):
+    # A PCD scan of the living room (the CLI's `sample`), its planes extracted on load as the
+    # CLI's trace extracts them: the same paths. The cloud budget is checked before reading.
+    cloud = tmp_path / "room.pcd"
+    done = cli("sample", "builtin:living-room", "-o", str(cloud), "--noise", "0.005",
+               "--density", "300")
+    assert done.returncode == 0, done.stderr
+    tx, rx = [5.6, 0.6, 2.2], [2.3, 2.1, 0.72]
+    scene = beamtrace.load(cloud, tx=tx, rx=rx)
+    assert_same_as_cli(scene.trace(max_order=2),
+                       cli_json(str(cloud), "--tx", vec(tx), "--rx", vec(rx), "--max-order", "2"))
+    with pytest.raises(beamtrace.BeamtraceError, match="max-cloud-points"):
+        beamtrace.load(cloud, max_cloud_points=100)

@@ -22,6 +22,10 @@ pub fn run(args: &ServeArgs) -> anyhow::Result<ExitCode> {
         max_receivers: usize::try_from(args.max_receivers).context("--max-receivers")?,
     };
     let mut server = Server::new(dynamic, options, radio, limits);
+    if args.arrays.tx_array.is_some() || args.arrays.rx_array.is_some() {
+        let beams = crate::channel::beam_options(&args.arrays, &radio, args.top)?;
+        server = server.with_beams(beams);
+    }
     match &args.listen {
         None => {
             let input = std::io::stdin().lock();

@@ -403,6 +403,7 @@ fn load(
         max_file_bytes: defaults.max_file_bytes,
         max_xml_substitution: defaults.max_xml_substitution,
         max_mesh_elements: defaults.merge.max_elements,
+        max_cloud_points: defaults.cloud.max_points,
     });
     let options = LoadOptions {
         terminals: terminals(tx, rx),
@@ -413,6 +414,12 @@ fn load(
             ..bt_mesh::MergeOptions::default()
         },
         min_reflector_area_m2: min_reflector_area,
+        // As the CLI: a cloud's points and its file are budgeted like every other input.
+        cloud: bt_import::cloud::ReadOptions {
+            max_points: budgets.max_cloud_points,
+            max_file_bytes: budgets.max_file_bytes,
+            ..defaults.cloud
+        },
         max_file_bytes: budgets.max_file_bytes,
         max_xml_substitution: budgets.max_xml_substitution,
         frequency_hz: frequency.unwrap_or(bt_scene::DEFAULT_FREQUENCY_HZ),
@@ -484,6 +491,11 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
         bt_import::xml::MAX_XML_SUBSTITUTION.limit,
     )?;
     m.add("DEFAULT_MAX_MESH_ELEMENTS", bt_mesh::DEFAULT_MAX_ELEMENTS)?;
+    m.add(
+        "DEFAULT_MAX_CLOUD_POINTS",
+        bt_import::cloud::DEFAULT_MAX_POINTS,
+    )?;
+    m.add("DEFAULT_MAX_BEAM_PAIRS", bt_channel::MAX_BEAM_PAIRS.limit)?;
     m.add_class::<PyScene>()?;
     m.add_class::<tracer::PyTracer>()?;
     m.add_function(wrap_pyfunction!(load, m)?)?;

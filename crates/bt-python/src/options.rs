@@ -107,6 +107,8 @@ pub struct LoadBudgets {
     pub max_xml_substitution: u64,
     /// Vertices and faces of a mesh file, and of all meshes of an XML scene.
     pub max_mesh_elements: u64,
+    /// Points a point-cloud file declares.
+    pub max_cloud_points: u64,
 }
 
 /// `load`'s `material=` and `thickness=` (the CLI's `--material`, `--thickness`): the radio

@@ -410,12 +410,26 @@ class Tracer:
     and RX). ``tx`` overrides the scene's transmitter. ``options`` are :meth:`Scene.trace`'s
     keywords with its defaults (``max_order=3``, ``solver``, ``diffraction``, ...); an unknown
     one raises ``TypeError``, a bad value ``ValueError``, here.
+
+    With ``tx_array`` or ``rx_array`` (``(rows, columns)``; the other one 1 × 8) every answer
+    also holds ``"beams"``, as ``serve --tx-array/--rx-array``: the beam sweep of ``beamtrace
+    beams`` over the answer's paths, its ``best`` pair and the first ``top`` pairs, with
+    ``tx_spacing``/``rx_spacing`` (wavelengths), ``ranking`` ("power" or "paper") and the
+    ``max_beam_pairs`` budget.
     """
 
     def __init__(
         self,
         scene: Union[str, "os.PathLike[str]", Scene],
         tx: Optional[Point] = None,
+        *,
+        tx_array: Optional[Sequence[int]] = None,
+        rx_array: Optional[Sequence[int]] = None,
+        tx_spacing: float = 0.5,
+        rx_spacing: float = 0.5,
+        ranking: str = "power",
+        top: int = 5,
+        max_beam_pairs: int = _native.DEFAULT_MAX_BEAM_PAIRS,
         **options: Any,
     ) -> None:
         rx = None
@@ -426,7 +440,21 @@ class Tracer:
         else:
             source = os.fspath(scene)
         keywords = _trace_keywords(options)
-        self._native = _native.Tracer(source, keywords, _point(tx, "tx"), _point(rx, "rx"))
+        beams = None
+        if tx_array is not None or rx_array is not None:
+            shape = lambda a: None if a is None else (int(a[0]), int(a[1]))  # noqa: E731
+            beams = {
+                "tx_array": shape(tx_array),
+                "rx_array": shape(rx_array),
+                "tx_spacing": float(tx_spacing),
+                "rx_spacing": float(rx_spacing),
+                "ranking": ranking,
+                "top": int(top),
+                "max_beam_pairs": int(max_beam_pairs),
+            }
+        self._native = _native.Tracer(
+            source, keywords, _point(tx, "tx"), _point(rx, "rx"), beams
+        )
 
     def update(
         self,
@@ -550,20 +578,22 @@ def load(
     max_file_bytes: int = _native.DEFAULT_MAX_FILE_BYTES,
     max_xml_substitution: int = _native.DEFAULT_MAX_XML_SUBSTITUTION,
     max_mesh_elements: int = _native.DEFAULT_MAX_MESH_ELEMENTS,
+    max_cloud_points: int = _native.DEFAULT_MAX_CLOUD_POINTS,
     cache: bool = False,
     frequency: Optional[float] = None,
     material: Optional[str] = None,
     thickness: Optional[float] = None,
 ) -> Scene:
-    """Load a scene: a file the CLI reads (.json, .toml, .obj, .ply) or ``"builtin:NAME"``.
+    """Load a scene: a file the CLI reads (.json, .toml, .obj, .ply mesh, Mitsuba .xml, .ply/.pcd
+    point cloud, whose planes are extracted as the CLI does) or ``"builtin:NAME"``.
 
     ``tx``/``rx`` override the file's terminals. Meshes, XML scenes and point clouds carry
     none: load them bare and give ``tx``/``rx`` to each :meth:`Scene.trace`. The mesh
     options are ``beamtrace trace``'s ``--min-reflector-area`` (m²), ``--merge-angle-deg`` and
     ``--merge-distance`` (m); the budgets are its ``--max-file-bytes`` (any input file),
-    ``--max-xml-substitution`` (bytes an XML scene's ``$parameters`` expand to) and
-    ``--max-mesh-elements`` (vertices and faces of a mesh, or of all meshes of an XML scene),
-    each checked before the work. ``cache=True`` is ``--cache``: the loaded scene is kept in
+    ``--max-xml-substitution`` (bytes an XML scene's ``$parameters`` expand to),
+    ``--max-mesh-elements`` (vertices and faces of a mesh, or of all meshes of an XML scene) and
+    ``--max-cloud-points`` (points a point-cloud file declares), each checked before the work. ``cache=True`` is ``--cache``: the loaded scene is kept in
     the user's cache directory (``$BEAMTRACE_CACHE_DIR``, else ``$XDG_CACHE_HOME/beamtrace``,
     else ``~/.cache/beamtrace``) and read from there while the files and options are unchanged;
     a damaged entry is rebuilt with a :class:`RuntimeWarning`. ``frequency`` (Hz),
@@ -585,6 +615,7 @@ def load(
             "max_file_bytes": max_file_bytes,
             "max_xml_substitution": max_xml_substitution,
             "max_mesh_elements": max_mesh_elements,
+            "max_cloud_points": max_cloud_points,
         },
         cache=bool(cache),
         frequency=None if frequency is None else float(frequency),

@@ -15,6 +15,8 @@ DEFAULT_MAX_RAYS: int
 DEFAULT_MAX_FILE_BYTES: int
 DEFAULT_MAX_XML_SUBSTITUTION: int
 DEFAULT_MAX_MESH_ELEMENTS: int
+DEFAULT_MAX_CLOUD_POINTS: int
+DEFAULT_MAX_BEAM_PAIRS: int
 
 class BeamtraceError(Exception): ...
 
@@ -50,7 +52,12 @@ class Scene:
 
 class Tracer:
     def __init__(
-        self, source: str, keywords: Dict[str, Any], tx: _Point, rx: _Point
+        self,
+        source: str,
+        keywords: Dict[str, Any],
+        tx: _Point,
+        rx: _Point,
+        beams: Optional[Dict[str, Any]] = None,
     ) -> None: ...
     def answer(self, line: str) -> str: ...
 
