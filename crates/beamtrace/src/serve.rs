@@ -21,6 +21,7 @@ pub fn run(args: &ServeArgs) -> anyhow::Result<ExitCode> {
         max_line_bytes: usize::try_from(args.max_line_bytes).context("--max-line-bytes")?,
         max_receivers: usize::try_from(args.max_receivers).context("--max-receivers")?,
     };
+    stop::install();
     let mut server = Server::new(dynamic, options, radio, limits);
     if args.arrays.tx_array.is_some() || args.arrays.rx_array.is_some() {
         let beams = crate::channel::beam_options(&args.arrays, &radio, args.top)?;
@@ -30,7 +31,7 @@ pub fn run(args: &ServeArgs) -> anyhow::Result<ExitCode> {
         None => {
             let input = std::io::stdin().lock();
             let output = BufWriter::new(std::io::stdout().lock());
-            server.serve(input, output)?;
+            server.serve_until(input, output, &stop::requested)?;
         }
         Some(Listen::Tcp(address)) => serve_tcp(&mut server, address)?,
         Some(Listen::Unix(path)) => serve_unix(&mut server, path)?,
@@ -46,9 +47,16 @@ fn serve_tcp(server: &mut Server, address: &str) -> anyhow::Result<()> {
         .local_addr()
         .context("--listen: the bound address")?;
     eprintln!("listening on tcp:{bound}");
-    for (n, stream) in listener.incoming().enumerate() {
+    for n in 0.. {
+        let Some(stream) = stop::accept(|| listener.accept().map(|(s, _)| s)) else {
+            break;
+        };
         let stream = stream.context("--listen: accepting a connection")?;
-        let outcome = server.serve(BufReader::new(&stream), BufWriter::new(&stream));
+        let outcome = server.serve_until(
+            BufReader::new(&stream),
+            BufWriter::new(&stream),
+            &stop::requested,
+        );
         end_connection(server, n, outcome);
     }
     Ok(())
@@ -75,11 +83,21 @@ fn serve_unix(server: &mut Server, path: &Path) -> anyhow::Result<()> {
     let listener = UnixListener::bind(path)
         .with_context(|| format!("--listen unix:{shown}: cannot listen"))?;
     eprintln!("listening on unix:{shown}");
-    for (n, stream) in listener.incoming().enumerate() {
+    stop::remove_on_stop(path);
+    for n in 0.. {
+        let Some(stream) = stop::accept(|| listener.accept().map(|(s, _)| s)) else {
+            break;
+        };
         let stream = stream.context("--listen: accepting a connection")?;
-        let outcome = server.serve(BufReader::new(&stream), BufWriter::new(&stream));
+        let outcome = server.serve_until(
+            BufReader::new(&stream),
+            BufWriter::new(&stream),
+            &stop::requested,
+        );
         end_connection(server, n, outcome);
     }
+    // Stopped by a signal between connections: the socket this server made goes with it.
+    std::fs::remove_file(path).ok();
     Ok(())
 }
 
@@ -102,4 +120,80 @@ fn end_connection(
         eprintln!("warning: connection {}: {e}", n + 1);
     }
     server.end_session();
+}
+
+/// SIGTERM and SIGINT stop the server cleanly: the answer in hand is written and flushed, a
+/// read waiting for a request ends (the handler leaves reads interruptible), and the Unix
+/// socket the server made is removed. While it waits for a client (the standard library
+/// retries an interrupted accept) nothing is in flight: the handler removes the socket and
+/// exits at once (`unlink` and `_exit` are async-signal-safe).
+#[cfg(unix)]
+mod stop {
+    use std::ffi::CString;
+    use std::sync::OnceLock;
+    use std::sync::atomic::{AtomicBool, Ordering};
+
+    static STOP: AtomicBool = AtomicBool::new(false);
+    static ACCEPTING: AtomicBool = AtomicBool::new(false);
+    static SOCKET: OnceLock<CString> = OnceLock::new();
+
+    extern "C" fn on_signal(_: libc::c_int) {
+        STOP.store(true, Ordering::SeqCst);
+        if ACCEPTING.load(Ordering::SeqCst) {
+            if let Some(path) = SOCKET.get() {
+                // SAFETY: a valid C string; unlink is async-signal-safe.
+                unsafe { libc::unlink(path.as_ptr()) };
+            }
+            // SAFETY: _exit is async-signal-safe; every answer was flushed already.
+            unsafe { libc::_exit(0) };
+        }
+    }
+
+    /// Handle SIGTERM and SIGINT (without `SA_RESTART`, so a blocked read returns).
+    pub fn install() {
+        // SAFETY: a zeroed sigaction with an extern "C" handler and an empty mask is valid.
+        unsafe {
+            let mut action: libc::sigaction = std::mem::zeroed();
+            action.sa_sigaction = on_signal as extern "C" fn(libc::c_int) as usize;
+            libc::sigemptyset(&mut action.sa_mask);
+            for signal in [libc::SIGTERM, libc::SIGINT] {
+                libc::sigaction(signal, &action, std::ptr::null_mut());
+            }
+        }
+    }
+
+    /// Whether a signal asked the server to stop.
+    pub fn requested() -> bool {
+        STOP.load(Ordering::SeqCst)
+    }
+
+    /// The next client from `accept`, or `None` once a stop was asked for.
+    pub fn accept<S>(accept: impl FnOnce() -> std::io::Result<S>) -> Option<std::io::Result<S>> {
+        ACCEPTING.store(true, Ordering::SeqCst);
+        if requested() {
+            return None;
+        }
+        let client = accept();
+        ACCEPTING.store(false, Ordering::SeqCst);
+        Some(client)
+    }
+
+    /// Remove the Unix socket at `path` when a signal stops the server.
+    pub fn remove_on_stop(path: &std::path::Path) {
+        use std::os::unix::ffi::OsStrExt;
+        if let Ok(path) = CString::new(path.as_os_str().as_bytes()) {
+            let _ = SOCKET.set(path);
+        }
+    }
+}
+
+#[cfg(not(unix))]
+mod stop {
+    pub fn install() {}
+    pub fn requested() -> bool {
+        false
+    }
+    pub fn accept<S>(accept: impl FnOnce() -> std::io::Result<S>) -> Option<std::io::Result<S>> {
+        Some(accept())
+    }
 }

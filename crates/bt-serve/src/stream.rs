@@ -30,12 +30,25 @@ pub fn read_bounded_line(
     buf: &mut Vec<u8>,
     max: usize,
 ) -> std::io::Result<Option<Line>> {
+    read_line_until(input, buf, max, &|| false)
+}
+
+/// [`read_bounded_line`], which also ends (`None`, a partial line dropped) when a read is
+/// interrupted by a signal and `stop()` says so: a server told to stop (SIGTERM) while it
+/// waits for a request.
+fn read_line_until(
+    input: &mut impl BufRead,
+    buf: &mut Vec<u8>,
+    max: usize,
+    stop: &dyn Fn() -> bool,
+) -> std::io::Result<Option<Line>> {
     buf.clear();
     let mut seen = 0usize;
     let mut any = false;
     loop {
         let available = match input.fill_buf() {
             Ok(b) => b,
+            Err(e) if e.kind() == ErrorKind::Interrupted && stop() => return Ok(None),
             Err(e) if e.kind() == ErrorKind::Interrupted => continue,
             Err(e) => return Err(e),
         };
@@ -77,15 +90,27 @@ impl Server {
     /// most [`crate::Limits::max_line_bytes`] of a line is kept.
     pub fn serve(
         &mut self,
+        input: impl BufRead,
+        output: impl Write,
+    ) -> Result<Summary, ServeError> {
+        self.serve_until(input, output, &|| false)
+    }
+
+    /// [`Server::serve`], which also ends cleanly once `stop()` holds: after the answer in
+    /// hand is written and flushed, or while it waits for a request when a signal interrupts
+    /// the read (the binary's SIGTERM handler sets what `stop` reads).
+    pub fn serve_until(
+        &mut self,
         mut input: impl BufRead,
         mut output: impl Write,
+        stop: &dyn Fn() -> bool,
     ) -> Result<Summary, ServeError> {
         let mut line = Vec::new();
         let mut answer = Vec::new();
         let mut summary = Summary::default();
         let max = self.limits().max_line_bytes;
         while let Some(read) =
-            read_bounded_line(&mut input, &mut line, max).map_err(ServeError::Read)?
+            read_line_until(&mut input, &mut line, max, stop).map_err(ServeError::Read)?
         {
             answer.clear();
             let ok = match read {
@@ -108,6 +133,9 @@ impl Server {
             output.flush().map_err(ServeError::Write)?;
             shrink(&mut line, max);
             shrink(&mut answer, max);
+            if stop() {
+                break;
+            }
         }
         Ok(summary)
     }

@@ -265,3 +265,54 @@ fn arrays_give_each_answer_the_beam_sweep_of_beams() {
         &["beam pairs", "100"],
     );
 }
+
+/// SIGTERM to `child`.
+fn terminate(child: &Child) {
+    let pid = libc::pid_t::try_from(child.id()).unwrap();
+    // SAFETY: kill with a child's pid and a standard signal.
+    assert_eq!(unsafe { libc::kill(pid, libc::SIGTERM) }, 0);
+}
+
+/// SIGTERM ends serve cleanly: while it waits for the next request on stdin (its answers so
+/// far written whole), between connections on a Unix socket (the socket it made removed),
+/// and in the middle of a connection.
+#[test]
+fn sigterm_closes_cleanly() {
+    let mut child = spawn(&["serve", "builtin:living-room", "--max-order", "1"]);
+    let mut stdin = child.stdin.take().unwrap();
+    stdin
+        .write_all(b"{\"id\": 7, \"rx\": [1, 1, 1]}\n")
+        .unwrap();
+    let mut out = BufReader::new(child.stdout.take().unwrap());
+    let mut first = String::new();
+    out.read_line(&mut first).unwrap();
+    assert_eq!(answers(&first)[0]["id"], 7);
+    terminate(&child); // stdin still open: serve waits for a request
+    let status = child.wait().unwrap();
+    assert!(status.success(), "{status:?}");
+    let mut rest = String::new();
+    out.read_to_string(&mut rest).unwrap();
+    assert_eq!(rest, "", "nothing after the whole answers");
+    drop(stdin);
+
+    let dir = scratch("serve-sigterm");
+    let socket = dir.join("s.sock");
+    let (mut child, _) = start(&format!("unix:{}", socket.display()));
+    assert!(socket.exists());
+    terminate(&child);
+    assert!(child.wait().unwrap().success());
+    assert!(!socket.exists(), "the server's own socket is removed");
+
+    let (mut child, _) = start(&format!("unix:{}", socket.display()));
+    let mut stream = std::os::unix::net::UnixStream::connect(&socket).unwrap();
+    stream
+        .write_all(b"{\"id\": 1, \"rx\": [1, 1, 1]}\n")
+        .unwrap();
+    let mut line = String::new();
+    BufReader::new(&stream).read_line(&mut line).unwrap();
+    assert_eq!(answers(&line)[0]["id"], 1);
+    terminate(&child); // the connection stays open: serve waits on it
+    assert!(child.wait().unwrap().success());
+    assert!(!socket.exists());
+    std::fs::remove_dir_all(dir).ok();
+}
