@@ -464,7 +464,9 @@ impl Around {
                 hn.surface
             },
             t0,
-            n: gap / PI,
+            // A free edge's gap is a whole turn; rounding may make it a hair more (two
+            // coplanar faces on one side of the edge): n stays in UTD's [1, 2].
+            n: (gap / PI).min(2.0),
             tn: face_direction(e, t0, gap),
             touching,
         })
