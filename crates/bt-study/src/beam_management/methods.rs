@@ -104,15 +104,15 @@ pub struct KeepPrevious {
 impl KeepPrevious {
     /// The decision at this measurement.
     pub fn decide(&mut self, m: &Measurement<'_>, drop_db: Real) -> Decision {
-        if let Some((pair, reference)) = self.kept {
-            if m.narrow(pair) >= reference - drop_db {
-                return Decision {
-                    chosen: pair,
-                    predicted: pair,
-                    candidates: vec![pair],
-                    measured: 1,
-                };
-            }
+        if let Some((pair, reference)) = self.kept
+            && m.narrow(pair) >= reference - drop_db
+        {
+            return Decision {
+                chosen: pair,
+                predicted: pair,
+                candidates: vec![pair],
+                measured: 1,
+            };
         }
         let mut d = exhaustive(m);
         // The faded pair's own measurement came first.

@@ -331,38 +331,12 @@ fn run_scenario(
     let n = scenario.trajectory.len();
     let (truth, mut notes) = truth(scenario, config, &radio, tick)?;
     let draws = draws(config, index, &radio, n);
-    let measurement = |i: usize| Measurement {
-        truth: &truth.narrow[i],
-        error_db: &draws.narrow_error_db[i],
-        wide_truth: &truth.wide[i],
-        wide_error_db: &draws.wide_error_db[i],
+    let measure = Measure {
+        truth: &truth,
+        draws: &draws,
         step_db: config.rsrp_step_db,
     };
-    let groups = radio.wide_groups();
-    let mut keep = KeepPrevious::default();
-    let baselines: [(&str, Box<dyn FnMut(usize) -> Decision + '_>); 3] = [
-        (
-            "exhaustive",
-            Box::new(|i| methods::exhaustive(&measurement(i))),
-        ),
-        (
-            "hierarchical",
-            Box::new(|i| methods::hierarchical(&measurement(i), &groups)),
-        ),
-        (
-            "keep-previous",
-            Box::new(|i| keep.decide(&measurement(i), config.retrack_drop_db)),
-        ),
-    ];
-    let mut methods = Vec::new();
-    for (name, mut decide) in baselines {
-        let mut timed = |i: usize| {
-            let start = Instant::now();
-            let d = decide(i);
-            (d, start.elapsed().as_secs_f64())
-        };
-        methods.push(score(name, name, None, &truth.narrow, 0, &mut timed));
-    }
+    let mut methods = baselines(&measure, &radio, config);
     let twins = twins::rankings(scenario, config, &radio, &draws.position, tick)?;
     for twin in &twins {
         for &k in &config.top_k {
@@ -374,19 +348,19 @@ fn run_scenario(
             );
             let mut timed = |i: usize| {
                 let start = Instant::now();
-                let d = methods::twin_top_k(&measurement(i), &twin.rankings[i], k);
+                let d = methods::twin_top_k(&measure.at(i), &twin.rankings[i], k);
                 (d, twin.compute_s[i] + start.elapsed().as_secs_f64())
             };
-            let mut m = score(
+            let twin_of = Some((twin.sigma_m, twin.latency_s, k));
+            let (family, fallbacks) = (&twin.family, twin.fallbacks);
+            methods.push(score(
                 &name,
-                &twin.family,
-                None,
+                family,
+                twin_of,
                 &truth.narrow,
-                twin.fallbacks,
+                fallbacks,
                 &mut timed,
-            );
-            m.twin = Some((twin.sigma_m, twin.latency_s, k));
-            methods.push(m);
+            ));
         }
     }
     notes.extend(scenario.notes.iter().cloned());
@@ -409,6 +383,67 @@ fn run_scenario(
         notes,
         methods,
     })
+}
+
+/// What the methods measure at each decision.
+struct Measure<'a> {
+    truth: &'a Truth,
+    draws: &'a Draws,
+    step_db: Real,
+}
+
+impl Measure<'_> {
+    fn at(&self, i: usize) -> Measurement<'_> {
+        Measurement {
+            truth: &self.truth.narrow[i],
+            error_db: &self.draws.narrow_error_db[i],
+            wide_truth: &self.truth.wide[i],
+            wide_error_db: &self.draws.wide_error_db[i],
+            step_db: self.step_db,
+        }
+    }
+}
+
+/// The sweeps without a twin: exhaustive, hierarchical, keep-previous.
+fn baselines(
+    measure: &Measure<'_>,
+    radio: &Radio,
+    config: &BeamManagementConfig,
+) -> Vec<MethodResult> {
+    let groups = radio.wide_groups();
+    let mut keep = KeepPrevious::default();
+    type Decide<'a> = Box<dyn FnMut(usize) -> Decision + 'a>;
+    let baselines: [(&str, Decide<'_>); 3] = [
+        (
+            "exhaustive",
+            Box::new(|i| methods::exhaustive(&measure.at(i))),
+        ),
+        (
+            "hierarchical",
+            Box::new(|i| methods::hierarchical(&measure.at(i), &groups)),
+        ),
+        (
+            "keep-previous",
+            Box::new(|i| keep.decide(&measure.at(i), config.retrack_drop_db)),
+        ),
+    ];
+    let mut methods = Vec::new();
+    for (name, mut decide) in baselines {
+        let mut timed = |i: usize| {
+            let start = Instant::now();
+            let d = decide(i);
+            (d, start.elapsed().as_secs_f64())
+        };
+        methods.push(score(
+            name,
+            name,
+            None,
+            &measure.truth.narrow,
+            0,
+            &mut timed,
+        ));
+    }
+    methods
 }
 
 /// Decide at every decision with `decide` (the decision and its computing time, s) and score

@@ -10,6 +10,7 @@ use plotters::prelude::*;
 /// Largest SNR loss drawn in the CDF, dB (larger losses sit at the right edge).
 const LOSS_AXIS_DB: Real = 30.0;
 
+/// One colour per method family, in the order of [`FAMILIES`].
 const PALETTE: [RGBColor; 8] = [
     RGBColor(31, 119, 180),
     RGBColor(255, 127, 14),
@@ -20,6 +21,25 @@ const PALETTE: [RGBColor; 8] = [
     RGBColor(227, 119, 194),
     RGBColor(127, 127, 127),
 ];
+
+/// The families coloured by [`PALETTE`] (another family gets its last colour).
+const FAMILIES: [&str; 7] = [
+    "exhaustive",
+    "hierarchical",
+    "keep-previous",
+    "twin-exact",
+    "twin-stale",
+    "twin-extracted",
+    "geometric-los",
+];
+
+fn colour(family: &str) -> RGBColor {
+    let i = FAMILIES.iter().position(|f| *f == family);
+    PALETTE[i.unwrap_or(PALETTE.len() - 1)]
+}
+
+/// Lowest fraction drawn in the CDF (every method is right more often than this here).
+const CDF_FLOOR: Real = 0.5;
 
 /// The twins drawn: the smallest non-zero position error (else the first) at the first
 /// latency of the settings.
@@ -84,9 +104,8 @@ pub fn accuracy_vs_overhead<DB: DrawingBackend>(
         )
         .draw()
         .map_err(fail)?;
-        let mut colour = PALETTE.iter().cycle();
         for m in s.methods.iter().filter(|m| m.twin.is_none()) {
-            let c = *colour.next().unwrap_or(&PALETTE[0]);
+            let c = colour(&m.family);
             let p = (m.metrics.beams_measured.max(0.5), m.metrics.top1);
             let q = (p.0, m.metrics.top1_1db);
             chart
@@ -99,7 +118,7 @@ pub fn accuracy_vs_overhead<DB: DrawingBackend>(
                 .map_err(fail)?;
         }
         for family in families(s) {
-            let c = *colour.next().unwrap_or(&PALETTE[0]);
+            let c = colour(family);
             let line = twin_series(s, family, variant);
             let pts = |f: fn(&MethodResult) -> Real| -> Vec<(Real, Real)> {
                 line.iter()
@@ -125,8 +144,9 @@ pub fn accuracy_vs_overhead<DB: DrawingBackend>(
     Ok(())
 }
 
-/// The empirical CDF of the SNR loss (dB, losses above [`LOSS_AXIS_DB`] at the edge) of the
-/// baselines and of each twin at K = 1 and the largest K.
+/// The empirical CDF of the SNR loss (dB, losses above [`LOSS_AXIS_DB`] at the edge, fractions
+/// from [`CDF_FLOOR`]) of the baselines and of each twin at K = 1 (thin) and the largest K
+/// (thick), one colour per family.
 pub fn snr_loss_cdf<DB: DrawingBackend>(
     root: &DrawingArea<DB, Shift>,
     results: &BeamManagementResults,
@@ -147,7 +167,7 @@ pub fn snr_loss_cdf<DB: DrawingBackend>(
             .margin(12)
             .x_label_area_size(45)
             .y_label_area_size(60)
-            .build_cartesian_2d(0.0..LOSS_AXIS_DB, 0.0..1.02)
+            .build_cartesian_2d(0.0..LOSS_AXIS_DB, CDF_FLOOR..1.01)
             .map_err(fail)?;
         mesh(
             &mut chart,
@@ -167,8 +187,8 @@ pub fn snr_loss_cdf<DB: DrawingBackend>(
                     .filter(|m| m.twin.is_some_and(|t| t.2 == 1 || t.2 == k_max)),
             );
         }
-        for (m, c) in drawn.into_iter().zip(PALETTE.iter().cycle()) {
-            let c = *c;
+        for m in drawn {
+            let c = colour(&m.family);
             let mut loss: Vec<Real> = m
                 .outcomes
                 .iter()
