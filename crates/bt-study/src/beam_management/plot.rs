@@ -8,7 +8,7 @@ use plotters::coord::Shift;
 use plotters::prelude::*;
 
 /// Largest SNR loss drawn in the CDF, dB (larger losses sit at the right edge).
-const LOSS_AXIS_DB: Real = 30.0;
+pub const LOSS_AXIS_DB: Real = 30.0;
 
 /// One colour per method family, in the order of [`FAMILIES`].
 const PALETTE: [RGBColor; 8] = [
@@ -39,7 +39,7 @@ fn colour(family: &str) -> RGBColor {
 }
 
 /// Lowest fraction drawn in the CDF (every method is right more often than this here).
-const CDF_FLOOR: Real = 0.5;
+pub const CDF_FLOOR: Real = 0.5;
 
 /// The twins drawn: the smallest non-zero position error (else the first) at the first
 /// latency of the settings.

@@ -60,7 +60,7 @@ pub const BOUNDS_MARGIN_M: Real = 0.05;
 /// The built-in living room's loop: centre (x, y), semi-axes (x, y) and height, metres; the UE
 /// starts at angle 0 and walks it once counter-clockwise, about 10.2 m (a walker at 1 m/s with
 /// 10 ms between decisions), never nearer than 1.1 m to the walking person.
-const LOOP: ([Real; 2], [Real; 2], Real) = ([3.0, 2.25], [1.9, 1.3], 1.2);
+pub const LOOP: ([Real; 2], [Real; 2], Real) = ([3.0, 2.25], [1.9, 1.3], 1.2);
 
 /// Time between decisions of the living room (a 100 Hz beam report at walking speed), s.
 pub const ROOM_PERIOD_S: Real = 0.01;
