@@ -131,16 +131,16 @@ pub struct StudyBeamManagementArgs {
     #[arg(long)]
     pub twin_diffraction: bool,
     /// Standard deviation of the L1-RSRP measurement error, dB.
-    #[arg(long, default_value_t = 1.0, value_parser = numbers::non_negative)]
+    #[arg(long, default_value_t = 1.0, value_parser = numbers::decibels)]
     pub rsrp_noise_db: f64,
     /// L1-RSRP reporting step, dB (3GPP: 1; 0 reports exact values).
-    #[arg(long, default_value_t = 1.0, value_parser = numbers::non_negative)]
+    #[arg(long, default_value_t = 1.0, value_parser = numbers::decibels)]
     pub rsrp_step_db: f64,
     /// The twins' UE position errors σ (horizontal, per axis), metres, comma-separated.
-    #[arg(long, value_delimiter = ',', default_values_t = [0.0, 0.05, 0.3, 1.0], value_parser = numbers::non_negative)]
+    #[arg(long, value_delimiter = ',', default_values_t = [0.0, 0.05, 0.3, 1.0], value_parser = numbers::length_m)]
     pub position_sigmas: Vec<f64>,
     /// The twins' reporting latencies, milliseconds, comma-separated.
-    #[arg(long, value_delimiter = ',', default_values_t = [0.0, 100.0], value_parser = numbers::non_negative)]
+    #[arg(long, value_delimiter = ',', default_values_t = [0.0, 100.0], value_parser = numbers::milliseconds)]
     pub latencies_ms: Vec<f64>,
     /// The K of the twin top-K methods, comma-separated.
     #[arg(long, value_delimiter = ',', default_values_t = [1, 2, 4, 8])]
@@ -149,10 +149,10 @@ pub struct StudyBeamManagementArgs {
     #[arg(long, default_value_t = -6.0, value_parser = numbers::power_dbm, allow_hyphen_values = true)]
     pub tx_power_dbm: f64,
     /// Points per m² of the scan behind the extracted twin (0: no extracted twin).
-    #[arg(long, default_value_t = 2000.0, value_parser = numbers::non_negative)]
+    #[arg(long, default_value_t = 2000.0, value_parser = numbers::scan_density)]
     pub scan_density: f64,
     /// Range noise of the scan, metres.
-    #[arg(long, default_value_t = 0.005, value_parser = numbers::non_negative)]
+    #[arg(long, default_value_t = 0.005, value_parser = numbers::length_m)]
     pub scan_noise: f64,
     /// Budget: no extracted twin from a scan of more points than this.
     #[arg(long, default_value_t = 5_000_000)]
