@@ -159,10 +159,10 @@ pub fn run_beam_management(args: &StudyBeamManagementArgs) -> anyhow::Result<Exi
         scenarios.push(scenario);
         inputs.extend(sources);
     }
-    let bar = crate::progress::counter(0, "traces");
-    let results = beam_management::run(&scenarios, &config, &mut |done, total| {
-        bar.set_length(total as u64);
-        bar.set_position(done as u64);
+    let total = beam_management::planned_traces(&scenarios, &config);
+    let bar = crate::progress::counter(total as u64, "traces");
+    let results = beam_management::run(&scenarios, &config, &mut |done, _| {
+        bar.set_position(done as u64)
     })?;
     bar.finish_and_clear();
     let done = bt_study::io::write_beam_management(&args.out, &results, &inputs)?;

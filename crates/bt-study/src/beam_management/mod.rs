@@ -284,6 +284,16 @@ fn draws(config: &BeamManagementConfig, scenario: usize, radio: &Radio, n: usize
     }
 }
 
+/// The traces [`run`] makes over `scenarios` (the length of its progress).
+pub fn planned_traces(scenarios: &[Scenario], config: &BeamManagementConfig) -> usize {
+    let variants = config.position_sigmas_m.len() * config.latencies_s.len();
+    let per_scenario = |s: &Scenario| {
+        let twins = 1 + usize::from(s.stale.is_some()) + usize::from(s.extracted.is_some());
+        s.trajectory.len() * (1 + twins * variants)
+    };
+    scenarios.iter().map(per_scenario).sum()
+}
+
 /// Run the study over `scenarios`, reporting `progress(done, total)` in traces.
 pub fn run(
     scenarios: &[Scenario],
@@ -291,12 +301,7 @@ pub fn run(
     progress: &mut dyn FnMut(usize, usize),
 ) -> Result<BeamManagementResults, StudyError> {
     StudyError::check_settings(config.problems())?;
-    let variants = config.position_sigmas_m.len() * config.latencies_s.len();
-    let per_scenario = |s: &Scenario| {
-        let twins = 1 + usize::from(s.stale.is_some()) + usize::from(s.extracted.is_some());
-        s.trajectory.len() * (1 + twins * variants)
-    };
-    let total = scenarios.iter().map(per_scenario).sum();
+    let total = planned_traces(scenarios, config);
     let mut done = 0;
     let mut results = Vec::new();
     for (index, scenario) in scenarios.iter().enumerate() {

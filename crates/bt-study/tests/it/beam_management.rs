@@ -170,3 +170,40 @@ fn bad_settings_name_their_options() {
         assert!(e.contains(option), "{option} in {e}");
     }
 }
+
+#[test]
+fn the_extracted_twin_is_scanned_from_the_empty_room() {
+    // The default scan (2,000 points/m², 5 mm noise): every extracted plane lies on a surface
+    // of the stale room (its centroid within 2 cm of that surface's plane and over it, 10 cm
+    // of slack for the traced boundary), so none comes from the walking person.
+    let options = bt_import::LoadOptions::default();
+    let loaded = bt_import::load_dynamic("builtin:living-room-dynamic", &options, &mut |_| {})
+        .expect("built-in scene");
+    let scan = BeamManagementConfig::default().scan;
+    let scenario = Scenario::living_room("living-room", loaded.scene, 4, &scan).expect("scenario");
+    let stale = scenario.stale.as_ref().expect("stale twin");
+    let extracted = scenario.extracted.as_ref().expect("extracted twin");
+    assert!(
+        (15..=60).contains(&extracted.surfaces().len()),
+        "{} planes",
+        extracted.surfaces().len()
+    );
+    for plane in extracted.surfaces() {
+        let c = extracted.to_world(plane.polygon.centroid());
+        let on = stale.surfaces().iter().any(|s| {
+            let local = stale.to_local(c);
+            s.polygon.plane().signed_distance(local).abs() < 0.02 && s.polygon.contains(local, 0.1)
+        });
+        assert!(
+            on,
+            "{} at {c} lies on no surface of the empty room",
+            plane.name
+        );
+    }
+    assert!(
+        scenario
+            .notes
+            .iter()
+            .any(|n| n.contains("every plane concrete"))
+    );
+}
