@@ -194,27 +194,11 @@ pub fn run_beam_management(args: &StudyBeamManagementArgs) -> anyhow::Result<Exi
 fn beam_management_scenario(
     name: &str,
     config: &BeamManagementConfig,
-) -> anyhow::Result<(beam_management::scenario::Scenario, Vec<PathBuf>)> {
-    let source = match name {
-        "living-room" => "builtin:living-room-dynamic",
-        "city" => "builtin:city",
-        file => file,
-    };
+) -> anyhow::Result<(Scenario, Vec<PathBuf>)> {
+    let source = beam_management::scenario::source_of(name);
     let loaded = crate::load::load_dynamic(&SceneArgs::defaults_for(source))
         .with_context(|| format!("--scenario {name}"))?;
-    let label = match name {
-        "living-room" | "city" => name.to_string(),
-        file => std::path::Path::new(file)
-            .file_stem()
-            .and_then(|s| s.to_str())
-            .unwrap_or("scene")
-            .to_string(),
-    };
-    let build = match name {
-        "living-room" => Scenario::living_room,
-        _ => Scenario::street,
-    };
-    let scenario = build(&label, loaded.scene, config.positions, &config.scan)
+    let scenario = Scenario::named(name, loaded.scene, config.positions, &config.scan)
         .with_context(|| format!("--scenario {name}"))?;
     Ok((scenario, loaded.sources))
 }

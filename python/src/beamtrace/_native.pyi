@@ -67,3 +67,11 @@ def load(
     thickness: Optional[float] = None,
 ) -> Scene: ...
 def builtin_names() -> List[str]: ...
+def study_beam_management(
+    out: str,
+    *,
+    scenarios: Optional[List[str]] = None,
+    seed: int = 1,
+    positions: int = 1000,
+    scan_density: float = 2000.0,
+) -> str: ...

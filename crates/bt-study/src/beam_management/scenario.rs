@@ -84,7 +84,39 @@ fn centroid(points: &[Vec3]) -> Vec3 {
     points.iter().fold(Vec3::ZERO, |a, p| a + *p) / points.len().max(1) as Real
 }
 
+/// The scene a scenario name loads: `living-room` the built-in dynamic living room, `city`
+/// the built-in city, anything else a scene file.
+pub fn source_of(name: &str) -> &str {
+    match name {
+        "living-room" => "builtin:living-room-dynamic",
+        "city" => "builtin:city",
+        file => file,
+    }
+}
+
 impl Scenario {
+    /// The scenario `name` (see [`source_of`]) over `truth`, the scene loaded from its source:
+    /// the living room's loop for `living-room`, a street otherwise; a file's scenario is named
+    /// after its stem.
+    pub fn named(
+        name: &str,
+        truth: DynamicScene,
+        positions: usize,
+        scan: &ScanSettings,
+    ) -> Result<Scenario, StudyError> {
+        let label = match name {
+            "living-room" | "city" => name,
+            file => std::path::Path::new(file)
+                .file_stem()
+                .and_then(|s| s.to_str())
+                .unwrap_or("scene"),
+        };
+        match name {
+            "living-room" => Self::living_room(label, truth, positions, scan),
+            _ => Self::street(label, truth, positions, scan),
+        }
+    }
+
     /// The dynamic living room (`builtin:living-room-dynamic` or a scene like it): the AP at
     /// the scene's TX, the UE walking [`LOOP`] in `positions` decisions while the scene's
     /// objects move through all their steps.
