@@ -31,9 +31,10 @@ PY_TIMEOUT_S = 600
 
 
 def blocks(text, lang):
-    """(heading, body) of every fenced block of `lang`, with the `##` heading above it."""
+    """(heading, body) of every fenced block of `lang`, with the `##` (or `###`) heading above
+    it."""
     heading, out = "", []
-    for m in re.finditer(r"^(## [^\n]*)$|^```" + lang + r"\n(.*?)^```$", text, re.M | re.S):
+    for m in re.finditer(r"^(###? [^\n]*)$|^```" + lang + r"\n(.*?)^```$", text, re.M | re.S):
         if m.group(1):
             heading = m.group(1)
         else:
@@ -107,11 +108,14 @@ def main():
             if run_sh(body) != 0:
                 failures.append("the quick tour stopped at the line echoed last")
     if args.only in (None, "python"):
-        for k, (heading, body) in enumerate(blocks(text, "python")):
-            print(f"+ python block {k + 1} ({heading})", file=sys.stderr)
-            problem = run_python(body, args.python)
-            if problem:
-                failures.append(f"python block {k + 1} under {heading!r}: {problem}")
+        # The top README's Python blocks, then the API page's (python/README.md).
+        for readme in (ROOT / "README.md", ROOT / "python" / "README.md"):
+            name = readme.relative_to(ROOT)
+            for k, (heading, body) in enumerate(blocks(readme.read_text(), "python")):
+                print(f"+ {name}: python block {k + 1} ({heading})", file=sys.stderr)
+                problem = run_python(body, args.python)
+                if problem:
+                    failures.append(f"{name}: python block {k + 1} under {heading!r}: {problem}")
     after = checkout_state()
     if after != before:
         changed = sorted(set(after) ^ set(before))

@@ -228,6 +228,22 @@ CASES = [
         ),
     ),
     dict(
+        name="canyon-refraction-d2",
+        scene="simple_street_canyon",
+        tx=[-45.0, 0.0, 10.0],
+        rx=[[23.5, 25.0, 1.5], [-23.0, -25.0, 1.5], [30.0, 0.0, 1.5]],
+        max_depth=2,
+        refraction=True,
+        diffraction=False,
+        why=(
+            "canyon-d3's positions with refraction (Sionna's thin-slab transmission: every "
+            "material of the scene is an ITU slab 0.1 m thick) and no diffraction: the "
+            "receivers round the corners are reached through buildings' walls (two "
+            "crossings, or one crossing and a reflection), the one down the street also by "
+            "LoS and reflections. beamtrace's `--transmission` is compared with it."
+        ),
+    ),
+    dict(
         name="florence-mast-d3",
         scene="florence",
         tx_above_ground=[5.0, -55.0, 60.0],
@@ -355,9 +371,9 @@ def solve(scene, case, solver):
         los=True,
         specular_reflection=True,
         diffuse_reflection=False,
-        refraction=False,
-        diffraction=True,
-        edge_diffraction=True,
+        refraction=case.get("refraction", False),
+        diffraction=case.get("diffraction", True),
+        edge_diffraction=case.get("diffraction", True),
         diffraction_lit_region=True,
         seed=SEED,
     )
@@ -551,9 +567,9 @@ def run_case(case, timing=True):
             "los": True,
             "specular_reflection": True,
             "diffuse_reflection": False,
-            "refraction": False,
-            "diffraction": True,
-            "edge_diffraction": True,
+            "refraction": case.get("refraction", False),
+            "diffraction": case.get("diffraction", True),
+            "edge_diffraction": case.get("diffraction", True),
             "diffraction_lit_region": True,
             "seed": SEED,
             "antenna": 'PlanarArray(num_rows=1, num_cols=1, pattern="iso", polarization="V") at TX and RX',

@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 
 import beamtrace
-from conftest import TESTDATA, vec
+from conftest import REPO, TESTDATA, vec
 
 
 def assert_same_as_cli(paths: beamtrace.Paths, doc: dict) -> None:
@@ -28,7 +28,8 @@ def assert_same_as_cli(paths: beamtrace.Paths, doc: dict) -> None:
                 e[key]["elevation"],
             ]
         assert paths.incidence_deg[i].tolist() == e["incidence_deg"]
-        for key in ("free_space_loss_db", "reflection_loss_db", "loss_db"):
+        assert paths.interactions[i] == e["interactions"]
+        for key in ("free_space_loss_db", "reflection_loss_db", "transmission_loss_db", "loss_db"):
             assert paths.to_dict()[key][i] == e[key]
         assert paths.gain[i] == complex(e["gain"][0], e["gain"][1])
         for key in ("gain_db", "power_dbm"):
@@ -111,6 +112,27 @@ def test_diffraction_coefficient_matches_cli(cli_json):
     assert many[0].gain.tolist() == sionna.gain.tolist()
 
 
+def test_transmission_matches_cli(cli_json):
+    # Through the partition (plasterboard) with transmission=True, as `--transmission`; the
+    # curtain's material opens it either way.
+    two_rooms = str(REPO / "examples" / "two-rooms.json")
+    scene = beamtrace.load(two_rooms)
+    through = scene.trace(max_order=3, transmission=True)
+    assert_same_as_cli(through, cli_json(two_rooms, "--max-order", "3", "--transmission"))
+    crossed = {s for kinds, names in zip(through.interactions, through.surfaces)
+               for k, s in zip(kinds, names) if k == "transmission"}
+    assert {"partition", "curtain"} <= crossed
+    assert through.transmission_loss_db.max() > 0
+    plain = scene.trace(max_order=3)
+    assert_same_as_cli(plain, cli_json(two_rooms, "--max-order", "3"))
+    assert len(plain) < len(through)
+    many = scene.trace_many(scene.tx, np.array([scene.rx]), max_order=3, transmission=True)
+    assert many[0].gain.tolist() == through.gain.tolist()
+    tracer = beamtrace.Tracer(two_rooms, max_order=3, transmission=True)
+    answer = tracer.update(rx=list(scene.rx))
+    assert [p["gain"] for p in answer["paths"]] == [[g.real, g.imag] for g in through.gain]
+
+
 def test_scene_properties():
     scene = beamtrace.load("builtin:living-room")
     assert scene.name == "living-room"
@@ -191,3 +213,18 @@ def test_ipc_and_sbr_settings_match_cli(cli, cli_json):
     assert done.returncode != 0 and str(info.value) in done.stderr
     with pytest.raises(ValueError, match="ipc-threshold|ipc_threshold"):
         scene.trace(solver="ipc", ipc_threshold=-1.0)
+
+
+def test_point_cloud_matches_cli(cli, cli_json, tmp_path):
+    # A PCD scan of the living room (the CLI's `sample`), its planes extracted on load as the
+    # CLI's trace extracts them: the same paths. The cloud budget is checked before reading.
+    cloud = tmp_path / "room.pcd"
+    done = cli("sample", "builtin:living-room", "-o", str(cloud), "--noise", "0.005",
+               "--density", "300")
+    assert done.returncode == 0, done.stderr
+    tx, rx = [5.6, 0.6, 2.2], [2.3, 2.1, 0.72]
+    scene = beamtrace.load(cloud, tx=tx, rx=rx)
+    assert_same_as_cli(scene.trace(max_order=2),
+                       cli_json(str(cloud), "--tx", vec(tx), "--rx", vec(rx), "--max-order", "2"))
+    with pytest.raises(beamtrace.BeamtraceError, match="max-cloud-points"):
+        beamtrace.load(cloud, max_cloud_points=100)

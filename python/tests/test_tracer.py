@@ -97,3 +97,22 @@ def test_bad_arguments_are_value_errors():
         tracer.update(rx=[1.0, 2.0])
     with pytest.raises(ValueError, match="finite"):
         tracer.update(rx=[1.0, float("nan"), 1.0])
+
+
+def test_arrays_give_each_answer_serves_beams(cli):
+    # Tracer(tx_array=, rx_array=) answers with serve --tx-array/--rx-array's "beams": the
+    # sweep of `beamtrace beams` for that receiver, its best pair and the first `top`.
+    tracer = beamtrace.Tracer("builtin:living-room", tx_array=(2, 4), rx_array=(1, 4),
+                              ranking="paper", top=3)
+    answer = tracer.update(rx=[2.3, 2.1, 0.72])
+    done = cli("beams", "builtin:living-room", "--rx", "2.3,2.1,0.72", "--tx-array", "2x4",
+               "--rx-array", "1x4", "--ranking", "paper", "--json")
+    assert done.returncode == 0, done.stderr
+    pairs = json.loads(done.stdout)["pairs"]
+    assert answer["beams"]["top"] == pairs[:3]
+    assert answer["beams"]["best"] == pairs[0]
+    assert "beams" not in beamtrace.Tracer("builtin:living-room").update(rx=[1, 1, 1.2])
+    with pytest.raises(ValueError, match="ranking must be one of"):
+        beamtrace.Tracer("builtin:living-room", tx_array=(1, 4), ranking="best")
+    with pytest.raises(ValueError, match="max_beam_pairs"):
+        beamtrace.Tracer("builtin:living-room", tx_array=(8, 8), rx_array=(8, 8), max_beam_pairs=10)

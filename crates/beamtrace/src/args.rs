@@ -505,6 +505,13 @@ pub struct ServeArgs {
     #[arg(long, default_value_t = bt_serve::MAX_RECEIVERS as u64,
           value_parser = clap::value_parser!(u64).range(1..=1 << 20))]
     pub max_receivers: u64,
+    /// With --tx-array or --rx-array (the other one 1x8), every answer holds a "beams" object:
+    /// the beam sweep of `beams` over its paths, its best pair and the first --top pairs.
+    #[command(flatten)]
+    pub arrays: ArrayArgs,
+    /// Pairs of the ranking in each answer's "beams".
+    #[arg(long, default_value_t = 5)]
+    pub top: usize,
 }
 
 /// The transport of `serve --listen`.
@@ -594,6 +601,11 @@ pub struct SolveArgs {
     /// Edges shorter than this (metres) do not diffract.
     #[arg(long, default_value_t = 0.0, value_parser = numbers::length_m)]
     pub min_edge_length: f64,
+    /// Transmission: waves also cross every reflector whose material is a slab (ITU-R P.2040
+    /// thin slab, no deflection; each crossing counts in --max-order). Half-spaces stay
+    /// opaque; a material's "transmission": true does the same for that material alone.
+    #[arg(long)]
+    pub transmission: bool,
 }
 
 #[derive(Debug, Args, Clone)]
@@ -710,6 +722,7 @@ impl SolveArgs {
             max_candidates: self.max_candidates,
             max_wvrn_tests: self.max_wvrn_tests,
             parallel: !self.single_thread,
+            transmission: self.transmission,
             diffraction: bt_solve::pipeline::DiffractionOptions {
                 max_diffractions: self
                     .max_diffractions
@@ -800,6 +813,9 @@ pub struct PathArgs {
     /// Edge diffraction: paths may diffract once (as `trace --diffraction`).
     #[arg(long)]
     pub diffraction: bool,
+    /// Transmission through slab reflectors (as `trace --transmission`).
+    #[arg(long)]
+    pub transmission: bool,
 }
 
 impl PathArgs {
@@ -810,6 +826,7 @@ impl PathArgs {
             radio: self.radio.clone(),
             solve: SolveArgs {
                 diffraction: self.diffraction,
+                transmission: self.transmission,
                 ..SolveArgs::with(self.max_order, self.solver)
             },
             json: false,
@@ -856,17 +873,16 @@ pub enum RankingArg {
     Paper,
 }
 
+/// The arrays of a beam sweep (`beams`; `serve` answers with one when an array is given).
 #[derive(Debug, Args, Clone)]
-pub struct BeamsArgs {
-    #[command(flatten)]
-    pub paths: PathArgs,
+pub struct ArrayArgs {
     /// TX array ROWSxCOLUMNS (1xN is a horizontal ULA), elements in the antenna's local y-z
-    /// plane, boresight along the antenna orientation.
-    #[arg(long, default_value = "1x8", value_parser = parse_array_shape)]
-    pub tx_array: (usize, usize),
-    /// RX array ROWSxCOLUMNS.
-    #[arg(long, default_value = "1x8", value_parser = parse_array_shape)]
-    pub rx_array: (usize, usize),
+    /// plane, boresight along the antenna orientation [beams: default 1x8].
+    #[arg(long, value_parser = parse_array_shape)]
+    pub tx_array: Option<(usize, usize)>,
+    /// RX array ROWSxCOLUMNS [beams: default 1x8].
+    #[arg(long, value_parser = parse_array_shape)]
+    pub rx_array: Option<(usize, usize)>,
     /// TX element spacing, wavelengths.
     #[arg(long, default_value_t = 0.5, value_parser = numbers::spacing_wavelengths)]
     pub tx_spacing: f64,
@@ -879,6 +895,17 @@ pub struct BeamsArgs {
     /// Budget: refuse a sweep of more beam pairs (TX beams × RX beams) than this.
     #[arg(long, default_value_t = bt_channel::MAX_BEAM_PAIRS.limit)]
     pub max_beam_pairs: u64,
+}
+
+/// The array shape `beams` sweeps when none is given.
+pub const DEFAULT_ARRAY: (usize, usize) = bt_serve::DEFAULT_ARRAY;
+
+#[derive(Debug, Args, Clone)]
+pub struct BeamsArgs {
+    #[command(flatten)]
+    pub paths: PathArgs,
+    #[command(flatten)]
+    pub arrays: ArrayArgs,
     /// Print this many pairs of the ranked list (the JSON holds them all).
     #[arg(long, default_value_t = 10)]
     pub top: usize,
@@ -922,6 +949,7 @@ impl SolveArgs {
             diffraction: false,
             max_diffractions: None,
             min_edge_length: 0.0,
+            transmission: false,
         }
     }
 }

@@ -1,6 +1,6 @@
 //! `beamtrace channel` (CIR, CFR, power-delay profile) and `beamtrace beams` (codebook sweep).
 
-use crate::args::{BeamsArgs, ChannelArgs, PathArgs, RankingArg};
+use crate::args::{ArrayArgs, BeamsArgs, ChannelArgs, DEFAULT_ARRAY, PathArgs, RankingArg};
 use crate::load::load_scene;
 use crate::trace::warn_near_field;
 use anyhow::Context;
@@ -25,7 +25,7 @@ fn traced_paths(
     let scene = loaded.scene;
     let (tx, rx) = crate::load::terminals(&scene, &args.scene)?;
     let trace_args = args.trace_args();
-    let options = trace_args.solve.settings().trace_options(&scene)?;
+    let options = crate::trace::options_for(&trace_args.solve, &scene)?;
     let traced = bt_solve::Tracer::new(scene.clone(), options).trace(tx, rx)?;
     let radio = radio.for_order(options.max_order);
     let paths = bt_beams::report(&scene, &traced.result.paths, &radio)?;
@@ -67,7 +67,7 @@ fn cir_csv(paths: &[PathReport], carrier_hz: f64) -> String {
             opt(p.power_dbm),
             bb.re,
             bb.im,
-            bt_output::csv::text_field(&bt_scene::name::path(&p.surfaces))
+            bt_output::csv::text_field(&p.route())
         );
     }
     out
@@ -214,36 +214,25 @@ impl ArrayDoc {
 
 pub fn run_beams(args: &BeamsArgs) -> anyhow::Result<ExitCode> {
     let radio = args.paths.radio.options()?;
-    let array = |(rows, columns): (usize, usize), spacing: f64, which: &str, o| {
-        bt_channel::Array::new(rows, columns, spacing, o)
-            .with_context(|| format!("--{which}-array"))
-    };
-    let tx = array(args.tx_array, args.tx_spacing, "tx", radio.tx.orientation)?;
-    let rx = array(args.rx_array, args.rx_spacing, "rx", radio.rx.orientation)?;
-    // The beam pairs follow from the arrays alone: refused before the scene is loaded or
-    // traced (the sweep checks them again, with the pairs × paths it depends on).
-    bt_channel::check_beam_pairs(&tx, &rx, args.max_beam_pairs)?;
+    let beams = beam_options(&args.arrays, &radio, args.top)?;
+    let (tx, rx) = (&beams.tx, &beams.rx);
     let (scene, paths, inputs) = traced_paths(&args.paths, &radio)?;
-    let ranking = match args.ranking {
-        RankingArg::Power => BeamRanking::Power,
-        RankingArg::Paper => BeamRanking::Paper,
-    };
     let sweep = bt_beams::sweep(
         &paths,
-        &tx,
-        &rx,
+        tx,
+        rx,
         scene.frequency_hz(),
         radio.tx_power_dbm,
-        ranking,
-        args.max_beam_pairs,
+        beams.ranking,
+        beams.max_pairs,
     )?;
     let doc = BeamsDocument {
         scene: scene.name(),
         frequency_hz: scene.frequency_hz(),
         tx_power_dbm: radio.tx_power_dbm,
         diffraction_coefficient: radio.diffraction_coefficient,
-        tx_array: ArrayDoc::of(&tx),
-        rx_array: ArrayDoc::of(&rx),
+        tx_array: ArrayDoc::of(tx),
+        rx_array: ArrayDoc::of(rx),
         paths: paths.len(),
         sweep: &sweep,
     };
@@ -257,6 +246,32 @@ pub fn run_beams(args: &BeamsArgs) -> anyhow::Result<ExitCode> {
         print_beams(&doc, args.top);
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The sweep `arrays` give (a missing array [`DEFAULT_ARRAY`]) with the antennas'
+/// orientations of `radio`, `top` pairs per `serve` answer; refused before any scene is loaded
+/// or traced when over its pair budget ([`bt_serve::BeamOptions::new`]).
+pub fn beam_options(
+    arrays: &ArrayArgs,
+    radio: &bt_beams::RadioOptions,
+    top: usize,
+) -> anyhow::Result<bt_serve::BeamOptions> {
+    let spec = |shape: Option<(usize, usize)>, spacing: f64| {
+        let (rows, columns) = shape.unwrap_or(DEFAULT_ARRAY);
+        Some((rows, columns, spacing))
+    };
+    let ranking = match arrays.ranking {
+        RankingArg::Power => BeamRanking::Power,
+        RankingArg::Paper => BeamRanking::Paper,
+    };
+    let specs = [
+        spec(arrays.tx_array, arrays.tx_spacing),
+        spec(arrays.rx_array, arrays.rx_spacing),
+    ];
+    let budget = (top, arrays.max_beam_pairs);
+    bt_serve::BeamOptions::new(specs, radio, ranking, budget).map_err(|(which, e)| {
+        anyhow::Error::new(e).context(format!("--{}", which.replace('_', "-")))
+    })
 }
 
 fn print_beams(doc: &BeamsDocument<'_>, top: usize) {

@@ -29,7 +29,7 @@ pub fn print_table(doc: &TraceDocument) {
         let names = if p.surfaces.is_empty() {
             "(line of sight)".to_string()
         } else {
-            bt_scene::name::path(&p.surfaces)
+            p.route()
         };
         println!(
             "{:>4} {:>3} {:>8.3} {:>8.3} {:>8.2} {:>7.2} {:>8.2} {:>7.2} {:>7.2} {:>8}  {}",

@@ -15,13 +15,17 @@ pub fn run(args: &ServeArgs) -> anyhow::Result<ExitCode> {
     for w in dynamic.step(0).warnings() {
         eprintln!("warning: {w}");
     }
-    let options = args.solve.settings().trace_options(dynamic.step(0))?;
+    let options = crate::trace::options_for(&args.solve, dynamic.step(0))?;
     let radio = args.radio.options()?;
     let limits = Limits {
         max_line_bytes: usize::try_from(args.max_line_bytes).context("--max-line-bytes")?,
         max_receivers: usize::try_from(args.max_receivers).context("--max-receivers")?,
     };
     let mut server = Server::new(dynamic, options, radio, limits);
+    if args.arrays.tx_array.is_some() || args.arrays.rx_array.is_some() {
+        let beams = crate::channel::beam_options(&args.arrays, &radio, args.top)?;
+        server = server.with_beams(beams);
+    }
     match &args.listen {
         None => {
             let input = std::io::stdin().lock();

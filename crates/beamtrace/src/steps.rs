@@ -14,7 +14,7 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
     let dynamic = &loaded.scene;
     crate::load::require_every_step(dynamic.scenes(), &args.scene)?;
     let scene0 = dynamic.step(0);
-    let options = args.solve.settings().trace_options(scene0)?;
+    let options = crate::trace::options_for(&args.solve, scene0)?;
     let incremental = !args.from_scratch;
     let radio = args.radio.options()?.for_order(options.max_order);
     let mut tracer = bt_solve::Tracer::new(scene0.clone(), options);
@@ -78,7 +78,7 @@ fn print_table(doc: &StepsDocument) {
                 let names = if p.surfaces.is_empty() {
                     "(line of sight)".to_string()
                 } else {
-                    bt_scene::name::path(&p.surfaces)
+                    p.route()
                 };
                 format!("loss {:.1} dB  {names}", p.loss_db)
             })

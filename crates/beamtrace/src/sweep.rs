@@ -19,7 +19,7 @@ pub fn run(args: &SweepArgs) -> anyhow::Result<ExitCode> {
     }
     let scene = loaded.scene;
     crate::load::require_terminals(&scene, &[bt_scene::Terminal::Tx], &args.scene)?;
-    let options = args.solve.settings().trace_options(&scene)?;
+    let options = crate::trace::options_for(&args.solve, &scene)?;
     // Every output checked before the work and the first write: a heat map that could not be
     // written leaves no CSV behind.
     let csv = args.out.join("coverage.csv");

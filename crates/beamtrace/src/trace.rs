@@ -23,7 +23,7 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
         eprintln!("warning: {w}");
     }
     let (tx, rx) = crate::load::terminals(&scene, &args.scene)?;
-    let options = args.solve.settings().trace_options(&scene)?;
+    let options = options_for(&args.solve, &scene)?;
     let t1 = Instant::now();
     let (bar, mut progress) = crate::progress::tree_progress();
     let mut tracer = bt_solve::Tracer::new(scene, options);
@@ -46,6 +46,19 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
         output::print_table(&doc);
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// The trace options `solve` gives for `scene`, their warnings (transmission's opaque
+/// materials) printed to stderr: every command that traces takes its options here.
+pub fn options_for(
+    solve: &crate::args::SolveArgs,
+    scene: &Scene,
+) -> anyhow::Result<bt_solve::pipeline::TraceOptions> {
+    let options = solve.settings().trace_options(scene)?;
+    for w in options.warnings(scene) {
+        eprintln!("warning: {w}");
+    }
+    Ok(options)
 }
 
 /// Friis needs the far field: say so when a path is shorter than a wavelength (its loss is

@@ -24,7 +24,7 @@ pub fn run(args: &ViewArgs) -> anyhow::Result<ExitCode> {
             paths
         }
         None => {
-            let options = args.solve.settings().trace_options(scenes[0])?;
+            let options = crate::trace::options_for(&args.solve, scenes[0])?;
             let mut tracer = bt_solve::Tracer::new(scenes[0].clone(), options);
             let mut steps = Vec::with_capacity(scenes.len());
             for scene in &scenes {

@@ -17,7 +17,7 @@ use serde::{Deserialize, Serialize};
 use std::time::{Duration, Instant};
 
 /// Version of the documents' layout; bump on any incompatible change.
-pub const FORMAT_VERSION: u32 = 3;
+pub const FORMAT_VERSION: u32 = 4;
 
 /// The document of one trace (`beamtrace trace --json`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
@@ -36,6 +36,11 @@ pub struct TraceDocument {
     pub max_order: usize,
     /// The solver and its options.
     pub solver: Solver,
+    /// Transmission switched on for every slab reflector (`--transmission`; a material's
+    /// `"transmission": true` opens its surfaces either way). Read as `false` from a document
+    /// written before the field existed.
+    #[serde(default)]
+    pub transmission: bool,
     /// Antennas and transmitted power of the gains.
     pub radio: Radio,
     /// The valid paths, ranked.
@@ -113,6 +118,7 @@ impl TraceDocument {
             frequency_hz: scene.frequency_hz(),
             max_order: options.max_order,
             solver: options.solver,
+            transmission: options.transmission,
             radio: Radio {
                 tx_antenna: radio.tx,
                 rx_antenna: radio.rx,

@@ -24,6 +24,10 @@ pub(crate) fn path_gain(
                 normal: scene.surface(id).polygon.plane().normal,
                 response: surface_response(scene, id),
             }),
+            Interaction::Transmission(id) => bt_channel::Interaction::Transmission(Bounce {
+                normal: scene.surface(id).polygon.plane().normal,
+                response: surface_response(scene, id),
+            }),
             Interaction::Diffraction(e) => {
                 let edge = scene.edges().get(e);
                 // The exterior lies from t0 towards e × t0: face 0's free-space side.
@@ -60,4 +64,35 @@ pub(crate) fn path_gain(
         )?,
     };
     Ok((g.gain, g.diffraction_loss_db))
+}
+
+/// The loss of a path's crossings, dB ([`crate::PathReport::transmission_loss_db`]): for each
+/// crossing of `interactions` (aligned with `vertices[1..]`, the path TX → points → RX, local
+/// frame), −10·log10 of the mean of |T_TE|² and |T_TM|² at its incidence.
+pub(crate) fn transmission_loss_db(
+    scene: &Scene,
+    vertices: &[bt_geom::Vec3],
+    interactions: &[Interaction],
+) -> Result<Real, ReportError> {
+    let mut loss = 0.0;
+    for (k, it) in interactions.iter().enumerate() {
+        let Interaction::Transmission(id) = *it else {
+            continue;
+        };
+        let normal = scene.surface(id).polygon.plane().normal;
+        let cos = (vertices[k + 1] - vertices[k])
+            .normalize()
+            .dot(normal)
+            .abs();
+        let t = match surface_response(scene, id) {
+            bt_channel::SurfaceResponse::Radio(radio) => {
+                radio.transmission(scene.frequency_hz(), cos.min(1.0))?
+            }
+            // Only slabs are penetrable (`Scene::penetrable`): a constant loss has no model.
+            bt_channel::SurfaceResponse::ConstantLoss { .. } => continue,
+        };
+        let power = 0.5 * (t.te.norm_sqr() + t.tm.norm_sqr());
+        loss += -10.0 * power.log10();
+    }
+    Ok(loss)
 }

@@ -117,14 +117,14 @@ pub struct PathReport {
     pub rank: usize,
     /// Number of interactions, `len(points)` (0 = line of sight).
     pub order: usize,
-    /// What happens at each point, aligned with `points`: "reflection" or "diffraction"
-    /// (empty for line of sight).
+    /// What happens at each point, aligned with `points`: "reflection", "diffraction" or
+    /// "transmission" (empty for line of sight).
     pub interactions: Vec<InteractionKind>,
-    /// The surface of each interaction, aligned with `points`: a reflection's surface, a
-    /// wedge's two faces `"A|B"` (face 0, then face n), a free edge's face `"A"`; a diffraction's
+    /// The surface of each interaction, aligned with `points`: a reflection's or a crossing's
+    /// surface, a wedge's two faces `"A|B"` (face 0, then face n), a free edge's face `"A"`; a diffraction's
     /// names escaped (`\|`, `\\`) by [`bt_scene::name::edge`].
     pub surfaces: Vec<String>,
-    /// The reflecting surfaces' ids, TX side first (the diffraction left out).
+    /// The reflecting surfaces' ids, TX side first (the diffraction and crossings left out).
     #[serde(skip)]
     pub surface_ids: Vec<SurfaceId>,
     /// The diffraction (which point, which edge), when the path has one.
@@ -141,7 +141,8 @@ pub struct PathReport {
     /// Angle of arrival at RX (direction the wave comes from), degrees.
     pub aoa_deg: Direction,
     /// Angle of incidence at each point, from the surface normal, degrees, aligned with
-    /// `points`: `null` at a diffraction.
+    /// `points`: `null` at a diffraction. A crossing's is the angle of the straight ray
+    /// through it.
     pub incidence_deg: Vec<Option<Real>>,
     /// Free-space path loss over the unfolded length at the scene's frequency, dB.
     pub free_space_loss_db: Real,
@@ -151,7 +152,10 @@ pub struct PathReport {
     /// specular path): −20·log10(max(|D_s|, |D_h|)·√(L/(s·s'))), the stronger polarisation's
     /// UTD coefficient with the edge's spreading (docs/output-format.md).
     pub diffraction_loss_db: Real,
-    /// Total loss: free space plus reflections plus the diffraction, dB.
+    /// Loss of the crossings of penetrable surfaces, dB (0 without): Σ −10·log10 of the mean
+    /// of |T_TE|² and |T_TM|² (ITU-R P.2040 slab transmission at each crossing's incidence).
+    pub transmission_loss_db: Real,
+    /// Total loss: free space plus reflections plus the diffraction plus the crossings, dB.
     pub loss_db: Real,
     /// Complex path gain [re, im] (antennas, polarisation, reflections, λ/(4π·length); no
     /// propagation phase).
@@ -196,6 +200,14 @@ fn complex_from_pair<'de, D: Deserializer<'de>>(d: D) -> Result<Complex64, D::Er
 }
 
 impl PathReport {
+    /// The path's surfaces as one text for tables and CSV cells ([`bt_scene::name::route`]):
+    /// `a > through "b" > c` for a path reflecting on `a`, crossing `b`, reflecting on `c`.
+    pub fn route(&self) -> String {
+        bt_scene::name::route(&self.surfaces, |k| {
+            self.interactions.get(k) == Some(&InteractionKind::Transmission)
+        })
+    }
+
     /// A representative record for code that derives its layout from the serialization (the
     /// Python columns): one reflection, so every list has an element to show its type, and
     /// every optional field set, so every field of the document is written. A field added to
@@ -229,6 +241,7 @@ impl PathReport {
             free_space_loss_db,
             reflection_loss_db,
             diffraction_loss_db: 0.0,
+            transmission_loss_db: 0.0,
             loss_db,
             gain,
             gain_db,
@@ -275,6 +288,8 @@ pub enum InteractionKind {
     Reflection,
     /// An edge diffraction.
     Diffraction,
+    /// A crossing of a penetrable surface (thin-slab transmission).
+    Transmission,
 }
 
 /// The name of a path's interaction in the document: the surface's name for a reflection,
@@ -282,7 +297,9 @@ pub enum InteractionKind {
 /// for a diffraction.
 fn interaction_name(scene: &Scene, interaction: Interaction) -> String {
     match interaction {
-        Interaction::Reflection(id) => scene.surface(id).name.clone(),
+        Interaction::Reflection(id) | Interaction::Transmission(id) => {
+            scene.surface(id).name.clone()
+        }
         Interaction::Diffraction(e) => scene.edge_name(scene.edges().get(e)),
     }
 }
@@ -312,7 +329,7 @@ pub fn describe(
     let interactions = path.interactions();
     let incidence_deg = (interactions.iter().enumerate())
         .map(|(k, it)| match it {
-            Interaction::Reflection(id) => {
+            Interaction::Reflection(id) | Interaction::Transmission(id) => {
                 let normal = scene.surface(*id).polygon.plane().normal;
                 let incoming = (vertices[k] - vertices[k + 1]).normalize();
                 Some(incoming.dot(normal).abs().min(1.0).acos().to_degrees())
@@ -328,6 +345,7 @@ pub fn describe(
         .fold(0.0, |a, b| a + b);
     let free_space_loss_db = free_space_loss_db(length_m, scene.frequency_hz());
     let (gain, diffraction_loss_db) = gain::path_gain(scene, path, &interactions, radio)?;
+    let transmission_loss_db = gain::transmission_loss_db(scene, &vertices, &interactions)?;
     let gain_db = power_db(gain.norm_sqr());
     let n = vertices.len();
     Ok(PathReport {
@@ -337,6 +355,7 @@ pub fn describe(
             .map(|it| match it {
                 Interaction::Reflection(_) => InteractionKind::Reflection,
                 Interaction::Diffraction(_) => InteractionKind::Diffraction,
+                Interaction::Transmission(_) => InteractionKind::Transmission,
             })
             .collect(),
         surfaces: (interactions.iter())
@@ -357,7 +376,11 @@ pub fn describe(
         free_space_loss_db,
         reflection_loss_db,
         diffraction_loss_db,
-        loss_db: free_space_loss_db + reflection_loss_db + diffraction_loss_db,
+        transmission_loss_db,
+        loss_db: free_space_loss_db
+            + reflection_loss_db
+            + diffraction_loss_db
+            + transmission_loss_db,
         gain,
         gain_db,
         power_dbm: gain_db.map(|g| g + radio.tx_power_dbm),

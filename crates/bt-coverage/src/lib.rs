@@ -167,7 +167,7 @@ pub fn csv(rows: &[Row]) -> String {
                             s.order,
                             s.loss_db,
                             s.length_m,
-                            bt_output::csv::text_field(&bt_scene::name::path(&s.surfaces))
+                            bt_output::csv::text_field(&s.route())
                         )
                     })
                     .unwrap_or_else(|| ",,,".to_string());

@@ -24,7 +24,7 @@ use std::path::{Path, PathBuf};
 /// The version of the entries' layout and of what they hold; part of every key, so entries of
 /// another version are never read. Raise it whenever a load's result could change for the
 /// same inputs and options (a reader, the merge, validation, [`StoredScene`]).
-pub const CACHE_FORMAT_VERSION: u32 = 1;
+pub const CACHE_FORMAT_VERSION: u32 = 2;
 
 /// The first bytes of every entry.
 const MAGIC: &[u8; 8] = b"BTLOADC\0";

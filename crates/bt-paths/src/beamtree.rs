@@ -302,10 +302,12 @@ impl<'a> Prepared<'a> {
         })
     }
 
-    /// Whether surface `s` is convex.
-    fn is_convex(&self, s: u32) -> bool {
-        *self.shapes.convex[s as usize]
-            .get_or_init(|| convex::is_convex(&self.scene.surface(SurfaceId(s)).polygon))
+    /// Whether surface `s` may occlude: convex and opaque (a penetrable surface,
+    /// [`Scene::penetrable`], lets every beam through).
+    fn is_occluder(&self, s: u32) -> bool {
+        !self.scene.penetrable(SurfaceId(s))
+            && *self.shapes.convex[s as usize]
+                .get_or_init(|| convex::is_convex(&self.scene.surface(SurfaceId(s)).polygon))
     }
 }
 
@@ -1136,7 +1138,7 @@ fn occlude(
         scene.bvh().visit_segment(a, q, prep.tol, |item| {
             if Some(item) == parent.surface
                 || item == s
-                || !prep.is_convex(item)
+                || !prep.is_occluder(item)
                 || tested.contains(&item)
             {
                 return;

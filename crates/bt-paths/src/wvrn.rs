@@ -111,7 +111,7 @@ pub struct Wvrn {
     slot: Vec<u32>,
     /// `links[a * n + b]`, symmetric, `Linked` on the diagonal.
     links: Vec<Link>,
-    /// Whether each surface (by id) is convex (usable as an occluder).
+    /// Whether each surface (by id) is usable as an occluder ([`may_occlude`]).
     convex: Vec<bool>,
     /// `sides[node * surfaces + surface]`: on which side of the surface's plane all the node's
     /// points lie beyond the separation margin (+1 / -1, 0 when not strictly on one side), and
@@ -141,10 +141,8 @@ impl Wvrn {
             nodes,
             slot,
             links: vec![Link::Linked; n * n],
-            convex: scene
-                .surfaces()
-                .iter()
-                .map(|s| is_strictly_convex(&s.polygon))
+            convex: (0..m)
+                .map(|i| may_occlude(scene, SurfaceId(i as u32)))
                 .collect(),
             sides: vec![(0, 0.0); n * m],
             tx,
@@ -199,7 +197,7 @@ impl Wvrn {
         let mut moved_mask = vec![false; self.slot.len()];
         for id in moved {
             moved_mask[id.index()] = true;
-            self.convex[id.index()] = is_strictly_convex(&scene.surface(*id).polygon);
+            self.convex[id.index()] = may_occlude(scene, *id);
             if self.slot[id.index()] != NONE {
                 dirty[self.slot[id.index()] as usize] = true;
             }
@@ -519,6 +517,12 @@ fn crossings_inside(
         }
     }
     true
+}
+
+/// Whether surface `id` may occlude pairs: strictly convex and opaque (a penetrable surface,
+/// [`Scene::penetrable`], is crossed, not blocking).
+fn may_occlude(scene: &Scene, id: SurfaceId) -> bool {
+    !scene.penetrable(id) && is_strictly_convex(&scene.surface(id).polygon)
 }
 
 #[cfg(test)]

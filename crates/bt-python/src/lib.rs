@@ -215,6 +215,38 @@ impl PyScene {
         columns::to_dict(py, &paths)
     }
 
+    /// The viewer's page (`beamtrace view`: one offline HTML document, three.js inside) of the
+    /// scene with the paths traced from `tx` to `rx` under `keywords`; the geometry alone when
+    /// a terminal is neither given nor in the scene.
+    fn view(
+        &self,
+        py: Python<'_>,
+        tx: Option<[f64; 3]>,
+        rx: Option<[f64; 3]>,
+        keywords: TraceKeywords,
+    ) -> PyResult<String> {
+        let placed = tx.is_some() || self.scene.tx().is_some();
+        if !placed || (rx.is_none() && self.scene.rx().is_none()) {
+            return Ok(bt_view::page(&[&self.scene], &[bt_view::StepPaths::none()]));
+        }
+        let scene = self.moved(tx, rx)?;
+        let options = keywords
+            .trace_options(&scene)
+            .map_err(PyValueError::new_err)?;
+        let radio = keywords.radio().map_err(PyValueError::new_err)?;
+        let ends = scene.terminals().map_err(error)?;
+        let (tx, rx) = (scene.to_world(ends.tx), scene.to_world(ends.rx));
+        let page = py.detach(|| {
+            let traced = self.with_tracer(scene.clone(), options, |t| t.trace(tx, rx));
+            traced.map(|traced| {
+                let paths = bt_beams::report(&scene, &traced.result.paths, &radio)?;
+                let step = bt_view::StepPaths::from_reports(&scene, &paths);
+                Ok::<_, bt_beams::ReportError>(bt_view::page(&[&scene], &[step]))
+            })
+        });
+        page.map_err(|e| self.error(e))?.map_err(error)
+    }
+
     /// Trace one TX to each row of `receivers` (m × 3, metres) in parallel without the GIL;
     /// returns one column dict per receiver, in order.
     fn trace_many<'py>(
@@ -371,6 +403,7 @@ fn load(
         max_file_bytes: defaults.max_file_bytes,
         max_xml_substitution: defaults.max_xml_substitution,
         max_mesh_elements: defaults.merge.max_elements,
+        max_cloud_points: defaults.cloud.max_points,
     });
     let options = LoadOptions {
         terminals: terminals(tx, rx),
@@ -381,6 +414,12 @@ fn load(
             ..bt_mesh::MergeOptions::default()
         },
         min_reflector_area_m2: min_reflector_area,
+        // As the CLI: a cloud's points and its file are budgeted like every other input.
+        cloud: bt_import::cloud::ReadOptions {
+            max_points: budgets.max_cloud_points,
+            max_file_bytes: budgets.max_file_bytes,
+            ..defaults.cloud
+        },
         max_file_bytes: budgets.max_file_bytes,
         max_xml_substitution: budgets.max_xml_substitution,
         frequency_hz: frequency.unwrap_or(bt_scene::DEFAULT_FREQUENCY_HZ),
@@ -500,6 +539,11 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
         bt_import::xml::MAX_XML_SUBSTITUTION.limit,
     )?;
     m.add("DEFAULT_MAX_MESH_ELEMENTS", bt_mesh::DEFAULT_MAX_ELEMENTS)?;
+    m.add(
+        "DEFAULT_MAX_CLOUD_POINTS",
+        bt_import::cloud::DEFAULT_MAX_POINTS,
+    )?;
+    m.add("DEFAULT_MAX_BEAM_PAIRS", bt_channel::MAX_BEAM_PAIRS.limit)?;
     m.add_class::<PyScene>()?;
     m.add_class::<tracer::PyTracer>()?;
     m.add_function(wrap_pyfunction!(load, m)?)?;

@@ -22,6 +22,8 @@ pub struct TraceKeywords {
     pub max_wvrn_tests: u64,
     /// Solve on every core (the output is identical either way).
     pub parallel: bool,
+    /// Thin-slab transmission through every slab reflector (`--transmission`).
+    pub transmission: bool,
     /// `ipc_order` and `ipc_accel`.
     pub ipc: IpcKeywords,
     /// `sbr_step_deg`, `sbr_rays` and `sbr_planar`.
@@ -105,6 +107,8 @@ pub struct LoadBudgets {
     pub max_xml_substitution: u64,
     /// Vertices and faces of a mesh file, and of all meshes of an XML scene.
     pub max_mesh_elements: u64,
+    /// Points a point-cloud file declares.
+    pub max_cloud_points: u64,
 }
 
 /// `load`'s `material=` and `thickness=` (the CLI's `--material`, `--thickness`): the radio
@@ -190,6 +194,7 @@ impl TraceKeywords {
                 max_candidates: self.max_candidates,
                 max_wvrn_tests: self.max_wvrn_tests,
                 parallel: self.parallel,
+                transmission: self.transmission,
                 diffraction: bt_solve::pipeline::DiffractionOptions {
                     max_diffractions: self.diffraction.max_diffractions,
                     min_edge_length: self.diffraction.min_edge_length,
@@ -236,6 +241,7 @@ mod tests {
             max_candidates: 10,
             max_wvrn_tests: 10,
             parallel: true,
+            transmission: false,
             ipc: IpcKeywords {
                 order: "gauss-seidel".into(),
                 accel: "none".into(),

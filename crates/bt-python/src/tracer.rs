@@ -22,13 +22,14 @@ impl PyTracer {
     /// overriding its terminals, and trace under `keywords` (the trace keywords of
     /// `Scene.trace`).
     #[new]
-    #[pyo3(signature = (source, keywords, tx, rx))]
+    #[pyo3(signature = (source, keywords, tx, rx, beams=None))]
     fn new(
         py: Python<'_>,
         source: String,
         keywords: TraceKeywords,
         tx: Option<[f64; 3]>,
         rx: Option<[f64; 3]>,
+        beams: Option<BeamKeywords>,
     ) -> PyResult<Self> {
         let options = LoadOptions {
             terminals: terminals(tx, rx),
@@ -40,7 +41,10 @@ impl PyTracer {
             .trace_options(dynamic.step(0))
             .map_err(PyValueError::new_err)?;
         let radio = keywords.radio().map_err(PyValueError::new_err)?;
-        let server = Server::new(dynamic, trace_options, radio, Limits::default());
+        let mut server = Server::new(dynamic, trace_options, radio, Limits::default());
+        if let Some(beams) = beams {
+            server = server.with_beams(beams.options(&radio)?);
+        }
         Ok(PyTracer {
             server: Mutex::new(server),
         })
@@ -57,5 +61,46 @@ impl PyTracer {
             server.answer_line(line.as_bytes(), &mut out);
             String::from_utf8(out).map_err(error)
         })
+    }
+}
+
+/// `Tracer`'s beam keywords, `serve`'s flags by the same names: `tx_array`/`rx_array` as
+/// (rows, columns) (one given: the other 1 × 8), `tx_spacing`/`rx_spacing` in wavelengths,
+/// `ranking` (`power` or `paper`), `top` and `max_beam_pairs`.
+#[derive(Debug, Clone, pyo3::FromPyObject)]
+#[pyo3(from_item_all)]
+pub struct BeamKeywords {
+    tx_array: Option<(usize, usize)>,
+    rx_array: Option<(usize, usize)>,
+    tx_spacing: f64,
+    rx_spacing: f64,
+    ranking: String,
+    top: usize,
+    max_beam_pairs: u64,
+}
+
+impl BeamKeywords {
+    /// The server's beam options; a bad value is a `ValueError` naming its keyword.
+    fn options(&self, radio: &bt_beams::RadioOptions) -> PyResult<bt_serve::BeamOptions> {
+        let ranking = match self.ranking.as_str() {
+            "power" => bt_beams::BeamRanking::Power,
+            "paper" => bt_beams::BeamRanking::Paper,
+            other => {
+                return Err(PyValueError::new_err(format!(
+                    "ranking must be one of \"power\", \"paper\", got {}",
+                    bt_scene::name::shown(other)
+                )));
+            }
+        };
+        let spec = |shape: Option<(usize, usize)>, spacing| {
+            let (rows, columns) = shape.unwrap_or(bt_serve::DEFAULT_ARRAY);
+            Some((rows, columns, spacing))
+        };
+        let arrays = [
+            spec(self.tx_array, self.tx_spacing),
+            spec(self.rx_array, self.rx_spacing),
+        ];
+        bt_serve::BeamOptions::new(arrays, radio, ranking, (self.top, self.max_beam_pairs))
+            .map_err(|(which, e)| PyValueError::new_err(format!("{which}: {e}")))
     }
 }

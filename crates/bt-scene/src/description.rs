@@ -56,6 +56,9 @@ pub struct MaterialDesc {
     pub conductivity: Option<Real>,
     /// Slab thickness, metres (absent: a half-space).
     pub thickness: Option<Real>,
+    /// `true`: waves cross surfaces of this material (a slab only: it needs a `thickness`)
+    /// even without `--transmission` (default `false`).
+    pub transmission: Option<bool>,
 }
 
 /// One planar polygon.

@@ -6,7 +6,7 @@
 //! [`SceneDescription`] or [`RawSurface`]s validated here.
 //!
 //! Module order (each uses only those before it): `name`, `material`, `problem`, `surface` →
-//! `frame`, `enclosure` → `model` → `edges` → `description` → `validate` → `dynamic`.
+//! `frame`, `enclosure` → `model` → `transmission`, `edges` → `description` → `validate` → `dynamic`.
 #![warn(missing_docs)]
 
 mod description;
@@ -20,6 +20,7 @@ pub mod name;
 mod problem;
 mod stored;
 mod surface;
+mod transmission;
 mod validate;
 
 pub use description::{

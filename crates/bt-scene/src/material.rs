@@ -18,8 +18,15 @@ pub struct Material {
     /// Electrical model for complex gains. `None`: the surface reflects both polarisations like
     /// a perfect conductor scaled by `reflection_loss_db` (R_TE = −a, R_TM = +a with
     /// a = 10^(−loss/20)); see `docs/channel.md`.
-    #[serde(default, skip_serializing_if = "Option::is_none")]
+    // Every field is always written: the load cache encodes with postcard, which is not
+    // self-describing (a skipped field would shift the bytes after it).
+    #[serde(default)]
     pub radio: Option<RadioMaterial>,
+    /// Waves cross surfaces of this material (thin-slab transmission, `docs/channel.md`) even
+    /// when a trace does not switch transmission on everywhere: the scene file's key
+    /// `"transmission": true`. Only a slab (a radio model with a thickness) lets waves through.
+    #[serde(default)]
+    pub transmission: bool,
 }
 
 /// Built-in materials with typical single-bounce losses at mmWave (dB), round numbers from
@@ -65,6 +72,7 @@ pub fn default_materials() -> BTreeMap<String, Material> {
             Material {
                 reflection_loss_db: loss,
                 radio: Some(radio),
+                transmission: false,
             },
         )
     })

@@ -33,18 +33,35 @@ pub struct Scene {
     pub(crate) bvh: Arc<Bvh>,
     /// The diffracting edges, derived on first use and shared like `surfaces`.
     pub(crate) edges: Arc<std::sync::OnceLock<crate::edges::Edges>>,
+    /// Which surfaces waves cross, and a path's interaction budget (`transmission`).
+    pub(crate) penetration: crate::transmission::Penetration,
 }
 
 /// The identity of a scene's surfaces ([`Scene::geometry_key`]). It holds no strong reference:
 /// the surfaces are freed with their last scene, while the key keeps their address from being
 /// reused, so a key never matches other geometry. Surfaces are never changed in place.
+/// Which surfaces waves cross (`Scene::penetrable`) belongs to the key too: derived data such
+/// as a beam tree's occlusion culling depends on it.
 #[derive(Debug, Clone)]
-pub struct GeometryKey(std::sync::Weak<Vec<Surface>>);
+pub struct GeometryKey(
+    std::sync::Weak<Vec<Surface>>,
+    Option<std::sync::Weak<[bool]>>,
+);
 
 impl GeometryKey {
-    /// Whether `scene` has exactly the surfaces this key was taken from.
+    /// Whether `scene` has exactly the surfaces this key was taken from, with the same
+    /// penetrable ones.
     pub fn matches(&self, scene: &Scene) -> bool {
-        self.0.strong_count() > 0 && std::ptr::eq(self.0.as_ptr(), Arc::as_ptr(&scene.surfaces))
+        let mask = scene.penetration.mask();
+        self.0.strong_count() > 0
+            && std::ptr::eq(self.0.as_ptr(), Arc::as_ptr(&scene.surfaces))
+            && match (&self.1, mask) {
+                (None, None) => true,
+                (Some(kept), Some(mask)) => {
+                    kept.strong_count() > 0 && std::ptr::addr_eq(kept.as_ptr(), Arc::as_ptr(mask))
+                }
+                _ => false,
+            }
     }
 }
 
@@ -61,7 +78,10 @@ impl Scene {
     /// receiver, terminals or frequency ([`GeometryKey::matches`]): lets a caller keep data
     /// derived from the surfaces alone across traces of the same geometry.
     pub fn geometry_key(&self) -> GeometryKey {
-        GeometryKey(Arc::downgrade(&self.surfaces))
+        GeometryKey(
+            Arc::downgrade(&self.surfaces),
+            self.penetration.mask().map(Arc::downgrade),
+        )
     }
     /// The surface with id `id`.
     #[inline]

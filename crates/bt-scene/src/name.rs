@@ -107,8 +107,21 @@ pub const PATH_SEPARATOR: &str = " > ";
 /// a `>` inside a name written `\>`, so [`PATH_SEPARATOR`] only ever separates names: the
 /// names `a > b` and `c` give `a \> b > c`, never the path `a`, `b`, `c`.
 pub fn path<S: AsRef<str>>(names: &[S]) -> String {
-    let names: Vec<String> = (names.iter())
-        .map(|n| escape(n.as_ref()).replace('>', "\\>"))
+    route(names, |_| false)
+}
+
+/// [`path`], with the names `crossed(k)` marks written `through "NAME"`: surfaces a path
+/// crosses (transmission) rather than reflects on. [`escape`] writes every `"` inside a name as
+/// `\"`, so the marker's quotes never come from a name.
+pub fn route<S: AsRef<str>>(names: &[S], crossed: impl Fn(usize) -> bool) -> String {
+    let names: Vec<String> = (names.iter().enumerate())
+        .map(|(k, n)| {
+            let name = escape(n.as_ref()).replace('>', "\\>");
+            match crossed(k) {
+                true => format!("through \"{name}\""),
+                false => name,
+            }
+        })
         .collect();
     names.join(PATH_SEPARATOR)
 }

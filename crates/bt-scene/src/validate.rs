@@ -255,7 +255,7 @@ impl Scene {
         // (vertices and local coordinates) was a third of a cached city load's allocations.
         let polygons: Vec<&Polygon> = surfaces.iter().map(|s| &s.polygon).collect();
         let bvh = Bvh::build(&polygons);
-        Scene {
+        let mut scene = Scene {
             name,
             origin,
             surfaces: surfaces.into(),
@@ -266,7 +266,10 @@ impl Scene {
             extent,
             bvh: bvh.into(),
             edges: Default::default(),
-        }
+            penetration: Default::default(),
+        };
+        scene.penetration = crate::transmission::Penetration::of(&scene, false, usize::MAX);
+        scene
     }
 }
 
@@ -333,6 +336,13 @@ fn material_from_desc(
             None
         }
     };
+    if m.transmission == Some(true) && m.thickness.is_none() {
+        problems.report(
+            &format!("{location}.transmission"),
+            "a half-space lets nothing through: give the material a \"thickness\" (metres) to \
+             make it a slab waves can cross",
+        );
+    }
     let reflection_loss_db = match (m.reflection_loss_db, &radio, frequency_hz) {
         (Some(loss), _, _) => loss,
         (None, Some(r), Some(f)) => match r.normal_loss_db(f) {
@@ -356,6 +366,7 @@ fn material_from_desc(
     (problems.count() == before).then_some(Material {
         reflection_loss_db,
         radio,
+        transmission: m.transmission.unwrap_or(false),
     })
 }
 
@@ -632,6 +643,13 @@ impl Scene {
         for m in Arc::make_mut(&mut scene.materials).values_mut() {
             m.radio = Some(radio);
         }
+        // Which surfaces waves cross depends on the materials: a new mask, and with it a new
+        // `geometry_key` when there are penetrable surfaces.
+        scene.penetration = crate::transmission::Penetration::of(
+            &scene,
+            self.transmission_everywhere(),
+            self.max_interactions(),
+        );
         let problems = radio_problems(&scene.surfaces, &scene.materials, scene.frequency_hz);
         if !problems.is_empty() {
             return Err(crate::SceneError::Invalid {

@@ -48,6 +48,56 @@ impl Default for Limits {
     }
 }
 
+/// Beam answers (`serve --tx-array/--rx-array`): every answer also sweeps the DFT codebooks of
+/// the two arrays over its paths, as `beamtrace beams` does, and holds the best pair and the
+/// first `top` pairs of the ranking.
+#[derive(Debug, Clone)]
+pub struct BeamOptions {
+    /// The TX array (its orientation is the TX antenna's).
+    pub tx: bt_channel::Array,
+    /// The RX array.
+    pub rx: bt_channel::Array,
+    /// How pairs are ranked.
+    pub ranking: bt_beams::BeamRanking,
+    /// Pairs of the ranking each answer holds.
+    pub top: usize,
+    /// Budget on TX beams × RX beams (`--max-beam-pairs`).
+    pub max_pairs: u64,
+}
+
+/// The array (rows, columns) a beam sweep takes when none is given (`beams`, Python's
+/// `Tracer`): a horizontal 8-element ULA.
+pub const DEFAULT_ARRAY: (usize, usize) = (1, 8);
+
+impl BeamOptions {
+    /// The sweep of a TX and an RX array, each `(rows, columns, spacing in wavelengths)` (a
+    /// missing one [`DEFAULT_ARRAY`], half a wavelength apart), oriented as `radio`'s antennas, ranked by
+    /// `ranking`, `top` pairs per answer, at most `max_pairs` pairs: the pairs follow from the
+    /// arrays alone, so an over-budget sweep is refused here, before any trace. An error
+    /// names the array (`tx_array`, `rx_array`) or the budget.
+    pub fn new(
+        arrays: [Option<(usize, usize, f64)>; 2],
+        radio: &bt_beams::RadioOptions,
+        ranking: bt_beams::BeamRanking,
+        (top, max_pairs): (usize, u64),
+    ) -> Result<Self, (&'static str, bt_channel::ChannelError)> {
+        let array = |spec: Option<(usize, usize, f64)>, which, orientation| {
+            let (rows, columns, spacing) = spec.unwrap_or((DEFAULT_ARRAY.0, DEFAULT_ARRAY.1, 0.5));
+            bt_channel::Array::new(rows, columns, spacing, orientation).map_err(|e| (which, e))
+        };
+        let tx = array(arrays[0], "tx_array", radio.tx.orientation)?;
+        let rx = array(arrays[1], "rx_array", radio.rx.orientation)?;
+        bt_channel::check_beam_pairs(&tx, &rx, max_pairs).map_err(|e| ("max_beam_pairs", e))?;
+        Ok(BeamOptions {
+            tx,
+            rx,
+            ranking,
+            top,
+            max_pairs,
+        })
+    }
+}
+
 /// What can go wrong: a request's own problem (answered with an error line, the stream goes
 /// on) or the transport's (the stream ends).
 #[derive(Debug, thiserror::Error)]
@@ -71,6 +121,9 @@ pub enum ServeError {
     /// The paths could not be reported (a material without a radio model).
     #[error(transparent)]
     Report(#[from] bt_beams::ReportError),
+    /// The beam sweep failed (over its pair budget).
+    #[error(transparent)]
+    Beams(#[from] bt_channel::ChannelError),
     /// Serialising an answer failed.
     #[error("serialising the answer: {0}")]
     Json(#[from] serde_json::Error),

@@ -1,8 +1,9 @@
 //! The session state and the answer to one request.
 
 use crate::request::{self, Receivers, Request};
-use crate::{Limits, ServeError};
-use bt_beams::{PathReport, RadioOptions, StepDocument, StepStats, TraceDocument};
+use crate::{BeamOptions, Limits, ServeError};
+use bt_beams::TraceDocument;
+use bt_beams::{BeamPair, BeamRanking, PathReport, RadioOptions, StepDocument, StepStats};
 use bt_geom::Vec3;
 use bt_scene::dynamic::{DynamicScene, Pose};
 use bt_scene::{SceneError, Terminals};
@@ -26,6 +27,8 @@ pub struct Server {
     session: Session,
     /// The object poses of the geometry the tracer holds (aligned with the objects).
     held: Vec<Pose>,
+    /// Beam answers, when the server sweeps arrays.
+    beams: Option<BeamOptions>,
 }
 
 /// What a request may leave out and take from the previous one.
@@ -43,6 +46,19 @@ struct Answer {
     rx: [f64; 3],
     paths: Vec<PathReport>,
     stats: AnswerStats,
+    #[serde(skip_serializing_if = "Option::is_none")]
+    beams: Option<BeamsAnswer>,
+}
+
+/// The beam sweep of one answer: the codebooks' sizes, the ranking, the best pair (`null` when
+/// no power arrives) and the first pairs of the ranking (`beamtrace beams`' records).
+#[derive(Serialize)]
+struct BeamsAnswer {
+    tx_beams: usize,
+    rx_beams: usize,
+    ranking: BeamRanking,
+    best: Option<BeamPair>,
+    top: Vec<BeamPair>,
 }
 
 /// The stats of `trace --json` for a trace, or of a `--steps` step for a request that moved
@@ -107,6 +123,15 @@ impl Server {
             session: initial.clone(),
             initial,
             held: poses,
+            beams: None,
+        }
+    }
+
+    /// The server answering with a beam sweep too ([`BeamOptions`]).
+    pub fn with_beams(self, beams: BeamOptions) -> Self {
+        Server {
+            beams: Some(beams),
+            ..self
         }
     }
 
@@ -314,9 +339,43 @@ impl Server {
         Ok(Answer {
             tx: doc.tx,
             rx: doc.rx,
+            beams: self.beams_of(&doc.paths, scene.frequency_hz())?,
             paths: doc.paths,
             stats: AnswerStats::Trace(doc.stats),
         })
+    }
+
+    /// The beam sweep of `paths` at `carrier_hz`, when the server sweeps arrays.
+    fn beams_of(
+        &self,
+        paths: &[PathReport],
+        carrier_hz: f64,
+    ) -> Result<Option<BeamsAnswer>, ServeError> {
+        let Some(b) = &self.beams else {
+            return Ok(None);
+        };
+        let power = self.radio.tx_power_dbm;
+        let sweep = bt_beams::sweep(
+            paths,
+            &b.tx,
+            &b.rx,
+            carrier_hz,
+            power,
+            b.ranking,
+            b.max_pairs,
+        )?;
+        let best = sweep
+            .pairs
+            .first()
+            .filter(|p| p.power_dbm.is_some())
+            .cloned();
+        Ok(Some(BeamsAnswer {
+            tx_beams: sweep.tx_beams,
+            rx_beams: sweep.rx_beams,
+            ranking: sweep.ranking,
+            best,
+            top: sweep.pairs.into_iter().take(b.top).collect(),
+        }))
     }
 
     /// Move the objects to `poses` and trace the first receiver as the tracer's next time
@@ -347,6 +406,7 @@ impl Server {
         let first = Answer {
             tx: doc.tx,
             rx: doc.rx,
+            beams: self.beams_of(&doc.paths, scene.frequency_hz())?,
             paths: doc.paths,
             stats: AnswerStats::Step(doc.stats),
         };

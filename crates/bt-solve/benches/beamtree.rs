@@ -197,5 +197,41 @@ fn living_room_diffraction(c: &mut Criterion) {
     group.finish();
 }
 
-criterion_group!(benches, living_room, living_room_diffraction, city);
+/// Transmission in the living room at order ≤ 3 (issue 28): every slab reflector (furniture,
+/// plasterboard, glass) is crossed, the concrete shell stays opaque; beside it the specular
+/// trace, and with one diffraction too.
+fn living_room_transmission(c: &mut Criterion) {
+    let scene = bt_import::builtin_scene("living-room", Terminals::default())
+        .unwrap()
+        .unwrap();
+    let mut group = c.benchmark_group("living-room-transmission");
+    let specular = options(3, CandidateMode::BeamTree, Solver::Image);
+    let mut tracer = Tracer::new(scene.clone(), specular);
+    group.bench_function("trace-specular", |b| b.iter(|| whole_trace(&mut tracer)));
+    let transmission = TraceOptions {
+        transmission: true,
+        ..specular
+    };
+    let mut tracer = Tracer::new(scene.clone(), transmission);
+    group.bench_function("trace-transmission", |b| {
+        b.iter(|| whole_trace(&mut tracer))
+    });
+    let both = TraceOptions {
+        diffraction: bt_solve::pipeline::DiffractionOptions::first_order(),
+        ..transmission
+    };
+    let mut tracer = Tracer::new(scene, both);
+    group.bench_function("trace-transmission-one-diffraction", |b| {
+        b.iter(|| whole_trace(&mut tracer))
+    });
+    group.finish();
+}
+
+criterion_group!(
+    benches,
+    living_room,
+    living_room_diffraction,
+    living_room_transmission,
+    city
+);
 criterion_main!(benches);

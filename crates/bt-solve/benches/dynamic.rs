@@ -27,6 +27,7 @@ fn options(candidates: CandidateMode) -> TraceOptions {
         max_candidates: u64::MAX,
         max_wvrn_tests: u64::MAX,
         parallel: false,
+        transmission: false,
         diffraction: Default::default(),
     }
 }

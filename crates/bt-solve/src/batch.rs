@@ -298,6 +298,7 @@ pub(crate) fn found_path(
         surfaces: seq.to_vec(),
         points: points.to_vec(),
         diffraction: None,
+        crossings: Vec::new(),
         iterations,
         residual,
     })

@@ -214,12 +214,21 @@ fn blocked(
             }),
         }
     };
+    let through = validate::may_cross(scene, n);
     for segment in 0..=n {
         let (a, b) = (vertex(segment), vertex(segment + 1));
         let (from, to) = (on(segment), on(segment + 1));
-        if let Some(by) = validate::blocker_excluding(scene, a, b, from, to, tol) {
+        if let Some(by) = validate::blocker_excluding(scene, (a, b), (from, to), tol, through) {
             return Validity::Blocked { segment, by };
         }
+    }
+    if through {
+        let path = validate::PathVertices {
+            vertex: &vertex,
+            on: &on,
+            points: n,
+        };
+        return validate::crossing_budget(scene, path, n);
     }
     Validity::Valid
 }

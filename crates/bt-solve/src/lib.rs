@@ -56,12 +56,16 @@ pub enum Solver {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FoundPath {
     /// Reflecting surfaces, TX side first (empty: line of sight, or a lone diffraction). With
-    /// a diffraction, one fewer than the points: [`FoundPath::interactions`] aligns them.
+    /// a diffraction or crossings, fewer than the points: [`FoundPath::interactions`] aligns
+    /// them.
     pub surfaces: Vec<SurfaceId>,
     /// Interaction points, TX side first, metres (TX and RX excluded).
     pub points: Vec<Vec3>,
     /// The diffraction, when the path has one.
     pub diffraction: Option<Diffraction>,
+    /// The penetrable surfaces the path crosses (thin-slab transmission), by point, in path
+    /// order; empty without transmission.
+    pub crossings: Vec<Crossing>,
     /// IPC rounds used (IPC only).
     pub iterations: Option<u32>,
     /// Mean displacement of IPC's last round, metres (IPC only).
@@ -77,6 +81,16 @@ pub struct Diffraction {
     pub edge: bt_scene::EdgeId,
 }
 
+/// A path's crossing of a penetrable surface ([`Scene::penetrable`]): which of its points,
+/// through which surface. The wave goes straight through (a thin slab deflects nothing).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
+pub struct Crossing {
+    /// Index of the crossing point in [`FoundPath::points`].
+    pub index: usize,
+    /// The surface crossed.
+    pub surface: SurfaceId,
+}
+
 /// One interaction of a path, aligned with its points.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
 pub enum Interaction {
@@ -84,20 +98,85 @@ pub enum Interaction {
     Reflection(SurfaceId),
     /// A diffraction on an edge.
     Diffraction(bt_scene::EdgeId),
+    /// A crossing of a penetrable surface (thin-slab transmission).
+    Transmission(SurfaceId),
 }
 
 impl FoundPath {
     /// The interactions, aligned with [`FoundPath::points`].
     pub fn interactions(&self) -> Vec<Interaction> {
-        let mut out: Vec<Interaction> = self
-            .surfaces
-            .iter()
-            .map(|s| Interaction::Reflection(*s))
-            .collect();
-        if let Some(d) = self.diffraction {
-            out.insert(d.index, Interaction::Diffraction(d.edge));
+        let mut reflections = self.surfaces.iter();
+        let mut crossings = self.crossings.iter().peekable();
+        (0..self.points.len())
+            .filter_map(|i| match crossings.next_if(|c| c.index == i) {
+                Some(c) => Some(Interaction::Transmission(c.surface)),
+                None => match self.diffraction {
+                    Some(d) if d.index == i => Some(Interaction::Diffraction(d.edge)),
+                    _ => reflections.next().map(|s| Interaction::Reflection(*s)),
+                },
+            })
+            .collect()
+    }
+
+    /// The path with the penetrable surfaces its segments cross in `scene` (between `ends`)
+    /// inserted as crossing points ([`validate::walk_crossings`]); the diffraction's index
+    /// moves with them. A path found without transmission comes back unchanged.
+    pub fn with_crossings(self, scene: &Scene, ends: Endpoints) -> FoundPath {
+        let n = self.points.len();
+        let interactions = self.interactions();
+        let edges = scene.edges();
+        let vertex = |k: usize| match k {
+            0 => ends.tx,
+            k if k == n + 1 => ends.rx,
+            k => self.points[k - 1],
+        };
+        let on = |k: usize| -> &[SurfaceId] {
+            match k.checked_sub(1).and_then(|i| interactions.get(i)) {
+                Some(Interaction::Reflection(s) | Interaction::Transmission(s)) => {
+                    std::slice::from_ref(s)
+                }
+                Some(Interaction::Diffraction(e)) => &edges.get(*e).touching,
+                None => &[],
+            }
+        };
+        let mut found: Vec<(usize, Vec3, SurfaceId)> = Vec::new();
+        let path = validate::PathVertices {
+            vertex: &vertex,
+            on: &on,
+            points: n,
+        };
+        validate::walk_crossings(scene, path, |segment, p, id| {
+            found.push((segment, p, id));
+            true
+        });
+        if found.is_empty() {
+            return self;
         }
-        out
+        let mut points = Vec::with_capacity(n + found.len());
+        let mut crossings = Vec::with_capacity(found.len());
+        let mut diffraction = self.diffraction;
+        let mut next = found.iter().peekable();
+        for segment in 0..=n {
+            while let Some((_, p, id)) = next.next_if(|c| c.0 == segment) {
+                crossings.push(Crossing {
+                    index: points.len(),
+                    surface: *id,
+                });
+                points.push(*p);
+            }
+            if let (Some(d), Some(old)) = (diffraction.as_mut(), self.diffraction)
+                && old.index == segment
+            {
+                d.index = points.len();
+            }
+            points.extend(self.points.get(segment));
+        }
+        FoundPath {
+            points,
+            crossings,
+            diffraction,
+            ..self
+        }
     }
 }
 
@@ -326,5 +405,10 @@ pub fn trace(
     let diffracted = diffraction::trace_set(scene, ends, &candidates.diffracted, solver, parallel);
     out.paths.extend(diffracted.paths);
     out.counts.merge(&diffracted.counts);
+    if scene.transmits() {
+        out.paths = (out.paths.into_iter())
+            .map(|p| p.with_crossings(scene, ends))
+            .collect();
+    }
     Ok(out)
 }

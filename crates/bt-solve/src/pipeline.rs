@@ -53,6 +53,12 @@ pub struct TraceOptions {
     /// Budget: the WVRN generator stops with [`TraceError::OverBudget`] before building a
     /// network of more pair tests than this ([`bt_paths::wvrn::build_tests`]).
     pub max_wvrn_tests: u64,
+    /// Thin-slab transmission through every reflector whose material is a slab (default off;
+    /// a material's `"transmission": true` switches it on for that material either way):
+    /// [`Tracer`](crate::Tracer) traces its scenes
+    /// [`with_transmission`](Scene::with_transmission)`(transmission, max_order)`, so that a
+    /// path's crossings count in `max_order`.
+    pub transmission: bool,
     /// Edge diffraction (default off).
     pub diffraction: DiffractionOptions,
 }
@@ -92,8 +98,40 @@ impl TraceOptions {
             parallel: true,
             max_candidates: DEFAULT_MAX_CANDIDATES,
             max_wvrn_tests: DEFAULT_MAX_WVRN_TESTS,
+            transmission: false,
             diffraction: DiffractionOptions::default(),
         }
+    }
+
+    /// What a user should know before tracing `scene` under these options: with
+    /// transmission, the reflector materials that stay opaque (half-spaces and constant-loss
+    /// materials have no thickness to cross), by name.
+    pub fn warnings(&self, scene: &Scene) -> Vec<String> {
+        let opaque = scene.opaque_materials();
+        if !self.transmission || opaque.is_empty() {
+            return Vec::new();
+        }
+        let names: Vec<String> = (opaque.iter().take(8))
+            .map(|m| format!("\"{}\"", bt_scene::name::shown(m)))
+            .collect();
+        let more = opaque.len().saturating_sub(names.len());
+        let more = if more > 0 {
+            format!(" and {more} more")
+        } else {
+            String::new()
+        };
+        vec![format!(
+            "--transmission: surfaces of {}{more} stay opaque: a half-space (or a material \
+             without a radio model) has no thickness to cross; give one with --thickness or \
+             the material's \"thickness\"",
+            names.join(", ")
+        )]
+    }
+
+    /// `scene` as traces under these options see it: its penetrable surfaces
+    /// ([`Scene::with_transmission`]) and a path's interaction budget, `max_order`.
+    pub fn scene_of(&self, scene: &Scene) -> Scene {
+        scene.with_transmission(self.transmission, self.max_order)
     }
 }
 
@@ -124,6 +162,18 @@ pub enum TraceError {
     /// A receiver (or transmitter) position is not valid in the scene.
     #[error(transparent)]
     Scene(#[from] SceneError),
+    /// SBR asked for in a scene with penetrable surfaces: it does not transmit.
+    #[error(
+        "the SBR solver does not transmit, and {penetrable} surface(s) of this scene are \
+         penetrable (the first: \"{first}\"; --transmission, or a material's \
+         \"transmission\": true): use --solver image or ipc"
+    )]
+    SbrTransmission {
+        /// Penetrable surfaces in the scene.
+        penetrable: usize,
+        /// The first one's name, as messages show names ([`bt_scene::name::shown`]).
+        first: String,
+    },
 }
 
 impl From<bt_paths::beamtree::TreeError> for TraceError {
@@ -184,6 +234,16 @@ fn generate(
     progress: Progress<'_>,
 ) -> Result<CandidateSet, TraceError> {
     scene.terminals()?;
+    if matches!(options.solver, Solver::Sbr(_)) && scene.transmits() {
+        let ids: Vec<bt_scene::SurfaceId> = (0..scene.surfaces().len() as u32)
+            .map(bt_scene::SurfaceId)
+            .filter(|&id| scene.penetrable(id))
+            .collect();
+        return Err(TraceError::SbrTransmission {
+            penetrable: ids.len(),
+            first: bt_scene::name::shown(&scene.surface(ids[0]).name),
+        });
+    }
     check_budget(scene, options)?;
     let diffraction = options.diffraction.enabled();
     let mut set = match options.candidates {

@@ -281,6 +281,7 @@ impl SbrPath {
         FoundPath {
             surfaces: self.surfaces.clone(),
             diffraction: None,
+            crossings: Vec::new(),
             points: self.points.clone(),
             iterations: None,
             residual: None,

@@ -71,6 +71,9 @@ pub struct SolveSettings {
     pub parallel: bool,
     /// Edge diffraction (`--diffraction`, `--max-diffractions`, `--min-edge-length`).
     pub diffraction: DiffractionOptions,
+    /// Thin-slab transmission through every reflector whose material is a slab
+    /// (`--transmission`; [`TraceOptions::transmission`]).
+    pub transmission: bool,
 }
 
 impl Default for SolveSettings {
@@ -96,6 +99,7 @@ impl Default for SolveSettings {
             max_wvrn_tests: crate::pipeline::DEFAULT_MAX_WVRN_TESTS,
             parallel: true,
             diffraction: DiffractionOptions::default(),
+            transmission: false,
         }
     }
 }
@@ -135,6 +139,9 @@ pub enum SettingsError {
     /// SBR finds specular paths only.
     #[error("--diffraction needs an exact solver (--solver image or ipc): sbr does not diffract")]
     SbrDiffraction,
+    /// SBR does not transmit.
+    #[error("--transmission needs an exact solver (--solver image or ipc): sbr does not transmit")]
+    SbrTransmission,
 }
 
 /// A setting chosen by name from a fixed list (the CLI's value names).
@@ -214,6 +221,9 @@ impl SolveSettings {
         if d.max_diffractions > 0 && self.solver == SolverKind::Sbr {
             return Err(SettingsError::SbrDiffraction);
         }
+        if self.transmission && self.solver == SolverKind::Sbr {
+            return Err(SettingsError::SbrTransmission);
+        }
         Ok(TraceOptions {
             max_order: self.max_order,
             solver: self.solver(scene)?,
@@ -221,6 +231,7 @@ impl SolveSettings {
             parallel: self.parallel,
             max_candidates: self.max_candidates,
             max_wvrn_tests: self.max_wvrn_tests,
+            transmission: self.transmission,
             diffraction: d,
         })
     }

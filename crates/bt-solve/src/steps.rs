@@ -213,10 +213,14 @@ impl Incremental {
         let ends = scene.terminals()?;
         let options = *options;
         let prev = self.state.take();
-        if matches!(options.solver, Solver::Sbr(_)) || options.diffraction.enabled().is_some() {
+        if matches!(options.solver, Solver::Sbr(_))
+            || options.diffraction.enabled().is_some()
+            || scene.transmits()
+        {
             // SBR traces the whole scene at once, not per candidate: nothing to reuse. The
-            // reuse of the steps covers specular candidates: with diffraction every step is
-            // traced in full (its edges derived from its own surfaces).
+            // reuse of the steps covers specular candidates through opaque surfaces: with
+            // diffraction (edges derived from each step's own surfaces) or transmission (a
+            // moved slab changes crossings, not blockers) every step is traced in full.
             let result = trace_scratch(scene, step, &options)?;
             self.state = Some(State {
                 scene: scene.clone(),

@@ -14,7 +14,7 @@ use bt_geom::Vec3;
 use bt_paths::beamtree::TreeCache;
 use bt_scene::Scene;
 
-/// Traces one scene: one TX–RX pair ([`Tracer::trace`]), one TX to many receivers with one beam
+/// Traces one scene (as its options see it, [`TraceOptions::scene_of`]): one TX–RX pair ([`Tracer::trace`]), one TX to many receivers with one beam
 /// tree ([`Tracer::trace_many`]), or the next time step of a dynamic scene, incrementally
 /// ([`Tracer::update`]).
 ///
@@ -45,7 +45,7 @@ impl Tracer {
     /// A tracer of `scene` under `options`, with nothing kept yet.
     pub fn new(scene: Scene, options: TraceOptions) -> Self {
         Tracer {
-            scene,
+            scene: options.scene_of(&scene),
             options,
             cache: TreeCache::default(),
             kept: None,
@@ -69,7 +69,7 @@ impl Tracer {
     /// frequency). The kept tree and the previous step are dropped; the caches stay and are
     /// reused while the geometry is the same.
     pub fn set_scene(&mut self, scene: Scene) {
-        self.scene = scene;
+        self.scene = self.options.scene_of(&scene);
         self.kept = None;
         self.previous = Incremental::default();
     }
@@ -79,6 +79,7 @@ impl Tracer {
     pub fn set_options(&mut self, options: TraceOptions) {
         if options != self.options {
             self.options = options;
+            self.scene = options.scene_of(&self.scene);
             self.kept = None;
             self.previous = Incremental::default();
         }
@@ -165,7 +166,7 @@ impl Tracer {
     pub fn update(&mut self, scene: &Scene) -> Result<StepTrace, TraceError> {
         let step = self.advance(scene);
         self.previous
-            .step(&self.options, scene, step, &mut self.cache)
+            .step(&self.options, &self.scene, step, &mut self.cache)
     }
 
     /// Trace `scene` as the next time step from scratch (the reference [`Tracer::update`]
@@ -173,14 +174,14 @@ impl Tracer {
     pub fn update_from_scratch(&mut self, scene: &Scene) -> Result<StepTrace, TraceError> {
         let step = self.advance(scene);
         self.previous = Incremental::default();
-        trace_scratch(scene, step, &self.options)
+        trace_scratch(&self.scene, step, &self.options)
     }
 
     /// Hold `scene` as the next step: the kept tree is dropped; returns the step's index. (A
     /// step without terminals is held too; its trace fails and the last traced step stays the
     /// one the next step is compared with.)
     fn advance(&mut self, scene: &Scene) -> usize {
-        self.scene = scene.clone();
+        self.scene = self.options.scene_of(scene);
         self.kept = None;
         self.next_step += 1;
         self.next_step - 1

@@ -1,5 +1,7 @@
 //! Validation of a found path: points inside their polygons, neighbours on the reflecting side,
-//! no segment blocked by another surface.
+//! no segment blocked by another surface. A penetrable surface ([`Scene::penetrable`]) never
+//! blocks: a segment crosses it (thin-slab transmission, no deflection), and a path's crossings
+//! count in its interaction budget ([`Scene::max_interactions`]).
 
 use bt_geom::{Real, Vec3};
 use bt_scene::edges::FLAT_WEDGE_RAD;
@@ -71,13 +73,140 @@ pub fn validate(scene: &Scene, seq: &[SurfaceId], tx: Vec3, rx: Vec3, points: &[
             return Validity::OppositeSides { index: k };
         }
     }
+    let through = may_cross(scene, n);
     for segment in 0..=n {
         let ((a, from), (b, to)) = segment_ends(seq, (tx, rx), points, segment);
-        if let Some(by) = blocker(scene, a, b, from, to, tol) {
+        let ends = (from.as_slice(), to.as_slice());
+        if let Some(by) = blocker_excluding(scene, (a, b), ends, tol, through) {
             return Validity::Blocked { segment, by };
         }
     }
+    if through {
+        let vertex = |k: usize| match k {
+            0 => tx,
+            k if k == n + 1 => rx,
+            k => points[k - 1],
+        };
+        let on = |k: usize| match k {
+            0 => &[][..],
+            k if k == n + 1 => &[][..],
+            k => std::slice::from_ref(&seq[k - 1]),
+        };
+        let path = PathVertices {
+            vertex: &vertex,
+            on: &on,
+            points: n,
+        };
+        return crossing_budget(scene, path, n);
+    }
     Validity::Valid
+}
+
+/// A path as the crossing walks see it: `points` interaction points, vertex `k` at `vertex(k)`
+/// for `k` in `0..=points + 1` (0 = TX, points + 1 = RX), lying on the surfaces `on(k)` (none
+/// for a terminal, its surface for a reflection, the edge's faces for a diffraction).
+#[derive(Clone, Copy)]
+pub struct PathVertices<'a, 's> {
+    /// Vertex `k`, metres, scene-local frame.
+    pub vertex: &'a dyn Fn(usize) -> Vec3,
+    /// The surfaces vertex `k` lies on.
+    pub on: &'a dyn Fn(usize) -> &'s [SurfaceId],
+    /// Interaction points (TX and RX excluded).
+    pub points: usize,
+}
+
+/// The crossing verdict of `path`, which has `interactions` reflections and diffractions: [`Validity::Blocked`] by the first crossing (in path order)
+/// beyond [`Scene::max_interactions`], else [`Validity::Valid`].
+#[inline(always)]
+pub fn crossing_budget<'s>(
+    scene: &'s Scene,
+    path: PathVertices<'_, 's>,
+    interactions: usize,
+) -> Validity {
+    let mut allowed = scene.max_interactions().saturating_sub(interactions);
+    let mut verdict = Validity::Valid;
+    walk_crossings(scene, path, |segment, _, by| {
+        if allowed == 0 {
+            verdict = Validity::Blocked { segment, by };
+            return false;
+        }
+        allowed -= 1;
+        true
+    });
+    verdict
+}
+
+/// Calls `each(segment, point, surface)` for every crossing of a penetrable surface on
+/// `path`, in path order, until `each` returns false. A segment crosses a penetrable surface that it would be
+/// blocked by were it opaque (the rule of [`blocker_excluding`]); where it crosses a seam
+/// between coplanar faces (normals within [`FLAT_WEDGE_RAD`], crossing points within the
+/// tolerance), it crosses once: the first face along the segment (the lower id at a tie).
+#[inline(always)]
+pub fn walk_crossings<'s>(
+    scene: &'s Scene,
+    path: PathVertices<'_, 's>,
+    mut each: impl FnMut(usize, Vec3, SurfaceId) -> bool,
+) {
+    let PathVertices {
+        vertex,
+        on,
+        points: n,
+    } = path;
+    let mut found: Vec<(Real, SurfaceId)> = Vec::new();
+    for segment in 0..=n {
+        let (a, b) = (vertex(segment), vertex(segment + 1));
+        segment_crossings(scene, (a, b), (on(segment), on(segment + 1)), &mut found);
+        for &(t, id) in &found {
+            if !each(segment, a + t * (b - a), id) {
+                return;
+            }
+        }
+    }
+}
+
+/// The penetrable surfaces the segment `a -> b` crosses, other than those its ends lie on
+/// (`from`, `to`), into `out` as (parameter along the segment, surface), ordered along it,
+/// seams crossed once (see [`walk_crossings`]).
+#[inline(always)]
+fn segment_crossings(
+    scene: &Scene,
+    (a, b): (Vec3, Vec3),
+    (from, to): (&[SurfaceId], &[SurfaceId]),
+    out: &mut Vec<(Real, SurfaceId)>,
+) {
+    out.clear();
+    let tol = scene.length_tolerance();
+    let length = a.distance(b);
+    let t_min = tol / length.max(tol);
+    scene.bvh().visit_segment(a, b, 2.0 * tol, |i| {
+        let id = SurfaceId(i);
+        if !scene.penetrable(id) || from.contains(&id) || to.contains(&id) {
+            return;
+        }
+        let polygon = &scene.surface(id).polygon;
+        if !polygon.blocks_segment(a, b, t_min, tol) {
+            return;
+        }
+        let plane = polygon.plane();
+        let (da, db) = (plane.signed_distance(a), plane.signed_distance(b));
+        if let Some(t) = bt_geom::Plane::crossing_parameter(da, db, a, b) {
+            out.push((t, id));
+        }
+    });
+    out.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+    let normal = |id: SurfaceId| scene.surface(id).polygon.plane().normal;
+    let mut kept = 0;
+    for k in 0..out.len() {
+        let seam = out[..kept].iter().any(|&(t, id)| {
+            (out[k].0 - t).abs() * length <= tol
+                && normal(id).dot(normal(out[k].1)).abs() >= FLAT_WEDGE_RAD.cos()
+        });
+        if !seam {
+            out[kept] = out[k];
+            kept += 1;
+        }
+    }
+    out.truncate(kept);
 }
 
 /// Why `p` is not a reflection point of surface `id` (point `index` of a path), or `None`
@@ -187,7 +316,8 @@ fn segment_ends(
     (start, end)
 }
 
-/// The first surface, other than those the segment's ends lie on (`from`, `to`: none for a
+/// The first surface that blocks (an opaque one; a penetrable one too unless `through`: then it
+/// is crossed, see [`walk_crossings`]), other than those the segment's ends lie on (`from`, `to`: none for a
 /// terminal, one for a reflection point, every surface touching the edge for a diffraction
 /// point), whose box grown by twice the scene's length tolerance (`blocks` may accept
 /// crossings within the tolerance outside a polygon) the segment `a -> b` touches and whose
@@ -197,6 +327,7 @@ fn first_blocking(
     scene: &Scene,
     (a, b): (Vec3, Vec3),
     (from, to): (&[SurfaceId], &[SurfaceId]),
+    through: bool,
     mut blocks: impl FnMut(&bt_geom::Polygon) -> bool,
 ) -> Option<SurfaceId> {
     let margin = 2.0 * scene.length_tolerance();
@@ -204,30 +335,34 @@ fn first_blocking(
         .bvh()
         .any_hit(a, b, margin, |i| {
             let id = SurfaceId(i);
-            !from.contains(&id) && !to.contains(&id) && blocks(&scene.surface(id).polygon)
+            let crossed = through && scene.penetrable(id);
+            !(from.contains(&id) || to.contains(&id) || crossed)
+                && blocks(&scene.surface(id).polygon)
         })
         .map(SurfaceId)
 }
 
 /// The first surface crossing the segment `a -> b` other than those its ends lie on (`from`,
-/// `to`: several at a diffraction point, which lies on every surface touching its edge).
+/// `to`: several at a diffraction point, which lies on every surface touching its edge):
+/// opaque surfaces only when `through` (the path may still cross penetrable ones), every
+/// surface otherwise.
 #[inline(always)]
 pub fn blocker_excluding(
     scene: &Scene,
-    a: Vec3,
-    b: Vec3,
-    from: &[SurfaceId],
-    to: &[SurfaceId],
+    (a, b): (Vec3, Vec3),
+    (from, to): (&[SurfaceId], &[SurfaceId]),
     tol: Real,
+    through: bool,
 ) -> Option<SurfaceId> {
     let length = a.distance(b);
     let t_min = tol / length.max(tol);
-    first_blocking(scene, (a, b), (from, to), |polygon| {
+    first_blocking(scene, (a, b), (from, to), through, |polygon| {
         polygon.blocks_segment(a, b, t_min, tol)
     })
 }
 
-/// The first surface (other than the segment's own end surfaces) crossing the segment `a -> b`.
+/// The first opaque surface (other than the segment's own end surfaces) crossing the segment
+/// `a -> b`.
 #[inline(always)]
 pub fn blocker(
     scene: &Scene,
@@ -237,7 +372,15 @@ pub fn blocker(
     to: Option<SurfaceId>,
     tol: Real,
 ) -> Option<SurfaceId> {
-    blocker_excluding(scene, a, b, from.as_slice(), to.as_slice(), tol)
+    blocker_excluding(scene, (a, b), (from.as_slice(), to.as_slice()), tol, true)
+}
+
+/// Whether a path with `interactions` reflections and diffractions may still cross penetrable
+/// surfaces (the scene has some, and the interaction budget is not spent): if not, a
+/// penetrable surface blocks it like an opaque one, and one early-exit test decides.
+#[inline(always)]
+pub fn may_cross(scene: &Scene, interactions: usize) -> bool {
+    scene.transmits() && scene.max_interactions() > interactions
 }
 
 /// Early stopping of IPC (`IpcOptions::early_reject`): the first segment of the path TX ->
@@ -272,7 +415,8 @@ pub fn blocked_for_good(
     for segment in 0..=n {
         let ((a, from), (b, to)) = segment_ends(seq, (tx, rx), points, segment);
         let length = a.distance(b);
-        let by = first_blocking(scene, (a, b), (from.as_slice(), to.as_slice()), |polygon| {
+        let ends = (from.as_slice(), to.as_slice());
+        let by = first_blocking(scene, (a, b), ends, true, |polygon| {
             // Unfused: the margins are far above its round-off, and the closure may be compiled
             // without the FMA feature (a software `fma` per call).
             let (da, db) = (

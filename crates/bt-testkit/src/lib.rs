@@ -198,6 +198,41 @@ fn random_unit(rng: &mut ChaCha8Rng) -> Vec3 {
 /// `terminals` picks how TX and RX are placed (0: random, 1: RX mirrored through an edge
 /// point of a surface, 2: TX in the plane of a surface).
 pub fn nasty_scene(seed: u64, n: usize, terminals: u8) -> Option<Scene> {
+    let d = nasty_description(seed, n, terminals);
+    // Random pieces may cross each other or put a terminal outside the room or on a surface:
+    // such draws are skipped (the scene validator says why), not forced.
+    Scene::from_description(&d, "nasty", Terminals::default()).ok()
+}
+
+/// [`nasty_scene`] with materials drawn per surface (seeded by `seed`): 6 mm glass or
+/// 12.5 mm plasterboard (slabs, penetrable under transmission), concrete (a half-space,
+/// opaque), or a 1 cm "curtain" slab whose material says `"transmission": true` (penetrable
+/// even without `--transmission`, blockers included); the room's walls plasterboard or
+/// concrete. For the transmission property tests.
+pub fn nasty_penetrable_scene(seed: u64, n: usize, terminals: u8) -> Option<Scene> {
+    let mut d = nasty_description(seed, n, terminals);
+    let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0x7ea5_5e1f);
+    d.materials.insert(
+        "curtain".into(),
+        bt_scene::MaterialDesc {
+            itu: Some("wood".into()),
+            thickness: Some(0.01),
+            transmission: Some(true),
+            ..Default::default()
+        },
+    );
+    const KINDS: [&str; 4] = ["glass", "plasterboard", "concrete", "curtain"];
+    for s in &mut d.surfaces {
+        s.material = Some(KINDS[rng.random_range(0..KINDS.len())].into());
+    }
+    for b in &mut d.boxes {
+        b.material = Some(["plasterboard", "concrete"][rng.random_range(0..2)].into());
+    }
+    Scene::from_description(&d, "nasty-penetrable", Terminals::default()).ok()
+}
+
+/// The description of [`nasty_scene`] (default materials).
+fn nasty_description(seed: u64, n: usize, terminals: u8) -> SceneDescription {
     let mut rng = ChaCha8Rng::seed_from_u64(seed);
     let size = Vec3::new(
         rng.random_range(3.0..7.0),
@@ -278,10 +313,7 @@ pub fn nasty_scene(seed: u64, n: usize, terminals: u8) -> Option<Scene> {
         surfaces.join(","),
         size.to_array()
     );
-    let d: SceneDescription = serde_json::from_str(&json).unwrap();
-    // Random pieces may cross each other or put a terminal outside the room or on a surface:
-    // such draws are skipped (the scene validator says why), not forced.
-    Scene::from_description(&d, "nasty", Terminals::default()).ok()
+    serde_json::from_str(&json).unwrap()
 }
 
 /// `desc` moved by `offset` (metres): every surface vertex, box corner, terminal (also per

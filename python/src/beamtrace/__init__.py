@@ -32,6 +32,7 @@ __all__ = [
     "Paths",
     "Scene",
     "Tracer",
+    "View",
     "builtin_names",
     "load",
     "study_beam_management",
@@ -57,7 +58,8 @@ class Paths:
     order: npt.NDArray[np.int64]
     """Number of interactions (0 = line of sight), shape (n,)."""
     interactions: List[List[str]]
-    """What happens at each point of each path: "reflection" or "diffraction"."""
+    """What happens at each point of each path: "reflection", "diffraction" or "transmission"
+    (a crossing of a penetrable surface)."""
     surfaces: List[List[str]]
     """The surface of each interaction, TX side first: "A|B" (a wedge's two faces) or "A" (a
     free edge's face) at a diffraction, with ``\\`` and ``|`` inside a face name written
@@ -82,6 +84,8 @@ class Paths:
     """Sum of the materials' reflection losses, dB, shape (n,)."""
     diffraction_loss_db: npt.NDArray[np.float64]
     """The diffraction's excess loss over free space, dB (0 for specular paths), shape (n,)."""
+    transmission_loss_db: npt.NDArray[np.float64]
+    """The crossings' loss (ITU-R P.2040 slab transmission), dB (0 without), shape (n,)."""
     loss_db: npt.NDArray[np.float64]
     """Total loss, dB, shape (n,)."""
     gain: npt.NDArray[np.complex128]
@@ -258,6 +262,7 @@ class Scene:
         max_diffractions: Optional[int] = None,
         min_edge_length: float = 0.0,
         diffraction_coefficient: str = "utd",
+        transmission: bool = False,
         tx_pattern: str = "iso",
         rx_pattern: str = "iso",
         tx_polarization: str = "V",
@@ -271,7 +276,9 @@ class Scene:
         an edge at least ``min_edge_length`` metres long, their gains with
         ``diffraction_coefficient`` "utd" (default) or "sionna-rt-2.2" (Sionna RT 2.2's gains,
         for comparing with Sionna: its combination, and its diffracted leg for a PathSolver
-        whose ``max_depth`` is ``max_order``; docs/channel.md §8).
+        whose ``max_depth`` is ``max_order``; docs/channel.md §8). ``transmission=True`` is
+        ``--transmission``: waves also cross every reflector whose material is a slab (ITU-R
+        P.2040 thin-slab transmission, no deflection; each crossing counts in ``max_order``).
 
         Options are ``beamtrace trace``'s flags: ``solver`` "image" | "ipc" | "sbr",
         ``candidates`` "beam-tree" | "wvrn" | "exhaustive", ``ipc_order`` "gauss-seidel" |
@@ -316,6 +323,7 @@ class Scene:
         max_diffractions: Optional[int] = None,
         min_edge_length: float = 0.0,
         diffraction_coefficient: str = "utd",
+        transmission: bool = False,
         tx_pattern: str = "iso",
         rx_pattern: str = "iso",
         tx_polarization: str = "V",
@@ -346,6 +354,48 @@ class Scene:
         )
         return [None if c is None else Paths(c) for c in results]
 
+    def view(
+        self, tx: Optional[Point] = None, rx: Optional[Point] = None, **options: Any
+    ) -> "View":
+        """The 3-D view of ``beamtrace view``: the scene with the paths from ``tx`` to ``rx``
+        (metres; the scene's own if None) traced with :meth:`trace`'s keywords, or the
+        geometry alone when a terminal is neither given nor in the scene. A Jupyter cell
+        shows it inline; :meth:`View.save` writes the page.
+
+        >>> scene.view(max_order=2, diffraction=True)      # last line of a notebook cell
+        """
+        keywords = _trace_keywords(options)
+        return View(self._native.view(_point(tx, "tx"), _point(rx, "rx"), keywords))
+
+
+class View:
+    """One offline HTML page (three.js inside) showing a scene and its paths: inline in
+    Jupyter (``_repr_html_``), or written with :meth:`save` and opened in a browser."""
+
+    def __init__(self, html: str) -> None:
+        self.html = html
+        """The whole page, as ``beamtrace view`` writes it."""
+
+    def _repr_html_(self) -> str:
+        escaped = self.html.replace("&", "&amp;").replace('"', "&quot;")
+        return f'<iframe srcdoc="{escaped}" style="width:100%;height:520px;border:0"></iframe>'
+
+    def save(self, path: Union[str, "os.PathLike[str]"]) -> None:
+        """Write the page to ``path`` (a new file, or one this view wrote before: an existing
+        file is refused with ``FileExistsError`` unless it holds a beamtrace page)."""
+        path = os.fspath(path)
+        if os.path.exists(path):
+            with open(path, encoding="utf-8", errors="replace") as f:
+                if "<title>beamtrace view:" not in f.read(4096):
+                    raise FileExistsError(f"{path} exists and is not a beamtrace view: not replaced")
+        tmp = f"{path}.{os.getpid()}.tmp"
+        with open(tmp, "w", encoding="utf-8") as f:
+            f.write(self.html)
+        os.replace(tmp, path)
+
+    def __repr__(self) -> str:
+        return f"View({len(self.html) // 1024} KiB)"
+
 
 class Tracer:
     """The real-time loop of ``beamtrace serve`` in Python: a scene kept loaded with one
@@ -361,12 +411,26 @@ class Tracer:
     and RX). ``tx`` overrides the scene's transmitter. ``options`` are :meth:`Scene.trace`'s
     keywords with its defaults (``max_order=3``, ``solver``, ``diffraction``, ...); an unknown
     one raises ``TypeError``, a bad value ``ValueError``, here.
+
+    With ``tx_array`` or ``rx_array`` (``(rows, columns)``; the other one 1 × 8) every answer
+    also holds ``"beams"``, as ``serve --tx-array/--rx-array``: the beam sweep of ``beamtrace
+    beams`` over the answer's paths, its ``best`` pair and the first ``top`` pairs, with
+    ``tx_spacing``/``rx_spacing`` (wavelengths), ``ranking`` ("power" or "paper") and the
+    ``max_beam_pairs`` budget.
     """
 
     def __init__(
         self,
         scene: Union[str, "os.PathLike[str]", Scene],
         tx: Optional[Point] = None,
+        *,
+        tx_array: Optional[Sequence[int]] = None,
+        rx_array: Optional[Sequence[int]] = None,
+        tx_spacing: float = 0.5,
+        rx_spacing: float = 0.5,
+        ranking: str = "power",
+        top: int = 5,
+        max_beam_pairs: int = _native.DEFAULT_MAX_BEAM_PAIRS,
         **options: Any,
     ) -> None:
         rx = None
@@ -377,7 +441,21 @@ class Tracer:
         else:
             source = os.fspath(scene)
         keywords = _trace_keywords(options)
-        self._native = _native.Tracer(source, keywords, _point(tx, "tx"), _point(rx, "rx"))
+        beams = None
+        if tx_array is not None or rx_array is not None:
+            shape = lambda a: None if a is None else (int(a[0]), int(a[1]))  # noqa: E731
+            beams = {
+                "tx_array": shape(tx_array),
+                "rx_array": shape(rx_array),
+                "tx_spacing": float(tx_spacing),
+                "rx_spacing": float(rx_spacing),
+                "ranking": ranking,
+                "top": int(top),
+                "max_beam_pairs": int(max_beam_pairs),
+            }
+        self._native = _native.Tracer(
+            source, keywords, _point(tx, "tx"), _point(rx, "rx"), beams
+        )
 
     def update(
         self,
@@ -458,6 +536,7 @@ def _options(arguments: Dict[str, Any]) -> Dict[str, Any]:
             "max_candidates",
             "max_wvrn_tests",
             "parallel",
+            "transmission",
         )
     }
     threshold = arguments["ipc_threshold"]
@@ -500,20 +579,22 @@ def load(
     max_file_bytes: int = _native.DEFAULT_MAX_FILE_BYTES,
     max_xml_substitution: int = _native.DEFAULT_MAX_XML_SUBSTITUTION,
     max_mesh_elements: int = _native.DEFAULT_MAX_MESH_ELEMENTS,
+    max_cloud_points: int = _native.DEFAULT_MAX_CLOUD_POINTS,
     cache: bool = False,
     frequency: Optional[float] = None,
     material: Optional[str] = None,
     thickness: Optional[float] = None,
 ) -> Scene:
-    """Load a scene: a file the CLI reads (.json, .toml, .obj, .ply) or ``"builtin:NAME"``.
+    """Load a scene: a file the CLI reads (.json, .toml, .obj, .ply mesh, Mitsuba .xml, .ply/.pcd
+    point cloud, whose planes are extracted as the CLI does) or ``"builtin:NAME"``.
 
     ``tx``/``rx`` override the file's terminals. Meshes, XML scenes and point clouds carry
     none: load them bare and give ``tx``/``rx`` to each :meth:`Scene.trace`. The mesh
     options are ``beamtrace trace``'s ``--min-reflector-area`` (m²), ``--merge-angle-deg`` and
     ``--merge-distance`` (m); the budgets are its ``--max-file-bytes`` (any input file),
-    ``--max-xml-substitution`` (bytes an XML scene's ``$parameters`` expand to) and
-    ``--max-mesh-elements`` (vertices and faces of a mesh, or of all meshes of an XML scene),
-    each checked before the work. ``cache=True`` is ``--cache``: the loaded scene is kept in
+    ``--max-xml-substitution`` (bytes an XML scene's ``$parameters`` expand to),
+    ``--max-mesh-elements`` (vertices and faces of a mesh, or of all meshes of an XML scene) and
+    ``--max-cloud-points`` (points a point-cloud file declares), each checked before the work. ``cache=True`` is ``--cache``: the loaded scene is kept in
     the user's cache directory (``$BEAMTRACE_CACHE_DIR``, else ``$XDG_CACHE_HOME/beamtrace``,
     else ``~/.cache/beamtrace``) and read from there while the files and options are unchanged;
     a damaged entry is rebuilt with a :class:`RuntimeWarning`. ``frequency`` (Hz),
@@ -535,6 +616,7 @@ def load(
             "max_file_bytes": max_file_bytes,
             "max_xml_substitution": max_xml_substitution,
             "max_mesh_elements": max_mesh_elements,
+            "max_cloud_points": max_cloud_points,
         },
         cache=bool(cache),
         frequency=None if frequency is None else float(frequency),

@@ -15,6 +15,8 @@ DEFAULT_MAX_RAYS: int
 DEFAULT_MAX_FILE_BYTES: int
 DEFAULT_MAX_XML_SUBSTITUTION: int
 DEFAULT_MAX_MESH_ELEMENTS: int
+DEFAULT_MAX_CLOUD_POINTS: int
+DEFAULT_MAX_BEAM_PAIRS: int
 
 class BeamtraceError(Exception): ...
 
@@ -45,10 +47,17 @@ class Scene:
         keywords: Dict[str, Any],
         skip_errors: bool,
     ) -> List[Optional[Dict[str, Any]]]: ...
+    def view(self, tx: _Point, rx: _Point, keywords: Dict[str, Any]) -> str: ...
+    def to_bytes(self) -> bytes: ...
 
 class Tracer:
     def __init__(
-        self, source: str, keywords: Dict[str, Any], tx: _Point, rx: _Point
+        self,
+        source: str,
+        keywords: Dict[str, Any],
+        tx: _Point,
+        rx: _Point,
+        beams: Optional[Dict[str, Any]] = None,
     ) -> None: ...
     def answer(self, line: str) -> str: ...
 
@@ -67,6 +76,7 @@ def load(
     thickness: Optional[float] = None,
 ) -> Scene: ...
 def builtin_names() -> List[str]: ...
+def scene_from_bytes(source: str, data: bytes) -> Scene: ...
 def study_beam_management(
     out: str,
     *,

@@ -14,4 +14,5 @@ mod serve;
 mod study;
 mod sweep;
 mod terminals;
+mod transmission;
 mod wvrn_steps;

@@ -190,3 +190,78 @@ fn a_unix_socket_round_trip_and_a_users_file_is_never_replaced() {
     let err = String::from_utf8_lossy(&again.stderr);
     assert!(err.contains("another server is listening"), "{err}");
 }
+
+/// With --tx-array/--rx-array each answer holds the beam sweep of `beams` for its receiver:
+/// the best pair and the first --top pairs equal `beams --json`'s ranked list; without arrays
+/// no "beams"; an over-budget sweep is refused before the stream starts.
+#[test]
+fn arrays_give_each_answer_the_beam_sweep_of_beams() {
+    let receivers = [[2.3, 2.1, 0.72], [1.0, 1.0, 1.2]];
+    let lines: Vec<String> = (receivers.iter().enumerate())
+        .map(|(i, rx)| json!({"id": i, "rx": rx}).to_string())
+        .collect();
+    let arrays = [
+        "--tx-array",
+        "2x4",
+        "--rx-array",
+        "1x4",
+        "--ranking",
+        "paper",
+    ];
+    let mut child = spawn(&[&["serve", "builtin:living-room", "--top", "3"][..], &arrays].concat());
+    let mut stdin = child.stdin.take().unwrap();
+    stdin
+        .write_all((lines.join("\n") + "\n").as_bytes())
+        .unwrap();
+    drop(stdin);
+    let out = child.wait_with_output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    for (answer, rx) in answers(&String::from_utf8(out.stdout).unwrap())
+        .iter()
+        .zip(receivers)
+    {
+        let at = format!("{},{},{}", rx[0], rx[1], rx[2]);
+        let sweep = run_json(
+            &[
+                &["beams", "builtin:living-room", "--rx", &at, "--json"][..],
+                &arrays,
+            ]
+            .concat(),
+        );
+        let beams = &answer["beams"];
+        let pairs = sweep["pairs"].as_array().unwrap();
+        assert_eq!(beams["top"].as_array().unwrap()[..], pairs[..3], "rx {at}");
+        assert_eq!(beams["best"], pairs[0]);
+        assert_eq!(
+            (&beams["tx_beams"], &beams["rx_beams"]),
+            (&json!(8), &json!(4))
+        );
+        assert_eq!(beams["ranking"], "paper");
+    }
+    let mut plain = spawn(&["serve", "builtin:living-room"]);
+    plain
+        .stdin
+        .take()
+        .unwrap()
+        .write_all(b"{\"rx\": [1, 1, 1.2]}\n")
+        .unwrap();
+    let plain = answers(&String::from_utf8(plain.wait_with_output().unwrap().stdout).unwrap());
+    assert!(plain[0].get("beams").is_none(), "{}", plain[0]);
+    crate::common::assert_clear_error(
+        &[
+            "serve",
+            "builtin:living-room",
+            "--tx-array",
+            "8x8",
+            "--rx-array",
+            "8x8",
+            "--max-beam-pairs",
+            "100",
+        ],
+        &["beam pairs", "100"],
+    );
+}

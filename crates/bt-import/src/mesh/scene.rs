@@ -42,6 +42,7 @@ pub fn from_mesh(
                                 .normal_loss_db(options.frequency_hz)
                                 .unwrap_or(default.reflection_loss_db),
                             radio: Some(radio),
+                            transmission: false,
                         },
                         Err(_) => {
                             warnings.push(format!(

@@ -198,3 +198,33 @@ fn a_damaged_entry_is_rebuilt_with_a_warning() {
     }
     std::fs::remove_dir_all(cache_dir).ok();
 }
+
+/// Every material field survives the cache: a constant-loss material (no radio model), a slab
+/// whose material opens it to transmission, the defaults. (Postcard, the entry's encoding, is
+/// not self-describing: a field skipped when empty would shift every later byte.)
+#[test]
+fn every_material_field_survives_the_cache() {
+    let dir = scratch("materials");
+    std::fs::create_dir_all(&dir).unwrap();
+    let file = dir.join("m.json");
+    std::fs::write(
+        &file,
+        r#"{ "materials": { "old": { "reflection_loss_db": 3 },
+                          "curtain": { "itu": "wood", "thickness": 0.01, "transmission": true } },
+             "surfaces": [
+               { "name": "a", "material": "old", "vertices": [[0, 0, 0], [1, 0, 0], [1, 1, 0]] },
+               { "name": "b", "material": "curtain", "vertices": [[0, 0, 1], [1, 0, 1], [1, 1, 1]] } ] }"#,
+    )
+    .unwrap();
+    let cache = LoadCache::at(dir.join("cache"));
+    let path = file.display().to_string();
+    let options = LoadOptions::default();
+    let fresh = bt_import::load(&path, &options).unwrap();
+    cache.load(&path, &options, &mut |_| {}).unwrap();
+    let (cached, notes) = cache.load(&path, &options, &mut |_| {}).unwrap();
+    assert_eq!(notes, Vec::<String>::new(), "the entry decodes");
+    assert_same(&fresh, &cached);
+    assert!(cached.scene.materials()["curtain"].transmission);
+    assert!(cached.scene.penetrable(bt_scene::SurfaceId(1)));
+    std::fs::remove_dir_all(dir).ok();
+}

@@ -62,6 +62,22 @@ pub fn random_scene_config() -> proptest::test_runner::Config {
     }
 }
 
+/// The valid paths of `scene` traced between its own terminals under `options`.
+pub fn paths_of(scene: &Scene, options: &TraceOptions) -> Vec<FoundPath> {
+    trace_scene(scene, options)
+        .expect("trace runs")
+        .result
+        .paths
+}
+
+/// Each path as (its interactions, its points): what two traces must agree on.
+pub fn listing(paths: &[FoundPath]) -> Vec<(Vec<bt_solve::Interaction>, Vec<Vec3>)> {
+    paths
+        .iter()
+        .map(|p| (p.interactions(), p.points.clone()))
+        .collect()
+}
+
 /// Trace `scene` between its own terminals with a fresh [`Tracer`].
 pub fn trace_scene(scene: &Scene, options: &TraceOptions) -> Result<Traced, TraceError> {
     Tracer::new(scene.clone(), *options).trace(scene.tx_world().unwrap(), scene.rx_world().unwrap())

@@ -3,11 +3,11 @@
 //! concave corners, coplanar neighbours and grazing terminals), the closed form obeys Keller's
 //! law and minimises the length along the edge, and IPC finds what the image method finds.
 
-use crate::common::{angle_between, scene_from_json, trace_scene};
+use crate::common::{angle_between, listing, paths_of, scene_from_json, trace_scene};
 use bt_geom::{Real, Vec3};
 use bt_scene::{Scene, SurfaceId};
 use bt_solve::pipeline::{CandidateMode, DiffractionOptions, TraceOptions};
-use bt_solve::{FoundPath, Interaction, IpcOptions, Solver, UpdateOrder};
+use bt_solve::{FoundPath, IpcOptions, Solver, UpdateOrder};
 use bt_testkit::nasty_scene;
 use proptest::prelude::*;
 
@@ -22,17 +22,7 @@ fn options(max_order: usize, mode: CandidateMode, solver: Solver) -> TraceOption
 }
 
 fn paths(scene: &Scene, max_order: usize, mode: CandidateMode, solver: Solver) -> Vec<FoundPath> {
-    trace_scene(scene, &options(max_order, mode, solver))
-        .expect("trace runs")
-        .result
-        .paths
-}
-
-fn listing(paths: &[FoundPath]) -> Vec<(Vec<Interaction>, Vec<Vec3>)> {
-    paths
-        .iter()
-        .map(|p| (p.interactions(), p.points.clone()))
-        .collect()
+    paths_of(scene, &options(max_order, mode, solver))
 }
 
 /// Largest deviation from Keller's law over the diffracted paths, as |cos β_in − cos β_out|.

@@ -28,6 +28,7 @@ fn image(candidates: CandidateMode, max_order: usize, parallel: bool) -> TraceOp
         max_candidates: u64::MAX,
         max_wvrn_tests: u64::MAX,
         parallel,
+        transmission: false,
         diffraction: Default::default(),
     }
 }

@@ -12,4 +12,5 @@ mod newton;
 mod sionna;
 mod terminals;
 mod translation;
+mod transmission;
 mod wvrn_completeness;

@@ -5,7 +5,8 @@
 //! spread reported (Sionna 2.2's coefficient is not Kouyoumjian–Pathak's:
 //! docs/sionna-diffraction-notes.md, docs/channel.md §8); with Sionna's coefficient and
 //! Sionna's diffracted leg (`bt_channel::path_gain_sionna_rt22`), every diffracted gain where
-//! Sionna's wedge is ours is Sionna's within 0.1 dB.
+//! Sionna's wedge is ours is Sionna's within 0.1 dB. With Sionna's refraction (its thin slab),
+//! every path it finds through walls is one of ours under `--transmission`, with its gain.
 
 use bt_beams::{InteractionKind, PathReport, RadioOptions};
 use bt_channel::DiffractionCoefficient;
@@ -51,6 +52,7 @@ fn expected(path: &Value) -> Expected {
     let kind = |k: &Value| match k.as_str().unwrap() {
         "reflection" => InteractionKind::Reflection,
         "diffraction" => InteractionKind::Diffraction,
+        "refraction" => InteractionKind::Transmission,
         other => panic!("unexpected interaction {other}"),
     };
     Expected {
@@ -180,6 +182,21 @@ fn reference(case: &str) -> (Value, bt_scene::Scene) {
     (doc, scene)
 }
 
+/// Our paths from `tx` to `rx` (world frame), each described with `radio`, and the scene
+/// with those terminals.
+fn described(
+    tracer: &mut Tracer,
+    (tx, rx): (Vec3, Vec3),
+    radio: &RadioOptions,
+) -> (bt_scene::Scene, Vec<(PathReport, FoundPath)>) {
+    let traced = tracer.trace(tx, rx).unwrap();
+    let scene = tracer.scene().with_terminals(tx, rx).unwrap();
+    let ours = (traced.result.paths.into_iter())
+        .map(|p| (bt_beams::describe(&scene, &p, radio).unwrap(), p))
+        .collect();
+    (scene, ours)
+}
+
 fn compare_case(case: &str, gains: Gains, out: &mut Differences) {
     let (doc, scene) = reference(case);
     let max_depth = doc["max_depth"].as_u64().unwrap() as usize;
@@ -192,11 +209,7 @@ fn compare_case(case: &str, gains: Gains, out: &mut Differences) {
     let tx = vec3(&doc["tx"]["position"]);
     for receiver in doc["receivers"].as_array().unwrap() {
         let rx = vec3(&receiver["position"]);
-        let traced = tracer.trace(tx, rx).unwrap();
-        let scene = tracer.scene().with_terminals(tx, rx).unwrap();
-        let ours: Vec<(PathReport, &FoundPath)> = (traced.result.paths.iter())
-            .map(|p| (bt_beams::describe(&scene, p, &radio).unwrap(), p))
-            .collect();
+        let (scene, ours) = described(&mut tracer, (tx, rx), &radio);
         for path in receiver["paths"].as_array().unwrap() {
             let e = expected(path);
             match matching(&ours, &e, 0.01) {
@@ -415,4 +428,53 @@ fn with_the_unfolded_leg_only_paths_reflecting_after_the_edge_differ() {
     assert!(plain.len() >= 190 && within(&plain, 0.1) == plain.len());
     assert!(grown.len() >= 60 && within(&grown, 1.0) == 0);
     assert!(grown.iter().all(|p| p.diff_db > 2.0 && p.diff_db < 9.0));
+}
+
+/// Sionna RT's refraction on the street canyon (`canyon-refraction-d2`: every material an ITU
+/// slab 0.1 m thick, no diffraction, `max_depth` 2): every path Sionna finds, through walls or
+/// not, is one of ours traced with transmission (same kinds in order, points within 1 cm), with
+/// its gain within 0.05 dB; and we find at least as many (Sionna samples its rays).
+#[test]
+fn sionnas_refracted_paths_are_ours_with_their_gains() {
+    let (doc, scene) = reference("canyon-refraction-d2");
+    let max_depth = doc["max_depth"].as_u64().unwrap() as usize;
+    let trace = TraceOptions {
+        transmission: true,
+        ..TraceOptions::new(max_depth)
+    };
+    let radio = RadioOptions::default().for_order(max_depth);
+    let mut tracer = Tracer::new(scene, trace);
+    let tx = vec3(&doc["tx"]["position"]);
+    let (mut crossing, mut worst, mut ours_total, mut theirs_total) = (0, 0.0 as Real, 0, 0);
+    for receiver in doc["receivers"].as_array().unwrap() {
+        let rx = vec3(&receiver["position"]);
+        let (_, ours) = described(&mut tracer, (tx, rx), &radio);
+        let theirs = receiver["paths"].as_array().unwrap();
+        for path in theirs {
+            let e = expected(path);
+            let Some((p, _)) = matching(&ours, &e, 0.01) else {
+                panic!(
+                    "rx {rx}: Sionna's {:?} at {:?} not found",
+                    e.kinds, e.vertices
+                );
+            };
+            let diff = p.gain_db.unwrap() - e.gain_db;
+            crossing += usize::from(e.kinds.contains(&InteractionKind::Transmission));
+            worst = worst.max(diff.abs());
+            assert!(
+                diff.abs() <= 0.05,
+                "rx {rx}: {:?} ours {:.4} dB, Sionna {:.4} dB",
+                e.kinds,
+                p.gain_db.unwrap(),
+                e.gain_db
+            );
+        }
+        ours_total += ours.len();
+        theirs_total += theirs.len();
+    }
+    eprintln!(
+        "canyon-refraction-d2: Sionna {theirs_total} paths ({crossing} through walls), ours \
+         {ours_total}; worst gain difference {worst:.4} dB"
+    );
+    assert!(crossing > 0 && ours_total >= theirs_total);
 }
