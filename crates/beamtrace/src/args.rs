@@ -95,6 +95,71 @@ pub enum StudyCommand {
     /// image method vs IPC vs SBR vs the FPGA's fixed-point IPC with per-step cycle counts
     /// (writes results.csv, fpga.csv, summary.md and Figs. 17-19 as SVG and PNG into --out).
     LivingRoom(StudyLivingRoomArgs),
+    /// Issue 31: twin-driven beam selection against exhaustive, hierarchical and
+    /// keep-previous sweeps with TR 38.843's metrics, a UE moving through each scenario
+    /// (writes summary.json, details.json, decisions.csv, trajectory.csv and two figures
+    /// into --out; docs/study-beam-management.md).
+    BeamManagement(StudyBeamManagementArgs),
+}
+
+#[derive(Debug, Args, Clone)]
+pub struct StudyBeamManagementArgs {
+    /// Output directory (created if missing).
+    #[arg(long)]
+    pub out: PathBuf,
+    /// Scenario: `living-room` (the dynamic living room, a UE walking a loop), `city` (a
+    /// street of the built-in city) or a scene file (a street through its TX and RX);
+    /// repeat for several. Default: living-room and city.
+    #[arg(long = "scenario")]
+    pub scenarios: Vec<String>,
+    /// Seed of every random draw (echoed into details.json).
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// UE positions (decisions) per scenario.
+    #[arg(long, default_value_t = 1000)]
+    pub positions: usize,
+    /// Highest interaction order of the truth (a diffraction counts as one).
+    #[arg(long, default_value_t = 2)]
+    pub max_order: usize,
+    /// Leave diffraction out of the truth.
+    #[arg(long)]
+    pub no_diffraction: bool,
+    /// Highest reflection order of the twins' traces.
+    #[arg(long, default_value_t = 2)]
+    pub twin_max_order: usize,
+    /// Let the twins trace first-order diffraction too.
+    #[arg(long)]
+    pub twin_diffraction: bool,
+    /// Standard deviation of the L1-RSRP measurement error, dB.
+    #[arg(long, default_value_t = 1.0, value_parser = numbers::decibels)]
+    pub rsrp_noise_db: f64,
+    /// L1-RSRP reporting step, dB (3GPP: 1; 0 reports exact values).
+    #[arg(long, default_value_t = 1.0, value_parser = numbers::decibels)]
+    pub rsrp_step_db: f64,
+    /// The twins' UE position errors σ (horizontal, per axis), metres, comma-separated.
+    #[arg(long, value_delimiter = ',', default_values_t = [0.0, 0.05, 0.3, 1.0], value_parser = numbers::length_m)]
+    pub position_sigmas: Vec<f64>,
+    /// The twins' reporting latencies, milliseconds, comma-separated.
+    #[arg(long, value_delimiter = ',', default_values_t = [0.0, 100.0], value_parser = numbers::milliseconds)]
+    pub latencies_ms: Vec<f64>,
+    /// The K of the twin top-K methods, comma-separated.
+    #[arg(long, value_delimiter = ',', default_values_t = [1, 2, 4, 8])]
+    pub top_k: Vec<usize>,
+    /// Transmitted power per resource element, dBm.
+    #[arg(long, default_value_t = -6.0, value_parser = numbers::power_dbm, allow_hyphen_values = true)]
+    pub tx_power_dbm: f64,
+    /// Points per m² of the scan behind the extracted twin (0: no extracted twin).
+    #[arg(long, default_value_t = 2000.0, value_parser = numbers::scan_density)]
+    pub scan_density: f64,
+    /// Range noise of the scan, metres.
+    #[arg(long, default_value_t = 0.005, value_parser = numbers::length_m)]
+    pub scan_noise: f64,
+    /// Budget: no extracted twin from a scan of more points than this.
+    #[arg(long, default_value_t = 5_000_000)]
+    pub max_scan_points: u64,
+    /// Budget: stop before the work rather than enumerate more candidates than this.
+    #[arg(long, default_value_t = bt_solve::pipeline::DEFAULT_MAX_CANDIDATES)]
+    pub max_candidates: u64,
 }
 
 #[derive(Debug, Args, Clone)]

@@ -92,6 +92,9 @@ fn run(cli: args::Cli) -> anyhow::Result<ExitCode> {
         args::Command::Study {
             command: args::StudyCommand::LivingRoom(a),
         } => study::run_living_room(&a),
+        args::Command::Study {
+            command: args::StudyCommand::BeamManagement(a),
+        } => study::run_beam_management(&a),
     }
 }
 

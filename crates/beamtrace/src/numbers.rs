@@ -195,6 +195,43 @@ pub fn power_dbm(s: &str) -> Result<f64, String> {
     )
 }
 
+/// A measurement error, reporting step or margin: 0 to 100 dB (more means nothing to a
+/// beam report).
+pub fn decibels(s: &str) -> Result<f64, String> {
+    checked(
+        s,
+        Range {
+            low: Included(0.0),
+            high: Included(100.0),
+            unit: "dB",
+        },
+    )
+}
+
+/// A latency: 0 to one hour, in milliseconds.
+pub fn milliseconds(s: &str) -> Result<f64, String> {
+    checked(
+        s,
+        Range {
+            low: Included(0.0),
+            high: Included(3.6e6),
+            unit: "ms",
+        },
+    )
+}
+
+/// A scan density: 0 (no scan) to 1e7 points/m² (a point every 0.3 mm).
+pub fn scan_density(s: &str) -> Result<f64, String> {
+    checked(
+        s,
+        Range {
+            low: Included(0.0),
+            high: Included(1e7),
+            unit: "points/m²",
+        },
+    )
+}
+
 /// An array element spacing: above 0, at most 1000 wavelengths.
 pub fn spacing_wavelengths(s: &str) -> Result<f64, String> {
     checked(

@@ -1,7 +1,10 @@
-//! `beamtrace study 2d` and `study living-room`: run a study with a progress bar and write
+//! `beamtrace study 2d`, `study living-room` and `study beam-management`: run a study with a progress bar and write
 //! its outputs (the studies themselves live in `bt-study`).
 
-use crate::args::{SceneArgs, Study2dArgs, StudyLivingRoomArgs};
+use crate::args::{SceneArgs, Study2dArgs, StudyBeamManagementArgs, StudyLivingRoomArgs};
+use anyhow::Context;
+use bt_study::beam_management::scenario::{ScanSettings, Scenario};
+use bt_study::beam_management::{self, BeamManagementConfig};
 use bt_study::living_room::{self, LivingRoomConfig};
 use bt_study::{StudyConfig, report};
 use std::io::Write;
@@ -114,4 +117,88 @@ pub fn run_living_room(args: &StudyLivingRoomArgs) -> anyhow::Result<ExitCode> {
     );
     print_headline_and_files(&headline, &done.files);
     Ok(ExitCode::SUCCESS)
+}
+
+pub fn run_beam_management(args: &StudyBeamManagementArgs) -> anyhow::Result<ExitCode> {
+    let config = BeamManagementConfig {
+        positions: args.positions,
+        seed: args.seed,
+        truth_max_order: args.max_order,
+        truth_diffraction: !args.no_diffraction,
+        twin_max_order: args.twin_max_order,
+        twin_diffraction: args.twin_diffraction,
+        rsrp_noise_db: args.rsrp_noise_db,
+        rsrp_step_db: args.rsrp_step_db,
+        position_sigmas_m: args.position_sigmas.clone(),
+        latencies_s: args.latencies_ms.iter().map(|ms| ms / 1e3).collect(),
+        top_k: args.top_k.clone(),
+        tx_power_dbm: args.tx_power_dbm,
+        scan: ScanSettings {
+            density_per_m2: args.scan_density,
+            noise_m: args.scan_noise,
+            max_points: args.max_scan_points,
+            seed: args.seed,
+        },
+        max_candidates: args.max_candidates,
+        ..BeamManagementConfig::default()
+    };
+    let problems = config.problems();
+    if !problems.is_empty() {
+        anyhow::bail!("{}", problems.join("; "));
+    }
+    let names = match args.scenarios.is_empty() {
+        true => vec!["living-room".to_string(), "city".to_string()],
+        false => args.scenarios.clone(),
+    };
+    let mut scenarios = Vec::new();
+    let mut inputs = Vec::new();
+    for name in &names {
+        let bar = crate::progress::spinner(&format!("scenario {name}: loading, scanning"));
+        let (scenario, sources) = beam_management_scenario(name, &config)?;
+        bar.finish_and_clear();
+        scenarios.push(scenario);
+        inputs.extend(sources);
+    }
+    let total = beam_management::planned_traces(&scenarios, &config);
+    let bar = crate::progress::counter(total as u64, "traces");
+    let results = beam_management::run(&scenarios, &config, &mut |done, _| {
+        bar.set_position(done as u64)
+    })?;
+    bar.finish_and_clear();
+    let done = bt_study::io::write_beam_management(&args.out, &results, &inputs)?;
+    crate::files::warn_left_alone(&done);
+    let mut headline = format!(
+        "seed {}, {} positions per scenario",
+        config.seed, config.positions
+    );
+    for s in &results.scenarios {
+        let of = |name: &str| s.methods.iter().find(|m| m.name == name);
+        let part = |name: &str, label: &str| {
+            of(name).map_or(String::new(), |m| {
+                format!(
+                    "; {label}: top-1 {:.3}, loss {:.2} dB mean, {:.1} beams",
+                    m.metrics.top1, m.metrics.snr_loss_db_mean, m.metrics.beams_measured
+                )
+            })
+        };
+        headline += &format!("\n{}", s.name);
+        headline += &part("exhaustive", "exhaustive");
+        headline += &part("twin-exact-s0.05m-l0ms-top4", "exact twin top-4 at 5 cm");
+    }
+    print_headline_and_files(&headline, &done.files);
+    Ok(ExitCode::SUCCESS)
+}
+
+/// Load the scenario `name` (`living-room`, `city` or a scene file) and build it; returns it
+/// and the files read.
+fn beam_management_scenario(
+    name: &str,
+    config: &BeamManagementConfig,
+) -> anyhow::Result<(Scenario, Vec<PathBuf>)> {
+    let source = beam_management::scenario::source_of(name);
+    let loaded = crate::load::load_dynamic(&SceneArgs::defaults_for(source))
+        .with_context(|| format!("--scenario {name}"))?;
+    let scenario = Scenario::named(name, loaded.scene, config.positions, &config.scan)
+        .with_context(|| format!("--scenario {name}"))?;
+    Ok((scenario, loaded.sources))
 }

@@ -468,6 +468,54 @@ fn builtin_names() -> Vec<&'static str> {
     bt_import::builtin_names().to_vec()
 }
 
+/// The CLI's `study beam-management` with its defaults but for the arguments given: run the
+/// study over `scenarios` (`living-room`, `city` or scene files; default both built-ins),
+/// write its files into `out` and return `summary.json`'s text. Bad settings raise
+/// `ValueError` naming the CLI's option; a scene or output problem `BeamtraceError`.
+#[pyfunction]
+#[pyo3(signature = (out, *, scenarios=None, seed=1, positions=1000, scan_density=2000.0))]
+fn study_beam_management(
+    py: Python<'_>,
+    out: std::path::PathBuf,
+    scenarios: Option<Vec<String>>,
+    seed: u64,
+    positions: usize,
+    scan_density: f64,
+) -> PyResult<String> {
+    use bt_study::beam_management::{self as study, BeamManagementConfig, scenario};
+    let defaults = BeamManagementConfig::default();
+    let config = BeamManagementConfig {
+        positions,
+        seed,
+        scan: scenario::ScanSettings {
+            density_per_m2: scan_density,
+            seed,
+            ..defaults.scan
+        },
+        ..defaults
+    };
+    let problems = config.problems();
+    if !problems.is_empty() {
+        return Err(PyValueError::new_err(problems.join("; ")));
+    }
+    let names = scenarios.unwrap_or_else(|| vec!["living-room".into(), "city".into()]);
+    py.detach(|| {
+        let (mut built, mut inputs) = (Vec::new(), Vec::new());
+        for name in &names {
+            let source = scenario::source_of(name);
+            let loaded = bt_import::load_dynamic(source, &LoadOptions::default(), &mut |_| {})
+                .map_err(|e| error(format!("scenario {name}: {e}")))?;
+            let s = scenario::Scenario::named(name, loaded.scene, positions, &config.scan)
+                .map_err(|e| error(format!("scenario {name}: {e}")))?;
+            built.push(s);
+            inputs.extend(loaded.sources);
+        }
+        let results = study::run(&built, &config, &mut |_, _| {}).map_err(error)?;
+        bt_study::io::write_beam_management(&out, &results, &inputs).map_err(error)?;
+        serde_json::to_string(&study::report::summary(&results)).map_err(error)
+    })
+}
+
 #[pymodule]
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("BeamtraceError", m.py().get_type::<BeamtraceError>())?;
@@ -501,5 +549,6 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(load, m)?)?;
     m.add_function(wrap_pyfunction!(builtin_names, m)?)?;
     m.add_function(wrap_pyfunction!(scene_from_bytes, m)?)?;
+    m.add_function(wrap_pyfunction!(study_beam_management, m)?)?;
     Ok(())
 }

@@ -1,6 +1,7 @@
 //! The only module of the studies that touches the filesystem: writes `results.csv`,
 //! `summary.md` and the figures as SVG and PNG into an output directory.
 
+use crate::beam_management::{self, BeamManagementResults};
 use crate::living_room::{self, LivingRoomResults};
 use crate::run::{RoomDrawing, StudyResults};
 use crate::{StudyError, plot, report};
@@ -144,4 +145,68 @@ pub fn write_living_room(
         LivingRoomResults
     );
     Ok(out.commit()?)
+}
+
+/// Write every output of the beam-management study into `dir` (created if missing; built aside
+/// and moved in): `summary.json`, `details.json`, `decisions.csv`, `trajectory.csv` and the
+/// figures `accuracy-vs-overhead` and `snr-loss-cdf` as SVG and PNG, refusing to replace any
+/// of `inputs` (the scenes' files). Returns the files written and those left alone.
+pub fn write_beam_management(
+    dir: &Path,
+    results: &BeamManagementResults,
+    inputs: &[PathBuf],
+) -> Result<Committed, StudyError> {
+    let json = |v: &dyn erased::Json| v.text();
+    let mut out = OutputDir::begin(dir, inputs)?;
+    write(
+        &mut out,
+        "summary.json",
+        &json(&beam_management::report::summary(results)),
+    )?;
+    write(
+        &mut out,
+        "details.json",
+        &json(&beam_management::report::details(results)),
+    )?;
+    write(
+        &mut out,
+        "decisions.csv",
+        &beam_management::report::decisions_csv(results),
+    )?;
+    write(
+        &mut out,
+        "trajectory.csv",
+        &beam_management::report::trajectory_csv(results),
+    )?;
+    let rows = results.scenarios.len().max(1) as u32;
+    figure!(
+        out,
+        "accuracy-vs-overhead",
+        (1200, 560 * rows),
+        beam_management::plot::accuracy_vs_overhead,
+        results,
+        BeamManagementResults
+    );
+    figure!(
+        out,
+        "snr-loss-cdf",
+        (1200, 560 * rows),
+        beam_management::plot::snr_loss_cdf,
+        results,
+        BeamManagementResults
+    );
+    Ok(out.commit()?)
+}
+
+/// Pretty JSON with a final newline for any serialisable document.
+mod erased {
+    pub trait Json {
+        fn text(&self) -> String;
+    }
+    impl<T: serde::Serialize> Json for T {
+        fn text(&self) -> String {
+            // Serialising plain data structs with string keys cannot fail.
+            serde_json::to_string_pretty(self).unwrap_or_default() + "\n"
+        }
+    }
 }

@@ -13,6 +13,7 @@
 //! `docs/study-2d.md` describes the method and the measured numbers.
 #![warn(missing_docs)]
 
+pub mod beam_management;
 pub mod embed;
 pub mod io;
 pub mod living_room;
@@ -56,6 +57,9 @@ pub enum StudyError {
         /// What failed.
         message: String,
     },
+    /// A trace of the beam-management study exceeded its budget.
+    #[error(transparent)]
+    Trace(#[from] bt_solve::pipeline::TraceError),
     /// An output could not be written safely.
     #[error(transparent)]
     Output(#[from] bt_output::OutputError),

@@ -35,6 +35,7 @@ __all__ = [
     "View",
     "builtin_names",
     "load",
+    "study_beam_management",
 ]
 
 Point = Union[Sequence[float], npt.NDArray[np.float64]]
@@ -630,6 +631,33 @@ def load(
 def builtin_names() -> List[str]:
     """Names of the built-in scenes, loadable as ``load("builtin:NAME")``."""
     return list(_native.builtin_names())
+
+
+def study_beam_management(
+    out: Union[str, "os.PathLike[str]"],
+    *,
+    scenarios: Optional[Sequence[str]] = None,
+    seed: int = 1,
+    positions: int = 1000,
+    scan_density: float = 2000.0,
+) -> Dict[str, Any]:
+    """Run ``beamtrace study beam-management`` (docs/study-beam-management.md) and write its
+    files into ``out``; returns the parsed ``summary.json``:
+    ``{"scenarios": {NAME: {"methods": {METHOD: {"top1", ...}}}}}``.
+
+    ``scenarios``: ``"living-room"``, ``"city"`` or scene files (default the two built-ins);
+    ``positions`` UE positions per scenario; ``scan_density`` points/m² of the scan behind
+    the extracted twin (0: none). Every other setting is the CLI's default.
+    """
+    text = _native.study_beam_management(
+        os.fspath(out),
+        scenarios=None if scenarios is None else [str(s) for s in scenarios],
+        seed=int(seed),
+        positions=int(positions),
+        scan_density=float(scan_density),
+    )
+    result: Dict[str, Any] = json.loads(text)
+    return result
 
 
 def __dir__() -> List[str]:

@@ -1,6 +1,7 @@
 //! Integration tests of the `beamtrace` binary, one test binary for the crate (one link): each
 //! module runs the built binary on one part of the CLI; `common` holds what they share.
 
+mod beam_management;
 mod cache;
 mod channel;
 mod cli;

@@ -52,6 +52,10 @@ const BASES: &[(&str, &str)] = &[
         "study living-room",
         "study living-room --max-order 1 --out slr",
     ),
+    (
+        "study beam-management",
+        "study beam-management --scenario living-room --positions 2 --scan-density 0 --position-sigmas 0 --latencies-ms 0 --top-k 1 --out sbm",
+    ),
 ];
 
 /// Options whose value is no single number (paths, names, vectors, grids, shapes), so the
@@ -66,6 +70,8 @@ const NOT_NUMBERS: &[&str] = &[
     "report",
     "paths",
     "steps-from",
+    // a scenario name or scene file
+    "scenario",
     // a transport, tcp:HOST:PORT or unix:PATH
     "listen",
     // X,Y,Z vectors (each coordinate checked finite by `parse_vec3`, tested in small.rs)
