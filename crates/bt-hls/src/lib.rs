@@ -1,7 +1,8 @@
 //! RTL generation, co-simulation and synthesis of the beamtrace IPC accelerator (paper
-//! sections IV-V): one PE per plane with its constants as shift-add networks, the PE
-//! scheduler as a ROM, the coordinate updater-buffer, per-path convergence flags and an
-//! Avalon-MM register interface.
+//! sections IV-V): one PE per plane with its constants as shift-add networks, a controller
+//! that dispatches each path's rounds at run time ([`dispatch`]: no round count is loaded, so
+//! the host never runs the model to plan), the coordinate updater-buffer, per-path
+//! convergence flags and an Avalon-MM register interface.
 //!
 //! * [`generate`] writes `rtl/*.v` (through the [`verilog`] AST and its one printer),
 //!   `tb/` (bus-program testbench + stimulus), `vectors/*.json`, `schedule.json`,
@@ -16,6 +17,7 @@
 
 #![warn(missing_docs)]
 
+pub mod dispatch;
 mod error;
 mod input;
 mod pe;
@@ -38,7 +40,8 @@ pub use input::{
 pub use input::{HlsInput, PlaneSpec, Platform, StepWork, pe_latency};
 pub use pe::{PE_CORE_MODULE, pe_module_name, point_bits, sum_bits};
 pub use plan::{
-    Plan, PlanOptions, ScheduleKind, plan, plan_on, run_cycles, schedule_entries, slot_cycles,
+    Plan, PlanOptions, ScheduleKind, plan, plan_dispatch, plan_on, predict_dispatch, run_cycles,
+    schedule_entries, slot_cycles,
 };
 pub use tools::{
     AdderMapping, BlockArea, EP4CE115_LES, LintReport, SimProgress, SimReport, Simulator,
@@ -68,11 +71,13 @@ pub mod regs {
     pub const TX: u32 = 4;
     /// RW: RX x, y, z (millimetre words) at 8, 9, 10.
     pub const RX: u32 = 8;
-    /// RW: slots of the loaded schedule (the run's makespan).
-    pub const SLOTS: u32 = 12;
+    /// RW: paths of the loaded step (the ready queue holds PATH_BASE[0..PATHS] at a start).
+    pub const PATHS: u32 = 12;
     /// W: the bits above 32 of the schedule entries written after it (only in designs whose
     /// entries are wider than 32 bits: many paths, points and PEs).
     pub const SCHED_HI: u32 = 13;
+    /// RW: round cap of every path (16 bits): a path that reaches it stops unconverged.
+    pub const ROUND_CAP: u32 = 14;
 }
 
 /// What [`generate`] produced.
@@ -173,76 +178,72 @@ pub fn status_word(r: &PathResult) -> u32 {
         | u32::from(r.converged)
 }
 
-/// The schedule-memory writes of one step: slot after slot (`0..makespan`) its jobs in
-/// ascending PE column, packed from entry 0, each slot's last flagged `tail` (an empty slot
-/// gets one invalid tail entry), then `SLOTS`. Entries after a slot's tail are never read, so nothing of an earlier
-/// step needs clearing.
-fn schedule_writes(d: &Design, s: &StepDesign, ops: &mut Vec<BusOp>) {
+/// The job-memory writes of one step: every path's groups (its round template), path after
+/// path, each group's jobs in ascending PE column with the last one flagged `tail` and the
+/// round's last job `end`; then `PATHS` and `ROUND_CAP`. The hardware repeats a path's
+/// groups until it stops, so nothing here depends on how many rounds a path will take.
+fn job_writes(d: &Design, s: &StepDesign, ops: &mut Vec<BusOp>) {
     let (pb, ptb) = (d.layout.path_bits, d.layout.point_bits);
-    // Each slot's jobs in write-back order (ascending column).
-    let rows: Vec<Vec<(u32, bt_schedule::Job)>> = s.work.schedule.slots[..s.makespan as usize]
-        .iter()
-        .map(|row| {
-            let mut jobs: Vec<(u32, bt_schedule::Job)> = row
-                .iter()
-                .enumerate()
-                .filter_map(|(i, job)| job.map(|j| (s.columns[i], j)))
-                .collect();
-            jobs.sort_by_key(|&(col, _)| col);
-            jobs
-        })
-        .collect();
-    let mut last_of_round = std::collections::BTreeMap::new();
-    for (t, jobs) in rows.iter().enumerate() {
-        for (e, (_, job)) in jobs.iter().enumerate() {
-            last_of_round.insert((job.path, job.round), (t, e));
-        }
-    }
     let tail_bit = 1u64 << (5 + pb + ptb);
     let wide = crate::input::sched_entry_bits(pb, ptb, d.layout.inst_bits) > 32;
+    let phases = s.work.input.round_order.phases();
     let mut high = None;
     let mut entry = 0u32;
-    for (t, jobs) in rows.iter().enumerate() {
-        let mut words: Vec<u64> = jobs
-            .iter()
-            .enumerate()
-            .map(|(e, &(col, job))| {
-                let n = s.work.input.paths[job.path as usize].len() as u32;
-                let point = s.first_point[job.path as usize] + job.point;
-                let end = last_of_round[&(job.path, job.round)] == (t, e);
+    for (p, groups) in s.groups.iter().enumerate() {
+        let n = s.work.input.paths[p].len() as u32;
+        for (g, group) in groups.iter().enumerate() {
+            let mut jobs: Vec<(u32, u32)> = group
+                .jobs
+                .iter()
+                .map(|&(c, point)| (s.columns[c as usize], point))
+                .collect();
+            jobs.sort_unstable();
+            for (e, &(col, point)) in jobs.iter().enumerate() {
+                let tail = e + 1 == jobs.len();
+                let end = tail && g + 1 == groups.len();
                 // A job after its round's first phase reads its neighbours' new points.
-                let late = job.point % s.work.input.round_order.phases() != 0;
-                1 | u64::from(job.path) << 1
-                    | u64::from(point) << (1 + pb)
-                    | u64::from(job.point == 0) << (1 + pb + ptb)
-                    | u64::from(job.point + 1 == n) << (2 + pb + ptb)
+                let late = point % phases != 0;
+                let word = 1
+                    | (p as u64) << 1
+                    | u64::from(s.first_point[p] + point) << (1 + pb)
+                    | u64::from(point == 0) << (1 + pb + ptb)
+                    | u64::from(point + 1 == n) << (2 + pb + ptb)
                     | u64::from(end) << (3 + pb + ptb)
                     | u64::from(late) << (4 + pb + ptb)
-                    | u64::from(col) << (6 + pb + ptb)
-            })
-            .collect();
-        if words.is_empty() {
-            words.push(0);
-        }
-        if let Some(last) = words.last_mut() {
-            *last |= tail_bit;
-        }
-        for word in words {
-            // A wide entry's high bits go to SCHED_HI first, when they change.
-            let hi = (word >> 32) as u32;
-            if wide && high != Some(hi) {
-                ops.push(BusOp::Write(regs::SCHED_HI, hi));
-                high = Some(hi);
+                    | if tail { tail_bit } else { 0 }
+                    | u64::from(col) << (6 + pb + ptb);
+                // A wide entry's high bits go to SCHED_HI first, when they change.
+                let hi = (word >> 32) as u32;
+                if wide && high != Some(hi) {
+                    ops.push(BusOp::Write(regs::SCHED_HI, hi));
+                    high = Some(hi);
+                }
+                ops.push(BusOp::Write(d.layout.map.sched_base + entry, word as u32));
+                entry += 1;
             }
-            ops.push(BusOp::Write(d.layout.map.sched_base + entry, word as u32));
-            entry += 1;
         }
     }
-    ops.push(BusOp::Write(regs::SLOTS, s.makespan));
+    ops.push(BusOp::Write(regs::PATHS, s.groups.len() as u32));
+    ops.push(BusOp::Write(regs::ROUND_CAP, s.work.input.max_rounds));
 }
 
-/// One run of step `s`: write the start points (bank 0) and TX/RX, start, read CYCLES, every
-/// status word and every final point.
+/// The ready queue's start of a run: `PATH_BASE[p] = {first, first}`, path `p`'s first
+/// job-memory entry twice (its first group and its next one). A run consumes the queue, so
+/// every run writes it.
+fn queue_writes(d: &Design, s: &StepDesign, ops: &mut Vec<BusOp>) {
+    let eb = d.layout.entry_bits;
+    let mut first = 0u32;
+    for (p, groups) in s.groups.iter().enumerate() {
+        ops.push(BusOp::Write(
+            d.layout.map.status_base + p as u32,
+            (first << eb) | first,
+        ));
+        first += groups.iter().map(|g| g.jobs.len() as u32).sum::<u32>();
+    }
+}
+
+/// One run of step `s`: write the ready queue, the start points (bank 0) and TX/RX, start,
+/// read CYCLES, every status word and every final point.
 fn run_ops(
     d: &Design,
     s: &StepDesign,
@@ -251,6 +252,7 @@ fn run_ops(
 ) -> (Vec<BusOp>, VectorExpectation) {
     let map = &d.layout.map;
     let mut ops = Vec::new();
+    queue_writes(d, s, &mut ops);
     for p in 0..s.work.input.paths.len() {
         for (i, pt) in s.model.init_points(p).iter().enumerate() {
             let g = s.first_point[p] + i as u32;
@@ -269,9 +271,18 @@ fn run_ops(
     for (k, c) in rx.iter().enumerate() {
         ops.push(BusOp::Write(regs::RX + k as u32, c.0 as u32));
     }
-    let cycles = crate::plan::run_cycles(&s.work.schedule, pe_latency(d.platform.coord_bits));
+    // The expected words: the model run to each path's own stop (convergence, freezing or
+    // the round cap), as the dispatching hardware runs it; verification only.
+    let paths = s.model.run_fixed(tx, rx, None);
+    let rounds: Vec<u32> = paths.iter().map(|r| r.rounds).collect();
+    let run = crate::dispatch::predict(
+        &s.groups,
+        d.layout.num_instances as usize,
+        &rounds,
+        pe_latency(d.platform.coord_bits),
+    );
+    let cycles = run.cycles;
     ops.push(BusOp::Start(cycles));
-    let paths = s.model.run_fixed(tx, rx, Some(&s.budgets));
     let mut reads = vec![(regs::CYCLES, cycles as u32)];
     for (p, r) in paths.iter().enumerate() {
         reads.push((map.status_base + p as u32, status_word(r)));
@@ -308,7 +319,7 @@ fn host_program(d: &Design) -> Result<(Vec<BusOp>, Vec<VectorExpectation>), HlsE
     let mut ops = Vec::new();
     let mut runs = Vec::new();
     for (k, s) in d.steps.iter().enumerate() {
-        schedule_writes(d, s, &mut ops);
+        job_writes(d, s, &mut ops);
         for v in s.work.input.vectors()? {
             let (o, e) = run_ops(d, s, k, v);
             ops.extend(o);
@@ -363,12 +374,20 @@ fn register_map(d: &Design) -> String {
     s.push_str("| 0x0004-0x0006 | RW | TX_X, TX_Y, TX_Z | transmitter, mm |\n");
     s.push_str("| 0x0008-0x000a | RW | RX_X, RX_Y, RX_Z | receiver, mm |\n");
     s.push_str(&format!(
-        "| 0x000c | RW | SLOTS | slots of the loaded schedule, 1 to {} |\n",
-        cap.slots
+        "| 0x000c | RW | PATHS | paths of the loaded step, up to {} |\n",
+        cap.paths
     ));
+    s.push_str(
+        "| 0x000e | RW | ROUND_CAP | rounds after which a path stops unconverged (16 bits) |\n",
+    );
     s.push_str(&format!(
         "| 0x{:04x} + p | R | PATH_STATUS[p] | `{{rounds[15:0], 12'b0, left_bounds, overflow, zero_sum, converged}}`, p < {} |\n",
         l.map.status_base, cap.paths
+    ));
+    s.push_str(&format!(
+        "| 0x{:04x} + i | W | PATH_BASE[i] | ready queue at the start: `{{first[{eb}:0], first[{eb}:0]}}`, the job-memory entry of the i-th queued path's first group, i < PATHS |\n",
+        l.map.status_base,
+        eb = l.entry_bits - 1
     ));
     s.push_str(&format!(
         "| 0x{:04x} + 8i + 4b + {{0,1,2}} | RW | POINT[i].X/Y/Z, bank b | floor(mm) of point i, i < {} |\n",
@@ -379,13 +398,12 @@ fn register_map(d: &Design) -> String {
         l.map.point_base
     ));
     s.push_str(&format!(
-        "| 0x{:04x} + j | W | SCHED[j] | schedule entry j (the jobs of slot 0, then slot 1, ..., each slot's in ascending PE column): `{{column[{}:0], tail, late, end, last, first, point[{}:0], path[{}:0], valid}}`, `valid` at bit 0, `tail` on a slot's last entry, `late` on a job that reads its round's new points (red-black), j < {}, slots < {} |\n\n",
+        "| 0x{:04x} + j | W | SCHED[j] | job memory entry j (one round of every path as groups, path after path, each group's jobs in ascending PE column): `{{column[{}:0], tail, late, end, last, first, point[{}:0], path[{}:0], valid}}`, `valid` at bit 0, `tail` on a group's last job, `end` on the round's last job, `late` on a job that reads its round's new points (red-black), j < {} |\n\n",
         l.map.sched_base,
         l.inst_bits - 1,
         l.point_bits - 1,
         l.path_bits - 1,
-        cap.entries,
-        cap.slots
+        cap.entries
     ));
     s.push_str("PE columns: ");
     let cols: Vec<String> = d
@@ -398,20 +416,24 @@ fn register_map(d: &Design) -> String {
     s.push_str(&cols.join(", "));
     s.push_str(".\n\n");
     s.push_str(
-        "Per time step the host writes the schedule (the jobs of each slot 0..SLOTS-1 packed from \
-         entry 0, the last one with `tail` set; an empty slot as one entry with only `tail`) and \
-         SLOTS; per run it writes every path point's start value into bank 0 \
-         (X, Y, Z, then FRAC), TX_X..RX_Z, CTRL = 1, waits for `ins_irq` (or polls STATUS bit 1), \
-         then reads CYCLES, PATH_STATUS[*] and each point in bank `rounds & 1` of its path. \
-         Point i of path p is global index `first_point[p] + i` (paths in order, points TX \
-         side first); `first`/`last` mark the points next to TX/RX, `end` the last job of a \
-         path's round.\n\n",
+        "Per time step the host writes the job memory (one round of every path, as groups: a \
+         group's jobs run in one slot), PATHS and ROUND_CAP; per run it writes PATH_BASE[*] \
+         (the ready queue), every path point's start value into bank 0 (X, Y, Z, then FRAC), \
+         TX_X..RX_Z, CTRL = 1, waits for `ins_irq` (or polls STATUS bit 1), then reads CYCLES, \
+         PATH_STATUS[*] and each point in bank `rounds & 1` of its path. The controller \
+         dispatches the queued groups into slots (a group whose PEs are free in the slot being \
+         built), queues a path's next group at write-back and stops a path when it converges, \
+         freezes or reaches ROUND_CAP: no round count is loaded. Point i of path p is global \
+         index `first_point[p] + i` (paths in order, points TX side first); `first`/`last` \
+         mark the points next to TX/RX.\n\n",
     );
     s.push_str("## Cycle formulas (exact, checked by co-simulation)\n\n");
     s.push_str(&format!(
-        "* CYCLES = sum over slots of (2 x (jobs + 2) + PE_LATENCY), PE_LATENCY = {} \
-         (5 + {} halving steps of Algorithm 3 at the {}-bit coordinate word; an empty slot \
-         counts as 1 job); idle PEs cost nothing\n",
+        "* CYCLES = sum over dispatched slots of (2 x (jobs + 2) + max(PE_LATENCY, dispatch + 1)) \
+         plus the dispatches with no slot running (dispatch + 1 each); dispatch = 1 + per examined \
+         group (at most {}) 1 + its jobs, + 2; PE_LATENCY = {} (5 + {} halving steps of \
+         Algorithm 3 at the {}-bit coordinate word); `bt_hls::dispatch::predict` is the exact twin\n",
+        dispatch::SCAN_LIMIT,
         pe_latency(d.platform.coord_bits),
         bt_fixed::Widths::for_coord(d.platform.coord_bits).iterations,
         d.platform.coord_bits

@@ -1,5 +1,7 @@
-//! `bt_top`: PE matrix, scheduler ROM, coordinate updater-buffer, convergence flags and the
-//! Avalon-MM slave. Twin of `bt_fixed::FixedIpc::run_fixed` with the schedule's budgets.
+//! `bt_top`: PE matrix, job memory, ready queue and dispatcher, slot buffer, coordinate
+//! updater-buffer, convergence flags and the Avalon-MM slave. Twin of
+//! `bt_fixed::FixedIpc::run_fixed` with each path's own stop (no budgets), and of
+//! `crate::dispatch::predict` cycle for cycle.
 
 use crate::input::{Layout, bits_for, pe_latency, sched_entry_bits};
 use crate::pe::{pe_module_name, point_bits, port, sext_slice, sum_bits};
@@ -7,13 +9,23 @@ use crate::verilog::{BinaryOp, Direction, Expr, Item, Module, Signal, Stmt, Unar
 
 /// FSM state encodings.
 const S_IDLE: u128 = 0;
+const S_DISP: u128 = 1;
 const S_LOAD: u128 = 2;
 const S_EXEC: u128 = 3;
 const S_WB: u128 = 4;
 const STATE_BITS: u32 = 3;
 
 /// Register-map version reported in `INFO[15:8]`.
-pub const MAP_VERSION: u32 = 5;
+pub const MAP_VERSION: u32 = 6;
+
+/// Dispatcher state encodings (`dstate`): idle, read the queue's head once, pop a queued
+/// group (reading its first job), examine its jobs, publish the slot's length.
+const D_OFF: u128 = 0;
+const D_POP: u128 = 1;
+const D_WARM: u128 = 2;
+const D_JOB: u128 = 3;
+const D_FIN: u128 = 4;
+const DSTATE_BITS: u32 = 3;
 
 /// Width of the early-stopping comparisons (`bt_fixed::FineBox::outside`): a 40-bit point
 /// plus or minus `(L1 move) << 4` and the ±2^41 box bounds fit in 48 signed bits.
@@ -30,6 +42,9 @@ fn lit(w: u32, v: u128) -> Expr {
 }
 fn state_is(s: u128) -> Expr {
     id("state").eq(lit(STATE_BITS, s))
+}
+fn dstate_is(s: u128) -> Expr {
+    id("dstate").eq(lit(DSTATE_BITS, s))
 }
 fn or(a: Expr, b: Expr) -> Expr {
     Expr::bin(BinaryOp::Or, a, b)
@@ -95,7 +110,6 @@ struct Dims<'a> {
     pb: u32,
     ptb: u32,
     ib: u32,
-    sb: u32,
     eb: u32,
     /// Path slots (`2^pb`): the width of the per-path flag vectors.
     np2: u32,
@@ -123,7 +137,6 @@ impl<'a> Dims<'a> {
             pb: l.path_bits,
             ptb: l.point_bits,
             ib: l.inst_bits,
-            sb: l.slot_bits,
             eb: l.entry_bits,
             np2: 1u32 << l.path_bits,
             cnt_bits: bits_for(
@@ -149,10 +162,10 @@ struct PeWires {
 /// Header comment, the controller's registers, the per-path flag vectors, the `rounds` and
 /// point memories and the PE wires. All state is declared first, as the golden files show it.
 fn declare_state(t: &Dims<'_>, items: &mut Vec<Item>) -> Vec<PeWires> {
-    let (k, pb, ptb, ib, sb, eb, np2) = (t.k, t.pb, t.ptb, t.ib, t.sb, t.eb, t.np2);
+    let (k, pb, ptb, ib, eb, np2) = (t.k, t.pb, t.ptb, t.ib, t.eb, t.np2);
     let cap = t.p.platform.capacity;
     items.push(Item::Comment(format!(
-        "{} PE instances, capacity {} paths, {} points, {} slots; 2 x (jobs + 2) + {} cycles per slot, threshold {} fine LSB",
+        "{} PE instances, capacity {} paths, {} points, {} groups; 2 x (jobs + 2) + max({}, dispatch + 1) cycles per slot, threshold {} fine LSB",
         k,
         cap.paths,
         cap.points,
@@ -163,9 +176,11 @@ fn declare_state(t: &Dims<'_>, items: &mut Vec<Item>) -> Vec<PeWires> {
     for (n, w) in [
         ("state", STATE_BITS),
         ("cnt", t.cnt_bits),
-        ("slot", sb),
-        ("sbase", eb),
-        ("slots_r", sb + 1),
+        ("paths_r", pb + 1),
+        ("cap_r", 16),
+        ("rsel", 1),
+        ("slen_0", ib + 1),
+        ("slen_1", ib + 1),
         ("cycles", 32),
         ("done", 1),
         ("tx_x", 32),
@@ -186,9 +201,9 @@ fn declare_state(t: &Dims<'_>, items: &mut Vec<Item>) -> Vec<PeWires> {
         ("pov", np2),
         ("rd_a", point_bits(t.wd)),
         ("rd_b", point_bits(t.wd)),
-        ("sched_q", sched_entry_bits(pb, ptb, ib)),
+        ("sched_q", sched_entry_bits(pb, ptb, ib) + 2 * eb),
         ("sq_ok", 1),
-        ("seen_tail", 1),
+        ("sq_tail", 1),
         ("ld_q_en", 1),
         ("ld_q_tail", 1),
         ("ld_q_first", 1),
@@ -200,6 +215,9 @@ fn declare_state(t: &Dims<'_>, items: &mut Vec<Item>) -> Vec<PeWires> {
         ("wb_q_path", pb),
         ("wb_q_point", ptb),
         ("wb_q_inst", ib),
+        ("wb_q_gtail", 1),
+        ("wb_q_src", eb),
+        ("wb_q_gbase", eb),
         ("rq_valid", 1),
         ("rq_kind", 2),
         ("rq_reg", 4),
@@ -210,6 +228,7 @@ fn declare_state(t: &Dims<'_>, items: &mut Vec<Item>) -> Vec<PeWires> {
     ] {
         items.push(Item::Reg(n.into(), w));
     }
+    declare_dispatch_state(t, items);
     let sw = sched_entry_bits(pb, ptb, ib);
     if sw > 32 {
         // Entries wider than the bus word: the host writes their high bits first.
@@ -234,6 +253,38 @@ fn declare_state(t: &Dims<'_>, items: &mut Vec<Item>) -> Vec<PeWires> {
             zs: Signal::wire(items, format!("pe_zs_{j}"), 1),
         })
         .collect()
+}
+
+/// The ready queue's pointers and head word, and the dispatcher's registers.
+fn declare_dispatch_state(t: &Dims<'_>, items: &mut Vec<Item>) {
+    let (pb, ptb, ib, eb) = (t.pb, t.ptb, t.ib, t.eb);
+    for (n, w) in [
+        ("rq_head", pb),
+        ("rq_tail", pb),
+        ("rq_count", pb + 1),
+        ("rq_q", 2 * eb),
+        ("job_q", sched_entry_bits(pb, ptb, ib)),
+        ("dstate", DSTATE_BITS),
+        ("d_scan", pb + 1),
+        ("d_used", 1 << ib),
+        ("d_save", 1 << ib),
+        ("d_nsl", ib + 1),
+        ("d_gi", ib + 1),
+        ("d_conf", 1),
+        ("d_gbase", eb),
+        ("d_gptr", eb),
+    ] {
+        items.push(Item::Reg(n.into(), w));
+    }
+    // The ready queue (one entry per queued path: {first group, next group}, entry indices of
+    // the job memory) and the slot buffer (two slots: the running one and the next, each job
+    // with {its job-memory entry, its path's first group}).
+    items.push(Item::Memory("rq".into(), 2 * eb, t.np2));
+    items.push(Item::Memory(
+        "sbuf".into(),
+        sched_entry_bits(pb, ptb, ib) + 2 * eb,
+        2 << ib,
+    ));
 }
 
 /// The Avalon-MM address decode: which region a bus access hits, and the host's write strobes.
@@ -305,15 +356,13 @@ fn bus_decode(t: &Dims<'_>, items: &mut Vec<Item>) -> Decode {
     }
 }
 
-/// The fields of the schedule entry read this cycle (`sched_q`, gated by `sq_ok`).
+/// The fields of the slot-buffer entry read this cycle (`sched_q`, gated by `sq_ok`).
 struct ScheduleRead {
-    /// The entry is a job.
+    /// The entry is a job of the running slot.
     valid: Signal,
     /// The slot's last entry.
     tail: Signal,
-    /// The slot's tail was read (this cycle or before): later entries are not used.
-    stop: Signal,
-    /// Path, point (1-based, inner points) and PE column of the job.
+    /// Path, point (global index) and PE column of the job.
     path: Signal,
     point: Signal,
     inst: Signal,
@@ -326,32 +375,38 @@ struct ScheduleRead {
     /// The job runs after its round's first phase (red-black): its neighbours' points are
     /// read from the bank the round writes, not the committed one.
     late: Signal,
+    /// The job is its group's last: its write-back queues the path's next group.
+    gtail: Signal,
+    /// The job's entry in the job memory, and its path's first group's.
+    src: Signal,
+    gbase: Signal,
 }
 
-/// Schedule memory (M9K): the jobs packed slot after slot (ascending PE column, each slot's
-/// last one flagged `tail`), written by the host, read one cycle after the address
-/// sbase + cnt (sbase = the slot's first entry): entry cnt - 1 is in sched_q. Entries after
-/// the tail are never used (`stop`), so a slot takes 2 x (jobs + 2) + pe_latency cycles
-/// whatever the PE count.
-fn schedule_memory(t: &Dims<'_>, bus: &Decode, items: &mut Vec<Item>) -> ScheduleRead {
-    let (pb, ptb, ib, eb, cnt_bits) = (t.pb, t.ptb, t.ib, t.eb, t.cnt_bits);
+/// The bit of the job word that marks a group's last job.
+fn gtail_bit(t: &Dims<'_>) -> u32 {
+    5 + t.pb + t.ptb
+}
+
+/// Job memory (M9K), written by the host per step: one round of every path as groups
+/// (`{column, tail, late, end, last, first, point, path, valid}`, `tail` on a group's last
+/// job), path after path. Read by the dispatcher only (`job_q`, one cycle after the address).
+fn job_memory(t: &Dims<'_>, bus: &Decode, items: &mut Vec<Item>) {
+    let (pb, ptb, ib, eb) = (t.pb, t.ptb, t.ib, t.eb);
     let sw = sched_entry_bits(pb, ptb, ib);
     items.push(Item::Comment(format!(
-        "PE schedule memory, written per step by the host: entry -> {{column, tail, late, end, last, first, point, path, valid}} ({sw} bits)"
+        "job memory, written per step by the host: one round of every path as groups, entry -> {{column, group tail, late, end, last, first, point, path, valid}} ({sw} bits)"
     )));
-    let sched_addr = Signal::assigned(
+    let gi = zero_extend("d_gi", ib + 1, eb);
+    let job_ra = Signal::assigned(
         items,
-        "sched_addr",
+        "job_ra",
         eb,
-        id("sbase").plus(zero_extend("cnt", cnt_bits, eb)),
+        Expr::mux(
+            dstate_is(D_POP),
+            Expr::slice("rq_q", eb - 1, 0),
+            id("d_gptr").plus(gi).plus(lit(eb, 1)),
+        ),
     );
-    let tail = Signal::assigned(
-        items,
-        "rom_tail",
-        1,
-        Expr::bit("sched_q", 5 + pb + ptb).and(id("sq_ok")),
-    );
-    let stop = Signal::assigned(items, "stop", 1, or(id("seen_tail"), tail.e()));
     items.push(Item::Memory("sched".into(), sw, 1 << eb));
     let entry = if sw > 32 {
         Expr::concat(vec![id("sched_hi"), id("avs_writedata")])
@@ -367,46 +422,336 @@ fn schedule_memory(t: &Dims<'_>, bus: &Decode, items: &mut Vec<Item>) -> Schedul
             )],
             vec![],
         ),
-        nb(id("sched_q"), Expr::id("sched").at(sched_addr.e())),
+        nb(id("job_q"), Expr::id("sched").at(job_ra.e())),
+    ]));
+}
+
+/// Slot buffer, read side: entry `cnt` of the running slot (`rsel`) one cycle after the
+/// address, valid below the slot's length; its fields.
+fn slot_buffer_read(t: &Dims<'_>, items: &mut Vec<Item>) -> ScheduleRead {
+    let (pb, ptb, ib, eb, cnt_bits) = (t.pb, t.ptb, t.ib, t.eb, t.cnt_bits);
+    let sw = sched_entry_bits(pb, ptb, ib);
+    items.push(Item::Comment(
+        "slot buffer: the running slot's jobs (rsel), the next slot's written by the dispatcher"
+            .into(),
+    ));
+    let slen = Signal::assigned(
+        items,
+        "slen_cur",
+        ib + 1,
+        Expr::mux(id("rsel"), id("slen_1"), id("slen_0")),
+    );
+    let w = cnt_bits.max(ib + 1);
+    let cnt_w = zero_extend("cnt", cnt_bits, w);
+    let len_w = zero_extend(slen.name(), ib + 1, w);
+    let in_slot = Expr::bin(BinaryOp::Lt, cnt_w.clone(), len_w.clone());
+    let is_last = cnt_w.plus(lit(w, 1)).eq(len_w);
+    let sb_ra = Signal::assigned(
+        items,
+        "sb_ra",
+        ib + 1,
+        Expr::concat(vec![id("rsel"), zero_extend("cnt", cnt_bits, ib)]),
+    );
+    items.push(Item::AlwaysFf(vec![
+        nb(id("sched_q"), Expr::id("sbuf").at(sb_ra.e())),
         nb(
             id("sq_ok"),
-            or(state_is(S_LOAD), state_is(S_WB))
-                .and(Expr::bin(
-                    BinaryOp::Lt,
-                    id("cnt"),
-                    lit(cnt_bits, t.k.into()),
-                ))
-                .and(stop.e().lnot()),
+            or(state_is(S_LOAD), state_is(S_WB)).and(in_slot),
         ),
+        nb(id("sq_tail"), is_last),
     ]));
-    let valid = Signal::assigned(
-        items,
-        "rom_valid",
-        1,
-        Expr::bit("sched_q", 0).and(id("sq_ok")),
-    );
     let field = |items: &mut Vec<Item>, n: &str, w: u32, lo: u32| {
         Signal::assigned(items, n, w, Expr::slice("sched_q", lo + w - 1, lo))
     };
-    let path = field(items, "rom_path", pb, 1);
-    let point = field(items, "rom_point", ptb, 1 + pb);
-    let inst = field(items, "rom_inst", ib, 6 + pb + ptb);
-    let first = field(items, "rom_first", 1, 1 + pb + ptb);
-    let last = field(items, "rom_last", 1, 2 + pb + ptb);
-    let end = field(items, "rom_end", 1, 3 + pb + ptb);
-    let late = field(items, "rom_late", 1, 4 + pb + ptb);
+    let valid = Signal::assigned(items, "rom_valid", 1, id("sq_ok"));
+    let tail = Signal::assigned(items, "rom_tail", 1, id("sq_ok").and(id("sq_tail")));
     ScheduleRead {
         valid,
         tail,
-        stop,
-        path,
-        point,
-        inst,
-        first,
-        last,
-        end,
-        late,
+        path: field(items, "rom_path", pb, 1),
+        point: field(items, "rom_point", ptb, 1 + pb),
+        inst: field(items, "rom_inst", ib, 6 + pb + ptb),
+        first: field(items, "rom_first", 1, 1 + pb + ptb),
+        last: field(items, "rom_last", 1, 2 + pb + ptb),
+        end: field(items, "rom_end", 1, 3 + pb + ptb),
+        late: field(items, "rom_late", 1, 4 + pb + ptb),
+        gtail: field(items, "rom_gtail", 1, gtail_bit(t)),
+        src: field(items, "rom_src", eb, sw + eb),
+        gbase: field(items, "rom_gbase", eb, sw),
     }
+}
+
+/// The dispatcher's view of the job in `job_q`: its column, whether it ends its group, and
+/// whether its group cannot run in the slot being built (a column taken).
+struct DispatchJob {
+    gtail: Signal,
+    conflict: Signal,
+    /// Pop the queue's head this cycle.
+    pop: Signal,
+    /// Put the examined group back at the queue's tail this cycle.
+    push_back: Signal,
+}
+
+/// The dispatcher's combinational signals.
+fn dispatch_signals(t: &Dims<'_>, items: &mut Vec<Item>) -> DispatchJob {
+    let (pb, ptb, ib) = (t.pb, t.ptb, t.ib);
+    let col = Signal::assigned(
+        items,
+        "j_col",
+        ib,
+        Expr::slice("job_q", 6 + pb + ptb + ib - 1, 6 + pb + ptb),
+    );
+    let gtail = Signal::assigned(items, "j_gtail", 1, Expr::bit("job_q", gtail_bit(t)));
+    let conflict = Signal::assigned(
+        items,
+        "j_conf",
+        1,
+        or(id("d_conf"), Expr::id("d_used").at(col.e())),
+    );
+    let all_used = Expr::slice("d_used", t.k - 1, 0).eq(lit(t.k, (1u128 << t.k) - 1));
+    let stop = Signal::assigned(
+        items,
+        "d_stop",
+        1,
+        or(id("d_scan").eq(lit(pb + 1, 0)), all_used),
+    );
+    let pop = Signal::assigned(items, "d_pop", 1, dstate_is(D_POP).and(stop.e().lnot()));
+    let push_back = Signal::assigned(
+        items,
+        "d_push",
+        1,
+        dstate_is(D_JOB).and(gtail.e()).and(conflict.e()),
+    );
+    DispatchJob {
+        gtail,
+        conflict,
+        pop,
+        push_back,
+    }
+}
+
+/// The dispatcher (twin of `crate::dispatch::predict`): on `d_go` it builds the next slot in
+/// the buffer the running slot does not use, examining up to `SCAN_LIMIT` queued groups, each
+/// put into the slot when all its columns are free (else back to the queue), then publishes
+/// the slot's length. `rq_q` always holds the queue's head: it is read every cycle, and a
+/// pop is at least one job after the last (`D_WARM` reads it after a start or a push).
+fn dispatcher(t: &Dims<'_>, d: &DispatchJob, go: &Signal, scan_init: &Signal) -> Item {
+    let (ib, eb) = (t.ib, t.eb);
+    let n = 1u32 << ib;
+    let gi_plus = |k: u128| id("d_gi").plus(lit(ib + 1, k));
+    let on_tail = vec![Stmt::If(
+        d.conflict.e().lnot(),
+        vec![nb(id("d_nsl"), id("d_nsl").plus(gi_plus(1)))],
+        vec![nb(id("d_used"), id("d_save"))],
+    )];
+    let job = vec![
+        nb(Expr::id("d_used").at(id("j_col")), lit(1, 1)),
+        Stmt::If(
+            d.gtail.e(),
+            on_tail
+                .into_iter()
+                .chain([nb(id("dstate"), lit(DSTATE_BITS, D_POP))])
+                .collect(),
+            vec![nb(id("d_gi"), gi_plus(1)), nb(id("d_conf"), d.conflict.e())],
+        ),
+    ];
+    let arms = vec![
+        (
+            lit(DSTATE_BITS, D_OFF),
+            vec![Stmt::If(
+                go.e(),
+                vec![
+                    nb(id("dstate"), lit(DSTATE_BITS, D_WARM)),
+                    nb(id("d_scan"), scan_init.e()),
+                    nb(id("d_used"), lit(n, 0)),
+                    nb(id("d_nsl"), lit(ib + 1, 0)),
+                ],
+                vec![],
+            )],
+        ),
+        (
+            lit(DSTATE_BITS, D_WARM),
+            vec![nb(id("dstate"), lit(DSTATE_BITS, D_POP))],
+        ),
+        (
+            lit(DSTATE_BITS, D_POP),
+            vec![Stmt::If(
+                d.pop.e(),
+                vec![
+                    nb(id("dstate"), lit(DSTATE_BITS, D_JOB)),
+                    nb(id("d_scan"), id("d_scan").minus(lit(t.pb + 1, 1))),
+                    nb(id("d_gbase"), Expr::slice("rq_q", 2 * eb - 1, eb)),
+                    nb(id("d_gptr"), Expr::slice("rq_q", eb - 1, 0)),
+                    nb(id("d_gi"), lit(ib + 1, 0)),
+                    nb(id("d_conf"), lit(1, 0)),
+                    nb(id("d_save"), id("d_used")),
+                ],
+                vec![nb(id("dstate"), lit(DSTATE_BITS, D_FIN))],
+            )],
+        ),
+        (lit(DSTATE_BITS, D_JOB), job),
+        (
+            lit(DSTATE_BITS, D_FIN),
+            vec![
+                Stmt::If(
+                    id("rsel"),
+                    vec![nb(id("slen_0"), id("d_nsl"))],
+                    vec![nb(id("slen_1"), id("d_nsl"))],
+                ),
+                nb(id("dstate"), lit(DSTATE_BITS, D_OFF)),
+            ],
+        ),
+    ];
+    Item::AlwaysFf(vec![Stmt::If(
+        id("rst_n").lnot(),
+        vec![
+            nb(id("dstate"), lit(DSTATE_BITS, D_OFF)),
+            nb(id("slen_0"), lit(ib + 1, 0)),
+            nb(id("slen_1"), lit(ib + 1, 0)),
+        ],
+        vec![Stmt::Case(
+            id("dstate"),
+            arms,
+            vec![nb(id("dstate"), lit(DSTATE_BITS, D_OFF))],
+        )],
+    )])
+}
+
+/// Slot buffer, write side: a job of the group being examined, while no column of it is
+/// taken, at `{~rsel, d_nsl + d_gi}` with its job-memory entry and its path's first group.
+fn slot_buffer_write(t: &Dims<'_>, d: &DispatchJob, items: &mut Vec<Item>) {
+    let (ib, eb) = (t.ib, t.eb);
+    let we = dstate_is(D_JOB).and(d.conflict.e().lnot());
+    // Below the PE count while no column of the group is taken: ib bits.
+    let wi = Signal::assigned(
+        items,
+        "sb_wi",
+        ib,
+        Expr::slice("d_nsl", ib - 1, 0).plus(Expr::slice("d_gi", ib - 1, 0)),
+    );
+    let at = Expr::concat(vec![id("rsel").inv(), wi.e()]);
+    let src = id("d_gptr").plus(zero_extend("d_gi", ib + 1, eb));
+    items.push(Item::AlwaysFf(vec![Stmt::If(
+        we,
+        vec![nb(
+            Expr::id("sbuf").at(at),
+            Expr::concat(vec![src, id("d_gbase"), id("job_q")]),
+        )],
+        vec![],
+    )]));
+}
+
+/// Write-back's queue push: a group's last job queues the path's next group, or after the
+/// round's last group the path's first group again, unless the path converged, froze or
+/// reached the round cap (`cap_r`).
+fn writeback_push(t: &Dims<'_>, f: &WritebackFlags, items: &mut Vec<Item>) -> (Signal, Signal) {
+    let eb = t.eb;
+    let mut goes_on = f
+        .any_big
+        .e()
+        .and(f.any_dz.e().lnot())
+        .and(f.any_ov.e().lnot());
+    if let Some(lb) = &f.any_lb {
+        goes_on = goes_on.and(lb.e().lnot());
+    }
+    let below_cap = Expr::bin(BinaryOp::Lt, id("rounds_cur").plus(lit(16, 1)), id("cap_r"));
+    let again = Signal::assigned(items, "wb_again", 1, goes_on.and(below_cap));
+    let push = Signal::assigned(
+        items,
+        "wb_push",
+        1,
+        f.go.e()
+            .and(id("wb_q_gtail"))
+            .and(or(id("wb_q_end").lnot(), again.e())),
+    );
+    let next = Expr::mux(
+        id("wb_q_end"),
+        id("wb_q_gbase"),
+        id("wb_q_src").plus(lit(eb, 1)),
+    );
+    let data = Signal::assigned(
+        items,
+        "wb_push_data",
+        2 * eb,
+        Expr::concat(vec![id("wb_q_gbase"), next]),
+    );
+    (push, data)
+}
+
+/// The ready queue (`rq`): a circular buffer of `{first group, next group}` per queued
+/// path, written by the host while idle (PATH_BASE[p] = path p's entry), then by the
+/// dispatcher's push-backs and write-back's pushes (never in the same cycle); read at the head.
+fn ready_queue(
+    t: &Dims<'_>,
+    bus: &Decode,
+    d: &DispatchJob,
+    (wb_push, wb_data): (&Signal, &Signal),
+    start: &Signal,
+    items: &mut Vec<Item>,
+) {
+    let (pb, eb) = (t.pb, t.eb);
+    let push = Signal::assigned(items, "rq_push", 1, or(d.push_back.e(), wb_push.e()));
+    let host = bus.host_wr.e().and(bus.is_status.e());
+    let data = Expr::mux(
+        bus.host_wr.e(),
+        Expr::slice("avs_writedata", 2 * eb - 1, 0),
+        Expr::mux(
+            d.push_back.e(),
+            Expr::concat(vec![id("d_gbase"), id("d_gptr")]),
+            wb_data.e(),
+        ),
+    );
+    let addr = Expr::mux(
+        bus.host_wr.e(),
+        Expr::slice("avs_address", pb - 1, 0),
+        id("rq_tail"),
+    );
+    items.push(Item::AlwaysFf(vec![
+        Stmt::If(
+            or(host, push.e()),
+            vec![nb(Expr::id("rq").at(addr), data)],
+            vec![],
+        ),
+        nb(id("rq_q"), Expr::id("rq").at(id("rq_head"))),
+    ]));
+    let inc = |n: &str, w: u32| id(n).plus(lit(w, 1));
+    items.push(Item::AlwaysFf(vec![Stmt::If(
+        id("rst_n").lnot(),
+        vec![
+            nb(id("rq_head"), lit(pb, 0)),
+            nb(id("rq_tail"), lit(pb, 0)),
+            nb(id("rq_count"), lit(pb + 1, 0)),
+        ],
+        vec![Stmt::If(
+            start.e(),
+            vec![
+                nb(id("rq_head"), lit(pb, 0)),
+                nb(id("rq_tail"), Expr::slice("paths_r", pb - 1, 0)),
+                nb(id("rq_count"), id("paths_r")),
+            ],
+            vec![
+                Stmt::If(
+                    d.pop.e(),
+                    vec![nb(id("rq_head"), inc("rq_head", pb))],
+                    vec![],
+                ),
+                Stmt::If(
+                    push.e(),
+                    vec![nb(id("rq_tail"), inc("rq_tail", pb))],
+                    vec![],
+                ),
+                Stmt::If(
+                    push.e(),
+                    vec![nb(id("rq_count"), inc("rq_count", pb + 1))],
+                    vec![Stmt::If(
+                        d.pop.e(),
+                        vec![nb(id("rq_count"), id("rq_count").minus(lit(pb + 1, 1)))],
+                        vec![],
+                    )],
+                ),
+            ],
+        )],
+    )]));
 }
 
 /// The ports of the coordinate updater-buffer (the two point memory copies).
@@ -806,25 +1151,25 @@ fn cnt_inc(t: &Dims<'_>) -> Expr {
     id("cnt").plus(lit(t.cnt_bits, 1))
 }
 
-/// IDLE on a start request: clear the counters and every path's flags and rounds; with no
-/// slot to run, report done at once.
+/// IDLE on a start request: clear the counters and every path's flags and rounds and let the
+/// dispatcher build the first slot (the queue holds every path's first group); with no path,
+/// report done at once.
 fn fsm_on_start(t: &Dims<'_>) -> Vec<Stmt> {
     let all_zero = lit(t.np2, 0);
-    let no_slot = id("slots_r").eq(lit(t.sb + 1, 0));
+    let no_path = id("paths_r").eq(lit(t.pb + 1, 0));
     let mut on_start = vec![
         nb(
             id("state"),
             Expr::mux(
-                no_slot.clone(),
+                no_path.clone(),
                 lit(STATE_BITS, S_IDLE),
-                lit(STATE_BITS, S_LOAD),
+                lit(STATE_BITS, S_DISP),
             ),
         ),
         nb(id("cnt"), lit(t.cnt_bits, 0)),
-        nb(id("slot"), lit(t.sb, 0)),
-        nb(id("sbase"), lit(t.eb, 0)),
+        nb(id("rsel"), lit(1, 0)),
         nb(id("cycles"), lit(32, 0)),
-        nb(id("done"), no_slot),
+        nb(id("done"), no_path),
     ];
     for v in ["cur", "conv", "dz", "ov", "pbig", "pdz", "pov"] {
         on_start.push(nb(id(v), all_zero.clone()));
@@ -837,7 +1182,34 @@ fn fsm_on_start(t: &Dims<'_>) -> Vec<Stmt> {
     on_start
 }
 
-/// LOAD: register the schedule entry for the operand broadcast until the slot's tail, then EXEC.
+/// The next slot's length (the buffer the dispatcher wrote: not `rsel`).
+fn next_len(t: &Dims<'_>) -> Expr {
+    Expr::mux(id("rsel"), id("slen_0"), id("slen_1")).eq(lit(t.ib + 1, 0))
+}
+
+/// DISP: wait for the dispatcher; run the slot it built, or report done if it found none
+/// (nothing queued, nothing running).
+fn fsm_disp(t: &Dims<'_>) -> Vec<Stmt> {
+    vec![Stmt::If(
+        dstate_is(D_OFF),
+        vec![Stmt::If(
+            next_len(t),
+            vec![
+                nb(id("state"), lit(STATE_BITS, S_IDLE)),
+                nb(id("done"), lit(1, 1)),
+            ],
+            vec![
+                nb(id("state"), lit(STATE_BITS, S_LOAD)),
+                nb(id("rsel"), id("rsel").inv()),
+                nb(id("cnt"), lit(t.cnt_bits, 0)),
+            ],
+        )],
+        vec![],
+    )]
+}
+
+/// LOAD: register the slot's entries for the operand broadcast until its tail, then EXEC
+/// (the dispatcher starts on the next slot at the same edge).
 fn fsm_load(t: &Dims<'_>, rom: &ScheduleRead) -> Vec<Stmt> {
     let mut stmts = register_entry(&[
         ("ld_q_en", &rom.valid),
@@ -851,9 +1223,8 @@ fn fsm_load(t: &Dims<'_>, rom: &ScheduleRead) -> Vec<Stmt> {
         vec![
             nb(id("state"), lit(STATE_BITS, S_EXEC)),
             nb(id("cnt"), lit(t.cnt_bits, 0)),
-            nb(id("seen_tail"), lit(1, 0)),
         ],
-        next_entry(t, rom),
+        vec![nb(id("cnt"), cnt_inc(t))],
     ));
     stmts
 }
@@ -866,19 +1237,18 @@ fn register_entry(pairs: &[(&str, &Signal)]) -> Vec<Stmt> {
         .collect()
 }
 
-/// Before the slot's tail: step to the next entry and note whether the tail was read.
-fn next_entry(t: &Dims<'_>, rom: &ScheduleRead) -> Vec<Stmt> {
-    vec![nb(id("cnt"), cnt_inc(t)), nb(id("seen_tail"), rom.stop.e())]
-}
-
-/// EXEC: wait the PE latency ([`pe_latency`]) for every PE of the slot, then WB.
+/// EXEC: wait the PE latency ([`pe_latency`]) and for the dispatcher, then WB.
 fn fsm_exec(t: &Dims<'_>) -> Vec<Stmt> {
     vec![Stmt::If(
         id("cnt").eq(lit(t.cnt_bits, u128::from(t.latency() - 1))),
-        vec![
-            nb(id("state"), lit(STATE_BITS, S_WB)),
-            nb(id("cnt"), lit(t.cnt_bits, 0)),
-        ],
+        vec![Stmt::If(
+            dstate_is(D_OFF),
+            vec![
+                nb(id("state"), lit(STATE_BITS, S_WB)),
+                nb(id("cnt"), lit(t.cnt_bits, 0)),
+            ],
+            vec![],
+        )],
         vec![nb(id("cnt"), cnt_inc(t))],
     )]
 }
@@ -930,10 +1300,14 @@ fn path_commit(f: &WritebackFlags) -> Vec<Stmt> {
     )]
 }
 
-/// WB: register the entry for the write-back, commit, and at the slot's tail move to the next
-/// slot's LOAD (or IDLE with done after the last slot).
-fn fsm_writeback(t: &Dims<'_>, rom: &ScheduleRead, f: &WritebackFlags) -> Vec<Stmt> {
-    let (sb, eb, cnt_bits) = (t.sb, t.eb, t.cnt_bits);
+/// WB: register the entry for the write-back, commit, and at the slot's tail run the slot
+/// the dispatcher built, or dispatch now if it found none while paths are queued, or stop.
+fn fsm_writeback(
+    t: &Dims<'_>,
+    rom: &ScheduleRead,
+    f: &WritebackFlags,
+    queue_empty: &Signal,
+) -> Vec<Stmt> {
     let mut stmts = register_entry(&[
         ("wb_q_en", &rom.valid),
         ("wb_q_tail", &rom.tail),
@@ -941,49 +1315,41 @@ fn fsm_writeback(t: &Dims<'_>, rom: &ScheduleRead, f: &WritebackFlags) -> Vec<St
         ("wb_q_path", &rom.path),
         ("wb_q_point", &rom.point),
         ("wb_q_inst", &rom.inst),
+        ("wb_q_gtail", &rom.gtail),
+        ("wb_q_src", &rom.src),
+        ("wb_q_gbase", &rom.gbase),
     ]);
+    let after = Stmt::If(
+        next_len(t),
+        vec![Stmt::If(
+            queue_empty.e(),
+            vec![
+                nb(id("state"), lit(STATE_BITS, S_IDLE)),
+                nb(id("done"), lit(1, 1)),
+            ],
+            vec![nb(id("state"), lit(STATE_BITS, S_DISP))],
+        )],
+        vec![
+            nb(id("state"), lit(STATE_BITS, S_LOAD)),
+            nb(id("rsel"), id("rsel").inv()),
+        ],
+    );
     stmts.extend([
         Stmt::If(f.go.e(), path_commit(f), vec![]),
         Stmt::If(
             id("wb_q_tail"),
-            vec![
-                nb(id("cnt"), lit(cnt_bits, 0)),
-                nb(id("seen_tail"), lit(1, 0)),
-                // The slot had cnt - 1 entries (its tail was read at cnt - 2).
-                nb(
-                    id("sbase"),
-                    id("sbase")
-                        .plus(zero_extend("cnt", cnt_bits, eb))
-                        .minus(lit(eb, 1)),
-                ),
-                Stmt::If(
-                    Expr::concat(vec![lit(1, 0), id("slot")])
-                        .plus(lit(sb + 1, 1))
-                        .eq(id("slots_r")),
-                    vec![
-                        nb(id("state"), lit(STATE_BITS, S_IDLE)),
-                        nb(id("done"), lit(1, 1)),
-                    ],
-                    vec![
-                        nb(id("state"), lit(STATE_BITS, S_LOAD)),
-                        nb(id("slot"), id("slot").plus(lit(sb, 1))),
-                    ],
-                ),
-            ],
-            next_entry(t, rom),
+            vec![nb(id("cnt"), lit(t.cnt_bits, 0)), after],
+            vec![nb(id("cnt"), cnt_inc(t))],
         ),
     ]);
     stmts
 }
 
-/// The main FSM (controller): IDLE -> per slot LOAD, EXEC, WB -> IDLE with done, and the
-/// cycle counter.
-fn controller(t: &Dims<'_>, rom: &ScheduleRead, f: &WritebackFlags, items: &mut Vec<Item>) {
-    let cnt_bits = t.cnt_bits;
-    items.push(Item::Comment(format!(
-        "main FSM: IDLE -> per slot LOAD (jobs + 2) EXEC ({}) WB (jobs + 2) -> IDLE with done after SLOTS slots",
-        t.latency()
-    )));
+/// The start request and the dispatcher's trigger: at a start, when a slot's PEs start
+/// (LOAD's tail) and when a slot ends with no next slot while paths are queued. Returns
+/// `(start_req, d_go, d_scan_init, queue_empty)`.
+fn dispatch_triggers(t: &Dims<'_>, wb_push: &Signal, items: &mut Vec<Item>) -> [Signal; 4] {
+    let pb = t.pb;
     let start_req = Signal::assigned(
         items,
         "start_req",
@@ -993,19 +1359,75 @@ fn controller(t: &Dims<'_>, rom: &ScheduleRead, f: &WritebackFlags, items: &mut 
             .and(Expr::bit("avs_writedata", 0))
             .and(state_is(S_IDLE)),
     );
+    let queued = Signal::assigned(
+        items,
+        "rq_after",
+        pb + 1,
+        Expr::mux(
+            wb_push.e(),
+            id("rq_count").plus(lit(pb + 1, 1)),
+            id("rq_count"),
+        ),
+    );
+    let empty = Signal::assigned(items, "rq_empty", 1, queued.e().eq(lit(pb + 1, 0)));
+    let at_wb_tail = state_is(S_WB)
+        .and(id("wb_q_tail"))
+        .and(next_len(t))
+        .and(empty.e().lnot());
+    let go = Signal::assigned(
+        items,
+        "d_go",
+        1,
+        or(
+            or(
+                start_req.e().and(id("paths_r").eq(lit(pb + 1, 0)).lnot()),
+                state_is(S_LOAD).and(id("ld_q_tail")),
+            ),
+            at_wb_tail,
+        ),
+    );
+    let limit = u128::from(crate::dispatch::SCAN_LIMIT.min(1 << pb));
+    let count = Expr::mux(start_req.e(), id("paths_r"), queued.e());
+    let scan = Signal::assigned(items, "d_scan_init", pb + 1, count);
+    let capped = Signal::assigned(
+        items,
+        "d_scan_cap",
+        pb + 1,
+        Expr::mux(
+            Expr::bin(BinaryOp::Gt, scan.e(), lit(pb + 1, limit)),
+            lit(pb + 1, limit),
+            scan.e(),
+        ),
+    );
+    [start_req, go, capped, empty]
+}
+
+/// The main FSM (controller): IDLE -> DISP -> per slot LOAD, EXEC, WB -> ... -> IDLE with
+/// done, and the cycle counter.
+fn controller(
+    t: &Dims<'_>,
+    rom: &ScheduleRead,
+    f: &WritebackFlags,
+    [start_req, empty]: [&Signal; 2],
+    items: &mut Vec<Item>,
+) {
+    let cnt_bits = t.cnt_bits;
+    items.push(Item::Comment(format!(
+        "main FSM: IDLE -> DISP -> per slot LOAD (jobs + 2) EXEC (max({}, dispatch + 1)) WB (jobs + 2) -> IDLE with done when no path is queued",
+        t.latency()
+    )));
     items.push(Item::AlwaysFf(vec![Stmt::If(
         id("rst_n").lnot(),
         vec![
             nb(id("state"), lit(STATE_BITS, S_IDLE)),
             nb(id("cnt"), lit(cnt_bits, 0)),
-            nb(id("slot"), lit(t.sb, 0)),
+            nb(id("rsel"), lit(1, 0)),
             nb(id("cycles"), lit(32, 0)),
             nb(id("done"), lit(1, 0)),
             nb(id("ld_q_en"), lit(1, 0)),
             nb(id("ld_q_tail"), lit(1, 0)),
             nb(id("wb_q_en"), lit(1, 0)),
             nb(id("wb_q_tail"), lit(1, 0)),
-            nb(id("seen_tail"), lit(1, 0)),
             nb(id("rvalid"), lit(t.np2, 0)),
         ],
         vec![
@@ -1021,9 +1443,10 @@ fn controller(t: &Dims<'_>, rom: &ScheduleRead, f: &WritebackFlags, items: &mut 
                         lit(STATE_BITS, S_IDLE),
                         vec![Stmt::If(start_req.e(), fsm_on_start(t), vec![])],
                     ),
+                    (lit(STATE_BITS, S_DISP), fsm_disp(t)),
                     (lit(STATE_BITS, S_LOAD), fsm_load(t, rom)),
                     (lit(STATE_BITS, S_EXEC), fsm_exec(t)),
-                    (lit(STATE_BITS, S_WB), fsm_writeback(t, rom, f)),
+                    (lit(STATE_BITS, S_WB), fsm_writeback(t, rom, f, empty)),
                 ],
                 vec![nb(id("state"), lit(STATE_BITS, S_IDLE))],
             ),
@@ -1034,7 +1457,7 @@ fn controller(t: &Dims<'_>, rom: &ScheduleRead, f: &WritebackFlags, items: &mut 
 /// Avalon-MM slave, writes: the transmitter, receiver and slot-count registers and the
 /// staging words of a point (its last word, the fractions, goes to the point memory).
 fn register_writes(t: &Dims<'_>, bus: &Decode, items: &mut Vec<Item>) {
-    let (ab, sb) = (t.ab, t.sb);
+    let (ab, pb) = (t.ab, t.pb);
     let wr = |addr: u32, reg: &str| {
         Stmt::If(
             id("avs_address").eq(lit(ab, addr.into())),
@@ -1051,7 +1474,8 @@ fn register_writes(t: &Dims<'_>, bus: &Decode, items: &mut Vec<Item>) {
             nb(id("rx_x"), lit(32, 0)),
             nb(id("rx_y"), lit(32, 0)),
             nb(id("rx_z"), lit(32, 0)),
-            nb(id("slots_r"), lit(sb + 1, 0)),
+            nb(id("paths_r"), lit(pb + 1, 0)),
+            nb(id("cap_r"), lit(16, 0)),
         ],
         vec![Stmt::If(
             bus.host_wr.e(),
@@ -1063,8 +1487,13 @@ fn register_writes(t: &Dims<'_>, bus: &Decode, items: &mut Vec<Item>) {
                 wr(9, "rx_y"),
                 wr(10, "rx_z"),
                 Stmt::If(
-                    id("avs_address").eq(lit(ab, crate::regs::SLOTS.into())),
-                    vec![nb(id("slots_r"), Expr::slice("avs_writedata", sb, 0))],
+                    id("avs_address").eq(lit(ab, crate::regs::PATHS.into())),
+                    vec![nb(id("paths_r"), Expr::slice("avs_writedata", pb, 0))],
+                    vec![],
+                ),
+                Stmt::If(
+                    id("avs_address").eq(lit(ab, crate::regs::ROUND_CAP.into())),
+                    vec![nb(id("cap_r"), Expr::slice("avs_writedata", 15, 0))],
                     vec![],
                 ),
                 Stmt::If(
@@ -1171,7 +1600,8 @@ fn control_read_arms(t: &Dims<'_>, mux: &Signal) -> Vec<(Expr, Vec<Stmt>)> {
         read(8, id("rx_x")),
         read(9, id("rx_y")),
         read(10, id("rx_z")),
-        read(12, Expr::concat(vec![lit(31 - t.sb, 0), id("slots_r")])),
+        read(12, Expr::concat(vec![lit(31 - t.pb, 0), id("paths_r")])),
+        read(14, Expr::concat(vec![lit(16, 0), id("cap_r")])),
     ]
 }
 
@@ -1240,7 +1670,12 @@ fn read_mux(t: &Dims<'_>, mux: &Signal, items: &mut Vec<Item>) {
 /// the linter sees them consumed on purpose.
 fn interrupt_and_unused(items: &mut Vec<Item>) {
     items.push(Item::Assign(id("ins_irq"), id("done")));
-    let unused = vec![lit(1, 0), Expr::slice("avs_writedata", 31, 1)];
+    // The slot buffer's `valid` bit: every entry below the slot's length is a job.
+    let unused = vec![
+        lit(1, 0),
+        Expr::slice("avs_writedata", 31, 1),
+        Expr::bit("sched_q", 0),
+    ];
     items.push(Item::Wire("bt_unused_ok".into(), 1));
     items.push(Item::Assign(
         id("bt_unused_ok"),
@@ -1282,7 +1717,10 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
     let mut items = Vec::new();
     let pe = declare_state(&t, &mut items);
     let bus = bus_decode(&t, &mut items);
-    let rom = schedule_memory(&t, &bus, &mut items);
+    job_memory(&t, &bus, &mut items);
+    let rom = slot_buffer_read(&t, &mut items);
+    let dj = dispatch_signals(&t, &mut items);
+    slot_buffer_write(&t, &dj, &mut items);
     rounds_read(&t, &rom, &mut items);
     let ports = updater_read_ports(&t, &bus, &rom, &mut items);
     let sel = pe_output_select(&t, &pe, &mut items);
@@ -1292,10 +1730,14 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
         .as_ref()
         .map(|(stop, boxes)| early_stop_logic(d, stop, boxes, &disp, &mut items));
     let flags = writeback_flags(&sel, &disp, wb_lb, &mut items);
+    let (push, push_data) = writeback_push(&t, &flags, &mut items);
+    let [start_req, go, scan, empty] = dispatch_triggers(&t, &push, &mut items);
+    ready_queue(&t, &bus, &dj, (&push, &push_data), &start_req, &mut items);
+    items.push(dispatcher(&t, &dj, &go, &scan));
     rounds_write(&flags, &mut items);
     updater_write_port(&bus, &ports, &sel, &flags, &mut items);
     pe_matrix(&t, &pe, &mut items);
-    controller(&t, &rom, &flags, &mut items);
+    controller(&t, &rom, &flags, [&start_req, &empty], &mut items);
     register_writes(&t, &bus, &mut items);
     sched_hi_register(&t, &bus, &mut items);
     let mux = read_pipeline(&t, &bus, &mut items);
