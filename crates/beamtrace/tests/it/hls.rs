@@ -3,7 +3,6 @@
 //! equal to the dispatching controller's twin; no model run feeds the host's work.
 
 use crate::common::*;
-use serde_json::Value;
 use std::path::PathBuf;
 
 /// `hls gen` with the arguments `line` and `values` (see [`cli`]) followed by `-o` into a fresh
@@ -111,13 +110,6 @@ fn no_model_run_feeds_the_host_with_or_without_copies() {
     }
     assert_eq!(p["stats"]["duplicates"], 0);
     assert!(d["stats"]["duplicates"].as_u64().unwrap() > 0, "{d}");
-    let cycles = |v: &Value| v["predicted_cycles"].as_u64().unwrap();
-    assert!(
-        cycles(&d) < cycles(&p),
-        "copies: {} vs {}",
-        cycles(&d),
-        cycles(&p)
-    );
     // The same PE jobs either way: each path runs its own rounds.
     assert_eq!(p["dispatch"]["jobs"], d["dispatch"]["jobs"]);
     std::fs::remove_dir_all(root).ok();
