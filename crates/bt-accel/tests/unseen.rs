@@ -147,3 +147,50 @@ fn an_unseen_room_cosimulates_bit_exact_within_a_millisecond() {
     eprintln!("seed {}: measured {:?} s", SEEDS[1], measured);
     assert!(measured[0] <= 1e-3, "{measured:?}");
 }
+
+/// The host's work of one cold step and nothing else (candidates single-threaded, the
+/// accelerator's input, the round template), for instruction counts under callgrind
+/// (docs/hardware.md, Nios II estimate): `valgrind --tool=callgrind
+/// --toggle-collect='*host_work_of_one_step*' <test binary> host_work_unseen --exact`.
+/// Checks that the template holds one job per path point.
+fn host_work(scene: &bt_scene::Scene) {
+    let planes = static_reflectors(std::slice::from_ref(scene));
+    let (points, jobs) = host_work_of_one_step(scene, &planes);
+    assert!(points > 0);
+    assert_eq!(jobs, points);
+}
+
+/// The scene alone (the baseline subtracted from `host_work_unseen` under valgrind's lackey,
+/// which counts the whole process).
+#[test]
+fn host_work_baseline_unseen() {
+    let scene = bt_testkit::random_scene(SEEDS[1], 34);
+    assert!(!static_reflectors(std::slice::from_ref(&scene)).is_empty());
+}
+
+#[test]
+fn host_work_unseen() {
+    host_work(&bt_testkit::random_scene(SEEDS[1], 34));
+}
+
+#[test]
+fn host_work_living_room() {
+    let scene = bt_import::builtin_scene("living-room", bt_scene::Terminals::default());
+    host_work(&scene.unwrap().unwrap());
+}
+
+/// Path points and template jobs of one step's host work.
+#[inline(never)]
+fn host_work_of_one_step(scene: &bt_scene::Scene, planes: &[bt_scene::SurfaceId]) -> (u64, u64) {
+    let o = options();
+    let trace = TraceOptions {
+        parallel: false,
+        ..o.trace
+    };
+    let c = bt_solve::pipeline::candidates(scene, &trace).unwrap();
+    let mut s = bt_accel::step_input(scene, planes, &c, o.threshold_lsb, o.max_rounds).unwrap();
+    s.input.round_order = o.round_order;
+    let plan = bt_hls::plan_dispatch(&s.input.one_round_problem(), &o.plan, None).unwrap();
+    let points = s.input.paths.iter().map(|p| p.len() as u64).sum();
+    (points, plan.schedule.job_count())
+}
