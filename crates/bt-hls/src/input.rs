@@ -388,7 +388,7 @@ impl Layout {
             )));
         }
         let sw = sched_entry_bits(path_bits, point_bits, inst_bits);
-        let word = crate::pe::point_bits(bt_fixed::Widths::for_coord(platform.coord_bits));
+        let word = crate::rtl::pe::point_bits(bt_fixed::Widths::for_coord(platform.coord_bits));
         // Point memory copies, job memory, slot buffer (two slots) and ready queue.
         let blocks = 2 * m9k_blocks(1 << (point_bits + 1), word.into())
             + m9k_blocks(1 << entry_bits, sw.into())
