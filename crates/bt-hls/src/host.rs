@@ -9,7 +9,7 @@ use crate::input::{Design, StepDesign, pe_latency};
 use crate::{CLOCK_HZ, HlsError, MAP_VERSION, dispatch, regs};
 
 /// The cycle counts of a host program by the exact formulas (checked by co-simulation),
-/// computed once from the program: [`Report`] carries them, [`SimReport`] sets the measured
+/// computed once from the program: [`crate::Report`] carries them, [`crate::SimReport`] sets the measured
 /// counts beside them.
 #[derive(Debug, Clone, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
 pub struct CyclePrediction {
