@@ -200,10 +200,10 @@ pub struct Capacity {
     pub paths: u32,
     /// Path points per run (sum of the paths' orders).
     pub points: u32,
-    /// Schedule slots per run (the makespan).
+    /// Groups of a step's round template (its slots: one group each).
     pub slots: u32,
-    /// Schedule-memory entries per run: the jobs, packed slot after slot (an empty slot takes
-    /// one entry), [`crate::schedule_entries`].
+    /// Job-memory entries per run: one round of every path, one entry per path point
+    /// ([`crate::schedule_entries`] of the template).
     #[serde(default)]
     pub entries: u32,
 }

@@ -90,7 +90,7 @@ pub struct Report {
     pub num_instances: u32,
     /// RAM sizes of the platform.
     pub capacity: Capacity,
-    /// Schedule makespan of each step, slots.
+    /// Groups of each step's round template (its makespan, one group a slot).
     pub makespans: Vec<u32>,
     /// The cycles the host program takes (JSON: `run_cycles`, `predicted_tb_cycles`).
     #[serde(flatten)]
