@@ -1127,30 +1127,29 @@ pub struct HlsGenArgs {
     /// Candidate generator of each step (as `trace --candidates`).
     #[arg(long, value_enum, default_value_t = CandidatesArg::BeamTree)]
     pub candidates: CandidatesArg,
-    /// Scheduler of each step: the list scheduler (host, per step) or the GA (offline sizing).
-    #[arg(long, value_enum, default_value_t = ScheduleArg::List)]
-    pub schedule: ScheduleArg,
-    /// Total PE instances per step: with the GA, default planes used + 25 % for duplicates;
-    /// with the list scheduler, extra PEs become copies of the busiest planes (default none).
+    /// Total PE instances: the PEs beyond one per plane used become copies of the planes with
+    /// the most jobs in one round (sized at step 0 for the whole stream; default none).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub pe_budget: Option<u32>,
-    /// GA seed.
-    #[arg(long, default_value_t = 1)]
-    pub seed: u64,
     /// Convergence threshold on a round's largest displacement, in 1/256 mm.
     #[arg(long, default_value_t = 16)]
     pub threshold_lsb: u32,
-    /// Round cap of the fixed-point IPC (1 to 65536: each round is a pass over every path).
-    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=65536))]
+    /// Round cap of the fixed-point IPC (1 to 65535: the accelerator's ROUND_CAP register).
+    #[arg(long, default_value_t = 256, value_parser = clap::value_parser!(u32).range(1..=65535))]
     pub max_rounds: u32,
     /// M9K blocks the point and schedule memories may take (default: the EP4CE115's 432);
     /// a design that needs more is refused.
     #[arg(long, default_value_t = bt_hls::EP4CE115_M9K_BLOCKS)]
     pub m9k_budget: u32,
-    /// With --steps: start every step from the beam tree's window centres instead of the
-    /// points the previous step converged to.
-    #[arg(long)]
+    /// With --steps: start every step from the beam tree's window centres (the default; the
+    /// flag is kept for scripts written before `--warm-start`).
+    #[arg(long, conflicts_with = "warm_start")]
     pub cold_start: bool,
+    /// With --steps: start each path the previous step converged on from the points it read
+    /// back. `hls gen` has no accelerator to read from, so the model stands in for the
+    /// read-back and the summary counts it in `host_model_runs`.
+    #[arg(long)]
+    pub warm_start: bool,
     /// Update order of the accelerator's rounds.
     #[arg(long, value_enum, default_value_t = RoundOrderArg::RedBlack)]
     pub round_order: RoundOrderArg,

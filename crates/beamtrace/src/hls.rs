@@ -107,6 +107,17 @@ fn simulate(dir: &Path, simulator: bt_hls::Simulator) -> anyhow::Result<ExitCode
         r.tb_cycles,
         r.predicted.tb_cycles
     );
+    let latency = r.step_latency_s();
+    let worst = latency.iter().copied().fold(0.0, f64::max);
+    println!(
+        "measured latency per step at 50 MHz (longest run of each step, ms): {}; worst {:.3} ms",
+        latency
+            .iter()
+            .map(|s| format!("{:.3}", s * 1e3))
+            .collect::<Vec<_>>()
+            .join(", "),
+        worst * 1e3
+    );
     for m in r.mismatch_details.iter().take(20) {
         println!("  mismatch: {m}");
     }
@@ -132,25 +143,35 @@ pub struct HlsSummary {
     pub points: usize,
     /// Candidates through a moving surface, solved by the host (image method).
     pub host_paths: usize,
-    /// Paths started from the points they converged to at the previous step (`--steps`
-    /// without `--cold-start`).
+    /// Paths started from the points they converged to at the previous step (`--steps
+    /// --warm-start`).
     pub warm_started: usize,
+    /// `dynamic`: the host loads one round of every path as groups (the round template) and
+    /// the accelerator dispatches them until each path stops.
     pub schedule: &'static str,
-    pub seed: u64,
     pub pe_budget: u32,
+    /// The round template's statistics (makespan = its groups).
     pub stats: bt_schedule::ScheduleStats,
-    pub list_makespan: u32,
+    /// Slots, jobs and dispatcher waits of the dispatched run (from the verification run).
+    pub dispatch: bt_hls::dispatch::DispatchRun,
     /// PE instances of the platform (the one design all steps run on).
     pub platform_instances: u32,
-    /// Mean cycles of a slot (`2·(jobs + 2) + pe_latency` per slot; idle PEs cost nothing).
+    /// Mean cycles of a dispatched slot (`2·(jobs + 2) + max(pe_latency, dispatch + 1)`).
     pub mean_cycles_per_slot: f64,
+    /// `CYCLES` of the run, predicted by the controller's cycle-exact twin
+    /// (`bt_hls::dispatch::predict`) from the verification run; `hls sim` measures it.
     pub predicted_cycles: u64,
     pub latency_s_at_50mhz: f64,
-    /// Host work per step, seconds: candidates, accelerator input and the PE schedule.
+    /// Host work per step, seconds: candidates, accelerator input and the round template.
     pub host_time_s: f64,
-    /// Seconds the host spends running the fixed-point model to size each path's round
-    /// budget (not yet replaced by a fixed budget; see docs/hardware.md).
-    pub budget_model_time_s: f64,
+    /// Runs of the bit-exact model whose results feed the template or the bus program: 0
+    /// (1 on warm-started steps, where the model stands in for the read-back).
+    pub host_model_runs: u32,
+    /// Seconds of the model run after the plan (verification only: expected bus words,
+    /// `predicted_cycles`, `fixed_vs_f64`).
+    pub verify_model_time_s: f64,
+    /// Fixed point vs the f64 image method, from the verification run (whose results the
+    /// co-simulation proves equal to the accelerator's, bit for bit).
     pub fixed_vs_f64: bt_accel::FixedDeviation,
     pub rtl_written: bool,
 }
@@ -240,17 +261,17 @@ fn summary(
         points: p.plan.points as usize,
         host_paths: p.step.host_sequences.len(),
         warm_started: p.warm_started,
-        schedule: args.schedule.kind().name(),
-        seed: args.seed,
+        schedule: "dynamic",
         pe_budget: p.plan.pe_budget,
-        list_makespan: p.plan.list_makespan,
+        dispatch: p.plan.dispatch,
         stats: p.plan.stats,
         platform_instances: k,
         mean_cycles_per_slot: p.plan.mean_cycles_per_slot,
         predicted_cycles: cycles,
         latency_s_at_50mhz: cycles as f64 / CLOCK_HZ,
         host_time_s: p.host_time_s,
-        budget_model_time_s: p.budget_model_time_s,
+        host_model_runs: p.host_model_runs,
+        verify_model_time_s: p.verify_model_time_s,
         fixed_vs_f64: p.fixed,
         rtl_written,
     }
@@ -271,14 +292,11 @@ fn step_options(args: &HlsGenArgs) -> bt_accel::StepOptions {
         threshold_lsb: args.threshold_lsb,
         max_rounds: args.max_rounds,
         plan: PlanOptions {
-            schedule: args.schedule.kind(),
+            schedule: bt_hls::ScheduleKind::List,
             pe_budget: args.pe_budget,
-            ga: GaParams {
-                seed: args.seed,
-                ..GaParams::default()
-            },
+            ga: GaParams::default(),
         },
-        warm_start: !args.cold_start,
+        warm_start: args.warm_start,
         round_order: args.round_order.order(),
     }
 }
@@ -296,7 +314,7 @@ fn report_steps(
         "paths",
         "host",
         "points",
-        "makespan",
+        "slots",
         "cycles",
         "ms@50MHz",
         "host ms",
@@ -310,7 +328,7 @@ fn report_steps(
             s.paths,
             s.host_paths,
             s.points,
-            s.stats.makespan,
+            s.dispatch.slots,
             s.predicted_cycles,
             s.latency_s_at_50mhz * 1e3,
             s.host_time_s * 1e3,
@@ -323,8 +341,7 @@ fn report_steps(
     let doc = StepsSummary {
         scene: summaries[0].scene.clone(),
         max_order: args.max_order,
-        schedule: args.schedule.kind().name(),
-        seed: args.seed,
+        schedule: "dynamic",
         clock_hz: CLOCK_HZ,
         rtl_written: !args.plan_only,
         platform_instances: summaries[0].platform_instances,
@@ -358,7 +375,6 @@ pub struct StepsSummary {
     pub scene: String,
     pub max_order: usize,
     pub schedule: &'static str,
-    pub seed: u64,
     pub clock_hz: f64,
     pub rtl_written: bool,
     /// PE instances of the one design every step runs on.
@@ -379,25 +395,23 @@ fn print_summary(s: &HlsSummary, dir: &Path) {
         s.scene, s.planes, s.paths, s.max_order, s.points, s.host_paths
     );
     println!(
-        "schedule {} (seed {}): {} PE instances ({} duplicates, budget {}), makespan {} slots (list scheduler: {}), LF {}, utilisation {:.1} %",
+        "schedule {}: {} PE instances ({} duplicates), round template of {} groups; dispatched {} slots, {} jobs",
         s.schedule,
-        s.seed,
         s.stats.instances,
         s.stats.duplicates,
-        s.pe_budget,
         s.stats.makespan,
-        s.list_makespan,
-        s.stats.latency_factor,
-        100.0 * s.stats.utilisation
+        s.dispatch.slots,
+        s.dispatch.jobs
     );
     println!(
-        "cycles per run {} ({:.1} per slot, {} PEs on the platform) = {:.3} ms at 50 MHz; host {:.3} ms (+ {:.3} ms model run for the round budgets)",
+        "cycles per run {} ({:.1} per slot, {} PEs on the platform) = {:.3} ms at 50 MHz; host {:.3} ms, {} model runs feeding the host's work (+ {:.3} ms verification run)",
         s.predicted_cycles,
         s.mean_cycles_per_slot,
         s.platform_instances,
         s.latency_s_at_50mhz * 1e3,
         s.host_time_s * 1e3,
-        s.budget_model_time_s * 1e3
+        s.host_model_runs,
+        s.verify_model_time_s * 1e3
     );
     let f = &s.fixed_vs_f64;
     println!(

@@ -1,5 +1,7 @@
-//! One time step on the host: candidates, the accelerator's input, the fixed-point model run
-//! that sizes each path's round budget, the PE schedule and the comparison with f64.
+//! One time step on the host: candidates, the accelerator's input and the round template of
+//! dynamic dispatch (no model run: the accelerator decides each path's rounds itself); then,
+//! for verification only, the fixed-point model run that stands for the accelerator's
+//! read-back (expected words, the run's cycles) and the comparison with f64.
 
 use std::time::Instant;
 
@@ -70,18 +72,29 @@ pub struct PlannedStep {
     pub index: usize,
     /// The accelerator's input and the host's share of the candidates.
     pub step: StepInput,
-    /// The model's results (what the accelerator reads back, bit for bit).
+    /// The model's results (what the accelerator reads back, bit for bit), computed after the
+    /// plan for verification: nothing the host loads depends on them.
     pub results: Vec<PathResult>,
     /// Paths started from the previous step's converged points.
     pub warm_started: usize,
-    /// The PE schedule of this step.
+    /// The round template of this step, and the cycles its dispatched run takes (from
+    /// `results`).
     pub plan: Plan,
     /// Fixed point vs the f64 image method.
     pub fixed: FixedDeviation,
-    /// Host work, seconds: candidates, accelerator input and the PE schedule.
+    /// Host work, seconds: candidates, accelerator input and the round template.
     pub host_time_s: f64,
-    /// Seconds of the model run that sizes each path's round budget.
+    /// Runs of the bit-exact model whose results feed the schedule or the bus program: 0 by
+    /// default (the template needs no round count; the model runs after, for verification);
+    /// 1 with [`StepOptions::warm_start`] from step 1 on, where the previous step's model run
+    /// stands in for the accelerator's read-back of its points.
+    pub host_model_runs: u32,
+    /// Seconds of a model run that sized round budgets: always 0 since dynamic dispatch
+    /// (kept for callers that add it to the host's time).
     pub budget_model_time_s: f64,
+    /// Seconds of the verification run of the model after the plan (`results`): not host
+    /// work of a deployed accelerator, which reads its results back.
+    pub verify_model_time_s: f64,
 }
 
 /// Whether the PE copies are sized once for all steps: the list scheduler with a PE budget
@@ -125,33 +138,37 @@ pub fn plan_step(
     )
     .map_err(|e| candidates_failed(e.into()))?;
     step.input.round_order = options.round_order;
-    let warm_started = match previous {
-        Some(p) if options.warm_start => warm_start(&mut step, &p.step, &p.results),
-        _ => 0,
+    // A warm start feeds the previous step's results into this step's start points: on the
+    // accelerator those are its read-back, here the model's run stands in for it.
+    let (warm_started, host_model_runs) = match previous {
+        Some(p) if options.warm_start => (warm_start(&mut step, &p.step, &p.results), 1),
+        _ => (0, 0),
     };
-    let t1 = Instant::now();
     if step.input.paths.is_empty() {
         return Err(AccelError::NoCandidate {
             step: index,
             max_order: trace.max_order,
         });
     }
+    let problem = step.input.one_round_problem();
+    let copies = match previous {
+        // Copies sized once, at the first step, within the PE budget; every later step runs
+        // on them, so that one design runs the whole stream.
+        Some(p) if fixed_copies(&options.plan) => Some(p.plan.schedule.copies()),
+        _ => None,
+    };
+    let mut plan =
+        bt_hls::plan_dispatch(&problem, &options.plan, copies.as_deref()).map_err(hardware)?;
+    let t2 = Instant::now();
+    // Verification only, after the plan: the model stands for the accelerator's read-back.
     let model = step.input.model().map_err(hardware)?;
     let results = model
         .run(step.input.tx, step.input.rx)
         .map_err(|e| hardware(e.into()))?;
-    let problem = step.input.problem_for(&results);
-    let latency = step.input.pe_latency();
-    let t2 = Instant::now();
-    let plan = match previous {
-        // Copies sized once, at the first step, within the PE budget; every later step is
-        // scheduled onto them, so that one design runs the whole stream.
-        Some(p) if fixed_copies(&options.plan) => {
-            bt_hls::plan_on(&problem, &options.plan, &p.plan.schedule.copies(), latency)
-        }
-        _ => bt_hls::plan(&problem, &options.plan, latency),
-    }
-    .map_err(hardware)?;
+    let rounds: Vec<u32> = results.iter().map(|r| r.rounds).collect();
+    let columns = platform_columns(step.input.planes.len(), &plan.schedule.copies());
+    bt_hls::predict_dispatch(&mut plan, &rounds, columns, step.input.pe_latency())
+        .map_err(hardware)?;
     let t3 = Instant::now();
     let fixed = fixed_deviation(scene, &step, &results, trace.max_order)
         .map_err(|e| candidates_failed(e.into()))?;
@@ -162,9 +179,19 @@ pub fn plan_step(
         warm_started,
         plan,
         fixed,
-        host_time_s: ((t1 - t0) + (t3 - t2)).as_secs_f64(),
-        budget_model_time_s: (t2 - t1).as_secs_f64(),
+        host_time_s: (t2 - t0).as_secs_f64(),
+        host_model_runs,
+        budget_model_time_s: 0.0,
+        verify_model_time_s: (t3 - t2).as_secs_f64(),
     })
+}
+
+/// PE columns of a platform with one PE per plane of `planes` and `copies[p]` of plane `p`
+/// ([`bt_hls::Platform::fitting`]).
+fn platform_columns(planes: usize, copies: &[u32]) -> usize {
+    (0..planes)
+        .map(|p| copies.get(p).copied().unwrap_or(0).max(1) as usize)
+        .sum()
 }
 
 impl PlannedStep {

@@ -98,6 +98,23 @@ impl HlsInput {
         Ok(self.problem_for(&results))
     }
 
+    /// The scheduling problem of one round of every path (rounds 1, the input's phases): what
+    /// dynamic dispatch plans from ([`crate::plan_dispatch`]). Runs no model.
+    pub fn one_round_problem(&self) -> Problem {
+        Problem {
+            num_planes: self.planes.len() as u32,
+            paths: self
+                .paths
+                .iter()
+                .map(|planes| PathJob {
+                    planes: planes.clone(),
+                    rounds: 1,
+                    phases: self.round_order.phases(),
+                })
+                .collect(),
+        }
+    }
+
     /// The scheduling problem from model results already computed at the design TX/RX
     /// (`results[p]` of path `p`, as [`FixedIpc::run`] returns them): saves a second run.
     pub fn problem_for(&self, results: &[PathResult]) -> Problem {
@@ -183,10 +200,10 @@ pub struct Capacity {
     pub paths: u32,
     /// Path points per run (sum of the paths' orders).
     pub points: u32,
-    /// Schedule slots per run (the makespan).
+    /// Groups of a step's round template (its slots: one group each).
     pub slots: u32,
-    /// Schedule-memory entries per run: the jobs, packed slot after slot (an empty slot takes
-    /// one entry), [`crate::schedule_entries`].
+    /// Job-memory entries per run: one round of every path, one entry per path point
+    /// ([`crate::schedule_entries`] of the template).
     #[serde(default)]
     pub entries: u32,
 }
@@ -291,11 +308,11 @@ pub(crate) struct StepDesign {
     pub work: StepWork,
     /// The fixed-point model of the step's paths, which computes the expected bus words.
     pub model: FixedIpc,
-    /// Round budget of each path (rounds its schedule holds).
-    pub budgets: Vec<u32>,
+    /// Each path's groups (one round), from the step's round template.
+    pub groups: Vec<Vec<crate::dispatch::Group>>,
     /// Global index of the first point of each path.
     pub first_point: Vec<u32>,
-    /// Slots of the schedule, at least 1.
+    /// Groups of the round template (its slots), at least 1.
     pub makespan: u32,
     /// Platform column of each schedule instance.
     pub columns: Vec<u32>,
@@ -339,7 +356,6 @@ pub(crate) struct Layout {
     pub path_bits: u32,
     pub point_bits: u32,
     pub inst_bits: u32,
-    pub slot_bits: u32,
     /// Bits of a schedule-memory entry index.
     pub entry_bits: u32,
     /// Width of `avs_address`, bits.
@@ -359,7 +375,6 @@ impl Layout {
         let path_bits = bits_for(cap.paths.into());
         let point_bits = bits_for(cap.points.into());
         let inst_bits = bits_for(num_instances.into());
-        let slot_bits = bits_for(cap.slots.into());
         let status_bits = path_bits.max(4);
         let point_region_bits = (point_bits + 3).max(status_bits + 1);
         let entry_bits = bits_for(cap.entries.max(1).into());
@@ -373,15 +388,25 @@ impl Layout {
             )));
         }
         let sw = sched_entry_bits(path_bits, point_bits, inst_bits);
-        let word = crate::pe::point_bits(bt_fixed::Widths::for_coord(platform.coord_bits));
+        let word = crate::rtl::pe::point_bits(bt_fixed::Widths::for_coord(platform.coord_bits));
+        // Point memory copies, job memory, slot buffer (two slots) and ready queue.
         let blocks = 2 * m9k_blocks(1 << (point_bits + 1), word.into())
-            + m9k_blocks(1 << entry_bits, sw.into());
+            + m9k_blocks(1 << entry_bits, sw.into())
+            + m9k_blocks(2 << inst_bits, (sw + 2 * entry_bits).into())
+            + m9k_blocks(1 << path_bits, (2 * entry_bits).into());
         if blocks > platform.m9k_budget.into() {
             return Err(HlsError::TooLarge(format!(
                 "{} paths, {} points and {} schedule entries ({} slots, {} PEs) need {blocks} M9K \
                  blocks for the point and schedule memories, more than the budget of {}: lower \
                  --max-order or use fewer reflectors",
                 cap.paths, cap.points, cap.entries, cap.slots, num_instances, platform.m9k_budget
+            )));
+        }
+        if 2 * entry_bits > 32 {
+            return Err(HlsError::TooLarge(format!(
+                "{} job-memory entries: a ready-queue entry (two entry indices) exceeds the \
+                 32-bit bus word",
+                cap.entries
             )));
         }
         if sw > 64 {
@@ -400,7 +425,6 @@ impl Layout {
             path_bits,
             point_bits,
             inst_bits,
-            slot_bits,
             entry_bits,
             address_bits,
             map: AddressMap {
@@ -497,6 +521,12 @@ fn check_step(platform: &Platform, k: usize, input: &HlsInput) -> Result<FixedIp
             input.coord_bits, platform.coord_bits
         ));
     }
+    if !(1..=0xffff).contains(&input.max_rounds) {
+        problems.push(format!(
+            "step {k}: round cap {} outside 1..=65535 (ROUND_CAP holds 16 bits)",
+            input.max_rounds
+        ));
+    }
     let vectors = input.vectors();
     if let Err(e) = &vectors {
         problems.push(format!("step {k} test vector: {e}"));
@@ -516,29 +546,11 @@ fn step_design(platform: &Platform, k: usize, w: &StepWork) -> Result<StepDesign
     let input = &w.input;
     let schedule = &w.schedule;
     let model = check_step(platform, k, input)?;
-    let mut budgets = vec![0u32; input.paths.len()];
-    for row in &schedule.slots {
-        for job in row.iter().flatten() {
-            if let Some(b) = budgets.get_mut(job.path as usize) {
-                *b = (*b).max(job.round + 1);
-            }
-        }
-    }
-    let problem = Problem {
-        num_planes: input.planes.len() as u32,
-        paths: input
-            .paths
-            .iter()
-            .zip(&budgets)
-            .map(|(planes, &rounds)| PathJob {
-                planes: planes.clone(),
-                rounds,
-                phases: input.round_order.phases(),
-            })
-            .collect(),
-    };
+    let problem = input.one_round_problem();
     schedule
         .check(&problem)
+        .map_err(|e| HlsError::Schedule(format!("step {k}: {e}")))?;
+    let groups = crate::dispatch::groups(schedule, input.paths.len())
         .map_err(|e| HlsError::Schedule(format!("step {k}: {e}")))?;
     let makespan = schedule.makespan();
     if makespan == 0 {
@@ -587,7 +599,7 @@ fn step_design(platform: &Platform, k: usize, w: &StepWork) -> Result<StepDesign
     Ok(StepDesign {
         work: w.clone(),
         model,
-        budgets,
+        groups,
         first_point,
         makespan,
         columns,
@@ -638,25 +650,30 @@ mod tests {
             (l.map.sched_base, l.address_bits),
             (1 << 14, MIN_ADDRESS_BITS)
         );
-        // 70,000 entries (2^17) need 18 address bits instead of a refusal.
-        let l = Layout::of(&platform(104, 270, 70_000, 25, EP4CE115_M9K_BLOCKS)).unwrap();
-        assert_eq!((l.map.sched_base, l.address_bits), (1 << 17, 18));
+        // 40,000 entries (2^16) need 17 address bits instead of a refusal.
+        let l = Layout::of(&platform(104, 270, 40_000, 25, EP4CE115_M9K_BLOCKS)).unwrap();
+        assert_eq!((l.map.sched_base, l.address_bits), (1 << 16, 17));
+        // 70,000 entries (2^17): a ready-queue entry, two entry indices, would not fit the bus
+        // word.
+        let e = Layout::of(&platform(104, 270, 70_000, 25, EP4CE115_M9K_BLOCKS)).unwrap_err();
+        assert!(e.to_string().contains("ready-queue entry"), "{e}");
     }
 
     #[test]
     fn memories_over_the_m9k_budget_are_refused_with_the_numbers() {
-        // Point memories 2 x 1 K x 120 bits (two banks of 270 points; 14 blocks each),
-        // schedule 256 K x 26 bits ({column 5, tail, end, last, first, point 9, path 7,
-        // valid}; 1K x 9 shape: 256 x 3 = 768 blocks): 796 blocks, over the EP4CE115's 432.
+        // Point memories 2 x 1 K x 120 bits (two banks of 270 points; 14 blocks each), job
+        // memory 256 K x 26 bits ({column 5, tail, end, last, first, point 9, path 7, valid};
+        // 1K x 9 shape: 256 x 3 = 768 blocks), slot buffer 64 x (26 + 2 x 18) bits (2 blocks)
+        // and ready queue 128 x 36 bits (1 block): 799 blocks, over the EP4CE115's 432.
         let e = Layout::of(&platform(104, 270, 200_000, 25, EP4CE115_M9K_BLOCKS)).unwrap_err();
         let text = e.to_string();
         assert!(matches!(e, HlsError::TooLarge(_)), "{text}");
         assert!(
-            text.contains("796 M9K blocks") && text.contains("budget of 432"),
+            text.contains("799 M9K blocks") && text.contains("budget of 432"),
             "{text}"
         );
-        // The order-3 room itself: 2 x 14 + 16K x 26 (1K x 9 shape: 16 x 3 = 48) = 76 blocks.
-        let e = Layout::of(&platform(104, 270, 12_000, 25, 75)).unwrap_err();
-        assert!(e.to_string().contains("76 M9K blocks"), "{e}");
+        // 12,000 entries: 2 x 14 + 16K x 26 (1K x 9 shape: 16 x 3 = 48) + 2 + 1 = 79 blocks.
+        let e = Layout::of(&platform(104, 270, 12_000, 25, 78)).unwrap_err();
+        assert!(e.to_string().contains("79 M9K blocks"), "{e}");
     }
 }

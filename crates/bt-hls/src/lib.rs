@@ -1,7 +1,8 @@
 //! RTL generation, co-simulation and synthesis of the beamtrace IPC accelerator (paper
-//! sections IV-V): one PE per plane with its constants as shift-add networks, the PE
-//! scheduler as a ROM, the coordinate updater-buffer, per-path convergence flags and an
-//! Avalon-MM register interface.
+//! sections IV-V): one PE per plane with its constants as shift-add networks, a controller
+//! that dispatches each path's rounds at run time ([`dispatch`]: no round count is loaded, so
+//! the host never runs the model to plan), the coordinate updater-buffer, per-path
+//! convergence flags and an Avalon-MM register interface.
 //!
 //! * [`generate`] writes `rtl/*.v` (through the [`verilog`] AST and its one printer),
 //!   `tb/` (bus-program testbench + stimulus), `vectors/*.json`, `schedule.json`,
@@ -16,39 +17,42 @@
 
 #![warn(missing_docs)]
 
+pub mod dispatch;
 mod error;
+mod host;
 mod input;
-mod pe;
 mod plan;
+mod rtl;
 mod tools;
-mod top;
-pub mod verilog;
 
 use std::path::{Path, PathBuf};
 
-use bt_fixed::FixedPoint;
 pub use bt_output::OutputDir;
 use bt_schedule::Schedule;
 
 pub use bt_fixed::{BoundsM, EarlyStop, FixedOutcome, PathResult, RoundOrder};
 pub use error::HlsError;
+pub use host::{BusOp, CyclePrediction, TB_PROGRAM_WORDS, VectorExpectation, status_word};
 pub use input::{
     AddressMap, Capacity, EP4CE115_M9K_BLOCKS, MAX_ADDRESS_BITS, MIN_ADDRESS_BITS, m9k_blocks,
 };
 pub use input::{HlsInput, PlaneSpec, Platform, StepWork, pe_latency};
-pub use pe::{PE_CORE_MODULE, pe_module_name, point_bits, sum_bits};
 pub use plan::{
-    Plan, PlanOptions, ScheduleKind, plan, plan_on, run_cycles, schedule_entries, slot_cycles,
+    Plan, PlanOptions, ScheduleKind, plan, plan_dispatch, plan_on, predict_dispatch, run_cycles,
+    schedule_entries, slot_cycles,
 };
+pub use rtl::pe::{PE_CORE_MODULE, pe_module_name, point_bits, sum_bits};
+pub use rtl::top::MAP_VERSION;
+pub use rtl::verilog;
 pub use tools::{
     AdderMapping, BlockArea, EP4CE115_LES, LintReport, SimProgress, SimReport, Simulator,
     SynthOptions, SynthReport, area_markdown, cell_models, lint, simulate, simulate_netlist,
     simulate_with, synthesize, synthesize_rtl, synthesize_with,
 };
-pub use top::MAP_VERSION;
 
 use error::io_err;
-use input::{Design, StepDesign};
+use host::{host_program, register_map, stimulus};
+use input::Design;
 
 /// Clock of the accelerator on the paper's platform (Intel Cyclone IV E at 50 MHz), Hz: a run
 /// takes its cycle count (the CYCLES register, [`run_cycles`]) over this, in seconds.
@@ -68,11 +72,13 @@ pub mod regs {
     pub const TX: u32 = 4;
     /// RW: RX x, y, z (millimetre words) at 8, 9, 10.
     pub const RX: u32 = 8;
-    /// RW: slots of the loaded schedule (the run's makespan).
-    pub const SLOTS: u32 = 12;
+    /// RW: paths of the loaded step (the ready queue holds PATH_BASE[0..PATHS] at a start).
+    pub const PATHS: u32 = 12;
     /// W: the bits above 32 of the schedule entries written after it (only in designs whose
     /// entries are wider than 32 bits: many paths, points and PEs).
     pub const SCHED_HI: u32 = 13;
+    /// RW: round cap of every path (16 bits): a path that reaches it stops unconverged.
+    pub const ROUND_CAP: u32 = 14;
 }
 
 /// What [`generate`] produced.
@@ -84,7 +90,7 @@ pub struct Report {
     pub num_instances: u32,
     /// RAM sizes of the platform.
     pub capacity: Capacity,
-    /// Schedule makespan of each step, slots.
+    /// Groups of each step's round template (its makespan, one group a slot).
     pub makespans: Vec<u32>,
     /// The cycles the host program takes (JSON: `run_cycles`, `predicted_tb_cycles`).
     #[serde(flatten)]
@@ -97,332 +103,6 @@ pub struct Report {
     pub address_map: AddressMap,
     /// Register map and cycle formulas (markdown), also in `report.md`.
     pub docs: String,
-}
-
-/// The cycle counts of a host program by the exact formulas (checked by co-simulation),
-/// computed once from the program: [`Report`] carries them, [`SimReport`] sets the measured
-/// counts beside them.
-#[derive(Debug, Clone, PartialEq, Eq, Default, serde::Serialize, serde::Deserialize)]
-pub struct CyclePrediction {
-    /// `CYCLES` register value of every run (steps in order, each step's vectors in order),
-    /// clock cycles: the sum over the step's slots of `2·(jobs + 2) + pe_latency`.
-    pub run_cycles: Vec<u64>,
-    /// Testbench clock edges of the whole bus program (1 per write, 2 per read, 1 + CYCLES per
-    /// start).
-    #[serde(rename = "predicted_tb_cycles")]
-    pub tb_cycles: u64,
-}
-
-impl CyclePrediction {
-    /// The prediction of the bus program `ops` whose runs the model expects as `runs`.
-    fn of(ops: &[BusOp], runs: &[VectorExpectation]) -> CyclePrediction {
-        CyclePrediction {
-            run_cycles: runs.iter().map(|r| r.cycles).collect(),
-            tb_cycles: ops.iter().map(|o| o.tb_cycles()).sum(),
-        }
-    }
-}
-
-/// One bus operation of the host program (and of the testbench's stimulus).
-#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
-pub enum BusOp {
-    /// Single-cycle write `(word address, data)`.
-    Write(u32, u32),
-    /// Read `(word address, expected data from the model)`.
-    Read(u32, u32),
-    /// Write CTRL = 1 and wait for the interrupt; the run's predicted `CYCLES`.
-    Start(u64),
-}
-
-impl BusOp {
-    /// Testbench clock edges of the operation.
-    pub fn tb_cycles(self) -> u64 {
-        match self {
-            BusOp::Write(..) => 1,
-            BusOp::Read(..) => 2,
-            BusOp::Start(c) => 1 + c,
-        }
-    }
-}
-
-/// Expected bus words of one run, from the fixed-point model.
-#[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
-pub struct VectorExpectation {
-    /// Time step (index into the design's work).
-    pub step: usize,
-    /// TX, millimetre words.
-    pub tx: FixedPoint,
-    /// RX, millimetre words.
-    pub rx: FixedPoint,
-    /// `(word address, expected data)` of every read, in program order.
-    pub reads: Vec<(u32, u32)>,
-    /// Predicted `CYCLES`.
-    pub cycles: u64,
-    /// Model outcome per path.
-    pub paths: Vec<PathResult>,
-}
-
-/// The status word of a path:
-/// `{rounds[15:0], 12'b0, left_bounds, overflow, zero_sum, converged}`. The final points are
-/// in bank `rounds & 1`.
-pub fn status_word(r: &PathResult) -> u32 {
-    (r.rounds.min(0xffff) << 16)
-        | (u32::from(r.left_bounds) << 3)
-        | (u32::from(r.overflow) << 2)
-        | (u32::from(r.zero_sum) << 1)
-        | u32::from(r.converged)
-}
-
-/// The schedule-memory writes of one step: slot after slot (`0..makespan`) its jobs in
-/// ascending PE column, packed from entry 0, each slot's last flagged `tail` (an empty slot
-/// gets one invalid tail entry), then `SLOTS`. Entries after a slot's tail are never read, so nothing of an earlier
-/// step needs clearing.
-fn schedule_writes(d: &Design, s: &StepDesign, ops: &mut Vec<BusOp>) {
-    let (pb, ptb) = (d.layout.path_bits, d.layout.point_bits);
-    // Each slot's jobs in write-back order (ascending column).
-    let rows: Vec<Vec<(u32, bt_schedule::Job)>> = s.work.schedule.slots[..s.makespan as usize]
-        .iter()
-        .map(|row| {
-            let mut jobs: Vec<(u32, bt_schedule::Job)> = row
-                .iter()
-                .enumerate()
-                .filter_map(|(i, job)| job.map(|j| (s.columns[i], j)))
-                .collect();
-            jobs.sort_by_key(|&(col, _)| col);
-            jobs
-        })
-        .collect();
-    let mut last_of_round = std::collections::BTreeMap::new();
-    for (t, jobs) in rows.iter().enumerate() {
-        for (e, (_, job)) in jobs.iter().enumerate() {
-            last_of_round.insert((job.path, job.round), (t, e));
-        }
-    }
-    let tail_bit = 1u64 << (5 + pb + ptb);
-    let wide = crate::input::sched_entry_bits(pb, ptb, d.layout.inst_bits) > 32;
-    let mut high = None;
-    let mut entry = 0u32;
-    for (t, jobs) in rows.iter().enumerate() {
-        let mut words: Vec<u64> = jobs
-            .iter()
-            .enumerate()
-            .map(|(e, &(col, job))| {
-                let n = s.work.input.paths[job.path as usize].len() as u32;
-                let point = s.first_point[job.path as usize] + job.point;
-                let end = last_of_round[&(job.path, job.round)] == (t, e);
-                // A job after its round's first phase reads its neighbours' new points.
-                let late = job.point % s.work.input.round_order.phases() != 0;
-                1 | u64::from(job.path) << 1
-                    | u64::from(point) << (1 + pb)
-                    | u64::from(job.point == 0) << (1 + pb + ptb)
-                    | u64::from(job.point + 1 == n) << (2 + pb + ptb)
-                    | u64::from(end) << (3 + pb + ptb)
-                    | u64::from(late) << (4 + pb + ptb)
-                    | u64::from(col) << (6 + pb + ptb)
-            })
-            .collect();
-        if words.is_empty() {
-            words.push(0);
-        }
-        if let Some(last) = words.last_mut() {
-            *last |= tail_bit;
-        }
-        for word in words {
-            // A wide entry's high bits go to SCHED_HI first, when they change.
-            let hi = (word >> 32) as u32;
-            if wide && high != Some(hi) {
-                ops.push(BusOp::Write(regs::SCHED_HI, hi));
-                high = Some(hi);
-            }
-            ops.push(BusOp::Write(d.layout.map.sched_base + entry, word as u32));
-            entry += 1;
-        }
-    }
-    ops.push(BusOp::Write(regs::SLOTS, s.makespan));
-}
-
-/// One run of step `s`: write the start points (bank 0) and TX/RX, start, read CYCLES, every
-/// status word and every final point.
-fn run_ops(
-    d: &Design,
-    s: &StepDesign,
-    step: usize,
-    [tx, rx]: [FixedPoint; 2],
-) -> (Vec<BusOp>, VectorExpectation) {
-    let map = &d.layout.map;
-    let mut ops = Vec::new();
-    for p in 0..s.work.input.paths.len() {
-        for (i, pt) in s.model.init_points(p).iter().enumerate() {
-            let g = s.first_point[p] + i as u32;
-            for (k, c) in pt.iter().enumerate() {
-                ops.push(BusOp::Write(
-                    map.point_word(g, 0, k as u32),
-                    c.floor_mm().0 as u32,
-                ));
-            }
-            ops.push(BusOp::Write(map.point_word(g, 0, 3), frac_word(pt)));
-        }
-    }
-    for (k, c) in tx.iter().enumerate() {
-        ops.push(BusOp::Write(regs::TX + k as u32, c.0 as u32));
-    }
-    for (k, c) in rx.iter().enumerate() {
-        ops.push(BusOp::Write(regs::RX + k as u32, c.0 as u32));
-    }
-    let cycles = crate::plan::run_cycles(&s.work.schedule, pe_latency(d.platform.coord_bits));
-    ops.push(BusOp::Start(cycles));
-    let paths = s.model.run_fixed(tx, rx, Some(&s.budgets));
-    let mut reads = vec![(regs::CYCLES, cycles as u32)];
-    for (p, r) in paths.iter().enumerate() {
-        reads.push((map.status_base + p as u32, status_word(r)));
-    }
-    for (p, r) in paths.iter().enumerate() {
-        for (i, pt) in r.points.iter().enumerate() {
-            let g = s.first_point[p] + i as u32;
-            let bank = r.rounds & 1;
-            for (k, c) in pt.iter().enumerate() {
-                reads.push((map.point_word(g, bank, k as u32), c.floor_mm().0 as u32));
-            }
-            reads.push((map.point_word(g, bank, 3), frac_word(pt)));
-        }
-    }
-    ops.extend(reads.iter().map(|&(a, v)| BusOp::Read(a, v)));
-    let v = VectorExpectation {
-        step,
-        tx,
-        rx,
-        reads,
-        cycles,
-        paths,
-    };
-    (ops, v)
-}
-
-fn frac_word(pt: &bt_fixed::FinePoint) -> u32 {
-    u32::from(pt[0].frac()) | u32::from(pt[1].frac()) << 8 | u32::from(pt[2].frac()) << 16
-}
-
-/// The whole host program of the design (every step: load the schedule once, then per vector
-/// load the start points and TX/RX, run, read back) and the model's expectation per run.
-fn host_program(d: &Design) -> Result<(Vec<BusOp>, Vec<VectorExpectation>), HlsError> {
-    let mut ops = Vec::new();
-    let mut runs = Vec::new();
-    for (k, s) in d.steps.iter().enumerate() {
-        schedule_writes(d, s, &mut ops);
-        for v in s.work.input.vectors()? {
-            let (o, e) = run_ops(d, s, k, v);
-            ops.extend(o);
-            runs.push(e);
-        }
-    }
-    Ok((ops, runs))
-}
-
-/// The testbench stimulus: 3 words per operation (1 = write addr data, 2 = read addr, 3 =
-/// start addr data, 0 = end).
-fn stimulus(ops: &[BusOp]) -> Vec<u32> {
-    let mut prog = Vec::with_capacity(3 * ops.len() + 3);
-    for op in ops {
-        match *op {
-            BusOp::Write(a, v) => prog.extend([1, a, v]),
-            BusOp::Read(a, _) => prog.extend([2, a, 0]),
-            BusOp::Start(_) => prog.extend([3, regs::CTRL, 1]),
-        }
-    }
-    prog.extend([0, 0, 0]);
-    prog
-}
-
-/// Words the testbench's program memory holds (`prog` in `bt_tb.v`).
-pub const TB_PROGRAM_WORDS: usize = 1 << 22;
-
-fn register_map(d: &Design) -> String {
-    let (cap, l) = (d.platform.capacity, &d.layout);
-    let mut s = String::new();
-    s.push_str("# bt_top register map (Avalon-MM slave)\n\n");
-    s.push_str(&format!(
-        "32-bit data, word addresses on `avs_address[{}:0]`, no waitrequest, single-cycle writes, \
-         pipelined reads with a fixed latency of 2 cycles (`avs_readdatavalid` marks the data), \
-         interrupt `ins_irq` = done (level, cleared by the next start). Coordinates on the bus \
-         are millimetre words (two's complement, metres x 1000). Writes other than CTRL are \
-         ignored while busy.\n\n",
-        l.address_bits - 1
-    ));
-    s.push_str("| address | access | name | content |\n|---|---|---|---|\n");
-    s.push_str("| 0x0000 | W | CTRL | bit 0 = 1 starts a run (ignored while busy) |\n");
-    s.push_str("| 0x0000 | R | STATUS | bit 0 busy, bit 1 done |\n");
-    s.push_str("| 0x0001 | R | CYCLES | clock cycles of the last run |\n");
-    s.push_str(&format!(
-        "| 0x0002 | R | INFO | `{{instances[7:0], version[7:0], path capacity[15:0]}}` = 0x{:08x} |\n",
-        (l.num_instances << 24) | (MAP_VERSION << 16) | (cap.paths & 0xffff)
-    ));
-    s.push_str(&format!(
-        "| 0x0003 | R | THRESHOLD | {} fine LSB (1/256 mm) |\n",
-        d.platform.threshold_lsb
-    ));
-    s.push_str("| 0x0004-0x0006 | RW | TX_X, TX_Y, TX_Z | transmitter, mm |\n");
-    s.push_str("| 0x0008-0x000a | RW | RX_X, RX_Y, RX_Z | receiver, mm |\n");
-    s.push_str(&format!(
-        "| 0x000c | RW | SLOTS | slots of the loaded schedule, 1 to {} |\n",
-        cap.slots
-    ));
-    s.push_str(&format!(
-        "| 0x{:04x} + p | R | PATH_STATUS[p] | `{{rounds[15:0], 12'b0, left_bounds, overflow, zero_sum, converged}}`, p < {} |\n",
-        l.map.status_base, cap.paths
-    ));
-    s.push_str(&format!(
-        "| 0x{:04x} + 8i + 4b + {{0,1,2}} | RW | POINT[i].X/Y/Z, bank b | floor(mm) of point i, i < {} |\n",
-        l.map.point_base, cap.points
-    ));
-    s.push_str(&format!(
-        "| 0x{:04x} + 8i + 4b + 3 | RW | POINT[i].FRAC, bank b | `{{8'b0, z_frac, y_frac, x_frac}}` (1/256 mm; value = mm + frac/256); a write stores the point (X, Y, Z written before) |\n",
-        l.map.point_base
-    ));
-    s.push_str(&format!(
-        "| 0x{:04x} + j | W | SCHED[j] | schedule entry j (the jobs of slot 0, then slot 1, ..., each slot's in ascending PE column): `{{column[{}:0], tail, late, end, last, first, point[{}:0], path[{}:0], valid}}`, `valid` at bit 0, `tail` on a slot's last entry, `late` on a job that reads its round's new points (red-black), j < {}, slots < {} |\n\n",
-        l.map.sched_base,
-        l.inst_bits - 1,
-        l.point_bits - 1,
-        l.path_bits - 1,
-        cap.entries,
-        cap.slots
-    ));
-    s.push_str("PE columns: ");
-    let cols: Vec<String> = d
-        .platform
-        .instances
-        .iter()
-        .enumerate()
-        .map(|(c, i)| format!("{c} = plane {} copy {}", i.plane, i.copy))
-        .collect();
-    s.push_str(&cols.join(", "));
-    s.push_str(".\n\n");
-    s.push_str(
-        "Per time step the host writes the schedule (the jobs of each slot 0..SLOTS-1 packed from \
-         entry 0, the last one with `tail` set; an empty slot as one entry with only `tail`) and \
-         SLOTS; per run it writes every path point's start value into bank 0 \
-         (X, Y, Z, then FRAC), TX_X..RX_Z, CTRL = 1, waits for `ins_irq` (or polls STATUS bit 1), \
-         then reads CYCLES, PATH_STATUS[*] and each point in bank `rounds & 1` of its path. \
-         Point i of path p is global index `first_point[p] + i` (paths in order, points TX \
-         side first); `first`/`last` mark the points next to TX/RX, `end` the last job of a \
-         path's round.\n\n",
-    );
-    s.push_str("## Cycle formulas (exact, checked by co-simulation)\n\n");
-    s.push_str(&format!(
-        "* CYCLES = sum over slots of (2 x (jobs + 2) + PE_LATENCY), PE_LATENCY = {} \
-         (5 + {} halving steps of Algorithm 3 at the {}-bit coordinate word; an empty slot \
-         counts as 1 job); idle PEs cost nothing\n",
-        pe_latency(d.platform.coord_bits),
-        bt_fixed::Widths::for_coord(d.platform.coord_bits).iterations,
-        d.platform.coord_bits
-    ));
-    s.push_str("* testbench edges: 1 per write, 2 per read, 1 + CYCLES per start\n");
-    s.push_str(&format!(
-        "* at {} MHz (the paper's clock) one run takes CYCLES x {} ns\n",
-        CLOCK_HZ / 1e6,
-        1e9 / CLOCK_HZ
-    ));
-    s
 }
 
 fn write(
@@ -450,14 +130,14 @@ fn rtl_of(
     let planes: std::collections::BTreeSet<u32> =
         platform.instances.iter().map(|i| i.plane).collect();
     let wd = bt_fixed::Widths::for_coord(model.coord_bits());
-    let core = pe::pe_core_module(wd);
+    let core = rtl::pe::pe_core_module(wd);
     let mut out = vec![(core.name.clone(), verilog::print_module(&core))];
     for p in planes {
         let spec = &platform.planes[p as usize];
-        let m = pe::pe_module(p as usize, &spec.name, &model.planes()[p as usize], wd)?;
+        let m = rtl::pe::pe_module(p as usize, &spec.name, &model.planes()[p as usize], wd)?;
         out.push((m.name.clone(), verilog::print_module(&m)));
     }
-    let top = top::top_module(&top::TopParams::of(platform, model)?);
+    let top = rtl::top::top_module(&rtl::top::TopParams::of(platform, model)?);
     out.push((top.name.clone(), verilog::print_module(&top)));
     Ok(out)
 }

@@ -57,8 +57,12 @@ pub struct Plan {
     pub points: u64,
     /// Mean cycles of a schedule slot ([`slot_cycles`]): `predicted_cycles / makespan`.
     pub mean_cycles_per_slot: f64,
-    /// Cycles from start to done ([`run_cycles`]): what the `CYCLES` register will read.
+    /// Cycles from start to done ([`run_cycles`], or with dynamic dispatch
+    /// [`crate::dispatch::predict`] once the rounds are known): what `CYCLES` will read.
     pub predicted_cycles: u64,
+    /// Slots, jobs and dispatch waits of a dynamically dispatched run ([`plan_dispatch`] and
+    /// [`predict_dispatch`]); zero for a static schedule.
+    pub dispatch: crate::dispatch::DispatchRun,
 }
 
 /// Cycles of one schedule slot holding `jobs` jobs: load operands (jobs + 2: the schedule
@@ -168,6 +172,7 @@ fn plan_with(
     let pe_budget = budget.max_instances.max(schedule.instances.len() as u32);
     let points: u64 = problem.paths.iter().map(|p| p.planes.len() as u64).sum();
     Ok(Plan {
+        dispatch: crate::dispatch::DispatchRun::default(),
         predicted_cycles: run_cycles(&schedule, latency),
         mean_cycles_per_slot: run_cycles(&schedule, latency) as f64
             / f64::from(stats.makespan.max(1)),
@@ -177,4 +182,54 @@ fn plan_with(
         pe_budget,
         points,
     })
+}
+
+/// Plan a step for dynamic dispatch without knowing any path's rounds (no model run): the
+/// round template of `problem` ([`bt_schedule::round_template`]; its `rounds` are not read)
+/// on `copies[p]` PEs of plane `p` (the platform's), or with [`PlanOptions::pe_budget`] on the
+/// copies [`bt_schedule::size_copies`] picks by one round's load per plane, or one PE per
+/// plane. `predicted_cycles` stays 0 until [`predict_dispatch`].
+pub fn plan_dispatch(
+    problem: &Problem,
+    options: &PlanOptions,
+    copies: Option<&[u32]>,
+) -> Result<Plan, HlsError> {
+    let one = problem.one_round();
+    let copies = match (copies, options.pe_budget) {
+        (Some(c), _) => c.to_vec(),
+        (None, Some(b)) => bt_schedule::size_copies(&one, &Budget { max_instances: b })?,
+        (None, None) => Vec::new(),
+    };
+    let schedule = bt_schedule::round_template(&one, &copies)?;
+    schedule.check(&one)?;
+    let stats = schedule.stats(&one);
+    let points: u64 = problem.paths.iter().map(|p| p.planes.len() as u64).sum();
+    Ok(Plan {
+        list_makespan: stats.makespan,
+        pe_budget: options.pe_budget.unwrap_or(0).max(stats.instances),
+        stats,
+        schedule,
+        points,
+        mean_cycles_per_slot: 0.0,
+        predicted_cycles: 0,
+        dispatch: crate::dispatch::DispatchRun::default(),
+    })
+}
+
+/// The cycles of a [`plan_dispatch`] plan once path `p`'s rounds are known (`rounds[p]`,
+/// read back from the accelerator, or from the model run after the step for verification)
+/// on a platform of `columns` PEs whose PE takes `latency` cycles: sets `predicted_cycles`,
+/// `mean_cycles_per_slot` and `dispatch`.
+pub fn predict_dispatch(
+    plan: &mut Plan,
+    rounds: &[u32],
+    columns: usize,
+    latency: u32,
+) -> Result<(), HlsError> {
+    let groups = crate::dispatch::groups(&plan.schedule, rounds.len())?;
+    let run = crate::dispatch::predict(&groups, columns, rounds, latency);
+    plan.predicted_cycles = run.cycles;
+    plan.mean_cycles_per_slot = run.cycles as f64 / run.slots.max(1) as f64;
+    plan.dispatch = run;
+    Ok(())
 }

@@ -166,9 +166,24 @@ pub struct SimReport {
     pub vectors: usize,
     /// Time steps loaded.
     pub steps: usize,
+    /// The time step of each run (`irq_cycles[i]` is a run of step `run_steps[i]`).
+    #[serde(default)]
+    pub run_steps: Vec<usize>,
 }
 
 impl SimReport {
+    /// The measured latency of each step at [`crate::CLOCK_HZ`], seconds: the longest of its
+    /// runs' cycles from the start command to the interrupt (= the `CYCLES` register).
+    pub fn step_latency_s(&self) -> Vec<f64> {
+        let mut worst = vec![0u64; self.steps];
+        for (&step, &c) in self.run_steps.iter().zip(&self.irq_cycles) {
+            if let Some(w) = worst.get_mut(step) {
+                *w = (*w).max(c);
+            }
+        }
+        worst.iter().map(|&c| c as f64 / crate::CLOCK_HZ).collect()
+    }
+
     /// No mismatch, and every run's cycles and the program's edges as predicted.
     pub fn passed(&self) -> bool {
         self.mismatches == 0
@@ -365,6 +380,7 @@ fn compare(
         words_compared: 0,
         vectors: runs.len(),
         steps: runs.last().map_or(0, |r| r.step + 1),
+        run_steps: runs.iter().map(|r| r.step).collect(),
     };
     let note = |r: &mut SimReport, s: String| {
         r.mismatches += 1;

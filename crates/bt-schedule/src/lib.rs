@@ -14,6 +14,8 @@
 //!   slot, no duplicates.
 //! - [`schedule_ga`] is the paper's three-pass procedure: (1) a genetic algorithm over path
 //!   priorities, (2) duplication of the busiest PEs within a [`Budget`], (3) ASAP fill.
+//! - [`round_template`] is what dynamic dispatch loads: one round of every path as groups
+//!   (a phase's jobs on distinct PEs), built without knowing any path's rounds.
 //! - [`Schedule::check`] proves a schedule legal; [`Schedule::stats`] measures it (makespan,
 //!   latency factor of eq. 14, utilisation).
 //!
@@ -34,11 +36,13 @@ mod list;
 mod occupancy;
 mod problem;
 pub mod synthetic;
+mod template;
 
 pub use check::ScheduleStats;
 pub use error::{ProblemIssue, REPORT_LIMIT, Report, ScheduleError, ScheduleViolation};
 pub use ga::{GaParams, schedule_ga};
 pub use list::{schedule_list, schedule_list_duplicated, schedule_list_on, size_copies};
+pub use template::round_template;
 
 /// One candidate path as the scheduler sees it.
 #[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]

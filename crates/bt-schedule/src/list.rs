@@ -71,13 +71,7 @@ pub fn schedule_list_duplicated(
 /// once for all its time steps.
 pub fn schedule_list_on(problem: &Problem, copies: &[u32]) -> Result<Schedule, ScheduleError> {
     let prep = Prepared::new(problem)?;
-    let copies: Vec<u32> = prep
-        .base_copies()
-        .iter()
-        .enumerate()
-        .map(|(p, &base)| base.max(copies.get(p).copied().unwrap_or(0)))
-        .collect();
-    let inst = InstanceSet::from_copies(&copies);
+    let inst = InstanceSet::from_copies(&prep.copies_at_least(copies));
     let mut order: Vec<u32> = (0..problem.paths.len() as u32).collect();
     let jobs = |p: u32| {
         let path = &problem.paths[p as usize];

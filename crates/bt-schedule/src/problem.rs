@@ -237,6 +237,15 @@ impl<'a> Prepared<'a> {
         Ok(())
     }
 
+    /// `copies[p]` PEs of plane `p`, raised to one for every used plane.
+    pub fn copies_at_least(&self, copies: &[u32]) -> Vec<u32> {
+        self.base_copies()
+            .iter()
+            .enumerate()
+            .map(|(p, &base)| base.max(copies.get(p).copied().unwrap_or(0)))
+            .collect()
+    }
+
     /// One PE per used plane.
     pub fn base_copies(&self) -> Vec<u32> {
         let mut copies = vec![0u32; self.problem.num_planes as usize];

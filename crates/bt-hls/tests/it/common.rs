@@ -4,7 +4,7 @@ use std::path::PathBuf;
 use std::sync::OnceLock;
 
 use bt_hls::{HlsInput, PlaneSpec, Report};
-use bt_schedule::{Budget, GaParams, Schedule, schedule_ga};
+use bt_schedule::{Schedule, round_template};
 
 /// A 5 m x 4 m x 3 m room: four walls (the x = 0 wall tilted by ~5.7 degrees so its PE has a
 /// real CSD network), floor and ceiling; all first-order paths and every second-order path
@@ -87,10 +87,10 @@ pub fn small_scene_early() -> HlsInput {
     s
 }
 
-/// The schedule: the paper's GA + duplication + ASAP with 2 duplicate PEs, fixed seed.
+/// The schedule: the round template of dynamic dispatch (no model run) with a second PE for
+/// the floor, so that the copies' columns are exercised.
 pub fn small_schedule(input: &HlsInput) -> Schedule {
-    let problem = input.problem().expect("problem");
-    schedule_ga(&problem, &Budget { max_instances: 8 }, &GaParams::default()).expect("schedule")
+    round_template(&input.one_round_problem(), &[1, 1, 1, 1, 2, 1]).expect("template")
 }
 
 pub struct Generated {

@@ -13,12 +13,14 @@ module bt_top (
   output reg  avs_readdatavalid,
   output wire ins_irq
 );
-  // 7 PE instances, capacity 26 paths, 46 points, 237 slots; 2 x (jobs + 2) + 29 cycles per slot, threshold 16 fine LSB
+  // 7 PE instances, capacity 26 paths, 46 points, 26 groups; 2 x (jobs + 2) + max(29, dispatch + 1) cycles per slot, threshold 16 fine LSB
   reg [2:0] state;
   reg [4:0] cnt;
-  reg [7:0] slot;
-  reg [10:0] sbase;
-  reg [8:0] slots_r;
+  reg [5:0] paths_r;
+  reg [15:0] cap_r;
+  reg rsel;
+  reg [3:0] slen_0;
+  reg [3:0] slen_1;
   reg [31:0] cycles;
   reg done;
   reg [31:0] tx_x;
@@ -39,9 +41,9 @@ module bt_top (
   reg [31:0] pov;
   reg [71:0] rd_a;
   reg [71:0] rd_b;
-  reg [19:0] sched_q;
+  reg [31:0] sched_q;
   reg sq_ok;
-  reg seen_tail;
+  reg sq_tail;
   reg ld_q_en;
   reg ld_q_tail;
   reg ld_q_first;
@@ -53,6 +55,9 @@ module bt_top (
   reg [4:0] wb_q_path;
   reg [5:0] wb_q_point;
   reg [2:0] wb_q_inst;
+  reg wb_q_gtail;
+  reg [5:0] wb_q_src;
+  reg [5:0] wb_q_gbase;
   reg rq_valid;
   reg [1:0] rq_kind;
   reg [3:0] rq_reg;
@@ -60,6 +65,22 @@ module bt_top (
   reg [4:0] rq_path;
   reg [15:0] rounds_q;
   reg [31:0] rvalid;
+  reg [4:0] rq_head;
+  reg [4:0] rq_tail;
+  reg [5:0] rq_count;
+  reg [11:0] rq_q;
+  reg [19:0] job_q;
+  reg [2:0] dstate;
+  reg [5:0] d_scan;
+  reg [7:0] d_used;
+  reg [7:0] d_save;
+  reg [3:0] d_nsl;
+  reg [3:0] d_gi;
+  reg d_conf;
+  reg [5:0] d_gbase;
+  reg [5:0] d_gptr;
+  reg [11:0] rq [0:31];
+  reg [31:0] sbuf [0:15];
   reg [15:0] rounds [0:31];
   reg [71:0] pm_a [0:127];
   reg [71:0] pm_b [0:127];
@@ -93,30 +114,37 @@ module bt_top (
   wire is_point;
   assign is_point = (avs_address[15:9] == 7'd1);
   wire is_sched;
-  assign is_sched = (avs_address[15:11] == 5'd1);
+  assign is_sched = (avs_address[15:10] == 6'd1);
   wire [5:0] bus_point;
   assign bus_point = avs_address[8:3];
   wire host_wr;
   assign host_wr = (avs_write && idle);
   wire pt_we;
   assign pt_we = ((host_wr && is_point) && (avs_address[1:0] == 2'd3));
-  // PE schedule memory, written per step by the host: entry -> {column, tail, late, end, last, first, point, path, valid} (20 bits)
-  wire [10:0] sched_addr;
-  assign sched_addr = (sbase + {6'd0, cnt});
-  wire rom_tail;
-  assign rom_tail = (sched_q[16] && sq_ok);
-  wire stop;
-  assign stop = (seen_tail | rom_tail);
-  reg [19:0] sched [0:2047];
+  // job memory, written per step by the host: one round of every path as groups, entry -> {column, group tail, late, end, last, first, point, path, valid} (20 bits)
+  wire [5:0] job_ra;
+  assign job_ra = ((dstate == 3'd1) ? rq_q[5:0] : ((d_gptr + {2'd0, d_gi}) + 6'd1));
+  reg [19:0] sched [0:63];
   always @(posedge clk) begin
     if ((host_wr && is_sched)) begin
-      sched[avs_address[10:0]] <= avs_writedata[19:0];
+      sched[avs_address[5:0]] <= avs_writedata[19:0];
     end
-    sched_q <= sched[sched_addr];
-    sq_ok <= ((((state == 3'd2) | (state == 3'd4)) && (cnt < 5'd7)) && !(stop));
+    job_q <= sched[job_ra];
+  end
+  // slot buffer: the running slot's jobs (rsel), the next slot's written by the dispatcher
+  wire [3:0] slen_cur;
+  assign slen_cur = (rsel ? slen_1 : slen_0);
+  wire [3:0] sb_ra;
+  assign sb_ra = {rsel, cnt[2:0]};
+  always @(posedge clk) begin
+    sched_q <= sbuf[sb_ra];
+    sq_ok <= (((state == 3'd2) | (state == 3'd4)) && (cnt < {1'd0, slen_cur}));
+    sq_tail <= ((cnt + 5'd1) == {1'd0, slen_cur});
   end
   wire rom_valid;
-  assign rom_valid = (sched_q[0] && sq_ok);
+  assign rom_valid = sq_ok;
+  wire rom_tail;
+  assign rom_tail = (sq_ok && sq_tail);
   wire [4:0] rom_path;
   assign rom_path = sched_q[5:1];
   wire [5:0] rom_point;
@@ -131,6 +159,31 @@ module bt_top (
   assign rom_end = sched_q[14];
   wire rom_late;
   assign rom_late = sched_q[15];
+  wire rom_gtail;
+  assign rom_gtail = sched_q[16];
+  wire [5:0] rom_src;
+  assign rom_src = sched_q[31:26];
+  wire [5:0] rom_gbase;
+  assign rom_gbase = sched_q[25:20];
+  wire [2:0] j_col;
+  assign j_col = job_q[19:17];
+  wire j_gtail;
+  assign j_gtail = job_q[16];
+  wire j_conf;
+  assign j_conf = (d_conf | d_used[j_col]);
+  wire d_stop;
+  assign d_stop = ((d_scan == 6'd0) | (d_used[6:0] == 7'd127));
+  wire d_pop;
+  assign d_pop = ((dstate == 3'd1) && !(d_stop));
+  wire d_push;
+  assign d_push = (((dstate == 3'd3) && j_gtail) && j_conf);
+  wire [2:0] sb_wi;
+  assign sb_wi = (d_nsl[2:0] + d_gi[2:0]);
+  always @(posedge clk) begin
+    if (((dstate == 3'd3) && !(j_conf))) begin
+      sbuf[{~(rsel), sb_wi}] <= {(d_gptr + {2'd0, d_gi}), d_gbase, job_q};
+    end
+  end
   // rounds memory (M9K): read at the write-back entry's path, or the bus address
   wire [4:0] rounds_ra;
   assign rounds_ra = ((state == 3'd4) ? rom_path : avs_address[4:0]);
@@ -253,6 +306,118 @@ module bt_top (
   assign any_dz = (pdz[wb_q_path] | pe_sel_zs);
   wire any_ov;
   assign any_ov = (pov[wb_q_path] | pe_sel_ov);
+  wire wb_again;
+  assign wb_again = (((any_big && !(any_dz)) && !(any_ov)) && ((rounds_cur + 16'h1) < cap_r));
+  wire wb_push;
+  assign wb_push = ((wb_go && wb_q_gtail) && (!(wb_q_end) | wb_again));
+  wire [11:0] wb_push_data;
+  assign wb_push_data = {wb_q_gbase, (wb_q_end ? wb_q_gbase : (wb_q_src + 6'd1))};
+  wire start_req;
+  assign start_req = (((avs_write && (avs_address == 16'h0)) && avs_writedata[0]) && (state == 3'd0));
+  wire [5:0] rq_after;
+  assign rq_after = (wb_push ? (rq_count + 6'd1) : rq_count);
+  wire rq_empty;
+  assign rq_empty = (rq_after == 6'd0);
+  wire d_go;
+  assign d_go = (((start_req && !((paths_r == 6'd0))) | ((state == 3'd2) && ld_q_tail)) | ((((state == 3'd4) && wb_q_tail) && ((rsel ? slen_0 : slen_1) == 4'd0)) && !(rq_empty)));
+  wire [5:0] d_scan_init;
+  assign d_scan_init = (start_req ? paths_r : rq_after);
+  wire [5:0] d_scan_cap;
+  assign d_scan_cap = ((d_scan_init > 6'd10) ? 6'd10 : d_scan_init);
+  wire rq_push;
+  assign rq_push = (d_push | wb_push);
+  always @(posedge clk) begin
+    if (((host_wr && is_status) | rq_push)) begin
+      rq[(host_wr ? avs_address[4:0] : rq_tail)] <= (host_wr ? avs_writedata[11:0] : (d_push ? {d_gbase, d_gptr} : wb_push_data));
+    end
+    rq_q <= rq[rq_head];
+  end
+  always @(posedge clk) begin
+    if (!(rst_n)) begin
+      rq_head <= 5'd0;
+      rq_tail <= 5'd0;
+      rq_count <= 6'd0;
+    end else begin
+      if (start_req) begin
+        rq_head <= 5'd0;
+        rq_tail <= paths_r[4:0];
+        rq_count <= paths_r;
+      end else begin
+        if (d_pop) begin
+          rq_head <= (rq_head + 5'd1);
+        end
+        if (rq_push) begin
+          rq_tail <= (rq_tail + 5'd1);
+        end
+        if (rq_push) begin
+          rq_count <= (rq_count + 6'd1);
+        end else begin
+          if (d_pop) begin
+            rq_count <= (rq_count - 6'd1);
+          end
+        end
+      end
+    end
+  end
+  always @(posedge clk) begin
+    if (!(rst_n)) begin
+      dstate <= 3'd0;
+      slen_0 <= 4'd0;
+      slen_1 <= 4'd0;
+    end else begin
+      case (dstate)
+        3'd0: begin
+          if (d_go) begin
+            dstate <= 3'd2;
+            d_scan <= d_scan_cap;
+            d_used <= 8'd0;
+            d_nsl <= 4'd0;
+          end
+        end
+        3'd2: begin
+          dstate <= 3'd1;
+        end
+        3'd1: begin
+          if (d_pop) begin
+            dstate <= 3'd3;
+            d_scan <= (d_scan - 6'd1);
+            d_gbase <= rq_q[11:6];
+            d_gptr <= rq_q[5:0];
+            d_gi <= 4'd0;
+            d_conf <= 1'd0;
+            d_save <= d_used;
+          end else begin
+            dstate <= 3'd4;
+          end
+        end
+        3'd3: begin
+          d_used[j_col] <= 1'd1;
+          if (j_gtail) begin
+            if (!(j_conf)) begin
+              d_nsl <= (d_nsl + (d_gi + 4'd1));
+            end else begin
+              d_used <= d_save;
+            end
+            dstate <= 3'd1;
+          end else begin
+            d_gi <= (d_gi + 4'd1);
+            d_conf <= j_conf;
+          end
+        end
+        3'd4: begin
+          if (rsel) begin
+            slen_0 <= d_nsl;
+          end else begin
+            slen_1 <= d_nsl;
+          end
+          dstate <= 3'd0;
+        end
+        default: begin
+          dstate <= 3'd0;
+        end
+      endcase
+    end
+  end
   always @(posedge clk) begin
     if ((wb_go && wb_q_end)) begin
       rounds[wb_q_path] <= (rounds_cur + 16'h1);
@@ -362,21 +527,18 @@ module bt_top (
   assign pe_load_4 = (((state == 3'd2) && ld_q_en) && (ld_q_inst == 3'd4));
   assign pe_load_5 = (((state == 3'd2) && ld_q_en) && (ld_q_inst == 3'd5));
   assign pe_load_6 = (((state == 3'd2) && ld_q_en) && (ld_q_inst == 3'd6));
-  // main FSM: IDLE -> per slot LOAD (jobs + 2) EXEC (29) WB (jobs + 2) -> IDLE with done after SLOTS slots
-  wire start_req;
-  assign start_req = (((avs_write && (avs_address == 16'h0)) && avs_writedata[0]) && (state == 3'd0));
+  // main FSM: IDLE -> DISP -> per slot LOAD (jobs + 2) EXEC (max(29, dispatch + 1)) WB (jobs + 2) -> IDLE with done when no path is queued
   always @(posedge clk) begin
     if (!(rst_n)) begin
       state <= 3'd0;
       cnt <= 5'd0;
-      slot <= 8'd0;
+      rsel <= 1'd0;
       cycles <= 32'h0;
       done <= 1'd0;
       ld_q_en <= 1'd0;
       ld_q_tail <= 1'd0;
       wb_q_en <= 1'd0;
       wb_q_tail <= 1'd0;
-      seen_tail <= 1'd0;
       rvalid <= 32'h0;
     end else begin
       if ((state != 3'd0)) begin
@@ -385,12 +547,11 @@ module bt_top (
       case (state)
         3'd0: begin
           if (start_req) begin
-            state <= ((slots_r == 9'h0) ? 3'd0 : 3'd2);
+            state <= ((paths_r == 6'd0) ? 3'd0 : 3'd1);
             cnt <= 5'd0;
-            slot <= 8'd0;
-            sbase <= 11'h0;
+            rsel <= 1'd0;
             cycles <= 32'h0;
-            done <= (slots_r == 9'h0);
+            done <= (paths_r == 6'd0);
             cur <= 32'h0;
             conv <= 32'h0;
             dz <= 32'h0;
@@ -399,6 +560,18 @@ module bt_top (
             pdz <= 32'h0;
             pov <= 32'h0;
             rvalid <= 32'h0;
+          end
+        end
+        3'd1: begin
+          if ((dstate == 3'd0)) begin
+            if (((rsel ? slen_0 : slen_1) == 4'd0)) begin
+              state <= 3'd0;
+              done <= 1'd1;
+            end else begin
+              state <= 3'd2;
+              rsel <= ~(rsel);
+              cnt <= 5'd0;
+            end
           end
         end
         3'd2: begin
@@ -410,16 +583,16 @@ module bt_top (
           if (ld_q_tail) begin
             state <= 3'd3;
             cnt <= 5'd0;
-            seen_tail <= 1'd0;
           end else begin
             cnt <= (cnt + 5'd1);
-            seen_tail <= stop;
           end
         end
         3'd3: begin
           if ((cnt == 5'd28)) begin
-            state <= 3'd4;
-            cnt <= 5'd0;
+            if ((dstate == 3'd0)) begin
+              state <= 3'd4;
+              cnt <= 5'd0;
+            end
           end else begin
             cnt <= (cnt + 5'd1);
           end
@@ -431,6 +604,9 @@ module bt_top (
           wb_q_path <= rom_path;
           wb_q_point <= rom_point;
           wb_q_inst <= rom_inst;
+          wb_q_gtail <= rom_gtail;
+          wb_q_src <= rom_src;
+          wb_q_gbase <= rom_gbase;
           if (wb_go) begin
             if (wb_q_end) begin
               cur[wb_q_path] <= ~(cur[wb_q_path]);
@@ -449,18 +625,19 @@ module bt_top (
           end
           if (wb_q_tail) begin
             cnt <= 5'd0;
-            seen_tail <= 1'd0;
-            sbase <= ((sbase + {6'd0, cnt}) - 11'h1);
-            if ((({1'd0, slot} + 9'h1) == slots_r)) begin
-              state <= 3'd0;
-              done <= 1'd1;
+            if (((rsel ? slen_0 : slen_1) == 4'd0)) begin
+              if (rq_empty) begin
+                state <= 3'd0;
+                done <= 1'd1;
+              end else begin
+                state <= 3'd1;
+              end
             end else begin
               state <= 3'd2;
-              slot <= (slot + 8'd1);
+              rsel <= ~(rsel);
             end
           end else begin
             cnt <= (cnt + 5'd1);
-            seen_tail <= stop;
           end
         end
         default: begin
@@ -477,7 +654,8 @@ module bt_top (
       rx_x <= 32'h0;
       rx_y <= 32'h0;
       rx_z <= 32'h0;
-      slots_r <= 9'h0;
+      paths_r <= 6'd0;
+      cap_r <= 16'h0;
     end else begin
       if (host_wr) begin
         if ((avs_address == 16'h4)) begin
@@ -499,7 +677,10 @@ module bt_top (
           rx_z <= avs_writedata;
         end
         if ((avs_address == 16'hc)) begin
-          slots_r <= avs_writedata[8:0];
+          paths_r <= avs_writedata[5:0];
+        end
+        if ((avs_address == 16'he)) begin
+          cap_r <= avs_writedata[15:0];
         end
         if (is_point) begin
           case (avs_address[1:0])
@@ -547,7 +728,7 @@ module bt_top (
             read_mux = cycles;
           end
           4'd2: begin
-            read_mux = 32'h705001a;
+            read_mux = 32'h706001a;
           end
           4'd3: begin
             read_mux = 32'h10;
@@ -571,7 +752,10 @@ module bt_top (
             read_mux = rx_z;
           end
           4'd12: begin
-            read_mux = {23'h0, slots_r};
+            read_mux = {26'h0, paths_r};
+          end
+          4'd14: begin
+            read_mux = {16'h0, cap_r};
           end
           default: begin
             read_mux = 32'h0;
@@ -604,6 +788,6 @@ module bt_top (
   end
   assign ins_irq = done;
   wire bt_unused_ok;
-  assign bt_unused_ok = &({1'd0, avs_writedata[31:1]});
+  assign bt_unused_ok = &({1'd0, avs_writedata[31:1], sched_q[0]});
 endmodule
 `default_nettype wire

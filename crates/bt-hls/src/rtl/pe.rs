@@ -6,7 +6,7 @@
 use bt_fixed::{FixedPlane, GUARD_BITS, NORMAL_FRAC, Widths};
 
 use crate::HlsError;
-use crate::verilog::{BinaryOp, Direction, Expr, Item, Module, Port, Signal, Stmt, UnaryOp};
+use crate::rtl::verilog::{BinaryOp, Direction, Expr, Item, Module, Port, Signal, Stmt, UnaryOp};
 
 /// Width of a packed point `{z, y, x}` of fine words in a design of widths `wd`.
 pub fn point_bits(wd: Widths) -> u32 {

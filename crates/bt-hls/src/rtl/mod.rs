@@ -1,0 +1,7 @@
+//! The emitted hardware: the Verilog AST and its one printer ([`verilog`]), the PEs (`pe`:
+//! each plane's constant networks around the shared core) and `bt_top` (`top`: controller,
+//! bus, updater-buffer, write-back).
+
+pub(crate) mod pe;
+pub(crate) mod top;
+pub mod verilog;

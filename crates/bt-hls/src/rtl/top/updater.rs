@@ -1,0 +1,168 @@
+//! The coordinate updater-buffer of `bt_top`: the point memory copies' ports and the
+//! per-path `rounds` memory.
+
+use super::*;
+
+/// The ports of the coordinate updater-buffer (the two point memory copies).
+pub(super) struct UpdaterPorts {
+    /// Read addresses of the two copies (port a: previous or own point, port b: next point).
+    pub(super) ra_addr: Signal,
+    pub(super) rb_addr: Signal,
+    /// Write enable, address `{point, bank}` and data of the common write port.
+    pub(super) wr_en: Signal,
+    pub(super) wr_addr: Signal,
+    pub(super) wr_data: Signal,
+}
+
+/// Rounds memory, read side: `rounds_q` <= rounds[addr] every cycle, the address being the
+/// schedule entry's path at write-back (so `rounds_q` holds rounds[wb_q_path] when the entry
+/// commits: a path's jobs in a slot belong to one round, so no commit of the same path sits
+/// between) and the bus address otherwise (a PATH_STATUS read while idle).
+/// `rounds_cur` = the rounds `wb_q_path` has committed since the start.
+pub(super) fn rounds_read(t: &Dims<'_>, rom: &ScheduleRead, items: &mut Vec<Item>) {
+    items.push(Item::Comment(
+        "rounds memory (M9K): read at the write-back entry's path, or the bus address".into(),
+    ));
+    let addr = Signal::assigned(
+        items,
+        "rounds_ra",
+        t.pb,
+        Expr::mux(
+            state_is(S_WB),
+            rom.path.e(),
+            Expr::slice("avs_address", t.pb - 1, 0),
+        ),
+    );
+    items.push(Item::AlwaysFf(vec![nb(
+        id("rounds_q"),
+        Expr::id("rounds").at(addr.e()),
+    )]));
+    Signal::assigned(
+        items,
+        "rounds_cur",
+        16,
+        Expr::mux(
+            Expr::id("rvalid").at(id("wb_q_path")),
+            id("rounds_q"),
+            lit(16, 0),
+        ),
+    );
+}
+
+/// Rounds memory, write side: a committed round's end writes rounds_cur + 1.
+pub(super) fn rounds_write(f: &WritebackFlags, items: &mut Vec<Item>) {
+    items.push(Item::AlwaysFf(vec![Stmt::If(
+        f.go.e().and(id("wb_q_end")),
+        vec![nb(
+            Expr::id("rounds").at(id("wb_q_path")),
+            id("rounds_cur").plus(lit(16, 1)),
+        )],
+        vec![],
+    )]));
+}
+
+/// Coordinate updater-buffer, read side: two banks per point, bank = cur[path] holds the last
+/// committed round. Port a reads the job's previous point at load and its own point at
+/// write-back (the old value, for the displacement); port b reads the next point.
+pub(super) fn updater_read_ports(
+    t: &Dims<'_>,
+    bus: &Decode,
+    rom: &ScheduleRead,
+    items: &mut Vec<Item>,
+) -> UpdaterPorts {
+    let ptb = t.ptb;
+    items.push(Item::Comment(
+        "coordinate updater-buffer: address {point, bank}; cur[path] = bank of the committed round"
+            .into(),
+    ));
+    let rom_bank = Expr::id("cur").at(rom.path.e());
+    // Neighbours: the committed bank, or for a late job the bank its round writes.
+    let nb_bank = Expr::bin(BinaryOp::Xor, rom_bank.clone(), rom.late.e());
+    let ra_addr = Signal::reg(items, "ra_addr", ptb + 1);
+    let rb_addr = Signal::reg(items, "rb_addr", ptb + 1);
+    let wr_addr = Signal::reg(items, "wr_addr", ptb + 1);
+    let wr_en = Signal::reg(items, "wr_en", 1);
+    let wr_data = Signal::reg(items, "wr_data", point_bits(t.wd));
+    let one_pt = lit(ptb, 1);
+    items.push(Item::AlwaysComb(vec![
+        Stmt::Blocking(ra_addr.e(), bus_cell(bus)),
+        Stmt::If(
+            state_is(S_LOAD),
+            vec![Stmt::Blocking(
+                ra_addr.e(),
+                Expr::concat(vec![rom.point.e().minus(one_pt.clone()), nb_bank.clone()]),
+            )],
+            vec![Stmt::If(
+                state_is(S_WB),
+                vec![Stmt::Blocking(
+                    ra_addr.e(),
+                    Expr::concat(vec![rom.point.e(), rom_bank.clone()]),
+                )],
+                vec![],
+            )],
+        ),
+        Stmt::Blocking(
+            rb_addr.e(),
+            Expr::concat(vec![rom.point.e().plus(one_pt), nb_bank]),
+        ),
+    ]));
+    UpdaterPorts {
+        ra_addr,
+        rb_addr,
+        wr_en,
+        wr_addr,
+        wr_data,
+    }
+}
+
+/// Coordinate updater-buffer, write side: the host's point writes while idle, the selected
+/// PE's result into the other bank at write-back; both memory copies take every write.
+pub(super) fn updater_write_port(
+    bus: &Decode,
+    ports: &UpdaterPorts,
+    sel: &Selected,
+    flags: &WritebackFlags,
+    items: &mut Vec<Item>,
+) {
+    // `st_<axis>` hold the millimetre words' kept bits already (`mm_width`).
+    let host_point = Expr::concat(vec![
+        id("st_z"),
+        Expr::slice("avs_writedata", 23, 16),
+        id("st_y"),
+        Expr::slice("avs_writedata", 15, 8),
+        id("st_x"),
+        Expr::slice("avs_writedata", 7, 0),
+    ]);
+    items.push(Item::AlwaysComb(vec![
+        Stmt::Blocking(ports.wr_en.e(), bus.pt_we.e().or(flags.go.e())),
+        Stmt::Blocking(ports.wr_addr.e(), bus_cell(bus)),
+        Stmt::Blocking(ports.wr_data.e(), host_point),
+        Stmt::If(
+            state_is(S_WB),
+            vec![
+                Stmt::Blocking(
+                    ports.wr_addr.e(),
+                    Expr::concat(vec![
+                        id("wb_q_point"),
+                        Expr::id("cur").at(id("wb_q_path")).inv(),
+                    ]),
+                ),
+                Stmt::Blocking(ports.wr_data.e(), sel.point.e()),
+            ],
+            vec![],
+        ),
+    ]));
+    for (mem, rd, addr) in [
+        ("pm_a", "rd_a", &ports.ra_addr),
+        ("pm_b", "rd_b", &ports.rb_addr),
+    ] {
+        items.push(Item::AlwaysFf(vec![
+            Stmt::If(
+                ports.wr_en.e(),
+                vec![nb(Expr::id(mem).at(ports.wr_addr.e()), ports.wr_data.e())],
+                vec![],
+            ),
+            nb(id(rd), Expr::id(mem).at(addr.e())),
+        ]));
+    }
+}

@@ -1,0 +1,402 @@
+//! Write-back in `bt_top`: PE output select and saturation, displacement, the per-path
+//! flags and queue push, early stopping.
+
+use super::*;
+
+/// Width of the early-stopping comparisons (`bt_fixed::FineBox::outside`): a 40-bit point
+/// plus or minus `(L1 move) << 4` and the ±2^41 box bounds fit in 48 signed bits.
+pub(super) const BOX_BITS: u32 = 48;
+
+/// Write-back's queue push: a group's last job queues the path's next group, or after the
+/// round's last group the path's first group again, unless the path converged, froze or
+/// reached the round cap (`cap_r`).
+pub(super) fn writeback_push(
+    t: &Dims<'_>,
+    f: &WritebackFlags,
+    items: &mut Vec<Item>,
+) -> (Signal, Signal) {
+    let eb = t.eb;
+    let mut goes_on = f
+        .any_big
+        .e()
+        .and(f.any_dz.e().lnot())
+        .and(f.any_ov.e().lnot());
+    if let Some(lb) = &f.any_lb {
+        goes_on = goes_on.and(lb.e().lnot());
+    }
+    let below_cap = Expr::bin(BinaryOp::Lt, id("rounds_cur").plus(lit(16, 1)), id("cap_r"));
+    let again = Signal::assigned(items, "wb_again", 1, goes_on.and(below_cap));
+    let push = Signal::assigned(
+        items,
+        "wb_push",
+        1,
+        f.go.e()
+            .and(id("wb_q_gtail"))
+            .and(or(id("wb_q_end").lnot(), again.e())),
+    );
+    let next = Expr::mux(
+        id("wb_q_end"),
+        id("wb_q_gbase"),
+        id("wb_q_src").plus(lit(eb, 1)),
+    );
+    let data = Signal::assigned(
+        items,
+        "wb_push_data",
+        2 * eb,
+        Expr::concat(vec![id("wb_q_gbase"), next]),
+    );
+    (push, data)
+}
+
+/// The selected PE's result at write-back, saturated once for all PEs.
+pub(super) struct Selected {
+    /// The saturated point `{z, y, x}`.
+    pub(super) point: Signal,
+    /// Some axis saturated.
+    pub(super) ov: Signal,
+    /// The PE reported a zero distance sum.
+    pub(super) zs: Signal,
+}
+
+/// Write-back, PE output select and saturation (twin of the model's `saturate`).
+pub(super) fn pe_output_select(t: &Dims<'_>, pe: &[PeWires], items: &mut Vec<Item>) -> Selected {
+    let cw = t.wd.coord;
+    let sel_sum = Signal::reg(items, "pe_sel_sum", sum_bits(t.wd));
+    let zs = Signal::reg(items, "pe_sel_zs", 1);
+    let sel_arms = pe
+        .iter()
+        .enumerate()
+        .map(|(j, w)| {
+            (
+                lit(t.ib, j as u128),
+                vec![
+                    Stmt::Blocking(sel_sum.e(), w.sum.e()),
+                    Stmt::Blocking(zs.e(), w.zs.e()),
+                ],
+            )
+        })
+        .collect();
+    let sel_default = vec![
+        Stmt::Blocking(sel_sum.e(), lit(sum_bits(t.wd), 0)),
+        Stmt::Blocking(zs.e(), lit(1, 0)),
+    ];
+    items.push(Item::AlwaysComb(vec![Stmt::Case(
+        id("wb_q_inst"),
+        sel_arms,
+        sel_default,
+    )]));
+    let spw = t.wd.sum_point;
+    let mut sat_parts = Vec::new();
+    let mut ovf_terms = Vec::new();
+    for (a, axis) in ["x", "y", "z"].iter().enumerate() {
+        let sum = Signal::assigned(
+            items,
+            format!("sum_{axis}"),
+            spw,
+            sel_sum.slice(spw * (a as u32 + 1) - 1, spw * a as u32),
+        );
+        let top = sum.slice(spw - 1, cw - 1);
+        let topw = spw - cw + 1;
+        let ovf = Signal::assigned(
+            items,
+            format!("ovf_{axis}"),
+            1,
+            Expr::bin(
+                BinaryOp::LogicAnd,
+                Expr::bin(BinaryOp::Ne, top.clone(), lit(topw, 0)),
+                Expr::bin(BinaryOp::Ne, top, lit(topw, (1u128 << topw) - 1)),
+            ),
+        );
+        let sat = Signal::assigned(
+            items,
+            format!("sat_{axis}"),
+            cw,
+            Expr::mux(
+                ovf.e(),
+                Expr::mux(
+                    sum.bit(spw - 1),
+                    lit(cw, 1 << (cw - 1)),
+                    lit(cw, (1 << (cw - 1)) - 1),
+                ),
+                sum.slice(cw - 1, 0),
+            ),
+        );
+        sat_parts.insert(0, sat.e());
+        ovf_terms.push(ovf.e());
+    }
+    let point = Signal::assigned(items, "pe_sel", point_bits(t.wd), Expr::concat(sat_parts));
+    let ov = Signal::assigned(items, "pe_sel_ov", 1, or_all(ovf_terms));
+    Selected { point, ov, zs }
+}
+
+/// The move of the written point against its stored value.
+pub(super) struct Displacement {
+    /// `new_<axis>`: the written coordinate.
+    pub(super) new: Vec<Signal>,
+    /// `adiff_<axis>`: |new − old| per axis.
+    pub(super) adiff: Vec<Signal>,
+    /// `wb_big`: the L∞ move exceeds the threshold.
+    pub(super) big: Signal,
+}
+
+/// Write-back displacement: per-axis |new − old| and the threshold test.
+pub(super) fn displacement(t: &Dims<'_>, sel: &Selected, items: &mut Vec<Item>) -> Displacement {
+    let cw = t.wd.coord;
+    let dispw = cw + 1;
+    let (mut new, mut adiff, mut big_terms) = (Vec::new(), Vec::new(), Vec::new());
+    for (a, axis) in ["x", "y", "z"].iter().enumerate() {
+        let (hi, lo) = (cw * (a as u32 + 1) - 1, cw * a as u32);
+        let nw = Signal::assigned(items, format!("new_{axis}"), cw, sel.point.slice(hi, lo));
+        let old = Expr::slice("rd_a", hi, lo);
+        let ow = Signal::assigned(items, format!("old_{axis}"), cw, old);
+        let wide = |s: &Signal| crate::rtl::pe::sext(s.name(), cw, dispw);
+        let delta = wide(&nw).minus(wide(&ow));
+        let diff = Signal::assigned(items, format!("diff_{axis}"), dispw, delta);
+        let abs = Signal::assigned(
+            items,
+            format!("adiff_{axis}"),
+            dispw,
+            Expr::mux(
+                diff.bit(dispw - 1),
+                diff.e().inv().plus(lit(dispw, 1)),
+                diff.e(),
+            ),
+        );
+        big_terms.push(Expr::bin(
+            BinaryOp::Gt,
+            abs.e(),
+            lit(dispw, t.p.platform.threshold_lsb.into()),
+        ));
+        new.push(nw);
+        adiff.push(abs);
+    }
+    items.push(Item::Comment(
+        "wb_big: L-infinity displacement of the written point exceeds the threshold".into(),
+    ));
+    let big = Signal::assigned(items, "wb_big", 1, or_all(big_terms));
+    Displacement { new, adiff, big }
+}
+
+/// The write-back decision and the round's accumulated flags of the written path.
+pub(super) struct WritebackFlags {
+    /// Commit the PE's result (write-back state, a job, path not frozen).
+    pub(super) go: Signal,
+    /// Some point of the path moved more than the threshold this round.
+    pub(super) any_big: Signal,
+    /// Some point of the path had a zero distance sum this round.
+    pub(super) any_dz: Signal,
+    /// Some point of the path saturated this round.
+    pub(super) any_ov: Signal,
+    /// Some point of the path left its box this round (early stopping only).
+    pub(super) any_lb: Option<Signal>,
+}
+
+/// Write-back flags: a path is frozen once converged, degenerate, saturated or (early
+/// stopping) left its box; the `any_*` flags fold this job into its round's flags.
+pub(super) fn writeback_flags(
+    sel: &Selected,
+    disp: &Displacement,
+    wb_lb: Option<Signal>,
+    items: &mut Vec<Item>,
+) -> WritebackFlags {
+    let at_wb = |v: &str| Expr::id(v).at(id("wb_q_path"));
+    let frozen_sig = Signal::wire(items, "wb_frozen", 1);
+    let mut frozen = or(or(at_wb("conv"), at_wb("dz")), at_wb("ov"));
+    let any_lb = wb_lb.map(|lb| {
+        frozen = or(frozen.clone(), at_wb("lb"));
+        Signal::assigned(items, "any_lb", 1, or(at_wb("plb"), lb.e()))
+    });
+    items.push(Item::Assign(frozen_sig.e(), frozen));
+    let go = Signal::assigned(
+        items,
+        "wb_go",
+        1,
+        state_is(S_WB).and(id("wb_q_en")).and(frozen_sig.e().lnot()),
+    );
+    let any_big = Signal::assigned(items, "any_big", 1, or(at_wb("pbig"), disp.big.e()));
+    let any_dz = Signal::assigned(items, "any_dz", 1, or(at_wb("pdz"), sel.zs.e()));
+    let any_ov = Signal::assigned(items, "any_ov", 1, or(at_wb("pov"), sel.ov.e()));
+    WritebackFlags {
+        go,
+        any_big,
+        any_dz,
+        any_ov,
+        any_lb,
+    }
+}
+
+/// A committed job's effect on its path's flags: at the round's end, flip the bank, count the
+/// round and decide convergence; inside the round, accumulate the flags.
+pub(super) fn path_commit(f: &WritebackFlags) -> Vec<Stmt> {
+    let wbp = |v: &str| Expr::id(v).at(id("wb_q_path"));
+    let mut conv_next = f
+        .any_big
+        .e()
+        .lnot()
+        .and(f.any_dz.e().lnot())
+        .and(f.any_ov.e().lnot());
+    let mut at_end = Vec::new();
+    let mut in_round = Vec::new();
+    if let Some(any_lb) = &f.any_lb {
+        conv_next = conv_next.and(any_lb.e().lnot());
+        at_end.push(nb(
+            wbp("lb"),
+            any_lb.e().and(f.any_dz.e().lnot()).and(f.any_ov.e().lnot()),
+        ));
+        at_end.push(nb(wbp("plb"), lit(1, 0)));
+        in_round.push(nb(wbp("plb"), any_lb.e()));
+    }
+    vec![Stmt::If(
+        id("wb_q_end"),
+        vec![
+            nb(wbp("cur"), wbp("cur").inv()),
+            nb(wbp("rvalid"), lit(1, 1)),
+            nb(wbp("dz"), f.any_dz.e()),
+            nb(wbp("ov"), f.any_ov.e()),
+            nb(wbp("conv"), conv_next),
+            nb(wbp("pbig"), lit(1, 0)),
+            nb(wbp("pdz"), lit(1, 0)),
+            nb(wbp("pov"), lit(1, 0)),
+        ]
+        .into_iter()
+        .chain(at_end)
+        .collect(),
+        vec![
+            nb(wbp("pbig"), f.any_big.e()),
+            nb(wbp("pdz"), f.any_dz.e()),
+            nb(wbp("pov"), f.any_ov.e()),
+        ]
+        .into_iter()
+        .chain(in_round)
+        .collect(),
+    )]
+}
+
+/// The widened polygon box of the written instance's plane, per axis (sign bit flipped).
+pub(super) struct InstanceBox {
+    /// `box_lo_<axis>`.
+    pub(super) lo: Vec<Signal>,
+    /// `box_hi_<axis>`.
+    pub(super) hi: Vec<Signal>,
+}
+
+/// Early stopping, box table: the box of the instance being written (`wb_q_inst`), its
+/// constants biased by 2^47 so that signed comparisons become unsigned ones.
+pub(super) fn instance_box(
+    d: &TopParams<'_>,
+    boxes: &[bt_fixed::FineBox],
+    items: &mut Vec<Item>,
+) -> InstanceBox {
+    let w = BOX_BITS;
+    let bias = 1i128 << (w - 1);
+    let biased = |v: i64| lit(w, ((i128::from(v) + bias) as u128) & ((1u128 << w) - 1));
+    let (mut lo, mut hi, mut defaults) = (Vec::new(), Vec::new(), Vec::new());
+    for axis in ["x", "y", "z"] {
+        lo.push(Signal::reg(items, format!("box_lo_{axis}"), w));
+        hi.push(Signal::reg(items, format!("box_hi_{axis}"), w));
+    }
+    for (l, h) in lo.iter().zip(&hi) {
+        defaults.push(Stmt::Blocking(l.e(), lit(w, 0)));
+        defaults.push(Stmt::Blocking(h.e(), lit(w, 0)));
+    }
+    let arms = d
+        .platform
+        .instances
+        .iter()
+        .enumerate()
+        .map(|(j, inst)| {
+            let b = &boxes[inst.plane as usize];
+            let mut stmts = Vec::new();
+            for a in 0..3 {
+                stmts.push(Stmt::Blocking(lo[a].e(), biased(b.lo[a])));
+                stmts.push(Stmt::Blocking(hi[a].e(), biased(b.hi[a])));
+            }
+            (lit(d.layout.inst_bits, j as u128), stmts)
+        })
+        .collect();
+    items.push(Item::Comment(
+        "early stopping: widened polygon box of the written instance's plane (sign bit flipped)"
+            .into(),
+    ));
+    items.push(Item::AlwaysComb(vec![Stmt::Case(
+        id("wb_q_inst"),
+        arms,
+        defaults,
+    )]));
+    InstanceBox { lo, hi }
+}
+
+/// Early stopping at write-back (twin of `bt_fixed::FineBox::outside` and the `min_rounds`
+/// rule of `FixedIpc::run_path`): `wb_lb` = the written point lies outside its instance's
+/// widened box by more than `(L1 move) << shift`, in a round ≥ `min_rounds`. Signed 48-bit
+/// comparisons are unsigned ones with the sign bit flipped (the box constants are flipped
+/// when generated).
+pub(super) fn early_stop_logic(
+    d: &TopParams<'_>,
+    stop: &bt_fixed::EarlyStop,
+    boxes: &[bt_fixed::FineBox],
+    disp: &Displacement,
+    items: &mut Vec<Item>,
+) -> Signal {
+    let w = BOX_BITS;
+    let axes = ["x", "y", "z"];
+    let bx = instance_box(d, boxes, items);
+    let cw = d.model.coord_bits();
+    let dispw = cw + 1;
+    let mvw = w - bt_fixed::EarlyStop::MAX_SHIFT;
+    let zext = |s: &Signal| Expr::concat(vec![lit(mvw - dispw, 0), s.e()]);
+    items.push(Item::Wire("mv_l1".into(), mvw));
+    items.push(Item::Assign(
+        id("mv_l1"),
+        zext(&disp.adiff[0])
+            .plus(zext(&disp.adiff[1]))
+            .plus(zext(&disp.adiff[2])),
+    ));
+    let shift = stop.displacement_shift;
+    items.push(Item::Wire("slack".into(), w));
+    let mut parts = vec![lit(w - mvw - shift, 0), id("mv_l1")];
+    if shift > 0 {
+        parts.push(lit(shift, 0));
+    }
+    items.push(Item::Assign(id("slack"), Expr::concat(parts)));
+    let mut terms = Vec::new();
+    for (a, (axis, new)) in axes.iter().zip(&disp.new).enumerate() {
+        let pw = format!("bp_{axis}");
+        items.push(Item::Wire(pw.clone(), w));
+        items.push(Item::Assign(
+            id(&pw),
+            crate::rtl::pe::sext(new.name(), cw, w),
+        ));
+        for (side, expr) in [
+            ("lo", id(&pw).plus(id("slack"))),
+            ("hi", id(&pw).minus(id("slack"))),
+        ] {
+            let n = format!("bq_{side}_{axis}");
+            items.push(Item::Wire(n.clone(), w));
+            items.push(Item::Assign(id(&n), expr));
+            let flipped = Expr::concat(vec![Expr::bit(&n, w - 1).inv(), Expr::slice(&n, w - 2, 0)]);
+            let op = if side == "lo" {
+                BinaryOp::Lt
+            } else {
+                BinaryOp::Gt
+            };
+            let bound = if side == "lo" { &bx.lo[a] } else { &bx.hi[a] };
+            terms.push(Expr::bin(op, flipped, bound.e()));
+        }
+    }
+    let outside = or_all(terms);
+    let late = if stop.min_rounds >= 2 {
+        Expr::bin(
+            BinaryOp::Gt,
+            id("rounds_cur"),
+            lit(16, u128::from(stop.min_rounds - 2)),
+        )
+    } else {
+        lit(1, 1)
+    };
+    items.push(Item::Comment(format!(
+        "wb_lb: outside the box by more than (L1 move) << {shift}, in round >= {}",
+        stop.min_rounds
+    )));
+    Signal::assigned(items, "wb_lb", 1, late.and(outside))
+}
