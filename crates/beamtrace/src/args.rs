@@ -178,21 +178,11 @@ pub struct StudyLivingRoomArgs {
     /// Highest reflection order.
     #[arg(long, default_value_t = 3)]
     pub max_order: usize,
-    /// PE scheduler of each step's accelerator: the list scheduler (host, per step, as
-    /// `hls gen`) or the GA (offline sizing).
-    #[arg(long, value_enum, default_value_t = ScheduleArg::List)]
-    pub schedule: ScheduleArg,
-    /// GA seed (echoed into the outputs).
+    /// Seed (echoed into the outputs).
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// GA chromosomes per generation (hls gen uses 12).
-    #[arg(long, default_value_t = 4)]
-    pub ga_population: u32,
-    /// GA generations after the initial population (hls gen uses 12).
-    #[arg(long, default_value_t = 2)]
-    pub ga_generations: u32,
-    /// Total PE instances per step: with the GA, default planes used + 25 % for duplicates;
-    /// with the list scheduler, extra PEs become copies of the busiest planes (default none).
+    /// Total PE instances per step: extra PEs become copies of the busiest planes (default
+    /// none). Each step's accelerator dispatches its paths' rounds itself (docs/hardware.md).
     #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
     pub pe_budget: Option<u32>,
     /// Fixed-point convergence threshold on a round's largest displacement, in 1/256 mm.
@@ -1093,23 +1083,6 @@ impl RoundOrderArg {
         match self {
             RoundOrderArg::Jacobi => bt_hls::RoundOrder::Jacobi,
             RoundOrderArg::RedBlack => bt_hls::RoundOrder::RedBlack,
-        }
-    }
-}
-
-#[derive(Debug, Clone, Copy, PartialEq, Eq, ValueEnum)]
-pub enum ScheduleArg {
-    /// Genetic algorithm + PE duplication + ASAP fill (the paper's three passes).
-    Ga,
-    /// Simple list scheduler (baseline, no duplication).
-    List,
-}
-
-impl ScheduleArg {
-    pub fn kind(self) -> bt_hls::ScheduleKind {
-        match self {
-            ScheduleArg::Ga => bt_hls::ScheduleKind::Ga,
-            ScheduleArg::List => bt_hls::ScheduleKind::List,
         }
     }
 }

@@ -72,13 +72,11 @@ pub fn run_living_room(args: &StudyLivingRoomArgs) -> anyhow::Result<ExitCode> {
         sbr_step_deg: args.sbr_step_deg,
         threshold_lsb: args.threshold_lsb,
         max_rounds: args.max_rounds,
-        schedule: args.schedule.kind(),
         seed: args.seed,
-        ga_population: args.ga_population,
-        ga_generations: args.ga_generations,
         pe_budget: args.pe_budget,
         warm_start: !args.cold_start,
         round_order: args.round_order.order(),
+        ..LivingRoomConfig::default()
     };
     let problems = config.problems();
     if !problems.is_empty() {

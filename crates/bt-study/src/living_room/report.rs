@@ -220,8 +220,9 @@ fn settings(results: &LivingRoomResults) -> String {
          beam tree's candidates of order 1-{} over the static reflectors (one platform for \
          all steps; candidates through the moving door go to the host's image method), {}; \
          converged paths are checked by the host (`bt_accel::host_accepts`), which also adds \
-         line of sight. One PE schedule per step: {} (seed {}, GA population {}, {} \
-         generations), PE budget {}; latency = predicted cycles on the platform / {} MHz.\n\
+         line of sight. Each step's accelerator dispatches its paths' rounds itself (a ready \
+         queue, no model run on the host: docs/hardware.md), PE budget {}; latency = the \
+         controller's cycles on the platform / {} MHz.\n\
          Every solver runs single-threaded; times are wall clock from the scene to the paths \
          (candidate enumeration included).\n",
         results.scene_name,
@@ -240,10 +241,6 @@ fn settings(results: &LivingRoomResults) -> String {
         } else {
             "every step from the beam tree's window centres"
         },
-        c.schedule.name(),
-        c.seed,
-        c.ga_population,
-        c.ga_generations,
         c.pe_budget
             .map_or_else(|| "planes used + 25 %".to_string(), |b| b.to_string()),
         CLOCK_HZ / 1e6,

@@ -253,15 +253,6 @@ fn study_and_accelerator_sizes_are_bounded() {
     let dir = scratch("sizes");
     let out = dir.join("out");
     let out = out.to_str().unwrap();
-    let ga = |extra: &[&str]| {
-        let mut args = vec!["study", "living-room", "--schedule", "ga", "--out", out];
-        args.extend_from_slice(extra);
-        beamtrace(&args)
-    };
-    let o = ga(&["--ga-population", "4000000000"]);
-    assert_refused(&o, &["population", "at most 1000"]);
-    let o = ga(&["--ga-population", "1000", "--ga-generations", "4000000000"]);
-    assert_refused(&o, &["population × (generations + 1)", "100000"]);
     for flag in ["--max-rounds", "--pe-budget"] {
         let o = beamtrace(&[
             "hls",
