@@ -887,9 +887,6 @@ pub struct ArrayArgs {
     pub max_beam_pairs: u64,
 }
 
-/// The array shape `beams` sweeps when none is given.
-pub const DEFAULT_ARRAY: (usize, usize) = bt_serve::DEFAULT_ARRAY;
-
 #[derive(Debug, Args, Clone)]
 pub struct BeamsArgs {
     #[command(flatten)]

@@ -1,6 +1,6 @@
 //! `beamtrace channel` (CIR, CFR, power-delay profile) and `beamtrace beams` (codebook sweep).
 
-use crate::args::{ArrayArgs, BeamsArgs, ChannelArgs, DEFAULT_ARRAY, PathArgs, RankingArg};
+use crate::args::{ArrayArgs, BeamsArgs, ChannelArgs, PathArgs, RankingArg};
 use crate::load::load_scene;
 use crate::trace::warn_near_field;
 use anyhow::Context;
@@ -248,7 +248,7 @@ pub fn run_beams(args: &BeamsArgs) -> anyhow::Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// The sweep `arrays` give (a missing array [`DEFAULT_ARRAY`]) with the antennas'
+/// The sweep `arrays` give (a missing array [`bt_serve::DEFAULT_ARRAY`]) with the antennas'
 /// orientations of `radio`, `top` pairs per `serve` answer; refused before any scene is loaded
 /// or traced when over its pair budget ([`bt_serve::BeamOptions::new`]).
 pub fn beam_options(
@@ -256,17 +256,13 @@ pub fn beam_options(
     radio: &bt_beams::RadioOptions,
     top: usize,
 ) -> anyhow::Result<bt_serve::BeamOptions> {
-    let spec = |shape: Option<(usize, usize)>, spacing: f64| {
-        let (rows, columns) = shape.unwrap_or(DEFAULT_ARRAY);
-        Some((rows, columns, spacing))
-    };
     let ranking = match arrays.ranking {
         RankingArg::Power => BeamRanking::Power,
         RankingArg::Paper => BeamRanking::Paper,
     };
     let specs = [
-        spec(arrays.tx_array, arrays.tx_spacing),
-        spec(arrays.rx_array, arrays.rx_spacing),
+        (arrays.tx_array, arrays.tx_spacing),
+        (arrays.rx_array, arrays.rx_spacing),
     ];
     let budget = (top, arrays.max_beam_pairs);
     bt_serve::BeamOptions::new(specs, radio, ranking, budget).map_err(|(which, e)| {

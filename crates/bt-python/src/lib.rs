@@ -101,6 +101,31 @@ impl PyScene {
             .map_err(|e| self.error(TraceError::Scene(e)))
     }
 
+    /// The paths from `tx` to `rx` (the scene's own where `None`) traced under `keywords`
+    /// without the GIL and reported as `trace --json` reports them, with the scene they were
+    /// traced in (`Scene.trace` and `Scene.view`).
+    fn reported(
+        &self,
+        py: Python<'_>,
+        tx: Option<[f64; 3]>,
+        rx: Option<[f64; 3]>,
+        keywords: &TraceKeywords,
+    ) -> PyResult<(Scene, Vec<bt_beams::PathReport>)> {
+        let scene = self.moved(tx, rx)?;
+        let options = keywords
+            .trace_options(&scene)
+            .map_err(PyValueError::new_err)?;
+        let radio = keywords.radio().map_err(PyValueError::new_err)?;
+        let ends = scene.terminals().map_err(error)?;
+        let (tx, rx) = (scene.to_world(ends.tx), scene.to_world(ends.rx));
+        let paths = py.detach(|| {
+            let traced = self.with_tracer(scene.clone(), options, |t| t.trace(tx, rx));
+            traced.map(|traced| bt_beams::report(&scene, &traced.result.paths, &radio))
+        });
+        let paths = paths.map_err(|e| self.error(e))?.map_err(error)?;
+        Ok((scene, paths))
+    }
+
     /// `f` on the kept tracer, set to `scene` and `options`; a call made while another thread
     /// traces this scene gets a tracer of its own (the same result, without the caches).
     fn with_tracer<R>(
@@ -200,18 +225,7 @@ impl PyScene {
         rx: Option<[f64; 3]>,
         keywords: TraceKeywords,
     ) -> PyResult<Bound<'py, PyDict>> {
-        let scene = self.moved(tx, rx)?;
-        let options = keywords
-            .trace_options(&scene)
-            .map_err(PyValueError::new_err)?;
-        let radio = keywords.radio().map_err(PyValueError::new_err)?;
-        let ends = scene.terminals().map_err(error)?;
-        let (tx, rx) = (scene.to_world(ends.tx), scene.to_world(ends.rx));
-        let paths = py.detach(|| {
-            let traced = self.with_tracer(scene.clone(), options, |t| t.trace(tx, rx));
-            traced.map(|traced| bt_beams::report(&scene, &traced.result.paths, &radio))
-        });
-        let paths = paths.map_err(|e| self.error(e))?.map_err(error)?;
+        let (_, paths) = self.reported(py, tx, rx, &keywords)?;
         columns::to_dict(py, &paths)
     }
 
@@ -229,22 +243,9 @@ impl PyScene {
         if !placed || (rx.is_none() && self.scene.rx().is_none()) {
             return Ok(bt_view::page(&[&self.scene], &[bt_view::StepPaths::none()]));
         }
-        let scene = self.moved(tx, rx)?;
-        let options = keywords
-            .trace_options(&scene)
-            .map_err(PyValueError::new_err)?;
-        let radio = keywords.radio().map_err(PyValueError::new_err)?;
-        let ends = scene.terminals().map_err(error)?;
-        let (tx, rx) = (scene.to_world(ends.tx), scene.to_world(ends.rx));
-        let page = py.detach(|| {
-            let traced = self.with_tracer(scene.clone(), options, |t| t.trace(tx, rx));
-            traced.map(|traced| {
-                let paths = bt_beams::report(&scene, &traced.result.paths, &radio)?;
-                let step = bt_view::StepPaths::from_reports(&scene, &paths);
-                Ok::<_, bt_beams::ReportError>(bt_view::page(&[&scene], &[step]))
-            })
-        });
-        page.map_err(|e| self.error(e))?.map_err(error)
+        let (scene, paths) = self.reported(py, tx, rx, &keywords)?;
+        let step = bt_view::StepPaths::from_reports(&scene, &paths);
+        Ok(py.detach(|| bt_view::page(&[&scene], &[step])))
     }
 
     /// Trace one TX to each row of `receivers` (m × 3, metres) in parallel without the GIL;

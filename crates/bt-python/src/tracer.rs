@@ -92,13 +92,9 @@ impl BeamKeywords {
                 )));
             }
         };
-        let spec = |shape: Option<(usize, usize)>, spacing| {
-            let (rows, columns) = shape.unwrap_or(bt_serve::DEFAULT_ARRAY);
-            Some((rows, columns, spacing))
-        };
         let arrays = [
-            spec(self.tx_array, self.tx_spacing),
-            spec(self.rx_array, self.rx_spacing),
+            (self.tx_array, self.tx_spacing),
+            (self.rx_array, self.rx_spacing),
         ];
         bt_serve::BeamOptions::new(arrays, radio, ranking, (self.top, self.max_beam_pairs))
             .map_err(|(which, e)| PyValueError::new_err(format!("{which}: {e}")))

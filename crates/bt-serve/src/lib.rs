@@ -70,19 +70,19 @@ pub struct BeamOptions {
 pub const DEFAULT_ARRAY: (usize, usize) = (1, 8);
 
 impl BeamOptions {
-    /// The sweep of a TX and an RX array, each `(rows, columns, spacing in wavelengths)` (a
-    /// missing one [`DEFAULT_ARRAY`], half a wavelength apart), oriented as `radio`'s antennas, ranked by
+    /// The sweep of a TX and an RX array, each `(shape, spacing in wavelengths)` with the shape
+    /// `(rows, columns)` or, when missing, [`DEFAULT_ARRAY`], oriented as `radio`'s antennas, ranked by
     /// `ranking`, `top` pairs per answer, at most `max_pairs` pairs: the pairs follow from the
     /// arrays alone, so an over-budget sweep is refused here, before any trace. An error
     /// names the array (`tx_array`, `rx_array`) or the budget.
     pub fn new(
-        arrays: [Option<(usize, usize, f64)>; 2],
+        arrays: [(Option<(usize, usize)>, f64); 2],
         radio: &bt_beams::RadioOptions,
         ranking: bt_beams::BeamRanking,
         (top, max_pairs): (usize, u64),
     ) -> Result<Self, (&'static str, bt_channel::ChannelError)> {
-        let array = |spec: Option<(usize, usize, f64)>, which, orientation| {
-            let (rows, columns, spacing) = spec.unwrap_or((DEFAULT_ARRAY.0, DEFAULT_ARRAY.1, 0.5));
+        let array = |(shape, spacing): (Option<(usize, usize)>, f64), which, orientation| {
+            let (rows, columns) = shape.unwrap_or(DEFAULT_ARRAY);
             bt_channel::Array::new(rows, columns, spacing, orientation).map_err(|e| (which, e))
         };
         let tx = array(arrays[0], "tx_array", radio.tx.orientation)?;
