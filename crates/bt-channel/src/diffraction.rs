@@ -126,8 +126,8 @@ pub struct Wedge {
 }
 
 /// The wedge's validated orthonormal frame.
-struct Frame {
-    e: Vec3,
+pub(crate) struct Frame {
+    pub(crate) e: Vec3,
     t0: Vec3,
     n0: Vec3,
     /// A unit normal of face n (its sign does not matter for reflection).
@@ -184,7 +184,7 @@ impl Wedge {
     }
 
     /// Check the fields (units, orthogonality, n in [1, 2]) and build the frame.
-    fn frame(&self) -> Result<Frame, ChannelError> {
+    pub(crate) fn frame(&self) -> Result<Frame, ChannelError> {
         let (t0, n0) = (self.face0, self.normal0);
         if !(is_unit(self.edge) && is_unit(t0) && is_unit(n0)) {
             return Err(invalid(format!(
@@ -340,7 +340,7 @@ fn incident_basis(k: Vec3, e: Vec3) -> (Vec3, Vec3) {
 }
 
 /// Edge-fixed basis (φ̂, β̂0) of a ray leaving along `k`: φ̂ = ê × k/|ê × k|, β̂0 = φ̂ × k.
-fn outgoing_basis(k: Vec3, e: Vec3) -> (Vec3, Vec3) {
+pub(crate) fn outgoing_basis(k: Vec3, e: Vec3) -> (Vec3, Vec3) {
     let phi = e.cross(k).normalize();
     (phi, phi.cross(k))
 }
@@ -376,10 +376,72 @@ fn face_matrix(
 /// reflections on that side).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub(crate) struct Legs {
-    /// s': source to diffraction point.
+    /// s': source (or the previous diffraction point) to diffraction point.
     pub incident: Real,
-    /// s: diffraction point to observer.
+    /// s: diffraction point to observer (or the next diffraction point).
     pub diffracted: Real,
+    /// The incident wave's curvature when it is not a point source's sphere of radius
+    /// `incident`: a wave diffracted by an edge before.
+    pub astigmatic: Option<Caustics>,
+}
+
+/// An astigmatic incident wave at a diffraction point: its principal radii of curvature ρ1,
+/// ρ2 and ρ_e, its radius in the edge-fixed plane of incidence (the plane of the incident ray
+/// and the edge), metres (Kouyoumjian and Pathak 1974, eqs. 25 and 29).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub(crate) struct Caustics {
+    /// ρ1, ρ2: the principal radii.
+    pub principal: (Real, Real),
+    /// ρ_e: the radius in the edge-fixed plane of incidence.
+    pub in_plane: Real,
+}
+
+impl Caustics {
+    /// The wave a first diffraction sends on, at the second edge (unit direction `edge`): its
+    /// rays leave a line (the first edge, `from_edge` metres back along the ray: radius s1 in
+    /// the direction around that edge) and spread along it as the source's sphere did (radius
+    /// s0 + s1 in the direction `beta`, unit, ⊥ the ray `k`, in the plane of the first edge
+    /// and the ray). Euler's formula gives the radius in the plane of `k` and `edge`:
+    /// 1/ρ_e = cos²α/(s0 + s1) + sin²α/s1, α the angle between `beta` and the edge's
+    /// direction seen across the ray.
+    pub fn after_edge((s0, s1): (Real, Real), beta: Vec3, (k, edge): (Vec3, Vec3)) -> Caustics {
+        let along = (s0 + s1, s1);
+        let u = (edge - edge.dot(k) * k).normalize_or_zero();
+        let cos2 = u.dot(beta).powi(2).min(1.0);
+        Caustics {
+            principal: along,
+            in_plane: 1.0 / (cos2 / along.0 + (1.0 - cos2) / along.1),
+        }
+    }
+}
+
+impl Legs {
+    /// The legs clamped to at least one wavelength (the far-field floor of
+    /// [`crate::free_space`]), the radii too.
+    fn clamped(self, wavelength: Real) -> Legs {
+        Legs {
+            incident: self.incident.max(wavelength),
+            diffracted: self.diffracted.max(wavelength),
+            astigmatic: self.astigmatic.map(|c| Caustics {
+                principal: (c.principal.0.max(wavelength), c.principal.1.max(wavelength)),
+                in_plane: c.in_plane.max(wavelength),
+            }),
+        }
+    }
+
+    /// k·L, UTD's distance parameter L (metres) times the wavenumber `k` (rad/m), for the
+    /// ray's sin β0: L = s·s'/(s + s')·sin²β0 for a point source; s·(ρ_e + s)·ρ1·ρ2·sin²β0 /
+    /// (ρ_e·(ρ1 + s)·(ρ2 + s)) for an astigmatic wave.
+    fn kl(self, k: Real, sin_beta: Real) -> Real {
+        let (s_i, s) = (self.incident, self.diffracted);
+        match self.astigmatic {
+            None => k * s_i * s / (s_i + s) * sin_beta * sin_beta,
+            Some(c) => {
+                let ((r1, r2), re) = (c.principal, c.in_plane);
+                k * s * (re + s) * r1 * r2 * sin_beta * sin_beta / (re * (r1 + s) * (r2 + s))
+            }
+        }
+    }
 }
 
 /// UTD amplitude factor of a point source diffracted once: λ/(4π)·1/√(s'·s·(s' + s)) =
@@ -392,6 +454,20 @@ pub(crate) fn spreading(legs: Legs, frequency_hz: Real) -> Real {
         legs.diffracted.max(wavelength),
     );
     wavelength / (4.0 * PI) / (s_i * s_d * (s_i + s_d)).sqrt()
+}
+
+/// UTD amplitude factor of a point source diffracted twice (the product form): λ/(4π)·(1/s0)
+/// ·√(s0/(s1·(s0 + s1)))·√(ρ_e/(s2·(ρ_e + s2))), with the first edge's legs (s0, s1), the
+/// second's s2 and its incident wave's ρ_e ([`Caustics::after_edge`]), each clamped to at
+/// least one wavelength. For parallel edges ρ_e = s0 + s1 and the factor is
+/// λ/(4π)/√(s0·s1·s2·(s0 + s1 + s2)), the same read from either end.
+pub(crate) fn spreading_twice(first: Legs, second: Legs, frequency_hz: Real) -> Real {
+    let wavelength = SPEED_OF_LIGHT / frequency_hz;
+    let (first, second) = (first.clamped(wavelength), second.clamped(wavelength));
+    let (s0, s1) = (first.incident, first.diffracted);
+    let s2 = second.diffracted;
+    let re = second.astigmatic.map_or(s0 + s1, |c| c.in_plane);
+    wavelength / (4.0 * PI) / s0 * (s0 / (s1 * (s0 + s1))).sqrt() * (re / (s2 * (re + s2))).sqrt()
 }
 
 /// The diffraction's Jones matrix J from the incident ray's edge-fixed basis (φ̂', β̂0') to the
@@ -422,11 +498,7 @@ pub(crate) fn jones(
     let phi = exterior_angle(&frame, k_out, "diffracted ray")?;
     let wavelength = SPEED_OF_LIGHT / frequency_hz;
     let k = 2.0 * PI / wavelength;
-    let (s_i, s_d) = (
-        legs.incident.max(wavelength),
-        legs.diffracted.max(wavelength),
-    );
-    let kl = k * s_i * s_d / (s_i + s_d) * sin_beta * sin_beta;
+    let kl = legs.clamped(wavelength).kl(k, sin_beta);
     let n = frame.n;
     let factor =
         -Complex64::from_polar(1.0, -FRAC_PI_4) / (2.0 * n * (2.0 * PI * k).sqrt() * sin_beta);

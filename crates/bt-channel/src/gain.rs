@@ -6,7 +6,8 @@
 use crate::ChannelError;
 use crate::antenna::Antenna;
 use crate::diffraction::{
-    DiffractionCoefficient, Legs, Wedge, diffract, largest_singular_value, spreading,
+    Caustics, DiffractionCoefficient, Legs, Wedge, diffract, largest_singular_value,
+    outgoing_basis, spreading, spreading_twice,
 };
 use crate::material::{RadioMaterial, Reflection, SPEED_OF_LIGHT, Transmission};
 use bt_geom::{Real, Vec3};
@@ -179,7 +180,7 @@ pub enum Interaction {
     /// A crossing of a slab (ITU-R P.2040 transmission, no deflection): the surface's normal
     /// and response, as for a reflection.
     Transmission(Bounce),
-    /// An edge diffraction (UTD); at most one per path.
+    /// An edge diffraction (UTD); at most two per path.
     Diffraction(Wedge),
 }
 
@@ -242,15 +243,18 @@ pub struct PathGain {
     pub diffraction_loss_db: Real,
 }
 
-/// Complex gain of a path of reflections and at most one edge diffraction: TX → `points` →
-/// RX (world frame, metres), one [`Interaction`] per point, at `frequency_hz`.
+/// Complex gain of a path of reflections, crossings and at most two edge diffractions: TX →
+/// `points` → RX (world frame, metres), one [`Interaction`] per point, at `frequency_hz`.
 ///
 /// Without a diffraction it is [`path_gain`]'s value, bit for bit. With one at point Q, the
 /// Jones chain runs through the UTD step of [`Wedge`] with `coefficient`'s combination of the
 /// terms ([`DiffractionCoefficient`]) and the spreading is UTD's for a point
 /// source, λ/(4π)·1/√(s'·s·(s' + s)) with s' and s the unfolded lengths TX → Q and Q → RX
-/// (each clamped to at least one wavelength), instead of λ/(4π·(s' + s)). No propagation
-/// phase. Errors: lengths differ, two or more diffractions, an invalid wedge, a ray along the
+/// (each clamped to at least one wavelength), instead of λ/(4π·(s' + s)). With two (at Q1,
+/// then Q2; legs s0, s1, s2 unfolded) it is UTD's product form: the first edge's coefficient
+/// with (s', s) = (s0, s1), the second's with the astigmatic wave the first sends on (its
+/// distance parameter from the wave's caustics), and the spreading of both
+/// (`docs/channel.md`, "Two diffractions"). No propagation phase. Errors: lengths differ, three or more diffractions, an invalid wedge, a ray along the
 /// edge or off Keller's cone, a ray inside the wedge (`docs/channel.md`).
 pub fn path_gain_detailed(
     tx: Vec3,
@@ -289,16 +293,19 @@ pub(crate) fn path_gain_with_leg(
             ),
         });
     }
-    let mut diffractions = interactions
+    let diffractions: Vec<usize> = interactions
         .iter()
         .enumerate()
         .filter(|(_, i)| matches!(i, Interaction::Diffraction(_)))
-        .map(|(index, _)| index);
-    let diffraction = diffractions.next();
-    if diffractions.next().is_some() {
+        .map(|(index, _)| index)
+        .collect();
+    if diffractions.len() > 2 {
         return Err(ChannelError::Invalid {
             field: "interactions",
-            message: "more than one diffraction in a path (only first-order diffraction)".into(),
+            message: format!(
+                "{} diffractions in a path (at most two)",
+                diffractions.len()
+            ),
         });
     }
     let mut vertices = Vec::with_capacity(points.len() + 2);
@@ -307,50 +314,128 @@ pub(crate) fn path_gain_with_leg(
     vertices.push(rx);
     let segments: Vec<Real> = vertices.windows(2).map(|w| w[0].distance(w[1])).collect();
     let length: Real = segments.iter().sum();
-    let legs = |index: usize| Legs {
-        incident: segments[..=index].iter().sum(),
-        diffracted: diffracted_leg.unwrap_or_else(|| segments[index + 1..].iter().sum()),
-    };
-    let mut k = (vertices[1] - vertices[0]).normalize();
-    let one = Complex64::new(1.0, 0.0);
-    let mut field = scaled(antennas.0.field(k), one);
-    let mut excess_db = 0.0;
-    for (index, interaction) in interactions.iter().enumerate() {
-        match interaction {
-            Interaction::Reflection(bounce) => {
-                (field, k) = reflect(field, k, bounce, frequency_hz)?;
-            }
-            Interaction::Transmission(crossing) => {
-                field = transmit(field, k, crossing, frequency_hz)?;
-            }
-            Interaction::Diffraction(wedge) => {
-                let k_out = (vertices[index + 2] - vertices[index + 1]).normalize();
-                let matrix;
-                (field, matrix) = diffract(
-                    field,
-                    (k, k_out),
-                    wedge,
-                    legs(index),
-                    (frequency_hz, coefficient),
-                )?;
-                // Excess over free space along the same length: the strongest polarisation's
-                // coefficient with the edge's spreading relative to λ/(4π·length).
-                let ratio = spreading(legs(index), frequency_hz)
-                    / free_space(length, frequency_hz).amplitude;
-                excess_db = -20.0 * (largest_singular_value(&matrix) * ratio).log10();
-                k = k_out;
-            }
+    // Each diffraction's legs run from the source or the diffraction before, to the next
+    // diffraction or the observer (Sionna's diffracted leg: one diffraction only).
+    let legs = |index: usize| {
+        let from = diffractions
+            .iter()
+            .rev()
+            .find(|&&d| d < index)
+            .map_or(0, |d| d + 1);
+        let to = diffractions.iter().find(|&&d| d > index).copied();
+        Legs {
+            incident: segments[from..=index].iter().sum(),
+            diffracted: match (to, diffracted_leg) {
+                (Some(to), _) => segments[index + 1..=to].iter().sum(),
+                (None, Some(leg)) if diffractions.len() == 1 => leg,
+                (None, _) => segments[index + 1..].iter().sum(),
+            },
+            astigmatic: None,
         }
-    }
+    };
+    let walk = Walk {
+        vertices: &vertices,
+        legs: &legs,
+        radio: (frequency_hz, coefficient),
+    };
+    let (field, k, chain) = walk.run(interactions, antennas.0)?;
     let received = dot(&field, antennas.1.field(-k));
-    let amplitude = match diffraction {
-        None => free_space(length, frequency_hz).amplitude,
-        Some(index) => spreading(legs(index), frequency_hz),
+    let free = free_space(length, frequency_hz).amplitude;
+    let (amplitude, excess_db) = match (diffractions.as_slice(), chain) {
+        ([], _) => (free, 0.0),
+        ([index], chain) => {
+            let amplitude = spreading(legs(*index), frequency_hz);
+            (
+                amplitude,
+                -20.0 * (chain.sigma * (amplitude / free)).log10(),
+            )
+        }
+        (_, chain) => {
+            let amplitude = spreading_twice(chain.legs[0], chain.legs[1], frequency_hz);
+            (
+                amplitude,
+                -20.0 * (chain.sigma * (amplitude / free)).log10(),
+            )
+        }
     };
     Ok(PathGain {
         gain: received * amplitude,
         diffraction_loss_db: excess_db,
     })
+}
+
+/// The walk of a field along a path's vertices (TX first), with each diffraction's legs.
+struct Walk<'a, L: Fn(usize) -> Legs> {
+    vertices: &'a [Vec3],
+    legs: &'a L,
+    radio: (Real, DiffractionCoefficient),
+}
+
+/// What the diffractions of a walk leave: the product of their matrices' largest singular
+/// values and their legs (the second's with its incident wave's caustics).
+#[derive(Clone, Copy)]
+struct Chain {
+    sigma: Real,
+    legs: [Legs; 2],
+}
+
+impl<L: Fn(usize) -> Legs> Walk<'_, L> {
+    /// The field leaving TX's `antenna` carried through `interactions` (aligned with the
+    /// vertices' inner points): the field at RX, its direction of travel, and the chain.
+    fn run(
+        &self,
+        interactions: &[Interaction],
+        antenna: &Antenna,
+    ) -> Result<(Field, Vec3, Chain), ChannelError> {
+        let (frequency_hz, _) = self.radio;
+        let vertices = self.vertices;
+        let mut k = (vertices[1] - vertices[0]).normalize();
+        let mut field = scaled(antenna.field(k), Complex64::new(1.0, 0.0));
+        let empty = Legs {
+            incident: 0.0,
+            diffracted: 0.0,
+            astigmatic: None,
+        };
+        let mut chain = Chain {
+            sigma: 1.0,
+            legs: [empty; 2],
+        };
+        // β̂ of the wave leaving the last edge, carried through the reflections since.
+        let mut beta: Option<Vec3> = None;
+        let mut count = 0;
+        for (index, interaction) in interactions.iter().enumerate() {
+            match interaction {
+                Interaction::Reflection(bounce) => {
+                    (field, k) = reflect(field, k, bounce, frequency_hz)?;
+                    beta = beta.map(|b| b - 2.0 * b.dot(bounce.normal) * bounce.normal);
+                }
+                Interaction::Transmission(crossing) => {
+                    field = transmit(field, k, crossing, frequency_hz)?;
+                }
+                Interaction::Diffraction(wedge) => {
+                    let e = wedge.frame()?.e;
+                    let k_out = (vertices[index + 2] - vertices[index + 1]).normalize();
+                    let mut legs = (self.legs)(index);
+                    if let Some(b) = beta {
+                        let before = chain.legs[0];
+                        legs.astigmatic = Some(Caustics::after_edge(
+                            (before.incident, before.diffracted),
+                            b,
+                            (k, e),
+                        ));
+                    }
+                    let matrix;
+                    (field, matrix) = diffract(field, (k, k_out), wedge, legs, self.radio)?;
+                    chain.sigma *= largest_singular_value(&matrix);
+                    chain.legs[count.min(1)] = legs;
+                    count += 1;
+                    beta = Some(outgoing_basis(k_out, e).1);
+                    k = k_out;
+                }
+            }
+        }
+        Ok((field, k, chain))
+    }
 }
 
 #[cfg(test)]

@@ -174,6 +174,7 @@ fn diffract_v(wedge: &Wedge, k_in: Vec3, k_out: Vec3) -> Result<Field, ChannelEr
     let legs = Legs {
         incident: 3.0,
         diffracted: 4.0,
+        astigmatic: None,
     };
     diffract(field, (k_in, k_out), wedge, legs, (3.5e9, UTD)).map(|(f, _)| f)
 }
@@ -218,6 +219,7 @@ fn grazing_incidence_is_finite_and_soft_vanishes() {
     let legs = Legs {
         incident: 3.0,
         diffracted: 4.0,
+        astigmatic: None,
     };
     let (hard, _) = diffract(scaled(Vec3::Y, one), (k_in, k_out), &w, legs, (3.5e9, UTD)).unwrap();
     let magnitude = hard.iter().map(|c| c.norm_sqr()).sum::<Real>().sqrt();
@@ -242,6 +244,7 @@ fn vacuum_faces_keep_only_the_incident_terms() {
         let legs = Legs {
             incident: 3.0,
             diffracted: 4.0,
+            astigmatic: None,
         };
         diffract(
             scaled(k_in.cross(Vec3::Z), one),
@@ -288,6 +291,7 @@ fn sionna_coefficient_does_not_depend_on_which_face_is_face_0() {
     let legs = Legs {
         incident: 20.0,
         diffracted: 15.0,
+        astigmatic: None,
     };
     let sionna = DiffractionCoefficient::SionnaRt22;
     // Sources behind face n, in front of both faces, behind face 0 (standard angles).

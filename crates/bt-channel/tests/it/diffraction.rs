@@ -408,7 +408,7 @@ fn mixed_paths_reduce_to_reflections_and_reject_bad_lists() {
     let plain = path_gain(tx, &[image_point], rx, &[floor], (&a, &a), F).unwrap();
     let mixed = path_gain_mixed(tx, &[image_point], rx, &[interactions[0]], (&a, &a), F).unwrap();
     assert_eq!(plain, mixed);
-    let two = [interactions[1], interactions[1]];
+    let three = [interactions[1]; 3];
     let invalid = |r: Result<Complex64, ChannelError>| {
         matches!(
             r,
@@ -420,9 +420,9 @@ fn mixed_paths_reduce_to_reflections_and_reject_bad_lists() {
     };
     assert!(invalid(path_gain_mixed(
         tx,
-        &[points[1], points[1]],
+        &[points[1]; 3],
         rx,
-        &two,
+        &three,
         (&a, &a),
         F
     )));
@@ -583,4 +583,142 @@ fn sionnas_diffracted_leg_grows_with_its_solver_depth() {
     let (two, three) = (edge_last(2).unwrap(), edge_last(3).unwrap());
     assert!((three - two).abs() < 1e-12, "{three} vs {two}");
     assert!(bt_channel::sionna_rt22_diffracted_leg(&points, rx, &interactions, 1).is_err());
+}
+
+/// A thin conducting screen below a horizontal edge along y (face 0 pointing down), as in
+/// [`knife_edge_matches_fresnel_kirchhoff_in_the_shadow`].
+fn screen() -> Wedge {
+    Wedge {
+        edge: Vec3::Y,
+        face0: -Vec3::Z,
+        normal0: -Vec3::X,
+        n: 2.0,
+        response0: conductor(),
+        response_n: conductor(),
+    }
+}
+
+/// Height of `p` above the line from `a` to `b` (all in the plane y = 0), metres.
+fn height_above(p: Vec3, a: Vec3, b: Vec3) -> Real {
+    let t = (p.x - a.x) / (b.x - a.x);
+    p.z - (a.z + t * (b.z - a.z))
+}
+
+/// Fresnel–Kirchhoff's v of an edge at height `h` above the line between two points `d_a`
+/// and `d_b` metres before and after it.
+fn fresnel_v(h: Real, d_a: Real, d_b: Real) -> Real {
+    let wavelength = SPEED_OF_LIGHT / F;
+    h * (2.0 / wavelength * (1.0 / d_a + 1.0 / d_b)).sqrt()
+}
+
+/// Two parallel screens (issue 28): the path over both edges against the Epstein–Peterson
+/// construction, each edge's Fresnel–Kirchhoff knife edge in turn (the first between TX and
+/// the second edge, the second between the first edge and RX), relative to free space over
+/// the direct distance.
+/// - Well-separated edges: within 3 dB, closer the further apart (Epstein–Peterson assumes
+///   each edge in the far field of the one before).
+/// - Any spacing: within 1.5 dB of Epstein–Peterson with Millington's correction for close
+///   edges (Millington, Hewitt and Immirzi 1962), 20·log10 √(s1·(s0 + s1 + s2) / ((s0 + s1)
+///   ·(s1 + s2))) dB added, which UTD's product form reproduces in deep shadow (docs/channel.md,
+///   "Two diffractions").
+#[test]
+fn two_screens_match_epstein_peterson() {
+    println!("   gap    h    v1     v2    EP (dB)  +Millington  UTD V   UTD H");
+    let mut separated = Vec::new();
+    for (gap, h) in [
+        (5.0, 3.0),
+        (5.0, 6.0),
+        (20.0, 3.0),
+        (40.0, 3.0),
+        (80.0, 3.0),
+        (160.0, 3.0),
+        (160.0, 8.0),
+    ] {
+        let (tx, rx) = (Vec3::new(-50.0, 0.0, 0.0), Vec3::new(gap + 70.0, 0.0, 0.0));
+        let (e1, e2) = (Vec3::new(0.0, 0.0, h), Vec3::new(gap, 0.0, h));
+        let (s0, s1, s2) = (tx.distance(e1), gap, e2.distance(rx));
+        let v1 = fresnel_v(height_above(e1, tx, e2), 50.0, gap);
+        let v2 = fresnel_v(height_above(e2, e1, rx), gap, 70.0);
+        let ep = db((fresnel_kirchhoff(v1) * fresnel_kirchhoff(v2)).norm());
+        let millington = ep + db((s1 * (s0 + s1 + s2) / ((s0 + s1) * (s1 + s2))).sqrt());
+        let mut row = Vec::new();
+        for polarization in [Polarization::V, Polarization::H] {
+            let a = isotropic(polarization);
+            let twice = [Interaction::Diffraction(screen()); 2];
+            let g = path_gain_mixed(tx, &[e1, e2], rx, &twice, (&a, &a), F).unwrap();
+            let free = path_gain(tx, &[], rx, &[], (&a, &a), F).unwrap();
+            row.push(db(g.norm() / free.norm()));
+        }
+        println!(
+            "  {gap:5.0}  {h:3.0}  {v1:5.2}  {v2:5.2}  {ep:7.2}  {millington:7.2}     {:7.2} {:7.2}",
+            row[0], row[1]
+        );
+        for utd in &row {
+            assert!(
+                (utd - millington).abs() < 1.5,
+                "gap {gap} m: UTD {utd:.2} dB, Epstein-Peterson-Millington {millington:.2} dB"
+            );
+        }
+        if gap >= 40.0 && h == 3.0 {
+            let worst = row.iter().map(|utd| (utd - ep).abs()).fold(0.0, Real::max);
+            assert!(
+                worst < 3.0,
+                "gap {gap} m: {row:?} against Epstein-Peterson {ep:.2} dB"
+            );
+            separated.push(worst);
+        }
+    }
+    assert!(
+        separated.windows(2).all(|w| w[1] < w[0]),
+        "the further apart, the closer to Epstein-Peterson: {separated:?}"
+    );
+}
+
+/// Two diffractions read from either end, TX and RX on the edges' Keller cones (issue 28's
+/// stated tolerance, docs/channel.md "Two diffractions"):
+/// - parallel edges: the same gain to 1e-9, both polarisations;
+/// - skew edges: the same spreading (the astigmatic wave the first edge sends on makes it
+///   so), but UTD's distance parameter of the second edge, from that wave's caustics, is not
+///   the one read backwards; in the transition regions the magnitudes differ by up to 0.5 dB.
+#[test]
+fn two_diffractions_are_reciprocal() {
+    for (skew, tolerance_db) in [(Vec3::Y, 1e-8), (Vec3::new(0.0, 0.8, 0.6), 0.5)] {
+        let hanging = (Vec3::Z - Vec3::Z.dot(skew) * skew).normalize();
+        let second = Wedge {
+            edge: skew,
+            face0: -hanging,
+            normal0: skew.cross(-hanging),
+            ..screen()
+        };
+        let (d1, d2) = (Vec3::new(0.0, 0.3, 0.0), Vec3::new(12.0, 2.0, 1.5));
+        let u = (d2 - d1).normalize();
+        // TX and RX on the edges' Keller cones: ŝ'·ê = ŝ·ê at both.
+        let cone = |axis: Vec3, (p, q): (Vec3, Vec3), angle: Real| {
+            let c = u.dot(axis);
+            c * axis + (1.0 - c * c).sqrt() * (angle.cos() * p + angle.sin() * q)
+        };
+        let w = cone(Vec3::Y, (Vec3::X, Vec3::Z), 0.2);
+        let v = cone(skew, (Vec3::X, skew.cross(Vec3::X)), -0.3);
+        let (tx, rx) = (d1 - 40.0 * w, d2 + 50.0 * v);
+        let twice = [
+            Interaction::Diffraction(screen()),
+            Interaction::Diffraction(second),
+        ];
+        let mut back = twice;
+        back.reverse();
+        for polarization in [Polarization::V, Polarization::H] {
+            let a = isotropic(polarization);
+            let g = path_gain_mixed(tx, &[d1, d2], rx, &twice, (&a, &a), F).unwrap();
+            let h = path_gain_mixed(rx, &[d2, d1], tx, &back, (&a, &a), F).unwrap();
+            let off = (db(g.norm()) - db(h.norm())).abs();
+            println!("{skew:?} {polarization:?}: {off:.3e} dB");
+            assert!(
+                off <= tolerance_db,
+                "{polarization:?}: {g} one way, {h} the other"
+            );
+            if skew == Vec3::Y {
+                assert!((g - h).norm() <= 1e-9 * g.norm(), "{g} vs {h}");
+            }
+        }
+    }
 }
