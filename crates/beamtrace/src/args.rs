@@ -585,7 +585,8 @@ pub struct SolveArgs {
     /// sequence (the diffraction counts in --max-order). Same as --max-diffractions 1.
     #[arg(long)]
     pub diffraction: bool,
-    /// Diffractions per path (0 or 1; overrides --diffraction).
+    /// Diffractions per path (0, 1 or 2; overrides --diffraction). Each counts in
+    /// --max-order.
     #[arg(long)]
     pub max_diffractions: Option<usize>,
     /// Edges shorter than this (metres) do not diffract.

@@ -127,9 +127,9 @@ pub struct PathReport {
     /// The reflecting surfaces' ids, TX side first (the diffraction and crossings left out).
     #[serde(skip)]
     pub surface_ids: Vec<SurfaceId>,
-    /// The diffraction (which point, which edge), when the path has one.
+    /// The diffractions (which point, which edge), in path order.
     #[serde(skip)]
-    pub diffraction: Option<bt_solve::Diffraction>,
+    pub diffractions: Vec<bt_solve::Diffraction>,
     /// Interaction points, TX side first, metres (TX and RX excluded).
     pub points: Vec<[Real; 3]>,
     /// Total unfolded length, metres.
@@ -231,7 +231,7 @@ impl PathReport {
             interactions: vec![InteractionKind::Reflection],
             surfaces: vec!["floor".to_string()],
             surface_ids: vec![SurfaceId(0)],
-            diffraction: None,
+            diffractions: Vec::new(),
             points: vec![floor.to_array()],
             length_m,
             delay_s: length_m / SPEED_OF_LIGHT,
@@ -362,7 +362,7 @@ pub fn describe(
             .map(|it| interaction_name(scene, *it))
             .collect(),
         surface_ids: path.surfaces.clone(),
-        diffraction: path.diffraction,
+        diffractions: path.diffractions.clone(),
         points: path
             .points
             .iter()
@@ -435,11 +435,12 @@ pub fn report(
             .then(a.length_m.total_cmp(&b.length_m))
             .then(key(a).total_cmp(&key(b)))
             .then(a.surface_ids.cmp(&b.surface_ids))
-            .then(
-                a.diffraction
-                    .map(|d| (d.index, d.edge))
-                    .cmp(&b.diffraction.map(|d| (d.index, d.edge))),
-            )
+            .then_with(|| {
+                let edges = |r: &PathReport| -> Vec<(usize, bt_scene::EdgeId)> {
+                    r.diffractions.iter().map(|d| (d.index, d.edge)).collect()
+                };
+                edges(a).cmp(&edges(b))
+            })
     });
     for (i, r) in reports.iter_mut().enumerate() {
         r.rank = i + 1;

@@ -28,6 +28,8 @@ use serde::{Deserialize, Serialize};
 use std::cell::OnceCell;
 
 mod diffraction;
+
+use crate::diffraction::Diffracting;
 mod rebuild;
 pub use diffraction::{DiffractionSide, join as join_diffracted};
 pub use rebuild::RebuildStats;
@@ -1326,14 +1328,13 @@ pub fn candidates_in(
     candidates_and_diffracted_in(scene, options, None, cache, progress)
 }
 
-/// [`candidates_in`], with `diffraction: Some(min_edge_length)` also the candidates with one
-/// diffraction on an edge at least that long (metres) in [`CandidateSet::diffracted`]: the TX
-/// tree's levels below the last are joined with a tree grown from RX
-/// ([`join_diffracted`]).
+/// [`candidates_in`], with `diffraction: Some(..)` also the candidates with one or two
+/// diffractions it allows in [`CandidateSet::diffracted`]: the TX tree's levels below the last
+/// are joined with a tree grown from RX ([`join_diffracted`]).
 pub fn candidates_and_diffracted_in(
     scene: &Scene,
     options: TreeOptions,
-    diffraction: Option<Real>,
+    diffraction: Option<Diffracting>,
     cache: &mut TreeCache,
     progress: Progress<'_>,
 ) -> Result<CandidateSet, TreeError> {
@@ -1364,8 +1365,7 @@ pub fn candidates_and_diffracted_in(
     }
     set.stats = tree.candidate_stats(set.len() as u64);
     set.tree = Some(tree.stats.clone());
-    let side =
-        diffraction.map(|min_edge_length| KeptSide::take(cache, scene, &tree, min_edge_length));
+    let side = diffraction.map(|diffracting| KeptSide::take(cache, scene, &tree, diffracting));
     Arenas {
         nodes: tree.nodes,
         verts: tree.verts,
@@ -1385,23 +1385,23 @@ pub fn candidates_and_diffracted_in(
 /// that the next trace from the same TX (a moving receiver) skips the TX side's reaches.
 struct KeptSide {
     geometry: bt_scene::GeometryKey,
-    /// The TX (scene-local frame, m), the tree's options, the minimum edge length and (in
+    /// The TX (scene-local frame, m), the tree's options, the diffraction options and (in
     /// `side`) the tree's tolerance: equal bit for bit, or the side is built anew.
     tx: Vec3,
     options: TreeOptions,
-    min_edge_length: Real,
+    diffracting: Diffracting,
     side: DiffractionSide,
 }
 
 impl KeptSide {
     /// `cache`'s kept side when it was built for `tx`'s tree in `scene`, or a new one.
-    fn take(cache: &mut TreeCache, scene: &Scene, tx: &BeamTree, min_edge_length: Real) -> Self {
+    fn take(cache: &mut TreeCache, scene: &Scene, tx: &BeamTree, diffracting: Diffracting) -> Self {
         let same = |k: &KeptSide| {
             k.geometry.matches(scene)
                 && k.tx == tx.tx
                 && k.options == tx.options
                 && k.side.tol == tx.tol
-                && k.min_edge_length == min_edge_length
+                && k.diffracting == diffracting
         };
         match cache.side.take() {
             Some(kept) if same(&kept) => kept,
@@ -1409,8 +1409,8 @@ impl KeptSide {
                 geometry: scene.geometry_key(),
                 tx: tx.tx,
                 options: tx.options,
-                min_edge_length,
-                side: DiffractionSide::of(scene, tx, tx.options.max_order, min_edge_length),
+                diffracting,
+                side: DiffractionSide::of(scene, tx, tx.options.max_order, diffracting),
             },
         }
     }

@@ -1,10 +1,12 @@
-//! Candidates with one edge diffraction: reflections before the edge, the edge, reflections
-//! after it ([`DiffractedSet`]), and their blind enumeration, the reference the beam tree's
-//! join ([`crate::beamtree`]) is checked against.
+//! Candidates with one or two edge diffractions: reflections before the first edge, the edge,
+//! reflections between the edges and the second edge (with two), reflections after the last
+//! edge ([`DiffractedSet`]), and their blind enumeration, the reference the beam tree's join
+//! ([`crate::beamtree`]) is checked against.
 //!
-//! A diffracted candidate of order `k` has `k` interactions, one of them the diffraction at
-//! position `p` (the number of reflections before it): D, R-D, D-R, R-D-R, ... No surface
-//! appears twice in a row among the reflections on either side of the edge.
+//! A diffracted candidate of order `k` has `k` interactions, one or two of them diffractions:
+//! D, R-D, D-R, R-D-R, ..., D-D, R-D-D, D-R-D, D-D-R, ... No surface appears twice in a row
+//! among the reflections of one stretch (before, between, after the edges). Two diffractions
+//! in a row are on different edges (a ray from one point of an edge to another runs along it).
 
 use bt_geom::Real;
 use bt_scene::{EdgeId, Scene, SurfaceId};
@@ -12,37 +14,91 @@ use bt_scene::{EdgeId, Scene, SurfaceId};
 /// One diffracted candidate, borrowed from its set.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct DiffractedCandidate<'a> {
-    /// Every reflection of the candidate, TX side first (the edge left out).
+    /// Every reflection of the candidate, TX side first (the edges left out).
     pub reflections: &'a [SurfaceId],
-    /// The diffracting edge.
+    /// The (first) diffracting edge.
     pub edge: EdgeId,
-    /// The number of reflections before the edge (the diffraction's index among the points).
+    /// The number of reflections before the (first) edge: its index among the points.
     pub position: usize,
+    /// The second diffraction, when there are two: its edge and the number of reflections
+    /// between the two edges.
+    pub second: Option<(EdgeId, usize)>,
+}
+
+/// What happens at one point of a diffracted candidate.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Site {
+    /// A reflection on the surface.
+    Reflection(SurfaceId),
+    /// A diffraction on the edge.
+    Diffraction(EdgeId),
 }
 
 impl<'a> DiffractedCandidate<'a> {
-    /// The reflections between TX and the edge.
+    /// The reflections between TX and the first edge.
     pub fn before(&self) -> &'a [SurfaceId] {
         &self.reflections[..self.position]
     }
-    /// The reflections between the edge and RX.
-    pub fn after(&self) -> &'a [SurfaceId] {
-        &self.reflections[self.position..]
+    /// The reflections between the two edges (empty with one).
+    pub fn between(&self) -> &'a [SurfaceId] {
+        let q = self.second.map_or(0, |(_, q)| q);
+        &self.reflections[self.position..self.position + q]
     }
-    /// Number of interactions (reflections plus the diffraction).
+    /// The reflections between the last edge and RX.
+    pub fn after(&self) -> &'a [SurfaceId] {
+        let q = self.second.map_or(0, |(_, q)| q);
+        &self.reflections[self.position + q..]
+    }
+    /// Number of interactions (reflections plus diffractions).
     pub fn order(&self) -> usize {
-        self.reflections.len() + 1
+        self.reflections.len() + self.diffractions()
+    }
+    /// Number of diffractions (1 or 2).
+    pub fn diffractions(&self) -> usize {
+        1 + usize::from(self.second.is_some())
+    }
+    /// The points' indices of the diffractions with their edges, TX side first.
+    pub fn edges(&self) -> impl Iterator<Item = (usize, EdgeId)> + 'a {
+        let first = (self.position, self.edge);
+        let position = self.position;
+        std::iter::once(first).chain(self.second.map(|(edge, q)| (position + 1 + q, edge)))
+    }
+    /// What happens at point `k` (`k < order()`).
+    #[inline]
+    pub fn site(&self, k: usize) -> Site {
+        let p = self.position;
+        match self.second {
+            _ if k < p => Site::Reflection(self.reflections[k]),
+            _ if k == p => Site::Diffraction(self.edge),
+            None => Site::Reflection(self.reflections[k - 1]),
+            Some((_, q)) if k <= p + q => Site::Reflection(self.reflections[k - 1]),
+            Some((edge, q)) if k == p + q + 1 => Site::Diffraction(edge),
+            Some(_) => Site::Reflection(self.reflections[k - 2]),
+        }
     }
 }
 
+/// Which diffracted candidates to make: paths with up to `max_diffractions` (1 or 2)
+/// diffractions, on edges at least `min_edge_length` metres long.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Diffracting {
+    /// Shortest edge that diffracts, metres.
+    pub min_edge_length: Real,
+    /// Most diffractions per path (1 or 2).
+    pub max_diffractions: usize,
+}
+
 /// A set of diffracted candidates, stored flat, in a canonical order: by order, position,
-/// edge, then reflections (so two generators of the same candidates give equal sets).
+/// edge, then reflections, then the second diffraction (so two generators of the same
+/// candidates give equal sets).
 #[derive(Debug, Clone, PartialEq, Eq)]
 pub struct DiffractedSet {
     ids: Vec<SurfaceId>,
     offsets: Vec<u32>,
     edges: Vec<EdgeId>,
     positions: Vec<u8>,
+    /// Per candidate: the second edge and the reflections between, `None` with one.
+    seconds: Vec<Option<(EdgeId, u8)>>,
 }
 
 impl Default for DiffractedSet {
@@ -52,6 +108,7 @@ impl Default for DiffractedSet {
             offsets: vec![0],
             edges: Vec::new(),
             positions: Vec::new(),
+            seconds: Vec::new(),
         }
     }
 }
@@ -72,6 +129,7 @@ impl DiffractedSet {
             reflections: &self.ids[self.offsets[i] as usize..self.offsets[i + 1] as usize],
             edge: self.edges[i],
             position: self.positions[i] as usize,
+            second: self.seconds[i].map(|(e, q)| (e, q as usize)),
         }
     }
     /// All candidates in order.
@@ -80,16 +138,35 @@ impl DiffractedSet {
     }
     /// Append a candidate: `before` the edge (TX side first), the edge, `after` it.
     pub fn push(&mut self, before: &[SurfaceId], edge: EdgeId, after: &[SurfaceId]) {
-        self.ids.extend_from_slice(before);
-        self.ids.extend_from_slice(after);
+        self.push_parts(&[before, after], edge, None);
+    }
+    /// Append a candidate with two diffractions: `before` the first edge, `edges.0`, the
+    /// reflections `between`, `edges.1`, `after` it.
+    pub fn push_twice(
+        &mut self,
+        before: &[SurfaceId],
+        edges: (EdgeId, EdgeId),
+        between: &[SurfaceId],
+        after: &[SurfaceId],
+    ) {
+        let second = Some((edges.1, between.len() as u8));
+        self.push_parts(&[before, between, after], edges.0, second);
+    }
+    /// Append the reflections `parts` (the first before the first edge) with the edges.
+    fn push_parts(&mut self, parts: &[&[SurfaceId]], edge: EdgeId, second: Option<(EdgeId, u8)>) {
+        for part in parts {
+            self.ids.extend_from_slice(part);
+        }
         self.offsets.push(self.ids.len() as u32);
         self.edges.push(edge);
-        self.positions.push(before.len() as u8);
+        self.positions.push(parts[0].len() as u8);
+        self.seconds.push(second);
     }
     /// Put the candidates in the canonical order and drop repeats.
     pub fn canonicalise(&mut self) {
         // (order, position, edge, first two reflections) packed into one integer, which
-        // decides alone up to order 3; longer reflection lists only on ties.
+        // decides alone up to order 3 with one diffraction; longer reflection lists and the
+        // second diffraction only on ties.
         let mut keyed: Vec<(u128, u32)> = (0..self.len())
             .map(|i| {
                 let c = self.get(i);
@@ -105,7 +182,9 @@ impl DiffractedSet {
         let compare = |a: &(u128, u32), b: &(u128, u32)| {
             a.0.cmp(&b.0).then_with(|| {
                 let (x, y) = (self.get(a.1 as usize), self.get(b.1 as usize));
-                x.reflections.cmp(y.reflections)
+                x.reflections
+                    .cmp(y.reflections)
+                    .then_with(|| x.second.cmp(&y.second))
             })
         };
         keyed.sort_unstable_by(compare);
@@ -113,7 +192,10 @@ impl DiffractedSet {
         let mut sorted = DiffractedSet::default();
         for (_, i) in keyed {
             let c = self.get(i as usize);
-            sorted.push(c.before(), c.edge, c.after());
+            match c.second {
+                None => sorted.push(c.before(), c.edge, c.after()),
+                Some((e, _)) => sorted.push_twice(c.before(), (c.edge, e), c.between(), c.after()),
+            }
         }
         *self = sorted;
     }
@@ -131,9 +213,11 @@ pub fn usable_edges(scene: &Scene, min_edge_length: Real) -> impl Iterator<Item 
         .map(|(i, _)| EdgeId(i as u32))
 }
 
-/// Number of diffracted sequences up to `max_order` over `n` reflectors and `m` edges
-/// (saturating): Σ_k Σ_p m·c(p)·c(k−1−p), with c(0) = 1, c(j) = n(n−1)^(j−1).
-pub fn diffracted_count(n: u64, m: u64, max_order: usize) -> u64 {
+/// Number of diffracted sequences up to `max_order` over `n` reflectors and `m` edges with
+/// at most `max_diffractions` (1 or 2) diffractions (saturating): with one,
+/// Σ_k Σ_p m·c(p)·c(k−1−p); with two also Σ_k Σ_(p+q+r = k−2) m·m'·c(p)·c(q)·c(r), m' = m − 1
+/// when q = 0 (two edges in a row differ), else m; c(0) = 1, c(j) = n(n−1)^(j−1).
+pub fn diffracted_count(n: u64, m: u64, max_order: usize, max_diffractions: usize) -> u64 {
     let c = |j: usize| -> u64 {
         match j {
             0 => 1,
@@ -145,20 +229,30 @@ pub fn diffracted_count(n: u64, m: u64, max_order: usize) -> u64 {
         for p in 0..k {
             total = total.saturating_add(m.saturating_mul(c(p)).saturating_mul(c(k - 1 - p)));
         }
+        if max_diffractions < 2 || k < 2 {
+            continue;
+        }
+        for p in 0..=k - 2 {
+            for q in 0..=k - 2 - p {
+                let pairs = m.saturating_mul(if q == 0 { m.saturating_sub(1) } else { m });
+                let reflections = c(p).saturating_mul(c(q)).saturating_mul(c(k - 2 - p - q));
+                total = total.saturating_add(pairs.saturating_mul(reflections));
+            }
+        }
     }
     total
 }
 
-/// Every diffracted sequence up to `max_order` over the scene's reflectors and usable edges,
-/// unpruned: the reference enumeration (its count is [`diffracted_count`]; callers check
-/// their budget first).
+/// Every diffracted sequence up to `max_order` with up to `max_diffractions` (1 or 2)
+/// diffractions over the scene's reflectors and usable edges, unpruned: the reference
+/// enumeration (its count is [`diffracted_count`]; callers check their budget first).
 pub fn enumerate_diffracted(
     scene: &Scene,
     max_order: usize,
-    min_edge_length: Real,
+    diffracting: Diffracting,
 ) -> DiffractedSet {
     let reflectors: Vec<SurfaceId> = scene.reflectors().collect();
-    let edges: Vec<EdgeId> = usable_edges(scene, min_edge_length).collect();
+    let edges: Vec<EdgeId> = usable_edges(scene, diffracting.min_edge_length).collect();
     let mut set = DiffractedSet::default();
     for k in 1..=max_order {
         for p in 0..k {
@@ -172,13 +266,42 @@ pub fn enumerate_diffracted(
                 }
             }
         }
+        if diffracting.max_diffractions >= 2 && k >= 2 {
+            enumerate_twice(&mut set, (&reflectors, &edges), k);
+        }
     }
     set.canonicalise();
     set
 }
 
+/// Every sequence of order `k` with two diffractions into `set`.
+fn enumerate_twice(
+    set: &mut DiffractedSet,
+    (reflectors, edges): (&[SurfaceId], &[EdgeId]),
+    k: usize,
+) {
+    for p in 0..=k - 2 {
+        for q in 0..=k - 2 - p {
+            let befores = sequences(reflectors, p);
+            let betweens = sequences(reflectors, q);
+            let afters = sequences(reflectors, k - 2 - p - q);
+            for &e1 in edges {
+                for &e2 in edges.iter().filter(|&&e2| q > 0 || e2 != e1) {
+                    for before in &befores {
+                        for between in &betweens {
+                            for after in &afters {
+                                set.push_twice(before, (e1, e2), between, after);
+                            }
+                        }
+                    }
+                }
+            }
+        }
+    }
+}
+
 /// Every sequence of `len` surfaces from `reflectors` with none twice in a row.
-fn sequences(reflectors: &[SurfaceId], len: usize) -> Vec<Vec<SurfaceId>> {
+pub(crate) fn sequences(reflectors: &[SurfaceId], len: usize) -> Vec<Vec<SurfaceId>> {
     let mut out = vec![Vec::new()];
     for _ in 0..len {
         out = out
@@ -209,14 +332,23 @@ mod tests {
         let m = scene.edges().len() as u64;
         assert_eq!(m, 12);
         for order in 0..=3 {
-            let set = enumerate_diffracted(&scene, order, 0.0);
-            assert_eq!(
-                set.len() as u64,
-                diffracted_count(6, m, order),
-                "order {order}"
-            );
+            for max_diffractions in [1, 2] {
+                let diffracting = Diffracting {
+                    min_edge_length: 0.0,
+                    max_diffractions,
+                };
+                let set = enumerate_diffracted(&scene, order, diffracting);
+                assert_eq!(
+                    set.len() as u64,
+                    diffracted_count(6, m, order, max_diffractions),
+                    "order {order}, {max_diffractions} diffractions"
+                );
+            }
         }
         // D: 12; RD, DR: 2·6·12; RRD, RDR, DRR: 6·5·12 + 6·6·12 + 6·5·12.
-        assert_eq!(diffracted_count(6, 12, 3), 12 + 144 + 360 + 432 + 360);
+        assert_eq!(diffracted_count(6, 12, 3, 1), 12 + 144 + 360 + 432 + 360);
+        // DD: 12·11; RDD, DDR: 6·12·11 each; DRD: 12·6·12.
+        let twice = 132 + 2 * 792 + 864;
+        assert_eq!(diffracted_count(6, 12, 3, 2), 1308 + twice);
     }
 }

@@ -134,7 +134,7 @@ pub fn radio_material(
 #[derive(Debug, Clone, pyo3::FromPyObject)]
 #[pyo3(from_item_all)]
 pub struct DiffractionKeywords {
-    /// Diffractions per path (0 or 1).
+    /// Diffractions per path (0, 1 or 2).
     pub max_diffractions: usize,
     /// Edges shorter than this (metres) do not diffract.
     pub min_edge_length: f64,

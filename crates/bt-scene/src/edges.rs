@@ -15,6 +15,10 @@
 //! point about the edge is measured from `t0` towards `y0`; the free space (the *exterior*) is
 //! φ ∈ (0, nπ), face 0 lies at φ = 0 and face n at φ = nπ, n ∈ (1, 2] ([`Edge::n`]).
 
+mod keller;
+
+pub use keller::{EdgeLine, KELLER_PAIR_TOL, keller_pair};
+
 use crate::surface::{Surface, SurfaceId, SurfaceKind};
 use bt_geom::{Bvh, Plane, Real, Vec3, bvh::Occluder};
 use std::f64::consts::PI;

@@ -114,7 +114,10 @@ fn run(what: &str, scene: &Scene, i: usize, tree: &BeamTree, kept: &mut Kept) ->
         "diff" => bt_paths::beamtree::candidates_and_diffracted_in(
             scene,
             TreeOptions::new(3),
-            Some(0.0),
+            Some(bt_paths::diffraction::Diffracting {
+                min_edge_length: 0.0,
+                max_diffractions: 1,
+            }),
             &mut kept.cache,
             &mut |_| {},
         )

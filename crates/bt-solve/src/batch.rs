@@ -297,7 +297,7 @@ pub(crate) fn found_path(
     Some(FoundPath {
         surfaces: seq.to_vec(),
         points: points.to_vec(),
-        diffraction: None,
+        diffractions: Vec::new(),
         crossings: Vec::new(),
         iterations,
         residual,

@@ -1,10 +1,14 @@
-//! Paths with one edge diffraction: solving and validating a [`DiffractedCandidate`].
+//! Paths with one or two edge diffractions: solving and validating a [`DiffractedCandidate`].
 //!
 //! **Image method (closed form).** TX is mirrored through the planes before the edge (`I`), RX
 //! through those after it, from RX's side (`J`). The diffraction point `D` is the Keller point
 //! of `I` and `J` on the edge line (equal angles with the edge, [`bt_scene::Edge::keller`]):
 //! the stationary point of the unfolded length `|I − D| + |D − J|`. The reflection points are
-//! then the image method's between TX and `D`, and between `D` and RX.
+//! then the image method's between TX and `D`, and between `D` and RX. With two diffractions
+//! the second edge and `J` are also mirrored through the reflections between the edges, and
+//! the two points are the stationary point of the unfolded length over both edge lines
+//! ([`bt_scene::edges::keller_pair`]: Newton's method from the one-edge closed forms, to
+//! 1e-10 m); the reflection points are the image method's on the three stretches.
 //!
 //! **IPC.** Each point is updated in turn from its two neighbours by its own closed form: a
 //! reflection point where the neighbour mirrored through its plane sees the other neighbour,
@@ -12,7 +16,7 @@
 //! a convex function of the points on their planes and line, and stop when a round moves the
 //! points by at most the threshold on average.
 //!
-//! **Validation.** Reflection points as for specular paths ([`crate::validate`]); the
+//! **Validation.** Reflection points as for specular paths ([`crate::validate`]); each
 //! diffraction point strictly inside its edge (one length tolerance from either end: a corner
 //! is not an edge); both neighbours of `D` in the edge's exterior ([`bt_scene::Edge::in_exterior`]:
 //! a path on a face or inside the wedge does not diffract); the ray not along the edge (sin β0
@@ -23,13 +27,14 @@ use crate::image::ImageFailure;
 use crate::validate::{self, Validity};
 use crate::{CandidateOutcome, Diffraction, FoundPath, IpcOptions, IpcOutcome, TraceResult};
 use bt_geom::{Real, Vec3};
-use bt_paths::diffraction::DiffractedCandidate;
 use bt_paths::diffraction::DiffractedSet;
+use bt_paths::diffraction::{DiffractedCandidate, Site};
+use bt_scene::edges::{EdgeLine, keller_pair};
 use bt_scene::{Edge, Endpoints, Scene, SurfaceId};
 use rayon::prelude::*;
 
 /// The interaction points of `c` by the image method into `points` (length `c.order()`,
-/// metres, TX side first, the diffraction point at index `c.position`).
+/// metres, TX side first, the diffraction points at their indices).
 #[inline(always)]
 pub fn solve_image(
     scene: &Scene,
@@ -38,25 +43,64 @@ pub fn solve_image(
     points: &mut [Vec3],
 ) -> Result<(), ImageFailure> {
     let p = c.position;
-    let edge = scene.edges().get(c.edge);
+    let plane = |id: &SurfaceId| scene.surface(*id).polygon.plane();
     let mirror = |from: Vec3, seq: &mut dyn Iterator<Item = &SurfaceId>| {
-        seq.fold(from, |image, id| {
-            scene.surface(*id).polygon.plane().mirror(image)
-        })
+        seq.fold(from, |image, id| plane(id).mirror(image))
     };
     let i = mirror(ends.tx, &mut c.before().iter());
     let j = mirror(ends.rx, &mut c.after().iter().rev());
-    let t = edge
-        .keller(i, j)
-        .ok_or(ImageFailure::Parallel { index: p })?;
-    let d = edge.point(t);
-    points[p] = d;
-    crate::image::solve(scene, c.before(), ends.tx, d, &mut points[..p])?;
-    crate::image::solve(scene, c.after(), d, ends.rx, &mut points[p + 1..]).map_err(|e| match e {
-        ImageFailure::Parallel { index } => ImageFailure::Parallel {
-            index: index + p + 1,
-        },
-    })
+    let edge = scene.edges().get(c.edge);
+    let Some((second, q)) = c.second else {
+        let t = edge
+            .keller(i, j)
+            .ok_or(ImageFailure::Parallel { index: p })?;
+        let d = edge.point(t);
+        points[p] = d;
+        return stretches(
+            scene,
+            &[(c.before(), ends.tx), (c.after(), d)],
+            ends.rx,
+            points,
+        );
+    };
+    let other = scene.edges().get(second);
+    let mut line = EdgeLine::of(other);
+    let mut j = j;
+    for id in c.between().iter().rev() {
+        line = line.mirrored(plane(id));
+        j = plane(id).mirror(j);
+    }
+    let (t1, t2) =
+        keller_pair(i, EdgeLine::of(edge), line, j).ok_or(ImageFailure::Parallel { index: p })?;
+    let (d1, d2) = (edge.point(t1), other.point(t2));
+    (points[p], points[p + q + 1]) = (d1, d2);
+    let parts = [(c.before(), ends.tx), (c.between(), d1), (c.after(), d2)];
+    stretches(scene, &parts, ends.rx, points)
+}
+
+/// The reflection points of each stretch `(surfaces, from)` of a path whose diffraction
+/// points are already in `points`: each stretch runs from `from` to the next stretch's start
+/// (the last to `to`), its points right after the previous stretch's and its diffraction.
+fn stretches(
+    scene: &Scene,
+    parts: &[(&[SurfaceId], Vec3)],
+    to: Vec3,
+    points: &mut [Vec3],
+) -> Result<(), ImageFailure> {
+    let mut start = 0;
+    for (k, (surfaces, from)) in parts.iter().enumerate() {
+        let end = parts.get(k + 1).map_or(to, |next| next.1);
+        let range = start..start + surfaces.len();
+        crate::image::solve(scene, surfaces, *from, end, &mut points[range]).map_err(
+            |e| match e {
+                ImageFailure::Parallel { index } => ImageFailure::Parallel {
+                    index: index + start,
+                },
+            },
+        )?;
+        start += surfaces.len() + 1;
+    }
+    Ok(())
 }
 
 /// The interaction points of `c` by IPC rounds (module docs) from `points` (the start: e.g.
@@ -68,7 +112,6 @@ pub fn solve_ipc(
     options: &IpcOptions,
     points: &mut [Vec3],
 ) -> IpcOutcome {
-    let edge = scene.edges().get(c.edge);
     let n = points.len();
     let neighbour = |points: &[Vec3], k: usize| {
         let prev = if k == 0 { ends.tx } else { points[k - 1] };
@@ -86,11 +129,15 @@ pub fn solve_ipc(
         let mut moved = 0.0;
         for k in 0..n {
             let (prev, next) = neighbour(points, k);
-            let new = if k == c.position {
-                edge.keller(prev, next).map(|t| edge.point(t))
-            } else {
-                let plane = scene.surface(reflection_at(c, k)).polygon.plane();
-                crate::ipc::intersection_point(plane, prev, next, min_sum)
+            let new = match c.site(k) {
+                Site::Diffraction(e) => {
+                    let edge = scene.edges().get(e);
+                    edge.keller(prev, next).map(|t| edge.point(t))
+                }
+                Site::Reflection(id) => {
+                    let plane = scene.surface(id).polygon.plane();
+                    crate::ipc::intersection_point(plane, prev, next, min_sum)
+                }
             };
             let Some(new) = new else {
                 return degenerate(k, round);
@@ -115,25 +162,16 @@ pub fn solve_ipc(
     }
 }
 
-/// IPC's start points of `c`: each polygon's centroid, the edge's midpoint.
+/// IPC's start points of `c`: each polygon's centroid, each edge's midpoint.
 pub fn ipc_start(scene: &Scene, c: DiffractedCandidate<'_>, points: &mut [Vec3]) {
     for (k, p) in points.iter_mut().enumerate() {
-        *p = if k == c.position {
-            let edge = scene.edges().get(c.edge);
-            edge.point(0.5 * edge.length)
-        } else {
-            scene.surface(reflection_at(c, k)).polygon.centroid()
+        *p = match c.site(k) {
+            Site::Diffraction(e) => {
+                let edge = scene.edges().get(e);
+                edge.point(0.5 * edge.length)
+            }
+            Site::Reflection(id) => scene.surface(id).polygon.centroid(),
         };
-    }
-}
-
-/// The surface of interaction `k` (not the diffraction) of `c`.
-#[inline(always)]
-fn reflection_at(c: DiffractedCandidate<'_>, k: usize) -> SurfaceId {
-    if k < c.position {
-        c.reflections[k]
-    } else {
-        c.reflections[k - 1]
     }
 }
 
@@ -146,7 +184,6 @@ pub fn validate(
     points: &[Vec3],
 ) -> Validity {
     let tol = scene.length_tolerance();
-    let edge = scene.edges().get(c.edge);
     let n = points.len();
     if points.iter().any(|p| !p.is_finite()) {
         return Validity::NonFinite;
@@ -156,19 +193,25 @@ pub fn validate(
         k if k == n + 1 => ends.rx,
         k => points[k - 1],
     };
-    let t = edge.parameter(points[c.position]);
-    if t <= tol || t >= edge.length - tol {
-        return Validity::OffEdge { index: c.position };
+    for (k, e) in c.edges() {
+        let t = scene.edges().get(e).parameter(points[k]);
+        if t <= tol || t >= scene.edges().get(e).length - tol {
+            return Validity::OffEdge { index: k };
+        }
     }
-    for k in (0..n).filter(|&k| k != c.position) {
-        if let Some(verdict) =
-            validate::reflection_point(scene, reflection_at(c, k), points[k], tol, k)
-        {
+    let reflections = || {
+        (0..n).filter_map(move |k| match c.site(k) {
+            Site::Reflection(id) => Some((k, id)),
+            Site::Diffraction(_) => None,
+        })
+    };
+    for (k, id) in reflections() {
+        if let Some(verdict) = validate::reflection_point(scene, id, points[k], tol, k) {
             return verdict;
         }
     }
-    for k in (0..n).filter(|&k| k != c.position) {
-        let plane = scene.surface(reflection_at(c, k)).polygon.plane();
+    for (k, id) in reflections() {
+        let plane = scene.surface(id).polygon.plane();
         let (a, b) = (
             plane.signed_distance(vertex(k)),
             plane.signed_distance(vertex(k + 2)),
@@ -180,16 +223,38 @@ pub fn validate(
             return Validity::OppositeSides { index: k };
         }
     }
-    if !edge.in_exterior(vertex(c.position), tol) || !edge.in_exterior(vertex(c.position + 2), tol)
-    {
-        return Validity::InsideWedge { index: c.position };
+    for (k, e) in c.edges() {
+        if let Some(verdict) = diffraction_point(
+            scene.edges().get(e),
+            (vertex(k), points[k], vertex(k + 2)),
+            k,
+            tol,
+        ) {
+            return verdict;
+        }
+    }
+    blocked(scene, c, (vertex, n))
+}
+
+/// The verdict on a diffraction point `d` (point `index`) of `edge` between its neighbours
+/// `prev` and `next`, when it fails: both neighbours in the edge's exterior, the ray not
+/// along the edge (sin β0 at least `bt_channel::diffraction::MIN_SIN_BETA`, where UTD holds).
+#[inline(always)]
+fn diffraction_point(
+    edge: &Edge,
+    (prev, d, next): (Vec3, Vec3, Vec3),
+    index: usize,
+    tol: Real,
+) -> Option<Validity> {
+    if !edge.in_exterior(prev, tol) || !edge.in_exterior(next, tol) {
+        return Some(Validity::InsideWedge { index });
     }
     // A ray (nearly) along the edge has no UTD coefficient (sin β0 → 0): grazing.
-    let incoming = (points[c.position] - vertex(c.position)).normalize();
+    let incoming = (d - prev).normalize();
     if incoming.cross(edge.direction).length() < bt_channel::diffraction::MIN_SIN_BETA {
-        return Validity::Grazing { index: c.position };
+        return Some(Validity::Grazing { index });
     }
-    blocked(scene, c, (vertex, n), edge)
+    None
 }
 
 /// The blocking verdict of the segments of the path with vertices `vertex(0..=n + 1)`.
@@ -198,20 +263,18 @@ fn blocked(
     scene: &Scene,
     c: DiffractedCandidate<'_>,
     (vertex, n): (impl Fn(usize) -> Vec3, usize),
-    edge: &Edge,
 ) -> Validity {
     let tol = scene.length_tolerance();
     let on = |k: usize| -> &[SurfaceId] {
-        // Vertex k (0 = TX) lies on: nothing for the terminals, the edge's surfaces for D.
+        // Vertex k (0 = TX) lies on: nothing for the terminals, its edge's surfaces for a
+        // diffraction point.
         match k {
             0 => &[],
             k if k == n + 1 => &[],
-            k if k - 1 == c.position => &edge.touching,
-            k => std::slice::from_ref(if k - 1 < c.position {
-                &c.reflections[k - 1]
-            } else {
-                &c.reflections[k - 2]
-            }),
+            k => match c.site(k - 1) {
+                Site::Diffraction(e) => &scene.edges().get(e).touching,
+                Site::Reflection(_) => reflection_slice(c, k - 1),
+            },
         }
     };
     let through = validate::may_cross(scene, n);
@@ -231,6 +294,13 @@ fn blocked(
         return validate::crossing_budget(scene, path, n);
     }
     Validity::Valid
+}
+
+/// The one-surface slice of reflection point `k` of `c` (borrowed from its reflections).
+#[inline(always)]
+fn reflection_slice<'a>(c: DiffractedCandidate<'a>, k: usize) -> &'a [SurfaceId] {
+    let skipped = c.edges().filter(|&(index, _)| index < k).count();
+    std::slice::from_ref(&c.reflections[k - skipped])
 }
 
 /// Solve and validate `c` with `solver` (the image method or IPC; SBR does not diffract and
@@ -357,17 +427,17 @@ fn solve_range_impl(work: &Work<'_>, range: std::ops::Range<usize>) -> TraceResu
 }
 
 /// The found path of a valid outcome: the specular batch's ([`crate::batch::found_path`])
-/// with its diffraction.
+/// with its diffractions.
 fn found(
     c: DiffractedCandidate<'_>,
     outcome: &CandidateOutcome,
     points: &[Vec3],
 ) -> Option<FoundPath> {
     crate::batch::found_path(c.reflections, outcome, points).map(|path| FoundPath {
-        diffraction: Some(Diffraction {
-            index: c.position,
-            edge: c.edge,
-        }),
+        diffractions: c
+            .edges()
+            .map(|(index, edge)| Diffraction { index, edge })
+            .collect(),
         ..path
     })
 }

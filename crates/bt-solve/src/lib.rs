@@ -61,8 +61,8 @@ pub struct FoundPath {
     pub surfaces: Vec<SurfaceId>,
     /// Interaction points, TX side first, metres (TX and RX excluded).
     pub points: Vec<Vec3>,
-    /// The diffraction, when the path has one.
-    pub diffraction: Option<Diffraction>,
+    /// The diffractions (none, one or two), in path order.
+    pub diffractions: Vec<Diffraction>,
     /// The penetrable surfaces the path crosses (thin-slab transmission), by point, in path
     /// order; empty without transmission.
     pub crossings: Vec<Crossing>,
@@ -107,20 +107,21 @@ impl FoundPath {
     pub fn interactions(&self) -> Vec<Interaction> {
         let mut reflections = self.surfaces.iter();
         let mut crossings = self.crossings.iter().peekable();
+        let mut diffractions = self.diffractions.iter().peekable();
         (0..self.points.len())
             .filter_map(|i| match crossings.next_if(|c| c.index == i) {
                 Some(c) => Some(Interaction::Transmission(c.surface)),
-                None => match self.diffraction {
-                    Some(d) if d.index == i => Some(Interaction::Diffraction(d.edge)),
-                    _ => reflections.next().map(|s| Interaction::Reflection(*s)),
+                None => match diffractions.next_if(|d| d.index == i) {
+                    Some(d) => Some(Interaction::Diffraction(d.edge)),
+                    None => reflections.next().map(|s| Interaction::Reflection(*s)),
                 },
             })
             .collect()
     }
 
     /// The path with the penetrable surfaces its segments cross in `scene` (between `ends`)
-    /// inserted as crossing points ([`validate::walk_crossings`]); the diffraction's index
-    /// moves with them. A path found without transmission comes back unchanged.
+    /// inserted as crossing points ([`validate::walk_crossings`]); the diffractions' indices
+    /// move with them. A path found without transmission comes back unchanged.
     pub fn with_crossings(self, scene: &Scene, ends: Endpoints) -> FoundPath {
         let n = self.points.len();
         let interactions = self.interactions();
@@ -154,7 +155,7 @@ impl FoundPath {
         }
         let mut points = Vec::with_capacity(n + found.len());
         let mut crossings = Vec::with_capacity(found.len());
-        let mut diffraction = self.diffraction;
+        let mut diffractions = self.diffractions.clone();
         let mut next = found.iter().peekable();
         for segment in 0..=n {
             while let Some((_, p, id)) = next.next_if(|c| c.0 == segment) {
@@ -164,17 +165,17 @@ impl FoundPath {
                 });
                 points.push(*p);
             }
-            if let (Some(d), Some(old)) = (diffraction.as_mut(), self.diffraction)
-                && old.index == segment
-            {
-                d.index = points.len();
+            for (d, old) in diffractions.iter_mut().zip(&self.diffractions) {
+                if old.index == segment {
+                    d.index = points.len();
+                }
             }
             points.extend(self.points.get(segment));
         }
         FoundPath {
             points,
             crossings,
-            diffraction,
+            diffractions,
             ..self
         }
     }

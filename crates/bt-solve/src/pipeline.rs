@@ -11,6 +11,7 @@ use bt_paths::beamtree::{
     BeamTree, DiffractionSide, TreeCache, TreeOptions, TreeStats, diffracted_with,
 };
 pub use bt_paths::beamtree::{BuildProgress, Progress};
+use bt_paths::diffraction::Diffracting;
 use bt_paths::{AllVisible, CandidateSet, CandidateStats};
 use bt_scene::{Scene, SceneError};
 use rayon::prelude::*;
@@ -68,7 +69,7 @@ pub struct TraceOptions {
 /// diffractions.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
 pub struct DiffractionOptions {
-    /// Diffractions per path: 0 (off, the default) or 1.
+    /// Diffractions per path: 0 (off, the default), 1 or 2.
     pub max_diffractions: usize,
     /// Edges shorter than this (metres) do not diffract (default 0: every edge).
     pub min_edge_length: bt_geom::Real,
@@ -82,9 +83,12 @@ impl DiffractionOptions {
             min_edge_length: 0.0,
         }
     }
-    /// The minimum edge length when diffraction is on.
-    pub fn enabled(&self) -> Option<bt_geom::Real> {
-        (self.max_diffractions > 0).then_some(self.min_edge_length)
+    /// What the candidates diffract on, when diffraction is on.
+    pub fn enabled(&self) -> Option<Diffracting> {
+        (self.max_diffractions > 0).then_some(Diffracting {
+            min_edge_length: self.min_edge_length,
+            max_diffractions: self.max_diffractions,
+        })
     }
 }
 
@@ -264,9 +268,9 @@ fn generate(
         }
     };
     // The enumerating modes diffract blindly (the WVRN relates surfaces, not edges).
-    if let Some(min_edge_length) = diffraction {
+    if let Some(diffracting) = diffraction {
         set.diffracted =
-            bt_paths::diffraction::enumerate_diffracted(scene, options.max_order, min_edge_length);
+            bt_paths::diffraction::enumerate_diffracted(scene, options.max_order, diffracting);
         set.stats.diffracted = set.diffracted.len() as u64;
     }
     Ok(set)
@@ -322,12 +326,14 @@ pub fn wvrn_budget(scene: &Scene, budget: u64) -> Result<(), TraceError> {
 fn options_budget(scene: &Scene, options: &TraceOptions) -> Result<(), TraceError> {
     let reflectors = scene.reflectors().count() as u64;
     let mut estimate = exhaustive_count(reflectors, options.max_order);
-    if let Some(min_edge_length) = options.diffraction.enabled() {
-        let edges = bt_paths::diffraction::usable_edges(scene, min_edge_length).count() as u64;
+    if let Some(diffracting) = options.diffraction.enabled() {
+        let edges =
+            bt_paths::diffraction::usable_edges(scene, diffracting.min_edge_length).count() as u64;
         estimate = estimate.saturating_add(bt_paths::diffraction::diffracted_count(
             reflectors,
             edges,
             options.max_order,
+            diffracting.max_diffractions,
         ));
     }
     check_estimate(estimate, options.max_candidates, options.max_order)
@@ -467,9 +473,10 @@ impl KeptTx {
         cache: &mut TreeCache,
     ) -> Result<KeptTx, TraceError> {
         let tree = BeamTree::build_in(scene, solver_tree_options(options), cache, &mut |_| {})?;
-        let side = options.diffraction.enabled().map(|min_edge_length| {
-            DiffractionSide::of(scene, &tree, options.max_order, min_edge_length)
-        });
+        let side = options
+            .diffraction
+            .enabled()
+            .map(|diffracting| DiffractionSide::of(scene, &tree, options.max_order, diffracting));
         Ok(KeptTx { tree, side })
     }
 

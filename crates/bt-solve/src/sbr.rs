@@ -280,7 +280,7 @@ impl SbrPath {
     pub fn to_found(&self) -> FoundPath {
         FoundPath {
             surfaces: self.surfaces.clone(),
-            diffraction: None,
+            diffractions: Vec::new(),
             crossings: Vec::new(),
             points: self.points.clone(),
             iterations: None,

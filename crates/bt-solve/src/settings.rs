@@ -129,9 +129,7 @@ pub enum SettingsError {
     #[error("{0}")]
     Sbr(String),
     /// More diffractions per path than the tracer does.
-    #[error(
-        "--max-diffractions must be 0 or 1 (two diffractions per path are not supported yet), got {0}"
-    )]
+    #[error("--max-diffractions must be 0, 1 or 2, got {0}")]
     MaxDiffractions(usize),
     /// The minimum edge length is not a finite non-negative number of metres.
     #[error("--min-edge-length must be a finite number of metres >= 0, got {0}")]
@@ -212,7 +210,7 @@ impl SolveSettings {
     /// The pipeline options for `scene`.
     pub fn trace_options(&self, scene: &Scene) -> Result<TraceOptions, SettingsError> {
         let d = self.diffraction;
-        if d.max_diffractions > 1 {
+        if d.max_diffractions > 2 {
             return Err(SettingsError::MaxDiffractions(d.max_diffractions));
         }
         if !(d.min_edge_length.is_finite() && d.min_edge_length >= 0.0) {

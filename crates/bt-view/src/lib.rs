@@ -313,16 +313,18 @@ fn shown_edges(scene: &Scene, paths: &[PathReport], cap: usize) -> Vec<EdgeId> {
     ids.into_iter().collect()
 }
 
-/// The edges `path` diffracts on: its edge id when it was traced here; for a path read from a
+/// The edges `path` diffracts on: its edges' ids when it was traced here; for a path read from a
 /// trace document (which carries no ids), the edges through its diffraction point (within the
 /// edges' own matching tolerance, [`bt_scene::edges::REL_EDGE_MATCH`] of the scene's extent)
 /// whose faces have the names the path gives.
 fn diffracted_edges(scene: &Scene, path: &PathReport) -> Vec<EdgeId> {
     let edges = scene.edges();
-    if let Some(d) = path.diffraction {
-        return (d.edge.index() < edges.len())
-            .then_some(d.edge)
-            .into_iter()
+    if !path.diffractions.is_empty() {
+        return path
+            .diffractions
+            .iter()
+            .map(|d| d.edge)
+            .filter(|e| e.index() < edges.len())
             .collect();
     }
     let tol = bt_geom::tol::scaled(bt_scene::edges::REL_EDGE_MATCH, scene.extent());
@@ -520,11 +522,11 @@ mod tests {
         assert_eq!(shown_edges(&scene, &reports, 4).len(), 4, "at the cap: all");
         assert!(shown_edges(&scene, &[], 3).is_empty(), "no path, no edge");
         let over = shown_edges(&scene, &reports[..1], 3);
-        assert_eq!(over, vec![reports[0].diffraction.unwrap().edge]);
+        assert_eq!(over, vec![reports[0].diffractions[0].edge]);
         // A path read back from a trace document has no edge id: found by its point and name.
         let json = serde_json::to_string(&reports[..1]).unwrap();
         let read: Vec<PathReport> = serde_json::from_str(&json).unwrap();
-        assert!(read[0].diffraction.is_none());
+        assert!(read[0].diffractions.is_empty());
         assert_eq!(shown_edges(&scene, &read, 3), over);
         let mut renamed = read.clone();
         renamed[0].surfaces = vec!["other".to_string()];

@@ -20,8 +20,10 @@
 //! keeps the tree's margins on the inclusive side, so no path validation accepts is lost
 //! (property tests against [`crate::diffraction::enumerate_diffracted`]).
 
+mod twice;
+
 use super::{BeamTree, EPS, GROW, ROOT, TreeError};
-use crate::diffraction::DiffractedSet;
+use crate::diffraction::{DiffractedSet, Diffracting};
 use bt_geom::bvh::box_meets_halfspaces;
 use bt_geom::{Plane, Real, Vec3};
 use bt_scene::{Edge, EdgeId, Scene, SurfaceId};
@@ -186,6 +188,9 @@ fn clip(edge: &Edge, planes: &[Plane], eps: Real) -> Option<(Real, Real)> {
 pub struct DiffractionSide {
     reaches: Vec<Vec<Reach>>,
     max_order: usize,
+    /// Per edge: at least the minimum edge length long.
+    usable: Vec<bool>,
+    max_diffractions: usize,
     /// (parent, surface) of the tree's nodes to depth `max_order − 1`.
     prefixes: Vec<(u32, u32)>,
     /// The tree's length tolerance (m), for the join's margin (and the cache's key).
@@ -194,10 +199,10 @@ pub struct DiffractionSide {
 
 impl DiffractionSide {
     /// The side of `tx` (materialised to depth `max_order − 1` at least) for paths of up to
-    /// `max_order` interactions over the edges at least `min_edge_length` metres long.
-    pub fn of(scene: &Scene, tx: &BeamTree, max_order: usize, min_edge_length: Real) -> Self {
+    /// `max_order` interactions, as `diffracting` says.
+    pub fn of(scene: &Scene, tx: &BeamTree, max_order: usize, diffracting: Diffracting) -> Self {
         let mut usable = vec![false; scene.edges().len()];
-        for e in crate::diffraction::usable_edges(scene, min_edge_length) {
+        for e in crate::diffraction::usable_edges(scene, diffracting.min_edge_length) {
             usable[e.index()] = true;
         }
         let limit: Vec<usize> = usable
@@ -208,6 +213,8 @@ impl DiffractionSide {
         DiffractionSide {
             reaches,
             max_order,
+            usable,
+            max_diffractions: diffracting.max_diffractions,
             prefixes: tx.prefixes(max_order.saturating_sub(1)),
             tol: tx.tol,
         }
@@ -228,41 +235,102 @@ pub fn join(
     if max_order == 0 {
         return Ok(set);
     }
-    let margin = GROW * side.tol.max(rx.tol);
-    let tx_node = |k: u32| side.prefixes[k as usize];
-    let rx_node = |k: u32| (rx.nodes[k as usize].parent, rx.nodes[k as usize].surface);
     let from_tx = &side.reaches;
-    // An RX reach on an edge fits the order only with the shallowest TX reach there at most.
+    // An RX reach on an edge fits the order only with the shallowest TX reach there at most;
+    // with two diffractions, with the TX root on another edge.
+    let twice = side.max_diffractions >= 2 && max_order >= 2;
     let limit: Vec<usize> = from_tx
         .iter()
-        .map(|r| r.first().map_or(0, |a| max_order - a.depth))
+        .zip(&side.usable)
+        .map(|(r, &usable)| {
+            let once = r.first().map_or(0, |a| max_order - a.depth);
+            if twice && usable {
+                once.max(max_order - 1)
+            } else {
+                once
+            }
+        })
         .collect();
     let from_rx = rx.reaches(scene, &limit);
-    let (mut before, mut after) = (Vec::new(), Vec::new());
-    for (e, edge) in scene.edges().all().iter().enumerate() {
-        for a in &from_tx[e] {
-            // Reaches come in ascending depth: stop at the first too deep to fit the order.
-            let fits = |b: &&Reach| a.depth + b.depth < max_order;
-            for b in from_rx[e].iter().take_while(fits) {
-                if a.lo.max(b.lo) > a.hi.min(b.hi) + margin {
-                    continue;
-                }
-                let Some(t) = edge.keller(a.image, b.image) else {
-                    continue;
-                };
-                let inside = |r: &Reach| t >= r.lo - margin && t <= r.hi + margin;
-                if inside(a) && inside(b) {
-                    surfaces_of(tx_node, a.node, &mut before);
-                    surfaces_of(rx_node, b.node, &mut after);
-                    after.reverse();
-                    set.push(&before, EdgeId(e as u32), &after);
-                    if set.len() as u64 > budget {
-                        return Err(TreeError::DiffractedBudget { budget, max_order });
+    let pairing = Pairing {
+        side,
+        rx,
+        from_rx: &from_rx,
+        margin: GROW * side.tol.max(rx.tol),
+        budget,
+    };
+    pairing.once(scene, &mut set)?;
+    if twice {
+        pairing.twice(scene, &mut set)?;
+    }
+    set.canonicalise();
+    Ok(set)
+}
+
+/// What the join pairs: the TX side's reaches and the RX tree's, per edge.
+struct Pairing<'a> {
+    side: &'a DiffractionSide,
+    rx: &'a BeamTree,
+    from_rx: &'a [Vec<Reach>],
+    /// Slack of the tests that a Keller point lies in a reach, metres.
+    margin: Real,
+    budget: u64,
+}
+
+impl Pairing<'_> {
+    /// The surfaces of TX node `a` (TX side first) and of RX node `b` (RX side last) into
+    /// `before` and `after`.
+    fn surfaces(
+        &self,
+        (a, b): (u32, u32),
+        (before, after): (&mut Vec<SurfaceId>, &mut Vec<SurfaceId>),
+    ) {
+        let tx_node = |k: u32| self.side.prefixes[k as usize];
+        let rx_node = |k: u32| {
+            let node = &self.rx.nodes[k as usize];
+            (node.parent, node.surface)
+        };
+        surfaces_of(tx_node, a, before);
+        surfaces_of(rx_node, b, after);
+        after.reverse();
+    }
+
+    fn check_budget(&self, set: &DiffractedSet) -> Result<(), TreeError> {
+        if set.len() as u64 > self.budget {
+            return Err(TreeError::DiffractedBudget {
+                budget: self.budget,
+                max_order: self.side.max_order,
+            });
+        }
+        Ok(())
+    }
+
+    /// The candidates with one diffraction: per edge, the TX and RX reaches whose depths fit
+    /// the order and whose Keller point lies in both.
+    fn once(&self, scene: &Scene, set: &mut DiffractedSet) -> Result<(), TreeError> {
+        let max_order = self.side.max_order;
+        let margin = self.margin;
+        let (mut before, mut after) = (Vec::new(), Vec::new());
+        for (e, edge) in scene.edges().all().iter().enumerate() {
+            for a in &self.side.reaches[e] {
+                // Reaches come in ascending depth: stop at the first too deep to fit the order.
+                let fits = |b: &&Reach| a.depth + b.depth < max_order;
+                for b in self.from_rx[e].iter().take_while(fits) {
+                    if a.lo.max(b.lo) > a.hi.min(b.hi) + margin {
+                        continue;
+                    }
+                    let Some(t) = edge.keller(a.image, b.image) else {
+                        continue;
+                    };
+                    let inside = |r: &Reach| t >= r.lo - margin && t <= r.hi + margin;
+                    if inside(a) && inside(b) {
+                        self.surfaces((a.node, b.node), (&mut before, &mut after));
+                        set.push(&before, EdgeId(e as u32), &after);
+                        self.check_budget(set)?;
                     }
                 }
             }
         }
+        Ok(())
     }
-    set.canonicalise();
-    Ok(set)
 }

@@ -151,7 +151,7 @@ proptest! {
             let reference = trace_scene(&moved, &diffraction(CandidateMode::Exhaustive))
                 .expect("trace runs").result.paths;
             let kinds = |paths: &[FoundPath]| -> Vec<_> {
-                paths.iter().map(|p| (p.surfaces.clone(), p.diffraction)).collect()
+                paths.iter().map(|p| (p.surfaces.clone(), p.diffractions.first().copied())).collect()
             };
             prop_assert_eq!(kinds(&got.result.paths), kinds(&reference));
             prop_assert!(max_point_distance(&got.result.paths, &reference) < 1e-9);

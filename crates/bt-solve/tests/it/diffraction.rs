@@ -27,7 +27,7 @@ fn paths(scene: &Scene, max_order: usize, mode: CandidateMode, solver: Solver) -
 
 /// Largest deviation from Keller's law over the diffracted paths, as |cos β_in − cos β_out|.
 fn keller_error(scene: &Scene, path: &FoundPath) -> Real {
-    let Some(d) = path.diffraction else {
+    let Some(d) = path.diffractions.first().copied() else {
         return 0.0;
     };
     let ends = scene.terminals().unwrap();
@@ -72,9 +72,9 @@ proptest! {
         let ipc = Solver::Ipc(IpcOptions::for_scene(&scene, UpdateOrder::GaussSeidel));
         let found = paths(&scene, order, CandidateMode::BeamTree, ipc);
         let key = |p: &FoundPath| p.interactions();
-        let diffracted = |v: &[FoundPath]| v.iter().filter(|p| p.diffraction.is_some()).map(key).collect::<Vec<_>>();
+        let diffracted = |v: &[FoundPath]| v.iter().filter(|p| !p.diffractions.is_empty()).map(key).collect::<Vec<_>>();
         prop_assert_eq!(diffracted(&found), diffracted(&image));
-        for (p, q) in found.iter().zip(&image).filter(|(p, _)| p.diffraction.is_some()) {
+        for (p, q) in found.iter().zip(&image).filter(|(p, _)| !p.diffractions.is_empty()) {
             for (x, y) in p.points.iter().zip(&q.points) {
                 prop_assert!(x.distance(*y) < 1e-9, "{} vs {}", x, y);
             }
@@ -95,7 +95,7 @@ fn a_screen_is_passed_round_each_of_its_edges() {
     assert_eq!(found.len(), 4, "{found:?}");
     let ends = scene.terminals().unwrap();
     for p in &found {
-        let d = p.diffraction.expect("diffracted");
+        let d = p.diffractions.first().copied().expect("diffracted");
         let edge = scene.edges().get(d.edge);
         assert!(edge.is_free() && (edge.n - 2.0).abs() < 1e-12);
         let at = |t: Real| ends.tx.distance(edge.point(t)) + edge.point(t).distance(ends.rx);
@@ -121,12 +121,16 @@ fn a_corner_diffracts_on_its_reflex_side_only() {
     let corner: Vec<&FoundPath> = found
         .iter()
         .filter(|p| {
-            p.diffraction
+            p.diffractions
+                .first()
+                .copied()
                 .is_some_and(|d| !scene.edges().get(d.edge).is_free())
         })
         .collect();
     assert_eq!(corner.len(), 1, "{found:?}");
-    let edge = scene.edges().get(corner[0].diffraction.unwrap().edge);
+    let edge = scene
+        .edges()
+        .get(corner[0].diffractions.first().copied().unwrap().edge);
     assert!((edge.n - 1.5).abs() < 1e-12);
     // The same corner from inside (both terminals in x, y > 0): no path round the corner.
     let inside = scene
@@ -134,7 +138,9 @@ fn a_corner_diffracts_on_its_reflex_side_only() {
         .unwrap();
     let found = paths(&inside, 1, CandidateMode::BeamTree, Solver::Image);
     assert!(found.iter().all(|p| {
-        p.diffraction
+        p.diffractions
+            .first()
+            .copied()
             .is_none_or(|d| scene.edges().get(d.edge).is_free())
     }));
     assert!(angle_between(Vec3::X, Vec3::Y) > 1.5);
@@ -151,7 +157,7 @@ fn random_scenes_diffract_at_every_position() {
             continue;
         };
         for p in paths(&scene, 3, CandidateMode::BeamTree, Solver::Image) {
-            if let Some(d) = p.diffraction {
+            if let Some(d) = p.diffractions.first().copied() {
                 positions[d.index] += 1;
             }
         }
@@ -215,7 +221,7 @@ fn a_reflection_point_on_an_edge_is_a_diffraction_not_a_reflection() {
     let found = paths(&scene, 1, CandidateMode::BeamTree, Solver::Image);
     let through: Vec<&FoundPath> = found.iter().filter(|p| at_corner(p)).collect();
     assert_eq!(through.len(), 1, "{found:?}");
-    assert!(through[0].diffraction.is_some());
+    assert!(!through[0].diffractions.is_empty());
 }
 
 /// The same rule on a seam between coplanar faces, which is no edge: the point reflects, once,
@@ -244,7 +250,7 @@ fn a_reflection_point_on_a_seam_reflects_once() {
                 .result
                 .paths
                 .iter()
-                .filter(|p| p.points.len() == 1 && p.diffraction.is_none())
+                .filter(|p| p.points.len() == 1 && p.diffractions.first().copied().is_none())
                 .collect();
             assert_eq!(reflected.len(), 1, "{mode:?}: {reflected:?}");
             assert_eq!(reflected[0].surfaces, vec![SurfaceId(0)]);

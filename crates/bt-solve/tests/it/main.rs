@@ -13,4 +13,5 @@ mod sionna;
 mod terminals;
 mod translation;
 mod transmission;
+mod two_diffractions;
 mod wvrn_completeness;

@@ -216,7 +216,7 @@ fn compare_case(case: &str, gains: Gains, out: &mut Differences) {
                 Some((p, _)) => {
                     let gain_db = p.gain_db.unwrap();
                     let diff_db = gain_db - e.gain_db;
-                    match p.diffraction {
+                    match p.diffractions.first().copied() {
                         Some(d) => {
                             let reflected_after = d.index + 1 < p.points.len();
                             out.diffracted.push(Diffracted {

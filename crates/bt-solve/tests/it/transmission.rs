@@ -158,7 +158,10 @@ proptest! {
         let set = bt_paths::beamtree::candidates_and_diffracted_in(
             &traced,
             TreeOptions { culling, ..TreeOptions::new(order) },
-            diffract.then_some(0.0),
+            diffract.then_some(bt_paths::diffraction::Diffracting {
+                min_edge_length: 0.0,
+                max_diffractions: 1,
+            }),
             &mut TreeCache::default(),
             &mut |_| {},
         )
