@@ -16,74 +16,231 @@
 use super::{Pairing, Reach};
 use crate::beamtree::TreeError;
 use crate::diffraction::DiffractedSet;
+use bt_geom::{Real, Vec3};
 use bt_scene::edges::{EdgeLine, keller_pair};
-use bt_scene::{EdgeId, Scene, SurfaceId};
+use bt_scene::{Edge, EdgeId, Scene, SurfaceId};
+
+/// Angular slack (rad) of the prefilters: far above round-off, far below any angle a valid
+/// path could need.
+const SLACK: Real = 1e-6;
+
+/// A TX reach on the first edge, as the prefilters read it: its line, its interval (grown by
+/// the margin) and the range of cos β0 of rays from its image over the interval.
+struct Near {
+    edge: usize,
+    reach: Reach,
+    line: EdgeLine,
+    ends: [Vec3; 2],
+    /// cos β0 at the interval's ends (increasing along the edge).
+    incidence: (Real, Real),
+}
+
+/// An RX reach on the second edge and the middle reflections: the edge's line, interval ends
+/// and the RX image, unfolded through the middle into the first edge's frame, and the range
+/// of cos β0 of rays leaving towards the image.
+struct Far<'m> {
+    edge: usize,
+    reach: Reach,
+    middle: &'m [SurfaceId],
+    line: EdgeLine,
+    image: Vec3,
+    ends: [Vec3; 2],
+    /// cos β0 of the ray from the interval's ends towards the image.
+    leaving: (Real, Real),
+}
+
+/// cos of the angle between unit `direction` and the ray from the point at parameter `t` of
+/// `line` to `p`: (t_p − t)/√((t_p − t)² + r²), monotone in t.
+fn cos_towards(line: &EdgeLine, t: Real, p: Vec3) -> Real {
+    let v = p - line.point(t);
+    v.dot(line.direction) / v.length()
+}
+
+/// Whether `p` lies strictly inside `edge`'s interior wedge (not in its exterior, by more
+/// than [`SLACK`]): a convex region, so a segment with both ends there lies in it.
+fn deep_inside(edge: &Edge, p: Vec3) -> bool {
+    let a = edge.about(p);
+    a.r > 0.0 && a.sin0 < -SLACK * a.r && a.sin_n < -SLACK * a.r
+}
+
+/// The range of cos β between unit `direction` and `q − p` for `p` on segment `ps`, `q` on
+/// segment `qs` (conservative: the numerator's and the length's ranges taken apart).
+fn cos_range(ps: [Vec3; 2], qs: [Vec3; 2], direction: Vec3) -> (Real, Real) {
+    let corners = [qs[0] - ps[0], qs[0] - ps[1], qs[1] - ps[0], qs[1] - ps[1]];
+    let along = corners.map(|v| v.dot(direction));
+    let n_lo = along.iter().copied().fold(Real::INFINITY, Real::min);
+    let n_hi = along.iter().copied().fold(Real::NEG_INFINITY, Real::max);
+    let d_hi = corners.iter().map(|v| v.length()).fold(0.0, Real::max);
+    if !(d_hi > 0.0) {
+        return (-1.0, 1.0);
+    }
+    let d_lo = segment_distance_bound(ps, qs);
+    let ratio = |n: Real, d: Real| {
+        if d > 0.0 {
+            (n / d).clamp(-1.0, 1.0)
+        } else {
+            n.signum()
+        }
+    };
+    let lo = if n_lo >= 0.0 {
+        n_lo / d_hi
+    } else {
+        ratio(n_lo, d_lo)
+    };
+    let hi = if n_hi >= 0.0 {
+        ratio(n_hi, d_lo)
+    } else {
+        n_hi / d_hi
+    };
+    (lo, hi)
+}
+
+/// A lower bound on the distance between two segments: the larger of their lines' distance
+/// and their midpoints' distance less both half-lengths (0 at worst).
+fn segment_distance_bound(ps: [Vec3; 2], qs: [Vec3; 2]) -> Real {
+    let (u, v) = (ps[1] - ps[0], qs[1] - qs[0]);
+    let spheres =
+        (0.5 * (ps[0] + ps[1])).distance(0.5 * (qs[0] + qs[1])) - 0.5 * (u.length() + v.length());
+    let normal = u.cross(v);
+    let lines = if normal.length_squared() > 1e-24 * u.length_squared() * v.length_squared() {
+        (qs[0] - ps[0]).dot(normal).abs() / normal.length()
+    } else {
+        0.0
+    };
+    spheres.max(lines).max(0.0)
+}
+
+/// Whether the ranges overlap, up to [`SLACK`].
+fn overlap(a: (Real, Real), b: (Real, Real)) -> bool {
+    a.0 <= b.1 + SLACK && b.0 <= a.1 + SLACK
+}
 
 impl Pairing<'_> {
     /// The candidates with two diffractions: every TX reach, RX reach and middle sequence
     /// whose depths fit the order (two edges in a row differ) and whose Keller pair lies in
-    /// both reaches.
+    /// both reaches. Cheap necessary tests come first ([`Pairing::may_pair`]).
     pub(super) fn twice(&self, scene: &Scene, set: &mut DiffractedSet) -> Result<(), TreeError> {
         let deepest = self.side.max_order - 2;
         let reflectors: Vec<SurfaceId> = scene.reflectors().collect();
         let middles: Vec<Vec<Vec<SurfaceId>>> = (0..=deepest)
             .map(|q| crate::diffraction::sequences(&reflectors, q))
             .collect();
-        let shallow = |reaches: &[Vec<Reach>]| -> Vec<(usize, Reach)> {
-            let mut out = Vec::new();
-            for (e, on_edge) in reaches.iter().enumerate() {
-                out.extend(
-                    on_edge
-                        .iter()
-                        .filter(|r| r.depth <= deepest)
-                        .map(|r| (e, *r)),
-                );
-            }
-            out
-        };
-        let (tx, rx) = (shallow(&self.side.reaches), shallow(self.from_rx));
-        let edges = scene.edges().all();
+        let near = self.near(scene, deepest);
         let (mut before, mut after) = (Vec::new(), Vec::new());
-        for (e1, a) in &tx {
-            let first = EdgeLine::of(&edges[*e1]);
-            for (e2, b) in rx.iter().filter(|(_, b)| a.depth + b.depth <= deepest) {
-                for middle in middles[..=deepest - a.depth - b.depth].iter().flatten() {
-                    if (middle.is_empty() && e1 == e2)
-                        || !self.may_join(scene, (a, first), middle, (b, *e2))
-                    {
-                        continue;
+        for (e2, on_edge) in self.from_rx.iter().enumerate() {
+            for b in on_edge.iter().filter(|b| b.depth <= deepest) {
+                for middle in middles[..=deepest - b.depth].iter().flatten() {
+                    let far = self.far(scene, (e2, *b), middle);
+                    let fits = |a: &&Near| a.reach.depth + b.depth + middle.len() <= deepest;
+                    for a in near.iter().filter(fits) {
+                        if !self.may_pair(scene, a, &far) || !self.may_join(a, &far) {
+                            continue;
+                        }
+                        self.surfaces((a.reach.node, b.node), (&mut before, &mut after));
+                        let pair = (EdgeId(a.edge as u32), EdgeId(e2 as u32));
+                        set.push_twice(&before, pair, middle, &after);
+                        self.check_budget(set)?;
                     }
-                    self.surfaces((a.node, b.node), (&mut before, &mut after));
-                    let pair = (EdgeId(*e1 as u32), EdgeId(*e2 as u32));
-                    set.push_twice(&before, pair, middle, &after);
-                    self.check_budget(set)?;
                 }
             }
         }
         Ok(())
     }
 
-    /// Whether TX reach `a` (on the line `first`), the `middle` reflections and RX reach `b`
-    /// (on edge `e2`) may make a path: the Keller pair lies in both reaches, or cannot be
-    /// computed.
-    fn may_join(
-        &self,
-        scene: &Scene,
-        (a, first): (&Reach, EdgeLine),
-        middle: &[SurfaceId],
-        (b, e2): (&Reach, usize),
-    ) -> bool {
-        let mut second = EdgeLine::of(&scene.edges().all()[e2]);
-        let mut j = b.image;
+    /// The TX reaches that may start a twice-diffracted path (depth at most `deepest`).
+    fn near(&self, scene: &Scene, deepest: usize) -> Vec<Near> {
+        let m = self.margin;
+        let mut out = Vec::new();
+        for (e, on_edge) in self.side.reaches.iter().enumerate() {
+            let line = EdgeLine::of(&scene.edges().all()[e]);
+            for r in on_edge.iter().filter(|r| r.depth <= deepest) {
+                let (lo, hi) = (r.lo - m, r.hi + m);
+                out.push(Near {
+                    edge: e,
+                    reach: *r,
+                    line,
+                    ends: [line.point(lo), line.point(hi)],
+                    incidence: (
+                        -cos_towards(&line, lo, r.image),
+                        -cos_towards(&line, hi, r.image),
+                    ),
+                });
+            }
+        }
+        out
+    }
+
+    /// RX reach `b` on edge `e2` with the `middle` reflections, unfolded ([`Far`]).
+    fn far<'m>(&self, scene: &Scene, (e2, b): (usize, Reach), middle: &'m [SurfaceId]) -> Far<'m> {
+        let mut line = EdgeLine::of(&scene.edges().all()[e2]);
+        let mut image = b.image;
         for id in middle.iter().rev() {
             let plane = scene.surface(*id).polygon.plane();
-            second = second.mirrored(plane);
-            j = plane.mirror(j);
+            line = line.mirrored(plane);
+            image = plane.mirror(image);
         }
-        let Some((t1, t2)) = keller_pair(a.image, first, second, j) else {
+        let (lo, hi) = (b.lo - self.margin, b.hi + self.margin);
+        Far {
+            edge: e2,
+            reach: b,
+            middle,
+            line,
+            image,
+            ends: [line.point(lo), line.point(hi)],
+            leaving: (cos_towards(&line, hi, image), cos_towards(&line, lo, image)),
+        }
+    }
+
+    /// Necessary conditions of a valid path through `a`'s and `far`'s intervals, each
+    /// conservative: two edges in a row differ; the stretch between the edges leaves each
+    /// into its exterior (the other interval is not wholly inside its interior wedge);
+    /// across one middle reflection both points may lie on one side of its plane; Keller's
+    /// law may hold at both points (the cos β0 ranges of the incident and diffracted rays
+    /// over the intervals overlap).
+    fn may_pair(&self, scene: &Scene, a: &Near, far: &Far<'_>) -> bool {
+        let edges = scene.edges().all();
+        if far.middle.is_empty() && a.edge == far.edge {
+            return false;
+        }
+        let inside = |edge: &Edge, ends: [Vec3; 2]| ends.iter().all(|p| deep_inside(edge, *p));
+        if inside(&edges[a.edge], far.ends) {
+            return false;
+        }
+        // The first edge's interval seen from the second edge's own frame: folded back
+        // through the middle reflections.
+        let folded = a.ends.map(|p| {
+            far.middle
+                .iter()
+                .fold(p, |p, id| scene.surface(*id).polygon.plane().mirror(p))
+        });
+        if inside(&edges[far.edge], folded) {
+            return false;
+        }
+        if let [m] = far.middle {
+            // Both points on one side of the middle reflection's plane: the second's real
+            // place is its unfolded one mirrored back, on the other side of the plane.
+            let plane = scene.surface(*m).polygon.plane();
+            let first = a.ends.map(|p| plane.signed_distance(p));
+            let second = far.ends.map(|p| -plane.signed_distance(p));
+            let opposite = |x: [Real; 2], y: [Real; 2]| {
+                x.iter().all(|d| *d > 0.0) && y.iter().all(|d| *d < 0.0)
+            };
+            if opposite(first, second) || opposite(second, first) {
+                return false;
+            }
+        }
+        overlap(cos_range(a.ends, far.ends, a.line.direction), a.incidence)
+            && overlap(cos_range(a.ends, far.ends, far.line.direction), far.leaving)
+    }
+
+    /// Whether the Keller pair of `a` and `far` lies in both reaches (within the margin), or
+    /// cannot be computed.
+    fn may_join(&self, a: &Near, far: &Far<'_>) -> bool {
+        let Some((t1, t2)) = keller_pair(a.reach.image, a.line, far.line, far.image) else {
             return true;
         };
         let m = self.margin;
+        let (a, b) = (&a.reach, &far.reach);
         t1 >= a.lo - m && t1 <= a.hi + m && t2 >= b.lo - m && t2 <= b.hi + m
     }
 }
