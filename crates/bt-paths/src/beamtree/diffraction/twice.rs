@@ -71,7 +71,7 @@ fn cos_range(ps: [Vec3; 2], qs: [Vec3; 2], direction: Vec3) -> (Real, Real) {
     let n_lo = along.iter().copied().fold(Real::INFINITY, Real::min);
     let n_hi = along.iter().copied().fold(Real::NEG_INFINITY, Real::max);
     let d_hi = corners.iter().map(|v| v.length()).fold(0.0, Real::max);
-    if !(d_hi > 0.0) {
+    if d_hi.is_nan() || d_hi <= 0.0 {
         return (-1.0, 1.0);
     }
     let d_lo = segment_distance_bound(ps, qs);
