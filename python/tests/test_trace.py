@@ -27,9 +27,12 @@ def assert_same_as_cli(paths: beamtrace.Paths, doc: dict) -> None:
                 e[key]["azimuth"],
                 e[key]["elevation"],
             ]
-        assert paths.incidence_deg[i].tolist() == e["incidence_deg"]
+        # A diffraction's incidence is the document's null, −inf in Python.
+        incidence = [-np.inf if x is None else x for x in e["incidence_deg"]]
+        assert paths.incidence_deg[i].tolist() == incidence
         assert paths.interactions[i] == e["interactions"]
-        for key in ("free_space_loss_db", "reflection_loss_db", "transmission_loss_db", "loss_db"):
+        for key in ("free_space_loss_db", "reflection_loss_db", "diffraction_loss_db",
+                    "transmission_loss_db", "loss_db"):
             assert paths.to_dict()[key][i] == e[key]
         assert paths.gain[i] == complex(e["gain"][0], e["gain"][1])
         for key in ("gain_db", "power_dbm"):
@@ -131,6 +134,22 @@ def test_transmission_matches_cli(cli_json):
     tracer = beamtrace.Tracer(two_rooms, max_order=3, transmission=True)
     answer = tracer.update(rx=list(scene.rx))
     assert [p["gain"] for p in answer["paths"]] == [[g.real, g.imag] for g in through.gain]
+
+
+def test_two_diffractions_match_cli(cli_json):
+    # max_diffractions=2 is `--max-diffractions 2`: the paths over both garden walls, which
+    # one diffraction cannot give, field by field as the CLI's.
+    two_walls = str(REPO / "examples" / "two-walls.json")
+    scene = beamtrace.load(two_walls)
+    twice = scene.trace(max_order=3, max_diffractions=2)
+    assert_same_as_cli(twice, cli_json(two_walls, "--max-order", "3", "--max-diffractions", "2"))
+    over = [names for kinds, names in zip(twice.interactions, twice.surfaces)
+            if list(kinds) == ["diffraction", "diffraction"]]
+    assert ["wall-a", "wall-b"] in [list(n) for n in over]
+    once = scene.trace(max_order=3, diffraction=True)
+    assert not any("wall-a" in names and "wall-b" in names for names in once.surfaces)
+    with pytest.raises(ValueError, match="max-diffractions"):
+        scene.trace(max_order=3, max_diffractions=3)
 
 
 def test_scene_properties():

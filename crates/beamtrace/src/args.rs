@@ -804,6 +804,9 @@ pub struct PathArgs {
     /// Edge diffraction: paths may diffract once (as `trace --diffraction`).
     #[arg(long)]
     pub diffraction: bool,
+    /// Diffractions per path (0, 1 or 2; overrides --diffraction; as `trace`).
+    #[arg(long)]
+    pub max_diffractions: Option<usize>,
     /// Transmission through slab reflectors (as `trace --transmission`).
     #[arg(long)]
     pub transmission: bool,
@@ -817,6 +820,7 @@ impl PathArgs {
             radio: self.radio.clone(),
             solve: SolveArgs {
                 diffraction: self.diffraction,
+                max_diffractions: self.max_diffractions,
                 transmission: self.transmission,
                 ..SolveArgs::with(self.max_order, self.solver)
             },

@@ -15,4 +15,5 @@ mod study;
 mod sweep;
 mod terminals;
 mod transmission;
+mod two_diffractions;
 mod wvrn_steps;
