@@ -101,6 +101,24 @@ pub enum TreeError {
         /// The budget.
         budget: u64,
     },
+    /// More pairs of reaches to test for two diffractions than the budget allows
+    /// ([`PAIR_TESTS_PER_CANDIDATE`] per candidate of the budget), counted before testing.
+    #[error(
+        "candidate budget exceeded: {pairs} pairs of edge reaches to test for two diffractions \
+         at order {max_order}, more than {allowed} ({PAIR_TESTS_PER_CANDIDATE} per candidate of \
+         --max-candidates {budget}); lower the order, use --max-diffractions 1, raise \
+         --min-edge-length or raise --max-candidates"
+    )]
+    PairBudget {
+        /// Pairs that would be tested.
+        pairs: u64,
+        /// Pairs allowed.
+        allowed: u64,
+        /// The candidate budget.
+        budget: u64,
+        /// The order asked for.
+        max_order: usize,
+    },
     /// More diffracted candidates than the budget.
     #[error(
         "candidate budget exceeded: more than {budget} diffracted candidates at order {max_order}; \
@@ -215,6 +233,10 @@ pub struct BeamTree {
 /// points within 1 tolerance of a polygon), plane tests keep `EPS`, occluders must cover with
 /// `COVER` to spare.
 const GROW: Real = 4.0;
+
+/// Pair tests of the two-diffraction join allowed per candidate of the budget
+/// ([`TreeError::PairBudget`]): a test costs a small fraction of a candidate's solve.
+pub const PAIR_TESTS_PER_CANDIDATE: u64 = 64;
 const EPS: Real = 1.0;
 const COVER: Real = 4.0;
 

@@ -155,3 +155,28 @@ fn two_screens_are_passed_over_both_edges() {
     // No single diffraction gets over both screens, and nothing passes straight.
     assert!(found.iter().all(|p| p.diffractions.len() == 2), "{found:?}");
 }
+
+/// The pairs of reaches the two-diffraction join would test are counted first: beyond
+/// `PAIR_TESTS_PER_CANDIDATE` per candidate of the budget the trace stops, saying so.
+#[test]
+fn the_pair_tests_stop_at_the_budget() {
+    let scene = bt_import::builtin_scene("living-room", bt_scene::Terminals::default())
+        .unwrap()
+        .unwrap();
+    let tight = TraceOptions {
+        max_candidates: 1500,
+        ..options(3, CandidateMode::BeamTree, Solver::Image)
+    };
+    let error = crate::common::trace_scene(&scene, &tight)
+        .unwrap_err()
+        .to_string();
+    assert!(
+        error.contains("pairs of edge reaches") && error.contains("--max-candidates 1500"),
+        "{error}"
+    );
+    let roomy = TraceOptions {
+        max_candidates: 1_000_000,
+        ..tight
+    };
+    assert!(crate::common::trace_scene(&scene, &roomy).is_ok());
+}

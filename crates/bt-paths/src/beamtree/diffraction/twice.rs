@@ -14,7 +14,7 @@
 //! valid paths, which property tests check against blind enumeration.
 
 use super::{Pairing, Reach};
-use crate::beamtree::TreeError;
+use crate::beamtree::{PAIR_TESTS_PER_CANDIDATE, TreeError};
 use crate::diffraction::DiffractedSet;
 use bt_geom::{Real, Vec3};
 use bt_scene::edges::{EdgeLine, keller_pair};
@@ -126,6 +126,7 @@ impl Pairing<'_> {
             .map(|q| crate::diffraction::sequences(&reflectors, q))
             .collect();
         let near = self.near(scene, deepest);
+        self.check_pairs(&near, middles.iter().map(Vec::len).collect(), deepest)?;
         let (mut before, mut after) = (Vec::new(), Vec::new());
         for (e2, on_edge) in self.from_rx.iter().enumerate() {
             for b in on_edge.iter().filter(|b| b.depth <= deepest) {
@@ -143,6 +144,48 @@ impl Pairing<'_> {
                     }
                 }
             }
+        }
+        Ok(())
+    }
+
+    /// Stop before the pairs' tests when there are more than the budget allows: the TX
+    /// reaches of each depth times the RX reaches and middles that fit with them
+    /// (`middles[q]`: the number of middle sequences of `q` reflections).
+    fn check_pairs(
+        &self,
+        near: &[Near],
+        middles: Vec<usize>,
+        deepest: usize,
+    ) -> Result<(), TreeError> {
+        let count = |depths: &mut dyn Iterator<Item = usize>| {
+            let mut by = vec![0u64; deepest + 1];
+            depths.for_each(|d| by[d] += 1);
+            by
+        };
+        let tx = count(&mut near.iter().map(|a| a.reach.depth));
+        let rx = count(
+            &mut self
+                .from_rx
+                .iter()
+                .flatten()
+                .map(|b| b.depth)
+                .filter(|&d| d <= deepest),
+        );
+        let mut pairs = 0u64;
+        for (p, &a) in tx.iter().enumerate() {
+            for (r, &b) in rx.iter().enumerate().take(deepest + 1 - p) {
+                let fitting: u64 = middles[..=deepest - p - r].iter().map(|&m| m as u64).sum();
+                pairs = pairs.saturating_add(a.saturating_mul(b).saturating_mul(fitting));
+            }
+        }
+        let allowed = self.budget.saturating_mul(PAIR_TESTS_PER_CANDIDATE);
+        if pairs > allowed {
+            return Err(TreeError::PairBudget {
+                pairs,
+                allowed,
+                budget: self.budget,
+                max_order: self.side.max_order,
+            });
         }
         Ok(())
     }
