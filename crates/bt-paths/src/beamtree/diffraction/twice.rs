@@ -63,16 +63,14 @@ fn deep_inside(edge: &Edge, p: Vec3) -> bool {
     a.r > 0.0 && a.sin0 < -SLACK * a.r && a.sin_n < -SLACK * a.r
 }
 
-/// The range of cos β between unit `direction` and `q − p` for `p` on segment `ps`, `q` on
-/// segment `qs` (conservative: the numerator's and the length's ranges taken apart).
-fn cos_range(ps: [Vec3; 2], qs: [Vec3; 2], direction: Vec3) -> (Real, Real) {
+/// The ranges of cos β between `q − p` and each of the unit `directions`, for `p` on segment
+/// `ps` and `q` on segment `qs` (conservative: each numerator's and the length's ranges taken
+/// apart; the corners and the length bounds shared).
+fn cos_ranges(ps: [Vec3; 2], qs: [Vec3; 2], directions: [Vec3; 2]) -> [(Real, Real); 2] {
     let corners = [qs[0] - ps[0], qs[0] - ps[1], qs[1] - ps[0], qs[1] - ps[1]];
-    let along = corners.map(|v| v.dot(direction));
-    let n_lo = along.iter().copied().fold(Real::INFINITY, Real::min);
-    let n_hi = along.iter().copied().fold(Real::NEG_INFINITY, Real::max);
     let d_hi = corners.iter().map(|v| v.length()).fold(0.0, Real::max);
     if d_hi.is_nan() || d_hi <= 0.0 {
-        return (-1.0, 1.0);
+        return [(-1.0, 1.0); 2];
     }
     let d_lo = segment_distance_bound(ps, qs);
     let ratio = |n: Real, d: Real| {
@@ -82,17 +80,22 @@ fn cos_range(ps: [Vec3; 2], qs: [Vec3; 2], direction: Vec3) -> (Real, Real) {
             n.signum()
         }
     };
-    let lo = if n_lo >= 0.0 {
-        n_lo / d_hi
-    } else {
-        ratio(n_lo, d_lo)
-    };
-    let hi = if n_hi >= 0.0 {
-        ratio(n_hi, d_lo)
-    } else {
-        n_hi / d_hi
-    };
-    (lo, hi)
+    directions.map(|direction| {
+        let along = corners.map(|v| v.dot(direction));
+        let n_lo = along.iter().copied().fold(Real::INFINITY, Real::min);
+        let n_hi = along.iter().copied().fold(Real::NEG_INFINITY, Real::max);
+        let lo = if n_lo >= 0.0 {
+            n_lo / d_hi
+        } else {
+            ratio(n_lo, d_lo)
+        };
+        let hi = if n_hi >= 0.0 {
+            ratio(n_hi, d_lo)
+        } else {
+            n_hi / d_hi
+        };
+        (lo, hi)
+    })
 }
 
 /// A lower bound on the distance between two segments: the larger of their lines' distance
@@ -128,13 +131,17 @@ impl Pairing<'_> {
         let near = self.near(scene, deepest);
         self.check_pairs(&near, middles.iter().map(Vec::len).collect(), deepest)?;
         let (mut before, mut after) = (Vec::new(), Vec::new());
+        // Per far interval, per first edge: whether the interval leaves that edge's interior.
+        let mut seen: Vec<Option<bool>> = Vec::new();
         for (e2, on_edge) in self.from_rx.iter().enumerate() {
             for b in on_edge.iter().filter(|b| b.depth <= deepest) {
                 for middle in middles[..=deepest - b.depth].iter().flatten() {
                     let far = self.far(scene, (e2, *b), middle);
+                    seen.clear();
+                    seen.resize(scene.edges().len(), None);
                     let fits = |a: &&Near| a.reach.depth + b.depth + middle.len() <= deepest;
                     for a in near.iter().filter(fits) {
-                        if !self.may_pair(scene, a, &far) || !self.may_join(a, &far) {
+                        if !self.may_pair(scene, (a, &far), &mut seen) || !self.may_join(a, &far) {
                             continue;
                         }
                         self.surfaces((a.reach.node, b.node), (&mut before, &mut after));
@@ -234,29 +241,20 @@ impl Pairing<'_> {
         }
     }
 
-    /// Necessary conditions of a valid path through `a`'s and `far`'s intervals, each
-    /// conservative: two edges in a row differ; the stretch between the edges leaves each
+    /// Necessary conditions of a valid path through `a`'s and `far`'s intervals (`seen`
+    /// caches, per first edge, the test of `far`'s interval against it), each conservative: two edges in a row differ; the stretch between the edges leaves each
     /// into its exterior (the other interval is not wholly inside its interior wedge);
     /// across one middle reflection both points may lie on one side of its plane; Keller's
     /// law may hold at both points (the cos β0 ranges of the incident and diffracted rays
     /// over the intervals overlap).
-    fn may_pair(&self, scene: &Scene, a: &Near, far: &Far<'_>) -> bool {
+    fn may_pair(
+        &self,
+        scene: &Scene,
+        (a, far): (&Near, &Far<'_>),
+        seen: &mut [Option<bool>],
+    ) -> bool {
         let edges = scene.edges().all();
         if far.middle.is_empty() && a.edge == far.edge {
-            return false;
-        }
-        let inside = |edge: &Edge, ends: [Vec3; 2]| ends.iter().all(|p| deep_inside(edge, *p));
-        if inside(&edges[a.edge], far.ends) {
-            return false;
-        }
-        // The first edge's interval seen from the second edge's own frame: folded back
-        // through the middle reflections.
-        let folded = a.ends.map(|p| {
-            far.middle
-                .iter()
-                .fold(p, |p, id| scene.surface(*id).polygon.plane().mirror(p))
-        });
-        if inside(&edges[far.edge], folded) {
             return false;
         }
         if let [m] = far.middle {
@@ -272,8 +270,23 @@ impl Pairing<'_> {
                 return false;
             }
         }
-        overlap(cos_range(a.ends, far.ends, a.line.direction), a.incidence)
-            && overlap(cos_range(a.ends, far.ends, far.line.direction), far.leaving)
+        let inside = |edge: &Edge, ends: [Vec3; 2]| ends.iter().all(|p| deep_inside(edge, *p));
+        // The far interval against the first edge: one answer per edge for all its reaches.
+        if !*seen[a.edge].get_or_insert_with(|| !inside(&edges[a.edge], far.ends)) {
+            return false;
+        }
+        // The first edge's interval seen from the second edge's own frame: folded back
+        // through the middle reflections.
+        let folded = a.ends.map(|p| {
+            far.middle
+                .iter()
+                .fold(p, |p, id| scene.surface(*id).polygon.plane().mirror(p))
+        });
+        if inside(&edges[far.edge], folded) {
+            return false;
+        }
+        let [first, second] = cos_ranges(a.ends, far.ends, [a.line.direction, far.line.direction]);
+        overlap(first, a.incidence) && overlap(second, far.leaving)
     }
 
     /// Whether the Keller pair of `a` and `far` lies in both reaches (within the margin), or
