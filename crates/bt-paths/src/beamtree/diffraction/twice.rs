@@ -16,7 +16,7 @@
 use super::{Pairing, Reach};
 use crate::beamtree::{PAIR_TESTS_PER_CANDIDATE, TreeError};
 use crate::diffraction::DiffractedSet;
-use bt_geom::{Real, Vec3};
+use bt_geom::{Polygon, Real, Vec3};
 use bt_scene::edges::{EdgeLine, keller_pair};
 use bt_scene::{Edge, EdgeId, Scene, SurfaceId};
 
@@ -111,6 +111,37 @@ fn segment_distance_bound(ps: [Vec3; 2], qs: [Vec3; 2]) -> Real {
         0.0
     };
     spheres.max(lines).max(0.0)
+}
+
+/// Whether no stretch from a point of segment `near` to one of segment `far` (the second
+/// edge's interval unfolded through a middle reflection) crosses the reflection's plane within
+/// `margin` of its polygon's box `(lo, hi)`, when the segments lie strictly on either side of
+/// the plane: the crossings lie in the convex hull of the four corner-to-corner crossings
+/// (the tetrahedron of the four ends meets the plane there), so when those four are beyond one
+/// face of the grown box, every crossing is. Straddling segments are never rejected.
+fn misses_window(polygon: &Polygon, (near, far): ([Vec3; 2], [Vec3; 2]), margin: Real) -> bool {
+    let plane = polygon.plane();
+    let (dn, df) = (
+        near.map(|p| plane.signed_distance(p)),
+        far.map(|p| plane.signed_distance(p)),
+    );
+    let split =
+        |x: [Real; 2], y: [Real; 2]| x.iter().all(|d| *d > 0.0) && y.iter().all(|d| *d < 0.0);
+    if !(split(dn, df) || split(df, dn)) {
+        return false;
+    }
+    let crossing = |i: usize, j: usize| near[i] + (far[j] - near[i]) * (dn[i] / (dn[i] - df[j]));
+    let crossings = [
+        crossing(0, 0),
+        crossing(0, 1),
+        crossing(1, 0),
+        crossing(1, 1),
+    ];
+    let (lo, hi) = polygon.bounds();
+    (0..3).any(|axis| {
+        crossings.iter().all(|c| c[axis] > hi[axis] + margin)
+            || crossings.iter().all(|c| c[axis] < lo[axis] - margin)
+    })
 }
 
 /// Whether the ranges overlap, up to [`SLACK`].
@@ -267,6 +298,9 @@ impl Pairing<'_> {
                 x.iter().all(|d| *d > 0.0) && y.iter().all(|d| *d < 0.0)
             };
             if opposite(first, second) || opposite(second, first) {
+                return false;
+            }
+            if misses_window(&scene.surface(*m).polygon, (a.ends, far.ends), self.margin) {
                 return false;
             }
         }
