@@ -79,12 +79,17 @@ pub fn keller_pair(a: Vec3, first: EdgeLine, second: EdgeLine, b: Vec3) -> Optio
     };
     let t1 = first.keller(a, b)?;
     let (mut t1, mut t2) = round(second.keller(first.point(t1), b)?)?;
+    let mut current = length(t1, t2);
     for _ in 0..MAX_ROUNDS {
         let (s1, s2) = newton_step(a, (first, second), b, (t1, t2))?;
-        let next = if length(t1 + s1, t2 + s2) <= length(t1, t2) {
+        let shorter = length(t1 + s1, t2 + s2);
+        let next = if shorter <= current {
+            current = shorter;
             (t1 + s1, t2 + s2)
         } else {
-            round(t2)?
+            let next = round(t2)?;
+            current = length(next.0, next.1);
+            next
         };
         let moved = (next.0 - t1).abs().max((next.1 - t2).abs());
         (t1, t2) = next;
