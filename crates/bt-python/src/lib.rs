@@ -280,9 +280,11 @@ impl PyScene {
         let radio = keywords.radio().map_err(PyValueError::new_err)?;
         let tx = scene.to_world(scene.terminals().map_err(error)?.tx);
         let reports = py.detach(|| {
-            // Each receiver reported in the task that traced it (in parallel when asked).
+            // Each receiver reported, and its columns gathered, in the task that traced it (in
+            // parallel when asked); only the arrays are made under the GIL.
             let report = |moved: &Scene, t: Traced| {
-                bt_beams::report(moved, &t.result.paths, &radio).map_err(|e| e.to_string())
+                let paths = bt_beams::report(moved, &t.result.paths, &radio);
+                columns::cells_of(&paths.map_err(|e| e.to_string())?)
             };
             let reported = self
                 .with_tracer(scene.clone(), options, |t| {
@@ -302,9 +304,9 @@ impl PyScene {
             }
         })?;
         let dicts = reports
-            .iter()
-            .map(|paths| match paths {
-                Some(paths) => Ok(Some(columns::to_dict(py, paths)?)),
+            .into_iter()
+            .map(|cells| match cells {
+                Some(cells) => Ok(Some(columns::cells_dict(py, cells)?)),
                 None => Ok(None),
             })
             .collect::<PyResult<Vec<_>>>()?;
@@ -335,8 +337,8 @@ enum Failure {
     Report(String),
 }
 
-/// One receiver's paths as the report gives them.
-type Report = Vec<bt_beams::PathReport>;
+/// One receiver's paths as columns, before they become arrays.
+type Report = columns::Cells;
 
 /// Why a many-receiver call failed: the receiver's index (none: the call as a whole).
 type Failed = (Option<usize>, Failure);

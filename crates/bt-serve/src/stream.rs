@@ -103,8 +103,8 @@ impl Server {
     /// hand are written and flushed, or while it waits for a request when a signal interrupts
     /// the read (the binary's SIGTERM handler sets what `stop` reads).
     ///
-    /// Receiver moves already waiting in the input are answered together
-    /// ([`crate::batch`]: a few receivers per core, traced and reported in parallel), each
+    /// Receiver moves already waiting in the input are answered together (`docs/serve.md`,
+    /// "Parallel answers": a few receivers per core, traced and reported in parallel), each
     /// answer still its own line in request order; a request is never held back for one that
     /// has not arrived: a batch is answered as soon as no whole line waits.
     pub fn serve_until(
