@@ -45,23 +45,32 @@ fn a_stream_answered_in_batches_is_the_stream_answered_one_by_one() {
         }
     }
     let input = lines.join("\n");
-    // One thread answers each request alone (no batch forms); in parallel, the moves that
-    // wait in the input are answered together.
-    let stream = |parallel: bool| {
+    let make = |parallel: bool| {
         let settings = SolveSettings {
             max_order: 2,
             parallel,
             ..SolveSettings::default()
         };
-        let mut s = server("builtin:living-room-dynamic", settings, Limits::default());
-        let mut out = Vec::new();
-        s.serve(input.as_bytes(), &mut out).expect("stream runs");
-        let text = String::from_utf8(out).expect("UTF-8");
-        text.lines().map(steady).collect::<Vec<_>>()
+        server("builtin:living-room-dynamic", settings, Limits::default())
     };
-    let alone = stream(false);
-    let batched = stream(true);
+    // The reference: one thread, each request answered alone by `answer_line` (no stream, so
+    // no batch).
+    let mut one = make(false);
+    let mut out = Vec::new();
+    let alone: Vec<String> = (lines.iter())
+        .map(|line| {
+            one.answer_line(line.as_bytes(), &mut out);
+            steady(std::str::from_utf8(&out).expect("UTF-8"))
+        })
+        .collect();
+    // The stream in parallel: the moves that wait in the input are answered together.
+    let mut many = make(true);
+    let mut out = Vec::new();
+    many.serve(input.as_bytes(), &mut out).expect("stream runs");
+    let text = String::from_utf8(out).expect("UTF-8");
+    let batched: Vec<String> = text.lines().map(steady).collect();
     assert_eq!(alone.len(), lines.len());
+    assert_eq!(batched.len(), lines.len());
     let errors = alone.iter().filter(|l| l.contains("\"error\"")).count();
     assert!((2..6).contains(&errors), "{errors} error lines");
     for (i, (a, b)) in alone.iter().zip(&batched).enumerate() {
