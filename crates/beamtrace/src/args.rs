@@ -483,9 +483,14 @@ pub struct ServeArgs {
     #[command(flatten)]
     pub solve: SolveArgs,
     /// Where requests come from: tcp:HOST:PORT or unix:PATH (one stream per connection,
-    /// one connection after another); stdin/stdout when absent.
+    /// connections served at the same time); stdin/stdout when absent.
     #[arg(long, value_parser = parse_listen)]
     pub listen: Option<Listen>,
+    /// Budget: with --listen, serve at most this many connections at a time (each holds its
+    /// own tracer); a further client waits to be accepted.
+    #[arg(long, default_value_t = bt_serve::MAX_CONNECTIONS as u64,
+          value_parser = clap::value_parser!(u64).range(1..=1024))]
+    pub max_connections: u64,
     /// Budget: refuse a request line longer than this many bytes (answered with an error
     /// line; the stream goes on).
     #[arg(long, default_value_t = bt_serve::MAX_LINE_BYTES as u64,

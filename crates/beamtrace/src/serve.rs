@@ -1,13 +1,15 @@
 //! `beamtrace serve`: the arguments become a `bt_serve::Server`, whose loop runs over
-//! stdin/stdout or over each connection of a TCP or Unix socket in turn (`docs/serve.md`).
+//! stdin/stdout or over each connection of a TCP or Unix socket, each on its own thread with
+//! its own copy of the server (`docs/serve.md`).
 
 use crate::args::{Listen, ServeArgs};
 use crate::load::load_dynamic;
 use anyhow::{Context, bail};
 use bt_serve::{Limits, Server};
-use std::io::{BufReader, BufWriter};
+use std::io::{BufReader, BufWriter, ErrorKind};
 use std::path::Path;
 use std::process::ExitCode;
+use std::time::Duration;
 
 pub fn run(args: &ServeArgs) -> anyhow::Result<ExitCode> {
     let loaded = load_dynamic(&args.scene)?;
@@ -21,6 +23,7 @@ pub fn run(args: &ServeArgs) -> anyhow::Result<ExitCode> {
         max_line_bytes: usize::try_from(args.max_line_bytes).context("--max-line-bytes")?,
         max_receivers: usize::try_from(args.max_receivers).context("--max-receivers")?,
     };
+    let max_connections = usize::try_from(args.max_connections).context("--max-connections")?;
     stop::install();
     let mut server = Server::new(dynamic, options, radio, limits);
     if args.arrays.tx_array.is_some() || args.arrays.rx_array.is_some() {
@@ -33,40 +36,31 @@ pub fn run(args: &ServeArgs) -> anyhow::Result<ExitCode> {
             let output = BufWriter::new(std::io::stdout().lock());
             server.serve_until(input, output, &stop::requested)?;
         }
-        Some(Listen::Tcp(address)) => serve_tcp(&mut server, address)?,
-        Some(Listen::Unix(path)) => serve_unix(&mut server, path)?,
+        Some(Listen::Tcp(address)) => serve_tcp(&server, address, max_connections)?,
+        Some(Listen::Unix(path)) => serve_unix(&server, path, max_connections)?,
     }
     Ok(ExitCode::SUCCESS)
 }
 
-/// Serve each connection to `address` in turn, until the process is stopped.
-fn serve_tcp(server: &mut Server, address: &str) -> anyhow::Result<()> {
+/// Serve the connections to `address`, each on its own thread, until the process is stopped.
+fn serve_tcp(server: &Server, address: &str, max: usize) -> anyhow::Result<()> {
     let listener = std::net::TcpListener::bind(address)
         .with_context(|| format!("--listen tcp:{address}: cannot listen"))?;
     let bound = listener
         .local_addr()
         .context("--listen: the bound address")?;
     eprintln!("listening on tcp:{bound}");
-    for n in 0.. {
-        let Some(stream) = stop::accept(|| listener.accept().map(|(s, _)| s)) else {
-            break;
-        };
-        let stream = stream.context("--listen: accepting a connection")?;
-        let outcome = server.serve_until(
-            BufReader::new(&stream),
-            BufWriter::new(&stream),
-            &stop::requested,
-        );
-        end_connection(server, n, outcome);
-    }
-    Ok(())
+    listener
+        .set_nonblocking(true)
+        .context("--listen: a non-blocking socket")?;
+    serve_connections(server, || listener.accept().map(|(s, _)| s), max)
 }
 
-/// Serve each connection to the Unix socket `path` in turn, until the process is stopped.
-/// A path that exists is refused unless it is a socket nobody listens on (one left by a
-/// server that was stopped): a user's file is never replaced.
+/// Serve the connections to the Unix socket `path`, each on its own thread, until the process
+/// is stopped. A path that exists is refused unless it is a socket nobody listens on (one left
+/// by a server that was stopped): a user's file is never replaced.
 #[cfg(unix)]
-fn serve_unix(server: &mut Server, path: &Path) -> anyhow::Result<()> {
+fn serve_unix(server: &Server, path: &Path, max: usize) -> anyhow::Result<()> {
     use std::os::unix::fs::FileTypeExt;
     use std::os::unix::net::{UnixListener, UnixStream};
     let shown = path.display();
@@ -83,43 +77,110 @@ fn serve_unix(server: &mut Server, path: &Path) -> anyhow::Result<()> {
     let listener = UnixListener::bind(path)
         .with_context(|| format!("--listen unix:{shown}: cannot listen"))?;
     eprintln!("listening on unix:{shown}");
-    stop::remove_on_stop(path);
-    for n in 0.. {
-        let Some(stream) = stop::accept(|| listener.accept().map(|(s, _)| s)) else {
-            break;
-        };
-        let stream = stream.context("--listen: accepting a connection")?;
-        let outcome = server.serve_until(
-            BufReader::new(&stream),
-            BufWriter::new(&stream),
-            &stop::requested,
-        );
-        end_connection(server, n, outcome);
-    }
-    // Stopped by a signal between connections: the socket this server made goes with it.
+    let served = listener
+        .set_nonblocking(true)
+        .context("--listen: a non-blocking socket")
+        .and_then(|()| serve_connections(server, || listener.accept().map(|(s, _)| s), max));
+    // Stopped (or failed): the socket this server made goes with it.
     std::fs::remove_file(path).ok();
-    Ok(())
+    served
 }
 
 #[cfg(not(unix))]
-fn serve_unix(_: &mut Server, path: &Path) -> anyhow::Result<()> {
+fn serve_unix(_: &Server, path: &Path, _: usize) -> anyhow::Result<()> {
     bail!(
         "--listen unix:{}: Unix sockets need a Unix system",
         path.display()
     )
 }
 
-/// A connection's end: its transport error, if any, on stderr (the server goes on with the
-/// next connection); the next client starts a new session.
-fn end_connection(
-    server: &mut Server,
-    n: usize,
-    outcome: Result<bt_serve::Summary, bt_serve::ServeError>,
-) {
-    if let Err(e) = outcome {
-        eprintln!("warning: connection {}: {e}", n + 1);
+/// How often a listener without a waiting client looks again (and whether it was stopped).
+const POLL: Duration = Duration::from_millis(20);
+
+/// A connected socket, TCP or Unix.
+trait Connection: Send + Sized + 'static {
+    /// Another handle of the same socket.
+    fn handle(&self) -> std::io::Result<Self>;
+    /// Blocking reads and writes (the listener's sockets are non-blocking).
+    fn blocking(&self) -> std::io::Result<()>;
+    /// End the reading side: a read waiting for a request returns the end of input.
+    fn end_reading(&self);
+}
+
+/// [`Connection`] for a standard socket type: both have the same methods under these names.
+macro_rules! connection {
+    ($stream:ty) => {
+        impl Connection for $stream {
+            fn handle(&self) -> std::io::Result<Self> {
+                self.try_clone()
+            }
+            fn blocking(&self) -> std::io::Result<()> {
+                self.set_nonblocking(false)
+            }
+            fn end_reading(&self) {
+                self.shutdown(std::net::Shutdown::Read).ok();
+            }
+        }
+    };
+}
+connection!(std::net::TcpStream);
+#[cfg(unix)]
+connection!(std::os::unix::net::UnixStream);
+
+/// Serve every client `accept` (non-blocking) gives, each on its own thread with its own copy
+/// of `server` (its own session and tracer; answers in its own request order), at most `max`
+/// at a time, until the process is stopped: then every connection's reading side is ended,
+/// so each writes the answer in hand and ends, and all are waited for.
+fn serve_connections<S: Connection>(
+    server: &Server,
+    mut accept: impl FnMut() -> std::io::Result<S>,
+    max: usize,
+) -> anyhow::Result<()>
+where
+    for<'a> &'a S: std::io::Read + std::io::Write,
+{
+    let mut live: Vec<(std::thread::JoinHandle<()>, S)> = Vec::new();
+    let mut accepted = 0usize;
+    while !stop::requested() {
+        live.retain(|(thread, _)| !thread.is_finished());
+        if live.len() >= max {
+            std::thread::sleep(POLL);
+            continue;
+        }
+        let stream = match accept() {
+            Ok(stream) => stream,
+            Err(e) if e.kind() == ErrorKind::WouldBlock || e.kind() == ErrorKind::Interrupted => {
+                std::thread::sleep(POLL);
+                continue;
+            }
+            Err(e) => return Err(e).context("--listen: accepting a connection"),
+        };
+        accepted += 1;
+        let n = accepted;
+        let handle = stream
+            .blocking()
+            .and_then(|()| stream.handle())
+            .context("--listen: setting up a connection")?;
+        let mut server = server.clone();
+        let thread = std::thread::spawn(move || {
+            let outcome = server.serve_until(
+                BufReader::new(&stream),
+                BufWriter::new(&stream),
+                &stop::requested,
+            );
+            if let Err(e) = outcome {
+                eprintln!("warning: connection {n}: {e}");
+            }
+        });
+        live.push((thread, handle));
     }
-    server.end_session();
+    for (_, stream) in &live {
+        stream.end_reading();
+    }
+    for (thread, _) in live {
+        thread.join().ok();
+    }
+    Ok(())
 }
 
 /// SIGTERM and SIGINT stop the server cleanly: the answer in hand is written and flushed, a
@@ -127,26 +188,17 @@ fn end_connection(
 /// socket the server made is removed. While it waits for a client (the standard library
 /// retries an interrupted accept) nothing is in flight: the handler removes the socket and
 /// exits at once (`unlink` and `_exit` are async-signal-safe).
+/// SIGTERM and SIGINT stop the server cleanly: the answer in hand is written and flushed, a
+/// read waiting for a request ends (the handler leaves reads interruptible; with `--listen`
+/// the listener sees the stop within [`POLL`] and ends every connection's reading side).
 #[cfg(unix)]
 mod stop {
-    use std::ffi::CString;
-    use std::sync::OnceLock;
     use std::sync::atomic::{AtomicBool, Ordering};
 
     static STOP: AtomicBool = AtomicBool::new(false);
-    static ACCEPTING: AtomicBool = AtomicBool::new(false);
-    static SOCKET: OnceLock<CString> = OnceLock::new();
 
     extern "C" fn on_signal(_: libc::c_int) {
         STOP.store(true, Ordering::SeqCst);
-        if ACCEPTING.load(Ordering::SeqCst) {
-            if let Some(path) = SOCKET.get() {
-                // SAFETY: a valid C string; unlink is async-signal-safe.
-                unsafe { libc::unlink(path.as_ptr()) };
-            }
-            // SAFETY: _exit is async-signal-safe; every answer was flushed already.
-            unsafe { libc::_exit(0) };
-        }
     }
 
     /// Handle SIGTERM and SIGINT (without `SA_RESTART`, so a blocked read returns).
@@ -166,25 +218,6 @@ mod stop {
     pub fn requested() -> bool {
         STOP.load(Ordering::SeqCst)
     }
-
-    /// The next client from `accept`, or `None` once a stop was asked for.
-    pub fn accept<S>(accept: impl FnOnce() -> std::io::Result<S>) -> Option<std::io::Result<S>> {
-        ACCEPTING.store(true, Ordering::SeqCst);
-        if requested() {
-            return None;
-        }
-        let client = accept();
-        ACCEPTING.store(false, Ordering::SeqCst);
-        Some(client)
-    }
-
-    /// Remove the Unix socket at `path` when a signal stops the server.
-    pub fn remove_on_stop(path: &std::path::Path) {
-        use std::os::unix::ffi::OsStrExt;
-        if let Ok(path) = CString::new(path.as_os_str().as_bytes()) {
-            let _ = SOCKET.set(path);
-        }
-    }
 }
 
 #[cfg(not(unix))]
@@ -192,8 +225,5 @@ mod stop {
     pub fn install() {}
     pub fn requested() -> bool {
         false
-    }
-    pub fn accept<S>(accept: impl FnOnce() -> std::io::Result<S>) -> Option<std::io::Result<S>> {
-        Some(accept())
     }
 }

@@ -50,7 +50,7 @@ enum Shape {
 
 /// One column: a key of the path objects and how its values become an array.
 #[derive(Debug, Clone, Copy, PartialEq)]
-struct Column {
+pub struct Column {
     name: &'static str,
     shape: Shape,
     /// The document may leave the key out (`skip_serializing_if`).
@@ -141,8 +141,30 @@ pub fn names() -> PyResult<Vec<&'static str>> {
 
 /// The paths as a dictionary of column name → NumPy array (or list of arrays / of names).
 pub fn to_dict<'py>(py: Python<'py>, paths: &[PathReport]) -> PyResult<Bound<'py, PyDict>> {
+    dict_of(py, present(paths).map_err(crate::error)?)
+}
+
+/// The columns of some paths before they become arrays ([`cells_of`]): plain Rust values, made
+/// without the GIL (in parallel, by `trace_many`).
+pub struct Cells(Vec<(Column, Vec<Value>)>);
+
+/// The columns of `paths` as [`Cells`]; the error names a field the example does not write.
+pub fn cells_of(paths: &[PathReport]) -> Result<Cells, String> {
+    present(paths).map(Cells)
+}
+
+/// The dictionary of column name → array of [`Cells`] (the GIL's part of [`to_dict`]).
+pub fn cells_dict<'py>(py: Python<'py>, cells: Cells) -> PyResult<Bound<'py, PyDict>> {
+    dict_of(py, cells.0)
+}
+
+/// The dictionary of column name → array of each column's values.
+fn dict_of<'py>(
+    py: Python<'py>,
+    columns: Vec<(Column, Vec<Value>)>,
+) -> PyResult<Bound<'py, PyDict>> {
     let dict = PyDict::new(py);
-    for (column, cells) in present(paths).map_err(crate::error)? {
+    for (column, cells) in columns {
         let value = column_value(py, column.shape, &cells).ok_or_else(|| {
             let name = column.name;
             crate::error(format!(

@@ -3,7 +3,8 @@
 //! Thin by design, like the CLI: Python arguments → library options → one library call
 //! (`bt_scene` loading, a `bt_solve::Tracer` per scene, `bt_beams::report`) → NumPy columns. The
 //! Python layer (`python/src/beamtrace`) normalises arrays and wraps the columns in `Paths`.
-//! Tracing releases the GIL; `trace_many` spreads receivers over rayon's pool.
+//! Tracing releases the GIL; `trace_many` traces and reports each receiver in one task,
+//! spread over rayon's pool (`Tracer::trace_each_then`).
 
 #![warn(missing_docs)]
 
@@ -23,7 +24,6 @@ use pyo3::create_exception;
 use pyo3::exceptions::{PyException, PyValueError};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList};
-use rayon::prelude::*;
 use std::sync::{Arc, Mutex};
 
 create_exception!(
@@ -280,16 +280,18 @@ impl PyScene {
         let radio = keywords.radio().map_err(PyValueError::new_err)?;
         let tx = scene.to_world(scene.terminals().map_err(error)?.tx);
         let reports = py.detach(|| {
-            let traced = self
-                .with_tracer(scene.clone(), options, |t| t.trace_each(tx, &receivers))
+            // Each receiver reported, and its columns gathered, in the task that traced it (in
+            // parallel when asked); only the arrays are made under the GIL.
+            let report = |moved: &Scene, t: Traced| {
+                let paths = bt_beams::report(moved, &t.result.paths, &radio);
+                columns::cells_of(&paths.map_err(|e| e.to_string())?)
+            };
+            let reported = self
+                .with_tracer(scene.clone(), options, |t| {
+                    t.trace_each_then(tx, &receivers, report)
+                })
                 .map_err(|e| (None, Failure::Trace(e)))?;
-            report_each(
-                &scene,
-                &receivers,
-                traced,
-                (&radio, options.parallel),
-                skip_errors,
-            )
+            first_failure(reported, skip_errors)
         });
         let reports = reports.map_err(|(index, e)| {
             let at = |message: String| match index {
@@ -302,9 +304,9 @@ impl PyScene {
             }
         })?;
         let dicts = reports
-            .iter()
-            .map(|paths| match paths {
-                Some(paths) => Ok(Some(columns::to_dict(py, paths)?)),
+            .into_iter()
+            .map(|cells| match cells {
+                Some(cells) => Ok(Some(columns::cells_dict(py, cells)?)),
                 None => Ok(None),
             })
             .collect::<PyResult<Vec<_>>>()?;
@@ -328,52 +330,34 @@ fn receivers_of(array: &PyReadonlyArray2<'_, f64>) -> PyResult<Vec<Vec3>> {
         .collect())
 }
 
-/// Why [`report_each`] or the trace before it failed: the trace, or a receiver's report (its
+/// Why a many-receiver trace or a receiver's report failed: the trace, or a receiver's report (its
 /// message).
 enum Failure {
     Trace(TraceError),
     Report(String),
 }
 
-/// One receiver's paths as the report gives them.
-type Report = Vec<bt_beams::PathReport>;
+/// One receiver's paths as columns, before they become arrays.
+type Report = columns::Cells;
 
 /// Why a many-receiver call failed: the receiver's index (none: the call as a whole).
 type Failed = (Option<usize>, Failure);
 
-/// Each receiver's report of its trace with `radio` (in parallel when asked). A receiver that
-/// could not be traced is `None` when `skip_errors`, else the first such fails the call with
-/// its index.
-fn report_each(
-    scene: &Scene,
-    receivers: &[Vec3],
-    traced: Vec<Result<Traced, TraceError>>,
-    (radio, parallel): (&bt_beams::RadioOptions, bool),
+/// Each receiver's report, in order: a receiver that could not be traced is `None` when
+/// `skip_errors`, else the first such (in receiver order, whichever failed first in time)
+/// fails the call with its index, as does the first report that failed.
+fn first_failure(
+    reported: Vec<Result<Result<Report, String>, TraceError>>,
     skip_errors: bool,
 ) -> Result<Vec<Option<Report>>, Failed> {
-    let one = |(i, (rx, t)): (usize, (&Vec3, Result<Traced, TraceError>))| {
-        let t = match t {
-            Ok(t) => t,
-            Err(_) if skip_errors => return Ok(None),
-            Err(e) => return Err((Some(i), Failure::Trace(e))),
-        };
-        let moved = scene
-            .with_receiver(*rx)
-            .map_err(|e| (Some(i), Failure::Trace(e.into())))?;
-        bt_beams::report(&moved, &t.result.paths, radio)
-            .map(Some)
-            .map_err(|e| (Some(i), Failure::Report(e.to_string())))
-    };
-    let pairs = receivers.iter().zip(traced);
-    // Each receiver's outcome in order, then the first failure in receiver order (a parallel
-    // collect into a Result would stop at whichever failure came first in time).
-    let outcomes: Vec<_> = if parallel {
-        let pairs: Vec<_> = pairs.collect();
-        pairs.into_par_iter().enumerate().map(one).collect()
-    } else {
-        pairs.enumerate().map(one).collect()
-    };
-    outcomes.into_iter().collect()
+    (reported.into_iter().enumerate())
+        .map(|(i, outcome)| match outcome {
+            Ok(Ok(report)) => Ok(Some(report)),
+            Ok(Err(message)) => Err((Some(i), Failure::Report(message))),
+            Err(_) if skip_errors => Ok(None),
+            Err(e) => Err((Some(i), Failure::Trace(e))),
+        })
+        .collect()
 }
 
 /// Load a scene; `tx`/`rx` override the file's (meshes, XML and point clouds carry none: then

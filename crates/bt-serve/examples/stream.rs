@@ -1,7 +1,8 @@
 //! A probe of the serve loop in process: a seeded random walk of receivers in the living room
 //! (order 3 unless given), streamed through one `Server` as JSON lines from memory into
-//! memory, one receiver per request and then in requests of `--batch` receivers. Prints the
-//! throughput and the percentiles of `latency_us` (docs/performance.md).
+//! memory: one request at a time (`answer_line`, as a client that waits for each answer), then
+//! the whole stream at once (consecutive moves answered together), then in requests of BATCH
+//! receivers. Prints the throughput and the percentiles of `latency_us` (docs/performance.md).
 //!
 //! `cargo run --release -p bt-serve --example stream -- [MOVES] [MAX_ORDER] [BATCH]`
 
@@ -36,21 +37,78 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         })
         .collect();
     println!("living room, order {max_order}, {moves} receiver moves (seed 30)");
+    // A client that waits for each answer before its next request: answered alone.
+    let (seconds, latencies) = one_at_a_time(max_order, &single)?;
+    report("1 at a time", moves, seconds, &latencies);
     for (name, lines) in [("1 per request", &single), ("batched", &batched)] {
         let (seconds, latencies) = stream(max_order, lines)?;
-        let per_move = seconds / moves as f64 * 1e6;
-        let p = |q: f64| latencies[((latencies.len() - 1) as f64 * q) as usize];
-        println!(
-            "{name:>14}: {:>8.0} moves/s, {per_move:>6.1} us per move; latency_us per request \
-             p50 {:.1} p99 {:.1} max {:.1} ({} requests)",
-            moves as f64 / seconds,
-            p(0.5),
-            p(0.99),
-            p(1.0),
-            latencies.len()
-        );
+        report(name, moves, seconds, &latencies);
     }
     Ok(())
+}
+
+/// Prints the throughput and the percentiles of the sorted `latencies`.
+fn report(name: &str, moves: usize, seconds: f64, latencies: &[f64]) {
+    let per_move = seconds / moves as f64 * 1e6;
+    let p = |q: f64| latencies[((latencies.len() - 1) as f64 * q) as usize];
+    println!(
+        "{name:>14}: {:>8.0} moves/s, {per_move:>6.1} us per move; latency_us per request \
+         p50 {:.1} p99 {:.1} max {:.1} ({} requests)",
+        moves as f64 / seconds,
+        p(0.5),
+        p(0.99),
+        p(1.0),
+        latencies.len()
+    );
+}
+
+/// Answers `lines` one at a time (`Server::answer_line`, nothing else waiting: no batch), as
+/// a client that waits for each answer; the wall time and each answer's `latency_us`, sorted.
+fn one_at_a_time(
+    max_order: usize,
+    lines: &[String],
+) -> Result<(f64, Vec<f64>), Box<dyn std::error::Error>> {
+    let mut server = server(max_order)?;
+    let mut answers = Vec::with_capacity(lines.len());
+    let mut out = Vec::new();
+    let t0 = Instant::now();
+    for line in lines {
+        server.answer_line(line.as_bytes(), &mut out);
+        answers.push(out.clone());
+    }
+    let seconds = t0.elapsed().as_secs_f64();
+    latencies(answers.iter().map(Vec::as_slice), seconds)
+}
+
+/// Each answer's `latency_us`, sorted, beside `seconds`.
+fn latencies<'a>(
+    answers: impl Iterator<Item = &'a [u8]>,
+    seconds: f64,
+) -> Result<(f64, Vec<f64>), Box<dyn std::error::Error>> {
+    let mut latencies = Vec::new();
+    for line in answers.filter(|l| !l.is_empty()) {
+        let v: serde_json::Value = serde_json::from_slice(line)?;
+        latencies.extend(v["latency_us"].as_f64());
+    }
+    latencies.sort_by(f64::total_cmp);
+    Ok((seconds, latencies))
+}
+
+/// A server of the living room at `max_order`, as `beamtrace serve` makes it.
+fn server(max_order: usize) -> Result<Server, Box<dyn std::error::Error>> {
+    let options = bt_import::LoadOptions::default();
+    let dynamic = bt_import::load_dynamic("builtin:living-room", &options, &mut |_| {})?.scene;
+    let settings = SolveSettings {
+        max_order,
+        ..SolveSettings::default()
+    };
+    let options = settings.trace_options(dynamic.step(0))?;
+    Ok(Server::new(
+        dynamic,
+        options,
+        RadioOptions::default(),
+        Limits::default(),
+    ))
 }
 
 /// Streams `lines` through a fresh server; the wall time of the whole stream and each
@@ -59,15 +117,7 @@ fn stream(
     max_order: usize,
     lines: &[String],
 ) -> Result<(f64, Vec<f64>), Box<dyn std::error::Error>> {
-    let options = bt_import::LoadOptions::default();
-    let dynamic = bt_import::load_dynamic("builtin:living-room", &options, &mut |_| {})?.scene;
-    let settings = SolveSettings {
-        max_order,
-        ..SolveSettings::default()
-    };
-    let options = settings.trace_options(dynamic.step(0))?;
-    let limits = Limits::default();
-    let mut server = Server::new(dynamic, options, RadioOptions::default(), limits);
+    let mut server = server(max_order)?;
     let input = lines.join("\n");
     let mut output = Vec::with_capacity(input.len() * 64);
     let t0 = Instant::now();
@@ -78,13 +128,7 @@ fn stream(
         "{:>14}  {} requests, {} error answers",
         "", summary.requests, summary.errors
     );
-    let mut latencies = Vec::new();
-    for line in output.split(|&b| b == b'\n').filter(|l| !l.is_empty()) {
-        let v: serde_json::Value = serde_json::from_slice(line)?;
-        latencies.extend(v["latency_us"].as_f64());
-    }
-    latencies.sort_by(f64::total_cmp);
-    Ok((seconds, latencies))
+    latencies(output.split(|&b| b == b'\n'), seconds)
 }
 
 /// The seeded walk of the tests: 0.2 m steps on a millimetre grid, 0.3 m from the walls.

@@ -14,6 +14,7 @@
 //! read and write errors end [`Server::serve`].
 #![warn(missing_docs)]
 
+mod batch;
 pub mod request;
 mod server;
 mod stream;
@@ -29,6 +30,11 @@ pub const MAX_LINE_BYTES: usize = 1 << 20;
 /// Most receivers in one request (each answer holds every path record of its receiver:
 /// about 32 KB for the living room at order 3, so 1,024 receivers make a 32 MB line).
 pub const MAX_RECEIVERS: usize = 1024;
+
+/// Most connections `beamtrace serve --listen` serves at a time (`--max-connections`): each
+/// holds its own [`Server`] (a tracer with its kept tree and caches, about 7 MB in the living
+/// room), so the number bounds the memory.
+pub const MAX_CONNECTIONS: usize = 16;
 
 /// The bounds every request is checked against before any work.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

@@ -16,27 +16,29 @@ use std::time::{Duration, Instant};
 
 /// A long-lived tracer answering requests: one [`Tracer`] for the whole life of the server
 /// (its TX tree and caches carry over from request to request), the scene's objects and the
-/// session's transmitter, receivers and poses.
+/// session's transmitter, receivers and poses. A clone serves another stream (a connection)
+/// from the same state, with caches of its own.
+#[derive(Clone)]
 pub struct Server {
-    tracer: Tracer,
+    pub(crate) tracer: Tracer,
     dynamic: DynamicScene,
     radio: RadioOptions,
     limits: Limits,
     /// The session's state when it starts ([`Server::end_session`] goes back to it).
     initial: Session,
-    session: Session,
+    pub(crate) session: Session,
     /// The object poses of the geometry the tracer holds (aligned with the objects).
-    held: Vec<Pose>,
+    pub(crate) held: Vec<Pose>,
     /// Beam answers, when the server sweeps arrays.
     beams: Option<BeamOptions>,
 }
 
 /// What a request may leave out and take from the previous one.
 #[derive(Debug, Clone)]
-struct Session {
-    tx: Option<Vec3>,
-    rx: Option<Receivers>,
-    poses: Vec<Pose>,
+pub(crate) struct Session {
+    pub(crate) tx: Option<Vec3>,
+    pub(crate) rx: Option<Receivers>,
+    pub(crate) poses: Vec<Pose>,
 }
 
 /// The answer for one receiver: the fields of `trace --json` a receiver changes.
@@ -70,26 +72,16 @@ enum AnswerStats {
     Step(StepStats),
 }
 
-#[derive(Serialize)]
-struct Reply<'a> {
-    id: &'a Value,
-    #[serde(flatten)]
-    body: Body,
-}
+/// One receiver's outcome: its answer object serialised (`{"tx": ..., "stats": {...}}`, the
+/// fields of [`Answer`]), or its error. Serialised where it is traced (on its worker thread
+/// when receivers run in parallel), so only bytes travel back to the request's line.
+pub(crate) type Outcome = Result<Vec<u8>, ServeError>;
 
+/// The entry of `results` for a receiver that could not be traced.
 #[derive(Serialize)]
-#[serde(untagged)]
-enum Body {
-    One(Box<Answer>),
-    Many { results: Vec<Entry> },
-}
-
-/// One entry of `results`: an answer, or the error of that receiver alone.
-#[derive(Serialize)]
-#[serde(untagged)]
-enum Entry {
-    Answer(Box<Answer>),
-    Error { rx: [f64; 3], error: String },
+struct EntryError {
+    rx: [f64; 3],
+    error: String,
 }
 
 #[derive(Serialize)]
@@ -162,11 +154,22 @@ impl Server {
                 return false;
             }
         };
-        let t0 = Instant::now();
-        match self.answer(&request, t0, out) {
+        self.answer_request(&request, Instant::now(), out)
+    }
+
+    /// Answer a parsed `request` (parsed at `t0`) by appending its line to `out` (without a
+    /// line break); false when the answer is an error line.
+    pub(crate) fn answer_request(
+        &mut self,
+        request: &Request,
+        t0: Instant,
+        out: &mut Vec<u8>,
+    ) -> bool {
+        let start = out.len();
+        match self.answer(request, t0, out) {
             Ok(()) => true,
             Err(e) => {
-                out.clear();
+                out.truncate(start);
                 self.write_error(&request.id, &e, out);
                 false
             }
@@ -179,8 +182,9 @@ impl Server {
             id,
             error: e.to_string(),
         };
+        let start = out.len();
         if serde_json::to_writer(&mut *out, &line).is_err() {
-            out.clear();
+            out.truncate(start);
             out.extend_from_slice(br#"{"id":null,"error":"the answer could not be written"}"#);
         }
     }
@@ -201,37 +205,19 @@ impl Server {
             ServeError::request("rx", "no receiver yet: give \"rx\": [x, y, z] (or --rx)")
         })?;
         let poses = self.poses(request)?;
-        let field = |i: usize| match rx {
-            Receivers::One(_) => "rx".to_string(),
-            Receivers::Many(_) => format!("rx[{i}]"),
-        };
+        let field = |i: usize| rx_field(&rx, i);
         let positions = rx.positions();
-        let mut outcomes = match poses != self.held {
+        let outcomes = match poses != self.held {
             true => self.update_and_trace(tx, positions, &poses, &field)?,
             false => self.trace(tx, positions, 0, &field)?,
         };
-        let body = match rx {
-            Receivers::One(_) => Body::One(Box::new(outcomes.pop().unwrap_or_else(|| {
-                Err(ServeError::request("rx", "no answer for the receiver"))
-            })?)),
-            Receivers::Many(_) => Body::Many {
-                results: (positions.iter().zip(outcomes))
-                    .map(|(p, o)| match o {
-                        Ok(answer) => Entry::Answer(Box::new(answer)),
-                        Err(e) => Entry::Error {
-                            rx: p.to_array(),
-                            error: e.to_string(),
-                        },
-                    })
-                    .collect(),
-            },
-        };
+        write_reply(&request.id, &rx, outcomes, t0, out)?;
         self.session = Session {
             tx: Some(tx),
             rx: Some(rx),
             poses,
         };
-        write_reply(&request.id, body, t0, out)
+        Ok(())
     }
 
     /// The poses a request asks for: the session's, or step `step`'s, then `objects`'.
@@ -289,8 +275,8 @@ impl Server {
         tx: Vec3,
         positions: &[Vec3],
         first: usize,
-        field: &dyn Fn(usize) -> String,
-    ) -> Result<Vec<Result<Answer, ServeError>>, ServeError> {
+        field: &Field<'_>,
+    ) -> Result<Vec<Outcome>, ServeError> {
         if positions.is_empty() {
             return Ok(Vec::new());
         }
@@ -298,14 +284,38 @@ impl Server {
             let scene = self.with_transmitter(tx, positions, first, field)?;
             self.tracer.set_scene(scene);
         }
-        let traced = self.tracer.trace_each(tx, positions);
+        self.traced_answers(tx, positions, first, field)
+    }
+
+    /// Each receiver of `positions` (the first at index `first` of `field`) traced from `tx`
+    /// and its answer reported and serialised in the same task: in parallel over the cores
+    /// when the tracer runs in parallel and there is more than one receiver (the report and
+    /// its JSON cost more than the walk of the kept tree), in order. Fails as a whole only
+    /// when the TX cannot be traced ([`Tracer::trace_each`]).
+    pub(crate) fn traced_answers(
+        &mut self,
+        tx: Vec3,
+        positions: &[Vec3],
+        first: usize,
+        field: &Field<'_>,
+    ) -> Result<Vec<Outcome>, ServeError> {
+        let reporter = Reporter {
+            options: *self.tracer.options(),
+            radio: &self.radio,
+            beams: self.beams.as_ref(),
+        };
+        let traced = self.tracer.trace_each_then(tx, positions, |scene, traced| {
+            reporter.trace_answer(scene, &traced)
+        });
         let traced = traced.map_err(|e| trace_error(e, &field(first)))?;
-        Ok((traced.into_iter().zip(positions).enumerate())
-            .map(|(i, (t, &rx))| {
-                let t = t.map_err(|e| trace_error(e, &field(first + i)))?;
-                self.trace_answer(tx, rx, &t)
-            })
+        Ok((traced.into_iter().enumerate())
+            .map(|(i, outcome)| outcome.unwrap_or_else(|e| Err(trace_error(e, &field(first + i)))))
             .collect())
+    }
+
+    /// Whether receivers are traced and answered in parallel (the trace options').
+    pub(crate) fn parallel(&self) -> bool {
+        self.tracer.options().parallel
     }
 
     /// The scene held with the transmitter at `tx` and, as its receiver, the first of
@@ -316,7 +326,7 @@ impl Server {
         tx: Vec3,
         positions: &[Vec3],
         first: usize,
-        field: &dyn Fn(usize) -> String,
+        field: &Field<'_>,
     ) -> Result<bt_scene::Scene, ServeError> {
         let mut refusal = None;
         for (i, &rx) in positions.iter().enumerate() {
@@ -330,13 +340,65 @@ impl Server {
         Err(refusal.unwrap_or_else(|| ServeError::request("rx", "no receiver")))
     }
 
-    /// The answer of a trace from `tx` to `rx`, reported by the one report of `trace --json`.
-    fn trace_answer(&self, tx: Vec3, rx: Vec3, traced: &Traced) -> Result<Answer, ServeError> {
-        let scene = self.tracer.scene().with_terminals(tx, rx);
-        let scene = scene.map_err(|e| scene_error(&e, "rx"))?;
-        let options = self.tracer.options();
-        let doc = TraceDocument::report(&scene, options, traced, &self.radio, Duration::ZERO)?;
-        Ok(Answer {
+    /// Move the objects to `poses` and trace the first receiver as the tracer's next time
+    /// step (incrementally, as `trace --steps`), the others in that geometry.
+    fn update_and_trace(
+        &mut self,
+        tx: Vec3,
+        positions: &[Vec3],
+        poses: &[Pose],
+        field: &Field<'_>,
+    ) -> Result<Vec<Outcome>, ServeError> {
+        let Some(&rx0) = positions.first() else {
+            return Ok(Vec::new());
+        };
+        let terminals = Terminals {
+            tx: Some(tx),
+            rx: Some(rx0),
+        };
+        let scene = self.dynamic.posed(poses, terminals);
+        let scene = scene.map_err(|e| scene_error(&e, &field(0)))?;
+        self.held = poses.to_vec();
+        let t0 = Instant::now();
+        let step = self
+            .tracer
+            .update(&scene)
+            .map_err(|e| trace_error(e, &field(0)))?;
+        let doc = StepDocument::report(&scene, step, &self.radio, t0.elapsed())?;
+        let first = serialise(&Answer {
+            tx: doc.tx,
+            rx: doc.rx,
+            beams: Reporter {
+                options: *self.tracer.options(),
+                radio: &self.radio,
+                beams: self.beams.as_ref(),
+            }
+            .beams_of(&doc.paths, scene.frequency_hz())?,
+            paths: doc.paths,
+            stats: AnswerStats::Step(doc.stats),
+        });
+        let mut outcomes = vec![first];
+        outcomes.extend(self.trace(tx, &positions[1..], 1, field)?);
+        Ok(outcomes)
+    }
+}
+
+/// The options and the radio side of every answer: the part of a [`Server`] the receivers'
+/// answers need, shared by the threads that trace and report them.
+#[derive(Clone, Copy)]
+struct Reporter<'a> {
+    options: TraceOptions,
+    radio: &'a RadioOptions,
+    beams: Option<&'a BeamOptions>,
+}
+
+impl Reporter<'_> {
+    /// The answer of a trace in `scene` (with its TX and RX), reported by the one report of
+    /// `trace --json`.
+    fn trace_answer(&self, scene: &bt_scene::Scene, traced: &Traced) -> Outcome {
+        let options = &self.options;
+        let doc = TraceDocument::report(scene, options, traced, self.radio, Duration::ZERO)?;
+        serialise(&Answer {
             tx: doc.tx,
             rx: doc.rx,
             beams: self.beams_of(&doc.paths, scene.frequency_hz())?,
@@ -351,7 +413,7 @@ impl Server {
         paths: &[PathReport],
         carrier_hz: f64,
     ) -> Result<Option<BeamsAnswer>, ServeError> {
-        let Some(b) = &self.beams else {
+        let Some(b) = self.beams else {
             return Ok(None);
         };
         let power = self.radio.tx_power_dbm;
@@ -377,50 +439,78 @@ impl Server {
             top: sweep.pairs.into_iter().take(b.top).collect(),
         }))
     }
+}
 
-    /// Move the objects to `poses` and trace the first receiver as the tracer's next time
-    /// step (incrementally, as `trace --steps`), the others in that geometry.
-    fn update_and_trace(
-        &mut self,
-        tx: Vec3,
-        positions: &[Vec3],
-        poses: &[Pose],
-        field: &dyn Fn(usize) -> String,
-    ) -> Result<Vec<Result<Answer, ServeError>>, ServeError> {
-        let Some(&rx0) = positions.first() else {
-            return Ok(Vec::new());
-        };
-        let terminals = Terminals {
-            tx: Some(tx),
-            rx: Some(rx0),
-        };
-        let scene = self.dynamic.posed(poses, terminals);
-        let scene = scene.map_err(|e| scene_error(&e, &field(0)))?;
-        self.held = poses.to_vec();
-        let t0 = Instant::now();
-        let step = self
-            .tracer
-            .update(&scene)
-            .map_err(|e| trace_error(e, &field(0)))?;
-        let doc = StepDocument::report(&scene, step, &self.radio, t0.elapsed())?;
-        let first = Answer {
-            tx: doc.tx,
-            rx: doc.rx,
-            beams: self.beams_of(&doc.paths, scene.frequency_hz())?,
-            paths: doc.paths,
-            stats: AnswerStats::Step(doc.stats),
-        };
-        let mut outcomes = vec![Ok(first)];
-        outcomes.extend(self.trace(tx, &positions[1..], 1, field)?);
-        Ok(outcomes)
+/// The field of a request's receiver `i` in messages (`rx`, or `rx[i]` in a list); shared by
+/// the receivers' parallel answers.
+pub(crate) type Field<'a> = dyn Fn(usize) -> String + Sync + 'a;
+
+/// The field of receiver `i` of `rx` in messages: `rx` for one, `rx[i]` in a list.
+pub(crate) fn rx_field(rx: &Receivers, i: usize) -> String {
+    match rx {
+        Receivers::One(_) => "rx".to_string(),
+        Receivers::Many(_) => format!("rx[{i}]"),
     }
 }
 
-/// The reply `{"id", ...body, "latency_us"}` into `out`: `latency_us` is the time from the
-/// parsed request (`t0`) to the serialised answer, written last.
-fn write_reply(id: &Value, body: Body, t0: Instant, out: &mut Vec<u8>) -> Result<(), ServeError> {
-    serde_json::to_writer(&mut *out, &Reply { id, body })?;
-    out.pop(); // the closing brace: `latency_us` goes last
+/// One receiver's answer as JSON bytes, room made for a typical answer up front.
+fn serialise(answer: &Answer) -> Outcome {
+    let mut bytes = Vec::with_capacity(1024 + 1024 * answer.paths.len());
+    serde_json::to_writer(&mut bytes, answer)?;
+    Ok(bytes)
+}
+
+/// The reply `{"id", ...answer or "results", "latency_us"}` of a request for `rx` appended to
+/// `out`, from each receiver's `outcomes` (aligned with `rx`'s positions): one receiver's
+/// answer fields at the top level (its error is the request's), a list's as `results`, one
+/// entry each (an error entry `{"rx", "error"}` for a receiver that failed alone).
+/// `latency_us` is the time from the parsed request (`t0`) to the serialised answer, written
+/// last. The bytes are those of serde's `{"id": .., #[serde(flatten)] answer}`.
+pub(crate) fn write_reply(
+    id: &Value,
+    rx: &Receivers,
+    outcomes: Vec<Outcome>,
+    t0: Instant,
+    out: &mut Vec<u8>,
+) -> Result<(), ServeError> {
+    let start = out.len();
+    let mut outcomes = outcomes.into_iter();
+    match rx {
+        Receivers::One(_) => {
+            let answer = outcomes
+                .next()
+                .unwrap_or_else(|| Err(ServeError::request("rx", "no answer for the receiver")))?;
+            out.extend_from_slice(b"{\"id\":");
+            serde_json::to_writer(&mut *out, id)?;
+            // The answer's fields without its braces: `{"tx": ...}` → `"tx": ...`.
+            if let Some(fields) = answer.get(1..answer.len().saturating_sub(1)) {
+                out.push(b',');
+                out.extend_from_slice(fields);
+            }
+        }
+        Receivers::Many(positions) => {
+            out.extend_from_slice(b"{\"id\":");
+            serde_json::to_writer(&mut *out, id)?;
+            out.extend_from_slice(b",\"results\":[");
+            for (k, (p, outcome)) in positions.iter().zip(outcomes).enumerate() {
+                if k > 0 {
+                    out.push(b',');
+                }
+                match outcome {
+                    Ok(answer) => out.extend_from_slice(&answer),
+                    Err(e) => {
+                        let entry = EntryError {
+                            rx: p.to_array(),
+                            error: e.to_string(),
+                        };
+                        serde_json::to_writer(&mut *out, &entry)?;
+                    }
+                }
+            }
+            out.push(b']');
+        }
+    }
+    debug_assert!(out[start..].starts_with(b"{\"id\":"));
     let latency_us = t0.elapsed().as_nanos() as f64 / 1e3;
     write!(out, ",\"latency_us\":{latency_us}}}").map_err(ServeError::Write)
 }

@@ -1,7 +1,10 @@
 //! The loop over a request stream: bounded lines in, one flushed answer line out per request.
 
-use crate::{ServeError, Server};
-use std::io::{BufRead, ErrorKind, Write};
+use crate::batch::{Batch, refusal};
+use crate::{ServeError, Server, request};
+use serde_json::Value;
+use std::io::{BufRead, BufReader, ErrorKind, Write};
+use std::time::Instant;
 
 /// What a stream did, for the caller's log.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
@@ -96,50 +99,82 @@ impl Server {
         self.serve_until(input, output, &|| false)
     }
 
-    /// [`Server::serve`], which also ends cleanly once `stop()` holds: after the answer in
-    /// hand is written and flushed, or while it waits for a request when a signal interrupts
+    /// [`Server::serve`], which also ends cleanly once `stop()` holds: after the answers in
+    /// hand are written and flushed, or while it waits for a request when a signal interrupts
     /// the read (the binary's SIGTERM handler sets what `stop` reads).
+    ///
+    /// Receiver moves already waiting in the input are answered together (`docs/serve.md`,
+    /// "Parallel answers": a few receivers per core, traced and reported in parallel), each
+    /// answer still its own line in request order; a request is never held back for one that
+    /// has not arrived: a batch is answered as soon as no whole line waits.
     pub fn serve_until(
         &mut self,
-        mut input: impl BufRead,
+        input: impl BufRead,
         mut output: impl Write,
         stop: &dyn Fn() -> bool,
     ) -> Result<Summary, ServeError> {
+        // Our own buffer over the input, so that whether another whole line waits can be
+        // seen without blocking.
+        let mut input = BufReader::with_capacity(INPUT_BUFFER, input);
         let mut line = Vec::new();
         let mut answer = Vec::new();
         let mut summary = Summary::default();
+        let mut batch = Batch::default();
         let max = self.limits().max_line_bytes;
+        let per_batch = self.batch_receivers();
         while let Some(read) =
             read_line_until(&mut input, &mut line, max, stop).map_err(ServeError::Read)?
         {
-            answer.clear();
-            let ok = match read {
-                Line::Read if line.iter().all(u8::is_ascii_whitespace) => continue,
-                Line::Read => self.answer_line(&line, &mut answer),
-                Line::TooLong(bytes) => {
-                    let message = format!(
-                        "the line has {bytes} bytes, more than the budget of {max} bytes per \
-                         request; split the request"
-                    );
-                    let e = ServeError::request("request", message);
-                    self.write_error(&serde_json::Value::Null, &e, &mut answer);
-                    false
+            let blank = matches!(read, Line::Read if line.iter().all(u8::is_ascii_whitespace));
+            if !blank {
+                summary.requests += 1;
+                let parsed = match read {
+                    Line::Read => request::parse(&line, self.limits()),
+                    Line::TooLong(bytes) => Err((Value::Null, refusal(bytes, max))),
+                };
+                let t0 = Instant::now();
+                match parsed {
+                    Ok(request) if self.batchable(&request) => {
+                        self.enqueue(&mut batch, request, t0)
+                    }
+                    parsed => {
+                        summary.errors += self.answer_batch(&mut batch, &mut answer);
+                        let ok = match parsed {
+                            Ok(request) => self.answer_request(&request, t0, &mut answer),
+                            Err((id, e)) => {
+                                self.write_error(&id, &e, &mut answer);
+                                false
+                            }
+                        };
+                        summary.errors += u64::from(!ok);
+                        answer.push(b'\n');
+                    }
                 }
-            };
-            summary.requests += 1;
-            summary.errors += u64::from(!ok);
-            answer.push(b'\n');
-            output.write_all(&answer).map_err(ServeError::Write)?;
-            output.flush().map_err(ServeError::Write)?;
+            }
+            let waiting = input.buffer().contains(&b'\n');
+            if batch.receivers() >= per_batch || !waiting || stop() {
+                summary.errors += self.answer_batch(&mut batch, &mut answer);
+            }
+            if !answer.is_empty() {
+                output.write_all(&answer).map_err(ServeError::Write)?;
+                output.flush().map_err(ServeError::Write)?;
+                answer.clear();
+            }
             shrink(&mut line, max);
             shrink(&mut answer, max);
             if stop() {
                 break;
             }
         }
+        summary.errors += self.answer_batch(&mut batch, &mut answer);
+        output.write_all(&answer).map_err(ServeError::Write)?;
+        output.flush().map_err(ServeError::Write)?;
         Ok(summary)
     }
 }
+
+/// The input buffer of [`Server::serve_until`], bytes: many short requests at once.
+const INPUT_BUFFER: usize = 64 * 1024;
 
 /// Give back a buffer's memory once one large request has passed, so a long stream holds no
 /// more than one ordinary request's worth.

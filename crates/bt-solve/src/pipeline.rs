@@ -410,34 +410,40 @@ pub(crate) fn solve_set(
 /// others are still traced. Receivers run in parallel when `options.parallel`; each one's own
 /// trace is then single-threaded. `tree` is the beam tree of `base`'s TX when the caller has
 /// one (a fixed TX: every receiver is a walk); `cache` serves a single receiver's trace.
-pub(crate) fn trace_each_receiver(
+/// `then` turns each receiver's trace, beside the scene it was traced in, into its outcome,
+/// in the task that traced it.
+pub(crate) fn trace_each_receiver<T: Send>(
     base: &Scene,
     receivers: &[Vec3],
     options: &TraceOptions,
-    tree: Option<&KeptTx>,
-    cache: &mut TreeCache,
-) -> Vec<Result<Traced, TraceError>> {
+    (tree, cache): (Option<&KeptTx>, &mut TreeCache),
+    then: &(impl Fn(&Scene, Traced) -> T + Sync),
+) -> Vec<Result<T, TraceError>> {
     let inner = TraceOptions {
         parallel: false,
         ..*options
     };
     if let ([rx], None) = (receivers, tree) {
         let one = base.with_receiver(*rx).map_err(TraceError::from);
-        return vec![one.and_then(|moved| trace_scene_in(&moved, &inner, cache, &mut |_| {}))];
+        return vec![one.and_then(|moved| {
+            let traced = trace_scene_in(&moved, &inner, cache, &mut |_| {})?;
+            Ok(then(&moved, traced))
+        })];
     }
-    let one = |rx: &Vec3| -> Result<Traced, TraceError> {
+    let one = |rx: &Vec3| -> Result<T, TraceError> {
         let moved = base.with_receiver(*rx)?;
-        match tree {
+        let traced = match tree {
             // The tree's margins hold for receivers whose scene tolerance is no larger.
             Some(kept) if moved.length_tolerance() <= kept.tree.tolerance() => {
                 let t0 = Instant::now();
                 let set = kept.candidates(&moved, &inner)?;
-                solve_set(&moved, set, &inner, t0.elapsed())
+                solve_set(&moved, set, &inner, t0.elapsed())?
             }
             // Receivers traced in parallel cannot share one cache (`tree` is built in beam-tree
             // mode, so this is a receiver that grows the scene, or another mode: no tree).
-            _ => trace_scene_in(&moved, &inner, &mut TreeCache::default(), &mut |_| {}),
-        }
+            _ => trace_scene_in(&moved, &inner, &mut TreeCache::default(), &mut |_| {})?,
+        };
+        Ok(then(&moved, traced))
     };
     // One receiver runs on the caller's thread: handing it to the pool only adds a wake-up
     // (a whole scheduler slice, ~4 ms, when the cores are busy: serve's p99).

@@ -124,6 +124,20 @@ impl Tracer {
         tx: Vec3,
         receivers: &[Vec3],
     ) -> Result<Vec<Result<Traced, TraceError>>, TraceError> {
+        self.trace_each_then(tx, receivers, |_, traced| traced)
+    }
+
+    /// [`Tracer::trace_each`], with `then` applied to each receiver's trace, beside the scene
+    /// it was traced in (the scene with `tx` and that receiver), in the task that traced it:
+    /// a caller that reports each receiver does so on the thread that traced it, in parallel
+    /// when the receivers are, with no second placement of the receiver and no second pass
+    /// over the cores.
+    pub fn trace_each_then<T: Send>(
+        &mut self,
+        tx: Vec3,
+        receivers: &[Vec3],
+        then: impl Fn(&Scene, Traced) -> T + Sync,
+    ) -> Result<Vec<Result<T, TraceError>>, TraceError> {
         let Some(first) = receivers.first() else {
             return Ok(Vec::new());
         };
@@ -141,8 +155,8 @@ impl Tracer {
                 &base,
                 receivers,
                 &options,
-                tree.as_ref(),
-                cache,
+                (tree.as_ref(), cache),
+                &then,
             ));
         }
         if walk && self.kept.is_none() {
@@ -153,8 +167,8 @@ impl Tracer {
             &self.scene,
             receivers,
             &options,
-            tree,
-            &mut self.cache,
+            (tree, &mut self.cache),
+            &then,
         ))
     }
 

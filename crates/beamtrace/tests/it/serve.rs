@@ -147,6 +147,37 @@ fn a_tcp_client_gets_its_answers_and_the_next_client_a_new_session() {
     assert_eq!(b[0]["rx"], json!([2.3, 2.1, 0.72]));
 }
 
+/// Connections are served at the same time, each its own stream and session: a client that
+/// keeps its connection open does not hold back the next one.
+#[test]
+fn connections_are_served_at_the_same_time_each_its_own_session() {
+    let (mut child, address) = start("tcp:127.0.0.1:0");
+    let mut open = std::net::TcpStream::connect(&address).unwrap();
+    open.write_all(b"{\"id\": \"a\", \"tx\": [3, 3, 2], \"rx\": [1, 1, 1]}\n")
+        .unwrap();
+    let mut reader = BufReader::new(open.try_clone().unwrap());
+    let mut line = String::new();
+    reader.read_line(&mut line).unwrap();
+    assert_eq!(answers(&line)[0]["tx"], json!([3.0, 3.0, 2.0]));
+    // The first connection stays open and idle: the second is answered all the same.
+    let shut = |s: &std::net::TcpStream| s.shutdown(std::net::Shutdown::Write).unwrap();
+    let other = std::net::TcpStream::connect(&address).unwrap();
+    let b = round_trip(other, "{\"id\": \"b\", \"rx\": [1, 1, 1]}\n", shut);
+    assert_eq!(b.len(), 1);
+    assert_eq!(b[0]["tx"], json!([5.6, 0.6, 2.2]), "its own session");
+    // And the first goes on with its own TX.
+    open.write_all(b"{\"id\": \"c\"}\n").unwrap();
+    line.clear();
+    reader.read_line(&mut line).unwrap();
+    let c = answers(&line);
+    assert_eq!(
+        (&c[0]["id"], &c[0]["tx"]),
+        (&json!("c"), &json!([3.0, 3.0, 2.0]))
+    );
+    child.kill().unwrap();
+    child.wait().unwrap();
+}
+
 #[cfg(unix)]
 #[test]
 fn a_unix_socket_round_trip_and_a_users_file_is_never_replaced() {
