@@ -7,8 +7,10 @@
 //! is not running: `{first group, next group}`). While the PEs of slot `s` compute, its
 //! dispatcher pops up to [`SCAN_LIMIT`] queued groups and puts each into slot `s + 1` when
 //! all its PE columns are still free there (else back to the queue's tail). At write-back
-//! the last job of a group queues the path's next group; after a round's last group the
-//! path is queued again only if it neither converged nor froze and is below the round cap.
+//! the last job of a group queues the path's next group at the queue's *head*, so running
+//! paths go before waiting ones (a long chain is not held up behind every queued path); after
+//! a round's last group the path is queued again only if it neither converged nor froze and
+//! is below the round cap.
 //!
 //! [`predict`] is the cycle-exact twin of that controller (pinned by co-simulation): it
 //! needs each path's rounds, which only the run itself (or the model run *after* it, for
@@ -153,14 +155,16 @@ pub fn predict(groups: &[Vec<Group>], columns: usize, rounds: &[u32], latency: u
         run.dispatch_wait_cycles += exec - u64::from(latency);
         run.slots += 1;
         run.jobs += n;
+        // Write-back, job by job in slot order: each group's last job queues its path's next
+        // group at the queue's head.
         for &(p, g) in &slot {
             let pi = p as usize;
             if g + 1 < groups[pi].len() {
-                queue.push_back((p, g + 1));
+                queue.push_front((p, g + 1));
             } else {
                 done[pi] += 1;
                 if done[pi] < rounds.get(pi).copied().unwrap_or(1).max(1) {
-                    queue.push_back((p, 0));
+                    queue.push_front((p, 0));
                 }
             }
         }

@@ -432,7 +432,7 @@ module bt_top (
   assign rq_push = (d_push | wb_push);
   always @(posedge clk) begin
     if (((host_wr && is_status) | rq_push)) begin
-      rq[(host_wr ? avs_address[4:0] : rq_tail)] <= (host_wr ? avs_writedata[11:0] : (d_push ? {d_gbase, d_gptr} : wb_push_data));
+      rq[(host_wr ? avs_address[4:0] : (wb_push ? (rq_head - 5'd1) : rq_tail))] <= (host_wr ? avs_writedata[11:0] : (d_push ? {d_gbase, d_gptr} : wb_push_data));
     end
     rq_q <= rq[rq_head];
   end
@@ -449,8 +449,12 @@ module bt_top (
       end else begin
         if (d_pop) begin
           rq_head <= (rq_head + 5'd1);
+        end else begin
+          if (wb_push) begin
+            rq_head <= (rq_head - 5'd1);
+          end
         end
-        if (rq_push) begin
+        if (d_push) begin
           rq_tail <= (rq_tail + 5'd1);
         end
         if (rq_push) begin

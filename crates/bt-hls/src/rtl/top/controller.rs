@@ -331,7 +331,8 @@ pub(super) fn slot_buffer_write(t: &Dims<'_>, d: &DispatchJob, items: &mut Vec<I
 
 /// The ready queue (`rq`): a circular buffer of `{first group, next group}` per queued
 /// path, written by the host while idle (PATH_BASE[p] = path p's entry), then by the
-/// dispatcher's push-backs and write-back's pushes (never in the same cycle); read at the head.
+/// dispatcher's push-backs at the tail and write-back's pushes at the head (never in the same
+/// cycle); read at the head.
 pub(super) fn ready_queue(
     t: &Dims<'_>,
     bus: &Decode,
@@ -352,10 +353,13 @@ pub(super) fn ready_queue(
             wb_data.e(),
         ),
     );
+    // Write-back queues a path's next group at the head (the running paths first: a long
+    // chain is not held up behind every waiting path), the dispatcher's push-backs at the tail.
+    let head_before = id("rq_head").minus(lit(pb, 1));
     let addr = Expr::mux(
         bus.host_wr.e(),
         Expr::slice("avs_address", pb - 1, 0),
-        id("rq_tail"),
+        Expr::mux(wb_push.e(), head_before.clone(), id("rq_tail")),
     );
     items.push(Item::AlwaysFf(vec![
         Stmt::If(
@@ -384,10 +388,14 @@ pub(super) fn ready_queue(
                 Stmt::If(
                     d.pop.e(),
                     vec![nb(id("rq_head"), inc("rq_head", pb))],
-                    vec![],
+                    vec![Stmt::If(
+                        wb_push.e(),
+                        vec![nb(id("rq_head"), head_before)],
+                        vec![],
+                    )],
                 ),
                 Stmt::If(
-                    push.e(),
+                    d.push_back.e(),
                     vec![nb(id("rq_tail"), inc("rq_tail", pb))],
                     vec![],
                 ),
