@@ -4,11 +4,13 @@
 //! round count is needed beforehand (no oracle: the host never runs the model to plan).
 //!
 //! The controller of `bt_top` keeps a ready queue of groups (`rq`, one entry per path that
-//! is not running: `{first group, next group}`). While the PEs of slot `s` compute, its
-//! dispatcher pops up to [`SCAN_LIMIT`] queued groups and puts each into slot `s + 1` when
+//! is not running: `{first group, next group}`). While slot `s` loads and its PEs compute,
+//! the dispatcher pops up to [`SCAN_LIMIT`] queued groups and puts each into slot `s + 1` when
 //! all its PE columns are still free there (else back to the queue's tail). At write-back
-//! the last job of a group queues the path's next group; after a round's last group the
-//! path is queued again only if it neither converged nor froze and is below the round cap.
+//! the last job of a group queues the path's next group at the queue's *head*, so running
+//! paths go before waiting ones (a long chain is not held up behind every queued path); after
+//! a round's last group the path is queued again only if it neither converged nor froze and
+//! is below the round cap.
 //!
 //! [`predict`] is the cycle-exact twin of that controller (pinned by co-simulation): it
 //! needs each path's rounds, which only the run itself (or the model run *after* it, for
@@ -132,8 +134,10 @@ fn dispatch_slot(
 
 /// The `CYCLES` of one run of the dispatching controller whose PEs take `latency` cycles,
 /// for a template ([`groups`]) over `columns` PE columns when path `p` runs `rounds[p]`
-/// rounds (at least one). Per slot of `n` jobs: load `n + 2`, PEs `max(latency, dispatch +
-/// 1)`, write back `n + 2`; a dispatch with no slot running costs its own cycles plus one.
+/// rounds (at least one). Per slot of `n` jobs: load `n + 2`, or `n` right after a
+/// write-back (which read its first two entries ahead), PEs `max(latency, dispatch + 1 -
+/// load)` (the dispatcher starts with the load), write back `n + 2`; a dispatch with no slot
+/// running costs its own cycles plus one.
 pub fn predict(groups: &[Vec<Group>], columns: usize, rounds: &[u32], latency: u32) -> DispatchRun {
     let mut queue: std::collections::VecDeque<(u32, usize)> =
         (0..groups.len() as u32).map(|p| (p, 0)).collect();
@@ -142,34 +146,42 @@ pub fn predict(groups: &[Vec<Group>], columns: usize, rounds: &[u32], latency: u
     let (mut slot, d) = dispatch_slot(groups, &mut queue, columns);
     run.cycles += d + 1;
     run.dispatch_wait_cycles += d + 1;
+    let mut ahead = false;
     while !slot.is_empty() {
         let n: u64 = slot
             .iter()
             .map(|&(p, g)| groups[p as usize][g].jobs.len() as u64)
             .sum();
+        // The load takes n + 2 cycles, or n when the previous write-back read its first two
+        // entries ahead; the dispatcher starts with it, the PEs after it.
+        let load = if ahead { n } else { n + 2 };
         let (next, d) = dispatch_slot(groups, &mut queue, columns);
-        let exec = u64::from(latency).max(d + 1);
-        run.cycles += 2 * (n + 2) + exec;
+        let exec = u64::from(latency).max((d + 1).saturating_sub(load));
+        run.cycles += load + exec + n + 2;
         run.dispatch_wait_cycles += exec - u64::from(latency);
         run.slots += 1;
         run.jobs += n;
+        // Write-back, job by job in slot order: each group's last job queues its path's next
+        // group at the queue's head.
         for &(p, g) in &slot {
             let pi = p as usize;
             if g + 1 < groups[pi].len() {
-                queue.push_back((p, g + 1));
+                queue.push_front((p, g + 1));
             } else {
                 done[pi] += 1;
                 if done[pi] < rounds.get(pi).copied().unwrap_or(1).max(1) {
-                    queue.push_back((p, 0));
+                    queue.push_front((p, 0));
                 }
             }
         }
         slot = next;
+        ahead = true;
         if slot.is_empty() && !queue.is_empty() {
             let (s, d) = dispatch_slot(groups, &mut queue, columns);
             run.cycles += d + 1;
             run.dispatch_wait_cycles += d + 1;
             slot = s;
+            ahead = false;
         }
     }
     run
@@ -218,11 +230,12 @@ mod tests {
         // One round each: slot 1 = path 0 (2 jobs), slot 2 = path 1 (1 job).
         // Dispatch 0: D_WARM, D_POP, 2 jobs [placed: both PEs taken], D_POP (every PE
         // taken: stop), D_FIN = 6 cycles, DISP 7. Slot 1: load 4, PEs max(10, dispatch of
-        // path 1 (D_WARM, D_POP, 1 job, D_POP, D_FIN = 5) + 1), write back 4 = 18. Slot 2:
-        // 3 + 10 + 3 = 16 (the queue is empty: D_WARM, D_POP, D_FIN).
+        // path 1 (D_WARM, D_POP, 1 job, D_POP, D_FIN = 5) + 1 - the load's 4), write back 4
+        // = 18. Slot 2: its entry was read ahead during slot 1's write-back: load 1, PEs 10,
+        // write back 3 = 14 (the queue is empty: D_WARM, D_POP, D_FIN).
         let r = predict(&g, 2, &[1, 1], latency);
         assert_eq!((r.slots, r.jobs), (2, 3));
-        assert_eq!(r.cycles, 7 + 18 + 16);
+        assert_eq!(r.cycles, 7 + 18 + 14);
         assert_eq!(r.dispatch_wait_cycles, 7);
         // More rounds: more slots, never fewer cycles.
         let r3 = predict(&g, 2, &[3, 2], latency);

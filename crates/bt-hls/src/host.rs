@@ -331,10 +331,18 @@ pub(crate) fn register_map(d: &Design) -> String {
          index `first_point[p] + i` (paths in order, points TX side first); `first`/`last` \
          mark the points next to TX/RX.\n\n",
     );
-    s.push_str("## Cycle formulas (exact, checked by co-simulation)\n\n");
+    s.push_str(&cycle_formulas(d));
+    s
+}
+
+/// The register map's section on the cycle count.
+fn cycle_formulas(d: &Design) -> String {
+    let mut s = String::from("## Cycle formulas (exact, checked by co-simulation)\n\n");
     s.push_str(&format!(
-        "* CYCLES = sum over dispatched slots of (2 x (jobs + 2) + max(PE_LATENCY, dispatch + 1)) \
-         plus the dispatches with no slot running (dispatch + 1 each); dispatch = 1 + per examined \
+        "* CYCLES = sum over dispatched slots of (load + max(PE_LATENCY, dispatch + 1 - load) + \
+         jobs + 2), load = jobs right after a write-back (its first two entries read ahead), else \
+         jobs + 2, plus the dispatches with no slot running (dispatch + 1 each); the dispatcher \
+         builds the next slot from the start of the load; dispatch = 1 + per examined \
          group (at most {}) 1 + its jobs, + 2; PE_LATENCY = {} (5 + {} halving steps of \
          Algorithm 3 at the {}-bit coordinate word); `bt_hls::dispatch::predict` is the exact twin\n",
         dispatch::SCAN_LIMIT,

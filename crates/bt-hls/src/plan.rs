@@ -197,7 +197,7 @@ pub fn plan_dispatch(
     let one = problem.one_round();
     let copies = match (copies, options.pe_budget) {
         (Some(c), _) => c.to_vec(),
-        (None, Some(b)) => bt_schedule::size_copies(&one, &Budget { max_instances: b })?,
+        (None, Some(b)) => bt_schedule::dispatch_copies(&one, &Budget { max_instances: b })?,
         (None, None) => Vec::new(),
     };
     let schedule = bt_schedule::round_template(&one, &copies)?;

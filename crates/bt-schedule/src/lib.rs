@@ -42,7 +42,7 @@ pub use check::ScheduleStats;
 pub use error::{ProblemIssue, REPORT_LIMIT, Report, ScheduleError, ScheduleViolation};
 pub use ga::{GaParams, schedule_ga};
 pub use list::{schedule_list, schedule_list_duplicated, schedule_list_on, size_copies};
-pub use template::round_template;
+pub use template::{dispatch_copies, round_template};
 
 /// One candidate path as the scheduler sees it.
 #[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]

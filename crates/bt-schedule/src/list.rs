@@ -27,7 +27,12 @@ pub fn schedule_list(problem: &Problem, budget: &Budget) -> Result<Schedule, Sch
 pub fn size_copies(problem: &Problem, budget: &Budget) -> Result<Vec<u32>, ScheduleError> {
     let prep = Prepared::new(problem)?;
     prep.check_budget(budget)?;
-    let mut copies = prep.base_copies();
+    Ok(grow_by_load(problem, prep.base_copies(), budget))
+}
+
+/// `copies` grown one at a time, within `budget`, for the plane with the largest load per copy
+/// (the rule of [`size_copies`]).
+pub(crate) fn grow_by_load(problem: &Problem, mut copies: Vec<u32>, budget: &Budget) -> Vec<u32> {
     let mut load = vec![0u64; copies.len()];
     for path in &problem.paths {
         for &plane in &path.planes {
@@ -52,7 +57,7 @@ pub fn size_copies(problem: &Problem, budget: &Budget) -> Result<Vec<u32>, Sched
         copies[p] += 1;
         total += 1;
     }
-    Ok(copies)
+    copies
 }
 
 /// The list scheduler on duplicated PEs: copies per plane from [`size_copies`] within

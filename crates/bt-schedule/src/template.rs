@@ -20,20 +20,28 @@ pub fn round_template(problem: &Problem, copies: &[u32]) -> Result<Schedule, Sch
     let prep = Prepared::new(&one)?;
     let inst = InstanceSet::from_copies(&prep.copies_at_least(copies));
     let mut slots = Vec::new();
+    // Jobs given to each column so far: a point takes its plane's free copy with the fewest,
+    // so the copies share the paths (a fixed copy 0 first would leave them to A-B-A paths).
+    let mut given = vec![0u64; inst.len()];
     for (p, path) in one.paths.iter().enumerate() {
         let phases = prep.phases(p);
         for phase in 0..phases {
             let mut row: Vec<Option<Job>> = vec![None; inst.len()];
             for point in (phase..path.planes.len() as u32).step_by(phases as usize) {
                 let plane = path.planes[point as usize];
-                let free = |row: &[Option<Job>]| inst.columns(plane).find(|&c| row[c].is_none());
-                let column = match free(&row) {
+                let least = |row: &[Option<Job>]| {
+                    inst.columns(plane)
+                        .filter(|&c| row[c].is_none())
+                        .min_by_key(|&c| (given[c], c))
+                };
+                let column = match least(&row) {
                     Some(c) => c,
                     None => {
                         slots.push(std::mem::replace(&mut row, vec![None; inst.len()]));
-                        inst.columns(plane).start
+                        least(&row).unwrap_or(inst.columns(plane).start)
                     }
                 };
+                given[column] += 1;
                 row[column] = Some(Job {
                     path: p as u32,
                     round: 0,
@@ -47,6 +55,49 @@ pub fn round_template(problem: &Problem, copies: &[u32]) -> Result<Schedule, Sch
         instances: inst.instances,
         slots,
     })
+}
+
+/// PE copies per plane for dynamic dispatch within `budget`, from one round of `problem`
+/// (its `rounds` are not read: no model run). One per used plane; then one more at a time for
+/// the plane whose next copy saves the most *groups* of a round (a plane met `n` times in one
+/// phase of a path splits that phase into `n` groups, and each group is a link of the path's
+/// chain of slots; ties to the lower plane); once no copy saves a group, for the plane with the
+/// largest one-round load per copy (the rule of [`crate::size_copies`]).
+pub fn dispatch_copies(
+    problem: &Problem,
+    budget: &crate::Budget,
+) -> Result<Vec<u32>, ScheduleError> {
+    let one = problem.one_round();
+    let prep = Prepared::new(&one)?;
+    prep.check_budget(budget)?;
+    let mut copies = prep.base_copies();
+    // Per plane: how often each path meets it in one phase, where more than once.
+    let mut repeats: Vec<Vec<u32>> = vec![Vec::new(); copies.len()];
+    for (p, path) in one.paths.iter().enumerate() {
+        let phases = prep.phases(p);
+        for phase in 0..phases {
+            let mut count = std::collections::BTreeMap::new();
+            for point in (phase..path.planes.len() as u32).step_by(phases as usize) {
+                *count.entry(path.planes[point as usize]).or_insert(0u32) += 1;
+            }
+            for (plane, n) in count.into_iter().filter(|&(_, n)| n > 1) {
+                repeats[plane as usize].push(n);
+            }
+        }
+    }
+    let mut total: u32 = copies.iter().sum();
+    while total < budget.max_instances {
+        let saved = |pl: usize| repeats[pl].iter().filter(|&&n| n > copies[pl]).count();
+        let best = (0..copies.len()).max_by_key(|&pl| (saved(pl), std::cmp::Reverse(pl)));
+        match best {
+            Some(pl) if saved(pl) > 0 => {
+                copies[pl] += 1;
+                total += 1;
+            }
+            _ => break,
+        }
+    }
+    Ok(crate::list::grow_by_load(&one, copies, budget))
 }
 
 impl Problem {
@@ -69,7 +120,58 @@ impl Problem {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::PathJob;
+    use crate::{Budget, PathJob};
+
+    fn one_point(plane: u32) -> PathJob {
+        PathJob {
+            planes: vec![plane],
+            rounds: 1,
+            phases: 1,
+        }
+    }
+
+    #[test]
+    fn copies_share_the_paths_of_their_plane() {
+        // Two one-point paths on plane 0, two copies: each path gets its own copy, so both
+        // can run in one slot (a fixed copy 0 first served only paths meeting a plane twice).
+        let p = Problem {
+            num_planes: 1,
+            paths: vec![one_point(0), one_point(0), one_point(0)],
+        };
+        let t = round_template(&p, &[2]).unwrap();
+        t.check(&p.one_round()).unwrap();
+        let column = |slot: usize| t.slots[slot].iter().position(Option::is_some).unwrap();
+        assert_ne!(column(0), column(1));
+        // The third goes to the copy with fewer jobs so far; both have one: the lower.
+        assert_eq!(column(2), column(0));
+    }
+
+    #[test]
+    fn dispatch_copies_go_first_to_a_plane_met_twice_in_a_phase() {
+        // Path 0 meets plane 0 at points 0 and 2, both in red-black's phase 0: its round is
+        // three groups on one PE of plane 0, two with a copy. Plane 1 carries more jobs.
+        let p = Problem {
+            num_planes: 2,
+            paths: vec![
+                PathJob {
+                    planes: vec![0, 1, 0],
+                    rounds: 40,
+                    phases: 2,
+                },
+                one_point(1),
+                one_point(1),
+            ],
+        };
+        let three = dispatch_copies(&p, &Budget { max_instances: 3 }).unwrap();
+        assert_eq!(three, vec![2, 1]);
+        let groups = |c: &[u32]| round_template(&p, c).unwrap().slots.len();
+        assert_eq!((groups(&[1, 1]), groups(&three)), (5, 4));
+        // No copy saves another group: the one-round load decides (plane 1: 3 jobs, plane 0:
+        // 2 on two copies); the rounds (40) are not read.
+        let four = dispatch_copies(&p, &Budget { max_instances: 4 }).unwrap();
+        assert_eq!(four, vec![2, 2]);
+        assert!(dispatch_copies(&p, &Budget { max_instances: 1 }).is_err());
+    }
 
     fn problem(phases: u32) -> Problem {
         Problem {

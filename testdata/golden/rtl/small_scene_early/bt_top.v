@@ -13,7 +13,7 @@ module bt_top (
   output reg  avs_readdatavalid,
   output wire ins_irq
 );
-  // 7 PE instances, capacity 26 paths, 46 points, 26 groups; 2 x (jobs + 2) + max(29, dispatch + 1) cycles per slot, threshold 16 fine LSB
+  // 7 PE instances, capacity 26 paths, 46 points, 26 groups; load (jobs, or jobs + 2 after a dispatch wait) + max(29, dispatch + 1 - load) + write-back (jobs + 2) cycles per slot, threshold 16 fine LSB
   reg [2:0] state;
   reg [4:0] cnt;
   reg [5:0] paths_r;
@@ -44,6 +44,7 @@ module bt_top (
   reg [31:0] sched_q;
   reg sq_ok;
   reg sq_tail;
+  reg sq_ld;
   reg ld_q_en;
   reg ld_q_tail;
   reg ld_q_first;
@@ -136,17 +137,32 @@ module bt_top (
   // slot buffer: the running slot's jobs (rsel), the next slot's written by the dispatcher
   wire [3:0] slen_cur;
   assign slen_cur = (rsel ? slen_1 : slen_0);
+  wire sb_in;
+  assign sb_in = (cnt < {1'd0, slen_cur});
+  wire [3:0] slen_nxt;
+  assign slen_nxt = (rsel ? slen_0 : slen_1);
+  wire sb_pf;
+  assign sb_pf = ((state == 3'd4) && !(sb_in));
+  wire [4:0] sb_pf_idx;
+  assign sb_pf_idx = (cnt - {1'd0, slen_cur});
   wire [3:0] sb_ra;
-  assign sb_ra = {rsel, cnt[2:0]};
+  assign sb_ra = (sb_pf ? {~(rsel), sb_pf_idx[2:0]} : {rsel, cnt[2:0]});
   always @(posedge clk) begin
     sched_q <= sbuf[sb_ra];
-    sq_ok <= (((state == 3'd2) | (state == 3'd4)) && (cnt < {1'd0, slen_cur}));
-    sq_tail <= ((cnt + 5'd1) == {1'd0, slen_cur});
+    sq_ok <= ((((state == 3'd2) | (state == 3'd4)) && sb_in) | (sb_pf && (sb_pf_idx < {1'd0, slen_nxt})));
+    sq_tail <= (sb_pf ? ((sb_pf_idx + 5'd1) == {1'd0, slen_nxt}) : ((cnt + 5'd1) == {1'd0, slen_cur}));
+    sq_ld <= ((state == 3'd2) | sb_pf);
   end
   wire rom_valid;
   assign rom_valid = sq_ok;
   wire rom_tail;
   assign rom_tail = (sq_ok && sq_tail);
+  wire rom_wb_valid;
+  assign rom_wb_valid = (sq_ok && !(sq_ld));
+  wire rom_wb_tail;
+  assign rom_wb_tail = (rom_wb_valid && sq_tail);
+  wire rom_ld;
+  assign rom_ld = sq_ld;
   wire [4:0] rom_path;
   assign rom_path = sched_q[5:1];
   wire [5:0] rom_point;
@@ -202,7 +218,7 @@ module bt_top (
   reg [71:0] wr_data;
   always @* begin
     ra_addr = {bus_point, avs_address[2]};
-    if ((state == 3'd2)) begin
+    if (((state == 3'd2) | rom_ld)) begin
       ra_addr = {(rom_point - 6'd1), (cur[rom_path] ^ rom_late)};
     end else begin
       if ((state == 3'd4)) begin
@@ -422,8 +438,12 @@ module bt_top (
   assign rq_after = (wb_push ? (rq_count + 6'd1) : rq_count);
   wire rq_empty;
   assign rq_empty = (rq_after == 6'd0);
+  wire wb_end;
+  assign wb_end = ((state == 3'd4) && wb_q_tail);
+  wire to_load;
+  assign to_load = ((wb_end | ((state == 3'd1) && (dstate == 3'd0))) && !(((rsel ? slen_0 : slen_1) == 4'd0)));
   wire d_go;
-  assign d_go = (((start_req && !((paths_r == 6'd0))) | ((state == 3'd2) && ld_q_tail)) | ((((state == 3'd4) && wb_q_tail) && ((rsel ? slen_0 : slen_1) == 4'd0)) && !(rq_empty)));
+  assign d_go = (((start_req && !((paths_r == 6'd0))) | to_load) | ((wb_end && ((rsel ? slen_0 : slen_1) == 4'd0)) && !(rq_empty)));
   wire [5:0] d_scan_init;
   assign d_scan_init = (start_req ? paths_r : rq_after);
   wire [5:0] d_scan_cap;
@@ -432,7 +452,7 @@ module bt_top (
   assign rq_push = (d_push | wb_push);
   always @(posedge clk) begin
     if (((host_wr && is_status) | rq_push)) begin
-      rq[(host_wr ? avs_address[4:0] : rq_tail)] <= (host_wr ? avs_writedata[11:0] : (d_push ? {d_gbase, d_gptr} : wb_push_data));
+      rq[(host_wr ? avs_address[4:0] : (wb_push ? (rq_head - 5'd1) : rq_tail))] <= (host_wr ? avs_writedata[11:0] : (d_push ? {d_gbase, d_gptr} : wb_push_data));
     end
     rq_q <= rq[rq_head];
   end
@@ -449,8 +469,12 @@ module bt_top (
       end else begin
         if (d_pop) begin
           rq_head <= (rq_head + 5'd1);
+        end else begin
+          if (wb_push) begin
+            rq_head <= (rq_head - 5'd1);
+          end
         end
-        if (rq_push) begin
+        if (d_push) begin
           rq_tail <= (rq_tail + 5'd1);
         end
         if (rq_push) begin
@@ -631,7 +655,7 @@ module bt_top (
   assign pe_load_4 = (((state == 3'd2) && ld_q_en) && (ld_q_inst == 3'd4));
   assign pe_load_5 = (((state == 3'd2) && ld_q_en) && (ld_q_inst == 3'd5));
   assign pe_load_6 = (((state == 3'd2) && ld_q_en) && (ld_q_inst == 3'd6));
-  // main FSM: IDLE -> DISP -> per slot LOAD (jobs + 2) EXEC (max(29, dispatch + 1)) WB (jobs + 2) -> IDLE with done when no path is queued
+  // main FSM: IDLE -> DISP -> per slot LOAD (jobs + 2, or jobs after a write-back) EXEC (max(29, dispatch + 1 - load)) WB (jobs + 2) -> IDLE with done when no path is queued
   always @(posedge clk) begin
     if (!(rst_n)) begin
       state <= 3'd0;
@@ -704,8 +728,8 @@ module bt_top (
           end
         end
         3'd4: begin
-          wb_q_en <= rom_valid;
-          wb_q_tail <= rom_tail;
+          wb_q_en <= rom_wb_valid;
+          wb_q_tail <= rom_wb_tail;
           wb_q_end <= rom_end;
           wb_q_path <= rom_path;
           wb_q_point <= rom_point;
@@ -713,6 +737,13 @@ module bt_top (
           wb_q_gtail <= rom_gtail;
           wb_q_src <= rom_src;
           wb_q_gbase <= rom_gbase;
+          if (rom_ld) begin
+            ld_q_en <= rom_valid;
+            ld_q_tail <= rom_tail;
+            ld_q_first <= rom_first;
+            ld_q_last <= rom_last;
+            ld_q_inst <= rom_inst;
+          end
           if (wb_go) begin
             if (wb_q_end) begin
               cur[wb_q_path] <= ~(cur[wb_q_path]);
@@ -744,6 +775,7 @@ module bt_top (
             end else begin
               state <= 3'd2;
               rsel <= ~(rsel);
+              cnt <= 5'd2;
             end
           end else begin
             cnt <= (cnt + 5'd1);

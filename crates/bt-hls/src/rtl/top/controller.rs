@@ -50,6 +50,12 @@ pub(super) struct ScheduleRead {
     pub(super) valid: Signal,
     /// The slot's last entry.
     pub(super) tail: Signal,
+    /// `valid` and `tail` for write-back: not an entry of the next slot read ahead for its
+    /// load.
+    pub(super) wb_valid: Signal,
+    pub(super) wb_tail: Signal,
+    /// The entry is for the load (read in LOAD, or read ahead in write-back's last cycles).
+    pub(super) load: Signal,
     /// Path, point (global index) and PE column of the job.
     pub(super) path: Signal,
     pub(super) point: Signal,
@@ -132,30 +138,69 @@ pub(super) fn slot_buffer_read(t: &Dims<'_>, items: &mut Vec<Item>) -> ScheduleR
     let w = cnt_bits.max(ib + 1);
     let cnt_w = zero_extend("cnt", cnt_bits, w);
     let len_w = zero_extend(slen.name(), ib + 1, w);
-    let in_slot = Expr::bin(BinaryOp::Lt, cnt_w.clone(), len_w.clone());
-    let is_last = cnt_w.plus(lit(w, 1)).eq(len_w);
+    let in_slot = Signal::assigned(
+        items,
+        "sb_in",
+        1,
+        Expr::bin(BinaryOp::Lt, cnt_w.clone(), len_w.clone()),
+    );
+    let is_last = cnt_w.clone().plus(lit(w, 1)).eq(len_w.clone());
+    // Write-back's last two cycles leave the buffer's read port free: they read the next
+    // slot's first two entries, so its load starts with them in hand (`sq_ld` marks them).
+    let next_len = Signal::assigned(
+        items,
+        "slen_nxt",
+        ib + 1,
+        Expr::mux(id("rsel"), id("slen_0"), id("slen_1")),
+    );
+    let prefetch = Signal::assigned(items, "sb_pf", 1, state_is(S_WB).and(in_slot.e().lnot()));
+    let pf_idx = Signal::assigned(items, "sb_pf_idx", w, cnt_w.minus(len_w));
+    let nlen_w = zero_extend(next_len.name(), ib + 1, w);
+    let pf_in = Expr::bin(BinaryOp::Lt, pf_idx.e(), nlen_w.clone());
+    let pf_last = pf_idx.e().plus(lit(w, 1)).eq(nlen_w);
     let sb_ra = Signal::assigned(
         items,
         "sb_ra",
         ib + 1,
-        Expr::concat(vec![id("rsel"), zero_extend("cnt", cnt_bits, ib)]),
+        Expr::mux(
+            prefetch.e(),
+            Expr::concat(vec![
+                id("rsel").inv(),
+                Expr::slice(pf_idx.name(), ib - 1, 0),
+            ]),
+            Expr::concat(vec![id("rsel"), zero_extend("cnt", cnt_bits, ib)]),
+        ),
     );
     items.push(Item::AlwaysFf(vec![
         nb(id("sched_q"), Expr::id("sbuf").at(sb_ra.e())),
         nb(
             id("sq_ok"),
-            or(state_is(S_LOAD), state_is(S_WB)).and(in_slot),
+            or(
+                or(state_is(S_LOAD), state_is(S_WB)).and(in_slot.e()),
+                prefetch.e().and(pf_in),
+            ),
         ),
-        nb(id("sq_tail"), is_last),
+        nb(id("sq_tail"), Expr::mux(prefetch.e(), pf_last, is_last)),
+        nb(id("sq_ld"), or(state_is(S_LOAD), prefetch.e())),
     ]));
     let field = |items: &mut Vec<Item>, n: &str, w: u32, lo: u32| {
         Signal::assigned(items, n, w, Expr::slice("sched_q", lo + w - 1, lo))
     };
     let valid = Signal::assigned(items, "rom_valid", 1, id("sq_ok"));
     let tail = Signal::assigned(items, "rom_tail", 1, id("sq_ok").and(id("sq_tail")));
+    let wb_valid = Signal::assigned(
+        items,
+        "rom_wb_valid",
+        1,
+        id("sq_ok").and(id("sq_ld").lnot()),
+    );
+    let wb_tail = Signal::assigned(items, "rom_wb_tail", 1, wb_valid.e().and(id("sq_tail")));
     ScheduleRead {
         valid,
         tail,
+        wb_valid,
+        wb_tail,
+        load: Signal::assigned(items, "rom_ld", 1, id("sq_ld")),
         path: field(items, "rom_path", pb, 1),
         point: field(items, "rom_point", ptb, 1 + pb),
         inst: field(items, "rom_inst", ib, 6 + pb + ptb),
@@ -331,7 +376,8 @@ pub(super) fn slot_buffer_write(t: &Dims<'_>, d: &DispatchJob, items: &mut Vec<I
 
 /// The ready queue (`rq`): a circular buffer of `{first group, next group}` per queued
 /// path, written by the host while idle (PATH_BASE[p] = path p's entry), then by the
-/// dispatcher's push-backs and write-back's pushes (never in the same cycle); read at the head.
+/// dispatcher's push-backs at the tail and write-back's pushes at the head (never in the same
+/// cycle); read at the head.
 pub(super) fn ready_queue(
     t: &Dims<'_>,
     bus: &Decode,
@@ -352,10 +398,13 @@ pub(super) fn ready_queue(
             wb_data.e(),
         ),
     );
+    // Write-back queues a path's next group at the head (the running paths first: a long
+    // chain is not held up behind every waiting path), the dispatcher's push-backs at the tail.
+    let head_before = id("rq_head").minus(lit(pb, 1));
     let addr = Expr::mux(
         bus.host_wr.e(),
         Expr::slice("avs_address", pb - 1, 0),
-        id("rq_tail"),
+        Expr::mux(wb_push.e(), head_before.clone(), id("rq_tail")),
     );
     items.push(Item::AlwaysFf(vec![
         Stmt::If(
@@ -384,10 +433,14 @@ pub(super) fn ready_queue(
                 Stmt::If(
                     d.pop.e(),
                     vec![nb(id("rq_head"), inc("rq_head", pb))],
-                    vec![],
+                    vec![Stmt::If(
+                        wb_push.e(),
+                        vec![nb(id("rq_head"), head_before)],
+                        vec![],
+                    )],
                 ),
                 Stmt::If(
-                    push.e(),
+                    d.push_back.e(),
                     vec![nb(id("rq_tail"), inc("rq_tail", pb))],
                     vec![],
                 ),
@@ -468,15 +521,9 @@ pub(super) fn fsm_disp(t: &Dims<'_>) -> Vec<Stmt> {
 }
 
 /// LOAD: register the slot's entries for the operand broadcast until its tail, then EXEC
-/// (the dispatcher starts on the next slot at the same edge).
+/// (the dispatcher has been building the next slot since LOAD began).
 pub(super) fn fsm_load(t: &Dims<'_>, rom: &ScheduleRead) -> Vec<Stmt> {
-    let mut stmts = register_entry(&[
-        ("ld_q_en", &rom.valid),
-        ("ld_q_tail", &rom.tail),
-        ("ld_q_first", &rom.first),
-        ("ld_q_last", &rom.last),
-        ("ld_q_inst", &rom.inst),
-    ]);
+    let mut stmts = register_load_entry(rom);
     stmts.push(Stmt::If(
         id("ld_q_tail"),
         vec![
@@ -486,6 +533,17 @@ pub(super) fn fsm_load(t: &Dims<'_>, rom: &ScheduleRead) -> Vec<Stmt> {
         vec![nb(id("cnt"), cnt_inc(t))],
     ));
     stmts
+}
+
+/// Registers the entry's fields for the operand broadcast.
+fn register_load_entry(rom: &ScheduleRead) -> Vec<Stmt> {
+    register_entry(&[
+        ("ld_q_en", &rom.valid),
+        ("ld_q_tail", &rom.tail),
+        ("ld_q_first", &rom.first),
+        ("ld_q_last", &rom.last),
+        ("ld_q_inst", &rom.inst),
+    ])
 }
 
 /// Registers the schedule entry's fields: one `register <= field` per pair, in order.
@@ -521,8 +579,8 @@ pub(super) fn fsm_writeback(
     queue_empty: &Signal,
 ) -> Vec<Stmt> {
     let mut stmts = register_entry(&[
-        ("wb_q_en", &rom.valid),
-        ("wb_q_tail", &rom.tail),
+        ("wb_q_en", &rom.wb_valid),
+        ("wb_q_tail", &rom.wb_tail),
         ("wb_q_end", &rom.end),
         ("wb_q_path", &rom.path),
         ("wb_q_point", &rom.point),
@@ -544,9 +602,12 @@ pub(super) fn fsm_writeback(
         vec![
             nb(id("state"), lit(STATE_BITS, S_LOAD)),
             nb(id("rsel"), id("rsel").inv()),
+            // Its first two entries were read ahead.
+            nb(id("cnt"), lit(t.cnt_bits, 2)),
         ],
     );
     stmts.extend([
+        Stmt::If(rom.load.e(), register_load_entry(rom), vec![]),
         Stmt::If(f.go.e(), path_commit(f), vec![]),
         Stmt::If(
             id("wb_q_tail"),
@@ -557,8 +618,9 @@ pub(super) fn fsm_writeback(
     stmts
 }
 
-/// The start request and the dispatcher's trigger: at a start, when a slot's PEs start
-/// (LOAD's tail) and when a slot ends with no next slot while paths are queued. Returns
+/// The start request and the dispatcher's trigger: at a start, when a slot starts loading
+/// (so the dispatcher has the load and the PE latency for the slot after it) and when a slot
+/// ends with no next slot while paths are queued. Returns
 /// `(start_req, d_go, d_scan_init, queue_empty)`.
 pub(super) fn dispatch_triggers(
     t: &Dims<'_>,
@@ -586,10 +648,17 @@ pub(super) fn dispatch_triggers(
         ),
     );
     let empty = Signal::assigned(items, "rq_empty", 1, queued.e().eq(lit(pb + 1, 0)));
-    let at_wb_tail = state_is(S_WB)
-        .and(id("wb_q_tail"))
-        .and(next_len(t))
-        .and(empty.e().lnot());
+    // A slot ends with its write-back's last entry; the next one starts loading at once when
+    // the dispatcher built it (from DISP when it was built with no slot running).
+    let wb_end = Signal::assigned(items, "wb_end", 1, state_is(S_WB).and(id("wb_q_tail")));
+    let at_wb_tail = wb_end.e().and(next_len(t)).and(empty.e().lnot());
+    let to_load = Signal::assigned(
+        items,
+        "to_load",
+        1,
+        or(wb_end.e(), state_is(S_DISP).and(dstate_is(D_OFF))).and(next_len(t).lnot()),
+    );
+    // The dispatcher builds the slot after next while this one loads and computes.
     let go = Signal::assigned(
         items,
         "d_go",
@@ -597,7 +666,7 @@ pub(super) fn dispatch_triggers(
         or(
             or(
                 start_req.e().and(id("paths_r").eq(lit(pb + 1, 0)).lnot()),
-                state_is(S_LOAD).and(id("ld_q_tail")),
+                to_load.e(),
             ),
             at_wb_tail,
         ),
@@ -629,7 +698,7 @@ pub(super) fn controller(
 ) {
     let cnt_bits = t.cnt_bits;
     items.push(Item::Comment(format!(
-        "main FSM: IDLE -> DISP -> per slot LOAD (jobs + 2) EXEC (max({}, dispatch + 1)) WB (jobs + 2) -> IDLE with done when no path is queued",
+        "main FSM: IDLE -> DISP -> per slot LOAD (jobs + 2, or jobs after a write-back) EXEC (max({}, dispatch + 1 - load)) WB (jobs + 2) -> IDLE with done when no path is queued",
         t.latency()
     )));
     items.push(Item::AlwaysFf(vec![Stmt::If(

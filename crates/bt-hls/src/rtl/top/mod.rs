@@ -162,7 +162,7 @@ fn declare_state(t: &Dims<'_>, items: &mut Vec<Item>) -> Vec<PeWires> {
     let (k, pb, ptb, ib, eb, np2) = (t.k, t.pb, t.ptb, t.ib, t.eb, t.np2);
     let cap = t.p.platform.capacity;
     items.push(Item::Comment(format!(
-        "{} PE instances, capacity {} paths, {} points, {} groups; 2 x (jobs + 2) + max({}, dispatch + 1) cycles per slot, threshold {} fine LSB",
+        "{} PE instances, capacity {} paths, {} points, {} groups; load (jobs, or jobs + 2 after a dispatch wait) + max({}, dispatch + 1 - load) + write-back (jobs + 2) cycles per slot, threshold {} fine LSB",
         k,
         cap.paths,
         cap.points,
@@ -201,6 +201,7 @@ fn declare_state(t: &Dims<'_>, items: &mut Vec<Item>) -> Vec<PeWires> {
         ("sched_q", sched_entry_bits(pb, ptb, ib) + 2 * eb),
         ("sq_ok", 1),
         ("sq_tail", 1),
+        ("sq_ld", 1),
         ("ld_q_en", 1),
         ("ld_q_tail", 1),
         ("ld_q_first", 1),

@@ -87,7 +87,7 @@ pub(super) fn updater_read_ports(
     items.push(Item::AlwaysComb(vec![
         Stmt::Blocking(ra_addr.e(), bus_cell(bus)),
         Stmt::If(
-            state_is(S_LOAD),
+            or(state_is(S_LOAD), rom.load.e()),
             vec![Stmt::Blocking(
                 ra_addr.e(),
                 Expr::concat(vec![rom.point.e().minus(one_pt.clone()), nb_bank.clone()]),
