@@ -611,6 +611,44 @@ fn fresnel_v(h: Real, d_a: Real, d_b: Real) -> Real {
     h * (2.0 / wavelength * (1.0 / d_a + 1.0 / d_b)).sqrt()
 }
 
+/// One row of the two-screen comparison: (v1, v2, Epstein–Peterson, with Millington's
+/// correction, UTD V, UTD H), the last four dB relative to free space over the direct distance.
+type ScreenRow = (Real, Real, Real, Real, Real, Real);
+
+/// A curve of the two-screen figure: its label, colour and which column of a row it draws.
+type Curve = (
+    &'static str,
+    plotters::style::RGBColor,
+    fn(&ScreenRow) -> Real,
+);
+
+/// The two-screen comparison at one gap (TX 50 m before the first screen, RX 70 m after the
+/// second, both `h` metres below the edges).
+fn two_screens(gap: Real, h: Real) -> ScreenRow {
+    let (tx, rx) = (Vec3::new(-50.0, 0.0, 0.0), Vec3::new(gap + 70.0, 0.0, 0.0));
+    let (e1, e2) = (Vec3::new(0.0, 0.0, h), Vec3::new(gap, 0.0, h));
+    let (s0, s1, s2) = (tx.distance(e1), gap, e2.distance(rx));
+    let v1 = fresnel_v(height_above(e1, tx, e2), 50.0, gap);
+    let v2 = fresnel_v(height_above(e2, e1, rx), gap, 70.0);
+    let ep = db((fresnel_kirchhoff(v1) * fresnel_kirchhoff(v2)).norm());
+    let millington = ep + db((s1 * (s0 + s1 + s2) / ((s0 + s1) * (s1 + s2))).sqrt());
+    let utd = |polarization| {
+        let a = isotropic(polarization);
+        let twice = [Interaction::Diffraction(screen()); 2];
+        let g = path_gain_mixed(tx, &[e1, e2], rx, &twice, (&a, &a), F).unwrap();
+        let free = path_gain(tx, &[], rx, &[], (&a, &a), F).unwrap();
+        db(g.norm() / free.norm())
+    };
+    (
+        v1,
+        v2,
+        ep,
+        millington,
+        utd(Polarization::V),
+        utd(Polarization::H),
+    )
+}
+
 /// Two parallel screens (issue 28): the path over both edges against the Epstein–Peterson
 /// construction, each edge's Fresnel–Kirchhoff knife edge in turn (the first between TX and
 /// the second edge, the second between the first edge and RX), relative to free space over
@@ -634,21 +672,8 @@ fn two_screens_match_epstein_peterson() {
         (160.0, 3.0),
         (160.0, 8.0),
     ] {
-        let (tx, rx) = (Vec3::new(-50.0, 0.0, 0.0), Vec3::new(gap + 70.0, 0.0, 0.0));
-        let (e1, e2) = (Vec3::new(0.0, 0.0, h), Vec3::new(gap, 0.0, h));
-        let (s0, s1, s2) = (tx.distance(e1), gap, e2.distance(rx));
-        let v1 = fresnel_v(height_above(e1, tx, e2), 50.0, gap);
-        let v2 = fresnel_v(height_above(e2, e1, rx), gap, 70.0);
-        let ep = db((fresnel_kirchhoff(v1) * fresnel_kirchhoff(v2)).norm());
-        let millington = ep + db((s1 * (s0 + s1 + s2) / ((s0 + s1) * (s1 + s2))).sqrt());
-        let mut row = Vec::new();
-        for polarization in [Polarization::V, Polarization::H] {
-            let a = isotropic(polarization);
-            let twice = [Interaction::Diffraction(screen()); 2];
-            let g = path_gain_mixed(tx, &[e1, e2], rx, &twice, (&a, &a), F).unwrap();
-            let free = path_gain(tx, &[], rx, &[], (&a, &a), F).unwrap();
-            row.push(db(g.norm() / free.norm()));
-        }
+        let (v1, v2, ep, millington, v, h_pol) = two_screens(gap, h);
+        let row = [v, h_pol];
         println!(
             "  {gap:5.0}  {h:3.0}  {v1:5.2}  {v2:5.2}  {ep:7.2}  {millington:7.2}     {:7.2} {:7.2}",
             row[0], row[1]
@@ -721,4 +746,62 @@ fn two_diffractions_are_reciprocal() {
             }
         }
     }
+}
+
+/// docs/img/channel-two-screens.svg (docs/channel.md, "Two diffractions"): UTD's product form
+/// against Epstein–Peterson, plain and with Millington's correction, over the gap between the
+/// screens; the figure is a golden file (`UPDATE_GOLDEN=1` redraws it).
+#[test]
+fn the_two_screen_figure_is_current() {
+    use plotters::prelude::*;
+    let gaps: Vec<Real> = (0..=39).map(|k| 5.0 * 1.1f64.powi(k)).collect();
+    let rows: Vec<_> = gaps.iter().map(|&g| (g, two_screens(g, 3.0))).collect();
+    let mut svg = String::new();
+    {
+        let root = SVGBackend::with_string(&mut svg, (800, 480)).into_drawing_area();
+        bt_plot::blank(&root).unwrap();
+        let mut chart = ChartBuilder::on(&root)
+            .caption(
+                "Two screens, 3 m over the path, 3.5 GHz: path over both edges",
+                (bt_plot::FAMILY, 17),
+            )
+            .margin(12)
+            .x_label_area_size(40)
+            .y_label_area_size(55)
+            .build_cartesian_2d((5.0..250.0).log_scale(), -40.0..-18.0)
+            .unwrap();
+        bt_plot::mesh(
+            &mut chart,
+            ("gap between the screens (m)", "dB re free space"),
+            (12, 14),
+        )
+        .disable_x_mesh()
+        .x_labels(6)
+        .x_label_formatter(&|g| format!("{g:.0}"))
+        .draw()
+        .unwrap();
+        let series: [Curve; 4] = [
+            ("Epstein-Peterson", BLACK, |r| r.2),
+            (
+                "Epstein-Peterson + Millington",
+                RGBColor(120, 120, 120),
+                |r| r.3,
+            ),
+            ("UTD product form, V (hard)", BLUE, |r| r.4),
+            ("UTD product form, H (soft)", RED, |r| r.5),
+        ];
+        for (label, colour, value) in series {
+            let points = rows.iter().map(|(g, r)| (*g, value(r)));
+            chart
+                .draw_series(LineSeries::new(points, colour.stroke_width(2)))
+                .unwrap()
+                .label(label)
+                .legend(move |(x, y)| PathElement::new(vec![(x, y), (x + 20, y)], colour));
+        }
+        bt_plot::legend(&mut chart, SeriesLabelPosition::UpperRight, 12).unwrap();
+        root.present().unwrap();
+    }
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../docs/img/channel-two-screens.svg");
+    bt_testkit::golden::assert_golden(path, svg);
 }
