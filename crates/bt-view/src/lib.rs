@@ -516,6 +516,53 @@ mod tests {
         }
     }
 
+    /// Two parallel screens, TX and RX below their tops: the page holds the paths over both
+    /// screens (two diffractions each), and over the cap it draws both edges of a shown path,
+    /// from its ids and, read back from a document, from its points and names.
+    #[test]
+    fn twice_diffracted_paths_and_both_their_edges_are_shown() {
+        let json = r#"{ "tx": [0, -3, 0.5], "rx": [0.3, 6, 0.4],
+            "surfaces": [
+              { "name": "near", "vertices": [[-30, 0, -30], [30, 0, -30], [30, 0, 2], [-30, 0, 2]] },
+              { "name": "far", "vertices": [[-30, 3, -30], [30, 3, -30], [30, 3, 2], [-30, 3, 2]] } ] }"#;
+        let desc: bt_scene::SceneDescription = serde_json::from_str(json).unwrap();
+        let scene = Scene::from_description(&desc, "screens", Default::default()).unwrap();
+        let options = bt_solve::pipeline::TraceOptions {
+            parallel: false,
+            diffraction: bt_solve::pipeline::DiffractionOptions {
+                max_diffractions: 2,
+                min_edge_length: 0.0,
+            },
+            ..bt_solve::pipeline::TraceOptions::new(2)
+        };
+        let ends = scene.terminals().unwrap();
+        let traced = bt_solve::Tracer::new(scene.clone(), options)
+            .trace(scene.to_world(ends.tx), scene.to_world(ends.rx))
+            .unwrap();
+        let reports = bt_beams::report(&scene, &traced.result.paths, &Default::default()).unwrap();
+        let over: Vec<&PathReport> = reports
+            .iter()
+            .filter(|r| r.surfaces == ["near", "far"] && r.points.iter().all(|p| p[2] == 2.0))
+            .collect();
+        assert_eq!(over.len(), 1, "one path over both tops: {reports:?}");
+        let html = page(&[&scene], &[StepPaths::from_reports(&scene, &reports)]);
+        let paths = embedded(&html)["steps"][0]["paths"]
+            .as_array()
+            .unwrap()
+            .clone();
+        assert!(
+            paths
+                .iter()
+                .any(|p| p["interactions"] == serde_json::json!(["diffraction", "diffraction"])),
+            "{paths:?}"
+        );
+        let shown = shown_edges(&scene, &[over[0].clone()], 0);
+        assert_eq!(shown.len(), 2, "both edges of the path");
+        let json = serde_json::to_string(&[over[0].clone()]).unwrap();
+        let read: Vec<PathReport> = serde_json::from_str(&json).unwrap();
+        assert_eq!(shown_edges(&scene, &read, 0), shown);
+    }
+
     #[test]
     fn over_the_cap_only_the_edges_of_the_shown_paths_are_drawn() {
         let (scene, reports) = screen_and_paths();
