@@ -138,13 +138,7 @@ impl Edge {
     /// the projections on it; `None` when both lie on the line.
     #[inline]
     pub fn keller(&self, a: Vec3, b: Vec3) -> Option<Real> {
-        let (da, db) = (
-            self.perpendicular(a).length(),
-            self.perpendicular(b).length(),
-        );
-        let sum = da + db;
-        (sum > 0.0 && sum.is_finite())
-            .then(|| (db * self.parameter(a) + da * self.parameter(b)) / sum)
+        EdgeLine::of(self).keller(a, b)
     }
 }
 

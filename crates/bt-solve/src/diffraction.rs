@@ -194,8 +194,9 @@ pub fn validate(
         k => points[k - 1],
     };
     for (k, e) in c.edges() {
-        let t = scene.edges().get(e).parameter(points[k]);
-        if t <= tol || t >= scene.edges().get(e).length - tol {
+        let edge = scene.edges().get(e);
+        let t = edge.parameter(points[k]);
+        if t <= tol || t >= edge.length - tol {
             return Validity::OffEdge { index: k };
         }
     }

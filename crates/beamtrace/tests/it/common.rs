@@ -120,6 +120,23 @@ pub fn read_json(path: &Path) -> Value {
     serde_json::from_str(&text).unwrap_or_else(|e| panic!("{}: {e}", path.display()))
 }
 
+/// Each path of a trace document as (its `interactions`, its `surfaces`).
+pub fn kinds_and_surfaces(doc: &Value) -> Vec<(Vec<String>, Vec<String>)> {
+    let strings = |v: &Value| -> Vec<String> {
+        v.as_array()
+            .unwrap()
+            .iter()
+            .map(|s| s.as_str().unwrap().to_string())
+            .collect()
+    };
+    doc["paths"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| (strings(&p["interactions"]), strings(&p["surfaces"])))
+        .collect()
+}
+
 /// The largest TX angle error, degrees, of the fixed-point model against f64 in the summary
 /// `hls gen` writes for a design or a step.
 pub fn fixed_point_tx_error_deg(summary: &Value) -> f64 {

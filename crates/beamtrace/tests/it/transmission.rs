@@ -14,18 +14,8 @@ fn example() -> String {
 /// The crossings of each path of a trace document: (interactions, surfaces) where any
 /// interaction is a transmission.
 fn crossing_paths(doc: &Value) -> Vec<(Vec<String>, Vec<String>)> {
-    let strings = |v: &Value| -> Vec<String> {
-        v.as_array()
-            .unwrap()
-            .iter()
-            .map(|s| s.as_str().unwrap().to_string())
-            .collect()
-    };
-    doc["paths"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|p| (strings(&p["interactions"]), strings(&p["surfaces"])))
+    kinds_and_surfaces(doc)
+        .into_iter()
         .filter(|(kinds, _)| kinds.iter().any(|k| k == "transmission"))
         .collect()
 }

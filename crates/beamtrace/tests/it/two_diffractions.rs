@@ -14,18 +14,8 @@ fn example() -> String {
 /// The paths of a document that pass both walls (a surface of each wall among their
 /// interactions), as (interactions, surfaces).
 fn over_both(doc: &Value) -> Vec<(Vec<String>, Vec<String>)> {
-    let strings = |v: &Value| -> Vec<String> {
-        v.as_array()
-            .unwrap()
-            .iter()
-            .map(|s| s.as_str().unwrap().to_string())
-            .collect()
-    };
-    doc["paths"]
-        .as_array()
-        .unwrap()
-        .iter()
-        .map(|p| (strings(&p["interactions"]), strings(&p["surfaces"])))
+    kinds_and_surfaces(doc)
+        .into_iter()
         .filter(|(_, names)| {
             names.iter().any(|n| n == "wall-a") && names.iter().any(|n| n == "wall-b")
         })

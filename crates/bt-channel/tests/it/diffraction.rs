@@ -67,14 +67,7 @@ fn fresnel_kirchhoff(v: Real) -> Complex64 {
 fn knife_edge_matches_fresnel_kirchhoff_in_the_shadow() {
     let (d1, d2) = (40.0, 60.0);
     let wavelength = SPEED_OF_LIGHT / F;
-    let screen = Wedge {
-        edge: Vec3::Y,
-        face0: -Vec3::Z,
-        normal0: -Vec3::X,
-        n: 2.0,
-        response0: conductor(),
-        response_n: conductor(),
-    };
+    let screen = screen();
     println!("    v   Fresnel-Kirchhoff   UTD V (hard)   UTD H (soft)   (dB re free space)");
     for v in [0.5, 1.0, 1.5, 2.0, 3.0, 4.0, 5.0] {
         let h = v / (2.0 / wavelength * (1.0 / d1 + 1.0 / d2)).sqrt();
@@ -585,8 +578,8 @@ fn sionnas_diffracted_leg_grows_with_its_solver_depth() {
     assert!(bt_channel::sionna_rt22_diffracted_leg(&points, rx, &interactions, 1).is_err());
 }
 
-/// A thin conducting screen below a horizontal edge along y (face 0 pointing down), as in
-/// [`knife_edge_matches_fresnel_kirchhoff_in_the_shadow`].
+/// A thin conducting screen below a horizontal edge along y through the origin (face 0
+/// pointing down): the knife edge.
 fn screen() -> Wedge {
     Wedge {
         edge: Vec3::Y,

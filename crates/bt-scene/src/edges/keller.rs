@@ -52,7 +52,9 @@ impl EdgeLine {
         }
     }
 
-    /// The Keller point of `a → line → b` ([`Edge::keller`]'s closed form).
+    /// The Keller point of `a → line → b`: the parameter `t* = (d_b·t_a + d_a·t_b)/(d_a + d_b)`,
+    /// `d` the distances to the line and `t` the projections on it (the one closed form,
+    /// [`Edge::keller`] too); `None` when both lie on the line.
     pub fn keller(&self, a: Vec3, b: Vec3) -> Option<Real> {
         let perpendicular = |p: Vec3| {
             let v = p - self.start;

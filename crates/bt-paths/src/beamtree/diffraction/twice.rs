@@ -115,16 +115,16 @@ fn segment_distance_bound(ps: [Vec3; 2], qs: [Vec3; 2]) -> Real {
 
 /// Whether no stretch from a point of segment `near` to one of segment `far` (the second
 /// edge's interval unfolded through a middle reflection) crosses the reflection's plane within
-/// `margin` of its polygon's box `(lo, hi)`, when the segments lie strictly on either side of
-/// the plane: the crossings lie in the convex hull of the four corner-to-corner crossings
+/// `margin` of its polygon's box, when the segments lie strictly on either side of the plane
+/// (`dn`, `df`: the ends' signed distances from it): the crossings lie in the convex hull of the four corner-to-corner crossings
 /// (the tetrahedron of the four ends meets the plane there), so when those four are beyond one
 /// face of the grown box, every crossing is. Straddling segments are never rejected.
-fn misses_window(polygon: &Polygon, (near, far): ([Vec3; 2], [Vec3; 2]), margin: Real) -> bool {
-    let plane = polygon.plane();
-    let (dn, df) = (
-        near.map(|p| plane.signed_distance(p)),
-        far.map(|p| plane.signed_distance(p)),
-    );
+fn misses_window(
+    polygon: &Polygon,
+    (near, far): ([Vec3; 2], [Vec3; 2]),
+    (dn, df): ([Real; 2], [Real; 2]),
+    margin: Real,
+) -> bool {
     let split =
         |x: [Real; 2], y: [Real; 2]| x.iter().all(|d| *d > 0.0) && y.iter().all(|d| *d < 0.0);
     if !(split(dn, df) || split(df, dn)) {
@@ -300,7 +300,9 @@ impl Pairing<'_> {
             if opposite(first, second) || opposite(second, first) {
                 return false;
             }
-            if misses_window(&scene.surface(*m).polygon, (a.ends, far.ends), self.margin) {
+            let unfolded = second.map(|d| -d);
+            let polygon = &scene.surface(*m).polygon;
+            if misses_window(polygon, (a.ends, far.ends), (first, unfolded), self.margin) {
                 return false;
             }
         }
