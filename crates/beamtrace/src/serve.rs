@@ -184,27 +184,39 @@ where
 }
 
 /// SIGTERM and SIGINT stop the server cleanly: the answer in hand is written and flushed, a
-/// read waiting for a request ends (the handler leaves reads interruptible), and the Unix
-/// socket the server made is removed. While it waits for a client (the standard library
-/// retries an interrupted accept) nothing is in flight: the handler removes the socket and
-/// exits at once (`unlink` and `_exit` are async-signal-safe).
-/// SIGTERM and SIGINT stop the server cleanly: the answer in hand is written and flushed, a
 /// read waiting for a request ends (the handler leaves reads interruptible; with `--listen`
 /// the listener sees the stop within [`POLL`] and ends every connection's reading side).
 #[cfg(unix)]
 mod stop {
-    use std::sync::atomic::{AtomicBool, Ordering};
+    use std::sync::atomic::{AtomicBool, AtomicU64, Ordering};
 
     static STOP: AtomicBool = AtomicBool::new(false);
+    /// The thread that installed the handler (the one reading stdin), as a `pthread_t`.
+    static READER: AtomicU64 = AtomicU64::new(0);
 
-    extern "C" fn on_signal(_: libc::c_int) {
+    /// The kernel hands a process's signal to any thread that does not block it, e.g. an idle
+    /// worker of the tracing pool, whose wait just resumes: the reader's blocked `read` would
+    /// never return. So a handler running elsewhere passes the signal on to the reader
+    /// (`pthread_self` and `pthread_kill` are async-signal-safe).
+    extern "C" fn on_signal(signal: libc::c_int) {
         STOP.store(true, Ordering::SeqCst);
+        // SAFETY: `pthread_self` has no preconditions; READER holds a live thread's id (the
+        // reader outlives the signal handling: it is the thread that returns from `serve`).
+        unsafe {
+            let reader = READER.load(Ordering::SeqCst) as libc::pthread_t;
+            if libc::pthread_self() != reader {
+                libc::pthread_kill(reader, signal);
+            }
+        }
     }
 
-    /// Handle SIGTERM and SIGINT (without `SA_RESTART`, so a blocked read returns).
+    /// Handle SIGTERM and SIGINT (without `SA_RESTART`, so a blocked read returns), on behalf
+    /// of the calling thread: the one that then reads the requests.
     pub fn install() {
-        // SAFETY: a zeroed sigaction with an extern "C" handler and an empty mask is valid.
+        // SAFETY: `pthread_self` has no preconditions; a zeroed sigaction with an extern "C"
+        // handler and an empty mask is valid.
         unsafe {
+            READER.store(libc::pthread_self() as u64, Ordering::SeqCst);
             let mut action: libc::sigaction = std::mem::zeroed();
             action.sa_sigaction = on_signal as extern "C" fn(libc::c_int) as usize;
             libc::sigemptyset(&mut action.sa_mask);
