@@ -179,16 +179,21 @@ impl DiffractedSet {
                 (key, i as u32)
             })
             .collect();
-        let compare = |a: &(u128, u32), b: &(u128, u32)| {
-            a.0.cmp(&b.0).then_with(|| {
-                let (x, y) = (self.get(a.1 as usize), self.get(b.1 as usize));
-                x.reflections
-                    .cmp(y.reflections)
-                    .then_with(|| x.second.cmp(&y.second))
-            })
+        let ties = |a: &(u128, u32), b: &(u128, u32)| {
+            let (x, y) = (self.get(a.1 as usize), self.get(b.1 as usize));
+            x.reflections
+                .cmp(y.reflections)
+                .then_with(|| x.second.cmp(&y.second))
         };
-        keyed.sort_unstable_by(compare);
-        keyed.dedup_by(|a, b| compare(a, b).is_eq());
+        // The key alone sorts almost everything; only runs of equal keys (longer reflection
+        // lists, two diffractions) are ordered by the candidates themselves.
+        keyed.sort_unstable_by_key(|k| k.0);
+        for run in keyed.chunk_by_mut(|a, b| a.0 == b.0) {
+            if run.len() > 1 {
+                run.sort_unstable_by(ties);
+            }
+        }
+        keyed.dedup_by(|a, b| a.0 == b.0 && ties(a, b).is_eq());
         let mut sorted = DiffractedSet::default();
         for (_, i) in keyed {
             let c = self.get(i as usize);

@@ -26,6 +26,7 @@ use super::{BeamTree, EPS, GROW, ROOT, TreeError};
 use crate::diffraction::{DiffractedSet, Diffracting};
 use bt_geom::bvh::box_meets_halfspaces;
 use bt_geom::{Plane, Real, Vec3};
+use bt_scene::edges::EdgeLine;
 use bt_scene::{Edge, EdgeId, Scene, SurfaceId};
 
 /// Angular slack (rad) of the exterior test on images: far above round-off, far below any
@@ -43,11 +44,40 @@ struct Reach {
     hi: Real,
 }
 
+/// At the RX tree's deepest level (depth `order − 1`) a reach pairs with the TX root alone
+/// (the TX itself, whose reach is the whole edge): the join keeps it only when the Keller
+/// point of TX and the node's image lies on the edge within the join's margin. [`BeamTree::reaches`]
+/// tests that first and clips only the nodes that pass, so the join sees the same pairs.
+#[derive(Debug, Clone, Copy)]
+struct RootOnly {
+    /// The depth (≥ 1) whose reaches pair with the TX root alone.
+    depth: usize,
+    /// TX (m, scene frame).
+    tx: Vec3,
+    /// The join's margin (m).
+    margin: Real,
+}
+
+/// TX's half of the Keller point on an edge tested at a [`RootOnly`] level: its distance
+/// from the edge line and its projection on it (m; the TX half of
+/// [`bt_scene::edges::EdgeLine::keller`], bit for bit).
+#[derive(Debug, Clone, Copy)]
+struct Focus {
+    tx_distance: Real,
+    tx_along: Real,
+}
+
 impl BeamTree {
     /// The nodes (the root included) whose image lies in an edge's exterior and whose beam
     /// reaches the edge, per edge, each edge's in ascending depth: on edge `e` the nodes of
-    /// depth below `limit[e]` (none when 0).
-    fn reaches(&self, scene: &Scene, limit: &[usize]) -> Vec<Vec<Reach>> {
+    /// depth below `limit[e]` (none when 0). At `root_only`'s depth, only the nodes whose
+    /// Keller point with TX lies on the edge (within the margin).
+    fn reaches(
+        &self,
+        scene: &Scene,
+        limit: &[usize],
+        root_only: Option<RootOnly>,
+    ) -> Vec<Vec<Reach>> {
         let max_depth = limit.iter().max().map_or(0, |m| m.saturating_sub(1));
         let edges = scene.edges();
         let in_plane: Vec<Vec<u32>> = edges
@@ -69,17 +99,22 @@ impl BeamTree {
             }
         }
         for (d, &(lo, hi)) in self.levels.iter().enumerate().take(max_depth) {
-            for i in lo..hi {
+            let depth = d + 1;
+            // At the root-only depth, TX's half of each edge's Keller point.
+            let focus = root_only
+                .filter(|r| r.depth == depth)
+                .map(|r| (focus(scene, r.tx), r.margin));
+            for i in (lo..hi).filter(|&i| self.nodes[i].live) {
                 let node = &self.nodes[i];
-                if !node.live {
-                    continue;
-                }
                 let planes = &self.planes[node.planes.0 as usize..node.planes.1 as usize];
                 let test = |min, max| box_meets_halfspaces(min, max, planes, eps);
                 edges.bvh().visit(test, |e| {
                     let edge = &edges.all()[e as usize];
-                    if d + 1 >= limit[e as usize]
+                    if depth >= limit[e as usize]
                         || in_plane[e as usize].contains(&node.surface)
+                        || focus.as_ref().is_some_and(|(focus, margin)| {
+                            !on_edge(edge, focus[e as usize], node.image, *margin)
+                        })
                         || !in_sector(edge, node.image)
                     {
                         return;
@@ -87,7 +122,7 @@ impl BeamTree {
                     if let Some((lo, hi)) = clip(edge, planes, eps) {
                         out[e as usize].push(Reach {
                             node: i as u32,
-                            depth: d + 1,
+                            depth,
                             image: node.image,
                             lo,
                             hi,
@@ -154,6 +189,41 @@ fn in_sector(edge: &Edge, p: Vec3) -> bool {
     about.r > 0.0 && about.in_sector(EXTERIOR_SLACK_RAD * about.r)
 }
 
+/// TX's half of the Keller point on every edge, by edge index.
+fn focus(scene: &Scene, tx: Vec3) -> Vec<Focus> {
+    scene
+        .edges()
+        .all()
+        .iter()
+        .map(|edge| {
+            let line = EdgeLine::of(edge);
+            Focus {
+                tx_distance: line.distance(tx),
+                tx_along: line.along(tx),
+            }
+        })
+        .collect()
+}
+
+/// Whether the Keller point of TX and `image` on `edge` lies on the edge within `margin`
+/// (what the join asks of a pair with the TX root, [`Pairing::once`]): the same closed form
+/// as [`EdgeLine::keller`], TX's half from `f`. The point is a weighted mean of the two
+/// projections, so when both lie beyond the same end by twice the margin (far above the
+/// closed form's round-off) it does too, and no square root is needed.
+#[inline]
+fn on_edge(edge: &Edge, f: Focus, image: Vec3, margin: Real) -> bool {
+    let line = EdgeLine::of(edge);
+    let along = line.along(image);
+    let (near, far) = (f.tx_along.min(along), f.tx_along.max(along));
+    if far < -2.0 * margin || near > edge.length + 2.0 * margin {
+        return false;
+    }
+    match line.keller_from(f.tx_distance, f.tx_along, image) {
+        Some(t) => t >= -margin && t <= edge.length + margin,
+        None => false,
+    }
+}
+
 /// The parameter interval of `edge` inside every half-space `{x : plane(x) ≥ −eps}`, or
 /// `None` when empty.
 fn clip(edge: &Edge, planes: &[Plane], eps: Real) -> Option<(Real, Real)> {
@@ -195,6 +265,8 @@ pub struct DiffractionSide {
     prefixes: Vec<(u32, u32)>,
     /// The tree's length tolerance (m), for the join's margin (and the cache's key).
     pub(super) tol: Real,
+    /// TX (m, scene frame).
+    tx: Vec3,
 }
 
 impl DiffractionSide {
@@ -209,7 +281,7 @@ impl DiffractionSide {
             .iter()
             .map(|&u| if u { max_order } else { 0 })
             .collect();
-        let reaches = tx.reaches(scene, &limit);
+        let reaches = tx.reaches(scene, &limit, None);
         DiffractionSide {
             reaches,
             max_order,
@@ -217,6 +289,7 @@ impl DiffractionSide {
             max_diffractions: diffracting.max_diffractions,
             prefixes: tx.prefixes(max_order.saturating_sub(1)),
             tol: tx.tol,
+            tx: tx.tx,
         }
     }
 }
@@ -251,12 +324,18 @@ pub fn join(
             }
         })
         .collect();
-    let from_rx = rx.reaches(scene, &limit);
+    let margin = GROW * side.tol.max(rx.tol);
+    let root_only = RootOnly {
+        depth: max_order - 1,
+        tx: side.tx,
+        margin,
+    };
+    let from_rx = rx.reaches(scene, &limit, (max_order >= 2).then_some(root_only));
     let pairing = Pairing {
         side,
         rx,
         from_rx: &from_rx,
-        margin: GROW * side.tol.max(rx.tol),
+        margin,
         budget,
     };
     pairing.once(scene, &mut set)?;

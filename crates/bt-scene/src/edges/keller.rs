@@ -52,18 +52,34 @@ impl EdgeLine {
         }
     }
 
+    /// The distance of `p` from the line (m).
+    #[inline]
+    pub fn distance(&self, p: Vec3) -> Real {
+        let v = p - self.start;
+        (v - v.dot(self.direction) * self.direction).length()
+    }
+
+    /// The parameter of `p`'s projection on the line (m).
+    #[inline]
+    pub fn along(&self, p: Vec3) -> Real {
+        (p - self.start).dot(self.direction)
+    }
+
     /// The Keller point of `a → line → b`: the parameter `t* = (d_b·t_a + d_a·t_b)/(d_a + d_b)`,
     /// `d` the distances to the line and `t` the projections on it (the one closed form,
     /// [`Edge::keller`] too); `None` when both lie on the line.
+    #[inline]
     pub fn keller(&self, a: Vec3, b: Vec3) -> Option<Real> {
-        let perpendicular = |p: Vec3| {
-            let v = p - self.start;
-            (v - v.dot(self.direction) * self.direction).length()
-        };
-        let (da, db) = (perpendicular(a), perpendicular(b));
+        self.keller_from(self.distance(a), self.along(a), b)
+    }
+
+    /// [`Self::keller`] with `a` given by its distance from the line and its parameter (for
+    /// one `a` against many `b`; the same value, bit for bit).
+    #[inline]
+    pub fn keller_from(&self, a_distance: Real, a_along: Real, b: Vec3) -> Option<Real> {
+        let (da, db) = (a_distance, self.distance(b));
         let sum = da + db;
-        let along = |p: Vec3| (p - self.start).dot(self.direction);
-        (sum > 0.0 && sum.is_finite()).then(|| (db * along(a) + da * along(b)) / sum)
+        (sum > 0.0 && sum.is_finite()).then(|| (db * a_along + da * self.along(b)) / sum)
     }
 }
 
