@@ -262,6 +262,20 @@ CASES = [
             "ground is the flat plane z = 0)."
         ),
     ),
+    dict(
+        name="munich-roof-d3",
+        scene="munich",
+        tx=[8.5, 21.0, 27.0],
+        rx_above_ground=[[45.0, 90.0, 1.5], [60.0, 20.0, 1.5], [-50.0, 0.0, 1.5]],
+        max_depth=3,
+        why=(
+            "The 40k-triangle city (38,936 triangles) of issue 28's speed target, with the TX "
+            "of the city benchmarks (issue 29): 1 m above a 26 m roof at (8.5, 21), i.e. at "
+            "z = 27 m. Three street receivers 1.5 m above the ground (z = 0): RX0 in an open "
+            "square 39 m from the nearest wall, RX1 in a street 9 m from the walls, RX2 in a "
+            "lane 4.5 m from them. Mostly reached over roof edges and by reflections."
+        ),
+    ),
 ]
 
 # --------------------------------------------------------------------------
