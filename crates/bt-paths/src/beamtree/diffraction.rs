@@ -88,7 +88,7 @@ impl BeamTree {
         let eps = EPS * self.tol;
         let mut out: Vec<Vec<Reach>> = vec![Vec::new(); edges.len()];
         for (e, edge) in edges.all().iter().enumerate() {
-            if limit[e] > 0 && in_sector(edge, self.tx) {
+            if limit[e] > 0 && in_sector(edge, self.tx) && !hidden_from(scene, self.tx, edge) {
                 out[e].push(Reach {
                     node: ROOT,
                     depth: 0,
@@ -222,6 +222,42 @@ fn on_edge(edge: &Edge, f: Focus, image: Vec3, margin: Real) -> bool {
         Some(t) => t >= -margin && t <= edge.length + margin,
         None => false,
     }
+}
+
+/// How far inside an occluder, and off its plane, the rays of [`hidden_from`] must cross it,
+/// in length tolerances: above validation's blocking test's tolerance (one), so that what
+/// this calls hidden, validation calls blocked.
+const HIDDEN: Real = 4.0;
+
+/// Whether one opaque convex surface hides all of `edge` from `apex` (TX or RX): the segments
+/// from `apex` to both ends of the edge cross it, each end and `apex` off its plane on either
+/// side and the crossings inside it, all by [`HIDDEN`] tolerances. Its shadow from `apex` is
+/// convex, so it then holds the whole edge: the segment from `apex` to any diffraction point
+/// crosses it inside, and validation finds that leg blocked. The surfaces touching the edge
+/// (every diffraction point lies on them) and penetrable ones never hide it.
+fn hidden_from(scene: &Scene, apex: Vec3, edge: &Edge) -> bool {
+    let margin = HIDDEN * scene.length_tolerance();
+    let crosses = |polygon: &bt_geom::Polygon, p: Vec3| {
+        let plane = polygon.plane();
+        let (da, dp) = (plane.signed_distance(apex), plane.signed_distance(p));
+        if (da > 0.0) == (dp > 0.0) || da.abs() <= margin || dp.abs() <= margin {
+            return false;
+        }
+        polygon.inside_by(apex + (da / (da - dp)) * (p - apex), margin)
+    };
+    let hides = |item: u32| {
+        let id = SurfaceId(item);
+        let polygon = &scene.surface(id).polygon;
+        !scene.penetrable(id)
+            && !edge.touching.contains(&id)
+            && crosses(polygon, edge.start)
+            && crosses(polygon, edge.end)
+            && bt_geom::convex::is_convex(polygon)
+    };
+    scene
+        .bvh()
+        .any_hit(apex, edge.start, margin, hides)
+        .is_some()
 }
 
 /// The parameter interval of `edge` inside every half-space `{x : plane(x) ≥ −eps}`, or

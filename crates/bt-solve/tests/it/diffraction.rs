@@ -257,3 +257,56 @@ fn a_reflection_point_on_a_seam_reflects_once() {
         }
     }
 }
+
+/// A wall hides a small screen's four edges from TX entirely: the join starts no candidate
+/// from TX straight onto them (their TX reaches are dropped as hidden), and the paths are
+/// still exactly those of blind enumeration.
+#[test]
+fn edges_a_wall_hides_from_tx_start_no_candidate_and_lose_no_path() {
+    let scene = scene_from_json(
+        r#"{ "tx": [0.2, 0, 0.1], "rx": [0.3, 6, 2.5],
+            "surfaces": [
+              { "name": "wall", "material": "metal",
+                "vertices": [[-3,2,-3],[3,2,-3],[3,2,3],[-3,2,3]] },
+              { "name": "screen", "material": "metal",
+                "vertices": [[-1,4,-1],[1,4,-1],[1,4,1],[-1,4,1]] } ] }"#,
+    );
+    let screen = SurfaceId(1);
+    let on_screen = |e: bt_scene::EdgeId| scene.edges().get(e).touching.contains(&screen);
+    let set = bt_paths::beamtree::candidates_and_diffracted_in(
+        &scene,
+        bt_paths::beamtree::TreeOptions::new(2),
+        Some(bt_paths::diffraction::Diffracting {
+            min_edge_length: 0.0,
+            max_diffractions: 1,
+        }),
+        &mut bt_paths::beamtree::TreeCache::default(),
+        &mut |_| {},
+    )
+    .unwrap();
+    let diffracted = &set.diffracted;
+    let from_tx = (0..diffracted.len())
+        .map(|i| diffracted.get(i))
+        .filter(|c| c.position == 0 && on_screen(c.edge))
+        .count();
+    assert_eq!(from_tx, 0, "a hidden edge starts no candidate from TX");
+    // Without the wall's shadow the pair (TX, RX) would be a candidate on the screen's top
+    // edge: both lie in its exterior, and their Keller point lies on it.
+    let ends = scene.terminals().unwrap();
+    let tol = scene.length_tolerance();
+    let top = (0..scene.edges().len() as u32)
+        .map(bt_scene::EdgeId)
+        .filter(|&e| on_screen(e))
+        .map(|e| scene.edges().get(e))
+        .find(|edge| {
+            edge.keller(ends.tx, ends.rx)
+                .is_some_and(|t| t > 0.0 && t < edge.length)
+        })
+        .expect("an edge of the screen between TX and RX");
+    assert!(top.in_exterior(ends.tx, tol) && top.in_exterior(ends.rx, tol));
+    for order in 1..=2 {
+        let reference = paths(&scene, order, CandidateMode::Exhaustive, Solver::Image);
+        let tree = paths(&scene, order, CandidateMode::BeamTree, Solver::Image);
+        assert_eq!(listing(&tree), listing(&reference), "order {order}");
+    }
+}
