@@ -164,29 +164,41 @@ impl LoadCache {
             Ok(_) => return Lookup::Damaged("written under another key".into()),
             Err(why) => return Lookup::Damaged(why),
         };
-        let Some(((_, first), others)) = entry.inputs.split_first() else {
+        drop(bytes);
+        let Entry {
+            inputs,
+            scene,
+            warnings,
+            ..
+        } = entry;
+        let Some(((_, first), others)) = inputs.split_first() else {
             return Lookup::Damaged("lists no input".into());
         };
         if first != named {
             return Lookup::Damaged("lists another named file".into());
         }
-        // On all cores (Munich: 2,367 meshes, 11 MB). Changed or gone: a plain miss, the
-        // fresh load reports what is wrong.
+        // The inputs are read and hashed on all cores (Munich: 2,367 meshes, 11 MB) while the
+        // scene is rebuilt beside them; changed or gone, it is a plain miss (the rebuilt scene
+        // is dropped unused and the fresh load reports what is wrong).
         let unchanged = |(path, recorded): &(PathBuf, Digest)| {
             read_file(path, max_bytes).is_ok_and(|bytes| digest(&bytes) == *recorded)
         };
-        if !others.par_iter().all(unchanged) {
+        let source = file.display().to_string();
+        let (unchanged, scene) = rayon::join(
+            || others.par_iter().all(unchanged),
+            || Scene::from_stored(scene, &source),
+        );
+        if !unchanged {
             return Lookup::Miss;
         }
-        let source = file.display().to_string();
-        let scene = match Scene::from_stored(entry.scene, &source) {
+        let scene = match scene {
             Ok(scene) => scene,
             Err(e) => return Lookup::Damaged(e.to_string()),
         };
-        let (sources, digests) = entry.inputs.into_iter().unzip();
+        let (sources, digests) = inputs.into_iter().unzip();
         Lookup::Hit(Box::new(Loaded {
             scene,
-            warnings: entry.warnings,
+            warnings,
             sources,
             digests,
         }))
