@@ -390,7 +390,10 @@ impl Polygon {
     }
 }
 
-fn bounds(points: &[Vec3]) -> (Vec3, Vec3) {
+/// The axis-aligned box `(min, max)` of `points` (metres), exactly as [`Polygon::bounds`]
+/// gives it for a polygon of these vertices (empty: `(+inf, -inf)`): callers may index
+/// vertices before their polygon is built, and get the same bits.
+pub fn bounds(points: &[Vec3]) -> (Vec3, Vec3) {
     points
         .iter()
         .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), p| {

@@ -8,7 +8,8 @@
 //! load options and the named file's content. It holds every other file the load read with the
 //! SHA-256 of the bytes the load parsed ([`Loaded::digests`]), checked against the files'
 //! current content on every hit, so an edited mesh misses. The entry is
-//! `MAGIC | version | payload length | payload (postcard) | SHA-256 of all before`; anything
+//! `MAGIC | version | payload length | payload (postcard; the scene inside it postcard bytes of
+//! its own, decoded while the inputs are hashed) | SHA-256 of all before`; anything
 //! that does not decode, check or rebuild (damaged, truncated, foreign, over the file budget)
 //! is ignored with a warning and replaced by a fresh load. Writes are atomic (a temporary file
 //! in the cache directory, renamed); a failed write is a warning, never a failed load.
@@ -24,7 +25,7 @@ use std::path::{Path, PathBuf};
 /// The version of the entries' layout and of what they hold; part of every key, so entries of
 /// another version are never read. Raise it whenever a load's result could change for the
 /// same inputs and options (a reader, the merge, validation, [`StoredScene`]).
-pub const CACHE_FORMAT_VERSION: u32 = 2;
+pub const CACHE_FORMAT_VERSION: u32 = 3;
 
 /// The first bytes of every entry.
 const MAGIC: &[u8; 8] = b"BTLOADC\0";
@@ -39,13 +40,16 @@ pub struct LoadCache {
 
 /// What an entry holds, as postcard encodes it.
 #[derive(Serialize, Deserialize)]
-struct Entry {
+struct Entry<'a> {
     /// The key the entry was written under (its file name), checked on reading.
     key: Digest,
     /// Every file the load read, in [`Loaded::sources`] order, with its SHA-256 as parsed.
     inputs: Vec<(PathBuf, Digest)>,
-    scene: StoredScene,
     warnings: Vec<String>,
+    /// The [`StoredScene`], postcard-encoded on its own: a hit decodes it while the inputs
+    /// are hashed, instead of before.
+    #[serde(borrow)]
+    scene: &'a [u8],
 }
 
 impl LoadCache {
@@ -164,29 +168,42 @@ impl LoadCache {
             Ok(_) => return Lookup::Damaged("written under another key".into()),
             Err(why) => return Lookup::Damaged(why),
         };
-        let Some(((_, first), others)) = entry.inputs.split_first() else {
+        let Entry {
+            inputs,
+            scene,
+            warnings,
+            ..
+        } = entry;
+        let Some(((_, first), others)) = inputs.split_first() else {
             return Lookup::Damaged("lists no input".into());
         };
         if first != named {
             return Lookup::Damaged("lists another named file".into());
         }
-        // On all cores (Munich: 2,367 meshes, 11 MB). Changed or gone: a plain miss, the
-        // fresh load reports what is wrong.
+        // The inputs are read and hashed on all cores (Munich: 2,367 meshes, 11 MB) while the
+        // scene is rebuilt beside them; changed or gone, it is a plain miss (the rebuilt scene
+        // is dropped unused and the fresh load reports what is wrong).
         let unchanged = |(path, recorded): &(PathBuf, Digest)| {
             read_file(path, max_bytes).is_ok_and(|bytes| digest(&bytes) == *recorded)
         };
-        if !others.par_iter().all(unchanged) {
+        let source = file.display().to_string();
+        let rebuild = || {
+            let stored: StoredScene =
+                postcard::from_bytes(scene).map_err(|e| format!("does not decode: {e}"))?;
+            Scene::from_stored(stored, &source).map_err(|e| e.to_string())
+        };
+        let (unchanged, scene) = rayon::join(|| others.par_iter().all(unchanged), rebuild);
+        if !unchanged {
             return Lookup::Miss;
         }
-        let source = file.display().to_string();
-        let scene = match Scene::from_stored(entry.scene, &source) {
+        let scene = match scene {
             Ok(scene) => scene,
-            Err(e) => return Lookup::Damaged(e.to_string()),
+            Err(why) => return Lookup::Damaged(why),
         };
-        let (sources, digests) = entry.inputs.into_iter().unzip();
+        let (sources, digests) = inputs.into_iter().unzip();
         Lookup::Hit(Box::new(Loaded {
             scene,
-            warnings: entry.warnings,
+            warnings,
             sources,
             digests,
         }))
@@ -194,24 +211,31 @@ impl LoadCache {
 
     /// Write the entry of `loaded` to `file` atomically, creating the cache directory.
     fn store(&self, file: &Path, key: Digest, loaded: &Loaded) -> Result<(), String> {
+        let scene = postcard::to_stdvec(&loaded.scene.to_stored()).map_err(|e| e.to_string())?;
         let entry = Entry {
             key,
             inputs: (loaded.sources.iter().cloned())
                 .zip(loaded.digests.iter().copied())
                 .collect(),
-            scene: loaded.scene.to_stored(),
             warnings: loaded.warnings.clone(),
+            scene: &scene,
         };
-        let payload = postcard::to_stdvec(&entry).map_err(|e| e.to_string())?;
-        let mut bytes = Vec::with_capacity(HEADER + payload.len() + 32);
-        bytes.extend_from_slice(MAGIC);
-        bytes.extend_from_slice(&CACHE_FORMAT_VERSION.to_le_bytes());
-        bytes.extend_from_slice(&(payload.len() as u64).to_le_bytes());
-        bytes.extend_from_slice(&payload);
-        bytes.extend_from_slice(&digest(&bytes));
+        let bytes = seal(&entry)?;
         std::fs::create_dir_all(&self.dir).map_err(|e| format!("{}: {e}", self.dir.display()))?;
         bt_output::write_atomic(file, &bytes).map_err(|e| e.to_string())
     }
+}
+
+/// The bytes of a file holding `entry`: header, payload and checksum, as [`decode`] reads them.
+fn seal(entry: &Entry<'_>) -> Result<Vec<u8>, String> {
+    let payload = postcard::to_stdvec(entry).map_err(|e| e.to_string())?;
+    let mut bytes = Vec::with_capacity(HEADER + payload.len() + 32);
+    bytes.extend_from_slice(MAGIC);
+    bytes.extend_from_slice(&CACHE_FORMAT_VERSION.to_le_bytes());
+    bytes.extend_from_slice(&(payload.len() as u64).to_le_bytes());
+    bytes.extend_from_slice(&payload);
+    bytes.extend_from_slice(&digest(&bytes));
+    Ok(bytes)
 }
 
 /// What a look-up found.
@@ -226,7 +250,7 @@ enum Lookup {
 
 /// The entry in `bytes`, or why it is not one: header, length and checksum checked before
 /// the payload is decoded.
-fn decode(bytes: &[u8]) -> Result<Entry, String> {
+fn decode(bytes: &[u8]) -> Result<Entry<'_>, String> {
     if bytes.len() < HEADER + 32 || &bytes[..8] != MAGIC {
         return Err("not a beamtrace load-cache entry".into());
     }
@@ -263,4 +287,48 @@ fn key(source: &str, options: &LoadOptions, named: &Digest) -> Digest {
 /// `bytes` in lowercase hexadecimal.
 fn hex(bytes: &[u8]) -> String {
     bytes.iter().map(|b| format!("{b:02x}")).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// An entry sound to its checksum whose scene bytes are cut short (the checksum guards
+    /// the file, the scene's own decoding guards what is inside): ignored, rebuilt, warned.
+    #[test]
+    fn an_entry_whose_scene_does_not_decode_is_rebuilt() {
+        let dir = std::env::temp_dir().join(format!("bt-cache-inner-{}", std::process::id()));
+        let _ = std::fs::remove_dir_all(&dir);
+        let cache = LoadCache::at(&dir);
+        let xml = Path::new(env!("CARGO_MANIFEST_DIR"))
+            .join("../../testdata/scenes/sionna-rt/simple_street_canyon/simple_street_canyon.xml");
+        let xml = xml.to_str().unwrap();
+        let options = LoadOptions::default();
+        let (fresh, notes) = cache.load(xml, &options, &mut |_| {}).unwrap();
+        assert!(notes.is_empty(), "{notes:?}");
+        let file = std::fs::read_dir(&dir)
+            .unwrap()
+            .next()
+            .unwrap()
+            .unwrap()
+            .path();
+        let good = std::fs::read(&file).unwrap();
+        let entry = decode(&good).unwrap();
+        let cut = Entry {
+            scene: &entry.scene[..entry.scene.len() / 2],
+            ..entry
+        };
+        std::fs::write(&file, seal(&cut).unwrap()).unwrap();
+        let (loaded, notes) = cache.load(xml, &options, &mut |_| {}).unwrap();
+        assert_eq!(notes.len(), 1, "{notes:?}");
+        assert!(notes[0].contains("does not decode"), "{notes:?}");
+        assert!(notes[0].contains("ignored and rebuilt"), "{notes:?}");
+        assert_eq!(loaded.scene.surfaces(), fresh.scene.surfaces());
+        assert_eq!(
+            std::fs::read(&file).unwrap(),
+            good,
+            "the entry is written anew"
+        );
+        std::fs::remove_dir_all(dir).ok();
+    }
 }

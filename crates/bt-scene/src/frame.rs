@@ -18,7 +18,7 @@
 //!   the world geometry to the bit, and `to_world(to_local(p)) == p`.
 
 use crate::problem::ProblemSink;
-use crate::surface::RawSurface;
+use crate::surface::Pending;
 use bt_geom::{Real, Vec3, tol};
 
 /// A scene is recentred when its bounding-box centre is more than this many extents (of at
@@ -106,7 +106,7 @@ pub(crate) fn to_world(local: Vec3, origin: Vec3) -> Vec3 {
 /// every vertex and of the terminals given (world); a surface whose coordinates are too large
 /// to resolve the scene's tolerance is reported and dropped (its polygon would be a guess).
 pub(crate) fn recentre(
-    raw: &mut Vec<RawSurface>,
+    raw: &mut Vec<Pending>,
     terminals: [Option<Vec3>; 2],
     problems: &mut impl ProblemSink,
 ) -> Vec3 {
@@ -124,7 +124,7 @@ pub(crate) fn recentre(
             .fold(0.0, |m: Real, p| m.max(p.abs().max_element()));
         match unresolvable(magnitude, tolerance) {
             Some(why) => {
-                problems.report(&format!("{}.vertices", r.location), why);
+                problems.report(&format!("{}.vertices", r.location()), why);
                 false
             }
             None => true,

@@ -2,14 +2,14 @@
 //!
 //! [`StoredScene`] holds what validation produced (the surfaces' vertices in the scene-local
 //! frame, the frame's origin, terminals, frequency, materials); [`Scene::from_stored`] rebuilds
-//! every polygon with [`Polygon::new`] (the polygon checks run again) and the BVH, and checks
-//! that the data fits together (finite numbers, known materials, unique names), so a stored
-//! scene that passes is a scene validation could have made. It does not repeat the
+//! every polygon with [`bt_geom::Polygon::new`] (the polygon checks run again, on all cores)
+//! and the BVH, and checks that the data fits together (finite numbers, known materials,
+//! unique names), so a stored scene that passes is a scene validation could have made. It does not repeat the
 //! scene-level checks whose cost grows with the scene (coplanar duplicates, terminals on
 //! surfaces): the cache's checksum and key say the data is what a validated load wrote.
 
 use crate::{Material, Problem, Scene, SceneError, Surface, SurfaceKind};
-use bt_geom::{Polygon, Real, Vec3};
+use bt_geom::{Real, Vec3};
 use serde::{Deserialize, Serialize};
 use std::collections::{BTreeMap, HashSet};
 
@@ -69,7 +69,7 @@ impl Scene {
     /// The scene `stored` describes (the inverse of [`Scene::to_stored`]): every polygon
     /// rebuilt and checked, the BVH built anew, the edges derived on first use as always.
     /// Data that does not fit together is an error naming `source` and the first problem.
-    pub fn from_stored(stored: StoredScene, source: &str) -> Result<Scene, SceneError> {
+    pub fn from_stored(mut stored: StoredScene, source: &str) -> Result<Scene, SceneError> {
         let invalid = |location: String, message: String| SceneError::Invalid {
             source_name: source.to_string(),
             problems: vec![Problem { location, message }],
@@ -79,14 +79,22 @@ impl Scene {
         if !points.iter().flatten().all(finite) || !stored.frequency_hz.is_finite() {
             return Err(invalid("scene".into(), "a number is not finite".into()));
         }
+        // Each list converted in place (`[Real; 3]` and `Vec3` have one layout), then the
+        // polygons built on all cores beside the BVH, as validation does.
+        let mut vertices: Vec<Vec<Vec3>> = (stored.surfaces.iter_mut())
+            .map(|s| {
+                let list = std::mem::take(&mut s.vertices);
+                list.into_iter().map(Vec3::from_array).collect()
+            })
+            .collect();
+        let (polygons, bvh) = crate::validate::polygons_and_bvh(&mut vertices);
         let mut surfaces = Vec::with_capacity(stored.surfaces.len());
-        for (i, s) in stored.surfaces.into_iter().enumerate() {
+        for (i, (s, polygon)) in stored.surfaces.into_iter().zip(polygons).enumerate() {
             let location = || format!("surfaces[{i}]");
             if !stored.materials.contains_key(&s.material) {
                 return Err(invalid(location(), "an unknown material".into()));
             }
-            let vertices = s.vertices.iter().map(|v| Vec3::from_array(*v)).collect();
-            let polygon = Polygon::new(vertices).map_err(|e| invalid(location(), e.to_string()))?;
+            let polygon = polygon.map_err(|e| invalid(location(), e.to_string()))?;
             surfaces.push(Surface {
                 name: s.name,
                 material: s.material,
@@ -98,10 +106,14 @@ impl Scene {
         if let Some(i) = surfaces.iter().position(|s| !names.insert(s.name.as_str())) {
             return Err(invalid(format!("surfaces[{i}]"), "a repeated name".into()));
         }
+        let geometry = crate::validate::Geometry {
+            surfaces,
+            bvh: Some(bvh),
+        };
         Ok(Scene::assemble(
             stored.name,
             Vec3::from_array(stored.origin),
-            surfaces,
+            geometry,
             stored.tx.map(Vec3::from_array),
             stored.rx.map(Vec3::from_array),
             stored.frequency_hz,

@@ -1,15 +1,16 @@
 //! Validation of a [`SceneDescription`] into a [`Scene`], collecting every problem at once.
 
-use crate::description::{BOX_FACES, SceneDescription};
+use crate::description::{BOX_FACES, SceneDescription, SurfaceDesc};
 use crate::frame::{to_local, to_world};
 use crate::material::{DEFAULT_MATERIAL, Material, default_materials};
 use crate::model::{Scene, scene_extent};
 use crate::problem::{Collector, Problem, ProblemSink, SceneError};
-use crate::surface::{RawSurface, Surface, SurfaceKind};
+use crate::surface::{Pending, Place, RawSurface, Surface, SurfaceKind};
 use bt_channel::RadioMaterial;
 use bt_geom::polygon::MAX_VERTICES;
 use bt_geom::{Bvh, Polygon, Real, Vec3};
-use std::collections::{BTreeMap, BTreeSet};
+use rayon::prelude::*;
+use std::collections::{BTreeMap, BTreeSet, HashSet};
 use std::sync::Arc;
 
 /// Default carrier frequency when a scene names none: 28 GHz (FR2 mmWave).
@@ -53,6 +54,29 @@ impl Scene {
         source_name: &str,
         terminals: Terminals,
     ) -> Result<Scene, SceneError> {
+        let surfaces = desc.surfaces.iter().cloned();
+        Scene::described(desc, surfaces, source_name, terminals)
+    }
+
+    /// [`Scene::from_description`] of a description given up: its surfaces' names and
+    /// vertex lists move into the scene instead of being copied (an importer's description of
+    /// a city holds 17,803 of them).
+    pub fn from_owned_description(
+        mut desc: SceneDescription,
+        source_name: &str,
+        terminals: Terminals,
+    ) -> Result<Scene, SceneError> {
+        let surfaces = std::mem::take(&mut desc.surfaces);
+        Scene::described(&desc, surfaces.into_iter(), source_name, terminals)
+    }
+
+    /// Validate `desc` whose surfaces are `surfaces` (its own, moved or copied).
+    fn described(
+        desc: &SceneDescription,
+        surfaces: impl ExactSizeIterator<Item = SurfaceDesc>,
+        source_name: &str,
+        terminals: Terminals,
+    ) -> Result<Scene, SceneError> {
         let mut problems = Collector(Vec::new());
         if let Some(name) = &desc.name
             && let Err(e) = crate::name::check(name)
@@ -69,28 +93,28 @@ impl Scene {
         };
         let materials =
             described_materials(desc, frequency_ok.then_some(frequency_hz), &mut problems);
-        let mut raw = raw_surfaces(desc, &mut problems);
+        let mut raw = raw_surfaces(desc, surfaces, &mut problems);
         let given = [
             terminals.tx.or(desc.tx.map(Vec3::from_array)),
             terminals.rx.or(desc.rx.map(Vec3::from_array)),
         ];
         let origin = crate::frame::recentre(&mut raw, given, &mut problems);
-        let surfaces = build_surfaces(raw, &materials, &mut problems);
+        let geometry = build_surfaces(raw, &materials, &mut problems);
         if frequency_ok {
             problems
                 .0
-                .extend(radio_problems(&surfaces, &materials, frequency_hz));
+                .extend(radio_problems(&geometry.surfaces, &materials, frequency_hz));
         }
 
         let tx = terminal("tx", given[0], &mut problems).map(|p| to_local(p, origin));
         let rx = terminal("rx", given[1], &mut problems).map(|p| to_local(p, origin));
-        let extent = scene_extent(&surfaces, tx, rx);
-        if let Err(p) = check_terminals(&surfaces, tx, rx, extent, origin) {
+        let extent = scene_extent(&geometry.surfaces, tx, rx);
+        if let Err(p) = check_terminals(&geometry.surfaces, tx, rx, extent, origin) {
             problems.0.extend(p);
         }
         let name = desc.name.clone().unwrap_or_else(|| source_name.to_string());
         conclude(source_name, problems.0, || {
-            Scene::assemble(name, origin, surfaces, tx, rx, frequency_hz, materials)
+            Scene::assemble(name, origin, geometry, tx, rx, frequency_hz, materials)
         })
     }
 }
@@ -104,26 +128,27 @@ impl Scene {
     pub fn from_surfaces(
         name: &str,
         source_name: &str,
-        mut raw: Vec<RawSurface>,
+        raw: Vec<RawSurface>,
         materials: BTreeMap<String, Material>,
         terminals: Terminals,
         frequency_hz: Real,
     ) -> Result<Scene, SceneError> {
+        let mut raw: Vec<Pending> = raw.into_iter().map(Pending::from).collect();
         let mut problems = Collector(Vec::new());
         let given = [terminals.tx, terminals.rx];
         let origin = crate::frame::recentre(&mut raw, given, &mut problems);
-        let surfaces = build_surfaces(raw, &materials, &mut problems);
+        let geometry = build_surfaces(raw, &materials, &mut problems);
         let tx = terminal("tx", given[0], &mut problems).map(|p| to_local(p, origin));
         let rx = terminal("rx", given[1], &mut problems).map(|p| to_local(p, origin));
         let mut problems = problems.0;
-        let extent = scene_extent(&surfaces, tx, rx);
-        if let Err(p) = check_terminals(&surfaces, tx, rx, extent, origin) {
+        let extent = scene_extent(&geometry.surfaces, tx, rx);
+        if let Err(p) = check_terminals(&geometry.surfaces, tx, rx, extent, origin) {
             problems.extend(p);
         }
-        problems.extend(radio_problems(&surfaces, &materials, frequency_hz));
+        problems.extend(radio_problems(&geometry.surfaces, &materials, frequency_hz));
         let name = name.to_string();
         conclude(source_name, problems, || {
-            Scene::assemble(name, origin, surfaces, tx, rx, frequency_hz, materials)
+            Scene::assemble(name, origin, geometry, tx, rx, frequency_hz, materials)
         })
     }
 }
@@ -189,16 +214,22 @@ fn described_materials(
     materials
 }
 
-/// The description's surfaces and its boxes' faces, before any geometric check.
-fn raw_surfaces(desc: &SceneDescription, problems: &mut Collector) -> Vec<RawSurface> {
-    let mut raw: Vec<RawSurface> = Vec::new();
-    for (i, s) in desc.surfaces.iter().enumerate() {
-        raw.push(RawSurface {
-            location: format!("surfaces[{i}] \"{}\"", crate::name::shown(&s.name)),
-            name: s.name.clone(),
-            material: s.material.clone(),
+/// The description's surfaces (`surfaces`, in its order) and its boxes' faces, before any
+/// geometric check.
+fn raw_surfaces(
+    desc: &SceneDescription,
+    surfaces: impl ExactSizeIterator<Item = SurfaceDesc>,
+    problems: &mut Collector,
+) -> Vec<Pending> {
+    let mut raw: Vec<Pending> = Vec::with_capacity(surfaces.len());
+    for (i, s) in surfaces.enumerate() {
+        raw.push(Pending {
+            place: Place::Described(i),
+            name: s.name,
+            material: s.material,
             kind: s.kind.unwrap_or(SurfaceKind::Reflector),
-            vertices: s.vertices.iter().map(|v| Vec3::from_array(*v)).collect(),
+            // In place: `[Real; 3]` and `Vec3` have one layout.
+            vertices: s.vertices.into_iter().map(Vec3::from_array).collect(),
         });
     }
     for (i, b) in desc.boxes.iter().enumerate() {
@@ -226,8 +257,8 @@ fn raw_surfaces(desc: &SceneDescription, problems: &mut Collector) -> Vec<RawSur
             if b.omit.iter().any(|o| o == face) {
                 continue;
             }
-            raw.push(RawSurface {
-                location: format!("{location}.{face}"),
+            raw.push(Pending {
+                place: Place::BoxFace(i, face),
                 name: format!("{}.{face}", b.name),
                 material: b.material.clone(),
                 kind: b.kind.unwrap_or(SurfaceKind::Reflector),
@@ -244,17 +275,20 @@ impl Scene {
     pub(crate) fn assemble(
         name: String,
         origin: Vec3,
-        surfaces: Vec<Surface>,
+        geometry: impl Into<Geometry>,
         tx: Option<Vec3>,
         rx: Option<Vec3>,
         frequency_hz: Real,
         materials: std::collections::BTreeMap<String, Material>,
     ) -> Scene {
+        let Geometry { surfaces, bvh } = geometry.into();
         let extent = scene_extent(&surfaces, tx, rx);
         // References, not clones: the BVH needs only the boxes, and copying 17,808 polygons
         // (vertices and local coordinates) was a third of a cached city load's allocations.
-        let polygons: Vec<&Polygon> = surfaces.iter().map(|s| &s.polygon).collect();
-        let bvh = Bvh::build(&polygons);
+        let bvh = bvh.unwrap_or_else(|| {
+            let polygons: Vec<&Polygon> = surfaces.iter().map(|s| &s.polygon).collect();
+            Bvh::build(&polygons)
+        });
         let mut scene = Scene {
             name,
             origin,
@@ -398,12 +432,10 @@ pub(crate) fn radio_problems(
 }
 
 pub(crate) fn build_surfaces(
-    raw: Vec<RawSurface>,
+    mut raw: Vec<Pending>,
     materials: &std::collections::BTreeMap<String, Material>,
     problems: &mut impl ProblemSink,
-) -> Vec<Surface> {
-    let mut names = BTreeSet::new();
-    let mut surfaces = Vec::with_capacity(raw.len());
+) -> Geometry {
     // Polygons over the per-surface limit are refused by their own check, before any work.
     let counts = raw.iter().map(|r| r.vertices.len());
     let pairs = bt_geom::polygon::vertex_pairs(counts.filter(|&n| n <= MAX_VERTICES));
@@ -418,38 +450,99 @@ pub(crate) fn build_surfaces(
                 bt_geom::polygon::MAX_VERTEX_PAIRS as f64
             ),
         );
-        return surfaces;
+        return Vec::new().into();
     }
-    for r in raw {
+    let (polygons, bvh) = polygons_and_bvh(&mut raw);
+    let mut names = HashSet::with_capacity(raw.len());
+    for (r, polygon) in raw.iter().zip(&polygons) {
         if let Err(e) = crate::name::check(&r.name) {
-            problems.report(&r.location, e);
-        } else if !names.insert(r.name.clone()) {
+            problems.report(&r.location(), e);
+        } else if !names.insert(r.name.as_str()) {
             problems.report(
-                &r.location,
+                &r.location(),
                 format!("duplicate surface name \"{}\"", crate::name::shown(&r.name)),
             );
         }
-        let material = r.material.unwrap_or_else(|| DEFAULT_MATERIAL.to_string());
-        if !materials.contains_key(&material) {
+        let material = r.material.as_deref().unwrap_or(DEFAULT_MATERIAL);
+        if !materials.contains_key(material) {
             problems.report(
-                &r.location,
+                &r.location(),
                 format!(
                     "unknown material \"{}\" (add it under \"materials\")",
-                    crate::name::shown(&material)
+                    crate::name::shown(material)
                 ),
             );
         }
-        match Polygon::new(r.vertices) {
-            Ok(polygon) => surfaces.push(Surface {
-                name: r.name,
-                material,
-                kind: r.kind,
-                polygon,
-            }),
-            Err(e) => problems.report(&format!("{}.vertices", r.location), e.to_string()),
+        if let Err(e) = polygon {
+            problems.report(&format!("{}.vertices", r.location()), e.to_string());
         }
     }
-    surfaces
+    let all = polygons.iter().all(Result::is_ok);
+    let surfaces = (raw.into_iter().zip(polygons))
+        .filter_map(|(r, polygon)| {
+            Some(Surface {
+                polygon: polygon.ok()?,
+                name: r.name,
+                material: r.material.unwrap_or_else(|| DEFAULT_MATERIAL.to_string()),
+                kind: r.kind,
+            })
+        })
+        .collect();
+    Geometry {
+        surfaces,
+        bvh: all.then_some(bvh),
+    }
+}
+
+/// The polygons of `vertices` (each list taken) built on all cores, order kept, and beside
+/// them the BVH over the vertices' boxes: the boxes [`Polygon::bounds`] gives, to the bit
+/// ([`bt_geom::polygon::bounds`]), so it is the BVH of the polygons whenever all are built.
+pub(crate) fn polygons_and_bvh<V: AsMut<Vec<Vec3>> + Send>(
+    vertices: &mut [V],
+) -> (Vec<Result<Polygon, bt_geom::PolygonError>>, Bvh) {
+    let boxes: Vec<VertexBox> = (vertices.iter_mut())
+        .map(|v| VertexBox(bt_geom::polygon::bounds(v.as_mut())))
+        .collect();
+    rayon::join(
+        || {
+            (vertices.par_iter_mut())
+                .map(|v| Polygon::new(std::mem::take(v.as_mut())))
+                .collect()
+        },
+        || Bvh::build(&boxes),
+    )
+}
+
+/// A box `(min, max)` of vertices, metres, as a BVH item.
+struct VertexBox((Vec3, Vec3));
+
+impl bt_geom::Occluder for VertexBox {
+    fn bounds(&self) -> (Vec3, Vec3) {
+        self.0
+    }
+}
+
+impl AsMut<Vec<Vec3>> for Pending {
+    fn as_mut(&mut self) -> &mut Vec<Vec3> {
+        &mut self.vertices
+    }
+}
+
+/// Validated surfaces, and the BVH over their polygons when it is built already.
+pub(crate) struct Geometry {
+    /// The surfaces in order.
+    pub surfaces: Vec<Surface>,
+    /// The BVH of `surfaces`' polygons, if built.
+    pub bvh: Option<Bvh>,
+}
+
+impl From<Vec<Surface>> for Geometry {
+    fn from(surfaces: Vec<Surface>) -> Geometry {
+        Geometry {
+            surfaces,
+            bvh: None,
+        }
+    }
 }
 
 /// A terminal given (world frame) when finite; not given is no problem (bare geometry).

@@ -170,7 +170,7 @@ pub(crate) fn load_xml_read(
     for round in xml.shapes.chunks(SHAPES_PER_ROUND) {
         reading.round(round, &mut desc, &mut warnings)?;
     }
-    let scene = Scene::from_description(&desc, &display, options.terminals)?;
+    let scene = Scene::from_owned_description(desc, &display, options.terminals)?;
     let (sources, digests) = reading.meshes.into_iter().unzip();
     let loaded = Loaded {
         sources,
@@ -265,14 +265,15 @@ fn add_shape(
     }
     desc.surfaces
         .extend(import.surfaces.into_iter().map(|s| SurfaceDesc {
-            name: format!("{}.{}", shape.name, s.name),
+            name: [shape.name.as_str(), ".", &s.name].concat(),
             material: material.clone(),
             kind: Some(if s.region_area_m2 >= options.min_reflector_area_m2 {
                 SurfaceKind::Reflector
             } else {
                 SurfaceKind::Blocker
             }),
-            vertices: s.vertices.iter().map(|v| v.to_array()).collect(),
+            // In place: `Vec3` and `[Real; 3]` have one layout.
+            vertices: s.vertices.into_iter().map(|v| v.to_array()).collect(),
             ..SurfaceDesc::default()
         }));
 }
