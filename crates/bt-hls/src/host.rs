@@ -339,7 +339,7 @@ pub(crate) fn register_map(d: &Design) -> String {
 fn cycle_formulas(d: &Design) -> String {
     let mut s = String::from("## Cycle formulas (exact, checked by co-simulation)\n\n");
     s.push_str(&format!(
-        "* CYCLES = sum over dispatched slots of (load + max(PE_LATENCY - jobs + 1, 1, dispatch + \
+        "* CYCLES = sum over dispatched slots of (load + max(PE_LATENCY - jobs - 1, 1, dispatch + \
          1 - load) + jobs + 2) (each PE starts the cycle after its own load), load = jobs right \
          after a write-back (its first two entries read ahead), else jobs + 2, plus the dispatches with no slot running (dispatch + 1 each); the dispatcher \
          builds the next slot from the start of the load; dispatch = 1 + per examined \

@@ -13,7 +13,7 @@ module bt_top (
   output reg  avs_readdatavalid,
   output wire ins_irq
 );
-  // 7 PE instances, capacity 26 paths, 46 points, 26 groups; load (jobs, or jobs + 2 after a dispatch wait) + max(29 - jobs + 1, 1, dispatch + 1 - load) + write-back (jobs + 2) cycles per slot (each PE starts after its own load), threshold 16 fine LSB
+  // 7 PE instances, capacity 26 paths, 46 points, 26 groups; load (jobs, or jobs + 2 after a dispatch wait) + max(29 - jobs - 1, 1, dispatch + 1 - load) + write-back (jobs + 2) cycles per slot (each PE starts after its own load), threshold 16 fine LSB
   reg [2:0] state;
   reg [4:0] cnt;
   reg [5:0] paths_r;
@@ -677,7 +677,7 @@ module bt_top (
   assign pe_start_5 = (ld_go && (ld_go_inst == 3'd5));
   assign pe_load_6 = (((state == 3'd2) && ld_q_en) && (ld_q_inst == 3'd6));
   assign pe_start_6 = (ld_go && (ld_go_inst == 3'd6));
-  // main FSM: IDLE -> DISP -> per slot LOAD (jobs + 2, or jobs after a write-back) EXEC (max(29 - jobs + 1, 1, dispatch + 1 - load): each PE starts after its own load) WB (jobs + 2) -> IDLE with done when no path is queued
+  // main FSM: IDLE -> DISP -> per slot LOAD (jobs + 2, or jobs after a write-back) EXEC (max(29 - jobs - 1, 1, dispatch + 1 - load): each PE starts after its own load) WB (jobs + 2) -> IDLE with done when no path is queued
   always @(posedge clk) begin
     if (!(rst_n)) begin
       state <= 3'd0;
@@ -740,7 +740,7 @@ module bt_top (
           end
         end
         3'd3: begin
-          if ((({1'd0, cnt} + {2'd0, slen_cur}) > 6'd28)) begin
+          if (((({1'd0, cnt} + {2'd0, slen_cur}) + 6'd2) > 6'd28)) begin
             if ((dstate == 3'd0)) begin
               state <= 3'd4;
               cnt <= 5'd0;
