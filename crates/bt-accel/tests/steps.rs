@@ -206,9 +206,11 @@ fn red_black_rounds_halve_the_cold_start_and_keep_every_path() {
 }
 
 #[test]
-fn two_copies_take_every_cold_step_of_the_living_room_under_a_millisecond() {
+fn one_copy_takes_every_cold_step_of_the_living_room_under_a_millisecond() {
     // docs/hardware.md's per-step table: order 3, cold steps, no model run before the plan;
     // the copies are sized at step 0 from one round (wall-north, then wall-south) and kept.
+    // One copy (wall-north, the setting within 43 % of the EP4CE115) and two both stay under
+    // 1 ms, two faster.
     let scene = living_room();
     let steps = scene.scenes();
     let planes = static_reflectors(steps);
@@ -221,19 +223,31 @@ fn two_copies_take_every_cold_step_of_the_living_room_under_a_millisecond() {
     };
     let plain = plan_step(&steps[0], &planes, 0, &options(None), None).unwrap();
     let budget = plain.plan.schedule.instances.len() as u32 + 2;
+    let one = plan_step(&steps[0], &planes, 0, &options(Some(budget - 1)), None).unwrap();
     let first = plan_step(&steps[0], &planes, 0, &options(Some(budget)), None).unwrap();
-    let copied: Vec<&str> = first
-        .plan
-        .schedule
-        .copies()
-        .iter()
-        .enumerate()
-        .filter(|&(_, &c)| c > 1)
-        .map(|(p, _)| first.step.input.planes[p].name.as_str())
-        .collect();
-    assert_eq!(copied, ["wall-south", "wall-north"]);
+    let copied = |p: &PlannedStep| -> Vec<String> {
+        p.plan
+            .schedule
+            .copies()
+            .iter()
+            .enumerate()
+            .filter(|&(_, &c)| c > 1)
+            .map(|(i, _)| p.step.input.planes[i].name.clone())
+            .collect()
+    };
+    assert_eq!(copied(&one), ["wall-north"]);
+    assert!(first.plan.predicted_cycles < one.plan.predicted_cycles);
+    assert_eq!(copied(&first), ["wall-south", "wall-north"]);
     let last = plan_step(&steps[9], &planes, 9, &options(Some(budget)), Some(&first)).unwrap();
-    for p in [&first, &last] {
+    let last_one = plan_step(
+        &steps[9],
+        &planes,
+        9,
+        &options(Some(budget - 1)),
+        Some(&one),
+    )
+    .unwrap();
+    for p in [&one, &last_one, &first, &last] {
         assert_eq!(p.host_model_runs, 0);
         assert_eq!((p.fixed.missed, p.fixed.spurious), (0, 0), "{:?}", p.fixed);
         let ms = p.plan.predicted_cycles as f64 / bt_hls::CLOCK_HZ * 1e3;

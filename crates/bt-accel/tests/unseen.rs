@@ -114,7 +114,8 @@ fn unseen_rooms_need_no_model_run_and_lose_no_path() {
         assert!(rounds > 0);
         assert_eq!(p.plan.dispatch.jobs, points_rounds, "seed {seed}");
         // Without knowing any round count the run stays within a third of the oracle's
-        // schedule (measured: 1.14-1.17x).
+        // schedule (measured: 0.89-0.98x since each PE starts after its own load; the
+        // oracle's figure is the static design's formula, PEs started after the last load).
         assert!(
             3 * p.plan.predicted_cycles < 4 * oracle.predicted_cycles,
             "seed {seed}: {} vs {}",

@@ -135,9 +135,9 @@ fn dispatch_slot(
 /// The `CYCLES` of one run of the dispatching controller whose PEs take `latency` cycles,
 /// for a template ([`groups`]) over `columns` PE columns when path `p` runs `rounds[p]`
 /// rounds (at least one). Per slot of `n` jobs: load `n + 2`, or `n` right after a
-/// write-back (which read its first two entries ahead), PEs `max(latency, dispatch + 1 -
-/// load)` (the dispatcher starts with the load), write back `n + 2`; a dispatch with no slot
-/// running costs its own cycles plus one.
+/// write-back (which read its first two entries ahead), PEs `max(latency - n - 1, 1,
+/// dispatch + 1 - load)` (each PE starts after its own load, write-back takes its result two
+/// cycles after reading its entry; the dispatcher starts with the load), write back `n + 2`; a dispatch with no slot running costs its own cycles plus one.
 pub fn predict(groups: &[Vec<Group>], columns: usize, rounds: &[u32], latency: u32) -> DispatchRun {
     let mut queue: std::collections::VecDeque<(u32, usize)> =
         (0..groups.len() as u32).map(|p| (p, 0)).collect();
@@ -156,9 +156,14 @@ pub fn predict(groups: &[Vec<Group>], columns: usize, rounds: &[u32], latency: u
         // entries ahead; the dispatcher starts with it, the PEs after it.
         let load = if ahead { n } else { n + 2 };
         let (next, d) = dispatch_slot(groups, &mut queue, columns);
-        let exec = u64::from(latency).max((d + 1).saturating_sub(load));
+        // Each PE starts the cycle after its own load and write-back reads the jobs in load
+        // order, each two cycles after its entry's read, so the last job's PE needs `latency`
+        // cycles less the slot's other loads and those two (at least one); the dispatcher
+        // must have finished too.
+        let lat = u64::from(latency).saturating_sub(n + 1).max(1);
+        let exec = lat.max((d + 1).saturating_sub(load));
         run.cycles += load + exec + n + 2;
-        run.dispatch_wait_cycles += exec - u64::from(latency);
+        run.dispatch_wait_cycles += exec - lat;
         run.slots += 1;
         run.jobs += n;
         // Write-back, job by job in slot order: each group's last job queues its path's next
@@ -229,13 +234,15 @@ mod tests {
         let latency = 10;
         // One round each: slot 1 = path 0 (2 jobs), slot 2 = path 1 (1 job).
         // Dispatch 0: D_WARM, D_POP, 2 jobs [placed: both PEs taken], D_POP (every PE
-        // taken: stop), D_FIN = 6 cycles, DISP 7. Slot 1: load 4, PEs max(10, dispatch of
-        // path 1 (D_WARM, D_POP, 1 job, D_POP, D_FIN = 5) + 1 - the load's 4), write back 4
-        // = 18. Slot 2: its entry was read ahead during slot 1's write-back: load 1, PEs 10,
-        // write back 3 = 14 (the queue is empty: D_WARM, D_POP, D_FIN).
+        // taken: stop), D_FIN = 6 cycles, DISP 7. Slot 1: load 4, PEs max(10 - 2 - 1 (the
+        // first PE started a cycle before the last, write-back takes a result two cycles
+        // after reading its entry), dispatch of path 1 (D_WARM, D_POP, 1 job, D_POP, D_FIN =
+        // 5) + 1 - the load's 4), write back 4 = 15. Slot 2: its entry was read ahead during
+        // slot 1's write-back: load 1, PEs 8, write back 3 = 12 (the queue is empty: D_WARM,
+        // D_POP, D_FIN).
         let r = predict(&g, 2, &[1, 1], latency);
         assert_eq!((r.slots, r.jobs), (2, 3));
-        assert_eq!(r.cycles, 7 + 18 + 14);
+        assert_eq!(r.cycles, 7 + 15 + 12);
         assert_eq!(r.dispatch_wait_cycles, 7);
         // More rounds: more slots, never fewer cycles.
         let r3 = predict(&g, 2, &[3, 2], latency);

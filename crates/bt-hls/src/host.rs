@@ -339,9 +339,9 @@ pub(crate) fn register_map(d: &Design) -> String {
 fn cycle_formulas(d: &Design) -> String {
     let mut s = String::from("## Cycle formulas (exact, checked by co-simulation)\n\n");
     s.push_str(&format!(
-        "* CYCLES = sum over dispatched slots of (load + max(PE_LATENCY, dispatch + 1 - load) + \
-         jobs + 2), load = jobs right after a write-back (its first two entries read ahead), else \
-         jobs + 2, plus the dispatches with no slot running (dispatch + 1 each); the dispatcher \
+        "* CYCLES = sum over dispatched slots of (load + max(PE_LATENCY - jobs - 1, 1, dispatch + \
+         1 - load) + jobs + 2) (each PE starts the cycle after its own load), load = jobs right \
+         after a write-back (its first two entries read ahead), else jobs + 2, plus the dispatches with no slot running (dispatch + 1 each); the dispatcher \
          builds the next slot from the start of the load; dispatch = 1 + per examined \
          group (at most {}) 1 + its jobs, + 2; PE_LATENCY = {} (5 + {} halving steps of \
          Algorithm 3 at the {}-bit coordinate word); `bt_hls::dispatch::predict` is the exact twin\n",

@@ -13,7 +13,7 @@ module bt_top (
   output reg  avs_readdatavalid,
   output wire ins_irq
 );
-  // 7 PE instances, capacity 26 paths, 46 points, 26 groups; load (jobs, or jobs + 2 after a dispatch wait) + max(29, dispatch + 1 - load) + write-back (jobs + 2) cycles per slot, threshold 16 fine LSB
+  // 7 PE instances, capacity 26 paths, 46 points, 26 groups; load (jobs, or jobs + 2 after a dispatch wait) + max(29 - jobs - 1, 1, dispatch + 1 - load) + write-back (jobs + 2) cycles per slot (each PE starts after its own load), threshold 16 fine LSB
   reg [2:0] state;
   reg [4:0] cnt;
   reg [5:0] paths_r;
@@ -50,6 +50,8 @@ module bt_top (
   reg ld_q_first;
   reg ld_q_last;
   reg [2:0] ld_q_inst;
+  reg ld_go;
+  reg [2:0] ld_go_inst;
   reg wb_q_en;
   reg wb_q_tail;
   reg wb_q_end;
@@ -86,24 +88,31 @@ module bt_top (
   reg [71:0] pm_a [0:127];
   reg [71:0] pm_b [0:127];
   wire pe_load_0;
+  wire pe_start_0;
   wire [83:0] pe_sum_0;
   wire pe_zs_0;
   wire pe_load_1;
+  wire pe_start_1;
   wire [83:0] pe_sum_1;
   wire pe_zs_1;
   wire pe_load_2;
+  wire pe_start_2;
   wire [83:0] pe_sum_2;
   wire pe_zs_2;
   wire pe_load_3;
+  wire pe_start_3;
   wire [83:0] pe_sum_3;
   wire pe_zs_3;
   wire pe_load_4;
+  wire pe_start_4;
   wire [83:0] pe_sum_4;
   wire pe_zs_4;
   wire pe_load_5;
+  wire pe_start_5;
   wire [83:0] pe_sum_5;
   wire pe_zs_5;
   wire pe_load_6;
+  wire pe_start_6;
   wire [83:0] pe_sum_6;
   wire pe_zs_6;
   wire idle;
@@ -468,13 +477,19 @@ module bt_top (
     end
     rd_b <= pm_b[rb_addr];
   end
-  wire pe_start;
-  assign pe_start = ((state == 3'd3) && (cnt == 5'd0));
+  always @(posedge clk) begin
+    if (!(rst_n)) begin
+      ld_go <= 1'd0;
+    end else begin
+      ld_go <= ((state == 3'd2) && ld_q_en);
+      ld_go_inst <= ld_q_inst;
+    end
+  end
   bt_pe_0 u_pe_0 (
     .clk(clk),
     .rst_n(rst_n),
     .load(pe_load_0),
-    .start(pe_start),
+    .start(pe_start_0),
     .s_prev(opnd_prev),
     .s_next(opnd_next),
     .s_sum(pe_sum_0),
@@ -484,7 +499,7 @@ module bt_top (
     .clk(clk),
     .rst_n(rst_n),
     .load(pe_load_1),
-    .start(pe_start),
+    .start(pe_start_1),
     .s_prev(opnd_prev),
     .s_next(opnd_next),
     .s_sum(pe_sum_1),
@@ -494,7 +509,7 @@ module bt_top (
     .clk(clk),
     .rst_n(rst_n),
     .load(pe_load_2),
-    .start(pe_start),
+    .start(pe_start_2),
     .s_prev(opnd_prev),
     .s_next(opnd_next),
     .s_sum(pe_sum_2),
@@ -504,7 +519,7 @@ module bt_top (
     .clk(clk),
     .rst_n(rst_n),
     .load(pe_load_3),
-    .start(pe_start),
+    .start(pe_start_3),
     .s_prev(opnd_prev),
     .s_next(opnd_next),
     .s_sum(pe_sum_3),
@@ -514,7 +529,7 @@ module bt_top (
     .clk(clk),
     .rst_n(rst_n),
     .load(pe_load_4),
-    .start(pe_start),
+    .start(pe_start_4),
     .s_prev(opnd_prev),
     .s_next(opnd_next),
     .s_sum(pe_sum_4),
@@ -524,7 +539,7 @@ module bt_top (
     .clk(clk),
     .rst_n(rst_n),
     .load(pe_load_5),
-    .start(pe_start),
+    .start(pe_start_5),
     .s_prev(opnd_prev),
     .s_next(opnd_next),
     .s_sum(pe_sum_5),
@@ -534,7 +549,7 @@ module bt_top (
     .clk(clk),
     .rst_n(rst_n),
     .load(pe_load_6),
-    .start(pe_start),
+    .start(pe_start_6),
     .s_prev(opnd_prev),
     .s_next(opnd_next),
     .s_sum(pe_sum_6),
@@ -545,13 +560,20 @@ module bt_top (
   wire [71:0] opnd_next;
   assign opnd_next = (ld_q_last ? {{rx_z[15:0], 8'd0}, {rx_y[15:0], 8'd0}, {rx_x[15:0], 8'd0}} : rd_b);
   assign pe_load_0 = (((state == 3'd2) && ld_q_en) && (ld_q_inst == 3'd0));
+  assign pe_start_0 = (ld_go && (ld_go_inst == 3'd0));
   assign pe_load_1 = (((state == 3'd2) && ld_q_en) && (ld_q_inst == 3'd1));
+  assign pe_start_1 = (ld_go && (ld_go_inst == 3'd1));
   assign pe_load_2 = (((state == 3'd2) && ld_q_en) && (ld_q_inst == 3'd2));
+  assign pe_start_2 = (ld_go && (ld_go_inst == 3'd2));
   assign pe_load_3 = (((state == 3'd2) && ld_q_en) && (ld_q_inst == 3'd3));
+  assign pe_start_3 = (ld_go && (ld_go_inst == 3'd3));
   assign pe_load_4 = (((state == 3'd2) && ld_q_en) && (ld_q_inst == 3'd4));
+  assign pe_start_4 = (ld_go && (ld_go_inst == 3'd4));
   assign pe_load_5 = (((state == 3'd2) && ld_q_en) && (ld_q_inst == 3'd5));
+  assign pe_start_5 = (ld_go && (ld_go_inst == 3'd5));
   assign pe_load_6 = (((state == 3'd2) && ld_q_en) && (ld_q_inst == 3'd6));
-  // main FSM: IDLE -> DISP -> per slot LOAD (jobs + 2, or jobs after a write-back) EXEC (max(29, dispatch + 1 - load)) WB (jobs + 2) -> IDLE with done when no path is queued
+  assign pe_start_6 = (ld_go && (ld_go_inst == 3'd6));
+  // main FSM: IDLE -> DISP -> per slot LOAD (jobs + 2, or jobs after a write-back) EXEC (max(29 - jobs - 1, 1, dispatch + 1 - load): each PE starts after its own load) WB (jobs + 2) -> IDLE with done when no path is queued
   always @(posedge clk) begin
     if (!(rst_n)) begin
       state <= 3'd0;
@@ -612,7 +634,7 @@ module bt_top (
           end
         end
         3'd3: begin
-          if ((cnt == 5'd28)) begin
+          if (((({1'd0, cnt} + {2'd0, slen_cur}) + 6'd2) > 6'd28)) begin
             if ((dstate == 3'd0)) begin
               state <= 3'd4;
               cnt <= 5'd0;

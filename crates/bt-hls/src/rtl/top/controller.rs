@@ -554,10 +554,18 @@ pub(super) fn register_entry(pairs: &[(&str, &Signal)]) -> Vec<Stmt> {
         .collect()
 }
 
-/// EXEC: wait the PE latency ([`pe_latency`]) and for the dispatcher, then WB.
+/// EXEC: wait until the slot's last PE has run the PE latency ([`pe_latency`]) less the
+/// slot's other loads and the two cycles write-back takes from reading an entry to taking its
+/// PE's result (each PE started after its own load, and write-back reads the jobs in load
+/// order, one a cycle: `cnt + jobs + 2 >= latency`, at least one cycle) and for the
+/// dispatcher, then WB.
 pub(super) fn fsm_exec(t: &Dims<'_>) -> Vec<Stmt> {
+    let w = t.cnt_bits.max(t.ib + 1) + 1;
+    let ran = zero_extend("cnt", t.cnt_bits, w)
+        .plus(zero_extend("slen_cur", t.ib + 1, w))
+        .plus(lit(w, 2));
     vec![Stmt::If(
-        id("cnt").eq(lit(t.cnt_bits, u128::from(t.latency() - 1))),
+        Expr::bin(BinaryOp::Gt, ran, lit(w, u128::from(t.latency() - 1))),
         vec![Stmt::If(
             dstate_is(D_OFF),
             vec![
@@ -698,7 +706,7 @@ pub(super) fn controller(
 ) {
     let cnt_bits = t.cnt_bits;
     items.push(Item::Comment(format!(
-        "main FSM: IDLE -> DISP -> per slot LOAD (jobs + 2, or jobs after a write-back) EXEC (max({}, dispatch + 1 - load)) WB (jobs + 2) -> IDLE with done when no path is queued",
+        "main FSM: IDLE -> DISP -> per slot LOAD (jobs + 2, or jobs after a write-back) EXEC (max({} - jobs - 1, 1, dispatch + 1 - load): each PE starts after its own load) WB (jobs + 2) -> IDLE with done when no path is queued",
         t.latency()
     )));
     items.push(Item::AlwaysFf(vec![Stmt::If(

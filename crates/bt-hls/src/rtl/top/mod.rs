@@ -150,6 +150,8 @@ impl<'a> Dims<'a> {
 struct PeWires {
     /// `pe_load_<j>`: latch the broadcast operands.
     load: Signal,
+    /// `pe_start_<j>`: start the evaluation (the cycle after the PE's own load).
+    start: Signal,
     /// `pe_sum_<j>`: the unsaturated result.
     sum: Signal,
     /// `pe_zs_<j>`: zero distance sum (degenerate path).
@@ -162,7 +164,7 @@ fn declare_state(t: &Dims<'_>, items: &mut Vec<Item>) -> Vec<PeWires> {
     let (k, pb, ptb, ib, eb, np2) = (t.k, t.pb, t.ptb, t.ib, t.eb, t.np2);
     let cap = t.p.platform.capacity;
     items.push(Item::Comment(format!(
-        "{} PE instances, capacity {} paths, {} points, {} groups; load (jobs, or jobs + 2 after a dispatch wait) + max({}, dispatch + 1 - load) + write-back (jobs + 2) cycles per slot, threshold {} fine LSB",
+        "{} PE instances, capacity {} paths, {} points, {} groups; load (jobs, or jobs + 2 after a dispatch wait) + max({} - jobs - 1, 1, dispatch + 1 - load) + write-back (jobs + 2) cycles per slot (each PE starts after its own load), threshold {} fine LSB",
         k,
         cap.paths,
         cap.points,
@@ -207,6 +209,8 @@ fn declare_state(t: &Dims<'_>, items: &mut Vec<Item>) -> Vec<PeWires> {
         ("ld_q_first", 1),
         ("ld_q_last", 1),
         ("ld_q_inst", ib),
+        ("ld_go", 1),
+        ("ld_go_inst", ib),
         ("wb_q_en", 1),
         ("wb_q_tail", 1),
         ("wb_q_end", 1),
@@ -247,6 +251,7 @@ fn declare_state(t: &Dims<'_>, items: &mut Vec<Item>) -> Vec<PeWires> {
     (0..k)
         .map(|j| PeWires {
             load: Signal::wire(items, format!("pe_load_{j}"), 1),
+            start: Signal::wire(items, format!("pe_start_{j}"), 1),
             sum: Signal::wire(items, format!("pe_sum_{j}"), sum_bits(t.wd)),
             zs: Signal::wire(items, format!("pe_zs_{j}"), 1),
         })
@@ -255,14 +260,19 @@ fn declare_state(t: &Dims<'_>, items: &mut Vec<Item>) -> Vec<PeWires> {
 
 /// PE matrix and operand load: one instance per platform instance; the operands (previous and
 /// next point, or the transmitter/receiver at a path's ends) are broadcast one instance per
-/// cycle, memory data one cycle after the address, and the addressed PE latches them.
+/// cycle, memory data one cycle after the address, and the addressed PE latches them. Each PE
+/// starts the cycle after its own load (`ld_go`, `ld_go_inst`), so a slot's first PEs compute
+/// while its later jobs load, and write-back (job after job, in load order) follows them.
 fn pe_matrix(t: &Dims<'_>, pe: &[PeWires], items: &mut Vec<Item>) {
-    let start = Signal::assigned(
-        items,
-        "pe_start",
-        1,
-        state_is(S_EXEC).and(id("cnt").eq(lit(t.cnt_bits, 0))),
-    );
+    let loading = state_is(S_LOAD).and(id("ld_q_en"));
+    items.push(Item::AlwaysFf(vec![Stmt::If(
+        id("rst_n").lnot(),
+        vec![nb(id("ld_go"), lit(1, 0))],
+        vec![
+            nb(id("ld_go"), loading.clone()),
+            nb(id("ld_go_inst"), id("ld_q_inst")),
+        ],
+    )]));
     // The operand wires follow the instances in the file: build them aside first.
     let mut operands = Vec::new();
     let fine = |n: &str| Expr::concat(vec![mm_bits(n, t.wd), lit(8, 0)]);
@@ -282,7 +292,7 @@ fn pe_matrix(t: &Dims<'_>, pe: &[PeWires], items: &mut Vec<Item>) {
                 ("clk".into(), id("clk")),
                 ("rst_n".into(), id("rst_n")),
                 ("load".into(), w.load.e()),
-                ("start".into(), start.e()),
+                ("start".into(), w.start.e()),
                 ("s_prev".into(), prev.e()),
                 ("s_next".into(), next.e()),
                 ("s_sum".into(), w.sum.e()),
@@ -291,9 +301,13 @@ fn pe_matrix(t: &Dims<'_>, pe: &[PeWires], items: &mut Vec<Item>) {
         });
         operands.push(Item::Assign(
             w.load.e(),
-            state_is(S_LOAD)
-                .and(id("ld_q_en"))
+            loading
+                .clone()
                 .and(id("ld_q_inst").eq(lit(t.ib, j as u128))),
+        ));
+        operands.push(Item::Assign(
+            w.start.e(),
+            id("ld_go").and(id("ld_go_inst").eq(lit(t.ib, j as u128))),
         ));
     }
     items.extend(operands);
