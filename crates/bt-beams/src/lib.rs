@@ -429,12 +429,13 @@ pub fn report(
             .copied()
             .fold(0.0, Real::max)
     };
+    // Each tie-break computed only when the keys before it tie.
     reports.sort_by(|a, b| {
         a.order
             .cmp(&b.order)
-            .then(a.length_m.total_cmp(&b.length_m))
-            .then(key(a).total_cmp(&key(b)))
-            .then(a.surface_ids.cmp(&b.surface_ids))
+            .then_with(|| a.length_m.total_cmp(&b.length_m))
+            .then_with(|| key(a).total_cmp(&key(b)))
+            .then_with(|| a.surface_ids.cmp(&b.surface_ids))
             .then_with(|| {
                 let edges = |r: &PathReport| -> Vec<(usize, bt_scene::EdgeId)> {
                     r.diffractions.iter().map(|d| (d.index, d.edge)).collect()
