@@ -3,30 +3,96 @@
 //! its wedge's frame and faces.
 
 use crate::{RadioOptions, ReportError, surface_response};
-use bt_channel::{Bounce, Complex64, DiffractionCoefficient, Wedge};
+use bt_channel::{
+    Bounce, Complex64, DiffractionCoefficient, RadioMaterial, RadioModel, SurfaceResponse, Wedge,
+};
 use bt_geom::Real;
-use bt_scene::Scene;
+use bt_scene::{Scene, SurfaceId};
 use bt_solve::{FoundPath, Interaction};
+
+/// The surfaces a report's paths touch, each looked up once per report: its response with
+/// the radio model evaluated at the scene's frequency, and its material's reflection loss.
+/// An ITU material's (εr', σ) at the frequency (two powers) becomes the same numbers as a
+/// custom model, which gives the same bits: a custom model's properties are its numbers, and
+/// every coefficient goes through [`RadioMaterial::properties`] at that frequency.
+pub(crate) struct Responses<'a> {
+    scene: &'a Scene,
+    /// Surfaces looked up so far (a few dozen at most are kept; the rest are looked up each
+    /// time, so a report of many paths in a large scene stays linear).
+    known: Vec<(SurfaceId, SurfaceResponse, Real)>,
+}
+
+/// Surfaces a [`Responses`] keeps.
+const KNOWN_SURFACES: usize = 64;
+
+impl<'a> Responses<'a> {
+    /// No surface looked up yet in `scene`.
+    pub(crate) fn new(scene: &'a Scene) -> Self {
+        Responses {
+            scene,
+            known: Vec::new(),
+        }
+    }
+
+    /// The scene.
+    pub(crate) fn scene(&self) -> &'a Scene {
+        self.scene
+    }
+
+    /// Surface `id`'s response and its material's reflection loss (dB).
+    pub(crate) fn get(&mut self, id: SurfaceId) -> (SurfaceResponse, Real) {
+        if let Some(&(_, response, loss_db)) = self.known.iter().find(|k| k.0 == id) {
+            return (response, loss_db);
+        }
+        let response = match surface_response(self.scene, id) {
+            SurfaceResponse::Radio(radio) => {
+                SurfaceResponse::Radio(at_frequency(radio, self.scene.frequency_hz()))
+            }
+            constant => constant,
+        };
+        let loss_db = self.scene.material_of(id).reflection_loss_db;
+        if self.known.len() < KNOWN_SURFACES {
+            self.known.push((id, response, loss_db));
+        }
+        (response, loss_db)
+    }
+}
+
+/// `radio` with its model's (εr', σ) evaluated at `frequency_hz` (unchanged when it has none
+/// there: its error then comes where it came before).
+fn at_frequency(radio: RadioMaterial, frequency_hz: Real) -> RadioMaterial {
+    match radio.properties(frequency_hz) {
+        Ok((relative_permittivity, conductivity)) => RadioMaterial {
+            model: RadioModel::Custom {
+                relative_permittivity,
+                conductivity,
+            },
+            ..radio
+        },
+        Err(_) => radio,
+    }
+}
 
 /// The gain of `path` (interactions `interactions`, aligned with its points) in `scene`, and
 /// its diffraction's excess loss, dB (0 for a specular path).
 pub(crate) fn path_gain(
-    scene: &Scene,
+    responses: &mut Responses<'_>,
     path: &FoundPath,
     interactions: &[Interaction],
     radio: &RadioOptions,
 ) -> Result<(Complex64, Real), ReportError> {
+    let scene = responses.scene();
     let ends = scene.terminals()?;
     let channel: Vec<bt_channel::Interaction> = interactions
         .iter()
         .map(|it| match *it {
             Interaction::Reflection(id) => bt_channel::Interaction::Reflection(Bounce {
                 normal: scene.surface(id).polygon.plane().normal,
-                response: surface_response(scene, id),
+                response: responses.get(id).0,
             }),
             Interaction::Transmission(id) => bt_channel::Interaction::Transmission(Bounce {
                 normal: scene.surface(id).polygon.plane().normal,
-                response: surface_response(scene, id),
+                response: responses.get(id).0,
             }),
             Interaction::Diffraction(e) => {
                 let edge = scene.edges().get(e);
@@ -36,8 +102,8 @@ pub(crate) fn path_gain(
                     face0: edge.t0,
                     normal0: edge.direction.cross(edge.t0),
                     n: edge.n,
-                    response0: surface_response(scene, edge.face0),
-                    response_n: surface_response(scene, edge.face_n),
+                    response0: responses.get(edge.face0).0,
+                    response_n: responses.get(edge.face_n).0,
                 })
             }
         })
@@ -70,10 +136,11 @@ pub(crate) fn path_gain(
 /// crossing of `interactions` (aligned with `vertices[1..]`, the path TX → points → RX, local
 /// frame), −10·log10 of the mean of |T_TE|² and |T_TM|² at its incidence.
 pub(crate) fn transmission_loss_db(
-    scene: &Scene,
+    responses: &mut Responses<'_>,
     vertices: &[bt_geom::Vec3],
     interactions: &[Interaction],
 ) -> Result<Real, ReportError> {
+    let scene = responses.scene();
     let mut loss = 0.0;
     for (k, it) in interactions.iter().enumerate() {
         let Interaction::Transmission(id) = *it else {
@@ -84,7 +151,7 @@ pub(crate) fn transmission_loss_db(
             .normalize()
             .dot(normal)
             .abs();
-        let t = match surface_response(scene, id) {
+        let t = match responses.get(id).0 {
             bt_channel::SurfaceResponse::Radio(radio) => {
                 radio.transmission(scene.frequency_hz(), cos.min(1.0))?
             }
@@ -95,4 +162,48 @@ pub(crate) fn transmission_loss_db(
         loss += -10.0 * power.log10();
     }
     Ok(loss)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use bt_channel::ItuMaterial;
+
+    /// Every ITU material, as a half-space and as a slab, gives the same bits once evaluated
+    /// at the frequency as it gives itself, reflected and crossed at any angle; a frequency
+    /// outside its bands leaves it as it is.
+    #[test]
+    fn a_material_evaluated_at_the_frequency_gives_the_same_bits() {
+        let cosines = (0..=64).map(|k| f64::from(k) / 64.0).chain([1e-9, 0.3333]);
+        let cosines: Vec<f64> = cosines.collect();
+        let mut compared = 0;
+        for material in ItuMaterial::ALL {
+            for thickness in [None, Some(0.004), Some(0.2)] {
+                let radio = RadioMaterial::itu(material.name(), thickness).unwrap();
+                for f in [1e9, 5.8e9, 28e9, 60e9] {
+                    let Ok(at) = radio.properties(f).map(|_| at_frequency(radio, f)) else {
+                        assert_eq!(at_frequency(radio, f), radio);
+                        continue;
+                    };
+                    assert!(matches!(at.model, RadioModel::Custom { .. }));
+                    for &cos in &cosines {
+                        let (a, b) = (radio.reflection(f, cos), at.reflection(f, cos));
+                        let (a, b) = (a.unwrap(), b.unwrap());
+                        assert_eq!(bits(a.te, a.tm), bits(b.te, b.tm), "{material} {f} {cos}");
+                        if thickness.is_some() {
+                            let (a, b) = (radio.transmission(f, cos), at.transmission(f, cos));
+                            let (a, b) = (a.unwrap(), b.unwrap());
+                            assert_eq!(bits(a.te, a.tm), bits(b.te, b.tm));
+                        }
+                        compared += 1;
+                    }
+                }
+            }
+        }
+        assert!(compared > 1000, "{compared}");
+    }
+
+    fn bits(te: Complex64, tm: Complex64) -> [u64; 4] {
+        [te.re, te.im, tm.re, tm.im].map(f64::to_bits)
+    }
 }

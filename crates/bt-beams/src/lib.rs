@@ -325,6 +325,16 @@ pub fn describe(
     path: &FoundPath,
     radio: &RadioOptions,
 ) -> Result<PathReport, ReportError> {
+    describe_with(&mut gain::Responses::new(scene), path, radio)
+}
+
+/// [`describe`] with the surfaces' responses looked up once for all the paths of a report.
+fn describe_with(
+    responses: &mut gain::Responses<'_>,
+    path: &FoundPath,
+    radio: &RadioOptions,
+) -> Result<PathReport, ReportError> {
+    let scene = responses.scene();
     let (vertices, length_m) = vertices(scene, path)?;
     let interactions = path.interactions();
     let incidence_deg = (interactions.iter().enumerate())
@@ -341,11 +351,11 @@ pub fn describe(
     let reflection_loss_db = path
         .surfaces
         .iter()
-        .map(|id| scene.material_of(*id).reflection_loss_db)
+        .map(|id| responses.get(*id).1)
         .fold(0.0, |a, b| a + b);
     let free_space_loss_db = free_space_loss_db(length_m, scene.frequency_hz());
-    let (gain, diffraction_loss_db) = gain::path_gain(scene, path, &interactions, radio)?;
-    let transmission_loss_db = gain::transmission_loss_db(scene, &vertices, &interactions)?;
+    let (gain, diffraction_loss_db) = gain::path_gain(responses, path, &interactions, radio)?;
+    let transmission_loss_db = gain::transmission_loss_db(responses, &vertices, &interactions)?;
     let gain_db = power_db(gain.norm_sqr());
     let n = vertices.len();
     Ok(PathReport {
@@ -418,9 +428,10 @@ pub fn report(
     paths: &[FoundPath],
     radio: &RadioOptions,
 ) -> Result<Vec<PathReport>, ReportError> {
+    let mut responses = gain::Responses::new(scene);
     let mut reports = paths
         .iter()
-        .map(|p| describe(scene, p, radio))
+        .map(|p| describe_with(&mut responses, p, radio))
         .collect::<Result<Vec<_>, _>>()?;
     let key = |r: &PathReport| {
         r.incidence_deg
@@ -429,12 +440,13 @@ pub fn report(
             .copied()
             .fold(0.0, Real::max)
     };
+    // Each tie-break computed only when the keys before it tie.
     reports.sort_by(|a, b| {
         a.order
             .cmp(&b.order)
-            .then(a.length_m.total_cmp(&b.length_m))
-            .then(key(a).total_cmp(&key(b)))
-            .then(a.surface_ids.cmp(&b.surface_ids))
+            .then_with(|| a.length_m.total_cmp(&b.length_m))
+            .then_with(|| key(a).total_cmp(&key(b)))
+            .then_with(|| a.surface_ids.cmp(&b.surface_ids))
             .then_with(|| {
                 let edges = |r: &PathReport| -> Vec<(usize, bt_scene::EdgeId)> {
                     r.diffractions.iter().map(|d| (d.index, d.edge)).collect()

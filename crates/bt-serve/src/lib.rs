@@ -15,6 +15,7 @@
 #![warn(missing_docs)]
 
 mod batch;
+mod json;
 pub mod request;
 mod server;
 mod stream;

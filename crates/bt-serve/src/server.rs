@@ -1,5 +1,6 @@
 //! The session state and the answer to one request.
 
+use crate::json;
 use crate::request::{self, Receivers, Request};
 use crate::{BeamOptions, Limits, ServeError};
 use bt_beams::TraceDocument;
@@ -365,15 +366,15 @@ impl Server {
             .update(&scene)
             .map_err(|e| trace_error(e, &field(0)))?;
         let doc = StepDocument::report(&scene, step, &self.radio, t0.elapsed())?;
+        let reporter = Reporter {
+            options: *self.tracer.options(),
+            radio: &self.radio,
+            beams: self.beams.as_ref(),
+        };
         let first = serialise(&Answer {
             tx: doc.tx,
             rx: doc.rx,
-            beams: Reporter {
-                options: *self.tracer.options(),
-                radio: &self.radio,
-                beams: self.beams.as_ref(),
-            }
-            .beams_of(&doc.paths, scene.frequency_hz())?,
+            beams: reporter.beams_of(&doc.paths, scene.frequency_hz())?,
             paths: doc.paths,
             stats: AnswerStats::Step(doc.stats),
         });
@@ -453,10 +454,24 @@ pub(crate) fn rx_field(rx: &Receivers, i: usize) -> String {
     }
 }
 
-/// One receiver's answer as JSON bytes, room made for a typical answer up front.
+/// One receiver's answer as JSON bytes, room made for a typical answer up front: the bytes
+/// serde_json writes for [`Answer`], its path records written by hand ([`crate::json`]).
 fn serialise(answer: &Answer) -> Outcome {
     let mut bytes = Vec::with_capacity(1024 + 1024 * answer.paths.len());
-    serde_json::to_writer(&mut bytes, answer)?;
+    let io = |e: std::io::Error| ServeError::Json(serde_json::Error::io(e));
+    bytes.extend_from_slice(b"{\"tx\":");
+    json::write_reals(&mut bytes, &answer.tx).map_err(io)?;
+    bytes.extend_from_slice(b",\"rx\":");
+    json::write_reals(&mut bytes, &answer.rx).map_err(io)?;
+    bytes.extend_from_slice(b",\"paths\":");
+    json::write_paths(&mut bytes, &answer.paths).map_err(io)?;
+    bytes.extend_from_slice(b",\"stats\":");
+    serde_json::to_writer(&mut bytes, &answer.stats)?;
+    if let Some(beams) = &answer.beams {
+        bytes.extend_from_slice(b",\"beams\":");
+        serde_json::to_writer(&mut bytes, beams)?;
+    }
+    bytes.push(b'}');
     Ok(bytes)
 }
 
@@ -537,4 +552,104 @@ fn scene_error(e: &SceneError, rx_field: &str) -> ServeError {
         })
         .collect();
     ServeError::Scene(shown.join("; "))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use bt_solve::pipeline::DiffractionOptions;
+    use bt_solve::settings::{SolveSettings, SolverKind};
+
+    /// The answers of the living room's receivers under `settings` (with a beam sweep when
+    /// `beams`), written by hand and by serde_json: the same bytes.
+    fn same_bytes(settings: SolveSettings, beams: bool) -> usize {
+        let options = bt_import::LoadOptions::default();
+        let dynamic = bt_import::load_dynamic("builtin:living-room", &options, &mut |_| {})
+            .unwrap()
+            .scene;
+        let scene = dynamic.step(0).clone();
+        let options = settings.trace_options(&scene).unwrap();
+        let radio = RadioOptions::default();
+        let sweep = beams.then(|| {
+            let arrays = [(Some((2, 4)), 0.5), (None, 0.5)];
+            BeamOptions::new(arrays, &radio, BeamRanking::Power, (3, 1 << 20)).unwrap()
+        });
+        let reporter = Reporter {
+            options,
+            radio: &radio,
+            beams: sweep.as_ref(),
+        };
+        let tx = scene.tx_world().unwrap();
+        let mut tracer = Tracer::new(scene, options);
+        let mut records = 0;
+        for rx in [
+            [1.0, 1.0, 1.0],
+            [2.3, 2.1, 0.72],
+            [4.1, 3.3, 1.9],
+            [0.5, 3.9, 2.3],
+        ] {
+            let rx = Vec3::from_array(rx);
+            let scene = tracer.scene().with_terminals(tx, rx).unwrap();
+            let traced = tracer.trace(tx, rx).unwrap();
+            let doc = TraceDocument::report(&scene, &options, &traced, &radio, Duration::ZERO);
+            let doc = doc.unwrap();
+            let answer = Answer {
+                tx: doc.tx,
+                rx: doc.rx,
+                beams: reporter.beams_of(&doc.paths, scene.frequency_hz()).unwrap(),
+                paths: doc.paths,
+                stats: AnswerStats::Trace(doc.stats),
+            };
+            let mine = String::from_utf8(serialise(&answer).unwrap()).unwrap();
+            assert_eq!(mine, serde_json::to_string(&answer).unwrap());
+            records += answer.paths.len();
+        }
+        records
+    }
+
+    #[test]
+    fn answers_are_written_as_serde_writes_them() {
+        let base = SolveSettings::default();
+        let variants = [
+            (base, true),
+            (
+                SolveSettings {
+                    max_order: 2,
+                    diffraction: DiffractionOptions::first_order(),
+                    ..base
+                },
+                false,
+            ),
+            (
+                SolveSettings {
+                    max_order: 2,
+                    diffraction: DiffractionOptions {
+                        max_diffractions: 2,
+                        min_edge_length: 0.0,
+                    },
+                    ..base
+                },
+                false,
+            ),
+            (
+                SolveSettings {
+                    transmission: true,
+                    ..base
+                },
+                false,
+            ),
+            (
+                SolveSettings {
+                    max_order: 2,
+                    solver: SolverKind::Ipc,
+                    ..base
+                },
+                false,
+            ),
+        ];
+        for (settings, beams) in variants {
+            let records = same_bytes(settings, beams);
+            assert!(records > 10, "{settings:?}: only {records} records");
+        }
+    }
 }
