@@ -41,6 +41,11 @@ pub struct TraceDocument {
     /// written before the field existed.
     #[serde(default)]
     pub transmission: bool,
+    /// Most diffractions per path the trace allowed: 0 without diffraction, 1 with
+    /// `--diffraction`, 2 with `--max-diffractions 2`. Read as 0 from a document written before
+    /// the field existed.
+    #[serde(default)]
+    pub max_diffractions: usize,
     /// Antennas and transmitted power of the gains.
     pub radio: Radio,
     /// The valid paths, ranked.
@@ -119,6 +124,7 @@ impl TraceDocument {
             max_order: options.max_order,
             solver: options.solver,
             transmission: options.transmission,
+            max_diffractions: options.diffraction.max_diffractions,
             radio: Radio {
                 tx_antenna: radio.tx,
                 rx_antenna: radio.rx,
