@@ -88,6 +88,23 @@ impl Plane {
         Self::crossing_parameter(self.signed_distance(a), self.signed_distance(b), a, b)
     }
 
+    /// Where the segment `a → b` crosses the plane when `a` and `b` lie on opposite sides,
+    /// each more than `margin` metres off it, with the sum of their distances from it (m);
+    /// `None` otherwise. The crossing is then strictly inside the segment, more than `margin`
+    /// from the plane at either end. Unfused distances
+    /// ([`Plane::signed_distance_unfused`]): only for margins far above their round-off.
+    #[inline]
+    pub fn crossing_beyond(&self, a: Vec3, b: Vec3, margin: Real) -> Option<(Vec3, Real)> {
+        let (da, db) = (
+            self.signed_distance_unfused(a),
+            self.signed_distance_unfused(b),
+        );
+        if (da > 0.0) == (db > 0.0) || da.abs() <= margin || db.abs() <= margin {
+            return None;
+        }
+        Some((a + (da / (da - db)) * (b - a), da.abs() + db.abs()))
+    }
+
     /// [`Plane::line_parameter`] from the signed distances `da`, `db` of `a` and `b` already
     /// computed: `None` when the line is parallel to the plane.
     #[inline]

@@ -417,17 +417,11 @@ pub fn blocked_for_good(
         let length = a.distance(b);
         let ends = (from.as_slice(), to.as_slice());
         let by = first_blocking(scene, (a, b), ends, true, |polygon| {
-            // Unfused: the margins are far above its round-off, and the closure may be compiled
-            // without the FMA feature (a software `fma` per call).
-            let (da, db) = (
-                polygon.plane().signed_distance_unfused(a),
-                polygon.plane().signed_distance_unfused(b),
-            );
-            let span = da.abs() + db.abs();
-            if (da > 0.0) == (db > 0.0) || da.abs() <= margin || db.abs() <= margin {
+            // Unfused distances: the margins are far above their round-off, and the closure
+            // may be compiled without the FMA feature (a software `fma` per call).
+            let Some((crossing, span)) = polygon.plane().crossing_beyond(a, b, margin) else {
                 return false;
-            }
-            let crossing = a + (da / (da - db)) * (b - a);
+            };
             let shift = reach * (1.0 + length / (span - 2.0 * reach));
             polygon.inside_by(crossing, tol + shift)
         });

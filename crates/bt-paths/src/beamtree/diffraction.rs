@@ -238,12 +238,8 @@ const HIDDEN: Real = 4.0;
 fn hidden_from(scene: &Scene, apex: Vec3, edge: &Edge) -> bool {
     let margin = HIDDEN * scene.length_tolerance();
     let crosses = |polygon: &bt_geom::Polygon, p: Vec3| {
-        let plane = polygon.plane();
-        let (da, dp) = (plane.signed_distance(apex), plane.signed_distance(p));
-        if (da > 0.0) == (dp > 0.0) || da.abs() <= margin || dp.abs() <= margin {
-            return false;
-        }
-        polygon.inside_by(apex + (da / (da - dp)) * (p - apex), margin)
+        (polygon.plane().crossing_beyond(apex, p, margin))
+            .is_some_and(|(crossing, _)| polygon.inside_by(crossing, margin))
     };
     let hides = |item: u32| {
         let id = SurfaceId(item);
