@@ -21,6 +21,12 @@ impl<T: Occluder> Occluder for &T {
     }
 }
 
+impl Occluder for (Vec3, Vec3) {
+    fn bounds(&self) -> (Vec3, Vec3) {
+        *self
+    }
+}
+
 impl Occluder for crate::Polygon {
     fn bounds(&self) -> (Vec3, Vec3) {
         crate::Polygon::bounds(self)
@@ -54,11 +60,16 @@ const LEAF_SIZE: usize = 4;
 /// are tested several at once by the CPU's vector units.
 pub const SCAN_UP_TO: usize = 64;
 
-/// Item boxes as arrays, by bound and coordinate (m).
+/// Boxes tested at once by `Boxes::scan` (four `f64` in an AVX register).
+const LANES: usize = 4;
+
+/// Item boxes as arrays, by bound and coordinate (m), padded with zeros to whole [`LANES`].
 #[derive(Debug, Clone, Default)]
 struct Boxes {
     min: [Vec<Real>; 3],
     max: [Vec<Real>; 3],
+    /// Items stored (the arrays hold as many, then the padding).
+    len: usize,
 }
 
 impl Bvh {
@@ -70,10 +81,17 @@ impl Bvh {
         if !items.is_empty() {
             build_node(&boxes, &mut order, 0, items.len(), &mut nodes);
         }
-        let axis = |f: fn(&(Vec3, Vec3)) -> Vec3, k: usize| boxes.iter().map(|b| f(b)[k]).collect();
+        // Padded to whole lanes (the padding's bits are masked off in `scan`).
+        let lanes = boxes.len().next_multiple_of(LANES);
+        let axis = |f: fn(&(Vec3, Vec3)) -> Vec3, k: usize| {
+            let mut v: Vec<Real> = boxes.iter().map(|b| f(b)[k]).collect();
+            v.resize(lanes, 0.0);
+            v
+        };
         let scan = (boxes.len() <= SCAN_UP_TO).then(|| Boxes {
             min: std::array::from_fn(|k| axis(|b| b.0, k)),
             max: std::array::from_fn(|k| axis(|b| b.1, k)),
+            len: boxes.len(),
         });
         Self {
             nodes,
@@ -102,6 +120,27 @@ impl Bvh {
             Some(boxes) => boxes.scan(&slab, hit),
             None => self.walk(|min, max| slab.hits_box(min, max), hit),
         }
+    }
+
+    /// [`Bvh::any_hit`] restricted to the items of `among` (bit `i` for item `i`) when the
+    /// boxes are scanned ([`Bvh::scans`]), else `None` without calling `hit`: the same first
+    /// item, when every item `any_hit` would accept is in `among`.
+    #[inline(always)]
+    pub fn any_hit_among(
+        &self,
+        (a, b): (Vec3, Vec3),
+        margin: Real,
+        among: u64,
+        hit: impl FnMut(u32) -> bool,
+    ) -> Option<Option<u32>> {
+        let boxes = self.boxes.as_ref()?;
+        Some(boxes.scan_among(&Slab::new(a, b, margin), among, hit))
+    }
+
+    /// Whether segment queries test every item's box (at most [`SCAN_UP_TO`] items), so that
+    /// [`Bvh::any_hit_among`] answers.
+    pub fn scans(&self) -> bool {
+        self.boxes.is_some()
     }
 
     /// The one traversal: descend into nodes whose box passes `box_test`, call `hit` on the
@@ -233,17 +272,76 @@ impl Boxes {
     /// index order, up to the first it accepts.
     #[inline(always)]
     fn scan(&self, slab: &Slab, mut hit: impl FnMut(u32) -> bool) -> Option<u32> {
-        let n = self.min[0].len().min(SCAN_UP_TO);
-        let [x0, y0, z0] = [&self.min[0][..n], &self.min[1][..n], &self.min[2][..n]];
-        let [x1, y1, z1] = [&self.max[0][..n], &self.max[1][..n], &self.max[2][..n]];
-        let mut touched = [false; SCAN_UP_TO];
-        for (j, t) in touched[..n].iter_mut().enumerate() {
-            *t = slab.hits_box(
-                Vec3::new(x0[j], y0[j], z0[j]),
-                Vec3::new(x1[j], y1[j], z1[j]),
-            );
+        let padded = self.min[0].len().min(SCAN_UP_TO);
+        let mut touched = 0u64;
+        for base in (0..padded).step_by(LANES) {
+            touched |= u64::from(self.lanes_hit(slab, base)) << base;
         }
-        (0..n as u32).find(|&j| touched[j as usize] && hit(j))
+        let n = self.len;
+        touched &= if n >= 64 { u64::MAX } else { (1 << n) - 1 };
+        while touched != 0 {
+            let j = touched.trailing_zeros();
+            if hit(j) {
+                return Some(j);
+            }
+            touched &= touched - 1;
+        }
+        None
+    }
+
+    /// [`Boxes::scan`] over the items of `among` alone, each box tested in turn.
+    #[inline(always)]
+    fn scan_among(
+        &self,
+        slab: &Slab,
+        mut among: u64,
+        mut hit: impl FnMut(u32) -> bool,
+    ) -> Option<u32> {
+        while among != 0 {
+            let j = among.trailing_zeros();
+            let i = j as usize;
+            if i >= self.len {
+                break;
+            }
+            let corner = |v: &[Vec<Real>; 3]| Vec3::new(v[0][i], v[1][i], v[2][i]);
+            if slab.hits_box(corner(&self.min), corner(&self.max)) && hit(j) {
+                return Some(j);
+            }
+            among &= among - 1;
+        }
+        None
+    }
+
+    /// Boxes `base..base + LANES` against `slab` ([`Slab::hits_box`], lane by lane, written
+    /// so that the compiler keeps the lanes in one vector register): bit `l` for box
+    /// `base + l`.
+    #[inline(always)]
+    fn lanes_hit(&self, slab: &Slab, base: usize) -> u8 {
+        let lane = |v: &Vec<Real>| -> [Real; LANES] { v[base..base + LANES].try_into().unwrap() };
+        let (from_min, from_max, inv) = (
+            slab.from_min.to_array(),
+            slab.from_max.to_array(),
+            slab.inv.to_array(),
+        );
+        let mut enter = [0.0 as Real; LANES];
+        let mut exit = [1.0 as Real; LANES];
+        for k in 0..3 {
+            let (lo, hi) = (lane(&self.min[k]), lane(&self.max[k]));
+            for l in 0..LANES {
+                let t0 = (lo[l] - from_min[k]) * inv[k];
+                let t1 = (hi[l] - from_max[k]) * inv[k];
+                // As `Vec3::min`/`max` (the first if strictly less/greater, else the
+                // second), then `f64::max`/`min` (NaN dropped): `Slab::hits_box` exactly.
+                let (near, far) = (if t0 < t1 { t0 } else { t1 }, if t0 > t1 { t0 } else { t1 });
+                enter[l] = enter[l].max(near);
+                exit[l] = exit[l].min(far);
+            }
+        }
+        let mut bits = 0u8;
+        for l in 0..LANES {
+            bits |= u8::from(enter[l] <= exit[l]) << l;
+        }
+        bits
     }
 }
 
@@ -334,6 +432,39 @@ mod tests {
                 let (brute, seen) = brute_and_bvh(&walls, &bvh, (a, b));
                 assert_eq!(brute, seen, "segment {k} among {} walls", walls.len());
             }
+        }
+    }
+
+    proptest::proptest! {
+        /// The scan (four boxes per step) and the scan over a subset touch exactly the boxes
+        /// the one-box slab test touches, on a coarse grid where segments run along axes and
+        /// in the planes of grown faces (the NaN cases).
+        #[test]
+        fn the_scans_touch_what_the_slab_test_touches(
+            corners in proptest::collection::vec(proptest::array::uniform6(-2i8..3), 1..40),
+            ends in proptest::array::uniform6(-3i8..4),
+            among: u64,
+        ) {
+            let margin = 1.0;
+            let v = |c: &[i8]| Vec3::new(c[0] as Real, c[1] as Real, c[2] as Real);
+            let boxes: Vec<(Vec3, Vec3)> = corners
+                .iter()
+                .map(|c| (v(&c[..3]).min(v(&c[3..])), v(&c[..3]).max(v(&c[3..]))))
+                .collect();
+            let bvh = Bvh::build(&boxes);
+            let (a, b) = (v(&ends[..3]), v(&ends[3..]));
+            let slab = Slab::new(a, b, margin);
+            let expected: Vec<u32> = (0..boxes.len() as u32)
+                .filter(|&i| slab.hits_box(boxes[i as usize].0, boxes[i as usize].1))
+                .collect();
+            let mut seen = Vec::new();
+            proptest::prop_assert_eq!(bvh.any_hit(a, b, margin, |i| { seen.push(i); false }), None);
+            proptest::prop_assert_eq!(&seen, &expected);
+            let mut seen_among = Vec::new();
+            let answer = bvh.any_hit_among((a, b), margin, among, |i| { seen_among.push(i); false });
+            proptest::prop_assert_eq!(answer, Some(None));
+            let subset: Vec<u32> = expected.into_iter().filter(|&i| among >> i & 1 == 1).collect();
+            proptest::prop_assert_eq!(seen_among, subset);
         }
     }
 
