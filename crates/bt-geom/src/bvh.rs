@@ -122,27 +122,6 @@ impl Bvh {
         }
     }
 
-    /// [`Bvh::any_hit`] restricted to the items of `among` (bit `i` for item `i`) when the
-    /// boxes are scanned ([`Bvh::scans`]), else `None` without calling `hit`: the same first
-    /// item, when every item `any_hit` would accept is in `among`.
-    #[inline(always)]
-    pub fn any_hit_among(
-        &self,
-        (a, b): (Vec3, Vec3),
-        margin: Real,
-        among: u64,
-        hit: impl FnMut(u32) -> bool,
-    ) -> Option<Option<u32>> {
-        let boxes = self.boxes.as_ref()?;
-        Some(boxes.scan_among(&Slab::new(a, b, margin), among, hit))
-    }
-
-    /// Whether segment queries test every item's box (at most [`SCAN_UP_TO`] items), so that
-    /// [`Bvh::any_hit_among`] answers.
-    pub fn scans(&self) -> bool {
-        self.boxes.is_some()
-    }
-
     /// The one traversal: descend into nodes whose box passes `box_test`, call `hit` on the
     /// items of the leaves reached, stop at (and return) the first item `hit` accepts.
     #[inline(always)]
@@ -289,29 +268,6 @@ impl Boxes {
         None
     }
 
-    /// [`Boxes::scan`] over the items of `among` alone, each box tested in turn.
-    #[inline(always)]
-    fn scan_among(
-        &self,
-        slab: &Slab,
-        mut among: u64,
-        mut hit: impl FnMut(u32) -> bool,
-    ) -> Option<u32> {
-        while among != 0 {
-            let j = among.trailing_zeros();
-            let i = j as usize;
-            if i >= self.len {
-                break;
-            }
-            let corner = |v: &[Vec<Real>; 3]| Vec3::new(v[0][i], v[1][i], v[2][i]);
-            if slab.hits_box(corner(&self.min), corner(&self.max)) && hit(j) {
-                return Some(j);
-            }
-            among &= among - 1;
-        }
-        None
-    }
-
     /// Boxes `base..base + LANES` against `slab` ([`Slab::hits_box`], lane by lane, written
     /// so that the compiler keeps the lanes in one vector register): bit `l` for box
     /// `base + l`.
@@ -436,14 +392,13 @@ mod tests {
     }
 
     proptest::proptest! {
-        /// The scan (four boxes per step) and the scan over a subset touch exactly the boxes
-        /// the one-box slab test touches, on a coarse grid where segments run along axes and
+        /// The scan (four boxes per step) touches exactly the boxes the one-box slab test
+        /// touches, on a coarse grid where segments run along axes and
         /// in the planes of grown faces (the NaN cases).
         #[test]
         fn the_scans_touch_what_the_slab_test_touches(
             corners in proptest::collection::vec(proptest::array::uniform6(-2i8..3), 1..40),
             ends in proptest::array::uniform6(-3i8..4),
-            among: u64,
         ) {
             let margin = 1.0;
             let v = |c: &[i8]| Vec3::new(c[0] as Real, c[1] as Real, c[2] as Real);
@@ -460,11 +415,6 @@ mod tests {
             let mut seen = Vec::new();
             proptest::prop_assert_eq!(bvh.any_hit(a, b, margin, |i| { seen.push(i); false }), None);
             proptest::prop_assert_eq!(&seen, &expected);
-            let mut seen_among = Vec::new();
-            let answer = bvh.any_hit_among((a, b), margin, among, |i| { seen_among.push(i); false });
-            proptest::prop_assert_eq!(answer, Some(None));
-            let subset: Vec<u32> = expected.into_iter().filter(|&i| among >> i & 1 == 1).collect();
-            proptest::prop_assert_eq!(seen_among, subset);
         }
     }
 
