@@ -81,6 +81,9 @@ pub fn solve_image(
 /// The reflection points of each stretch `(surfaces, from)` of a path whose diffraction
 /// points are already in `points`: each stretch runs from `from` to the next stretch's start
 /// (the last to `to`), its points right after the previous stretch's and its diffraction.
+/// Inlined into the caller's FMA body (`solve_range`): compiled apart, each plane's fused
+/// distance would be a software call.
+#[inline(always)]
 fn stretches(
     scene: &Scene,
     parts: &[(&[SurfaceId], Vec3)],
