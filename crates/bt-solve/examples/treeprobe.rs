@@ -11,7 +11,8 @@
 //! tree / exhaustive candidates), `ipc` (whole IPC Gauss-Seidel trace), `walk` (a new RX on a
 //! kept tree, walk only), `newrx` (walk + image method + validation), `diff` (candidates with
 //! one diffraction), `rxtree` (a tree materialised to depth 2, as the RX side of `diff`), `diffimage` (the
-//! whole image-method trace with one diffraction).
+//! whole image-method trace with one diffraction), `diff2t` (the same with two diffractions
+//! and transmission).
 
 use bt_paths::beamtree::{BeamTree, TreeCache, TreeOptions, candidates_in};
 use bt_scene::{Scene, Terminals, Vec3};
@@ -76,6 +77,18 @@ fn run(what: &str, scene: &Scene, i: usize, tree: &BeamTree, kept: &mut Kept) ->
                 ..trace_options(Solver::Image, CandidateMode::BeamTree)
             },
         ),
+        "diff2t" => traced_paths(
+            kept,
+            scene,
+            &TraceOptions {
+                diffraction: bt_solve::pipeline::DiffractionOptions {
+                    max_diffractions: 2,
+                    min_edge_length: 0.0,
+                },
+                transmission: true,
+                ..trace_options(Solver::Image, CandidateMode::BeamTree)
+            },
+        ),
         "report" => {
             let traced = trace_scene(
                 kept,
@@ -136,7 +149,7 @@ fn run(what: &str, scene: &Scene, i: usize, tree: &BeamTree, kept: &mut Kept) ->
         }
         other => {
             panic!(
-                "unknown workload {other:?}: cand, image, exh, ipc, walk, newrx, diff, rxtree or diffimage"
+                "unknown workload {other:?}: cand, image, exh, ipc, walk, newrx, diff, rxtree, diffimage or diff2t"
             )
         }
     }
