@@ -149,6 +149,33 @@ fn an_unseen_room_cosimulates_bit_exact_within_a_millisecond() {
     assert!(measured[0] <= 1e-3, "{measured:?}");
 }
 
+/// Every unseen room's design, generated for synthesis (docs/hardware.md, the area of the
+/// tilted rooms: `beamtrace hls synth target/tmp/bt_accel_unseen_<seed>`): one PE per
+/// reflector, and the generator's predicted cycles are the plan's.
+#[test]
+fn every_unseen_room_generates_its_design() {
+    for seed in SEEDS {
+        let (_, p) = cold_step(seed);
+        let work = vec![p.work()];
+        let platform = bt_hls::Platform::fitting(&work).unwrap();
+        assert_eq!(
+            platform.instances.len(),
+            p.step.input.planes.len(),
+            "seed {seed}"
+        );
+        let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+            .join(format!("bt_accel_unseen_{seed}"));
+        let _ = std::fs::remove_dir_all(&dir);
+        let report = bt_hls::generate_steps(&platform, &work, &dir).unwrap();
+        assert_eq!(
+            report.predicted.run_cycles,
+            vec![p.plan.predicted_cycles],
+            "seed {seed}"
+        );
+        assert!(dir.join("rtl").join("bt_top.v").is_file(), "seed {seed}");
+    }
+}
+
 /// The host's work of one cold step and nothing else (candidates single-threaded, the
 /// accelerator's input, the round template), for instruction counts under callgrind
 /// (docs/hardware.md, Nios II estimate): `valgrind --tool=callgrind

@@ -193,12 +193,13 @@ pub(crate) fn pe_core_module(wd: Widths) -> Module {
 /// `bt_unused_ok = &{1'b0, unused...}`: reads the bits a module computes but does not use, so
 /// that linters see them read (the value is never used).
 fn unused_ok(items: &mut Vec<Item>, mut unused: Vec<Expr>) {
-    items.push(Item::Wire("bt_unused_ok".into(), 1));
     unused.insert(0, Expr::lit(1, 0));
-    items.push(Item::Assign(
-        Expr::id("bt_unused_ok"),
+    Signal::assigned(
+        items,
+        "bt_unused_ok",
+        1,
         Expr::Unary(UnaryOp::ReduceAnd, Box::new(Expr::concat(unused))),
-    ));
+    );
 }
 
 /// The signals between a PE's plane front end and its core: what the core shows of its
@@ -277,9 +278,10 @@ impl Link {
     /// In the front end: the core instance, every port by name (the PE's own ports, which the
     /// core shares, passed through).
     fn core_instance(&self, wd: Widths) -> Item {
-        let mut ports: Vec<(String, Expr)> = pe_ports(wd)
+        let mut ports: Vec<(String, Expr)> = PePorts::new(wd)
+            .each()
             .into_iter()
-            .map(|p| (p.name.clone(), Expr::id(p.name)))
+            .map(|(s, _)| (s.name().to_string(), s.e()))
             .collect();
         ports.extend(
             self.outputs()
@@ -310,6 +312,8 @@ struct PeRegs {
     b: Vec<Signal>,
     /// The design's datapath widths.
     wd: Widths,
+    /// The ports.
+    io: PePorts,
 }
 
 /// The plane's header comment of `bt_pe_<index>`.
@@ -352,6 +356,7 @@ fn pe_state(wd: Widths, items: &mut Vec<Item>) -> PeRegs {
         a,
         b,
         wd,
+        io: PePorts::new(wd),
     }
 }
 
@@ -644,8 +649,8 @@ fn pe_outputs(r: &PeRegs, items: &mut Vec<Item>) {
         sum_parts.insert(0, a.slice(aw - 1, g));
     }
     debug_assert_eq!(aw - g, wd.sum_point);
-    items.push(Item::Assign(Expr::id("s_sum"), Expr::concat(sum_parts)));
-    items.push(Item::Assign(Expr::id("zero_sum"), r.zs.e()));
+    items.push(Item::Assign(r.io.s_sum.e(), Expr::concat(sum_parts)));
+    items.push(Item::Assign(r.io.zero_sum.e(), r.zs.e()));
 }
 
 /// `reg <= value;`
@@ -665,16 +670,16 @@ fn seq_idle(r: &PeRegs, d_new: &Signal) -> Vec<Stmt> {
     let mut load = Vec::new();
     for k in 0..AXES.len() {
         let (hi, lo) = (cw * (k as u32 + 1) - 1, cw * k as u32);
-        load.push(nb(&r.a[k], sext_slice("s_prev", hi, lo, aw)));
-        load.push(nb(&r.b[k], sext_slice("s_next", hi, lo, lpw)));
+        load.push(nb(&r.a[k], sext_slice(r.io.s_prev.name(), hi, lo, aw)));
+        load.push(nb(&r.b[k], sext_slice(r.io.s_next.name(), hi, lo, lpw)));
     }
     vec![Stmt::If(
-        Expr::id("start"),
+        r.io.start.e(),
         vec![
             nb(&r.r_e, sext(d_new.name(), wd.distance, wd.search_diff)),
             goto(r, 1),
         ],
-        vec![Stmt::If(Expr::id("load"), load, vec![])],
+        vec![Stmt::If(r.io.load.e(), load, vec![])],
     )]
 }
 
@@ -770,7 +775,7 @@ fn sequencer(
     proj_prev.push(goto(r, 3));
     proj_next.push(goto(r, 4));
     items.push(Item::AlwaysFf(vec![Stmt::If(
-        Expr::id("rst_n").lnot(),
+        r.io.rst_n.e().lnot(),
         vec![goto(r, 0)],
         vec![Stmt::Case(
             r.step.e(),
@@ -822,18 +827,60 @@ fn pe_shell(index: usize, plane_name: &str, wd: Widths, items: Vec<Item>) -> Mod
 }
 
 /// The ports of a PE (and the first ones of its core): clock, reset, `load`, `start`, the
-/// operands and the result.
+/// operands and the result, each declared once.
+struct PePorts {
+    clk: Signal,
+    rst_n: Signal,
+    /// Latch the operands.
+    load: Signal,
+    /// Start the evaluation.
+    start: Signal,
+    /// The previous and next points `{z, y, x}`.
+    s_prev: Signal,
+    s_next: Signal,
+    /// The unsaturated result `{z, y, x}`.
+    s_sum: Signal,
+    /// Zero distance sum.
+    zero_sum: Signal,
+}
+
+impl PePorts {
+    fn new(wd: Widths) -> PePorts {
+        PePorts {
+            clk: Signal::port("clk", 1),
+            rst_n: Signal::port("rst_n", 1),
+            load: Signal::port("load", 1),
+            start: Signal::port("start", 1),
+            s_prev: Signal::port("s_prev", point_bits(wd)),
+            s_next: Signal::port("s_next", point_bits(wd)),
+            s_sum: Signal::port("s_sum", sum_bits(wd)),
+            zero_sum: Signal::port("zero_sum", 1),
+        }
+    }
+
+    /// The ports in order, with their directions.
+    fn each(&self) -> [(&Signal, Direction); 8] {
+        use Direction::{Input, Output};
+        [
+            (&self.clk, Input),
+            (&self.rst_n, Input),
+            (&self.load, Input),
+            (&self.start, Input),
+            (&self.s_prev, Input),
+            (&self.s_next, Input),
+            (&self.s_sum, Output),
+            (&self.zero_sum, Output),
+        ]
+    }
+}
+
+/// The port list of a PE (and the first ports of its core).
 fn pe_ports(wd: Widths) -> Vec<Port> {
-    vec![
-        port("clk", Direction::Input, 1),
-        port("rst_n", Direction::Input, 1),
-        port("load", Direction::Input, 1),
-        port("start", Direction::Input, 1),
-        port("s_prev", Direction::Input, point_bits(wd)),
-        port("s_next", Direction::Input, point_bits(wd)),
-        port("s_sum", Direction::Output, sum_bits(wd)),
-        port("zero_sum", Direction::Output, 1),
-    ]
+    PePorts::new(wd)
+        .each()
+        .into_iter()
+        .map(|(s, dir)| port(s.name(), dir, s.width()))
+        .collect()
 }
 
 /// `name[hi:lo]` sign-extended to `total` bits.

@@ -196,6 +196,21 @@ impl Signal {
         items.push(Item::Reg(s.name.clone(), width));
         s
     }
+    /// Declares `reg [width-1:0] name [0:depth-1];` in `items`: a memory of `depth` words of
+    /// `width` bits, read and written word by word ([`Signal::at`]).
+    pub fn memory(
+        items: &mut Vec<Item>,
+        name: impl Into<String>,
+        width: u32,
+        depth: u32,
+    ) -> Signal {
+        let s = Signal {
+            name: name.into(),
+            width,
+        };
+        items.push(Item::Memory(s.name.clone(), width, depth));
+        s
+    }
     /// The name.
     pub fn name(&self) -> &str {
         &self.name
@@ -215,6 +230,10 @@ impl Signal {
     /// `name[bit]`.
     pub fn bit(&self, bit: u32) -> Expr {
         Expr::bit(self.name.clone(), bit)
+    }
+    /// `name[index]` with a dynamic index: a bit of a vector, or a word of a memory.
+    pub fn at(&self, index: Expr) -> Expr {
+        self.e().at(index)
     }
 }
 

@@ -32,15 +32,15 @@ pub(super) fn bus_decode(t: &Dims<'_>, items: &mut Vec<Item>) -> Decode {
             items,
             name,
             1,
-            Expr::slice("avs_address", hi, bits).eq(lit(ab - bits, 1)),
+            t.io.avs_address.slice(hi, bits).eq(lit(ab - bits, 1)),
         )
     };
-    let idle = Signal::assigned(items, "idle", 1, state_is(S_IDLE));
+    let idle = Signal::assigned(items, "idle", 1, state_is(t, S_IDLE));
     let is_ctrl = Signal::assigned(
         items,
         "is_ctrl",
         1,
-        Expr::slice("avs_address", hi, 4).eq(lit(ab - 4, 0)),
+        t.io.avs_address.slice(hi, 4).eq(lit(ab - 4, 0)),
     );
     let is_status = window(items, "is_status", l.map.status_base);
     let is_point = window(items, "is_point", l.map.point_base);
@@ -49,9 +49,9 @@ pub(super) fn bus_decode(t: &Dims<'_>, items: &mut Vec<Item>) -> Decode {
         items,
         "bus_point",
         t.ptb,
-        Expr::slice("avs_address", t.ptb + 2, 3),
+        t.io.avs_address.slice(t.ptb + 2, 3),
     );
-    let host_wr = Signal::assigned(items, "host_wr", 1, id("avs_write").and(idle.e()));
+    let host_wr = Signal::assigned(items, "host_wr", 1, t.io.avs_write.e().and(idle.e()));
     let pt_we = Signal::assigned(
         items,
         "pt_we",
@@ -59,7 +59,7 @@ pub(super) fn bus_decode(t: &Dims<'_>, items: &mut Vec<Item>) -> Decode {
         host_wr
             .e()
             .and(is_point.e())
-            .and(Expr::slice("avs_address", 1, 0).eq(lit(2, 3))),
+            .and(t.io.avs_address.slice(1, 0).eq(lit(2, 3))),
     );
     Decode {
         is_ctrl,
@@ -73,68 +73,70 @@ pub(super) fn bus_decode(t: &Dims<'_>, items: &mut Vec<Item>) -> Decode {
 }
 
 /// `{bus_point, avs_address[2]}`: the memory cell a point-window bus access addresses.
-pub(super) fn bus_cell(bus: &Decode) -> Expr {
-    Expr::concat(vec![bus.bus_point.e(), Expr::bit("avs_address", 2)])
+pub(super) fn bus_cell(t: &Dims<'_>, bus: &Decode) -> Expr {
+    Expr::concat(vec![bus.bus_point.e(), t.io.avs_address.bit(2)])
 }
 
 /// Avalon-MM slave, writes: the transmitter, receiver and slot-count registers and the
 /// staging words of a point (its last word, the fractions, goes to the point memory).
 pub(super) fn register_writes(t: &Dims<'_>, bus: &Decode, items: &mut Vec<Item>) {
     let (ab, pb) = (t.ab, t.pb);
-    let wr = |addr: u32, reg: &str| {
+    let wr = |addr: u32, reg: &Signal| {
         Stmt::If(
-            id("avs_address").eq(lit(ab, addr.into())),
-            vec![nb(id(reg), id("avs_writedata"))],
+            t.io.avs_address.e().eq(lit(ab, addr.into())),
+            vec![nb(reg.e(), t.io.avs_writedata.e())],
             vec![],
         )
     };
     items.push(Item::AlwaysFf(vec![Stmt::If(
-        id("rst_n").lnot(),
+        t.io.rst_n.e().lnot(),
         vec![
-            nb(id("tx_x"), lit(32, 0)),
-            nb(id("tx_y"), lit(32, 0)),
-            nb(id("tx_z"), lit(32, 0)),
-            nb(id("rx_x"), lit(32, 0)),
-            nb(id("rx_y"), lit(32, 0)),
-            nb(id("rx_z"), lit(32, 0)),
-            nb(id("paths_r"), lit(pb + 1, 0)),
-            nb(id("cap_r"), lit(16, 0)),
+            clear(&t.r.tx_x),
+            clear(&t.r.tx_y),
+            clear(&t.r.tx_z),
+            clear(&t.r.rx_x),
+            clear(&t.r.rx_y),
+            clear(&t.r.rx_z),
+            clear(&t.r.paths_r),
+            clear(&t.r.cap_r),
         ],
         vec![Stmt::If(
             bus.host_wr.e(),
             vec![
-                wr(4, "tx_x"),
-                wr(5, "tx_y"),
-                wr(6, "tx_z"),
-                wr(8, "rx_x"),
-                wr(9, "rx_y"),
-                wr(10, "rx_z"),
+                wr(4, &t.r.tx_x),
+                wr(5, &t.r.tx_y),
+                wr(6, &t.r.tx_z),
+                wr(8, &t.r.rx_x),
+                wr(9, &t.r.rx_y),
+                wr(10, &t.r.rx_z),
                 Stmt::If(
-                    id("avs_address").eq(lit(ab, crate::regs::PATHS.into())),
-                    vec![nb(id("paths_r"), Expr::slice("avs_writedata", pb, 0))],
+                    t.io.avs_address.e().eq(lit(ab, crate::regs::PATHS.into())),
+                    vec![nb(t.r.paths_r.e(), t.io.avs_writedata.slice(pb, 0))],
                     vec![],
                 ),
                 Stmt::If(
-                    id("avs_address").eq(lit(ab, crate::regs::ROUND_CAP.into())),
-                    vec![nb(id("cap_r"), Expr::slice("avs_writedata", 15, 0))],
+                    t.io.avs_address
+                        .e()
+                        .eq(lit(ab, crate::regs::ROUND_CAP.into())),
+                    vec![nb(t.r.cap_r.e(), t.io.avs_writedata.slice(15, 0))],
                     vec![],
                 ),
                 Stmt::If(
                     bus.is_point.e(),
                     vec![Stmt::Case(
-                        Expr::slice("avs_address", 1, 0),
+                        t.io.avs_address.slice(1, 0),
                         vec![
                             (
                                 lit(2, 0),
-                                vec![nb(id("st_x"), mm_bits("avs_writedata", t.wd))],
+                                vec![nb(t.r.st_x.e(), mm_bits(&t.io.avs_writedata, t.wd))],
                             ),
                             (
                                 lit(2, 1),
-                                vec![nb(id("st_y"), mm_bits("avs_writedata", t.wd))],
+                                vec![nb(t.r.st_y.e(), mm_bits(&t.io.avs_writedata, t.wd))],
                             ),
                             (
                                 lit(2, 2),
-                                vec![nb(id("st_z"), mm_bits("avs_writedata", t.wd))],
+                                vec![nb(t.r.st_z.e(), mm_bits(&t.io.avs_writedata, t.wd))],
                             ),
                         ],
                         vec![],
@@ -153,16 +155,16 @@ pub(super) fn read_pipeline(t: &Dims<'_>, bus: &Decode, items: &mut Vec<Item>) -
     let mut mux_decl = Vec::new();
     let read_mux = Signal::reg(&mut mux_decl, "read_mux", 32);
     items.push(Item::AlwaysFf(vec![Stmt::If(
-        id("rst_n").lnot(),
+        t.io.rst_n.e().lnot(),
         vec![
-            nb(id("rq_valid"), lit(1, 0)),
-            nb(id("avs_readdatavalid"), lit(1, 0)),
-            nb(id("avs_readdata"), lit(32, 0)),
+            clear(&t.r.rq_valid),
+            nb(t.io.avs_readdatavalid.e(), lit(1, 0)),
+            nb(t.io.avs_readdata.e(), lit(32, 0)),
         ],
         vec![
-            nb(id("rq_valid"), id("avs_read")),
+            nb(t.r.rq_valid.e(), t.io.avs_read.e()),
             nb(
-                id("rq_kind"),
+                t.r.rq_kind.e(),
                 Expr::mux(
                     bus.is_ctrl.e(),
                     lit(2, 1),
@@ -173,11 +175,11 @@ pub(super) fn read_pipeline(t: &Dims<'_>, bus: &Decode, items: &mut Vec<Item>) -
                     ),
                 ),
             ),
-            nb(id("rq_reg"), Expr::slice("avs_address", 3, 0)),
-            nb(id("rq_word"), Expr::slice("avs_address", 1, 0)),
-            nb(id("rq_path"), Expr::slice("avs_address", t.pb - 1, 0)),
-            nb(id("avs_readdatavalid"), id("rq_valid")),
-            nb(id("avs_readdata"), read_mux.e()),
+            nb(t.r.rq_reg.e(), t.io.avs_address.slice(3, 0)),
+            nb(t.r.rq_word.e(), t.io.avs_address.slice(1, 0)),
+            nb(t.r.rq_path.e(), t.io.avs_address.slice(t.pb - 1, 0)),
+            nb(t.io.avs_readdatavalid.e(), t.r.rq_valid.e()),
+            nb(t.io.avs_readdata.e(), read_mux.e()),
         ],
     )]));
     items.extend(mux_decl);
@@ -188,14 +190,16 @@ pub(super) fn read_pipeline(t: &Dims<'_>, bus: &Decode, items: &mut Vec<Item>) -
 /// (only in designs whose entries exceed 32 bits).
 pub(super) fn sched_hi_register(t: &Dims<'_>, bus: &Decode, items: &mut Vec<Item>) {
     let sw = sched_entry_bits(t.pb, t.ptb, t.ib);
-    if sw <= 32 {
+    let Some(sched_hi) = &t.r.sched_hi else {
         return;
-    }
+    };
     items.push(Item::AlwaysFf(vec![Stmt::If(
-        bus.host_wr
-            .e()
-            .and(id("avs_address").eq(lit(t.ab, crate::regs::SCHED_HI.into()))),
-        vec![nb(id("sched_hi"), Expr::slice("avs_writedata", sw - 33, 0))],
+        bus.host_wr.e().and(
+            t.io.avs_address
+                .e()
+                .eq(lit(t.ab, crate::regs::SCHED_HI.into())),
+        ),
+        vec![nb(sched_hi.e(), t.io.avs_writedata.slice(sw - 33, 0))],
         vec![],
     )]));
 }
@@ -210,21 +214,21 @@ pub(super) fn control_read_arms(t: &Dims<'_>, mux: &Signal) -> Vec<(Expr, Vec<St
             0,
             Expr::concat(vec![
                 lit(30, 0),
-                id("done"),
-                Expr::bin(BinaryOp::Ne, id("state"), lit(STATE_BITS, S_IDLE)),
+                t.r.done.e(),
+                Expr::bin(BinaryOp::Ne, t.r.state.e(), lit(STATE_BITS, S_IDLE)),
             ]),
         ),
-        read(1, id("cycles")),
+        read(1, t.r.cycles.e()),
         read(2, lit(32, info.into())),
         read(3, lit(32, platform.threshold_lsb.into())),
-        read(4, id("tx_x")),
-        read(5, id("tx_y")),
-        read(6, id("tx_z")),
-        read(8, id("rx_x")),
-        read(9, id("rx_y")),
-        read(10, id("rx_z")),
-        read(12, Expr::concat(vec![lit(31 - t.pb, 0), id("paths_r")])),
-        read(14, Expr::concat(vec![lit(16, 0), id("cap_r")])),
+        read(4, t.r.tx_x.e()),
+        read(5, t.r.tx_y.e()),
+        read(6, t.r.tx_z.e()),
+        read(8, t.r.rx_x.e()),
+        read(9, t.r.rx_y.e()),
+        read(10, t.r.rx_z.e()),
+        read(12, Expr::concat(vec![lit(31 - t.pb, 0), t.r.paths_r.e()])),
+        read(14, Expr::concat(vec![lit(16, 0), t.r.cap_r.e()])),
     ]
 }
 
@@ -233,47 +237,45 @@ pub(super) fn control_read_arms(t: &Dims<'_>, mux: &Signal) -> Vec<(Expr, Vec<St
 pub(super) fn read_mux(t: &Dims<'_>, mux: &Signal, items: &mut Vec<Item>) {
     let cw = t.wd.coord;
     let set = |value: Expr| vec![Stmt::Blocking(mux.e(), value)];
-    let rqp = |v: &str| Expr::id(v).at(id("rq_path"));
+    let rqp = |v: &Signal| v.at(t.r.rq_path.e());
     let point_arms = vec![
-        (lit(2, 0), set(sext_slice("rd_a", cw - 1, 8, 32))),
-        (lit(2, 1), set(sext_slice("rd_a", 2 * cw - 1, cw + 8, 32))),
+        (lit(2, 0), set(sext_slice(t.r.rd_a.name(), cw - 1, 8, 32))),
+        (
+            lit(2, 1),
+            set(sext_slice(t.r.rd_a.name(), 2 * cw - 1, cw + 8, 32)),
+        ),
         (
             lit(2, 2),
-            set(sext_slice("rd_a", 3 * cw - 1, 2 * cw + 8, 32)),
+            set(sext_slice(t.r.rd_a.name(), 3 * cw - 1, 2 * cw + 8, 32)),
         ),
     ];
     let frac_word = Expr::concat(vec![
         lit(8, 0),
-        Expr::slice("rd_a", 2 * cw + 7, 2 * cw),
-        Expr::slice("rd_a", cw + 7, cw),
-        Expr::slice("rd_a", 7, 0),
+        t.r.rd_a.slice(2 * cw + 7, 2 * cw),
+        t.r.rd_a.slice(cw + 7, cw),
+        t.r.rd_a.slice(7, 0),
     ]);
     let status_word = Expr::concat(vec![
         // `rounds_q` holds rounds[rq_path]: read with the request's address while idle.
-        Expr::mux(
-            Expr::id("rvalid").at(id("rq_path")),
-            id("rounds_q"),
-            lit(16, 0),
-        ),
+        Expr::mux(t.r.rvalid.at(t.r.rq_path.e()), t.r.rounds_q.e(), lit(16, 0)),
         lit(12, 0),
-        if t.early.is_some() {
-            rqp("lb")
-        } else {
-            lit(1, 0)
+        match &t.r.lb {
+            Some(lb) => rqp(lb),
+            None => lit(1, 0),
         },
-        rqp("ov"),
-        rqp("dz"),
-        rqp("conv"),
+        rqp(&t.r.ov),
+        rqp(&t.r.dz),
+        rqp(&t.r.conv),
     ]);
     items.push(Item::AlwaysComb(vec![
         Stmt::Blocking(mux.e(), lit(32, 0)),
         Stmt::Case(
-            id("rq_kind"),
+            t.r.rq_kind.e(),
             vec![
                 (
                     lit(2, 1),
                     vec![Stmt::Case(
-                        id("rq_reg"),
+                        t.r.rq_reg.e(),
                         control_read_arms(t, mux),
                         set(lit(32, 0)),
                     )],
@@ -281,7 +283,7 @@ pub(super) fn read_mux(t: &Dims<'_>, mux: &Signal, items: &mut Vec<Item>) {
                 (lit(2, 2), set(status_word)),
                 (
                     lit(2, 3),
-                    vec![Stmt::Case(id("rq_word"), point_arms, set(frac_word))],
+                    vec![Stmt::Case(t.r.rq_word.e(), point_arms, set(frac_word))],
                 ),
             ],
             set(lit(32, 0)),
@@ -291,17 +293,18 @@ pub(super) fn read_mux(t: &Dims<'_>, mux: &Signal, items: &mut Vec<Item>) {
 
 /// The interrupt (`ins_irq = done`) and `bt_unused_ok`, which reads the bits no block uses so
 /// the linter sees them consumed on purpose.
-pub(super) fn interrupt_and_unused(items: &mut Vec<Item>) {
-    items.push(Item::Assign(id("ins_irq"), id("done")));
+pub(super) fn interrupt_and_unused(t: &Dims<'_>, items: &mut Vec<Item>) {
+    items.push(Item::Assign(t.io.ins_irq.e(), t.r.done.e()));
     // The slot buffer's `valid` bit: every entry below the slot's length is a job.
     let unused = vec![
         lit(1, 0),
-        Expr::slice("avs_writedata", 31, 1),
-        Expr::bit("sched_q", 0),
+        t.io.avs_writedata.slice(31, 1),
+        t.r.sched_q.bit(0),
     ];
-    items.push(Item::Wire("bt_unused_ok".into(), 1));
-    items.push(Item::Assign(
-        id("bt_unused_ok"),
+    Signal::assigned(
+        items,
+        "bt_unused_ok",
+        1,
         Expr::Unary(UnaryOp::ReduceAnd, Box::new(Expr::concat(unused))),
-    ));
+    );
 }

@@ -12,40 +12,10 @@ pub(super) const D_JOB: u128 = 3;
 pub(super) const D_FIN: u128 = 4;
 pub(super) const DSTATE_BITS: u32 = 3;
 
-/// The ready queue's pointers and head word, and the dispatcher's registers.
-pub(super) fn declare_dispatch_state(t: &Dims<'_>, items: &mut Vec<Item>) {
-    let (pb, ptb, ib, eb) = (t.pb, t.ptb, t.ib, t.eb);
-    for (n, w) in [
-        ("rq_head", pb),
-        ("rq_tail", pb),
-        ("rq_count", pb + 1),
-        ("rq_q", 2 * eb),
-        ("job_q", sched_entry_bits(pb, ptb, ib)),
-        ("dstate", DSTATE_BITS),
-        ("d_scan", pb + 1),
-        ("d_used", 1 << ib),
-        ("d_save", 1 << ib),
-        ("d_nsl", ib + 1),
-        ("d_gi", ib + 1),
-        ("d_conf", 1),
-        ("d_gbase", eb),
-        ("d_gptr", eb),
-    ] {
-        items.push(Item::Reg(n.into(), w));
-    }
-    // The ready queue (one entry per queued path: {first group, next group}, entry indices of
-    // the job memory) and the slot buffer (two slots: the running one and the next, each job
-    // with {its job-memory entry, its path's first group}).
-    items.push(Item::Memory("rq".into(), 2 * eb, t.np2));
-    items.push(Item::Memory(
-        "sbuf".into(),
-        sched_entry_bits(pb, ptb, ib) + 2 * eb,
-        2 << ib,
-    ));
-}
-
 /// The fields of the slot-buffer entry read this cycle (`sched_q`, gated by `sq_ok`).
 pub(super) struct ScheduleRead {
+    /// The running slot's length (`slen_cur`).
+    pub(super) slen: Signal,
     /// The entry is a job of the running slot.
     pub(super) valid: Signal,
     /// The slot's last entry.
@@ -90,33 +60,29 @@ pub(super) fn job_memory(t: &Dims<'_>, bus: &Decode, items: &mut Vec<Item>) {
     items.push(Item::Comment(format!(
         "job memory, written per step by the host: one round of every path as groups, entry -> {{column, group tail, late, end, last, first, point, path, valid}} ({sw} bits)"
     )));
-    let gi = zero_extend("d_gi", ib + 1, eb);
+    let gi = zero_extend(&t.r.d_gi, eb);
     let job_ra = Signal::assigned(
         items,
         "job_ra",
         eb,
         Expr::mux(
-            dstate_is(D_POP),
-            Expr::slice("rq_q", eb - 1, 0),
-            id("d_gptr").plus(gi).plus(lit(eb, 1)),
+            dstate_is(t, D_POP),
+            t.r.rq_q.slice(eb - 1, 0),
+            t.r.d_gptr.e().plus(gi).plus(lit(eb, 1)),
         ),
     );
-    items.push(Item::Memory("sched".into(), sw, 1 << eb));
-    let entry = if sw > 32 {
-        Expr::concat(vec![id("sched_hi"), id("avs_writedata")])
-    } else {
-        Expr::slice("avs_writedata", sw - 1, 0)
+    let sched = Signal::memory(items, "sched", sw, 1 << eb);
+    let entry = match &t.r.sched_hi {
+        Some(hi) => Expr::concat(vec![hi.e(), t.io.avs_writedata.e()]),
+        None => t.io.avs_writedata.slice(sw - 1, 0),
     };
     items.push(Item::AlwaysFf(vec![
         Stmt::If(
             bus.host_wr.e().and(bus.is_sched.e()),
-            vec![nb(
-                Expr::id("sched").at(Expr::slice("avs_address", eb - 1, 0)),
-                entry,
-            )],
+            vec![nb(sched.at(t.io.avs_address.slice(eb - 1, 0)), entry)],
             vec![],
         ),
-        nb(id("job_q"), Expr::id("sched").at(job_ra.e())),
+        nb(t.r.job_q.e(), sched.at(job_ra.e())),
     ]));
 }
 
@@ -133,11 +99,11 @@ pub(super) fn slot_buffer_read(t: &Dims<'_>, items: &mut Vec<Item>) -> ScheduleR
         items,
         "slen_cur",
         ib + 1,
-        Expr::mux(id("rsel"), id("slen_1"), id("slen_0")),
+        Expr::mux(t.r.rsel.e(), t.r.slen_1.e(), t.r.slen_0.e()),
     );
     let w = cnt_bits.max(ib + 1);
-    let cnt_w = zero_extend("cnt", cnt_bits, w);
-    let len_w = zero_extend(slen.name(), ib + 1, w);
+    let cnt_w = zero_extend(&t.r.cnt, w);
+    let len_w = zero_extend(&slen, w);
     let in_slot = Signal::assigned(
         items,
         "sb_in",
@@ -151,11 +117,11 @@ pub(super) fn slot_buffer_read(t: &Dims<'_>, items: &mut Vec<Item>) -> ScheduleR
         items,
         "slen_nxt",
         ib + 1,
-        Expr::mux(id("rsel"), id("slen_0"), id("slen_1")),
+        Expr::mux(t.r.rsel.e(), t.r.slen_0.e(), t.r.slen_1.e()),
     );
-    let prefetch = Signal::assigned(items, "sb_pf", 1, state_is(S_WB).and(in_slot.e().lnot()));
+    let prefetch = Signal::assigned(items, "sb_pf", 1, state_is(t, S_WB).and(in_slot.e().lnot()));
     let pf_idx = Signal::assigned(items, "sb_pf_idx", w, cnt_w.minus(len_w));
-    let nlen_w = zero_extend(next_len.name(), ib + 1, w);
+    let nlen_w = zero_extend(&next_len, w);
     let pf_in = Expr::bin(BinaryOp::Lt, pf_idx.e(), nlen_w.clone());
     let pf_last = pf_idx.e().plus(lit(w, 1)).eq(nlen_w);
     let sb_ra = Signal::assigned(
@@ -165,42 +131,43 @@ pub(super) fn slot_buffer_read(t: &Dims<'_>, items: &mut Vec<Item>) -> ScheduleR
         Expr::mux(
             prefetch.e(),
             Expr::concat(vec![
-                id("rsel").inv(),
+                t.r.rsel.e().inv(),
                 Expr::slice(pf_idx.name(), ib - 1, 0),
             ]),
-            Expr::concat(vec![id("rsel"), zero_extend("cnt", cnt_bits, ib)]),
+            Expr::concat(vec![t.r.rsel.e(), zero_extend(&t.r.cnt, ib)]),
         ),
     );
     items.push(Item::AlwaysFf(vec![
-        nb(id("sched_q"), Expr::id("sbuf").at(sb_ra.e())),
+        nb(t.r.sched_q.e(), t.r.sbuf.at(sb_ra.e())),
         nb(
-            id("sq_ok"),
+            t.r.sq_ok.e(),
             or(
-                or(state_is(S_LOAD), state_is(S_WB)).and(in_slot.e()),
+                or(state_is(t, S_LOAD), state_is(t, S_WB)).and(in_slot.e()),
                 prefetch.e().and(pf_in),
             ),
         ),
-        nb(id("sq_tail"), Expr::mux(prefetch.e(), pf_last, is_last)),
-        nb(id("sq_ld"), or(state_is(S_LOAD), prefetch.e())),
+        nb(t.r.sq_tail.e(), Expr::mux(prefetch.e(), pf_last, is_last)),
+        nb(t.r.sq_ld.e(), or(state_is(t, S_LOAD), prefetch.e())),
     ]));
     let field = |items: &mut Vec<Item>, n: &str, w: u32, lo: u32| {
-        Signal::assigned(items, n, w, Expr::slice("sched_q", lo + w - 1, lo))
+        Signal::assigned(items, n, w, t.r.sched_q.slice(lo + w - 1, lo))
     };
-    let valid = Signal::assigned(items, "rom_valid", 1, id("sq_ok"));
-    let tail = Signal::assigned(items, "rom_tail", 1, id("sq_ok").and(id("sq_tail")));
+    let valid = Signal::assigned(items, "rom_valid", 1, t.r.sq_ok.e());
+    let tail = Signal::assigned(items, "rom_tail", 1, t.r.sq_ok.e().and(t.r.sq_tail.e()));
     let wb_valid = Signal::assigned(
         items,
         "rom_wb_valid",
         1,
-        id("sq_ok").and(id("sq_ld").lnot()),
+        t.r.sq_ok.e().and(t.r.sq_ld.e().lnot()),
     );
-    let wb_tail = Signal::assigned(items, "rom_wb_tail", 1, wb_valid.e().and(id("sq_tail")));
+    let wb_tail = Signal::assigned(items, "rom_wb_tail", 1, wb_valid.e().and(t.r.sq_tail.e()));
     ScheduleRead {
+        slen,
         valid,
         tail,
         wb_valid,
         wb_tail,
-        load: Signal::assigned(items, "rom_ld", 1, id("sq_ld")),
+        load: Signal::assigned(items, "rom_ld", 1, t.r.sq_ld.e()),
         path: field(items, "rom_path", pb, 1),
         point: field(items, "rom_point", ptb, 1 + pb),
         inst: field(items, "rom_inst", ib, 6 + pb + ptb),
@@ -217,6 +184,8 @@ pub(super) fn slot_buffer_read(t: &Dims<'_>, items: &mut Vec<Item>) -> ScheduleR
 /// The dispatcher's view of the job in `job_q`: its column, whether it ends its group, and
 /// whether its group cannot run in the slot being built (a column taken).
 pub(super) struct DispatchJob {
+    /// The job's PE column.
+    pub(super) col: Signal,
     pub(super) gtail: Signal,
     pub(super) conflict: Signal,
     /// Pop the queue's head this cycle.
@@ -232,30 +201,34 @@ pub(super) fn dispatch_signals(t: &Dims<'_>, items: &mut Vec<Item>) -> DispatchJ
         items,
         "j_col",
         ib,
-        Expr::slice("job_q", 6 + pb + ptb + ib - 1, 6 + pb + ptb),
+        t.r.job_q.slice(6 + pb + ptb + ib - 1, 6 + pb + ptb),
     );
-    let gtail = Signal::assigned(items, "j_gtail", 1, Expr::bit("job_q", gtail_bit(t)));
+    let gtail = Signal::assigned(items, "j_gtail", 1, t.r.job_q.bit(gtail_bit(t)));
     let conflict = Signal::assigned(
         items,
         "j_conf",
         1,
-        or(id("d_conf"), Expr::id("d_used").at(col.e())),
+        or(t.r.d_conf.e(), t.r.d_used.at(col.e())),
     );
-    let all_used = Expr::slice("d_used", t.k - 1, 0).eq(lit(t.k, (1u128 << t.k) - 1));
+    let all_used =
+        t.r.d_used
+            .slice(t.k - 1, 0)
+            .eq(lit(t.k, (1u128 << t.k) - 1));
     let stop = Signal::assigned(
         items,
         "d_stop",
         1,
-        or(id("d_scan").eq(lit(pb + 1, 0)), all_used),
+        or(t.r.d_scan.e().eq(lit(pb + 1, 0)), all_used),
     );
-    let pop = Signal::assigned(items, "d_pop", 1, dstate_is(D_POP).and(stop.e().lnot()));
+    let pop = Signal::assigned(items, "d_pop", 1, dstate_is(t, D_POP).and(stop.e().lnot()));
     let push_back = Signal::assigned(
         items,
         "d_push",
         1,
-        dstate_is(D_JOB).and(gtail.e()).and(conflict.e()),
+        dstate_is(t, D_JOB).and(gtail.e()).and(conflict.e()),
     );
     DispatchJob {
+        col,
         gtail,
         conflict,
         pop,
@@ -270,22 +243,24 @@ pub(super) fn dispatch_signals(t: &Dims<'_>, items: &mut Vec<Item>) -> DispatchJ
 /// pop is at least one job after the last (`D_WARM` reads it after a start or a push).
 pub(super) fn dispatcher(t: &Dims<'_>, d: &DispatchJob, go: &Signal, scan_init: &Signal) -> Item {
     let (ib, eb) = (t.ib, t.eb);
-    let n = 1u32 << ib;
-    let gi_plus = |k: u128| id("d_gi").plus(lit(ib + 1, k));
+    let gi_plus = |k: u128| t.r.d_gi.e().plus(lit(ib + 1, k));
     let on_tail = vec![Stmt::If(
         d.conflict.e().lnot(),
-        vec![nb(id("d_nsl"), id("d_nsl").plus(gi_plus(1)))],
-        vec![nb(id("d_used"), id("d_save"))],
+        vec![nb(t.r.d_nsl.e(), t.r.d_nsl.e().plus(gi_plus(1)))],
+        vec![nb(t.r.d_used.e(), t.r.d_save.e())],
     )];
     let job = vec![
-        nb(Expr::id("d_used").at(id("j_col")), lit(1, 1)),
+        nb(t.r.d_used.at(d.col.e()), lit(1, 1)),
         Stmt::If(
             d.gtail.e(),
             on_tail
                 .into_iter()
-                .chain([nb(id("dstate"), lit(DSTATE_BITS, D_POP))])
+                .chain([nb(t.r.dstate.e(), lit(DSTATE_BITS, D_POP))])
                 .collect(),
-            vec![nb(id("d_gi"), gi_plus(1)), nb(id("d_conf"), d.conflict.e())],
+            vec![
+                nb(t.r.d_gi.e(), gi_plus(1)),
+                nb(t.r.d_conf.e(), d.conflict.e()),
+            ],
         ),
     ];
     let arms = vec![
@@ -294,32 +269,32 @@ pub(super) fn dispatcher(t: &Dims<'_>, d: &DispatchJob, go: &Signal, scan_init: 
             vec![Stmt::If(
                 go.e(),
                 vec![
-                    nb(id("dstate"), lit(DSTATE_BITS, D_WARM)),
-                    nb(id("d_scan"), scan_init.e()),
-                    nb(id("d_used"), lit(n, 0)),
-                    nb(id("d_nsl"), lit(ib + 1, 0)),
+                    nb(t.r.dstate.e(), lit(DSTATE_BITS, D_WARM)),
+                    nb(t.r.d_scan.e(), scan_init.e()),
+                    clear(&t.r.d_used),
+                    clear(&t.r.d_nsl),
                 ],
                 vec![],
             )],
         ),
         (
             lit(DSTATE_BITS, D_WARM),
-            vec![nb(id("dstate"), lit(DSTATE_BITS, D_POP))],
+            vec![nb(t.r.dstate.e(), lit(DSTATE_BITS, D_POP))],
         ),
         (
             lit(DSTATE_BITS, D_POP),
             vec![Stmt::If(
                 d.pop.e(),
                 vec![
-                    nb(id("dstate"), lit(DSTATE_BITS, D_JOB)),
-                    nb(id("d_scan"), id("d_scan").minus(lit(t.pb + 1, 1))),
-                    nb(id("d_gbase"), Expr::slice("rq_q", 2 * eb - 1, eb)),
-                    nb(id("d_gptr"), Expr::slice("rq_q", eb - 1, 0)),
-                    nb(id("d_gi"), lit(ib + 1, 0)),
-                    nb(id("d_conf"), lit(1, 0)),
-                    nb(id("d_save"), id("d_used")),
+                    nb(t.r.dstate.e(), lit(DSTATE_BITS, D_JOB)),
+                    nb(t.r.d_scan.e(), t.r.d_scan.e().minus(lit(t.pb + 1, 1))),
+                    nb(t.r.d_gbase.e(), t.r.rq_q.slice(2 * eb - 1, eb)),
+                    nb(t.r.d_gptr.e(), t.r.rq_q.slice(eb - 1, 0)),
+                    clear(&t.r.d_gi),
+                    clear(&t.r.d_conf),
+                    nb(t.r.d_save.e(), t.r.d_used.e()),
                 ],
-                vec![nb(id("dstate"), lit(DSTATE_BITS, D_FIN))],
+                vec![nb(t.r.dstate.e(), lit(DSTATE_BITS, D_FIN))],
             )],
         ),
         (lit(DSTATE_BITS, D_JOB), job),
@@ -327,25 +302,25 @@ pub(super) fn dispatcher(t: &Dims<'_>, d: &DispatchJob, go: &Signal, scan_init: 
             lit(DSTATE_BITS, D_FIN),
             vec![
                 Stmt::If(
-                    id("rsel"),
-                    vec![nb(id("slen_0"), id("d_nsl"))],
-                    vec![nb(id("slen_1"), id("d_nsl"))],
+                    t.r.rsel.e(),
+                    vec![nb(t.r.slen_0.e(), t.r.d_nsl.e())],
+                    vec![nb(t.r.slen_1.e(), t.r.d_nsl.e())],
                 ),
-                nb(id("dstate"), lit(DSTATE_BITS, D_OFF)),
+                nb(t.r.dstate.e(), lit(DSTATE_BITS, D_OFF)),
             ],
         ),
     ];
     Item::AlwaysFf(vec![Stmt::If(
-        id("rst_n").lnot(),
+        t.io.rst_n.e().lnot(),
         vec![
-            nb(id("dstate"), lit(DSTATE_BITS, D_OFF)),
-            nb(id("slen_0"), lit(ib + 1, 0)),
-            nb(id("slen_1"), lit(ib + 1, 0)),
+            nb(t.r.dstate.e(), lit(DSTATE_BITS, D_OFF)),
+            clear(&t.r.slen_0),
+            clear(&t.r.slen_1),
         ],
         vec![Stmt::Case(
-            id("dstate"),
+            t.r.dstate.e(),
             arms,
-            vec![nb(id("dstate"), lit(DSTATE_BITS, D_OFF))],
+            vec![nb(t.r.dstate.e(), lit(DSTATE_BITS, D_OFF))],
         )],
     )])
 }
@@ -354,21 +329,21 @@ pub(super) fn dispatcher(t: &Dims<'_>, d: &DispatchJob, go: &Signal, scan_init: 
 /// taken, at `{~rsel, d_nsl + d_gi}` with its job-memory entry and its path's first group.
 pub(super) fn slot_buffer_write(t: &Dims<'_>, d: &DispatchJob, items: &mut Vec<Item>) {
     let (ib, eb) = (t.ib, t.eb);
-    let we = dstate_is(D_JOB).and(d.conflict.e().lnot());
+    let we = dstate_is(t, D_JOB).and(d.conflict.e().lnot());
     // Below the PE count while no column of the group is taken: ib bits.
     let wi = Signal::assigned(
         items,
         "sb_wi",
         ib,
-        Expr::slice("d_nsl", ib - 1, 0).plus(Expr::slice("d_gi", ib - 1, 0)),
+        t.r.d_nsl.slice(ib - 1, 0).plus(t.r.d_gi.slice(ib - 1, 0)),
     );
-    let at = Expr::concat(vec![id("rsel").inv(), wi.e()]);
-    let src = id("d_gptr").plus(zero_extend("d_gi", ib + 1, eb));
+    let at = Expr::concat(vec![t.r.rsel.e().inv(), wi.e()]);
+    let src = t.r.d_gptr.e().plus(zero_extend(&t.r.d_gi, eb));
     items.push(Item::AlwaysFf(vec![Stmt::If(
         we,
         vec![nb(
-            Expr::id("sbuf").at(at),
-            Expr::concat(vec![src, id("d_gbase"), id("job_q")]),
+            t.r.sbuf.at(at),
+            Expr::concat(vec![src, t.r.d_gbase.e(), t.r.job_q.e()]),
         )],
         vec![],
     )]));
@@ -391,65 +366,61 @@ pub(super) fn ready_queue(
     let host = bus.host_wr.e().and(bus.is_status.e());
     let data = Expr::mux(
         bus.host_wr.e(),
-        Expr::slice("avs_writedata", 2 * eb - 1, 0),
+        t.io.avs_writedata.slice(2 * eb - 1, 0),
         Expr::mux(
             d.push_back.e(),
-            Expr::concat(vec![id("d_gbase"), id("d_gptr")]),
+            Expr::concat(vec![t.r.d_gbase.e(), t.r.d_gptr.e()]),
             wb_data.e(),
         ),
     );
     // Write-back queues a path's next group at the head (the running paths first: a long
     // chain is not held up behind every waiting path), the dispatcher's push-backs at the tail.
-    let head_before = id("rq_head").minus(lit(pb, 1));
+    let head_before = t.r.rq_head.e().minus(lit(pb, 1));
     let addr = Expr::mux(
         bus.host_wr.e(),
-        Expr::slice("avs_address", pb - 1, 0),
-        Expr::mux(wb_push.e(), head_before.clone(), id("rq_tail")),
+        t.io.avs_address.slice(pb - 1, 0),
+        Expr::mux(wb_push.e(), head_before.clone(), t.r.rq_tail.e()),
     );
     items.push(Item::AlwaysFf(vec![
-        Stmt::If(
-            or(host, push.e()),
-            vec![nb(Expr::id("rq").at(addr), data)],
-            vec![],
-        ),
-        nb(id("rq_q"), Expr::id("rq").at(id("rq_head"))),
+        Stmt::If(or(host, push.e()), vec![nb(t.r.rq.at(addr), data)], vec![]),
+        nb(t.r.rq_q.e(), t.r.rq.at(t.r.rq_head.e())),
     ]));
-    let inc = |n: &str, w: u32| id(n).plus(lit(w, 1));
+    let inc = |n: &Signal, w: u32| n.e().plus(lit(w, 1));
     items.push(Item::AlwaysFf(vec![Stmt::If(
-        id("rst_n").lnot(),
+        t.io.rst_n.e().lnot(),
         vec![
-            nb(id("rq_head"), lit(pb, 0)),
-            nb(id("rq_tail"), lit(pb, 0)),
-            nb(id("rq_count"), lit(pb + 1, 0)),
+            clear(&t.r.rq_head),
+            clear(&t.r.rq_tail),
+            clear(&t.r.rq_count),
         ],
         vec![Stmt::If(
             start.e(),
             vec![
-                nb(id("rq_head"), lit(pb, 0)),
-                nb(id("rq_tail"), Expr::slice("paths_r", pb - 1, 0)),
-                nb(id("rq_count"), id("paths_r")),
+                clear(&t.r.rq_head),
+                nb(t.r.rq_tail.e(), t.r.paths_r.slice(pb - 1, 0)),
+                nb(t.r.rq_count.e(), t.r.paths_r.e()),
             ],
             vec![
                 Stmt::If(
                     d.pop.e(),
-                    vec![nb(id("rq_head"), inc("rq_head", pb))],
+                    vec![nb(t.r.rq_head.e(), inc(&t.r.rq_head, pb))],
                     vec![Stmt::If(
                         wb_push.e(),
-                        vec![nb(id("rq_head"), head_before)],
+                        vec![nb(t.r.rq_head.e(), head_before)],
                         vec![],
                     )],
                 ),
                 Stmt::If(
                     d.push_back.e(),
-                    vec![nb(id("rq_tail"), inc("rq_tail", pb))],
+                    vec![nb(t.r.rq_tail.e(), inc(&t.r.rq_tail, pb))],
                     vec![],
                 ),
                 Stmt::If(
                     push.e(),
-                    vec![nb(id("rq_count"), inc("rq_count", pb + 1))],
+                    vec![nb(t.r.rq_count.e(), inc(&t.r.rq_count, pb + 1))],
                     vec![Stmt::If(
                         d.pop.e(),
-                        vec![nb(id("rq_count"), id("rq_count").minus(lit(pb + 1, 1)))],
+                        vec![nb(t.r.rq_count.e(), t.r.rq_count.e().minus(lit(pb + 1, 1)))],
                         vec![],
                     )],
                 ),
@@ -460,7 +431,7 @@ pub(super) fn ready_queue(
 
 /// `cnt + 1`.
 pub(super) fn cnt_inc(t: &Dims<'_>) -> Expr {
-    id("cnt").plus(lit(t.cnt_bits, 1))
+    t.r.cnt.e().plus(lit(t.cnt_bits, 1))
 }
 
 /// IDLE on a start request: clear the counters and every path's flags and rounds and let the
@@ -468,52 +439,53 @@ pub(super) fn cnt_inc(t: &Dims<'_>) -> Expr {
 /// report done at once.
 pub(super) fn fsm_on_start(t: &Dims<'_>) -> Vec<Stmt> {
     let all_zero = lit(t.np2, 0);
-    let no_path = id("paths_r").eq(lit(t.pb + 1, 0));
+    let no_path = t.r.paths_r.e().eq(lit(t.pb + 1, 0));
     let mut on_start = vec![
         nb(
-            id("state"),
+            t.r.state.e(),
             Expr::mux(
                 no_path.clone(),
                 lit(STATE_BITS, S_IDLE),
                 lit(STATE_BITS, S_DISP),
             ),
         ),
-        nb(id("cnt"), lit(t.cnt_bits, 0)),
-        nb(id("rsel"), lit(1, 0)),
-        nb(id("cycles"), lit(32, 0)),
-        nb(id("done"), no_path),
+        clear(&t.r.cnt),
+        clear(&t.r.rsel),
+        clear(&t.r.cycles),
+        nb(t.r.done.e(), no_path),
     ];
-    for v in ["cur", "conv", "dz", "ov", "pbig", "pdz", "pov"] {
-        on_start.push(nb(id(v), all_zero.clone()));
+    let r = &t.r;
+    for v in [&r.cur, &r.conv, &r.dz, &r.ov, &r.pbig, &r.pdz, &r.pov] {
+        on_start.push(nb(v.e(), all_zero.clone()));
     }
-    if t.early.is_some() {
-        on_start.push(nb(id("lb"), all_zero.clone()));
-        on_start.push(nb(id("plb"), all_zero.clone()));
+    if let Some((lb, plb)) = t.r.early() {
+        on_start.push(nb(lb.e(), all_zero.clone()));
+        on_start.push(nb(plb.e(), all_zero.clone()));
     }
-    on_start.push(nb(id("rvalid"), all_zero));
+    on_start.push(nb(t.r.rvalid.e(), all_zero));
     on_start
 }
 
 /// The next slot's length (the buffer the dispatcher wrote: not `rsel`).
 pub(super) fn next_len(t: &Dims<'_>) -> Expr {
-    Expr::mux(id("rsel"), id("slen_0"), id("slen_1")).eq(lit(t.ib + 1, 0))
+    Expr::mux(t.r.rsel.e(), t.r.slen_0.e(), t.r.slen_1.e()).eq(lit(t.ib + 1, 0))
 }
 
 /// DISP: wait for the dispatcher; run the slot it built, or report done if it found none
 /// (nothing queued, nothing running).
 pub(super) fn fsm_disp(t: &Dims<'_>) -> Vec<Stmt> {
     vec![Stmt::If(
-        dstate_is(D_OFF),
+        dstate_is(t, D_OFF),
         vec![Stmt::If(
             next_len(t),
             vec![
-                nb(id("state"), lit(STATE_BITS, S_IDLE)),
-                nb(id("done"), lit(1, 1)),
+                nb(t.r.state.e(), lit(STATE_BITS, S_IDLE)),
+                nb(t.r.done.e(), lit(1, 1)),
             ],
             vec![
-                nb(id("state"), lit(STATE_BITS, S_LOAD)),
-                nb(id("rsel"), id("rsel").inv()),
-                nb(id("cnt"), lit(t.cnt_bits, 0)),
+                nb(t.r.state.e(), lit(STATE_BITS, S_LOAD)),
+                nb(t.r.rsel.e(), t.r.rsel.e().inv()),
+                clear(&t.r.cnt),
             ],
         )],
         vec![],
@@ -523,34 +495,31 @@ pub(super) fn fsm_disp(t: &Dims<'_>) -> Vec<Stmt> {
 /// LOAD: register the slot's entries for the operand broadcast until its tail, then EXEC
 /// (the dispatcher has been building the next slot since LOAD began).
 pub(super) fn fsm_load(t: &Dims<'_>, rom: &ScheduleRead) -> Vec<Stmt> {
-    let mut stmts = register_load_entry(rom);
+    let mut stmts = register_load_entry(t, rom);
     stmts.push(Stmt::If(
-        id("ld_q_tail"),
-        vec![
-            nb(id("state"), lit(STATE_BITS, S_EXEC)),
-            nb(id("cnt"), lit(t.cnt_bits, 0)),
-        ],
-        vec![nb(id("cnt"), cnt_inc(t))],
+        t.r.ld_q_tail.e(),
+        vec![nb(t.r.state.e(), lit(STATE_BITS, S_EXEC)), clear(&t.r.cnt)],
+        vec![nb(t.r.cnt.e(), cnt_inc(t))],
     ));
     stmts
 }
 
 /// Registers the entry's fields for the operand broadcast.
-fn register_load_entry(rom: &ScheduleRead) -> Vec<Stmt> {
+fn register_load_entry(t: &Dims<'_>, rom: &ScheduleRead) -> Vec<Stmt> {
     register_entry(&[
-        ("ld_q_en", &rom.valid),
-        ("ld_q_tail", &rom.tail),
-        ("ld_q_first", &rom.first),
-        ("ld_q_last", &rom.last),
-        ("ld_q_inst", &rom.inst),
+        (&t.r.ld_q_en, &rom.valid),
+        (&t.r.ld_q_tail, &rom.tail),
+        (&t.r.ld_q_first, &rom.first),
+        (&t.r.ld_q_last, &rom.last),
+        (&t.r.ld_q_inst, &rom.inst),
     ])
 }
 
 /// Registers the schedule entry's fields: one `register <= field` per pair, in order.
-pub(super) fn register_entry(pairs: &[(&str, &Signal)]) -> Vec<Stmt> {
+pub(super) fn register_entry(pairs: &[(&Signal, &Signal)]) -> Vec<Stmt> {
     pairs
         .iter()
-        .map(|(reg, field)| nb(id(reg), field.e()))
+        .map(|(reg, field)| nb(reg.e(), field.e()))
         .collect()
 }
 
@@ -559,22 +528,19 @@ pub(super) fn register_entry(pairs: &[(&str, &Signal)]) -> Vec<Stmt> {
 /// PE's result (each PE started after its own load, and write-back reads the jobs in load
 /// order, one a cycle: `cnt + jobs + 2 >= latency`, at least one cycle) and for the
 /// dispatcher, then WB.
-pub(super) fn fsm_exec(t: &Dims<'_>) -> Vec<Stmt> {
+pub(super) fn fsm_exec(t: &Dims<'_>, rom: &ScheduleRead) -> Vec<Stmt> {
     let w = t.cnt_bits.max(t.ib + 1) + 1;
-    let ran = zero_extend("cnt", t.cnt_bits, w)
-        .plus(zero_extend("slen_cur", t.ib + 1, w))
+    let ran = zero_extend(&t.r.cnt, w)
+        .plus(zero_extend(&rom.slen, w))
         .plus(lit(w, 2));
     vec![Stmt::If(
         Expr::bin(BinaryOp::Gt, ran, lit(w, u128::from(t.latency() - 1))),
         vec![Stmt::If(
-            dstate_is(D_OFF),
-            vec![
-                nb(id("state"), lit(STATE_BITS, S_WB)),
-                nb(id("cnt"), lit(t.cnt_bits, 0)),
-            ],
+            dstate_is(t, D_OFF),
+            vec![nb(t.r.state.e(), lit(STATE_BITS, S_WB)), clear(&t.r.cnt)],
             vec![],
         )],
-        vec![nb(id("cnt"), cnt_inc(t))],
+        vec![nb(t.r.cnt.e(), cnt_inc(t))],
     )]
 }
 
@@ -587,40 +553,40 @@ pub(super) fn fsm_writeback(
     queue_empty: &Signal,
 ) -> Vec<Stmt> {
     let mut stmts = register_entry(&[
-        ("wb_q_en", &rom.wb_valid),
-        ("wb_q_tail", &rom.wb_tail),
-        ("wb_q_end", &rom.end),
-        ("wb_q_path", &rom.path),
-        ("wb_q_point", &rom.point),
-        ("wb_q_inst", &rom.inst),
-        ("wb_q_gtail", &rom.gtail),
-        ("wb_q_src", &rom.src),
-        ("wb_q_gbase", &rom.gbase),
+        (&t.r.wb_q_en, &rom.wb_valid),
+        (&t.r.wb_q_tail, &rom.wb_tail),
+        (&t.r.wb_q_end, &rom.end),
+        (&t.r.wb_q_path, &rom.path),
+        (&t.r.wb_q_point, &rom.point),
+        (&t.r.wb_q_inst, &rom.inst),
+        (&t.r.wb_q_gtail, &rom.gtail),
+        (&t.r.wb_q_src, &rom.src),
+        (&t.r.wb_q_gbase, &rom.gbase),
     ]);
     let after = Stmt::If(
         next_len(t),
         vec![Stmt::If(
             queue_empty.e(),
             vec![
-                nb(id("state"), lit(STATE_BITS, S_IDLE)),
-                nb(id("done"), lit(1, 1)),
+                nb(t.r.state.e(), lit(STATE_BITS, S_IDLE)),
+                nb(t.r.done.e(), lit(1, 1)),
             ],
-            vec![nb(id("state"), lit(STATE_BITS, S_DISP))],
+            vec![nb(t.r.state.e(), lit(STATE_BITS, S_DISP))],
         )],
         vec![
-            nb(id("state"), lit(STATE_BITS, S_LOAD)),
-            nb(id("rsel"), id("rsel").inv()),
+            nb(t.r.state.e(), lit(STATE_BITS, S_LOAD)),
+            nb(t.r.rsel.e(), t.r.rsel.e().inv()),
             // Its first two entries were read ahead.
-            nb(id("cnt"), lit(t.cnt_bits, 2)),
+            nb(t.r.cnt.e(), lit(t.cnt_bits, 2)),
         ],
     );
     stmts.extend([
-        Stmt::If(rom.load.e(), register_load_entry(rom), vec![]),
-        Stmt::If(f.go.e(), path_commit(f), vec![]),
+        Stmt::If(rom.load.e(), register_load_entry(t, rom), vec![]),
+        Stmt::If(f.go.e(), path_commit(t, f), vec![]),
         Stmt::If(
-            id("wb_q_tail"),
-            vec![nb(id("cnt"), lit(t.cnt_bits, 0)), after],
-            vec![nb(id("cnt"), cnt_inc(t))],
+            t.r.wb_q_tail.e(),
+            vec![clear(&t.r.cnt), after],
+            vec![nb(t.r.cnt.e(), cnt_inc(t))],
         ),
     ]);
     stmts
@@ -640,10 +606,11 @@ pub(super) fn dispatch_triggers(
         items,
         "start_req",
         1,
-        id("avs_write")
-            .and(id("avs_address").eq(lit(t.ab, 0)))
-            .and(Expr::bit("avs_writedata", 0))
-            .and(state_is(S_IDLE)),
+        t.io.avs_write
+            .e()
+            .and(t.io.avs_address.e().eq(lit(t.ab, 0)))
+            .and(t.io.avs_writedata.bit(0))
+            .and(state_is(t, S_IDLE)),
     );
     let queued = Signal::assigned(
         items,
@@ -651,20 +618,20 @@ pub(super) fn dispatch_triggers(
         pb + 1,
         Expr::mux(
             wb_push.e(),
-            id("rq_count").plus(lit(pb + 1, 1)),
-            id("rq_count"),
+            t.r.rq_count.e().plus(lit(pb + 1, 1)),
+            t.r.rq_count.e(),
         ),
     );
     let empty = Signal::assigned(items, "rq_empty", 1, queued.e().eq(lit(pb + 1, 0)));
     // A slot ends with its write-back's last entry; the next one starts loading at once when
     // the dispatcher built it (from DISP when it was built with no slot running).
-    let wb_end = Signal::assigned(items, "wb_end", 1, state_is(S_WB).and(id("wb_q_tail")));
+    let wb_end = Signal::assigned(items, "wb_end", 1, state_is(t, S_WB).and(t.r.wb_q_tail.e()));
     let at_wb_tail = wb_end.e().and(next_len(t)).and(empty.e().lnot());
     let to_load = Signal::assigned(
         items,
         "to_load",
         1,
-        or(wb_end.e(), state_is(S_DISP).and(dstate_is(D_OFF))).and(next_len(t).lnot()),
+        or(wb_end.e(), state_is(t, S_DISP).and(dstate_is(t, D_OFF))).and(next_len(t).lnot()),
     );
     // The dispatcher builds the slot after next while this one loads and computes.
     let go = Signal::assigned(
@@ -673,14 +640,14 @@ pub(super) fn dispatch_triggers(
         1,
         or(
             or(
-                start_req.e().and(id("paths_r").eq(lit(pb + 1, 0)).lnot()),
+                start_req.e().and(t.r.paths_r.e().eq(lit(pb + 1, 0)).lnot()),
                 to_load.e(),
             ),
             at_wb_tail,
         ),
     );
     let limit = u128::from(crate::dispatch::SCAN_LIMIT.min(1 << pb));
-    let count = Expr::mux(start_req.e(), id("paths_r"), queued.e());
+    let count = Expr::mux(start_req.e(), t.r.paths_r.e(), queued.e());
     let scan = Signal::assigned(items, "d_scan_init", pb + 1, count);
     let capped = Signal::assigned(
         items,
@@ -704,33 +671,32 @@ pub(super) fn controller(
     [start_req, empty]: [&Signal; 2],
     items: &mut Vec<Item>,
 ) {
-    let cnt_bits = t.cnt_bits;
     items.push(Item::Comment(format!(
         "main FSM: IDLE -> DISP -> per slot LOAD (jobs + 2, or jobs after a write-back) EXEC (max({} - jobs - 1, 1, dispatch + 1 - load): each PE starts after its own load) WB (jobs + 2) -> IDLE with done when no path is queued",
         t.latency()
     )));
     items.push(Item::AlwaysFf(vec![Stmt::If(
-        id("rst_n").lnot(),
+        t.io.rst_n.e().lnot(),
         vec![
-            nb(id("state"), lit(STATE_BITS, S_IDLE)),
-            nb(id("cnt"), lit(cnt_bits, 0)),
-            nb(id("rsel"), lit(1, 0)),
-            nb(id("cycles"), lit(32, 0)),
-            nb(id("done"), lit(1, 0)),
-            nb(id("ld_q_en"), lit(1, 0)),
-            nb(id("ld_q_tail"), lit(1, 0)),
-            nb(id("wb_q_en"), lit(1, 0)),
-            nb(id("wb_q_tail"), lit(1, 0)),
-            nb(id("rvalid"), lit(t.np2, 0)),
+            nb(t.r.state.e(), lit(STATE_BITS, S_IDLE)),
+            clear(&t.r.cnt),
+            clear(&t.r.rsel),
+            clear(&t.r.cycles),
+            clear(&t.r.done),
+            clear(&t.r.ld_q_en),
+            clear(&t.r.ld_q_tail),
+            clear(&t.r.wb_q_en),
+            clear(&t.r.wb_q_tail),
+            clear(&t.r.rvalid),
         ],
         vec![
             Stmt::If(
-                Expr::bin(BinaryOp::Ne, id("state"), lit(STATE_BITS, S_IDLE)),
-                vec![nb(id("cycles"), id("cycles").plus(lit(32, 1)))],
+                Expr::bin(BinaryOp::Ne, t.r.state.e(), lit(STATE_BITS, S_IDLE)),
+                vec![nb(t.r.cycles.e(), t.r.cycles.e().plus(lit(32, 1)))],
                 vec![],
             ),
             Stmt::Case(
-                id("state"),
+                t.r.state.e(),
                 vec![
                     (
                         lit(STATE_BITS, S_IDLE),
@@ -738,10 +704,10 @@ pub(super) fn controller(
                     ),
                     (lit(STATE_BITS, S_DISP), fsm_disp(t)),
                     (lit(STATE_BITS, S_LOAD), fsm_load(t, rom)),
-                    (lit(STATE_BITS, S_EXEC), fsm_exec(t)),
+                    (lit(STATE_BITS, S_EXEC), fsm_exec(t, rom)),
                     (lit(STATE_BITS, S_WB), fsm_writeback(t, rom, f, empty)),
                 ],
-                vec![nb(id("state"), lit(STATE_BITS, S_IDLE))],
+                vec![nb(t.r.state.e(), lit(STATE_BITS, S_IDLE))],
             ),
         ],
     )]));

@@ -9,11 +9,13 @@ use crate::rtl::verilog::{BinaryOp, Direction, Expr, Item, Module, Signal, Stmt,
 
 mod bus;
 mod controller;
+mod regs;
 mod updater;
 mod writeback;
 
 use bus::*;
 use controller::*;
+use regs::*;
 use updater::*;
 use writeback::*;
 
@@ -31,17 +33,18 @@ pub const MAP_VERSION: u32 = 6;
 fn nb(l: Expr, r: Expr) -> Stmt {
     Stmt::NonBlocking(l, r)
 }
-fn id(n: &str) -> Expr {
-    Expr::id(n)
+/// `s <= 0;` at the register's declared width.
+fn clear(s: &Signal) -> Stmt {
+    nb(s.e(), lit(s.width(), 0))
 }
 fn lit(w: u32, v: u128) -> Expr {
     Expr::lit(w, v)
 }
-fn state_is(s: u128) -> Expr {
-    id("state").eq(lit(STATE_BITS, s))
+fn state_is(t: &Dims<'_>, s: u128) -> Expr {
+    t.r.state.e().eq(lit(STATE_BITS, s))
 }
-fn dstate_is(s: u128) -> Expr {
-    id("dstate").eq(lit(DSTATE_BITS, s))
+fn dstate_is(t: &Dims<'_>, s: u128) -> Expr {
+    t.r.dstate.e().eq(lit(DSTATE_BITS, s))
 }
 fn or(a: Expr, b: Expr) -> Expr {
     Expr::bin(BinaryOp::Or, a, b)
@@ -76,24 +79,25 @@ fn mm_width(wd: bt_fixed::Widths) -> u32 {
     (wd.coord - bt_fixed::POINT_FRAC).min(32)
 }
 
-/// The low bits of the 32-bit millimetre bus word `name` that a fine coordinate of the
+/// The low bits of the 32-bit millimetre bus word `word` that a fine coordinate of the
 /// design's width keeps above its 8 fraction bits (all 32 in the full 40-bit design; the host
 /// writes only values that fit, [`bt_fixed::FixedIpc::check_terminal`]).
-fn mm_bits(name: &str, wd: bt_fixed::Widths) -> Expr {
+fn mm_bits(word: &Signal, wd: bt_fixed::Widths) -> Expr {
     let keep = mm_width(wd);
     if keep >= 32 {
-        id(name)
+        word.e()
     } else {
-        Expr::slice(name, keep - 1, 0)
+        word.slice(keep - 1, 0)
     }
 }
 
-/// `name` (`from` bits) as an `to`-bit unsigned value: zero-extended or truncated.
-fn zero_extend(name: &str, from: u32, to: u32) -> Expr {
+/// `s` as an `to`-bit unsigned value: zero-extended or truncated.
+fn zero_extend(s: &Signal, to: u32) -> Expr {
+    let from = s.width();
     match from.cmp(&to) {
-        std::cmp::Ordering::Less => Expr::concat(vec![lit(to - from, 0), id(name)]),
-        std::cmp::Ordering::Equal => id(name),
-        std::cmp::Ordering::Greater => Expr::slice(name, to - 1, 0),
+        std::cmp::Ordering::Less => Expr::concat(vec![lit(to - from, 0), s.e()]),
+        std::cmp::Ordering::Equal => s.e(),
+        std::cmp::Ordering::Greater => s.slice(to - 1, 0),
     }
 }
 
@@ -118,6 +122,10 @@ struct Dims<'a> {
     early: Option<(bt_fixed::EarlyStop, Vec<bt_fixed::FineBox>)>,
     /// Datapath widths (the model's coordinate word).
     wd: bt_fixed::Widths,
+    /// The ports.
+    io: Ports,
+    /// Every register and memory, declared once.
+    r: Regs,
 }
 
 impl<'a> Dims<'a> {
@@ -126,22 +134,47 @@ impl<'a> Dims<'a> {
         pe_latency(self.wd.coord)
     }
 
-    fn of(p: &'a TopParams<'a>) -> Self {
+    /// The sizes of `p`'s design, its ports, and its registers and memories declared in
+    /// `items` after the header comment.
+    fn of(p: &'a TopParams<'a>, items: &mut Vec<Item>) -> Self {
         let l = &p.layout;
-        Dims {
-            p,
-            k: l.num_instances,
+        let wd = bt_fixed::Widths::for_coord(p.model.coord_bits());
+        let latency = pe_latency(p.model.coord_bits());
+        let cap = p.platform.capacity;
+        let sizes = RegSizes {
             pb: l.path_bits,
             ptb: l.point_bits,
             ib: l.inst_bits,
             eb: l.entry_bits,
             np2: 1u32 << l.path_bits,
-            cnt_bits: bits_for(
-                u64::from((l.num_instances + 2).max(pe_latency(p.model.coord_bits()))) + 1,
-            ),
+            cnt_bits: bits_for(u64::from((l.num_instances + 2).max(latency)) + 1),
+            wd,
+            early: p.model.early_stop().is_some(),
+        };
+        items.push(Item::Comment(format!(
+            "{} PE instances, capacity {} paths, {} points, {} groups; load (jobs, or jobs + 2 after a dispatch wait) + max({} - jobs - 1, 1, dispatch + 1 - load) + write-back (jobs + 2) cycles per slot (each PE starts after its own load), threshold {} fine LSB",
+            l.num_instances,
+            cap.paths,
+            cap.points,
+            cap.slots,
+            latency,
+            p.platform.threshold_lsb
+        )));
+        let r = Regs::declare(&sizes, items);
+        Dims {
+            p,
+            k: l.num_instances,
+            pb: sizes.pb,
+            ptb: sizes.ptb,
+            ib: sizes.ib,
+            eb: sizes.eb,
+            np2: sizes.np2,
+            cnt_bits: sizes.cnt_bits,
             ab: l.address_bits,
             early: p.model.early_stop().map(|(s, b)| (*s, b.to_vec())),
-            wd: bt_fixed::Widths::for_coord(p.model.coord_bits()),
+            wd,
+            io: Ports::new(l.address_bits),
+            r,
         }
     }
 }
@@ -158,97 +191,10 @@ struct PeWires {
     zs: Signal,
 }
 
-/// Header comment, the controller's registers, the per-path flag vectors, the `rounds` and
-/// point memories and the PE wires. All state is declared first, as the golden files show it.
-fn declare_state(t: &Dims<'_>, items: &mut Vec<Item>) -> Vec<PeWires> {
-    let (k, pb, ptb, ib, eb, np2) = (t.k, t.pb, t.ptb, t.ib, t.eb, t.np2);
-    let cap = t.p.platform.capacity;
-    items.push(Item::Comment(format!(
-        "{} PE instances, capacity {} paths, {} points, {} groups; load (jobs, or jobs + 2 after a dispatch wait) + max({} - jobs - 1, 1, dispatch + 1 - load) + write-back (jobs + 2) cycles per slot (each PE starts after its own load), threshold {} fine LSB",
-        k,
-        cap.paths,
-        cap.points,
-        cap.slots,
-        t.latency(),
-        t.p.platform.threshold_lsb
-    )));
-    for (n, w) in [
-        ("state", STATE_BITS),
-        ("cnt", t.cnt_bits),
-        ("paths_r", pb + 1),
-        ("cap_r", 16),
-        ("rsel", 1),
-        ("slen_0", ib + 1),
-        ("slen_1", ib + 1),
-        ("cycles", 32),
-        ("done", 1),
-        ("tx_x", 32),
-        ("tx_y", 32),
-        ("tx_z", 32),
-        ("rx_x", 32),
-        ("rx_y", 32),
-        ("rx_z", 32),
-        ("st_x", mm_width(t.wd)),
-        ("st_y", mm_width(t.wd)),
-        ("st_z", mm_width(t.wd)),
-        ("cur", np2),
-        ("conv", np2),
-        ("dz", np2),
-        ("ov", np2),
-        ("pbig", np2),
-        ("pdz", np2),
-        ("pov", np2),
-        ("rd_a", point_bits(t.wd)),
-        ("rd_b", point_bits(t.wd)),
-        ("sched_q", sched_entry_bits(pb, ptb, ib) + 2 * eb),
-        ("sq_ok", 1),
-        ("sq_tail", 1),
-        ("sq_ld", 1),
-        ("ld_q_en", 1),
-        ("ld_q_tail", 1),
-        ("ld_q_first", 1),
-        ("ld_q_last", 1),
-        ("ld_q_inst", ib),
-        ("ld_go", 1),
-        ("ld_go_inst", ib),
-        ("wb_q_en", 1),
-        ("wb_q_tail", 1),
-        ("wb_q_end", 1),
-        ("wb_q_path", pb),
-        ("wb_q_point", ptb),
-        ("wb_q_inst", ib),
-        ("wb_q_gtail", 1),
-        ("wb_q_src", eb),
-        ("wb_q_gbase", eb),
-        ("rq_valid", 1),
-        ("rq_kind", 2),
-        ("rq_reg", 4),
-        ("rq_word", 2),
-        ("rq_path", pb),
-        ("rounds_q", 16),
-        ("rvalid", np2),
-    ] {
-        items.push(Item::Reg(n.into(), w));
-    }
-    declare_dispatch_state(t, items);
-    let sw = sched_entry_bits(pb, ptb, ib);
-    if sw > 32 {
-        // Entries wider than the bus word: the host writes their high bits first.
-        items.push(Item::Reg("sched_hi".into(), sw - 32));
-    }
-    if t.early.is_some() {
-        items.push(Item::Reg("lb".into(), np2));
-        items.push(Item::Reg("plb".into(), np2));
-    }
-    // Rounds per path in a RAM (M9K), not 16 registers a path: `rvalid` marks the paths that
-    // committed a round since the start (the RAM cannot be cleared in one cycle).
-    items.push(Item::Memory("rounds".into(), 16, np2));
-    // Two copies of the point memory (one per read port, both written): each is a plain
-    // 1-write 1-read array with a registered read, which Yosys maps to M9K blocks.
-    let depth = 1u32 << (ptb + 1);
-    items.push(Item::Memory("pm_a".into(), point_bits(t.wd), depth));
-    items.push(Item::Memory("pm_b".into(), point_bits(t.wd), depth));
-    (0..k)
+/// The PE wires (the header comment and every register and memory are declared by
+/// [`Dims::of`] before them, as the golden files show).
+fn declare_pe_wires(t: &Dims<'_>, items: &mut Vec<Item>) -> Vec<PeWires> {
+    (0..t.k)
         .map(|j| PeWires {
             load: Signal::wire(items, format!("pe_load_{j}"), 1),
             start: Signal::wire(items, format!("pe_start_{j}"), 1),
@@ -264,33 +210,34 @@ fn declare_state(t: &Dims<'_>, items: &mut Vec<Item>) -> Vec<PeWires> {
 /// starts the cycle after its own load (`ld_go`, `ld_go_inst`), so a slot's first PEs compute
 /// while its later jobs load, and write-back (job after job, in load order) follows them.
 fn pe_matrix(t: &Dims<'_>, pe: &[PeWires], items: &mut Vec<Item>) {
-    let loading = state_is(S_LOAD).and(id("ld_q_en"));
+    let loading = state_is(t, S_LOAD).and(t.r.ld_q_en.e());
     items.push(Item::AlwaysFf(vec![Stmt::If(
-        id("rst_n").lnot(),
-        vec![nb(id("ld_go"), lit(1, 0))],
+        t.io.rst_n.e().lnot(),
+        vec![clear(&t.r.ld_go)],
         vec![
-            nb(id("ld_go"), loading.clone()),
-            nb(id("ld_go_inst"), id("ld_q_inst")),
+            nb(t.r.ld_go.e(), loading.clone()),
+            nb(t.r.ld_go_inst.e(), t.r.ld_q_inst.e()),
         ],
     )]));
     // The operand wires follow the instances in the file: build them aside first.
     let mut operands = Vec::new();
-    let fine = |n: &str| Expr::concat(vec![mm_bits(n, t.wd), lit(8, 0)]);
-    let tx_fine = Expr::concat(vec![fine("tx_z"), fine("tx_y"), fine("tx_x")]);
-    let rx_fine = Expr::concat(vec![fine("rx_z"), fine("rx_y"), fine("rx_x")]);
+    let r = &t.r;
+    let fine = |n: &Signal| Expr::concat(vec![mm_bits(n, t.wd), lit(8, 0)]);
+    let tx_fine = Expr::concat(vec![fine(&r.tx_z), fine(&r.tx_y), fine(&r.tx_x)]);
+    let rx_fine = Expr::concat(vec![fine(&r.rx_z), fine(&r.rx_y), fine(&r.rx_x)]);
     let pw = point_bits(t.wd);
     // A path's first point reads TX as its previous point, its last RX as its next.
-    let prev_or_tx = Expr::mux(id("ld_q_first"), tx_fine, id("rd_a"));
+    let prev_or_tx = Expr::mux(t.r.ld_q_first.e(), tx_fine, t.r.rd_a.e());
     let prev = Signal::assigned(&mut operands, "opnd_prev", pw, prev_or_tx);
-    let next_or_rx = Expr::mux(id("ld_q_last"), rx_fine, id("rd_b"));
+    let next_or_rx = Expr::mux(t.r.ld_q_last.e(), rx_fine, t.r.rd_b.e());
     let next = Signal::assigned(&mut operands, "opnd_next", pw, next_or_rx);
     for (j, (inst, w)) in t.p.platform.instances.iter().zip(pe).enumerate() {
         items.push(Item::Instance {
             module: pe_module_name(inst.plane as usize),
             name: format!("u_pe_{j}"),
             ports: vec![
-                ("clk".into(), id("clk")),
-                ("rst_n".into(), id("rst_n")),
+                ("clk".into(), t.io.clk.e()),
+                ("rst_n".into(), t.io.rst_n.e()),
                 ("load".into(), w.load.e()),
                 ("start".into(), w.start.e()),
                 ("s_prev".into(), prev.e()),
@@ -303,11 +250,13 @@ fn pe_matrix(t: &Dims<'_>, pe: &[PeWires], items: &mut Vec<Item>) {
             w.load.e(),
             loading
                 .clone()
-                .and(id("ld_q_inst").eq(lit(t.ib, j as u128))),
+                .and(t.r.ld_q_inst.e().eq(lit(t.ib, j as u128))),
         ));
         operands.push(Item::Assign(
             w.start.e(),
-            id("ld_go").and(id("ld_go_inst").eq(lit(t.ib, j as u128))),
+            t.r.ld_go
+                .e()
+                .and(t.r.ld_go_inst.e().eq(lit(t.ib, j as u128))),
         ));
     }
     items.extend(operands);
@@ -325,17 +274,7 @@ fn top_shell(t: &Dims<'_>, items: Vec<Item>) -> Module {
                 "Avalon-MM slave, 32-bit words, word address {ab} bits, fixed read latency 2, irq = done."
             ),
         ],
-        ports: vec![
-            port("clk", Direction::Input, 1),
-            port("rst_n", Direction::Input, 1),
-            port("avs_address", Direction::Input, ab),
-            port("avs_read", Direction::Input, 1),
-            port("avs_write", Direction::Input, 1),
-            port("avs_writedata", Direction::Input, 32),
-            port("avs_readdata", Direction::OutputReg, 32),
-            port("avs_readdatavalid", Direction::OutputReg, 1),
-            port("ins_irq", Direction::Output, 1),
-        ],
+        ports: t.io.list(),
         items,
     }
 }
@@ -343,35 +282,35 @@ fn top_shell(t: &Dims<'_>, items: Vec<Item>) -> Module {
 /// Builds `bt_top`: an outline that calls one builder per block, in the order the blocks
 /// appear in the emitted file.
 pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
-    let t = Dims::of(d);
     let mut items = Vec::new();
-    let pe = declare_state(&t, &mut items);
+    let t = Dims::of(d, &mut items);
+    let pe = declare_pe_wires(&t, &mut items);
     let bus = bus_decode(&t, &mut items);
     job_memory(&t, &bus, &mut items);
     let rom = slot_buffer_read(&t, &mut items);
     let dj = dispatch_signals(&t, &mut items);
     slot_buffer_write(&t, &dj, &mut items);
-    rounds_read(&t, &rom, &mut items);
+    let rounds_cur = rounds_read(&t, &rom, &mut items);
     let ports = updater_read_ports(&t, &bus, &rom, &mut items);
     let sel = pe_output_select(&t, &pe, &mut items);
     let disp = displacement(&t, &sel, &mut items);
     let wb_lb = t
         .early
         .as_ref()
-        .map(|(stop, boxes)| early_stop_logic(d, stop, boxes, &disp, &mut items));
-    let flags = writeback_flags(&sel, &disp, wb_lb, &mut items);
+        .map(|(stop, boxes)| early_stop_logic(&t, (stop, boxes), (&disp, &rounds_cur), &mut items));
+    let flags = writeback_flags(&t, (&sel, &disp), wb_lb, rounds_cur, &mut items);
     let (push, push_data) = writeback_push(&t, &flags, &mut items);
     let [start_req, go, scan, empty] = dispatch_triggers(&t, &push, &mut items);
     ready_queue(&t, &bus, &dj, (&push, &push_data), &start_req, &mut items);
     items.push(dispatcher(&t, &dj, &go, &scan));
-    rounds_write(&flags, &mut items);
-    updater_write_port(&bus, &ports, &sel, &flags, &mut items);
+    rounds_write(&t, &flags, &mut items);
+    updater_write_port(&t, &bus, &ports, &sel, &flags, &mut items);
     pe_matrix(&t, &pe, &mut items);
     controller(&t, &rom, &flags, [&start_req, &empty], &mut items);
     register_writes(&t, &bus, &mut items);
     sched_hi_register(&t, &bus, &mut items);
     let mux = read_pipeline(&t, &bus, &mut items);
     read_mux(&t, &mux, &mut items);
-    interrupt_and_unused(&mut items);
+    interrupt_and_unused(&t, &mut items);
     top_shell(&t, items)
 }

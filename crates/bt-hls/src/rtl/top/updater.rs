@@ -19,7 +19,7 @@ pub(super) struct UpdaterPorts {
 /// commits: a path's jobs in a slot belong to one round, so no commit of the same path sits
 /// between) and the bus address otherwise (a PATH_STATUS read while idle).
 /// `rounds_cur` = the rounds `wb_q_path` has committed since the start.
-pub(super) fn rounds_read(t: &Dims<'_>, rom: &ScheduleRead, items: &mut Vec<Item>) {
+pub(super) fn rounds_read(t: &Dims<'_>, rom: &ScheduleRead, items: &mut Vec<Item>) -> Signal {
     items.push(Item::Comment(
         "rounds memory (M9K): read at the write-back entry's path, or the bus address".into(),
     ));
@@ -28,34 +28,34 @@ pub(super) fn rounds_read(t: &Dims<'_>, rom: &ScheduleRead, items: &mut Vec<Item
         "rounds_ra",
         t.pb,
         Expr::mux(
-            state_is(S_WB),
+            state_is(t, S_WB),
             rom.path.e(),
-            Expr::slice("avs_address", t.pb - 1, 0),
+            t.io.avs_address.slice(t.pb - 1, 0),
         ),
     );
     items.push(Item::AlwaysFf(vec![nb(
-        id("rounds_q"),
-        Expr::id("rounds").at(addr.e()),
+        t.r.rounds_q.e(),
+        t.r.rounds.at(addr.e()),
     )]));
     Signal::assigned(
         items,
         "rounds_cur",
         16,
         Expr::mux(
-            Expr::id("rvalid").at(id("wb_q_path")),
-            id("rounds_q"),
+            t.r.rvalid.at(t.r.wb_q_path.e()),
+            t.r.rounds_q.e(),
             lit(16, 0),
         ),
-    );
+    )
 }
 
 /// Rounds memory, write side: a committed round's end writes rounds_cur + 1.
-pub(super) fn rounds_write(f: &WritebackFlags, items: &mut Vec<Item>) {
+pub(super) fn rounds_write(t: &Dims<'_>, f: &WritebackFlags, items: &mut Vec<Item>) {
     items.push(Item::AlwaysFf(vec![Stmt::If(
-        f.go.e().and(id("wb_q_end")),
+        f.go.e().and(t.r.wb_q_end.e()),
         vec![nb(
-            Expr::id("rounds").at(id("wb_q_path")),
-            id("rounds_cur").plus(lit(16, 1)),
+            t.r.rounds.at(t.r.wb_q_path.e()),
+            f.rounds.e().plus(lit(16, 1)),
         )],
         vec![],
     )]));
@@ -75,7 +75,7 @@ pub(super) fn updater_read_ports(
         "coordinate updater-buffer: address {point, bank}; cur[path] = bank of the committed round"
             .into(),
     ));
-    let rom_bank = Expr::id("cur").at(rom.path.e());
+    let rom_bank = t.r.cur.at(rom.path.e());
     // Neighbours: the committed bank, or for a late job the bank its round writes.
     let nb_bank = Expr::bin(BinaryOp::Xor, rom_bank.clone(), rom.late.e());
     let ra_addr = Signal::reg(items, "ra_addr", ptb + 1);
@@ -85,15 +85,15 @@ pub(super) fn updater_read_ports(
     let wr_data = Signal::reg(items, "wr_data", point_bits(t.wd));
     let one_pt = lit(ptb, 1);
     items.push(Item::AlwaysComb(vec![
-        Stmt::Blocking(ra_addr.e(), bus_cell(bus)),
+        Stmt::Blocking(ra_addr.e(), bus_cell(t, bus)),
         Stmt::If(
-            or(state_is(S_LOAD), rom.load.e()),
+            or(state_is(t, S_LOAD), rom.load.e()),
             vec![Stmt::Blocking(
                 ra_addr.e(),
                 Expr::concat(vec![rom.point.e().minus(one_pt.clone()), nb_bank.clone()]),
             )],
             vec![Stmt::If(
-                state_is(S_WB),
+                state_is(t, S_WB),
                 vec![Stmt::Blocking(
                     ra_addr.e(),
                     Expr::concat(vec![rom.point.e(), rom_bank.clone()]),
@@ -118,6 +118,7 @@ pub(super) fn updater_read_ports(
 /// Coordinate updater-buffer, write side: the host's point writes while idle, the selected
 /// PE's result into the other bank at write-back; both memory copies take every write.
 pub(super) fn updater_write_port(
+    t: &Dims<'_>,
     bus: &Decode,
     ports: &UpdaterPorts,
     sel: &Selected,
@@ -126,25 +127,25 @@ pub(super) fn updater_write_port(
 ) {
     // `st_<axis>` hold the millimetre words' kept bits already (`mm_width`).
     let host_point = Expr::concat(vec![
-        id("st_z"),
-        Expr::slice("avs_writedata", 23, 16),
-        id("st_y"),
-        Expr::slice("avs_writedata", 15, 8),
-        id("st_x"),
-        Expr::slice("avs_writedata", 7, 0),
+        t.r.st_z.e(),
+        t.io.avs_writedata.slice(23, 16),
+        t.r.st_y.e(),
+        t.io.avs_writedata.slice(15, 8),
+        t.r.st_x.e(),
+        t.io.avs_writedata.slice(7, 0),
     ]);
     items.push(Item::AlwaysComb(vec![
         Stmt::Blocking(ports.wr_en.e(), bus.pt_we.e().or(flags.go.e())),
-        Stmt::Blocking(ports.wr_addr.e(), bus_cell(bus)),
+        Stmt::Blocking(ports.wr_addr.e(), bus_cell(t, bus)),
         Stmt::Blocking(ports.wr_data.e(), host_point),
         Stmt::If(
-            state_is(S_WB),
+            state_is(t, S_WB),
             vec![
                 Stmt::Blocking(
                     ports.wr_addr.e(),
                     Expr::concat(vec![
-                        id("wb_q_point"),
-                        Expr::id("cur").at(id("wb_q_path")).inv(),
+                        t.r.wb_q_point.e(),
+                        t.r.cur.at(t.r.wb_q_path.e()).inv(),
                     ]),
                 ),
                 Stmt::Blocking(ports.wr_data.e(), sel.point.e()),
@@ -153,16 +154,16 @@ pub(super) fn updater_write_port(
         ),
     ]));
     for (mem, rd, addr) in [
-        ("pm_a", "rd_a", &ports.ra_addr),
-        ("pm_b", "rd_b", &ports.rb_addr),
+        (&t.r.pm_a, &t.r.rd_a, &ports.ra_addr),
+        (&t.r.pm_b, &t.r.rd_b, &ports.rb_addr),
     ] {
         items.push(Item::AlwaysFf(vec![
             Stmt::If(
                 ports.wr_en.e(),
-                vec![nb(Expr::id(mem).at(ports.wr_addr.e()), ports.wr_data.e())],
+                vec![nb(mem.at(ports.wr_addr.e()), ports.wr_data.e())],
                 vec![],
             ),
-            nb(id(rd), Expr::id(mem).at(addr.e())),
+            nb(rd.e(), mem.at(addr.e())),
         ]));
     }
 }

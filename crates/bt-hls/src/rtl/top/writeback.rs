@@ -24,26 +24,26 @@ pub(super) fn writeback_push(
     if let Some(lb) = &f.any_lb {
         goes_on = goes_on.and(lb.e().lnot());
     }
-    let below_cap = Expr::bin(BinaryOp::Lt, id("rounds_cur").plus(lit(16, 1)), id("cap_r"));
+    let below_cap = Expr::bin(BinaryOp::Lt, f.rounds.e().plus(lit(16, 1)), t.r.cap_r.e());
     let again = Signal::assigned(items, "wb_again", 1, goes_on.and(below_cap));
     let push = Signal::assigned(
         items,
         "wb_push",
         1,
         f.go.e()
-            .and(id("wb_q_gtail"))
-            .and(or(id("wb_q_end").lnot(), again.e())),
+            .and(t.r.wb_q_gtail.e())
+            .and(or(t.r.wb_q_end.e().lnot(), again.e())),
     );
     let next = Expr::mux(
-        id("wb_q_end"),
-        id("wb_q_gbase"),
-        id("wb_q_src").plus(lit(eb, 1)),
+        t.r.wb_q_end.e(),
+        t.r.wb_q_gbase.e(),
+        t.r.wb_q_src.e().plus(lit(eb, 1)),
     );
     let data = Signal::assigned(
         items,
         "wb_push_data",
         2 * eb,
-        Expr::concat(vec![id("wb_q_gbase"), next]),
+        Expr::concat(vec![t.r.wb_q_gbase.e(), next]),
     );
     (push, data)
 }
@@ -81,7 +81,7 @@ pub(super) fn pe_output_select(t: &Dims<'_>, pe: &[PeWires], items: &mut Vec<Ite
         Stmt::Blocking(zs.e(), lit(1, 0)),
     ];
     items.push(Item::AlwaysComb(vec![Stmt::Case(
-        id("wb_q_inst"),
+        t.r.wb_q_inst.e(),
         sel_arms,
         sel_default,
     )]));
@@ -147,7 +147,7 @@ pub(super) fn displacement(t: &Dims<'_>, sel: &Selected, items: &mut Vec<Item>) 
     for (a, axis) in ["x", "y", "z"].iter().enumerate() {
         let (hi, lo) = (cw * (a as u32 + 1) - 1, cw * a as u32);
         let nw = Signal::assigned(items, format!("new_{axis}"), cw, sel.point.slice(hi, lo));
-        let old = Expr::slice("rd_a", hi, lo);
+        let old = t.r.rd_a.slice(hi, lo);
         let ow = Signal::assigned(items, format!("old_{axis}"), cw, old);
         let wide = |s: &Signal| crate::rtl::pe::sext(s.name(), cw, dispw);
         let delta = wide(&nw).minus(wide(&ow));
@@ -189,46 +189,54 @@ pub(super) struct WritebackFlags {
     pub(super) any_ov: Signal,
     /// Some point of the path left its box this round (early stopping only).
     pub(super) any_lb: Option<Signal>,
+    /// `rounds_cur`: the rounds the written path has committed since the start.
+    pub(super) rounds: Signal,
 }
 
 /// Write-back flags: a path is frozen once converged, degenerate, saturated or (early
 /// stopping) left its box; the `any_*` flags fold this job into its round's flags.
 pub(super) fn writeback_flags(
-    sel: &Selected,
-    disp: &Displacement,
+    t: &Dims<'_>,
+    (sel, disp): (&Selected, &Displacement),
     wb_lb: Option<Signal>,
+    rounds: Signal,
     items: &mut Vec<Item>,
 ) -> WritebackFlags {
-    let at_wb = |v: &str| Expr::id(v).at(id("wb_q_path"));
+    let r = &t.r;
+    let at_wb = |v: &Signal| v.at(r.wb_q_path.e());
     let frozen_sig = Signal::wire(items, "wb_frozen", 1);
-    let mut frozen = or(or(at_wb("conv"), at_wb("dz")), at_wb("ov"));
-    let any_lb = wb_lb.map(|lb| {
-        frozen = or(frozen.clone(), at_wb("lb"));
-        Signal::assigned(items, "any_lb", 1, or(at_wb("plb"), lb.e()))
+    let mut frozen = or(or(at_wb(&r.conv), at_wb(&r.dz)), at_wb(&r.ov));
+    let any_lb = wb_lb.zip(r.early()).map(|(wb_lb, (lb, plb))| {
+        frozen = or(frozen.clone(), at_wb(lb));
+        Signal::assigned(items, "any_lb", 1, or(at_wb(plb), wb_lb.e()))
     });
     items.push(Item::Assign(frozen_sig.e(), frozen));
     let go = Signal::assigned(
         items,
         "wb_go",
         1,
-        state_is(S_WB).and(id("wb_q_en")).and(frozen_sig.e().lnot()),
+        state_is(t, S_WB)
+            .and(t.r.wb_q_en.e())
+            .and(frozen_sig.e().lnot()),
     );
-    let any_big = Signal::assigned(items, "any_big", 1, or(at_wb("pbig"), disp.big.e()));
-    let any_dz = Signal::assigned(items, "any_dz", 1, or(at_wb("pdz"), sel.zs.e()));
-    let any_ov = Signal::assigned(items, "any_ov", 1, or(at_wb("pov"), sel.ov.e()));
+    let any_big = Signal::assigned(items, "any_big", 1, or(at_wb(&r.pbig), disp.big.e()));
+    let any_dz = Signal::assigned(items, "any_dz", 1, or(at_wb(&r.pdz), sel.zs.e()));
+    let any_ov = Signal::assigned(items, "any_ov", 1, or(at_wb(&r.pov), sel.ov.e()));
     WritebackFlags {
         go,
         any_big,
         any_dz,
         any_ov,
         any_lb,
+        rounds,
     }
 }
 
 /// A committed job's effect on its path's flags: at the round's end, flip the bank, count the
 /// round and decide convergence; inside the round, accumulate the flags.
-pub(super) fn path_commit(f: &WritebackFlags) -> Vec<Stmt> {
-    let wbp = |v: &str| Expr::id(v).at(id("wb_q_path"));
+pub(super) fn path_commit(t: &Dims<'_>, f: &WritebackFlags) -> Vec<Stmt> {
+    let r = &t.r;
+    let wbp = |v: &Signal| v.at(r.wb_q_path.e());
     let mut conv_next = f
         .any_big
         .e()
@@ -237,34 +245,34 @@ pub(super) fn path_commit(f: &WritebackFlags) -> Vec<Stmt> {
         .and(f.any_ov.e().lnot());
     let mut at_end = Vec::new();
     let mut in_round = Vec::new();
-    if let Some(any_lb) = &f.any_lb {
+    if let Some((any_lb, (lb, plb))) = f.any_lb.as_ref().zip(r.early()) {
         conv_next = conv_next.and(any_lb.e().lnot());
         at_end.push(nb(
-            wbp("lb"),
+            wbp(lb),
             any_lb.e().and(f.any_dz.e().lnot()).and(f.any_ov.e().lnot()),
         ));
-        at_end.push(nb(wbp("plb"), lit(1, 0)));
-        in_round.push(nb(wbp("plb"), any_lb.e()));
+        at_end.push(nb(wbp(plb), lit(1, 0)));
+        in_round.push(nb(wbp(plb), any_lb.e()));
     }
     vec![Stmt::If(
-        id("wb_q_end"),
+        t.r.wb_q_end.e(),
         vec![
-            nb(wbp("cur"), wbp("cur").inv()),
-            nb(wbp("rvalid"), lit(1, 1)),
-            nb(wbp("dz"), f.any_dz.e()),
-            nb(wbp("ov"), f.any_ov.e()),
-            nb(wbp("conv"), conv_next),
-            nb(wbp("pbig"), lit(1, 0)),
-            nb(wbp("pdz"), lit(1, 0)),
-            nb(wbp("pov"), lit(1, 0)),
+            nb(wbp(&r.cur), wbp(&r.cur).inv()),
+            nb(wbp(&r.rvalid), lit(1, 1)),
+            nb(wbp(&r.dz), f.any_dz.e()),
+            nb(wbp(&r.ov), f.any_ov.e()),
+            nb(wbp(&r.conv), conv_next),
+            nb(wbp(&r.pbig), lit(1, 0)),
+            nb(wbp(&r.pdz), lit(1, 0)),
+            nb(wbp(&r.pov), lit(1, 0)),
         ]
         .into_iter()
         .chain(at_end)
         .collect(),
         vec![
-            nb(wbp("pbig"), f.any_big.e()),
-            nb(wbp("pdz"), f.any_dz.e()),
-            nb(wbp("pov"), f.any_ov.e()),
+            nb(wbp(&r.pbig), f.any_big.e()),
+            nb(wbp(&r.pdz), f.any_dz.e()),
+            nb(wbp(&r.pov), f.any_ov.e()),
         ]
         .into_iter()
         .chain(in_round)
@@ -283,10 +291,11 @@ pub(super) struct InstanceBox {
 /// Early stopping, box table: the box of the instance being written (`wb_q_inst`), its
 /// constants biased by 2^47 so that signed comparisons become unsigned ones.
 pub(super) fn instance_box(
-    d: &TopParams<'_>,
+    t: &Dims<'_>,
     boxes: &[bt_fixed::FineBox],
     items: &mut Vec<Item>,
 ) -> InstanceBox {
+    let d = t.p;
     let w = BOX_BITS;
     let bias = 1i128 << (w - 1);
     let biased = |v: i64| lit(w, ((i128::from(v) + bias) as u128) & ((1u128 << w) - 1));
@@ -319,7 +328,7 @@ pub(super) fn instance_box(
             .into(),
     ));
     items.push(Item::AlwaysComb(vec![Stmt::Case(
-        id("wb_q_inst"),
+        t.r.wb_q_inst.e(),
         arms,
         defaults,
     )]));
@@ -332,49 +341,47 @@ pub(super) fn instance_box(
 /// comparisons are unsigned ones with the sign bit flipped (the box constants are flipped
 /// when generated).
 pub(super) fn early_stop_logic(
-    d: &TopParams<'_>,
-    stop: &bt_fixed::EarlyStop,
-    boxes: &[bt_fixed::FineBox],
-    disp: &Displacement,
+    t: &Dims<'_>,
+    (stop, boxes): (&bt_fixed::EarlyStop, &[bt_fixed::FineBox]),
+    (disp, rounds_cur): (&Displacement, &Signal),
     items: &mut Vec<Item>,
 ) -> Signal {
+    let d = t.p;
     let w = BOX_BITS;
     let axes = ["x", "y", "z"];
-    let bx = instance_box(d, boxes, items);
+    let bx = instance_box(t, boxes, items);
     let cw = d.model.coord_bits();
     let dispw = cw + 1;
     let mvw = w - bt_fixed::EarlyStop::MAX_SHIFT;
     let zext = |s: &Signal| Expr::concat(vec![lit(mvw - dispw, 0), s.e()]);
-    items.push(Item::Wire("mv_l1".into(), mvw));
-    items.push(Item::Assign(
-        id("mv_l1"),
+    let mv_l1 = Signal::assigned(
+        items,
+        "mv_l1",
+        mvw,
         zext(&disp.adiff[0])
             .plus(zext(&disp.adiff[1]))
             .plus(zext(&disp.adiff[2])),
-    ));
+    );
     let shift = stop.displacement_shift;
-    items.push(Item::Wire("slack".into(), w));
-    let mut parts = vec![lit(w - mvw - shift, 0), id("mv_l1")];
+    let mut parts = vec![lit(w - mvw - shift, 0), mv_l1.e()];
     if shift > 0 {
         parts.push(lit(shift, 0));
     }
-    items.push(Item::Assign(id("slack"), Expr::concat(parts)));
+    let slack = Signal::assigned(items, "slack", w, Expr::concat(parts));
     let mut terms = Vec::new();
     for (a, (axis, new)) in axes.iter().zip(&disp.new).enumerate() {
-        let pw = format!("bp_{axis}");
-        items.push(Item::Wire(pw.clone(), w));
-        items.push(Item::Assign(
-            id(&pw),
+        let bp = Signal::assigned(
+            items,
+            format!("bp_{axis}"),
+            w,
             crate::rtl::pe::sext(new.name(), cw, w),
-        ));
+        );
         for (side, expr) in [
-            ("lo", id(&pw).plus(id("slack"))),
-            ("hi", id(&pw).minus(id("slack"))),
+            ("lo", bp.e().plus(slack.e())),
+            ("hi", bp.e().minus(slack.e())),
         ] {
-            let n = format!("bq_{side}_{axis}");
-            items.push(Item::Wire(n.clone(), w));
-            items.push(Item::Assign(id(&n), expr));
-            let flipped = Expr::concat(vec![Expr::bit(&n, w - 1).inv(), Expr::slice(&n, w - 2, 0)]);
+            let q = Signal::assigned(items, format!("bq_{side}_{axis}"), w, expr);
+            let flipped = Expr::concat(vec![q.bit(w - 1).inv(), q.slice(w - 2, 0)]);
             let op = if side == "lo" {
                 BinaryOp::Lt
             } else {
@@ -388,7 +395,7 @@ pub(super) fn early_stop_logic(
     let late = if stop.min_rounds >= 2 {
         Expr::bin(
             BinaryOp::Gt,
-            id("rounds_cur"),
+            rounds_cur.e(),
             lit(16, u128::from(stop.min_rounds - 2)),
         )
     } else {
