@@ -42,7 +42,9 @@ fn reused_records_are_the_fresh_report() {
             let traced = tracer.trace(tx, rx).unwrap();
             let moved = tracer.scene().with_terminals(tx, rx).unwrap();
             let fresh = report(&moved, &traced.result.paths, &radio).unwrap();
-            let reused = records.report(&moved, &traced.result.paths, &radio).unwrap();
+            let reused = records
+                .report(&moved, &traced.result.paths, &radio)
+                .unwrap();
             assert_eq!(reused, fresh.as_slice(), "{settings:?} at {rx}");
             sizes.push(fresh.len());
         }
