@@ -113,13 +113,13 @@ impl TraceDocument {
     ) -> Result<Self, ReportError> {
         let t0 = Instant::now();
         let paths = crate::report(scene, &traced.result.paths, radio)?;
-        let ends = scene.terminals()?;
+        let [tx, rx] = terminals_world(scene)?;
         let report = t0.elapsed();
         Ok(Self {
             format_version: FORMAT_VERSION,
             scene: scene.name().to_string(),
-            tx: scene.to_world(ends.tx).to_array(),
-            rx: scene.to_world(ends.rx).to_array(),
+            tx,
+            rx,
             frequency_hz: scene.frequency_hz(),
             max_order: options.max_order,
             solver: options.solver,
@@ -131,22 +131,42 @@ impl TraceDocument {
                 tx_power_dbm: radio.tx_power_dbm,
                 diffraction_coefficient: radio.diffraction_coefficient,
             },
-            stats: Stats {
-                candidates: traced.candidates,
-                tree: traced.tree.clone(),
-                outcomes: traced.result.counts,
-                valid_paths: paths.len(),
-                received_power_dbm: crate::received_power_dbm(&paths, radio.tx_power_dbm),
-                time_s: StageTimes {
-                    load: load.as_secs_f64(),
-                    candidates: traced.time.candidates.as_secs_f64(),
-                    solve: traced.time.solve.as_secs_f64(),
-                    report: report.as_secs_f64(),
-                },
-            },
+            stats: Stats::of(traced, &paths, radio, [load, report]),
             paths,
         })
     }
+}
+
+impl Stats {
+    /// The stats of a trace: `traced`'s counts and stage times, the number and power of its
+    /// reported `paths`, and `[load, report]`, the times the scene took to load and the paths
+    /// to be reported.
+    pub fn of(
+        traced: &Traced,
+        paths: &[PathReport],
+        radio: &RadioOptions,
+        [load, report]: [Duration; 2],
+    ) -> Self {
+        Stats {
+            candidates: traced.candidates,
+            tree: traced.tree.clone(),
+            outcomes: traced.result.counts,
+            valid_paths: paths.len(),
+            received_power_dbm: crate::received_power_dbm(paths, radio.tx_power_dbm),
+            time_s: StageTimes {
+                load: load.as_secs_f64(),
+                candidates: traced.time.candidates.as_secs_f64(),
+                solve: traced.time.solve.as_secs_f64(),
+                report: report.as_secs_f64(),
+            },
+        }
+    }
+}
+
+/// The terminals of `scene` in the world frame, metres: `[tx, rx]` as a document writes them.
+pub fn terminals_world(scene: &Scene) -> Result<[[f64; 3]; 2], ReportError> {
+    let ends = scene.terminals()?;
+    Ok([ends.tx, ends.rx].map(|p| scene.to_world(p).to_array()))
 }
 
 /// The document of every time step of a dynamic scene (`beamtrace trace --steps --json`).
@@ -236,11 +256,11 @@ impl StepDocument {
         time: Duration,
     ) -> Result<Self, ReportError> {
         let paths = crate::report(scene, &traced.trace.paths, radio)?;
-        let ends = scene.terminals()?;
+        let [tx, rx] = terminals_world(scene)?;
         Ok(StepDocument {
             step: traced.step,
-            tx: scene.to_world(ends.tx).to_array(),
-            rx: scene.to_world(ends.rx).to_array(),
+            tx,
+            rx,
             stats: StepStats {
                 candidates: traced.candidates,
                 outcomes: traced.trace.counts,

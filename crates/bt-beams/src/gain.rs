@@ -74,47 +74,47 @@ fn at_frequency(radio: RadioMaterial, frequency_hz: Real) -> RadioMaterial {
 }
 
 /// The gain of `path` (interactions `interactions`, aligned with its points) in `scene`, and
-/// its diffraction's excess loss, dB (0 for a specular path).
+/// its diffraction's excess loss, dB (0 for a specular path). `channel` is a buffer for the
+/// interactions as the channel model takes them (cleared first).
 pub(crate) fn path_gain(
     responses: &mut Responses<'_>,
+    channel: &mut Vec<bt_channel::Interaction>,
     path: &FoundPath,
     interactions: &[Interaction],
     radio: &RadioOptions,
 ) -> Result<(Complex64, Real), ReportError> {
     let scene = responses.scene();
     let ends = scene.terminals()?;
-    let channel: Vec<bt_channel::Interaction> = interactions
-        .iter()
-        .map(|it| match *it {
-            Interaction::Reflection(id) => bt_channel::Interaction::Reflection(Bounce {
-                normal: scene.surface(id).polygon.plane().normal,
-                response: responses.get(id).0,
-            }),
-            Interaction::Transmission(id) => bt_channel::Interaction::Transmission(Bounce {
-                normal: scene.surface(id).polygon.plane().normal,
-                response: responses.get(id).0,
-            }),
-            Interaction::Diffraction(e) => {
-                let edge = scene.edges().get(e);
-                // The exterior lies from t0 towards e × t0: face 0's free-space side.
-                bt_channel::Interaction::Diffraction(Wedge {
-                    edge: edge.direction,
-                    face0: edge.t0,
-                    normal0: edge.direction.cross(edge.t0),
-                    n: edge.n,
-                    response0: responses.get(edge.face0).0,
-                    response_n: responses.get(edge.face_n).0,
-                })
-            }
-        })
-        .collect();
+    channel.clear();
+    channel.extend(interactions.iter().map(|it| match *it {
+        Interaction::Reflection(id) => bt_channel::Interaction::Reflection(Bounce {
+            normal: scene.surface(id).polygon.plane().normal,
+            response: responses.get(id).0,
+        }),
+        Interaction::Transmission(id) => bt_channel::Interaction::Transmission(Bounce {
+            normal: scene.surface(id).polygon.plane().normal,
+            response: responses.get(id).0,
+        }),
+        Interaction::Diffraction(e) => {
+            let edge = scene.edges().get(e);
+            // The exterior lies from t0 towards e × t0: face 0's free-space side.
+            bt_channel::Interaction::Diffraction(Wedge {
+                edge: edge.direction,
+                face0: edge.t0,
+                normal0: edge.direction.cross(edge.t0),
+                n: edge.n,
+                response0: responses.get(edge.face0).0,
+                response_n: responses.get(edge.face_n).0,
+            })
+        }
+    }));
     let antennas = (&radio.tx, &radio.rx);
     let g = match (radio.diffraction_coefficient, radio.sionna_max_depth) {
         (DiffractionCoefficient::SionnaRt22, Some(max_depth)) => bt_channel::path_gain_sionna_rt22(
             ends.tx,
             &path.points,
             ends.rx,
-            &channel,
+            channel,
             antennas,
             scene.frequency_hz(),
             max_depth,
@@ -123,7 +123,7 @@ pub(crate) fn path_gain(
             ends.tx,
             &path.points,
             ends.rx,
-            &channel,
+            channel,
             antennas,
             scene.frequency_hz(),
             coefficient,

@@ -10,11 +10,14 @@
 
 pub mod document;
 mod gain;
+mod records;
 pub mod sweep;
 
 pub use document::{
-    FORMAT_VERSION, Radio, StageTimes, Stats, StepDocument, StepStats, StepsDocument, TraceDocument,
+    FORMAT_VERSION, Radio, StageTimes, Stats, StepDocument, StepStats, StepsDocument,
+    TraceDocument, terminals_world,
 };
+pub use records::Records;
 pub use sweep::{BeamPair, BeamRanking, Sweep, sweep};
 
 use bt_channel::{Complex64, DiffractionCoefficient, SurfaceResponse, Tap};
@@ -208,6 +211,37 @@ impl PathReport {
         })
     }
 
+    /// A record with nothing in it yet, for [`describe_into`] to fill.
+    pub(crate) fn blank() -> Self {
+        Self {
+            rank: 0,
+            order: 0,
+            interactions: Vec::new(),
+            surfaces: Vec::new(),
+            surface_ids: Vec::new(),
+            diffractions: Vec::new(),
+            points: Vec::new(),
+            length_m: 0.0,
+            delay_s: 0.0,
+            aod_deg: Direction::of(Vec3::X),
+            aoa_deg: Direction::of(Vec3::X),
+            incidence_deg: Vec::new(),
+            free_space_loss_db: 0.0,
+            reflection_loss_db: 0.0,
+            diffraction_loss_db: 0.0,
+            transmission_loss_db: 0.0,
+            loss_db: 0.0,
+            gain: Complex64::new(0.0, 0.0),
+            gain_db: None,
+            power_dbm: None,
+            near_field: false,
+            departure: Vec3::X,
+            arrival: Vec3::X,
+            iterations: None,
+            residual_m: None,
+        }
+    }
+
     /// A representative record for code that derives its layout from the serialization (the
     /// Python columns): one reflection, so every list has an element to show its type, and
     /// every optional field set, so every field of the document is written. A field added to
@@ -292,22 +326,35 @@ pub enum InteractionKind {
     Transmission,
 }
 
-/// The name of a path's interaction in the document: the surface's name for a reflection,
-/// the edge's ([`Scene::edge_name`]: `"A|B"`, its two faces escaped, or `"A"` for a free edge)
-/// for a diffraction.
-fn interaction_name(scene: &Scene, interaction: Interaction) -> String {
-    match interaction {
-        Interaction::Reflection(id) | Interaction::Transmission(id) => {
-            scene.surface(id).name.clone()
+/// The names of a path's interactions in the document, into `names` (its strings reused):
+/// the surface's name for a reflection or a crossing, the edge's ([`Scene::edge_name`]:
+/// `"A|B"`, its two faces escaped, or `"A"` for a free edge) for a diffraction.
+fn interaction_names(scene: &Scene, interactions: &[Interaction], names: &mut Vec<String>) {
+    names.truncate(interactions.len());
+    for (k, it) in interactions.iter().enumerate() {
+        if k == names.len() {
+            names.push(String::new());
         }
-        Interaction::Diffraction(e) => scene.edge_name(scene.edges().get(e)),
+        let name = &mut names[k];
+        match *it {
+            Interaction::Reflection(id) | Interaction::Transmission(id) => {
+                name.clear();
+                name.push_str(&scene.surface(id).name);
+            }
+            Interaction::Diffraction(e) => *name = scene.edge_name(scene.edges().get(e)),
+        }
     }
 }
 
-/// The path's vertices TX → points → RX (local frame) and its unfolded length (m).
-fn vertices(scene: &Scene, path: &FoundPath) -> Result<(Vec<Vec3>, Real), ReportError> {
+/// The path's vertices TX → points → RX (local frame) into `vertices` (cleared first), and
+/// its unfolded length (m).
+fn vertices(
+    scene: &Scene,
+    path: &FoundPath,
+    vertices: &mut Vec<Vec3>,
+) -> Result<Real, ReportError> {
     let bt_scene::Endpoints { tx, rx } = scene.terminals()?;
-    let mut vertices = Vec::with_capacity(path.points.len() + 2);
+    vertices.clear();
     vertices.push(tx);
     vertices.extend_from_slice(&path.points);
     vertices.push(rx);
@@ -315,7 +362,16 @@ fn vertices(scene: &Scene, path: &FoundPath) -> Result<(Vec<Vec3>, Real), Report
         .windows(2)
         .map(|w| w[0].distance(w[1]))
         .fold(0.0, |a, b| a + b);
-    Ok((vertices, length_m))
+    Ok(length_m)
+}
+
+/// Buffers a report's paths reuse one after the other, so that describing a path allocates
+/// only what its record keeps: its vertices and its interactions as the channel model sees
+/// them.
+#[derive(Default)]
+pub(crate) struct Scratch {
+    vertices: Vec<Vec3>,
+    channel: Vec<bt_channel::Interaction>,
 }
 
 /// Describe one found path (rank 0 until [`report`] ranks it); `scene` is the one it was
@@ -325,28 +381,37 @@ pub fn describe(
     path: &FoundPath,
     radio: &RadioOptions,
 ) -> Result<PathReport, ReportError> {
-    describe_with(&mut gain::Responses::new(scene), path, radio)
+    let responses = &mut gain::Responses::new(scene);
+    let mut record = PathReport::blank();
+    describe_into(responses, &mut Scratch::default(), path, radio, &mut record)?;
+    Ok(record)
 }
 
-/// [`describe`] with the surfaces' responses looked up once for all the paths of a report.
-fn describe_with(
+/// [`describe`] into `record`, whose vectors and names are reused (cleared and refilled, so a
+/// record of a previous report costs no allocation), with the surfaces' responses looked up
+/// once for all the paths of a report.
+pub(crate) fn describe_into(
     responses: &mut gain::Responses<'_>,
+    scratch: &mut Scratch,
     path: &FoundPath,
     radio: &RadioOptions,
-) -> Result<PathReport, ReportError> {
+    record: &mut PathReport,
+) -> Result<(), ReportError> {
     let scene = responses.scene();
-    let (vertices, length_m) = vertices(scene, path)?;
+    let length_m = vertices(scene, path, &mut scratch.vertices)?;
+    let vertices = &scratch.vertices;
     let interactions = path.interactions();
-    let incidence_deg = (interactions.iter().enumerate())
-        .map(|(k, it)| match it {
+    let incidence_deg = refill(
+        &mut record.incidence_deg,
+        (interactions.iter().enumerate()).map(|(k, it)| match it {
             Interaction::Reflection(id) | Interaction::Transmission(id) => {
                 let normal = scene.surface(*id).polygon.plane().normal;
                 let incoming = (vertices[k] - vertices[k + 1]).normalize();
                 Some(incoming.dot(normal).abs().min(1.0).acos().to_degrees())
             }
             Interaction::Diffraction(_) => None,
-        })
-        .collect();
+        }),
+    );
     // Fold from +0.0: an empty f64 sum is -0.0, which would print as -0.0 for line of sight.
     let reflection_loss_db = path
         .surfaces
@@ -354,30 +419,31 @@ fn describe_with(
         .map(|id| responses.get(*id).1)
         .fold(0.0, |a, b| a + b);
     let free_space_loss_db = free_space_loss_db(length_m, scene.frequency_hz());
-    let (gain, diffraction_loss_db) = gain::path_gain(responses, path, &interactions, radio)?;
-    let transmission_loss_db = gain::transmission_loss_db(responses, &vertices, &interactions)?;
+    let (gain, diffraction_loss_db) =
+        gain::path_gain(responses, &mut scratch.channel, path, &interactions, radio)?;
+    let transmission_loss_db = gain::transmission_loss_db(responses, vertices, &interactions)?;
     let gain_db = power_db(gain.norm_sqr());
     let n = vertices.len();
-    Ok(PathReport {
+    let mut surfaces = std::mem::take(&mut record.surfaces);
+    interaction_names(scene, &interactions, &mut surfaces);
+    *record = PathReport {
         rank: 0,
         order: path.points.len(),
-        interactions: (interactions.iter())
-            .map(|it| match it {
+        interactions: refill(
+            &mut record.interactions,
+            interactions.iter().map(|it| match it {
                 Interaction::Reflection(_) => InteractionKind::Reflection,
                 Interaction::Diffraction(_) => InteractionKind::Diffraction,
                 Interaction::Transmission(_) => InteractionKind::Transmission,
-            })
-            .collect(),
-        surfaces: (interactions.iter())
-            .map(|it| interaction_name(scene, *it))
-            .collect(),
-        surface_ids: path.surfaces.clone(),
-        diffractions: path.diffractions.clone(),
-        points: path
-            .points
-            .iter()
-            .map(|p| scene.to_world(*p).to_array())
-            .collect(),
+            }),
+        ),
+        surfaces,
+        surface_ids: refill(&mut record.surface_ids, path.surfaces.iter().copied()),
+        diffractions: refill(&mut record.diffractions, path.diffractions.iter().copied()),
+        points: refill(
+            &mut record.points,
+            (path.points.iter()).map(|p| scene.to_world(*p).to_array()),
+        ),
         length_m,
         delay_s: length_m / SPEED_OF_LIGHT,
         aod_deg: Direction::of(vertices[1] - vertices[0]),
@@ -399,7 +465,17 @@ fn describe_with(
         arrival: (vertices[n - 2] - vertices[n - 1]).normalize(),
         iterations: path.iterations,
         residual_m: path.residual,
-    })
+    };
+    Ok(())
+}
+
+/// `buffer`'s vector (taken, so the record it came from holds an empty one) refilled with
+/// `items`: its capacity is reused.
+fn refill<T>(buffer: &mut Vec<T>, items: impl Iterator<Item = T>) -> Vec<T> {
+    let mut v = std::mem::take(buffer);
+    v.clear();
+    v.extend(items);
+    v
 }
 
 /// The channel taps of reported paths (gain, delay), in report order.
@@ -422,42 +498,16 @@ pub fn received_power_dbm(paths: &[PathReport], tx_power_dbm: Real) -> Option<Re
 /// Describe and rank all paths: by order, then length, then the largest incidence angle
 /// (closer to normal first), then surface ids — the paper's principles, made total. Fails only
 /// if a material has no radio model at the scene's frequency (scenes are validated against
-/// that) or the scene lacks a terminal (it cannot then have been traced).
+/// that) or the scene lacks a terminal (it cannot then have been traced). A caller that
+/// reports again and again reuses the records' memory with a [`Records`].
 pub fn report(
     scene: &Scene,
     paths: &[FoundPath],
     radio: &RadioOptions,
 ) -> Result<Vec<PathReport>, ReportError> {
-    let mut responses = gain::Responses::new(scene);
-    let mut reports = paths
-        .iter()
-        .map(|p| describe_with(&mut responses, p, radio))
-        .collect::<Result<Vec<_>, _>>()?;
-    let key = |r: &PathReport| {
-        r.incidence_deg
-            .iter()
-            .flatten()
-            .copied()
-            .fold(0.0, Real::max)
-    };
-    // Each tie-break computed only when the keys before it tie.
-    reports.sort_by(|a, b| {
-        a.order
-            .cmp(&b.order)
-            .then_with(|| a.length_m.total_cmp(&b.length_m))
-            .then_with(|| key(a).total_cmp(&key(b)))
-            .then_with(|| a.surface_ids.cmp(&b.surface_ids))
-            .then_with(|| {
-                let edges = |r: &PathReport| -> Vec<(usize, bt_scene::EdgeId)> {
-                    r.diffractions.iter().map(|d| (d.index, d.edge)).collect()
-                };
-                edges(a).cmp(&edges(b))
-            })
-    });
-    for (i, r) in reports.iter_mut().enumerate() {
-        r.rank = i + 1;
-    }
-    Ok(reports)
+    let mut records = Records::default();
+    records.report(scene, paths, radio)?;
+    Ok(records.into_paths())
 }
 
 #[cfg(test)]

@@ -89,14 +89,16 @@ pub fn sweep(
     );
     let mut rows = Vec::with_capacity(points.len());
     let mut tracer = Tracer::new(scene.clone(), *options);
+    // Each receiver reported into the previous one's records (their memory reused).
+    let mut records = bt_beams::Records::default();
     for chunk in points.chunks(CHUNK) {
         let traced = tracer.trace_each(tx, chunk)?;
         for (rx, outcome) in chunk.iter().zip(traced) {
             let status = match outcome {
                 Ok(traced) => {
                     let moved = scene.with_receiver(*rx).map_err(TraceError::from)?;
-                    let reports = bt_beams::report(&moved, &traced.result.paths, radio)?;
-                    summarise(&reports, radio.tx_power_dbm)
+                    let reports = records.report(&moved, &traced.result.paths, radio)?;
+                    summarise(reports, radio.tx_power_dbm)
                 }
                 Err(TraceError::Scene(e)) => PointStatus::Skipped(skip_reason(&e)),
                 Err(e) => return Err(e.into()),

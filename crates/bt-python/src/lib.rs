@@ -283,8 +283,10 @@ impl PyScene {
             // Each receiver reported, and its columns gathered, in the task that traced it (in
             // parallel when asked); only the arrays are made under the GIL.
             let report = |moved: &Scene, t: Traced| {
-                let paths = bt_beams::report(moved, &t.result.paths, &radio);
-                columns::cells_of(&paths.map_err(|e| e.to_string())?)
+                REPORTS.with_borrow_mut(|records| {
+                    let paths = records.report(moved, &t.result.paths, &radio);
+                    columns::cells_of(paths.map_err(|e| e.to_string())?)
+                })
             };
             let reported = self
                 .with_tracer(scene.clone(), options, |t| {
@@ -312,6 +314,12 @@ impl PyScene {
             .collect::<PyResult<Vec<_>>>()?;
         PyList::new(py, dicts)
     }
+}
+
+thread_local! {
+    /// The path records of the last receiver `trace_many` reported on this thread, whose
+    /// memory the next receiver's reuse (their columns are copied out in the same task).
+    static REPORTS: std::cell::RefCell<bt_beams::Records> = std::cell::RefCell::default();
 }
 
 /// The rows of an (m, 3) array as points.

@@ -6,8 +6,9 @@
 //! - `serve/person-move`: a request moving the person of `living-room-dynamic` (the
 //!   incremental update of `trace --steps`, report, JSON), two poses in turn;
 //! - `trace_many/kept-tree`: `Tracer::trace_each_then` with the full report of each receiver
-//!   (what Python's `trace_many` runs before its columns), 64 receivers per call, on a pool of
-//!   one thread and of two: the ratio is the speed-up on two cores.
+//!   into its thread's reused records (what Python's `trace_many` runs before its columns), 64
+//!   receivers per call, on a pool of one thread and of two: the ratio is the speed-up on two
+//!   cores.
 //!
 //! `cargo bench -p bt-serve --bench serve`
 
@@ -128,13 +129,23 @@ fn trace_many(c: &mut Criterion) {
             .expect("pool");
         let mut tracer = Tracer::new(scene.clone(), options);
         let report = |moved: &bt_scene::Scene, t: bt_solve::pipeline::Traced| {
-            bt_beams::report(moved, &t.result.paths, &radio).expect("report")
+            REPORTS.with_borrow_mut(|records| {
+                let paths = records.report(moved, &t.result.paths, &radio);
+                let paths = paths.expect("report");
+                (paths.len(), bt_beams::received_power_dbm(paths, 0.0))
+            })
         };
         group.bench_function(format!("kept-tree-{threads}-thread"), |b| {
             b.iter(|| pool.install(|| black_box(tracer.trace_each_then(tx, &receivers, report))))
         });
     }
     group.finish();
+}
+
+thread_local! {
+    /// Each thread's report records, reused from receiver to receiver as Python's
+    /// `trace_many` reuses them.
+    static REPORTS: std::cell::RefCell<bt_beams::Records> = std::cell::RefCell::default();
 }
 
 criterion_group!(benches, serve, trace_many);

@@ -3,8 +3,9 @@
 use crate::json;
 use crate::request::{self, Receivers, Request};
 use crate::{BeamOptions, Limits, ServeError};
-use bt_beams::TraceDocument;
-use bt_beams::{BeamPair, BeamRanking, PathReport, RadioOptions, StepDocument, StepStats};
+use bt_beams::{
+    BeamPair, BeamRanking, PathReport, RadioOptions, Records, Stats, StepDocument, StepStats,
+};
 use bt_geom::Vec3;
 use bt_scene::dynamic::{DynamicScene, Pose};
 use bt_scene::{SceneError, Terminals};
@@ -44,10 +45,10 @@ pub(crate) struct Session {
 
 /// The answer for one receiver: the fields of `trace --json` a receiver changes.
 #[derive(Serialize)]
-struct Answer {
+struct Answer<'a> {
     tx: [f64; 3],
     rx: [f64; 3],
-    paths: Vec<PathReport>,
+    paths: &'a [PathReport],
     stats: AnswerStats,
     #[serde(skip_serializing_if = "Option::is_none")]
     beams: Option<BeamsAnswer>,
@@ -301,7 +302,6 @@ impl Server {
         field: &Field<'_>,
     ) -> Result<Vec<Outcome>, ServeError> {
         let reporter = Reporter {
-            options: *self.tracer.options(),
             radio: &self.radio,
             beams: self.beams.as_ref(),
         };
@@ -367,7 +367,6 @@ impl Server {
             .map_err(|e| trace_error(e, &field(0)))?;
         let doc = StepDocument::report(&scene, step, &self.radio, t0.elapsed())?;
         let reporter = Reporter {
-            options: *self.tracer.options(),
             radio: &self.radio,
             beams: self.beams.as_ref(),
         };
@@ -375,7 +374,7 @@ impl Server {
             tx: doc.tx,
             rx: doc.rx,
             beams: reporter.beams_of(&doc.paths, scene.frequency_hz())?,
-            paths: doc.paths,
+            paths: &doc.paths,
             stats: AnswerStats::Step(doc.stats),
         });
         let mut outcomes = vec![first];
@@ -384,27 +383,39 @@ impl Server {
     }
 }
 
-/// The options and the radio side of every answer: the part of a [`Server`] the receivers'
+thread_local! {
+    /// The path records of the last answer reported on this thread, whose memory the next
+    /// answer's records reuse: a serve stream's answers allocate no path records once the
+    /// threads have seen a typical answer (the stream's memory stays flat: at most the
+    /// largest answer's records and [`Records`]' spares per thread).
+    static REPORTS: std::cell::RefCell<Records> = std::cell::RefCell::default();
+}
+
+/// The radio side of every answer: the part of a [`Server`] the receivers'
 /// answers need, shared by the threads that trace and report them.
 #[derive(Clone, Copy)]
 struct Reporter<'a> {
-    options: TraceOptions,
     radio: &'a RadioOptions,
     beams: Option<&'a BeamOptions>,
 }
 
 impl Reporter<'_> {
-    /// The answer of a trace in `scene` (with its TX and RX), reported by the one report of
-    /// `trace --json`.
+    /// The answer of a trace in `scene` (with its TX and RX): the fields `trace --json` writes
+    /// ([`bt_beams::TraceDocument::report`]), its paths reported into this thread's [`Records`] (the
+    /// previous answer's memory; `REPORTS`).
     fn trace_answer(&self, scene: &bt_scene::Scene, traced: &Traced) -> Outcome {
-        let options = &self.options;
-        let doc = TraceDocument::report(scene, options, traced, self.radio, Duration::ZERO)?;
-        serialise(&Answer {
-            tx: doc.tx,
-            rx: doc.rx,
-            beams: self.beams_of(&doc.paths, scene.frequency_hz())?,
-            paths: doc.paths,
-            stats: AnswerStats::Trace(doc.stats),
+        REPORTS.with_borrow_mut(|records| {
+            let t0 = Instant::now();
+            let paths = records.report(scene, &traced.result.paths, self.radio)?;
+            let [tx, rx] = bt_beams::terminals_world(scene)?;
+            let stats = Stats::of(traced, paths, self.radio, [Duration::ZERO, t0.elapsed()]);
+            serialise(&Answer {
+                tx,
+                rx,
+                beams: self.beams_of(paths, scene.frequency_hz())?,
+                paths,
+                stats: AnswerStats::Trace(stats),
+            })
         })
     }
 
@@ -456,7 +467,7 @@ pub(crate) fn rx_field(rx: &Receivers, i: usize) -> String {
 
 /// One receiver's answer as JSON bytes, room made for a typical answer up front: the bytes
 /// serde_json writes for [`Answer`], its path records written by hand ([`crate::json`]).
-fn serialise(answer: &Answer) -> Outcome {
+fn serialise(answer: &Answer<'_>) -> Outcome {
     let mut bytes = Vec::with_capacity(1024 + 1024 * answer.paths.len());
     let io = |e: std::io::Error| ServeError::Json(serde_json::Error::io(e));
     bytes.extend_from_slice(b"{\"tx\":");
@@ -464,7 +475,7 @@ fn serialise(answer: &Answer) -> Outcome {
     bytes.extend_from_slice(b",\"rx\":");
     json::write_reals(&mut bytes, &answer.rx).map_err(io)?;
     bytes.extend_from_slice(b",\"paths\":");
-    json::write_paths(&mut bytes, &answer.paths).map_err(io)?;
+    json::write_paths(&mut bytes, answer.paths).map_err(io)?;
     bytes.extend_from_slice(b",\"stats\":");
     serde_json::to_writer(&mut bytes, &answer.stats)?;
     if let Some(beams) = &answer.beams {
@@ -557,6 +568,7 @@ fn scene_error(e: &SceneError, rx_field: &str) -> ServeError {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use bt_beams::TraceDocument;
     use bt_solve::pipeline::DiffractionOptions;
     use bt_solve::settings::{SolveSettings, SolverKind};
 
@@ -575,7 +587,6 @@ mod tests {
             BeamOptions::new(arrays, &radio, BeamRanking::Power, (3, 1 << 20)).unwrap()
         });
         let reporter = Reporter {
-            options,
             radio: &radio,
             beams: sweep.as_ref(),
         };
@@ -597,7 +608,7 @@ mod tests {
                 tx: doc.tx,
                 rx: doc.rx,
                 beams: reporter.beams_of(&doc.paths, scene.frequency_hz()).unwrap(),
-                paths: doc.paths,
+                paths: &doc.paths,
                 stats: AnswerStats::Trace(doc.stats),
             };
             let mine = String::from_utf8(serialise(&answer).unwrap()).unwrap();
