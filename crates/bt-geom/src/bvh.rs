@@ -161,6 +161,12 @@ impl Bvh {
 }
 
 impl Bvh {
+    /// The box `(min, max)` around every item (the root's, metres), `None` without items:
+    /// the bits of folding `min` and `max` over the items' boxes in any order.
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        self.nodes.first().map(|root| (root.min, root.max))
+    }
+
     /// Calls `visit(item)` for every item whose box passes `box_test(min, max)`, descending only
     /// into nodes whose box passes it. `box_test` must be conservative (a node's box contains its
     /// items' boxes): answering `false` for a box prunes everything inside it.

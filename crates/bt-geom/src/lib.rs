@@ -7,6 +7,7 @@
 pub mod bvh;
 pub mod convex;
 pub mod count;
+pub mod hash;
 pub mod plane;
 pub mod poly2;
 pub mod polygon;

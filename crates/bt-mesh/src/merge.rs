@@ -13,8 +13,10 @@
 //!    loops without holes ([`crate::trace`]), otherwise simple pieces of the group's own faces
 //!    ([`crate::split`]). Either way every face's area is in exactly one surface.
 
+use bt_geom::hash::KeyMap;
 use bt_geom::poly2::{self, first_contact};
 use bt_geom::{Real, Vec2, Vec3};
+use rayon::prelude::*;
 use std::collections::HashMap;
 
 use crate::edges::EdgeTable;
@@ -68,6 +70,10 @@ struct FaceCounts {
     unusable: usize,
 }
 
+/// Groups of one mesh from which they are outlined in parallel: below, the work is too small
+/// to pay for handing it to other threads (most meshes of a city hold a few groups).
+const PARALLEL_GROUPS: usize = 64;
+
 /// Runs the whole merge. `opts` must be validated.
 pub(crate) fn merge(mesh: &RawMesh, opts: &MergeOptions, file: &str) -> Merged {
     let extent = bounding_diagonal(&mesh.positions);
@@ -78,16 +84,27 @@ pub(crate) fn merge(mesh: &RawMesh, opts: &MergeOptions, file: &str) -> Merged {
     let faces = drop_duplicates(faces, &mut counts);
     let groups = grow_regions(&faces, &points, opts);
 
+    // Each group is outlined on its own: on all cores when there are many (a large mesh, say
+    // a church of 12,000 faces, would otherwise keep one core busy while the other waits).
+    let outline_group = |group: &Group| {
+        let frame = Frame::of_faces(&faces, &group.faces);
+        match crate::trace::whole_outlines(&faces, group, &frame, &points, zero_length) {
+            Some(outlines) => (frame, outlines, 0),
+            None => {
+                let split = crate::split::split_group(&faces, group, &frame, &points, zero_length);
+                (frame, split.outlines, split.unusable)
+            }
+        }
+    };
+    let outlined: Vec<(Frame, Vec<Outline>, usize)> = if groups.len() >= PARALLEL_GROUPS {
+        groups.par_iter().map(outline_group).collect()
+    } else {
+        groups.iter().map(outline_group).collect()
+    };
     let mut surfaces = Vec::new();
     let mut name_counts: HashMap<String, usize> = HashMap::new();
-    for group in &groups {
-        let frame = Frame::of_faces(&faces, &group.faces);
-        let outlines = crate::trace::whole_outlines(&faces, group, &frame, &points, zero_length)
-            .unwrap_or_else(|| {
-                let split = crate::split::split_group(&faces, group, &frame, &points, zero_length);
-                counts.unusable += split.unusable;
-                split.outlines
-            });
+    for (group, (frame, outlines, unusable)) in groups.iter().zip(outlined) {
+        counts.unusable += unusable;
         let first = &faces[group.faces[0]];
         let base = first
             .key
@@ -160,12 +177,12 @@ fn bounding_diagonal(points: &[Vec3]) -> Real {
 
 /// Maps every position to a welded vertex id; returns the map and the welded positions (the
 /// first position of each cluster). A position joins the nearest earlier welded vertex within
-/// `tol`, found through a hash grid of cell size `tol`; `tol == 0` welds exact duplicates only.
+/// `tol` (the lowest id among equally near ones); `tol == 0` welds exact duplicates only.
 fn weld(positions: &[Vec3], tol: Real) -> (Vec<u32>, Vec<Vec3>) {
     let mut map = Vec::with_capacity(positions.len());
     let mut welded: Vec<Vec3> = Vec::new();
     if tol <= 0.0 {
-        let mut exact: HashMap<[u64; 3], u32> = HashMap::new();
+        let mut exact: KeyMap<[u64; 3], u32> = KeyMap::default();
         for &p in positions {
             // `+ 0.0` turns -0.0 into 0.0 so both weld.
             let key = (p + Vec3::ZERO).to_array().map(Real::to_bits);
@@ -177,40 +194,90 @@ fn weld(positions: &[Vec3], tol: Real) -> (Vec<u32>, Vec<Vec3>) {
         }
         return (map, welded);
     }
-    let cell_of = |p: Vec3| (p / tol).floor().to_array().map(|c| c as i64);
-    let mut grid: HashMap<[i64; 3], Vec<u32>> = HashMap::new();
+    let mut grid = WeldGrid::new(tol, positions.len());
     for &p in positions {
-        let cell = cell_of(p);
-        let mut best: Option<(Real, u32)> = None;
-        for dx in -1..=1i64 {
-            for dy in -1..=1i64 {
-                for dz in -1..=1i64 {
-                    let neighbour = [
-                        cell[0].saturating_add(dx),
-                        cell[1].saturating_add(dy),
-                        cell[2].saturating_add(dz),
-                    ];
-                    for &id in grid.get(&neighbour).into_iter().flatten() {
-                        let d = welded[id as usize].distance(p);
-                        if d <= tol && best.is_none_or(|(bd, bid)| (d, id) < (bd, bid)) {
-                            best = Some((d, id));
-                        }
-                    }
-                }
-            }
-        }
-        let id = match best {
-            Some((_, id)) => id,
+        let id = match grid.nearest(p, &welded) {
+            Some(id) => id,
             None => {
                 welded.push(p);
                 let id = (welded.len() - 1) as u32;
-                grid.entry(cell).or_default().push(id);
+                grid.insert(p, id);
                 id
             }
         };
         map.push(id);
     }
     (map, welded)
+}
+
+/// The welded vertices by cell, for [`weld`]: cubes of edge `2.5 tol`, so that the ball of
+/// radius `tol` around a point, widened to `1.2 tol` for rounding, meets at most two cells
+/// per axis, eight in all. Each cell holds a chain of ids through `next` (no allocation per cell).
+struct WeldGrid {
+    tol: Real,
+    cell: Real,
+    /// The last id inserted into each cell.
+    head: KeyMap<[i64; 3], u32>,
+    /// Per welded id: the id inserted before it into its cell, or `u32::MAX`.
+    next: Vec<u32>,
+}
+
+impl WeldGrid {
+    fn new(tol: Real, capacity: usize) -> Self {
+        let mut head = KeyMap::default();
+        head.reserve(capacity);
+        WeldGrid {
+            tol,
+            cell: 2.5 * tol,
+            head,
+            next: Vec::with_capacity(capacity),
+        }
+    }
+
+    /// The cell of `p` (`as` saturates, so absurd coordinates land in the outermost cell).
+    fn cell_of(&self, p: Vec3) -> [i64; 3] {
+        (p / self.cell).floor().to_array().map(|c| c as i64)
+    }
+
+    fn insert(&mut self, p: Vec3, id: u32) {
+        let cell = self.cell_of(p);
+        let before = self.head.insert(cell, id).unwrap_or(u32::MAX);
+        self.next.push(before);
+    }
+
+    /// The nearest welded vertex within `tol` of `p`, the lowest id among equally near ones.
+    fn nearest(&self, p: Vec3, welded: &[Vec3]) -> Option<u32> {
+        // A distance computed within `tol` holds a true offset within `tol (1 + 4 eps)` on
+        // every axis; the margin of `0.2 tol` also covers the rounding of `p ± reach` up to
+        // coordinates of `0.2 tol / eps` (9e10 m at the default 0.1 mm).
+        let reach = Vec3::splat(1.2 * self.tol);
+        let (lo, hi) = (self.cell_of(p - reach), self.cell_of(p + reach));
+        let mut best: Option<(Real, u32)> = None;
+        for x in [lo[0], hi[0]]
+            .into_iter()
+            .take(1 + usize::from(hi[0] != lo[0]))
+        {
+            for y in [lo[1], hi[1]]
+                .into_iter()
+                .take(1 + usize::from(hi[1] != lo[1]))
+            {
+                for z in [lo[2], hi[2]]
+                    .into_iter()
+                    .take(1 + usize::from(hi[2] != lo[2]))
+                {
+                    let mut id = self.head.get(&[x, y, z]).copied().unwrap_or(u32::MAX);
+                    while id != u32::MAX {
+                        let d = welded[id as usize].distance(p);
+                        if d <= self.tol && best.is_none_or(|(bd, bid)| (d, id) < (bd, bid)) {
+                            best = Some((d, id));
+                        }
+                        id = self.next[id as usize];
+                    }
+                }
+            }
+        }
+        best.map(|(_, id)| id)
+    }
 }
 
 /// Builds the planar, simple faces, counting in `counts` the faces dropped as degenerate and
@@ -225,6 +292,7 @@ fn planar_faces(
 ) -> Vec<Face> {
     let mut faces = Vec::with_capacity(mesh.face_count());
     let mut ids: Vec<u32> = Vec::new();
+    let mut scratch: Vec<Vec3> = Vec::new();
     for f in 0..mesh.face_count() {
         ids.clear();
         for &i in mesh.face(f) {
@@ -237,7 +305,7 @@ fn planar_faces(
             ids.pop();
         }
         let key = (mesh.face_name[f], mesh.face_material[f]);
-        let Some(face) = make_face(&ids, f, key, points, zero_length) else {
+        let Some(face) = make_face(&ids, f, key, points, zero_length, &mut scratch) else {
             counts.degenerate += 1;
             continue;
         };
@@ -256,7 +324,7 @@ fn planar_faces(
         }
         for k in 1..ids.len() - 1 {
             let tri = [ids[0], ids[k], ids[k + 1]];
-            match make_face(&tri, f, key, points, zero_length) {
+            match make_face(&tri, f, key, points, zero_length, &mut scratch) {
                 Some(t) => faces.push(t),
                 None => counts.degenerate += 1,
             }
@@ -283,18 +351,22 @@ fn is_simple_face(face: &Face, points: &[Vec3], eps: Real) -> bool {
 
 /// A face from welded ids, or `None` when it is degenerate: fewer than three distinct vertices,
 /// or an area so small that the face's height over its longest edge is within `zero_length`.
+/// `pts` is scratch space (its contents are replaced).
 fn make_face(
     ids: &[u32],
     source: usize,
     key: (Option<u32>, Option<u32>),
     points: &[Vec3],
     zero_length: Real,
+    pts: &mut Vec<Vec3>,
 ) -> Option<Face> {
     if ids.len() < 3 {
         return None;
     }
-    let pts: Vec<Vec3> = ids.iter().map(|&i| points[i as usize]).collect();
-    let area_vec = 0.5 * poly2::newell(&pts);
+    pts.clear();
+    pts.extend(ids.iter().map(|&i| points[i as usize]));
+    let pts = pts.as_slice();
+    let area_vec = 0.5 * poly2::newell(pts);
     let area = area_vec.length();
     let longest = (0..pts.len())
         .map(|i| pts[i].distance(pts[(i + 1) % pts.len()]))
@@ -445,6 +517,51 @@ mod tests {
         assert_eq!(welded.len(), 3);
         let (map, _) = weld(&[Vec3::ZERO, Vec3::new(-0.0, 0.0, 0.0)], 0.0);
         assert_eq!(map, [0, 0]);
+    }
+
+    /// [`weld`] by a scan of every welded vertex: the nearest earlier one within `tol`, the
+    /// lowest id among equally near ones.
+    fn weld_by_scan(positions: &[Vec3], tol: Real) -> (Vec<u32>, Vec<Vec3>) {
+        let mut welded: Vec<Vec3> = Vec::new();
+        let map = positions
+            .iter()
+            .map(|&p| {
+                let near = (0..welded.len() as u32)
+                    .map(|id| (welded[id as usize].distance(p), id))
+                    .filter(|&(d, _)| d <= tol)
+                    .min_by(|a, b| a.partial_cmp(b).expect("finite"));
+                near.map_or_else(
+                    || {
+                        welded.push(p);
+                        (welded.len() - 1) as u32
+                    },
+                    |(_, id)| id,
+                )
+            })
+            .collect();
+        (map, welded)
+    }
+
+    proptest::proptest! {
+        /// The grid of cells finds what a scan of every welded vertex finds, for points packed
+        /// within a few tolerances of each other (many on and across cell boundaries), far
+        /// from the origin too.
+        #[test]
+        fn weld_finds_what_a_scan_finds(
+            steps in proptest::collection::vec((-12i32..12, -12i32..12, -3i32..3), 1..120),
+            jitter in 0.0f64..0.5,
+            offset in proptest::prop_oneof![proptest::strategy::Just(0.0), -5e3f64..5e3],
+        ) {
+            let tol = 1e-4;
+            let positions: Vec<Vec3> = (steps.iter().enumerate())
+                .map(|(i, &(x, y, z))| {
+                    let wobble = jitter * ((i * 7 % 5) as Real - 2.0) * 0.25;
+                    let grid = Vec3::new(x as Real, y as Real, z as Real) * 0.45 * tol;
+                    Vec3::splat(offset) + grid + Vec3::splat(wobble * tol)
+                })
+                .collect();
+            proptest::prop_assert_eq!(weld(&positions, tol), weld_by_scan(&positions, tol));
+        }
     }
 
     #[test]

@@ -9,7 +9,6 @@
 //! left to [`crate::split`], which loses nothing.
 
 use bt_geom::{Real, Vec2, Vec3};
-use std::collections::HashMap;
 
 use crate::edges::edge_key;
 use crate::merge::{Face, Group};
@@ -76,10 +75,17 @@ fn closed_loops(
 ) -> Option<Vec<Vec<Vec2>>> {
     let project = |id: u32| frame.project(points[id as usize]);
     let boundary = boundary_edges(faces, group);
-    let mut outgoing: HashMap<u32, Vec<usize>> = HashMap::new();
-    for (h, &(a, _)) in boundary.iter().enumerate() {
-        outgoing.entry(a).or_default().push(h);
-    }
+    // The boundary edges by start vertex (in edge order for each): a sorted list, no
+    // allocation per vertex.
+    let mut outgoing: Vec<(u32, usize)> = (boundary.iter().enumerate())
+        .map(|(h, &(a, _))| (a, h))
+        .collect();
+    outgoing.sort_unstable();
+    let leaving = |at: u32| {
+        let start = outgoing.partition_point(|&(a, _)| a < at);
+        let end = start + outgoing[start..].partition_point(|&(a, _)| a == at);
+        outgoing[start..end].iter().map(|&(_, h)| h)
+    };
     let mut loops = Vec::new();
     let mut used = vec![false; boundary.len()];
     for start in 0..boundary.len() {
@@ -96,11 +102,7 @@ fn closed_loops(
             // there), take the sharpest right turn: it follows the exterior wedge, so the
             // loops separate into simple ones (outline and hole) instead of one self-touching
             // loop that would hide the hole.
-            let next = outgoing
-                .get(&at)
-                .into_iter()
-                .flatten()
-                .copied()
+            let next = leaving(at)
                 .filter(|&h| !used[h] || h == start)
                 .filter(|&h| h != current)
                 .map(|h| {

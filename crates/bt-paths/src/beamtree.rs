@@ -31,8 +31,10 @@ mod diffraction;
 
 use crate::diffraction::Diffracting;
 mod rebuild;
+mod receivers;
 pub use diffraction::{DiffractionSide, join as join_diffracted};
 pub use rebuild::RebuildStats;
+pub use receivers::ReceiverNodes;
 
 /// How the tree is built.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -560,6 +562,16 @@ impl BeamTree {
     /// `rx`, by order then lexicographically, with IPC start points inside the windows (when
     /// the tree's options ask for them).
     pub fn candidates(&self, rx: Vec3) -> CandidateSet {
+        self.candidates_among(rx, self.levels.iter().flat_map(|&(lo, hi)| lo..hi))
+    }
+
+    /// [`BeamTree::candidates`], testing only `nodes` (ascending indices, a superset of the
+    /// live nodes holding `rx`, such as [`ReceiverNodes::of`] gives): the same set.
+    pub fn candidates_among(
+        &self,
+        rx: Vec3,
+        nodes: impl IntoIterator<Item = usize>,
+    ) -> CandidateSet {
         let mut set = CandidateSet::with_starts();
         set.reserve(
             RESERVED_CANDIDATES,
@@ -569,12 +581,10 @@ impl BeamTree {
         set.push_with_starts(&[], &[]);
         let mut seq = Vec::with_capacity(self.max_order);
         let mut starts = Vec::with_capacity(self.max_order);
-        for &(lo, hi) in &self.levels {
-            for i in lo..hi {
-                if self.nodes[i].live && self.holds(i, rx) {
-                    self.prefix(i as u32, &mut seq, &mut starts);
-                    push(&mut set, &seq, &starts);
-                }
+        for i in nodes {
+            if self.nodes[i].live && self.holds(i, rx) {
+                self.prefix(i as u32, &mut seq, &mut starts);
+                push(&mut set, &seq, &starts);
             }
         }
         set.stats = self.candidate_stats(set.len() as u64);

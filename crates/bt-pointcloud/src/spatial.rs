@@ -1,8 +1,8 @@
 //! Uniform voxel hash over a point set, for fixed-radius neighbour queries without O(n²).
 
+use bt_geom::hash::KeyMap;
 use bt_geom::{Real, Vec3};
-use std::collections::HashMap;
-use std::hash::{BuildHasherDefault, Hash, Hasher};
+use std::hash::Hash;
 
 use rayon::prelude::*;
 
@@ -16,7 +16,7 @@ pub(crate) struct VoxelIndex {
 }
 
 /// Where each key's run lies in a slice sorted by key: `key -> (start, end)`, end exclusive.
-pub(crate) type KeyRanges<K> = HashMap<K, (u32, u32), BuildHasherDefault<KeyHasher>>;
+pub(crate) type KeyRanges<K> = KeyMap<K, (u32, u32)>;
 
 /// The runs of equal keys in `keyed`, which must be sorted by key (the bucket index of a
 /// spatial hash: the items of one cell are `keyed[start..end]`).
@@ -31,32 +31,6 @@ pub(crate) fn key_ranges<K: Copy + Ord + Hash>(keyed: &[(K, u32)]) -> KeyRanges<
         }
     }
     ranges
-}
-
-/// Multiply-rotate hasher for voxel keys: lookups dominate neighbour queries and the
-/// default SipHash is several times slower. Keys come from coordinates, not from an
-/// adversary choosing collisions, and iteration order is never used.
-#[derive(Default)]
-pub(crate) struct KeyHasher(u64);
-
-impl Hasher for KeyHasher {
-    fn finish(&self) -> u64 {
-        self.0
-    }
-    fn write(&mut self, bytes: &[u8]) {
-        for &b in bytes {
-            self.write_u64(u64::from(b));
-        }
-    }
-    fn write_i64(&mut self, v: i64) {
-        self.write_u64(v as u64);
-    }
-    fn write_u64(&mut self, v: u64) {
-        self.0 = (self.0.rotate_left(5) ^ v).wrapping_mul(0x51_7c_c1_b7_27_22_0a_95);
-    }
-    fn write_usize(&mut self, v: usize) {
-        self.write_u64(v as u64);
-    }
 }
 
 pub(crate) fn voxel_key(p: Vec3, cell: Real) -> [i64; 3] {

@@ -457,7 +457,7 @@ fn posed_scene(
     let tx = at.tx.map(|p| to_local(p, origin)).or(base.tx());
     let rx = at.rx.map(|p| to_local(p, origin)).or(base.rx());
     let extent = crate::model::scene_extent(&surfaces, tx, rx);
-    if let Err(list) = check_terminals(&surfaces, tx, rx, extent, origin) {
+    if let Err(list) = check_terminals((&surfaces, None), tx, rx, extent, origin) {
         problems.extend(list.into_iter().map(|p| Problem {
             location: format!("{location}{}", p.location),
             message: p.message,

@@ -312,8 +312,10 @@ impl Scene {
         conflicts.chain(enclosed).collect()
     }
 
+    /// [`scene_extent`] of the surfaces with `tx` and `rx`, from the BVH's box instead of a
+    /// pass over every surface (the same bits).
     pub(crate) fn extent_with(&self, tx: Vec3, rx: Vec3) -> Real {
-        scene_extent(&self.surfaces, Some(tx), Some(rx))
+        extent_of(self.bvh.bounds(), Some(tx), Some(rx))
     }
 }
 
@@ -331,13 +333,28 @@ pub struct Endpoints {
 /// With both terminals the box starts from them, as it always did: outputs of scenes with
 /// terminals stay bit-identical.
 pub(crate) fn scene_extent(surfaces: &[Surface], tx: Option<Vec3>, rx: Option<Vec3>) -> Real {
+    extent_of(surfaces_box(surfaces, None), tx, rx)
+}
+
+/// The box `(min, max)` around every surface, metres, `None` without surfaces. `bvh`, when
+/// given, must be the BVH of `surfaces`' polygons: its root box is taken instead of a pass
+/// over the surfaces, the same bits (`min` and `max` are exact in any order).
+pub(crate) fn surfaces_box(surfaces: &[Surface], bvh: Option<&Bvh>) -> Option<(Vec3, Vec3)> {
+    match bvh {
+        Some(bvh) => bvh.bounds(),
+        None => (surfaces.iter().map(|s| s.polygon.bounds()))
+            .reduce(|(a, b), (c, d)| (a.min(c), b.max(d))),
+    }
+}
+
+/// [`scene_extent`] of surfaces whose box is `surfaces` ([`surfaces_box`]).
+fn extent_of(surfaces: Option<(Vec3, Vec3)>, tx: Option<Vec3>, rx: Option<Vec3>) -> Real {
     let (mut lo, mut hi) = match (tx, rx) {
         (Some(tx), Some(rx)) => (tx.min(rx), tx.max(rx)),
         (Some(p), None) | (None, Some(p)) => (p, p),
         (None, None) => (Vec3::INFINITY, Vec3::NEG_INFINITY),
     };
-    for s in surfaces {
-        let (a, b) = s.polygon.bounds();
+    if let Some((a, b)) = surfaces {
         lo = lo.min(a);
         hi = hi.max(b);
     }

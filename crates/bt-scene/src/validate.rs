@@ -3,7 +3,7 @@
 use crate::description::{BOX_FACES, SceneDescription, SurfaceDesc};
 use crate::frame::{to_local, to_world};
 use crate::material::{DEFAULT_MATERIAL, Material, default_materials};
-use crate::model::{Scene, scene_extent};
+use crate::model::{Scene, scene_extent, surfaces_box};
 use crate::problem::{Collector, Problem, ProblemSink, SceneError};
 use crate::surface::{Pending, Place, RawSurface, Surface, SurfaceKind};
 use bt_channel::RadioMaterial;
@@ -109,7 +109,8 @@ impl Scene {
         let tx = terminal("tx", given[0], &mut problems).map(|p| to_local(p, origin));
         let rx = terminal("rx", given[1], &mut problems).map(|p| to_local(p, origin));
         let extent = scene_extent(&geometry.surfaces, tx, rx);
-        if let Err(p) = check_terminals(&geometry.surfaces, tx, rx, extent, origin) {
+        let placed = (geometry.surfaces.as_slice(), geometry.bvh.as_ref());
+        if let Err(p) = check_terminals(placed, tx, rx, extent, origin) {
             problems.0.extend(p);
         }
         let name = desc.name.clone().unwrap_or_else(|| source_name.to_string());
@@ -142,7 +143,8 @@ impl Scene {
         let rx = terminal("rx", given[1], &mut problems).map(|p| to_local(p, origin));
         let mut problems = problems.0;
         let extent = scene_extent(&geometry.surfaces, tx, rx);
-        if let Err(p) = check_terminals(&geometry.surfaces, tx, rx, extent, origin) {
+        let placed = (geometry.surfaces.as_slice(), geometry.bvh.as_ref());
+        if let Err(p) = check_terminals(placed, tx, rx, extent, origin) {
             problems.extend(p);
         }
         problems.extend(radio_problems(&geometry.surfaces, &materials, frequency_hz));
@@ -558,9 +560,11 @@ fn terminal(field: &str, value: Option<Vec3>, problems: &mut Collector) -> Optio
 
 /// TX and RX, where given, must be finite, resolvable and off every surface, and distinct when
 /// both are. Surfaces and terminals are in the local frame whose origin is `origin` (world):
-/// the resolution check looks at the world coordinates.
+/// the resolution check looks at the world coordinates. The BVH beside the surfaces, when
+/// given, must be that of their polygons: it answers the box and on-surface tests without a
+/// pass over every surface (a sweep places thousands of receivers), with the same answers.
 pub(crate) fn check_terminals(
-    surfaces: &[Surface],
+    (surfaces, bvh): (&[Surface], Option<&Bvh>),
     tx: Option<Vec3>,
     rx: Option<Vec3>,
     extent: Real,
@@ -583,7 +587,7 @@ pub(crate) fn check_terminals(
             problems.report(field, why);
         }
     }
-    far_terminals(surfaces, &given, &mut problems);
+    far_terminals(surfaces_box(surfaces, bvh), &given, &mut problems);
     if !problems.is_empty() {
         // A far or unresolvable terminal scales the tolerance: the tests below would blame
         // the other terminal.
@@ -595,7 +599,7 @@ pub(crate) fn check_terminals(
         problems.report("tx", "tx and rx are at the same position");
     }
     for &(field, p) in &given {
-        for s in surfaces {
+        for s in near(surfaces, bvh, p, eps) {
             if s.polygon.plane().signed_distance(p).abs() <= eps && s.polygon.contains(p, eps) {
                 problems.report(
                     field,
@@ -611,19 +615,38 @@ pub(crate) fn check_terminals(
     }
 }
 
+/// The surfaces, in order, that may hold points within `eps` of `p`: every one, or with the
+/// BVH of their polygons those whose box reaches the cube of half-side `4 eps` around `p`
+/// (a point within `eps` of a polygon's plane and of its outline lies within `1.5 eps` of its
+/// box on every axis; the rest is slack for rounding).
+fn near<'a>(
+    surfaces: &'a [Surface],
+    bvh: Option<&Bvh>,
+    p: Vec3,
+    eps: Real,
+) -> Box<dyn Iterator<Item = &'a Surface> + 'a> {
+    let Some(bvh) = bvh else {
+        return Box::new(surfaces.iter());
+    };
+    let mut ids = Vec::new();
+    bvh.visit_near(p, 4.0 * eps, |i| ids.push(i as usize));
+    ids.sort_unstable();
+    Box::new(ids.into_iter().map(|i| &surfaces[i]))
+}
+
 /// A terminal may lie at most this many extents of the surfaces (of at least 1 m) from their
 /// bounding box: beyond it, the length tolerance, which scales with the extent of surfaces and
 /// terminals together, would grow past the size of the scene's details.
 pub const MAX_TERMINAL_DISTANCE_RATIO: Real = 10_000.0;
 
-/// Report each given terminal farther from the surfaces than [`MAX_TERMINAL_DISTANCE_RATIO`]
-/// extents, naming it (not the other terminal, whose checks the inflated tolerance would fail).
-fn far_terminals(surfaces: &[Surface], given: &[(&str, Vec3)], problems: &mut Vec<Problem>) {
-    let Some((lo, hi)) = surfaces
-        .iter()
-        .map(|s| s.polygon.bounds())
-        .reduce(|(a, b), (c, d)| (a.min(c), b.max(d)))
-    else {
+/// Report each given terminal farther from the surfaces (whose box is `surfaces`) than
+/// [`MAX_TERMINAL_DISTANCE_RATIO`] extents, naming it (not the other terminal, whose checks the inflated tolerance would fail).
+fn far_terminals(
+    surfaces: Option<(Vec3, Vec3)>,
+    given: &[(&str, Vec3)],
+    problems: &mut Vec<Problem>,
+) {
+    let Some((lo, hi)) = surfaces else {
         return;
     };
     let limit = MAX_TERMINAL_DISTANCE_RATIO * (hi - lo).length().max(1.0);
@@ -678,12 +701,13 @@ impl Scene {
     pub fn with_terminals(&self, tx: Vec3, rx: Vec3) -> Result<Scene, crate::SceneError> {
         let (tx, rx) = (self.to_local(tx), self.to_local(rx));
         let extent = self.extent_with(tx, rx);
-        check_terminals(&self.surfaces, Some(tx), Some(rx), extent, self.origin).map_err(
-            |problems| crate::SceneError::Invalid {
+        let placed = (self.surfaces.as_slice(), Some(self.bvh.as_ref()));
+        check_terminals(placed, Some(tx), Some(rx), extent, self.origin).map_err(|problems| {
+            crate::SceneError::Invalid {
                 source_name: self.name.clone(),
                 problems,
-            },
-        )?;
+            }
+        })?;
         let mut scene = self.clone();
         scene.tx = Some(tx);
         scene.rx = Some(rx);

@@ -404,6 +404,10 @@ pub(crate) fn solve_set(
     })
 }
 
+/// Receivers from which a many-receiver trace narrows the kept tree's nodes for boxes of
+/// receivers ([`BeamTree::receiver_nodes`]) before walking it for each.
+const BATCHED_RECEIVERS: usize = 16;
+
 /// Trace `base`'s TX to each of `receivers` (metres, world frame: converted into the scene's
 /// local frame here; the paths found are local, see [`Scene::to_world`]), one outcome per
 /// receiver: a receiver on a surface or at the TX gets its own [`TraceError::Scene`] and the
@@ -430,13 +434,23 @@ pub(crate) fn trace_each_receiver<T: Send>(
             Ok(then(&moved, traced))
         })];
     }
-    let one = |rx: &Vec3| -> Result<T, TraceError> {
+    // Which of the tree's nodes may hold each receiver, found for boxes of nearby receivers
+    // at once (a superset: the candidates are the same as testing every node). A few
+    // receivers (a stream of moves, `beamtrace serve`) test every node instead.
+    let nodes = tree
+        .filter(|_| receivers.len() >= BATCHED_RECEIVERS)
+        .map(|kept| {
+            let local: Vec<Vec3> = receivers.iter().map(|&rx| base.to_local(rx)).collect();
+            kept.tree.receiver_nodes(&local)
+        });
+    let one = |(k, rx): (usize, &Vec3)| -> Result<T, TraceError> {
         let moved = base.with_receiver(*rx)?;
         let traced = match tree {
             // The tree's margins hold for receivers whose scene tolerance is no larger.
             Some(kept) if moved.length_tolerance() <= kept.tree.tolerance() => {
                 let t0 = Instant::now();
-                let set = kept.candidates(&moved, &inner)?;
+                let among = nodes.as_ref().map(|n| n.of(k));
+                let set = kept.candidates(&moved, among, &inner)?;
                 solve_set(&moved, set, &inner, t0.elapsed())?
             }
             // Receivers traced in parallel cannot share one cache (`tree` is built in beam-tree
@@ -448,9 +462,9 @@ pub(crate) fn trace_each_receiver<T: Send>(
     // One receiver runs on the caller's thread: handing it to the pool only adds a wake-up
     // (a whole scheduler slice, ~4 ms, when the cores are busy: serve's p99).
     if options.parallel && receivers.len() > 1 {
-        receivers.par_iter().map(one).collect()
+        receivers.par_iter().enumerate().map(one).collect()
     } else {
-        receivers.iter().map(one).collect()
+        receivers.iter().enumerate().map(one).collect()
     }
 }
 
@@ -486,14 +500,20 @@ impl KeptTx {
         Ok(KeptTx { tree, side })
     }
 
-    /// The candidates of `scene`'s RX (`scene` has this tree's TX): a walk of the tree, and
-    /// the diffracted ones joined with a tree grown from RX.
+    /// The candidates of `scene`'s RX (`scene` has this tree's TX): a walk of the tree (of
+    /// the nodes `among`, when given: a superset of those holding RX from
+    /// [`BeamTree::receiver_nodes`]), and the diffracted ones joined with a tree grown from RX.
     fn candidates(
         &self,
         scene: &Scene,
+        among: Option<&[u32]>,
         options: &TraceOptions,
     ) -> Result<CandidateSet, TraceError> {
-        let mut set = self.tree.candidates(scene.terminals()?.rx);
+        let rx = scene.terminals()?.rx;
+        let mut set = match among {
+            Some(nodes) => (self.tree).candidates_among(rx, nodes.iter().map(|&i| i as usize)),
+            None => self.tree.candidates(rx),
+        };
         if let Some(side) = &self.side {
             let tree_options = solver_tree_options(options);
             // Receivers in parallel cannot share one cache: each RX tree gets its own.

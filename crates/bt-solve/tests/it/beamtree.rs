@@ -495,3 +495,38 @@ fn kept_hulls_give_the_candidates_of_a_fresh_thread() {
         assert!(here == fresh(scene), "trace {i}: candidates differ");
     }
 }
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
+
+    /// The nodes a box of receivers narrows the kept tree to ([`BeamTree::receiver_nodes`])
+    /// give each receiver exactly the candidates, in order, of a walk over every node: clusters
+    /// of receivers (small boxes, tight against the beams' planes), scattered ones (large
+    /// boxes), receivers on the beams' boundary planes themselves (the surfaces' vertices)
+    /// and one with a non-finite coordinate.
+    #[test]
+    fn receiver_boxes_keep_every_candidate_of_a_full_walk(
+        seed in 0u64..1_000_000, n in 1usize..9, order in 1usize..4, spread in 0.0f64..1.0,
+    ) {
+        let Some(scene) = nasty_scene(seed, n, 0) else { return Ok(()) };
+        let tree = BeamTree::build(&scene, TreeOptions::new(order)).expect("tree builds");
+        let mut rng = ChaCha8Rng::seed_from_u64(seed ^ 0xb0c5);
+        let (lo, hi) = (0..scene.surfaces().len())
+            .map(|i| scene.surfaces()[i].polygon.bounds())
+            .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(a, b), (c, d)| (a.min(c), b.max(d)));
+        let centre = 0.5 * (lo + hi);
+        let mut receivers: Vec<Vec3> = (0..60)
+            .map(|_| {
+                let t = Vec3::new(rng.random(), rng.random(), rng.random());
+                centre + (lo - centre + t * (hi - lo)) * (0.02 + spread)
+            })
+            .collect();
+        receivers.extend(scene.surfaces().iter().flat_map(|s| s.polygon.vertices().iter().copied()));
+        receivers.push(Vec3::new(f64::NAN, centre.y, centre.z));
+        let nodes = tree.receiver_nodes(&receivers);
+        for (k, &rx) in receivers.iter().enumerate() {
+            let among = tree.candidates_among(rx, nodes.of(k).iter().map(|&i| i as usize));
+            prop_assert_eq!(listing(&among), listing(&tree.candidates(rx)), "receiver {}", k);
+        }
+    }
+}
