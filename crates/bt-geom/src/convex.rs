@@ -143,7 +143,7 @@ pub fn is_convex(polygon: &Polygon) -> bool {
 /// (`bt_paths::wvrn::occludes`). A nearly straight corner whose turn rounds the wrong way
 /// makes the polygon count as non-convex, which only skips it as an occluder (the safe side).
 pub fn is_strictly_convex(polygon: &Polygon) -> bool {
-    poly2::is_convex(polygon.local_vertices(), StraightCorners::Refused)
+    polygon.is_strictly_convex()
 }
 
 #[cfg(test)]

@@ -301,6 +301,12 @@ impl Polygon {
         self.inside_by_edges(q, margin)
     }
 
+    /// Whether every corner turns the same way, exactly (no straight corner): decided once,
+    /// when the polygon is built ([`crate::convex::is_strictly_convex`] asks here).
+    pub(crate) fn is_strictly_convex(&self) -> bool {
+        !self.convex_lines.is_empty()
+    }
+
     /// [`Polygon::inside_by`] for the in-plane point `q`, by the bounding box, the crossing
     /// number and the edges' segments (any simple polygon).
     #[inline]
@@ -409,7 +415,8 @@ impl Polygon {
 }
 
 /// The edges' lines of the 2-D polygon `local` as (inward unit normal, offset) when it is
-/// strictly convex ([`poly2::is_convex`] without straight corners), else none.
+/// strictly convex ([`poly2::is_convex`] without straight corners: the one test of
+/// [`crate::convex::is_strictly_convex`]), else none.
 fn inward_lines(local: &[Vec2]) -> Vec<(Vec2, Real)> {
     if !poly2::is_convex(local, poly2::StraightCorners::Refused) {
         return Vec::new();
@@ -669,7 +676,7 @@ mod contains_props {
                 ring.reverse();
             }
             let Ok(polygon) = Polygon::new(ring) else { return Ok(()) };
-            prop_assume!(!polygon.convex_lines.is_empty());
+            prop_assume!(polygon.is_strictly_convex());
             let p = Vec3::new(x, y * tilt.cos(), y * tilt.sin() + 3.0);
             let distance = polygon.signed_boundary_distance(p);
             prop_assume!((distance - margin).abs() > 1e-12);
