@@ -413,8 +413,14 @@ fn transmitted_cos(eta: Complex64, cos: Real) -> Complex64 {
     if s.im > 0.0 { -s } else { s }
 }
 
+/// Whether `den` is too small to divide by: |den| ≤ [`tol::COEFFICIENT_DENOMINATOR`], compared
+/// squared (no `hypot`).
+fn vanishes(den: Complex64) -> bool {
+    den.norm_sqr() <= tol::COEFFICIENT_DENOMINATOR * tol::COEFFICIENT_DENOMINATOR
+}
+
 fn ratio(num: Complex64, den: Complex64) -> Complex64 {
-    if den.norm() <= tol::COEFFICIENT_DENOMINATOR {
+    if vanishes(den) {
         Complex64::new(0.0, 0.0)
     } else {
         num / den
@@ -425,25 +431,30 @@ fn ratio(num: Complex64, den: Complex64) -> Complex64 {
 /// `eta` and cos θ = `cos_incidence`:
 /// r_TE = (cos θ − s)/(cos θ + s), r_TM = (η cos θ − s)/(η cos θ + s), s = √(η − sin²θ).
 pub fn fresnel(eta: Complex64, cos_incidence: Real) -> Reflection {
-    let cos = cos_incidence.clamp(0.0, 1.0);
+    half_space(eta, cos_incidence.clamp(0.0, 1.0)).0
+}
+
+/// [`fresnel`] at cos θ = `cos` (already clamped to [0, 1]) and s = √(η − sin²θ) beside it,
+/// which the slab formulas reuse.
+fn half_space(eta: Complex64, cos: Real) -> (Reflection, Complex64) {
     let s = transmitted_cos(eta, cos);
-    Reflection {
+    let r = Reflection {
         te: ratio(cos - s, cos + s),
         tm: ratio(eta * cos - s, eta * cos + s),
-    }
+    };
+    (r, s)
 }
 
 /// Single-layer slab in vacuum (P.2040 §2.2.2): R = r·(1 − e^{−j2q}) / (1 − r²·e^{−j2q}) with
 /// q = 2π·(d/λ)·√(η − sin²θ), per polarisation, r the half-space coefficient.
 /// `thickness_wavelengths` = d/λ.
 pub fn slab(eta: Complex64, cos_incidence: Real, thickness_wavelengths: Real) -> Reflection {
-    let cos = cos_incidence.clamp(0.0, 1.0);
-    let half = fresnel(eta, cos);
-    let q = transmitted_cos(eta, cos) * (2.0 * PI * thickness_wavelengths);
+    let (half, s) = half_space(eta, cos_incidence.clamp(0.0, 1.0));
+    let q = s * (2.0 * PI * thickness_wavelengths);
     let phase = (Complex64::new(0.0, -2.0) * q).exp();
     let layer = |r: Complex64| {
         let den = 1.0 - r * r * phase;
-        if den.norm() <= tol::COEFFICIENT_DENOMINATOR {
+        if vanishes(den) {
             r
         } else {
             r * (1.0 - phase) / den
@@ -465,9 +476,8 @@ pub fn slab_transmission(
     cos_incidence: Real,
     thickness_wavelengths: Real,
 ) -> Transmission {
-    let cos = cos_incidence.clamp(0.0, 1.0);
-    let half = fresnel(eta, cos);
-    let q = transmitted_cos(eta, cos) * (2.0 * PI * thickness_wavelengths);
+    let (half, s) = half_space(eta, cos_incidence.clamp(0.0, 1.0));
+    let q = s * (2.0 * PI * thickness_wavelengths);
     let (once, twice) = (
         (Complex64::new(0.0, -1.0) * q).exp(),
         (Complex64::new(0.0, -2.0) * q).exp(),
