@@ -409,8 +409,25 @@ fn check_thickness(thickness: Option<Real>) -> Result<(), ChannelError> {
 /// √(η − sin²θ) on the branch with a non-positive imaginary part (a wave decaying into the
 /// material under e^{+jωt}).
 fn transmitted_cos(eta: Complex64, cos: Real) -> Complex64 {
-    let s = (eta - (1.0 - cos * cos)).sqrt();
+    let s = principal_sqrt(eta - (1.0 - cos * cos));
     if s.im > 0.0 { -s } else { s }
+}
+
+/// The principal square root of `z` (real part ≥ 0, the imaginary part's sign that of
+/// `z.im`, −0 included), computed algebraically: with m = |z|, t = √((m + |Re z|)/2) is
+/// the larger part and Im z/(2t) the other, so neither cancels. `Complex64::sqrt` goes
+/// through polar form (an `atan2` and a `sincos` more).
+fn principal_sqrt(z: Complex64) -> Complex64 {
+    let m = z.norm();
+    if m == 0.0 {
+        return Complex64::new(0.0, z.im);
+    }
+    let t = (0.5 * (m + z.re.abs())).sqrt();
+    let other = 0.5 * z.im.abs() / t;
+    match z.re >= 0.0 {
+        true => Complex64::new(t, z.im.signum() * other),
+        false => Complex64::new(other, t.copysign(z.im)),
+    }
 }
 
 /// Whether `den` is too small to divide by: |den| ≤ [`tol::COEFFICIENT_DENOMINATOR`], compared
@@ -500,6 +517,28 @@ mod tests {
 
     fn close(a: Complex64, b: Complex64, eps: Real) -> bool {
         (a - b).norm() <= eps
+    }
+
+    proptest! {
+        /// The algebraic root agrees with `Complex64::sqrt` (polar form) to a few ulps of |z|,
+        /// and squares back to z.
+        #[test]
+        fn principal_sqrt_is_the_principal_root(
+            re in -1e3f64..1e3, im in -1e3f64..1e3, zero_im in any::<bool>(), neg in any::<bool>(),
+        ) {
+            let im = match (zero_im, neg) {
+                (true, true) => -0.0,
+                (true, false) => 0.0,
+                _ => im,
+            };
+            let z = c(re, im);
+            let (mine, polar) = (principal_sqrt(z), z.sqrt());
+            let scale = z.norm().sqrt().max(Real::MIN_POSITIVE);
+            prop_assert!(close(mine, polar, 1e-14 * scale), "{z}: {mine} vs {polar}");
+            prop_assert!(close(mine * mine, z, 1e-14 * z.norm().max(1e-300)), "{z}: {mine}");
+            prop_assert!(mine.re >= 0.0);
+            prop_assert_eq!(mine.im.is_sign_negative(), im.is_sign_negative());
+        }
     }
 
     #[test]
