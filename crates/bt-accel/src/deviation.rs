@@ -57,7 +57,7 @@ pub fn fixed_deviation(
     for (seq, r) in step.sequences.iter().zip(results) {
         match host_accepts(scene, ends, seq, r) {
             Ok(_) => {
-                if !reference.paths.iter().any(|p| p.surfaces == *seq) {
+                if !reference.paths.iter().any(|p| p.surfaces[..] == seq[..]) {
                     err.spurious += 1;
                 }
             }
@@ -69,11 +69,19 @@ pub fn fixed_deviation(
     let mut count = 0usize;
     // Line of sight (no surface) needs no accelerator: the host adds it.
     for path in reference.paths.iter().filter(|p| !p.surfaces.is_empty()) {
-        if step.host_sequences.contains(&path.surfaces) {
+        if step
+            .host_sequences
+            .iter()
+            .any(|s| s[..] == path.surfaces[..])
+        {
             err.host_solved += 1;
             continue;
         }
-        let Some(k) = step.sequences.iter().position(|s| *s == path.surfaces) else {
+        let Some(k) = step
+            .sequences
+            .iter()
+            .position(|s| s[..] == path.surfaces[..])
+        else {
             err.missed += 1;
             continue;
         };

@@ -6,7 +6,7 @@
 
 use crate::ipc::IpcOptions;
 use crate::{
-    CandidateOutcome, FoundPath, IpcOutcome, Solver, Validity, ipc_verdict, lanes,
+    CandidateOutcome, FoundPath, Inline, IpcOutcome, Solver, Validity, ipc_verdict, lanes,
     solve_candidate_from,
 };
 use bt_geom::{Real, Vec3};
@@ -295,10 +295,10 @@ pub(crate) fn found_path(
         _ => (None, None),
     };
     Some(FoundPath {
-        surfaces: seq.to_vec(),
-        points: points.to_vec(),
-        diffractions: Vec::new(),
-        crossings: Vec::new(),
+        surfaces: Inline::from_slice(seq),
+        points: Inline::from_slice(points),
+        diffractions: Inline::new(),
+        crossings: Inline::new(),
         iterations,
         residual,
     })

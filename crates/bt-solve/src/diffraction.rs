@@ -345,14 +345,15 @@ pub fn solve_candidate(
 }
 
 /// Solve and validate every candidate of `set` (in parallel when `parallel`; the output is
-/// the same either way): the valid paths in set order, and every outcome counted.
+/// the same either way): the valid paths in set order, and every outcome counted, as the
+/// results of consecutive chunks of the set ([`TraceResult::concat`] joins them).
 pub fn trace_set(
     scene: &Scene,
     ends: Endpoints,
     set: &DiffractedSet,
     solver: &crate::Solver,
     parallel: bool,
-) -> TraceResult {
+) -> Vec<TraceResult> {
     let chunks: Vec<std::ops::Range<usize>> = (0..set.len())
         .step_by(CHUNK)
         .map(|start| start..(start + CHUNK).min(set.len()))
@@ -368,17 +369,11 @@ pub fn trace_set(
             range.clone(),
         )
     };
-    let parts: Vec<TraceResult> = if parallel && set.len() >= 2 * CHUNK {
+    if parallel && set.len() >= 2 * CHUNK {
         chunks.par_iter().map(run).collect()
     } else {
         chunks.iter().map(run).collect()
-    };
-    let mut out = TraceResult::default();
-    for part in parts {
-        out.counts.merge(&part.counts);
-        out.paths.extend(part.paths);
     }
-    out
 }
 
 /// Diffracted candidates per parallel chunk.

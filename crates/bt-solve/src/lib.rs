@@ -52,20 +52,26 @@ pub enum Solver {
     Sbr(SbrOptions),
 }
 
+/// A path's short list, held inline up to `N` items (no allocation for the paths of
+/// ordinary orders), on the heap beyond: a slice to read.
+pub type Inline<T, const N: usize> = smallvec::SmallVec<[T; N]>;
+
 /// A valid path found by a solver: specular, or with one edge diffraction.
+///
+/// Its lists are [`Inline`]: up to order 4 a path costs no allocation (a trace finds hundreds).
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct FoundPath {
     /// Reflecting surfaces, TX side first (empty: line of sight, or a lone diffraction). With
     /// a diffraction or crossings, fewer than the points: [`FoundPath::interactions`] aligns
     /// them.
-    pub surfaces: Vec<SurfaceId>,
+    pub surfaces: Inline<SurfaceId, 4>,
     /// Interaction points, TX side first, metres (TX and RX excluded).
-    pub points: Vec<Vec3>,
+    pub points: Inline<Vec3, 4>,
     /// The diffractions (none, one or two), in path order.
-    pub diffractions: Vec<Diffraction>,
+    pub diffractions: Inline<Diffraction, 2>,
     /// The penetrable surfaces the path crosses (thin-slab transmission), by point, in path
     /// order; empty without transmission.
-    pub crossings: Vec<Crossing>,
+    pub crossings: Inline<Crossing, 2>,
     /// IPC rounds used (IPC only).
     pub iterations: Option<u32>,
     /// Mean displacement of IPC's last round, metres (IPC only).
@@ -153,8 +159,8 @@ impl FoundPath {
         if found.is_empty() {
             return self;
         }
-        let mut points = Vec::with_capacity(n + found.len());
-        let mut crossings = Vec::with_capacity(found.len());
+        let mut points = Inline::with_capacity(n + found.len());
+        let mut crossings = Inline::with_capacity(found.len());
         let mut diffractions = self.diffractions.clone();
         let mut next = found.iter().peekable();
         for segment in 0..=n {
@@ -170,7 +176,7 @@ impl FoundPath {
                     d.index = points.len();
                 }
             }
-            points.extend(self.points.get(segment));
+            points.extend(self.points.get(segment).copied());
         }
         FoundPath {
             points,
@@ -270,6 +276,24 @@ pub struct TraceResult {
     pub paths: Vec<FoundPath>,
     /// Outcome counts over all candidates.
     pub counts: OutcomeCounts,
+}
+
+impl TraceResult {
+    /// The results of consecutive parts as one, in order: the paths moved once into a
+    /// vector of their total length (a path holds its lists inline, so it is worth not
+    /// moving twice).
+    pub fn concat(parts: impl IntoIterator<Item = TraceResult>) -> TraceResult {
+        let parts: Vec<TraceResult> = parts.into_iter().collect();
+        let mut out = TraceResult {
+            paths: Vec::with_capacity(parts.iter().map(|p| p.paths.len()).sum()),
+            counts: OutcomeCounts::default(),
+        };
+        for part in parts {
+            out.paths.extend(part.paths);
+            out.counts.merge(&part.counts);
+        }
+        out
+    }
 }
 
 /// Solve and validate one candidate from `ends.tx` to `ends.rx` (the scene's, from
@@ -397,15 +421,15 @@ pub fn trace(
         solver,
         parallel,
     };
-    let parts = solve_batch(&batch, Todo::All, |_| None, keep_valid);
-    let mut out = TraceResult::default();
-    for part in parts {
-        out.paths.extend(part.paths);
-        out.counts.merge(&part.counts);
-    }
-    let diffracted = diffraction::trace_set(scene, ends, &candidates.diffracted, solver, parallel);
-    out.paths.extend(diffracted.paths);
-    out.counts.merge(&diffracted.counts);
+    let mut parts = solve_batch(&batch, Todo::All, |_| None, keep_valid);
+    parts.extend(diffraction::trace_set(
+        scene,
+        ends,
+        &candidates.diffracted,
+        solver,
+        parallel,
+    ));
+    let mut out = TraceResult::concat(parts);
     if scene.transmits() {
         out.paths = (out.paths.into_iter())
             .map(|p| p.with_crossings(scene, ends))

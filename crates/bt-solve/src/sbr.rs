@@ -20,7 +20,7 @@
 //! table of best rays per surface sequence, which only grows when a new sequence appears.
 //! Chunks are merged in ray order, so the result does not depend on the thread count.
 
-use crate::{FoundPath, OutcomeCounts, TraceResult};
+use crate::{FoundPath, Inline, OutcomeCounts, TraceResult};
 use bt_geom::{Real, Vec3};
 use bt_scene::{Endpoints, Scene, SceneError, SurfaceId, SurfaceKind};
 use rayon::prelude::*;
@@ -279,10 +279,10 @@ impl SbrPath {
     /// The path as the other solvers report it (hit points; no IPC fields).
     pub fn to_found(&self) -> FoundPath {
         FoundPath {
-            surfaces: self.surfaces.clone(),
-            diffractions: Vec::new(),
-            crossings: Vec::new(),
-            points: self.points.clone(),
+            surfaces: Inline::from_slice(&self.surfaces),
+            diffractions: Inline::new(),
+            crossings: Inline::new(),
+            points: Inline::from_slice(&self.points),
             iterations: None,
             residual: None,
         }
@@ -597,12 +597,12 @@ mod tests {
     fn compare(scene: &Scene, options: &SbrOptions, max_order: usize) -> (Real, usize, usize) {
         let exact = image_paths(scene, max_order);
         let sbr = trace_detailed(scene, options, max_order, true).unwrap();
-        let exact_seqs: BTreeSet<_> = exact.iter().map(|p| p.surfaces.clone()).collect();
+        let exact_seqs: BTreeSet<_> = exact.iter().map(|p| p.surfaces.to_vec()).collect();
         let sbr_seqs: BTreeSet<_> = sbr.paths.iter().map(|p| p.surfaces.clone()).collect();
         let mut sum = 0.0;
         let mut matched = 0;
         for p in &sbr.paths {
-            if let Some(e) = exact.iter().find(|e| e.surfaces == p.surfaces) {
+            if let Some(e) = exact.iter().find(|e| e.surfaces[..] == p.surfaces[..]) {
                 let first = e.points.first().copied().unwrap_or(scene.rx().unwrap());
                 sum += angle_deg(p.departure, first - scene.tx().unwrap());
                 let last = e.points.last().copied().unwrap_or(scene.tx().unwrap());
@@ -694,7 +694,7 @@ mod tests {
         let exact_paths = image_paths(&scene, 2);
         let seq = [[floor, west], [west, floor]]
             .into_iter()
-            .find(|s| exact_paths.iter().any(|p| p.surfaces == s))
+            .find(|s| exact_paths.iter().any(|p| p.surfaces[..] == s[..]))
             .unwrap();
         let other = [seq[1], seq[0]];
         assert!(

@@ -399,7 +399,7 @@ pub(crate) fn run_solver(
         .into_iter()
         .map(|p| {
             let d = exact_directions(ends, &p.points);
-            (p.surfaces, d)
+            (p.surfaces.to_vec(), d)
         })
         .collect();
     Ok((map, elapsed))

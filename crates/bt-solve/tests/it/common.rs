@@ -40,7 +40,7 @@ pub fn angle_between(a: Vec3, b: Vec3) -> Real {
 }
 
 pub fn sequences(paths: &[FoundPath]) -> Vec<Vec<SurfaceId>> {
-    paths.iter().map(|p| p.surfaces.clone()).collect()
+    paths.iter().map(|p| p.surfaces.to_vec()).collect()
 }
 
 /// Largest point distance between matching paths (same sequences in the same order), metres.
@@ -74,7 +74,7 @@ pub fn paths_of(scene: &Scene, options: &TraceOptions) -> Vec<FoundPath> {
 pub fn listing(paths: &[FoundPath]) -> Vec<(Vec<bt_solve::Interaction>, Vec<Vec3>)> {
     paths
         .iter()
-        .map(|p| (p.interactions(), p.points.clone()))
+        .map(|p| (p.interactions(), p.points.to_vec()))
         .collect()
 }
 

@@ -253,7 +253,7 @@ fn a_reflection_point_on_a_seam_reflects_once() {
                 .filter(|p| p.points.len() == 1 && p.diffractions.first().copied().is_none())
                 .collect();
             assert_eq!(reflected.len(), 1, "{mode:?}: {reflected:?}");
-            assert_eq!(reflected[0].surfaces, vec![SurfaceId(0)]);
+            assert_eq!(reflected[0].surfaces[..], [SurfaceId(0)]);
         }
     }
 }

@@ -197,7 +197,7 @@ proptest! {
         let opaque = paths(&scene, &options(order, CandidateMode::BeamTree, false, false));
         let all = listing(&through);
         for p in opaque.iter().filter(|p| p.crossings.is_empty()) {
-            prop_assert!(all.contains(&(p.interactions(), p.points.clone())), "{:?} lost", p.interactions());
+            prop_assert!(all.contains(&(p.interactions(), p.points.to_vec())), "{:?} lost", p.interactions());
         }
         let ends = scene.terminals().unwrap();
         let back = scene.with_terminals(scene.to_world(ends.rx), scene.to_world(ends.tx)).unwrap();

@@ -90,7 +90,7 @@ proptest! {
         let mut a: Vec<_> = forward.iter().map(|p| {
             let mut kinds = p.interactions();
             kinds.reverse();
-            let mut points = p.points.clone();
+            let mut points = p.points.to_vec();
             points.reverse();
             (kinds, points)
         }).collect();

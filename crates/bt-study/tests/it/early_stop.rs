@@ -47,7 +47,7 @@ fn check(scene: &Scene, max_order: usize) -> Counts {
     for path in reference.paths.iter().filter(|p| !p.surfaces.is_empty()) {
         let k = sequences
             .iter()
-            .position(|s| *s == path.surfaces)
+            .position(|s| s[..] == path.surfaces[..])
             .expect("every valid path is a candidate");
         c.valid += 1;
         match host_accepts(scene, ends, &sequences[k], &early[k]) {
@@ -62,7 +62,7 @@ fn check(scene: &Scene, max_order: usize) -> Counts {
     }
     for (seq, r) in sequences.iter().zip(&early) {
         if host_accepts(scene, ends, seq, r).is_ok()
-            && !reference.paths.iter().any(|p| p.surfaces == *seq)
+            && !reference.paths.iter().any(|p| p.surfaces[..] == seq[..])
         {
             c.spurious += 1;
         }
