@@ -101,7 +101,7 @@ pub(crate) fn merge(mesh: &RawMesh, opts: &MergeOptions, file: &str) -> Merged {
     } else {
         groups.iter().map(outline_group).collect()
     };
-    let mut surfaces = Vec::new();
+    let mut surfaces = Vec::with_capacity(outlined.iter().map(|(_, o, _)| o.len()).sum());
     let mut name_counts: HashMap<String, usize> = HashMap::new();
     for (group, (frame, outlines, unusable)) in groups.iter().zip(outlined) {
         counts.unusable += unusable;
@@ -118,7 +118,17 @@ pub(crate) fn merge(mesh: &RawMesh, opts: &MergeOptions, file: &str) -> Merged {
             source_faces,
         } in outlines
         {
-            let counter = name_counts.entry(base.to_owned()).or_insert(0);
+            // A name is copied once, when first counted (not for every surface).
+            let counter = match name_counts.get_mut(base) {
+                Some(counter) => {
+                    *counter += 1;
+                    *counter - 1
+                }
+                None => {
+                    name_counts.insert(base.to_owned(), 1);
+                    0
+                }
+            };
             surfaces.push(MeshSurface {
                 name: format!("{base}_{counter}"),
                 material: material.clone(),
@@ -128,7 +138,6 @@ pub(crate) fn merge(mesh: &RawMesh, opts: &MergeOptions, file: &str) -> Merged {
                 region_area_m2: region_area,
                 source_faces,
             });
-            *counter += 1;
         }
     }
     Merged {
