@@ -469,6 +469,8 @@ fn grow_regions(faces: &[Face], points: &[Vec3], opts: &MergeOptions) -> Vec<Gro
         let mut normal_sum = faces[seed].normal * faces[seed].area;
         let mut centroid_sum = faces[seed].centroid * faces[seed].area;
         let mut area_sum = faces[seed].area;
+        // The group's plane (normal, origin) as it stands, until a face joins.
+        let mut plane: Option<(Vec3, Vec3)> = None;
         queue.push_back(seed);
         while let Some(f) = queue.pop_front() {
             let face = &faces[f];
@@ -479,8 +481,8 @@ fn grow_regions(faces: &[Face], points: &[Vec3], opts: &MergeOptions) -> Vec<Gro
                     if group_of[other].is_some() || faces[other].key != face.key {
                         continue;
                     }
-                    let normal = normal_sum.normalize();
-                    let origin = centroid_sum / area_sum;
+                    let (normal, origin) = *plane
+                        .get_or_insert_with(|| (normal_sum.normalize(), centroid_sum / area_sum));
                     let candidate = &faces[other];
                     let coplanar = candidate.normal.dot(normal) >= cos_tol
                         && candidate.vertices.iter().all(|&v| {
@@ -492,6 +494,7 @@ fn grow_regions(faces: &[Face], points: &[Vec3], opts: &MergeOptions) -> Vec<Gro
                         normal_sum += candidate.normal * candidate.area;
                         centroid_sum += candidate.centroid * candidate.area;
                         area_sum += candidate.area;
+                        plane = None;
                         queue.push_back(other);
                     }
                 }
