@@ -2,7 +2,9 @@
 //! loads"): `cargo run --release -p bt-import --example loadtime -- FILE... [--runs N]`.
 //! Best of N in-process wall times (N = 3 by default) of `bt_import::load` and of a cache hit
 //! (`LoadCache::load` after one load that writes the entry, in a fresh temporary cache
-//! directory), with the surface count and the entry's size.
+//! directory), with the surface count and the entry's size. `--only fresh` or `--only hit`
+//! times one of the two (the other column shows `-`), for profiling one alone: with
+//! `--only hit` one load writes the entry first; with `--only fresh` nothing else runs.
 
 use bt_import::LoadOptions;
 use bt_import::cache::LoadCache;
@@ -29,31 +31,55 @@ fn main() {
         runs = args.get(i + 1).and_then(|n| n.parse().ok()).unwrap_or(3);
         args.drain(i..(i + 2).min(args.len()));
     }
+    let mut only = None;
+    if let Some(i) = args.iter().position(|a| a == "--only") {
+        only = args.get(i + 1).cloned();
+        args.drain(i..(i + 2).min(args.len()));
+    }
+    let (do_fresh, do_hit) = match only.as_deref() {
+        None => (true, true),
+        Some("fresh") => (true, false),
+        Some("hit") => (false, true),
+        Some(other) => panic!("--only fresh|hit, not {other:?}"),
+    };
     let dir = std::env::temp_dir().join(format!("bt-loadtime-{}", std::process::id()));
     let cache = LoadCache::at(&dir);
     let options = LoadOptions::default();
     println!("| scene | surfaces | fresh load | cache hit | entry |");
     println!("|---|---:|---:|---:|---:|");
     for file in &args {
-        let loaded = bt_import::load(file, &options).expect("loads");
-        let fresh = best(runs, || {
-            drop(bt_import::load(file, &options).expect("loads"))
-        });
-        cache.load(file, &options, &mut |_| {}).expect("loads");
-        let hit = best(runs, || {
-            drop(cache.load(file, &options, &mut |_| {}).expect("loads"))
-        });
-        let entry: u64 = (std::fs::read_dir(&dir).expect("cache written"))
+        let mut surfaces = 0;
+        let mut fresh = None;
+        if do_fresh {
+            drop(bt_import::load(file, &options).expect("loads")); // warm-up, untimed
+            fresh = Some(best(runs, || {
+                let loaded = bt_import::load(file, &options).expect("loads");
+                surfaces = loaded.scene.surfaces().len();
+                loaded
+            }));
+        }
+        let mut hit = None;
+        if do_hit {
+            cache.load(file, &options, &mut |_| {}).expect("loads");
+            hit = Some(best(runs, || {
+                let (loaded, _) = cache.load(file, &options, &mut |_| {}).expect("loads");
+                surfaces = loaded.scene.surfaces().len();
+                loaded
+            }));
+        }
+        let ms = |t: Option<Duration>| {
+            t.map_or("-".into(), |t| format!("{:.1} ms", t.as_secs_f64() * 1e3))
+        };
+        let entry: u64 = (std::fs::read_dir(&dir).into_iter().flatten())
             .map(|e| {
                 e.map(|e| e.metadata().map(|m| m.len()).unwrap_or(0))
                     .unwrap_or(0)
             })
             .sum();
         println!(
-            "| {file} | {} | {:.1} ms | {:.1} ms | {:.2} MB |",
-            loaded.scene.surfaces().len(),
-            fresh.as_secs_f64() * 1e3,
-            hit.as_secs_f64() * 1e3,
+            "| {file} | {surfaces} | {} | {} | {:.2} MB |",
+            ms(fresh),
+            ms(hit),
             entry as f64 / 1e6
         );
         let _ = std::fs::remove_dir_all(&dir);

@@ -9,7 +9,8 @@
 //! SHA-256 of the bytes the load parsed ([`Loaded::digests`]), checked against the files'
 //! current content on every hit, so an edited mesh misses. The entry is
 //! `MAGIC | version | payload length | payload (postcard; the scene inside it postcard bytes of
-//! its own, decoded while the inputs are hashed) | SHA-256 of all before`; anything
+//! its own, decoded while the inputs are hashed) | checksum of all before` (the SHA-256 of the
+//! SHA-256s of its 64 KiB pieces, [`checksum`]); anything
 //! that does not decode, check or rebuild (damaged, truncated, foreign, over the file budget)
 //! is ignored with a warning and replaced by a fresh load. Writes are atomic (a temporary file
 //! in the cache directory, renamed); a failed write is a warning, never a failed load.
@@ -25,7 +26,7 @@ use std::path::{Path, PathBuf};
 /// The version of the entries' layout and of what they hold; part of every key, so entries of
 /// another version are never read. Raise it whenever a load's result could change for the
 /// same inputs and options (a reader, the merge, validation, [`StoredScene`]).
-pub const CACHE_FORMAT_VERSION: u32 = 3;
+pub const CACHE_FORMAT_VERSION: u32 = 4;
 
 /// The first bytes of every entry.
 const MAGIC: &[u8; 8] = b"BTLOADC\0";
@@ -234,8 +235,19 @@ fn seal(entry: &Entry<'_>) -> Result<Vec<u8>, String> {
     bytes.extend_from_slice(&CACHE_FORMAT_VERSION.to_le_bytes());
     bytes.extend_from_slice(&(payload.len() as u64).to_le_bytes());
     bytes.extend_from_slice(&payload);
-    bytes.extend_from_slice(&digest(&bytes));
+    bytes.extend_from_slice(&checksum(&bytes));
     Ok(bytes)
+}
+
+/// Bytes of an entry hashed apart for its checksum (the last piece may be shorter).
+const CHECKSUM_PIECE: usize = 1 << 16;
+
+/// The checksum of an entry's `bytes`: the SHA-256 of the SHA-256s of its pieces of
+/// [`CHECKSUM_PIECE`] bytes, the pieces hashed on all cores (a city's 2.8 MB entry was one
+/// core's work before anything else of a hit could start).
+fn checksum(bytes: &[u8]) -> Digest {
+    let pieces: Vec<Digest> = bytes.par_chunks(CHECKSUM_PIECE).map(digest).collect();
+    digest(pieces.as_flattened())
 }
 
 /// What a look-up found.
@@ -263,7 +275,7 @@ fn decode(bytes: &[u8]) -> Result<Entry<'_>, String> {
         return Err("truncated or extended (length differs from its header)".into());
     }
     let (body, checksum) = bytes.split_at(bytes.len() - 32);
-    if digest(body) != checksum {
+    if self::checksum(body) != checksum {
         return Err("checksum differs (damaged)".into());
     }
     postcard::from_bytes(&body[HEADER..]).map_err(|e| format!("does not decode: {e}"))
@@ -292,6 +304,27 @@ fn hex(bytes: &[u8]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The checksum of an entry of several pieces notices one changed byte in any piece, and
+    /// two pieces swapped.
+    #[test]
+    fn the_checksum_covers_every_piece_and_their_order() {
+        let bytes: Vec<u8> = (0..CHECKSUM_PIECE * 7 / 2)
+            .map(|i| (i % 251) as u8)
+            .collect();
+        let good = checksum(&bytes);
+        for piece in 0..4 {
+            let mut changed = bytes.clone();
+            changed[piece * CHECKSUM_PIECE + 17] ^= 1;
+            assert_ne!(checksum(&changed), good, "piece {piece}");
+        }
+        let mut swapped = bytes[CHECKSUM_PIECE..2 * CHECKSUM_PIECE].to_vec();
+        swapped.extend_from_slice(&bytes[..CHECKSUM_PIECE]);
+        swapped.extend_from_slice(&bytes[2 * CHECKSUM_PIECE..]);
+        assert_ne!(swapped, bytes);
+        assert_ne!(checksum(&swapped), good);
+        assert_ne!(checksum(&bytes[..bytes.len() - 1]), good, "one byte fewer");
+    }
 
     /// An entry sound to its checksum whose scene bytes are cut short (the checksum guards
     /// the file, the scene's own decoding guards what is inside): ignored, rebuilt, warned.

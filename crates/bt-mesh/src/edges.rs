@@ -18,8 +18,10 @@ pub(crate) struct EdgeTable {
 impl EdgeTable {
     /// The table of `faces`, each given by its vertex cycle; faces are numbered in order.
     pub fn new<'a>(faces: impl IntoIterator<Item = &'a [u32]>) -> Self {
-        let mut entries = Vec::new();
-        for (f, vs) in faces.into_iter().enumerate() {
+        let faces = faces.into_iter();
+        // Room for triangles; larger faces grow it.
+        let mut entries = Vec::with_capacity(3 * faces.size_hint().0);
+        for (f, vs) in faces.enumerate() {
             for i in 0..vs.len() {
                 entries.push((edge_key(vs[i], vs[(i + 1) % vs.len()]), f as u32));
             }

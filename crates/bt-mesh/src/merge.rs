@@ -101,7 +101,7 @@ pub(crate) fn merge(mesh: &RawMesh, opts: &MergeOptions, file: &str) -> Merged {
     } else {
         groups.iter().map(outline_group).collect()
     };
-    let mut surfaces = Vec::new();
+    let mut surfaces = Vec::with_capacity(outlined.iter().map(|(_, o, _)| o.len()).sum());
     let mut name_counts: HashMap<String, usize> = HashMap::new();
     for (group, (frame, outlines, unusable)) in groups.iter().zip(outlined) {
         counts.unusable += unusable;
@@ -118,7 +118,17 @@ pub(crate) fn merge(mesh: &RawMesh, opts: &MergeOptions, file: &str) -> Merged {
             source_faces,
         } in outlines
         {
-            let counter = name_counts.entry(base.to_owned()).or_insert(0);
+            // A name is copied once, when first counted (not for every surface).
+            let counter = match name_counts.get_mut(base) {
+                Some(counter) => {
+                    *counter += 1;
+                    *counter - 1
+                }
+                None => {
+                    name_counts.insert(base.to_owned(), 1);
+                    0
+                }
+            };
             surfaces.push(MeshSurface {
                 name: format!("{base}_{counter}"),
                 material: material.clone(),
@@ -128,7 +138,6 @@ pub(crate) fn merge(mesh: &RawMesh, opts: &MergeOptions, file: &str) -> Merged {
                 region_area_m2: region_area,
                 source_faces,
             });
-            *counter += 1;
         }
     }
     Merged {
@@ -460,6 +469,8 @@ fn grow_regions(faces: &[Face], points: &[Vec3], opts: &MergeOptions) -> Vec<Gro
         let mut normal_sum = faces[seed].normal * faces[seed].area;
         let mut centroid_sum = faces[seed].centroid * faces[seed].area;
         let mut area_sum = faces[seed].area;
+        // The group's plane (normal, origin) as it stands, until a face joins.
+        let mut plane: Option<(Vec3, Vec3)> = None;
         queue.push_back(seed);
         while let Some(f) = queue.pop_front() {
             let face = &faces[f];
@@ -470,8 +481,8 @@ fn grow_regions(faces: &[Face], points: &[Vec3], opts: &MergeOptions) -> Vec<Gro
                     if group_of[other].is_some() || faces[other].key != face.key {
                         continue;
                     }
-                    let normal = normal_sum.normalize();
-                    let origin = centroid_sum / area_sum;
+                    let (normal, origin) = *plane
+                        .get_or_insert_with(|| (normal_sum.normalize(), centroid_sum / area_sum));
                     let candidate = &faces[other];
                     let coplanar = candidate.normal.dot(normal) >= cos_tol
                         && candidate.vertices.iter().all(|&v| {
@@ -483,6 +494,7 @@ fn grow_regions(faces: &[Face], points: &[Vec3], opts: &MergeOptions) -> Vec<Gro
                         normal_sum += candidate.normal * candidate.area;
                         centroid_sum += candidate.centroid * candidate.area;
                         area_sum += candidate.area;
+                        plane = None;
                         queue.push_back(other);
                     }
                 }

@@ -42,7 +42,8 @@ pub(crate) fn whole_outlines(
 /// The group's boundary as directed edges `(from, to)` in face order: the half-edges whose
 /// undirected edge the group uses once.
 fn boundary_edges(faces: &[Face], group: &Group) -> Vec<(u32, u32)> {
-    let mut half: Vec<(u64, u32, u32)> = Vec::new();
+    let edges = group.faces.iter().map(|&f| faces[f].vertices.len()).sum();
+    let mut half: Vec<(u64, u32, u32)> = Vec::with_capacity(edges);
     for &f in &group.faces {
         let vs = &faces[f].vertices;
         for i in 0..vs.len() {
@@ -102,21 +103,30 @@ fn closed_loops(
             // there), take the sharpest right turn: it follows the exterior wedge, so the
             // loops separate into simple ones (outline and hole) instead of one self-touching
             // loop that would hide the hole.
-            let next = leaving(at)
+            // One edge leaving (nearly always): it is the turn, no angle needed.
+            let mut open = leaving(at)
                 .filter(|&h| !used[h] || h == start)
-                .filter(|&h| h != current)
-                .map(|h| {
-                    let out = project(boundary[h].1) - project(at);
-                    (incoming.perp_dot(out).atan2(incoming.dot(out)), h)
-                })
-                .fold(None, |best: Option<(Real, usize)>, (turn, h)| match best {
-                    Some((bt, _)) if bt <= turn => best,
-                    _ => Some((turn, h)),
-                });
+                .filter(|&h| h != current);
+            let next = match (open.next(), open.next()) {
+                (None, _) => None,
+                (Some(h), None) => Some(h),
+                (Some(a), Some(b)) => [a, b]
+                    .into_iter()
+                    .chain(open)
+                    .map(|h| {
+                        let out = project(boundary[h].1) - project(at);
+                        (incoming.perp_dot(out).atan2(incoming.dot(out)), h)
+                    })
+                    .fold(None, |best: Option<(Real, usize)>, (turn, h)| match best {
+                        Some((bt, _)) if bt <= turn => best,
+                        _ => Some((turn, h)),
+                    })
+                    .map(|(_, h)| h),
+            };
             match next {
                 None => return None,
-                Some((_, h)) if h == start => break,
-                Some((_, h)) => {
+                Some(h) if h == start => break,
+                Some(h) => {
                     used[h] = true;
                     ids.push(at);
                     current = h;

@@ -421,7 +421,17 @@ pub(crate) fn radio_problems(
     materials: &std::collections::BTreeMap<String, Material>,
     frequency_hz: Real,
 ) -> Vec<Problem> {
-    let used: BTreeSet<&str> = surfaces.iter().map(|s| s.material.as_str()).collect();
+    // Neighbouring surfaces mostly share a material (an imported shape's): each run is
+    // inserted once.
+    let mut used: BTreeSet<&str> = BTreeSet::new();
+    let mut last = None;
+    for s in surfaces {
+        let name = s.material.as_str();
+        if last != Some(name) {
+            used.insert(name);
+            last = Some(name);
+        }
+    }
     let mut problems = Vec::new();
     for name in used {
         if let Some(Some(radio)) = materials.get(name).map(|m| m.radio)
@@ -456,6 +466,8 @@ pub(crate) fn build_surfaces(
     }
     let (polygons, bvh) = polygons_and_bvh(&mut raw);
     let mut names = HashSet::with_capacity(raw.len());
+    // The last material found: neighbouring surfaces mostly share one (an imported shape's).
+    let mut known: Option<&str> = None;
     for (r, polygon) in raw.iter().zip(&polygons) {
         if let Err(e) = crate::name::check(&r.name) {
             problems.report(&r.location(), e);
@@ -466,7 +478,9 @@ pub(crate) fn build_surfaces(
             );
         }
         let material = r.material.as_deref().unwrap_or(DEFAULT_MATERIAL);
-        if !materials.contains_key(material) {
+        if known == Some(material) || materials.contains_key(material) {
+            known = Some(material);
+        } else {
             problems.report(
                 &r.location(),
                 format!(

@@ -48,15 +48,18 @@ pub(crate) fn parse(bytes: &[u8], file: &str, max_elements: u64) -> Result<RawMe
         let indices = (e == layout.face_element).then_some(layout.index_slot);
         for index in 0..element.count {
             reader.skip_space();
-            let start = Position::Element {
-                element: element.name.clone(),
+            // Where the entry starts, built only for an error (a `String` per vertex and face
+            // was most of a city's small allocations).
+            let line = (header.format == Format::Ascii).then_some(reader.line);
+            let start = At {
+                element: &element.name,
                 index,
-                line: (header.format == Format::Ascii).then_some(reader.line),
+                line,
             };
             let entry = Entry {
                 values: &mut values,
                 face: &mut face,
-                at: &start,
+                at: start,
             };
             reader.entry(element, indices, layout.vertex_count, entry)?;
             if e == layout.vertex_element {
@@ -65,7 +68,7 @@ pub(crate) fn parse(bytes: &[u8], file: &str, max_elements: u64) -> Result<RawMe
                 if face.len() < 3 {
                     return Err(MeshError::FaceTooSmall {
                         file: file.to_owned(),
-                        position: start,
+                        position: start.position(),
                         count: face.len(),
                     });
                 }
@@ -142,14 +145,14 @@ impl Layout {
     }
 
     /// The vertex position among one vertex entry's `values` (all finite).
-    fn position(&self, values: &[Real], file: &str, at: Position) -> Result<Vec3, MeshError> {
+    fn position(&self, values: &[Real], file: &str, at: At<'_>) -> Result<Vec3, MeshError> {
         let mut xyz = [0.0; 3];
         for (k, (&slot, axis)) in self.xyz_slots.iter().zip(['x', 'y', 'z']).enumerate() {
             let value = values[slot];
             if !value.is_finite() {
                 return Err(MeshError::NonFiniteCoordinate {
                     file: file.to_owned(),
-                    position: at,
+                    position: at.position(),
                     axis,
                     value,
                 });
@@ -165,7 +168,26 @@ impl Layout {
 struct Entry<'a> {
     values: &'a mut Vec<Real>,
     face: &'a mut Vec<u32>,
-    at: &'a Position,
+    at: At<'a>,
+}
+
+/// Where an entry starts, as [`Position::Element`] without its owned name.
+#[derive(Clone, Copy)]
+struct At<'a> {
+    element: &'a str,
+    index: u64,
+    line: Option<usize>,
+}
+
+impl At<'_> {
+    /// The position for an error message.
+    fn position(self) -> Position {
+        Position::Element {
+            element: self.element.to_owned(),
+            index: self.index,
+            line: self.line,
+        }
+    }
 }
 
 /// Refuses a header declaring more than `max_elements` vertices or faces, before allocating.
@@ -282,7 +304,7 @@ impl Reader<'_> {
                     if n < 0.0 {
                         return Err(MeshError::Syntax {
                             file: self.file.to_owned(),
-                            position: at.clone(),
+                            position: at.position(),
                             detail: format!(
                                 "list \"{}\" has negative length {n}",
                                 bt_scene::name::shown(&property.name)
@@ -301,7 +323,7 @@ impl Reader<'_> {
                             if v < 0.0 || v >= vertex_count as Real {
                                 return Err(MeshError::IndexOutOfRange {
                                     file: self.file.to_owned(),
-                                    position: at.clone(),
+                                    position: at.position(),
                                     index: v as i64,
                                     vertex_count: vertex_count as usize,
                                 });
@@ -317,10 +339,10 @@ impl Reader<'_> {
     }
 
     /// One scalar of type `ty` as f64 (exact for every PLY integer type).
-    fn read(&mut self, ty: Scalar, property: &str, at: &Position) -> Result<Real, MeshError> {
+    fn read(&mut self, ty: Scalar, property: &str, at: At<'_>) -> Result<Real, MeshError> {
         let truncated = || MeshError::Truncated {
             file: self.file.to_owned(),
-            position: at.clone(),
+            position: at.position(),
             detail: format!(
                 "data ends while reading property \"{}\"",
                 bt_scene::name::shown(property)
@@ -348,7 +370,7 @@ impl Reader<'_> {
                 };
                 value.ok_or_else(|| MeshError::Syntax {
                     file: self.file.to_owned(),
-                    position: at.clone(),
+                    position: at.position(),
                     detail: format!(
                         "property \"{}\": \"{}\" is not a valid {ty:?} value",
                         bt_scene::name::shown(property),

@@ -212,16 +212,18 @@ impl Reading<'_> {
         warnings: &mut Vec<String>,
     ) -> Result<(), ImportError> {
         use rayon::prelude::*;
+        // The files are looked up (`stat`) on all cores; their sizes are charged in order.
+        let stated: Vec<_> = (shapes.par_iter())
+            .map(|shape| {
+                let file = resolve(self.folder, &shape.filename)?;
+                let metadata = std::fs::metadata(&file);
+                Ok((file, metadata))
+            })
+            .collect();
         let mut found = Vec::with_capacity(shapes.len());
         let mut refused = None;
-        for shape in shapes {
-            match find_shape(
-                shape,
-                self.folder,
-                self.xml,
-                self.options,
-                &mut self.bytes_left,
-            ) {
+        for (shape, stated) in shapes.iter().zip(stated) {
+            match find_shape(shape, stated, self.xml, self.options, &mut self.bytes_left) {
                 Ok(file) => found.push((shape, file)),
                 Err(e) => {
                     refused = Some(e);
@@ -230,9 +232,9 @@ impl Reading<'_> {
             }
         }
         let imports: Vec<Result<_, ImportError>> = (found.par_iter())
-            .map(|(shape, file)| read_shape(shape, file, self.options))
+            .map(|(shape, (file, metadata))| read_shape(shape, file, metadata, self.options))
             .collect();
-        for ((shape, file), import) in found.into_iter().zip(imports) {
+        for ((shape, (file, _)), import) in found.into_iter().zip(imports) {
             let (import, read) = import?;
             (self.elements).charge(&import, shape, self.xml, self.options.merge.max_elements)?;
             if self.seen.insert(file.clone()) {
@@ -382,22 +384,27 @@ fn visual_material(b: &XmlBsdf, kind: &str, warnings: &mut Vec<String>) -> Mater
     desc
 }
 
-/// The mesh file of `shape` under `folder`, checked before it is read: a plain relative path,
-/// its size within `--max-file-bytes` and within what is left of `bytes_left` (charged).
+/// The file of `shape`'s filename (resolved under the XML's folder by [`resolve`]) and its
+/// metadata, or why it has none.
+type Stated = Result<(PathBuf, std::io::Result<std::fs::Metadata>), &'static str>;
+
+/// The mesh file of `shape`, checked before it is read: a plain relative path (`stated`: the
+/// file [`resolve`]d and its `stat`), its size within `--max-file-bytes` and within what is
+/// left of `bytes_left` (charged). The file with its metadata, for [`read_shape`].
 fn find_shape(
     shape: &XmlShape,
-    folder: &Path,
+    stated: Stated,
     xml: &str,
     options: &LoadOptions,
     bytes_left: &mut u64,
-) -> Result<PathBuf, ImportError> {
+) -> Result<(PathBuf, std::fs::Metadata), ImportError> {
     let at = |message: String| ImportError::Xml {
         path: xml.to_string(),
         line: shape.at.line,
         column: shape.at.column,
         message,
     };
-    let file = resolve(folder, &shape.filename).map_err(|why| {
+    let (file, metadata) = stated.map_err(|why| {
         at(format!(
             "<shape id=\"{}\"> filename \"{}\": {why}",
             bt_scene::name::shown(&shape.name),
@@ -405,14 +412,13 @@ fn find_shape(
         ))
     })?;
     let shown = file.display().to_string();
-    let size = std::fs::metadata(&file)
-        .map_err(|e| {
-            at(format!(
-                "<shape id=\"{}\"> mesh file {shown}: {e}",
-                bt_scene::name::shown(&shape.name)
-            ))
-        })?
-        .len();
+    let metadata = metadata.map_err(|e| {
+        at(format!(
+            "<shape id=\"{}\"> mesh file {shown}: {e}",
+            bt_scene::name::shown(&shape.name)
+        ))
+    })?;
+    let size = metadata.len();
     if let Err(e) = crate::MAX_FILE_BYTES
         .with_limit(options.max_file_bytes)
         .check(size)
@@ -429,18 +435,25 @@ fn find_shape(
         )));
     }
     *bytes_left -= size;
-    Ok(file)
+    Ok((file, metadata))
 }
 
-/// Read `shape`'s mesh `file` (found by [`find_shape`]) and merge it through its transform;
-/// the mesh and the SHA-256 of the bytes read.
+/// Read `shape`'s mesh `file` (found by [`find_shape`], with its `metadata`) and merge it
+/// through its transform; the mesh and the SHA-256 of the bytes read.
 fn read_shape(
     shape: &XmlShape,
     file: &Path,
+    metadata: &std::fs::Metadata,
     options: &LoadOptions,
 ) -> Result<(bt_mesh::MeshImport, crate::source::Digest), ImportError> {
     let shown = file.display().to_string();
-    let bytes = read_bounded(file, options.max_file_bytes, &shown)?;
+    let bytes =
+        crate::source::read_stated(file, metadata, options.max_file_bytes).map_err(|source| {
+            ImportError::Io {
+                path: shown.clone(),
+                source,
+            }
+        })?;
     let format = match shape.kind {
         MeshKind::Ply => crate::mesh::MeshFormat::Ply,
         MeshKind::Obj => crate::mesh::MeshFormat::Obj,
