@@ -120,9 +120,10 @@ fn slot_columns<'a>(
         .flat_map(|&(p, g)| groups[p as usize][g].jobs.iter().map(|&(c, _)| c))
 }
 
-/// The dispatcher's choice for one slot and its cycles (`D_WARM`, then per examined group a
-/// `D_POP` and one `D_JOB` per job, a last `D_POP` and `D_FIN`); `front` is the slot running
-/// (loading or computing) while it dispatches, whose write-back the new slot's load overlaps.
+/// The dispatcher's choice for one slot and its cycles (`D_WARM`, a `D_POP` for the first
+/// examined group, one `D_JOB` per job of each examined group, whose last also pops the next
+/// group, and `D_FIN`); `front` is the slot running (loading or computing) while it
+/// dispatches, whose write-back the new slot's load overlaps.
 fn dispatch_slot(
     groups: &[Vec<Group>],
     queue: &mut std::collections::VecDeque<(u32, usize)>,
@@ -132,13 +133,9 @@ fn dispatch_slot(
     let mut used = vec![false; columns];
     let mut placed = Vec::new();
     let mut scan = (queue.len() as u32).min(SCAN_LIMIT);
-    // D_WARM: the queue's head is read once before the first pop.
-    let mut cycles = 1u64;
-    loop {
-        cycles += 1;
-        if scan == 0 || used.iter().all(|&u| u) {
-            break;
-        }
+    // D_WARM (the queue's head is read once before the first pop), the first D_POP, D_FIN.
+    let mut cycles = 3u64;
+    while scan > 0 && !used.iter().all(|&u| u) {
         let Some((p, g)) = queue.pop_front() else {
             break;
         };
@@ -168,7 +165,7 @@ fn dispatch_slot(
         slot.jobs += 1;
     }
     slot.groups = placed;
-    (slot, cycles + 1)
+    (slot, cycles)
 }
 
 /// Write-back of `slot`, job by job in slot order: each group's last job queues its path's
@@ -296,17 +293,17 @@ mod tests {
         let g = groups(&t, 2).unwrap();
         let latency = 10;
         // One round each: slot 1 = path 0 (2 jobs), slot 2 = path 1 (1 job).
-        // Dispatch 0 (cycles 0-5): D_WARM, D_POP, 2 jobs [both PEs taken], D_POP (stop),
-        // D_FIN; DISP ends at cycle 6, slot 1's load enters at 7. Its first job loads at 9
-        // (two registered reads), the last at 10; write-back starts at max(9 + 9, the
-        // dispatch of path 1 [cycles 7-11: D_WARM, D_POP, 1 job, D_POP, D_FIN] + 2) = 18
-        // and ends at 21. Slot 2 shares column 0 at the same position (no delay): its load
-        // enters at 18, loads at 20, writes back from max(20 + 9, 21 + 2, the empty
-        // dispatch at 22-24 + 2) = 29 to 31: 32 cycles.
+        // Dispatch 0 (cycles 0-4): D_WARM, D_POP, 2 jobs [both PEs taken: stop], D_FIN;
+        // DISP ends at cycle 5, slot 1's load enters at 6. Its first job loads at 8 (two
+        // registered reads), the last at 9; write-back starts at max(8 + 9, the dispatch of
+        // path 1 [cycles 6-9: D_WARM, D_POP, 1 job, D_FIN] + 2) = 17 and ends at 20. Slot 2
+        // shares column 0 at the same position (no delay): its load enters at 17, loads at
+        // 19, writes back from max(19 + 9, 20 + 2, the empty dispatch at 21-23 + 2) = 28 to
+        // 30: 31 cycles.
         let r = predict(&g, 2, &[1, 1], latency);
         assert_eq!((r.slots, r.jobs), (2, 3));
-        assert_eq!(r.cycles, 32);
-        assert_eq!(r.dispatch_wait_cycles, 7);
+        assert_eq!(r.cycles, 31);
+        assert_eq!(r.dispatch_wait_cycles, 6);
         // Slot 2's column 0 is at position 0 in slot 1 too; put path 1 on plane 1 behind
         // path 0's job on it (position 1) and its load waits a cycle for that write-back.
         let p2 = Problem {
@@ -314,7 +311,7 @@ mod tests {
             paths: vec![PathJob::jacobi(vec![0, 1], 1), PathJob::jacobi(vec![1], 1)],
         };
         let g2 = groups(&round_template(&p2, &[]).unwrap(), 2).unwrap();
-        assert_eq!(predict(&g2, 2, &[1, 1], latency).cycles, 33);
+        assert_eq!(predict(&g2, 2, &[1, 1], latency).cycles, 32);
         // More rounds: more slots, never fewer cycles.
         let r3 = predict(&g, 2, &[3, 2], latency);
         assert_eq!(r3.jobs, 3 * 2 + 2);

@@ -149,16 +149,6 @@ module bt_top (
   assign host_wr = (avs_write && idle);
   wire pt_we;
   assign pt_we = ((host_wr && is_point) && (avs_address[1:0] == 2'd3));
-  // job memory, written per step by the host: one round of every path as groups, entry -> {column, group tail, late, end, last, first, point, path, valid} (20 bits)
-  wire [5:0] job_ra;
-  assign job_ra = ((dstate == 3'd1) ? rq_q[5:0] : ((d_gptr + {2'd0, d_gi}) + 6'd1));
-  reg [19:0] sched [0:63];
-  always @(posedge clk) begin
-    if ((host_wr && is_sched)) begin
-      sched[avs_address[5:0]] <= avs_writedata[19:0];
-    end
-    job_q <= sched[job_ra];
-  end
   // slot buffer: the front slot's jobs (rsel) for the load, the written-back slot's (wsel) for the write-back, the next slot's written by the dispatcher
   wire [3:0] slen_cur;
   assign slen_cur = (rsel ? slen_1 : slen_0);
@@ -216,10 +206,14 @@ module bt_top (
   assign j_conf = (d_conf | d_used[j_col]);
   wire d_stop;
   assign d_stop = ((d_scan == 6'd0) | (d_used[6:0] == 7'd127));
-  wire d_pop;
-  assign d_pop = ((dstate == 3'd1) && !(d_stop));
   wire d_push;
   assign d_push = (((dstate == 3'd3) && j_gtail) && j_conf);
+  wire [7:0] d_used_after;
+  assign d_used_after = (j_conf ? d_save : (d_used | {(j_col == 3'd7), (j_col == 3'd6), (j_col == 3'd5), (j_col == 3'd4), (j_col == 3'd3), (j_col == 3'd2), (j_col == 3'd1), (j_col == 3'd0)}));
+  wire d_pop_next;
+  assign d_pop_next = (((dstate == 3'd3) && j_gtail) && !(((d_scan == 6'd0) | (d_used_after[6:0] == 7'd127))));
+  wire d_pop;
+  assign d_pop = (((dstate == 3'd1) && !(d_stop)) | d_pop_next);
   wire [2:0] d_wi;
   assign d_wi = (d_nsl[2:0] + d_gi[2:0]);
   wire [2:0] d_fpos;
@@ -230,6 +224,18 @@ module bt_top (
   assign dly_cand = (d_fpos - d_wi);
   wire dly_take;
   assign dly_take = (((d_front && d_fused[j_col]) && (d_fpos > d_wi)) && (dly_cand > d_dly));
+  wire [2:0] d_dly_after;
+  assign d_dly_after = (j_conf ? d_dsave : (dly_take ? dly_cand : d_dly));
+  // job memory, written per step by the host: one round of every path as groups, entry -> {column, group tail, late, end, last, first, point, path, valid} (20 bits)
+  wire [5:0] job_ra;
+  assign job_ra = (((dstate == 3'd1) | d_pop_next) ? rq_q[5:0] : ((d_gptr + {2'd0, d_gi}) + 6'd1));
+  reg [19:0] sched [0:63];
+  always @(posedge clk) begin
+    if ((host_wr && is_sched)) begin
+      sched[avs_address[5:0]] <= avs_writedata[19:0];
+    end
+    job_q <= sched[job_ra];
+  end
   always @(posedge clk) begin
     if (((dstate == 3'd3) && !(j_conf))) begin
       sbuf[{~(rsel), d_wi}] <= {(d_gptr + {2'd0, d_gi}), d_gbase, job_q};
@@ -486,7 +492,7 @@ module bt_top (
     if (((host_wr && is_status) | rq_push)) begin
       rq[(host_wr ? avs_address[4:0] : (wb_push ? (rq_head - 5'd1) : rq_tail))] <= (host_wr ? avs_writedata[11:0] : (d_push ? {d_gbase, d_gptr} : wb_push_data));
     end
-    rq_q <= rq[rq_head];
+    rq_q <= rq[(d_pop ? (rq_head + 5'd1) : rq_head)];
   end
   always @(posedge clk) begin
     if (!(rst_n)) begin
@@ -509,10 +515,10 @@ module bt_top (
         if (d_push) begin
           rq_tail <= (rq_tail + 5'd1);
         end
-        if (rq_push) begin
+        if ((rq_push && !(d_pop))) begin
           rq_count <= (rq_count + 6'd1);
         end else begin
-          if (d_pop) begin
+          if ((d_pop && !(rq_push))) begin
             rq_count <= (rq_count - 6'd1);
           end
         end
@@ -565,7 +571,17 @@ module bt_top (
               d_used <= d_save;
               d_dly <= d_dsave;
             end
-            dstate <= 3'd1;
+            if (d_pop_next) begin
+              d_scan <= (d_scan - 6'd1);
+              d_gbase <= rq_q[11:6];
+              d_gptr <= rq_q[5:0];
+              d_gi <= 4'd0;
+              d_conf <= 1'd0;
+              d_save <= d_used_after;
+              d_dsave <= d_dly_after;
+            end else begin
+              dstate <= 3'd4;
+            end
           end else begin
             d_gi <= (d_gi + 4'd1);
             d_conf <= j_conf;

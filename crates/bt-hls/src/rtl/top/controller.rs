@@ -60,8 +60,9 @@ pub(super) fn gtail_bit(t: &Dims<'_>) -> u32 {
 
 /// Job memory (M9K), written by the host per step: one round of every path as groups
 /// (`{column, tail, late, end, last, first, point, path, valid}`, `tail` on a group's last
-/// job), path after path. Read by the dispatcher only (`job_q`, one cycle after the address).
-pub(super) fn job_memory(t: &Dims<'_>, bus: &Decode, items: &mut Vec<Item>) {
+/// job), path after path. Read by the dispatcher only (`job_q`, one cycle after the address:
+/// a popped group's first job, else the examined group's next).
+pub(super) fn job_memory(t: &Dims<'_>, bus: &Decode, d: &DispatchJob, items: &mut Vec<Item>) {
     let (pb, ptb, ib, eb) = (t.pb, t.ptb, t.ib, t.eb);
     let sw = sched_entry_bits(pb, ptb, ib);
     items.push(Item::Comment(format!(
@@ -73,7 +74,7 @@ pub(super) fn job_memory(t: &Dims<'_>, bus: &Decode, items: &mut Vec<Item>) {
         "job_ra",
         eb,
         Expr::mux(
-            dstate_is(t, D_POP),
+            or(dstate_is(t, D_POP), d.pop_next.e()),
             t.r.rq_q.slice(eb - 1, 0),
             t.r.d.d_gptr.e().plus(gi).plus(lit(eb, 1)),
         ),
@@ -187,8 +188,14 @@ pub(super) struct DispatchJob {
     pub(super) col: Signal,
     pub(super) gtail: Signal,
     pub(super) conflict: Signal,
-    /// Pop the queue's head this cycle.
+    /// Pop the queue's head this cycle: in D_POP (the first group) or at the last job of a
+    /// group (the next group's first job is read while this one's tail is examined).
     pub(super) pop: Signal,
+    /// A pop at a group's last job (stay in D_JOB), and the used columns and load delay
+    /// after that group (its own, or the saved ones when it is pushed back).
+    pub(super) pop_next: Signal,
+    pub(super) used_after: Signal,
+    pub(super) dly_after: Signal,
     /// Put the examined group back at the queue's tail this cycle.
     pub(super) push_back: Signal,
     /// The job's position in the slot being built.
@@ -215,23 +222,22 @@ pub(super) fn dispatch_signals(t: &Dims<'_>, items: &mut Vec<Item>) -> DispatchJ
         1,
         or(t.r.d.d_conf.e(), t.r.d.d_used.at(col.e())),
     );
-    let all_used =
-        t.r.d
-            .d_used
-            .slice(t.k - 1, 0)
-            .eq(lit(t.k, (1u128 << t.k) - 1));
-    let stop = Signal::assigned(
-        items,
-        "d_stop",
-        1,
-        or(t.r.d.d_scan.e().eq(lit(pb + 1, 0)), all_used),
-    );
-    let pop = Signal::assigned(items, "d_pop", 1, dstate_is(t, D_POP).and(stop.e().lnot()));
+    let all_ones = lit(t.k, (1u128 << t.k) - 1);
+    let all_used = t.r.d.d_used.slice(t.k - 1, 0).eq(all_ones);
+    let scan_out = t.r.d.d_scan.e().eq(lit(pb + 1, 0));
+    let stop = Signal::assigned(items, "d_stop", 1, or(scan_out.clone(), all_used));
     let push_back = Signal::assigned(
         items,
         "d_push",
         1,
         dstate_is(t, D_JOB).and(gtail.e()).and(conflict.e()),
+    );
+    let (pop_next, used_after) = next_group(t, (&col, &conflict, &gtail), scan_out, items);
+    let pop = Signal::assigned(
+        items,
+        "d_pop",
+        1,
+        or(dstate_is(t, D_POP).and(stop.e().lnot()), pop_next.e()),
     );
     // Below the PE count while no column of the group is taken: ib bits.
     let wi = Signal::assigned(
@@ -265,16 +271,83 @@ pub(super) fn dispatch_signals(t: &Dims<'_>, items: &mut Vec<Item>) -> DispatchJ
             .and(Expr::bin(BinaryOp::Gt, fpos.e(), wi.e()))
             .and(Expr::bin(BinaryOp::Gt, cand.e(), t.r.d.d_dly.e())),
     );
+    let dly_after = Signal::assigned(
+        items,
+        "d_dly_after",
+        ib,
+        Expr::mux(
+            conflict.e(),
+            t.r.d.d_dsave.e(),
+            Expr::mux(take.e(), cand.e(), t.r.d.d_dly.e()),
+        ),
+    );
     DispatchJob {
         col,
         gtail,
         conflict,
         pop,
+        pop_next,
+        used_after,
+        dly_after,
         push_back,
         wi,
         dly_take: take,
         dly_cand: cand,
     }
+}
+
+/// At a group's last job: the columns used after the group (`d_used` with the job's column,
+/// or `d_save` when the group is pushed back) and whether the next group is popped at once
+/// (`d_pop_next`: some scan left and a column free). Returns `(d_pop_next, d_used_after)`.
+fn next_group(
+    t: &Dims<'_>,
+    (col, conflict, gtail): (&Signal, &Signal, &Signal),
+    scan_out: Expr,
+    items: &mut Vec<Item>,
+) -> (Signal, Signal) {
+    let n = 1u32 << t.ib;
+    let onehot = Expr::concat(
+        (0..n)
+            .rev()
+            .map(|b| col.e().eq(lit(t.ib, u128::from(b))))
+            .collect(),
+    );
+    let used_after = Signal::assigned(
+        items,
+        "d_used_after",
+        n,
+        Expr::mux(
+            conflict.e(),
+            t.r.d.d_save.e(),
+            Expr::bin(BinaryOp::Or, t.r.d.d_used.e(), onehot),
+        ),
+    );
+    let all_ones = lit(t.k, (1u128 << t.k) - 1);
+    let full = used_after.slice(t.k - 1, 0).eq(all_ones);
+    let pop_next = Signal::assigned(
+        items,
+        "d_pop_next",
+        1,
+        dstate_is(t, D_JOB)
+            .and(gtail.e())
+            .and(or(scan_out, full).lnot()),
+    );
+    (pop_next, used_after)
+}
+
+/// The dispatcher's pop of the queue's head: the group's entry and first group, its job
+/// index, and the used columns and load delay before it (`save`, `dsave`).
+fn pop_actions(t: &Dims<'_>, save: Expr, dsave: Expr) -> Vec<Stmt> {
+    let eb = t.eb;
+    vec![
+        nb(t.r.d.d_scan.e(), t.r.d.d_scan.e().minus(lit(t.pb + 1, 1))),
+        nb(t.r.d.d_gbase.e(), t.r.rq_q.slice(2 * eb - 1, eb)),
+        nb(t.r.d.d_gptr.e(), t.r.rq_q.slice(eb - 1, 0)),
+        clear(&t.r.d.d_gi),
+        clear(&t.r.d.d_conf),
+        nb(t.r.d.d_save.e(), save),
+        nb(t.r.d.d_dsave.e(), dsave),
+    ]
 }
 
 /// D_FIN: publish the built slot's length, load delay and PE columns in the half the front
@@ -301,14 +374,14 @@ fn publish_slot(t: &Dims<'_>) -> Vec<Stmt> {
 /// The dispatcher (twin of `crate::dispatch::predict`): on `d_go` it builds the next slot in
 /// the buffer the running slot does not use, examining up to `SCAN_LIMIT` queued groups, each
 /// put into the slot when all its columns are free (else back to the queue), then publishes
-/// the slot's length. `rq_q` always holds the queue's head: it is read every cycle, and a
-/// pop is at least one job after the last (`D_WARM` reads it after a start or a push).
+/// the slot's length. `rq_q` always holds the queue's head: it is read every cycle (at the
+/// head after this cycle's pop), and `D_WARM` reads it after a start or a write-back's push.
 pub(super) fn dispatcher(
     t: &Dims<'_>,
     d: &DispatchJob,
     [go, scan_init, front]: [&Signal; 3],
 ) -> Item {
-    let (ib, eb) = (t.ib, t.eb);
+    let ib = t.ib;
     let gi_plus = |k: u128| t.r.d.d_gi.e().plus(lit(ib + 1, k));
     let on_tail = vec![Stmt::If(
         d.conflict.e().lnot(),
@@ -329,7 +402,11 @@ pub(super) fn dispatcher(
             d.gtail.e(),
             on_tail
                 .into_iter()
-                .chain([nb(t.r.dstate.e(), lit(DSTATE_BITS, D_POP))])
+                .chain([Stmt::If(
+                    d.pop_next.e(),
+                    pop_actions(t, d.used_after.e(), d.dly_after.e()),
+                    vec![nb(t.r.dstate.e(), lit(DSTATE_BITS, D_FIN))],
+                )])
                 .collect(),
             vec![
                 nb(t.r.d.d_gi.e(), gi_plus(1)),
@@ -361,16 +438,10 @@ pub(super) fn dispatcher(
             lit(DSTATE_BITS, D_POP),
             vec![Stmt::If(
                 d.pop.e(),
-                vec![
-                    nb(t.r.dstate.e(), lit(DSTATE_BITS, D_JOB)),
-                    nb(t.r.d.d_scan.e(), t.r.d.d_scan.e().minus(lit(t.pb + 1, 1))),
-                    nb(t.r.d.d_gbase.e(), t.r.rq_q.slice(2 * eb - 1, eb)),
-                    nb(t.r.d.d_gptr.e(), t.r.rq_q.slice(eb - 1, 0)),
-                    clear(&t.r.d.d_gi),
-                    clear(&t.r.d.d_conf),
-                    nb(t.r.d.d_save.e(), t.r.d.d_used.e()),
-                    nb(t.r.d.d_dsave.e(), t.r.d.d_dly.e()),
-                ],
+                [nb(t.r.dstate.e(), lit(DSTATE_BITS, D_JOB))]
+                    .into_iter()
+                    .chain(pop_actions(t, t.r.d.d_used.e(), t.r.d.d_dly.e()))
+                    .collect(),
                 vec![nb(t.r.dstate.e(), lit(DSTATE_BITS, D_FIN))],
             )],
         ),
@@ -447,7 +518,16 @@ pub(super) fn ready_queue(
     );
     items.push(Item::AlwaysFf(vec![
         Stmt::If(or(host, push.e()), vec![nb(t.r.rq.at(addr), data)], vec![]),
-        nb(t.r.rq_q.e(), t.r.rq.at(t.r.rq_head.e())),
+        // The head after this cycle's pop: a group's last job pops the next group, whose
+        // first job the next cycle reads from `rq_q`.
+        nb(
+            t.r.rq_q.e(),
+            t.r.rq.at(Expr::mux(
+                d.pop.e(),
+                t.r.rq_head.e().plus(lit(pb, 1)),
+                t.r.rq_head.e(),
+            )),
+        ),
     ]));
     let inc = |n: &Signal, w: u32| n.e().plus(lit(w, 1));
     items.push(Item::AlwaysFf(vec![Stmt::If(
@@ -479,11 +559,12 @@ pub(super) fn ready_queue(
                     vec![nb(t.r.rq_tail.e(), inc(&t.r.rq_tail, pb))],
                     vec![],
                 ),
+                // A push-back and the next pop can share a cycle (the count stays).
                 Stmt::If(
-                    push.e(),
+                    push.e().and(d.pop.e().lnot()),
                     vec![nb(t.r.rq_count.e(), inc(&t.r.rq_count, pb + 1))],
                     vec![Stmt::If(
-                        d.pop.e(),
+                        d.pop.e().and(push.e().lnot()),
                         vec![nb(t.r.rq_count.e(), t.r.rq_count.e().minus(lit(pb + 1, 1)))],
                         vec![],
                     )],

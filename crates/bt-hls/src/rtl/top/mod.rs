@@ -288,10 +288,10 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
     let t = Dims::of(d, &mut items);
     let pe = declare_pe_wires(&t, &mut items);
     let bus = bus_decode(&t, &mut items);
-    job_memory(&t, &bus, &mut items);
     let lrom = slot_buffer_load(&t, &mut items);
     let rom = slot_buffer_writeback(&t, &mut items);
     let dj = dispatch_signals(&t, &mut items);
+    job_memory(&t, &bus, &dj, &mut items);
     slot_buffer_write(&t, &dj, &mut items);
     let rounds_cur = rounds_read(&t, &rom, &mut items);
     let ports = updater_read_ports(&t, &bus, (&rom, &lrom), &mut items);
