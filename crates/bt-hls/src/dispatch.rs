@@ -96,6 +96,10 @@ pub struct DispatchRun {
     /// Cycles the PEs waited for the dispatcher (EXEC longer than the PE latency, and the
     /// dispatches that found no slot running).
     pub dispatch_wait_cycles: u64,
+    /// Cycles slots' loads waited for the write-back of a shared PE column in the slot
+    /// before (the sum of the slots' load delays).
+    #[serde(default)]
+    pub load_delay_cycles: u64,
 }
 
 /// One dispatched slot: its groups in slot order, and the cycles the load waits after the
@@ -226,6 +230,7 @@ pub fn predict(groups: &[Vec<Group>], columns: usize, rounds: &[u32], latency: u
         run.dispatch_wait_cycles += wb - pe_ready.max(wb_last.map_or(0, |w| w + 2));
         run.slots += 1;
         run.jobs += n;
+        run.load_delay_cycles += slot.delay;
         write_back(groups, &slot, rounds, &mut done, &mut queue);
         let last = wb + n + 1;
         wb_last = Some(last);
