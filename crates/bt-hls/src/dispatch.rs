@@ -25,7 +25,9 @@ use crate::HlsError;
 /// queued groups wait for the same busy PE.
 /// (Measured on three unseen 29-plane rooms at order 3: 8, 10, 12 and 16 examined groups
 /// gave 1,816, 1,724, 1,660 and 1,606 slots on one of them, but 12 and more make the
-/// dispatcher outlast the PE latency, so 10 took the fewest cycles.)
+/// dispatcher outlast the PE latency, so 10 took the fewest cycles. Measured again with the
+/// write-back/load overlap and the pop at a group's last job: 8, 9 and 12 gave 50,480,
+/// 47,241 and 48,974 cycles on seed 13 against 46,247 at 10; docs/hardware.md.)
 pub const SCAN_LIMIT: u32 = 10;
 
 /// One group: the jobs of one phase of one path's round that run together in one slot.

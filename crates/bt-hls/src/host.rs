@@ -347,7 +347,7 @@ fn cycle_formulas(d: &Design) -> String {
          cycle + 2, dispatcher's last cycle + 2); the dispatcher of the slot after it starts \
          when the previous write-back ends; a slot dispatched with no slot running loads \
          dispatch + 1 cycles after that dispatch began; CYCLES ends with the last write-back; \
-         dispatch = 1 + per examined group (at most {}) 1 + its jobs, + 2; PE_LATENCY = {} \
+         dispatch = 3 + the jobs of the examined groups (at most {}); PE_LATENCY = {} \
          (5 + {} halving steps of Algorithm 3 at the {}-bit coordinate word); \
          `bt_hls::dispatch::predict` is the exact twin\n",
         dispatch::SCAN_LIMIT,
