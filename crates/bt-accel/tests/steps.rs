@@ -225,6 +225,12 @@ fn one_copy_takes_every_cold_step_of_the_living_room_under_a_millisecond() {
     let budget = plain.plan.schedule.instances.len() as u32 + 2;
     let one = plan_step(&steps[0], &planes, 0, &options(Some(budget - 1)), None).unwrap();
     let first = plan_step(&steps[0], &planes, 0, &options(Some(budget)), None).unwrap();
+    eprintln!(
+        "living room step 0 (cycles, slots): no copy {:?}, 1 copy {:?}, 2 copies {:?}",
+        (plain.plan.predicted_cycles, plain.plan.dispatch.slots),
+        (one.plan.predicted_cycles, one.plan.dispatch.slots),
+        (first.plan.predicted_cycles, first.plan.dispatch.slots)
+    );
     let copied = |p: &PlannedStep| -> Vec<String> {
         p.plan
             .schedule

@@ -75,13 +75,14 @@ fn unseen_rooms_need_no_model_run_and_lose_no_path() {
         let (_, p) = cold_step(seed);
         let latency_ms = p.plan.predicted_cycles as f64 / bt_hls::CLOCK_HZ * 1e3;
         eprintln!(
-            "seed {seed}: {} planes, {} paths, {} slots, {} jobs, {} cycles = {latency_ms:.3} ms, dispatch waits {}, {:?}",
+            "seed {seed}: {} planes, {} paths, {} slots, {} jobs, {} cycles = {latency_ms:.3} ms, dispatch waits {}, load delays {}, {:?}",
             p.step.input.planes.len(),
             p.step.input.paths.len(),
             p.plan.dispatch.slots,
             p.plan.dispatch.jobs,
             p.plan.predicted_cycles,
             p.plan.dispatch.dispatch_wait_cycles,
+            p.plan.dispatch.load_delay_cycles,
             p.fixed
         );
         // The alternative measured for docs/hardware.md: the static list schedule with every
@@ -114,16 +115,25 @@ fn unseen_rooms_need_no_model_run_and_lose_no_path() {
         assert!(rounds > 0);
         assert_eq!(p.plan.dispatch.jobs, points_rounds, "seed {seed}");
         // Without knowing any round count the run stays within a third of the oracle's
-        // schedule (measured: 0.89-0.98x since each PE starts after its own load; the
-        // oracle's figure is the static design's formula, PEs started after the last load).
+        // schedule (measured: 0.76-0.86x with the write-back/load overlap; the oracle's
+        // figure is the static design's formula, PEs started after the last load).
         assert!(
             3 * p.plan.predicted_cycles < 4 * oracle.predicted_cycles,
             "seed {seed}: {} vs {}",
             p.plan.predicted_cycles,
             oracle.predicted_cycles
         );
-        if p.step.input.paths.len() <= 120 {
-            // The size of room (116 paths): within the paper's millisecond.
+        // With the write-back/load overlap each slot costs at least the PE round trip
+        // (latency + 1: load, compute, the write-back taking the result) plus its load delay.
+        let d = &p.plan.dispatch;
+        let round_trip = u64::from(p.step.input.pe_latency()) + 1;
+        assert!(
+            p.plan.predicted_cycles >= d.slots * round_trip + d.load_delay_cycles,
+            "seed {seed}: {d:?}"
+        );
+        if p.step.input.paths.len() <= 180 {
+            // The size of room (116 paths) and seed 13's 179: within the paper's
+            // millisecond (measured 0.541 and 0.925 ms; seed 11, 187 paths: 1.157 ms).
             assert!(latency_ms <= 1.0, "seed {seed}: {latency_ms} ms");
         }
     }

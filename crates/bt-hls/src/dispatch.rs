@@ -4,9 +4,10 @@
 //! round count is needed beforehand (no oracle: the host never runs the model to plan).
 //!
 //! The controller of `bt_top` keeps a ready queue of groups (`rq`, one entry per path that
-//! is not running: `{first group, next group}`). While slot `s` loads and its PEs compute,
-//! the dispatcher pops up to [`SCAN_LIMIT`] queued groups and puts each into slot `s + 1` when
-//! all its PE columns are still free there (else back to the queue's tail). At write-back
+//! is not running: `{first group, next group}`). While slot `s` computes (from the end of
+//! slot `s − 1`'s write-back, which its load overlaps), the dispatcher pops up to
+//! [`SCAN_LIMIT`] queued groups and puts each into slot `s + 1` when all its PE columns are
+//! still free there (else back to the queue's tail). At write-back
 //! the last job of a group queues the path's next group at the queue's *head*, so running
 //! paths go before waiting ones (a long chain is not held up behind every queued path); after
 //! a round's last group the path is queued again only if it neither converged nor froze and
@@ -24,7 +25,9 @@ use crate::HlsError;
 /// queued groups wait for the same busy PE.
 /// (Measured on three unseen 29-plane rooms at order 3: 8, 10, 12 and 16 examined groups
 /// gave 1,816, 1,724, 1,660 and 1,606 slots on one of them, but 12 and more make the
-/// dispatcher outlast the PE latency, so 10 took the fewest cycles.)
+/// dispatcher outlast the PE latency, so 10 took the fewest cycles. Measured again with the
+/// write-back/load overlap and the pop at a group's last job: 8, 9 and 12 gave 50,480,
+/// 47,241 and 48,974 cycles on seed 13 against 46,247 at 10; docs/hardware.md.)
 pub const SCAN_LIMIT: u32 = 10;
 
 /// One group: the jobs of one phase of one path's round that run together in one slot.
@@ -95,25 +98,50 @@ pub struct DispatchRun {
     /// Cycles the PEs waited for the dispatcher (EXEC longer than the PE latency, and the
     /// dispatches that found no slot running).
     pub dispatch_wait_cycles: u64,
+    /// Cycles slots' loads waited for the write-back of a shared PE column in the slot
+    /// before (the sum of the slots' load delays).
+    #[serde(default)]
+    pub load_delay_cycles: u64,
 }
 
-/// The dispatcher's choice for one slot and its cycles (`D_WARM`, then per examined group a
-/// `D_POP` and one `D_JOB` per job, a last `D_POP` and `D_FIN`).
+/// One dispatched slot: its groups in slot order, and the cycles the load waits after the
+/// previous slot's write-back starts (`delay`).
+#[derive(Debug, Clone, Default)]
+struct Slot {
+    groups: Vec<(u32, usize)>,
+    /// Jobs in the slot.
+    jobs: u64,
+    /// `max(0, max over the PE columns both slots use of (position in the front slot −
+    /// position in this one))`: the load of a column may not overtake the write-back of the
+    /// front slot's job on that column, which reads its PE's result.
+    delay: u64,
+}
+
+/// The PE column of every job of `slot`, in slot (load and write-back) order.
+fn slot_columns<'a>(
+    groups: &'a [Vec<Group>],
+    slot: &'a [(u32, usize)],
+) -> impl Iterator<Item = u32> + 'a {
+    slot.iter()
+        .flat_map(|&(p, g)| groups[p as usize][g].jobs.iter().map(|&(c, _)| c))
+}
+
+/// The dispatcher's choice for one slot and its cycles (`D_WARM`, a `D_POP` for the first
+/// examined group, one `D_JOB` per job of each examined group, whose last also pops the next
+/// group, and `D_FIN`); `front` is the slot running (loading or computing) while it
+/// dispatches, whose write-back the new slot's load overlaps.
 fn dispatch_slot(
     groups: &[Vec<Group>],
     queue: &mut std::collections::VecDeque<(u32, usize)>,
     columns: usize,
-) -> (Vec<(u32, usize)>, u64) {
+    front: Option<&Slot>,
+) -> (Slot, u64) {
     let mut used = vec![false; columns];
     let mut placed = Vec::new();
     let mut scan = (queue.len() as u32).min(SCAN_LIMIT);
-    // D_WARM: the queue's head is read once before the first pop.
-    let mut cycles = 1u64;
-    loop {
-        cycles += 1;
-        if scan == 0 || used.iter().all(|&u| u) {
-            break;
-        }
+    // D_WARM (the queue's head is read once before the first pop), the first D_POP, D_FIN.
+    let mut cycles = 3u64;
+    while scan > 0 && !used.iter().all(|&u| u) {
         let Some((p, g)) = queue.pop_front() else {
             break;
         };
@@ -129,64 +157,103 @@ fn dispatch_slot(
             queue.push_back((p, g));
         }
     }
-    (placed, cycles + 1)
+    let mut front_pos = vec![None; columns];
+    if let Some(f) = front {
+        for (i, c) in slot_columns(groups, &f.groups).enumerate() {
+            front_pos[c as usize] = Some(i as u64);
+        }
+    }
+    let mut slot = Slot::default();
+    for (i, c) in slot_columns(groups, &placed).enumerate() {
+        if let Some(fi) = front_pos[c as usize] {
+            slot.delay = slot.delay.max(fi.saturating_sub(i as u64));
+        }
+        slot.jobs += 1;
+    }
+    slot.groups = placed;
+    (slot, cycles)
+}
+
+/// Write-back of `slot`, job by job in slot order: each group's last job queues its path's
+/// next group at the queue's head, or its first group again while the path runs rounds.
+fn write_back(
+    groups: &[Vec<Group>],
+    slot: &Slot,
+    rounds: &[u32],
+    done: &mut [u32],
+    queue: &mut std::collections::VecDeque<(u32, usize)>,
+) {
+    for &(p, g) in &slot.groups {
+        let pi = p as usize;
+        if g + 1 < groups[pi].len() {
+            queue.push_front((p, g + 1));
+        } else {
+            done[pi] += 1;
+            if done[pi] < rounds.get(pi).copied().unwrap_or(1).max(1) {
+                queue.push_front((p, 0));
+            }
+        }
+    }
 }
 
 /// The `CYCLES` of one run of the dispatching controller whose PEs take `latency` cycles,
 /// for a template ([`groups`]) over `columns` PE columns when path `p` runs `rounds[p]`
-/// rounds (at least one). Per slot of `n` jobs: load `n + 2`, or `n` right after a
-/// write-back (which read its first two entries ahead), PEs `max(latency - n - 1, 1,
-/// dispatch + 1 - load)` (each PE starts after its own load, write-back takes its result two
-/// cycles after reading its entry; the dispatcher starts with the load), write back `n + 2`; a dispatch with no slot running costs its own cycles plus one.
+/// rounds (at least one). Cycle 0 is the first after the start command.
+///
+/// A slot of `n` jobs whose load enters at cycle `L` loads its first job at `P = L + delay +
+/// 2` (the slot buffer's and the point memory's registered reads) and its last at `P + n −
+/// 1`; each PE starts the cycle after its own load. Its write-back starts at `W = max(P +
+/// max(latency − 1, n + 1), previous write-back's last cycle + 2, dispatcher's last cycle +
+/// 2)` (its EXEC ends in a cycle with neither running), reads an
+/// entry a cycle and takes job `i`'s result at `W + i + 2` (`n + 2` cycles). The next slot's
+/// load enters at `W` (it overlaps the write-back: its own slot-buffer port, and a third
+/// point-memory copy for the written points' old values), the dispatcher of the slot after it
+/// starts when this write-back ends (so it sees the paths it queued). A slot dispatched with
+/// no slot running waits for that dispatch: its load enters `d + 1` cycles after it began.
 pub fn predict(groups: &[Vec<Group>], columns: usize, rounds: &[u32], latency: u32) -> DispatchRun {
     let mut queue: std::collections::VecDeque<(u32, usize)> =
         (0..groups.len() as u32).map(|p| (p, 0)).collect();
     let mut done = vec![0u32; groups.len()];
     let mut run = DispatchRun::default();
-    let (mut slot, d) = dispatch_slot(groups, &mut queue, columns);
-    run.cycles += d + 1;
+    let lat = u64::from(latency);
+    let (mut slot, d) = dispatch_slot(groups, &mut queue, columns, None);
     run.dispatch_wait_cycles += d + 1;
-    let mut ahead = false;
-    while !slot.is_empty() {
-        let n: u64 = slot
-            .iter()
-            .map(|&(p, g)| groups[p as usize][g].jobs.len() as u64)
-            .sum();
-        // The load takes n + 2 cycles, or n when the previous write-back read its first two
-        // entries ahead; the dispatcher starts with it, the PEs after it.
-        let load = if ahead { n } else { n + 2 };
-        let (next, d) = dispatch_slot(groups, &mut queue, columns);
-        // Each PE starts the cycle after its own load and write-back reads the jobs in load
-        // order, each two cycles after its entry's read, so the last job's PE needs `latency`
-        // cycles less the slot's other loads and those two (at least one); the dispatcher
-        // must have finished too.
-        let lat = u64::from(latency).saturating_sub(n + 1).max(1);
-        let exec = lat.max((d + 1).saturating_sub(load));
-        run.cycles += load + exec + n + 2;
-        run.dispatch_wait_cycles += exec - lat;
+    // The load of `slot` enters at `enter`; the dispatcher of the next ends at `d_end` (its
+    // last cycle); the previous write-back's last cycle is `wb_last`.
+    let mut enter = d + 1;
+    let mut wb_last = None::<u64>;
+    let (mut next, d) = dispatch_slot(groups, &mut queue, columns, Some(&slot));
+    let mut d_end = enter + d - 1;
+    while slot.jobs > 0 {
+        let n = slot.jobs;
+        let first_load = enter + slot.delay + 2;
+        let pe_ready = first_load + (lat - 1).max(n + 1);
+        let wb = pe_ready.max(d_end + 2).max(wb_last.map_or(0, |w| w + 2));
+        run.dispatch_wait_cycles += wb - pe_ready.max(wb_last.map_or(0, |w| w + 2));
         run.slots += 1;
         run.jobs += n;
-        // Write-back, job by job in slot order: each group's last job queues its path's next
-        // group at the queue's head.
-        for &(p, g) in &slot {
-            let pi = p as usize;
-            if g + 1 < groups[pi].len() {
-                queue.push_front((p, g + 1));
-            } else {
-                done[pi] += 1;
-                if done[pi] < rounds.get(pi).copied().unwrap_or(1).max(1) {
-                    queue.push_front((p, 0));
-                }
-            }
-        }
-        slot = next;
-        ahead = true;
-        if slot.is_empty() && !queue.is_empty() {
-            let (s, d) = dispatch_slot(groups, &mut queue, columns);
-            run.cycles += d + 1;
+        run.load_delay_cycles += slot.delay;
+        write_back(groups, &slot, rounds, &mut done, &mut queue);
+        let last = wb + n + 1;
+        wb_last = Some(last);
+        if next.jobs > 0 {
+            enter = wb;
+            slot = next;
+            let (nn, d) = dispatch_slot(groups, &mut queue, columns, Some(&slot));
+            d_end = last + d;
+            next = nn;
+        } else if queue.is_empty() {
+            run.cycles = last + 1;
+            break;
+        } else {
+            // No slot running: dispatch now (DISP), then load it.
+            let (s, d) = dispatch_slot(groups, &mut queue, columns, None);
             run.dispatch_wait_cycles += d + 1;
+            enter = last + d + 2;
             slot = s;
-            ahead = false;
+            let (nn, d) = dispatch_slot(groups, &mut queue, columns, Some(&slot));
+            d_end = enter + d - 1;
+            next = nn;
         }
     }
     run
@@ -233,17 +300,25 @@ mod tests {
         let g = groups(&t, 2).unwrap();
         let latency = 10;
         // One round each: slot 1 = path 0 (2 jobs), slot 2 = path 1 (1 job).
-        // Dispatch 0: D_WARM, D_POP, 2 jobs [placed: both PEs taken], D_POP (every PE
-        // taken: stop), D_FIN = 6 cycles, DISP 7. Slot 1: load 4, PEs max(10 - 2 - 1 (the
-        // first PE started a cycle before the last, write-back takes a result two cycles
-        // after reading its entry), dispatch of path 1 (D_WARM, D_POP, 1 job, D_POP, D_FIN =
-        // 5) + 1 - the load's 4), write back 4 = 15. Slot 2: its entry was read ahead during
-        // slot 1's write-back: load 1, PEs 8, write back 3 = 12 (the queue is empty: D_WARM,
-        // D_POP, D_FIN).
+        // Dispatch 0 (cycles 0-4): D_WARM, D_POP, 2 jobs [both PEs taken: stop], D_FIN;
+        // DISP ends at cycle 5, slot 1's load enters at 6. Its first job loads at 8 (two
+        // registered reads), the last at 9; write-back starts at max(8 + 9, the dispatch of
+        // path 1 [cycles 6-9: D_WARM, D_POP, 1 job, D_FIN] + 2) = 17 and ends at 20. Slot 2
+        // shares column 0 at the same position (no delay): its load enters at 17, loads at
+        // 19, writes back from max(19 + 9, 20 + 2, the empty dispatch at 21-23 + 2) = 28 to
+        // 30: 31 cycles.
         let r = predict(&g, 2, &[1, 1], latency);
         assert_eq!((r.slots, r.jobs), (2, 3));
-        assert_eq!(r.cycles, 7 + 15 + 12);
-        assert_eq!(r.dispatch_wait_cycles, 7);
+        assert_eq!(r.cycles, 31);
+        assert_eq!(r.dispatch_wait_cycles, 6);
+        // Slot 2's column 0 is at position 0 in slot 1 too; put path 1 on plane 1 behind
+        // path 0's job on it (position 1) and its load waits a cycle for that write-back.
+        let p2 = Problem {
+            num_planes: 2,
+            paths: vec![PathJob::jacobi(vec![0, 1], 1), PathJob::jacobi(vec![1], 1)],
+        };
+        let g2 = groups(&round_template(&p2, &[]).unwrap(), 2).unwrap();
+        assert_eq!(predict(&g2, 2, &[1, 1], latency).cycles, 32);
         // More rounds: more slots, never fewer cycles.
         let r3 = predict(&g, 2, &[3, 2], latency);
         assert_eq!(r3.jobs, 3 * 2 + 2);

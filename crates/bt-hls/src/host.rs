@@ -339,12 +339,17 @@ pub(crate) fn register_map(d: &Design) -> String {
 fn cycle_formulas(d: &Design) -> String {
     let mut s = String::from("## Cycle formulas (exact, checked by co-simulation)\n\n");
     s.push_str(&format!(
-        "* CYCLES = sum over dispatched slots of (load + max(PE_LATENCY - jobs - 1, 1, dispatch + \
-         1 - load) + jobs + 2) (each PE starts the cycle after its own load), load = jobs right \
-         after a write-back (its first two entries read ahead), else jobs + 2, plus the dispatches with no slot running (dispatch + 1 each); the dispatcher \
-         builds the next slot from the start of the load; dispatch = 1 + per examined \
-         group (at most {}) 1 + its jobs, + 2; PE_LATENCY = {} (5 + {} halving steps of \
-         Algorithm 3 at the {}-bit coordinate word); `bt_hls::dispatch::predict` is the exact twin\n",
+        "* a slot's load enters when the previous slot's write-back starts (it overlaps it) and \
+         waits `delay` cycles (the largest lead of a shared PE column's position in the previous \
+         slot over its position in this one), loads its first job 2 cycles later and one a \
+         cycle (each PE starts the cycle after its own load); its write-back (jobs + 2 cycles) \
+         starts at max(first load + max(PE_LATENCY - 1, jobs + 1), previous write-back's last \
+         cycle + 2, dispatcher's last cycle + 2); the dispatcher of the slot after it starts \
+         when the previous write-back ends; a slot dispatched with no slot running loads \
+         dispatch + 1 cycles after that dispatch began; CYCLES ends with the last write-back; \
+         dispatch = 3 + the jobs of the examined groups (at most {}); PE_LATENCY = {} \
+         (5 + {} halving steps of Algorithm 3 at the {}-bit coordinate word); \
+         `bt_hls::dispatch::predict` is the exact twin\n",
         dispatch::SCAN_LIMIT,
         pe_latency(d.platform.coord_bits),
         bt_fixed::Widths::for_coord(d.platform.coord_bits).iterations,

@@ -389,8 +389,9 @@ impl Layout {
         }
         let sw = sched_entry_bits(path_bits, point_bits, inst_bits);
         let word = crate::rtl::pe::point_bits(bt_fixed::Widths::for_coord(platform.coord_bits));
-        // Point memory copies, job memory, slot buffer (two slots) and ready queue.
-        let blocks = 2 * m9k_blocks(1 << (point_bits + 1), word.into())
+        // Point memory copies (three: the load's two neighbours, the write-back's old point),
+        // job memory, slot buffer (two slots) and ready queue.
+        let blocks = 3 * m9k_blocks(1 << (point_bits + 1), word.into())
             + m9k_blocks(1 << entry_bits, sw.into())
             + m9k_blocks(2 << inst_bits, (sw + 2 * entry_bits).into())
             + m9k_blocks(1 << path_bits, (2 * entry_bits).into());
@@ -661,19 +662,19 @@ mod tests {
 
     #[test]
     fn memories_over_the_m9k_budget_are_refused_with_the_numbers() {
-        // Point memories 2 x 1 K x 120 bits (two banks of 270 points; 14 blocks each), job
+        // Point memories 3 x 1 K x 120 bits (two banks of 270 points; 14 blocks each), job
         // memory 256 K x 26 bits ({column 5, tail, end, last, first, point 9, path 7, valid};
         // 1K x 9 shape: 256 x 3 = 768 blocks), slot buffer 64 x (26 + 2 x 18) bits (2 blocks)
-        // and ready queue 128 x 36 bits (1 block): 799 blocks, over the EP4CE115's 432.
+        // and ready queue 128 x 36 bits (1 block): 813 blocks, over the EP4CE115's 432.
         let e = Layout::of(&platform(104, 270, 200_000, 25, EP4CE115_M9K_BLOCKS)).unwrap_err();
         let text = e.to_string();
         assert!(matches!(e, HlsError::TooLarge(_)), "{text}");
         assert!(
-            text.contains("799 M9K blocks") && text.contains("budget of 432"),
+            text.contains("813 M9K blocks") && text.contains("budget of 432"),
             "{text}"
         );
-        // 12,000 entries: 2 x 14 + 16K x 26 (1K x 9 shape: 16 x 3 = 48) + 2 + 1 = 79 blocks.
-        let e = Layout::of(&platform(104, 270, 12_000, 25, 78)).unwrap_err();
-        assert!(e.to_string().contains("79 M9K blocks"), "{e}");
+        // 12,000 entries: 3 x 14 + 16K x 26 (1K x 9 shape: 16 x 3 = 48) + 2 + 1 = 93 blocks.
+        let e = Layout::of(&platform(104, 270, 12_000, 25, 92)).unwrap_err();
+        assert!(e.to_string().contains("93 M9K blocks"), "{e}");
     }
 }

@@ -13,7 +13,7 @@ module bt_top (
   output reg  avs_readdatavalid,
   output wire ins_irq
 );
-  // 7 PE instances, capacity 26 paths, 46 points, 26 groups; load (jobs, or jobs + 2 after a dispatch wait) + max(29 - jobs - 1, 1, dispatch + 1 - load) + write-back (jobs + 2) cycles per slot (each PE starts after its own load), threshold 16 fine LSB
+  // 7 PE instances, capacity 26 paths, 46 points, 26 groups; per slot load (delay + jobs + 2, beside the previous slot's write-back) + max(29 - jobs - 1, 1) + write-back (jobs + 2) cycles (each PE starts after its own load), threshold 16 fine LSB
   reg [2:0] state;
   reg [4:0] cnt;
   reg [5:0] paths_r;
@@ -21,6 +21,14 @@ module bt_top (
   reg rsel;
   reg [3:0] slen_0;
   reg [3:0] slen_1;
+  reg [2:0] dly_0;
+  reg [2:0] dly_1;
+  reg [7:0] sused_0;
+  reg [7:0] sused_1;
+  reg wb_on;
+  reg [4:0] wcnt;
+  reg wsel;
+  reg [2:0] ldly;
   reg [31:0] cycles;
   reg done;
   reg [31:0] tx_x;
@@ -41,10 +49,13 @@ module bt_top (
   reg [31:0] pov;
   reg [71:0] rd_a;
   reg [71:0] rd_b;
+  reg [71:0] rd_c;
   reg [31:0] sched_q;
   reg sq_ok;
   reg sq_tail;
-  reg sq_ld;
+  reg [31:0] wsched_q;
+  reg wq_ok;
+  reg wq_tail;
   reg ld_q_en;
   reg ld_q_tail;
   reg ld_q_first;
@@ -82,11 +93,16 @@ module bt_top (
   reg d_conf;
   reg [5:0] d_gbase;
   reg [5:0] d_gptr;
+  reg [2:0] d_dly;
+  reg [2:0] d_dsave;
+  reg d_front;
   reg [11:0] rq [0:31];
   reg [31:0] sbuf [0:15];
+  reg [2:0] spos [0:15];
   reg [15:0] rounds [0:31];
   reg [71:0] pm_a [0:127];
   reg [71:0] pm_b [0:127];
+  reg [71:0] pm_c [0:127];
   wire pe_load_0;
   wire pe_start_0;
   wire [83:0] pe_sum_0;
@@ -131,65 +147,55 @@ module bt_top (
   assign host_wr = (avs_write && idle);
   wire pt_we;
   assign pt_we = ((host_wr && is_point) && (avs_address[1:0] == 2'd3));
-  // job memory, written per step by the host: one round of every path as groups, entry -> {column, group tail, late, end, last, first, point, path, valid} (20 bits)
-  wire [5:0] job_ra;
-  assign job_ra = ((dstate == 3'd1) ? rq_q[5:0] : ((d_gptr + {2'd0, d_gi}) + 6'd1));
-  reg [19:0] sched [0:63];
-  always @(posedge clk) begin
-    if ((host_wr && is_sched)) begin
-      sched[avs_address[5:0]] <= avs_writedata[19:0];
-    end
-    job_q <= sched[job_ra];
-  end
-  // slot buffer: the running slot's jobs (rsel), the next slot's written by the dispatcher
+  // slot buffer: the front slot's jobs (rsel) for the load, the written-back slot's (wsel) for the write-back, the next slot's written by the dispatcher
   wire [3:0] slen_cur;
   assign slen_cur = (rsel ? slen_1 : slen_0);
-  wire sb_in;
-  assign sb_in = (cnt < {1'd0, slen_cur});
-  wire [3:0] slen_nxt;
-  assign slen_nxt = (rsel ? slen_0 : slen_1);
-  wire sb_pf;
-  assign sb_pf = ((state == 3'd4) && !(sb_in));
-  wire [4:0] sb_pf_idx;
-  assign sb_pf_idx = (cnt - {1'd0, slen_cur});
-  wire [3:0] sb_ra;
-  assign sb_ra = (sb_pf ? {~(rsel), sb_pf_idx[2:0]} : {rsel, cnt[2:0]});
   always @(posedge clk) begin
-    sched_q <= sbuf[sb_ra];
-    sq_ok <= ((((state == 3'd2) | (state == 3'd4)) && sb_in) | (sb_pf && (sb_pf_idx < {1'd0, slen_nxt})));
-    sq_tail <= (sb_pf ? ((sb_pf_idx + 5'd1) == {1'd0, slen_nxt}) : ((cnt + 5'd1) == {1'd0, slen_cur}));
-    sq_ld <= ((state == 3'd2) | sb_pf);
+    sched_q <= sbuf[{rsel, cnt[2:0]}];
+    sq_ok <= (((state == 3'd2) && (ldly == 3'd0)) && (cnt < {1'd0, slen_cur}));
+    sq_tail <= ((cnt + 5'd1) == {1'd0, slen_cur});
+  end
+  wire lrom_valid;
+  assign lrom_valid = sq_ok;
+  wire lrom_tail;
+  assign lrom_tail = (sq_ok && sq_tail);
+  wire [4:0] lrom_path;
+  assign lrom_path = sched_q[5:1];
+  wire [5:0] lrom_point;
+  assign lrom_point = sched_q[11:6];
+  wire [2:0] lrom_inst;
+  assign lrom_inst = sched_q[19:17];
+  wire lrom_first;
+  assign lrom_first = sched_q[12];
+  wire lrom_last;
+  assign lrom_last = sched_q[13];
+  wire lrom_late;
+  assign lrom_late = sched_q[15];
+  wire [3:0] slen_wb;
+  assign slen_wb = (wsel ? slen_1 : slen_0);
+  always @(posedge clk) begin
+    wsched_q <= sbuf[{wsel, wcnt[2:0]}];
+    wq_ok <= (wb_on && (wcnt < {1'd0, slen_wb}));
+    wq_tail <= ((wcnt + 5'd1) == {1'd0, slen_wb});
   end
   wire rom_valid;
-  assign rom_valid = sq_ok;
+  assign rom_valid = wq_ok;
   wire rom_tail;
-  assign rom_tail = (sq_ok && sq_tail);
-  wire rom_wb_valid;
-  assign rom_wb_valid = (sq_ok && !(sq_ld));
-  wire rom_wb_tail;
-  assign rom_wb_tail = (rom_wb_valid && sq_tail);
-  wire rom_ld;
-  assign rom_ld = sq_ld;
+  assign rom_tail = (rom_valid && wq_tail);
   wire [4:0] rom_path;
-  assign rom_path = sched_q[5:1];
+  assign rom_path = wsched_q[5:1];
   wire [5:0] rom_point;
-  assign rom_point = sched_q[11:6];
+  assign rom_point = wsched_q[11:6];
   wire [2:0] rom_inst;
-  assign rom_inst = sched_q[19:17];
-  wire rom_first;
-  assign rom_first = sched_q[12];
-  wire rom_last;
-  assign rom_last = sched_q[13];
+  assign rom_inst = wsched_q[19:17];
   wire rom_end;
-  assign rom_end = sched_q[14];
-  wire rom_late;
-  assign rom_late = sched_q[15];
+  assign rom_end = wsched_q[14];
   wire rom_gtail;
-  assign rom_gtail = sched_q[16];
+  assign rom_gtail = wsched_q[16];
   wire [5:0] rom_src;
-  assign rom_src = sched_q[31:26];
+  assign rom_src = wsched_q[31:26];
   wire [5:0] rom_gbase;
-  assign rom_gbase = sched_q[25:20];
+  assign rom_gbase = wsched_q[25:20];
   wire [2:0] j_col;
   assign j_col = job_q[19:17];
   wire j_gtail;
@@ -198,20 +204,45 @@ module bt_top (
   assign j_conf = (d_conf | d_used[j_col]);
   wire d_stop;
   assign d_stop = ((d_scan == 6'd0) | (d_used[6:0] == 7'd127));
-  wire d_pop;
-  assign d_pop = ((dstate == 3'd1) && !(d_stop));
   wire d_push;
   assign d_push = (((dstate == 3'd3) && j_gtail) && j_conf);
-  wire [2:0] sb_wi;
-  assign sb_wi = (d_nsl[2:0] + d_gi[2:0]);
+  wire [7:0] d_used_after;
+  assign d_used_after = (j_conf ? d_save : (d_used | {(j_col == 3'd7), (j_col == 3'd6), (j_col == 3'd5), (j_col == 3'd4), (j_col == 3'd3), (j_col == 3'd2), (j_col == 3'd1), (j_col == 3'd0)}));
+  wire d_pop_next;
+  assign d_pop_next = (((dstate == 3'd3) && j_gtail) && !(((d_scan == 6'd0) | (d_used_after[6:0] == 7'd127))));
+  wire d_pop;
+  assign d_pop = (((dstate == 3'd1) && !(d_stop)) | d_pop_next);
+  wire [2:0] d_wi;
+  assign d_wi = (d_nsl[2:0] + d_gi[2:0]);
+  wire [2:0] d_fpos;
+  assign d_fpos = spos[{rsel, j_col}];
+  wire [7:0] d_fused;
+  assign d_fused = (rsel ? sused_1 : sused_0);
+  wire [2:0] dly_cand;
+  assign dly_cand = (d_fpos - d_wi);
+  wire dly_take;
+  assign dly_take = (((d_front && d_fused[j_col]) && (d_fpos > d_wi)) && (dly_cand > d_dly));
+  wire [2:0] d_dly_after;
+  assign d_dly_after = (j_conf ? d_dsave : (dly_take ? dly_cand : d_dly));
+  // job memory, written per step by the host: one round of every path as groups, entry -> {column, group tail, late, end, last, first, point, path, valid} (20 bits)
+  wire [5:0] job_ra;
+  assign job_ra = (((dstate == 3'd1) | d_pop_next) ? rq_q[5:0] : ((d_gptr + {2'd0, d_gi}) + 6'd1));
+  reg [19:0] sched [0:63];
+  always @(posedge clk) begin
+    if ((host_wr && is_sched)) begin
+      sched[avs_address[5:0]] <= avs_writedata[19:0];
+    end
+    job_q <= sched[job_ra];
+  end
   always @(posedge clk) begin
     if (((dstate == 3'd3) && !(j_conf))) begin
-      sbuf[{~(rsel), sb_wi}] <= {(d_gptr + {2'd0, d_gi}), d_gbase, job_q};
+      sbuf[{~(rsel), d_wi}] <= {(d_gptr + {2'd0, d_gi}), d_gbase, job_q};
+      spos[{~(rsel), j_col}] <= d_wi;
     end
   end
   // rounds memory (M9K): read at the write-back entry's path, or the bus address
   wire [4:0] rounds_ra;
-  assign rounds_ra = ((state == 3'd4) ? rom_path : avs_address[4:0]);
+  assign rounds_ra = (wb_on ? rom_path : avs_address[4:0]);
   always @(posedge clk) begin
     rounds_q <= rounds[rounds_ra];
   end
@@ -220,19 +251,17 @@ module bt_top (
   // coordinate updater-buffer: address {point, bank}; cur[path] = bank of the committed round
   reg [6:0] ra_addr;
   reg [6:0] rb_addr;
+  reg [6:0] rc_addr;
   reg [6:0] wr_addr;
   reg wr_en;
   reg [71:0] wr_data;
   always @* begin
     ra_addr = {bus_point, avs_address[2]};
-    if (((state == 3'd2) | rom_ld)) begin
-      ra_addr = {(rom_point - 6'd1), (cur[rom_path] ^ rom_late)};
-    end else begin
-      if ((state == 3'd4)) begin
-        ra_addr = {rom_point, cur[rom_path]};
-      end
+    if ((state == 3'd2)) begin
+      ra_addr = {(lrom_point - 6'd1), (cur[lrom_path] ^ lrom_late)};
     end
-    rb_addr = {(rom_point + 6'd1), (cur[rom_path] ^ rom_late)};
+    rb_addr = {(lrom_point + 6'd1), (cur[lrom_path] ^ lrom_late)};
+    rc_addr = {rom_point, cur[rom_path]};
   end
   reg [83:0] pe_sel_sum;
   reg pe_sel_zs;
@@ -297,7 +326,7 @@ module bt_top (
   wire [23:0] new_x;
   assign new_x = pe_sel[23:0];
   wire [23:0] old_x;
-  assign old_x = rd_a[23:0];
+  assign old_x = rd_c[23:0];
   wire [24:0] diff_x;
   assign diff_x = ({{1{new_x[23]}}, new_x} - {{1{old_x[23]}}, old_x});
   wire [24:0] adiff_x;
@@ -305,7 +334,7 @@ module bt_top (
   wire [23:0] new_y;
   assign new_y = pe_sel[47:24];
   wire [23:0] old_y;
-  assign old_y = rd_a[47:24];
+  assign old_y = rd_c[47:24];
   wire [24:0] diff_y;
   assign diff_y = ({{1{new_y[23]}}, new_y} - {{1{old_y[23]}}, old_y});
   wire [24:0] adiff_y;
@@ -313,7 +342,7 @@ module bt_top (
   wire [23:0] new_z;
   assign new_z = pe_sel[71:48];
   wire [23:0] old_z;
-  assign old_z = rd_a[71:48];
+  assign old_z = rd_c[71:48];
   wire [24:0] diff_z;
   assign diff_z = ({{1{new_z[23]}}, new_z} - {{1{old_z[23]}}, old_z});
   wire [24:0] adiff_z;
@@ -324,7 +353,7 @@ module bt_top (
   wire wb_frozen;
   assign wb_frozen = ((conv[wb_q_path] | dz[wb_q_path]) | ov[wb_q_path]);
   wire wb_go;
-  assign wb_go = (((state == 3'd4) && wb_q_en) && !(wb_frozen));
+  assign wb_go = ((wb_on && wb_q_en) && !(wb_frozen));
   wire any_big;
   assign any_big = (pbig[wb_q_path] | wb_big);
   wire any_dz;
@@ -344,11 +373,11 @@ module bt_top (
   wire rq_empty;
   assign rq_empty = (rq_after == 6'd0);
   wire wb_end;
-  assign wb_end = ((state == 3'd4) && wb_q_tail);
-  wire to_load;
-  assign to_load = ((wb_end | ((state == 3'd1) && (dstate == 3'd0))) && !(((rsel ? slen_0 : slen_1) == 4'd0)));
+  assign wb_end = (wb_on && wb_q_tail);
+  wire d_front_in;
+  assign d_front_in = ((((state == 3'd1) && (dstate == 3'd0)) && !(((~(rsel) ? slen_1 : slen_0) == 4'd0))) | (wb_end && ((state == 3'd2) | (state == 3'd3))));
   wire d_go;
-  assign d_go = (((start_req && !((paths_r == 6'd0))) | to_load) | ((wb_end && ((rsel ? slen_0 : slen_1) == 4'd0)) && !(rq_empty)));
+  assign d_go = (((start_req && !((paths_r == 6'd0))) | d_front_in) | ((wb_end && (state == 3'd4)) && !(rq_empty)));
   wire [5:0] d_scan_init;
   assign d_scan_init = (start_req ? paths_r : rq_after);
   wire [5:0] d_scan_cap;
@@ -359,7 +388,7 @@ module bt_top (
     if (((host_wr && is_status) | rq_push)) begin
       rq[(host_wr ? avs_address[4:0] : (wb_push ? (rq_head - 5'd1) : rq_tail))] <= (host_wr ? avs_writedata[11:0] : (d_push ? {d_gbase, d_gptr} : wb_push_data));
     end
-    rq_q <= rq[rq_head];
+    rq_q <= rq[(d_pop ? (rq_head + 5'd1) : rq_head)];
   end
   always @(posedge clk) begin
     if (!(rst_n)) begin
@@ -382,10 +411,10 @@ module bt_top (
         if (d_push) begin
           rq_tail <= (rq_tail + 5'd1);
         end
-        if (rq_push) begin
+        if ((rq_push && !(d_pop))) begin
           rq_count <= (rq_count + 6'd1);
         end else begin
-          if (d_pop) begin
+          if ((d_pop && !(rq_push))) begin
             rq_count <= (rq_count - 6'd1);
           end
         end
@@ -405,6 +434,8 @@ module bt_top (
             d_scan <= d_scan_cap;
             d_used <= 8'd0;
             d_nsl <= 4'd0;
+            d_dly <= 3'd0;
+            d_front <= d_front_in;
           end
         end
         3'd2: begin
@@ -419,19 +450,34 @@ module bt_top (
             d_gi <= 4'd0;
             d_conf <= 1'd0;
             d_save <= d_used;
+            d_dsave <= d_dly;
           end else begin
             dstate <= 3'd4;
           end
         end
         3'd3: begin
           d_used[j_col] <= 1'd1;
+          if ((!(j_conf) && dly_take)) begin
+            d_dly <= dly_cand;
+          end
           if (j_gtail) begin
             if (!(j_conf)) begin
               d_nsl <= (d_nsl + (d_gi + 4'd1));
             end else begin
               d_used <= d_save;
+              d_dly <= d_dsave;
             end
-            dstate <= 3'd1;
+            if (d_pop_next) begin
+              d_scan <= (d_scan - 6'd1);
+              d_gbase <= rq_q[11:6];
+              d_gptr <= rq_q[5:0];
+              d_gi <= 4'd0;
+              d_conf <= 1'd0;
+              d_save <= d_used_after;
+              d_dsave <= d_dly_after;
+            end else begin
+              dstate <= 3'd4;
+            end
           end else begin
             d_gi <= (d_gi + 4'd1);
             d_conf <= j_conf;
@@ -440,8 +486,12 @@ module bt_top (
         3'd4: begin
           if (rsel) begin
             slen_0 <= d_nsl;
+            dly_0 <= d_dly;
+            sused_0 <= d_used;
           end else begin
             slen_1 <= d_nsl;
+            dly_1 <= d_dly;
+            sused_1 <= d_used;
           end
           dstate <= 3'd0;
         end
@@ -460,7 +510,7 @@ module bt_top (
     wr_en = (pt_we || wb_go);
     wr_addr = {bus_point, avs_address[2]};
     wr_data = {st_z, avs_writedata[23:16], st_y, avs_writedata[15:8], st_x, avs_writedata[7:0]};
-    if ((state == 3'd4)) begin
+    if (wb_on) begin
       wr_addr = {wb_q_point, ~(cur[wb_q_path])};
       wr_data = pe_sel;
     end
@@ -476,6 +526,12 @@ module bt_top (
       pm_b[wr_addr] <= wr_data;
     end
     rd_b <= pm_b[rb_addr];
+  end
+  always @(posedge clk) begin
+    if (wr_en) begin
+      pm_c[wr_addr] <= wr_data;
+    end
+    rd_c <= pm_c[rc_addr];
   end
   always @(posedge clk) begin
     if (!(rst_n)) begin
@@ -573,7 +629,7 @@ module bt_top (
   assign pe_start_5 = (ld_go && (ld_go_inst == 3'd5));
   assign pe_load_6 = (((state == 3'd2) && ld_q_en) && (ld_q_inst == 3'd6));
   assign pe_start_6 = (ld_go && (ld_go_inst == 3'd6));
-  // main FSM: IDLE -> DISP -> per slot LOAD (jobs + 2, or jobs after a write-back) EXEC (max(29 - jobs - 1, 1, dispatch + 1 - load): each PE starts after its own load) WB (jobs + 2) -> IDLE with done when no path is queued
+  // main FSM: IDLE -> DISP -> per slot LOAD (delay + jobs + 2) EXEC (max(29 - jobs - 1, 1), the previous write-back and the dispatcher done) -> write-back (jobs + 2) beside the next slot's LOAD -> IDLE with done when no path is queued
   always @(posedge clk) begin
     if (!(rst_n)) begin
       state <= 3'd0;
@@ -585,10 +641,48 @@ module bt_top (
       ld_q_tail <= 1'd0;
       wb_q_en <= 1'd0;
       wb_q_tail <= 1'd0;
+      wb_on <= 1'd0;
       rvalid <= 32'h0;
     end else begin
       if ((state != 3'd0)) begin
         cycles <= (cycles + 32'h1);
+      end
+      ld_q_en <= lrom_valid;
+      ld_q_tail <= lrom_tail;
+      ld_q_first <= lrom_first;
+      ld_q_last <= lrom_last;
+      ld_q_inst <= lrom_inst;
+      wb_q_en <= rom_valid;
+      wb_q_tail <= rom_tail;
+      wb_q_end <= rom_end;
+      wb_q_path <= rom_path;
+      wb_q_point <= rom_point;
+      wb_q_inst <= rom_inst;
+      wb_q_gtail <= rom_gtail;
+      wb_q_src <= rom_src;
+      wb_q_gbase <= rom_gbase;
+      if (wb_go) begin
+        if (wb_q_end) begin
+          cur[wb_q_path] <= ~(cur[wb_q_path]);
+          rvalid[wb_q_path] <= 1'd1;
+          dz[wb_q_path] <= any_dz;
+          ov[wb_q_path] <= any_ov;
+          conv[wb_q_path] <= ((!(any_big) && !(any_dz)) && !(any_ov));
+          pbig[wb_q_path] <= 1'd0;
+          pdz[wb_q_path] <= 1'd0;
+          pov[wb_q_path] <= 1'd0;
+        end else begin
+          pbig[wb_q_path] <= any_big;
+          pdz[wb_q_path] <= any_dz;
+          pov[wb_q_path] <= any_ov;
+        end
+      end
+      if (wb_on) begin
+        if (wb_q_tail) begin
+          wb_on <= 1'd0;
+        end else begin
+          wcnt <= (wcnt + 5'd1);
+        end
       end
       case (state)
         3'd0: begin
@@ -610,88 +704,56 @@ module bt_top (
         end
         3'd1: begin
           if ((dstate == 3'd0)) begin
-            if (((rsel ? slen_0 : slen_1) == 4'd0)) begin
+            if (((~(rsel) ? slen_1 : slen_0) == 4'd0)) begin
               state <= 3'd0;
               done <= 1'd1;
             end else begin
               state <= 3'd2;
               rsel <= ~(rsel);
               cnt <= 5'd0;
+              ldly <= (rsel ? dly_0 : dly_1);
             end
           end
         end
         3'd2: begin
-          ld_q_en <= rom_valid;
-          ld_q_tail <= rom_tail;
-          ld_q_first <= rom_first;
-          ld_q_last <= rom_last;
-          ld_q_inst <= rom_inst;
           if (ld_q_tail) begin
             state <= 3'd3;
             cnt <= 5'd0;
           end else begin
-            cnt <= (cnt + 5'd1);
+            if ((ldly == 3'd0)) begin
+              cnt <= (cnt + 5'd1);
+            end else begin
+              ldly <= (ldly - 3'd1);
+            end
           end
         end
         3'd3: begin
           if (((({1'd0, cnt} + {2'd0, slen_cur}) + 6'd2) > 6'd28)) begin
-            if ((dstate == 3'd0)) begin
-              state <= 3'd4;
-              cnt <= 5'd0;
+            if (((dstate == 3'd0) && !(wb_on))) begin
+              wb_on <= 1'd1;
+              wcnt <= 5'd0;
+              wsel <= rsel;
+              if (((~(rsel) ? slen_1 : slen_0) == 4'd0)) begin
+                state <= 3'd4;
+              end else begin
+                state <= 3'd2;
+                rsel <= ~(rsel);
+                cnt <= 5'd0;
+                ldly <= (rsel ? dly_0 : dly_1);
+              end
             end
           end else begin
             cnt <= (cnt + 5'd1);
           end
         end
         3'd4: begin
-          wb_q_en <= rom_wb_valid;
-          wb_q_tail <= rom_wb_tail;
-          wb_q_end <= rom_end;
-          wb_q_path <= rom_path;
-          wb_q_point <= rom_point;
-          wb_q_inst <= rom_inst;
-          wb_q_gtail <= rom_gtail;
-          wb_q_src <= rom_src;
-          wb_q_gbase <= rom_gbase;
-          if (rom_ld) begin
-            ld_q_en <= rom_valid;
-            ld_q_tail <= rom_tail;
-            ld_q_first <= rom_first;
-            ld_q_last <= rom_last;
-            ld_q_inst <= rom_inst;
-          end
-          if (wb_go) begin
-            if (wb_q_end) begin
-              cur[wb_q_path] <= ~(cur[wb_q_path]);
-              rvalid[wb_q_path] <= 1'd1;
-              dz[wb_q_path] <= any_dz;
-              ov[wb_q_path] <= any_ov;
-              conv[wb_q_path] <= ((!(any_big) && !(any_dz)) && !(any_ov));
-              pbig[wb_q_path] <= 1'd0;
-              pdz[wb_q_path] <= 1'd0;
-              pov[wb_q_path] <= 1'd0;
+          if ((wb_on && wb_q_tail)) begin
+            if (rq_empty) begin
+              state <= 3'd0;
+              done <= 1'd1;
             end else begin
-              pbig[wb_q_path] <= any_big;
-              pdz[wb_q_path] <= any_dz;
-              pov[wb_q_path] <= any_ov;
+              state <= 3'd1;
             end
-          end
-          if (wb_q_tail) begin
-            cnt <= 5'd0;
-            if (((rsel ? slen_0 : slen_1) == 4'd0)) begin
-              if (rq_empty) begin
-                state <= 3'd0;
-                done <= 1'd1;
-              end else begin
-                state <= 3'd1;
-              end
-            end else begin
-              state <= 3'd2;
-              rsel <= ~(rsel);
-              cnt <= 5'd2;
-            end
-          end else begin
-            cnt <= (cnt + 5'd1);
           end
         end
         default: begin
@@ -842,6 +904,6 @@ module bt_top (
   end
   assign ins_irq = done;
   wire bt_unused_ok;
-  assign bt_unused_ok = &({1'd0, avs_writedata[31:1], sched_q[0]});
+  assign bt_unused_ok = &({1'd0, avs_writedata[31:1], sched_q[0], sched_q[14], sched_q[16], sched_q[31:20], wsched_q[0], wsched_q[13:12], wsched_q[15]});
 endmodule
 `default_nettype wire

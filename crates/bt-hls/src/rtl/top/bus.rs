@@ -295,11 +295,20 @@ pub(super) fn read_mux(t: &Dims<'_>, mux: &Signal, items: &mut Vec<Item>) {
 /// the linter sees them consumed on purpose.
 pub(super) fn interrupt_and_unused(t: &Dims<'_>, items: &mut Vec<Item>) {
     items.push(Item::Assign(t.io.ins_irq.e(), t.r.done.e()));
-    // The slot buffer's `valid` bit: every entry below the slot's length is a job.
+    // The slot buffer's `valid` bit (every entry below the slot's length is a job), the
+    // write-back fields the load does not read and the load fields the write-back does not.
+    let (pb, ptb) = (t.pb, t.ptb);
+    let top = t.r.sched_q.width() - 1;
     let unused = vec![
         lit(1, 0),
         t.io.avs_writedata.slice(31, 1),
         t.r.sched_q.bit(0),
+        t.r.sched_q.bit(3 + pb + ptb),
+        t.r.sched_q.bit(gtail_bit(t)),
+        t.r.sched_q.slice(top, sched_entry_bits(pb, ptb, t.ib)),
+        t.r.wsched_q.bit(0),
+        t.r.wsched_q.slice(2 + pb + ptb, 1 + pb + ptb),
+        t.r.wsched_q.bit(4 + pb + ptb),
     ];
     Signal::assigned(
         items,

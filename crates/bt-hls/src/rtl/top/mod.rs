@@ -24,6 +24,8 @@ const S_IDLE: u128 = 0;
 const S_DISP: u128 = 1;
 const S_LOAD: u128 = 2;
 const S_EXEC: u128 = 3;
+/// The last slot's write-back runs with no slot loading (the write-back engine, `wb_on`, runs
+/// beside LOAD and EXEC too).
 const S_WB: u128 = 4;
 const STATE_BITS: u32 = 3;
 
@@ -152,7 +154,7 @@ impl<'a> Dims<'a> {
             early: p.model.early_stop().is_some(),
         };
         items.push(Item::Comment(format!(
-            "{} PE instances, capacity {} paths, {} points, {} groups; load (jobs, or jobs + 2 after a dispatch wait) + max({} - jobs - 1, 1, dispatch + 1 - load) + write-back (jobs + 2) cycles per slot (each PE starts after its own load), threshold {} fine LSB",
+            "{} PE instances, capacity {} paths, {} points, {} groups; per slot load (delay + jobs + 2, beside the previous slot's write-back) + max({} - jobs - 1, 1) + write-back (jobs + 2) cycles (each PE starts after its own load), threshold {} fine LSB",
             l.num_instances,
             cap.paths,
             cap.points,
@@ -286,12 +288,13 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
     let t = Dims::of(d, &mut items);
     let pe = declare_pe_wires(&t, &mut items);
     let bus = bus_decode(&t, &mut items);
-    job_memory(&t, &bus, &mut items);
-    let rom = slot_buffer_read(&t, &mut items);
+    let lrom = slot_buffer_load(&t, &mut items);
+    let rom = slot_buffer_writeback(&t, &mut items);
     let dj = dispatch_signals(&t, &mut items);
+    job_memory(&t, &bus, &dj, &mut items);
     slot_buffer_write(&t, &dj, &mut items);
     let rounds_cur = rounds_read(&t, &rom, &mut items);
-    let ports = updater_read_ports(&t, &bus, &rom, &mut items);
+    let ports = updater_read_ports(&t, &bus, (&rom, &lrom), &mut items);
     let sel = pe_output_select(&t, &pe, &mut items);
     let disp = displacement(&t, &sel, &mut items);
     let wb_lb = t
@@ -300,13 +303,13 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
         .map(|(stop, boxes)| early_stop_logic(&t, (stop, boxes), (&disp, &rounds_cur), &mut items));
     let flags = writeback_flags(&t, (&sel, &disp), wb_lb, rounds_cur, &mut items);
     let (push, push_data) = writeback_push(&t, &flags, &mut items);
-    let [start_req, go, scan, empty] = dispatch_triggers(&t, &push, &mut items);
+    let [start_req, go, scan, front, empty] = dispatch_triggers(&t, &push, &mut items);
     ready_queue(&t, &bus, &dj, (&push, &push_data), &start_req, &mut items);
-    items.push(dispatcher(&t, &dj, &go, &scan));
+    items.push(dispatcher(&t, &dj, [&go, &scan, &front]));
     rounds_write(&t, &flags, &mut items);
     updater_write_port(&t, &bus, &ports, &sel, &flags, &mut items);
     pe_matrix(&t, &pe, &mut items);
-    controller(&t, &rom, &flags, [&start_req, &empty], &mut items);
+    controller(&t, (&rom, &lrom), &flags, [&start_req, &empty], &mut items);
     register_writes(&t, &bus, &mut items);
     sched_hi_register(&t, &bus, &mut items);
     let mux = read_pipeline(&t, &bus, &mut items);

@@ -73,10 +73,21 @@ pub(super) struct Regs {
     /// PATHS and ROUND_CAP.
     pub(super) paths_r: Signal,
     pub(super) cap_r: Signal,
-    /// The slot-buffer half of the running slot, and each half's length.
+    /// The slot-buffer half of the front slot (loading or computing), and each half's
+    /// length, load delay and PE columns.
     pub(super) rsel: Signal,
     pub(super) slen_0: Signal,
     pub(super) slen_1: Signal,
+    pub(super) dly_0: Signal,
+    pub(super) dly_1: Signal,
+    pub(super) sused_0: Signal,
+    pub(super) sused_1: Signal,
+    /// The write-back engine: running, its step counter and its slot-buffer half.
+    pub(super) wb_on: Signal,
+    pub(super) wcnt: Signal,
+    pub(super) wsel: Signal,
+    /// Cycles the front slot's load still waits for the write-back it overlaps.
+    pub(super) ldly: Signal,
     /// CYCLES and done.
     pub(super) cycles: Signal,
     pub(super) done: Signal,
@@ -100,14 +111,19 @@ pub(super) struct Regs {
     pub(super) pbig: Signal,
     pub(super) pdz: Signal,
     pub(super) pov: Signal,
-    /// The point memories' read data.
+    /// The point memories' read data (a: previous point or a bus read, b: next point, c: the
+    /// written point's old value).
     pub(super) rd_a: Signal,
     pub(super) rd_b: Signal,
-    /// The slot-buffer entry read this cycle and its qualifiers.
+    pub(super) rd_c: Signal,
+    /// The slot-buffer entries read this cycle for the load (`sched_q`) and the write-back
+    /// (`wsched_q`), and their qualifiers.
     pub(super) sched_q: Signal,
     pub(super) sq_ok: Signal,
     pub(super) sq_tail: Signal,
-    pub(super) sq_ld: Signal,
+    pub(super) wsched_q: Signal,
+    pub(super) wq_ok: Signal,
+    pub(super) wq_tail: Signal,
     /// The registered load entry.
     pub(super) ld_q_en: Signal,
     pub(super) ld_q_tail: Signal,
@@ -118,15 +134,7 @@ pub(super) struct Regs {
     pub(super) ld_go: Signal,
     pub(super) ld_go_inst: Signal,
     /// The registered write-back entry.
-    pub(super) wb_q_en: Signal,
-    pub(super) wb_q_tail: Signal,
-    pub(super) wb_q_end: Signal,
-    pub(super) wb_q_path: Signal,
-    pub(super) wb_q_point: Signal,
-    pub(super) wb_q_inst: Signal,
-    pub(super) wb_q_gtail: Signal,
-    pub(super) wb_q_src: Signal,
-    pub(super) wb_q_gbase: Signal,
+    pub(super) wbe: WbEntry,
     /// The bus read request in flight.
     pub(super) rq_valid: Signal,
     pub(super) rq_kind: Signal,
@@ -143,9 +151,63 @@ pub(super) struct Regs {
     pub(super) rq_q: Signal,
     /// The job-memory word the dispatcher reads.
     pub(super) job_q: Signal,
-    /// The dispatcher's state, scan budget, used / saved columns, slot length, job index,
-    /// conflict, and the examined group's first group and entry.
+    /// The dispatcher's state and registers.
     pub(super) dstate: Signal,
+    pub(super) d: DispatchRegs,
+    /// Memories: the ready queue, the slot buffer and each slot's position per PE column.
+    pub(super) rq: Signal,
+    pub(super) sbuf: Signal,
+    pub(super) spos: Signal,
+    /// The high bits of wide job-memory entries (entries over 32 bits only).
+    pub(super) sched_hi: Option<Signal>,
+    /// Early stopping: left its box, and the round's pending flag.
+    pub(super) lb: Option<Signal>,
+    pub(super) plb: Option<Signal>,
+    /// Memories: per-path rounds and the three point-memory copies.
+    pub(super) rounds: Signal,
+    pub(super) pm_a: Signal,
+    pub(super) pm_b: Signal,
+    pub(super) pm_c: Signal,
+}
+
+/// The registered write-back entry: valid, the slot's tail, the round's end, path, point, PE
+/// column, the group's tail, the job's entry and its path's first group.
+pub(super) struct WbEntry {
+    pub(super) wb_q_en: Signal,
+    pub(super) wb_q_tail: Signal,
+    pub(super) wb_q_end: Signal,
+    pub(super) wb_q_path: Signal,
+    pub(super) wb_q_point: Signal,
+    pub(super) wb_q_inst: Signal,
+    pub(super) wb_q_gtail: Signal,
+    pub(super) wb_q_src: Signal,
+    pub(super) wb_q_gbase: Signal,
+}
+
+impl WbEntry {
+    /// Declares them in order with `r` (path, point, instance and entry bits).
+    fn declare(
+        r: &mut impl FnMut(&str, u32) -> Signal,
+        (pb, ptb, ib, eb): (u32, u32, u32, u32),
+    ) -> Self {
+        WbEntry {
+            wb_q_en: r("wb_q_en", 1),
+            wb_q_tail: r("wb_q_tail", 1),
+            wb_q_end: r("wb_q_end", 1),
+            wb_q_path: r("wb_q_path", pb),
+            wb_q_point: r("wb_q_point", ptb),
+            wb_q_inst: r("wb_q_inst", ib),
+            wb_q_gtail: r("wb_q_gtail", 1),
+            wb_q_src: r("wb_q_src", eb),
+            wb_q_gbase: r("wb_q_gbase", eb),
+        }
+    }
+}
+
+/// The dispatcher's registers: scan budget, used / saved columns, slot length, job index,
+/// conflict, the examined group's first group and entry, the slot's load delay (and its value
+/// before the examined group) and whether a front slot runs.
+pub(super) struct DispatchRegs {
     pub(super) d_scan: Signal,
     pub(super) d_used: Signal,
     pub(super) d_save: Signal,
@@ -154,18 +216,28 @@ pub(super) struct Regs {
     pub(super) d_conf: Signal,
     pub(super) d_gbase: Signal,
     pub(super) d_gptr: Signal,
-    /// Memories: the ready queue and the slot buffer.
-    pub(super) rq: Signal,
-    pub(super) sbuf: Signal,
-    /// The high bits of wide job-memory entries (entries over 32 bits only).
-    pub(super) sched_hi: Option<Signal>,
-    /// Early stopping: left its box, and the round's pending flag.
-    pub(super) lb: Option<Signal>,
-    pub(super) plb: Option<Signal>,
-    /// Memories: per-path rounds and the two point-memory copies.
-    pub(super) rounds: Signal,
-    pub(super) pm_a: Signal,
-    pub(super) pm_b: Signal,
+    pub(super) d_dly: Signal,
+    pub(super) d_dsave: Signal,
+    pub(super) d_front: Signal,
+}
+
+impl DispatchRegs {
+    /// Declares them in order with `r` (path, instance and entry bits `(pb, ib, eb)`).
+    fn declare(r: &mut impl FnMut(&str, u32) -> Signal, (pb, ib, eb): (u32, u32, u32)) -> Self {
+        DispatchRegs {
+            d_scan: r("d_scan", pb + 1),
+            d_used: r("d_used", 1 << ib),
+            d_save: r("d_save", 1 << ib),
+            d_nsl: r("d_nsl", ib + 1),
+            d_gi: r("d_gi", ib + 1),
+            d_conf: r("d_conf", 1),
+            d_gbase: r("d_gbase", eb),
+            d_gptr: r("d_gptr", eb),
+            d_dly: r("d_dly", ib),
+            d_dsave: r("d_dsave", ib),
+            d_front: r("d_front", 1),
+        }
+    }
 }
 
 impl Regs {
@@ -185,6 +257,14 @@ impl Regs {
             rsel: r("rsel", 1),
             slen_0: r("slen_0", ib + 1),
             slen_1: r("slen_1", ib + 1),
+            dly_0: r("dly_0", ib),
+            dly_1: r("dly_1", ib),
+            sused_0: r("sused_0", 1 << ib),
+            sused_1: r("sused_1", 1 << ib),
+            wb_on: r("wb_on", 1),
+            wcnt: r("wcnt", s.cnt_bits),
+            wsel: r("wsel", 1),
+            ldly: r("ldly", ib),
             cycles: r("cycles", 32),
             done: r("done", 1),
             tx_x: r("tx_x", 32),
@@ -205,10 +285,13 @@ impl Regs {
             pov: r("pov", np2),
             rd_a: r("rd_a", pw),
             rd_b: r("rd_b", pw),
+            rd_c: r("rd_c", pw),
             sched_q: r("sched_q", sw + 2 * eb),
             sq_ok: r("sq_ok", 1),
             sq_tail: r("sq_tail", 1),
-            sq_ld: r("sq_ld", 1),
+            wsched_q: r("wsched_q", sw + 2 * eb),
+            wq_ok: r("wq_ok", 1),
+            wq_tail: r("wq_tail", 1),
             ld_q_en: r("ld_q_en", 1),
             ld_q_tail: r("ld_q_tail", 1),
             ld_q_first: r("ld_q_first", 1),
@@ -216,15 +299,7 @@ impl Regs {
             ld_q_inst: r("ld_q_inst", ib),
             ld_go: r("ld_go", 1),
             ld_go_inst: r("ld_go_inst", ib),
-            wb_q_en: r("wb_q_en", 1),
-            wb_q_tail: r("wb_q_tail", 1),
-            wb_q_end: r("wb_q_end", 1),
-            wb_q_path: r("wb_q_path", pb),
-            wb_q_point: r("wb_q_point", ptb),
-            wb_q_inst: r("wb_q_inst", ib),
-            wb_q_gtail: r("wb_q_gtail", 1),
-            wb_q_src: r("wb_q_src", eb),
-            wb_q_gbase: r("wb_q_gbase", eb),
+            wbe: WbEntry::declare(&mut r, (pb, ptb, ib, eb)),
             rq_valid: r("rq_valid", 1),
             rq_kind: r("rq_kind", 2),
             rq_reg: r("rq_reg", 4),
@@ -238,19 +313,16 @@ impl Regs {
             rq_q: r("rq_q", 2 * eb),
             job_q: r("job_q", sw),
             dstate: r("dstate", DSTATE_BITS),
-            d_scan: r("d_scan", pb + 1),
-            d_used: r("d_used", 1 << ib),
-            d_save: r("d_save", 1 << ib),
-            d_nsl: r("d_nsl", ib + 1),
-            d_gi: r("d_gi", ib + 1),
-            d_conf: r("d_conf", 1),
-            d_gbase: r("d_gbase", eb),
-            d_gptr: r("d_gptr", eb),
+            d: DispatchRegs::declare(&mut r, (pb, ib, eb)),
             // The ready queue (one entry per queued path: {first group, next group}, entry
             // indices of the job memory) and the slot buffer (two slots: the running one and
             // the next, each job with {its job-memory entry, its path's first group}).
             rq: Signal::memory(items, "rq", 2 * eb, np2),
             sbuf: Signal::memory(items, "sbuf", sw + 2 * eb, 2 << ib),
+            // The position of each PE column's job in the slot of each half (valid where that
+            // half's `sused` bit is set): the dispatcher compares the front slot's with the
+            // one it builds, for the load delay.
+            spos: Signal::memory(items, "spos", ib, 2 << ib),
             // Entries wider than the bus word: the host writes their high bits first.
             sched_hi: (sw > 32).then(|| Signal::reg(items, "sched_hi", sw - 32)),
             lb: s.early.then(|| Signal::reg(items, "lb", np2)),
@@ -259,10 +331,12 @@ impl Regs {
             // paths that committed a round since the start (the RAM cannot be cleared in one
             // cycle).
             rounds: Signal::memory(items, "rounds", 16, np2),
-            // Two copies of the point memory (one per read port, both written): each is a
-            // plain 1-write 1-read array with a registered read, which Yosys maps to M9K.
+            // Three copies of the point memory (one per read port, all written: the load's
+            // two neighbours, the write-back's old point): each is a plain 1-write 1-read
+            // array with a registered read, which Yosys maps to M9K.
             pm_a: Signal::memory(items, "pm_a", pw, depth),
             pm_b: Signal::memory(items, "pm_b", pw, depth),
+            pm_c: Signal::memory(items, "pm_c", pw, depth),
         }
     }
 

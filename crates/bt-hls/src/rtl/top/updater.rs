@@ -5,9 +5,11 @@ use super::*;
 
 /// The ports of the coordinate updater-buffer (the two point memory copies).
 pub(super) struct UpdaterPorts {
-    /// Read addresses of the two copies (port a: previous or own point, port b: next point).
+    /// Read addresses of the three copies (port a: previous point or a bus read, port b:
+    /// next point, port c: the written point's old value).
     pub(super) ra_addr: Signal,
     pub(super) rb_addr: Signal,
+    pub(super) rc_addr: Signal,
     /// Write enable, address `{point, bank}` and data of the common write port.
     pub(super) wr_en: Signal,
     pub(super) wr_addr: Signal,
@@ -15,10 +17,10 @@ pub(super) struct UpdaterPorts {
 }
 
 /// Rounds memory, read side: `rounds_q` <= rounds[addr] every cycle, the address being the
-/// schedule entry's path at write-back (so `rounds_q` holds rounds[wb_q_path] when the entry
-/// commits: a path's jobs in a slot belong to one round, so no commit of the same path sits
-/// between) and the bus address otherwise (a PATH_STATUS read while idle).
-/// `rounds_cur` = the rounds `wb_q_path` has committed since the start.
+/// write-back entry's path while the write-back engine runs (so `rounds_q` holds
+/// rounds[wb_q_path] when the entry commits: a path's jobs in a slot belong to one round, so
+/// no commit of the same path sits between) and the bus address otherwise (a PATH_STATUS read
+/// while idle). `rounds_cur` = the rounds `wb_q_path` has committed since the start.
 pub(super) fn rounds_read(t: &Dims<'_>, rom: &ScheduleRead, items: &mut Vec<Item>) -> Signal {
     items.push(Item::Comment(
         "rounds memory (M9K): read at the write-back entry's path, or the bus address".into(),
@@ -28,7 +30,7 @@ pub(super) fn rounds_read(t: &Dims<'_>, rom: &ScheduleRead, items: &mut Vec<Item
         "rounds_ra",
         t.pb,
         Expr::mux(
-            state_is(t, S_WB),
+            t.r.wb_on.e(),
             rom.path.e(),
             t.io.avs_address.slice(t.pb - 1, 0),
         ),
@@ -42,7 +44,7 @@ pub(super) fn rounds_read(t: &Dims<'_>, rom: &ScheduleRead, items: &mut Vec<Item
         "rounds_cur",
         16,
         Expr::mux(
-            t.r.rvalid.at(t.r.wb_q_path.e()),
+            t.r.rvalid.at(t.r.wbe.wb_q_path.e()),
             t.r.rounds_q.e(),
             lit(16, 0),
         ),
@@ -52,9 +54,9 @@ pub(super) fn rounds_read(t: &Dims<'_>, rom: &ScheduleRead, items: &mut Vec<Item
 /// Rounds memory, write side: a committed round's end writes rounds_cur + 1.
 pub(super) fn rounds_write(t: &Dims<'_>, f: &WritebackFlags, items: &mut Vec<Item>) {
     items.push(Item::AlwaysFf(vec![Stmt::If(
-        f.go.e().and(t.r.wb_q_end.e()),
+        f.go.e().and(t.r.wbe.wb_q_end.e()),
         vec![nb(
-            t.r.rounds.at(t.r.wb_q_path.e()),
+            t.r.rounds.at(t.r.wbe.wb_q_path.e()),
             f.rounds.e().plus(lit(16, 1)),
         )],
         vec![],
@@ -62,12 +64,13 @@ pub(super) fn rounds_write(t: &Dims<'_>, f: &WritebackFlags, items: &mut Vec<Ite
 }
 
 /// Coordinate updater-buffer, read side: two banks per point, bank = cur[path] holds the last
-/// committed round. Port a reads the job's previous point at load and its own point at
-/// write-back (the old value, for the displacement); port b reads the next point.
+/// committed round. Port a reads the loaded job's previous point (or a bus read while idle),
+/// port b its next point, port c the written-back job's own point (the old value, for the
+/// displacement), so a slot loads while the previous one writes back.
 pub(super) fn updater_read_ports(
     t: &Dims<'_>,
     bus: &Decode,
-    rom: &ScheduleRead,
+    (rom, lrom): (&ScheduleRead, &LoadRead),
     items: &mut Vec<Item>,
 ) -> UpdaterPorts {
     let ptb = t.ptb;
@@ -75,11 +78,11 @@ pub(super) fn updater_read_ports(
         "coordinate updater-buffer: address {point, bank}; cur[path] = bank of the committed round"
             .into(),
     ));
-    let rom_bank = t.r.cur.at(rom.path.e());
     // Neighbours: the committed bank, or for a late job the bank its round writes.
-    let nb_bank = Expr::bin(BinaryOp::Xor, rom_bank.clone(), rom.late.e());
+    let nb_bank = Expr::bin(BinaryOp::Xor, t.r.cur.at(lrom.path.e()), lrom.late.e());
     let ra_addr = Signal::reg(items, "ra_addr", ptb + 1);
     let rb_addr = Signal::reg(items, "rb_addr", ptb + 1);
+    let rc_addr = Signal::reg(items, "rc_addr", ptb + 1);
     let wr_addr = Signal::reg(items, "wr_addr", ptb + 1);
     let wr_en = Signal::reg(items, "wr_en", 1);
     let wr_data = Signal::reg(items, "wr_data", point_bits(t.wd));
@@ -87,28 +90,26 @@ pub(super) fn updater_read_ports(
     items.push(Item::AlwaysComb(vec![
         Stmt::Blocking(ra_addr.e(), bus_cell(t, bus)),
         Stmt::If(
-            or(state_is(t, S_LOAD), rom.load.e()),
+            state_is(t, S_LOAD),
             vec![Stmt::Blocking(
                 ra_addr.e(),
-                Expr::concat(vec![rom.point.e().minus(one_pt.clone()), nb_bank.clone()]),
+                Expr::concat(vec![lrom.point.e().minus(one_pt.clone()), nb_bank.clone()]),
             )],
-            vec![Stmt::If(
-                state_is(t, S_WB),
-                vec![Stmt::Blocking(
-                    ra_addr.e(),
-                    Expr::concat(vec![rom.point.e(), rom_bank.clone()]),
-                )],
-                vec![],
-            )],
+            vec![],
         ),
         Stmt::Blocking(
             rb_addr.e(),
-            Expr::concat(vec![rom.point.e().plus(one_pt), nb_bank]),
+            Expr::concat(vec![lrom.point.e().plus(one_pt), nb_bank]),
+        ),
+        Stmt::Blocking(
+            rc_addr.e(),
+            Expr::concat(vec![rom.point.e(), t.r.cur.at(rom.path.e())]),
         ),
     ]));
     UpdaterPorts {
         ra_addr,
         rb_addr,
+        rc_addr,
         wr_en,
         wr_addr,
         wr_data,
@@ -116,7 +117,7 @@ pub(super) fn updater_read_ports(
 }
 
 /// Coordinate updater-buffer, write side: the host's point writes while idle, the selected
-/// PE's result into the other bank at write-back; both memory copies take every write.
+/// PE's result into the other bank at write-back; every memory copy takes every write.
 pub(super) fn updater_write_port(
     t: &Dims<'_>,
     bus: &Decode,
@@ -139,13 +140,13 @@ pub(super) fn updater_write_port(
         Stmt::Blocking(ports.wr_addr.e(), bus_cell(t, bus)),
         Stmt::Blocking(ports.wr_data.e(), host_point),
         Stmt::If(
-            state_is(t, S_WB),
+            t.r.wb_on.e(),
             vec![
                 Stmt::Blocking(
                     ports.wr_addr.e(),
                     Expr::concat(vec![
-                        t.r.wb_q_point.e(),
-                        t.r.cur.at(t.r.wb_q_path.e()).inv(),
+                        t.r.wbe.wb_q_point.e(),
+                        t.r.cur.at(t.r.wbe.wb_q_path.e()).inv(),
                     ]),
                 ),
                 Stmt::Blocking(ports.wr_data.e(), sel.point.e()),
@@ -156,6 +157,7 @@ pub(super) fn updater_write_port(
     for (mem, rd, addr) in [
         (&t.r.pm_a, &t.r.rd_a, &ports.ra_addr),
         (&t.r.pm_b, &t.r.rd_b, &ports.rb_addr),
+        (&t.r.pm_c, &t.r.rd_c, &ports.rc_addr),
     ] {
         items.push(Item::AlwaysFf(vec![
             Stmt::If(

@@ -31,19 +31,19 @@ pub(super) fn writeback_push(
         "wb_push",
         1,
         f.go.e()
-            .and(t.r.wb_q_gtail.e())
-            .and(or(t.r.wb_q_end.e().lnot(), again.e())),
+            .and(t.r.wbe.wb_q_gtail.e())
+            .and(or(t.r.wbe.wb_q_end.e().lnot(), again.e())),
     );
     let next = Expr::mux(
-        t.r.wb_q_end.e(),
-        t.r.wb_q_gbase.e(),
-        t.r.wb_q_src.e().plus(lit(eb, 1)),
+        t.r.wbe.wb_q_end.e(),
+        t.r.wbe.wb_q_gbase.e(),
+        t.r.wbe.wb_q_src.e().plus(lit(eb, 1)),
     );
     let data = Signal::assigned(
         items,
         "wb_push_data",
         2 * eb,
-        Expr::concat(vec![t.r.wb_q_gbase.e(), next]),
+        Expr::concat(vec![t.r.wbe.wb_q_gbase.e(), next]),
     );
     (push, data)
 }
@@ -81,7 +81,7 @@ pub(super) fn pe_output_select(t: &Dims<'_>, pe: &[PeWires], items: &mut Vec<Ite
         Stmt::Blocking(zs.e(), lit(1, 0)),
     ];
     items.push(Item::AlwaysComb(vec![Stmt::Case(
-        t.r.wb_q_inst.e(),
+        t.r.wbe.wb_q_inst.e(),
         sel_arms,
         sel_default,
     )]));
@@ -147,7 +147,7 @@ pub(super) fn displacement(t: &Dims<'_>, sel: &Selected, items: &mut Vec<Item>) 
     for (a, axis) in ["x", "y", "z"].iter().enumerate() {
         let (hi, lo) = (cw * (a as u32 + 1) - 1, cw * a as u32);
         let nw = Signal::assigned(items, format!("new_{axis}"), cw, sel.point.slice(hi, lo));
-        let old = t.r.rd_a.slice(hi, lo);
+        let old = t.r.rd_c.slice(hi, lo);
         let ow = Signal::assigned(items, format!("old_{axis}"), cw, old);
         let wide = |s: &Signal| crate::rtl::pe::sext(s.name(), cw, dispw);
         let delta = wide(&nw).minus(wide(&ow));
@@ -203,7 +203,7 @@ pub(super) fn writeback_flags(
     items: &mut Vec<Item>,
 ) -> WritebackFlags {
     let r = &t.r;
-    let at_wb = |v: &Signal| v.at(r.wb_q_path.e());
+    let at_wb = |v: &Signal| v.at(r.wbe.wb_q_path.e());
     let frozen_sig = Signal::wire(items, "wb_frozen", 1);
     let mut frozen = or(or(at_wb(&r.conv), at_wb(&r.dz)), at_wb(&r.ov));
     let any_lb = wb_lb.zip(r.early()).map(|(wb_lb, (lb, plb))| {
@@ -215,8 +215,9 @@ pub(super) fn writeback_flags(
         items,
         "wb_go",
         1,
-        state_is(t, S_WB)
-            .and(t.r.wb_q_en.e())
+        t.r.wb_on
+            .e()
+            .and(t.r.wbe.wb_q_en.e())
             .and(frozen_sig.e().lnot()),
     );
     let any_big = Signal::assigned(items, "any_big", 1, or(at_wb(&r.pbig), disp.big.e()));
@@ -236,7 +237,7 @@ pub(super) fn writeback_flags(
 /// round and decide convergence; inside the round, accumulate the flags.
 pub(super) fn path_commit(t: &Dims<'_>, f: &WritebackFlags) -> Vec<Stmt> {
     let r = &t.r;
-    let wbp = |v: &Signal| v.at(r.wb_q_path.e());
+    let wbp = |v: &Signal| v.at(r.wbe.wb_q_path.e());
     let mut conv_next = f
         .any_big
         .e()
@@ -255,7 +256,7 @@ pub(super) fn path_commit(t: &Dims<'_>, f: &WritebackFlags) -> Vec<Stmt> {
         in_round.push(nb(wbp(plb), any_lb.e()));
     }
     vec![Stmt::If(
-        t.r.wb_q_end.e(),
+        t.r.wbe.wb_q_end.e(),
         vec![
             nb(wbp(&r.cur), wbp(&r.cur).inv()),
             nb(wbp(&r.rvalid), lit(1, 1)),
@@ -328,7 +329,7 @@ pub(super) fn instance_box(
             .into(),
     ));
     items.push(Item::AlwaysComb(vec![Stmt::Case(
-        t.r.wb_q_inst.e(),
+        t.r.wbe.wb_q_inst.e(),
         arms,
         defaults,
     )]));
