@@ -190,7 +190,7 @@ impl Antenna {
     /// receiver).
     ///
     /// Unrotated antennas skip the rotation, isotropic ones the angles: the basis comes from
-    /// the direction's components ([`basis_towards`]).
+    /// the direction's components.
     pub fn field(&self, direction: Vec3) -> Vec3 {
         let rotation =
             (self.orientation != Orientation::default()).then(|| self.orientation.matrix());

@@ -10,7 +10,7 @@
 //! current content on every hit, so an edited mesh misses. The entry is
 //! `MAGIC | version | payload length | payload (postcard; the scene inside it postcard bytes of
 //! its own, decoded while the inputs are hashed) | checksum of all before` (the SHA-256 of the
-//! SHA-256s of its 64 KiB pieces, [`checksum`]); anything
+//! SHA-256s of its 64 KiB pieces, `checksum`); anything
 //! that does not decode, check or rebuild (damaged, truncated, foreign, over the file budget)
 //! is ignored with a warning and replaced by a fresh load. Writes are atomic (a temporary file
 //! in the cache directory, renamed); a failed write is a warning, never a failed load.
