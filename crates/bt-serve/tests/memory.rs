@@ -1,5 +1,5 @@
 //! Memory stays flat over a long stream: the live heap after a warm-up stream and after a
-//! five times longer one differ by less than one answer's worth.
+//! 25 times longer one differ by less than three answers' worth.
 //!
 //! Its own test binary (not a module of `tests/it`): the counting allocator sees every thread
 //! of the process, so no other test may run beside it.
@@ -91,13 +91,18 @@ fn memory_stays_flat_over_a_long_stream() {
     let (answered, sent) = stream(&mut server, 0..200);
     assert_eq!(answered as usize, sent);
     let warm = LIVE.load(Ordering::Relaxed);
-    let (answered, sent) = stream(&mut server, 200..1200);
+    let (answered, sent) = stream(&mut server, 200..5200);
     assert_eq!(answered as usize, sent);
     let after = LIVE.load(Ordering::Relaxed);
     let growth = after - warm;
-    // One answer of the living room at order 2 is ~15 KB; 1,000 requests kept would be MBs.
+    // One answer of the living room at order 2 is ~15 KB; 5,000 requests kept would be tens
+    // of MB. What is held between requests may still differ by a few answers' worth: each
+    // pool thread keeps the records of the largest report it has made, and which thread
+    // gets which receiver of a batch depends on the scheduling (up to 26 KB over 1,000
+    // requests in 120 runs). Three answers' worth over 5,000 requests catches any leak of
+    // 10 bytes a request or more.
     assert!(
-        growth < 16 * 1024,
-        "live heap grew by {growth} bytes over 1,000 requests ({warm} -> {after})"
+        growth < 48 * 1024,
+        "live heap grew by {growth} bytes over 5,000 requests ({warm} -> {after})"
     );
 }
