@@ -228,8 +228,10 @@ pub fn predict(groups: &[Vec<Group>], columns: usize, rounds: &[u32], latency: u
         let n = slot.jobs;
         let first_load = enter + slot.delay + 2;
         let pe_ready = first_load + (lat - 1).max(n + 1);
-        let wb = pe_ready.max(d_end + 2).max(wb_last.map_or(0, |w| w + 2));
-        run.dispatch_wait_cycles += wb - pe_ready.max(wb_last.map_or(0, |w| w + 2));
+        // Ready but for the dispatcher: the PEs done and the previous write-back over.
+        let ready = pe_ready.max(wb_last.map_or(0, |w| w + 2));
+        let wb = ready.max(d_end + 2);
+        run.dispatch_wait_cycles += wb - ready;
         run.slots += 1;
         run.jobs += n;
         run.load_delay_cycles += slot.delay;

@@ -34,8 +34,9 @@ impl Server {
     /// Receivers a batch gathers before it is answered: eight per core, so each core has
     /// work between the batch's serial steps (reading, writing) and the uneven traces even out,
     /// while a waiting request's answer stays a few traces away. A batch only fills when
-    /// requests queue up (it is answered as soon as no whole line waits); two per core spent
-    /// 1.6-1.7 s CPU on a 10,000-move stream against 1.4 s for eight (docs/performance.md).
+    /// requests queue up (it is answered as soon as no whole line waits); with two per core a
+    /// 10,000-move stream took 1.59-1.74 s of CPU, with eight 1.35-1.48 s (the same build
+    /// otherwise, run alternately).
     /// One when the tracer runs on one thread: each request is answered as it comes.
     pub(crate) fn batch_receivers(&self) -> usize {
         match self.parallel() {

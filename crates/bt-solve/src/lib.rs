@@ -56,7 +56,8 @@ pub enum Solver {
 /// ordinary orders), on the heap beyond: a slice to read.
 pub type Inline<T, const N: usize> = smallvec::SmallVec<[T; N]>;
 
-/// A valid path found by a solver: specular, or with one edge diffraction.
+/// A valid path found by a solver: reflections, with up to two edge diffractions and any
+/// slab crossings.
 ///
 /// Its lists are [`Inline`]: up to order 4 a path costs no allocation (a trace finds hundreds).
 #[derive(Debug, Clone, PartialEq, Serialize)]
