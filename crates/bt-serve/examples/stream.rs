@@ -2,7 +2,8 @@
 //! (order 3 unless given), streamed through one `Server` as JSON lines from memory into
 //! memory: one request at a time (`answer_line`, as a client that waits for each answer), then
 //! the whole stream at once (consecutive moves answered together), then in requests of BATCH
-//! receivers. Prints the throughput and the percentiles of `latency_us` (docs/performance.md).
+//! receivers. Prints the throughput, the percentiles of `latency_us` and, for one receiver per
+//! request, the mean paths and stage times of an answer (docs/performance.md).
 //!
 //! `cargo run --release -p bt-serve --example stream -- [MOVES] [MAX_ORDER] [BATCH]`
 
@@ -86,9 +87,26 @@ fn latencies<'a>(
     seconds: f64,
 ) -> Result<(f64, Vec<f64>), Box<dyn std::error::Error>> {
     let mut latencies = Vec::new();
+    // One receiver's answers: its stage times and paths, summed (a list's are inside
+    // `results`, not summed).
+    let (mut stages, mut paths) = ([0.0; 3], 0);
     for line in answers.filter(|l| !l.is_empty()) {
         let v: serde_json::Value = serde_json::from_slice(line)?;
         latencies.extend(v["latency_us"].as_f64());
+        for (sum, stage) in stages.iter_mut().zip(["candidates", "solve", "report"]) {
+            *sum += v["stats"]["time_s"][stage].as_f64().unwrap_or(0.0);
+        }
+        paths += v["paths"].as_array().map_or(0, Vec::len);
+    }
+    if paths > 0 {
+        let n = latencies.len().max(1) as f64;
+        let [c, s, r] = stages.map(|t| t / n * 1e6);
+        println!(
+            "{:>14}  per answer: {:.1} paths; candidates {c:.1} us, solve {s:.1} us, report \
+             {r:.1} us",
+            "",
+            paths as f64 / n
+        );
     }
     latencies.sort_by(f64::total_cmp);
     Ok((seconds, latencies))
