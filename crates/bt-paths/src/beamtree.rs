@@ -25,11 +25,12 @@ use bt_geom::bvh::box_meets_halfspaces;
 use bt_geom::{Plane, Real, Vec3, convex};
 use bt_scene::{Scene, SurfaceId, SurfaceKind};
 use serde::{Deserialize, Serialize};
-use std::cell::OnceCell;
+use std::sync::OnceLock;
 
 mod diffraction;
 
 use crate::diffraction::Diffracting;
+mod chunked;
 mod rebuild;
 mod receivers;
 pub use diffraction::{DiffractionSide, join as join_diffracted};
@@ -49,6 +50,10 @@ pub struct TreeOptions {
     /// not read them (the image method) turn this off: a single-receiver trace then does not
     /// clip the last window of each candidate it emits.
     pub starts: bool,
+    /// Grow the materialised levels of a large scene's tree on all cores (rayon). The tree
+    /// is the same either way: its levels are grown in fixed chunks of parents, appended in
+    /// order.
+    pub parallel: bool,
 }
 
 /// When the tree tests its nodes for occlusion (`occlude`). Culling never changes the paths
@@ -70,13 +75,14 @@ pub enum Culling {
 }
 
 impl TreeOptions {
-    /// Order `max_order`, 2 million nodes (about 1 GB), [`Culling::Auto`] (64).
+    /// Order `max_order`, 2 million nodes (about 1 GB), [`Culling::Auto`] (64), one thread.
     pub fn new(max_order: usize) -> Self {
         TreeOptions {
             max_order,
             max_nodes: 2_000_000,
             culling: Culling::Auto { min_work: 64 },
             starts: true,
+            parallel: false,
         }
     }
 }
@@ -175,6 +181,17 @@ pub struct TreeStats {
     /// candidates stay a superset of what a new tree would give, with the same valid paths.
     #[serde(skip)]
     pub occluders: Vec<u32>,
+}
+
+impl TreeStats {
+    /// Add `other`'s counts and occluders (a chunk's, [`BeamTree::grow_level`]) to these.
+    fn absorb(&mut self, other: &TreeStats) {
+        self.tested += other.tested;
+        self.empty += other.empty;
+        self.occluded += other.occluded;
+        self.occluder_clips += other.occluder_clips;
+        self.occluders.extend_from_slice(&other.occluders);
+    }
 }
 
 /// One node: a prefix ending on `surface`.
@@ -381,8 +398,8 @@ impl std::fmt::Debug for TreeCache {
 struct Shapes {
     geometry: Option<bt_scene::GeometryKey>,
     margin: Real,
-    hulls: Vec<OnceCell<Vec<Vec3>>>,
-    convex: Vec<OnceCell<bool>>,
+    hulls: Vec<OnceLock<Vec<Vec3>>>,
+    convex: Vec<OnceLock<bool>>,
 }
 
 impl Shapes {
@@ -400,8 +417,8 @@ impl Shapes {
         Shapes {
             geometry: Some(scene.geometry_key()),
             margin,
-            hulls: (0..n).map(|_| OnceCell::new()).collect(),
-            convex: (0..n).map(|_| OnceCell::new()).collect(),
+            hulls: (0..n).map(|_| OnceLock::new()).collect(),
+            convex: (0..n).map(|_| OnceLock::new()).collect(),
         }
     }
 }
@@ -641,6 +658,14 @@ impl BeamTree {
         progress: Progress<'_>,
     ) -> Result<(), TreeError> {
         let materialised = leaf.is_none();
+        if prep.cull_at_build {
+            // Nodes are culled as they are built, so no parent changes: chunks of parents
+            // can grow apart.
+            return match leaf {
+                None => self.grow_level_chunked(prep, depth, progress),
+                Some(leaf) => self.grow_leaves_chunked(prep, depth, leaf, progress),
+            };
+        }
         if materialised {
             // A fresh level (a rebuild instead keeps the old tree's arenas, already sized).
             let parents = match depth {
@@ -996,8 +1021,9 @@ impl BeamTree {
 /// The last level of a single-receiver trace: RX, each surface's signed distance to RX and
 /// RX's mirror image in it (computed once, read by every leaf test), the candidates emitted.
 struct Leaf<'o> {
-    /// Per surface: (signed distance of RX, m; RX mirrored through the plane).
-    mirrored: Vec<(Real, Vec3)>,
+    /// Per surface: (signed distance of RX, m; RX mirrored through the plane), shared by the
+    /// chunks of a level grown in parallel.
+    mirrored: std::sync::Arc<[(Real, Vec3)]>,
     /// The current parent's apex's signed distance to each of its beam planes, m (read by
     /// each of its leaf tests).
     apex_d: Vec<Real>,
@@ -1030,6 +1056,11 @@ impl<'o> Leaf<'o> {
                 (d, rx - (2.0 * d) * pl.normal)
             })
             .collect();
+        Leaf::with_mirrored(mirrored, out)
+    }
+
+    /// Leaf tests against the RX of `mirrored` (see [`Leaf::mirrored`]), emitting into `out`.
+    fn with_mirrored(mirrored: std::sync::Arc<[(Real, Vec3)]>, out: &'o mut CandidateSet) -> Self {
         Leaf {
             mirrored,
             apex_d: Vec::new(),
@@ -1292,29 +1323,15 @@ fn worth_rx_visibility(prep: &Prepared<'_>, tree: &BeamTree) -> bool {
 /// window. A reflector that a convex occluder covers entirely as seen from RX ends no valid
 /// path: its last segment would cross the occluder (the reverse of culling a first
 /// reflection from TX). Blockers are `false`.
-fn rx_visibility(
-    prep: &Prepared<'_>,
-    rx: Vec3,
-    scratch: &mut Scratch,
-    stats: &mut TreeStats,
-) -> RxVisible {
+fn rx_visibility(prep: &Prepared<'_>, rx: Vec3, stats: &mut TreeStats) -> RxVisible {
     let mut visible = vec![false; prep.planes.len()];
-    let from_rx = Parent {
-        index: ROOT,
-        surface: None,
-        apex: rx,
-        planes: &[],
-    };
-    for &s in &prep.reflectors {
-        if prep.plane(s).signed_distance_unfused(rx).abs() <= prep.tol {
-            // RX in the surface's plane: every path ending there grazes; keep it (validation
-            // decides), as the tree keeps what it cannot prove.
+    for (part, seen) in
+        chunked::map_chunks(prep, &prep.reflectors, |chunk| rx_sees(prep, rx, chunk))
+    {
+        stats.absorb(&part);
+        for s in seen {
             visible[s as usize] = true;
-            continue;
         }
-        scratch.a.clear();
-        scratch.a.extend_from_slice(prep.hull(s));
-        visible[s as usize] = !occlude(prep, &from_rx, s, scratch, stats);
     }
     let ids: Vec<u32> = prep
         .reflectors
@@ -1331,6 +1348,30 @@ fn rx_visibility(
         bvh: bt_geom::bvh::Bvh::build(&polygons),
         ids,
     }
+}
+
+/// The reflectors of `chunk` that RX sees (see [`rx_visibility`]), and the occlusion tests'
+/// statistics.
+fn rx_sees(prep: &Prepared<'_>, rx: Vec3, chunk: &[u32]) -> (TreeStats, Vec<u32>) {
+    let from_rx = Parent {
+        index: ROOT,
+        surface: None,
+        apex: rx,
+        planes: &[],
+    };
+    let (mut stats, mut scratch) = (TreeStats::default(), Scratch::default());
+    let seen = chunk.iter().copied().filter(|&s| {
+        if prep.plane(s).signed_distance_unfused(rx).abs() <= prep.tol {
+            // RX in the surface's plane: every path ending there grazes; keep it (validation
+            // decides), as the tree keeps what it cannot prove.
+            return true;
+        }
+        scratch.a.clear();
+        scratch.a.extend_from_slice(prep.hull(s));
+        !occlude(prep, &from_rx, s, &mut scratch, &mut stats)
+    });
+    let seen = seen.collect();
+    (stats, seen)
 }
 
 /// The candidates of `scene` for its own RX up to `options.max_order`: the tree is built to
@@ -1384,7 +1425,7 @@ pub fn candidates_and_diffracted_in(
     let mut set = tree.candidates(rx);
     if options.max_order > 0 {
         if worth_rx_visibility(&prep, &tree) {
-            prep.rx_visible = Some(rx_visibility(&prep, rx, &mut scratch, &mut tree.stats));
+            prep.rx_visible = Some(rx_visibility(&prep, rx, &mut tree.stats));
         }
         let mut leaf = Leaf::new(&prep, rx, &mut set);
         tree.grow_level(

@@ -124,6 +124,15 @@ impl CandidateSet {
         self.starts.extend_from_slice(starts);
         self.push(seq);
     }
+    /// Append `other`'s candidates in order, with their start points when `other` has them.
+    pub fn append(&mut self, other: &CandidateSet) {
+        for i in 0..other.len() {
+            match other.start(i) {
+                Some(starts) => self.push_with_starts(other.get(i), starts),
+                None => self.push(other.get(i)),
+            }
+        }
+    }
     /// All candidates in order.
     pub fn iter(&self) -> impl ExactSizeIterator<Item = &[SurfaceId]> + '_ {
         (0..self.len()).map(|i| self.get(i))

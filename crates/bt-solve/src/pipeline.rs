@@ -280,6 +280,7 @@ fn generate(
 pub(crate) fn tree_options(options: &TraceOptions) -> TreeOptions {
     TreeOptions {
         max_nodes: options.max_candidates,
+        parallel: options.parallel,
         ..TreeOptions::new(options.max_order)
     }
 }

@@ -496,6 +496,43 @@ fn kept_hulls_give_the_candidates_of_a_fresh_thread() {
     }
 }
 
+/// A large scene's levels grow in fixed chunks, on all cores when the options say so: the
+/// small city's candidates and start points (single-receiver traces and kept trees, with
+/// culling as it is built by default and for every node), and a culled-at-build room's, are the
+/// same on one thread and on all, and so are the trees' statistics.
+#[test]
+fn a_tree_grown_on_all_cores_is_the_tree_grown_on_one() {
+    let rooms = (0..3).map(|seed| bt_testkit::random_scene(seed, 34));
+    let scenes: Vec<Scene> = [small_city(95.0, 1.5), small_city(20.0, 3.0)]
+        .into_iter()
+        .chain(rooms)
+        .collect();
+    for (k, scene) in scenes.iter().enumerate() {
+        for culling in [Culling::Auto { min_work: 64 }, Culling::Always] {
+            let one = TreeOptions {
+                culling,
+                starts: true,
+                ..TreeOptions::new(3)
+            };
+            let all = TreeOptions {
+                parallel: true,
+                ..one
+            };
+            let [a, b] = [one, all].map(|o| bt_paths::beamtree::candidates(scene, o).unwrap());
+            assert!(
+                listing(&a) == listing(&b),
+                "scene {k}, {culling:?}: candidates differ"
+            );
+            assert_eq!(a.tree, b.tree, "scene {k}, {culling:?}");
+            let [a, b] = [one, all].map(|o| BeamTree::build(scene, o).unwrap());
+            let rx = scene.rx().unwrap();
+            let walks = [&a, &b].map(|t| listing(&t.candidates(rx)));
+            assert!(walks[0] == walks[1], "scene {k}, {culling:?}: walks differ");
+            assert_eq!(a.stats(), b.stats(), "scene {k}, {culling:?}");
+        }
+    }
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 48, ..ProptestConfig::default() })]
 
