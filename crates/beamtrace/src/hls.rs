@@ -207,6 +207,12 @@ fn generate(args: &HlsGenArgs) -> anyhow::Result<ExitCode> {
         ..bt_hls::Platform::fitting(&work)?
     };
     let k = platform.instances.len() as u32;
+    for p in planned.iter_mut() {
+        // A stream's platform may hold PEs a step does not use: predict on all of them.
+        if p.plan.schedule.instances.len() != k as usize {
+            p.predict_on(k as usize)?;
+        }
+    }
     let rtl_written = !args.plan_only;
     if rtl_written {
         let report = bt_hls::generate_steps_into(&platform, &work, &mut out)?;
