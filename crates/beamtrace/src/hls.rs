@@ -190,7 +190,8 @@ fn generate(args: &HlsGenArgs) -> anyhow::Result<ExitCode> {
     // The output directory is locked, built aside and moved in: a user's own files survive.
     let mut out = OutputDir::begin(&args.output, &loaded.sources)
         .with_context(|| format!("creating {}", args.output.display()))?;
-    // The platform: one PE per reflector that no step moves.
+    // The platform's planes: the reflectors that no step moves (a PE for each that a step
+    // meets, `bt_hls::Platform::fitting`).
     let planes = bt_accel::static_reflectors(scenes);
     let options = step_options(args);
     let mut planned: Vec<bt_accel::PlannedStep> = Vec::with_capacity(scenes.len());
