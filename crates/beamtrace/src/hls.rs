@@ -190,7 +190,8 @@ fn generate(args: &HlsGenArgs) -> anyhow::Result<ExitCode> {
     // The output directory is locked, built aside and moved in: a user's own files survive.
     let mut out = OutputDir::begin(&args.output, &loaded.sources)
         .with_context(|| format!("creating {}", args.output.display()))?;
-    // The platform: one PE per reflector that no step moves.
+    // The platform's planes: the reflectors that no step moves (a PE for each that a step
+    // meets, `bt_hls::Platform::fitting`).
     let planes = bt_accel::static_reflectors(scenes);
     let options = step_options(args);
     let mut planned: Vec<bt_accel::PlannedStep> = Vec::with_capacity(scenes.len());
@@ -207,6 +208,12 @@ fn generate(args: &HlsGenArgs) -> anyhow::Result<ExitCode> {
         ..bt_hls::Platform::fitting(&work)?
     };
     let k = platform.instances.len() as u32;
+    for p in planned.iter_mut() {
+        // A stream's platform may hold PEs a step does not use: predict on all of them.
+        if p.plan.schedule.instances.len() != k as usize {
+            p.predict_on(k as usize)?;
+        }
+    }
     let rtl_written = !args.plan_only;
     if rtl_written {
         let report = bt_hls::generate_steps_into(&platform, &work, &mut out)?;

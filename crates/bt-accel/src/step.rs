@@ -166,7 +166,9 @@ pub fn plan_step(
         .run(step.input.tx, step.input.rx)
         .map_err(|e| hardware(e.into()))?;
     let rounds: Vec<u32> = results.iter().map(|r| r.rounds).collect();
-    let columns = platform_columns(step.input.planes.len(), &plan.schedule.copies());
+    // The platform fitted to this step alone ([`bt_hls::Platform::fitting`]): a PE per
+    // instance of the schedule; [`PlannedStep::predict_on`] re-predicts on a larger one.
+    let columns = plan.schedule.instances.len();
     bt_hls::predict_dispatch(&mut plan, &rounds, columns, step.input.pe_latency())
         .map_err(hardware)?;
     let t3 = Instant::now();
@@ -186,15 +188,25 @@ pub fn plan_step(
     })
 }
 
-/// PE columns of a platform with one PE per plane of `planes` and `copies[p]` of plane `p`
-/// ([`bt_hls::Platform::fitting`]).
-fn platform_columns(planes: usize, copies: &[u32]) -> usize {
-    (0..planes)
-        .map(|p| copies.get(p).copied().unwrap_or(0).max(1) as usize)
-        .sum()
-}
-
 impl PlannedStep {
+    /// Predict the step's cycles again on a platform of `columns` PEs (one that runs several
+    /// steps may have PEs this step's schedule does not use; the dispatcher stops examining
+    /// groups once every PE column of the slot it builds is taken, so the count matters).
+    /// Sets `plan.predicted_cycles` and `plan.dispatch`.
+    pub fn predict_on(&mut self, columns: usize) -> Result<(), AccelError> {
+        let rounds: Vec<u32> = self.results.iter().map(|r| r.rounds).collect();
+        bt_hls::predict_dispatch(
+            &mut self.plan,
+            &rounds,
+            columns,
+            self.step.input.pe_latency(),
+        )
+        .map_err(|source| AccelError::Hardware {
+            step: self.index,
+            source,
+        })
+    }
+
     /// The work the host loads over the bus for this step.
     pub fn work(&self) -> bt_hls::StepWork {
         bt_hls::StepWork {

@@ -249,8 +249,9 @@ pub struct StepWork {
 
 impl Platform {
     /// The smallest platform that runs every step of `work`: the planes, threshold, early
-    /// stopping and coordinate word of the first step, one PE per plane (more where a step's schedule duplicates
-    /// it), and RAMs for the largest step.
+    /// stopping and coordinate word of the first step, one PE per plane that some step's
+    /// schedule uses (more where a schedule duplicates it; none for a plane no step's paths
+    /// meet, which would never get a job), and RAMs for the largest step.
     pub fn fitting(work: &[StepWork]) -> Result<Platform, HlsError> {
         let Some(first) = work.first() else {
             return Err(HlsError::InvalidInput {
@@ -258,7 +259,8 @@ impl Platform {
             });
         };
         let n = first.input.planes.len();
-        let mut copies = vec![1u32; n];
+        // No PE for a plane that no step's schedule uses: it would never get a job.
+        let mut copies = vec![0u32; n];
         let mut capacity = Capacity {
             paths: 1,
             points: 1,

@@ -94,8 +94,16 @@ fn one_design_runs_every_step_bit_exact() {
 #[test]
 fn steps_that_do_not_fit_the_platform_are_rejected() {
     let work = three_steps();
-    let platform = Platform::fitting(&work[2..]).unwrap();
     let dir = PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("bt_hls_steps_never");
+    // Step 2's platform has no PE for plane 0 (no path of step 2 meets it), which step 0 needs.
+    let mut platform = Platform::fitting(&work[2..]).unwrap();
+    assert!(platform.instances.iter().all(|i| i.plane != 0));
+    match bt_hls::generate_steps(&platform, &work, &dir) {
+        Err(bt_hls::HlsError::Schedule(e)) => assert!(e.contains("not on the platform"), "{e}"),
+        other => panic!("{other:?}"),
+    }
+    // With every PE, its RAMs (sized for step 2) are still too small for step 0.
+    platform.instances = Platform::fitting(&work).unwrap().instances;
     assert!(matches!(
         bt_hls::generate_steps(&platform, &work, &dir),
         Err(bt_hls::HlsError::TooLarge(_))

@@ -389,8 +389,10 @@ fn fixed_point_step(
     })
 }
 
-/// The PE count of the one platform all steps run on ([`bt_hls::Platform::fitting`]); a
-/// step's cycles depend on its schedule only.
+/// The PE count of the one platform all steps run on ([`bt_hls::Platform::fitting`]). Each
+/// step's cycles are predicted on the PEs its own schedule uses; a step that used fewer than
+/// the platform (not so in the living room, whose steps share their PEs) would need
+/// `PlannedStep::predict_on`, as `beamtrace hls gen` does.
 fn fill_platform_instances(
     fpga: &mut [FpgaStep],
     work: &[bt_hls::StepWork],
@@ -422,7 +424,8 @@ pub fn run(
     let mut rows = Vec::with_capacity(steps * SOLVERS.len());
     let mut fpga = Vec::with_capacity(steps);
     let mut rays = Vec::new();
-    // The platform: one PE per reflector that no step moves.
+    // The platform's planes: the reflectors that no step moves (a PE for each that a step
+    // meets, `bt_hls::Platform::fitting`).
     let planes = fpga::static_reflectors(scene.scenes());
     let mut work = Vec::with_capacity(steps);
     let mut previous = None;
