@@ -193,7 +193,7 @@ fn generate(args: &HlsGenArgs) -> anyhow::Result<ExitCode> {
     // The platform's planes: the reflectors that no step moves (a PE for each that a step
     // meets, `bt_hls::Platform::fitting`).
     let planes = bt_accel::static_reflectors(scenes);
-    let options = step_options(args);
+    let options = step_options(args, planes.len());
     let mut planned: Vec<bt_accel::PlannedStep> = Vec::with_capacity(scenes.len());
     for (k, scene) in scenes.iter().enumerate() {
         let bar = crate::progress::spinner(&format!("planning step {k} of {}", scenes.len()));
@@ -284,8 +284,9 @@ fn summary(
     }
 }
 
-/// How `hls gen` plans each step.
-fn step_options(args: &HlsGenArgs) -> bt_accel::StepOptions {
+/// How `hls gen` plans each step on a platform of `planes` static reflectors: as many PEs as
+/// planes unless `--pe-budget` says otherwise (the PEs of planes no path meets become copies).
+fn step_options(args: &HlsGenArgs, planes: usize) -> bt_accel::StepOptions {
     bt_accel::StepOptions {
         trace: bt_solve::pipeline::TraceOptions {
             candidates: args.candidates.mode(),
@@ -300,7 +301,7 @@ fn step_options(args: &HlsGenArgs) -> bt_accel::StepOptions {
         max_rounds: args.max_rounds,
         plan: PlanOptions {
             schedule: bt_hls::ScheduleKind::List,
-            pe_budget: args.pe_budget,
+            pe_budget: Some(args.pe_budget.unwrap_or(planes as u32)),
             ga: GaParams::default(),
         },
         warm_start: args.warm_start,

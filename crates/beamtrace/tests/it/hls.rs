@@ -88,12 +88,18 @@ fn hls_sim_takes_the_readmes_relative_directory() {
 }
 
 /// Dynamic dispatch needs no model run on the host, with or without PE copies
-/// (`--pe-budget`), and each path runs its own rounds whatever the PEs.
+/// (`--pe-budget`: 1 gives none, the default gives the PEs of planes no path meets to copies),
+/// and each path runs its own rounds whatever the PEs.
 #[test]
 fn no_model_run_feeds_the_host_with_or_without_copies() {
     let root = scratch("hls-dispatch");
-    let (plain, dup) = (root.join("plain"), root.join("dup"));
-    for (dir, extra) in [(&plain, vec![]), (&dup, vec!["--pe-budget", "40"])] {
+    let (plain, dup, default) = (root.join("plain"), root.join("dup"), root.join("default"));
+    let runs = [
+        (&plain, vec!["--pe-budget", "1"]),
+        (&dup, vec!["--pe-budget", "40"]),
+        (&default, vec![]),
+    ];
+    for (dir, extra) in runs {
         let mut args = cli(
             "hls gen builtin:living-room --max-order 2 --plan-only -o {}",
             &[dir.to_str().unwrap()],
@@ -102,16 +108,20 @@ fn no_model_run_feeds_the_host_with_or_without_copies() {
         run_ok(&args);
     }
     let summary = |dir: &std::path::Path| read_json(&dir.join("summary.json"));
-    let (p, d) = (summary(&plain), summary(&dup));
-    for s in [&p, &d] {
+    let (p, d, f) = (summary(&plain), summary(&dup), summary(&default));
+    for s in [&p, &d, &f] {
         assert_eq!(s["host_model_runs"], 0, "{s}");
         assert_eq!(s["schedule"], "dynamic", "{s}");
         assert_eq!(s["fixed_vs_f64"]["missed"], 0, "{s}");
     }
     assert_eq!(p["stats"]["duplicates"], 0);
     assert!(d["stats"]["duplicates"].as_u64().unwrap() > 0, "{d}");
-    // The same PE jobs either way: each path runs its own rounds.
+    // The default: one PE per static reflector of the room, some of them copies.
+    assert_eq!(f["platform_instances"], f["planes"], "{f}");
+    assert!(f["stats"]["duplicates"].as_u64().unwrap() > 0, "{f}");
+    // The same PE jobs every way: each path runs its own rounds.
     assert_eq!(p["dispatch"]["jobs"], d["dispatch"]["jobs"]);
+    assert_eq!(p["dispatch"]["jobs"], f["dispatch"]["jobs"]);
     std::fs::remove_dir_all(root).ok();
 }
 
