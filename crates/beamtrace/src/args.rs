@@ -1108,10 +1108,10 @@ pub struct HlsGenArgs {
     #[arg(long, value_enum, default_value_t = CandidatesArg::BeamTree)]
     pub candidates: CandidatesArg,
     /// Total PE instances: the PEs beyond one per plane used become copies of the planes with
-    /// the most jobs in one round (sized at step 0 for the whole stream; default: one per
-    /// static reflector, so the PEs of planes no path meets become copies; a budget at or
-    /// below the planes used gives no copy).
-    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=4096))]
+    /// the most jobs in one round (sized at step 0 for the whole stream). Default: one per
+    /// static reflector, so the PEs of planes no path meets become copies; 0: no copy, one PE
+    /// per plane a path meets.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=4096))]
     pub pe_budget: Option<u32>,
     /// Convergence threshold on a round's largest displacement, in 1/256 mm.
     #[arg(long, default_value_t = 16)]

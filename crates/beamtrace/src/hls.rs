@@ -285,7 +285,8 @@ fn summary(
 }
 
 /// How `hls gen` plans each step on a platform of `planes` static reflectors: as many PEs as
-/// planes unless `--pe-budget` says otherwise (the PEs of planes no path meets become copies).
+/// planes unless `--pe-budget` says otherwise (the PEs of planes no path meets become copies;
+/// 0: no copy).
 fn step_options(args: &HlsGenArgs, planes: usize) -> bt_accel::StepOptions {
     bt_accel::StepOptions {
         trace: bt_solve::pipeline::TraceOptions {
@@ -301,7 +302,11 @@ fn step_options(args: &HlsGenArgs, planes: usize) -> bt_accel::StepOptions {
         max_rounds: args.max_rounds,
         plan: PlanOptions {
             schedule: bt_hls::ScheduleKind::List,
-            pe_budget: Some(args.pe_budget.unwrap_or(planes as u32)),
+            pe_budget: match args.pe_budget {
+                None => Some(planes as u32),
+                Some(0) => None,
+                Some(n) => Some(n),
+            },
             ga: GaParams::default(),
         },
         warm_start: args.warm_start,

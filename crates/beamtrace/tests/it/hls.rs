@@ -88,14 +88,14 @@ fn hls_sim_takes_the_readmes_relative_directory() {
 }
 
 /// Dynamic dispatch needs no model run on the host, with or without PE copies
-/// (`--pe-budget`: 1 gives none, the default gives the PEs of planes no path meets to copies),
+/// (`--pe-budget`: 0 gives none, the default gives the PEs of planes no path meets to copies),
 /// and each path runs its own rounds whatever the PEs.
 #[test]
 fn no_model_run_feeds_the_host_with_or_without_copies() {
     let root = scratch("hls-dispatch");
     let (plain, dup, default) = (root.join("plain"), root.join("dup"), root.join("default"));
     let runs = [
-        (&plain, vec!["--pe-budget", "1"]),
+        (&plain, vec!["--pe-budget", "0"]),
         (&dup, vec!["--pe-budget", "40"]),
         (&default, vec![]),
     ];
