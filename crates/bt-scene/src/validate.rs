@@ -2,7 +2,7 @@
 
 use crate::description::{BOX_FACES, SceneDescription, SurfaceDesc};
 use crate::frame::{to_local, to_world};
-use crate::material::{DEFAULT_MATERIAL, Material, default_materials};
+use crate::material::{DEFAULT_MATERIAL, Material, MaterialRuns, default_materials};
 use crate::model::{Scene, scene_extent, surfaces_box};
 use crate::problem::{Collector, Problem, ProblemSink, SceneError};
 use crate::surface::{Pending, Place, RawSurface, Surface, SurfaceKind};
@@ -421,16 +421,12 @@ pub(crate) fn radio_problems(
     materials: &std::collections::BTreeMap<String, Material>,
     frequency_hz: Real,
 ) -> Vec<Problem> {
-    // Neighbouring surfaces mostly share a material (an imported shape's): each run is
-    // inserted once.
     let mut used: BTreeSet<&str> = BTreeSet::new();
-    let mut last = None;
+    let mut runs = MaterialRuns::new();
     for s in surfaces {
-        let name = s.material.as_str();
-        if last != Some(name) {
+        runs.get(&s.material, |name| {
             used.insert(name);
-            last = Some(name);
-        }
+        });
     }
     let mut problems = Vec::new();
     for name in used {
@@ -466,8 +462,7 @@ pub(crate) fn build_surfaces(
     }
     let (polygons, bvh) = polygons_and_bvh(&mut raw);
     let mut names = HashSet::with_capacity(raw.len());
-    // The last material found: neighbouring surfaces mostly share one (an imported shape's).
-    let mut known: Option<&str> = None;
+    let mut known = MaterialRuns::new();
     for (r, polygon) in raw.iter().zip(&polygons) {
         if let Err(e) = crate::name::check(&r.name) {
             problems.report(&r.location(), e);
@@ -478,9 +473,7 @@ pub(crate) fn build_surfaces(
             );
         }
         let material = r.material.as_deref().unwrap_or(DEFAULT_MATERIAL);
-        if known == Some(material) || materials.contains_key(material) {
-            known = Some(material);
-        } else {
+        if !known.get(material, |m| materials.contains_key(m)) {
             problems.report(
                 &r.location(),
                 format!(
