@@ -242,7 +242,7 @@ pub(crate) fn merge(mesh: &RawMesh, opts: &MergeOptions, file: &str) -> Merged {
                 }
             };
             surfaces.push(MeshSurface {
-                name: format!("{base}_{counter}"),
+                name: numbered(base, counter),
                 material: material.clone(),
                 vertices: outline.into_iter().map(|p| frame.lift(p)).collect(),
                 normal: frame.normal,
@@ -256,6 +256,24 @@ pub(crate) fn merge(mesh: &RawMesh, opts: &MergeOptions, file: &str) -> Merged {
         surfaces,
         warnings: warnings(file, &counts),
     }
+}
+
+/// `<base>_<counter>`, written without the formatting machinery (`format!` was a tenth of
+/// the merge's own instructions on a city of small meshes).
+fn numbered(base: &str, counter: usize) -> String {
+    let mut digits = [0u8; 20];
+    let mut at = digits.len();
+    let mut rest = counter;
+    loop {
+        at -= 1;
+        digits[at] = b'0' + (rest % 10) as u8;
+        rest /= 10;
+        if rest == 0 {
+            break;
+        }
+    }
+    let digits = std::str::from_utf8(&digits[at..]).unwrap_or_default();
+    [base, "_", digits].concat()
 }
 
 /// The notes about faces dropped or split on the way.
@@ -689,6 +707,14 @@ mod tests {
                 .collect();
             proptest::prop_assert_eq!(weld(&positions, tol), weld_by_scan(&positions, tol));
         }
+    }
+
+    #[test]
+    fn numbered_names_match_format() {
+        for counter in [0, 7, 10, 99, 12345, usize::MAX] {
+            assert_eq!(numbered("face", counter), format!("face_{counter}"));
+        }
+        assert_eq!(numbered("", 3), "_3");
     }
 
     #[test]

@@ -122,12 +122,16 @@ fn closed_loops(
     let mut loops = Vec::new();
     used.clear();
     used.resize(boundary.len(), false);
+    // Boundary edges not yet in a loop: the most the next loop can take (sized once, not
+    // grown vertex by vertex).
+    let mut left = boundary.len();
     for start in 0..boundary.len() {
         if used[start] {
             continue;
         }
         used[start] = true;
-        let mut ring = vec![project(boundary[start].0)];
+        let mut ring = Vec::with_capacity(left);
+        ring.push(project(boundary[start].0));
         let mut current = start;
         loop {
             let (from, at) = boundary[current];
@@ -166,6 +170,7 @@ fn closed_loops(
                 }
             }
         }
+        left -= ring.len();
         loops.push(ring);
     }
     Some(loops)
