@@ -460,27 +460,20 @@ pub(crate) fn build_surfaces(
         );
         return Vec::new().into();
     }
-    let (polygons, bvh) = polygons_and_bvh(&mut raw);
-    let mut names = HashSet::with_capacity(raw.len());
-    let mut known = MaterialRuns::new();
-    for (r, polygon) in raw.iter().zip(&polygons) {
-        if let Err(e) = crate::name::check(&r.name) {
-            problems.report(&r.location(), e);
-        } else if !names.insert(r.name.as_str()) {
-            problems.report(
-                &r.location(),
-                format!("duplicate surface name \"{}\"", crate::name::shown(&r.name)),
-            );
-        }
-        let material = r.material.as_deref().unwrap_or(DEFAULT_MATERIAL);
-        if !known.get(material, |m| materials.contains_key(m)) {
-            problems.report(
-                &r.location(),
-                format!(
-                    "unknown material \"{}\" (add it under \"materials\")",
-                    crate::name::shown(material)
-                ),
-            );
+    // The polygons and their BVH are built on all cores while the names and materials are
+    // checked beside them (the vertices are taken out first, so the two share nothing).
+    let mut vertices: Vec<Vec<Vec3>> = (raw.iter_mut())
+        .map(|r| std::mem::take(&mut r.vertices))
+        .collect();
+    let ((polygons, bvh), named) = rayon::join(
+        || polygons_and_bvh(&mut vertices),
+        || name_and_material_problems(&raw, materials),
+    );
+    // Each surface's problems in order: its name and material, then its polygon.
+    let mut named = named.into_iter().peekable();
+    for (i, (r, polygon)) in raw.iter().zip(&polygons).enumerate() {
+        while let Some((_, location, message)) = named.next_if(|(at, _, _)| *at == i) {
+            problems.report(&location, message);
         }
         if let Err(e) = polygon {
             problems.report(&format!("{}.vertices", r.location()), e.to_string());
@@ -501,6 +494,34 @@ pub(crate) fn build_surfaces(
         surfaces,
         bvh: all.then_some(bvh),
     }
+}
+
+/// The problems of `raw`'s names (not printable, duplicated) and materials (not in
+/// `materials`), each as (surface index, location, message), in surface order.
+fn name_and_material_problems(
+    raw: &[Pending],
+    materials: &std::collections::BTreeMap<String, Material>,
+) -> Vec<(usize, String, String)> {
+    let mut found = Vec::new();
+    let mut names = HashSet::with_capacity(raw.len());
+    let mut known = MaterialRuns::new();
+    for (i, r) in raw.iter().enumerate() {
+        if let Err(e) = crate::name::check(&r.name) {
+            found.push((i, r.location(), e));
+        } else if !names.insert(r.name.as_str()) {
+            let message = format!("duplicate surface name \"{}\"", crate::name::shown(&r.name));
+            found.push((i, r.location(), message));
+        }
+        let material = r.material.as_deref().unwrap_or(DEFAULT_MATERIAL);
+        if !known.get(material, |m| materials.contains_key(m)) {
+            let message = format!(
+                "unknown material \"{}\" (add it under \"materials\")",
+                crate::name::shown(material)
+            );
+            found.push((i, r.location(), message));
+        }
+    }
+    found
 }
 
 /// The polygons of `vertices` (each list taken) built on all cores, order kept, and beside
