@@ -556,8 +556,9 @@ fn drop_duplicates(mut faces: Faces, counts: &mut FaceCounts) -> Faces {
             }
         }
     }
-    counts.duplicates += duplicate.iter().filter(|&&d| d).count();
-    if counts.duplicates > 0 {
+    let dropped = duplicate.iter().filter(|&&d| d).count();
+    counts.duplicates += dropped;
+    if dropped > 0 {
         let mut d = duplicate.into_iter();
         faces.list.retain(|_| !d.next().unwrap_or(false));
     }

@@ -165,8 +165,9 @@ pub(crate) fn load_xml_read(
         options,
         bytes_left: MAX_MESH_TOTAL_BYTES,
         elements: SceneElements::default(),
-        meshes: Vec::new(),
-        seen: std::collections::HashSet::new(),
+        // Sized for one file per shape (as in Sionna's cities), not grown and rehashed.
+        meshes: Vec::with_capacity(xml.shapes.len()),
+        seen: std::collections::HashSet::with_capacity(xml.shapes.len()),
     };
     for round in xml.shapes.chunks(SHAPES_PER_ROUND) {
         reading.round(round, &mut desc, &mut warnings)?;
