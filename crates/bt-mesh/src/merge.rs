@@ -31,10 +31,12 @@ pub(crate) struct Merged {
     pub warnings: Vec<String>,
 }
 
-/// A planar face after welding, with its plane.
+/// A planar face after welding, with its plane. Its vertices are a range of the shared id
+/// list of its [`Faces`] (one allocation for all faces, not one per face).
 pub(crate) struct Face {
-    /// Welded vertex ids, distinct, at least three, a simple polygon in its plane.
-    pub vertices: Vec<u32>,
+    /// Where its welded vertex ids lie in [`Faces`]'s id list: `start..end`.
+    start: usize,
+    end: usize,
     /// Index of the face in the file.
     pub source: usize,
     /// Object/group name and material (interned indices).
@@ -47,12 +49,113 @@ pub(crate) struct Face {
     pub centroid: Vec3,
 }
 
-/// A set of coplanar, edge-connected faces.
-pub(crate) struct Group {
+/// The planar faces of a mesh: per face its plane and a range of one list of welded vertex
+/// ids. Index it by face number for the plane, [`Faces::vertices`] for the ids.
+#[derive(Default)]
+pub(crate) struct Faces {
+    /// Every face's welded vertex ids, one face after the other (ranges of dropped faces
+    /// stay, unused).
+    ids: Vec<u32>,
+    list: Vec<Face>,
+}
+
+impl Faces {
+    /// Room for `faces` faces of `ids` vertex ids in all.
+    fn with_capacity(faces: usize, ids: usize) -> Self {
+        Faces {
+            ids: Vec::with_capacity(ids),
+            list: Vec::with_capacity(faces),
+        }
+    }
+
+    /// Number of faces.
+    pub fn len(&self) -> usize {
+        self.list.len()
+    }
+
+    /// Face `f`'s welded vertex ids: distinct, at least three, a simple polygon in its plane.
+    pub fn vertices(&self, f: usize) -> &[u32] {
+        let face = &self.list[f];
+        &self.ids[face.start..face.end]
+    }
+
+    /// Every face's vertex ids, in face order.
+    pub fn all_vertices(&self) -> impl ExactSizeIterator<Item = &[u32]> {
+        self.list.iter().map(|f| &self.ids[f.start..f.end])
+    }
+
+    /// Appends the face with vertex ids `ids` and plane `plane`, from file face `source`.
+    fn push(&mut self, ids: &[u32], source: usize, key: (Option<u32>, Option<u32>), plane: Plane) {
+        let start = self.ids.len();
+        self.ids.extend_from_slice(ids);
+        self.list.push(Face {
+            start,
+            end: self.ids.len(),
+            source,
+            key,
+            normal: plane.normal,
+            area: plane.area,
+            centroid: plane.centroid,
+        });
+    }
+}
+
+impl std::ops::Index<usize> for Faces {
+    type Output = Face;
+
+    fn index(&self, f: usize) -> &Face {
+        &self.list[f]
+    }
+}
+
+/// A face's plane as [`make_face`] computes it.
+#[derive(Clone, Copy)]
+struct Plane {
+    /// Unit normal (right-hand rule on the vertex order).
+    normal: Vec3,
+    /// Area in m².
+    area: Real,
+    /// Vertex average, a point on the face's plane.
+    centroid: Vec3,
+}
+
+/// A set of coplanar, edge-connected faces: a view of [`Groups`].
+#[derive(Clone, Copy)]
+pub(crate) struct Group<'a> {
     /// Indices into the face list, ascending.
-    pub faces: Vec<usize>,
+    pub faces: &'a [usize],
     /// Number of distinct file faces.
     pub source_faces: usize,
+}
+
+/// The groups of a mesh: their members one group after the other in one list.
+#[derive(Default)]
+pub(crate) struct Groups {
+    members: Vec<usize>,
+    /// Per group: the end of its members in `members` and its number of distinct file faces.
+    ends: Vec<(usize, usize)>,
+}
+
+impl Groups {
+    /// Number of groups.
+    fn len(&self) -> usize {
+        self.ends.len()
+    }
+
+    /// The groups in order.
+    fn iter(&self) -> impl ExactSizeIterator<Item = Group<'_>> + '_ {
+        (0..self.ends.len()).map(|g| self.get(g))
+    }
+
+    /// Group `g`.
+    fn get(&self, g: usize) -> Group<'_> {
+        let start = g.checked_sub(1).map_or(0, |p| self.ends[p].0);
+        let (end, source_faces) = self.ends[g];
+        Group {
+            faces: &self.members[start..end],
+            source_faces,
+        }
+    }
 }
 
 /// What became of the file's faces on the way to [`Face`]s, for the warnings.
@@ -86,9 +189,12 @@ pub(crate) fn merge(mesh: &RawMesh, opts: &MergeOptions, file: &str) -> Merged {
 
     // Each group is outlined on its own: on all cores when there are many (a large mesh, say
     // a church of 12,000 faces, would otherwise keep one core busy while the other waits).
-    let outline_group = |group: &Group| {
-        let frame = Frame::of_faces(&faces, &group.faces);
-        match crate::trace::whole_outlines(&faces, group, &frame, &points, zero_length) {
+    let outline_group = |scratch: &mut crate::trace::Scratch, g: usize| {
+        let group = groups.get(g);
+        let frame = Frame::of_faces(&faces, group.faces);
+        let whole =
+            crate::trace::whole_outlines(&faces, group, &frame, &points, zero_length, scratch);
+        match whole {
             Some(outlines) => (frame, outlines, 0),
             None => {
                 let split = crate::split::split_group(&faces, group, &frame, &points, zero_length);
@@ -97,9 +203,15 @@ pub(crate) fn merge(mesh: &RawMesh, opts: &MergeOptions, file: &str) -> Merged {
         }
     };
     let outlined: Vec<(Frame, Vec<Outline>, usize)> = if groups.len() >= PARALLEL_GROUPS {
-        groups.par_iter().map(outline_group).collect()
+        (0..groups.len())
+            .into_par_iter()
+            .map_init(crate::trace::Scratch::default, outline_group)
+            .collect()
     } else {
-        groups.iter().map(outline_group).collect()
+        let mut scratch = crate::trace::Scratch::default();
+        (0..groups.len())
+            .map(|g| outline_group(&mut scratch, g))
+            .collect()
     };
     let mut surfaces = Vec::with_capacity(outlined.iter().map(|(_, o, _)| o.len()).sum());
     let mut name_counts: HashMap<String, usize> = HashMap::new();
@@ -130,7 +242,7 @@ pub(crate) fn merge(mesh: &RawMesh, opts: &MergeOptions, file: &str) -> Merged {
                 }
             };
             surfaces.push(MeshSurface {
-                name: format!("{base}_{counter}"),
+                name: numbered(base, counter),
                 material: material.clone(),
                 vertices: outline.into_iter().map(|p| frame.lift(p)).collect(),
                 normal: frame.normal,
@@ -144,6 +256,24 @@ pub(crate) fn merge(mesh: &RawMesh, opts: &MergeOptions, file: &str) -> Merged {
         surfaces,
         warnings: warnings(file, &counts),
     }
+}
+
+/// `<base>_<counter>`, written without the formatting machinery (`format!` was a tenth of
+/// the merge's own instructions on a city of small meshes).
+fn numbered(base: &str, counter: usize) -> String {
+    let mut digits = [0u8; 20];
+    let mut at = digits.len();
+    let mut rest = counter;
+    loop {
+        at -= 1;
+        digits[at] = b'0' + (rest % 10) as u8;
+        rest /= 10;
+        if rest == 0 {
+            break;
+        }
+    }
+    let digits = std::str::from_utf8(&digits[at..]).unwrap_or_default();
+    [base, "_", digits].concat()
 }
 
 /// The notes about faces dropped or split on the way.
@@ -298,8 +428,8 @@ fn planar_faces(
     opts: &MergeOptions,
     zero_length: Real,
     counts: &mut FaceCounts,
-) -> Vec<Face> {
-    let mut faces = Vec::with_capacity(mesh.face_count());
+) -> Faces {
+    let mut faces = Faces::with_capacity(mesh.face_count(), mesh.indices.len());
     let mut ids: Vec<u32> = Vec::new();
     let mut scratch: Vec<Vec3> = Vec::new();
     for f in 0..mesh.face_count() {
@@ -314,16 +444,20 @@ fn planar_faces(
             ids.pop();
         }
         let key = (mesh.face_name[f], mesh.face_material[f]);
-        let Some(face) = make_face(&ids, f, key, points, zero_length, &mut scratch) else {
+        let Some(plane) = make_face(&ids, points, zero_length, &mut scratch) else {
             counts.degenerate += 1;
             continue;
         };
-        let planar = face.vertices.iter().all(|&v| {
-            (points[v as usize] - face.centroid).dot(face.normal).abs() <= opts.dist_tol_m
+        let planar = ids.iter().all(|&v| {
+            (points[v as usize] - plane.centroid)
+                .dot(plane.normal)
+                .abs()
+                <= opts.dist_tol_m
         });
-        let simple = ids.len() == 3 || (planar && is_simple_face(&face, points, zero_length));
+        let simple =
+            ids.len() == 3 || (planar && is_simple_face(&ids, &plane, points, zero_length));
         if planar && simple {
-            faces.push(face);
+            faces.push(&ids, f, key, plane);
             continue;
         }
         if planar {
@@ -333,8 +467,8 @@ fn planar_faces(
         }
         for k in 1..ids.len() - 1 {
             let tri = [ids[0], ids[k], ids[k + 1]];
-            match make_face(&tri, f, key, points, zero_length, &mut scratch) {
-                Some(t) => faces.push(t),
+            match make_face(&tri, points, zero_length, &mut scratch) {
+                Some(t) => faces.push(&tri, f, key, t),
                 None => counts.degenerate += 1,
             }
         }
@@ -342,33 +476,30 @@ fn planar_faces(
     faces
 }
 
-/// Whether a planar polygon face is simple in its plane by a margin of `eps` metres (no vertex
-/// used twice, no edges touching).
-fn is_simple_face(face: &Face, points: &[Vec3], eps: Real) -> bool {
-    let u = face.normal.any_orthonormal_vector();
-    let v = face.normal.cross(u);
-    let local: Vec<Vec2> = face
-        .vertices
+/// Whether a planar polygon face (welded `ids`, its `plane`) is simple in its plane by a
+/// margin of `eps` metres (no vertex used twice, no edges touching).
+fn is_simple_face(ids: &[u32], plane: &Plane, points: &[Vec3], eps: Real) -> bool {
+    let u = plane.normal.any_orthonormal_vector();
+    let v = plane.normal.cross(u);
+    let local: Vec<Vec2> = ids
         .iter()
         .map(|&i| {
-            let d = points[i as usize] - face.centroid;
+            let d = points[i as usize] - plane.centroid;
             Vec2::new(d.dot(u), d.dot(v))
         })
         .collect();
     first_contact(&local, eps).is_none()
 }
 
-/// A face from welded ids, or `None` when it is degenerate: fewer than three distinct vertices,
-/// or an area so small that the face's height over its longest edge is within `zero_length`.
-/// `pts` is scratch space (its contents are replaced).
+/// The plane of a face of welded `ids`, or `None` when it is degenerate: fewer than three
+/// distinct vertices, or an area so small that the face's height over its longest edge is
+/// within `zero_length`. `pts` is scratch space (its contents are replaced).
 fn make_face(
     ids: &[u32],
-    source: usize,
-    key: (Option<u32>, Option<u32>),
     points: &[Vec3],
     zero_length: Real,
     pts: &mut Vec<Vec3>,
-) -> Option<Face> {
+) -> Option<Plane> {
     if ids.len() < 3 {
         return None;
     }
@@ -384,10 +515,7 @@ fn make_face(
         return None;
     }
     let centroid = pts.iter().sum::<Vec3>() / pts.len() as Real;
-    Some(Face {
-        vertices: ids.to_vec(),
-        source,
-        key,
+    Some(Plane {
         normal: area_vec / area,
         area,
         centroid,
@@ -399,16 +527,16 @@ fn make_face(
 /// Faces are sorted by length and the start of their canonical cycle, then index (no hashing,
 /// no allocation per face); only faces agreeing there are compared in full, so each set of
 /// copies is one run led by its first face.
-fn drop_duplicates(faces: Vec<Face>, counts: &mut FaceCounts) -> Vec<Face> {
+fn drop_duplicates(mut faces: Faces, counts: &mut FaceCounts) -> Faces {
     let cycle = |i: usize| {
-        let vs = &faces[i].vertices;
+        let vs = faces.vertices(i);
         (0..vs.len()).map(canonical_cycle(vs))
     };
     let mut order: Vec<((usize, [u32; 3]), usize)> = (0..faces.len())
         .map(|i| {
             let mut head = cycle(i);
             let mut next = || head.next().unwrap_or(u32::MAX);
-            ((faces[i].vertices.len(), [next(), next(), next()]), i)
+            ((faces.vertices(i).len(), [next(), next(), next()]), i)
         })
         .collect();
     order.sort_unstable();
@@ -428,12 +556,13 @@ fn drop_duplicates(faces: Vec<Face>, counts: &mut FaceCounts) -> Vec<Face> {
             }
         }
     }
-    counts.duplicates += duplicate.iter().filter(|&&d| d).count();
+    let dropped = duplicate.iter().filter(|&&d| d).count();
+    counts.duplicates += dropped;
+    if dropped > 0 {
+        let mut d = duplicate.into_iter();
+        faces.list.retain(|_| !d.next().unwrap_or(false));
+    }
     faces
-        .into_iter()
-        .zip(duplicate)
-        .filter_map(|(face, d)| (!d).then_some(face))
-        .collect()
 }
 
 /// The vertex cycle as a function of position: from its smallest id, continuing towards the
@@ -453,11 +582,14 @@ fn canonical_cycle(vs: &[u32]) -> impl Fn(usize) -> u32 + '_ {
 
 /// The groups of coplanar, edge-connected faces with the same name and material, in the
 /// order of their first face.
-fn grow_regions(faces: &[Face], points: &[Vec3], opts: &MergeOptions) -> Vec<Group> {
+fn grow_regions(faces: &Faces, points: &[Vec3], opts: &MergeOptions) -> Groups {
     let cos_tol = opts.angle_tol_deg.to_radians().cos();
-    let mut edges = EdgeTable::new(faces.iter().map(|f| f.vertices.as_slice()));
+    let mut edges = EdgeTable::new(faces.all_vertices());
     let mut group_of: Vec<Option<u32>> = vec![None; faces.len()];
-    let mut groups = Vec::new();
+    let mut groups = Groups {
+        members: Vec::with_capacity(faces.len()),
+        ends: Vec::new(),
+    };
     let mut queue = std::collections::VecDeque::new();
     for seed in 0..faces.len() {
         if group_of[seed].is_some() {
@@ -465,7 +597,8 @@ fn grow_regions(faces: &[Face], points: &[Vec3], opts: &MergeOptions) -> Vec<Gro
         }
         let id = groups.len() as u32;
         group_of[seed] = Some(id);
-        let mut members = vec![seed];
+        let start = groups.members.len();
+        groups.members.push(seed);
         let mut normal_sum = faces[seed].normal * faces[seed].area;
         let mut centroid_sum = faces[seed].centroid * faces[seed].area;
         let mut area_sum = faces[seed].area;
@@ -473,24 +606,24 @@ fn grow_regions(faces: &[Face], points: &[Vec3], opts: &MergeOptions) -> Vec<Gro
         let mut plane: Option<(Vec3, Vec3)> = None;
         queue.push_back(seed);
         while let Some(f) = queue.pop_front() {
-            let face = &faces[f];
-            let n = face.vertices.len();
+            let vs = faces.vertices(f);
+            let n = vs.len();
             for i in 0..n {
-                let key = crate::edges::edge_key(face.vertices[i], face.vertices[(i + 1) % n]);
+                let key = crate::edges::edge_key(vs[i], vs[(i + 1) % n]);
                 for other in edges.unsettled(key, |g| group_of[g].is_some()) {
-                    if group_of[other].is_some() || faces[other].key != face.key {
+                    if group_of[other].is_some() || faces[other].key != faces[f].key {
                         continue;
                     }
                     let (normal, origin) = *plane
                         .get_or_insert_with(|| (normal_sum.normalize(), centroid_sum / area_sum));
                     let candidate = &faces[other];
                     let coplanar = candidate.normal.dot(normal) >= cos_tol
-                        && candidate.vertices.iter().all(|&v| {
+                        && faces.vertices(other).iter().all(|&v| {
                             (points[v as usize] - origin).dot(normal).abs() <= opts.dist_tol_m
                         });
                     if coplanar {
                         group_of[other] = Some(id);
-                        members.push(other);
+                        groups.members.push(other);
                         normal_sum += candidate.normal * candidate.area;
                         centroid_sum += candidate.centroid * candidate.area;
                         area_sum += candidate.area;
@@ -500,13 +633,14 @@ fn grow_regions(faces: &[Face], points: &[Vec3], opts: &MergeOptions) -> Vec<Gro
                 }
             }
         }
+        let members = &mut groups.members[start..];
         members.sort_unstable();
-        let mut sources: Vec<usize> = members.iter().map(|&m| faces[m].source).collect();
-        sources.dedup();
-        groups.push(Group {
-            source_faces: sources.len(),
-            faces: members,
-        });
+        // Distinct file faces: the runs of equal sources (as `dedup` would leave them).
+        let source_faces = 1
+            + (members.windows(2))
+                .filter(|w| faces[w[0]].source != faces[w[1]].source)
+                .count();
+        groups.ends.push((groups.members.len(), source_faces));
     }
     groups
 }
@@ -574,6 +708,14 @@ mod tests {
                 .collect();
             proptest::prop_assert_eq!(weld(&positions, tol), weld_by_scan(&positions, tol));
         }
+    }
+
+    #[test]
+    fn numbered_names_match_format() {
+        for counter in [0, 7, 10, 99, 12345, usize::MAX] {
+            assert_eq!(numbered("face", counter), format!("face_{counter}"));
+        }
+        assert_eq!(numbered("", 3), "_3");
     }
 
     #[test]

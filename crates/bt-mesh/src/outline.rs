@@ -9,7 +9,7 @@ use bt_geom::poly2::{first_contact, signed_area};
 use bt_geom::polygon::MAX_VERTICES;
 use bt_geom::{Real, Vec2, Vec3};
 
-use crate::merge::Face;
+use crate::merge::Faces;
 use crate::tol;
 
 /// A group's plane: the area-weighted normal and centroid of its faces, and an in-plane frame.
@@ -26,7 +26,7 @@ pub(crate) struct Frame {
 
 impl Frame {
     /// The plane of the faces `members` (indices into `faces`, at least one).
-    pub fn of_faces(faces: &[Face], members: &[usize]) -> Frame {
+    pub fn of_faces(faces: &Faces, members: &[usize]) -> Frame {
         let mut normal_sum = Vec3::ZERO;
         let mut centroid_sum = Vec3::ZERO;
         let mut area_sum = 0.0;
@@ -57,7 +57,7 @@ impl Frame {
     }
 
     /// Area (m²) of the faces `members` projected onto the plane: what their outlines must hold.
-    pub fn projected_area(&self, faces: &[Face], members: &[usize]) -> Real {
+    pub fn projected_area(&self, faces: &Faces, members: &[usize]) -> Real {
         members
             .iter()
             .map(|&f| faces[f].area * faces[f].normal.dot(self.normal))
@@ -121,43 +121,44 @@ fn redundant(a: Vec2, p: Vec2, b: Vec2, eps: Real) -> bool {
     len <= eps || ab.perp_dot(p - a).abs() <= eps * len
 }
 
-/// Removes repeated, collinear and spike vertices of a closed loop until none is left.
+/// Removes repeated, collinear and spike vertices of a closed loop until none is left. In
+/// place: each pass writes the loop it keeps over the one it reads (never ahead of it).
 pub(crate) fn simplify(mut pts: Vec<Vec2>, eps: Real) -> Vec<Vec2> {
     loop {
         let before = pts.len();
-        let mut out: Vec<Vec2> = Vec::with_capacity(before);
-        for &p in &pts {
-            if out.last().is_some_and(|q| q.distance(p) <= eps) {
+        // The kept loop is `pts[..kept]`.
+        let mut kept = 0;
+        for read in 0..before {
+            let p = pts[read];
+            if kept > 0 && pts[kept - 1].distance(p) <= eps {
                 continue;
             }
-            out.push(p);
-            while out.len() >= 3 {
-                let n = out.len();
-                if redundant(out[n - 3], out[n - 2], out[n - 1], eps) {
-                    out.remove(n - 2);
-                } else {
-                    break;
-                }
+            pts[kept] = p;
+            kept += 1;
+            // The middle of the last three goes while it is redundant.
+            while kept >= 3 && redundant(pts[kept - 3], pts[kept - 2], pts[kept - 1], eps) {
+                pts[kept - 2] = pts[kept - 1];
+                kept -= 1;
             }
         }
+        pts.truncate(kept);
         // Close the loop: the seam between the last and the first vertex.
-        while out.len() >= 2 && out[0].distance(out[out.len() - 1]) <= eps {
-            out.pop();
+        while pts.len() >= 2 && pts[0].distance(pts[pts.len() - 1]) <= eps {
+            pts.pop();
         }
-        while out.len() >= 3 {
-            let n = out.len();
-            if redundant(out[n - 2], out[n - 1], out[0], eps) {
-                out.pop();
-            } else if redundant(out[n - 1], out[0], out[1], eps) {
-                out.remove(0);
+        while pts.len() >= 3 {
+            let n = pts.len();
+            if redundant(pts[n - 2], pts[n - 1], pts[0], eps) {
+                pts.pop();
+            } else if redundant(pts[n - 1], pts[0], pts[1], eps) {
+                pts.remove(0);
             } else {
                 break;
             }
         }
-        if out.len() == before || out.len() < 3 {
-            return out;
+        if pts.len() == before || pts.len() < 3 {
+            return pts;
         }
-        pts = out;
     }
 }
 
@@ -167,6 +168,58 @@ mod tests {
 
     fn pts(xy: &[(Real, Real)]) -> Vec<Vec2> {
         xy.iter().map(|&(x, y)| Vec2::new(x, y)).collect()
+    }
+
+    /// [`simplify`] as it was written before it worked in place: a new list per pass.
+    fn simplify_by_copies(mut pts: Vec<Vec2>, eps: Real) -> Vec<Vec2> {
+        loop {
+            let before = pts.len();
+            let mut out: Vec<Vec2> = Vec::with_capacity(before);
+            for &p in &pts {
+                if out.last().is_some_and(|q| q.distance(p) <= eps) {
+                    continue;
+                }
+                out.push(p);
+                while out.len() >= 3 {
+                    let n = out.len();
+                    if redundant(out[n - 3], out[n - 2], out[n - 1], eps) {
+                        out.remove(n - 2);
+                    } else {
+                        break;
+                    }
+                }
+            }
+            while out.len() >= 2 && out[0].distance(out[out.len() - 1]) <= eps {
+                out.pop();
+            }
+            while out.len() >= 3 {
+                let n = out.len();
+                if redundant(out[n - 2], out[n - 1], out[0], eps) {
+                    out.pop();
+                } else if redundant(out[n - 1], out[0], out[1], eps) {
+                    out.remove(0);
+                } else {
+                    break;
+                }
+            }
+            if out.len() == before || out.len() < 3 {
+                return out;
+            }
+            pts = out;
+        }
+    }
+
+    proptest::proptest! {
+        /// In place, the loop comes out as the copying version made it: loops on a coarse
+        /// grid, so that repeated, collinear and spike vertices are common.
+        #[test]
+        fn simplify_in_place_matches_copies(
+            xy in proptest::collection::vec((-3i32..3, -3i32..3), 0..24),
+            eps in proptest::prop_oneof![proptest::strategy::Just(1e-9), 0.01f64..0.6],
+        ) {
+            let pts: Vec<Vec2> = xy.iter().map(|&(x, y)| Vec2::new(x as Real, y as Real)).collect();
+            proptest::prop_assert_eq!(simplify(pts.clone(), eps), simplify_by_copies(pts, eps));
+        }
     }
 
     #[test]

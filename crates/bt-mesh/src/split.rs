@@ -16,7 +16,7 @@ use bt_geom::{Real, Vec3};
 use std::collections::{HashMap, HashSet, VecDeque};
 
 use crate::edges::{EdgeTable, edge_key};
-use crate::merge::{Face, Group};
+use crate::merge::{Faces, Group};
 use crate::outline::{Frame, Outline, area_matches, outline};
 
 /// Most faces on one edge a growing piece looks at, counted from the first one not yet in an
@@ -35,13 +35,13 @@ pub(crate) struct Split {
 
 /// Splits `group` into simple pieces of its faces, in face order.
 pub(crate) fn split_group(
-    faces: &[Face],
-    group: &Group,
+    faces: &Faces,
+    group: Group<'_>,
     frame: &Frame,
     points: &[Vec3],
     eps: Real,
 ) -> Split {
-    let members = &group.faces;
+    let members = group.faces;
     let mut grower = Grower::new(faces, members);
     let mut done = vec![false; members.len()];
     let mut split = Split::default();
@@ -61,9 +61,7 @@ pub(crate) fn split_group(
         let (taken, outline) = match piece(&grower.boundary, &order) {
             Some(o) => (order.len(), Some(o)),
             None => longest_valid_prefix(&order, |prefix| {
-                let vertices = prefix
-                    .iter()
-                    .map(|&f| faces[members[f]].vertices.as_slice());
+                let vertices = prefix.iter().map(|&f| faces.vertices(members[f]));
                 piece(&Boundary::replay(vertices), prefix)
             }),
         };
@@ -105,7 +103,7 @@ fn longest_valid_prefix(
 /// when it is a valid polygon holding the faces' area.
 fn piece_outline(
     boundary: &Boundary,
-    faces: &[Face],
+    faces: &Faces,
     piece: &[usize],
     frame: &Frame,
     points: &[Vec3],
@@ -214,7 +212,7 @@ impl Boundary {
 
 /// Grows pieces over one group's faces (local indices into `members`).
 struct Grower<'a> {
-    faces: &'a [Face],
+    faces: &'a Faces,
     members: &'a [usize],
     edges: EdgeTable,
     in_piece: Vec<bool>,
@@ -223,11 +221,11 @@ struct Grower<'a> {
 }
 
 impl<'a> Grower<'a> {
-    fn new(faces: &'a [Face], members: &'a [usize]) -> Self {
+    fn new(faces: &'a Faces, members: &'a [usize]) -> Self {
         Grower {
             faces,
             members,
-            edges: EdgeTable::new(members.iter().map(|&f| faces[f].vertices.as_slice())),
+            edges: EdgeTable::new(members.iter().map(|&f| faces.vertices(f))),
             in_piece: vec![false; members.len()],
             boundary: Boundary::default(),
             queue: VecDeque::new(),
@@ -244,7 +242,7 @@ impl<'a> Grower<'a> {
             if done[f] || self.in_piece[f] {
                 continue;
             }
-            let vs = &self.faces[self.members[f]].vertices;
+            let vs = self.faces.vertices(self.members[f]);
             if !self.boundary.try_add(vs) {
                 continue;
             }

@@ -11,19 +11,36 @@
 use bt_geom::{Real, Vec2, Vec3};
 
 use crate::edges::edge_key;
-use crate::merge::{Face, Group};
+use crate::merge::{Faces, Group};
 use crate::outline::{Frame, Outline, area_matches, outline};
+
+/// Working lists of [`whole_outlines`], kept from one group to the next (one set per worker
+/// thread) so that tracing a group allocates only the loops it returns.
+#[derive(Default)]
+pub(crate) struct Scratch {
+    /// The group's half-edges in face order: (undirected edge key, from, to).
+    half: Vec<(u64, u32, u32)>,
+    /// The half-edges' keys with their positions in `half`, sorted.
+    keyed: Vec<(u64, u32)>,
+    /// Per half-edge: on the boundary; then per boundary edge: traced.
+    flags: Vec<bool>,
+    /// The boundary edges (from, to) in face order.
+    boundary: Vec<(u32, u32)>,
+    /// The boundary edges by start vertex: (from, position in `boundary`), sorted.
+    outgoing: Vec<(u32, usize)>,
+}
 
 /// The outlines of a plain group, in the order of their first boundary edge; `None` when the
 /// group is not plain and must be split.
 pub(crate) fn whole_outlines(
-    faces: &[Face],
-    group: &Group,
+    faces: &Faces,
+    group: Group<'_>,
     frame: &Frame,
     points: &[Vec3],
     eps: Real,
+    scratch: &mut Scratch,
 ) -> Option<Vec<Outline>> {
-    let loops = closed_loops(faces, group, frame, points)?;
+    let loops = closed_loops(faces, group, frame, points, scratch)?;
     let mut outlines = Vec::with_capacity(loops.len());
     for ring in loops {
         let cleaned = crate::outline::simplify(ring, eps);
@@ -35,52 +52,67 @@ pub(crate) fn whole_outlines(
         }
         outlines.push(outline(cleaned, group.source_faces, eps)?);
     }
-    let expected = frame.projected_area(faces, &group.faces);
+    let expected = frame.projected_area(faces, group.faces);
     (!outlines.is_empty() && area_matches(&outlines, expected, eps)).then_some(outlines)
 }
 
-/// The group's boundary as directed edges `(from, to)` in face order: the half-edges whose
-/// undirected edge the group uses once.
-fn boundary_edges(faces: &[Face], group: &Group) -> Vec<(u32, u32)> {
-    let edges = group.faces.iter().map(|&f| faces[f].vertices.len()).sum();
-    let mut half: Vec<(u64, u32, u32)> = Vec::with_capacity(edges);
-    for &f in &group.faces {
-        let vs = &faces[f].vertices;
+/// Fills `scratch.boundary` with the group's boundary as directed edges `(from, to)` in face
+/// order: the half-edges whose undirected edge the group uses once.
+fn boundary_edges(faces: &Faces, group: Group<'_>, scratch: &mut Scratch) {
+    let Scratch {
+        half,
+        keyed,
+        flags,
+        boundary,
+        ..
+    } = scratch;
+    half.clear();
+    for &f in group.faces {
+        let vs = faces.vertices(f);
         for i in 0..vs.len() {
             let (a, b) = (vs[i], vs[(i + 1) % vs.len()]);
             half.push((edge_key(a, b), a, b));
         }
     }
-    let mut by_key: Vec<usize> = (0..half.len()).collect();
-    by_key.sort_by_key(|&h| half[h].0);
-    let mut is_boundary = vec![false; half.len()];
-    for run in by_key.chunk_by(|&x, &y| half[x].0 == half[y].0) {
-        if run.len() == 1 {
-            is_boundary[run[0]] = true;
+    keyed.clear();
+    keyed.extend((half.iter().enumerate()).map(|(h, &(key, _, _))| (key, h as u32)));
+    keyed.sort_unstable();
+    flags.clear();
+    flags.resize(half.len(), false);
+    for run in keyed.chunk_by(|x, y| x.0 == y.0) {
+        if let [(_, h)] = run {
+            flags[*h as usize] = true;
         }
     }
-    half.iter()
-        .zip(&is_boundary)
-        .filter(|(_, b)| **b)
-        .map(|(&(_, a, b), _)| (a, b))
-        .collect()
+    boundary.clear();
+    boundary.extend(
+        (half.iter().zip(flags.iter()))
+            .filter(|(_, b)| **b)
+            .map(|(&(_, a, b), _)| (a, b)),
+    );
 }
 
 /// Every boundary loop of the group in frame coordinates, or `None` when a chain does not
 /// close (non-manifold edges, overlapping faces).
 fn closed_loops(
-    faces: &[Face],
-    group: &Group,
+    faces: &Faces,
+    group: Group<'_>,
     frame: &Frame,
     points: &[Vec3],
+    scratch: &mut Scratch,
 ) -> Option<Vec<Vec<Vec2>>> {
     let project = |id: u32| frame.project(points[id as usize]);
-    let boundary = boundary_edges(faces, group);
+    boundary_edges(faces, group, scratch);
+    let Scratch {
+        flags: used,
+        boundary,
+        outgoing,
+        ..
+    } = scratch;
     // The boundary edges by start vertex (in edge order for each): a sorted list, no
     // allocation per vertex.
-    let mut outgoing: Vec<(u32, usize)> = (boundary.iter().enumerate())
-        .map(|(h, &(a, _))| (a, h))
-        .collect();
+    outgoing.clear();
+    outgoing.extend((boundary.iter().enumerate()).map(|(h, &(a, _))| (a, h)));
     outgoing.sort_unstable();
     let leaving = |at: u32| {
         let start = outgoing.partition_point(|&(a, _)| a < at);
@@ -88,13 +120,18 @@ fn closed_loops(
         outgoing[start..end].iter().map(|&(_, h)| h)
     };
     let mut loops = Vec::new();
-    let mut used = vec![false; boundary.len()];
+    used.clear();
+    used.resize(boundary.len(), false);
+    // Boundary edges not yet in a loop: the most the next loop can take (sized once, not
+    // grown vertex by vertex).
+    let mut left = boundary.len();
     for start in 0..boundary.len() {
         if used[start] {
             continue;
         }
         used[start] = true;
-        let mut ids = vec![boundary[start].0];
+        let mut ring = Vec::with_capacity(left);
+        ring.push(project(boundary[start].0));
         let mut current = start;
         loop {
             let (from, at) = boundary[current];
@@ -128,12 +165,13 @@ fn closed_loops(
                 Some(h) if h == start => break,
                 Some(h) => {
                     used[h] = true;
-                    ids.push(at);
+                    ring.push(project(at));
                     current = h;
                 }
             }
         }
-        loops.push(ids.into_iter().map(project).collect());
+        left -= ring.len();
+        loops.push(ring);
     }
     Some(loops)
 }

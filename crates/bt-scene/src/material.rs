@@ -7,6 +7,32 @@ use bt_geom::Real;
 use serde::{Deserialize, Serialize};
 use std::collections::BTreeMap;
 
+/// A material's name looked up once per run of surfaces that name it: neighbouring surfaces
+/// mostly share one (an imported shape's), so validation, radio checks and the transmission
+/// mask ask the material table once per run instead of once per surface.
+pub(crate) struct MaterialRuns<'a, T> {
+    /// The last name looked up and what it gave.
+    last: Option<(&'a str, T)>,
+}
+
+impl<'a, T: Copy> MaterialRuns<'a, T> {
+    pub(crate) fn new() -> Self {
+        MaterialRuns { last: None }
+    }
+
+    /// What `look_up(name)` gives, calling it only when `name` differs from the last name.
+    pub(crate) fn get(&mut self, name: &'a str, look_up: impl FnOnce(&'a str) -> T) -> T {
+        match self.last {
+            Some((last, found)) if last == name => found,
+            _ => {
+                let found = look_up(name);
+                self.last = Some((name, found));
+                found
+            }
+        }
+    }
+}
+
 /// Name of the material used when a mesh names none.
 pub const DEFAULT_MATERIAL: &str = "default";
 

@@ -40,18 +40,12 @@ impl Penetration {
 
     /// The state of `scene`'s surfaces and materials with transmission `everywhere` or not.
     pub(crate) fn of(scene: &Scene, everywhere: bool, max_interactions: usize) -> Self {
-        // Neighbouring surfaces mostly share a material (an imported shape's): it is looked
-        // up once per run.
-        let mut last: Option<(&str, &crate::Material)> = None;
+        let mut runs = crate::material::MaterialRuns::new();
         let mask: Vec<bool> = scene
             .surfaces()
             .iter()
             .map(|s| {
-                let material = match last {
-                    Some((name, material)) if name == s.material => material,
-                    _ => &scene.materials()[&s.material],
-                };
-                last = Some((&s.material, material));
+                let material = runs.get(&s.material, |name| &scene.materials()[name]);
                 let slab = material.radio.is_some_and(|r| r.thickness.is_some());
                 slab && (material.transmission || (everywhere && s.kind == SurfaceKind::Reflector))
             })

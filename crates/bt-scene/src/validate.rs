@@ -2,7 +2,7 @@
 
 use crate::description::{BOX_FACES, SceneDescription, SurfaceDesc};
 use crate::frame::{to_local, to_world};
-use crate::material::{DEFAULT_MATERIAL, Material, default_materials};
+use crate::material::{DEFAULT_MATERIAL, Material, MaterialRuns, default_materials};
 use crate::model::{Scene, scene_extent, surfaces_box};
 use crate::problem::{Collector, Problem, ProblemSink, SceneError};
 use crate::surface::{Pending, Place, RawSurface, Surface, SurfaceKind};
@@ -421,16 +421,12 @@ pub(crate) fn radio_problems(
     materials: &std::collections::BTreeMap<String, Material>,
     frequency_hz: Real,
 ) -> Vec<Problem> {
-    // Neighbouring surfaces mostly share a material (an imported shape's): each run is
-    // inserted once.
     let mut used: BTreeSet<&str> = BTreeSet::new();
-    let mut last = None;
+    let mut runs = MaterialRuns::new();
     for s in surfaces {
-        let name = s.material.as_str();
-        if last != Some(name) {
+        runs.get(&s.material, |name| {
             used.insert(name);
-            last = Some(name);
-        }
+        });
     }
     let mut problems = Vec::new();
     for name in used {
@@ -464,30 +460,20 @@ pub(crate) fn build_surfaces(
         );
         return Vec::new().into();
     }
-    let (polygons, bvh) = polygons_and_bvh(&mut raw);
-    let mut names = HashSet::with_capacity(raw.len());
-    // The last material found: neighbouring surfaces mostly share one (an imported shape's).
-    let mut known: Option<&str> = None;
-    for (r, polygon) in raw.iter().zip(&polygons) {
-        if let Err(e) = crate::name::check(&r.name) {
-            problems.report(&r.location(), e);
-        } else if !names.insert(r.name.as_str()) {
-            problems.report(
-                &r.location(),
-                format!("duplicate surface name \"{}\"", crate::name::shown(&r.name)),
-            );
-        }
-        let material = r.material.as_deref().unwrap_or(DEFAULT_MATERIAL);
-        if known == Some(material) || materials.contains_key(material) {
-            known = Some(material);
-        } else {
-            problems.report(
-                &r.location(),
-                format!(
-                    "unknown material \"{}\" (add it under \"materials\")",
-                    crate::name::shown(material)
-                ),
-            );
+    // The polygons and their BVH are built on all cores while the names and materials are
+    // checked beside them (the vertices are taken out first, so the two share nothing).
+    let mut vertices: Vec<Vec<Vec3>> = (raw.iter_mut())
+        .map(|r| std::mem::take(&mut r.vertices))
+        .collect();
+    let ((polygons, bvh), named) = rayon::join(
+        || polygons_and_bvh(&mut vertices),
+        || name_and_material_problems(&raw, materials),
+    );
+    // Each surface's problems in order: its name and material, then its polygon.
+    let mut named = named.into_iter().peekable();
+    for (i, (r, polygon)) in raw.iter().zip(&polygons).enumerate() {
+        while let Some((_, location, message)) = named.next_if(|(at, _, _)| *at == i) {
+            problems.report(&location, message);
         }
         if let Err(e) = polygon {
             problems.report(&format!("{}.vertices", r.location()), e.to_string());
@@ -508,6 +494,34 @@ pub(crate) fn build_surfaces(
         surfaces,
         bvh: all.then_some(bvh),
     }
+}
+
+/// The problems of `raw`'s names (not printable, duplicated) and materials (not in
+/// `materials`), each as (surface index, location, message), in surface order.
+fn name_and_material_problems(
+    raw: &[Pending],
+    materials: &std::collections::BTreeMap<String, Material>,
+) -> Vec<(usize, String, String)> {
+    let mut found = Vec::new();
+    let mut names = HashSet::with_capacity(raw.len());
+    let mut known = MaterialRuns::new();
+    for (i, r) in raw.iter().enumerate() {
+        if let Err(e) = crate::name::check(&r.name) {
+            found.push((i, r.location(), e));
+        } else if !names.insert(r.name.as_str()) {
+            let message = format!("duplicate surface name \"{}\"", crate::name::shown(&r.name));
+            found.push((i, r.location(), message));
+        }
+        let material = r.material.as_deref().unwrap_or(DEFAULT_MATERIAL);
+        if !known.get(material, |m| materials.contains_key(m)) {
+            let message = format!(
+                "unknown material \"{}\" (add it under \"materials\")",
+                crate::name::shown(material)
+            );
+            found.push((i, r.location(), message));
+        }
+    }
+    found
 }
 
 /// The polygons of `vertices` (each list taken) built on all cores, order kept, and beside

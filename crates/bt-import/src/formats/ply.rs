@@ -145,6 +145,12 @@ fn next_line<'a>(bytes: &'a [u8], pos: &mut usize) -> Option<&'a [u8]> {
     Some(line.strip_suffix(b"\r").unwrap_or(line))
 }
 
+/// Words of a header line looked at, in a list on the stack (a `Vec` per line was most of a
+/// small mesh's allocations). The longest valid line other than a comment has five words
+/// (`property list <count> <item> <name>`), and every line of six words or more other than a
+/// comment is malformed whatever its further words, so the first six decide.
+const MAX_WORDS: usize = 6;
+
 impl PlyHeader {
     /// Parses the header at the start of `bytes` (the body is not looked at).
     pub fn parse(bytes: &[u8]) -> Result<PlyHeader, PlyHeaderError> {
@@ -168,8 +174,13 @@ impl PlyHeader {
                 }
                 continue;
             }
-            let words: Vec<&str> = text.split_ascii_whitespace().collect();
-            match words.as_slice() {
+            let mut words = [""; MAX_WORDS];
+            let mut count = 0;
+            for word in text.split_ascii_whitespace().take(MAX_WORDS) {
+                words[count] = word;
+                count += 1;
+            }
+            match &words[..count] {
                 [] | ["comment" | "obj_info", ..] => {}
                 ["format", rest @ ..] => format = Some(parse_format(rest, text).map_err(fail)?),
                 ["element", name, count] => elements.push(PlyElement {
@@ -287,6 +298,13 @@ mod tests {
             (b"ply\nelement v 1\nproperty float x\nproperty int x\n", 4, K::DuplicateProperty("x".into())),
             (b"ply\nelement v\n",                                     2, K::Malformed("element v".into())),
             (b"ply\nvertex 3\n",                                      2, K::Malformed("vertex 3".into())),
+            // Lines longer than the words looked at: the whole line is named.
+            (b"ply\nformat ascii 1.0 a b c d\n",                      2, K::Malformed("format ascii 1.0 a b c d".into())),
+            (b"ply\nformat middle 1.0 a b c d\n",                     2, K::UnknownFormat("middle".into())),
+            (b"ply\nelement v 1 a b c d\n",                           2, K::Malformed("element v 1 a b c d".into())),
+            (b"ply\nelement v 1\nproperty list uchar int f g h\n",     3, K::Malformed("property list uchar int f g h".into())),
+            (b"ply\nproperty list uchar int f g h\n",                  2, K::PropertyBeforeElement),
+            (b"ply\nend_header a b c d e f\n",                        2, K::Malformed("end_header a b c d e f".into())),
         ];
         for (bytes, line, kind) in cases {
             let e = PlyHeader::parse(bytes).unwrap_err();
@@ -298,5 +316,8 @@ mod tests {
             );
         }
         assert!(K::UnknownFormat(String::new()).is_unsupported() && !K::NoFormat.is_unsupported());
+        // A comment of any length is skipped.
+        let long = b"ply\ncomment a b c d e f g h\nformat ascii 1.0\nend_header\n";
+        assert_eq!(PlyHeader::parse(long).expect("a comment").lines, 4);
     }
 }

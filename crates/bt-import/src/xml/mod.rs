@@ -143,7 +143,8 @@ pub(crate) fn load_xml_read(
     options: &LoadOptions,
 ) -> Result<(Loaded, crate::source::Digest), ImportError> {
     let display = path.display().to_string();
-    let text = read_bounded(path, MAX_XML_BYTES.min(options.max_file_bytes), &display)?;
+    let limit = MAX_XML_BYTES.min(options.max_file_bytes);
+    let text = read_bounded(path, None, limit, &display)?;
     let read = crate::source::digest(&text);
     let text = String::from_utf8(text).map_err(|e| ImportError::Parse {
         path: display.clone(),
@@ -164,8 +165,9 @@ pub(crate) fn load_xml_read(
         options,
         bytes_left: MAX_MESH_TOTAL_BYTES,
         elements: SceneElements::default(),
-        meshes: Vec::new(),
-        seen: std::collections::HashSet::new(),
+        // Sized for one file per shape (as in Sionna's cities), not grown and rehashed.
+        meshes: Vec::with_capacity(xml.shapes.len()),
+        seen: std::collections::HashSet::with_capacity(xml.shapes.len()),
     };
     for round in xml.shapes.chunks(SHAPES_PER_ROUND) {
         reading.round(round, &mut desc, &mut warnings)?;
@@ -231,32 +233,44 @@ impl Reading<'_> {
                 }
             }
         }
+        // Each mesh is read, merged and turned into scene surfaces on the worker threads.
         let imports: Vec<Result<_, ImportError>> = (found.par_iter())
-            .map(|(shape, (file, metadata))| read_shape(shape, file, metadata, self.options))
+            .map(|(shape, (file, metadata))| {
+                let (import, read) = read_shape(shape, file, metadata, self.options)?;
+                Ok((shape_surfaces(shape, import, self.xml, self.options), read))
+            })
             .collect();
         for ((shape, (file, _)), import) in found.into_iter().zip(imports) {
-            let (import, read) = import?;
-            (self.elements).charge(&import, shape, self.xml, self.options.merge.max_elements)?;
+            let (added, read) = import?;
+            (self.elements).charge(&added, shape, self.xml, self.options.merge.max_elements)?;
             if self.seen.insert(file.clone()) {
                 self.meshes.push((file, read));
             }
-            add_shape(shape, import, self.xml, self.options, desc, warnings);
+            desc.surfaces.extend(added.surfaces);
+            warnings.extend(added.warnings);
         }
         refused.map_or(Ok(()), Err)
     }
 }
 
-/// Append the surfaces of `shape`'s merged mesh to `desc` (named `<shape>.<surface>`, with the
-/// shape's bsdf, blockers below the minimum reflector area) and its warnings to `warnings`.
-fn add_shape(
+/// What one shape's mesh adds to the scene: its surfaces and warnings, and the vertices and
+/// faces its file held (charged to the scene's budget).
+struct ShapeSurfaces {
+    surfaces: Vec<SurfaceDesc>,
+    warnings: Vec<String>,
+    vertices_read: usize,
+    faces_read: usize,
+}
+
+/// The surfaces of `shape`'s merged mesh (named `<shape>.<surface>`, with the shape's bsdf,
+/// blockers below the minimum reflector area) and its warnings, for the scene.
+fn shape_surfaces(
     shape: &XmlShape,
     import: bt_mesh::MeshImport,
     xml: &str,
     options: &LoadOptions,
-    desc: &mut SceneDescription,
-    warnings: &mut Vec<String>,
-) {
-    warnings.extend(import.warnings);
+) -> ShapeSurfaces {
+    let mut warnings = import.warnings;
     let material = shape.bsdf.as_ref().map(|(id, _)| id.clone());
     if material.is_none() {
         warnings.push(format!(
@@ -265,8 +279,8 @@ fn add_shape(
             bt_scene::name::shown(&shape.name)
         ));
     }
-    desc.surfaces
-        .extend(import.surfaces.into_iter().map(|s| SurfaceDesc {
+    let surfaces = (import.surfaces.into_iter())
+        .map(|s| SurfaceDesc {
             name: [shape.name.as_str(), ".", &s.name].concat(),
             material: material.clone(),
             kind: Some(if s.region_area_m2 >= options.min_reflector_area_m2 {
@@ -277,7 +291,14 @@ fn add_shape(
             // In place: `Vec3` and `[Real; 3]` have one layout.
             vertices: s.vertices.into_iter().map(|v| v.to_array()).collect(),
             ..SurfaceDesc::default()
-        }));
+        })
+        .collect();
+    ShapeSurfaces {
+        surfaces,
+        warnings,
+        vertices_read: import.vertices_read,
+        faces_read: import.faces_read,
+    }
 }
 
 /// The vertices and faces read so far from the meshes of one XML scene.
@@ -293,7 +314,7 @@ impl SceneElements {
     /// shapes of one large mesh do not pass where one file of all of them would not.
     fn charge(
         &mut self,
-        import: &bt_mesh::MeshImport,
+        import: &ShapeSurfaces,
         shape: &XmlShape,
         xml: &str,
         max_elements: u64,
@@ -447,13 +468,7 @@ fn read_shape(
     options: &LoadOptions,
 ) -> Result<(bt_mesh::MeshImport, crate::source::Digest), ImportError> {
     let shown = file.display().to_string();
-    let bytes =
-        crate::source::read_stated(file, metadata, options.max_file_bytes).map_err(|source| {
-            ImportError::Io {
-                path: shown.clone(),
-                source,
-            }
-        })?;
+    let bytes = read_bounded(file, Some(metadata), options.max_file_bytes, &shown)?;
     let format = match shape.kind {
         MeshKind::Ply => crate::mesh::MeshFormat::Ply,
         MeshKind::Obj => crate::mesh::MeshFormat::Obj,
@@ -486,9 +501,20 @@ fn resolve(folder: &Path, name: &str) -> Result<PathBuf, &'static str> {
     Ok(folder.join(relative))
 }
 
-/// The bytes of `path`, at most `limit` ([`crate::source::read_file`]).
-fn read_bounded(path: &Path, limit: u64, display: &str) -> Result<Vec<u8>, ImportError> {
-    crate::source::read_file(path, limit).map_err(|source| ImportError::Io {
+/// The bytes of `path`, at most `limit`: [`crate::source::read_stated`] with its `metadata`
+/// when the caller took it already, else [`crate::source::read_file`]. An I/O failure is an
+/// [`ImportError::Io`] naming the file as `display`.
+fn read_bounded(
+    path: &Path,
+    metadata: Option<&std::fs::Metadata>,
+    limit: u64,
+    display: &str,
+) -> Result<Vec<u8>, ImportError> {
+    let read = match metadata {
+        Some(metadata) => crate::source::read_stated(path, metadata, limit),
+        None => crate::source::read_file(path, limit),
+    };
+    read.map_err(|source| ImportError::Io {
         path: display.to_string(),
         source,
     })

@@ -10,6 +10,7 @@ use crate::ImportError;
 use bt_geom::Real;
 use glam::DMat4;
 use roxmltree::{Document, Node, ParsingOptions};
+use std::borrow::Cow;
 use std::cell::Cell;
 use std::collections::{BTreeMap, BTreeSet};
 
@@ -84,15 +85,20 @@ impl Ctx<'_> {
         }
     }
 
-    /// Attribute `name` with `$param` substituted from the `<default>`s (`\$` is a literal `$`).
-    pub(super) fn attr(
+    /// Attribute `name` with `$param` substituted from the `<default>`s (`\$` is a literal `$`);
+    /// borrowed from the document when there is nothing to substitute (nearly always: one
+    /// `String` per attribute was a tenth of the parse of a city's XML, on the calling thread).
+    pub(super) fn attr<'n>(
         &self,
-        node: Node<'_, '_>,
+        node: Node<'n, '_>,
         name: &str,
-    ) -> Result<Option<String>, ImportError> {
+    ) -> Result<Option<Cow<'n, str>>, ImportError> {
         let Some(raw) = node.attribute(name) else {
             return Ok(None);
         };
+        if !raw.contains('$') {
+            return Ok(Some(Cow::Borrowed(raw)));
+        }
         let mut out = String::with_capacity(raw.len());
         let mut rest = raw;
         while let Some(at) = rest.find('$') {
@@ -119,7 +125,7 @@ impl Ctx<'_> {
             rest = &tail[len..];
         }
         out.push_str(rest);
-        Ok(Some(out))
+        Ok(Some(Cow::Owned(out)))
     }
 
     /// Count `bytes` substituted for `$key` in attribute `name` against the budget, before they
@@ -142,7 +148,11 @@ impl Ctx<'_> {
     }
 
     /// A required attribute.
-    pub(super) fn required(&self, node: Node<'_, '_>, name: &str) -> Result<String, ImportError> {
+    pub(super) fn required<'n>(
+        &self,
+        node: Node<'n, '_>,
+        name: &str,
+    ) -> Result<Cow<'n, str>, ImportError> {
         self.attr(node, name)?.ok_or_else(|| {
             self.error(
                 node,
@@ -232,7 +242,9 @@ pub fn parse_xml_with(
     for node in elements(root).filter(|n| tag(*n) == "default") {
         let name = ctx.required(node, "name")?;
         let value = ctx.required(node, "value")?;
-        ctx.defaults.entry(name).or_insert(value);
+        ctx.defaults
+            .entry(name.into_owned())
+            .or_insert(value.into_owned());
     }
     let mut scene = XmlScene::default();
     let mut skipped: BTreeMap<String, u32> = BTreeMap::new();
@@ -240,7 +252,7 @@ pub fn parse_xml_with(
         match tag(node) {
             "default" => {}
             "bsdf" => {
-                let id = ctx.required(node, "id")?;
+                let id = ctx.required(node, "id")?.into_owned();
                 add_bsdf(&mut ctx, &mut scene, node, id)?;
             }
             "shape" => {
@@ -306,7 +318,9 @@ fn parse_bsdf(ctx: &Ctx<'_>, node: Node<'_, '_>) -> Result<XmlRadio, ImportError
     let kind = ctx.required(node, "type")?;
     let radio = kind == "itu-radio-material" || kind == "radio-material";
     if !radio {
-        return Ok(XmlRadio::Visual { kind });
+        return Ok(XmlRadio::Visual {
+            kind: kind.into_owned(),
+        });
     }
     let mut itu: Option<String> = None;
     let mut thickness = None;
@@ -314,9 +328,9 @@ fn parse_bsdf(ctx: &Ctx<'_>, node: Node<'_, '_>) -> Result<XmlRadio, ImportError
     let mut conductivity = None;
     for child in elements(node) {
         let name = ctx.required(child, "name")?;
-        match (tag(child), name.as_str(), kind.as_str()) {
+        match (tag(child), name.as_ref(), kind.as_ref()) {
             ("string", "type", "itu-radio-material") => {
-                itu = Some(ctx.required(child, "value")?);
+                itu = Some(ctx.required(child, "value")?.into_owned());
             }
             ("float", "thickness", _) => thickness = Some(ctx.number(child, "value")?),
             ("float", "relative_permittivity", "radio-material") => {
@@ -369,7 +383,7 @@ fn parse_shape(
     scene: &mut XmlScene,
     node: Node<'_, '_>,
 ) -> Result<XmlShape, ImportError> {
-    let kind = match ctx.required(node, "type")?.as_str() {
+    let kind = match ctx.required(node, "type")?.as_ref() {
         "ply" => MeshKind::Ply,
         "obj" => MeshKind::Obj,
         other => {
@@ -383,7 +397,7 @@ fn parse_shape(
         }
     };
     let name = match ctx.attr(node, "id")? {
-        Some(id) => id,
+        Some(id) => id.into_owned(),
         None => format!("shape-{}", scene.shapes.len()),
     };
     let mut shape = XmlShape {
@@ -420,13 +434,13 @@ fn shape_child(
             if value.is_empty() {
                 return Err(ctx.error(child, "<string name=\"filename\"> is empty"));
             }
-            *filename = Some(value);
+            *filename = Some(value.into_owned());
         }
         "boolean" => {
             let name = ctx.required(child, "name")?;
             let value = ctx.required(child, "value")?;
             if !matches!(
-                name.as_str(),
+                name.as_ref(),
                 "face_normals" | "flip_normals" | "flip_tex_coords"
             ) {
                 return Err(ctx.error(
@@ -437,7 +451,7 @@ fn shape_child(
                     ),
                 ));
             }
-            if !matches!(value.as_str(), "true" | "false") {
+            if !matches!(value.as_ref(), "true" | "false") {
                 return Err(ctx.error(
                     child,
                     format!(
@@ -459,12 +473,12 @@ fn shape_child(
                     ),
                 ));
             }
-            let id = ctx.required(child, "id")?;
+            let id = ctx.required(child, "id")?.into_owned();
             set_bsdf(ctx, shape, id, child)?;
         }
         "bsdf" => {
             let id = match ctx.attr(child, "id")? {
-                Some(id) => id,
+                Some(id) => id.into_owned(),
                 None => format!("{}.bsdf", shape.name),
             };
             add_bsdf(ctx, scene, child, id.clone())?;
