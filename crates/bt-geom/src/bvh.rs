@@ -63,13 +63,20 @@ pub const SCAN_UP_TO: usize = 64;
 /// Boxes tested at once by `Boxes::scan` (four `f64` in an AVX register).
 const LANES: usize = 4;
 
-/// Item boxes as arrays, by bound and coordinate (m), padded with zeros to whole [`LANES`].
+/// Item boxes in groups of [`LANES`], padded with zeros to whole groups.
 #[derive(Debug, Clone, Default)]
 struct Boxes {
-    min: [Vec<Real>; 3],
-    max: [Vec<Real>; 3],
-    /// Items stored (the arrays hold as many, then the padding).
+    groups: Vec<Group>,
+    /// Items stored (the groups hold as many, then the padding).
     len: usize,
+}
+
+/// The boxes of [`LANES`] consecutive items, by bound, coordinate and item (m): fixed-size
+/// arrays, so that the scan loads them without bounds checks.
+#[derive(Debug, Clone, Copy, Default)]
+struct Group {
+    min: [[Real; LANES]; 3],
+    max: [[Real; LANES]; 3],
 }
 
 impl Bvh {
@@ -81,17 +88,20 @@ impl Bvh {
         if !items.is_empty() {
             build_node(&boxes, &mut order, 0, items.len(), &mut nodes);
         }
-        // Padded to whole lanes (the padding's bits are masked off in `scan`).
-        let lanes = boxes.len().next_multiple_of(LANES);
-        let axis = |f: fn(&(Vec3, Vec3)) -> Vec3, k: usize| {
-            let mut v: Vec<Real> = boxes.iter().map(|b| f(b)[k]).collect();
-            v.resize(lanes, 0.0);
-            v
-        };
-        let scan = (boxes.len() <= SCAN_UP_TO).then(|| Boxes {
-            min: std::array::from_fn(|k| axis(|b| b.0, k)),
-            max: std::array::from_fn(|k| axis(|b| b.1, k)),
-            len: boxes.len(),
+        // Padded to whole groups (the padding's bits are masked off in `scan`).
+        let scan = (boxes.len() <= SCAN_UP_TO).then(|| {
+            let mut groups = vec![Group::default(); boxes.len().div_ceil(LANES)];
+            for (i, (min, max)) in boxes.iter().enumerate() {
+                let group = &mut groups[i / LANES];
+                for k in 0..3 {
+                    group.min[k][i % LANES] = min[k];
+                    group.max[k][i % LANES] = max[k];
+                }
+            }
+            Boxes {
+                groups,
+                len: boxes.len(),
+            }
         });
         Self {
             nodes,
@@ -257,10 +267,12 @@ impl Boxes {
     /// index order, up to the first it accepts.
     #[inline(always)]
     fn scan(&self, slab: &Slab, mut hit: impl FnMut(u32) -> bool) -> Option<u32> {
-        let padded = self.min[0].len().min(SCAN_UP_TO);
         let mut touched = 0u64;
-        for base in (0..padded).step_by(LANES) {
-            touched |= u64::from(self.lanes_hit(slab, base)) << base;
+        // At most SCAN_UP_TO / LANES groups (`Bvh::build`); the bound, known to the compiler,
+        // also makes it lay the loop out well (without it the diffracted trace costs 23 %
+        // more instructions).
+        for (g, group) in self.groups.iter().take(SCAN_UP_TO / LANES).enumerate() {
+            touched |= u64::from(group.hit_by(slab)) << (g * LANES);
         }
         let n = self.len;
         touched &= if n >= 64 { u64::MAX } else { (1 << n) - 1 };
@@ -273,13 +285,13 @@ impl Boxes {
         }
         None
     }
+}
 
-    /// Boxes `base..base + LANES` against `slab` ([`Slab::hits_box`], lane by lane, written
-    /// so that the compiler keeps the lanes in one vector register): bit `l` for box
-    /// `base + l`.
+impl Group {
+    /// The group's boxes against `slab` ([`Slab::hits_box`], lane by lane, written so that
+    /// the compiler keeps the lanes in one vector register): bit `l` for box `l`.
     #[inline(always)]
-    fn lanes_hit(&self, slab: &Slab, base: usize) -> u8 {
-        let lane = |v: &Vec<Real>| -> [Real; LANES] { v[base..base + LANES].try_into().unwrap() };
+    fn hit_by(&self, slab: &Slab) -> u8 {
         let (from_min, from_max, inv) = (
             slab.from_min.to_array(),
             slab.from_max.to_array(),
@@ -288,7 +300,7 @@ impl Boxes {
         let mut enter = [0.0 as Real; LANES];
         let mut exit = [1.0 as Real; LANES];
         for k in 0..3 {
-            let (lo, hi) = (lane(&self.min[k]), lane(&self.max[k]));
+            let (lo, hi) = (self.min[k], self.max[k]);
             for l in 0..LANES {
                 let t0 = (lo[l] - from_min[k]) * inv[k];
                 let t1 = (hi[l] - from_max[k]) * inv[k];

@@ -167,13 +167,16 @@ impl DiffractedSet {
         // (order, position, edge, first two reflections) packed into one integer, which
         // decides alone up to order 3 with one diffraction; longer reflection lists and the
         // second diffraction only on ties.
+        // From the flat arrays (what `get` would give: the order is the reflections plus the
+        // diffractions).
         let mut keyed: Vec<(u128, u32)> = (0..self.len())
             .map(|i| {
-                let c = self.get(i);
-                let id = |k: usize| c.reflections.get(k).map_or(0, |s| u128::from(s.0) + 1);
-                let key = ((c.order() as u128) << 120)
-                    | ((c.position as u128) << 112)
-                    | (u128::from(c.edge.0) << 80)
+                let reflections = &self.ids[self.offsets[i] as usize..self.offsets[i + 1] as usize];
+                let order = reflections.len() + 1 + usize::from(self.seconds[i].is_some());
+                let id = |k: usize| reflections.get(k).map_or(0, |s| u128::from(s.0) + 1);
+                let key = ((order as u128) << 120)
+                    | (u128::from(self.positions[i]) << 112)
+                    | (u128::from(self.edges[i].0) << 80)
                     | (id(0) << 40)
                     | id(1);
                 (key, i as u32)
@@ -194,13 +197,24 @@ impl DiffractedSet {
             }
         }
         keyed.dedup_by(|a, b| a.0 == b.0 && ties(a, b).is_eq());
-        let mut sorted = DiffractedSet::default();
+        // Each candidate copied whole (its reflections are contiguous, its position and
+        // second diffraction kept), into arrays sized once.
+        let mut sorted = DiffractedSet {
+            ids: Vec::with_capacity(self.ids.len()),
+            offsets: Vec::with_capacity(keyed.len() + 1),
+            edges: Vec::with_capacity(keyed.len()),
+            positions: Vec::with_capacity(keyed.len()),
+            seconds: Vec::with_capacity(keyed.len()),
+        };
+        sorted.offsets.push(0);
         for (_, i) in keyed {
-            let c = self.get(i as usize);
-            match c.second {
-                None => sorted.push(c.before(), c.edge, c.after()),
-                Some((e, _)) => sorted.push_twice(c.before(), (c.edge, e), c.between(), c.after()),
-            }
+            let i = i as usize;
+            let (lo, hi) = (self.offsets[i] as usize, self.offsets[i + 1] as usize);
+            sorted.ids.extend_from_slice(&self.ids[lo..hi]);
+            sorted.offsets.push(sorted.ids.len() as u32);
+            sorted.edges.push(self.edges[i]);
+            sorted.positions.push(self.positions[i]);
+            sorted.seconds.push(self.seconds[i]);
         }
         *self = sorted;
     }

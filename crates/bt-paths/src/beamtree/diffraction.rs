@@ -65,6 +65,10 @@ struct RootOnly {
 struct Focus {
     tx_distance: Real,
     tx_along: Real,
+    /// Whether [`on_edge`] may accept without the closed form when both projections lie on
+    /// the edge: TX off the line (a positive, moderate distance), its projection finite and
+    /// the margin above the closed form's rounding (a few ulps of the edge's length).
+    shortcut: bool,
 }
 
 impl BeamTree {
@@ -85,6 +89,7 @@ impl BeamTree {
             .iter()
             .map(|edge| plane_holds_edge(scene, edge))
             .collect();
+        let sectors: Vec<Sector> = edges.all().iter().map(Sector::of).collect();
         let eps = EPS * self.tol;
         let mut out: Vec<Vec<Reach>> = vec![Vec::new(); edges.len()];
         for (e, edge) in edges.all().iter().enumerate() {
@@ -103,7 +108,7 @@ impl BeamTree {
             // At the root-only depth, TX's half of each edge's Keller point.
             let focus = root_only
                 .filter(|r| r.depth == depth)
-                .map(|r| (focus(scene, r.tx), r.margin));
+                .map(|r| (focus(scene, r.tx, r.margin), r.margin));
             for i in (lo..hi).filter(|&i| self.nodes[i].live) {
                 let node = &self.nodes[i];
                 let planes = &self.planes[node.planes.0 as usize..node.planes.1 as usize];
@@ -115,7 +120,7 @@ impl BeamTree {
                         || focus.as_ref().is_some_and(|(focus, margin)| {
                             !on_edge(edge, focus[e as usize], node.image, *margin)
                         })
-                        || !in_sector(edge, node.image)
+                        || !sectors[e as usize].holds(edge, node.image)
                     {
                         return;
                     }
@@ -185,38 +190,92 @@ fn plane_holds_edge(scene: &Scene, edge: &Edge) -> Vec<u32> {
 /// sector).
 #[inline]
 fn in_sector(edge: &Edge, p: Vec3) -> bool {
-    let about = edge.about(p);
-    about.r > 0.0 && about.in_sector(EXTERIOR_SLACK_RAD * about.r)
+    Sector::of(edge).holds(edge, p)
 }
 
-/// TX's half of the Keller point on every edge, by edge index.
-fn focus(scene: &Scene, tx: Vec3) -> Vec<Focus> {
+/// The axes of an edge's exterior test ([`in_sector`]), computed once per edge for the tests
+/// of many points: `e × t0` and `tn × e`, as [`Edge::about`] computes them.
+#[derive(Debug, Clone, Copy)]
+struct Sector {
+    y0: Vec3,
+    yn: Vec3,
+}
+
+impl Sector {
+    fn of(edge: &Edge) -> Self {
+        Sector {
+            y0: edge.direction.cross(edge.t0),
+            yn: edge.tn.cross(edge.direction),
+        }
+    }
+
+    /// Whether `p` lies in `edge`'s exterior: `Edge::about(p)`'s `r > 0` and
+    /// `in_sector(EXTERIOR_SLACK_RAD · r)`, bit for bit, with the same products; the square
+    /// root only when `p` lies behind both faces' planes (r > 0 makes the slack non-negative,
+    /// so a point on the exterior side of either plane passes whatever r is).
+    #[inline]
+    fn holds(&self, edge: &Edge, p: Vec3) -> bool {
+        let v = p - edge.start;
+        let (sin0, cos0, sin_n) = (v.dot(self.y0), v.dot(edge.t0), v.dot(self.yn));
+        let r2 = sin0 * sin0 + cos0 * cos0;
+        // r = √r2 > 0 exactly when r2 > 0 (false for NaN).
+        r2 > 0.0 && {
+            sin0 >= 0.0 || sin_n >= 0.0 || {
+                let slack = EXTERIOR_SLACK_RAD * r2.sqrt();
+                sin0 >= -slack || sin_n >= -slack
+            }
+        }
+    }
+}
+
+/// TX's half of the Keller point on every edge, by edge index, for [`on_edge`] with `margin`.
+fn focus(scene: &Scene, tx: Vec3, margin: Real) -> Vec<Focus> {
     scene
         .edges()
         .all()
         .iter()
         .map(|edge| {
             let line = EdgeLine::of(edge);
+            let (tx_distance, tx_along) = (line.distance(tx), line.along(tx));
             Focus {
-                tx_distance: line.distance(tx),
-                tx_along: line.along(tx),
+                tx_distance,
+                tx_along,
+                shortcut: tx_distance > 0.0
+                    && tx_distance < MODERATE
+                    && tx_along.is_finite()
+                    && 4.0 * Real::EPSILON * edge.length <= margin,
             }
         })
         .collect()
 }
+
+/// Lengths below this (m) are moderate: sums of two stay finite.
+const MODERATE: Real = 1e150;
 
 /// Whether the Keller point of TX and `image` on `edge` lies on the edge within `margin`
 /// (what the join asks of a pair with the TX root, [`Pairing::once`]): the same closed form
 /// as [`EdgeLine::keller`], TX's half from `f`. The point is a weighted mean of the two
 /// projections, so when both lie beyond the same end by twice the margin (far above the
 /// closed form's round-off) it does too, and no square root is needed.
+///
+/// When both projections lie on the edge, so does the point up to its rounding: with
+/// non-negative weights and projections the closed form is non-negative, and it exceeds the
+/// edge's length `L` by at most about 2 ε·L (four roundings), below the margin
+/// ([`Focus::shortcut`]). It is defined when TX lies off the line and the image's offset is
+/// moderate (the sum of distances then positive and finite). So the answer is the closed
+/// form's, without its square root.
 #[inline]
 fn on_edge(edge: &Edge, f: Focus, image: Vec3, margin: Real) -> bool {
     let line = EdgeLine::of(edge);
-    let along = line.along(image);
+    let v = image - edge.start;
+    // `line.along(image)`, with the offset kept for the shortcut's test.
+    let along = v.dot(edge.direction);
     let (near, far) = (f.tx_along.min(along), f.tx_along.max(along));
     if far < -2.0 * margin || near > edge.length + 2.0 * margin {
         return false;
+    }
+    if f.shortcut && near >= 0.0 && far <= edge.length && v.length_squared() < MODERATE {
+        return true;
     }
     match line.keller_from(f.tx_distance, f.tx_along, image) {
         Some(t) => t >= -margin && t <= edge.length + margin,
@@ -443,5 +502,59 @@ impl Pairing<'_> {
             }
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// The exterior test as [`Edge::about`] states it, with its square root.
+    fn in_sector_by_about(edge: &Edge, p: Vec3) -> bool {
+        let about = edge.about(p);
+        about.r > 0.0 && about.in_sector(EXTERIOR_SLACK_RAD * about.r)
+    }
+
+    /// [`on_edge`] by the closed form alone ([`EdgeLine::keller_from`]).
+    fn on_edge_by_keller(edge: &Edge, f: Focus, image: Vec3, margin: Real) -> bool {
+        EdgeLine::of(edge)
+            .keller_from(f.tx_distance, f.tx_along, image)
+            .is_some_and(|t| t >= -margin && t <= edge.length + margin)
+    }
+
+    /// A point on a coarse grid (many on faces' planes, on edge lines and at the ends), or
+    /// off it by a small offset.
+    fn point(c: [i8; 3], off: [i8; 3]) -> Vec3 {
+        let v = |c: [i8; 3]| Vec3::new(c[0] as Real, c[1] as Real, c[2] as Real);
+        0.5 * v(c) + 1e-9 * v(off)
+    }
+
+    proptest! {
+        /// The sector test with its axes computed once, and the Keller test with its
+        /// shortcut, answer as the formulas they replace, on every edge of a box room and a
+        /// screen, for points on and near their faces, lines and ends.
+        #[test]
+        fn the_per_edge_tests_answer_as_their_formulas(
+            c in proptest::array::uniform3(-4i8..9),
+            off in proptest::array::uniform3(-3i8..4),
+            t in proptest::array::uniform3(-4i8..9),
+            margin_exp in -12i32..0,
+        ) {
+            let room = bt_testkit::box_room([4.0, 3.0, 2.5], [1.0, 1.0, 1.0], [3.0, 2.0, 1.5]);
+            let p = point(c, off);
+            let tx = point(t, [0; 3]);
+            let margin = (10.0 as Real).powi(margin_exp);
+            for edge in room.edges().all() {
+                prop_assert_eq!(Sector::of(edge).holds(edge, p), in_sector_by_about(edge, p));
+                let f = focus(&room, tx, margin)
+                    .into_iter()
+                    .zip(room.edges().all())
+                    .find(|(_, e)| *e == edge)
+                    .unwrap()
+                    .0;
+                prop_assert_eq!(on_edge(edge, f, p, margin), on_edge_by_keller(edge, f, p, margin));
+            }
+        }
     }
 }
