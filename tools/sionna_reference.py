@@ -211,6 +211,47 @@ CASES = [
         ),
     ),
     dict(
+        name="one-screen-d2",
+        scene="box_one_screen",
+        tx=[-3.0, 1.0, 2.5],
+        rx=[[3.0, -1.0, 2.0], [3.5, 2.5, 4.0], [2.0, -4.0, 1.0]],
+        max_depth=2,
+        why=(
+            "A metal 10 x 10 x 5 m box cut by a glass screen at x = 0 from floor to ceiling, "
+            "y in -3..3 (Sionna's own scene, not used before this case): TX west of the "
+            "screen, every receiver east of it. No LoS; reached round the screen's vertical "
+            "free edges at y = +-3 (alone, or with a reflection off the box before or after "
+            "them) and by reflections through the 2 m gaps beside the screen."
+        ),
+    ),
+    dict(
+        name="two-screens-d2",
+        scene="box_two_screens",
+        tx=[-4.0, 0.5, 2.5],
+        rx=[[0.0, 4.0, 3.0], [0.0, -1.0, 2.0], [4.0, -0.5, 2.0]],
+        max_depth=2,
+        why=(
+            "The same box with two glass screens at x = -2 and x = 2 (y in -3..3). TX "
+            "behind the first screen; RX0 and RX1 between the screens (round one screen's "
+            "edge, with a reflection or not), RX2 behind the second screen: there every "
+            "path needs two diffractions or reflections round both screens."
+        ),
+    ),
+    dict(
+        name="canyon-cars-d2",
+        scene="simple_street_canyon_with_cars",
+        tx=[-50.0, -3.0, 8.0],
+        rx=[[20.0, 3.0, 1.5], [40.0, 7.6, 1.0], [-12.0, 8.0, 0.8]],
+        max_depth=2,
+        why=(
+            "The street canyon with five cars parked along y in 4.7..6.5 (Sionna's own "
+            "scene, not used before this case). TX 8 m up at the west end; RX0 in the "
+            "street near a car, RX1 and RX2 behind cars (between the cars and the north "
+            "buildings), below the cars' roofs: reached over and round the cars' edges and "
+            "off the buildings."
+        ),
+    ),
+    dict(
         name="canyon-d3",
         scene="simple_street_canyon",
         tx=[-45.0, 0.0, 10.0],

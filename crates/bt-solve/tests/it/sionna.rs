@@ -18,7 +18,9 @@ use serde_json::Value;
 use std::path::{Path, PathBuf};
 
 /// The reference cases (one file each).
-const CASES: [&str; 6] = [
+const CASES: [&str; 8] = [
+    "one-screen-d2",
+    "two-screens-d2",
     "wedge-shadow-d1",
     "wedge-shadow-d2",
     "wedge-lit-d2",
@@ -390,6 +392,41 @@ fn every_sionna_path_is_found_with_its_gain() {
     );
     assert!(d.diffracted.len() > 200, "{}", d.diffracted.len());
     eprintln!("diffracting where we have no edge: {:#?}", d.no_edge);
+}
+
+/// The street canyon with parked cars (`canyon-cars-d2`, a Sionna scene first traced in this
+/// test, order 2): every Sionna path is ours, specular gains within 0.05 dB, and with Sionna's
+/// coefficient its 150 diffracted gains within 1 dB, all but one within 0.1 dB (rx2's
+/// reflection then diffraction on car_3's roof edge, 0.24 dB: not explained yet,
+/// docs/channel.md). Apart from `CASES` so that the others keep their 0.1 dB bound.
+#[test]
+fn in_the_canyon_with_cars_every_sionna_path_is_found() {
+    let mut d = Differences::default();
+    compare_case(
+        "canyon-cars-d2",
+        Gains::Report(DiffractionCoefficient::SionnaRt22),
+        &mut d,
+    );
+    assert!(d.missing.is_empty(), "missing: {:#?}", d.missing);
+    assert!(
+        d.specular.iter().all(|x| x.abs() <= 0.05),
+        "{:?}",
+        d.specular
+    );
+    let all = &d.diffracted;
+    assert!(all.len() >= 150, "{}", all.len());
+    assert!(
+        within(all, 1.0) == all.len(),
+        "{} of {}",
+        within(all, 1.0),
+        all.len()
+    );
+    assert!(
+        within(all, 0.1) + 1 >= all.len(),
+        "{} of {}",
+        within(all, 0.1),
+        all.len()
+    );
 }
 
 /// Munich (Sionna RT's 40k-triangle city), TX 1 m above a roof, three street receivers,
