@@ -16,7 +16,15 @@ use std::collections::{BTreeMap, HashSet};
 use std::path::{Path, PathBuf};
 
 /// The scenes checked, each expected at `testdata/scenes/sionna-rt/<scene>/<scene>.xml`.
-const SCENES: &[&str] = &["simple_street_canyon", "florence", "etoile", "munich"];
+const SCENES: &[&str] = &[
+    "simple_street_canyon",
+    "florence",
+    "etoile",
+    "munich",
+    "box_one_screen",
+    "box_two_screens",
+    "simple_street_canyon_with_cars",
+];
 
 /// Largest relative difference between a shape's loaded area and its mesh's triangle area.
 const REL_AREA: f64 = 1e-6;
