@@ -50,9 +50,9 @@ pub struct TreeOptions {
     /// not read them (the image method) turn this off: a single-receiver trace then does not
     /// clip the last window of each candidate it emits.
     pub starts: bool,
-    /// Grow the materialised levels of a large scene's tree on all cores (rayon). The tree
-    /// is the same either way: its levels are grown in fixed chunks of parents, appended in
-    /// order.
+    /// Grow the levels of a large scene's tree, and find which reflectors RX sees, on all
+    /// cores (rayon). The tree and its candidates are the same either way: the work is done
+    /// in fixed chunks, appended in order.
     pub parallel: bool,
 }
 
@@ -679,6 +679,34 @@ impl BeamTree {
         })
     }
 
+    /// The parents of level `depth`: the root, or the nodes of the level above.
+    fn parents_of(&self, depth: usize) -> Vec<u32> {
+        match depth {
+            1 => vec![ROOT],
+            _ => {
+                let (lo, hi) = self.levels[depth - 2];
+                (lo as u32..hi as u32).collect()
+            }
+        }
+    }
+
+    /// Report `done` of `parents` parents of level `depth` to `progress`.
+    fn report(
+        &self,
+        prep: &Prepared<'_>,
+        depth: usize,
+        (done, parents): (usize, usize),
+        progress: Progress<'_>,
+    ) {
+        progress(BuildProgress {
+            depth,
+            max_order: prep.options.max_order,
+            parents_done: done.min(parents),
+            parents,
+            nodes: self.nodes.len() as u64,
+        });
+    }
+
     /// Run `grow(tree, p, bufs)` for every parent `p` of depth `depth` (the root at depth 1),
     /// in order, reporting to `progress` and checking the node budget after each; then close
     /// the level (recorded when `materialised`). `bufs`: scratch for a parent's planes and
@@ -691,23 +719,11 @@ impl BeamTree {
         mut grow: impl FnMut(&mut Self, u32, (&mut Vec<Plane>, &mut Vec<u32>)),
     ) -> Result<(), TreeError> {
         let start = self.nodes.len();
-        let ids: Vec<u32> = match depth {
-            1 => vec![ROOT],
-            _ => {
-                let (lo, hi) = self.levels[depth - 2];
-                (lo as u32..hi as u32).collect()
-            }
-        };
+        let ids = self.parents_of(depth);
         let (mut planes, mut children) = (Vec::new(), Vec::new());
         for (done, &p) in ids.iter().enumerate() {
             if done % PROGRESS_EVERY == 0 {
-                progress(BuildProgress {
-                    depth,
-                    max_order: prep.options.max_order,
-                    parents_done: done,
-                    parents: ids.len(),
-                    nodes: self.nodes.len() as u64,
-                });
+                self.report(prep, depth, (done, ids.len()), progress);
             }
             grow(self, p, (&mut planes, &mut children));
             self.check_budget(prep, depth)?;

@@ -6,8 +6,7 @@
 //! bounds make the tree the same on any number of threads.
 
 use super::{
-    BeamTree, BuildProgress, Leaf, Node, PROGRESS_EVERY, Prepared, Progress, ROOT, Scratch,
-    TreeError, TreeStats,
+    BeamTree, Leaf, Node, PROGRESS_EVERY, Prepared, Progress, ROOT, Scratch, TreeError, TreeStats,
 };
 use crate::CandidateSet;
 use rayon::prelude::*;
@@ -41,26 +40,13 @@ impl BeamTree {
             1 => (prep.reflectors.chunks(CHUNK_CHILDREN).map(Work::Root)).collect(),
             _ => parents.chunks(CHUNK_PARENTS).map(Work::Parents).collect(),
         };
-        // A round covers PROGRESS_EVERY parents (at depth 1, chunks of the root's children:
-        // the root is done only when the level is).
-        let per_round = (PROGRESS_EVERY / CHUNK_PARENTS).max(2);
-        for (r, round) in work.chunks(per_round).enumerate() {
-            let done = if depth == 1 {
-                0
-            } else {
-                r * per_round * CHUNK_PARENTS
-            };
-            self.report(prep, depth, (done, parents.len()), progress);
-            let grow = |w: &Work<'_>| self.grow_chunk(prep, *w);
-            let parts: Vec<BeamTree> = match prep.options.parallel && round.len() > 1 {
-                true => round.par_iter().map(grow).collect(),
-                false => round.iter().map(grow).collect(),
-            };
-            for part in parts {
-                self.absorb(part);
-            }
-            self.check_budget(prep, depth)?;
-        }
+        self.in_rounds(
+            prep,
+            (depth, parents.len(), &work),
+            progress,
+            |tree, w| tree.grow_chunk(prep, *w),
+            BeamTree::absorb,
+        )?;
         self.end_level(start, true);
         Ok(())
     }
@@ -77,25 +63,47 @@ impl BeamTree {
         let start = self.nodes.len();
         let parents = self.parents_of(depth);
         let chunks: Vec<&[u32]> = parents.chunks(CHUNK_PARENTS).collect();
-        let per_round = (PROGRESS_EVERY / CHUNK_PARENTS).max(2);
-        for (r, round) in chunks.chunks(per_round).enumerate() {
-            self.report(
-                prep,
-                depth,
-                (r * per_round * CHUNK_PARENTS, parents.len()),
-                progress,
-            );
-            let grow = |ps: &&[u32]| self.leaves_of(prep, ps, &leaf.mirrored);
-            let parts: Vec<(CandidateSet, u64)> = match prep.options.parallel && round.len() > 1 {
-                true => round.par_iter().map(grow).collect(),
-                false => round.iter().map(grow).collect(),
-            };
-            for (set, tested) in parts {
+        let mirrored = leaf.mirrored.clone();
+        self.in_rounds(
+            prep,
+            (depth, parents.len(), &chunks),
+            progress,
+            |tree, ps| tree.leaves_of(prep, ps, &mirrored),
+            |tree, (set, tested)| {
                 leaf.out.append(&set);
-                self.stats.tested += tested;
-            }
-        }
+                tree.stats.tested += tested;
+            },
+        )?;
         self.end_level(start, false);
+        Ok(())
+    }
+
+    /// `grow` each chunk of `work` (of level `depth`, which has `parents` parents) and `merge`
+    /// its result into the tree, in order, a round of chunks at a time: the node budget is
+    /// checked and progress reported each round (about [`PROGRESS_EVERY`] parents; at depth 1
+    /// the root is done only when the level is).
+    fn in_rounds<W: Sync, R: Send>(
+        &mut self,
+        prep: &Prepared<'_>,
+        (depth, parents, work): (usize, usize, &[W]),
+        progress: Progress<'_>,
+        grow: impl Fn(&Self, &W) -> R + Sync,
+        mut merge: impl FnMut(&mut Self, R),
+    ) -> Result<(), TreeError> {
+        let per_round = (PROGRESS_EVERY / CHUNK_PARENTS).max(2);
+        for (r, round) in work.chunks(per_round).enumerate() {
+            let done = if depth == 1 {
+                0
+            } else {
+                r * per_round * CHUNK_PARENTS
+            };
+            self.report(prep, depth, (done, parents), progress);
+            let tree = &*self;
+            for part in in_order(prep, round, |w| grow(tree, w)) {
+                merge(self, part);
+            }
+            self.check_budget(prep, depth)?;
+        }
         Ok(())
     }
 
@@ -120,34 +128,6 @@ impl BeamTree {
             }
         }
         (set, tested)
-    }
-
-    /// The parents of level `depth`: the root, or the nodes of the level above.
-    fn parents_of(&self, depth: usize) -> Vec<u32> {
-        match depth {
-            1 => vec![ROOT],
-            _ => {
-                let (lo, hi) = self.levels[depth - 2];
-                (lo as u32..hi as u32).collect()
-            }
-        }
-    }
-
-    /// Report `done` of `parents` parents of level `depth` to `progress`.
-    fn report(
-        &self,
-        prep: &Prepared<'_>,
-        depth: usize,
-        (done, parents): (usize, usize),
-        progress: Progress<'_>,
-    ) {
-        progress(BuildProgress {
-            depth,
-            max_order: prep.options.max_order,
-            parents_done: done.min(parents),
-            parents,
-            nodes: self.nodes.len() as u64,
-        });
     }
 
     /// The nodes `work` grows, in arenas of their own (node windows and beam planes index
@@ -210,15 +190,25 @@ impl BeamTree {
     }
 }
 
-/// `f` of each chunk of [`CHUNK_CHILDREN`] `items`, in order; on all cores when the build's
-/// options say so (fixed chunks: the same results on any number of threads).
+/// `f` of each chunk of [`CHUNK_CHILDREN`] `items`, in order (see [`in_order`]).
 pub(super) fn map_chunks<R: Send>(
     prep: &Prepared<'_>,
     items: &[u32],
     f: impl Fn(&[u32]) -> R + Sync,
 ) -> Vec<R> {
-    match prep.options.parallel && items.len() > CHUNK_CHILDREN {
-        true => items.par_chunks(CHUNK_CHILDREN).map(&f).collect(),
-        false => items.chunks(CHUNK_CHILDREN).map(f).collect(),
+    let chunks: Vec<&[u32]> = items.chunks(CHUNK_CHILDREN).collect();
+    in_order(prep, &chunks, |c| f(c))
+}
+
+/// `f` of each of `items`, in order; on all cores when the build's options say so and there
+/// is more than one (each item is the same work on any number of threads).
+fn in_order<T: Sync, R: Send>(
+    prep: &Prepared<'_>,
+    items: &[T],
+    f: impl Fn(&T) -> R + Sync,
+) -> Vec<R> {
+    match prep.options.parallel && items.len() > 1 {
+        true => items.par_iter().map(&f).collect(),
+        false => items.iter().map(f).collect(),
     }
 }
