@@ -167,16 +167,13 @@ impl DiffractedSet {
         // (order, position, edge, first two reflections) packed into one integer, which
         // decides alone up to order 3 with one diffraction; longer reflection lists and the
         // second diffraction only on ties.
-        // From the flat arrays (what `get` would give: the order is the reflections plus the
-        // diffractions).
         let mut keyed: Vec<(u128, u32)> = (0..self.len())
             .map(|i| {
-                let reflections = &self.ids[self.offsets[i] as usize..self.offsets[i + 1] as usize];
-                let order = reflections.len() + 1 + usize::from(self.seconds[i].is_some());
-                let id = |k: usize| reflections.get(k).map_or(0, |s| u128::from(s.0) + 1);
-                let key = ((order as u128) << 120)
-                    | (u128::from(self.positions[i]) << 112)
-                    | (u128::from(self.edges[i].0) << 80)
+                let c = self.get(i);
+                let id = |k: usize| c.reflections.get(k).map_or(0, |s| u128::from(s.0) + 1);
+                let key = ((c.order() as u128) << 120)
+                    | ((c.position as u128) << 112)
+                    | (u128::from(c.edge.0) << 80)
                     | (id(0) << 40)
                     | id(1);
                 (key, i as u32)
