@@ -128,9 +128,14 @@ impl FoundPath {
 
     /// The path with the penetrable surfaces its segments cross in `scene` (between `ends`)
     /// inserted as crossing points ([`validate::walk_crossings`]); the diffractions' indices
-    /// move with them. A path found without transmission comes back unchanged.
+    /// move with them. A path found without transmission comes back unchanged, and so does
+    /// one whose reflections and diffractions spend the scene's interaction budget: its
+    /// validation let no penetrable surface cross it ([`validate::may_cross`]).
     pub fn with_crossings(self, scene: &Scene, ends: Endpoints) -> FoundPath {
         let n = self.points.len();
+        if !validate::may_cross(scene, n) {
+            return self;
+        }
         let interactions = self.interactions();
         let edges = scene.edges();
         let vertex = |k: usize| match k {

@@ -16,7 +16,7 @@
 use super::{Pairing, Reach};
 use crate::beamtree::{PAIR_TESTS_PER_CANDIDATE, TreeError};
 use crate::diffraction::DiffractedSet;
-use bt_geom::{Polygon, Real, Vec3};
+use bt_geom::{Plane, Polygon, Real, Vec3};
 use bt_scene::edges::{EdgeLine, keller_pair};
 use bt_scene::{Edge, EdgeId, Scene, SurfaceId};
 
@@ -24,15 +24,71 @@ use bt_scene::{Edge, EdgeId, Scene, SurfaceId};
 /// path could need.
 const SLACK: Real = 1e-6;
 
-/// A TX reach on the first edge, as the prefilters read it: its line, its interval (grown by
-/// the margin) and the range of cos β0 of rays from its image over the interval.
-struct Near {
+/// An interval on the first edge, as the prefilters read it: its line, its ends (grown by the
+/// margin) and the range of cos β0 of the incident rays over it.
+#[derive(Clone, Copy)]
+struct Span {
     edge: usize,
-    reach: Reach,
     line: EdgeLine,
+    /// The interval's parameters along the line, grown by the margin (m).
+    t: (Real, Real),
     ends: [Vec3; 2],
-    /// cos β0 at the interval's ends (increasing along the edge).
+    /// cos β0 at the interval's ends (increasing along the edge), or a range holding those of
+    /// several reaches.
     incidence: (Real, Real),
+}
+
+impl Span {
+    fn new(edge: usize, line: EdgeLine, t: (Real, Real), incidence: (Real, Real)) -> Self {
+        Span {
+            edge,
+            line,
+            t,
+            ends: [line.point(t.0), line.point(t.1)],
+            incidence,
+        }
+    }
+}
+
+/// A TX reach on the first edge and its [`Span`].
+struct Near {
+    span: Span,
+    reach: Reach,
+}
+
+/// The TX reaches of one edge and one depth (`members`, a range of the [`Near`] list) and a
+/// span holding all of theirs: the smallest interval holding their intervals and the union of
+/// their incidence ranges. Each prefilter of [`Pairing::may_pair`] fails for a member's span
+/// when it fails for the group's (its bounds only widen as the interval and the range grow), so
+/// one test of the group rejects all its members.
+struct Group {
+    span: Span,
+    depth: usize,
+    members: std::ops::Range<usize>,
+}
+
+/// The [`Group`]s of `near` (ordered by edge, each edge's reaches by depth).
+fn groups(near: &[Near]) -> Vec<Group> {
+    let mut out: Vec<Group> = Vec::new();
+    for (i, a) in near.iter().enumerate() {
+        match out.last_mut() {
+            Some(g) if g.span.edge == a.span.edge && g.depth == a.reach.depth => {
+                let (lo, hi) = (g.span.t.0.min(a.span.t.0), g.span.t.1.max(a.span.t.1));
+                let incidence = (
+                    g.span.incidence.0.min(a.span.incidence.0),
+                    g.span.incidence.1.max(a.span.incidence.1),
+                );
+                g.span = Span::new(a.span.edge, g.span.line, (lo, hi), incidence);
+                g.members.end = i + 1;
+            }
+            _ => out.push(Group {
+                span: a.span,
+                depth: a.reach.depth,
+                members: i..i + 1,
+            }),
+        }
+    }
+    out
 }
 
 /// An RX reach on the second edge and the middle reflections: the edge's line, interval ends
@@ -47,6 +103,51 @@ struct Far<'m> {
     ends: [Vec3; 2],
     /// cos β0 of the ray from the interval's ends towards the image.
     leaving: (Real, Real),
+    /// The second edge's interior wedge, unfolded as the line is.
+    wedge: Wedge,
+    /// With one middle reflection: its plane and the signed distances from it of the
+    /// interval's real ends (the unfolded ends mirrored back), negated.
+    across: Option<(Plane, [Real; 2])>,
+}
+
+/// An edge's interior wedge as [`deep_inside`] reads it: the edge line and the outward
+/// normals of its two faces' planes (`e × t0` and `tn × e`), possibly mirrored through
+/// reflections (a mirror keeps every distance, so a point's distances from the mirrored
+/// planes are its mirror image's from the edge's own).
+#[derive(Clone, Copy)]
+struct Wedge {
+    line: EdgeLine,
+    normal0: Vec3,
+    normal_n: Vec3,
+}
+
+impl Wedge {
+    fn of(edge: &Edge) -> Self {
+        Wedge {
+            line: EdgeLine::of(edge),
+            normal0: edge.direction.cross(edge.t0),
+            normal_n: edge.tn.cross(edge.direction),
+        }
+    }
+
+    fn mirrored(&self, plane: &Plane) -> Self {
+        let flip = |v: Vec3| v - 2.0 * v.dot(plane.normal) * plane.normal;
+        Wedge {
+            line: self.line.mirrored(plane),
+            normal0: flip(self.normal0),
+            normal_n: flip(self.normal_n),
+        }
+    }
+
+    /// Whether `p` lies strictly inside the wedge (not in the edge's exterior, by more than
+    /// [`SLACK`] of its distance from the line): a convex region, so a segment with both ends
+    /// there lies in it.
+    #[inline(always)]
+    fn deep_inside(&self, p: Vec3) -> bool {
+        let v = p - self.line.start;
+        let r = self.line.distance(p);
+        r > 0.0 && v.dot(self.normal0) < -SLACK * r && v.dot(self.normal_n) < -SLACK * r
+    }
 }
 
 /// cos of the angle between unit `direction` and the ray from the point at parameter `t` of
@@ -56,16 +157,10 @@ fn cos_towards(line: &EdgeLine, t: Real, p: Vec3) -> Real {
     v.dot(line.direction) / v.length()
 }
 
-/// Whether `p` lies strictly inside `edge`'s interior wedge (not in its exterior, by more
-/// than [`SLACK`]): a convex region, so a segment with both ends there lies in it.
-fn deep_inside(edge: &Edge, p: Vec3) -> bool {
-    let a = edge.about(p);
-    a.r > 0.0 && a.sin0 < -SLACK * a.r && a.sin_n < -SLACK * a.r
-}
-
 /// The ranges of cos β between `q − p` and each of the unit `directions`, for `p` on segment
 /// `ps` and `q` on segment `qs` (conservative: each numerator's and the length's ranges taken
 /// apart; the corners and the length bounds shared).
+#[inline(always)]
 fn cos_ranges(ps: [Vec3; 2], qs: [Vec3; 2], directions: [Vec3; 2]) -> [(Real, Real); 2] {
     let corners = [qs[0] - ps[0], qs[0] - ps[1], qs[1] - ps[0], qs[1] - ps[1]];
     let d_hi = corners.iter().map(|v| v.length()).fold(0.0, Real::max);
@@ -100,6 +195,7 @@ fn cos_ranges(ps: [Vec3; 2], qs: [Vec3; 2], directions: [Vec3; 2]) -> [(Real, Re
 
 /// A lower bound on the distance between two segments: the larger of their lines' distance
 /// and their midpoints' distance less both half-lengths (0 at worst).
+#[inline(always)]
 fn segment_distance_bound(ps: [Vec3; 2], qs: [Vec3; 2]) -> Real {
     let (u, v) = (ps[1] - ps[0], qs[1] - qs[0]);
     let spheres =
@@ -119,6 +215,7 @@ fn segment_distance_bound(ps: [Vec3; 2], qs: [Vec3; 2]) -> Real {
 /// (`dn`, `df`: the ends' signed distances from it): the crossings lie in the convex hull of the four corner-to-corner crossings
 /// (the tetrahedron of the four ends meets the plane there), so when those four are beyond one
 /// face of the grown box, every crossing is. Straddling segments are never rejected.
+#[inline(always)]
 fn misses_window(
     polygon: &Polygon,
     (near, far): ([Vec3; 2], [Vec3; 2]),
@@ -153,7 +250,26 @@ impl Pairing<'_> {
     /// The candidates with two diffractions: every TX reach, RX reach and middle sequence
     /// whose depths fit the order (two edges in a row differ) and whose Keller pair lies in
     /// both reaches. Cheap necessary tests come first ([`Pairing::may_pair`]).
+    /// Compiled with the `fma` target feature when the CPU has it (checked at run time; the
+    /// plane tests use `mul_add`, a software call without it; bit-identical either way, as
+    /// in `bt_solve`'s batches).
     pub(super) fn twice(&self, scene: &Scene, set: &mut DiffractedSet) -> Result<(), TreeError> {
+        #[cfg(target_arch = "x86_64")]
+        if std::arch::is_x86_feature_detected!("fma") {
+            // SAFETY: the CPU supports FMA (checked just above).
+            return unsafe { self.twice_fma(scene, set) };
+        }
+        self.twice_impl(scene, set)
+    }
+
+    #[cfg(target_arch = "x86_64")]
+    #[target_feature(enable = "fma")]
+    fn twice_fma(&self, scene: &Scene, set: &mut DiffractedSet) -> Result<(), TreeError> {
+        self.twice_impl(scene, set)
+    }
+
+    #[inline(always)]
+    fn twice_impl(&self, scene: &Scene, set: &mut DiffractedSet) -> Result<(), TreeError> {
         let deepest = self.side.max_order - 2;
         let reflectors: Vec<SurfaceId> = scene.reflectors().collect();
         let middles: Vec<Vec<Vec<SurfaceId>>> = (0..=deepest)
@@ -161,6 +277,7 @@ impl Pairing<'_> {
             .collect();
         let near = self.near(scene, deepest);
         self.check_pairs(&near, middles.iter().map(Vec::len).collect(), deepest)?;
+        let groups = groups(&near);
         let (mut before, mut after) = (Vec::new(), Vec::new());
         // Per far interval, per first edge: whether the interval leaves that edge's interior.
         let mut seen: Vec<Option<bool>> = Vec::new();
@@ -170,15 +287,23 @@ impl Pairing<'_> {
                     let far = self.far(scene, (e2, *b), middle);
                     seen.clear();
                     seen.resize(scene.edges().len(), None);
-                    let fits = |a: &&Near| a.reach.depth + b.depth + middle.len() <= deepest;
-                    for a in near.iter().filter(fits) {
-                        if !self.may_pair(scene, (a, &far), &mut seen) || !self.may_join(a, &far) {
+                    let fits = |g: &&Group| g.depth + b.depth + middle.len() <= deepest;
+                    for g in groups.iter().filter(fits) {
+                        if !self.may_pair(scene, (&g.span, &far), &mut seen) {
                             continue;
                         }
-                        self.surfaces((a.reach.node, b.node), (&mut before, &mut after));
-                        let pair = (EdgeId(a.edge as u32), EdgeId(e2 as u32));
-                        set.push_twice(&before, pair, middle, &after);
-                        self.check_budget(set)?;
+                        let single = g.members.len() == 1;
+                        for a in &near[g.members.clone()] {
+                            if !(single || self.may_pair(scene, (&a.span, &far), &mut seen))
+                                || !self.may_join(a, &far)
+                            {
+                                continue;
+                            }
+                            self.surfaces((a.reach.node, b.node), (&mut before, &mut after));
+                            let pair = (EdgeId(a.span.edge as u32), EdgeId(e2 as u32));
+                            set.push_twice(&before, pair, middle, &after);
+                            self.check_budget(set)?;
+                        }
                     }
                 }
             }
@@ -236,15 +361,13 @@ impl Pairing<'_> {
             let line = EdgeLine::of(&scene.edges().all()[e]);
             for r in on_edge.iter().filter(|r| r.depth <= deepest) {
                 let (lo, hi) = (r.lo - m, r.hi + m);
+                let incidence = (
+                    -cos_towards(&line, lo, r.image),
+                    -cos_towards(&line, hi, r.image),
+                );
                 out.push(Near {
-                    edge: e,
+                    span: Span::new(e, line, (lo, hi), incidence),
                     reach: *r,
-                    line,
-                    ends: [line.point(lo), line.point(hi)],
-                    incidence: (
-                        -cos_towards(&line, lo, r.image),
-                        -cos_towards(&line, hi, r.image),
-                    ),
                 });
             }
         }
@@ -254,21 +377,33 @@ impl Pairing<'_> {
     /// RX reach `b` on edge `e2` with the `middle` reflections, unfolded ([`Far`]).
     fn far<'m>(&self, scene: &Scene, (e2, b): (usize, Reach), middle: &'m [SurfaceId]) -> Far<'m> {
         let mut line = EdgeLine::of(&scene.edges().all()[e2]);
+        let mut wedge = Wedge::of(&scene.edges().all()[e2]);
         let mut image = b.image;
         for id in middle.iter().rev() {
             let plane = scene.surface(*id).polygon.plane();
             line = line.mirrored(plane);
+            wedge = wedge.mirrored(plane);
             image = plane.mirror(image);
         }
         let (lo, hi) = (b.lo - self.margin, b.hi + self.margin);
+        let ends = [line.point(lo), line.point(hi)];
+        let across = match middle {
+            [m] => {
+                let plane = *scene.surface(*m).polygon.plane();
+                Some((plane, ends.map(|p| -plane.signed_distance(p))))
+            }
+            _ => None,
+        };
         Far {
             edge: e2,
             reach: b,
             middle,
             line,
             image,
-            ends: [line.point(lo), line.point(hi)],
+            ends,
             leaving: (cos_towards(&line, hi, image), cos_towards(&line, lo, image)),
+            wedge,
+            across,
         }
     }
 
@@ -278,26 +413,24 @@ impl Pairing<'_> {
     /// across one middle reflection both points may lie on one side of its plane; Keller's
     /// law may hold at both points (the cos β0 ranges of the incident and diffracted rays
     /// over the intervals overlap).
+    #[inline(always)]
     fn may_pair(
         &self,
         scene: &Scene,
-        (a, far): (&Near, &Far<'_>),
+        (a, far): (&Span, &Far<'_>),
         seen: &mut [Option<bool>],
     ) -> bool {
-        let edges = scene.edges().all();
         if far.middle.is_empty() && a.edge == far.edge {
             return false;
         }
-        if let [m] = far.middle {
+        if let (Some((plane, second)), [m]) = (&far.across, far.middle) {
             // Both points on one side of the middle reflection's plane: the second's real
             // place is its unfolded one mirrored back, on the other side of the plane.
-            let plane = scene.surface(*m).polygon.plane();
             let first = a.ends.map(|p| plane.signed_distance(p));
-            let second = far.ends.map(|p| -plane.signed_distance(p));
             let opposite = |x: [Real; 2], y: [Real; 2]| {
                 x.iter().all(|d| *d > 0.0) && y.iter().all(|d| *d < 0.0)
             };
-            if opposite(first, second) || opposite(second, first) {
+            if opposite(first, *second) || opposite(*second, first) {
                 return false;
             }
             let unfolded = second.map(|d| -d);
@@ -306,19 +439,14 @@ impl Pairing<'_> {
                 return false;
             }
         }
-        let inside = |edge: &Edge, ends: [Vec3; 2]| ends.iter().all(|p| deep_inside(edge, *p));
+        let inside = |wedge: &Wedge, ends: [Vec3; 2]| ends.iter().all(|p| wedge.deep_inside(*p));
         // The far interval against the first edge: one answer per edge for all its reaches.
-        if !*seen[a.edge].get_or_insert_with(|| !inside(&edges[a.edge], far.ends)) {
+        let first_wedge = || Wedge::of(&scene.edges().all()[a.edge]);
+        if !*seen[a.edge].get_or_insert_with(|| !inside(&first_wedge(), far.ends)) {
             return false;
         }
-        // The first edge's interval seen from the second edge's own frame: folded back
-        // through the middle reflections.
-        let folded = a.ends.map(|p| {
-            far.middle
-                .iter()
-                .fold(p, |p, id| scene.surface(*id).polygon.plane().mirror(p))
-        });
-        if inside(&edges[far.edge], folded) {
+        // The first edge's interval against the second edge's wedge, unfolded into this frame.
+        if inside(&far.wedge, a.ends) {
             return false;
         }
         let [first, second] = cos_ranges(a.ends, far.ends, [a.line.direction, far.line.direction]);
@@ -327,8 +455,9 @@ impl Pairing<'_> {
 
     /// Whether the Keller pair of `a` and `far` lies in both reaches (within the margin), or
     /// cannot be computed.
+    #[inline(always)]
     fn may_join(&self, a: &Near, far: &Far<'_>) -> bool {
-        let Some((t1, t2)) = keller_pair(a.reach.image, a.line, far.line, far.image) else {
+        let Some((t1, t2)) = keller_pair(a.reach.image, a.span.line, far.line, far.image) else {
             return true;
         };
         let m = self.margin;
