@@ -164,10 +164,10 @@ impl DiffractedSet {
     }
     /// Put the candidates in the canonical order and drop repeats.
     pub fn canonicalise(&mut self) {
-        // (order, position, edge, first two reflections) packed into one integer, which
-        // decides alone up to order 3 with one diffraction; longer reflection lists and the
-        // second diffraction only on ties.
-        let mut keyed: Vec<(u128, u32)> = (0..self.len())
+        // (order, position, edge, first two reflections) packed into one integer, and (the
+        // next two reflections, whether more follow, the second diffraction) into another:
+        // together they decide alone up to four reflections; longer lists only on ties.
+        let mut keyed: Vec<(u128, u128, u32)> = (0..self.len())
             .map(|i| {
                 let c = self.get(i);
                 let id = |k: usize| c.reflections.get(k).map_or(0, |s| u128::from(s.0) + 1);
@@ -176,24 +176,30 @@ impl DiffractedSet {
                     | (u128::from(c.edge.0) << 80)
                     | (id(0) << 40)
                     | id(1);
-                (key, i as u32)
+                let long = c.reflections.len() > 4;
+                let second = match c.second {
+                    Some((edge, q)) if !long => 1 + ((u128::from(edge.0) << 8) | q as u128),
+                    _ => 0,
+                };
+                let next = (id(2) << 88) | (id(3) << 48) | (u128::from(long) << 41) | second;
+                (key, next, i as u32)
             })
             .collect();
-        let ties = |a: &(u128, u32), b: &(u128, u32)| {
-            let (x, y) = (self.get(a.1 as usize), self.get(b.1 as usize));
+        let ties = |a: &(u128, u128, u32), b: &(u128, u128, u32)| {
+            let (x, y) = (self.get(a.2 as usize), self.get(b.2 as usize));
             x.reflections
                 .cmp(y.reflections)
                 .then_with(|| x.second.cmp(&y.second))
         };
-        // The key alone sorts almost everything; only runs of equal keys (longer reflection
-        // lists, two diffractions) are ordered by the candidates themselves.
-        keyed.sort_unstable_by_key(|k| k.0);
-        for run in keyed.chunk_by_mut(|a, b| a.0 == b.0) {
+        // The keys alone sort almost everything; only runs of equal keys (more than four
+        // reflections) are ordered by the candidates themselves.
+        keyed.sort_unstable_by_key(|k| (k.0, k.1));
+        for run in keyed.chunk_by_mut(|a, b| (a.0, a.1) == (b.0, b.1)) {
             if run.len() > 1 {
                 run.sort_unstable_by(ties);
             }
         }
-        keyed.dedup_by(|a, b| a.0 == b.0 && ties(a, b).is_eq());
+        keyed.dedup_by(|a, b| (a.0, a.1) == (b.0, b.1) && ties(a, b).is_eq());
         // Each candidate copied whole (its reflections are contiguous, its position and
         // second diffraction kept), into arrays sized once.
         let mut sorted = DiffractedSet {
@@ -204,7 +210,7 @@ impl DiffractedSet {
             seconds: Vec::with_capacity(keyed.len()),
         };
         sorted.offsets.push(0);
-        for (_, i) in keyed {
+        for (_, _, i) in keyed {
             let i = i as usize;
             let (lo, hi) = (self.offsets[i] as usize, self.offsets[i + 1] as usize);
             sorted.ids.extend_from_slice(&self.ids[lo..hi]);

@@ -25,6 +25,13 @@ pub struct EdgeLine {
 /// Stop when a round moves neither point by more than this, metres.
 pub const KELLER_PAIR_TOL: Real = 1e-10;
 
+/// The Keller residual (|cos β_in − cos β_out| at either edge) [`keller_pair`] aims for once
+/// the points have settled.
+const KELLER_RESIDUAL: Real = 1e-10;
+
+/// Rounds [`keller_pair`] may add after the points settled, for [`KELLER_RESIDUAL`].
+const POLISH_ROUNDS: usize = 3;
+
 /// Most rounds of [`keller_pair`] before it gives up.
 const MAX_ROUNDS: usize = 64;
 
@@ -84,32 +91,30 @@ impl EdgeLine {
 }
 
 /// The parameters (t1 on `first`, t2 on `second`) of the shortest path `a → first → second →
-/// b` (module docs), to [`KELLER_PAIR_TOL`]. `None` when a point of the path falls on its
+/// b` (module docs), to [`KELLER_PAIR_TOL`] and, a few rounds allowing, [`KELLER_RESIDUAL`]. `None` when a point of the path falls on its
 /// neighbour (the two points on the lines' crossing included) or the solve does not settle.
 pub fn keller_pair(a: Vec3, first: EdgeLine, second: EdgeLine, b: Vec3) -> Option<(Real, Real)> {
-    let length = |t1: Real, t2: Real| {
-        let (p, q) = (first.point(t1), second.point(t2));
-        p.distance(a) + q.distance(p) + b.distance(q)
-    };
     let round = |t2: Real| {
         let t1 = first.keller(a, second.point(t2))?;
         Some((t1, second.keller(first.point(t1), b)?))
     };
+    let local = |t: (Real, Real)| local(a, (first, second), b, t);
     if shortest_at_crossing(a, (first, second), b) {
         return None;
     }
     let t1 = first.keller(a, b)?;
     let (mut t1, mut t2) = round(second.keller(first.point(t1), b)?)?;
-    let mut current = length(t1, t2);
-    for _ in 0..MAX_ROUNDS {
-        let (s1, s2) = newton_step(a, (first, second), b, (t1, t2))?;
-        let shorter = length(t1 + s1, t2 + s2);
-        let next = if shorter <= current {
-            current = shorter;
+    let mut here = local((t1, t2));
+    let mut polished = 0;
+    for done in 1..=MAX_ROUNDS {
+        let (s1, s2) = here.step?.by;
+        let there = local((t1 + s1, t2 + s2));
+        let next = if there.length <= here.length {
+            here = there;
             (t1 + s1, t2 + s2)
         } else {
             let next = round(t2)?;
-            current = length(next.0, next.1);
+            here = local(next);
             next
         };
         let moved = (next.0 - t1).abs().max((next.1 - t2).abs());
@@ -117,8 +122,16 @@ pub fn keller_pair(a: Vec3, first: EdgeLine, second: EdgeLine, b: Vec3) -> Optio
         if !(t1.is_finite() && t2.is_finite()) {
             return None;
         }
+        // Settled: the points stopped moving and Keller's law holds to KELLER_RESIDUAL
+        // (a short middle leg turns a tiny move into a larger angle: then a few more
+        // rounds, never a lost solution).
+        let residual = here.step.map_or(0.0, |s| s.residual);
         if moved <= KELLER_PAIR_TOL {
-            return Some((t1, t2));
+            let settled = residual <= KELLER_RESIDUAL || residual.is_nan();
+            if settled || polished == POLISH_ROUNDS || done == MAX_ROUNDS {
+                return Some((t1, t2));
+            }
+            polished += 1;
         }
     }
     None
@@ -159,22 +172,38 @@ fn shortest_at_crossing(a: Vec3, (first, second): (EdgeLine, EdgeLine), b: Vec3)
     x * alpha + y * beta < 1.0 - 1e-9
 }
 
-/// Newton's step (Δt1, Δt2) for the path length at (t1, t2): −H⁻¹·∇f, with ∇|v| = J^T·u and
+/// The path length at (t1, t2) and Newton's step there ([`newton_step`]), from the same legs.
+struct Local {
+    /// |P1 − a| + |P2 − P1| + |b − P2| (m).
+    length: Real,
+    /// `None` when a leg has no length.
+    step: Option<Step>,
+}
+
+#[inline(always)]
+fn local(a: Vec3, lines: (EdgeLine, EdgeLine), b: Vec3, (t1, t2): (Real, Real)) -> Local {
+    let (p, q) = (lines.0.point(t1), lines.1.point(t2));
+    let legs = [p - a, q - p, b - q];
+    let lengths = legs.map(|v| v.length());
+    Local {
+        length: lengths[0] + lengths[1] + lengths[2],
+        step: newton_step(lines, legs, lengths),
+    }
+}
+
+/// Newton's step (Δt1, Δt2) for the path length at the point whose three legs (from `a` to
+/// P1, P1 to P2, P2 to `b`) and their lengths are given: −H⁻¹·∇f, with ∇|v| = J^T·u and
 /// ∇²|v| = J^T·(I − u·u^T)·J/|v| for each leg v (unit u, Jacobian J); NaN (a step that
 /// shortens nothing, so the caller takes a coordinate round) when the Hessian is not positive
 /// definite. `None` when a leg has no length.
+#[inline(always)]
 fn newton_step(
-    a: Vec3,
     (first, second): (EdgeLine, EdgeLine),
-    b: Vec3,
-    (t1, t2): (Real, Real),
-) -> Option<(Real, Real)> {
-    let (p, q) = (first.point(t1), second.point(t2));
-    let unit = |v: Vec3| {
-        let l = v.length();
-        (l > 0.0).then(|| (v / l, l))
-    };
-    let ((u1, l1), (u2, l2), (u3, l3)) = (unit(p - a)?, unit(q - p)?, unit(b - q)?);
+    legs: [Vec3; 3],
+    lengths: [Real; 3],
+) -> Option<Step> {
+    let unit = |k: usize| (lengths[k] > 0.0).then(|| (legs[k] / lengths[k], lengths[k]));
+    let ((u1, l1), (u2, l2), (u3, l3)) = (unit(0)?, unit(1)?, unit(2)?);
     let (d1, d2) = (first.direction, second.direction);
     let (a1, a2, b2, b3) = (d1.dot(u1), d1.dot(u2), d2.dot(u2), d2.dot(u3));
     let (g1, g2) = (a1 - a2, b2 - b3);
@@ -182,10 +211,26 @@ fn newton_step(
     let h22 = (1.0 - b2 * b2) / l2 + (1.0 - b3 * b3) / l3;
     let h12 = (a2 * b2 - d1.dot(d2)) / l2;
     let det = h11 * h22 - h12 * h12;
+    let residual = g1.abs().max(g2.abs());
     if !(det > 0.0 && det.is_finite()) {
-        return Some((Real::NAN, Real::NAN));
+        return Some(Step {
+            by: (Real::NAN, Real::NAN),
+            residual,
+        });
     }
-    Some((-(h22 * g1 - h12 * g2) / det, -(h11 * g2 - h12 * g1) / det))
+    Some(Step {
+        by: (-(h22 * g1 - h12 * g2) / det, -(h11 * g2 - h12 * g1) / det),
+        residual,
+    })
+}
+
+/// A Newton step and the Keller residual where it starts.
+#[derive(Clone, Copy)]
+struct Step {
+    /// (Δt1, Δt2), metres.
+    by: (Real, Real),
+    /// The larger of |cos β_in − cos β_out| at the two edges.
+    residual: Real,
 }
 
 #[cfg(test)]

@@ -168,6 +168,14 @@ fn cos_ranges(ps: [Vec3; 2], qs: [Vec3; 2], directions: [Vec3; 2]) -> [(Real, Re
         return [(-1.0, 1.0); 2];
     }
     let d_lo = segment_distance_bound(ps, qs);
+    directions.map(|direction| cos_bounds(&corners.map(|v| v.dot(direction)), (d_lo, d_hi)))
+}
+
+/// The range of cos β = n/|v| over vectors `v` whose numerators `n` lie between the least and
+/// the greatest of `along` (the extreme corners of a convex set of vectors) and whose lengths
+/// lie in `(d_lo, d_hi)`, d_hi > 0 (conservative: each taken apart).
+#[inline(always)]
+fn cos_bounds(along: &[Real], (d_lo, d_hi): (Real, Real)) -> (Real, Real) {
     let ratio = |n: Real, d: Real| {
         if d > 0.0 {
             (n / d).clamp(-1.0, 1.0)
@@ -175,22 +183,61 @@ fn cos_ranges(ps: [Vec3; 2], qs: [Vec3; 2], directions: [Vec3; 2]) -> [(Real, Re
             n.signum()
         }
     };
-    directions.map(|direction| {
-        let along = corners.map(|v| v.dot(direction));
-        let n_lo = along.iter().copied().fold(Real::INFINITY, Real::min);
-        let n_hi = along.iter().copied().fold(Real::NEG_INFINITY, Real::max);
-        let lo = if n_lo >= 0.0 {
-            n_lo / d_hi
-        } else {
-            ratio(n_lo, d_lo)
-        };
-        let hi = if n_hi >= 0.0 {
-            ratio(n_hi, d_lo)
-        } else {
-            n_hi / d_hi
-        };
-        (lo, hi)
-    })
+    let n_lo = along.iter().copied().fold(Real::INFINITY, Real::min);
+    let n_hi = along.iter().copied().fold(Real::NEG_INFINITY, Real::max);
+    let lo = if n_lo >= 0.0 {
+        n_lo / d_hi
+    } else {
+        ratio(n_lo, d_lo)
+    };
+    let hi = if n_hi >= 0.0 {
+        ratio(n_hi, d_lo)
+    } else {
+        n_hi / d_hi
+    };
+    (lo, hi)
+}
+
+/// The range of cos β between `m − p` and the unit `direction`, for `p` on segment `ends` and
+/// `m` in the box `(lo, hi)` (conservative, as [`cos_ranges`]; the whole range when the box
+/// may touch the segment).
+#[inline(always)]
+fn cos_range_to_box(ends: [Vec3; 2], (lo, hi): (Vec3, Vec3), direction: Vec3) -> (Real, Real) {
+    let corner = |k: usize| {
+        Vec3::new(
+            if k & 1 == 0 { lo.x } else { hi.x },
+            if k & 2 == 0 { lo.y } else { hi.y },
+            if k & 4 == 0 { lo.z } else { hi.z },
+        )
+    };
+    let mut along = [0.0; 16];
+    let mut d_hi: Real = 0.0;
+    for k in 0..8 {
+        for (j, p) in ends.iter().enumerate() {
+            let v = corner(k) - *p;
+            along[2 * k + j] = v.dot(direction);
+            d_hi = d_hi.max(v.length());
+        }
+    }
+    if d_hi.is_nan() || d_hi <= 0.0 {
+        return (-1.0, 1.0);
+    }
+    let (center, radius) = (0.5 * (lo + hi), 0.5 * (hi - lo).length());
+    let d_lo = (point_segment_distance(center, ends) - radius).max(0.0);
+    cos_bounds(&along, (d_lo, d_hi))
+}
+
+/// The distance (m) from `p` to the segment `ends`.
+#[inline(always)]
+fn point_segment_distance(p: Vec3, ends: [Vec3; 2]) -> Real {
+    let u = ends[1] - ends[0];
+    let l2 = u.length_squared();
+    let t = if l2 > 0.0 {
+        ((p - ends[0]).dot(u) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    p.distance(ends[0] + t * u)
 }
 
 /// A lower bound on the distance between two segments: the larger of their lines' distance
@@ -241,6 +288,74 @@ fn misses_window(
     })
 }
 
+/// The join's working state for one TX side: its reaches, their groups and scratch.
+struct Pairs<'a> {
+    near: &'a [Near],
+    groups: &'a [Group],
+    /// The most reflections a path with two diffractions has room for.
+    deepest: usize,
+    /// Per far interval, per first edge: whether the interval leaves that edge's interior.
+    seen: Vec<Option<bool>>,
+    before: Vec<SurfaceId>,
+    after: Vec<SurfaceId>,
+}
+
+/// Per reflector, the groups of TX reaches whose diffracted rays may head into its box: a
+/// path `D1 → M → ...` reflecting at `M` right after `D1` leaves `D1` along `M − D1`, whose
+/// cos β0 with the first edge equals the incident ray's (Keller), and `M` lies in the
+/// reflector's polygon, within the margin of its box. A group whose range of that cosine
+/// ([`cos_range_to_box`]) misses its incidence range pairs with no interval beyond that
+/// reflector, so the join never looks at those pairs.
+struct Toward {
+    /// Per surface id: the groups (indices) for a middle starting there.
+    groups: Vec<Vec<u32>>,
+    /// Every group, for paths with no middle reflection.
+    all: Vec<u32>,
+}
+
+impl Toward {
+    fn of(scene: &Scene, groups: &[Group], margin: Real) -> Self {
+        let mut by_surface = vec![Vec::new(); scene.surfaces().len()];
+        for m in scene.reflectors() {
+            let bounds = grown_bounds(scene, m, margin);
+            by_surface[m.index()] = (0..groups.len() as u32)
+                .filter(|&g| {
+                    let span = &groups[g as usize].span;
+                    let range = cos_range_to_box(span.ends, bounds, span.line.direction);
+                    overlap(range, span.incidence)
+                })
+                .collect();
+        }
+        Toward {
+            groups: by_surface,
+            all: (0..groups.len() as u32).collect(),
+        }
+    }
+
+    /// The groups that may pair with `far`, or `None` when none may: with one middle
+    /// reflection, the ray arriving at the far interval from the reflector's box must obey
+    /// Keller's law there too (cos β0 of `q − M` against the leaving range).
+    fn groups(&self, scene: &Scene, far: &Far<'_>, margin: Real) -> Option<&[u32]> {
+        let Some(&m) = far.middle.first() else {
+            return Some(&self.all);
+        };
+        if let [m] = far.middle {
+            let bounds = grown_bounds(scene, *m, margin);
+            let (lo, hi) = cos_range_to_box(far.ends, bounds, far.line.direction);
+            if !overlap((-hi, -lo), far.leaving) {
+                return None;
+            }
+        }
+        Some(&self.groups[m.index()])
+    }
+}
+
+/// Surface `id`'s polygon box grown by `margin` (m).
+fn grown_bounds(scene: &Scene, id: SurfaceId, margin: Real) -> (Vec3, Vec3) {
+    let (lo, hi) = scene.surface(id).polygon.bounds();
+    (lo - Vec3::splat(margin), hi + Vec3::splat(margin))
+}
+
 /// Whether the ranges overlap, up to [`SLACK`].
 fn overlap(a: (Real, Real), b: (Real, Real)) -> bool {
     a.0 <= b.1 + SLACK && b.0 <= a.1 + SLACK
@@ -278,34 +393,61 @@ impl Pairing<'_> {
         let near = self.near(scene, deepest);
         self.check_pairs(&near, middles.iter().map(Vec::len).collect(), deepest)?;
         let groups = groups(&near);
-        let (mut before, mut after) = (Vec::new(), Vec::new());
-        // Per far interval, per first edge: whether the interval leaves that edge's interior.
-        let mut seen: Vec<Option<bool>> = Vec::new();
+        let index = Toward::of(scene, &groups, self.margin);
+        let mut pairs = Pairs {
+            near: &near,
+            groups: &groups,
+            deepest,
+            seen: Vec::new(),
+            before: Vec::new(),
+            after: Vec::new(),
+        };
         for (e2, on_edge) in self.from_rx.iter().enumerate() {
             for b in on_edge.iter().filter(|b| b.depth <= deepest) {
                 for middle in middles[..=deepest - b.depth].iter().flatten() {
                     let far = self.far(scene, (e2, *b), middle);
-                    seen.clear();
-                    seen.resize(scene.edges().len(), None);
-                    let fits = |g: &&Group| g.depth + b.depth + middle.len() <= deepest;
-                    for g in groups.iter().filter(fits) {
-                        if !self.may_pair(scene, (&g.span, &far), &mut seen) {
-                            continue;
-                        }
-                        let single = g.members.len() == 1;
-                        for a in &near[g.members.clone()] {
-                            if !(single || self.may_pair(scene, (&a.span, &far), &mut seen))
-                                || !self.may_join(a, &far)
-                            {
-                                continue;
-                            }
-                            self.surfaces((a.reach.node, b.node), (&mut before, &mut after));
-                            let pair = (EdgeId(a.span.edge as u32), EdgeId(e2 as u32));
-                            set.push_twice(&before, pair, middle, &after);
-                            self.check_budget(set)?;
-                        }
-                    }
+                    let Some(first) = index.groups(scene, &far, self.margin) else {
+                        continue;
+                    };
+                    self.pair_with(scene, &far, first, &mut pairs, set)?;
                 }
+            }
+        }
+        Ok(())
+    }
+
+    /// The candidates of `far` with the groups `first` (indices into `pairs.groups`) whose
+    /// depths fit.
+    #[inline(always)]
+    fn pair_with(
+        &self,
+        scene: &Scene,
+        far: &Far<'_>,
+        first: &[u32],
+        pairs: &mut Pairs<'_>,
+        set: &mut DiffractedSet,
+    ) -> Result<(), TreeError> {
+        let b = &far.reach;
+        pairs.seen.clear();
+        pairs.seen.resize(scene.edges().len(), None);
+        for g in first.iter().map(|&g| &pairs.groups[g as usize]) {
+            if g.depth + b.depth + far.middle.len() > pairs.deepest
+                || !self.may_pair(scene, (&g.span, far), &mut pairs.seen)
+            {
+                continue;
+            }
+            let single = g.members.len() == 1;
+            for a in &pairs.near[g.members.clone()] {
+                if !(single || self.may_pair(scene, (&a.span, far), &mut pairs.seen))
+                    || !self.may_join(a, far)
+                {
+                    continue;
+                }
+                let (before, after) = (&mut pairs.before, &mut pairs.after);
+                self.surfaces((a.reach.node, b.node), (before, after));
+                let edges = (EdgeId(a.span.edge as u32), EdgeId(far.edge as u32));
+                set.push_twice(before, edges, far.middle, after);
+                self.check_budget(set)?;
             }
         }
         Ok(())
