@@ -1186,10 +1186,25 @@ impl Probe {
             apex: image,
             planes: &self.planes,
         };
-        tree.child_candidates(prep, &node, true, &mut self.children);
-        tree.stats.tested += self.children.len() as u64;
         self.test.apex_distances(&node);
-        self.children.iter().any(|&c| self.test.hit(prep, &node, c))
+        let visible = prep.rx_visible.as_ref();
+        let Some(visible) = visible.filter(|_| prep.reflectors.len() > LINEAR_SCAN) else {
+            tree.child_candidates(prep, &node, true, &mut self.children);
+            tree.stats.tested += self.children.len() as u64;
+            return self.children.iter().any(|&c| self.test.hit(prep, &node, c));
+        };
+        // The first child that passes is enough: no list, no sort, and the walk stops there.
+        let mut tested = 0;
+        let found = visible.bvh.find(
+            |lo, hi| box_meets_halfspaces(lo, hi, node.planes, eps),
+            |i| {
+                let c = visible.ids[i as usize];
+                tested += u64::from(c != s);
+                c != s && self.test.hit(prep, &node, c)
+            },
+        );
+        tree.stats.tested += tested;
+        found.is_some()
     }
 }
 
