@@ -57,9 +57,10 @@ pub struct TreeOptions {
     /// In a single-receiver trace ([`candidates_in`], without diffraction) of a scene culled
     /// as it is built, test a node of the last materialised level for occlusion only when it
     /// can end or lead to a candidate (RX lies in its beam, or in one of its children's):
-    /// the others are never materialised. The candidates are those of culling every node (a
-    /// beam clipped by an occluder lies inside the unclipped one); the statistics count only
-    /// the nodes tested. Off: every node is culled as it is built, as in a kept tree.
+    /// the others are never materialised. The reflectors RX sees are then always found first;
+    /// with them, the candidates are those of culling every node (a beam clipped by an
+    /// occluder lies inside the unclipped one). The statistics count only the nodes tested.
+    /// Off: every node is culled as it is built, as in a kept tree.
     pub defer_culling: bool,
 }
 
