@@ -188,6 +188,18 @@ impl Bvh {
         });
     }
 
+    /// The first item (in walk order) whose box passes `box_test` and that `hit` accepts,
+    /// descending only into nodes whose box passes `box_test` (conservative, as for
+    /// [`Bvh::visit`]); the walk stops there.
+    #[inline]
+    pub fn find(
+        &self,
+        box_test: impl FnMut(Vec3, Vec3) -> bool,
+        hit: impl FnMut(u32) -> bool,
+    ) -> Option<u32> {
+        self.walk(box_test, hit)
+    }
+
     /// Calls `visit(item)` for every item whose box meets the cube of half-side `radius`
     /// (metres) around `p`.
     #[inline]
@@ -405,6 +417,30 @@ mod tests {
                 let b = a + Vec3::new(0.9, 0.1, 0.05);
                 let (brute, seen) = brute_and_bvh(&walls, &bvh, (a, b));
                 assert_eq!(brute, seen, "segment {k} among {} walls", walls.len());
+            }
+        }
+    }
+
+    /// `find` answers whether some item in the boxes a test accepts is accepted, as a visit
+    /// of every such item would, and stops at the first (no item is offered after it).
+    #[test]
+    fn find_stops_at_the_first_accepted_item_of_a_visit() {
+        for walls in wall_sets() {
+            let bvh = Bvh::build(&walls);
+            for (lo, hi) in [(3.2, 9.9), (-1.0, -0.5), (0.0, 100.0)] {
+                let in_slab = |min: Vec3, max: Vec3| max.x >= lo && min.x <= hi;
+                let mut visited = Vec::new();
+                bvh.visit(in_slab, |i| visited.push(i));
+                for wanted in [7u32, 40, 1000] {
+                    let mut offered = Vec::new();
+                    let found = bvh.find(in_slab, |i| {
+                        offered.push(i);
+                        i == wanted
+                    });
+                    assert_eq!(found.is_some(), visited.contains(&wanted), "{lo} {wanted}");
+                    assert_eq!(offered.last() == Some(&wanted), found.is_some());
+                    assert!(offered.iter().all(|i| visited.contains(i)));
+                }
             }
         }
     }

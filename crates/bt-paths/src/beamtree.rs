@@ -54,6 +54,14 @@ pub struct TreeOptions {
     /// cores (rayon). The tree and its candidates are the same either way: the work is done
     /// in fixed chunks, appended in order.
     pub parallel: bool,
+    /// In a single-receiver trace ([`candidates_in`], without diffraction) of a scene culled
+    /// as it is built, test a node of the last materialised level for occlusion only when it
+    /// can end or lead to a candidate (RX lies in its beam, or in one of its children's):
+    /// the others are never materialised. The reflectors RX sees are then always found first;
+    /// with them, the candidates are those of culling every node (a beam clipped by an
+    /// occluder lies inside the unclipped one). The statistics count only the nodes tested.
+    /// Off: every node is culled as it is built, as in a kept tree.
+    pub defer_culling: bool,
 }
 
 /// When the tree tests its nodes for occlusion (`occlude`). Culling never changes the paths
@@ -75,7 +83,8 @@ pub enum Culling {
 }
 
 impl TreeOptions {
-    /// Order `max_order`, 2 million nodes (about 1 GB), [`Culling::Auto`] (64), one thread.
+    /// Order `max_order`, 2 million nodes (about 1 GB), [`Culling::Auto`] (64), one thread,
+    /// culling of the last materialised level deferred.
     pub fn new(max_order: usize) -> Self {
         TreeOptions {
             max_order,
@@ -83,6 +92,7 @@ impl TreeOptions {
             culling: Culling::Auto { min_work: 64 },
             starts: true,
             parallel: false,
+            defer_culling: true,
         }
     }
 }
@@ -662,7 +672,7 @@ impl BeamTree {
             // Nodes are culled as they are built, so no parent changes: chunks of parents
             // can grow apart.
             return match leaf {
-                None => self.grow_level_chunked(prep, depth, progress),
+                None => self.grow_level_chunked(prep, depth, None, progress),
                 Some(leaf) => self.grow_leaves_chunked(prep, depth, leaf, progress),
             };
         }
@@ -761,7 +771,7 @@ impl BeamTree {
             // Leaves only read the tree: the parent's planes are borrowed in place.
             Some(leaf) => {
                 let parent = self.parent_ref(prep, p);
-                leaf.apex_distances(&parent);
+                leaf.test.apex_distances(&parent);
                 for &s in children.iter() {
                     self.leaf_child(prep, &parent, s, leaf);
                 }
@@ -950,6 +960,19 @@ impl BeamTree {
 
     /// Try child `s` of `parent`; push it when its window is not empty and not occluded.
     fn child(&mut self, prep: &Prepared<'_>, parent: &Parent<'_>, s: u32, scratch: &mut Scratch) {
+        self.child_probed(prep, parent, s, scratch, None);
+    }
+
+    /// [`BeamTree::child`]; with `probe`, the child is tested for occlusion and pushed only
+    /// when it can end or lead to a candidate ([`Probe::ends_a_candidate`]).
+    fn child_probed(
+        &mut self,
+        prep: &Prepared<'_>,
+        parent: &Parent<'_>,
+        s: u32,
+        scratch: &mut Scratch,
+        probe: Option<&mut Probe>,
+    ) {
         let plane = *prep.plane(s);
         if plane.signed_distance_unfused(parent.apex).abs() <= prep.tol {
             // Every ray from the apex to this plane runs in it: all such paths graze.
@@ -961,11 +984,16 @@ impl BeamTree {
             self.stats.empty += 1;
             return;
         }
+        let image = plane.mirror(parent.apex);
+        if let Some(probe) = probe
+            && !probe.ends_a_candidate(self, prep, (s, image), &scratch.a)
+        {
+            return;
+        }
         if prep.cull_at_build && occlude(prep, parent, s, scratch, &mut self.stats) {
             self.stats.occluded += 1;
             return;
         }
-        let image = plane.mirror(parent.apex);
         let planes = beam_planes(&plane, image, &scratch.a, &mut self.planes);
         let window = push_range(&mut self.verts, &scratch.a);
         self.nodes.push(Node {
@@ -986,38 +1014,7 @@ impl BeamTree {
     /// itself, though inside the window, is a worse start for the accelerator's Jacobi
     /// rounds: a third-order path of the dynamic living room then missed its 256-round cap.)
     fn leaf_child(&self, prep: &Prepared<'_>, parent: &Parent<'_>, s: u32, leaf: &mut Leaf<'_>) {
-        let plane = prep.plane(s);
-        let tol = prep.tol;
-        let eps = EPS * tol;
-        let d_apex = plane.signed_distance_unfused(parent.apex);
-        let (d_rx, rx_image) = leaf.mirrored[s as usize];
-        // RX must be on the apex's side of the plane (the reflected side) and off it.
-        let d_rx_same_side = if d_apex > 0.0 { d_rx } else { -d_rx };
-        if d_apex.abs() <= tol || d_rx_same_side < -eps {
-            return;
-        }
-        // The point is x = apex + t·(rx_image − apex) with t = num / den > 0 (den > 0: |d_apex|
-        // > tol ≥ eps ≥ −d_rx_same_side). A beam plane's distance is affine along the line,
-        // d(x) = a + t·(r − a) for a = d(apex), r = d(rx_image), so d(x) ≥ −eps is tested as
-        // a·den + num·(r − a) ≥ −eps·den: no division for the pairs the beam rejects.
-        let (num, den) = (d_apex.abs(), d_apex.abs() + d_rx_same_side);
-        if !parent.planes.iter().zip(&leaf.apex_d).all(|(p, &a)| {
-            let r = p.signed_distance_unfused(rx_image);
-            a * den + num * (r - a) >= -eps * den
-        }) {
-            return;
-        }
-        let t = num / den;
-        if !t.is_finite() {
-            return;
-        }
-        let x = parent.apex + t * (rx_image - parent.apex);
-        if !prep
-            .scene
-            .surface(SurfaceId(s))
-            .polygon
-            .contains(x, GROW * tol)
-        {
+        if !leaf.test.hit(prep, parent, s) {
             return;
         }
         self.prefix(parent.index, &mut leaf.seq, &mut leaf.starts);
@@ -1034,25 +1031,29 @@ impl BeamTree {
     }
 }
 
-/// The last level of a single-receiver trace: RX, each surface's signed distance to RX and
-/// RX's mirror image in it (computed once, read by every leaf test), the candidates emitted.
-struct Leaf<'o> {
+/// The leaf test of a single-receiver trace: RX, each surface's signed distance to RX and
+/// RX's mirror image in it (computed once, read by every leaf test).
+struct LeafTest {
     /// Per surface: (signed distance of RX, m; RX mirrored through the plane), shared by the
     /// chunks of a level grown in parallel.
-    mirrored: std::sync::Arc<[(Real, Vec3)]>,
+    mirrored: Mirrored,
     /// The current parent's apex's signed distance to each of its beam planes, m (read by
     /// each of its leaf tests).
     apex_d: Vec<Real>,
-    out: &'o mut CandidateSet,
-    /// Scratch for one candidate's sequence, start points and last window.
-    seq: Vec<SurfaceId>,
-    starts: Vec<Vec3>,
-    window: Vec<Vec3>,
-    tmp: Vec<Vec3>,
 }
 
-impl<'o> Leaf<'o> {
-    /// Prepare the leaf tests of `parent`'s children ([`Leaf::apex_d`]).
+/// Per surface: RX's signed distance to the plane (m) and RX mirrored through it.
+type Mirrored = std::sync::Arc<[(Real, Vec3)]>;
+
+impl LeafTest {
+    fn new(mirrored: Mirrored) -> Self {
+        LeafTest {
+            mirrored,
+            apex_d: Vec::new(),
+        }
+    }
+
+    /// Prepare the leaf tests of `parent`'s children ([`LeafTest::apex_d`]).
     fn apex_distances(&mut self, parent: &Parent<'_>) {
         self.apex_d.clear();
         self.apex_d.extend(
@@ -1063,29 +1064,148 @@ impl<'o> Leaf<'o> {
         );
     }
 
-    fn new(prep: &Prepared<'_>, rx: Vec3, out: &'o mut CandidateSet) -> Self {
-        let mirrored = prep
-            .planes
-            .iter()
-            .map(|pl| {
-                let d = pl.signed_distance_unfused(rx);
-                (d, rx - (2.0 * d) * pl.normal)
-            })
-            .collect();
-        Leaf::with_mirrored(mirrored, out)
+    /// Whether child `s` of `parent` ends a candidate: RX lies in its beam (see
+    /// [`BeamTree::leaf_child`]); [`LeafTest::apex_distances`] must have been given `parent`.
+    fn hit(&self, prep: &Prepared<'_>, parent: &Parent<'_>, s: u32) -> bool {
+        let plane = prep.plane(s);
+        let tol = prep.tol;
+        let eps = EPS * tol;
+        let d_apex = plane.signed_distance_unfused(parent.apex);
+        let (d_rx, rx_image) = self.mirrored[s as usize];
+        // RX must be on the apex's side of the plane (the reflected side) and off it.
+        let d_rx_same_side = if d_apex > 0.0 { d_rx } else { -d_rx };
+        if d_apex.abs() <= tol || d_rx_same_side < -eps {
+            return false;
+        }
+        // The point is x = apex + t·(rx_image − apex) with t = num / den > 0 (den > 0: |d_apex|
+        // > tol ≥ eps ≥ −d_rx_same_side). A beam plane's distance is affine along the line,
+        // d(x) = a + t·(r − a) for a = d(apex), r = d(rx_image), so d(x) ≥ −eps is tested as
+        // a·den + num·(r − a) ≥ −eps·den: no division for the pairs the beam rejects.
+        let (num, den) = (d_apex.abs(), d_apex.abs() + d_rx_same_side);
+        if !parent.planes.iter().zip(&self.apex_d).all(|(p, &a)| {
+            let r = p.signed_distance_unfused(rx_image);
+            a * den + num * (r - a) >= -eps * den
+        }) {
+            return false;
+        }
+        let t = num / den;
+        if !t.is_finite() {
+            return false;
+        }
+        let x = parent.apex + t * (rx_image - parent.apex);
+        prep.scene
+            .surface(SurfaceId(s))
+            .polygon
+            .contains(x, GROW * tol)
     }
+}
 
-    /// Leaf tests against the RX of `mirrored` (see [`Leaf::mirrored`]), emitting into `out`.
-    fn with_mirrored(mirrored: std::sync::Arc<[(Real, Vec3)]>, out: &'o mut CandidateSet) -> Self {
+/// RX's signed distance to each surface's plane and its mirror image in it ([`Mirrored`]).
+fn mirrored(prep: &Prepared<'_>, rx: Vec3) -> Mirrored {
+    prep.planes
+        .iter()
+        .map(|pl| {
+            let d = pl.signed_distance_unfused(rx);
+            (d, rx - (2.0 * d) * pl.normal)
+        })
+        .collect()
+}
+
+/// The last level of a single-receiver trace: the leaf test and the candidates emitted.
+struct Leaf<'o> {
+    test: LeafTest,
+    out: &'o mut CandidateSet,
+    /// Scratch for one candidate's sequence, start points and last window.
+    seq: Vec<SurfaceId>,
+    starts: Vec<Vec3>,
+    window: Vec<Vec3>,
+    tmp: Vec<Vec3>,
+}
+
+impl<'o> Leaf<'o> {
+    /// Leaf tests against the RX of `mirrored` (see [`LeafTest::mirrored`]), emitting into `out`.
+    fn with_mirrored(mirrored: Mirrored, out: &'o mut CandidateSet) -> Self {
         Leaf {
-            mirrored,
-            apex_d: Vec::new(),
+            test: LeafTest::new(mirrored),
             out,
             seq: Vec::new(),
             starts: Vec::new(),
             window: Vec::new(),
             tmp: Vec::new(),
         }
+    }
+}
+
+/// Whether a node of the last materialised level of a single-receiver trace can end or lead to
+/// a candidate ([`TreeOptions::defer_culling`]): its beam, from its window before occlusion
+/// culling, and its children's leaf tests.
+struct Probe {
+    rx: Vec3,
+    test: LeafTest,
+    planes: Vec<Plane>,
+    children: Vec<u32>,
+}
+
+/// The index of a node tried before it is materialised (never a parent in the arenas).
+const PENDING: u32 = u32::MAX - 1;
+
+impl Probe {
+    fn new(rx: Vec3, mirrored: Mirrored) -> Self {
+        Probe {
+            rx,
+            test: LeafTest::new(mirrored),
+            planes: Vec::new(),
+            children: Vec::new(),
+        }
+    }
+
+    /// Whether RX lies in the beam of surface `s`'s node (image `image`, window `window`), or
+    /// in the beam of one of its children ([`LeafTest::hit`]); counts the children tested in
+    /// `tree`'s statistics. Occlusion culling only shrinks a window, and the beam of a smaller
+    /// window lies inside the larger's: a node for which this is false holds no candidate and
+    /// has no child that does, culled or not.
+    fn ends_a_candidate(
+        &mut self,
+        tree: &mut BeamTree,
+        prep: &Prepared<'_>,
+        (s, image): (u32, Vec3),
+        window: &[Vec3],
+    ) -> bool {
+        self.planes.clear();
+        beam_planes(prep.plane(s), image, window, &mut self.planes);
+        let eps = EPS * prep.tol;
+        if self
+            .planes
+            .iter()
+            .all(|pl| pl.signed_distance_unfused(self.rx) >= -eps)
+        {
+            return true;
+        }
+        let node = Parent {
+            index: PENDING,
+            surface: Some(s),
+            apex: image,
+            planes: &self.planes,
+        };
+        self.test.apex_distances(&node);
+        let visible = prep.rx_visible.as_ref();
+        let Some(visible) = visible.filter(|_| prep.reflectors.len() > LINEAR_SCAN) else {
+            tree.child_candidates(prep, &node, true, &mut self.children);
+            tree.stats.tested += self.children.len() as u64;
+            return self.children.iter().any(|&c| self.test.hit(prep, &node, c));
+        };
+        // The first child that passes is enough: no list, no sort, and the walk stops there.
+        let mut tested = 0;
+        let found = visible.bvh.find(
+            |lo, hi| box_meets_halfspaces(lo, hi, node.planes, eps),
+            |i| {
+                let c = visible.ids[i as usize];
+                tested += u64::from(c != s);
+                c != s && self.test.hit(prep, &node, c)
+            },
+        );
+        tree.stats.tested += tested;
+        found.is_some()
     }
 }
 
@@ -1433,17 +1553,30 @@ pub fn candidates_and_diffracted_in(
     let arenas = Arenas::take(cache);
     (tree.nodes, tree.verts, tree.planes) = (arenas.nodes, arenas.verts, arenas.planes);
     let mut scratch = Scratch::default();
-    for depth in 1..options.max_order {
+    // Deferred culling: the last materialised level keeps only the nodes that can end or lead
+    // to a candidate, culled as they are kept; RX's view is needed to tell them.
+    let defer = options.defer_culling
+        && diffraction.is_none()
+        && prep.cull_at_build
+        && options.max_order >= 2;
+    let eager = options.max_order.saturating_sub(if defer { 2 } else { 1 });
+    for depth in 1..=eager {
         tree.grow_level(&prep, depth, &mut scratch, None, progress)?;
+    }
+    let rx_mirrored = mirrored(&prep, rx);
+    if defer {
+        prep.rx_visible = Some(rx_visibility(&prep, rx, &mut tree.stats));
+        let probe = (rx, rx_mirrored.clone());
+        tree.grow_level_chunked(&prep, options.max_order - 1, Some(&probe), progress)?;
     }
     // The materialised levels' candidates first, then the last level's, tested against RX
     // without being materialised, straight into the same set.
     let mut set = tree.candidates(rx);
     if options.max_order > 0 {
-        if worth_rx_visibility(&prep, &tree) {
+        if !defer && worth_rx_visibility(&prep, &tree) {
             prep.rx_visible = Some(rx_visibility(&prep, rx, &mut tree.stats));
         }
-        let mut leaf = Leaf::new(&prep, rx, &mut set);
+        let mut leaf = Leaf::with_mirrored(rx_mirrored, &mut set);
         tree.grow_level(
             &prep,
             options.max_order,

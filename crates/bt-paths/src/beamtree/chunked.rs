@@ -6,7 +6,8 @@
 //! bounds make the tree the same on any number of threads.
 
 use super::{
-    BeamTree, Leaf, Node, PROGRESS_EVERY, Prepared, Progress, ROOT, Scratch, TreeError, TreeStats,
+    BeamTree, Leaf, Mirrored, Node, PROGRESS_EVERY, Prepared, Probe, Progress, ROOT, Scratch,
+    TreeError, TreeStats,
 };
 use crate::CandidateSet;
 use rayon::prelude::*;
@@ -27,11 +28,14 @@ enum Work<'w> {
 
 impl BeamTree {
     /// Grow materialised level `depth` chunk by chunk (see the module), checking the node
-    /// budget and reporting progress after each round of chunks.
+    /// budget and reporting progress after each round of chunks. With `probe` (RX and its
+    /// mirror images), only the nodes that can end or lead to a candidate for that RX are
+    /// culled and kept ([`Probe`]).
     pub(super) fn grow_level_chunked(
         &mut self,
         prep: &Prepared<'_>,
         depth: usize,
+        probe: Option<&(bt_geom::Vec3, Mirrored)>,
         progress: Progress<'_>,
     ) -> Result<(), TreeError> {
         let start = self.nodes.len();
@@ -44,7 +48,7 @@ impl BeamTree {
             prep,
             (depth, parents.len(), &work),
             progress,
-            |tree, w| tree.grow_chunk(prep, *w),
+            |tree, w| tree.grow_chunk(prep, *w, probe),
             BeamTree::absorb,
         )?;
         self.end_level(start, true);
@@ -63,7 +67,7 @@ impl BeamTree {
         let start = self.nodes.len();
         let parents = self.parents_of(depth);
         let chunks: Vec<&[u32]> = parents.chunks(CHUNK_PARENTS).collect();
-        let mirrored = leaf.mirrored.clone();
+        let mirrored = leaf.test.mirrored.clone();
         self.in_rounds(
             prep,
             (depth, parents.len(), &chunks),
@@ -113,7 +117,7 @@ impl BeamTree {
         &self,
         prep: &Prepared<'_>,
         parents: &[u32],
-        mirrored: &std::sync::Arc<[(bt_geom::Real, bt_geom::Vec3)]>,
+        mirrored: &Mirrored,
     ) -> (CandidateSet, u64) {
         let mut set = CandidateSet::with_starts();
         let mut leaf = Leaf::with_mirrored(mirrored.clone(), &mut set);
@@ -122,7 +126,7 @@ impl BeamTree {
             let parent = self.parent_ref(prep, p);
             self.child_candidates(prep, &parent, true, &mut children);
             tested += children.len() as u64;
-            leaf.apex_distances(&parent);
+            leaf.test.apex_distances(&parent);
             for &s in &children {
                 self.leaf_child(prep, &parent, s, &mut leaf);
             }
@@ -132,15 +136,21 @@ impl BeamTree {
 
     /// The nodes `work` grows, in arenas of their own (node windows and beam planes index
     /// them; parents are this tree's nodes).
-    fn grow_chunk(&self, prep: &Prepared<'_>, work: Work<'_>) -> BeamTree {
+    fn grow_chunk(
+        &self,
+        prep: &Prepared<'_>,
+        work: Work<'_>,
+        probe: Option<&(bt_geom::Vec3, Mirrored)>,
+    ) -> BeamTree {
         let mut part = self.part();
         let mut scratch = Scratch::default();
+        let mut probe = probe.map(|(rx, m)| Probe::new(*rx, m.clone()));
         match work {
             Work::Root(children) => {
                 let parent = self.parent_ref(prep, ROOT);
                 part.stats.tested += children.len() as u64;
                 for &s in children {
-                    part.child(prep, &parent, s, &mut scratch);
+                    part.child_probed(prep, &parent, s, &mut scratch, probe.as_mut());
                 }
             }
             Work::Parents(parents) => {
@@ -150,7 +160,7 @@ impl BeamTree {
                     self.child_candidates(prep, &parent, false, &mut children);
                     part.stats.tested += children.len() as u64;
                     for &s in &children {
-                        part.child(prep, &parent, s, &mut scratch);
+                        part.child_probed(prep, &parent, s, &mut scratch, probe.as_mut());
                     }
                 }
             }

@@ -110,6 +110,25 @@ proptest! {
         assert_same(&walked, &reference)?;
     }
 
+    /// Deferred culling of the last materialised level (a node is culled and kept only when it
+    /// can end or lead to a candidate) gives the candidates, start points included, of
+    /// culling every node as it is built, and the paths of exhaustive enumeration: culled at
+    /// build on the nasty scenes (shared edges, coplanar neighbours, concave panels, grazing
+    /// terminals, RX on mirror rays through edges and corners), orders 2-4.
+    #[test]
+    fn deferred_culling_gives_the_candidates_of_culling_every_node(
+        seed in 0u64..1_000_000, n in 1usize..9, terminals in 0u8..3, order in 2usize..5,
+    ) {
+        let Some(scene) = nasty_scene(seed, n, terminals) else { return Ok(()) };
+        let [deferred, eager] = deferred_and_eager(&scene, order, Culling::Always);
+        prop_assert!(listing(&deferred) == listing(&eager), "candidates differ");
+        if order <= 3 {
+            let reference = paths(&scene, order, CandidateMode::Exhaustive);
+            let tree = bt_solve::trace(&scene, &deferred, &Solver::Image, false).unwrap().paths;
+            assert_same(&tree, &reference)?;
+        }
+    }
+
     #[test]
     fn a_kept_tree_answers_new_receivers_like_a_fresh_trace(
         seed in 0u64..1_000_000, n in 1usize..7,
@@ -564,6 +583,59 @@ proptest! {
         for (k, &rx) in receivers.iter().enumerate() {
             let among = tree.candidates_among(rx, nodes.of(k).iter().map(|&i| i as usize));
             prop_assert_eq!(listing(&among), listing(&tree.candidates(rx)), "receiver {}", k);
+        }
+    }
+}
+
+/// The single-receiver candidates of `scene` at `order` with `culling`, with start points,
+/// deferred ([`TreeOptions::defer_culling`]) and culled as built.
+fn deferred_and_eager(
+    scene: &Scene,
+    order: usize,
+    culling: Culling,
+) -> [bt_paths::CandidateSet; 2] {
+    [true, false].map(|defer_culling| {
+        let options = TreeOptions {
+            culling,
+            defer_culling,
+            ..TreeOptions::new(order)
+        };
+        bt_paths::beamtree::candidates(scene, options).expect("tree builds")
+    })
+}
+
+/// The small city (culled at build by default) at orders 2 and 3: deferred culling gives the
+/// candidates of culling every node and tests fewer nodes for occlusion, on one thread and on
+/// all.
+#[test]
+fn deferred_culling_in_the_small_city_tests_fewer_nodes_for_the_same_candidates() {
+    for (rx_y, rx_z) in [(95.0, 1.5), (150.0, 12.0), (20.0, 3.0)] {
+        let scene = small_city(rx_y, rx_z);
+        for order in 2..=3 {
+            let [deferred, eager] =
+                deferred_and_eager(&scene, order, Culling::Auto { min_work: 64 });
+            assert!(
+                listing(&deferred) == listing(&eager),
+                "order {order}: candidates differ"
+            );
+            let (d, e) = (deferred.tree.clone().unwrap(), eager.tree.unwrap());
+            assert!(
+                d.nodes_per_depth[order - 2] < e.nodes_per_depth[order - 2],
+                "order {order}: {d:?} against {e:?}"
+            );
+            let parallel = bt_paths::beamtree::candidates(
+                &scene,
+                TreeOptions {
+                    parallel: true,
+                    ..TreeOptions::new(order)
+                },
+            )
+            .unwrap();
+            assert!(
+                listing(&parallel) == listing(&deferred),
+                "order {order}: threads differ"
+            );
+            assert_eq!(parallel.tree.unwrap(), d, "order {order}");
         }
     }
 }
