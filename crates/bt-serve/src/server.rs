@@ -14,6 +14,7 @@ use bt_solve::pipeline::{TraceError, TraceOptions, Traced};
 use serde::Serialize;
 use serde_json::Value;
 use std::io::Write;
+use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
 /// A long-lived tracer answering requests: one [`Tracer`] for the whole life of the server
@@ -465,10 +466,42 @@ pub(crate) fn rx_field(rx: &Receivers, i: usize) -> String {
     }
 }
 
-/// One receiver's answer as JSON bytes, room made for a typical answer up front: the bytes
-/// serde_json writes for [`Answer`], its path records written by hand ([`crate::json`]).
+/// Answer buffers whose bytes went into their reply ([`write_reply`]), for the next answers
+/// ([`serialise`]): a stream's answers reuse a few buffers instead of allocating (and, for
+/// tens of kilobytes, faulting in fresh pages) one each. Shared by the threads, since an
+/// answer serialised on a worker is put into its reply on the serving thread.
+static SPARE_ANSWERS: Mutex<Vec<Vec<u8>>> = Mutex::new(Vec::new());
+
+/// Buffers [`SPARE_ANSWERS`] keeps at most (a request of many receivers in flight allocates
+/// the rest), and the largest it keeps, bytes: its memory stays bounded.
+const SPARE_ANSWER_BUFFERS: usize = 16;
+const SPARE_ANSWER_BYTES: usize = 1 << 20;
+
+/// An empty answer buffer: a spare one, or a new one.
+fn answer_buffer() -> Vec<u8> {
+    let spare = SPARE_ANSWERS.lock().ok().and_then(|mut spare| spare.pop());
+    spare.unwrap_or_default()
+}
+
+/// Give `bytes` (an answer put into its reply) back for a later answer, within the bounds.
+fn give_back(mut bytes: Vec<u8>) {
+    if bytes.capacity() > SPARE_ANSWER_BYTES {
+        return;
+    }
+    bytes.clear();
+    if let Ok(mut spare) = SPARE_ANSWERS.lock()
+        && spare.len() < SPARE_ANSWER_BUFFERS
+    {
+        spare.push(bytes);
+    }
+}
+
+/// One receiver's answer as JSON bytes, in a spare buffer ([`SPARE_ANSWERS`]) with room made
+/// for a typical answer up front: the bytes serde_json writes for [`Answer`], its path records
+/// written by hand ([`crate::json`]).
 fn serialise(answer: &Answer<'_>) -> Outcome {
-    let mut bytes = Vec::with_capacity(1024 + 1024 * answer.paths.len());
+    let mut bytes = answer_buffer();
+    bytes.reserve(1024 + 1024 * answer.paths.len());
     let io = |e: std::io::Error| ServeError::Json(serde_json::Error::io(e));
     bytes.extend_from_slice(b"{\"tx\":");
     json::write_reals(&mut bytes, &answer.tx).map_err(io)?;
@@ -513,6 +546,7 @@ pub(crate) fn write_reply(
                 out.push(b',');
                 out.extend_from_slice(fields);
             }
+            give_back(answer);
         }
         Receivers::Many(positions) => {
             out.extend_from_slice(b"{\"id\":");
@@ -523,7 +557,10 @@ pub(crate) fn write_reply(
                     out.push(b',');
                 }
                 match outcome {
-                    Ok(answer) => out.extend_from_slice(&answer),
+                    Ok(answer) => {
+                        out.extend_from_slice(&answer);
+                        give_back(answer);
+                    }
                     Err(e) => {
                         let entry = EntryError {
                             rx: p.to_array(),
