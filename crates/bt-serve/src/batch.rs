@@ -90,7 +90,7 @@ impl Server {
                 None => "rx".to_string(),
             }
         };
-        let outcomes = match self.traced_answers(tx, &positions, 0, &field) {
+        let outcomes = match self.traced_answers(tx, &positions, 0, &field, None) {
             Ok(outcomes) => outcomes,
             Err(_) => return self.answer_each(requests, out),
         };

@@ -2,10 +2,13 @@
 //! bytes serde_json writes for [`PathReport`] (compact, its field order, `null` for a
 //! non-finite number, numbers by serde_json's own formatter), without its per-key escaping
 //! and small writes, which took 28 % of a serve stream's instructions, more than the trace
-//! (docs/performance.md). Tested byte for byte against serde_json over drawn records (`tests`)
-//! and real answers (`server`'s tests); a field added to [`PathReport`] (and so to
-//! [`PathReport::example`], which every drawn record starts from) fails them until it is
-//! written here too.
+//! (docs/performance.md). Room for a whole record is reserved once; +0.0 is written as `0.0`
+//! and an integral point coordinate or loss below 10^15 (a wall's 6.0, a material's 4.0 dB)
+//! as its digits and `.0`, the bytes serde_json's shortest form gives them, without its
+//! search; a power equal to the gain (a transmitted power of 0 dBm) repeats the gain's bytes. Tested byte for byte against
+//! serde_json over drawn records (`tests`) and real answers (`server`'s tests); a field added
+//! to [`PathReport`] (and so to [`PathReport::example`], which every drawn record starts from)
+//! fails them until it is written here too.
 
 use bt_beams::{Direction, InteractionKind, PathReport};
 use serde_json::ser::{CompactFormatter, Formatter};
@@ -24,12 +27,28 @@ pub(crate) fn write_paths(out: &mut Vec<u8>, paths: &[PathReport]) -> io::Result
     Ok(())
 }
 
+/// Bytes a record's keys and punctuation take at most, besides its numbers and names
+/// (about 430 with every optional field).
+const RECORD_FRAME: usize = 512;
+
+/// Bytes a real takes at most (serde_json's longest, `-2.2250738585072014e-308`, is 24).
+const REAL: usize = 25;
+
+/// Room for `p`'s record: its frame, every number at its longest, its names unescaped and
+/// each interaction's kind (a name that needs escapes grows the buffer as it is written).
+fn record_bound(p: &PathReport) -> usize {
+    let names: usize = p.surfaces.iter().map(|s| s.len() + 3).sum();
+    let reals = 17 + 3 * p.points.len() + p.incidence_deg.len();
+    RECORD_FRAME + REAL * reals + names + 16 * p.interactions.len()
+}
+
 /// One path record, as serde_json writes [`PathReport`].
 pub(crate) fn write_path(out: &mut Vec<u8>, p: &PathReport) -> io::Result<()> {
+    out.reserve(record_bound(p));
     out.extend_from_slice(b"{\"rank\":");
-    write_usize(out, p.rank)?;
+    write_u64(out, p.rank as u64)?;
     out.extend_from_slice(b",\"order\":");
-    write_usize(out, p.order)?;
+    write_u64(out, p.order as u64)?;
     out.extend_from_slice(b",\"interactions\":[");
     for (k, kind) in p.interactions.iter().enumerate() {
         if k > 0 {
@@ -53,7 +72,13 @@ pub(crate) fn write_path(out: &mut Vec<u8>, p: &PathReport) -> io::Result<()> {
         if k > 0 {
             out.push(b',');
         }
-        write_reals(out, point)?;
+        out.push(b'[');
+        write_integral_or_real(out, point[0])?;
+        out.push(b',');
+        write_integral_or_real(out, point[1])?;
+        out.push(b',');
+        write_integral_or_real(out, point[2])?;
+        out.push(b']');
     }
     out.extend_from_slice(b"],\"length_m\":");
     write_real(out, p.length_m)?;
@@ -75,26 +100,34 @@ pub(crate) fn write_path(out: &mut Vec<u8>, p: &PathReport) -> io::Result<()> {
 
 /// The record's fields from `free_space_loss_db` to its end, and its closing brace.
 fn write_losses(out: &mut Vec<u8>, p: &PathReport) -> io::Result<()> {
-    let reals = [
-        (&b"],\"free_space_loss_db\":"[..], p.free_space_loss_db),
-        (b",\"reflection_loss_db\":", p.reflection_loss_db),
-        (b",\"diffraction_loss_db\":", p.diffraction_loss_db),
-        (b",\"transmission_loss_db\":", p.transmission_loss_db),
-        (b",\"loss_db\":", p.loss_db),
-    ];
-    for (key, value) in reals {
-        out.extend_from_slice(key);
-        write_real(out, value)?;
-    }
-    out.extend_from_slice(b",\"gain\":");
-    write_reals(out, &[p.gain.re, p.gain.im])?;
-    out.extend_from_slice(b",\"gain_db\":");
+    out.extend_from_slice(b"],\"free_space_loss_db\":");
+    write_real(out, p.free_space_loss_db)?;
+    out.extend_from_slice(b",\"reflection_loss_db\":");
+    write_integral_or_real(out, p.reflection_loss_db)?;
+    out.extend_from_slice(b",\"diffraction_loss_db\":");
+    write_integral_or_real(out, p.diffraction_loss_db)?;
+    out.extend_from_slice(b",\"transmission_loss_db\":");
+    write_integral_or_real(out, p.transmission_loss_db)?;
+    out.extend_from_slice(b",\"loss_db\":");
+    write_real(out, p.loss_db)?;
+    out.extend_from_slice(b",\"gain\":[");
+    write_real(out, p.gain.re)?;
+    out.push(b',');
+    write_real(out, p.gain.im)?;
+    out.extend_from_slice(b"],\"gain_db\":");
+    let gain_db = out.len();
     write_option(out, p.gain_db)?;
+    let gain_db = gain_db..out.len();
     out.extend_from_slice(b",\"power_dbm\":");
-    write_option(out, p.power_dbm)?;
+    // The same number (a transmitted power of 0 dBm), the same bytes.
+    match (p.gain_db, p.power_dbm) {
+        (Some(g), Some(p)) if g.to_bits() == p.to_bits() => out.extend_from_within(gain_db),
+        (None, None) => out.extend_from_within(gain_db),
+        (_, power_dbm) => write_option(out, power_dbm)?,
+    }
     if let Some(n) = p.iterations {
         out.extend_from_slice(b",\"iterations\":");
-        CompactFormatter.write_u32(out, n)?;
+        write_u64(out, n.into())?;
     }
     if let Some(r) = p.residual_m {
         out.extend_from_slice(b",\"residual_m\":");
@@ -127,12 +160,39 @@ pub(crate) fn write_reals(out: &mut Vec<u8>, values: &[f64]) -> io::Result<()> {
     Ok(())
 }
 
-/// A real as serde_json writes an `f64`: its formatter for a finite number, `null` otherwise.
+/// Integral reals below this magnitude are written as their digits and `.0`: serde_json's
+/// formatter writes every integral value below 10^16 in that fixed form, and its shortest
+/// digits of an integer below 2^53 are the integer's own.
+const INTEGRAL_BELOW: u64 = 1_000_000_000_000_000;
+
+/// A real as serde_json writes an `f64`: its formatter for a finite number, `null` otherwise
+/// (+0.0, the most frequent value, as the `0.0` it writes).
 fn write_real(out: &mut Vec<u8>, v: f64) -> io::Result<()> {
+    if v.to_bits() == 0 {
+        out.extend_from_slice(b"0.0");
+        return Ok(());
+    }
     match v.is_finite() {
         true => CompactFormatter.write_f64(out, v),
         false => CompactFormatter.write_null(out),
     }
+}
+
+/// [`write_real`] for a real often integral (a material's loss in dB, a wall's coordinate):
+/// an integral value below [`INTEGRAL_BELOW`] as its digits and `.0`, the bytes serde_json's
+/// formatter gives it, without its shortest-digits search.
+fn write_integral_or_real(out: &mut Vec<u8>, v: f64) -> io::Result<()> {
+    // `as` saturates (and takes NaN to 0): only an integral, finite value comes back equal.
+    let i = v as i64;
+    if i as f64 != v || i.unsigned_abs() >= INTEGRAL_BELOW {
+        return write_real(out, v);
+    }
+    if v.is_sign_negative() {
+        out.push(b'-');
+    }
+    write_u64(out, i.unsigned_abs())?;
+    out.extend_from_slice(b".0");
+    Ok(())
 }
 
 /// An optional real: `null` when absent.
@@ -143,8 +203,13 @@ fn write_option(out: &mut Vec<u8>, v: Option<f64>) -> io::Result<()> {
     }
 }
 
-fn write_usize(out: &mut Vec<u8>, n: usize) -> io::Result<()> {
-    CompactFormatter.write_u64(out, n as u64)
+/// An unsigned integer's decimal digits (a single digit without serde_json's formatter).
+fn write_u64(out: &mut Vec<u8>, n: u64) -> io::Result<()> {
+    if n < 10 {
+        out.push(b'0' + n as u8);
+        return Ok(());
+    }
+    CompactFormatter.write_u64(out, n)
 }
 
 /// A string as serde_json writes it: quoted as it is when nothing in it needs an escape
@@ -175,7 +240,7 @@ mod tests {
     /// A real drawn to hit the formatter's cases: special values, integers, tiny, huge,
     /// subnormal, negative zero, and plain random ones.
     fn real(rng: &mut ChaCha8Rng) -> f64 {
-        const SPECIAL: [f64; 14] = [
+        const SPECIAL: [f64; 22] = [
             0.0,
             -0.0,
             1.0,
@@ -190,11 +255,23 @@ mod tests {
             f64::NAN,
             f64::INFINITY,
             f64::NEG_INFINITY,
+            // Integral values at the edges of the digits-and-`.0` shortcut.
+            999_999_999_999_999.0,
+            -999_999_999_999_999.0,
+            1e15,
+            1e16,
+            9_007_199_254_740_992.0,
+            i64::MAX as f64,
+            i64::MIN as f64,
+            -1.0,
         ];
-        match rng.random_range(0..4) {
+        match rng.random_range(0..6) {
             0 => SPECIAL[rng.random_range(0..SPECIAL.len())],
             1 => f64::from_bits(rng.random()),
             2 => rng.random_range(-1e3..1e3),
+            // Integral values of every size the shortcut takes, and beyond it.
+            3 => (rng.random_range(-2e15..2e15_f64) / 10f64.powi(rng.random_range(0..16))).round(),
+            4 => rng.random_range(-200.0..200.0_f64).round() / 2.0,
             _ => rng.random_range(-200.0..200.0_f64).round(),
         }
     }
@@ -246,7 +323,11 @@ mod tests {
         p.loss_db = real(rng);
         p.gain = Complex64::new(real(rng), real(rng));
         p.gain_db = option(rng);
-        p.power_dbm = option(rng);
+        // A transmitted power of 0 dBm: the power is the gain, whose bytes it repeats.
+        p.power_dbm = match rng.random_bool(0.5) {
+            true => p.gain_db,
+            false => option(rng),
+        };
         p.iterations = rng.random_bool(0.5).then(|| rng.random());
         p.residual_m = option(rng);
         p
@@ -261,5 +342,41 @@ mod tests {
         }
         let example = [PathReport::example()];
         assert_eq!(mine(&example), serde_json::to_string(&example).unwrap());
+    }
+
+    /// The digits-and-`.0` shortcut against serde_json's formatter: every integer to ±2000 and
+    /// its halves, each power of ten and its neighbours up to 10^17, and the reals next to the
+    /// shortcut's bound.
+    #[test]
+    fn integral_reals_are_written_as_serde_writes_them() {
+        let mut values: Vec<f64> = (-4000..=4000).map(|k| f64::from(k) / 2.0).collect();
+        for e in 0..=17 {
+            let p = 10f64.powi(e);
+            values.extend([
+                p - 1.0,
+                p,
+                p + 1.0,
+                -p,
+                1.0 - p,
+                3.0 * p,
+                p.next_up(),
+                p.next_down(),
+            ]);
+        }
+        let bound = INTEGRAL_BELOW as f64;
+        values.extend([
+            bound,
+            bound.next_down(),
+            -bound.next_down(),
+            2f64.powi(53) - 1.0,
+        ]);
+        for v in values {
+            let serde = serde_json::to_string(&v).unwrap();
+            let (mut shortcut, mut real) = (Vec::new(), Vec::new());
+            write_integral_or_real(&mut shortcut, v).unwrap();
+            write_real(&mut real, v).unwrap();
+            assert_eq!(String::from_utf8(shortcut).unwrap(), serde, "{v:e}");
+            assert_eq!(String::from_utf8(real).unwrap(), serde, "{v:e}");
+        }
     }
 }

@@ -14,6 +14,7 @@ use bt_solve::pipeline::{TraceError, TraceOptions, Traced};
 use serde::Serialize;
 use serde_json::Value;
 use std::io::Write;
+use std::sync::Mutex;
 use std::time::{Duration, Instant};
 
 /// A long-lived tracer answering requests: one [`Tracer`] for the whole life of the server
@@ -46,6 +47,11 @@ pub(crate) struct Session {
 /// The answer for one receiver: the fields of `trace --json` a receiver changes.
 #[derive(Serialize)]
 struct Answer<'a> {
+    /// The reply's opening `{"id":ID` for the lone receiver of a request, written before the
+    /// fields ([`serialise`]) so that the answer becomes the reply line without a copy
+    /// ([`write_reply`]); not a field of the answer.
+    #[serde(skip)]
+    head: Option<&'a [u8]>,
     tx: [f64; 3],
     rx: [f64; 3],
     paths: &'a [PathReport],
@@ -209,9 +215,15 @@ impl Server {
         let poses = self.poses(request)?;
         let field = |i: usize| rx_field(&rx, i);
         let positions = rx.positions();
+        // A lone receiver's answer opens the reply itself.
+        let head = match rx {
+            Receivers::One(_) => Some(reply_head(&request.id)?),
+            Receivers::Many(_) => None,
+        };
+        let head = head.as_deref();
         let outcomes = match poses != self.held {
-            true => self.update_and_trace(tx, positions, &poses, &field)?,
-            false => self.trace(tx, positions, 0, &field)?,
+            true => self.update_and_trace(tx, positions, &poses, &field, head)?,
+            false => self.trace(tx, positions, 0, &field, head)?,
         };
         write_reply(&request.id, &rx, outcomes, t0, out)?;
         self.session = Session {
@@ -278,6 +290,7 @@ impl Server {
         positions: &[Vec3],
         first: usize,
         field: &Field<'_>,
+        head: Option<&[u8]>,
     ) -> Result<Vec<Outcome>, ServeError> {
         if positions.is_empty() {
             return Ok(Vec::new());
@@ -286,24 +299,27 @@ impl Server {
             let scene = self.with_transmitter(tx, positions, first, field)?;
             self.tracer.set_scene(scene);
         }
-        self.traced_answers(tx, positions, first, field)
+        self.traced_answers(tx, positions, first, field, head)
     }
 
     /// Each receiver of `positions` (the first at index `first` of `field`) traced from `tx`
     /// and its answer reported and serialised in the same task: in parallel over the cores
     /// when the tracer runs in parallel and there is more than one receiver (the report and
     /// its JSON cost more than the walk of the kept tree), in order. Fails as a whole only
-    /// when the TX cannot be traced ([`Tracer::trace_each`]).
+    /// when the TX cannot be traced ([`Tracer::trace_each`]). `head` opens each answer (a
+    /// request's lone receiver: [`Answer::head`]).
     pub(crate) fn traced_answers(
         &mut self,
         tx: Vec3,
         positions: &[Vec3],
         first: usize,
         field: &Field<'_>,
+        head: Option<&[u8]>,
     ) -> Result<Vec<Outcome>, ServeError> {
         let reporter = Reporter {
             radio: &self.radio,
             beams: self.beams.as_ref(),
+            head,
         };
         let traced = self.tracer.trace_each_then(tx, positions, |scene, traced| {
             reporter.trace_answer(scene, &traced)
@@ -342,13 +358,15 @@ impl Server {
     }
 
     /// Move the objects to `poses` and trace the first receiver as the tracer's next time
-    /// step (incrementally, as `trace --steps`), the others in that geometry.
+    /// step (incrementally, as `trace --steps`), the others in that geometry; `head` opens
+    /// the answers ([`Answer::head`]).
     fn update_and_trace(
         &mut self,
         tx: Vec3,
         positions: &[Vec3],
         poses: &[Pose],
         field: &Field<'_>,
+        head: Option<&[u8]>,
     ) -> Result<Vec<Outcome>, ServeError> {
         let Some(&rx0) = positions.first() else {
             return Ok(Vec::new());
@@ -369,8 +387,10 @@ impl Server {
         let reporter = Reporter {
             radio: &self.radio,
             beams: self.beams.as_ref(),
+            head,
         };
         let first = serialise(&Answer {
+            head,
             tx: doc.tx,
             rx: doc.rx,
             beams: reporter.beams_of(&doc.paths, scene.frequency_hz())?,
@@ -378,7 +398,7 @@ impl Server {
             stats: AnswerStats::Step(doc.stats),
         });
         let mut outcomes = vec![first];
-        outcomes.extend(self.trace(tx, &positions[1..], 1, field)?);
+        outcomes.extend(self.trace(tx, &positions[1..], 1, field, head)?);
         Ok(outcomes)
     }
 }
@@ -397,6 +417,8 @@ thread_local! {
 struct Reporter<'a> {
     radio: &'a RadioOptions,
     beams: Option<&'a BeamOptions>,
+    /// What opens each answer ([`Answer::head`]).
+    head: Option<&'a [u8]>,
 }
 
 impl Reporter<'_> {
@@ -410,6 +432,7 @@ impl Reporter<'_> {
             let [tx, rx] = bt_beams::terminals_world(scene)?;
             let stats = Stats::of(traced, paths, self.radio, [Duration::ZERO, t0.elapsed()]);
             serialise(&Answer {
+                head: self.head,
                 tx,
                 rx,
                 beams: self.beams_of(paths, scene.frequency_hz())?,
@@ -465,12 +488,50 @@ pub(crate) fn rx_field(rx: &Receivers, i: usize) -> String {
     }
 }
 
-/// One receiver's answer as JSON bytes, room made for a typical answer up front: the bytes
-/// serde_json writes for [`Answer`], its path records written by hand ([`crate::json`]).
+/// Answer buffers whose bytes went into their reply ([`write_reply`]), for the next answers
+/// ([`serialise`]): a stream's answers reuse a few buffers instead of allocating (and, for
+/// tens of kilobytes, faulting in fresh pages) one each. Shared by the threads, since an
+/// answer serialised on a worker is put into its reply on the serving thread.
+static SPARE_ANSWERS: Mutex<Vec<Vec<u8>>> = Mutex::new(Vec::new());
+
+/// Buffers [`SPARE_ANSWERS`] keeps at most (a request of many receivers in flight allocates
+/// the rest), and the largest it keeps, bytes: its memory stays bounded.
+const SPARE_ANSWER_BUFFERS: usize = 16;
+const SPARE_ANSWER_BYTES: usize = 1 << 20;
+
+/// An empty answer buffer: a spare one, or a new one.
+fn answer_buffer() -> Vec<u8> {
+    let spare = SPARE_ANSWERS.lock().ok().and_then(|mut spare| spare.pop());
+    spare.unwrap_or_default()
+}
+
+/// Give `bytes` (an answer put into its reply) back for a later answer, within the bounds.
+fn give_back(mut bytes: Vec<u8>) {
+    if bytes.capacity() > SPARE_ANSWER_BYTES {
+        return;
+    }
+    bytes.clear();
+    if let Ok(mut spare) = SPARE_ANSWERS.lock()
+        && spare.len() < SPARE_ANSWER_BUFFERS
+    {
+        spare.push(bytes);
+    }
+}
+
+/// One receiver's answer as JSON bytes, in a spare buffer ([`SPARE_ANSWERS`]) with room made
+/// for a typical answer up front: the bytes serde_json writes for [`Answer`], its path records
+/// written by hand ([`crate::json`]).
 fn serialise(answer: &Answer<'_>) -> Outcome {
-    let mut bytes = Vec::with_capacity(1024 + 1024 * answer.paths.len());
+    let mut bytes = answer_buffer();
+    bytes.reserve(1024 + 1024 * answer.paths.len());
     let io = |e: std::io::Error| ServeError::Json(serde_json::Error::io(e));
-    bytes.extend_from_slice(b"{\"tx\":");
+    match answer.head {
+        Some(head) => {
+            bytes.extend_from_slice(head);
+            bytes.extend_from_slice(b",\"tx\":");
+        }
+        None => bytes.extend_from_slice(b"{\"tx\":"),
+    }
     json::write_reals(&mut bytes, &answer.tx).map_err(io)?;
     bytes.extend_from_slice(b",\"rx\":");
     json::write_reals(&mut bytes, &answer.rx).map_err(io)?;
@@ -486,10 +547,26 @@ fn serialise(answer: &Answer<'_>) -> Outcome {
     Ok(bytes)
 }
 
+/// `{"id":ID`, the opening of the reply to the request of id `id`, into `out`.
+fn write_head(out: &mut Vec<u8>, id: &Value) -> Result<(), ServeError> {
+    out.extend_from_slice(b"{\"id\":");
+    serde_json::to_writer(&mut *out, id)?;
+    Ok(())
+}
+
+/// [`write_head`] as its own bytes, for a lone receiver's answer to open ([`Answer::head`]).
+fn reply_head(id: &Value) -> Result<Vec<u8>, ServeError> {
+    let mut head = Vec::new();
+    write_head(&mut head, id)?;
+    Ok(head)
+}
+
 /// The reply `{"id", ...answer or "results", "latency_us"}` of a request for `rx` appended to
 /// `out`, from each receiver's `outcomes` (aligned with `rx`'s positions): one receiver's
 /// answer fields at the top level (its error is the request's), a list's as `results`, one
-/// entry each (an error entry `{"rx", "error"}` for a receiver that failed alone).
+/// entry each (an error entry `{"rx", "error"}` for a receiver that failed alone). A lone
+/// receiver's answer opened by its head already is the reply: it becomes `out` when `out` is
+/// empty (no copy), and the buffer `out` had goes back to the pool.
 /// `latency_us` is the time from the parsed request (`t0`) to the serialised answer, written
 /// last. The bytes are those of serde's `{"id": .., #[serde(flatten)] answer}`.
 pub(crate) fn write_reply(
@@ -503,27 +580,39 @@ pub(crate) fn write_reply(
     let mut outcomes = outcomes.into_iter();
     match rx {
         Receivers::One(_) => {
-            let answer = outcomes
+            let mut answer = outcomes
                 .next()
                 .unwrap_or_else(|| Err(ServeError::request("rx", "no answer for the receiver")))?;
-            out.extend_from_slice(b"{\"id\":");
-            serde_json::to_writer(&mut *out, id)?;
-            // The answer's fields without its braces: `{"tx": ...}` → `"tx": ...`.
-            if let Some(fields) = answer.get(1..answer.len().saturating_sub(1)) {
-                out.push(b',');
-                out.extend_from_slice(fields);
+            if answer.starts_with(b"{\"id\":") {
+                // Opened by its head (`Answer::head`): the reply itself, without its closing
+                // brace; taken as it is into an empty `out`.
+                answer.pop();
+                match out.is_empty() {
+                    true => std::mem::swap(out, &mut answer),
+                    false => out.extend_from_slice(&answer),
+                }
+            } else {
+                write_head(out, id)?;
+                // The answer's fields without its braces: `{"tx": ...}` → `"tx": ...`.
+                if let Some(fields) = answer.get(1..answer.len().saturating_sub(1)) {
+                    out.push(b',');
+                    out.extend_from_slice(fields);
+                }
             }
+            give_back(answer);
         }
         Receivers::Many(positions) => {
-            out.extend_from_slice(b"{\"id\":");
-            serde_json::to_writer(&mut *out, id)?;
+            write_head(out, id)?;
             out.extend_from_slice(b",\"results\":[");
             for (k, (p, outcome)) in positions.iter().zip(outcomes).enumerate() {
                 if k > 0 {
                     out.push(b',');
                 }
                 match outcome {
-                    Ok(answer) => out.extend_from_slice(&answer),
+                    Ok(answer) => {
+                        out.extend_from_slice(&answer);
+                        give_back(answer);
+                    }
                     Err(e) => {
                         let entry = EntryError {
                             rx: p.to_array(),
@@ -589,6 +678,7 @@ mod tests {
         let reporter = Reporter {
             radio: &radio,
             beams: sweep.as_ref(),
+            head: None,
         };
         let tx = scene.tx_world().unwrap();
         let mut tracer = Tracer::new(scene, options);
@@ -605,6 +695,7 @@ mod tests {
             let doc = TraceDocument::report(&scene, &options, &traced, &radio, Duration::ZERO);
             let doc = doc.unwrap();
             let answer = Answer {
+                head: None,
                 tx: doc.tx,
                 rx: doc.rx,
                 beams: reporter.beams_of(&doc.paths, scene.frequency_hz()).unwrap(),
