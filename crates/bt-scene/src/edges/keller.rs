@@ -27,7 +27,7 @@ pub const KELLER_PAIR_TOL: Real = 1e-10;
 
 /// The Keller residual (|cos β_in − cos β_out| at either edge) [`keller_pair`] aims for once
 /// the points have settled.
-const KELLER_RESIDUAL: Real = 1e-10;
+pub const KELLER_RESIDUAL: Real = 1e-10;
 
 /// Rounds [`keller_pair`] may add after the points settled, for [`KELLER_RESIDUAL`].
 const POLISH_ROUNDS: usize = 3;
@@ -91,7 +91,8 @@ impl EdgeLine {
 }
 
 /// The parameters (t1 on `first`, t2 on `second`) of the shortest path `a → first → second →
-/// b` (module docs), to [`KELLER_PAIR_TOL`] and, a few rounds allowing, [`KELLER_RESIDUAL`]. `None` when a point of the path falls on its
+/// b` (module docs), to [`KELLER_PAIR_TOL`] and, a few rounds allowing, [`KELLER_RESIDUAL`].
+/// `None` when a point of the path falls on its
 /// neighbour (the two points on the lines' crossing included) or the solve does not settle.
 pub fn keller_pair(a: Vec3, first: EdgeLine, second: EdgeLine, b: Vec3) -> Option<(Real, Real)> {
     let round = |t2: Real| {
