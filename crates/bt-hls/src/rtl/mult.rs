@@ -286,7 +286,8 @@ mod tests {
         assert_eq!(signed_width(i64::from(i32::MIN)), 32);
     }
 
-    /// The pieces and groups reproduce `x · c mod 2^total` for every corner of x and c.
+    /// The pieces and groups reproduce `x · c mod 2^total` for corners of x (one, two and
+    /// three pieces) and c.
     #[test]
     fn partial_products_and_groups_sum_to_the_product() {
         let total = 50u32;
@@ -301,16 +302,11 @@ mod tests {
             0x3fff_ffff >> 1,
             -(1 << 29) - 1,
         ] {
-            for x in [
-                0i128,
-                1,
-                -1,
-                (1 << 25) - 1,
-                -(1 << 25),
-                0x12_3456,
-                -0x65_4321,
-            ] {
-                let products = partial_products(("x", 26), c, total);
+            for (w, x) in [18u32, 26, 42].into_iter().flat_map(|w| {
+                let top = 1i128 << (w - 1);
+                [0i128, 1, -1, top - 1, -top, 0x1_2345, -0x1_4321].map(|x| (w, x))
+            }) {
+                let products = partial_products(("x", w), c, total);
                 let terms: Vec<(u32, Option<u32>)> = products
                     .iter()
                     .map(|&(px, pc, s)| (s, (!px.top && !pc.top).then_some(px.width + pc.width)))
