@@ -1123,6 +1123,10 @@ pub struct HlsGenArgs {
     /// a design that needs more is refused.
     #[arg(long, default_value_t = bt_hls::EP4CE115_M9K_BLOCKS)]
     pub m9k_budget: u32,
+    /// 18 x 18 multiplier blocks the PEs' products may take (default: the EP4CE115's 266);
+    /// the networks that save the most adders get them, the rest stay CSD networks (0: all).
+    #[arg(long, default_value_t = bt_hls::EP4CE115_MULTIPLIERS)]
+    pub multiplier_budget: u32,
     /// With --steps: start every step from the beam tree's window centres (the default; the
     /// flag is kept for scripts written before `--warm-start`).
     #[arg(long, conflicts_with = "warm_start")]

@@ -51,13 +51,18 @@ pub fn run(args: &HlsArgs) -> anyhow::Result<ExitCode> {
                 r.memory_bits, r.m9k_blocks
             );
             println!(
+                "  18x18 multipliers {:>9}   (of {})",
+                r.multipliers,
+                bt_hls::EP4CE115_MULTIPLIERS
+            );
+            println!(
                 "  share of EP4CE115 {:>9.2} %   (paper, Table III: IPC 4 %-43 % of LEs)",
                 r.percent_of_ep4ce115
             );
             for b in &r.blocks {
                 println!(
-                    "  {:<16} {:>3} x {:>8} logic cells {:>7} registers {:>3} M9K",
-                    b.module, b.instances, b.logic_cells, b.registers, b.m9k_blocks
+                    "  {:<16} {:>3} x {:>8} logic cells {:>7} registers {:>3} M9K {:>3} multipliers",
+                    b.module, b.instances, b.logic_cells, b.registers, b.m9k_blocks, b.multipliers
                 );
             }
             println!(
@@ -205,6 +210,7 @@ fn generate(args: &HlsGenArgs) -> anyhow::Result<ExitCode> {
     let work: Vec<bt_hls::StepWork> = planned.iter().map(bt_accel::PlannedStep::work).collect();
     let platform = bt_hls::Platform {
         m9k_budget: args.m9k_budget,
+        multiplier_budget: args.multiplier_budget,
         ..bt_hls::Platform::fitting(&work)?
     };
     let k = platform.instances.len() as u32;

@@ -32,10 +32,15 @@ fn options() -> StepOptions {
 /// (`bt_schedule::dispatch_copies`, no model run). With one PE per reflector and no copy,
 /// seed 11 took 1.157 ms (docs/hardware.md).
 fn cold_step(seed: u64) -> (bt_scene::Scene, PlannedStep) {
+    cold_step_on(seed, None)
+}
+
+/// [`cold_step`] on `pes` PEs in all (`None`: as many as the room has reflectors).
+fn cold_step_on(seed: u64, pes: Option<u32>) -> (bt_scene::Scene, PlannedStep) {
     let scene = bt_testkit::random_scene(seed, 34);
     let planes = static_reflectors(std::slice::from_ref(&scene));
     let mut options = options();
-    options.plan.pe_budget = Some(planes.len() as u32);
+    options.plan.pe_budget = Some(pes.unwrap_or(planes.len() as u32));
     let step = plan_step(&scene, &planes, 0, &options, None).unwrap();
     (scene, step)
 }
@@ -189,6 +194,27 @@ fn every_unseen_room_generates_its_design() {
         );
         assert!(dir.join("rtl").join("bt_top.v").is_file(), "seed {seed}");
     }
+}
+
+/// Seed 12's design on 16 PEs, one per plane its candidates meet and no copy, for the area
+/// (docs/hardware.md: `beamtrace hls synth target/tmp/bt_accel_unseen_12_pe16`): the
+/// room's 13 idle reflectors give no PE, and the step stays within the millisecond.
+#[test]
+fn an_unseen_room_on_fewer_pes_generates_its_design() {
+    let (_, p) = cold_step_on(12, Some(16));
+    let work = vec![p.work()];
+    let platform = bt_hls::Platform::fitting(&work).unwrap();
+    assert_eq!(platform.instances.len(), 16);
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join("bt_accel_unseen_12_pe16");
+    let _ = std::fs::remove_dir_all(&dir);
+    let report = bt_hls::generate_steps(&platform, &work, &dir).unwrap();
+    assert_eq!(report.predicted.run_cycles, vec![p.plan.predicted_cycles]);
+    let latency_s = p.plan.predicted_cycles as f64 / 50e6;
+    eprintln!(
+        "seed 12 on 16 PEs: {} cycles, {latency_s} s",
+        p.plan.predicted_cycles
+    );
+    assert!(latency_s <= 1e-3, "{latency_s} s");
 }
 
 /// The host's work of one cold step and nothing else (candidates single-threaded, the

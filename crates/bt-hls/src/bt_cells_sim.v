@@ -1,4 +1,4 @@
-// bt-hls: simulation models for a netlist of bt-hls's Yosys flow, beside
+// bt-hls: simulation models for a netlist of bt-hls's Yosys flow (registers, M9K, multipliers), beside
 // cycloneive_lcell_comb from Yosys's cells_sim.v (see `cell_models`). The synthesis script
 // also reads this file as blackboxes: its altsyncram's port widths follow the parameters.
 //
@@ -40,4 +40,28 @@ module altsyncram (data_a, address_a, wren_a, rden_a, q_a, data_b, address_b, wr
 		if (rden_b) q_b <= mem[address_b];
 		if (wren_a) mem[address_a] <= data_a;
 	end
+endmodule
+
+// cycloneive_mac_mult and cycloneive_mac_out as bt_mul_map.v uses them (one 18 x 18 embedded
+// multiplier, no input or output register): dataout = dataa * datab, each operand signed when
+// its sign input is 1 (both are, or neither, in bt_mul_map.v).
+module cycloneive_mac_mult (dataa, datab, signa, signb, clk, aclr, ena, dataout);
+	parameter dataa_width = 18, datab_width = 18;
+	parameter dataa_clock = "none", datab_clock = "none", signa_clock = "none", signb_clock = "none";
+	parameter lpm_type = "cycloneive_mac_mult";
+	input [dataa_width-1:0] dataa;
+	input [datab_width-1:0] datab;
+	input signa, signb, clk, aclr, ena;
+	output [dataa_width+datab_width-1:0] dataout;
+	wire [dataa_width+datab_width-1:0] a = {{datab_width{signa & dataa[dataa_width-1]}}, dataa};
+	wire [dataa_width+datab_width-1:0] b = {{dataa_width{signb & datab[datab_width-1]}}, datab};
+	assign dataout = a * b;
+endmodule
+
+module cycloneive_mac_out (dataa, clk, aclr, ena, dataout);
+	parameter dataa_width = 36, output_clock = "none", lpm_type = "cycloneive_mac_out";
+	input [dataa_width-1:0] dataa;
+	input clk, aclr, ena;
+	output [dataa_width-1:0] dataout;
+	assign dataout = dataa;
 endmodule

@@ -6,6 +6,7 @@ use bt_fixed::{
 use bt_schedule::{PathJob, PeInstance, Problem, Schedule};
 
 use crate::HlsError;
+use crate::rtl::mult::EP4CE115_MULTIPLIERS;
 
 /// One reflection plane: `normal · x = offset_m` (normal unit, offset in metres).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -228,6 +229,12 @@ pub struct Platform {
     /// needs more is refused. Default: the EP4CE115's [`EP4CE115_M9K_BLOCKS`].
     #[serde(default = "default_m9k_budget")]
     pub m9k_budget: u32,
+    /// 18 × 18 multiplier blocks the PEs' products may take (every PE instance's): the
+    /// networks that save the most adders get multipliers while these last, the rest keep
+    /// their CSD shift-add networks; 0 builds every network as CSD. Default: the EP4CE115's
+    /// [`EP4CE115_MULTIPLIERS`].
+    #[serde(default = "default_multiplier_budget")]
+    pub multiplier_budget: u32,
     /// Width of the coordinate word, bits ([`HlsInput::coord_bits`]; every step's must equal it).
     #[serde(default = "full_coord_bits")]
     pub coord_bits: u32,
@@ -235,6 +242,10 @@ pub struct Platform {
 
 fn default_m9k_budget() -> u32 {
     EP4CE115_M9K_BLOCKS
+}
+
+fn default_multiplier_budget() -> u32 {
+    EP4CE115_MULTIPLIERS
 }
 
 /// One accelerator run's work as the host loads it: candidates, start points, TX/RX (the
@@ -298,6 +309,7 @@ impl Platform {
             instances,
             capacity,
             m9k_budget: EP4CE115_M9K_BLOCKS,
+            multiplier_budget: EP4CE115_MULTIPLIERS,
             coord_bits: first.input.coord_bits,
         })
     }
@@ -631,6 +643,7 @@ mod tests {
                 entries,
             },
             m9k_budget,
+            multiplier_budget: 0,
             coord_bits: full_coord_bits(),
         }
     }

@@ -41,6 +41,7 @@ pub use plan::{
     Plan, PlanOptions, ScheduleKind, plan, plan_dispatch, plan_on, predict_dispatch, run_cycles,
     schedule_entries, slot_cycles,
 };
+pub use rtl::mult::EP4CE115_MULTIPLIERS;
 pub use rtl::pe::{PE_CORE_MODULE, pe_module_name, point_bits, sum_bits};
 pub use rtl::top::MAP_VERSION;
 pub use rtl::verilog;
@@ -127,14 +128,26 @@ fn rtl_of(
     platform: &Platform,
     model: &bt_fixed::FixedIpc,
 ) -> Result<Vec<(String, String)>, HlsError> {
-    let planes: std::collections::BTreeSet<u32> =
-        platform.instances.iter().map(|i| i.plane).collect();
+    let mut planes: std::collections::BTreeMap<u32, u32> = std::collections::BTreeMap::new();
+    for i in &platform.instances {
+        *planes.entry(i.plane).or_insert(0) += 1;
+    }
     let wd = bt_fixed::Widths::for_coord(model.coord_bits());
+    let fixed: Vec<(u32, u32, &bt_fixed::FixedPlane)> = planes
+        .iter()
+        .map(|(&p, &copies)| (p, copies, &model.planes()[p as usize]))
+        .collect();
+    let multipliers = rtl::mult::network_forms(&fixed, wd, platform.multiplier_budget);
     let core = rtl::pe::pe_core_module(wd);
     let mut out = vec![(core.name.clone(), verilog::print_module(&core))];
-    for p in planes {
+    for (p, _, plane) in fixed {
         let spec = &platform.planes[p as usize];
-        let m = rtl::pe::pe_module(p as usize, &spec.name, &model.planes()[p as usize], wd)?;
+        let forms = multipliers
+            .forms
+            .get(&p)
+            .copied()
+            .unwrap_or([rtl::mult::NetworkForm::Csd; 3]);
+        let m = rtl::pe::pe_module(p as usize, &spec.name, (plane, forms), wd)?;
         out.push((m.name.clone(), verilog::print_module(&m)));
     }
     let top = rtl::top::top_module(&rtl::top::TopParams::of(platform, model)?);

@@ -6,6 +6,7 @@
 use bt_fixed::{FixedPlane, GUARD_BITS, NORMAL_FRAC, Widths};
 
 use crate::HlsError;
+use crate::rtl::mult::{NetworkForm, multiplier_network};
 use crate::rtl::verilog::{BinaryOp, Direction, Expr, Item, Module, Port, Signal, Stmt, UnaryOp};
 
 /// Width of a packed point `{z, y, x}` of fine words in a design of widths `wd`.
@@ -140,10 +141,13 @@ const FIRST_ITERATION_STEP: u32 = 5;
 ///
 /// `s_sum_k = a_k >> 16 = t_prev_k + round(B_p/2^16)`, valid from [`crate::pe_latency`] cycles
 /// after `start` until the next `load`.
+///
+/// `forms` picks, per normal component, the CSD network or the same product on 18 × 18
+/// multipliers ([`crate::rtl::mult::multiplier_network`]); both give the same bits.
 pub(crate) fn pe_module(
     index: usize,
     plane_name: &str,
-    plane: &FixedPlane,
+    (plane, forms): (&FixedPlane, [NetworkForm; 3]),
     wd: Widths,
 ) -> Result<Module, HlsError> {
     debug_assert_eq!(wd.projection, wd.distance);
@@ -153,7 +157,7 @@ pub(crate) fn pe_module(
     items.push(plane_comment((index, plane_name, plane), &csd));
     let link = Link::named(wd);
     link.declare(&mut items);
-    let nets = csd_networks(&link, &csd, wd, &mut items)?;
+    let nets = csd_networks(&link, (plane, &csd, forms), wd, (&mut items, &mut unused))?;
     signed_distance(plane, &nets, (&link.d_new, wd), &mut items, &mut unused)?;
     projections(index, &link, &nets, &mut items, &mut unused)?;
     items.push(link.core_instance(wd));
@@ -386,17 +390,21 @@ struct Network {
 }
 
 /// Shared networks, one per non-zero normal component: input selected by step[1:0] (0 = a,
-/// 1 = b, 2 = r_e, 3 = r_l).
+/// 1 = b, 2 = r_e, 3 = r_l); each a CSD network or multipliers, as `forms` says.
 fn csd_networks(
     r: &Link,
-    csd: &[bt_fixed::Csd],
+    (plane, csd, forms): (&FixedPlane, &[bt_fixed::Csd], [NetworkForm; 3]),
     wd: Widths,
-    items: &mut Vec<Item>,
+    (items, unused): (&mut Vec<Item>, &mut Vec<Expr>),
 ) -> Result<Vec<Option<Network>>, HlsError> {
-    items.push(Item::Comment(
-        "one CSD network per non-zero normal component, shared by d_prev, d_next, t_prev, t_next"
-            .into(),
-    ));
+    let kind = if forms.contains(&NetworkForm::Multipliers) {
+        "network (CSD or 18 x 18 multipliers)"
+    } else {
+        "CSD network"
+    };
+    items.push(Item::Comment(format!(
+        "one {kind} per non-zero normal component, shared by d_prev, d_next, t_prev, t_next"
+    )));
     let (s1, s0) = (r.step_sel.bit(1), r.step_sel.bit(0));
     let mut nets = Vec::new();
     for (k, axis) in AXES.iter().enumerate() {
@@ -415,16 +423,23 @@ fn csd_networks(
             ),
         );
         let nw = wd.dot_acc - bk;
-        items.push(Item::Comment(format!(
-            "net_{axis} = x_in_{axis} * n_{axis} / 2^{bk} ({} digits)",
-            csd[k].digits.len()
-        )));
-        let net = Signal::assigned(
-            items,
-            format!("net_{axis}"),
-            nw,
-            csd_sum(xin.name(), wd.distance, &csd[k], bk, nw)?,
-        );
+        let sum = match forms[k] {
+            NetworkForm::Csd => {
+                items.push(Item::Comment(format!(
+                    "net_{axis} = x_in_{axis} * n_{axis} / 2^{bk} ({} digits)",
+                    csd[k].digits.len()
+                )));
+                csd_sum(xin.name(), wd.distance, &csd[k], bk, nw)?
+            }
+            NetworkForm::Multipliers => {
+                items.push(Item::Comment(format!(
+                    "net_{axis} = x_in_{axis} * n_{axis} / 2^{bk} on 18 x 18 multipliers (pp_{axis}_<bit of x>_<bit of n / 2^{bk}>; {} CSD digits)",
+                    csd[k].digits.len()
+                )));
+                multiplier_network(axis, &xin, plane.normal[k].0, nw, items, unused)?
+            }
+        };
+        let net = Signal::assigned(items, format!("net_{axis}"), nw, sum);
         nets.push(Some(Network { base: bk, net }));
     }
     Ok(nets)

@@ -3,7 +3,9 @@
 //! Every generated file goes through [`Module`] and [`print_module`]; the printer is the only
 //! place that knows Verilog syntax. All vectors are unsigned: two's-complement arithmetic is
 //! spelled out by the generator (explicit sign extension, slices for arithmetic shifts), so no
-//! expression depends on Verilog's signedness rules. Output is a pure function of the AST.
+//! expression depends on Verilog's signedness rules, with one exception kept in one place:
+//! [`Signal::signed_product`], a signed product assigned alone to a wire of exactly its width
+//! (so that the context can neither widen nor unsign it). Output is a pure function of the AST.
 
 use std::fmt::Write as _;
 
@@ -33,6 +35,9 @@ pub enum Expr {
     Binary(BinaryOp, Box<Expr>, Box<Expr>),
     /// `c ? a : b`.
     Ternary(Box<Expr>, Box<Expr>, Box<Expr>),
+    /// `($signed(a) * $signed(b))`: only built by [`Signal::signed_product`], as the whole
+    /// right-hand side of a wire as wide as both operands together.
+    SignedProduct(Box<Expr>, Box<Expr>),
 }
 
 /// Unary operators.
@@ -178,6 +183,19 @@ impl Signal {
         let s = Signal::wire(items, name, width);
         items.push(Item::Assign(s.e(), value));
         s
+    }
+    /// Declares the `(a_width + b_width)`-bit wire `name = $signed(a) * $signed(b)`: the
+    /// exact two's-complement product of `a` (`a_width` bits) and `b` (`b_width` bits). The
+    /// wire is exactly as wide as the product, so Verilog's rules sign-extend both operands to
+    /// it and nothing around the expression can change that; Yosys sees one signed `$mul`.
+    pub fn signed_product(
+        items: &mut Vec<Item>,
+        name: impl Into<String>,
+        (a, a_width): (Expr, u32),
+        (b, b_width): (Expr, u32),
+    ) -> Signal {
+        let value = Expr::SignedProduct(Box::new(a), Box::new(b));
+        Signal::assigned(items, name, a_width + b_width, value)
     }
     /// A handle on a port of the module being built (declared by its port list, not in
     /// `items`).
@@ -373,6 +391,9 @@ pub fn print_expr(e: &Expr) -> String {
                 BinaryOp::Gt => ">",
             };
             format!("({} {o} {})", print_expr(a), print_expr(b))
+        }
+        Expr::SignedProduct(a, b) => {
+            format!("($signed({}) * $signed({}))", print_expr(a), print_expr(b))
         }
         Expr::Ternary(c, a, b) => format!(
             "({} ? {} : {})",

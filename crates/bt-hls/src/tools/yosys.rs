@@ -20,6 +20,10 @@ pub struct SynthReport {
     pub memory_bits: u64,
     /// M9K blocks (`altsyncram` cells, 9,216 bits each; the EP4CE115 has 432).
     pub m9k_blocks: u64,
+    /// 18 × 18 embedded multipliers (`cycloneive_mac_mult` cells, `bt_mul_map.v`; the
+    /// EP4CE115 has 266).
+    #[serde(default)]
+    pub multipliers: u64,
     /// Logic elements estimate `max(logic_cells, registers)` (each LE holds one LUT and one
     /// register; Quartus packing can only add to this) as a percentage of the EP4CE115's 114,480.
     pub percent_of_ep4ce115: f64,
@@ -45,6 +49,9 @@ pub struct BlockArea {
     pub registers: u64,
     /// `altsyncram` cells (M9K blocks) of one instance.
     pub m9k_blocks: u64,
+    /// `cycloneive_mac_mult` cells (18 × 18 multipliers) of one instance.
+    #[serde(default)]
+    pub multipliers: u64,
 }
 
 /// Logic elements of the EP4CE115 (paper's Cyclone IV E device).
@@ -119,6 +126,7 @@ pub fn synthesize_rtl(
         ("bt_m9k_map.v", include_str!("../bt_m9k_map.v")),
         ("bt_alu_map.v", include_str!("../bt_alu_map.v")),
         ("bt_carry_map.v", include_str!("../bt_carry_map.v")),
+        ("bt_mul_map.v", include_str!("../bt_mul_map.v")),
         ("bt_cells_sim.v", include_str!("../bt_cells_sim.v")),
     ] {
         let path = synth.join(name);
@@ -163,6 +171,7 @@ pub fn synthesize_rtl(
             logic_cells: r.logic_cells,
             registers: r.registers,
             m9k_blocks: r.m9k_blocks,
+            multipliers: r.multipliers,
         });
     }
     let mut report = synth_report(cells, parse_bram_bits(&log));
@@ -221,21 +230,27 @@ pub fn area_markdown(r: &SynthReport, options: &SynthOptions) -> String {
     };
     let mut md = format!(
         "## Area (Yosys synth_intel -family cycloneive, {adders}, {flat})\n\n\
-         * logic cells {}, registers {}, M9K blocks {} ({} memory bits)\n\
+         * logic cells {}, registers {}, M9K blocks {} ({} memory bits), 18 x 18 multipliers {} (of {})\n\
          * {:.1} % of the EP4CE115 (max(logic cells, registers) / {EP4CE115_LES})\n",
-        r.logic_cells, r.registers, r.m9k_blocks, r.memory_bits, r.percent_of_ep4ce115
+        r.logic_cells,
+        r.registers,
+        r.m9k_blocks,
+        r.memory_bits,
+        r.multipliers,
+        crate::EP4CE115_MULTIPLIERS,
+        r.percent_of_ep4ce115
     );
     if !r.blocks.is_empty() {
         md.push_str(
-            "\n| block | instances | logic cells (each) | registers (each) | M9K (each) | share of logic cells |\n\
-             |---|---:|---:|---:|---:|---:|\n",
+            "\n| block | instances | logic cells (each) | registers (each) | M9K (each) | multipliers (each) | share of logic cells |\n\
+             |---|---:|---:|---:|---:|---:|---:|\n",
         );
         for b in &r.blocks {
             let all = b.logic_cells * b.instances;
             let share = 100.0 * all as f64 / r.logic_cells.max(1) as f64;
             md.push_str(&format!(
-                "| `{}` | {} | {} | {} | {} | {share:.1} % |\n",
-                b.module, b.instances, b.logic_cells, b.registers, b.m9k_blocks
+                "| `{}` | {} | {} | {} | {} | {} | {share:.1} % |\n",
+                b.module, b.instances, b.logic_cells, b.registers, b.m9k_blocks, b.multipliers
             ));
         }
     }
@@ -244,7 +259,9 @@ pub fn area_markdown(r: &SynthReport, options: &SynthOptions) -> String {
 
 /// The Yosys script: synth_intel's steps, with its `coarse` step spelled out (Yosys 0.23's
 /// `synth -run coarse`) so that `bt_alu_map.v` runs before `alumacc`, the M9K mapping in place
-/// of `map_bram`, and `bt_carry_map.v` before the generic `techmap` of `map_ffram`. The cell
+/// of `map_bram`, and `bt_carry_map.v` before the generic `techmap` of `map_ffram`;
+/// `bt_mul_map.v` maps products of at most 18 × 18 bits onto the embedded multipliers (Yosys
+/// 0.23's synth_intel has no DSP step) before `alumacc` would turn them into `$macc`. The cell
 /// models of `bt_cells_sim.v`, read as blackboxes after synth_intel's `begin`, replace Yosys
 /// 0.23's `altsyncram` blackbox, whose fixed 8-bit addresses and 36-bit data cut every wider
 /// M9K address in the netlist ("Resizing cell port ... address_a from 13 bits to 8 bits").
@@ -260,6 +277,8 @@ fn yosys_script(files: &[String], top: &str, options: &SynthOptions) -> String {
          opt_clean"
             .to_string(),
     ];
+    // Products up to 18 x 18 onto the embedded multipliers, before alumacc makes them `$macc`.
+    steps.push("techmap -map synth/bt_mul_map.v".into());
     if chain {
         steps.push("techmap -map synth/bt_alu_map.v".into());
     }
@@ -292,6 +311,7 @@ fn synth_report(cells: BTreeMap<String, u64>, memory_bits: u64) -> SynthReport {
         registers,
         memory_bits,
         m9k_blocks: count("altsyncram"),
+        multipliers: count("cycloneive_mac_mult"),
         percent_of_ep4ce115: 100.0 * logic_cells.max(registers) as f64 / EP4CE115_LES as f64,
         cells,
         blocks: Vec::new(),
@@ -300,7 +320,8 @@ fn synth_report(cells: BTreeMap<String, u64>, memory_bits: u64) -> SynthReport {
 
 /// Simulation models of a netlist from [`synthesize_rtl`]: `cycloneive_lcell_comb` from
 /// Yosys's `intel/cycloneive/cells_sim.v` (found through `yosys-config --datdir`, else in
-/// `/usr/share/yosys`) with one fix, and this crate's `dffeas` and `altsyncram`
+/// `/usr/share/yosys`) with one fix, and this crate's `dffeas`, `altsyncram` and multiplier
+/// cells (`cycloneive_mac_mult`, `cycloneive_mac_out`)
 /// (`bt_cells_sim.v`). Yosys 0.23's `cycloneive_lcell_comb` never drives its internal `cin_w`,
 /// so every carry-chain cell would simulate as X (the fix adds `assign cin_w = cin;`); its
 /// `dffeas` ignores the clock enable and the clear, and it has no `altsyncram` model.

@@ -58,7 +58,7 @@ fn invalid_input_is_reported_not_panicked() {
 }
 
 /// A tiny scene (tilted wall + floor, 3 paths) keeps the Yosys run short.
-fn tiny_scene() -> HlsInput {
+pub(crate) fn tiny_scene() -> HlsInput {
     let mut s = small_scene();
     let keep = [0usize, 4];
     s.planes = keep

@@ -29,17 +29,33 @@ module bt_pe_0 (
   wire [25:0] t_x;
   wire [25:0] t_y;
   wire [25:0] t_z;
-  // one CSD network per non-zero normal component, shared by d_prev, d_next, t_prev, t_next
+  // one network (CSD or 18 x 18 multipliers) per non-zero normal component, shared by d_prev, d_next, t_prev, t_next
   wire [25:0] x_in_x;
   assign x_in_x = (step_sel[1] ? (step_sel[0] ? op_l : op_e) : (step_sel[0] ? op_b_x : op_a_x));
-  // net_x = x_in_x * n_x / 2^3 (8 digits)
+  // net_x = x_in_x * n_x / 2^3 on 18 x 18 multipliers (pp_x_<bit of x>_<bit of n / 2^3>; 8 CSD digits)
+  wire [35:0] pp_x_0_0;
+  assign pp_x_0_0 = ($signed({1'd0, x_in_x[16:0]}) * $signed(18'h1d60f));
+  wire [28:0] pp_x_0_17;
+  assign pp_x_0_17 = ($signed({1'd0, x_in_x[16:0]}) * $signed(11'h3fa));
+  wire [26:0] pp_x_17_0;
+  assign pp_x_17_0 = ($signed(x_in_x[25:17]) * $signed(18'h1d60f));
+  wire [19:0] pp_x_17_17;
+  assign pp_x_17_17 = ($signed(x_in_x[25:17]) * $signed(11'h3fa));
   wire [52:0] net_x;
-  assign net_x = ((((((((53'h0 - {{27{x_in_x[25]}}, x_in_x}) + {{23{x_in_x[25]}}, x_in_x, {4{1'd0}}}) - {{18{x_in_x[25]}}, x_in_x, {9{1'd0}}}) - {{16{x_in_x[25]}}, x_in_x, {11{1'd0}}}) - {{14{x_in_x[25]}}, x_in_x, {13{1'd0}}}) - {{10{x_in_x[25]}}, x_in_x, {17{1'd0}}}) - {{8{x_in_x[25]}}, x_in_x, {19{1'd0}}}) + {x_in_x, {27{1'd0}}});
+  assign net_x = (({pp_x_17_17[18:0], pp_x_0_0[33:0]} + {{7{pp_x_0_17[28]}}, pp_x_0_17[28:0], {17{1'd0}}}) + {{9{pp_x_17_0[26]}}, pp_x_17_0[26:0], {17{1'd0}}});
   wire [25:0] x_in_y;
   assign x_in_y = (step_sel[1] ? (step_sel[0] ? op_l : op_e) : (step_sel[0] ? op_b_y : op_a_y));
-  // net_y = x_in_y * n_y / 2^0 (11 digits)
+  // net_y = x_in_y * n_y / 2^0 on 18 x 18 multipliers (pp_y_<bit of x>_<bit of n / 2^0>; 11 CSD digits)
+  wire [35:0] pp_y_0_0;
+  assign pp_y_0_0 = ($signed({1'd0, x_in_y[16:0]}) * $signed(18'h44d9));
+  wire [28:0] pp_y_0_17;
+  assign pp_y_0_17 = ($signed({1'd0, x_in_y[16:0]}) * $signed(11'h32f));
+  wire [26:0] pp_y_17_0;
+  assign pp_y_17_0 = ($signed(x_in_y[25:17]) * $signed(18'h44d9));
+  wire [19:0] pp_y_17_17;
+  assign pp_y_17_17 = ($signed(x_in_y[25:17]) * $signed(11'h32f));
   wire [55:0] net_y;
-  assign net_y = (((((((((({{30{x_in_y[25]}}, x_in_y} - {{27{x_in_y[25]}}, x_in_y, {3{1'd0}}}) - {{25{x_in_y[25]}}, x_in_y, {5{1'd0}}}) + {{22{x_in_y[25]}}, x_in_y, {8{1'd0}}}) + {{20{x_in_y[25]}}, x_in_y, {10{1'd0}}}) + {{16{x_in_y[25]}}, x_in_y, {14{1'd0}}}) - {{13{x_in_y[25]}}, x_in_y, {17{1'd0}}}) - {{9{x_in_y[25]}}, x_in_y, {21{1'd0}}}) + {{7{x_in_y[25]}}, x_in_y, {23{1'd0}}}) - {{5{x_in_y[25]}}, x_in_y, {25{1'd0}}}) + {{3{x_in_y[25]}}, x_in_y, {27{1'd0}}});
+  assign net_y = (({{2{pp_y_17_17[19]}}, pp_y_17_17[19:0], pp_y_0_0[33:0]} + {{10{pp_y_0_17[28]}}, pp_y_0_17[28:0], {17{1'd0}}}) + {{12{pp_y_17_0[26]}}, pp_y_17_0[26:0], {17{1'd0}}});
   // dot = (n . x_in - offset * 2^30 + 2^29) / 2^0; d = dot >> 30
   wire [55:0] dot;
   assign dot = ((56'hffce3fa0000000 + {net_x, {3{1'd0}}}) + net_y);
@@ -75,6 +91,6 @@ module bt_pe_0 (
     .t_z(t_z)
   );
   wire bt_unused_ok;
-  assign bt_unused_ok = &({1'd0, dot[29:0], p_round_x[26:0], p_round_y[29:0]});
+  assign bt_unused_ok = &({1'd0, pp_x_0_0[35:34], pp_x_17_17[19], pp_y_0_0[35:34], dot[29:0], p_round_x[26:0], p_round_y[29:0]});
 endmodule
 `default_nettype wire
