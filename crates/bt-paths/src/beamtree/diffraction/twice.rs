@@ -549,12 +549,13 @@ impl Pairing<'_> {
         }
     }
 
-    /// Necessary conditions of a valid path through `a`'s and `far`'s intervals (`seen`
-    /// caches, per first edge, the test of `far`'s interval against it), each conservative: two edges in a row differ; the stretch between the edges leaves each
-    /// into its exterior (the other interval is not wholly inside its interior wedge);
-    /// across one middle reflection both points may lie on one side of its plane; Keller's
-    /// law may hold at both points (the cos β0 ranges of the incident and diffracted rays
-    /// over the intervals overlap).
+    /// Necessary conditions of a valid path through `a`'s and `far`'s intervals, each
+    /// conservative, the most selective first: two edges in a row differ; Keller's law may
+    /// hold at both points (the cos β0 ranges of the incident and diffracted rays over the
+    /// intervals overlap); across one middle reflection both points may lie on one side of
+    /// its plane and the stretch may cross its window; the stretch between the edges leaves
+    /// each into its exterior (the other interval is not wholly inside its interior wedge;
+    /// `seen` caches, per first edge, the test of `far`'s interval against it).
     #[inline(always)]
     fn may_pair(
         &self,
@@ -563,6 +564,12 @@ impl Pairing<'_> {
         seen: &mut [Option<bool>],
     ) -> bool {
         if far.middle.is_empty() && a.edge == far.edge {
+            return false;
+        }
+        // Keller's law at both points first: the most selective test.
+        let directions = [a.line.direction, far.line.direction];
+        let [at_first, at_second] = cos_ranges(a.ends, far.ends, directions);
+        if !(overlap(at_first, a.incidence) && overlap(at_second, far.leaving)) {
             return false;
         }
         if let (Some((plane, second)), [m]) = (&far.across, far.middle) {
@@ -591,8 +598,7 @@ impl Pairing<'_> {
         if inside(&far.wedge, a.ends) {
             return false;
         }
-        let [first, second] = cos_ranges(a.ends, far.ends, [a.line.direction, far.line.direction]);
-        overlap(first, a.incidence) && overlap(second, far.leaving)
+        true
     }
 
     /// Whether the Keller pair of `a` and `far` lies in both reaches (within the margin), or
