@@ -168,7 +168,20 @@ fn cos_ranges(ps: [Vec3; 2], qs: [Vec3; 2], directions: [Vec3; 2]) -> [(Real, Re
         return [(-1.0, 1.0); 2];
     }
     let d_lo = segment_distance_bound(ps, qs);
-    directions.map(|direction| cos_bounds(&corners.map(|v| v.dot(direction)), (d_lo, d_hi)))
+    // Written out, not `array::map`: that one is a call, compiled without the FMA feature.
+    let along = |d: Vec3| {
+        [
+            corners[0].dot(d),
+            corners[1].dot(d),
+            corners[2].dot(d),
+            corners[3].dot(d),
+        ]
+    };
+    let bounds = (d_lo, d_hi);
+    [
+        cos_bounds(&along(directions[0]), bounds),
+        cos_bounds(&along(directions[1]), bounds),
+    ]
 }
 
 /// The range of cos β = n/|v| over vectors `v` whose numerators `n` lie between the least and
@@ -575,14 +588,17 @@ impl Pairing<'_> {
         if let (Some((plane, second)), [m]) = (&far.across, far.middle) {
             // Both points on one side of the middle reflection's plane: the second's real
             // place is its unfolded one mirrored back, on the other side of the plane.
-            let first = a.ends.map(|p| plane.signed_distance(p));
+            let first = [
+                plane.signed_distance(a.ends[0]),
+                plane.signed_distance(a.ends[1]),
+            ];
             let opposite = |x: [Real; 2], y: [Real; 2]| {
                 x.iter().all(|d| *d > 0.0) && y.iter().all(|d| *d < 0.0)
             };
             if opposite(first, *second) || opposite(*second, first) {
                 return false;
             }
-            let unfolded = second.map(|d| -d);
+            let unfolded = [-second[0], -second[1]];
             let polygon = &scene.surface(*m).polygon;
             if misses_window(polygon, (a.ends, far.ends), (first, unfolded), self.margin) {
                 return false;
