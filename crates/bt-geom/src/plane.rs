@@ -81,6 +81,13 @@ impl Plane {
         p - 2.0 * self.signed_distance(p) * self.normal
     }
 
+    /// The direction (or any free vector) `v` mirrored through the plane: its component along
+    /// the normal reversed.
+    #[inline]
+    pub fn mirror_direction(&self, v: Vec3) -> Vec3 {
+        v - 2.0 * v.dot(self.normal) * self.normal
+    }
+
     /// Parameter `t` where the line `a + t (b - a)` crosses the plane, or `None` when the line
     /// is parallel to it (|n · (b - a)| below `f64::EPSILON` times the segment length).
     #[inline]

@@ -52,10 +52,9 @@ impl EdgeLine {
 
     /// The line mirrored through `plane` (a parameter names the mirrored point).
     pub fn mirrored(&self, plane: &Plane) -> Self {
-        let n = plane.normal;
         EdgeLine {
             start: plane.mirror(self.start),
-            direction: self.direction - 2.0 * self.direction.dot(n) * n,
+            direction: plane.mirror_direction(self.direction),
         }
     }
 
@@ -92,8 +91,8 @@ impl EdgeLine {
 
 /// The parameters (t1 on `first`, t2 on `second`) of the shortest path `a → first → second →
 /// b` (module docs), to [`KELLER_PAIR_TOL`] and, a few rounds allowing, [`KELLER_RESIDUAL`].
-/// `None` when a point of the path falls on its
-/// neighbour (the two points on the lines' crossing included) or the solve does not settle.
+/// `None` when a point of the path falls on its neighbour (the two points on the lines'
+/// crossing included) or the solve does not settle.
 pub fn keller_pair(a: Vec3, first: EdgeLine, second: EdgeLine, b: Vec3) -> Option<(Real, Real)> {
     let round = |t2: Real| {
         let t1 = first.keller(a, second.point(t2))?;
@@ -126,8 +125,8 @@ pub fn keller_pair(a: Vec3, first: EdgeLine, second: EdgeLine, b: Vec3) -> Optio
         // Settled: the points stopped moving and Keller's law holds to KELLER_RESIDUAL
         // (a short middle leg turns a tiny move into a larger angle: then a few more
         // rounds, never a lost solution).
-        let residual = here.step.map_or(0.0, |s| s.residual);
         if moved <= KELLER_PAIR_TOL {
+            let residual = here.step.map_or(0.0, |s| s.residual);
             let settled = residual <= KELLER_RESIDUAL || residual.is_nan();
             if settled || polished == POLISH_ROUNDS || done == MAX_ROUNDS {
                 return Some((t1, t2));

@@ -91,26 +91,25 @@ fn groups(near: &[Near]) -> Vec<Group> {
     out
 }
 
-/// An RX reach on the second edge and the middle reflections: the edge's line, interval ends
-/// and the RX image, unfolded through the middle into the first edge's frame, and the range
-/// of cos β0 of rays leaving towards the image.
+/// An RX reach on the second edge and the middle reflections: the edge's wedge (its line
+/// among it), interval ends and the RX image, unfolded through the middle into the first
+/// edge's frame, and the range of cos β0 of rays leaving towards the image.
 struct Far<'m> {
     edge: usize,
     reach: Reach,
     middle: &'m [SurfaceId],
-    line: EdgeLine,
     image: Vec3,
     ends: [Vec3; 2],
     /// cos β0 of the ray from the interval's ends towards the image.
     leaving: (Real, Real),
-    /// The second edge's interior wedge, unfolded as the line is.
+    /// The second edge's interior wedge and line, unfolded.
     wedge: Wedge,
     /// With one middle reflection: its plane and the signed distances from it of the
     /// interval's real ends (the unfolded ends mirrored back), negated.
     across: Option<(Plane, [Real; 2])>,
 }
 
-/// An edge's interior wedge as [`deep_inside`] reads it: the edge line and the outward
+/// An edge's interior wedge as [`Wedge::deep_inside`] reads it: the edge line and the outward
 /// normals of its two faces' planes (`e × t0` and `tn × e`), possibly mirrored through
 /// reflections (a mirror keeps every distance, so a point's distances from the mirrored
 /// planes are its mirror image's from the edge's own).
@@ -131,11 +130,10 @@ impl Wedge {
     }
 
     fn mirrored(&self, plane: &Plane) -> Self {
-        let flip = |v: Vec3| v - 2.0 * v.dot(plane.normal) * plane.normal;
         Wedge {
             line: self.line.mirrored(plane),
-            normal0: flip(self.normal0),
-            normal_n: flip(self.normal_n),
+            normal0: plane.mirror_direction(self.normal0),
+            normal_n: plane.mirror_direction(self.normal_n),
         }
     }
 
@@ -322,6 +320,8 @@ struct Pairs<'a> {
 struct Toward {
     /// Per surface id: the groups (indices) for a middle starting there.
     groups: Vec<Vec<u32>>,
+    /// Per surface id: a reflector's polygon box grown by the margin (m).
+    boxes: Vec<(Vec3, Vec3)>,
     /// Every group, for paths with no middle reflection.
     all: Vec<u32>,
 }
@@ -329,8 +329,11 @@ struct Toward {
 impl Toward {
     fn of(scene: &Scene, groups: &[Group], margin: Real) -> Self {
         let mut by_surface = vec![Vec::new(); scene.surfaces().len()];
+        let mut boxes = vec![(Vec3::ZERO, Vec3::ZERO); scene.surfaces().len()];
         for m in scene.reflectors() {
-            let bounds = grown_bounds(scene, m, margin);
+            let (lo, hi) = scene.surface(m).polygon.bounds();
+            let bounds = (lo - Vec3::splat(margin), hi + Vec3::splat(margin));
+            boxes[m.index()] = bounds;
             by_surface[m.index()] = (0..groups.len() as u32)
                 .filter(|&g| {
                     let span = &groups[g as usize].span;
@@ -341,6 +344,7 @@ impl Toward {
         }
         Toward {
             groups: by_surface,
+            boxes,
             all: (0..groups.len() as u32).collect(),
         }
     }
@@ -348,25 +352,19 @@ impl Toward {
     /// The groups that may pair with `far`, or `None` when none may: with one middle
     /// reflection, the ray arriving at the far interval from the reflector's box must obey
     /// Keller's law there too (cos β0 of `q − M` against the leaving range).
-    fn groups(&self, scene: &Scene, far: &Far<'_>, margin: Real) -> Option<&[u32]> {
+    fn groups(&self, far: &Far<'_>) -> Option<&[u32]> {
         let Some(&m) = far.middle.first() else {
             return Some(&self.all);
         };
-        if let [m] = far.middle {
-            let bounds = grown_bounds(scene, *m, margin);
-            let (lo, hi) = cos_range_to_box(far.ends, bounds, far.line.direction);
+        if far.middle.len() == 1 {
+            let direction = far.wedge.line.direction;
+            let (lo, hi) = cos_range_to_box(far.ends, self.boxes[m.index()], direction);
             if !overlap((-hi, -lo), far.leaving) {
                 return None;
             }
         }
         Some(&self.groups[m.index()])
     }
-}
-
-/// Surface `id`'s polygon box grown by `margin` (m).
-fn grown_bounds(scene: &Scene, id: SurfaceId, margin: Real) -> (Vec3, Vec3) {
-    let (lo, hi) = scene.surface(id).polygon.bounds();
-    (lo - Vec3::splat(margin), hi + Vec3::splat(margin))
 }
 
 /// Whether the ranges overlap, up to [`SLACK`].
@@ -419,7 +417,7 @@ impl Pairing<'_> {
             for b in on_edge.iter().filter(|b| b.depth <= deepest) {
                 for middle in middles[..=deepest - b.depth].iter().flatten() {
                     let far = self.far(scene, (e2, *b), middle);
-                    let Some(first) = index.groups(scene, &far, self.margin) else {
+                    let Some(first) = index.groups(&far) else {
                         continue;
                     };
                     self.pair_with(scene, &far, first, &mut pairs, set)?;
@@ -531,15 +529,14 @@ impl Pairing<'_> {
 
     /// RX reach `b` on edge `e2` with the `middle` reflections, unfolded ([`Far`]).
     fn far<'m>(&self, scene: &Scene, (e2, b): (usize, Reach), middle: &'m [SurfaceId]) -> Far<'m> {
-        let mut line = EdgeLine::of(&scene.edges().all()[e2]);
         let mut wedge = Wedge::of(&scene.edges().all()[e2]);
         let mut image = b.image;
         for id in middle.iter().rev() {
             let plane = scene.surface(*id).polygon.plane();
-            line = line.mirrored(plane);
             wedge = wedge.mirrored(plane);
             image = plane.mirror(image);
         }
+        let line = wedge.line;
         let (lo, hi) = (b.lo - self.margin, b.hi + self.margin);
         let ends = [line.point(lo), line.point(hi)];
         let across = match middle {
@@ -553,7 +550,6 @@ impl Pairing<'_> {
             edge: e2,
             reach: b,
             middle,
-            line,
             image,
             ends,
             leaving: (cos_towards(&line, hi, image), cos_towards(&line, lo, image)),
@@ -580,7 +576,7 @@ impl Pairing<'_> {
             return false;
         }
         // Keller's law at both points first: the most selective test.
-        let directions = [a.line.direction, far.line.direction];
+        let directions = [a.line.direction, far.wedge.line.direction];
         let [at_first, at_second] = cos_ranges(a.ends, far.ends, directions);
         if !(overlap(at_first, a.incidence) && overlap(at_second, far.leaving)) {
             return false;
@@ -621,7 +617,8 @@ impl Pairing<'_> {
     /// cannot be computed.
     #[inline(always)]
     fn may_join(&self, a: &Near, far: &Far<'_>) -> bool {
-        let Some((t1, t2)) = keller_pair(a.reach.image, a.span.line, far.line, far.image) else {
+        let Some((t1, t2)) = keller_pair(a.reach.image, a.span.line, far.wedge.line, far.image)
+        else {
             return true;
         };
         let m = self.margin;
