@@ -90,8 +90,9 @@ pub struct Diffracting {
 
 /// A set of diffracted candidates, stored flat, in a canonical order: by order, position,
 /// edge, then reflections, then the second diffraction (so two generators of the same
-/// candidates give equal sets).
-#[derive(Debug, Clone, PartialEq, Eq)]
+/// candidates give equal sets: equality compares the candidates, not the Keller parameters
+/// a generator may carry along, [`DiffractedSet::keller`]).
+#[derive(Debug, Clone)]
 pub struct DiffractedSet {
     ids: Vec<SurfaceId>,
     offsets: Vec<u32>,
@@ -99,7 +100,29 @@ pub struct DiffractedSet {
     positions: Vec<u8>,
     /// Per candidate: the second edge and the reflections between, `None` with one.
     seconds: Vec<Option<(EdgeId, u8)>>,
+    /// Per candidate: the Keller parameters of its two diffraction points, when known.
+    keller: Vec<Option<(Real, Real)>>,
 }
+
+impl PartialEq for DiffractedSet {
+    fn eq(&self, other: &Self) -> bool {
+        (
+            &self.ids,
+            &self.offsets,
+            &self.edges,
+            &self.positions,
+            &self.seconds,
+        ) == (
+            &other.ids,
+            &other.offsets,
+            &other.edges,
+            &other.positions,
+            &other.seconds,
+        )
+    }
+}
+
+impl Eq for DiffractedSet {}
 
 impl Default for DiffractedSet {
     fn default() -> Self {
@@ -109,6 +132,7 @@ impl Default for DiffractedSet {
             edges: Vec::new(),
             positions: Vec::new(),
             seconds: Vec::new(),
+            keller: Vec::new(),
         }
     }
 }
@@ -132,6 +156,16 @@ impl DiffractedSet {
             second: self.seconds[i].map(|(e, q)| (e, q as usize)),
         }
     }
+    /// The parameters (t1 along the first edge, t2 along the second, metres from each edge's
+    /// start) of the `i`-th candidate's two diffraction points, when its generator solved
+    /// them ([`bt_scene::edges::keller_pair`]) from the very inputs the image method reads:
+    /// TX mirrored through the reflections before the first edge, the first edge's line,
+    /// and the second edge's line and RX (mirrored through the reflections after the second
+    /// edge) both mirrored through those between, last first. `None` otherwise.
+    #[inline]
+    pub fn keller(&self, i: usize) -> Option<(Real, Real)> {
+        self.keller[i]
+    }
     /// All candidates in order.
     pub fn iter(&self) -> impl ExactSizeIterator<Item = DiffractedCandidate<'_>> + '_ {
         (0..self.len()).map(|i| self.get(i))
@@ -139,18 +173,22 @@ impl DiffractedSet {
     /// Append a candidate: `before` the edge (TX side first), the edge, `after` it.
     pub fn push(&mut self, before: &[SurfaceId], edge: EdgeId, after: &[SurfaceId]) {
         self.push_parts(&[before, after], edge, None);
+        self.keller.push(None);
     }
     /// Append a candidate with two diffractions: `before` the first edge, `edges.0`, the
-    /// reflections `between`, `edges.1`, `after` it.
+    /// reflections `between`, `edges.1`, `after` it, with its diffraction points' parameters
+    /// when known ([`Self::keller`]).
     pub fn push_twice(
         &mut self,
         before: &[SurfaceId],
         edges: (EdgeId, EdgeId),
         between: &[SurfaceId],
         after: &[SurfaceId],
+        keller: Option<(Real, Real)>,
     ) {
         let second = Some((edges.1, between.len() as u8));
         self.push_parts(&[before, between, after], edges.0, second);
+        self.keller.push(keller);
     }
     /// Append the reflections `parts` (the first before the first edge) with the edges.
     fn push_parts(&mut self, parts: &[&[SurfaceId]], edge: EdgeId, second: Option<(EdgeId, u8)>) {
@@ -208,6 +246,7 @@ impl DiffractedSet {
             edges: Vec::with_capacity(keyed.len()),
             positions: Vec::with_capacity(keyed.len()),
             seconds: Vec::with_capacity(keyed.len()),
+            keller: Vec::with_capacity(keyed.len()),
         };
         sorted.offsets.push(0);
         for (_, _, i) in keyed {
@@ -218,6 +257,7 @@ impl DiffractedSet {
             sorted.edges.push(self.edges[i]);
             sorted.positions.push(self.positions[i]);
             sorted.seconds.push(self.seconds[i]);
+            sorted.keller.push(self.keller[i]);
         }
         *self = sorted;
     }
@@ -312,7 +352,7 @@ fn enumerate_twice(
                     for before in &befores {
                         for between in &betweens {
                             for after in &afters {
-                                set.push_twice(before, (e1, e2), between, after);
+                                set.push_twice(before, (e1, e2), between, after, None);
                             }
                         }
                     }

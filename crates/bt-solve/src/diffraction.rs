@@ -34,12 +34,16 @@ use bt_scene::{Edge, Endpoints, Scene, SurfaceId};
 use rayon::prelude::*;
 
 /// The interaction points of `c` by the image method into `points` (length `c.order()`,
-/// metres, TX side first, the diffraction points at their indices).
+/// metres, TX side first, the diffraction points at their indices). With two diffractions,
+/// `keller` may give the points' parameters already solved from the same inputs
+/// ([`DiffractedSet::keller`]: the beam tree's join solves them); they are solved here
+/// otherwise.
 #[inline(always)]
 pub fn solve_image(
     scene: &Scene,
     ends: Endpoints,
     c: DiffractedCandidate<'_>,
+    keller: Option<(Real, Real)>,
     points: &mut [Vec3],
 ) -> Result<(), ImageFailure> {
     let p = c.position;
@@ -70,8 +74,9 @@ pub fn solve_image(
         line = line.mirrored(plane(id));
         j = plane(id).mirror(j);
     }
-    let (t1, t2) =
-        keller_pair(i, EdgeLine::of(edge), line, j).ok_or(ImageFailure::Parallel { index: p })?;
+    let (t1, t2) = keller
+        .or_else(|| keller_pair(i, EdgeLine::of(edge), line, j))
+        .ok_or(ImageFailure::Parallel { index: p })?;
     let (d1, d2) = (edge.point(t1), other.point(t2));
     (points[p], points[p + q + 1]) = (d1, d2);
     let parts = [(c.before(), ends.tx), (c.between(), d1), (c.after(), d2)];
@@ -308,18 +313,20 @@ fn reflection_slice<'a>(c: DiffractedCandidate<'a>, k: usize) -> &'a [SurfaceId]
 }
 
 /// Solve and validate `c` with `solver` (the image method or IPC; SBR does not diffract and
-/// gives `Missed`). `points` must have `c.order()` entries.
+/// gives `Missed`), the image method reading `keller` as [`solve_image`] does. `points` must
+/// have `c.order()` entries.
 #[inline(always)]
 pub fn solve_candidate(
     scene: &Scene,
     ends: Endpoints,
     c: DiffractedCandidate<'_>,
+    keller: Option<(Real, Real)>,
     solver: &crate::Solver,
     points: &mut [Vec3],
 ) -> CandidateOutcome {
     match solver {
         crate::Solver::Image => {
-            if let Err(e) = solve_image(scene, ends, c, points) {
+            if let Err(e) = solve_image(scene, ends, c, keller, points) {
                 return CandidateOutcome::ImageDegenerate(e);
             }
             CandidateOutcome::Solved {
@@ -418,7 +425,8 @@ fn solve_range_impl(work: &Work<'_>, range: std::ops::Range<usize>) -> TraceResu
             heap.resize(c.order(), Vec3::ZERO);
             &mut heap[..]
         };
-        let outcome = solve_candidate(work.scene, work.ends, c, work.solver, points);
+        let keller = work.set.keller(i);
+        let outcome = solve_candidate(work.scene, work.ends, c, keller, work.solver, points);
         out.counts.add(&outcome);
         out.paths.extend(found(c, &outcome, points));
     }

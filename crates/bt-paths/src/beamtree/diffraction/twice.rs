@@ -449,15 +449,16 @@ impl Pairing<'_> {
             }
             let single = g.members.len() == 1;
             for a in &pairs.near[g.members.clone()] {
-                if !(single || self.may_pair(scene, (&a.span, far), &mut pairs.seen))
-                    || !self.may_join(a, far)
-                {
+                if !(single || self.may_pair(scene, (&a.span, far), &mut pairs.seen)) {
                     continue;
                 }
+                let Some(keller) = self.may_join(a, far) else {
+                    continue;
+                };
                 let (before, after) = (&mut pairs.before, &mut pairs.after);
                 self.surfaces((a.reach.node, b.node), (before, after));
                 let edges = (EdgeId(a.span.edge as u32), EdgeId(far.edge as u32));
-                set.push_twice(before, edges, far.middle, after);
+                set.push_twice(before, edges, far.middle, after, keller);
                 self.check_budget(set)?;
             }
         }
@@ -613,16 +614,19 @@ impl Pairing<'_> {
         true
     }
 
-    /// Whether the Keller pair of `a` and `far` lies in both reaches (within the margin), or
-    /// cannot be computed.
+    /// `Some` when the Keller pair of `a` and `far` lies in both reaches (within the margin),
+    /// with the pair, or cannot be computed (`Some(None)`); `None` when it lies outside.
+    /// The pair's inputs are the image method's for the candidate
+    /// ([`DiffractedSet::keller`]), so the solve reuses it.
     #[inline(always)]
-    fn may_join(&self, a: &Near, far: &Far<'_>) -> bool {
+    fn may_join(&self, a: &Near, far: &Far<'_>) -> Option<Option<(Real, Real)>> {
         let Some((t1, t2)) = keller_pair(a.reach.image, a.span.line, far.wedge.line, far.image)
         else {
-            return true;
+            return Some(None);
         };
         let m = self.margin;
         let (a, b) = (&a.reach, &far.reach);
-        t1 >= a.lo - m && t1 <= a.hi + m && t2 >= b.lo - m && t2 <= b.hi + m
+        let inside = t1 >= a.lo - m && t1 <= a.hi + m && t2 >= b.lo - m && t2 <= b.hi + m;
+        inside.then_some(Some((t1, t2)))
     }
 }
