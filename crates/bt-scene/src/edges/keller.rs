@@ -89,6 +89,50 @@ impl EdgeLine {
     }
 }
 
+impl EdgeLine {
+    /// An interval of parameters on this line holding the Keller point of `a` and each point
+    /// of `other` with its parameter in `range` (m), `a` given by its distance from this line
+    /// and its parameter ([`Self::keller_from`]). Conservative: the Keller point is
+    /// `t_a + (t_q − t_a)·d_a/(d_a + d_q)` for `q` at distance `d_q` and parameter `t_q`, and
+    /// the offset `t_q − t_a` (affine along `other`: extreme at the ends) and the weight (from
+    /// the least and greatest `d_q`, the distance being convex along `other`) are bounded
+    /// apart. `None` when the Keller point may be undefined (a point of `other` in the range
+    /// and `a` both on this line) or a value is not finite.
+    #[inline(always)]
+    pub fn keller_range(
+        &self,
+        (a_distance, a_along): (Real, Real),
+        other: &EdgeLine,
+        (lo, hi): (Real, Real),
+    ) -> Option<(Real, Real)> {
+        let (p, q) = (other.point(lo), other.point(hi));
+        let (m0, m1) = (self.along(p) - a_along, self.along(q) - a_along);
+        // Each end's offset from the line, perpendicular to it: affine along `other`.
+        let offset = |x: Vec3| {
+            let v = x - self.start;
+            v - v.dot(self.direction) * self.direction
+        };
+        let (u, w) = (offset(p), offset(q) - offset(p));
+        let ww = w.length_squared();
+        let s = if ww > 0.0 {
+            (-u.dot(w) / ww).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let d_lo = (u + s * w).length();
+        let d_hi = u.length().max((u + w).length());
+        let (w_lo, w_hi) = (
+            a_distance / (a_distance + d_hi),
+            a_distance / (a_distance + d_lo),
+        );
+        let bounds = [m0 * w_lo, m0 * w_hi, m1 * w_lo, m1 * w_hi];
+        let k_lo = bounds.iter().copied().fold(Real::INFINITY, Real::min);
+        let k_hi = bounds.iter().copied().fold(Real::NEG_INFINITY, Real::max);
+        (a_distance + d_lo > 0.0 && k_lo.is_finite() && k_hi.is_finite())
+            .then_some((a_along + k_lo, a_along + k_hi))
+    }
+}
+
 /// The parameters (t1 on `first`, t2 on `second`) of the shortest path `a → first → second →
 /// b` (module docs), to [`KELLER_PAIR_TOL`] and, a few rounds allowing, [`KELLER_RESIDUAL`].
 /// `None` when a point of the path falls on its neighbour (the two points on the lines'
@@ -340,6 +384,49 @@ mod tests {
             }
         }
         assert!(seen.iter().all(|&n| n > 100), "{seen:?}");
+    }
+
+    /// The Keller points of a point and the points of a stretch of another line lie in
+    /// [`EdgeLine::keller_range`]'s interval (sampled densely, ends included), and the
+    /// interval is not much wider than the points' own spread on most cases.
+    #[test]
+    fn keller_points_over_a_stretch_lie_in_its_range() {
+        let mut rng = Stream(23);
+        let mut tight = 0;
+        for case in 0..2000 {
+            let line = EdgeLine {
+                start: rng.vec(5.0),
+                direction: rng.vec(1.0).normalize(),
+            };
+            let other = EdgeLine {
+                start: rng.vec(5.0),
+                direction: rng.vec(1.0).normalize(),
+            };
+            let a = if case % 5 == 0 {
+                line.point(rng.next())
+            } else {
+                rng.vec(10.0)
+            };
+            let (t0, len) = (rng.next() * 5.0, (rng.next() + 1.0) * 2.0);
+            let range = (t0, t0 + len);
+            let focus = (line.distance(a), line.along(a));
+            let Some((lo, hi)) = line.keller_range(focus, &other, range) else {
+                assert_eq!(focus.0, 0.0, "case {case}");
+                continue;
+            };
+            let (mut seen_lo, mut seen_hi) = (Real::INFINITY, Real::NEG_INFINITY);
+            for k in 0..=200 {
+                let q = other.point(range.0 + len * k as Real / 200.0);
+                let Some(t) = line.keller(a, q) else { continue };
+                assert!(
+                    t >= lo - 1e-9 && t <= hi + 1e-9,
+                    "case {case}: {t} not in {lo}..{hi}"
+                );
+                (seen_lo, seen_hi) = (seen_lo.min(t), seen_hi.max(t));
+            }
+            tight += usize::from(hi - lo <= 2.0 * (seen_hi - seen_lo) + 1e-9);
+        }
+        assert!(tight > 1000, "{tight}");
     }
 
     /// Parallel lines in a plane with the points: the path is the straight line's, bent where

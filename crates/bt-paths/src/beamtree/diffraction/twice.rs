@@ -54,6 +54,8 @@ impl Span {
 struct Near {
     span: Span,
     reach: Reach,
+    /// The TX image's distance from the edge line and its parameter (m).
+    focus: (Real, Real),
 }
 
 /// The TX reaches of one edge and one depth (`members`, a range of the [`Near`] list) and a
@@ -99,6 +101,8 @@ struct Far<'m> {
     reach: Reach,
     middle: &'m [SurfaceId],
     image: Vec3,
+    /// The image's distance from the unfolded edge line and its parameter (m).
+    focus: (Real, Real),
     ends: [Vec3; 2],
     /// cos β0 of the ray from the interval's ends towards the image.
     leaving: (Real, Real),
@@ -367,6 +371,13 @@ impl Toward {
     }
 }
 
+/// Length slack (m) of [`Pairing::apart`]'s intervals: far above their round-off and the
+/// Keller pair's tolerance, far below any reach.
+const APART_SLACK: Real = 1e-6;
+
+/// Rounds of [`Pairing::apart`].
+const APART_ROUNDS: usize = 2;
+
 /// Whether the ranges overlap, up to [`SLACK`].
 fn overlap(a: (Real, Real), b: (Real, Real)) -> bool {
     a.0 <= b.1 + SLACK && b.0 <= a.1 + SLACK
@@ -522,6 +533,7 @@ impl Pairing<'_> {
                 out.push(Near {
                     span: Span::new(e, line, (lo, hi), incidence),
                     reach: *r,
+                    focus: (line.distance(r.image), line.along(r.image)),
                 });
             }
         }
@@ -552,6 +564,7 @@ impl Pairing<'_> {
             reach: b,
             middle,
             image,
+            focus: (line.distance(image), line.along(image)),
             ends,
             leaving: (cos_towards(&line, hi, image), cos_towards(&line, lo, image)),
             wedge,
@@ -614,12 +627,49 @@ impl Pairing<'_> {
         true
     }
 
+    /// Whether the Keller pair of `a` and `far` surely lies outside their reaches (grown by
+    /// the margin): the pair `(t1, t2)` has `t1` at the Keller point of the TX image and
+    /// the point `t2`, and `t2` at that of the point `t1` and the RX image. So if `t2` lies in
+    /// its interval, `t1` lies in the range of Keller points over that interval
+    /// ([`EdgeLine::keller_range`]), and in turn for `t2`: each interval shrinks to its
+    /// intersection with that range, and an empty one proves the pair outside.
+    #[inline(always)]
+    fn apart(&self, a: &Near, far: &Far<'_>) -> bool {
+        let grow = self.margin + APART_SLACK;
+        let mut near = (a.reach.lo - grow, a.reach.hi + grow);
+        let mut away = (far.reach.lo - grow, far.reach.hi + grow);
+        let (first, second) = (&a.span.line, &far.wedge.line);
+        let shrink = |into: &mut (Real, Real), by: Option<(Real, Real)>| match by {
+            Some((lo, hi)) => {
+                *into = (into.0.max(lo - APART_SLACK), into.1.min(hi + APART_SLACK));
+                Some(into.0 > into.1)
+            }
+            None => None,
+        };
+        for _ in 0..APART_ROUNDS {
+            match shrink(&mut near, first.keller_range(a.focus, second, away)) {
+                Some(true) => return true,
+                Some(false) => {}
+                None => return false,
+            }
+            match shrink(&mut away, second.keller_range(far.focus, first, near)) {
+                Some(true) => return true,
+                Some(false) => {}
+                None => return false,
+            }
+        }
+        false
+    }
+
     /// `Some` when the Keller pair of `a` and `far` lies in both reaches (within the margin),
     /// with the pair, or cannot be computed (`Some(None)`); `None` when it lies outside.
     /// The pair's inputs are the image method's for the candidate
     /// ([`DiffractedSet::keller`]), so the solve reuses it.
     #[inline(always)]
     fn may_join(&self, a: &Near, far: &Far<'_>) -> Option<Option<(Real, Real)>> {
+        if self.apart(a, far) {
+            return None;
+        }
         let Some((t1, t2)) = keller_pair(a.reach.image, a.span.line, far.wedge.line, far.image)
         else {
             return Some(None);
