@@ -386,7 +386,8 @@ fn overlap(a: (Real, Real), b: (Real, Real)) -> bool {
 impl Pairing<'_> {
     /// The candidates with two diffractions: every TX reach, RX reach and middle sequence
     /// whose depths fit the order (two edges in a row differ) and whose Keller pair lies in
-    /// both reaches. Cheap necessary tests come first ([`Pairing::may_pair`]).
+    /// both reaches. Cheap necessary tests come first ([`Pairing::may_pair`] on each group of
+    /// TX reaches, then [`Pairing::apart`] on each reach).
     /// Compiled with the `fma` target feature when the CPU has it (checked at run time; the
     /// plane tests use `mul_add`, a software call without it; bit-identical either way, as
     /// in `bt_solve`'s batches).
@@ -458,11 +459,10 @@ impl Pairing<'_> {
             {
                 continue;
             }
-            let single = g.members.len() == 1;
+            // The members go straight to the Keller pair: their own prefilters, run again,
+            // dropped no candidate on the living room that the pair keeps and cost more
+            // than the pair's own first test ([`Pairing::apart`]).
             for a in &pairs.near[g.members.clone()] {
-                if !(single || self.may_pair(scene, (&a.span, far), &mut pairs.seen)) {
-                    continue;
-                }
                 let Some(keller) = self.may_join(a, far) else {
                     continue;
                 };
