@@ -202,54 +202,42 @@ impl DiffractedSet {
     }
     /// Put the candidates in the canonical order and drop repeats.
     pub fn canonicalise(&mut self) {
-        // (order, position, edge, first two reflections) packed into one integer, and (the
-        // next two reflections, whether more follow, the second diffraction) into another:
-        // together they decide alone up to four reflections; longer lists only on ties.
-        let mut keyed: Vec<(u128, u128, u32)> = (0..self.len())
-            .map(|i| {
-                let c = self.get(i);
-                let id = |k: usize| c.reflections.get(k).map_or(0, |s| u128::from(s.0) + 1);
-                let key = ((c.order() as u128) << 120)
-                    | ((c.position as u128) << 112)
-                    | (u128::from(c.edge.0) << 80)
-                    | (id(0) << 40)
-                    | id(1);
-                let long = c.reflections.len() > 4;
-                let second = match c.second {
-                    Some((edge, q)) if !long => 1 + ((u128::from(edge.0) << 8) | q as u128),
-                    _ => 0,
-                };
-                let next = (id(2) << 88) | (id(3) << 48) | (u128::from(long) << 41) | second;
-                (key, next, i as u32)
-            })
-            .collect();
-        let ties = |a: &(u128, u128, u32), b: &(u128, u128, u32)| {
-            let (x, y) = (self.get(a.2 as usize), self.get(b.2 as usize));
-            x.reflections
-                .cmp(y.reflections)
-                .then_with(|| x.second.cmp(&y.second))
+        let fields: Vec<[u64; KEY_FIELDS]> = (0..self.len()).map(|i| self.key_fields(i)).collect();
+        let widths: [u32; KEY_FIELDS] = std::array::from_fn(|f| {
+            let most = fields.iter().map(|k| k[f]).max().unwrap_or(0);
+            u64::BITS - most.leading_zeros()
+        });
+        // One integer holds the fields (and orders as they do) when their widths fit 64 bits:
+        // a smaller sort; otherwise two 128-bit integers with room for any field.
+        let order = if widths.iter().sum::<u32>() <= u64::BITS {
+            let packed = fields.iter().enumerate().map(|(i, k)| {
+                let key = (k.iter().zip(widths))
+                    .fold(0u64, |key, (&v, w)| key.checked_shl(w).unwrap_or(0) | v);
+                (key, i as u32)
+            });
+            self.canonical_order(packed.collect())
+        } else {
+            // Widths: order and position 8 bits, an edge 32, a reflection 33, the second 41.
+            let packed = fields.iter().enumerate().map(|(i, k)| {
+                let k = k.map(u128::from);
+                let first = (k[0] << 120) | (k[1] << 112) | (k[2] << 80) | (k[3] << 40) | k[4];
+                let next = (k[5] << 88) | (k[6] << 48) | (k[7] << 41) | k[8];
+                ((first, next), i as u32)
+            });
+            self.canonical_order(packed.collect())
         };
-        // The keys alone sort almost everything; only runs of equal keys (more than four
-        // reflections) are ordered by the candidates themselves.
-        keyed.sort_unstable_by_key(|k| (k.0, k.1));
-        for run in keyed.chunk_by_mut(|a, b| (a.0, a.1) == (b.0, b.1)) {
-            if run.len() > 1 {
-                run.sort_unstable_by(ties);
-            }
-        }
-        keyed.dedup_by(|a, b| (a.0, a.1) == (b.0, b.1) && ties(a, b).is_eq());
         // Each candidate copied whole (its reflections are contiguous, its position and
         // second diffraction kept), into arrays sized once.
         let mut sorted = DiffractedSet {
             ids: Vec::with_capacity(self.ids.len()),
-            offsets: Vec::with_capacity(keyed.len() + 1),
-            edges: Vec::with_capacity(keyed.len()),
-            positions: Vec::with_capacity(keyed.len()),
-            seconds: Vec::with_capacity(keyed.len()),
-            keller: Vec::with_capacity(keyed.len()),
+            offsets: Vec::with_capacity(order.len() + 1),
+            edges: Vec::with_capacity(order.len()),
+            positions: Vec::with_capacity(order.len()),
+            seconds: Vec::with_capacity(order.len()),
+            keller: Vec::with_capacity(order.len()),
         };
         sorted.offsets.push(0);
-        for (_, _, i) in keyed {
+        for i in order {
             let i = i as usize;
             let (lo, hi) = (self.offsets[i] as usize, self.offsets[i + 1] as usize);
             sorted.ids.extend_from_slice(&self.ids[lo..hi]);
@@ -261,7 +249,57 @@ impl DiffractedSet {
         }
         *self = sorted;
     }
+
+    /// The sort key of candidate `i`, field by field, most significant first: its order,
+    /// position and edge, its first four reflections (each id + 1, 0 when absent), whether
+    /// more follow, and its second diffraction (0 with none or with more than four
+    /// reflections, else 1 + (edge << 8 | reflections between)). Together they decide alone
+    /// up to four reflections; longer lists only on ties ([`Self::canonical_order`]).
+    fn key_fields(&self, i: usize) -> [u64; KEY_FIELDS] {
+        let c = self.get(i);
+        let id = |k: usize| c.reflections.get(k).map_or(0, |s| u64::from(s.0) + 1);
+        let long = c.reflections.len() > 4;
+        let second = match c.second {
+            Some((edge, q)) if !long => 1 + ((u64::from(edge.0) << 8) | q as u64),
+            _ => 0,
+        };
+        [
+            c.order() as u64,
+            c.position as u64,
+            u64::from(c.edge.0),
+            id(0),
+            id(1),
+            id(2),
+            id(3),
+            u64::from(long),
+            second,
+        ]
+    }
+
+    /// The candidates' indices in canonical order, repeats dropped, from their packed keys
+    /// (any integers ordering as [`Self::key_fields`] do): the keys sort almost everything;
+    /// only runs of equal keys (more than four reflections) are ordered by the candidates
+    /// themselves.
+    fn canonical_order<K: Ord + Copy>(&self, mut keyed: Vec<(K, u32)>) -> Vec<u32> {
+        let ties = |a: &(K, u32), b: &(K, u32)| {
+            let (x, y) = (self.get(a.1 as usize), self.get(b.1 as usize));
+            x.reflections
+                .cmp(y.reflections)
+                .then_with(|| x.second.cmp(&y.second))
+        };
+        keyed.sort_unstable_by_key(|k| k.0);
+        for run in keyed.chunk_by_mut(|a, b| a.0 == b.0) {
+            if run.len() > 1 {
+                run.sort_unstable_by(ties);
+            }
+        }
+        keyed.dedup_by(|a, b| a.0 == b.0 && ties(a, b).is_eq());
+        keyed.into_iter().map(|(_, i)| i).collect()
+    }
 }
+
+/// The fields of a candidate's sort key ([`DiffractedSet::key_fields`]).
+const KEY_FIELDS: usize = 9;
 
 /// The edges candidates may diffract on: those at least `min_edge_length` metres long, and
 /// only when `max_order` leaves room for a diffraction.
@@ -412,5 +450,56 @@ mod tests {
         // DD: 12·11; RDD, DDR: 6·12·11 each; DRD: 12·6·12.
         let twice = 132 + 2 * 792 + 864;
         assert_eq!(diffracted_count(6, 12, 3, 2), 1308 + twice);
+    }
+
+    /// The canonical order is the order of the candidates' key fields, then reflections, then
+    /// second diffraction, with repeats dropped: on sets whose keys pack into one integer
+    /// (small ids) and on sets that need two (ids up to `u32::MAX`), with long candidates
+    /// that tie on the keys and repeats pushed in a shuffled order.
+    #[test]
+    fn canonical_order_sorts_by_the_key_fields_with_either_packing() {
+        let mut state = 0x5eed_u64;
+        let mut next = |n: u64| {
+            state = state
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (state >> 33) % n
+        };
+        for big in [false, true] {
+            let id = |v: u64| if big { u32::MAX - v as u32 } else { v as u32 };
+            let mut set = DiffractedSet::default();
+            for _ in 0..3000 {
+                let surfaces = |len: u64, next: &mut dyn FnMut(u64) -> u64| -> Vec<SurfaceId> {
+                    (0..len).map(|_| SurfaceId(id(next(3)))).collect()
+                };
+                let before = surfaces(next(3), &mut next);
+                let after = surfaces(next(4), &mut next);
+                let edge = EdgeId(id(next(3)));
+                if next(2) == 0 {
+                    set.push(&before, edge, &after);
+                } else {
+                    let between = surfaces(next(2), &mut next);
+                    let second = EdgeId(id(next(3)));
+                    set.push_twice(&before, (edge, second), &between, &after, None);
+                }
+            }
+            let mut expected: Vec<_> = (0..set.len())
+                .map(|i| {
+                    let c = set.get(i);
+                    (set.key_fields(i), c.reflections.to_vec(), c.second)
+                })
+                .collect();
+            expected.sort();
+            expected.dedup();
+            set.canonicalise();
+            let got: Vec<_> = (0..set.len())
+                .map(|i| {
+                    let c = set.get(i);
+                    (set.key_fields(i), c.reflections.to_vec(), c.second)
+                })
+                .collect();
+            assert!(got.len() < 3000, "repeats were drawn");
+            assert_eq!(got, expected, "big ids: {big}");
+        }
     }
 }
