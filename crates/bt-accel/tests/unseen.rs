@@ -268,3 +268,60 @@ fn host_work_of_one_step(scene: &bt_scene::Scene, planes: &[bt_scene::SurfaceId]
     let points = s.input.paths.iter().map(|p| p.len() as u64).sum();
     (points, plan.schedule.job_count())
 }
+
+/// The twin's cycles if every PE could take any plane's job (coefficients as data, not
+/// constant networks; not built): the round template with each group's points on the
+/// least-loaded distinct PEs of all `g` (a phase of more than `g` points split in groups of
+/// `g`), then the dispatcher's twin with the rounds of the verification run.
+/// `cargo test --release -p bt-accel --test unseen generic_pes -- --ignored --nocapture`
+/// (docs/hardware.md, the tilted rooms' area).
+#[test]
+#[ignore = "an estimate for docs/hardware.md, prints only"]
+fn generic_pes_estimate() {
+    for seed in SEEDS {
+        let (_, p) = cold_step(seed);
+        let problem = p.step.input.one_round_problem();
+        let rounds: Vec<u32> = p.results.iter().map(|r| r.rounds).collect();
+        let mut line = format!("seed {seed}: {} jobs;", p.plan.dispatch.jobs);
+        for g in [6usize, 8, 10, 12, 14, 16, 20, 24] {
+            let template = generic_template(&problem, g);
+            let groups = bt_hls::dispatch::groups(&template, problem.paths.len()).unwrap();
+            let run = bt_hls::dispatch::predict(&groups, g, &rounds, p.step.input.pe_latency());
+            line += &format!(" {g}: {} = {:.3} ms;", run.cycles, run.cycles as f64 / 50e3);
+        }
+        eprintln!("{line}");
+    }
+}
+
+/// One round of `problem` on `g` interchangeable PEs (see [`generic_pes_estimate`]).
+fn generic_template(problem: &bt_schedule::Problem, g: usize) -> bt_schedule::Schedule {
+    let mut given = vec![0u64; g];
+    let mut slots = Vec::new();
+    for (p, path) in problem.paths.iter().enumerate() {
+        let n = path.planes.len() as u32;
+        let phases = path.phases.clamp(1, n);
+        for phase in 0..phases {
+            let points: Vec<u32> = (phase..n).step_by(phases as usize).collect();
+            for chunk in points.chunks(g) {
+                let mut row = vec![None; g];
+                for &point in chunk {
+                    let c = (0..g)
+                        .filter(|&c| row[c].is_none())
+                        .min_by_key(|&c| (given[c], c))
+                        .unwrap();
+                    given[c] += 1;
+                    row[c] = Some(bt_schedule::Job {
+                        path: p as u32,
+                        round: 0,
+                        point,
+                    });
+                }
+                slots.push(row);
+            }
+        }
+    }
+    let instances = (0..g as u32)
+        .map(|copy| bt_schedule::PeInstance { plane: 0, copy })
+        .collect();
+    bt_schedule::Schedule { instances, slots }
+}
