@@ -135,8 +135,8 @@ const FIRST_ITERATION_STEP: u32 = 5;
 /// | idle, `start` | `a_k` | `r_e ← d_prev` |
 /// | 1 | `b_k` | `r_l ← d_next` |
 /// | 2 | `r_e` | `a_k ← t_prev_k = a_k − round(d_prev·n_k)` |
-/// | 3 | `r_l` | `b_k ← t_next_k` |
-/// | 4 | - | `b_k ← L_p0 = δ_k·2^15`, `a_k ← (t_prev+t_next)·2^15 + 2^15` (= `t_prev·2^16 + 2^15 + B_p0`), `r_e ← E = (n−m)·2^15`, `r_l ← L = (m+n)·2^15` |
+/// | 3 | `r_l` | from `t_next_k = b_k − round(d_next·n_k)` as computed: `b_k ← L_p0 = δ_k·2^15`, `a_k ← (t_prev+t_next)·2^15 + 2^15` (= `t_prev·2^16 + 2^15 + B_p0`) |
+/// | 4 | - | `r_e ← E = (n−m)·2^15`, `r_l ← L = (m+n)·2^15` |
 /// | 5 .. 36 | - | one halving step: `r_l ← L/2`, `b_k ← L_p/2`, `E ± L/2`, `a_k ± L_p/2` (sign of `E` decides) |
 ///
 /// `s_sum_k = a_k >> 16 = t_prev_k + round(B_p/2^16)`, valid from [`crate::pe_latency`] cycles
@@ -176,7 +176,7 @@ pub(crate) fn pe_core_module(wd: Widths) -> Module {
     let regs = pe_state(wd, &mut items);
     let link = Link::named(wd);
     link.show(&regs, &mut items);
-    let setup = setup_values(&regs, &mut items, &mut unused);
+    let setup = setup_values(&regs, &link.t, &mut items, &mut unused);
     let halving = halving_step(&regs, &mut items, &mut unused);
     pe_outputs(&regs, &mut items);
     sequencer(&regs, &link.d_new, &link.t, &setup, &halving, &mut items);
@@ -312,7 +312,7 @@ struct PeRegs {
     r_l: Signal,
     /// Per axis: `s_prev`, `t_prev`, then the `B_p` accumulator.
     a: Vec<Signal>,
-    /// Per axis: `s_next`, `t_next`, then `L_p`.
+    /// Per axis: `s_next`, then `L_p` (`t_next` is never stored: step 3 writes `L_p0`).
     b: Vec<Signal>,
     /// The design's datapath widths.
     wd: Widths,
@@ -524,7 +524,8 @@ fn projections(
     Ok(())
 }
 
-/// The step-4 values: `m + n`, `n − m` and per axis `δ` and `t_prev + t_next + 1`.
+/// The set-up values: `m + n` and `n − m` (step 4), per axis `δ` and `t_prev + t_next + 1`
+/// (step 3, from `t_next` as the front end computes it, so that `b_k` never holds it).
 struct SetupValues {
     dist_sum: Signal,
     dist_diff: Signal,
@@ -532,8 +533,14 @@ struct SetupValues {
     tsum: Vec<Signal>,
 }
 
-/// Step 4: m, n, delta, and the Algorithm 3 initial values.
-fn setup_values(r: &PeRegs, items: &mut Vec<Item>, unused: &mut Vec<Expr>) -> SetupValues {
+/// Steps 3 and 4: m, n, delta, and the Algorithm 3 initial values; `t` is the front end's
+/// `t_next` at step 3.
+fn setup_values(
+    r: &PeRegs,
+    t: &[Signal],
+    items: &mut Vec<Item>,
+    unused: &mut Vec<Expr>,
+) -> SetupValues {
     let wd = r.wd;
     let (deltaw, sumw) = (wd.delta, wd.distance_sum);
     let abs = |items: &mut Vec<Item>, name: &str, reg: &Signal| {
@@ -561,31 +568,24 @@ fn setup_values(r: &PeRegs, items: &mut Vec<Item>, unused: &mut Vec<Expr>) -> Se
     );
     let (mut delta, mut tsum) = (Vec::new(), Vec::new());
     for (k, axis) in AXES.iter().enumerate() {
-        let (a, b) = (r.a[k].name(), r.b[k].name());
+        let (a, t_next) = (r.a[k].name(), t[k].name());
         delta.push(Signal::assigned(
             items,
             format!("delta_{axis}"),
             deltaw,
-            sext_slice(b, wd.distance - 1, 0, deltaw).minus(sext_slice(
-                a,
-                wd.distance - 1,
-                0,
-                deltaw,
-            )),
+            sext(t_next, wd.distance, deltaw).minus(sext_slice(a, wd.distance - 1, 0, deltaw)),
         ));
-        // t_prev + t_next + 1 as one adder: {b, 1} + {a, 1} = 2·(a + b + 1).
+        // t_prev + t_next + 1 as one adder: {t_next, 1} + {a, 1} = 2·(a + t_next + 1).
         let ts = Signal::assigned(
             items,
             format!("tsum_{axis}"),
             deltaw + 1,
-            Expr::concat(vec![
-                sext_slice(b, wd.distance - 1, 0, deltaw),
-                Expr::lit(1, 1),
-            ])
-            .plus(Expr::concat(vec![
-                sext_slice(a, wd.distance - 1, 0, deltaw),
-                Expr::lit(1, 1),
-            ])),
+            Expr::concat(vec![sext(t_next, wd.distance, deltaw), Expr::lit(1, 1)]).plus(
+                Expr::concat(vec![
+                    sext_slice(a, wd.distance - 1, 0, deltaw),
+                    Expr::lit(1, 1),
+                ]),
+            ),
         );
         unused.push(ts.bit(0));
         tsum.push(ts);
@@ -698,28 +698,15 @@ fn seq_idle(r: &PeRegs, d_new: &Signal) -> Vec<Stmt> {
     )]
 }
 
-/// Step 4: the Algorithm 3 initial values.
-fn seq_setup(r: &PeRegs, s: &SetupValues) -> Vec<Stmt> {
+/// Step 3: per axis the Algorithm 3 initial values from `t_prev` (in `a_k`) and the front
+/// end's `t_next`, written straight into `b_k` and `a_k` (the `t_next` register of before
+/// and its multiplexer input are gone).
+fn seq_setup_axes(r: &PeRegs, s: &SetupValues) -> Vec<Stmt> {
     let wd = r.wd;
     let g = GUARD_BITS;
-    let (deltaw, sumw, ew, aw) = (wd.delta, wd.distance_sum, wd.search_diff, wd.point_acc);
-    let mut setup = vec![
-        nb(
-            &r.r_e,
-            Expr::concat(vec![
-                s.dist_diff.bit(sumw).repeat(ew - (sumw + 1) - (g - 1)),
-                s.dist_diff.e(),
-                Expr::lit(1, 0).repeat(g - 1),
-            ]),
-        ),
-        nb(
-            &r.r_l,
-            Expr::concat(vec![s.dist_sum.e(), Expr::lit(1, 0).repeat(g - 1)]),
-        ),
-        nb(&r.zs, s.dist_sum.e().eq(Expr::lit(sumw, 0))),
-    ];
-    debug_assert_eq!(wd.half_sum, sumw + g - 1);
+    let (deltaw, aw) = (wd.delta, wd.point_acc);
     debug_assert_eq!(wd.half_delta, deltaw + g - 1);
+    let mut setup = Vec::new();
     for k in 0..AXES.len() {
         setup.push(nb(
             &r.b[k],
@@ -736,6 +723,31 @@ fn seq_setup(r: &PeRegs, s: &SetupValues) -> Vec<Stmt> {
         ));
     }
     debug_assert!(aw >= deltaw + g);
+    setup.push(goto(r, 4));
+    setup
+}
+
+/// Step 4: the scalar Algorithm 3 initial values (`E`, `L`, the zero flag).
+fn seq_setup(r: &PeRegs, s: &SetupValues) -> Vec<Stmt> {
+    let wd = r.wd;
+    let g = GUARD_BITS;
+    let (sumw, ew) = (wd.distance_sum, wd.search_diff);
+    let mut setup = vec![
+        nb(
+            &r.r_e,
+            Expr::concat(vec![
+                s.dist_diff.bit(sumw).repeat(ew - (sumw + 1) - (g - 1)),
+                s.dist_diff.e(),
+                Expr::lit(1, 0).repeat(g - 1),
+            ]),
+        ),
+        nb(
+            &r.r_l,
+            Expr::concat(vec![s.dist_sum.e(), Expr::lit(1, 0).repeat(g - 1)]),
+        ),
+        nb(&r.zs, s.dist_sum.e().eq(Expr::lit(sumw, 0))),
+    ];
+    debug_assert_eq!(wd.half_sum, sumw + g - 1);
     setup.push(goto(r, FIRST_ITERATION_STEP));
     setup
 }
@@ -780,15 +792,11 @@ fn sequencer(
 ) {
     let wd = r.wd;
     let (stepw, xw) = (step_bits(wd), wd.distance);
-    let (aw, lpw) = (wd.point_acc, wd.half_delta);
+    let aw = wd.point_acc;
     let mut proj_prev: Vec<Stmt> = (0..AXES.len())
         .map(|k| nb(&r.a[k], sext(t[k].name(), xw, aw)))
         .collect();
-    let mut proj_next: Vec<Stmt> = (0..AXES.len())
-        .map(|k| nb(&r.b[k], sext(t[k].name(), xw, lpw)))
-        .collect();
     proj_prev.push(goto(r, 3));
-    proj_next.push(goto(r, 4));
     items.push(Item::AlwaysFf(vec![Stmt::If(
         r.io.rst_n.e().lnot(),
         vec![goto(r, 0)],
@@ -807,7 +815,7 @@ fn sequencer(
                     ],
                 ),
                 (Expr::lit(stepw, 2), proj_prev),
-                (Expr::lit(stepw, 3), proj_next),
+                (Expr::lit(stepw, 3), seq_setup_axes(r, s)),
                 (Expr::lit(stepw, 4), seq_setup(r, s)),
             ],
             seq_iterate(r, h),

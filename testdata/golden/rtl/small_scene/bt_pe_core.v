@@ -53,17 +53,17 @@ module bt_pe_core (
   wire [26:0] dist_diff;
   assign dist_diff = ({1'd0, n_dist} - {1'd0, m_dist});
   wire [26:0] delta_x;
-  assign delta_x = ({{1{b_x[25]}}, b_x[25:0]} - {{1{a_x[25]}}, a_x[25:0]});
+  assign delta_x = ({{1{t_x[25]}}, t_x} - {{1{a_x[25]}}, a_x[25:0]});
   wire [27:0] tsum_x;
-  assign tsum_x = ({{{1{b_x[25]}}, b_x[25:0]}, 1'd1} + {{{1{a_x[25]}}, a_x[25:0]}, 1'd1});
+  assign tsum_x = ({{{1{t_x[25]}}, t_x}, 1'd1} + {{{1{a_x[25]}}, a_x[25:0]}, 1'd1});
   wire [26:0] delta_y;
-  assign delta_y = ({{1{b_y[25]}}, b_y[25:0]} - {{1{a_y[25]}}, a_y[25:0]});
+  assign delta_y = ({{1{t_y[25]}}, t_y} - {{1{a_y[25]}}, a_y[25:0]});
   wire [27:0] tsum_y;
-  assign tsum_y = ({{{1{b_y[25]}}, b_y[25:0]}, 1'd1} + {{{1{a_y[25]}}, a_y[25:0]}, 1'd1});
+  assign tsum_y = ({{{1{t_y[25]}}, t_y}, 1'd1} + {{{1{a_y[25]}}, a_y[25:0]}, 1'd1});
   wire [26:0] delta_z;
-  assign delta_z = ({{1{b_z[25]}}, b_z[25:0]} - {{1{a_z[25]}}, a_z[25:0]});
+  assign delta_z = ({{1{t_z[25]}}, t_z} - {{1{a_z[25]}}, a_z[25:0]});
   wire [27:0] tsum_z;
-  assign tsum_z = ({{{1{b_z[25]}}, b_z[25:0]}, 1'd1} + {{{1{a_z[25]}}, a_z[25:0]}, 1'd1});
+  assign tsum_z = ({{{1{t_z[25]}}, t_z}, 1'd1} + {{{1{a_z[25]}}, a_z[25:0]}, 1'd1});
   // Algorithm 3 on 16 guard bits, 24 steps frozen once L = 0; E = B - m*2^16 replaces B, m and the comparator
   wire go_up;
   assign go_up = r_e[42];
@@ -114,21 +114,18 @@ module bt_pe_core (
           step <= 5'd3;
         end
         5'd3: begin
-          b_x <= {{16{t_x[25]}}, t_x};
-          b_y <= {{16{t_y[25]}}, t_y};
-          b_z <= {{16{t_z[25]}}, t_z};
-          step <= 5'd4;
-        end
-        5'd4: begin
-          r_e <= {{1{dist_diff[26]}}, dist_diff, {15{1'd0}}};
-          r_l <= {dist_sum, {15{1'd0}}};
-          zs <= (dist_sum == 26'h0);
           b_x <= {delta_x, {15{1'd0}}};
           a_x <= {{2{tsum_x[27]}}, tsum_x[27:1], {15{1'd0}}};
           b_y <= {delta_y, {15{1'd0}}};
           a_y <= {{2{tsum_y[27]}}, tsum_y[27:1], {15{1'd0}}};
           b_z <= {delta_z, {15{1'd0}}};
           a_z <= {{2{tsum_z[27]}}, tsum_z[27:1], {15{1'd0}}};
+          step <= 5'd4;
+        end
+        5'd4: begin
+          r_e <= {{1{dist_diff[26]}}, dist_diff, {15{1'd0}}};
+          r_l <= {dist_sum, {15{1'd0}}};
+          zs <= (dist_sum == 26'h0);
           step <= 5'd5;
         end
         default: begin
