@@ -358,6 +358,8 @@ pub struct DiffractionSide {
     pub(super) tol: Real,
     /// TX (m, scene frame).
     tx: Vec3,
+    /// The two-diffraction join's TX part, made by the first join that needs it.
+    twice: std::sync::OnceLock<twice::TxPart>,
 }
 
 impl DiffractionSide {
@@ -381,6 +383,7 @@ impl DiffractionSide {
             prefixes: tx.prefixes(max_order.saturating_sub(1)),
             tol: tx.tol,
             tx: tx.tx,
+            twice: std::sync::OnceLock::new(),
         }
     }
 }

@@ -9,7 +9,7 @@ use crate::common::{listing, paths_of, scene_from_json};
 use bt_geom::{Real, Vec3};
 use bt_scene::Scene;
 use bt_solve::pipeline::{CandidateMode, DiffractionOptions, TraceOptions};
-use bt_solve::{FoundPath, IpcOptions, Solver, UpdateOrder};
+use bt_solve::{FoundPath, IpcOptions, Solver, Tracer, UpdateOrder};
 use bt_testkit::nasty_scene;
 use proptest::prelude::*;
 
@@ -75,6 +75,30 @@ proptest! {
         let at_most_one: Vec<FoundPath> =
             tree.iter().filter(|p| p.diffractions.len() < 2).cloned().collect();
         prop_assert_eq!(listing(&at_most_one), listing(&once));
+    }
+
+    /// One tracer, one receiver at a time: from the second trace on it reuses the TX side
+    /// kept in its cache (with the join's TX part), and gives a fresh tracer's candidates and
+    /// paths, bit for bit.
+    #[test]
+    fn a_kept_tracer_gives_a_fresh_tracers_twice_diffracted_paths(
+        seed in 0u64..1_000_000, n in 1usize..6,
+    ) {
+        let Some(scene) = nasty_scene(seed, n, 0) else { return Ok(()) };
+        let opts = options(3, CandidateMode::BeamTree, Solver::Image);
+        let (tx, rx) = (scene.tx_world().unwrap(), scene.rx_world().unwrap());
+        let mut kept = Tracer::new(scene.clone(), opts);
+        for k in 0..4 {
+            let step = k as Real;
+            let moved = rx + Vec3::new(0.37 * step, -0.21 * step, 0.13 * step);
+            if scene.with_receiver(moved).is_err() {
+                continue;
+            }
+            let fresh = Tracer::new(scene.clone(), opts).trace(tx, moved).expect("fresh trace");
+            let reused = kept.trace(tx, moved).expect("kept trace");
+            prop_assert_eq!(&reused.result.paths, &fresh.result.paths);
+            prop_assert_eq!(reused.candidates.diffracted, fresh.candidates.diffracted);
+        }
     }
 
     /// Traced from the other end, the same paths come back reversed.

@@ -26,7 +26,7 @@ const SLACK: Real = 1e-6;
 
 /// An interval on the first edge, as the prefilters read it: its line, its ends (grown by the
 /// margin) and the range of cos β0 of the incident rays over it.
-#[derive(Clone, Copy)]
+#[derive(Debug, Clone, Copy)]
 struct Span {
     edge: usize,
     line: EdgeLine,
@@ -51,6 +51,7 @@ impl Span {
 }
 
 /// A TX reach on the first edge and its [`Span`].
+#[derive(Debug, Clone)]
 struct Near {
     span: Span,
     reach: Reach,
@@ -63,6 +64,7 @@ struct Near {
 /// their incidence ranges. Each prefilter of [`Pairing::may_pair`] fails for a member's span
 /// when it fails for the group's (its bounds only widen as the interval and the range grow), so
 /// one test of the group rejects all its members.
+#[derive(Debug, Clone)]
 struct Group {
     span: Span,
     depth: usize,
@@ -303,6 +305,31 @@ fn misses_window(
     })
 }
 
+/// What the join takes from the TX side alone, for one margin (m): its reaches that may
+/// start a twice-diffracted path, their [`Group`]s and the reflector index ([`Toward`]).
+/// Kept with the [`DiffractionSide`](super::DiffractionSide) while only RX moves.
+#[derive(Debug, Clone)]
+pub(super) struct TxPart {
+    margin: Real,
+    near: Vec<Near>,
+    groups: Vec<Group>,
+    index: Toward,
+}
+
+impl TxPart {
+    fn of(pairing: &Pairing<'_>, scene: &Scene, deepest: usize) -> Self {
+        let near = pairing.near(scene, deepest);
+        let groups = groups(&near);
+        let index = Toward::of(scene, &groups, pairing.margin);
+        TxPart {
+            margin: pairing.margin,
+            near,
+            groups,
+            index,
+        }
+    }
+}
+
 /// The join's working state for one TX side: its reaches, their groups and scratch.
 struct Pairs<'a> {
     near: &'a [Near],
@@ -321,6 +348,7 @@ struct Pairs<'a> {
 /// reflector's polygon, within the margin of its box. A group whose range of that cosine
 /// ([`cos_range_to_box`]) misses its incidence range pairs with no interval beyond that
 /// reflector, so the join never looks at those pairs.
+#[derive(Debug, Clone)]
 struct Toward {
     /// Per surface id: the groups (indices) for a middle starting there.
     groups: Vec<Vec<u32>>,
@@ -413,13 +441,24 @@ impl Pairing<'_> {
         let middles: Vec<Vec<Vec<SurfaceId>>> = (0..=deepest)
             .map(|q| crate::diffraction::sequences(&reflectors, q))
             .collect();
-        let near = self.near(scene, deepest);
-        self.check_pairs(&near, middles.iter().map(Vec::len).collect(), deepest)?;
-        let groups = groups(&near);
-        let index = Toward::of(scene, &groups, self.margin);
+        // The TX side's part, kept with the side for the next receiver (built anew for
+        // another margin, which a kept side's RX trees in one scene do not give).
+        let kept = self
+            .side
+            .twice
+            .get_or_init(|| TxPart::of(self, scene, deepest));
+        let fresh;
+        let tx = if kept.margin == self.margin {
+            kept
+        } else {
+            fresh = TxPart::of(self, scene, deepest);
+            &fresh
+        };
+        let (near, index) = (&tx.near, &tx.index);
+        self.check_pairs(near, middles.iter().map(Vec::len).collect(), deepest)?;
         let mut pairs = Pairs {
-            near: &near,
-            groups: &groups,
+            near,
+            groups: &tx.groups,
             deepest,
             seen: Vec::new(),
             before: Vec::new(),
