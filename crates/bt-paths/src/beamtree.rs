@@ -463,6 +463,9 @@ struct Scratch {
     /// tried against it before any BVH walk.
     last_cover: Option<u32>,
     hits: Vec<(Real, u32)>,
+    /// The parent's beam plane that emptied the last empty window: siblings beyond the same
+    /// plane are told empty before any clipping ([`hull_beyond`]).
+    last_empty: usize,
 }
 
 /// The arenas of a tree (nodes, window vertices, beam planes), kept in a [`TreeCache`] between
@@ -979,8 +982,16 @@ impl BeamTree {
             self.stats.empty += 1;
             return;
         }
-        window_in_beam(prep, parent, s, (&mut scratch.a, &mut scratch.b));
-        if scratch.a.len() < 3 {
+        if hull_beyond(prep, parent, s, scratch.last_empty) {
+            debug_assert!(
+                window_in_beam(prep, parent, s, (&mut scratch.a, &mut scratch.b)).is_some(),
+                "a hull beyond a beam plane leaves a window"
+            );
+            self.stats.empty += 1;
+            return;
+        }
+        if let Some(k) = window_in_beam(prep, parent, s, (&mut scratch.a, &mut scratch.b)) {
+            scratch.last_empty = k;
             self.stats.empty += 1;
             return;
         }
@@ -1210,21 +1221,36 @@ impl Probe {
 }
 
 /// Child `s`'s window, its grown hull clipped by `parent`'s beam planes, into `window`
-/// (`tmp`: scratch; fewer than 3 vertices: empty).
+/// (`tmp`: scratch; fewer than 3 vertices: empty, and the index of the plane that emptied it
+/// is returned).
 fn window_in_beam(
     prep: &Prepared<'_>,
     parent: &Parent<'_>,
     s: u32,
     (window, tmp): (&mut Vec<Vec3>, &mut Vec<Vec3>),
-) {
+) -> Option<usize> {
     window.clear();
     window.extend_from_slice(prep.hull(s));
-    for pl in parent.planes {
+    for (k, pl) in parent.planes.iter().enumerate() {
         convex::clip_in_place(window, pl, EPS * prep.tol, tmp);
         if window.len() < 3 {
-            break;
+            return Some(k);
         }
     }
+    (window.len() < 3).then_some(0)
+}
+
+/// Whether child `s`'s window is empty because every vertex of its grown hull lies beyond
+/// `parent`'s beam plane `k` by more than twice the clipping margin (false when there is no
+/// plane `k`). Then [`window_in_beam`] leaves nothing either: whatever the planes before `k`
+/// cut, the window's vertices stay within the hull (up to rounding far below the margin), so
+/// plane `k` drops them all, if an earlier plane has not already.
+fn hull_beyond(prep: &Prepared<'_>, parent: &Parent<'_>, s: u32, k: usize) -> bool {
+    let Some(pl) = parent.planes.get(k) else {
+        return false;
+    };
+    let clearly = -2.0 * EPS * prep.tol;
+    (prep.hull(s).iter()).all(|&v| pl.signed_distance_unfused(v) < clearly)
 }
 
 /// Append candidate `seq` to `set` with its start points (`starts`, empty when the options

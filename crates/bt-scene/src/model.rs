@@ -282,7 +282,10 @@ impl Scene {
     /// Warnings about a valid scene that likely does not mean what it says (printable: names
     /// escaped).
     pub fn warnings(&self) -> Vec<String> {
-        let enclosed = self.separating_shells().into_iter().map(|(inside, shell)| {
+        // Two independent searches over the whole scene: side by side when cores are free.
+        let (shells, conflicts) =
+            rayon::join(|| self.separating_shells(), || self.coplanar_conflicts());
+        let enclosed = shells.into_iter().map(|(inside, shell)| {
             let names: Vec<String> = (shell.iter().take(3))
                 .map(|id| format!("\"{}\"", crate::name::shown(&self.surface(*id).name)))
                 .collect();
@@ -295,10 +298,7 @@ impl Scene {
                 names.join(", ")
             )
         });
-        let conflicts = self
-            .coplanar_conflicts()
-            .into_iter()
-            .map(|(a, b)| {
+        let conflicts = conflicts.into_iter().map(|(a, b)| {
                 let (a, b) = (self.surface(a), self.surface(b));
                 format!(
                     "surfaces \"{}\" ({}) and \"{}\" ({}) overlap in one plane with different materials: \

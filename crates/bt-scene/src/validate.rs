@@ -163,19 +163,26 @@ pub(crate) fn coplanar_overlaps(surfaces: &[Surface], tol: Real) -> Vec<(usize, 
     let polygons: Vec<&Polygon> = surfaces.iter().map(|s| &s.polygon).collect();
     let bvh = Bvh::build(&polygons);
     let reflector = |i: usize| surfaces[i].kind == SurfaceKind::Reflector;
-    let mut pairs = Vec::new();
-    for (i, a) in polygons.iter().enumerate().filter(|(i, _)| reflector(*i)) {
-        let (lo, hi) = a.bounds();
-        bvh.visit(
-            |min, max| (lo - max).max_element() <= tol && (min - hi).max_element() <= tol,
-            |j| {
-                let j = j as usize;
-                if j > i && reflector(j) && a.overlaps_coplanar(polygons[j], tol) {
-                    pairs.push((i, j));
-                }
-            },
-        );
-    }
+    // Each reflector's partners on all cores; sorted, so the same on any number of threads.
+    let mut pairs: Vec<(usize, usize)> = (0..polygons.len())
+        .into_par_iter()
+        .filter(|&i| reflector(i))
+        .flat_map_iter(|i| {
+            let a = polygons[i];
+            let (lo, hi) = a.bounds();
+            let mut pairs = Vec::new();
+            bvh.visit(
+                |min, max| (lo - max).max_element() <= tol && (min - hi).max_element() <= tol,
+                |j| {
+                    let j = j as usize;
+                    if j > i && reflector(j) && a.overlaps_coplanar(polygons[j], tol) {
+                        pairs.push((i, j));
+                    }
+                },
+            );
+            pairs
+        })
+        .collect();
     pairs.sort_unstable();
     pairs
 }
