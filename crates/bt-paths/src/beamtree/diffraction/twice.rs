@@ -494,6 +494,7 @@ impl Pairing<'_> {
         pairs.seen.resize(scene.edges().len(), None);
         for g in first.iter().map(|&g| &pairs.groups[g as usize]) {
             if g.depth + b.depth + far.middle.len() > pairs.deepest
+                || self.beyond(&g.span, far)
                 || !self.may_pair(scene, (&g.span, far), &mut pairs.seen)
             {
                 continue;
@@ -698,6 +699,23 @@ impl Pairing<'_> {
             }
         }
         false
+    }
+
+    /// Whether no reach of `span` (a group's) can pair with `far`: the second point of a pair
+    /// is the Keller point of the first and the RX image, so it lies in the range of those
+    /// over the span's interval ([`EdgeLine::keller_range`]); when that range misses the far
+    /// reach (grown as in [`Pairing::apart`]), so does every pair.
+    #[inline(always)]
+    fn beyond(&self, span: &Span, far: &Far<'_>) -> bool {
+        let grow = self.margin + APART_SLACK;
+        let line = &far.wedge.line;
+        let near = (span.t.0 - APART_SLACK, span.t.1 + APART_SLACK);
+        match line.keller_range(far.focus, &span.line, near) {
+            Some((lo, hi)) => {
+                hi + APART_SLACK < far.reach.lo - grow || lo - APART_SLACK > far.reach.hi + grow
+            }
+            None => false,
+        }
     }
 
     /// `Some` when the Keller pair of `a` and `far` lies in both reaches (within the margin),
