@@ -19,8 +19,11 @@ pub(crate) struct Responses<'a> {
     scene: &'a Scene,
     /// Surfaces looked up so far (a few dozen at most are kept; the rest are looked up each
     /// time, so a report of many paths in a large scene stays linear).
-    known: Vec<(SurfaceId, SurfaceResponse, Real)>,
+    known: Known,
 }
+
+/// The surfaces a [`Responses`] looked up: each one's response and reflection loss.
+pub(crate) type Known = Vec<(SurfaceId, SurfaceResponse, Real)>;
 
 /// Surfaces a [`Responses`] keeps.
 const KNOWN_SURFACES: usize = 64;
@@ -28,10 +31,19 @@ const KNOWN_SURFACES: usize = 64;
 impl<'a> Responses<'a> {
     /// No surface looked up yet in `scene`.
     pub(crate) fn new(scene: &'a Scene) -> Self {
-        Responses {
-            scene,
-            known: Vec::new(),
-        }
+        Self::with_known(scene, Vec::new())
+    }
+
+    /// The surfaces of `known` already looked up in `scene`: they were looked up in a scene of
+    /// the same [`bt_scene::RadioKey`] (the same surfaces, materials and frequency), or
+    /// `known` is empty.
+    pub(crate) fn with_known(scene: &'a Scene, known: Known) -> Self {
+        Responses { scene, known }
+    }
+
+    /// The surfaces looked up, for [`Responses::with_known`] in a scene of the same key.
+    pub(crate) fn into_known(self) -> Known {
+        self.known
     }
 
     /// The scene.
