@@ -271,26 +271,21 @@ mod tests {
         let desc: bt_scene::SceneDescription = serde_json::from_str(&json).unwrap();
         let scene = Scene::from_description(&desc, "slots", Default::default()).unwrap();
         let order: Vec<SurfaceId> = (0..600u32).map(|k| SurfaceId(k * 37 % 200)).collect();
+        let check = |responses: &mut Responses<'_>, ids: &mut dyn Iterator<Item = SurfaceId>| {
+            for id in ids {
+                let (fresh, fresh_loss) = Responses::new(&scene).get(id);
+                let (got, loss) = responses.get(id);
+                assert_eq!(
+                    (got, loss.to_bits()),
+                    (fresh, fresh_loss.to_bits()),
+                    "{id:?}"
+                );
+            }
+        };
         let mut first = Responses::new(&scene);
-        for &id in &order {
-            let (fresh, fresh_loss) = Responses::new(&scene).get(id);
-            let (got, loss) = first.get(id);
-            assert_eq!(
-                (got, loss.to_bits()),
-                (fresh, fresh_loss.to_bits()),
-                "{id:?}"
-            );
-        }
+        check(&mut first, &mut order.iter().copied());
         let mut again = Responses::with_known(&scene, first.into_known());
-        for &id in order.iter().rev() {
-            let (fresh, fresh_loss) = Responses::new(&scene).get(id);
-            let (got, loss) = again.get(id);
-            assert_eq!(
-                (got, loss.to_bits()),
-                (fresh, fresh_loss.to_bits()),
-                "{id:?}"
-            );
-        }
+        check(&mut again, &mut order.iter().rev().copied());
         assert_eq!(again.known.len(), KNOWN_SURFACES);
     }
 
