@@ -371,6 +371,7 @@ fn vertices(
 #[derive(Default)]
 pub(crate) struct Scratch {
     vertices: Vec<Vec3>,
+    interactions: Vec<Interaction>,
     channel: Vec<bt_channel::Interaction>,
 }
 
@@ -400,7 +401,8 @@ pub(crate) fn describe_into(
     let scene = responses.scene();
     let length_m = vertices(scene, path, &mut scratch.vertices)?;
     let vertices = &scratch.vertices;
-    let interactions = path.interactions();
+    path.interactions_into(&mut scratch.interactions);
+    let interactions = &scratch.interactions;
     let incidence_deg = refill(
         &mut record.incidence_deg,
         (interactions.iter().enumerate()).map(|(k, it)| match it {
@@ -418,14 +420,15 @@ pub(crate) fn describe_into(
         .iter()
         .map(|id| responses.get(*id).1)
         .fold(0.0, |a, b| a + b);
-    let free_space_loss_db = free_space_loss_db(length_m, scene.frequency_hz());
+    let free_space = bt_channel::free_space(length_m, scene.frequency_hz());
+    let free_space_loss_db = free_space.loss_db;
     let (gain, diffraction_loss_db) =
-        gain::path_gain(responses, &mut scratch.channel, path, &interactions, radio)?;
-    let transmission_loss_db = gain::transmission_loss_db(responses, vertices, &interactions)?;
+        gain::path_gain(responses, &mut scratch.channel, path, interactions, radio)?;
+    let transmission_loss_db = gain::transmission_loss_db(responses, vertices, interactions)?;
     let gain_db = power_db(gain.norm_sqr());
     let n = vertices.len();
     let mut surfaces = std::mem::take(&mut record.surfaces);
-    interaction_names(scene, &interactions, &mut surfaces);
+    interaction_names(scene, interactions, &mut surfaces);
     *record = PathReport {
         rank: 0,
         order: path.points.len(),
@@ -460,7 +463,7 @@ pub(crate) fn describe_into(
         gain,
         gain_db,
         power_dbm: gain_db.map(|g| g + radio.tx_power_dbm),
-        near_field: bt_channel::free_space(length_m, scene.frequency_hz()).near_field,
+        near_field: free_space.near_field,
         departure: (vertices[1] - vertices[0]).normalize(),
         arrival: (vertices[n - 2] - vertices[n - 1]).normalize(),
         iterations: path.iterations,

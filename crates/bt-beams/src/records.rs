@@ -22,6 +22,11 @@ pub struct Records {
     /// The ranking's permutation and its marks, kept too.
     order: Vec<usize>,
     placed: Vec<bool>,
+    /// The surfaces' responses of the last report and the key of its scene: the next report
+    /// in a scene of the same surfaces, materials and frequency starts from them (a material
+    /// looked up by name and its model evaluated at the frequency, about 14 surfaces a room's
+    /// report; docs/performance.md).
+    responses: Option<(bt_scene::RadioKey, gain::Known)>,
 }
 
 impl Records {
@@ -33,7 +38,11 @@ impl Records {
         paths: &[FoundPath],
         radio: &RadioOptions,
     ) -> Result<&[PathReport], ReportError> {
-        let mut responses = gain::Responses::new(scene);
+        let known = match self.responses.take() {
+            Some((key, known)) if key.matches(scene) => known,
+            _ => Vec::new(),
+        };
+        let mut responses = gain::Responses::with_known(scene, known);
         let mut scratch = Scratch::default();
         self.len = 0;
         if self.records.len() < paths.len() {
@@ -42,6 +51,7 @@ impl Records {
         for (path, record) in paths.iter().zip(&mut self.records) {
             describe_into(&mut responses, &mut scratch, path, radio, record)?;
         }
+        self.responses = Some((scene.radio_key(), responses.into_known()));
         self.len = paths.len();
         self.records.truncate(self.len + SPARE_RECORDS);
         self.rank();

@@ -11,11 +11,7 @@ use bt_solve::settings::SolveSettings;
 
 #[test]
 fn reused_records_are_the_fresh_report() {
-    let options = bt_import::LoadOptions::default();
-    let dynamic = bt_import::load_dynamic("builtin:living-room", &options, &mut |_| {})
-        .unwrap()
-        .scene;
-    let scene = dynamic.step(0).clone();
+    let scene = living_room();
     let tx = scene.tx_world().unwrap();
     let base = SolveSettings::default();
     let settings = [
@@ -52,4 +48,44 @@ fn reused_records_are_the_fresh_report() {
     // The reports grew and shrank, and some had diffracted paths (edge names).
     assert!(sizes.windows(2).any(|w| w[0] > w[1]) && sizes.windows(2).any(|w| w[0] < w[1]));
     assert!(sizes.iter().max() > Some(&100), "{sizes:?}");
+}
+
+/// Records keep the surfaces' responses from report to report in a scene of the same
+/// surfaces, materials and frequency ([`bt_scene::RadioKey`]): the same paths reported in
+/// turn in the scene, with other materials, at another frequency and in the scene again are
+/// each time the fresh report (a response kept across a change of materials or frequency
+/// would give the old gains and losses).
+#[test]
+fn kept_responses_follow_the_materials_and_the_frequency() {
+    let scene = living_room();
+    let (tx, rx) = (scene.tx_world().unwrap(), Vec3::new(2.3, 2.1, 0.72));
+    let settings = SolveSettings::default();
+    let mut tracer = Tracer::new(scene.clone(), settings.trace_options(&scene).unwrap());
+    let paths = tracer.trace(tx, rx).unwrap().result.paths;
+    let scene = tracer.scene().with_terminals(tx, rx).unwrap();
+    let metal = bt_channel::RadioMaterial::itu("metal", None).unwrap();
+    let scenes = [
+        scene.clone(),
+        scene.with_radio_material(metal).unwrap(),
+        scene.with_frequency(60e9).unwrap(),
+        scene.clone(),
+    ];
+    let radio = RadioOptions::default();
+    let mut records = Records::default();
+    let mut gains = Vec::new();
+    for (k, scene) in scenes.iter().enumerate() {
+        let fresh = report(scene, &paths, &radio).unwrap();
+        let reused = records.report(scene, &paths, &radio).unwrap();
+        assert_eq!(reused, fresh.as_slice(), "scene {k}");
+        gains.push(fresh.iter().map(|p| p.gain).collect::<Vec<_>>());
+    }
+    // The materials and the frequency changed the gains: the reports tell them apart.
+    assert!(gains[0] != gains[1] && gains[0] != gains[2] && gains[0] == gains[3]);
+}
+
+/// The living room's first step.
+fn living_room() -> bt_scene::Scene {
+    let options = bt_import::LoadOptions::default();
+    let dynamic = bt_import::load_dynamic("builtin:living-room", &options, &mut |_| {});
+    dynamic.unwrap().scene.step(0).clone()
 }

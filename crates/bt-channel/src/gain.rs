@@ -12,6 +12,7 @@ use crate::diffraction::{
 use crate::material::{RadioMaterial, Reflection, SPEED_OF_LIGHT, Transmission};
 use bt_geom::{Real, Vec3};
 use num_complex::Complex64;
+use smallvec::SmallVec;
 use std::f64::consts::PI;
 
 /// How a surface reflects.
@@ -269,6 +270,10 @@ pub fn path_gain_detailed(
     path_gain_with_leg(tx, points, rx, interactions, antennas, radio, None)
 }
 
+/// Vertices (TX, points, RX) of a path whose vertices and legs [`path_gain_with_leg`] keeps on
+/// the stack: order 6 and below.
+const PATH_VERTICES: usize = 8;
+
 /// [`path_gain_detailed`] (`radio` = (frequency, Hz; coefficient)), with the diffraction's
 /// diffracted leg s (metres; in the coefficient's distance parameter L and in the spreading)
 /// taken as `diffracted_leg` instead of the unfolded length from the diffraction point to RX
@@ -293,7 +298,8 @@ pub(crate) fn path_gain_with_leg(
             ),
         });
     }
-    let diffractions: Vec<usize> = interactions
+    // On the stack for the paths of a room (a report's paths allocate nothing here).
+    let diffractions: SmallVec<[usize; 2]> = interactions
         .iter()
         .enumerate()
         .filter(|(_, i)| matches!(i, Interaction::Diffraction(_)))
@@ -308,11 +314,12 @@ pub(crate) fn path_gain_with_leg(
             ),
         });
     }
-    let mut vertices = Vec::with_capacity(points.len() + 2);
+    let mut vertices: SmallVec<[Vec3; PATH_VERTICES]> = SmallVec::with_capacity(points.len() + 2);
     vertices.push(tx);
     vertices.extend_from_slice(points);
     vertices.push(rx);
-    let segments: Vec<Real> = vertices.windows(2).map(|w| w[0].distance(w[1])).collect();
+    let segments: SmallVec<[Real; PATH_VERTICES]> =
+        vertices.windows(2).map(|w| w[0].distance(w[1])).collect();
     let length: Real = segments.iter().sum();
     // Each diffraction's legs run from the source or the diffraction before, to the next
     // diffraction or the observer (Sionna's diffracted leg: one diffraction only).

@@ -29,7 +29,7 @@ pub use description::{
 pub use edges::{Edge, EdgeId, Edges};
 pub use frame::RECENTRE_RATIO;
 pub use material::{DEFAULT_MATERIAL, Material, default_materials};
-pub use model::{Endpoints, GeometryKey, Scene};
+pub use model::{Endpoints, GeometryKey, RadioKey, Scene};
 pub use problem::{MAX_PRINTED_PROBLEMS, Problem, SceneError, Terminal};
 pub use stored::{StoredScene, StoredSurface};
 pub use surface::{RawSurface, Surface, SurfaceId, SurfaceKind};

@@ -65,7 +65,40 @@ impl GeometryKey {
     }
 }
 
+/// The identity of what a surface's radio response depends on ([`Scene::radio_key`]): which
+/// material each surface names (its [`GeometryKey`]), the materials, and the frequency. Like
+/// the geometry's, it holds no strong reference and keeps the materials' address from being
+/// reused; materials are never changed in place while a key to them exists (a change makes a
+/// new map), so a key never matches other materials.
+#[derive(Debug, Clone)]
+pub struct RadioKey {
+    geometry: GeometryKey,
+    materials: std::sync::Weak<BTreeMap<String, Material>>,
+    frequency_hz: Real,
+}
+
+impl RadioKey {
+    /// Whether `scene` has the surfaces, the materials and the frequency this key was taken
+    /// from.
+    pub fn matches(&self, scene: &Scene) -> bool {
+        self.frequency_hz.to_bits() == scene.frequency_hz.to_bits()
+            && self.materials.strong_count() > 0
+            && std::ptr::eq(self.materials.as_ptr(), Arc::as_ptr(&scene.materials))
+            && self.geometry.matches(scene)
+    }
+}
+
 impl Scene {
+    /// The identity of this scene's surfaces, materials and frequency ([`RadioKey::matches`]):
+    /// lets a caller keep the surfaces' radio responses across reports in the same scene (a
+    /// serve stream's receivers).
+    pub fn radio_key(&self) -> RadioKey {
+        RadioKey {
+            geometry: self.geometry_key(),
+            materials: Arc::downgrade(&self.materials),
+            frequency_hz: self.frequency_hz,
+        }
+    }
     /// Scene name.
     pub fn name(&self) -> &str {
         &self.name

@@ -3,7 +3,10 @@
 //! memory: one request at a time (`answer_line`, as a client that waits for each answer), then
 //! the whole stream at once (consecutive moves answered together), then in requests of BATCH
 //! receivers. Prints the throughput, the percentiles of `latency_us` and, for one receiver per
-//! request, the mean paths and stage times of an answer (docs/performance.md).
+//! request, the mean paths and stage times of an answer (docs/performance.md). With
+//! `STREAM_TAIL=1` it also prints what the slowest 1 % of the answers are made of and the
+//! answers by their number of paths; with `STREAM_ONE=1` it runs the first mode alone, and `STREAM_OUT=FILE`
+//! writes that mode's answers to FILE, one a line.
 //!
 //! `cargo run --release -p bt-serve --example stream -- [MOVES] [MAX_ORDER] [BATCH]`
 
@@ -41,6 +44,10 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
     // A client that waits for each answer before its next request: answered alone.
     let (seconds, latencies) = one_at_a_time(max_order, &single)?;
     report("1 at a time", moves, seconds, &latencies);
+    // `STREAM_ONE=1`: that mode alone (for profiles of one answer at a time).
+    if std::env::var_os("STREAM_ONE").is_some() {
+        return Ok(());
+    }
     for (name, lines) in [("1 per request", &single), ("batched", &batched)] {
         let (seconds, latencies) = stream(max_order, lines)?;
         report(name, moves, seconds, &latencies);
@@ -84,6 +91,15 @@ fn one_at_a_time(
         ends.push(answers.len());
     }
     let seconds = t0.elapsed().as_secs_f64();
+    // `STREAM_OUT=FILE`: the answers, one a line, to compare builds.
+    if let Some(path) = std::env::var_os("STREAM_OUT") {
+        let mut file = std::io::BufWriter::new(std::fs::File::create(path)?);
+        let starts = std::iter::once(0).chain(ends.iter().copied());
+        for (a, &b) in starts.zip(&ends) {
+            std::io::Write::write_all(&mut file, &answers[a..b])?;
+            std::io::Write::write_all(&mut file, b"\n")?;
+        }
+    }
     let starts = std::iter::once(0).chain(ends.iter().copied());
     latencies(starts.zip(&ends).map(|(a, &b)| &answers[a..b]), seconds)
 }
@@ -93,30 +109,84 @@ fn latencies<'a>(
     answers: impl Iterator<Item = &'a [u8]>,
     seconds: f64,
 ) -> Result<(f64, Vec<f64>), Box<dyn std::error::Error>> {
-    let mut latencies = Vec::new();
-    // One receiver's answers: its stage times and paths, summed (a list's are inside
-    // `results`, not summed).
-    let (mut stages, mut paths) = ([0.0; 3], 0);
+    // One receiver's answers: its latency, paths and stage times (a list's are inside
+    // `results`, not counted).
+    let mut each = Vec::new();
     for line in answers.filter(|l| !l.is_empty()) {
         let v: serde_json::Value = serde_json::from_slice(line)?;
-        latencies.extend(v["latency_us"].as_f64());
-        for (sum, stage) in stages.iter_mut().zip(["candidates", "solve", "report"]) {
-            *sum += v["stats"]["time_s"][stage].as_f64().unwrap_or(0.0);
+        let Some(latency) = v["latency_us"].as_f64() else {
+            continue;
+        };
+        let stage = |s: &str| v["stats"]["time_s"][s].as_f64().unwrap_or(0.0) * 1e6;
+        let paths = v["paths"].as_array().map_or(0, Vec::len);
+        let stages = [stage("candidates"), stage("solve"), stage("report")];
+        each.push(Sample {
+            latency,
+            paths,
+            stages,
+        });
+    }
+    if each.iter().any(|s| s.paths > 0) {
+        println!("{:>14}  per answer: {}", "", Sample::mean(&each));
+        // What the slowest answers are made of (`STREAM_TAIL=1`): the slowest 1 % beside
+        // all, and the answers by their number of paths.
+        if std::env::var_os("STREAM_TAIL").is_some() {
+            tail(&mut each);
         }
-        paths += v["paths"].as_array().map_or(0, Vec::len);
     }
-    if paths > 0 {
-        let n = latencies.len().max(1) as f64;
-        let [c, s, r] = stages.map(|t| t / n * 1e6);
-        println!(
-            "{:>14}  per answer: {:.1} paths; candidates {c:.1} us, solve {s:.1} us, report \
-             {r:.1} us",
-            "",
-            paths as f64 / n
-        );
-    }
+    let mut latencies: Vec<f64> = each.iter().map(|s| s.latency).collect();
     latencies.sort_by(f64::total_cmp);
     Ok((seconds, latencies))
+}
+
+/// One answer of a lone receiver: its `latency_us`, paths and stage times (µs).
+struct Sample {
+    latency: f64,
+    paths: usize,
+    stages: [f64; 3],
+}
+
+impl Sample {
+    /// The mean of `samples`' paths, stages, latency and the rest (JSON, reply) as text.
+    fn mean(samples: &[Sample]) -> String {
+        let n = samples.len().max(1) as f64;
+        let sum = |f: &dyn Fn(&Sample) -> f64| samples.iter().map(f).sum::<f64>() / n;
+        let [c, s, r] = [0, 1, 2].map(|k| sum(&|x: &Sample| x.stages[k]));
+        let latency = sum(&|x: &Sample| x.latency);
+        format!(
+            "{:.1} paths; candidates {c:.1} us, solve {s:.1} us, report {r:.1} us, rest \
+             {:.1} us; latency {latency:.1} us ({} answers)",
+            sum(&|x: &Sample| x.paths as f64),
+            latency - c - s - r,
+            samples.len()
+        )
+    }
+}
+
+/// Print the slowest 1 % of `samples` beside the rest, and the samples by paths.
+fn tail(samples: &mut [Sample]) {
+    samples.sort_by(|a, b| a.latency.total_cmp(&b.latency));
+    let cut = samples.len() * 99 / 100;
+    println!(
+        "{:>14}  fastest 99 %: {}",
+        "",
+        Sample::mean(&samples[..cut])
+    );
+    println!("{:>14}  slowest 1 %: {}", "", Sample::mean(&samples[cut..]));
+    samples.sort_by_key(|s| s.paths);
+    for bin in samples.chunk_by(|a, b| a.paths / 20 == b.paths / 20) {
+        let mut l: Vec<f64> = bin.iter().map(|s| s.latency).collect();
+        l.sort_by(f64::total_cmp);
+        println!(
+            "{:>14}  {:>3}-{:<3} paths: p50 {:.1} p99 {:.1}; {}",
+            "",
+            bin[0].paths / 20 * 20,
+            bin[0].paths / 20 * 20 + 19,
+            l[l.len() / 2],
+            l[(l.len() - 1) * 99 / 100],
+            Sample::mean(bin)
+        );
+    }
 }
 
 /// A server of the living room at `max_order`, as `beamtrace serve` makes it.

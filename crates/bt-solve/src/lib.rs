@@ -112,18 +112,27 @@ pub enum Interaction {
 impl FoundPath {
     /// The interactions, aligned with [`FoundPath::points`].
     pub fn interactions(&self) -> Vec<Interaction> {
+        let mut interactions = Vec::with_capacity(self.points.len());
+        self.interactions_into(&mut interactions);
+        interactions
+    }
+
+    /// [`FoundPath::interactions`] into `interactions` (cleared first), whose memory a report
+    /// of many paths reuses.
+    pub fn interactions_into(&self, interactions: &mut Vec<Interaction>) {
         let mut reflections = self.surfaces.iter();
         let mut crossings = self.crossings.iter().peekable();
         let mut diffractions = self.diffractions.iter().peekable();
-        (0..self.points.len())
-            .filter_map(|i| match crossings.next_if(|c| c.index == i) {
+        interactions.clear();
+        interactions.extend((0..self.points.len()).filter_map(|i| {
+            match crossings.next_if(|c| c.index == i) {
                 Some(c) => Some(Interaction::Transmission(c.surface)),
                 None => match diffractions.next_if(|d| d.index == i) {
                     Some(d) => Some(Interaction::Diffraction(d.edge)),
                     None => reflections.next().map(|s| Interaction::Reflection(*s)),
                 },
-            })
-            .collect()
+            }
+        }));
     }
 
     /// The path with the penetrable surfaces its segments cross in `scene` (between `ends`)
