@@ -61,8 +61,14 @@ impl EdgeLine {
     /// The distance of `p` from the line (m).
     #[inline]
     pub fn distance(&self, p: Vec3) -> Real {
+        self.offset(p).length()
+    }
+
+    /// `p`'s offset from the line, perpendicular to it (m).
+    #[inline]
+    fn offset(&self, p: Vec3) -> Vec3 {
         let v = p - self.start;
-        (v - v.dot(self.direction) * self.direction).length()
+        v - v.dot(self.direction) * self.direction
     }
 
     /// The parameter of `p`'s projection on the line (m).
@@ -87,9 +93,7 @@ impl EdgeLine {
         let sum = da + db;
         (sum > 0.0 && sum.is_finite()).then(|| (db * a_along + da * self.along(b)) / sum)
     }
-}
 
-impl EdgeLine {
     /// An interval of parameters on this line holding the Keller point of `a` and each point
     /// of `other` with its parameter in `range` (m), `a` given by its distance from this line
     /// and its parameter ([`Self::keller_from`]). Conservative: the Keller point is
@@ -107,12 +111,9 @@ impl EdgeLine {
     ) -> Option<(Real, Real)> {
         let (p, q) = (other.point(lo), other.point(hi));
         let (m0, m1) = (self.along(p) - a_along, self.along(q) - a_along);
-        // Each end's offset from the line, perpendicular to it: affine along `other`.
-        let offset = |x: Vec3| {
-            let v = x - self.start;
-            v - v.dot(self.direction) * self.direction
-        };
-        let (u, w) = (offset(p), offset(q) - offset(p));
+        // The offset from the line is affine along `other`.
+        let u = self.offset(p);
+        let w = self.offset(q) - u;
         let ww = w.length_squared();
         let s = if ww > 0.0 {
             (-u.dot(w) / ww).clamp(0.0, 1.0)

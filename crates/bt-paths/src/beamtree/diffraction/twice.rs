@@ -406,6 +406,15 @@ const APART_SLACK: Real = 1e-6;
 /// Rounds of [`Pairing::apart`].
 const APART_ROUNDS: usize = 2;
 
+/// `into` cut to a range of Keller points `by` grown by [`APART_SLACK`]: whether it is now
+/// empty, or `None` (`into` unchanged) when there is no range.
+#[inline(always)]
+fn shrink(into: &mut (Real, Real), by: Option<(Real, Real)>) -> Option<bool> {
+    let (lo, hi) = by?;
+    *into = (into.0.max(lo - APART_SLACK), into.1.min(hi + APART_SLACK));
+    Some(into.0 > into.1)
+}
+
 /// Whether the ranges overlap, up to [`SLACK`].
 fn overlap(a: (Real, Real), b: (Real, Real)) -> bool {
     a.0 <= b.1 + SLACK && b.0 <= a.1 + SLACK
@@ -675,17 +684,9 @@ impl Pairing<'_> {
     /// intersection with that range, and an empty one proves the pair outside.
     #[inline(always)]
     fn apart(&self, a: &Near, far: &Far<'_>) -> bool {
-        let grow = self.margin + APART_SLACK;
-        let mut near = (a.reach.lo - grow, a.reach.hi + grow);
-        let mut away = (far.reach.lo - grow, far.reach.hi + grow);
+        let mut near = self.grown(&a.reach);
+        let mut away = self.grown(&far.reach);
         let (first, second) = (&a.span.line, &far.wedge.line);
-        let shrink = |into: &mut (Real, Real), by: Option<(Real, Real)>| match by {
-            Some((lo, hi)) => {
-                *into = (into.0.max(lo - APART_SLACK), into.1.min(hi + APART_SLACK));
-                Some(into.0 > into.1)
-            }
-            None => None,
-        };
         for _ in 0..APART_ROUNDS {
             match shrink(&mut near, first.keller_range(a.focus, second, away)) {
                 Some(true) => return true,
@@ -707,15 +708,17 @@ impl Pairing<'_> {
     /// reach (grown as in [`Pairing::apart`]), so does every pair.
     #[inline(always)]
     fn beyond(&self, span: &Span, far: &Far<'_>) -> bool {
-        let grow = self.margin + APART_SLACK;
-        let line = &far.wedge.line;
         let near = (span.t.0 - APART_SLACK, span.t.1 + APART_SLACK);
-        match line.keller_range(far.focus, &span.line, near) {
-            Some((lo, hi)) => {
-                hi + APART_SLACK < far.reach.lo - grow || lo - APART_SLACK > far.reach.hi + grow
-            }
-            None => false,
-        }
+        let range = far.wedge.line.keller_range(far.focus, &span.line, near);
+        shrink(&mut self.grown(&far.reach), range) == Some(true)
+    }
+
+    /// `reach`'s interval grown by the margin and [`APART_SLACK`] (m), as [`Pairing::apart`]
+    /// and [`Pairing::beyond`] test it.
+    #[inline(always)]
+    fn grown(&self, reach: &Reach) -> (Real, Real) {
+        let grow = self.margin + APART_SLACK;
+        (reach.lo - grow, reach.hi + grow)
     }
 
     /// `Some` when the Keller pair of `a` and `far` lies in both reaches (within the margin),
