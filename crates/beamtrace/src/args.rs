@@ -1113,6 +1113,11 @@ pub struct HlsGenArgs {
     /// per plane a path meets.
     #[arg(long, value_parser = clap::value_parser!(u32).range(0..=4096))]
     pub pe_budget: Option<u32>,
+    /// Build N generic PEs instead of one per plane: any PE takes any plane's job, its plane's
+    /// coefficients loaded with it from a plane table the host writes, so the PE count follows
+    /// the work, not the planes (docs/hardware.md; no early stopping). Not with --pe-budget.
+    #[arg(long, value_parser = clap::value_parser!(u32).range(1..=255), conflicts_with = "pe_budget")]
+    pub generic_pes: Option<u32>,
     /// Convergence threshold on a round's largest displacement, in 1/256 mm.
     #[arg(long, default_value_t = 16)]
     pub threshold_lsb: u32,

@@ -314,6 +314,7 @@ fn step_options(args: &HlsGenArgs, planes: usize) -> bt_accel::StepOptions {
                 Some(n) => Some(n),
             },
             ga: GaParams::default(),
+            generic_pes: args.generic_pes,
         },
         warm_start: args.warm_start,
         round_order: args.round_order.order(),

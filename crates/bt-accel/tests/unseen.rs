@@ -20,6 +20,7 @@ fn options() -> StepOptions {
             schedule: ScheduleKind::List,
             pe_budget: None,
             ga: GaParams::default(),
+            generic_pes: None,
         },
         warm_start: false,
         round_order: bt_fixed::RoundOrder::RedBlack,

@@ -129,7 +129,7 @@ fn rtl_of(
     model: &bt_fixed::FixedIpc,
 ) -> Result<Vec<(String, String)>, HlsError> {
     let mut planes: std::collections::BTreeMap<u32, u32> = std::collections::BTreeMap::new();
-    for i in &platform.instances {
+    for i in platform.instances.iter().filter(|i| !i.is_generic()) {
         *planes.entry(i.plane).or_insert(0) += 1;
     }
     let wd = bt_fixed::Widths::for_coord(model.coord_bits());
@@ -137,9 +137,13 @@ fn rtl_of(
         .iter()
         .map(|(&p, &copies)| (p, copies, &model.planes()[p as usize]))
         .collect();
-    let multipliers = rtl::mult::network_forms(&fixed, wd, platform.multiplier_budget);
     let core = rtl::pe::pe_core_module(wd);
     let mut out = vec![(core.name.clone(), verilog::print_module(&core))];
+    if platform.is_generic() {
+        let m = rtl::generic::generic_pe_module(wd)?;
+        out.push((m.name.clone(), verilog::print_module(&m)));
+    }
+    let multipliers = rtl::mult::network_forms(&fixed, wd, platform.multiplier_budget);
     for (p, _, plane) in fixed {
         let spec = &platform.planes[p as usize];
         let forms = multipliers
