@@ -351,13 +351,27 @@ pub(crate) fn register_map(d: &Design) -> String {
         l.path_bits - 1,
         cap.entries
     ));
+    if let Some(base) = l.map.plane_base {
+        s.push_str(&format!(
+            "Generic PEs: each SCHED entry also holds the job's plane, `plane[{}:0]`, above its \
+             column; the host writes the plane table per step at 0x{base:04x} + 8p + w \
+             (PLANE[p] word w, p < {}): w = 0, 1, 2 the normal's x, y, z (Q2.30, two's \
+             complement), w = 3.. −offset in fine LSB (1/256 mm), low word first. A PE latches \
+             its job's plane with the operands.\n\n",
+            l.plane_bits - 1,
+            d.platform.planes.len()
+        ));
+    }
     s.push_str("PE columns: ");
     let cols: Vec<String> = d
         .platform
         .instances
         .iter()
         .enumerate()
-        .map(|(c, i)| format!("{c} = plane {} copy {}", i.plane, i.copy))
+        .map(|(c, i)| match i.is_generic() {
+            true => format!("{c} = generic"),
+            false => format!("{c} = plane {} copy {}", i.plane, i.copy),
+        })
         .collect();
     s.push_str(&cols.join(", "));
     s.push_str(".\n\n");
