@@ -55,6 +55,11 @@ use error::io_err;
 use host::{host_program, register_map, stimulus};
 use input::Design;
 
+/// Generic PEs of `hls gen`'s design by default: the fewest at which the cold steps of the
+/// unseen ~30-plane rooms and of the living room stay within a millisecond at 50 MHz
+/// (docs/hardware.md's sweep: 0.73 ms at 12 on the hardest room, 1.07 ms at 10).
+pub const DEFAULT_GENERIC_PES: u32 = 12;
+
 /// Clock of the accelerator on the paper's platform (Intel Cyclone IV E at 50 MHz), Hz: a run
 /// takes its cycle count (the CYCLES register, [`run_cycles`]) over this, in seconds.
 pub const CLOCK_HZ: f64 = 50e6;
