@@ -209,8 +209,9 @@ pub struct Capacity {
     pub entries: u32,
 }
 
-/// The accelerator as synthesised once per static room: one PE per plane (plus duplicates)
-/// with its constants baked in, the convergence threshold, early stopping, and the capacity of
+/// The accelerator as synthesised once per static room: generic PEs
+/// ([`bt_schedule::PeInstance::generic`], the planes' coefficients in a plane table), or one PE
+/// per plane (plus duplicates) with its constants baked in, the convergence threshold, early stopping, and the capacity of
 /// the RAMs the host fills per time step.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Platform {
@@ -566,7 +567,7 @@ fn generic_problems(platform: &Platform) -> Vec<String> {
     if blocks > platform.multiplier_budget {
         problems.push(format!(
             "{generic} generic PEs need {blocks} 18 x 18 multiplier blocks, more than the budget \
-             of {}",
+             of {} (--multiplier-budget): use fewer --generic-pes",
             platform.multiplier_budget
         ));
     }

@@ -1,5 +1,6 @@
 //! RTL generation, co-simulation and synthesis of the beamtrace IPC accelerator (paper
-//! sections IV-V): one PE per plane with its constants as shift-add networks, a controller
+//! sections IV-V): generic PEs that take any plane's job (its coefficients from a plane table
+//! the host writes), or one PE per plane with its constants as shift-add networks, a controller
 //! that dispatches each path's rounds at run time ([`dispatch`]: no round count is loaded, so
 //! the host never runs the model to plan), the coordinate updater-buffer, per-path
 //! convergence flags and an Avalon-MM register interface.
