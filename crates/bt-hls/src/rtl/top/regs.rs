@@ -67,6 +67,14 @@ pub(super) struct RegSizes {
     pub(super) early: bool,
 }
 
+impl RegSizes {
+    /// Bits of the written job's plane that early stopping's box needs (generic PEs with
+    /// early stopping), or none.
+    fn box_plane_bits(&self) -> Option<u32> {
+        (self.early && self.plb > 0).then_some(self.plb)
+    }
+}
+
 /// The registers and memories of `bt_top` (field = Verilog name).
 pub(super) struct Regs {
     /// Main FSM state and its step counter.
@@ -305,11 +313,7 @@ impl Regs {
             ld_q_inst: r("ld_q_inst", ib),
             ld_go: r("ld_go", 1),
             ld_go_inst: r("ld_go_inst", ib),
-            wbe: WbEntry::declare(
-                &mut r,
-                (pb, ptb, ib, eb),
-                (s.early && s.plb > 0).then_some(s.plb),
-            ),
+            wbe: WbEntry::declare(&mut r, (pb, ptb, ib, eb), s.box_plane_bits()),
             rq_valid: r("rq_valid", 1),
             rq_kind: r("rq_kind", 2),
             rq_reg: r("rq_reg", 4),
