@@ -1107,12 +1107,18 @@ pub struct HlsGenArgs {
     /// Candidate generator of each step (as `trace --candidates`).
     #[arg(long, value_enum, default_value_t = CandidatesArg::BeamTree)]
     pub candidates: CandidatesArg,
-    /// Total PE instances: the PEs beyond one per plane used become copies of the planes with
-    /// the most jobs in one round (sized at step 0 for the whole stream). Default: one per
-    /// static reflector, so the PEs of planes no path meets become copies; 0: no copy, one PE
-    /// per plane a path meets.
+    /// PEs per plane (not generic), N in all: the PEs beyond one per plane used become copies
+    /// of the planes with the most jobs in one round (sized at step 0 for the whole stream).
+    /// With --generic-pes 0 and no budget: one per static reflector, so the PEs of planes no
+    /// path meets become copies; 0: no copy, one PE per plane a path meets.
     #[arg(long, value_parser = clap::value_parser!(u32).range(0..=4096))]
     pub pe_budget: Option<u32>,
+    /// Generic PEs (the default, 12): any PE takes any plane's job, its plane's coefficients
+    /// loaded with it from a plane table the host writes, so the PE count follows the work,
+    /// not the planes (docs/hardware.md). 0: PEs per plane, as the paper (sized by
+    /// --pe-budget, which implies 0).
+    #[arg(long, value_parser = clap::value_parser!(u32).range(0..=255), conflicts_with = "pe_budget")]
+    pub generic_pes: Option<u32>,
     /// Convergence threshold on a round's largest displacement, in 1/256 mm.
     #[arg(long, default_value_t = 16)]
     pub threshold_lsb: u32,

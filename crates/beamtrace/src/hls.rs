@@ -290,9 +290,10 @@ fn summary(
     }
 }
 
-/// How `hls gen` plans each step on a platform of `planes` static reflectors: as many PEs as
-/// planes unless `--pe-budget` says otherwise (the PEs of planes no path meets become copies;
-/// 0: no copy).
+/// How `hls gen` plans each step on a platform of `planes` static reflectors: on
+/// [`bt_hls::DEFAULT_GENERIC_PES`] generic PEs unless `--generic-pes` says otherwise; with
+/// `--generic-pes 0` or `--pe-budget`, PEs per plane: as many as planes unless `--pe-budget`
+/// says otherwise (the PEs of planes no path meets become copies; 0: no copy).
 fn step_options(args: &HlsGenArgs, planes: usize) -> bt_accel::StepOptions {
     bt_accel::StepOptions {
         trace: bt_solve::pipeline::TraceOptions {
@@ -314,6 +315,11 @@ fn step_options(args: &HlsGenArgs, planes: usize) -> bt_accel::StepOptions {
                 Some(n) => Some(n),
             },
             ga: GaParams::default(),
+            // --pe-budget sizes PEs per plane; otherwise generic PEs (0: per plane).
+            generic_pes: match (args.pe_budget, args.generic_pes) {
+                (Some(_), _) | (None, Some(0)) => None,
+                (None, g) => Some(g.unwrap_or(bt_hls::DEFAULT_GENERIC_PES)),
+            },
         },
         warm_start: args.warm_start,
         round_order: args.round_order.order(),

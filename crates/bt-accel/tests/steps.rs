@@ -20,6 +20,7 @@ fn options(max_order: usize, warm_start: bool) -> StepOptions {
             schedule: ScheduleKind::List,
             pe_budget: None,
             ga: GaParams::default(),
+            generic_pes: None,
         },
         warm_start,
         round_order: bt_fixed::RoundOrder::RedBlack,

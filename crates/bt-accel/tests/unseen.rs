@@ -20,6 +20,7 @@ fn options() -> StepOptions {
             schedule: ScheduleKind::List,
             pe_budget: None,
             ga: GaParams::default(),
+            generic_pes: None,
         },
         warm_start: false,
         round_order: bt_fixed::RoundOrder::RedBlack,
@@ -43,6 +44,84 @@ fn cold_step_on(seed: u64, pes: Option<u32>) -> (bt_scene::Scene, PlannedStep) {
     options.plan.pe_budget = Some(pes.unwrap_or(planes.len() as u32));
     let step = plan_step(&scene, &planes, 0, &options, None).unwrap();
     (scene, step)
+}
+
+/// PEs of the generic designs (docs/hardware.md: the fewest at which every room's cold step
+/// stays within the millisecond).
+const GENERIC_PES: u32 = 12;
+
+/// [`cold_step`] on `pes` generic PEs.
+fn cold_step_generic(seed: u64, pes: u32) -> PlannedStep {
+    let scene = bt_testkit::random_scene(seed, 34);
+    let planes = static_reflectors(std::slice::from_ref(&scene));
+    let mut options = options();
+    options.plan.generic_pes = Some(pes);
+    plan_step(&scene, &planes, 0, &options, None).unwrap()
+}
+
+/// The generic design of `seed`'s cold step, generated into `target/tmp` (for `beamtrace hls
+/// sim` and `hls synth`); returns the directory.
+fn generic_design(seed: u64, p: &PlannedStep) -> std::path::PathBuf {
+    let work = vec![p.work()];
+    let platform = bt_hls::Platform::fitting(&work).unwrap();
+    assert!(platform.is_generic(), "seed {seed}");
+    assert_eq!(
+        platform.instances.len(),
+        GENERIC_PES as usize,
+        "seed {seed}"
+    );
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
+        .join(format!("bt_accel_unseen_{seed}_generic{GENERIC_PES}"));
+    let _ = std::fs::remove_dir_all(&dir);
+    let report = bt_hls::generate_steps(&platform, &work, &dir).unwrap();
+    assert_eq!(
+        report.predicted.run_cycles,
+        vec![p.plan.predicted_cycles],
+        "seed {seed}"
+    );
+    dir
+}
+
+/// Every unseen room on 12 generic PEs (any PE takes any plane's job): no model run, no path
+/// missed or invented, every cold step within the millisecond, and each design generated
+/// (`beamtrace hls synth target/tmp/bt_accel_unseen_<seed>_generic12` gives the area in
+/// docs/hardware.md).
+#[test]
+fn unseen_rooms_on_generic_pes_stay_within_a_millisecond() {
+    for seed in SEEDS {
+        let p = cold_step_generic(seed, GENERIC_PES);
+        assert_eq!(p.host_model_runs, 0);
+        assert_eq!((p.fixed.missed, p.fixed.spurious), (0, 0), "seed {seed}");
+        let points_rounds: u64 = p
+            .results
+            .iter()
+            .map(|r| u64::from(r.rounds) * r.points.len() as u64)
+            .sum();
+        assert_eq!(p.plan.dispatch.jobs, points_rounds, "seed {seed}");
+        let latency_s = p.plan.predicted_cycles as f64 / bt_hls::CLOCK_HZ;
+        eprintln!(
+            "seed {seed} on {GENERIC_PES} generic PEs: {} cycles = {:.3} ms",
+            p.plan.predicted_cycles,
+            latency_s * 1e3
+        );
+        assert!(latency_s <= 1e-3, "seed {seed}: {latency_s} s");
+        generic_design(seed, &p);
+    }
+}
+
+/// The hardest unseen room (seed 11, the most jobs) through the generic design's RTL
+/// (Verilator): bit-exact, with the twin's cycles.
+#[test]
+fn an_unseen_room_on_generic_pes_cosimulates_bit_exact() {
+    let seed = SEEDS[0];
+    let p = cold_step_generic(seed, GENERIC_PES);
+    let dir = generic_design(seed, &p);
+    let sim = bt_hls::simulate(&dir).unwrap();
+    assert_eq!(sim.mismatches, 0, "{:#?}", sim.mismatch_details);
+    assert!(sim.passed());
+    let measured = sim.step_latency_s();
+    eprintln!("seed {seed} on generic PEs: measured {measured:?} s");
+    assert!(measured[0] <= 1e-3, "{measured:?}");
 }
 
 /// The alternative measured for docs/hardware.md: phases of static list schedules with read-back
@@ -269,59 +348,24 @@ fn host_work_of_one_step(scene: &bt_scene::Scene, planes: &[bt_scene::SurfaceId]
     (points, plan.schedule.job_count())
 }
 
-/// The twin's cycles if every PE could take any plane's job (coefficients as data, not
-/// constant networks; not built): the round template with each group's points on the
-/// least-loaded distinct PEs of all `g` (a phase of more than `g` points split in groups of
-/// `g`), then the dispatcher's twin with the rounds of the verification run.
-/// `cargo test --release -p bt-accel --test unseen generic_pes -- --ignored --nocapture`
-/// (docs/hardware.md, the tilted rooms' area).
+/// The twin's cycles on `g` generic PEs for several `g` ([`bt_schedule::generic_round_template`],
+/// then the dispatcher's twin with the rounds of the verification run), which picked
+/// [`GENERIC_PES`]: `cargo test --release -p bt-accel --test unseen generic_pes_sweep --
+/// --ignored --nocapture` (docs/hardware.md).
 #[test]
-#[ignore = "an estimate for docs/hardware.md, prints only"]
-fn generic_pes_estimate() {
+#[ignore = "a sweep for docs/hardware.md, prints only"]
+fn generic_pes_sweep() {
     for seed in SEEDS {
         let (_, p) = cold_step(seed);
         let problem = p.step.input.one_round_problem();
         let rounds: Vec<u32> = p.results.iter().map(|r| r.rounds).collect();
         let mut line = format!("seed {seed}: {} jobs;", p.plan.dispatch.jobs);
         for g in [6usize, 8, 10, 12, 14, 16, 20, 24] {
-            let template = generic_template(&problem, g);
+            let template = bt_schedule::generic_round_template(&problem, g as u32).unwrap();
             let groups = bt_hls::dispatch::groups(&template, problem.paths.len()).unwrap();
             let run = bt_hls::dispatch::predict(&groups, g, &rounds, p.step.input.pe_latency());
             line += &format!(" {g}: {} = {:.3} ms;", run.cycles, run.cycles as f64 / 50e3);
         }
         eprintln!("{line}");
     }
-}
-
-/// One round of `problem` on `g` interchangeable PEs (see [`generic_pes_estimate`]).
-fn generic_template(problem: &bt_schedule::Problem, g: usize) -> bt_schedule::Schedule {
-    let mut given = vec![0u64; g];
-    let mut slots = Vec::new();
-    for (p, path) in problem.paths.iter().enumerate() {
-        let n = path.planes.len() as u32;
-        let phases = path.phases.clamp(1, n);
-        for phase in 0..phases {
-            let points: Vec<u32> = (phase..n).step_by(phases as usize).collect();
-            for chunk in points.chunks(g) {
-                let mut row = vec![None; g];
-                for &point in chunk {
-                    let c = (0..g)
-                        .filter(|&c| row[c].is_none())
-                        .min_by_key(|&c| (given[c], c))
-                        .unwrap();
-                    given[c] += 1;
-                    row[c] = Some(bt_schedule::Job {
-                        path: p as u32,
-                        round: 0,
-                        point,
-                    });
-                }
-                slots.push(row);
-            }
-        }
-    }
-    let instances = (0..g as u32)
-        .map(|copy| bt_schedule::PeInstance { plane: 0, copy })
-        .collect();
-    bt_schedule::Schedule { instances, slots }
 }

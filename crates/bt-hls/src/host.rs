@@ -89,7 +89,8 @@ pub fn status_word(r: &PathResult) -> u32 {
 fn job_writes(d: &Design, s: &StepDesign, ops: &mut Vec<BusOp>) {
     let (pb, ptb) = (d.layout.path_bits, d.layout.point_bits);
     let tail_bit = 1u64 << (5 + pb + ptb);
-    let wide = crate::input::sched_entry_bits(pb, ptb, d.layout.inst_bits) > 32;
+    let l = &d.layout;
+    let wide = crate::input::sched_entry_bits(pb, ptb, l.inst_bits, l.plane_bits) > 32;
     let phases = s.work.input.round_order.phases();
     let mut high = None;
     let mut entry = 0u32;
@@ -115,7 +116,8 @@ fn job_writes(d: &Design, s: &StepDesign, ops: &mut Vec<BusOp>) {
                     | u64::from(end) << (3 + pb + ptb)
                     | u64::from(late) << (4 + pb + ptb)
                     | if tail { tail_bit } else { 0 }
-                    | u64::from(col) << (6 + pb + ptb);
+                    | u64::from(col) << (6 + pb + ptb)
+                    | plane_field(s, p, point) << (6 + pb + ptb + l.inst_bits);
                 // A wide entry's high bits go to SCHED_HI first, when they change.
                 let hi = (word >> 32) as u32;
                 if wide && high != Some(hi) {
@@ -129,6 +131,45 @@ fn job_writes(d: &Design, s: &StepDesign, ops: &mut Vec<BusOp>) {
     }
     ops.push(BusOp::Write(regs::PATHS, s.groups.len() as u32));
     ops.push(BusOp::Write(regs::ROUND_CAP, s.work.input.max_rounds));
+}
+
+/// The plane of point `point` of path `p` as a job's plane field, on generic PEs (0 on plane
+/// PEs, whose column says the plane).
+fn plane_field(s: &StepDesign, p: usize, point: u32) -> u64 {
+    if s.generic {
+        u64::from(s.work.input.paths[p][point as usize])
+    } else {
+        0
+    }
+}
+
+/// The plane table's writes (generic PEs only): per plane its bus words
+/// ([`crate::input::plane_table_words`]) at `plane_base + 8·plane + word`. Refused: an
+/// offset wider than the table's word.
+fn plane_writes(d: &Design, ops: &mut Vec<BusOp>) -> Result<(), HlsError> {
+    let Some(base) = d.layout.map.plane_base else {
+        return Ok(());
+    };
+    let wd = bt_fixed::Widths::for_coord(d.platform.coord_bits);
+    let ow = crate::rtl::generic::offset_bits(wd);
+    for (i, plane) in d.model.planes().iter().enumerate() {
+        let neg = -i128::from(plane.offset.0);
+        if neg >= 1 << (ow - 1) || neg < -(1 << (ow - 1)) {
+            return Err(HlsError::TooLarge(format!(
+                "plane {i}'s offset does not fit the plane table's {ow}-bit word"
+            )));
+        }
+        let at = base + 8 * i as u32;
+        for (k, n) in plane.normal.iter().enumerate() {
+            ops.push(BusOp::Write(at + k as u32, n.0 as u32));
+        }
+        let words = crate::input::plane_table_words(wd, true).len() - 3;
+        for w in 0..words {
+            let bits = (neg >> (32 * w)) as u32;
+            ops.push(BusOp::Write(at + 3 + w as u32, bits));
+        }
+    }
+    Ok(())
 }
 
 /// The ready queue's start of a run: `PATH_BASE[p] = {first, first}`, path `p`'s first
@@ -223,6 +264,7 @@ pub(crate) fn host_program(d: &Design) -> Result<(Vec<BusOp>, Vec<VectorExpectat
     let mut ops = Vec::new();
     let mut runs = Vec::new();
     for (k, s) in d.steps.iter().enumerate() {
+        plane_writes(d, &mut ops)?;
         job_writes(d, s, &mut ops);
         for v in s.work.input.vectors()? {
             let (o, e) = run_ops(d, s, k, v);
@@ -309,13 +351,27 @@ pub(crate) fn register_map(d: &Design) -> String {
         l.path_bits - 1,
         cap.entries
     ));
+    if let Some(base) = l.map.plane_base {
+        s.push_str(&format!(
+            "Generic PEs: each SCHED entry also holds the job's plane, `plane[{}:0]`, above its \
+             column; the host writes the plane table per step at 0x{base:04x} + 8p + w \
+             (PLANE[p] word w, p < {}): w = 0, 1, 2 the normal's x, y, z (Q2.30, two's \
+             complement), w = 3.. −offset in fine LSB (1/256 mm), low word first. A PE latches \
+             its job's plane with the operands.\n\n",
+            l.plane_bits - 1,
+            d.platform.planes.len()
+        ));
+    }
     s.push_str("PE columns: ");
     let cols: Vec<String> = d
         .platform
         .instances
         .iter()
         .enumerate()
-        .map(|(c, i)| format!("{c} = plane {} copy {}", i.plane, i.copy))
+        .map(|(c, i)| match i.is_generic() {
+            true => format!("{c} = generic"),
+            false => format!("{c} = plane {} copy {}", i.plane, i.copy),
+        })
         .collect();
     s.push_str(&cols.join(", "));
     s.push_str(".\n\n");

@@ -209,8 +209,9 @@ pub struct Capacity {
     pub entries: u32,
 }
 
-/// The accelerator as synthesised once per static room: one PE per plane (plus duplicates)
-/// with its constants baked in, the convergence threshold, early stopping, and the capacity of
+/// The accelerator as synthesised once per static room: generic PEs
+/// ([`bt_schedule::PeInstance::generic`], the planes' coefficients in a plane table), or one PE
+/// per plane (plus duplicates) with its constants baked in, the convergence threshold, early stopping, and the capacity of
 /// the RAMs the host fills per time step.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Platform {
@@ -259,6 +260,12 @@ pub struct StepWork {
 }
 
 impl Platform {
+    /// Whether the platform's PEs are generic ([`PeInstance::generic`]): any PE takes any
+    /// plane's job, the plane's coefficients loaded with it from the plane table.
+    pub fn is_generic(&self) -> bool {
+        self.instances.first().is_some_and(|i| i.is_generic())
+    }
+
     /// The smallest platform that runs every step of `work`: the planes, threshold, early
     /// stopping and coordinate word of the first step, one PE per plane that some step's
     /// schedule uses (more where a schedule duplicates it; none for a plane no step's paths
@@ -278,9 +285,12 @@ impl Platform {
             slots: 1,
             entries: 1,
         };
+        let mut generic = 0u32;
         for w in work {
             for inst in &w.schedule.instances {
-                if let Some(c) = copies.get_mut(inst.plane as usize) {
+                if inst.is_generic() {
+                    generic = generic.max(inst.copy + 1);
+                } else if let Some(c) = copies.get_mut(inst.plane as usize) {
                     *c = (*c).max(inst.copy + 1);
                 }
             }
@@ -301,6 +311,7 @@ impl Platform {
                     copy,
                 })
             })
+            .chain((0..generic).map(PeInstance::generic))
             .collect();
         Ok(Platform {
             planes: first.input.planes.clone(),
@@ -330,6 +341,8 @@ pub(crate) struct StepDesign {
     pub makespan: u32,
     /// Platform column of each schedule instance.
     pub columns: Vec<u32>,
+    /// The platform's PEs are generic: each job carries its plane.
+    pub generic: bool,
 }
 
 /// The validated design: platform, per-step work and every derived size.
@@ -353,6 +366,11 @@ pub struct AddressMap {
     pub point_base: u32,
     /// Word address of the first schedule entry (`SCHED[j]` at `sched_base + j`).
     pub sched_base: u32,
+    /// Word address of the plane table on generic PEs (`PLANE[p]` word `w` at
+    /// `plane_base + 8·p + w`: the normal's x, y, z in Q2.30, then −offset in fine LSB, low
+    /// word first); `None` on plane PEs.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub plane_base: Option<u32>,
 }
 
 impl AddressMap {
@@ -372,6 +390,8 @@ pub(crate) struct Layout {
     pub inst_bits: u32,
     /// Bits of a schedule-memory entry index.
     pub entry_bits: u32,
+    /// Bits of a job's plane field (generic PEs; 0 on plane PEs).
+    pub plane_bits: u32,
     /// Width of `avs_address`, bits.
     pub address_bits: u32,
     /// The status, point and schedule regions.
@@ -393,7 +413,15 @@ impl Layout {
         let point_region_bits = (point_bits + 3).max(status_bits + 1);
         let entry_bits = bits_for(cap.entries.max(1).into());
         let sched_region_bits = entry_bits.max(point_region_bits + 1);
-        let address_bits = (sched_region_bits + 1).max(MIN_ADDRESS_BITS);
+        let generic = platform.is_generic();
+        let plane_bits = if generic {
+            bits_for(platform.planes.len() as u64)
+        } else {
+            0
+        };
+        // The plane table (generic PEs): 8 words a plane above the schedule region.
+        let region_end = sched_region_bits + 1 + u32::from(generic);
+        let address_bits = region_end.max(MIN_ADDRESS_BITS);
         if address_bits > MAX_ADDRESS_BITS {
             return Err(HlsError::TooLarge(format!(
                 "{} paths, {} points and {} schedule entries need {address_bits} address bits, \
@@ -401,14 +429,20 @@ impl Layout {
                 cap.paths, cap.points, cap.entries
             )));
         }
-        let sw = sched_entry_bits(path_bits, point_bits, inst_bits);
-        let word = crate::rtl::pe::point_bits(bt_fixed::Widths::for_coord(platform.coord_bits));
+        let sw = sched_entry_bits(path_bits, point_bits, inst_bits, plane_bits);
+        let wd = bt_fixed::Widths::for_coord(platform.coord_bits);
+        let word = crate::rtl::pe::point_bits(wd);
         // Point memory copies (three: the load's two neighbours, the write-back's old point),
-        // job memory, slot buffer (two slots) and ready queue.
+        // job memory, slot buffer (two slots), ready queue and the plane table's words.
+        let table: u64 = plane_table_words(wd, generic)
+            .iter()
+            .map(|&w| m9k_blocks(1 << plane_bits, w.into()))
+            .sum();
         let blocks = 3 * m9k_blocks(1 << (point_bits + 1), word.into())
             + m9k_blocks(1 << entry_bits, sw.into())
             + m9k_blocks(2 << inst_bits, (sw + 2 * entry_bits).into())
-            + m9k_blocks(1 << path_bits, (2 * entry_bits).into());
+            + m9k_blocks(1 << path_bits, (2 * entry_bits).into())
+            + table;
         if blocks > platform.m9k_budget.into() {
             return Err(HlsError::TooLarge(format!(
                 "{} paths, {} points and {} schedule entries ({} slots, {} PEs) need {blocks} M9K \
@@ -441,20 +475,43 @@ impl Layout {
             point_bits,
             inst_bits,
             entry_bits,
+            plane_bits,
             address_bits,
             map: AddressMap {
                 status_base: 1 << status_bits,
                 point_base: 1 << point_region_bits,
                 sched_base: 1 << sched_region_bits,
+                plane_base: generic.then_some(1 << (sched_region_bits + 1)),
             },
         })
     }
 }
 
-/// Schedule-entry fields: `{column, tail, end, last, first, point, path, valid}` from bit 0
-/// up (`tail` marks a slot's last entry, `column` the PE).
-pub(crate) fn sched_entry_bits(path_bits: u32, point_bits: u32, inst_bits: u32) -> u32 {
-    6 + path_bits + point_bits + inst_bits
+/// Schedule-entry fields: `{plane, column, tail, late, end, last, first, point, path, valid}`
+/// from bit 0 up (`tail` marks a group's last entry, `column` the PE, `plane` the job's plane
+/// on generic PEs: `plane_bits` 0 otherwise).
+pub(crate) fn sched_entry_bits(
+    path_bits: u32,
+    point_bits: u32,
+    inst_bits: u32,
+    plane_bits: u32,
+) -> u32 {
+    6 + path_bits + point_bits + inst_bits + plane_bits
+}
+
+/// The widths of a plane-table entry's bus words (generic PEs; none on plane PEs): the
+/// normal's three Q2.30 components, then the negated offset in 32-bit words, low first.
+pub(crate) fn plane_table_words(wd: bt_fixed::Widths, generic: bool) -> Vec<u32> {
+    if !generic {
+        return Vec::new();
+    }
+    let mut words = vec![crate::rtl::generic::NORMAL_BITS; 3];
+    let mut left = crate::rtl::generic::offset_bits(wd);
+    while left > 0 {
+        words.push(left.min(32));
+        left -= left.min(32);
+    }
+    words
 }
 
 impl Design {
@@ -472,10 +529,11 @@ impl Design {
             problems.push("the platform has no PE".into());
         }
         for inst in &platform.instances {
-            if inst.plane as usize >= platform.planes.len() {
+            if inst.plane as usize >= platform.planes.len() && !inst.is_generic() {
                 problems.push(format!("PE of plane {} out of range", inst.plane));
             }
         }
+        problems.extend(generic_problems(platform));
         if !problems.is_empty() {
             return Err(HlsError::InvalidInput { problems });
         }
@@ -491,6 +549,29 @@ impl Design {
             layout: Layout::of(platform)?,
         })
     }
+}
+
+/// What a generic platform cannot do: mix generic and plane PEs, or hold more multiplier
+/// blocks than its budget.
+fn generic_problems(platform: &Platform) -> Vec<String> {
+    let generic = platform.instances.iter().filter(|i| i.is_generic()).count() as u32;
+    let mut problems = Vec::new();
+    if generic == 0 {
+        return problems;
+    }
+    if generic as usize != platform.instances.len() {
+        problems.push("a platform mixes generic PEs and plane PEs".into());
+    }
+    let wd = bt_fixed::Widths::for_coord(platform.coord_bits);
+    let blocks = generic * crate::rtl::generic::generic_pe_blocks(wd);
+    if blocks > platform.multiplier_budget {
+        problems.push(format!(
+            "{generic} generic PEs need {blocks} 18 x 18 multiplier blocks, more than the budget \
+             of {} (--multiplier-budget): use fewer --generic-pes",
+            platform.multiplier_budget
+        ));
+    }
+    problems
 }
 
 /// The fixed-point model of the platform's planes alone (no path): quantised planes and
@@ -618,6 +699,7 @@ fn step_design(platform: &Platform, k: usize, w: &StepWork) -> Result<StepDesign
         first_point,
         makespan,
         columns,
+        generic: platform.is_generic(),
     })
 }
 

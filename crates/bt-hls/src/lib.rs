@@ -1,5 +1,6 @@
 //! RTL generation, co-simulation and synthesis of the beamtrace IPC accelerator (paper
-//! sections IV-V): one PE per plane with its constants as shift-add networks, a controller
+//! sections IV-V): generic PEs that take any plane's job (its coefficients from a plane table
+//! the host writes), or one PE per plane with its constants as shift-add networks, a controller
 //! that dispatches each path's rounds at run time ([`dispatch`]: no round count is loaded, so
 //! the host never runs the model to plan), the coordinate updater-buffer, per-path
 //! convergence flags and an Avalon-MM register interface.
@@ -54,6 +55,11 @@ pub use tools::{
 use error::io_err;
 use host::{host_program, register_map, stimulus};
 use input::Design;
+
+/// Generic PEs of `hls gen`'s design by default: the fewest at which the cold steps of the
+/// unseen ~30-plane rooms and of the living room stay within a millisecond at 50 MHz
+/// (docs/hardware.md's sweep: 0.73 ms at 12 on the hardest room, 1.07 ms at 10).
+pub const DEFAULT_GENERIC_PES: u32 = 12;
 
 /// Clock of the accelerator on the paper's platform (Intel Cyclone IV E at 50 MHz), Hz: a run
 /// takes its cycle count (the CYCLES register, [`run_cycles`]) over this, in seconds.
@@ -129,7 +135,7 @@ fn rtl_of(
     model: &bt_fixed::FixedIpc,
 ) -> Result<Vec<(String, String)>, HlsError> {
     let mut planes: std::collections::BTreeMap<u32, u32> = std::collections::BTreeMap::new();
-    for i in &platform.instances {
+    for i in platform.instances.iter().filter(|i| !i.is_generic()) {
         *planes.entry(i.plane).or_insert(0) += 1;
     }
     let wd = bt_fixed::Widths::for_coord(model.coord_bits());
@@ -137,9 +143,13 @@ fn rtl_of(
         .iter()
         .map(|(&p, &copies)| (p, copies, &model.planes()[p as usize]))
         .collect();
-    let multipliers = rtl::mult::network_forms(&fixed, wd, platform.multiplier_budget);
     let core = rtl::pe::pe_core_module(wd);
     let mut out = vec![(core.name.clone(), verilog::print_module(&core))];
+    if platform.is_generic() {
+        let m = rtl::generic::generic_pe_module(wd)?;
+        out.push((m.name.clone(), verilog::print_module(&m)));
+    }
+    let multipliers = rtl::mult::network_forms(&fixed, wd, platform.multiplier_budget);
     for (p, _, plane) in fixed {
         let spec = &platform.planes[p as usize];
         let forms = multipliers

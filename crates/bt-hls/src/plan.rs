@@ -39,6 +39,11 @@ pub struct PlanOptions {
     pub pe_budget: Option<u32>,
     /// GA parameters (seed included); ignored by the list scheduler.
     pub ga: GaParams,
+    /// Dynamic dispatch on this many generic PEs (any PE takes any plane's job,
+    /// [`bt_schedule::generic_round_template`]) instead of PEs per plane; `pe_budget` is then
+    /// not read. `None`: PEs per plane.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub generic_pes: Option<u32>,
 }
 
 /// A scheduled run: the schedule, its statistics and its cycle count.
@@ -188,19 +193,26 @@ fn plan_with(
 /// round template of `problem` ([`bt_schedule::round_template`]; its `rounds` are not read)
 /// on `copies[p]` PEs of plane `p` (the platform's), or with [`PlanOptions::pe_budget`] on the
 /// copies [`bt_schedule::size_copies`] picks by one round's load per plane, or one PE per
-/// plane. `predicted_cycles` stays 0 until [`predict_dispatch`].
+/// plane; with [`PlanOptions::generic_pes`], on that many generic PEs. `predicted_cycles` stays 0 until [`predict_dispatch`].
 pub fn plan_dispatch(
     problem: &Problem,
     options: &PlanOptions,
     copies: Option<&[u32]>,
 ) -> Result<Plan, HlsError> {
     let one = problem.one_round();
-    let copies = match (copies, options.pe_budget) {
-        (Some(c), _) => c.to_vec(),
-        (None, Some(b)) => bt_schedule::dispatch_copies(&one, &Budget { max_instances: b })?,
-        (None, None) => Vec::new(),
+    let schedule = match options.generic_pes {
+        Some(g) => bt_schedule::generic_round_template(&one, g)?,
+        None => {
+            let copies = match (copies, options.pe_budget) {
+                (Some(c), _) => c.to_vec(),
+                (None, Some(b)) => {
+                    bt_schedule::dispatch_copies(&one, &Budget { max_instances: b })?
+                }
+                (None, None) => Vec::new(),
+            };
+            bt_schedule::round_template(&one, &copies)?
+        }
     };
-    let schedule = bt_schedule::round_template(&one, &copies)?;
     schedule.check(&one)?;
     let stats = schedule.stats(&one);
     let points: u64 = problem.paths.iter().map(|p| p.planes.len() as u64).sum();

@@ -5,7 +5,7 @@ use std::collections::BTreeSet;
 use crate::error::{Report, ScheduleError, ScheduleViolation};
 use crate::occupancy::NONE;
 use crate::problem::Prepared;
-use crate::{Job, Problem, Schedule};
+use crate::{Job, PeInstance, Problem, Schedule};
 
 /// Measurements of a schedule (serialised next to `schedule.json`).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -22,12 +22,14 @@ pub struct ScheduleStats {
     pub utilisation: f64,
     /// PE instances (columns), originals and duplicates.
     pub instances: u32,
-    /// Duplicates: instances minus distinct planes among them.
+    /// Duplicates: the dedicated instances minus distinct planes among them (generic PEs are
+    /// no plane's duplicates).
     pub duplicates: u32,
     /// Jobs placed (cells holding a job).
     pub jobs: u64,
     /// A lower bound on the makespan with these instances, in slots: the larger of the
-    /// busiest plane's jobs per copy and, over paths, rounds x slots one round's phases need.
+    /// busiest plane's jobs per copy and, over paths, rounds x slots one round's phases need;
+    /// on generic PEs, the jobs over the PEs.
     pub makespan_lower_bound: u32,
 }
 
@@ -61,7 +63,7 @@ impl Schedule {
                     copy: inst.copy,
                 });
             }
-            if inst.plane >= problem.num_planes {
+            if inst.plane >= problem.num_planes && !inst.is_generic() {
                 report.push(ScheduleViolation::InstancePlaneOutOfRange {
                     instance: to_u32(i),
                     plane: inst.plane,
@@ -103,7 +105,7 @@ impl Schedule {
                 };
                 let expected = problem.paths[job.path as usize].planes[job.point as usize];
                 let plane = self.instances[i].plane;
-                if plane != expected {
+                if !self.instances[i].takes(expected) {
                     report.push(ScheduleViolation::WrongPlane {
                         job,
                         instance,
@@ -130,7 +132,14 @@ impl Schedule {
     pub fn stats(&self, problem: &Problem) -> ScheduleStats {
         let makespan = self.makespan();
         let instances = to_u32(self.instances.len());
-        let planes: BTreeSet<u32> = self.instances.iter().map(|i| i.plane).collect();
+        let dedicated: Vec<PeInstance> = self
+            .instances
+            .iter()
+            .copied()
+            .filter(|i| !i.is_generic())
+            .collect();
+        let planes: BTreeSet<u32> = dedicated.iter().map(|i| i.plane).collect();
+        let generic = instances - to_u32(dedicated.len());
         let jobs = self.job_count();
         let cells = u64::from(instances) * u64::from(makespan);
         let utilisation = if cells == 0 {
@@ -169,9 +178,14 @@ impl Schedule {
             latency_factor,
             utilisation,
             instances,
-            duplicates: instances - to_u32(planes.len()),
+            duplicates: to_u32(dedicated.len()) - to_u32(planes.len()),
             jobs,
-            makespan_lower_bound: lower_bound(problem, &copies),
+            makespan_lower_bound: if generic > 0 {
+                // Any PE takes any job: the work spread over all of them.
+                u32::try_from(jobs.div_ceil(u64::from(instances))).unwrap_or(u32::MAX)
+            } else {
+                lower_bound(problem, &copies)
+            },
         }
     }
 }

@@ -219,6 +219,9 @@ pub enum ScheduleError {
         /// What is wrong with it.
         reason: &'static str,
     },
+    /// A generic platform of no PE was asked for.
+    #[error("a generic platform needs at least one pe")]
+    NoGenericPe,
     /// The schedule breaks the rules (see [`crate::Schedule::check`]).
     #[error("illegal schedule: {0}")]
     IllegalSchedule(Report<ScheduleViolation>),

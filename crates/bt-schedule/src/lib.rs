@@ -42,7 +42,7 @@ pub use check::ScheduleStats;
 pub use error::{ProblemIssue, REPORT_LIMIT, Report, ScheduleError, ScheduleViolation};
 pub use ga::{GaParams, schedule_ga};
 pub use list::{schedule_list, schedule_list_duplicated, schedule_list_on, size_copies};
-pub use template::{dispatch_copies, round_template};
+pub use template::{dispatch_copies, generic_round_template, round_template};
 
 /// One candidate path as the scheduler sees it.
 #[derive(Debug, Clone, PartialEq, Eq, serde::Serialize, serde::Deserialize)]
@@ -107,6 +107,30 @@ pub struct PeInstance {
     pub copy: u32,
 }
 
+impl PeInstance {
+    /// The `plane` of a generic PE: one that takes any plane's job, its plane's coefficients
+    /// loaded with the job (`bt-hls`'s generic platform).
+    pub const ANY_PLANE: u32 = u32::MAX;
+
+    /// Generic PE number `copy` ([`PeInstance::ANY_PLANE`]).
+    pub fn generic(copy: u32) -> PeInstance {
+        PeInstance {
+            plane: Self::ANY_PLANE,
+            copy,
+        }
+    }
+
+    /// Whether this is a generic PE.
+    pub fn is_generic(self) -> bool {
+        self.plane == Self::ANY_PLANE
+    }
+
+    /// Whether this PE can run a job on `plane`.
+    pub fn takes(self, plane: u32) -> bool {
+        self.is_generic() || self.plane == plane
+    }
+}
+
 /// A complete schedule: `slots[t][i]` is the job PE instance `instances[i]` runs in slot `t`.
 ///
 /// Serialised as is (`schedule.json`): `instances` as `{plane, copy}` objects and `slots` as
@@ -122,10 +146,11 @@ pub struct Schedule {
 }
 
 impl Schedule {
-    /// PE copies per plane (index = plane, up to the highest plane with an instance).
+    /// PE copies per plane (index = plane, up to the highest plane with an instance; generic
+    /// PEs are no plane's copies).
     pub fn copies(&self) -> Vec<u32> {
         let mut copies = Vec::new();
-        for inst in &self.instances {
+        for inst in self.instances.iter().filter(|i| !i.is_generic()) {
             let p = inst.plane as usize;
             if copies.len() <= p {
                 copies.resize(p + 1, 0);

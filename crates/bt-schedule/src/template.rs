@@ -3,7 +3,7 @@
 
 use crate::error::ScheduleError;
 use crate::problem::{InstanceSet, Prepared};
-use crate::{Job, Problem, Schedule};
+use crate::{Job, PeInstance, Problem, Schedule};
 
 /// One round of every path of `problem` as *groups*, one group per slot: a group is jobs of
 /// one phase of one path on distinct PE instances, so the accelerator can run a whole group
@@ -53,6 +53,50 @@ pub fn round_template(problem: &Problem, copies: &[u32]) -> Result<Schedule, Sch
     }
     Ok(Schedule {
         instances: inst.instances,
+        slots,
+    })
+}
+
+/// One round of every path of `problem` as groups (as [`round_template`]) on `pes` *generic*
+/// PEs ([`PeInstance::generic`]), each of which takes any plane's job: a phase's points fill
+/// a group on distinct PEs, the free PE with the fewest jobs so far first (ties to the lower
+/// column), and a phase of more than `pes` points continues in the next group. The PE count
+/// then follows the work, not the planes. Refused: `pes` = 0.
+pub fn generic_round_template(problem: &Problem, pes: u32) -> Result<Schedule, ScheduleError> {
+    if pes == 0 {
+        return Err(ScheduleError::NoGenericPe);
+    }
+    let one = problem.one_round();
+    let prep = Prepared::new(&one)?;
+    let g = pes as usize;
+    let mut given = vec![0u64; g];
+    let mut slots = Vec::new();
+    for (p, path) in one.paths.iter().enumerate() {
+        let phases = prep.phases(p);
+        for phase in 0..phases {
+            let points: Vec<u32> = (phase..path.planes.len() as u32)
+                .step_by(phases as usize)
+                .collect();
+            for chunk in points.chunks(g) {
+                let mut row: Vec<Option<Job>> = vec![None; g];
+                for &point in chunk {
+                    let column = (0..g)
+                        .filter(|&c| row[c].is_none())
+                        .min_by_key(|&c| (given[c], c))
+                        .expect("a chunk has at most one point per PE");
+                    given[column] += 1;
+                    row[column] = Some(Job {
+                        path: p as u32,
+                        round: 0,
+                        point,
+                    });
+                }
+                slots.push(row);
+            }
+        }
+    }
+    Ok(Schedule {
+        instances: (0..pes).map(PeInstance::generic).collect(),
         slots,
     })
 }
@@ -258,5 +302,49 @@ mod tests {
         let mut p = problem(1);
         p.paths[0].planes[0] = 9;
         assert!(round_template(&p, &[]).is_err());
+    }
+
+    #[test]
+    fn generic_pes_take_any_plane_and_split_only_long_phases() {
+        for seed in 0..20 {
+            let mut p = crate::synthetic::living_room(seed, 12, 40);
+            for (i, path) in p.paths.iter_mut().enumerate() {
+                path.phases = 1 + (i as u32 % 2);
+            }
+            for g in [1u32, 2, 3, 5, 12] {
+                let s = generic_round_template(&p, g).unwrap();
+                let one = p.one_round();
+                s.check(&one).unwrap();
+                let jobs: u64 = one.paths.iter().map(|q| q.planes.len() as u64).sum();
+                assert!(s.instances.iter().all(|i| i.is_generic()));
+                assert_eq!(s.job_count(), jobs);
+                // A group is one phase of one path; a phase splits only when it has more
+                // points than PEs, so its groups are ceil(points / g).
+                let want: u32 = one
+                    .paths
+                    .iter()
+                    .map(|path| {
+                        let n = path.planes.len() as u32;
+                        let h = path.phases.clamp(1, n);
+                        (0..h).map(|k| (n - k).div_ceil(h).div_ceil(g)).sum::<u32>()
+                    })
+                    .sum();
+                assert_eq!(s.makespan(), want, "seed {seed}, {g} PEs");
+                // The least-loaded rule gives every PE work when there is enough.
+                let mut load = vec![0u64; g as usize];
+                for row in &s.slots {
+                    for (c, j) in row.iter().enumerate() {
+                        load[c] += u64::from(j.is_some());
+                    }
+                }
+                if jobs >= u64::from(g) {
+                    assert!(
+                        load.iter().all(|&l| l > 0),
+                        "seed {seed}, {g} PEs: {load:?}"
+                    );
+                }
+            }
+        }
+        assert!(generic_round_template(&crate::synthetic::living_room(0, 4, 4), 0).is_err());
     }
 }

@@ -87,17 +87,19 @@ fn hls_sim_takes_the_readmes_relative_directory() {
     std::fs::remove_dir_all(&root).ok();
 }
 
-/// Dynamic dispatch needs no model run on the host, with or without PE copies
-/// (`--pe-budget`: 0 gives none, the default gives the PEs of planes no path meets to copies),
-/// and each path runs its own rounds whatever the PEs.
+/// Dynamic dispatch needs no model run on the host, on generic PEs (the default) and on PEs
+/// per plane with or without copies (`--pe-budget`: 0 gives none; `--generic-pes 0` gives the
+/// PEs of planes no path meets to copies), and each path runs its own rounds whatever the PEs.
 #[test]
 fn no_model_run_feeds_the_host_with_or_without_copies() {
     let root = scratch("hls-dispatch");
     let (plain, dup, default) = (root.join("plain"), root.join("dup"), root.join("default"));
+    let per_plane = root.join("per-plane");
     let runs = [
         (&plain, vec!["--pe-budget", "0"]),
         (&dup, vec!["--pe-budget", "40"]),
         (&default, vec![]),
+        (&per_plane, vec!["--generic-pes", "0"]),
     ];
     for (dir, extra) in runs {
         let mut args = cli(
@@ -109,19 +111,24 @@ fn no_model_run_feeds_the_host_with_or_without_copies() {
     }
     let summary = |dir: &std::path::Path| read_json(&dir.join("summary.json"));
     let (p, d, f) = (summary(&plain), summary(&dup), summary(&default));
-    for s in [&p, &d, &f] {
+    let r = summary(&per_plane);
+    for s in [&p, &d, &f, &r] {
         assert_eq!(s["host_model_runs"], 0, "{s}");
         assert_eq!(s["schedule"], "dynamic", "{s}");
         assert_eq!(s["fixed_vs_f64"]["missed"], 0, "{s}");
     }
     assert_eq!(p["stats"]["duplicates"], 0);
     assert!(d["stats"]["duplicates"].as_u64().unwrap() > 0, "{d}");
-    // The default: one PE per static reflector of the room, some of them copies.
-    assert_eq!(f["platform_instances"], f["planes"], "{f}");
-    assert!(f["stats"]["duplicates"].as_u64().unwrap() > 0, "{f}");
+    // The default: 12 generic PEs, no plane's copies.
+    assert_eq!(f["platform_instances"], bt_hls::DEFAULT_GENERIC_PES, "{f}");
+    assert_eq!(f["stats"]["duplicates"], 0, "{f}");
+    // PEs per plane: one per static reflector of the room, some of them copies.
+    assert_eq!(r["platform_instances"], r["planes"], "{r}");
+    assert!(r["stats"]["duplicates"].as_u64().unwrap() > 0, "{r}");
     // The same PE jobs every way: each path runs its own rounds.
     assert_eq!(p["dispatch"]["jobs"], d["dispatch"]["jobs"]);
     assert_eq!(p["dispatch"]["jobs"], f["dispatch"]["jobs"]);
+    assert_eq!(p["dispatch"]["jobs"], r["dispatch"]["jobs"]);
     std::fs::remove_dir_all(root).ok();
 }
 

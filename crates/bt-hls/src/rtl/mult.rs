@@ -86,12 +86,12 @@ struct Term {
     magnitude: Option<u32>,
 }
 
-/// The partial products of `x · c` (`x` of `x_width` bits, `c` the odd constant) whose shift
-/// lies below `total` bits, lowest shift first.
-fn partial_products(x: (&str, u32), c: i64, total: u32) -> Vec<(Piece, Piece, u32)> {
+/// The partial products of `x · c` (`x` of `x_width` bits, `c` a `c_width`-bit coefficient)
+/// whose shift lies below `total` bits, lowest shift first.
+fn partial_products(x: (&str, u32), c_width: u32, total: u32) -> Vec<(Piece, Piece, u32)> {
     let mut out = Vec::new();
     for px in pieces(x.1) {
-        for pc in pieces(signed_width(c)) {
+        for pc in pieces(c_width) {
             let shift = px.lo + pc.lo;
             if shift < total {
                 out.push((px, pc, shift));
@@ -127,7 +127,7 @@ fn groups(terms: &[(u32, Option<u32>)]) -> Vec<Vec<usize>> {
 fn multiplier_cost(n: i32, x_width: u32, dot_acc: u32) -> Option<(u32, u32)> {
     let (c, base) = odd_constant(n)?;
     let total = dot_acc.checked_sub(base)?;
-    let products = partial_products(("", x_width), c, total);
+    let products = partial_products(("", x_width), signed_width(c), total);
     let terms: Vec<(u32, Option<u32>)> = products
         .iter()
         .map(|&(px, pc, s)| (s, (!px.top && !pc.top).then_some(px.width + pc.width)))
@@ -136,10 +136,59 @@ fn multiplier_cost(n: i32, x_width: u32, dot_acc: u32) -> Option<(u32, u32)> {
     Some((products.len() as u32, adders))
 }
 
+/// The second operand of a product network: a plane's odd constant, or a coefficient
+/// register (a generic PE's normal component, two's complement).
+#[derive(Clone, Copy)]
+pub(crate) enum Coefficient<'a> {
+    /// The odd constant `c` of `n_k = c · 2^base`.
+    Constant(i64),
+    /// A register loaded with the job's plane.
+    Register(&'a Signal),
+}
+
+impl Coefficient<'_> {
+    /// Bits of the coefficient as a two's-complement word.
+    fn width(self) -> u32 {
+        match self {
+            Coefficient::Constant(c) => signed_width(c),
+            Coefficient::Register(s) => s.width(),
+        }
+    }
+
+    /// Piece `pc` as a multiplier operand (an unsigned piece with a zero sign bit).
+    fn piece(self, pc: Piece) -> Expr {
+        match self {
+            Coefficient::Constant(c) => {
+                let cv = c >> pc.lo;
+                let cv = if pc.top {
+                    cv
+                } else {
+                    cv & ((1 << pc.width) - 1)
+                };
+                Expr::lit_signed(pc.operand_width(), i128::from(cv))
+            }
+            Coefficient::Register(s) => piece_of(s, pc),
+        }
+    }
+}
+
+/// Piece `p` of the word `x` as a signed multiplier operand.
+fn piece_of(x: &Signal, p: Piece) -> Expr {
+    if p.top {
+        x.slice(x.width() - 1, p.lo)
+    } else {
+        Expr::concat(vec![Expr::lit(1, 0), x.slice(p.lo + p.width - 1, p.lo)])
+    }
+}
+
+/// Multiplier blocks of the product of an `x_width`-bit input and a `c_width`-bit coefficient
+/// register into `total` bits ([`product_network`] with [`Coefficient::Register`]).
+pub(crate) fn register_product_blocks(x_width: u32, c_width: u32, total: u32) -> u32 {
+    partial_products(("", x_width), c_width, total).len() as u32
+}
+
 /// `net = x · c mod 2^total` (the product `x · n_k / 2^base` of a CSD network, exactly) from
-/// signed 18 × 18 partial products of `x`'s pieces and `c`'s: the non-negative low products
-/// and the products above them are concatenated, the rest added. Declares the products as
-/// `pp_<axis>_<i>_<j>` (i, j: the pieces of x and c) and returns the sum in `total` bits.
+/// signed 18 × 18 partial products of `x`'s pieces and `c`'s (see [`product_network`]).
 pub(crate) fn multiplier_network(
     axis: &str,
     x: &Signal,
@@ -150,27 +199,27 @@ pub(crate) fn multiplier_network(
 ) -> Result<Expr, HlsError> {
     let (c, _) = odd_constant(n)
         .ok_or_else(|| HlsError::TooLarge(format!("normal component {axis} is zero")))?;
+    product_network(axis, x, Coefficient::Constant(c), total, (items, unused))
+}
+
+/// `net = x · c mod 2^total` from signed 18 × 18 partial products of `x`'s pieces and `c`'s:
+/// the non-negative low products and the products above them are concatenated, the rest
+/// added. Declares the products as `pp_<axis>_<i>_<j>` (i, j: the pieces of x and c) and
+/// returns the sum in `total` bits.
+pub(crate) fn product_network(
+    axis: &str,
+    x: &Signal,
+    c: Coefficient<'_>,
+    total: u32,
+    (items, unused): (&mut Vec<Item>, &mut Vec<Expr>),
+) -> Result<Expr, HlsError> {
     let mut terms = Vec::new();
-    for (px, pc, shift) in partial_products((x.name(), x.width()), c, total) {
-        let xa = if px.top {
-            x.slice(x.width() - 1, px.lo)
-        } else {
-            Expr::concat(vec![Expr::lit(1, 0), x.slice(px.lo + px.width - 1, px.lo)])
-        };
-        let cv = c >> pc.lo;
-        let cv = if pc.top {
-            cv
-        } else {
-            cv & ((1 << pc.width) - 1)
-        };
+    for (px, pc, shift) in partial_products((x.name(), x.width()), c.width(), total) {
         let product = Signal::signed_product(
             items,
             format!("pp_{axis}_{}_{}", px.lo, pc.lo),
-            (xa, px.operand_width()),
-            (
-                Expr::lit_signed(pc.operand_width(), i128::from(cv)),
-                pc.operand_width(),
-            ),
+            (piece_of(x, px), px.operand_width()),
+            (c.piece(pc), pc.operand_width()),
         );
         let magnitude = (!px.top && !pc.top).then_some(px.width + pc.width);
         terms.push(Term {
@@ -306,7 +355,7 @@ mod tests {
                 let top = 1i128 << (w - 1);
                 [0i128, 1, -1, top - 1, -top, 0x1_2345, -0x1_4321].map(|x| (w, x))
             }) {
-                let products = partial_products(("x", w), c, total);
+                let products = partial_products(("x", w), signed_width(c), total);
                 let terms: Vec<(u32, Option<u32>)> = products
                     .iter()
                     .map(|&(px, pc, s)| (s, (!px.top && !pc.top).then_some(px.width + pc.width)))

@@ -19,7 +19,7 @@ pub fn sum_bits(wd: Widths) -> u32 {
     3 * wd.sum_point
 }
 
-const AXES: [&str; 3] = ["x", "y", "z"];
+pub(super) const AXES: [&str; 3] = ["x", "y", "z"];
 
 pub(crate) fn port(name: &str, dir: Direction, width: u32) -> Port {
     Port {
@@ -158,8 +158,14 @@ pub(crate) fn pe_module(
     let link = Link::named(wd);
     link.declare(&mut items);
     let nets = csd_networks(&link, (plane, &csd, forms), wd, (&mut items, &mut unused))?;
-    signed_distance(plane, &nets, (&link.d_new, wd), &mut items, &mut unused)?;
-    projections(index, &link, &nets, &mut items, &mut unused)?;
+    signed_distance(
+        DotConstant::Plane(plane),
+        &nets,
+        (&link.d_new, wd),
+        &mut items,
+        &mut unused,
+    )?;
+    projections(&link, &nets, &mut items, &mut unused)?;
     items.push(link.core_instance(wd));
     unused_ok(&mut items, unused);
     Ok(pe_shell(index, plane_name, wd, items))
@@ -196,7 +202,7 @@ pub(crate) fn pe_core_module(wd: Widths) -> Module {
 
 /// `bt_unused_ok = &{1'b0, unused...}`: reads the bits a module computes but does not use, so
 /// that linters see them read (the value is never used).
-fn unused_ok(items: &mut Vec<Item>, mut unused: Vec<Expr>) {
+pub(super) fn unused_ok(items: &mut Vec<Item>, mut unused: Vec<Expr>) {
     unused.insert(0, Expr::lit(1, 0));
     Signal::assigned(
         items,
@@ -210,18 +216,18 @@ fn unused_ok(items: &mut Vec<Item>, mut unused: Vec<Expr>) {
 /// registers (`step_sel` = the step counter's low two bits; `op_a_k`, `op_b_k`, `op_e`,
 /// `op_l` = the low `wd.distance` bits of `a_k`, `b_k`, `r_e`, `r_l`) and what the front end
 /// returns (`d_new`, `t_k`, `wd.distance` bits each). The same names on both sides.
-struct Link {
+pub(super) struct Link {
     step_sel: Signal,
     a: Vec<Signal>,
     b: Vec<Signal>,
     e: Signal,
     l: Signal,
-    d_new: Signal,
+    pub(super) d_new: Signal,
     t: Vec<Signal>,
 }
 
 impl Link {
-    fn named(wd: Widths) -> Link {
+    pub(super) fn named(wd: Widths) -> Link {
         let x = wd.distance;
         let per_axis = |prefix: &str| {
             AXES.iter()
@@ -237,6 +243,22 @@ impl Link {
             d_new: Signal::port("d_new", x),
             t: per_axis("t"),
         }
+    }
+
+    /// `x_in_<axis>`, the input of axis `k`'s product network: the core register that
+    /// `step_sel` picks (0 = `a_k`, 1 = `b_k`, 2 = `r_e`, 3 = `r_l`).
+    pub(super) fn network_input(&self, k: usize, wd: Widths, items: &mut Vec<Item>) -> Signal {
+        let (s1, s0) = (self.step_sel.bit(1), self.step_sel.bit(0));
+        Signal::assigned(
+            items,
+            format!("x_in_{}", AXES[k]),
+            wd.distance,
+            Expr::mux(
+                s1,
+                Expr::mux(s0.clone(), self.l.e(), self.e.e()),
+                Expr::mux(s0, self.b[k].e(), self.a[k].e()),
+            ),
+        )
     }
 
     /// The core's outputs, then its inputs.
@@ -262,7 +284,7 @@ impl Link {
     }
 
     /// The front end's wires of the link.
-    fn declare(&self, items: &mut Vec<Item>) {
+    pub(super) fn declare(&self, items: &mut Vec<Item>) {
         for s in self.outputs().chain(self.inputs()) {
             items.push(Item::Wire(s.name().into(), s.width()));
         }
@@ -281,7 +303,7 @@ impl Link {
 
     /// In the front end: the core instance, every port by name (the PE's own ports, which the
     /// core shares, passed through).
-    fn core_instance(&self, wd: Widths) -> Item {
+    pub(super) fn core_instance(&self, wd: Widths) -> Item {
         let mut ports: Vec<(String, Expr)> = PePorts::new(wd)
             .each()
             .into_iter()
@@ -382,11 +404,11 @@ impl PeRegs {
 }
 
 /// One shared CSD network: `net = x_in · n_k / 2^base`.
-struct Network {
+pub(super) struct Network {
     /// The lowest digit shift (the network's exact low bits are all zero below it).
-    base: u32,
+    pub(super) base: u32,
     /// `net_<axis>`, `DOT_ACC − base` bits.
-    net: Signal,
+    pub(super) net: Signal,
 }
 
 /// Shared networks, one per non-zero normal component: input selected by step[1:0] (0 = a,
@@ -405,23 +427,13 @@ fn csd_networks(
     items.push(Item::Comment(format!(
         "one {kind} per non-zero normal component, shared by d_prev, d_next, t_prev, t_next"
     )));
-    let (s1, s0) = (r.step_sel.bit(1), r.step_sel.bit(0));
     let mut nets = Vec::new();
     for (k, axis) in AXES.iter().enumerate() {
         let Some(bk) = csd[k].digits.iter().map(|d| d.shift).min() else {
             nets.push(None);
             continue;
         };
-        let xin = Signal::assigned(
-            items,
-            format!("x_in_{axis}"),
-            wd.distance,
-            Expr::mux(
-                s1.clone(),
-                Expr::mux(s0.clone(), r.l.e(), r.e.e()),
-                Expr::mux(s0.clone(), r.b[k].e(), r.a[k].e()),
-            ),
-        );
+        let xin = r.network_input(k, wd, items);
         let nw = wd.dot_acc - bk;
         let sum = match forms[k] {
             NetworkForm::Csd => {
@@ -445,10 +457,46 @@ fn csd_networks(
     Ok(nets)
 }
 
+/// The constant term of a PE's dot product, `2^29 − offset·2^30`.
+#[derive(Clone, Copy)]
+pub(super) enum DotConstant<'a> {
+    /// The plane's offset, baked in.
+    Plane(&'a FixedPlane),
+    /// A register holding `−offset` (fine LSB, two's complement), loaded with the job's plane;
+    /// the networks' products must be whole (base 0).
+    NegatedOffset(&'a Signal),
+}
+
+impl DotConstant<'_> {
+    /// The term in `dw` bits above bit `sd` of the product.
+    fn expr(self, sd: u32, dw: u32) -> Result<Expr, HlsError> {
+        let nf = NORMAL_FRAC;
+        match self {
+            DotConstant::Plane(plane) => {
+                let dot_const = (1i128 << (nf - 1)) - (i128::from(plane.offset.0) << nf);
+                Ok(Expr::lit_signed(dw, dot_const >> sd))
+            }
+            DotConstant::NegatedOffset(neg) => {
+                let high = dw.checked_sub(nf).filter(|&h| sd == 0 && h >= neg.width());
+                let high = high.ok_or_else(|| {
+                    HlsError::TooLarge(format!(
+                        "offset register of {} bits does not fit a {dw}-bit dot product",
+                        neg.width()
+                    ))
+                })?;
+                Ok(Expr::concat(vec![
+                    sext(neg.name(), neg.width(), high),
+                    Expr::lit(nf, 1 << (nf - 1)),
+                ]))
+            }
+        }
+    }
+}
+
 /// Signed distance: round_half_up((Σ n_k x_k − offset·2^30) / 2^30), exact below bit `sd`,
 /// assigned to `d_new`.
-fn signed_distance(
-    plane: &FixedPlane,
+pub(super) fn signed_distance(
+    constant: DotConstant<'_>,
     nets: &[Option<Network>],
     (d_new, wd): (&Signal, Widths),
     items: &mut Vec<Item>,
@@ -463,9 +511,8 @@ fn signed_distance(
         .min()
         .unwrap_or(nf)
         .min(nf);
-    let dot_const = (1i128 << (nf - 1)) - (i128::from(plane.offset.0) << nf);
     let dw = accw - sd;
-    let mut dot = Expr::lit_signed(dw, dot_const >> sd);
+    let mut dot = constant.expr(sd, dw)?;
     for n in nets.iter().flatten() {
         dot = dot.plus(shifted_term(n.net.name(), accw - n.base, n.base - sd, dw)?);
     }
@@ -484,8 +531,7 @@ fn signed_distance(
 
 /// Projections: t_k = base_k − round_half_up(d · n_k / 2^30), base = a (step 2) or b (step 3),
 /// assigned to the link's `t_k`.
-fn projections(
-    index: usize,
+pub(super) fn projections(
     r: &Link,
     nets: &[Option<Network>],
     items: &mut Vec<Item>,
@@ -505,7 +551,7 @@ fn projections(
             // Multiple of 2^30: the rounding half cannot carry.
             if bk > nf {
                 return Err(HlsError::TooLarge(format!(
-                    "normal component {axis} of plane {index} has a digit above 2^30"
+                    "normal component {axis} has a digit above 2^30"
                 )));
             }
             net.e()
@@ -898,7 +944,7 @@ impl PePorts {
 }
 
 /// The port list of a PE (and the first ports of its core).
-fn pe_ports(wd: Widths) -> Vec<Port> {
+pub(super) fn pe_ports(wd: Widths) -> Vec<Port> {
     PePorts::new(wd)
         .each()
         .into_iter()

@@ -108,6 +108,7 @@ impl LivingRoomConfig {
                 elite: GaParams::default().elite.min(self.ga_population),
                 ..GaParams::default()
             },
+            generic_pes: None,
         }
     }
 

@@ -253,7 +253,7 @@ fn study_and_accelerator_sizes_are_bounded() {
     let dir = scratch("sizes");
     let out = dir.join("out");
     let out = out.to_str().unwrap();
-    for flag in ["--max-rounds", "--pe-budget"] {
+    for flag in ["--max-rounds", "--pe-budget", "--generic-pes"] {
         let o = beamtrace(&[
             "hls",
             "gen",

@@ -13,6 +13,8 @@ pub(super) struct Decode {
     pub(super) is_point: Signal,
     /// Schedule memory window.
     pub(super) is_sched: Signal,
+    /// Plane table window (generic PEs only).
+    pub(super) is_plane: Option<Signal>,
     /// The point index of a point-window address.
     pub(super) bus_point: Signal,
     /// A host write while idle.
@@ -45,6 +47,7 @@ pub(super) fn bus_decode(t: &Dims<'_>, items: &mut Vec<Item>) -> Decode {
     let is_status = window(items, "is_status", l.map.status_base);
     let is_point = window(items, "is_point", l.map.point_base);
     let is_sched = window(items, "is_sched", l.map.sched_base);
+    let is_plane = l.map.plane_base.map(|b| window(items, "is_plane", b));
     let bus_point = Signal::assigned(
         items,
         "bus_point",
@@ -66,6 +69,7 @@ pub(super) fn bus_decode(t: &Dims<'_>, items: &mut Vec<Item>) -> Decode {
         is_status,
         is_point,
         is_sched,
+        is_plane,
         bus_point,
         host_wr,
         pt_we,
@@ -189,7 +193,7 @@ pub(super) fn read_pipeline(t: &Dims<'_>, bus: &Decode, items: &mut Vec<Item>) -
 /// SCHED_HI: the high bits of wide schedule entries, written by the host before the entries
 /// (only in designs whose entries exceed 32 bits).
 pub(super) fn sched_hi_register(t: &Dims<'_>, bus: &Decode, items: &mut Vec<Item>) {
-    let sw = sched_entry_bits(t.pb, t.ptb, t.ib);
+    let sw = t.sw();
     let Some(sched_hi) = &t.r.sched_hi else {
         return;
     };
@@ -299,17 +303,22 @@ pub(super) fn interrupt_and_unused(t: &Dims<'_>, items: &mut Vec<Item>) {
     // write-back fields the load does not read and the load fields the write-back does not.
     let (pb, ptb) = (t.pb, t.ptb);
     let top = t.r.sched_q.width() - 1;
-    let unused = vec![
+    let mut unused = vec![
         lit(1, 0),
         t.io.avs_writedata.slice(31, 1),
         t.r.sched_q.bit(0),
         t.r.sched_q.bit(3 + pb + ptb),
         t.r.sched_q.bit(gtail_bit(t)),
-        t.r.sched_q.slice(top, sched_entry_bits(pb, ptb, t.ib)),
+        t.r.sched_q.slice(top, t.sw()),
         t.r.wsched_q.bit(0),
         t.r.wsched_q.slice(2 + pb + ptb, 1 + pb + ptb),
         t.r.wsched_q.bit(4 + pb + ptb),
     ];
+    if t.plb > 0 && t.early.is_none() {
+        // The write-back does not read the job's plane (early stopping's box would).
+        let lo = 6 + pb + ptb + t.ib;
+        unused.push(t.r.wsched_q.slice(lo + t.plb - 1, lo));
+    }
     Signal::assigned(
         items,
         "bt_unused_ok",

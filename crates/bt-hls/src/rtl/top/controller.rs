@@ -30,6 +30,8 @@ pub(super) struct ScheduleRead {
     /// The job's entry in the job memory, and its path's first group's.
     pub(super) src: Signal,
     pub(super) gbase: Signal,
+    /// The job's plane (generic PEs only).
+    pub(super) plane: Option<Signal>,
 }
 
 /// The fields of the slot-buffer entry the load reads this cycle (`sched_q`, gated by
@@ -51,6 +53,8 @@ pub(super) struct LoadRead {
     /// The job runs after its round's first phase (red-black): its neighbours' points are
     /// read from the bank the round writes, not the committed one.
     pub(super) late: Signal,
+    /// The job's plane (generic PEs only): the plane table's read address.
+    pub(super) plane: Option<Signal>,
 }
 
 /// The bit of the job word that marks a group's last job.
@@ -63,8 +67,8 @@ pub(super) fn gtail_bit(t: &Dims<'_>) -> u32 {
 /// job), path after path. Read by the dispatcher only (`job_q`, one cycle after the address:
 /// a popped group's first job, else the examined group's next).
 pub(super) fn job_memory(t: &Dims<'_>, bus: &Decode, d: &DispatchJob, items: &mut Vec<Item>) {
-    let (pb, ptb, ib, eb) = (t.pb, t.ptb, t.ib, t.eb);
-    let sw = sched_entry_bits(pb, ptb, ib);
+    let eb = t.eb;
+    let sw = t.sw();
     items.push(Item::Comment(format!(
         "job memory, written per step by the host: one round of every path as groups, entry -> {{column, group tail, late, end, last, first, point, path, valid}} ({sw} bits)"
     )));
@@ -149,6 +153,7 @@ pub(super) fn slot_buffer_load(t: &Dims<'_>, items: &mut Vec<Item>) -> LoadRead 
         first: field(items, "lrom_first", 1, 1 + pb + ptb),
         last: field(items, "lrom_last", 1, 2 + pb + ptb),
         late: field(items, "lrom_late", 1, 4 + pb + ptb),
+        plane: (t.plb > 0).then(|| field(items, "lrom_plane", t.plb, 6 + pb + ptb + ib)),
     }
 }
 
@@ -156,7 +161,7 @@ pub(super) fn slot_buffer_load(t: &Dims<'_>, items: &mut Vec<Item>) -> LoadRead 
 /// cycle after the address; its fields.
 pub(super) fn slot_buffer_writeback(t: &Dims<'_>, items: &mut Vec<Item>) -> ScheduleRead {
     let (pb, ptb, ib, eb) = (t.pb, t.ptb, t.ib, t.eb);
-    let sw = sched_entry_bits(pb, ptb, ib);
+    let sw = t.sw();
     let wlen = Signal::assigned(items, "slen_wb", ib + 1, half_len(t, t.r.wsel.e()));
     slot_read_port(
         t,
@@ -178,6 +183,8 @@ pub(super) fn slot_buffer_writeback(t: &Dims<'_>, items: &mut Vec<Item>) -> Sche
         gtail: field(items, "rom_gtail", 1, gtail_bit(t)),
         src: field(items, "rom_src", eb, sw + eb),
         gbase: field(items, "rom_gbase", eb, sw),
+        plane: (t.plb > 0 && t.early.is_some())
+            .then(|| field(items, "rom_plane", t.plb, 6 + pb + ptb + ib)),
     }
 }
 
@@ -727,6 +734,9 @@ fn writeback_engine(t: &Dims<'_>, rom: &ScheduleRead, f: &WritebackFlags) -> Vec
         (&t.r.wbe.wb_q_src, &rom.src),
         (&t.r.wbe.wb_q_gbase, &rom.gbase),
     ]);
+    if let (Some(reg), Some(field)) = (&t.r.wbe.wb_q_plane, &rom.plane) {
+        stmts.extend(register_entry(&[(reg, field)]));
+    }
     stmts.extend([
         Stmt::If(f.go.e(), path_commit(t, f), vec![]),
         Stmt::If(

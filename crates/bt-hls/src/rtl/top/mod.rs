@@ -9,12 +9,14 @@ use crate::rtl::verilog::{BinaryOp, Direction, Expr, Item, Module, Signal, Stmt,
 
 mod bus;
 mod controller;
+mod planes;
 mod regs;
 mod updater;
 mod writeback;
 
 use bus::*;
 use controller::*;
+use planes::*;
 use regs::*;
 use updater::*;
 use writeback::*;
@@ -114,6 +116,8 @@ struct Dims<'a> {
     ptb: u32,
     ib: u32,
     eb: u32,
+    /// Bits of a job's plane field (generic PEs; 0 otherwise).
+    plb: u32,
     /// Path slots (`2^pb`): the width of the per-path flag vectors.
     np2: u32,
     /// Width of the step counter `cnt`.
@@ -131,6 +135,11 @@ struct Dims<'a> {
 }
 
 impl<'a> Dims<'a> {
+    /// Bits of a job-memory entry.
+    fn sw(&self) -> u32 {
+        sched_entry_bits(self.pb, self.ptb, self.ib, self.plb)
+    }
+
     /// Cycles of one PE evaluation in this design.
     fn latency(&self) -> u32 {
         pe_latency(self.wd.coord)
@@ -148,6 +157,7 @@ impl<'a> Dims<'a> {
             ptb: l.point_bits,
             ib: l.inst_bits,
             eb: l.entry_bits,
+            plb: l.plane_bits,
             np2: 1u32 << l.path_bits,
             cnt_bits: bits_for(u64::from((l.num_instances + 2).max(latency)) + 1),
             wd,
@@ -170,6 +180,7 @@ impl<'a> Dims<'a> {
             ptb: sizes.ptb,
             ib: sizes.ib,
             eb: sizes.eb,
+            plb: sizes.plb,
             np2: sizes.np2,
             cnt_bits: sizes.cnt_bits,
             ab: l.address_bits,
@@ -211,7 +222,7 @@ fn declare_pe_wires(t: &Dims<'_>, items: &mut Vec<Item>) -> Vec<PeWires> {
 /// cycle, memory data one cycle after the address, and the addressed PE latches them. Each PE
 /// starts the cycle after its own load (`ld_go`, `ld_go_inst`), so a slot's first PEs compute
 /// while its later jobs load, and write-back (job after job, in load order) follows them.
-fn pe_matrix(t: &Dims<'_>, pe: &[PeWires], items: &mut Vec<Item>) {
+fn pe_matrix(t: &Dims<'_>, pe: &[PeWires], coefficients: Option<Vec<Expr>>, items: &mut Vec<Item>) {
     let loading = state_is(t, S_LOAD).and(t.r.ld_q_en.e());
     items.push(Item::AlwaysFf(vec![Stmt::If(
         t.io.rst_n.e().lnot(),
@@ -233,20 +244,34 @@ fn pe_matrix(t: &Dims<'_>, pe: &[PeWires], items: &mut Vec<Item>) {
     let prev = Signal::assigned(&mut operands, "opnd_prev", pw, prev_or_tx);
     let next_or_rx = Expr::mux(t.r.ld_q_last.e(), rx_fine, t.r.rd_b.e());
     let next = Signal::assigned(&mut operands, "opnd_next", pw, next_or_rx);
+    let coefficient_ports: Vec<(String, Expr)> = match coefficients {
+        Some(c) => crate::rtl::generic::coefficient_ports(t.wd)
+            .into_iter()
+            .map(|(name, _)| name)
+            .zip(c)
+            .collect(),
+        None => Vec::new(),
+    };
     for (j, (inst, w)) in t.p.platform.instances.iter().zip(pe).enumerate() {
+        let mut ports = vec![
+            ("clk".into(), t.io.clk.e()),
+            ("rst_n".into(), t.io.rst_n.e()),
+            ("load".into(), w.load.e()),
+            ("start".into(), w.start.e()),
+            ("s_prev".into(), prev.e()),
+            ("s_next".into(), next.e()),
+            ("s_sum".into(), w.sum.e()),
+            ("zero_sum".into(), w.zs.e()),
+        ];
+        ports.extend(coefficient_ports.iter().cloned());
         items.push(Item::Instance {
-            module: pe_module_name(inst.plane as usize),
+            module: if inst.is_generic() {
+                crate::rtl::generic::GENERIC_PE_MODULE.into()
+            } else {
+                pe_module_name(inst.plane as usize)
+            },
             name: format!("u_pe_{j}"),
-            ports: vec![
-                ("clk".into(), t.io.clk.e()),
-                ("rst_n".into(), t.io.rst_n.e()),
-                ("load".into(), w.load.e()),
-                ("start".into(), w.start.e()),
-                ("s_prev".into(), prev.e()),
-                ("s_next".into(), next.e()),
-                ("s_sum".into(), w.sum.e()),
-                ("zero_sum".into(), w.zs.e()),
-            ],
+            ports,
         });
         operands.push(Item::Assign(
             w.load.e(),
@@ -289,6 +314,7 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
     let pe = declare_pe_wires(&t, &mut items);
     let bus = bus_decode(&t, &mut items);
     let lrom = slot_buffer_load(&t, &mut items);
+    let coefficients = plane_table(&t, &bus, &lrom, &mut items);
     let rom = slot_buffer_writeback(&t, &mut items);
     let dj = dispatch_signals(&t, &mut items);
     job_memory(&t, &bus, &dj, &mut items);
@@ -308,7 +334,7 @@ pub(crate) fn top_module(d: &TopParams<'_>) -> Module {
     items.push(dispatcher(&t, &dj, [&go, &scan, &front]));
     rounds_write(&t, &flags, &mut items);
     updater_write_port(&t, &bus, &ports, &sel, &flags, &mut items);
-    pe_matrix(&t, &pe, &mut items);
+    pe_matrix(&t, &pe, coefficients, &mut items);
     controller(&t, (&rom, &lrom), &flags, [&start_req, &empty], &mut items);
     register_writes(&t, &bus, &mut items);
     sched_hi_register(&t, &bus, &mut items);

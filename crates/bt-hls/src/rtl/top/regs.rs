@@ -59,10 +59,20 @@ pub(super) struct RegSizes {
     pub(super) ptb: u32,
     pub(super) ib: u32,
     pub(super) eb: u32,
+    /// Bits of a job's plane field (generic PEs; 0 otherwise).
+    pub(super) plb: u32,
     pub(super) np2: u32,
     pub(super) cnt_bits: u32,
     pub(super) wd: bt_fixed::Widths,
     pub(super) early: bool,
+}
+
+impl RegSizes {
+    /// Bits of the written job's plane that early stopping's box needs (generic PEs with
+    /// early stopping), or none.
+    fn box_plane_bits(&self) -> Option<u32> {
+        (self.early && self.plb > 0).then_some(self.plb)
+    }
 }
 
 /// The registers and memories of `bt_top` (field = Verilog name).
@@ -182,6 +192,8 @@ pub(super) struct WbEntry {
     pub(super) wb_q_gtail: Signal,
     pub(super) wb_q_src: Signal,
     pub(super) wb_q_gbase: Signal,
+    /// The job's plane, for early stopping's box on generic PEs (none otherwise).
+    pub(super) wb_q_plane: Option<Signal>,
 }
 
 impl WbEntry {
@@ -189,6 +201,7 @@ impl WbEntry {
     fn declare(
         r: &mut impl FnMut(&str, u32) -> Signal,
         (pb, ptb, ib, eb): (u32, u32, u32, u32),
+        plane_bits: Option<u32>,
     ) -> Self {
         WbEntry {
             wb_q_en: r("wb_q_en", 1),
@@ -200,6 +213,7 @@ impl WbEntry {
             wb_q_gtail: r("wb_q_gtail", 1),
             wb_q_src: r("wb_q_src", eb),
             wb_q_gbase: r("wb_q_gbase", eb),
+            wb_q_plane: plane_bits.map(|w| r("wb_q_plane", w)),
         }
     }
 }
@@ -244,7 +258,7 @@ impl Regs {
     /// Declares every register and memory in `items`, in the order the golden files show.
     pub(super) fn declare(s: &RegSizes, items: &mut Vec<Item>) -> Regs {
         let (pb, ptb, ib, eb, np2) = (s.pb, s.ptb, s.ib, s.eb, s.np2);
-        let sw = sched_entry_bits(pb, ptb, ib);
+        let sw = sched_entry_bits(pb, ptb, ib, s.plb);
         let mm = mm_width(s.wd);
         let pw = point_bits(s.wd);
         let depth = 1u32 << (ptb + 1);
@@ -299,7 +313,7 @@ impl Regs {
             ld_q_inst: r("ld_q_inst", ib),
             ld_go: r("ld_go", 1),
             ld_go_inst: r("ld_go_inst", ib),
-            wbe: WbEntry::declare(&mut r, (pb, ptb, ib, eb)),
+            wbe: WbEntry::declare(&mut r, (pb, ptb, ib, eb), s.box_plane_bits()),
             rq_valid: r("rq_valid", 1),
             rq_kind: r("rq_kind", 2),
             rq_reg: r("rq_reg", 4),

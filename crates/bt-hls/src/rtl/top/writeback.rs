@@ -309,30 +309,48 @@ pub(super) fn instance_box(
         defaults.push(Stmt::Blocking(l.e(), lit(w, 0)));
         defaults.push(Stmt::Blocking(h.e(), lit(w, 0)));
     }
-    let arms = d
-        .platform
-        .instances
-        .iter()
-        .enumerate()
-        .map(|(j, inst)| {
-            let b = &boxes[inst.plane as usize];
-            let mut stmts = Vec::new();
-            for a in 0..3 {
-                stmts.push(Stmt::Blocking(lo[a].e(), biased(b.lo[a])));
-                stmts.push(Stmt::Blocking(hi[a].e(), biased(b.hi[a])));
-            }
-            (lit(d.layout.inst_bits, j as u128), stmts)
-        })
-        .collect();
-    items.push(Item::Comment(
-        "early stopping: widened polygon box of the written instance's plane (sign bit flipped)"
-            .into(),
-    ));
-    items.push(Item::AlwaysComb(vec![Stmt::Case(
-        t.r.wbe.wb_q_inst.e(),
-        arms,
-        defaults,
-    )]));
+    let set = |b: &bt_fixed::FineBox| {
+        let mut stmts = Vec::new();
+        for a in 0..3 {
+            stmts.push(Stmt::Blocking(lo[a].e(), biased(b.lo[a])));
+            stmts.push(Stmt::Blocking(hi[a].e(), biased(b.hi[a])));
+        }
+        stmts
+    };
+    // On generic PEs by the job's plane, else by the PE's (its instance).
+    let (select, arms) = match &t.r.wbe.wb_q_plane {
+        Some(plane) => (
+            plane.e(),
+            boxes
+                .iter()
+                .enumerate()
+                .map(|(p, b)| (lit(t.plb, p as u128), set(b)))
+                .collect(),
+        ),
+        None => (
+            t.r.wbe.wb_q_inst.e(),
+            d.platform
+                .instances
+                .iter()
+                .enumerate()
+                .map(|(j, inst)| {
+                    (
+                        lit(d.layout.inst_bits, j as u128),
+                        set(&boxes[inst.plane as usize]),
+                    )
+                })
+                .collect(),
+        ),
+    };
+    let whose = if t.r.wbe.wb_q_plane.is_some() {
+        "job's"
+    } else {
+        "instance's"
+    };
+    items.push(Item::Comment(format!(
+        "early stopping: widened polygon box of the written {whose} plane (sign bit flipped)"
+    )));
+    items.push(Item::AlwaysComb(vec![Stmt::Case(select, arms, defaults)]));
     InstanceBox { lo, hi }
 }
 
