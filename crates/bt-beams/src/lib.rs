@@ -348,7 +348,7 @@ fn interaction_names(scene: &Scene, interactions: &[Interaction], names: &mut Ve
 
 /// The path's vertices TX → points → RX (local frame) into `vertices` (cleared first), and
 /// its unfolded length (m).
-fn vertices(
+pub(crate) fn vertices(
     scene: &Scene,
     path: &FoundPath,
     vertices: &mut Vec<Vec3>,
@@ -358,11 +358,20 @@ fn vertices(
     vertices.push(tx);
     vertices.extend_from_slice(&path.points);
     vertices.push(rx);
-    let length_m: Real = vertices
-        .windows(2)
-        .map(|w| w[0].distance(w[1]))
-        .fold(0.0, |a, b| a + b);
-    Ok(length_m)
+    Ok(unfolded_length(tx, &path.points, rx))
+}
+
+/// The length (m) of the polyline `tx` → `points` → `rx`: its legs summed from TX, the one
+/// computation of a record's `length_m` (the ranking sorts by it before the records are
+/// described, [`Records`], and must see the same bits).
+pub(crate) fn unfolded_length(tx: Vec3, points: &[Vec3], rx: Vec3) -> Real {
+    let mut length = 0.0;
+    let mut from = tx;
+    for &to in points.iter().chain(std::iter::once(&rx)) {
+        length += from.distance(to);
+        from = to;
+    }
+    length
 }
 
 /// Buffers a report's paths reuse one after the other, so that describing a path allocates
