@@ -44,16 +44,22 @@ impl<'a> Responses<'a> {
     /// The surfaces of `known` already looked up in `scene`: they were looked up in a scene of
     /// the same [`bt_scene::RadioKey`] (the same surfaces, materials and frequency), or
     /// `known` is empty.
-    pub(crate) fn with_known(scene: &'a Scene, known: Known) -> Self {
-        let mut responses = Responses {
-            scene,
-            known: Vec::new(),
-            slots: [0; SLOTS],
-        };
-        for (id, response, loss_db) in known {
-            responses.keep(id, response, loss_db);
+    pub(crate) fn with_known(scene: &'a Scene, mut known: Known) -> Self {
+        // As `keep` would have kept them one by one, in `known`'s own memory.
+        known.truncate(KNOWN_SURFACES);
+        let mut slots = [0; SLOTS];
+        for (k, (id, ..)) in known.iter().enumerate() {
+            let slot = &mut slots[id.index() % SLOTS];
+            if *slot == 0 {
+                // At most KNOWN_SURFACES (64) positions: + 1 fits a byte.
+                *slot = (k + 1) as u8;
+            }
         }
-        responses
+        Responses {
+            scene,
+            known,
+            slots,
+        }
     }
 
     /// Keep surface `id`'s response and loss, when there is room.

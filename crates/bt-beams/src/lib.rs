@@ -377,7 +377,7 @@ pub(crate) fn unfolded_length(tx: Vec3, points: &[Vec3], rx: Vec3) -> Real {
 /// Buffers a report's paths reuse one after the other, so that describing a path allocates
 /// only what its record keeps: its vertices and its interactions as the channel model sees
 /// them.
-#[derive(Default)]
+#[derive(Debug, Default)]
 pub(crate) struct Scratch {
     vertices: Vec<Vec3>,
     interactions: Vec<Interaction>,
@@ -504,7 +504,11 @@ pub fn taps(paths: &[PathReport]) -> Vec<Tap> {
 /// Total received power of the paths, dBm: transmitted power + 10·log10 Σ|gain|² (a power sum:
 /// the wideband average, without interference between paths); `None` without power.
 pub fn received_power_dbm(paths: &[PathReport], tx_power_dbm: Real) -> Option<Real> {
-    power_db(bt_channel::total_power(&taps(paths))).map(|g| g + tx_power_dbm)
+    // `bt_channel::total_power` of the paths' taps, summed in place (no vector of taps).
+    let total = (paths.iter())
+        .map(|p| p.gain.norm_sqr())
+        .fold(0.0, |a, b| a + b);
+    power_db(total).map(|g| g + tx_power_dbm)
 }
 
 /// Describe and rank all paths: by order, then length, then the largest incidence angle

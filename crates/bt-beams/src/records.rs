@@ -26,6 +26,8 @@ pub struct Records {
     /// looked up by name and its model evaluated at the frequency, about 14 surfaces a room's
     /// report; docs/performance.md).
     responses: Option<(bt_scene::RadioKey, gain::Known)>,
+    /// The buffers each path is described with, kept too.
+    scratch: Scratch,
 }
 
 /// A path's first keys in the ranking ([`rank_order`]) and its index among the paths: its
@@ -52,7 +54,7 @@ impl Records {
             _ => Vec::new(),
         };
         let mut responses = gain::Responses::with_known(scene, known);
-        let mut scratch = Scratch::default();
+        let scratch = &mut self.scratch;
         self.len = 0;
         self.keys.clear();
         if !paths.is_empty() {
@@ -68,8 +70,7 @@ impl Records {
             self.records.resize_with(paths.len(), PathReport::blank);
         }
         for (&(_, _, index), record) in self.keys.iter().zip(&mut self.records) {
-            let described =
-                describe_into(&mut responses, &mut scratch, &paths[index], radio, record);
+            let described = describe_into(&mut responses, scratch, &paths[index], radio, record);
             if let Err(e) = described {
                 // The error a report in the paths' order meets first.
                 return Err(first_error(&mut responses, paths, radio).unwrap_or(e));
