@@ -24,6 +24,9 @@ pub(crate) struct Responses<'a> {
     /// first surface kept with that remainder (0: none), so that most look-ups read one entry
     /// instead of scanning `known` (a room's report looks up ~380 times, ~14 surfaces).
     slots: [u8; SLOTS],
+    /// The scene's terminals once looked up ([`Responses::terminals`]): each path of a
+    /// report needs them twice.
+    ends: Option<bt_scene::Endpoints>,
 }
 
 /// Slots of [`Responses::slots`].
@@ -59,6 +62,7 @@ impl<'a> Responses<'a> {
             scene,
             known,
             slots,
+            ends: None,
         }
     }
 
@@ -82,6 +86,16 @@ impl<'a> Responses<'a> {
     /// The scene.
     pub(crate) fn scene(&self) -> &'a Scene {
         self.scene
+    }
+
+    /// The scene's terminals ([`Scene::terminals`], looked up once).
+    pub(crate) fn terminals(&mut self) -> Result<bt_scene::Endpoints, ReportError> {
+        if let Some(ends) = self.ends {
+            return Ok(ends);
+        }
+        let ends = self.scene.terminals()?;
+        self.ends = Some(ends);
+        Ok(ends)
     }
 
     /// Surface `id`'s response and its material's reflection loss (dB).
@@ -133,7 +147,7 @@ pub(crate) fn path_gain(
     radio: &RadioOptions,
 ) -> Result<(Complex64, Real), ReportError> {
     let scene = responses.scene();
-    let ends = scene.terminals()?;
+    let ends = responses.terminals()?;
     channel.clear();
     channel.extend(interactions.iter().map(|it| match *it {
         Interaction::Reflection(id) => bt_channel::Interaction::Reflection(Bounce {

@@ -346,19 +346,15 @@ fn interaction_names(scene: &Scene, interactions: &[Interaction], names: &mut Ve
     }
 }
 
-/// The path's vertices TX → points → RX (local frame) into `vertices` (cleared first), and
-/// its unfolded length (m).
-pub(crate) fn vertices(
-    scene: &Scene,
-    path: &FoundPath,
-    vertices: &mut Vec<Vec3>,
-) -> Result<Real, ReportError> {
-    let bt_scene::Endpoints { tx, rx } = scene.terminals()?;
+/// The path's vertices TX → points → RX (the terminals `ends`, local frame) into `vertices`
+/// (cleared first), and its unfolded length (m).
+fn vertices(ends: bt_scene::Endpoints, path: &FoundPath, vertices: &mut Vec<Vec3>) -> Real {
+    let bt_scene::Endpoints { tx, rx } = ends;
     vertices.clear();
     vertices.push(tx);
     vertices.extend_from_slice(&path.points);
     vertices.push(rx);
-    Ok(unfolded_length(tx, &path.points, rx))
+    unfolded_length(tx, &path.points, rx)
 }
 
 /// The length (m) of the polyline `tx` → `points` → `rx`: its legs summed from TX, the one
@@ -408,7 +404,7 @@ pub(crate) fn describe_into(
     record: &mut PathReport,
 ) -> Result<(), ReportError> {
     let scene = responses.scene();
-    let length_m = vertices(scene, path, &mut scratch.vertices)?;
+    let length_m = vertices(responses.terminals()?, path, &mut scratch.vertices);
     let vertices = &scratch.vertices;
     path.interactions_into(&mut scratch.interactions);
     let interactions = &scratch.interactions;
