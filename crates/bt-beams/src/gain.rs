@@ -24,6 +24,9 @@ pub(crate) struct Responses<'a> {
     /// first surface kept with that remainder (0: none), so that most look-ups read one entry
     /// instead of scanning `known` (a room's report looks up ~380 times, ~14 surfaces).
     slots: [u8; SLOTS],
+    /// The scene's terminals once looked up ([`Responses::terminals`]): each path of a
+    /// report needs them twice.
+    ends: Option<bt_scene::Endpoints>,
 }
 
 /// Slots of [`Responses::slots`].
@@ -44,16 +47,23 @@ impl<'a> Responses<'a> {
     /// The surfaces of `known` already looked up in `scene`: they were looked up in a scene of
     /// the same [`bt_scene::RadioKey`] (the same surfaces, materials and frequency), or
     /// `known` is empty.
-    pub(crate) fn with_known(scene: &'a Scene, known: Known) -> Self {
-        let mut responses = Responses {
-            scene,
-            known: Vec::new(),
-            slots: [0; SLOTS],
-        };
-        for (id, response, loss_db) in known {
-            responses.keep(id, response, loss_db);
+    pub(crate) fn with_known(scene: &'a Scene, mut known: Known) -> Self {
+        // As `keep` would have kept them one by one, in `known`'s own memory.
+        known.truncate(KNOWN_SURFACES);
+        let mut slots = [0; SLOTS];
+        for (k, (id, ..)) in known.iter().enumerate() {
+            let slot = &mut slots[id.index() % SLOTS];
+            if *slot == 0 {
+                // At most KNOWN_SURFACES (64) positions: + 1 fits a byte.
+                *slot = (k + 1) as u8;
+            }
         }
-        responses
+        Responses {
+            scene,
+            known,
+            slots,
+            ends: None,
+        }
     }
 
     /// Keep surface `id`'s response and loss, when there is room.
@@ -76,6 +86,16 @@ impl<'a> Responses<'a> {
     /// The scene.
     pub(crate) fn scene(&self) -> &'a Scene {
         self.scene
+    }
+
+    /// The scene's terminals ([`Scene::terminals`], looked up once).
+    pub(crate) fn terminals(&mut self) -> Result<bt_scene::Endpoints, ReportError> {
+        if let Some(ends) = self.ends {
+            return Ok(ends);
+        }
+        let ends = self.scene.terminals()?;
+        self.ends = Some(ends);
+        Ok(ends)
     }
 
     /// Surface `id`'s response and its material's reflection loss (dB).
@@ -127,7 +147,7 @@ pub(crate) fn path_gain(
     radio: &RadioOptions,
 ) -> Result<(Complex64, Real), ReportError> {
     let scene = responses.scene();
-    let ends = scene.terminals()?;
+    let ends = responses.terminals()?;
     channel.clear();
     channel.extend(interactions.iter().map(|it| match *it {
         Interaction::Reflection(id) => bt_channel::Interaction::Reflection(Bounce {

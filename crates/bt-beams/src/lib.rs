@@ -346,29 +346,34 @@ fn interaction_names(scene: &Scene, interactions: &[Interaction], names: &mut Ve
     }
 }
 
-/// The path's vertices TX → points → RX (local frame) into `vertices` (cleared first), and
-/// its unfolded length (m).
-fn vertices(
-    scene: &Scene,
-    path: &FoundPath,
-    vertices: &mut Vec<Vec3>,
-) -> Result<Real, ReportError> {
-    let bt_scene::Endpoints { tx, rx } = scene.terminals()?;
+/// The path's vertices TX → points → RX (the terminals `ends`, local frame) into `vertices`
+/// (cleared first), and its unfolded length (m).
+fn vertices(ends: bt_scene::Endpoints, path: &FoundPath, vertices: &mut Vec<Vec3>) -> Real {
+    let bt_scene::Endpoints { tx, rx } = ends;
     vertices.clear();
     vertices.push(tx);
     vertices.extend_from_slice(&path.points);
     vertices.push(rx);
-    let length_m: Real = vertices
-        .windows(2)
-        .map(|w| w[0].distance(w[1]))
-        .fold(0.0, |a, b| a + b);
-    Ok(length_m)
+    unfolded_length(tx, &path.points, rx)
+}
+
+/// The length (m) of the polyline `tx` → `points` → `rx`: its legs summed from TX, the one
+/// computation of a record's `length_m` (the ranking sorts by it before the records are
+/// described, [`Records`], and must see the same bits).
+pub(crate) fn unfolded_length(tx: Vec3, points: &[Vec3], rx: Vec3) -> Real {
+    let mut length = 0.0;
+    let mut from = tx;
+    for &to in points.iter().chain(std::iter::once(&rx)) {
+        length += from.distance(to);
+        from = to;
+    }
+    length
 }
 
 /// Buffers a report's paths reuse one after the other, so that describing a path allocates
 /// only what its record keeps: its vertices and its interactions as the channel model sees
 /// them.
-#[derive(Default)]
+#[derive(Debug, Default)]
 pub(crate) struct Scratch {
     vertices: Vec<Vec3>,
     interactions: Vec<Interaction>,
@@ -399,7 +404,7 @@ pub(crate) fn describe_into(
     record: &mut PathReport,
 ) -> Result<(), ReportError> {
     let scene = responses.scene();
-    let length_m = vertices(scene, path, &mut scratch.vertices)?;
+    let length_m = vertices(responses.terminals()?, path, &mut scratch.vertices);
     let vertices = &scratch.vertices;
     path.interactions_into(&mut scratch.interactions);
     let interactions = &scratch.interactions;
@@ -495,7 +500,11 @@ pub fn taps(paths: &[PathReport]) -> Vec<Tap> {
 /// Total received power of the paths, dBm: transmitted power + 10·log10 Σ|gain|² (a power sum:
 /// the wideband average, without interference between paths); `None` without power.
 pub fn received_power_dbm(paths: &[PathReport], tx_power_dbm: Real) -> Option<Real> {
-    power_db(bt_channel::total_power(&taps(paths))).map(|g| g + tx_power_dbm)
+    // `bt_channel::total_power` of the paths' taps, summed in place (no vector of taps).
+    let total = (paths.iter())
+        .map(|p| p.gain.norm_sqr())
+        .fold(0.0, |a, b| a + b);
+    power_db(total).map(|g| g + tx_power_dbm)
 }
 
 /// Describe and rank all paths: by order, then length, then the largest incidence angle

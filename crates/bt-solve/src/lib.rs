@@ -120,10 +120,16 @@ impl FoundPath {
     /// [`FoundPath::interactions`] into `interactions` (cleared first), whose memory a report
     /// of many paths reuses.
     pub fn interactions_into(&self, interactions: &mut Vec<Interaction>) {
+        interactions.clear();
+        if self.crossings.is_empty() && self.diffractions.is_empty() {
+            // Reflections only (most of a room's paths): the merge below, without its tests.
+            let reflections = self.surfaces.iter().take(self.points.len());
+            interactions.extend(reflections.map(|&s| Interaction::Reflection(s)));
+            return;
+        }
         let mut reflections = self.surfaces.iter();
         let mut crossings = self.crossings.iter().peekable();
         let mut diffractions = self.diffractions.iter().peekable();
-        interactions.clear();
         interactions.extend((0..self.points.len()).filter_map(|i| {
             match crossings.next_if(|c| c.index == i) {
                 Some(c) => Some(Interaction::Transmission(c.surface)),
@@ -451,4 +457,36 @@ pub fn trace(
             .collect();
     }
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A path of reflections only takes the short way through
+    /// [`FoundPath::interactions_into`]: the same interactions as the merge of reflections,
+    /// crossings and diffractions (written out here as it runs for the others), also when
+    /// its surfaces and points disagree in number.
+    #[test]
+    fn reflections_alone_give_the_merged_interactions() {
+        let merged = |p: &FoundPath| -> Vec<Interaction> {
+            let mut reflections = p.surfaces.iter();
+            (0..p.points.len())
+                .filter_map(|_| reflections.next().map(|s| Interaction::Reflection(*s)))
+                .collect()
+        };
+        for (surfaces, points) in [(0, 0), (1, 1), (3, 3), (6, 6), (2, 4), (4, 2)] {
+            let path = FoundPath {
+                surfaces: (0..surfaces).map(|i| SurfaceId(7 * i + 1)).collect(),
+                points: (0..points).map(|i| Vec3::splat(i as Real)).collect(),
+                diffractions: Inline::new(),
+                crossings: Inline::new(),
+                iterations: None,
+                residual: None,
+            };
+            let mut kept = vec![Interaction::Transmission(SurfaceId(99))];
+            path.interactions_into(&mut kept);
+            assert_eq!(kept, merged(&path), "{surfaces} surfaces, {points} points");
+        }
+    }
 }
