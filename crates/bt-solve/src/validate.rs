@@ -123,14 +123,27 @@ pub fn crossing_budget<'s>(
     path: PathVertices<'_, 's>,
     interactions: usize,
 ) -> Validity {
+    crossing_budget_recording(scene, path, interactions, |_| {})
+}
+
+/// [`crossing_budget`], calling `record` on each crossing (segment, point, surface) within
+/// the budget, in path order: for a valid path, every crossing [`walk_crossings`] finds.
+#[inline(always)]
+pub(crate) fn crossing_budget_recording<'s>(
+    scene: &'s Scene,
+    path: PathVertices<'_, 's>,
+    interactions: usize,
+    mut record: impl FnMut((usize, Vec3, SurfaceId)),
+) -> Validity {
     let mut allowed = scene.max_interactions().saturating_sub(interactions);
     let mut verdict = Validity::Valid;
-    walk_crossings(scene, path, |segment, _, by| {
+    walk_crossings(scene, path, |segment, p, by| {
         if allowed == 0 {
             verdict = Validity::Blocked { segment, by };
             return false;
         }
         allowed -= 1;
+        record((segment, p, by));
         true
     });
     verdict
