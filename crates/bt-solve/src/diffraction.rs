@@ -191,6 +191,23 @@ pub fn validate(
     c: DiffractedCandidate<'_>,
     points: &[Vec3],
 ) -> Validity {
+    validate_recording(scene, ends, c, points, &mut Vec::new())
+}
+
+/// The crossings of penetrable surfaces that validation walked: (segment, point, surface),
+/// in path order ([`validate::walk_crossings`]); all of a valid path's.
+type Crossings = Vec<(usize, Vec3, SurfaceId)>;
+
+/// [`validate`], with the crossings walked into `crossings` (cleared first).
+#[inline(always)]
+fn validate_recording(
+    scene: &Scene,
+    ends: Endpoints,
+    c: DiffractedCandidate<'_>,
+    points: &[Vec3],
+    crossings: &mut Crossings,
+) -> Validity {
+    crossings.clear();
     let tol = scene.length_tolerance();
     let n = points.len();
     if points.iter().any(|p| !p.is_finite()) {
@@ -242,7 +259,7 @@ pub fn validate(
             return verdict;
         }
     }
-    blocked(scene, c, (vertex, n))
+    blocked(scene, c, (vertex, n), crossings)
 }
 
 /// The verdict on a diffraction point `d` (point `index`) of `edge` between its neighbours
@@ -272,6 +289,7 @@ fn blocked(
     scene: &Scene,
     c: DiffractedCandidate<'_>,
     (vertex, n): (impl Fn(usize) -> Vec3, usize),
+    crossings: &mut Crossings,
 ) -> Validity {
     let tol = scene.length_tolerance();
     let on = |k: usize| -> &[SurfaceId] {
@@ -300,7 +318,7 @@ fn blocked(
             on: &on,
             points: n,
         };
-        return validate::crossing_budget(scene, path, n);
+        return validate::crossing_budget_recording(scene, path, n, |c| crossings.push(c));
     }
     Validity::Valid
 }
@@ -324,13 +342,28 @@ pub fn solve_candidate(
     solver: &crate::Solver,
     points: &mut [Vec3],
 ) -> CandidateOutcome {
+    let mut crossings = Vec::new();
+    solve_candidate_recording(scene, ends, c, (keller, solver), points, &mut crossings)
+}
+
+/// [`solve_candidate`], with the crossings validation walked into `crossings`
+/// ([`validate_recording`]).
+#[inline(always)]
+fn solve_candidate_recording(
+    scene: &Scene,
+    ends: Endpoints,
+    c: DiffractedCandidate<'_>,
+    (keller, solver): (Option<(Real, Real)>, &crate::Solver),
+    points: &mut [Vec3],
+    crossings: &mut Crossings,
+) -> CandidateOutcome {
     match solver {
         crate::Solver::Image => {
             if let Err(e) = solve_image(scene, ends, c, keller, points) {
                 return CandidateOutcome::ImageDegenerate(e);
             }
             CandidateOutcome::Solved {
-                validity: validate(scene, ends, c, points),
+                validity: validate_recording(scene, ends, c, points, crossings),
                 ipc: None,
             }
         }
@@ -338,7 +371,7 @@ pub fn solve_candidate(
             ipc_start(scene, c, points);
             match solve_ipc(scene, ends, c, options, points) {
                 outcome @ IpcOutcome::Converged { .. } => CandidateOutcome::Solved {
-                    validity: validate(scene, ends, c, points),
+                    validity: validate_recording(scene, ends, c, points, crossings),
                     ipc: Some(outcome),
                 },
                 outcome @ IpcOutcome::NotConverged { .. } => {
@@ -352,7 +385,8 @@ pub fn solve_candidate(
 }
 
 /// Solve and validate every candidate of `set` (in parallel when `parallel`; the output is
-/// the same either way): the valid paths in set order, and every outcome counted, as the
+/// the same either way): the valid paths in set order, with the penetrable surfaces they
+/// cross inserted as [`FoundPath::with_crossings`] would, and every outcome counted, as the
 /// results of consecutive chunks of the set ([`TraceResult::concat`] joins them).
 pub fn trace_set(
     scene: &Scene,
@@ -417,6 +451,7 @@ fn solve_range_impl(work: &Work<'_>, range: std::ops::Range<usize>) -> TraceResu
     let mut out = TraceResult::default();
     let mut buffer = [Vec3::ZERO; 8];
     let mut heap = Vec::new();
+    let mut crossings = Vec::new();
     for i in range {
         let c = work.set.get(i);
         let points: &mut [Vec3] = if c.order() <= buffer.len() {
@@ -425,10 +460,14 @@ fn solve_range_impl(work: &Work<'_>, range: std::ops::Range<usize>) -> TraceResu
             heap.resize(c.order(), Vec3::ZERO);
             &mut heap[..]
         };
-        let keller = work.set.keller(i);
-        let outcome = solve_candidate(work.scene, work.ends, c, keller, work.solver, points);
+        let how = (work.set.keller(i), work.solver);
+        let outcome =
+            solve_candidate_recording(work.scene, work.ends, c, how, points, &mut crossings);
         out.counts.add(&outcome);
-        out.paths.extend(found(c, &outcome, points));
+        // With its crossings, which validation walked ([`crate::FoundPath::with_crossings`]
+        // would walk them again).
+        out.paths
+            .extend(found(c, &outcome, points).map(|p| p.with_found_crossings(&crossings)));
     }
     out
 }

@@ -177,9 +177,16 @@ impl FoundPath {
             found.push((segment, p, id));
             true
         });
+        self.with_found_crossings(&found)
+    }
+
+    /// The path with the crossings `found` ((segment, point, surface), in path order, as
+    /// [`validate::walk_crossings`] gives them) inserted as crossing points.
+    pub(crate) fn with_found_crossings(self, found: &[(usize, Vec3, SurfaceId)]) -> FoundPath {
         if found.is_empty() {
             return self;
         }
+        let n = self.points.len();
         let mut points = Inline::with_capacity(n + found.len());
         let mut crossings = Inline::with_capacity(found.len());
         let mut diffractions = self.diffractions.clone();
@@ -443,6 +450,14 @@ pub fn trace(
         parallel,
     };
     let mut parts = solve_batch(&batch, Todo::All, |_| None, keep_valid);
+    if scene.transmits() {
+        for part in &mut parts {
+            part.paths = (std::mem::take(&mut part.paths).into_iter())
+                .map(|p| p.with_crossings(scene, ends))
+                .collect();
+        }
+    }
+    // The diffracted paths come with their crossings: validation walked them.
     parts.extend(diffraction::trace_set(
         scene,
         ends,
@@ -450,13 +465,7 @@ pub fn trace(
         solver,
         parallel,
     ));
-    let mut out = TraceResult::concat(parts);
-    if scene.transmits() {
-        out.paths = (out.paths.into_iter())
-            .map(|p| p.with_crossings(scene, ends))
-            .collect();
-    }
-    Ok(out)
+    Ok(TraceResult::concat(parts))
 }
 
 #[cfg(test)]

@@ -123,14 +123,27 @@ pub fn crossing_budget<'s>(
     path: PathVertices<'_, 's>,
     interactions: usize,
 ) -> Validity {
+    crossing_budget_recording(scene, path, interactions, |_| {})
+}
+
+/// [`crossing_budget`], calling `record` on each crossing (segment, point, surface) within
+/// the budget, in path order: for a valid path, every crossing [`walk_crossings`] finds.
+#[inline(always)]
+pub(crate) fn crossing_budget_recording<'s>(
+    scene: &'s Scene,
+    path: PathVertices<'_, 's>,
+    interactions: usize,
+    mut record: impl FnMut((usize, Vec3, SurfaceId)),
+) -> Validity {
     let mut allowed = scene.max_interactions().saturating_sub(interactions);
     let mut verdict = Validity::Valid;
-    walk_crossings(scene, path, |segment, _, by| {
+    walk_crossings(scene, path, |segment, p, by| {
         if allowed == 0 {
             verdict = Validity::Blocked { segment, by };
             return false;
         }
         allowed -= 1;
+        record((segment, p, by));
         true
     });
     verdict
@@ -178,20 +191,23 @@ fn segment_crossings(
     let tol = scene.length_tolerance();
     let length = a.distance(b);
     let t_min = tol / length.max(tol);
-    scene.bvh().visit_segment(a, b, 2.0 * tol, |i| {
+    // `any_hit` rejecting every item: the items `first_blocking` tests (in a small scene
+    // the boxes the segment touches, scanned several at once), inlined into the caller.
+    scene.bvh().any_hit(a, b, 2.0 * tol, |i| {
         let id = SurfaceId(i);
         if !scene.penetrable(id) || from.contains(&id) || to.contains(&id) {
-            return;
+            return false;
         }
         let polygon = &scene.surface(id).polygon;
         if !polygon.blocks_segment(a, b, t_min, tol) {
-            return;
+            return false;
         }
         let plane = polygon.plane();
         let (da, db) = (plane.signed_distance(a), plane.signed_distance(b));
         if let Some(t) = bt_geom::Plane::crossing_parameter(da, db, a, b) {
             out.push((t, id));
         }
+        false
     });
     out.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
     let normal = |id: SurfaceId| scene.surface(id).polygon.plane().normal;

@@ -347,46 +347,81 @@ struct Pairs<'a> {
 /// cos β0 with the first edge equals the incident ray's (Keller), and `M` lies in the
 /// reflector's polygon, within the margin of its box. A group whose range of that cosine
 /// ([`cos_range_to_box`]) misses its incidence range pairs with no interval beyond that
-/// reflector, so the join never looks at those pairs.
+/// reflector, so the join never looks at those pairs. Likewise per second edge, for paths
+/// with no middle reflection: `D1 → D2` leaves `D1` towards the second edge's segment
+/// ([`heads_into`]).
+/// Each list holds its groups by depth (ascending), so that a far interval takes the
+/// prefix whose depths fit.
 #[derive(Debug, Clone)]
 struct Toward {
     /// Per surface id: the groups (indices) for a middle starting there.
     groups: Vec<Vec<u32>>,
     /// Per surface id: a reflector's polygon box grown by the margin (m).
     boxes: Vec<(Vec3, Vec3)>,
-    /// Every group, for paths with no middle reflection.
-    all: Vec<u32>,
+    /// Per second edge: the groups for paths with no middle reflection, made when first
+    /// asked for ([`Toward::straight`]).
+    straight: Vec<std::sync::OnceLock<Vec<u32>>>,
+    /// The margin (m).
+    margin: Real,
 }
 
 impl Toward {
     fn of(scene: &Scene, groups: &[Group], margin: Real) -> Self {
+        let by_depth = |mut list: Vec<u32>| {
+            list.sort_by_key(|&g| (groups[g as usize].depth, g));
+            list
+        };
         let mut by_surface = vec![Vec::new(); scene.surfaces().len()];
         let mut boxes = vec![(Vec3::ZERO, Vec3::ZERO); scene.surfaces().len()];
         for m in scene.reflectors() {
             let (lo, hi) = scene.surface(m).polygon.bounds();
             let bounds = (lo - Vec3::splat(margin), hi + Vec3::splat(margin));
             boxes[m.index()] = bounds;
-            by_surface[m.index()] = (0..groups.len() as u32)
-                .filter(|&g| {
-                    let span = &groups[g as usize].span;
-                    let range = cos_range_to_box(span.ends, bounds, span.line.direction);
-                    overlap(range, span.incidence)
-                })
-                .collect();
+            by_surface[m.index()] = by_depth(
+                (0..groups.len() as u32)
+                    .filter(|&g| {
+                        let span = &groups[g as usize].span;
+                        let range = cos_range_to_box(span.ends, bounds, span.line.direction);
+                        overlap(range, span.incidence)
+                    })
+                    .collect(),
+            );
         }
         Toward {
             groups: by_surface,
             boxes,
-            all: (0..groups.len() as u32).collect(),
+            straight: vec![std::sync::OnceLock::new(); scene.edges().len()],
+            margin,
         }
+    }
+
+    /// The groups for paths with no middle reflection to edge `e2` of `scene` ([`heads_into`]
+    /// its segment grown by the margin), by depth.
+    fn straight(&self, scene: &Scene, groups: &[Group], e2: usize) -> &[u32] {
+        self.straight[e2].get_or_init(|| {
+            let edge = &scene.edges().all()[e2];
+            let line = EdgeLine::of(edge);
+            let whole = [
+                line.point(-self.margin),
+                line.point(edge.length + self.margin),
+            ];
+            let mut list: Vec<u32> = (0..groups.len() as u32)
+                .filter(|&g| {
+                    let span = &groups[g as usize].span;
+                    span.edge != e2 && heads_into(span, whole)
+                })
+                .collect();
+            list.sort_by_key(|&g| (groups[g as usize].depth, g));
+            list
+        })
     }
 
     /// The groups that may pair with `far`, or `None` when none may: with one middle
     /// reflection, the ray arriving at the far interval from the reflector's box must obey
     /// Keller's law there too (cos β0 of `q − M` against the leaving range).
-    fn groups(&self, far: &Far<'_>) -> Option<&[u32]> {
+    fn groups(&self, scene: &Scene, groups: &[Group], far: &Far<'_>) -> Option<&[u32]> {
         let Some(&m) = far.middle.first() else {
-            return Some(&self.all);
+            return Some(self.straight(scene, groups, far.edge));
         };
         if far.middle.len() == 1 {
             let direction = far.wedge.line.direction;
@@ -398,6 +433,45 @@ impl Toward {
         Some(&self.groups[m.index()])
     }
 }
+
+/// Whether rays from `span`'s interval to the segment `whole` (a second edge grown by the
+/// margin: every far interval on that edge, with no middle reflection, is a part of it) may
+/// obey Keller's law at the first edge, with twice [`SLACK`]. When this fails, so does
+/// [`Pairing::may_pair`]'s first test for every far interval on the edge: a part's
+/// numerators lie between `whole`'s corners' and its lengths between the bounds taken here
+/// (the distance bound of the segments' enclosing spheres, less [`NEAR`], is below the
+/// part's), up to round-off; the distance bound of at least [`NEAR`] keeps that round-off's
+/// effect on the cosines far below the slack (closer segments always pass).
+fn heads_into(span: &Span, whole: [Vec3; 2]) -> bool {
+    let ps = span.ends;
+    let corners = [
+        whole[0] - ps[0],
+        whole[0] - ps[1],
+        whole[1] - ps[0],
+        whole[1] - ps[1],
+    ];
+    let d_hi = corners.iter().map(|v| v.length()).fold(0.0, Real::max);
+    let (u, v) = (ps[1] - ps[0], whole[1] - whole[0]);
+    let spheres = (0.5 * (ps[0] + ps[1])).distance(0.5 * (whole[0] + whole[1]))
+        - 0.5 * (u.length() + v.length());
+    let d_lo = spheres - NEAR;
+    // Also false for NaN.
+    if !(d_lo >= NEAR && d_hi > 0.0) {
+        return true;
+    }
+    let direction = span.line.direction;
+    let along = [
+        corners[0].dot(direction),
+        corners[1].dot(direction),
+        corners[2].dot(direction),
+        corners[3].dot(direction),
+    ];
+    let at = cos_bounds(&along, (d_lo, d_hi));
+    at.0 <= span.incidence.1 + 2.0 * SLACK && span.incidence.0 <= at.1 + 2.0 * SLACK
+}
+
+/// Length (m) below which [`heads_into`] takes two segments as close (and passes them).
+const NEAR: Real = 1e-6;
 
 /// Length slack (m) of [`Pairing::apart`]'s intervals: far above their round-off and the
 /// Keller pair's tolerance, far below any reach.
@@ -477,7 +551,7 @@ impl Pairing<'_> {
             for b in on_edge.iter().filter(|b| b.depth <= deepest) {
                 for middle in middles[..=deepest - b.depth].iter().flatten() {
                     let far = self.far(scene, (e2, *b), middle);
-                    let Some(first) = index.groups(&far) else {
+                    let Some(first) = index.groups(scene, &tx.groups, &far) else {
                         continue;
                     };
                     self.pair_with(scene, &far, first, &mut pairs, set)?;
@@ -501,11 +575,11 @@ impl Pairing<'_> {
         let b = &far.reach;
         pairs.seen.clear();
         pairs.seen.resize(scene.edges().len(), None);
-        for g in first.iter().map(|&g| &pairs.groups[g as usize]) {
-            if g.depth + b.depth + far.middle.len() > pairs.deepest
-                || self.beyond(&g.span, far)
-                || !self.may_pair(scene, (&g.span, far), &mut pairs.seen)
-            {
+        // The lists hold their groups by depth: those that fit come first.
+        let room = pairs.deepest - b.depth - far.middle.len();
+        let fit = first.partition_point(|&g| pairs.groups[g as usize].depth <= room);
+        for g in first[..fit].iter().map(|&g| &pairs.groups[g as usize]) {
+            if self.beyond(&g.span, far) || !self.may_pair(scene, (&g.span, far), &mut pairs.seen) {
                 continue;
             }
             // The members go straight to the Keller pair: their own prefilters, run again,
