@@ -213,6 +213,8 @@ fn generate(args: &HlsGenArgs) -> anyhow::Result<ExitCode> {
         multiplier_budget: args.multiplier_budget,
         ..bt_hls::Platform::fitting(&work)?
     };
+    // Refused here too with --plan-only: what could not be built is not planned.
+    platform.check()?;
     let k = platform.instances.len() as u32;
     for p in planned.iter_mut() {
         // A stream's platform may hold PEs a step does not use: predict on all of them.

@@ -260,6 +260,38 @@ pub struct StepWork {
 }
 
 impl Platform {
+    /// Checks what the platform alone must satisfy, every problem at once (as generating its
+    /// design would): named planes, at least one PE, PEs of existing planes, and on generic
+    /// PEs no mix with plane PEs and the multiplier budget. Lets a caller that only plans
+    /// (`hls gen --plan-only`) refuse what it could not build.
+    pub fn check(&self) -> Result<(), HlsError> {
+        let problems = self.problems();
+        if problems.is_empty() {
+            Ok(())
+        } else {
+            Err(HlsError::InvalidInput { problems })
+        }
+    }
+
+    fn problems(&self) -> Vec<String> {
+        let mut problems = Vec::new();
+        for (i, p) in self.planes.iter().enumerate() {
+            if p.name.is_empty() {
+                problems.push(format!("plane {i} has an empty name"));
+            }
+        }
+        if self.instances.is_empty() {
+            problems.push("the platform has no PE".into());
+        }
+        for inst in &self.instances {
+            if inst.plane as usize >= self.planes.len() && !inst.is_generic() {
+                problems.push(format!("PE of plane {} out of range", inst.plane));
+            }
+        }
+        problems.extend(generic_problems(self));
+        problems
+    }
+
     /// Whether the platform's PEs are generic ([`PeInstance::generic`]): any PE takes any
     /// plane's job, the plane's coefficients loaded with it from the plane table.
     pub fn is_generic(&self) -> bool {
@@ -516,24 +548,10 @@ pub(crate) fn plane_table_words(wd: bt_fixed::Widths, generic: bool) -> Vec<u32>
 
 impl Design {
     pub fn new(platform: &Platform, work: &[StepWork]) -> Result<Design, HlsError> {
-        let mut problems = Vec::new();
-        for (i, p) in platform.planes.iter().enumerate() {
-            if p.name.is_empty() {
-                problems.push(format!("plane {i} has an empty name"));
-            }
-        }
+        let mut problems = platform.problems();
         if work.is_empty() {
             problems.push("no step to run".into());
         }
-        if platform.instances.is_empty() {
-            problems.push("the platform has no PE".into());
-        }
-        for inst in &platform.instances {
-            if inst.plane as usize >= platform.planes.len() && !inst.is_generic() {
-                problems.push(format!("PE of plane {} out of range", inst.plane));
-            }
-        }
-        problems.extend(generic_problems(platform));
         if !problems.is_empty() {
             return Err(HlsError::InvalidInput { problems });
         }

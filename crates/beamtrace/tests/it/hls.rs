@@ -160,4 +160,16 @@ fn hls_errors_are_clear() {
         "{out}"
     );
     assert!(!dir.exists());
+    // Generic PEs beyond the device's multipliers: refused even when only planning.
+    let dir = root.join("generic");
+    let o = beamtrace(&cli(
+        "hls gen builtin:living-room --plan-only --generic-pes 30 -o {}",
+        &[dir.to_str().unwrap()],
+    ));
+    let (ok, out) = (o.status.success(), text(&o));
+    assert!(
+        !ok && out.contains("--multiplier-budget") && out.contains("--generic-pes"),
+        "{out}"
+    );
+    assert!(!dir.exists());
 }
