@@ -104,8 +104,10 @@ impl Reach {
             .copied()
     }
 
-    /// Whether the lists answer for the node on surface `s` with apex `apex` (m), window `window` and beam `planes` (its near plane first). The point `p` of a
-    /// passing leaf test (module docs) must then lie within half the margin of `s`'s box:
+    /// Whether the lists answer for the node on surface `s` with apex `apex` (m), window
+    /// `window` and beam `planes` (its near plane first): whether the point `p` of any passing
+    /// leaf test (module docs) surely lies within half the margin of `s`'s box and within a
+    /// quarter of it of `s`'s grown hull. It does when
     /// - every window edge has its side plane (none degenerate and left out);
     /// - `p` on `s`'s plane violates a side plane by at most 2 tolerances (the leaf test's
     ///   one, times at most 2 when `x` lies up to one tolerance before `s`'s plane: the
@@ -113,8 +115,7 @@ impl Reach {
     ///   the window, θ the smallest angle between a side plane and `s`'s plane and ψ the
     ///   window's smallest interior angle: required ≤ margin / 4;
     /// - when `x` lies before `s`'s plane, `p` lies beyond `x` by at most
-    ///   `|p − apex|·eps / h`, h the apex's distance to the plane: required ≤ margin / 8.
-    ///
+    ///   `|p − apex|·eps / h`, h the apex's distance to the plane: required ≤ margin / 8;
     /// - the window lies in `s`'s grown hull, which must lie within margin / 4 of `s`'s box
     ///   (the lists are found by a walk over the surfaces' boxes).
     ///
