@@ -31,6 +31,7 @@ mod diffraction;
 
 use crate::diffraction::Diffracting;
 mod chunked;
+mod reach;
 mod rebuild;
 mod receivers;
 pub use diffraction::{DiffractionSide, join as join_diffracted};
@@ -303,6 +304,9 @@ struct RxVisible {
     /// The visible reflectors, ascending, and a BVH over their boxes (item `i` = `ids[i]`).
     ids: Vec<u32>,
     bvh: bt_geom::bvh::Bvh,
+    /// For the probes of a deferred level: per reflector, the visible ones that can end a
+    /// candidate through it ([`reach::Reach`]).
+    reach: Option<reach::Reach>,
 }
 
 impl<'a> Prepared<'a> {
@@ -1199,6 +1203,17 @@ impl Probe {
             planes: &self.planes,
         };
         self.test.apex_distances(&node);
+        let mut tested = 0;
+        let reach = prep.rx_visible.as_ref().and_then(|v| v.reach.as_ref());
+        if let Some(reach) = reach.filter(|r| r.answers(prep, (s, image), window, &self.planes)) {
+            // Only the reflectors whose mirror beam reaches `s` can pass.
+            let found = reach.of_surface(prep, s, image).any(|c| {
+                tested += u64::from(c != s);
+                c != s && self.test.hit(prep, &node, c)
+            });
+            tree.stats.tested += tested;
+            return found;
+        }
         let visible = prep.rx_visible.as_ref();
         let Some(visible) = visible.filter(|_| prep.reflectors.len() > LINEAR_SCAN) else {
             tree.child_candidates(prep, &node, true, &mut self.children);
@@ -1206,7 +1221,6 @@ impl Probe {
             return self.children.iter().any(|&c| self.test.hit(prep, &node, c));
         };
         // The first child that passes is enough: no list, no sort, and the walk stops there.
-        let mut tested = 0;
         let found = visible.bvh.find(
             |lo, hi| box_meets_halfspaces(lo, hi, node.planes, eps),
             |i| {
@@ -1509,6 +1523,7 @@ fn rx_visibility(prep: &Prepared<'_>, rx: Vec3, stats: &mut TreeStats) -> RxVisi
         visible,
         bvh: bt_geom::bvh::Bvh::build(&polygons),
         ids,
+        reach: None,
     }
 }
 
@@ -1591,7 +1606,11 @@ pub fn candidates_and_diffracted_in(
     }
     let rx_mirrored = mirrored(&prep, rx);
     if defer {
-        prep.rx_visible = Some(rx_visibility(&prep, rx, &mut tree.stats));
+        let mut visible = rx_visibility(&prep, rx, &mut tree.stats);
+        if reach::Reach::pays(&prep, &visible.ids) {
+            visible.reach = Some(reach::Reach::of(&prep, &visible.ids, &rx_mirrored));
+        }
+        prep.rx_visible = Some(visible);
         let probe = (rx, rx_mirrored.clone());
         tree.grow_level_chunked(&prep, options.max_order - 1, Some(&probe), progress)?;
     }
