@@ -241,6 +241,47 @@ fn smallest_half_angle_sin2(window: &[Vec3]) -> Real {
 mod tests {
     use super::*;
 
+    /// A reflector `c` (the square |x|, |y| ≤ 1 at z = 0) below RX (0, 0, 1): its mirror beam
+    /// is the pyramid from J = (0, 0, −1) through `c`, whose side through `c`'s edge x = 1 is
+    /// x = 1 + z. A small square at z = 1 touching that side at one corner (x = 2) lies in the
+    /// beam only there: a node's ray through that corner reaches `c` at its edge, so `c` must
+    /// be in the square's list for an apex above it. A square a metre beyond the side must not
+    /// be. This pins the margin's sign, which the property tests cannot see (a
+    /// corner of one surface on the beam's side through another's edge is too rare there):
+    /// with the margin negated it fails.
+    #[test]
+    fn a_surface_touching_a_mirror_beam_at_one_corner_is_in_its_list() {
+        // A 10 cm square at z = 1 from (x, 0).
+        let square = |name: &str, x: Real| {
+            let a = x + 0.1;
+            format!(
+                r#"{{ "name": "{name}", "vertices": [[{x},0,1],[{a},0,1],[{a},0.1,1],[{x},0.1,1]] }}"#
+            )
+        };
+        let json = format!(
+            r#"{{ "tx": [0.5, 0.3, 4], "rx": [0, 0, 1], "surfaces": [
+                {{ "name": "c", "vertices": [[-1,-1,0],[1,-1,0],[1,1,0],[-1,1,0]] }}, {}, {} ] }}"#,
+            square("touching", 2.0),
+            square("beyond", 3.0),
+        );
+        let scene = bt_testkit::scene_from_json(&json);
+        let mut cache = super::super::TreeCache::default();
+        let prep = Prepared::new(&scene, super::super::TreeOptions::new(3), &mut cache).unwrap();
+        let mirrored = super::super::mirrored(&prep, scene.rx().unwrap());
+        let reach = Reach::of(&prep, &prep.reflectors, &mirrored);
+        let (c, touching, beyond) = (0, 1, 2);
+        assert_eq!(scene.surface(SurfaceId(touching)).name, "touching");
+        // A node on the square with its apex above it: its beam heads down, towards `c`.
+        let list = |s: u32, x: Real| -> Vec<u32> {
+            reach
+                .of_surface(&prep, s, Vec3::new(x + 0.05, 0.05, 5.0))
+                .collect()
+        };
+        let (touching, beyond) = (list(touching, 2.0), list(beyond, 3.0));
+        assert!(touching.contains(&c), "{touching:?}");
+        assert!(!beyond.contains(&c), "{beyond:?}");
+    }
+
     #[test]
     fn the_smallest_half_angle_is_that_of_the_sharpest_corner() {
         // A square of side 2 in the plane x = 3, its corners a quarter turn apart.
