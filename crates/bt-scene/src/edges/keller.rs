@@ -137,8 +137,31 @@ impl EdgeLine {
 /// The parameters (t1 on `first`, t2 on `second`) of the shortest path `a → first → second →
 /// b` (module docs), to [`KELLER_PAIR_TOL`] and, a few rounds allowing, [`KELLER_RESIDUAL`].
 /// `None` when a point of the path falls on its neighbour (the two points on the lines'
-/// crossing included) or the solve does not settle.
+/// crossing included) or the solve does not settle from either end.
+///
+/// The solve starts from one end (its first guess is that end's Keller point), so it runs
+/// from the end that sorts first (`a` or `b`, by coordinates), then from the other if that
+/// fails: a path and its reverse get the same parameters, bit for bit, and a start that
+/// stalls (a short middle leg near the lines' crossing) gets a second chance.
 pub fn keller_pair(a: Vec3, first: EdgeLine, second: EdgeLine, b: Vec3) -> Option<(Real, Real)> {
+    let forward = || keller_pair_from(a, first, second, b);
+    let backward = || keller_pair_from(b, second, first, a).map(|(t2, t1)| (t1, t2));
+    let key = |v: Vec3| [v.x, v.y, v.z];
+    let from_b = key(b)
+        .iter()
+        .zip(key(a))
+        .map(|(x, y)| x.total_cmp(&y))
+        .find(|o| o.is_ne())
+        == Some(std::cmp::Ordering::Less);
+    if from_b {
+        backward().or_else(forward)
+    } else {
+        forward().or_else(backward)
+    }
+}
+
+/// [`keller_pair`] solved from `a`'s end.
+fn keller_pair_from(a: Vec3, first: EdgeLine, second: EdgeLine, b: Vec3) -> Option<(Real, Real)> {
     let round = |t2: Real| {
         let t1 = first.keller(a, second.point(t2))?;
         Some((t1, second.keller(first.point(t1), b)?))
