@@ -144,6 +144,10 @@ impl EdgeLine {
 /// fails: a path and its reverse get the same parameters, bit for bit, and a start that
 /// stalls (a short middle leg near the lines' crossing) gets a second chance.
 pub fn keller_pair(a: Vec3, first: EdgeLine, second: EdgeLine, b: Vec3) -> Option<(Real, Real)> {
+    // The same test from either end (the crossing's subgradient condition is symmetric).
+    if shortest_at_crossing(a, (first, second), b) {
+        return None;
+    }
     let forward = || keller_pair_from(a, first, second, b);
     let backward = || keller_pair_from(b, second, first, a).map(|(t2, t1)| (t1, t2));
     let key = |v: Vec3| [v.x, v.y, v.z];
@@ -160,16 +164,13 @@ pub fn keller_pair(a: Vec3, first: EdgeLine, second: EdgeLine, b: Vec3) -> Optio
     }
 }
 
-/// [`keller_pair`] solved from `a`'s end.
+/// [`keller_pair`] solved from `a`'s end, the path not through the lines' crossing.
 fn keller_pair_from(a: Vec3, first: EdgeLine, second: EdgeLine, b: Vec3) -> Option<(Real, Real)> {
     let round = |t2: Real| {
         let t1 = first.keller(a, second.point(t2))?;
         Some((t1, second.keller(first.point(t1), b)?))
     };
     let local = |t: (Real, Real)| local(a, (first, second), b, t);
-    if shortest_at_crossing(a, (first, second), b) {
-        return None;
-    }
     let t1 = first.keller(a, b)?;
     let (mut t1, mut t2) = round(second.keller(first.point(t1), b)?)?;
     let mut here = local((t1, t2));
