@@ -19,38 +19,7 @@ pub fn round_template(problem: &Problem, copies: &[u32]) -> Result<Schedule, Sch
     let one = problem.one_round();
     let prep = Prepared::new(&one)?;
     let inst = InstanceSet::from_copies(&prep.copies_at_least(copies));
-    let mut slots = Vec::new();
-    // Jobs given to each column so far: a point takes its plane's free copy with the fewest,
-    // so the copies share the paths (a fixed copy 0 first would leave them to A-B-A paths).
-    let mut given = vec![0u64; inst.len()];
-    for (p, path) in one.paths.iter().enumerate() {
-        let phases = prep.phases(p);
-        for phase in 0..phases {
-            let mut row: Vec<Option<Job>> = vec![None; inst.len()];
-            for point in (phase..path.planes.len() as u32).step_by(phases as usize) {
-                let plane = path.planes[point as usize];
-                let least = |row: &[Option<Job>]| {
-                    inst.columns(plane)
-                        .filter(|&c| row[c].is_none())
-                        .min_by_key(|&c| (given[c], c))
-                };
-                let column = match least(&row) {
-                    Some(c) => c,
-                    None => {
-                        slots.push(std::mem::replace(&mut row, vec![None; inst.len()]));
-                        least(&row).unwrap_or(inst.columns(plane).start)
-                    }
-                };
-                given[column] += 1;
-                row[column] = Some(Job {
-                    path: p as u32,
-                    round: 0,
-                    point,
-                });
-            }
-            slots.push(row);
-        }
-    }
+    let slots = groups_on(&one, &prep, inst.len(), |plane| inst.columns(plane));
     Ok(Schedule {
         instances: inst.instances,
         slots,
@@ -68,37 +37,56 @@ pub fn generic_round_template(problem: &Problem, pes: u32) -> Result<Schedule, S
     }
     let one = problem.one_round();
     let prep = Prepared::new(&one)?;
-    let g = pes as usize;
-    let mut given = vec![0u64; g];
-    let mut slots = Vec::new();
-    for (p, path) in one.paths.iter().enumerate() {
-        let phases = prep.phases(p);
-        for phase in 0..phases {
-            let points: Vec<u32> = (phase..path.planes.len() as u32)
-                .step_by(phases as usize)
-                .collect();
-            for chunk in points.chunks(g) {
-                let mut row: Vec<Option<Job>> = vec![None; g];
-                for &point in chunk {
-                    let column = (0..g)
-                        .filter(|&c| row[c].is_none())
-                        .min_by_key(|&c| (given[c], c))
-                        .expect("a chunk has at most one point per PE");
-                    given[column] += 1;
-                    row[column] = Some(Job {
-                        path: p as u32,
-                        round: 0,
-                        point,
-                    });
-                }
-                slots.push(row);
-            }
-        }
-    }
+    let slots = groups_on(&one, &prep, pes as usize, |_| 0..pes as usize);
     Ok(Schedule {
         instances: (0..pes).map(PeInstance::generic).collect(),
         slots,
     })
+}
+
+/// The groups of one round of `one` on `width` columns, `columns(plane)` those that take a
+/// plane's job: paths in index order, each path's phases in order, a phase's points in
+/// ascending order; a point joins the current group while it has a free column for the
+/// point's plane, else it opens the next group.
+fn groups_on(
+    one: &Problem,
+    prep: &Prepared<'_>,
+    width: usize,
+    columns: impl Fn(u32) -> std::ops::Range<usize>,
+) -> Vec<Vec<Option<Job>>> {
+    let mut slots = Vec::new();
+    // Jobs given to each column so far: a point takes a free column with the fewest, so the
+    // copies share the paths (a fixed copy 0 first would leave them to A-B-A paths).
+    let mut given = vec![0u64; width];
+    for (p, path) in one.paths.iter().enumerate() {
+        let phases = prep.phases(p);
+        for phase in 0..phases {
+            let mut row: Vec<Option<Job>> = vec![None; width];
+            for point in (phase..path.planes.len() as u32).step_by(phases as usize) {
+                let plane = path.planes[point as usize];
+                let least = |row: &[Option<Job>]| {
+                    columns(plane)
+                        .filter(|&c| row[c].is_none())
+                        .min_by_key(|&c| (given[c], c))
+                };
+                let column = match least(&row) {
+                    Some(c) => c,
+                    None => {
+                        slots.push(std::mem::replace(&mut row, vec![None; width]));
+                        least(&row).unwrap_or(columns(plane).start)
+                    }
+                };
+                given[column] += 1;
+                row[column] = Some(Job {
+                    path: p as u32,
+                    round: 0,
+                    point,
+                });
+            }
+            slots.push(row);
+        }
+    }
+    slots
 }
 
 /// PE copies per plane for dynamic dispatch within `budget`, from one round of `problem`
