@@ -117,7 +117,7 @@ fn job_writes(d: &Design, s: &StepDesign, ops: &mut Vec<BusOp>) {
                     | u64::from(late) << (4 + pb + ptb)
                     | if tail { tail_bit } else { 0 }
                     | u64::from(col) << (6 + pb + ptb)
-                    | plane_field(s, p, point) << (6 + pb + ptb + l.inst_bits);
+                    | plane_field(d, s, p, point) << (6 + pb + ptb + l.inst_bits);
                 // A wide entry's high bits go to SCHED_HI first, when they change.
                 let hi = (word >> 32) as u32;
                 if wide && high != Some(hi) {
@@ -135,8 +135,8 @@ fn job_writes(d: &Design, s: &StepDesign, ops: &mut Vec<BusOp>) {
 
 /// The plane of point `point` of path `p` as a job's plane field, on generic PEs (0 on plane
 /// PEs, whose column says the plane).
-fn plane_field(s: &StepDesign, p: usize, point: u32) -> u64 {
-    if s.generic {
+fn plane_field(d: &Design, s: &StepDesign, p: usize, point: u32) -> u64 {
+    if d.platform.is_generic() {
         u64::from(s.work.input.paths[p][point as usize])
     } else {
         0
@@ -152,6 +152,7 @@ fn plane_writes(d: &Design, ops: &mut Vec<BusOp>) -> Result<(), HlsError> {
     };
     let wd = bt_fixed::Widths::for_coord(d.platform.coord_bits);
     let ow = crate::rtl::generic::offset_bits(wd);
+    let words = crate::input::plane_table_words(wd, true).len() - 3;
     for (i, plane) in d.model.planes().iter().enumerate() {
         let neg = -i128::from(plane.offset.0);
         if neg >= 1 << (ow - 1) || neg < -(1 << (ow - 1)) {
@@ -163,7 +164,6 @@ fn plane_writes(d: &Design, ops: &mut Vec<BusOp>) -> Result<(), HlsError> {
         for (k, n) in plane.normal.iter().enumerate() {
             ops.push(BusOp::Write(at + k as u32, n.0 as u32));
         }
-        let words = crate::input::plane_table_words(wd, true).len() - 3;
         for w in 0..words {
             let bits = (neg >> (32 * w)) as u32;
             ops.push(BusOp::Write(at + 3 + w as u32, bits));

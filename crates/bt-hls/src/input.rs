@@ -373,8 +373,6 @@ pub(crate) struct StepDesign {
     pub makespan: u32,
     /// Platform column of each schedule instance.
     pub columns: Vec<u32>,
-    /// The platform's PEs are generic: each job carries its plane.
-    pub generic: bool,
 }
 
 /// The validated design: platform, per-step work and every derived size.
@@ -717,7 +715,6 @@ fn step_design(platform: &Platform, k: usize, w: &StepWork) -> Result<StepDesign
         first_point,
         makespan,
         columns,
-        generic: platform.is_generic(),
     })
 }
 

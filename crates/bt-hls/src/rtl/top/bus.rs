@@ -316,7 +316,7 @@ pub(super) fn interrupt_and_unused(t: &Dims<'_>, items: &mut Vec<Item>) {
     ];
     if t.plb > 0 && t.early.is_none() {
         // The write-back does not read the job's plane (early stopping's box would).
-        let lo = 6 + pb + ptb + t.ib;
+        let lo = plane_lo_bit(t);
         unused.push(t.r.wsched_q.slice(lo + t.plb - 1, lo));
     }
     Signal::assigned(

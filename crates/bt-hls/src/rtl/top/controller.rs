@@ -62,6 +62,11 @@ pub(super) fn gtail_bit(t: &Dims<'_>) -> u32 {
     5 + t.pb + t.ptb
 }
 
+/// The lowest bit of the job word's plane field (generic PEs), above the column.
+pub(super) fn plane_lo_bit(t: &Dims<'_>) -> u32 {
+    6 + t.pb + t.ptb + t.ib
+}
+
 /// Job memory (M9K), written by the host per step: one round of every path as groups
 /// (`{column, tail, late, end, last, first, point, path, valid}`, `tail` on a group's last
 /// job), path after path. Read by the dispatcher only (`job_q`, one cycle after the address:
@@ -153,7 +158,7 @@ pub(super) fn slot_buffer_load(t: &Dims<'_>, items: &mut Vec<Item>) -> LoadRead 
         first: field(items, "lrom_first", 1, 1 + pb + ptb),
         last: field(items, "lrom_last", 1, 2 + pb + ptb),
         late: field(items, "lrom_late", 1, 4 + pb + ptb),
-        plane: (t.plb > 0).then(|| field(items, "lrom_plane", t.plb, 6 + pb + ptb + ib)),
+        plane: (t.plb > 0).then(|| field(items, "lrom_plane", t.plb, plane_lo_bit(t))),
     }
 }
 
@@ -184,7 +189,7 @@ pub(super) fn slot_buffer_writeback(t: &Dims<'_>, items: &mut Vec<Item>) -> Sche
         src: field(items, "rom_src", eb, sw + eb),
         gbase: field(items, "rom_gbase", eb, sw),
         plane: (t.plb > 0 && t.early.is_some())
-            .then(|| field(items, "rom_plane", t.plb, 6 + pb + ptb + ib)),
+            .then(|| field(items, "rom_plane", t.plb, plane_lo_bit(t))),
     }
 }
 

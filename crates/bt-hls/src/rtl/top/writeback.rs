@@ -318,7 +318,7 @@ pub(super) fn instance_box(
         stmts
     };
     // On generic PEs by the job's plane, else by the PE's (its instance).
-    let (select, arms) = match &t.r.wbe.wb_q_plane {
+    let (select, arms, whose) = match &t.r.wbe.wb_q_plane {
         Some(plane) => (
             plane.e(),
             boxes
@@ -326,6 +326,7 @@ pub(super) fn instance_box(
                 .enumerate()
                 .map(|(p, b)| (lit(t.plb, p as u128), set(b)))
                 .collect(),
+            "job's",
         ),
         None => (
             t.r.wbe.wb_q_inst.e(),
@@ -340,12 +341,8 @@ pub(super) fn instance_box(
                     )
                 })
                 .collect(),
+            "instance's",
         ),
-    };
-    let whose = if t.r.wbe.wb_q_plane.is_some() {
-        "job's"
-    } else {
-        "instance's"
     };
     items.push(Item::Comment(format!(
         "early stopping: widened polygon box of the written {whose} plane (sign bit flipped)"
