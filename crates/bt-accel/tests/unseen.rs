@@ -59,9 +59,10 @@ fn cold_step_generic(seed: u64, pes: u32) -> PlannedStep {
     plan_step(&scene, &planes, 0, &options, None).unwrap()
 }
 
-/// The generic design of `seed`'s cold step, generated into `target/tmp` (for `beamtrace hls
-/// sim` and `hls synth`); returns the directory.
-fn generic_design(seed: u64, p: &PlannedStep) -> std::path::PathBuf {
+/// The generic design of `seed`'s cold step, generated into
+/// `target/tmp/bt_accel_unseen_<seed>_generic12<suffix>` (for `beamtrace hls sim` and `hls
+/// synth`; each test its own suffix, as tests run side by side); returns the directory.
+fn generic_design(seed: u64, p: &PlannedStep, suffix: &str) -> std::path::PathBuf {
     let work = vec![p.work()];
     let platform = bt_hls::Platform::fitting(&work).unwrap();
     assert!(platform.is_generic(), "seed {seed}");
@@ -70,8 +71,9 @@ fn generic_design(seed: u64, p: &PlannedStep) -> std::path::PathBuf {
         GENERIC_PES as usize,
         "seed {seed}"
     );
-    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR"))
-        .join(format!("bt_accel_unseen_{seed}_generic{GENERIC_PES}"));
+    let dir = std::path::PathBuf::from(env!("CARGO_TARGET_TMPDIR")).join(format!(
+        "bt_accel_unseen_{seed}_generic{GENERIC_PES}{suffix}"
+    ));
     let _ = std::fs::remove_dir_all(&dir);
     let report = bt_hls::generate_steps(&platform, &work, &dir).unwrap();
     assert_eq!(
@@ -105,7 +107,7 @@ fn unseen_rooms_on_generic_pes_stay_within_a_millisecond() {
             latency_s * 1e3
         );
         assert!(latency_s <= 1e-3, "seed {seed}: {latency_s} s");
-        generic_design(seed, &p);
+        generic_design(seed, &p, "");
     }
 }
 
@@ -115,7 +117,7 @@ fn unseen_rooms_on_generic_pes_stay_within_a_millisecond() {
 fn an_unseen_room_on_generic_pes_cosimulates_bit_exact() {
     let seed = SEEDS[0];
     let p = cold_step_generic(seed, GENERIC_PES);
-    let dir = generic_design(seed, &p);
+    let dir = generic_design(seed, &p, "_cosim");
     let sim = bt_hls::simulate(&dir).unwrap();
     assert_eq!(sim.mismatches, 0, "{:#?}", sim.mismatch_details);
     assert!(sim.passed());
