@@ -6,7 +6,9 @@
 //! request, the mean paths and stage times of an answer (docs/performance.md). With
 //! `STREAM_TAIL=1` it also prints what the slowest 1 % of the answers are made of and the
 //! answers by their number of paths; with `STREAM_ONE=1` it runs the first mode alone, and `STREAM_OUT=FILE`
-//! writes that mode's answers to FILE, one a line.
+//! writes that mode's answers to FILE, one a line. `STREAM_SAME=1` sends the walk's first
+//! receiver every time: the same work each answer, so that the spread of `latency_us` is the
+//! machine's, not the data's.
 //!
 //! `cargo run --release -p bt-serve --example stream -- [MOVES] [MAX_ORDER] [BATCH]`
 
@@ -27,7 +29,11 @@ fn main() -> Result<(), Box<dyn std::error::Error>> {
         }
     };
     let (moves, max_order, batch) = (arg(1, 10_000)?, arg(2, 3)?, arg(3, 100)?.max(1));
-    let walk = walk(30, moves);
+    let mut walk = walk(30, moves);
+    if std::env::var_os("STREAM_SAME").is_some() {
+        let first = walk[0];
+        walk.fill(first);
+    }
     let single: Vec<String> = (walk.iter().enumerate())
         .map(|(i, p)| format!("{{\"id\":{i},\"rx\":[{},{},{}]}}", p[0], p[1], p[2]))
         .collect();
