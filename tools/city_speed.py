@@ -4,7 +4,8 @@
 What it measures
 ----------------
 For each of Sionna RT's city scenes committed under ``testdata/scenes/sionna-rt/`` (etoile,
-florence, munich) and one fixed transmitter/receiver pair each, in the same minutes:
+florence, munich), and San Francisco from the installed sionna-rt wheel (not committed here: a
+city no test was tuned on), with one fixed transmitter/receiver pair each, in the same minutes:
 
 * **Sionna RT 2.2** (``PathSolver``, CPU LLVM backend, 1e6 samples, ``max_depth`` 3, specular
   reflection and line of sight only, ``synthetic_array``, isotropic V-polarised antennas,
@@ -28,7 +29,7 @@ Install (outside the repository; see ``tools/sionna_reference.py`` for the detai
 
 Run
 ---
-    /work/sionna-venv/bin/python tools/city_speed.py                    # the three cities
+    /work/sionna-venv/bin/python tools/city_speed.py                    # the four cities
     /work/sionna-venv/bin/python tools/city_speed.py --scene munich --rounds 5
 """
 
@@ -47,12 +48,28 @@ CASES = [
     ("munich", (8.5, 21.0, 27.0), (45.0, 90.0, 1.5)),
     ("florence", (5.0, -55.0, 60.0), (0.0, -150.0, 1.5)),
     ("etoile", (0.0, 0.0, 30.0), (20.0, 5.0, 1.5)),
+    # Not committed to testdata/: taken from the installed sionna-rt wheel (an unseen city).
+    ("san_francisco", (185.4021453857422, -86.6235580444336, 45.3857421875),
+     (-12.491729736328125, 41.86780548095703, 14.31640625)),
 ]
 FREQUENCY_HZ = 3.5e9
 SAMPLES = 10**6
 MAX_DEPTH = 3
 # Seconds of rest before a scene's beamtrace runs, for Sionna's threads to go idle.
 SETTLE_S = 2.0
+
+
+def scene_xml(name):
+    """The scene's XML: the committed copy, else the one shipped in the sionna-rt wheel."""
+    xml = SCENES / name / f"{name}.xml"
+    if xml.is_file():
+        return xml
+    import importlib.util
+
+    spec = importlib.util.find_spec("sionna.rt.scenes")
+    if spec is None or not spec.submodule_search_locations:
+        sys.exit(f"scene {name}: not in {SCENES} and sionna-rt is not installed")
+    return Path(list(spec.submodule_search_locations)[0]) / name / f"{name}.xml"
 
 
 def sionna_setup(name, tx, rx):
@@ -62,7 +79,7 @@ def sionna_setup(name, tx, rx):
     import sionna.rt as rt
     from sionna.rt import PathSolver, PlanarArray, Receiver, Transmitter
 
-    scene = rt.load_scene(str(SCENES / name / f"{name}.xml"), merge_shapes=False)
+    scene = rt.load_scene(str(scene_xml(name)), merge_shapes=False)
     scene.frequency = FREQUENCY_HZ
     scene.tx_array = PlanarArray(num_rows=1, num_cols=1, pattern="iso", polarization="V")
     scene.rx_array = PlanarArray(num_rows=1, num_cols=1, pattern="iso", polarization="V")
@@ -98,7 +115,7 @@ def timed(f):
 
 def beamtrace_call(binary, name, tx, rx):
     """One whole ``beamtrace trace`` process; its path records' count."""
-    xml = SCENES / name / f"{name}.xml"
+    xml = scene_xml(name)
     args = [
         str(binary), "trace", str(xml),
         "--tx=" + ",".join(map(repr, tx)), "--rx=" + ",".join(map(repr, rx)),
@@ -132,7 +149,7 @@ def measure(binary, name, tx, rx, rounds):
 def main(argv=None):
     ap = argparse.ArgumentParser(description=__doc__.split("\n")[0])
     ap.add_argument("--scene", action="append", choices=[c[0] for c in CASES],
-                    help="a city to measure (repeatable; default: all three)")
+                    help="a city to measure (repeatable; default: all four)")
     ap.add_argument("--rounds", type=int, default=3, help="turns of each tool (best of them)")
     ap.add_argument("--beamtrace", type=Path, default=REPO / "target" / "release" / "beamtrace",
                     help="the beamtrace binary (default: target/release/beamtrace)")
