@@ -10,19 +10,22 @@
 
 use crate::surface::{Surface, SurfaceId};
 use bt_geom::{Real, Vec3};
-use std::collections::BTreeMap;
 
 /// Surfaces (by id) of each closed shell of at least 4 surfaces, in order of their first id.
 pub(crate) fn closed_shells(surfaces: &[Surface]) -> Vec<Vec<SurfaceId>> {
     let key = |p: Vec3| (p + Vec3::ZERO).to_array().map(Real::to_bits); // -0.0 as +0.0
-    let mut edges: BTreeMap<([u64; 3], [u64; 3]), Vec<usize>> = BTreeMap::new();
+    // Every edge as (its ends in order, its surface), sorted: the owners of one edge are then
+    // neighbours, in surface order (a sort, not a map: a city has 100,000 edges).
+    let mut edges: Vec<([u64; 3], [u64; 3], u32)> = Vec::new();
     for (i, s) in surfaces.iter().enumerate() {
         let v = s.polygon.vertices();
         for k in 0..v.len() {
             let (a, b) = (key(v[k]), key(v[(k + 1) % v.len()]));
-            edges.entry((a.min(b), a.max(b))).or_default().push(i);
+            edges.push((a.min(b), a.max(b), i as u32));
         }
     }
+    edges.sort_unstable();
+    let owners = || edges.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1));
     let mut parent: Vec<usize> = (0..surfaces.len()).collect();
     fn root(parent: &mut [usize], mut i: usize) -> usize {
         while parent[i] != i {
@@ -31,29 +34,33 @@ pub(crate) fn closed_shells(surfaces: &[Surface]) -> Vec<Vec<SurfaceId>> {
         }
         i
     }
-    for owners in edges.values() {
+    for owners in owners() {
         for w in owners.windows(2) {
-            let (a, b) = (root(&mut parent, w[0]), root(&mut parent, w[1]));
+            let (a, b) = (
+                root(&mut parent, w[0].2 as usize),
+                root(&mut parent, w[1].2 as usize),
+            );
             parent[a.max(b)] = a.min(b);
         }
     }
     let mut open = vec![false; surfaces.len()];
-    for owners in edges.values() {
-        let r = root(&mut parent, owners[0]);
+    for owners in owners() {
+        let r = root(&mut parent, owners[0].2 as usize);
         // an edge used once (a border) or by more than two faces (a fin) breaks watertightness
-        let two_distinct = owners.len() == 2 && owners[0] != owners[1];
+        let two_distinct = owners.len() == 2 && owners[0].2 != owners[1].2;
         open[r] |= !two_distinct;
     }
-    let mut shells: BTreeMap<usize, Vec<SurfaceId>> = BTreeMap::new();
+    // By root, the smallest id of its group (unions keep the smaller root): groups in order
+    // of their first id, only the closed ones collected.
+    let mut shells: Vec<Vec<SurfaceId>> = vec![Vec::new(); surfaces.len()];
     for i in 0..surfaces.len() {
         let r = root(&mut parent, i);
-        shells.entry(r).or_default().push(SurfaceId(i as u32));
+        if !open[r] {
+            shells[r].push(SurfaceId(i as u32));
+        }
     }
+    shells.retain(|members| members.len() >= 4);
     shells
-        .into_iter()
-        .filter(|(r, members)| !open[*r] && members.len() >= 4)
-        .map(|(_, members)| members)
-        .collect()
 }
 
 /// Ray directions tried in turn: none parallel to an axis or to a diagonal, so axis-aligned
@@ -64,6 +71,23 @@ const DIRECTIONS: [[Real; 3]; 4] = [
     [0.2249, -0.7517, -0.4302],
     [-0.6911, -0.1813, 0.5539],
 ];
+
+/// Whether the box around `shell`'s surfaces, grown by `eps` (metres), holds one of `points`:
+/// a point outside it lies outside the shell, so [`encloses`] need not be asked.
+pub(crate) fn box_holds_either(
+    surfaces: &[Surface],
+    shell: &[SurfaceId],
+    points: [Vec3; 2],
+    eps: Real,
+) -> bool {
+    let (mut lo, mut hi) = (Vec3::INFINITY, Vec3::NEG_INFINITY);
+    for id in shell {
+        let (a, b) = surfaces[id.index()].polygon.bounds();
+        (lo, hi) = (lo.min(a), hi.max(b));
+    }
+    let (lo, hi) = (lo - Vec3::splat(eps), hi + Vec3::splat(eps));
+    (points.iter()).any(|p| p.cmpge(lo).all() && p.cmple(hi).all())
+}
 
 /// Whether `p` lies inside the closed `shell` (`Some(true)`), outside (`Some(false)`), or too
 /// near its surfaces along every direction tried to tell (`None`). `eps`: the scene's length

@@ -241,7 +241,7 @@ impl Scene {
     /// reflecting there is found twice, with two losses. A warning for imported geometry (a
     /// scene file refuses every overlapping pair).
     pub fn coplanar_conflicts(&self) -> Vec<(SurfaceId, SurfaceId)> {
-        crate::validate::coplanar_overlaps(&self.surfaces, self.length_tolerance())
+        crate::validate::coplanar_overlaps(&self.surfaces, &self.bvh, self.length_tolerance())
             .into_iter()
             .filter(|&(i, j)| self.surfaces[i].material != self.surfaces[j].material)
             .map(|(i, j)| (SurfaceId(i as u32), SurfaceId(j as u32)))
@@ -253,7 +253,7 @@ impl Scene {
     /// ([`bt_geom::Polygon::coincides`]). Every path reflecting there is found twice.
     pub fn duplicates(&self) -> Vec<(SurfaceId, SurfaceId)> {
         let tol = self.length_tolerance();
-        crate::validate::coplanar_overlaps(&self.surfaces, tol)
+        crate::validate::coplanar_overlaps(&self.surfaces, &self.bvh, tol)
             .into_iter()
             .filter(|&(i, j)| (self.surfaces[i].polygon).coincides(&self.surfaces[j].polygon, tol))
             .map(|(i, j)| (SurfaceId(i as u32), SurfaceId(j as u32)))
@@ -304,6 +304,10 @@ impl Scene {
             |shell: &[SurfaceId], p| crate::enclosure::encloses(&self.surfaces, shell, p, eps);
         crate::enclosure::closed_shells(&self.surfaces)
             .into_iter()
+            // A shell whose box holds neither terminal holds neither (a city's buildings).
+            .filter(|shell| {
+                crate::enclosure::box_holds_either(&self.surfaces, shell, [tx, rx], eps)
+            })
             .filter_map(|shell| match (inside(&shell, tx)?, inside(&shell, rx)?) {
                 (true, false) => Some(("tx", shell)),
                 (false, true) => Some(("rx", shell)),

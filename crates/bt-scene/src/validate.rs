@@ -157,11 +157,10 @@ impl Scene {
 
 /// Pairs `(i, j)`, `i < j`, of reflectors in one plane whose interiors overlap
 /// ([`Polygon::overlaps_coplanar`] at `tol`, metres): a path reflecting there is found once per
-/// surface. Only pairs whose boxes meet are compared (a BVH over the boxes: a city mesh has
-/// 20,000 surfaces, 200 million pairs).
-pub(crate) fn coplanar_overlaps(surfaces: &[Surface], tol: Real) -> Vec<(usize, usize)> {
+/// surface. Only pairs whose boxes meet are compared, through `bvh`, the BVH over the
+/// surfaces' polygons (the scene's: a city mesh has 20,000 surfaces, 200 million pairs).
+pub(crate) fn coplanar_overlaps(surfaces: &[Surface], bvh: &Bvh, tol: Real) -> Vec<(usize, usize)> {
     let polygons: Vec<&Polygon> = surfaces.iter().map(|s| &s.polygon).collect();
-    let bvh = Bvh::build(&polygons);
     let reflector = |i: usize| surfaces[i].kind == SurfaceKind::Reflector;
     // Each reflector's partners on all cores; sorted, so the same on any number of threads.
     let mut pairs: Vec<(usize, usize)> = (0..polygons.len())
