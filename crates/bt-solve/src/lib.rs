@@ -15,6 +15,7 @@
 
 mod batch;
 pub mod diffraction;
+mod hints;
 pub mod image;
 pub mod ipc;
 mod lanes;
@@ -365,6 +366,22 @@ pub fn solve_candidate_from(
     points: &mut [Vec3],
     scratch: &mut [Vec3],
 ) -> CandidateOutcome {
+    solve_candidate_in(scene, ends, seq, solver, (warm, points, scratch), None)
+}
+
+/// [`solve_candidate_from`] (its `warm`, `points` and `scratch` as `buffers`), a path of the
+/// image method or SBR validated with a `hint` of where it was blocked before, if any
+/// ([`validate::validate_hinted`]: a blocked verdict's kind is exact, not its fields;
+/// without a hint, [`validate::validate`]'s verdict).
+#[inline(always)]
+pub(crate) fn solve_candidate_in(
+    scene: &Scene,
+    ends: Endpoints,
+    seq: &[SurfaceId],
+    solver: &Solver,
+    (warm, points, scratch): (Option<&[Vec3]>, &mut [Vec3], &mut [Vec3]),
+    hint: Option<(usize, SurfaceId)>,
+) -> CandidateOutcome {
     let Endpoints { tx, rx } = ends;
     match solver {
         Solver::Image => {
@@ -383,7 +400,7 @@ pub fn solve_candidate_from(
         },
     }
     CandidateOutcome::Solved {
-        validity: validate::validate(scene, seq, tx, rx, points),
+        validity: validate::validate_hinted(scene, (seq, points), (tx, rx), hint),
         ipc: None,
     }
 }
@@ -456,12 +473,14 @@ pub fn trace(
         let result = sbr::trace_detailed(scene, options, max_order, parallel)?;
         return Ok(sbr::to_trace_result(&result));
     }
+    // `keep_valid` counts a blocked candidate and keeps nothing else of it.
     let batch = Batch {
         scene,
         ends,
         candidates,
         solver,
         parallel,
+        counts_blocked: true,
     };
     let mut parts = solve_batch(&batch, Todo::All, |_| None, keep_valid);
     if scene.transmits() {
