@@ -54,11 +54,12 @@ pub(crate) fn write_path(out: &mut Vec<u8>, p: &PathReport) -> io::Result<()> {
         if k > 0 {
             out.push(b',');
         }
-        out.extend_from_slice(match kind {
-            InteractionKind::Reflection => b"\"reflection\"",
-            InteractionKind::Diffraction => b"\"diffraction\"",
-            InteractionKind::Transmission => b"\"transmission\"",
-        });
+        // One constant copy per kind (a slice of the kind's length would be a `memcpy` call).
+        match kind {
+            InteractionKind::Reflection => out.extend_from_slice(b"\"reflection\""),
+            InteractionKind::Diffraction => out.extend_from_slice(b"\"diffraction\""),
+            InteractionKind::Transmission => out.extend_from_slice(b"\"transmission\""),
+        }
     }
     out.extend_from_slice(b"],\"surfaces\":[");
     for (k, name) in p.surfaces.iter().enumerate() {
@@ -167,6 +168,7 @@ const INTEGRAL_BELOW: u64 = 1_000_000_000_000_000;
 
 /// A real as serde_json writes an `f64`: its formatter for a finite number, `null` otherwise
 /// (+0.0, the most frequent value, as the `0.0` it writes).
+#[inline]
 fn write_real(out: &mut Vec<u8>, v: f64) -> io::Result<()> {
     if v.to_bits() == 0 {
         out.extend_from_slice(b"0.0");
@@ -181,6 +183,7 @@ fn write_real(out: &mut Vec<u8>, v: f64) -> io::Result<()> {
 /// [`write_real`] for a real often integral (a material's loss in dB, a wall's coordinate):
 /// an integral value below [`INTEGRAL_BELOW`] as its digits and `.0`, the bytes serde_json's
 /// formatter gives it, without its shortest-digits search.
+#[inline]
 fn write_integral_or_real(out: &mut Vec<u8>, v: f64) -> io::Result<()> {
     // `as` saturates (and takes NaN to 0): only an integral, finite value comes back equal.
     let i = v as i64;
@@ -203,10 +206,15 @@ fn write_option(out: &mut Vec<u8>, v: Option<f64>) -> io::Result<()> {
     }
 }
 
-/// An unsigned integer's decimal digits (a single digit without serde_json's formatter).
+/// An unsigned integer's decimal digits (one or two digits without serde_json's formatter).
+#[inline]
 fn write_u64(out: &mut Vec<u8>, n: u64) -> io::Result<()> {
     if n < 10 {
         out.push(b'0' + n as u8);
+        return Ok(());
+    }
+    if n < 100 {
+        out.extend_from_slice(&[b'0' + (n / 10) as u8, b'0' + (n % 10) as u8]);
         return Ok(());
     }
     CompactFormatter.write_u64(out, n)
@@ -342,6 +350,20 @@ mod tests {
         }
         let example = [PathReport::example()];
         assert_eq!(mine(&example), serde_json::to_string(&example).unwrap());
+    }
+
+    /// Integers (ranks, orders, the digits of integral reals) against serde_json's
+    /// formatter: every one to 10,000, the shortcuts' bounds and the largest.
+    #[test]
+    fn integers_are_written_as_serde_writes_them() {
+        for n in (0..=10_000).chain([u64::from(u32::MAX), u64::MAX - 1, u64::MAX]) {
+            let mut out = Vec::new();
+            write_u64(&mut out, n).unwrap();
+            assert_eq!(
+                String::from_utf8(out).unwrap(),
+                serde_json::to_string(&n).unwrap()
+            );
+        }
     }
 
     /// The digits-and-`.0` shortcut against serde_json's formatter: every integer to ±2000 and
