@@ -414,12 +414,23 @@ fn first_blocking(
     mut blocks: impl FnMut(&bt_geom::Polygon) -> bool,
 ) -> Option<SurfaceId> {
     let margin = 2.0 * scene.length_tolerance();
-    scene
-        .bvh()
-        .any_hit(a, b, margin, |i| {
-            stops(scene, SurfaceId(i), (from, to), through, &mut blocks)
-        })
-        .map(SurfaceId)
+    let bvh = scene.bvh();
+    // A small scene's boxes are scanned at once: their items are tested in this loop, not in
+    // `any_hit`'s closure, whose body would be compiled apart from a batch's FMA code.
+    if let Some(mut touched) = bvh.touched_by(a, b, margin) {
+        while touched != 0 {
+            let id = SurfaceId(touched.trailing_zeros());
+            if stops(scene, id, (from, to), through, &mut blocks) {
+                return Some(id);
+            }
+            touched &= touched - 1;
+        }
+        return None;
+    }
+    bvh.any_hit(a, b, margin, |i| {
+        stops(scene, SurfaceId(i), (from, to), through, &mut blocks)
+    })
+    .map(SurfaceId)
 }
 
 /// Whether surface `id` stops a segment by the rule of [`first_blocking`]: not a
