@@ -132,6 +132,17 @@ impl Bvh {
         }
     }
 
+    /// The items [`Bvh::any_hit`] would offer its `hit` for the segment `a -> b` and `margin`,
+    /// as bits (bit `i` for item `i`: lowest first is `any_hit`'s order), when the BVH scans
+    /// every box (at most [`SCAN_UP_TO`] items); `None` for a tree. For a caller that tests
+    /// the items in its own loop (a closure's body is compiled apart from a caller's target
+    /// features).
+    #[inline(always)]
+    pub fn touched_by(&self, a: Vec3, b: Vec3, margin: Real) -> Option<u64> {
+        let boxes = self.boxes.as_ref()?;
+        Some(boxes.touched(&Slab::new(a, b, margin)))
+    }
+
     /// The one traversal: descend into nodes whose box passes `box_test`, call `hit` on the
     /// items of the leaves reached, stop at (and return) the first item `hit` accepts.
     #[inline(always)]
@@ -279,15 +290,7 @@ impl Boxes {
     /// index order, up to the first it accepts.
     #[inline(always)]
     fn scan(&self, slab: &Slab, mut hit: impl FnMut(u32) -> bool) -> Option<u32> {
-        let mut touched = 0u64;
-        // At most SCAN_UP_TO / LANES groups (`Bvh::build`); the bound, known to the compiler,
-        // also makes it lay the loop out well (without it the diffracted trace costs 23 %
-        // more instructions).
-        for (g, group) in self.groups.iter().take(SCAN_UP_TO / LANES).enumerate() {
-            touched |= u64::from(group.hit_by(slab)) << (g * LANES);
-        }
-        let n = self.len;
-        touched &= if n >= 64 { u64::MAX } else { (1 << n) - 1 };
+        let mut touched = self.touched(slab);
         while touched != 0 {
             let j = touched.trailing_zeros();
             if hit(j) {
@@ -296,6 +299,22 @@ impl Boxes {
             touched &= touched - 1;
         }
         None
+    }
+}
+
+impl Boxes {
+    /// The items whose box `slab` touches, as bits (bit `i` for item `i`).
+    #[inline(always)]
+    fn touched(&self, slab: &Slab) -> u64 {
+        let mut touched = 0u64;
+        // At most SCAN_UP_TO / LANES groups (`Bvh::build`); the bound, known to the compiler,
+        // also makes it lay the loop out well (without it the diffracted trace costs 23 %
+        // more instructions).
+        for (g, group) in self.groups.iter().take(SCAN_UP_TO / LANES).enumerate() {
+            touched |= u64::from(group.hit_by(slab)) << (g * LANES);
+        }
+        let n = self.len;
+        touched & if n >= 64 { u64::MAX } else { (1 << n) - 1 }
     }
 }
 
@@ -412,6 +431,10 @@ mod tests {
         for walls in wall_sets() {
             let bvh = Bvh::build(&walls);
             assert_eq!(bvh.boxes.is_some(), walls.len() <= SCAN_UP_TO);
+            assert_eq!(
+                bvh.touched_by(Vec3::ZERO, Vec3::X, 0.0).is_some(),
+                bvh.boxes.is_some()
+            );
             for k in 0..50 {
                 let a = Vec3::new(k as Real * 0.37 - 1.0, 0.5, 0.5);
                 let b = a + Vec3::new(0.9, 0.1, 0.05);
@@ -469,6 +492,11 @@ mod tests {
             let mut seen = Vec::new();
             proptest::prop_assert_eq!(bvh.any_hit(a, b, margin, |i| { seen.push(i); false }), None);
             proptest::prop_assert_eq!(&seen, &expected);
+            // `touched_by`'s bits are the items `any_hit` offers, lowest first.
+            let bits = bvh.touched_by(a, b, margin);
+            let from_bits: Option<Vec<u32>> =
+                bits.map(|t| (0..64).filter(|i| t >> i & 1 == 1).collect());
+            proptest::prop_assert_eq!(from_bits, Some(expected));
         }
     }
 

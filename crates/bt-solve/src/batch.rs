@@ -4,10 +4,11 @@
 //! else the candidate set's window start, else the centroids) and the per-candidate buffers.
 //! [`found_path`] turns a valid outcome into a [`FoundPath`].
 
+use crate::hints::{self, Hints};
 use crate::ipc::IpcOptions;
 use crate::{
     CandidateOutcome, FoundPath, Inline, IpcOutcome, Solver, Validity, ipc_verdict, lanes,
-    solve_candidate_from,
+    solve_candidate_from, solve_candidate_in,
 };
 use bt_geom::{Real, Vec3};
 use bt_paths::CandidateSet;
@@ -60,6 +61,11 @@ pub(crate) struct Batch<'a> {
     pub(crate) solver: &'a Solver,
     /// Whether to use rayon's pool for large batches.
     pub(crate) parallel: bool,
+    /// Whether the fold only counts a blocked candidate (not which segment, not by what):
+    /// then the image method's and SBR's paths are validated with the thread's hints first
+    /// ([`crate::hints`], [`crate::validate::validate_hinted`]: the same kind of verdict,
+    /// fewer BVH walks).
+    pub(crate) counts_blocked: bool,
 }
 
 /// Solve the candidates of `todo`. IPC starts from `warm(i)` when it gives points for candidate
@@ -156,6 +162,9 @@ where
         let mut stack_scratch = [Vec3::ZERO; STACK_ORDER];
         let mut heap_points = Vec::new();
         let mut heap_scratch = Vec::new();
+        // Taken out of the thread-local store, not used in a closure: a closure's body would
+        // be compiled without this function's FMA feature.
+        let mut hints = self.batch.counts_blocked.then(Hints::take);
         for k in range {
             let i = self.todo.index(k);
             let seq = candidates.get(i);
@@ -168,8 +177,18 @@ where
                 (&mut heap_points[..], &mut heap_scratch[..])
             };
             let start = (self.warm)(i).or_else(|| candidates.start(i));
-            let outcome = solve_candidate_from(scene, ends, seq, solver, start, points, scratch);
+            let key = hints.as_ref().and_then(|_| hints::key(seq));
+            let hint = key.and_then(|key| hints.as_ref()?.get(key));
+            let buffers = (start, &mut *points, scratch);
+            let outcome = solve_candidate_in(scene, ends, seq, solver, buffers, hint);
+            let blocked = blocked_at(&outcome);
+            if let (Some(hints), Some(key), true) = (&mut hints, key, blocked != hint) {
+                hints.record(key, blocked);
+            }
             (self.each)(&mut acc, i, seq, &outcome, points);
+        }
+        if let Some(hints) = hints {
+            hints.give_back();
         }
         acc
     }
@@ -252,6 +271,18 @@ where
             (self.each)(&mut acc, index(k), seq_at(k), outcome, solved);
         }
         acc
+    }
+}
+
+/// The segment and blocker of a blocked verdict.
+#[inline(always)]
+fn blocked_at(outcome: &CandidateOutcome) -> Option<(usize, SurfaceId)> {
+    match outcome {
+        CandidateOutcome::Solved {
+            validity: Validity::Blocked { segment, by },
+            ..
+        } => Some((*segment, *by)),
+        _ => None,
     }
 }
 

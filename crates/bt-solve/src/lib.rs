@@ -15,6 +15,7 @@
 
 mod batch;
 pub mod diffraction;
+mod hints;
 pub mod image;
 pub mod ipc;
 mod lanes;
@@ -309,9 +310,23 @@ pub struct TraceResult {
 impl TraceResult {
     /// The results of consecutive parts as one, in order: the paths moved once into a
     /// vector of their total length (a path holds its lists inline, so it is worth not
-    /// moving twice).
+    /// moving twice), or, when a single part has paths (a trace on one thread: a room's),
+    /// that part's vector as it is (no move at all).
     pub fn concat(parts: impl IntoIterator<Item = TraceResult>) -> TraceResult {
-        let parts: Vec<TraceResult> = parts.into_iter().collect();
+        let mut parts: Vec<TraceResult> = parts.into_iter().collect();
+        if parts.iter().filter(|p| !p.paths.is_empty()).count() <= 1 {
+            let mut counts = OutcomeCounts::default();
+            for part in &parts {
+                counts.merge(&part.counts);
+            }
+            let paths = parts.iter_mut().find(|p| !p.paths.is_empty());
+            return TraceResult {
+                paths: paths
+                    .map(|p| std::mem::take(&mut p.paths))
+                    .unwrap_or_default(),
+                counts,
+            };
+        }
         let mut out = TraceResult {
             paths: Vec::with_capacity(parts.iter().map(|p| p.paths.len()).sum()),
             counts: OutcomeCounts::default(),
@@ -351,6 +366,22 @@ pub fn solve_candidate_from(
     points: &mut [Vec3],
     scratch: &mut [Vec3],
 ) -> CandidateOutcome {
+    solve_candidate_in(scene, ends, seq, solver, (warm, points, scratch), None)
+}
+
+/// [`solve_candidate_from`] (its `warm`, `points` and `scratch` as `buffers`), a path of the
+/// image method or SBR validated with a `hint` of where it was blocked before, if any
+/// ([`validate::validate_hinted`]: a blocked verdict's kind is exact, not its fields;
+/// without a hint, [`validate::validate`]'s verdict).
+#[inline(always)]
+pub(crate) fn solve_candidate_in(
+    scene: &Scene,
+    ends: Endpoints,
+    seq: &[SurfaceId],
+    solver: &Solver,
+    (warm, points, scratch): (Option<&[Vec3]>, &mut [Vec3], &mut [Vec3]),
+    hint: Option<(usize, SurfaceId)>,
+) -> CandidateOutcome {
     let Endpoints { tx, rx } = ends;
     match solver {
         Solver::Image => {
@@ -369,7 +400,7 @@ pub fn solve_candidate_from(
         },
     }
     CandidateOutcome::Solved {
-        validity: validate::validate(scene, seq, tx, rx, points),
+        validity: validate::validate_hinted(scene, (seq, points), (tx, rx), hint),
         ipc: None,
     }
 }
@@ -442,12 +473,14 @@ pub fn trace(
         let result = sbr::trace_detailed(scene, options, max_order, parallel)?;
         return Ok(sbr::to_trace_result(&result));
     }
+    // `keep_valid` counts a blocked candidate and keeps nothing else of it.
     let batch = Batch {
         scene,
         ends,
         candidates,
         solver,
         parallel,
+        counts_blocked: true,
     };
     let mut parts = solve_batch(&batch, Todo::All, |_| None, keep_valid);
     if scene.transmits() {
@@ -471,6 +504,55 @@ pub fn trace(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// [`TraceResult::concat`] keeps a lone part's paths as they are, and otherwise moves
+    /// them: either way the paths of every part in order and the summed counts, also with
+    /// empty parts before, between and after.
+    #[test]
+    fn concat_gives_every_part_in_order() {
+        let path = |i: u32| FoundPath {
+            surfaces: [SurfaceId(i)].into_iter().collect(),
+            points: [Vec3::splat(Real::from(i))].into_iter().collect(),
+            diffractions: Inline::new(),
+            crossings: Inline::new(),
+            iterations: Some(i),
+            residual: None,
+        };
+        let part = |ids: std::ops::Range<u32>, blocked: u64| TraceResult {
+            paths: ids.clone().map(path).collect(),
+            counts: OutcomeCounts {
+                valid: ids.len() as u64,
+                blocked,
+                ..OutcomeCounts::default()
+            },
+        };
+        // Each part's path ids as (first, end).
+        let layouts: [&[(u32, u32)]; 6] = [
+            &[],
+            &[(0, 0)],
+            &[(0, 3)],
+            &[(0, 0), (0, 3), (3, 3)],
+            &[(0, 2), (2, 5)],
+            &[(0, 0), (0, 2), (2, 2), (2, 5), (5, 6)],
+        ];
+        for layout in layouts {
+            let parts: Vec<TraceResult> = (layout.iter().enumerate())
+                .map(|(k, &(a, b))| part(a..b, k as u64 + 1))
+                .collect();
+            let expected: Vec<u32> = layout.iter().flat_map(|&(a, b)| a..b).collect();
+            let blocked: u64 = (1..=layout.len() as u64).sum();
+            let out = TraceResult::concat(parts);
+            let got: Vec<u32> = out.paths.iter().map(|p| p.iterations.unwrap()).collect();
+            assert_eq!(got, expected, "{layout:?}");
+            assert_eq!(out.counts.valid, expected.len() as u64, "{layout:?}");
+            assert_eq!(out.counts.blocked, blocked, "{layout:?}");
+            assert!(
+                out.paths
+                    .iter()
+                    .all(|p| p.surfaces[0].0 == p.iterations.unwrap())
+            );
+        }
+    }
 
     /// A path of reflections only takes the short way through
     /// [`FoundPath::interactions_into`]: the same interactions as the merge of reflections,

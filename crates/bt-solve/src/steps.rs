@@ -315,6 +315,7 @@ impl Incremental {
             candidates: &candidates,
             solver: &options.solver,
             parallel: options.parallel,
+            counts_blocked: false,
         };
         let (records, points) = concat(solve_batch(&batch, Todo::All, |_| None, keep_all));
         let records: Vec<Record> = records
@@ -517,6 +518,7 @@ fn solve_planned(
         candidates,
         solver: &options.solver,
         parallel: options.parallel,
+        counts_blocked: false,
     };
     let (records, points) = concat(solve_batch(&batch, Todo::Only(&todo), warm, keep_all));
     let outcomes = records

@@ -54,25 +54,92 @@ pub enum Validity {
 /// Validate the path TX -> points -> RX over the surface sequence `seq`.
 #[inline(always)]
 pub fn validate(scene: &Scene, seq: &[SurfaceId], tx: Vec3, rx: Vec3, points: &[Vec3]) -> Validity {
+    if let Some(verdict) = point_verdict(scene, seq, tx, rx, points) {
+        return verdict;
+    }
+    segment_verdict(scene, seq, tx, rx, points)
+}
+
+/// [`validate`] for a batch that only counts a blocked path (`trace`'s fold), given a `hint`:
+/// a segment and the surface that blocked this candidate's path before (for a receiver
+/// nearby: [`crate::hints`]). When the points pass their checks and that surface blocks that
+/// segment now (by the rule of [`blocker_excluding`]), the verdict is
+/// [`Validity::Blocked`] at once: [`validate`] gives `Blocked` too, since that segment's BVH
+/// walk meets the surface, but its `segment` and `by` may differ (an earlier segment blocked
+/// as well, another surface met first). The verdict's kind is exact, its fields are those of
+/// a blocked segment. Otherwise (no hint, or it no longer blocks) [`validate`]'s verdict.
+#[inline(always)]
+pub(crate) fn validate_hinted(
+    scene: &Scene,
+    (seq, points): (&[SurfaceId], &[Vec3]),
+    (tx, rx): (Vec3, Vec3),
+    hint: Option<(usize, SurfaceId)>,
+) -> Validity {
+    if let Some(verdict) = point_verdict(scene, seq, tx, rx, points) {
+        return verdict;
+    }
+    // A hint from another scene may name any segment and surface: only real ones are tested.
+    let hint = hint
+        .filter(|&(segment, by)| segment <= seq.len() && (by.0 as usize) < scene.surfaces().len());
+    if let Some((segment, by)) = hint {
+        let tol = scene.length_tolerance();
+        let ((a, from), (b, to)) = segment_ends(seq, (tx, rx), points, segment);
+        let ends = (from.as_slice(), to.as_slice());
+        let t_min = tol / a.distance(b).max(tol);
+        let through = may_cross(scene, seq.len());
+        if stops(scene, by, ends, through, |polygon| {
+            polygon.blocks_segment(a, b, t_min, tol)
+        }) {
+            return Validity::Blocked { segment, by };
+        }
+    }
+    segment_verdict(scene, seq, tx, rx, points)
+}
+
+/// The verdict of the checks of `points` alone (inside their polygons, neighbours on the
+/// reflecting side), `None` when they pass.
+#[inline(always)]
+fn point_verdict(
+    scene: &Scene,
+    seq: &[SurfaceId],
+    tx: Vec3,
+    rx: Vec3,
+    points: &[Vec3],
+) -> Option<Validity> {
     let tol = scene.length_tolerance();
     let n = seq.len();
     if points.iter().any(|p| !p.is_finite()) {
-        return Validity::NonFinite;
+        return Some(Validity::NonFinite);
     }
     for k in 0..n {
         if let Some(verdict) = reflection_point(scene, seq[k], points[k], tol, k) {
-            return verdict;
+            return Some(verdict);
         }
     }
     for k in 0..n {
         let (a, b) = neighbour_distances(scene, seq, (tx, rx), points, k);
         if a.abs() <= tol || b.abs() <= tol {
-            return Validity::Grazing { index: k };
+            return Some(Validity::Grazing { index: k });
         }
         if (a > 0.0) != (b > 0.0) {
-            return Validity::OppositeSides { index: k };
+            return Some(Validity::OppositeSides { index: k });
         }
     }
+    None
+}
+
+/// The verdict of the segments of a path whose points passed [`point_verdict`]: the first
+/// blocked segment, else the crossings' budget.
+#[inline(always)]
+fn segment_verdict(
+    scene: &Scene,
+    seq: &[SurfaceId],
+    tx: Vec3,
+    rx: Vec3,
+    points: &[Vec3],
+) -> Validity {
+    let tol = scene.length_tolerance();
+    let n = seq.len();
     let through = may_cross(scene, n);
     for segment in 0..=n {
         let ((a, from), (b, to)) = segment_ends(seq, (tx, rx), points, segment);
@@ -347,15 +414,38 @@ fn first_blocking(
     mut blocks: impl FnMut(&bt_geom::Polygon) -> bool,
 ) -> Option<SurfaceId> {
     let margin = 2.0 * scene.length_tolerance();
-    scene
-        .bvh()
-        .any_hit(a, b, margin, |i| {
-            let id = SurfaceId(i);
-            let crossed = through && scene.penetrable(id);
-            !(from.contains(&id) || to.contains(&id) || crossed)
-                && blocks(&scene.surface(id).polygon)
-        })
-        .map(SurfaceId)
+    let bvh = scene.bvh();
+    // A small scene's boxes are scanned at once: their items are tested in this loop, not in
+    // `any_hit`'s closure, whose body would be compiled apart from a batch's FMA code.
+    if let Some(mut touched) = bvh.touched_by(a, b, margin) {
+        while touched != 0 {
+            let id = SurfaceId(touched.trailing_zeros());
+            if stops(scene, id, (from, to), through, &mut blocks) {
+                return Some(id);
+            }
+            touched &= touched - 1;
+        }
+        return None;
+    }
+    bvh.any_hit(a, b, margin, |i| {
+        stops(scene, SurfaceId(i), (from, to), through, &mut blocks)
+    })
+    .map(SurfaceId)
+}
+
+/// Whether surface `id` stops a segment by the rule of [`first_blocking`]: not a
+/// surface an end lies on (`from`, `to`), not a penetrable one it may cross (`through`), and
+/// its polygon passes `blocks`.
+#[inline(always)]
+fn stops(
+    scene: &Scene,
+    id: SurfaceId,
+    (from, to): (&[SurfaceId], &[SurfaceId]),
+    through: bool,
+    mut blocks: impl FnMut(&bt_geom::Polygon) -> bool,
+) -> bool {
+    let crossed = through && scene.penetrable(id);
+    !(from.contains(&id) || to.contains(&id) || crossed) && blocks(&scene.surface(id).polygon)
 }
 
 /// The first surface crossing the segment `a -> b` other than those its ends lie on (`from`,
@@ -446,4 +536,83 @@ pub fn blocked_for_good(
         }
     }
     None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use bt_paths::{AllVisible, enumerate};
+
+    /// Every candidate of `scene` up to `max_order` (exhaustive: every kind of verdict),
+    /// solved by the image method and validated fully, then with every segment and surface
+    /// as the hint (and hints out of range): the same kind of verdict every time, and a
+    /// blocked one that differs from the full test's only when it is the hint. Returns
+    /// (blocked candidates, verdicts the hint gave with other fields than the full test's).
+    fn check(scene: &Scene, max_order: usize) -> (usize, usize) {
+        let ends = scene.terminals().unwrap();
+        let set = enumerate(scene, max_order, &AllVisible).unwrap();
+        let surfaces = scene.surfaces().len() as u32;
+        let (mut blocked, mut differing) = (0, 0);
+        for i in 0..set.len() {
+            let seq = set.get(i);
+            let mut points = vec![Vec3::ZERO; seq.len()];
+            if crate::image::solve(scene, seq, ends.tx, ends.rx, &mut points).is_err() {
+                continue;
+            }
+            let full = validate(scene, seq, ends.tx, ends.rx, &points);
+            blocked += usize::from(matches!(full, Validity::Blocked { .. }));
+            let hints = (0..=seq.len() + 1)
+                .flat_map(|segment| (0..=surfaces).map(move |s| Some((segment, SurfaceId(s)))));
+            for hint in std::iter::once(None).chain(hints) {
+                let got = validate_hinted(scene, (seq, &points), (ends.tx, ends.rx), hint);
+                let what = format!("{seq:?} with {hint:?}: {got:?}, fully {full:?}");
+                assert_eq!(
+                    std::mem::discriminant(&got),
+                    std::mem::discriminant(&full),
+                    "{what}"
+                );
+                if got != full {
+                    let Validity::Blocked { segment, by } = got else {
+                        panic!("{what}");
+                    };
+                    assert_eq!(Some((segment, by)), hint, "{what}");
+                    differing += 1;
+                }
+            }
+        }
+        (blocked, differing)
+    }
+
+    #[test]
+    fn hints_give_the_same_kind_of_verdict_in_the_living_room() {
+        let scene = bt_import::builtin_scene("living-room", bt_scene::Terminals::default())
+            .unwrap()
+            .unwrap();
+        let mut totals = (0, 0);
+        for rx in [[2.0, 2.0, 1.2], [4.5, 1.0, 0.5], [1.0, 3.5, 1.7]] {
+            let scene = scene.with_receiver(Vec3::from(rx)).unwrap();
+            let (blocked, differing) = check(&scene, 3);
+            totals = (totals.0 + blocked, totals.1 + differing);
+        }
+        assert!(totals.0 > 0 && totals.1 > 0, "{totals:?}");
+    }
+
+    /// Penetrable surfaces: a surface the path may cross is no blocker, even as a hint.
+    #[test]
+    fn hints_give_the_same_kind_of_verdict_with_penetrable_surfaces() {
+        let mut totals = (0, 0);
+        let mut transmitting = 0;
+        for seed in 0..16 {
+            let Some(scene) = bt_testkit::nasty_penetrable_scene(seed, 2, (seed % 3) as u8) else {
+                continue;
+            };
+            transmitting += usize::from(may_cross(&scene, 2));
+            let (blocked, differing) = check(&scene, 2);
+            totals = (totals.0 + blocked, totals.1 + differing);
+        }
+        assert!(
+            transmitting > 0 && totals.0 > 0 && totals.1 > 0,
+            "{totals:?}"
+        );
+    }
 }

@@ -18,6 +18,7 @@ fn batched(scene: &Scene, set: &CandidateSet, solver: &Solver, parallel: bool) -
         candidates: set,
         solver,
         parallel,
+        counts_blocked: false,
     };
     let keep = |acc: &mut Solved, i: usize, _: &[SurfaceId], o: &CandidateOutcome, p: &[Vec3]| {
         acc.push((i, *o, p.to_vec()))
@@ -140,4 +141,35 @@ fn lanes_equal_one_by_one_on_random_scenes() {
             );
         }
     }
+}
+
+/// `trace` validates with the thread's hints of where each candidate was blocked
+/// ([`crate::hints`]): along a walk of receivers, each trace on this thread (hinted by the
+/// previous receivers') gives exactly what a trace on a fresh thread (no hints) gives.
+#[test]
+fn hinted_traces_equal_fresh_ones_along_a_walk() {
+    let scene = bt_import::builtin_scene("living-room", bt_scene::Terminals::default())
+        .unwrap()
+        .unwrap();
+    let mut hinted_blocked = 0;
+    for k in 0..8 {
+        let rx = Vec3::new(1.5 + 0.3 * f64::from(k), 2.0 + 0.1 * f64::from(k), 1.2);
+        let scene = scene.with_receiver(rx).unwrap();
+        let set = enumerate(&scene, 3, &AllVisible).unwrap();
+        let hints_before = crate::hints::Hints::take();
+        let known = set.iter().filter(|s| {
+            let key = crate::hints::key(s);
+            key.and_then(|key| hints_before.get(key)).is_some()
+        });
+        hinted_blocked += known.count();
+        hints_before.give_back();
+        let traced = crate::trace(&scene, &set, &Solver::Image, false).unwrap();
+        let fresh = std::thread::scope(|s| {
+            s.spawn(|| crate::trace(&scene, &set, &Solver::Image, false).unwrap())
+                .join()
+                .unwrap()
+        });
+        assert_eq!(format!("{traced:?}"), format!("{fresh:?}"), "receiver {k}");
+    }
+    assert!(hinted_blocked > 0, "no candidate had a hint");
 }
