@@ -320,7 +320,7 @@ impl TxPart {
     fn of(pairing: &Pairing<'_>, scene: &Scene, deepest: usize) -> Self {
         let near = pairing.near(scene, deepest);
         let groups = groups(&near);
-        let index = Toward::of(scene, &groups, pairing.margin);
+        let index = Toward::of(scene, &groups, pairing.margin, deepest);
         TxPart {
             margin: pairing.margin,
             near,
@@ -349,7 +349,9 @@ struct Pairs<'a> {
 /// ([`cos_range_to_box`]) misses its incidence range pairs with no interval beyond that
 /// reflector, so the join never looks at those pairs. Likewise per second edge, for paths
 /// with no middle reflection: `D1 → D2` leaves `D1` towards the second edge's segment
-/// ([`heads_into`]).
+/// ([`heads_into`]), and per (reflector, second edge) for paths with that one middle
+/// reflection: the reflector's groups whose rays may head into the second edge's segment
+/// mirrored through it.
 /// Each list holds its groups by depth (ascending), so that a far interval takes the
 /// prefix whose depths fit.
 #[derive(Debug, Clone)]
@@ -361,12 +363,17 @@ struct Toward {
     /// Per second edge: the groups for paths with no middle reflection, made when first
     /// asked for ([`Toward::straight`]).
     straight: Vec<std::sync::OnceLock<Vec<u32>>>,
+    /// Per (surface id, second edge), at `surface · edges + edge`: the groups for a middle of
+    /// that one reflection, made when first asked for ([`Toward::across`]).
+    across: Vec<std::sync::OnceLock<Vec<u32>>>,
     /// The margin (m).
     margin: Real,
+    /// The most reflections a path with two diffractions has room for.
+    deepest: usize,
 }
 
 impl Toward {
-    fn of(scene: &Scene, groups: &[Group], margin: Real) -> Self {
+    fn of(scene: &Scene, groups: &[Group], margin: Real, deepest: usize) -> Self {
         let by_depth = |mut list: Vec<u32>| {
             list.sort_by_key(|&g| (groups[g as usize].depth, g));
             list
@@ -391,7 +398,9 @@ impl Toward {
             groups: by_surface,
             boxes,
             straight: vec![std::sync::OnceLock::new(); scene.edges().len()],
+            across: vec![std::sync::OnceLock::new(); scene.surfaces().len() * scene.edges().len()],
             margin,
+            deepest,
         }
     }
 
@@ -416,6 +425,29 @@ impl Toward {
         })
     }
 
+    /// The groups for paths with the one middle reflection `m` to edge `e2` of `scene`: those
+    /// of `m`'s list ([`Toward::groups`], by depth) with room for the middle (depth below
+    /// `deepest`) that [`heads_into`] the edge's segment,
+    /// grown by the margin, mirrored through `m`'s plane as [`Pairing::far`] unfolds it (the
+    /// far intervals on the edge behind `m` are parts of that segment, as for
+    /// [`Toward::straight`]).
+    fn across(&self, scene: &Scene, groups: &[Group], m: SurfaceId, e2: usize) -> &[u32] {
+        let edges = scene.edges().all();
+        self.across[m.index() * edges.len() + e2].get_or_init(|| {
+            let edge = &edges[e2];
+            let line = EdgeLine::of(edge).mirrored(scene.surface(m).polygon.plane());
+            let whole = [
+                line.point(-self.margin),
+                line.point(edge.length + self.margin),
+            ];
+            let list = &self.groups[m.index()];
+            let fit = list.partition_point(|&g| groups[g as usize].depth < self.deepest);
+            (list[..fit].iter().copied())
+                .filter(|&g| heads_into(&groups[g as usize].span, whole))
+                .collect()
+        })
+    }
+
     /// The groups that may pair with `far`, or `None` when none may: with one middle
     /// reflection, the ray arriving at the far interval from the reflector's box must obey
     /// Keller's law there too (cos β0 of `q − M` against the leaving range).
@@ -429,13 +461,15 @@ impl Toward {
             if !overlap((-hi, -lo), far.leaving) {
                 return None;
             }
+            return Some(self.across(scene, groups, m, far.edge));
         }
         Some(&self.groups[m.index()])
     }
 }
 
 /// Whether rays from `span`'s interval to the segment `whole` (a second edge grown by the
-/// margin: every far interval on that edge, with no middle reflection, is a part of it) may
+/// margin, or that mirrored through one middle reflection: every far interval on that edge,
+/// with that middle, is a part of it, on the same line) may
 /// obey Keller's law at the first edge, with twice [`SLACK`]. When this fails, so does
 /// [`Pairing::may_pair`]'s first test for every far interval on the edge: a part's
 /// numerators lie between `whole`'s corners' and its lengths between the bounds taken here
