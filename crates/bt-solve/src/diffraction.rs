@@ -36,14 +36,14 @@ use rayon::prelude::*;
 /// The interaction points of `c` by the image method into `points` (length `c.order()`,
 /// metres, TX side first, the diffraction points at their indices). With two diffractions,
 /// `keller` may give the points' parameters already solved from the same inputs
-/// ([`DiffractedSet::keller`]: the beam tree's join solves them); they are solved here
-/// otherwise.
+/// ([`DiffractedSet::keller`]: the beam tree's join solves them; `Some(None)` when that
+/// solve found none); they are solved here otherwise.
 #[inline(always)]
 pub fn solve_image(
     scene: &Scene,
     ends: Endpoints,
     c: DiffractedCandidate<'_>,
-    keller: Option<(Real, Real)>,
+    keller: Option<Option<(Real, Real)>>,
     points: &mut [Vec3],
 ) -> Result<(), ImageFailure> {
     let p = c.position;
@@ -75,7 +75,7 @@ pub fn solve_image(
         j = plane(id).mirror(j);
     }
     let (t1, t2) = keller
-        .or_else(|| keller_pair(i, EdgeLine::of(edge), line, j))
+        .unwrap_or_else(|| keller_pair(i, EdgeLine::of(edge), line, j))
         .ok_or(ImageFailure::Parallel { index: p })?;
     let (d1, d2) = (edge.point(t1), other.point(t2));
     (points[p], points[p + q + 1]) = (d1, d2);
@@ -338,7 +338,7 @@ pub fn solve_candidate(
     scene: &Scene,
     ends: Endpoints,
     c: DiffractedCandidate<'_>,
-    keller: Option<(Real, Real)>,
+    keller: Option<Option<(Real, Real)>>,
     solver: &crate::Solver,
     points: &mut [Vec3],
 ) -> CandidateOutcome {
@@ -353,7 +353,7 @@ fn solve_candidate_recording(
     scene: &Scene,
     ends: Endpoints,
     c: DiffractedCandidate<'_>,
-    (keller, solver): (Option<(Real, Real)>, &crate::Solver),
+    (keller, solver): (Option<Option<(Real, Real)>>, &crate::Solver),
     points: &mut [Vec3],
     crossings: &mut Crossings,
 ) -> CandidateOutcome {

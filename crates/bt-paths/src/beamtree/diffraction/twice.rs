@@ -626,7 +626,7 @@ impl Pairing<'_> {
                 let (before, after) = (&mut pairs.before, &mut pairs.after);
                 self.surfaces((a.reach.node, b.node), (before, after));
                 let edges = (EdgeId(a.span.edge as u32), EdgeId(far.edge as u32));
-                set.push_twice(before, edges, far.middle, after, keller);
+                set.push_twice(before, edges, far.middle, after, Some(keller));
                 self.check_budget(set)?;
             }
         }
