@@ -119,7 +119,7 @@ struct Far<'m> {
 /// normals of its two faces' planes (`e × t0` and `tn × e`), possibly mirrored through
 /// reflections (a mirror keeps every distance, so a point's distances from the mirrored
 /// planes are its mirror image's from the edge's own).
-#[derive(Clone, Copy)]
+#[derive(Debug, Clone, Copy)]
 struct Wedge {
     line: EdgeLine,
     normal0: Vec3,
@@ -314,6 +314,8 @@ pub(super) struct TxPart {
     near: Vec<Near>,
     groups: Vec<Group>,
     index: Toward,
+    /// Every edge's [`Wedge`], by edge index (the scene's alone, made once with the rest).
+    wedges: Vec<Wedge>,
 }
 
 impl TxPart {
@@ -326,6 +328,7 @@ impl TxPart {
             near,
             groups,
             index,
+            wedges: scene.edges().all().iter().map(Wedge::of).collect(),
         }
     }
 }
@@ -338,6 +341,8 @@ struct Pairs<'a> {
     deepest: usize,
     /// Per far interval, per first edge: whether the interval leaves that edge's interior.
     seen: Vec<Option<bool>>,
+    /// Every edge's wedge ([`TxPart::wedges`]).
+    wedges: &'a [Wedge],
     before: Vec<SurfaceId>,
     after: Vec<SurfaceId>,
 }
@@ -578,13 +583,14 @@ impl Pairing<'_> {
             groups: &tx.groups,
             deepest,
             seen: Vec::new(),
+            wedges: &tx.wedges,
             before: Vec::new(),
             after: Vec::new(),
         };
         for (e2, on_edge) in self.from_rx.iter().enumerate() {
             for b in on_edge.iter().filter(|b| b.depth <= deepest) {
                 for middle in middles[..=deepest - b.depth].iter().flatten() {
-                    let far = self.far(scene, (e2, *b), middle);
+                    let far = self.far(scene, (e2, *b), middle, pairs.wedges[e2]);
                     let Some(first) = index.groups(scene, &tx.groups, &far) else {
                         continue;
                     };
@@ -613,7 +619,8 @@ impl Pairing<'_> {
         let room = pairs.deepest - b.depth - far.middle.len();
         let fit = first.partition_point(|&g| pairs.groups[g as usize].depth <= room);
         for g in first[..fit].iter().map(|&g| &pairs.groups[g as usize]) {
-            if self.beyond(&g.span, far) || !self.may_pair(scene, (&g.span, far), &mut pairs.seen) {
+            let seen = (&mut pairs.seen[..], pairs.wedges);
+            if self.beyond(&g.span, far) || !self.may_pair(scene, (&g.span, far), seen) {
                 continue;
             }
             // The members go straight to the Keller pair: their own prefilters, run again,
@@ -697,9 +704,15 @@ impl Pairing<'_> {
         out
     }
 
-    /// RX reach `b` on edge `e2` with the `middle` reflections, unfolded ([`Far`]).
-    fn far<'m>(&self, scene: &Scene, (e2, b): (usize, Reach), middle: &'m [SurfaceId]) -> Far<'m> {
-        let mut wedge = Wedge::of(&scene.edges().all()[e2]);
+    /// RX reach `b` on edge `e2` (whose [`Wedge`] is `wedge`) with the `middle` reflections,
+    /// unfolded ([`Far`]).
+    fn far<'m>(
+        &self,
+        scene: &Scene,
+        (e2, b): (usize, Reach),
+        middle: &'m [SurfaceId],
+        mut wedge: Wedge,
+    ) -> Far<'m> {
         let mut image = b.image;
         for id in middle.iter().rev() {
             let plane = scene.surface(*id).polygon.plane();
@@ -735,13 +748,14 @@ impl Pairing<'_> {
     /// intervals overlap); across one middle reflection both points may lie on one side of
     /// its plane and the stretch may cross its window; the stretch between the edges leaves
     /// each into its exterior (the other interval is not wholly inside its interior wedge;
-    /// `seen` caches, per first edge, the test of `far`'s interval against it).
+    /// `seen` caches, per first edge, the test of `far`'s interval against it, `wedges` the
+    /// edges' wedges).
     #[inline(always)]
     fn may_pair(
         &self,
         scene: &Scene,
         (a, far): (&Span, &Far<'_>),
-        seen: &mut [Option<bool>],
+        (seen, wedges): (&mut [Option<bool>], &[Wedge]),
     ) -> bool {
         if far.middle.is_empty() && a.edge == far.edge {
             return false;
@@ -773,8 +787,7 @@ impl Pairing<'_> {
         }
         let inside = |wedge: &Wedge, ends: [Vec3; 2]| ends.iter().all(|p| wedge.deep_inside(*p));
         // The far interval against the first edge: one answer per edge for all its reaches.
-        let first_wedge = || Wedge::of(&scene.edges().all()[a.edge]);
-        if !*seen[a.edge].get_or_insert_with(|| !inside(&first_wedge(), far.ends)) {
+        if !*seen[a.edge].get_or_insert_with(|| !inside(&wedges[a.edge], far.ends)) {
             return false;
         }
         // The first edge's interval against the second edge's wedge, unfolded into this frame.
