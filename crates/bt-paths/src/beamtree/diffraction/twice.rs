@@ -17,7 +17,7 @@ use super::{Pairing, Reach};
 use crate::beamtree::{PAIR_TESTS_PER_CANDIDATE, TreeError};
 use crate::diffraction::DiffractedSet;
 use bt_geom::{Plane, Polygon, Real, Vec3};
-use bt_scene::edges::{EdgeLine, keller_pair};
+use bt_scene::edges::{EdgeLine, KellerReach, keller_pair};
 use bt_scene::{Edge, EdgeId, Scene, SurfaceId};
 
 /// Angular slack (rad) of the prefilters: far above round-off, far below any angle a valid
@@ -626,8 +626,13 @@ impl Pairing<'_> {
             // The members go straight to the Keller pair: their own prefilters, run again,
             // dropped no candidate on the living room that the pair keeps and cost more
             // than the pair's own first test ([`Pairing::apart`]).
+            // The first test of each member's `apart`, less its own point: one for the group.
+            let toward = g
+                .span
+                .line
+                .keller_reach(&far.wedge.line, self.grown(&far.reach));
             for a in &pairs.near[g.members.clone()] {
-                let Some(keller) = self.may_join(a, far) else {
+                let Some(keller) = self.may_join(a, far, toward) else {
                     continue;
                 };
                 let (before, after) = (&mut pairs.before, &mut pairs.after);
@@ -802,14 +807,21 @@ impl Pairing<'_> {
     /// the point `t2`, and `t2` at that of the point `t1` and the RX image. So if `t2` lies in
     /// its interval, `t1` lies in the range of Keller points over that interval
     /// ([`EdgeLine::keller_range`]), and in turn for `t2`: each interval shrinks to its
-    /// intersection with that range, and an empty one proves the pair outside.
+    /// intersection with that range, and an empty one proves the pair outside. `toward` is
+    /// the far reach (grown) seen from `a`'s line ([`EdgeLine::keller_reach`]), the first
+    /// range's part shared by a group's members.
     #[inline(always)]
-    fn apart(&self, a: &Near, far: &Far<'_>) -> bool {
+    fn apart(&self, a: &Near, far: &Far<'_>, toward: KellerReach) -> bool {
         let mut near = self.grown(&a.reach);
         let mut away = self.grown(&far.reach);
         let (first, second) = (&a.span.line, &far.wedge.line);
-        for _ in 0..APART_ROUNDS {
-            match shrink(&mut near, first.keller_range(a.focus, second, away)) {
+        for round in 0..APART_ROUNDS {
+            let range = if round == 0 {
+                toward.range(a.focus)
+            } else {
+                first.keller_range(a.focus, second, away)
+            };
+            match shrink(&mut near, range) {
                 Some(true) => return true,
                 Some(false) => {}
                 None => return false,
@@ -845,10 +857,16 @@ impl Pairing<'_> {
     /// `Some` when the Keller pair of `a` and `far` lies in both reaches (within the margin),
     /// with the pair, or cannot be computed (`Some(None)`); `None` when it lies outside.
     /// The pair's inputs are the image method's for the candidate
-    /// ([`DiffractedSet::keller`]), so the solve reuses it.
+    /// ([`DiffractedSet::keller`]), so the solve reuses it. `toward` as for
+    /// [`Pairing::apart`].
     #[inline(always)]
-    fn may_join(&self, a: &Near, far: &Far<'_>) -> Option<Option<(Real, Real)>> {
-        if self.apart(a, far) {
+    fn may_join(
+        &self,
+        a: &Near,
+        far: &Far<'_>,
+        toward: KellerReach,
+    ) -> Option<Option<(Real, Real)>> {
+        if self.apart(a, far, toward) {
             return None;
         }
         let Some((t1, t2)) = keller_pair(a.reach.image, a.span.line, far.wedge.line, far.image)
