@@ -432,7 +432,8 @@ impl Toward {
 
     /// The groups for paths with the one middle reflection `m` to edge `e2` of `scene`: those
     /// of `m`'s list ([`Toward::groups`], by depth) with room for the middle (depth below
-    /// `deepest`) that [`heads_into`] the edge's segment,
+    /// `deepest`), not [`surely_apart`] from the edge across `m`'s plane, that [`heads_into`]
+    /// the edge's segment,
     /// grown by the margin, mirrored through `m`'s plane as [`Pairing::far`] unfolds it (the
     /// far intervals on the edge behind `m` are parts of that segment, as for
     /// [`Toward::straight`]).
@@ -445,10 +446,17 @@ impl Toward {
                 line.point(-self.margin),
                 line.point(edge.length + self.margin),
             ];
+            // The second edge's real ends' side of the plane (the unfolded ends mirrored back).
+            let plane = scene.surface(m).polygon.plane();
+            let behind = whole.map(|p| -plane.signed_distance(p));
             let list = &self.groups[m.index()];
             let fit = list.partition_point(|&g| groups[g as usize].depth < self.deepest);
             (list[..fit].iter().copied())
-                .filter(|&g| heads_into(&groups[g as usize].span, whole))
+                .filter(|&g| {
+                    let span = &groups[g as usize].span;
+                    heads_into(span, whole)
+                        && !surely_apart(span.ends.map(|p| plane.signed_distance(p)), behind)
+                })
                 .collect()
         })
     }
@@ -507,6 +515,17 @@ fn heads_into(span: &Span, whole: [Vec3; 2]) -> bool {
     ];
     let at = cos_bounds(&along, (d_lo, d_hi));
     at.0 <= span.incidence.1 + 2.0 * SLACK && span.incidence.0 <= at.1 + 2.0 * SLACK
+}
+
+/// Whether the span with signed distances `first` from a middle reflection's plane and every
+/// part of the second edge's segment whose real ends have the signed distances `whole` lie
+/// strictly on opposite sides of it, as [`Pairing::may_pair`] tests a part (its ends'
+/// distances lie between the whole's up to round-off, far below [`NEAR`], which the whole's
+/// must exceed).
+fn surely_apart(first: [Real; 2], whole: [Real; 2]) -> bool {
+    let beyond = |x: [Real; 2], sign: Real| x.iter().all(|d| sign * d > NEAR);
+    let on = |x: [Real; 2], sign: Real| x.iter().all(|d| sign * d > 0.0);
+    (on(first, 1.0) && beyond(whole, -1.0)) || (on(first, -1.0) && beyond(whole, 1.0))
 }
 
 /// Length (m) below which [`heads_into`] takes two segments as close (and passes them).
