@@ -347,6 +347,34 @@ struct Pairs<'a> {
     after: Vec<SurfaceId>,
 }
 
+/// A group in a [`Toward`] list: its index into the groups and, in the lists per second
+/// edge, its interval (grown as [`Pairing::beyond`] reads it, [`widened`]) seen from that
+/// edge's line as the far intervals on it unfold it ([`EdgeLine::keller_reach`]): the part
+/// of `beyond`'s Keller range that the TX side and the scene give, the same bits as made
+/// there.
+#[derive(Debug, Clone, Copy)]
+struct Listed {
+    group: u32,
+    seen: Option<KellerReach>,
+}
+
+impl Listed {
+    /// Group `group` of `groups` seen from the (unfolded) second edge line `line`.
+    fn seen_from(line: &EdgeLine, groups: &[Group], group: u32) -> Self {
+        let span = &groups[group as usize].span;
+        Listed {
+            group,
+            seen: Some(line.keller_reach(&span.line, widened(span))),
+        }
+    }
+}
+
+/// A span's interval grown by [`APART_SLACK`] (m), as [`Pairing::beyond`] reads it.
+#[inline(always)]
+fn widened(span: &Span) -> (Real, Real) {
+    (span.t.0 - APART_SLACK, span.t.1 + APART_SLACK)
+}
+
 /// Per reflector, the groups of TX reaches whose diffracted rays may head into its box: a
 /// path `D1 → M → ...` reflecting at `M` right after `D1` leaves `D1` along `M − D1`, whose
 /// cos β0 with the first edge equals the incident ray's (Keller), and `M` lies in the
@@ -358,19 +386,20 @@ struct Pairs<'a> {
 /// reflection: the reflector's groups whose rays may head into the second edge's segment
 /// mirrored through it.
 /// Each list holds its groups by depth (ascending), so that a far interval takes the
-/// prefix whose depths fit.
+/// prefix whose depths fit; the lists per second edge hold with each group its interval seen
+/// from that edge's (unfolded) line ([`Listed`]).
 #[derive(Debug, Clone)]
 struct Toward {
-    /// Per surface id: the groups (indices) for a middle starting there.
-    groups: Vec<Vec<u32>>,
+    /// Per surface id: the groups for a middle starting there.
+    groups: Vec<Vec<Listed>>,
     /// Per surface id: a reflector's polygon box grown by the margin (m).
     boxes: Vec<(Vec3, Vec3)>,
     /// Per second edge: the groups for paths with no middle reflection, made when first
     /// asked for ([`Toward::straight`]).
-    straight: Vec<std::sync::OnceLock<Vec<u32>>>,
+    straight: Vec<std::sync::OnceLock<Vec<Listed>>>,
     /// Per (surface id, second edge), at `surface · edges + edge`: the groups for a middle of
     /// that one reflection, made when first asked for ([`Toward::across`]).
-    across: Vec<std::sync::OnceLock<Vec<u32>>>,
+    across: Vec<std::sync::OnceLock<Vec<Listed>>>,
     /// The margin (m).
     margin: Real,
     /// The most reflections a path with two diffractions has room for.
@@ -381,7 +410,9 @@ impl Toward {
     fn of(scene: &Scene, groups: &[Group], margin: Real, deepest: usize) -> Self {
         let by_depth = |mut list: Vec<u32>| {
             list.sort_by_key(|&g| (groups[g as usize].depth, g));
-            list
+            (list.into_iter())
+                .map(|group| Listed { group, seen: None })
+                .collect()
         };
         let mut by_surface = vec![Vec::new(); scene.surfaces().len()];
         let mut boxes = vec![(Vec3::ZERO, Vec3::ZERO); scene.surfaces().len()];
@@ -411,7 +442,7 @@ impl Toward {
 
     /// The groups for paths with no middle reflection to edge `e2` of `scene` ([`heads_into`]
     /// its segment grown by the margin), by depth.
-    fn straight(&self, scene: &Scene, groups: &[Group], e2: usize) -> &[u32] {
+    fn straight(&self, scene: &Scene, groups: &[Group], e2: usize) -> &[Listed] {
         self.straight[e2].get_or_init(|| {
             let edge = &scene.edges().all()[e2];
             let line = EdgeLine::of(edge);
@@ -426,7 +457,9 @@ impl Toward {
                 })
                 .collect();
             list.sort_by_key(|&g| (groups[g as usize].depth, g));
-            list
+            (list.into_iter())
+                .map(|g| Listed::seen_from(&line, groups, g))
+                .collect()
         })
     }
 
@@ -437,7 +470,7 @@ impl Toward {
     /// grown by the margin, mirrored through `m`'s plane as [`Pairing::far`] unfolds it (the
     /// far intervals on the edge behind `m` are parts of that segment, as for
     /// [`Toward::straight`]).
-    fn across(&self, scene: &Scene, groups: &[Group], m: SurfaceId, e2: usize) -> &[u32] {
+    fn across(&self, scene: &Scene, groups: &[Group], m: SurfaceId, e2: usize) -> &[Listed] {
         let edges = scene.edges().all();
         self.across[m.index() * edges.len() + e2].get_or_init(|| {
             let edge = &edges[e2];
@@ -450,13 +483,14 @@ impl Toward {
             let plane = scene.surface(m).polygon.plane();
             let behind = whole.map(|p| -plane.signed_distance(p));
             let list = &self.groups[m.index()];
-            let fit = list.partition_point(|&g| groups[g as usize].depth < self.deepest);
-            (list[..fit].iter().copied())
-                .filter(|&g| {
-                    let span = &groups[g as usize].span;
+            let fit = list.partition_point(|l| groups[l.group as usize].depth < self.deepest);
+            (list[..fit].iter())
+                .filter(|l| {
+                    let span = &groups[l.group as usize].span;
                     heads_into(span, whole)
                         && !surely_apart(span.ends.map(|p| plane.signed_distance(p)), behind)
                 })
+                .map(|l| Listed::seen_from(&line, groups, l.group))
                 .collect()
         })
     }
@@ -464,7 +498,7 @@ impl Toward {
     /// The groups that may pair with `far`, or `None` when none may: with one middle
     /// reflection, the ray arriving at the far interval from the reflector's box must obey
     /// Keller's law there too (cos β0 of `q − M` against the leaving range).
-    fn groups(&self, scene: &Scene, groups: &[Group], far: &Far<'_>) -> Option<&[u32]> {
+    fn groups(&self, scene: &Scene, groups: &[Group], far: &Far<'_>) -> Option<&[Listed]> {
         let Some(&m) = far.middle.first() else {
             return Some(self.straight(scene, groups, far.edge));
         };
@@ -620,14 +654,14 @@ impl Pairing<'_> {
         Ok(())
     }
 
-    /// The candidates of `far` with the groups `first` (indices into `pairs.groups`) whose
-    /// depths fit.
+    /// The candidates of `far` with the groups `first` (indices into `pairs.groups`, with
+    /// their intervals seen from `far`'s line when known) whose depths fit.
     #[inline(always)]
     fn pair_with(
         &self,
         scene: &Scene,
         far: &Far<'_>,
-        first: &[u32],
+        first: &[Listed],
         pairs: &mut Pairs<'_>,
         set: &mut DiffractedSet,
     ) -> Result<(), TreeError> {
@@ -636,10 +670,12 @@ impl Pairing<'_> {
         pairs.seen.resize(scene.edges().len(), None);
         // The lists hold their groups by depth: those that fit come first.
         let room = pairs.deepest - b.depth - far.middle.len();
-        let fit = first.partition_point(|&g| pairs.groups[g as usize].depth <= room);
-        for g in first[..fit].iter().map(|&g| &pairs.groups[g as usize]) {
+        let fit = first.partition_point(|l| pairs.groups[l.group as usize].depth <= room);
+        for listed in &first[..fit] {
+            let g = &pairs.groups[listed.group as usize];
             let seen = (&mut pairs.seen[..], pairs.wedges);
-            if self.beyond(&g.span, far) || !self.may_pair(scene, (&g.span, far), seen) {
+            if self.beyond(&g.span, far, listed.seen) || !self.may_pair(scene, (&g.span, far), seen)
+            {
                 continue;
             }
             // The members go straight to the Keller pair: their own prefilters, run again,
@@ -857,12 +893,12 @@ impl Pairing<'_> {
     /// Whether no reach of `span` (a group's) can pair with `far`: the second point of a pair
     /// is the Keller point of the first and the RX image, so it lies in the range of those
     /// over the span's interval ([`EdgeLine::keller_range`]); when that range misses the far
-    /// reach (grown as in [`Pairing::apart`]), so does every pair.
+    /// reach (grown as in [`Pairing::apart`]), so does every pair. `seen`: the span's
+    /// interval seen from `far`'s line ([`Listed`]), made here when not given.
     #[inline(always)]
-    fn beyond(&self, span: &Span, far: &Far<'_>) -> bool {
-        let near = (span.t.0 - APART_SLACK, span.t.1 + APART_SLACK);
-        let range = far.wedge.line.keller_range(far.focus, &span.line, near);
-        shrink(&mut self.grown(&far.reach), range) == Some(true)
+    fn beyond(&self, span: &Span, far: &Far<'_>, seen: Option<KellerReach>) -> bool {
+        let seen = seen.unwrap_or_else(|| far.wedge.line.keller_reach(&span.line, widened(span)));
+        shrink(&mut self.grown(&far.reach), seen.range(far.focus)) == Some(true)
     }
 
     /// `reach`'s interval grown by the margin and [`APART_SLACK`] (m), as [`Pairing::apart`]
