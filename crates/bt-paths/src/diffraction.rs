@@ -100,8 +100,9 @@ pub struct DiffractedSet {
     positions: Vec<u8>,
     /// Per candidate: the second edge and the reflections between, `None` with one.
     seconds: Vec<Option<(EdgeId, u8)>>,
-    /// Per candidate: the Keller parameters of its two diffraction points, when known.
-    keller: Vec<Option<(Real, Real)>>,
+    /// Per candidate: the Keller parameters of its two diffraction points, when solved
+    /// (`Some(None)`: solved, no pair).
+    keller: Vec<Option<Option<(Real, Real)>>>,
 }
 
 impl PartialEq for DiffractedSet {
@@ -161,9 +162,10 @@ impl DiffractedSet {
     /// them ([`bt_scene::edges::keller_pair`]) from the very inputs the image method reads:
     /// TX mirrored through the reflections before the first edge, the first edge's line,
     /// and the second edge's line and RX (mirrored through the reflections after the second
-    /// edge) both mirrored through those between, last first. `None` otherwise.
+    /// edge) both mirrored through those between, last first: `Some(None)` when that solve
+    /// found no pair, `None` when it was not run.
     #[inline]
-    pub fn keller(&self, i: usize) -> Option<(Real, Real)> {
+    pub fn keller(&self, i: usize) -> Option<Option<(Real, Real)>> {
         self.keller[i]
     }
     /// All candidates in order.
@@ -184,7 +186,7 @@ impl DiffractedSet {
         edges: (EdgeId, EdgeId),
         between: &[SurfaceId],
         after: &[SurfaceId],
-        keller: Option<(Real, Real)>,
+        keller: Option<Option<(Real, Real)>>,
     ) {
         let second = Some((edges.1, between.len() as u8));
         self.push_parts(&[before, between, after], edges.0, second);

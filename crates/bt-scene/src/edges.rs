@@ -17,7 +17,7 @@
 
 mod keller;
 
-pub use keller::{EdgeLine, KELLER_PAIR_TOL, KELLER_RESIDUAL, keller_pair};
+pub use keller::{EdgeLine, KELLER_PAIR_TOL, KELLER_RESIDUAL, KellerReach, keller_pair};
 
 use crate::surface::{Surface, SurfaceId, SurfaceKind};
 use bt_geom::{Bvh, Plane, Real, Vec3, bvh::Occluder};

@@ -36,14 +36,14 @@ use rayon::prelude::*;
 /// The interaction points of `c` by the image method into `points` (length `c.order()`,
 /// metres, TX side first, the diffraction points at their indices). With two diffractions,
 /// `keller` may give the points' parameters already solved from the same inputs
-/// ([`DiffractedSet::keller`]: the beam tree's join solves them); they are solved here
-/// otherwise.
+/// ([`DiffractedSet::keller`]: the beam tree's join solves them; `Some(None)` when that
+/// solve found none); they are solved here otherwise.
 #[inline(always)]
 pub fn solve_image(
     scene: &Scene,
     ends: Endpoints,
     c: DiffractedCandidate<'_>,
-    keller: Option<(Real, Real)>,
+    keller: Option<Option<(Real, Real)>>,
     points: &mut [Vec3],
 ) -> Result<(), ImageFailure> {
     let p = c.position;
@@ -75,7 +75,7 @@ pub fn solve_image(
         j = plane(id).mirror(j);
     }
     let (t1, t2) = keller
-        .or_else(|| keller_pair(i, EdgeLine::of(edge), line, j))
+        .unwrap_or_else(|| keller_pair(i, EdgeLine::of(edge), line, j))
         .ok_or(ImageFailure::Parallel { index: p })?;
     let (d1, d2) = (edge.point(t1), other.point(t2));
     (points[p], points[p + q + 1]) = (d1, d2);
@@ -338,7 +338,7 @@ pub fn solve_candidate(
     scene: &Scene,
     ends: Endpoints,
     c: DiffractedCandidate<'_>,
-    keller: Option<(Real, Real)>,
+    keller: Option<Option<(Real, Real)>>,
     solver: &crate::Solver,
     points: &mut [Vec3],
 ) -> CandidateOutcome {
@@ -353,7 +353,7 @@ fn solve_candidate_recording(
     scene: &Scene,
     ends: Endpoints,
     c: DiffractedCandidate<'_>,
-    (keller, solver): (Option<(Real, Real)>, &crate::Solver),
+    (keller, solver): (Option<Option<(Real, Real)>>, &crate::Solver),
     points: &mut [Vec3],
     crossings: &mut Crossings,
 ) -> CandidateOutcome {
@@ -385,35 +385,44 @@ fn solve_candidate_recording(
 }
 
 /// Solve and validate every candidate of `set` (in parallel when `parallel`; the output is
-/// the same either way): the valid paths in set order, with the penetrable surfaces they
-/// cross inserted as [`FoundPath::with_crossings`] would, and every outcome counted, as the
-/// results of consecutive chunks of the set ([`TraceResult::concat`] joins them).
+/// the same either way) into `out`: the valid paths appended in set order, with the
+/// penetrable surfaces they cross inserted as [`FoundPath::with_crossings`] would, and every
+/// outcome counted. On one thread the paths go straight into `out` (no per-chunk vectors to
+/// grow and copy again); on several, consecutive chunks' results are appended in order.
 pub fn trace_set(
     scene: &Scene,
     ends: Endpoints,
     set: &DiffractedSet,
     solver: &crate::Solver,
     parallel: bool,
-) -> Vec<TraceResult> {
+    out: &mut TraceResult,
+) {
+    let work = Work {
+        scene,
+        ends,
+        set,
+        solver,
+    };
+    if !(parallel && set.len() >= 2 * CHUNK) {
+        solve_range(&work, 0..set.len(), out);
+        return;
+    }
     let chunks: Vec<std::ops::Range<usize>> = (0..set.len())
         .step_by(CHUNK)
         .map(|start| start..(start + CHUNK).min(set.len()))
         .collect();
-    let run = |range: &std::ops::Range<usize>| {
-        solve_range(
-            &Work {
-                scene,
-                ends,
-                set,
-                solver,
-            },
-            range.clone(),
-        )
-    };
-    if parallel && set.len() >= 2 * CHUNK {
-        chunks.par_iter().map(run).collect()
-    } else {
-        chunks.iter().map(run).collect()
+    let parts: Vec<TraceResult> = chunks
+        .par_iter()
+        .map(|range| {
+            let mut part = TraceResult::default();
+            solve_range(&work, range.clone(), &mut part);
+            part
+        })
+        .collect();
+    out.paths.reserve(parts.iter().map(|p| p.paths.len()).sum());
+    for part in parts {
+        out.paths.extend(part.paths);
+        out.counts.merge(&part.counts);
     }
 }
 
@@ -428,27 +437,27 @@ struct Work<'a> {
     solver: &'a crate::Solver,
 }
 
-/// Solve candidates `range` of the set: compiled with the `fma` target feature when the CPU
-/// has it (as the specular batch, `crate::batch`: the side and inside tests use `mul_add`,
-/// a software call without the feature; results are bit-identical either way).
-fn solve_range(work: &Work<'_>, range: std::ops::Range<usize>) -> TraceResult {
+/// Solve candidates `range` of the set into `out` (appended): compiled with the `fma` target
+/// feature when the CPU has it (as the specular batch, `crate::batch`: the side and inside
+/// tests use `mul_add`, a software call without the feature; results are bit-identical
+/// either way).
+fn solve_range(work: &Work<'_>, range: std::ops::Range<usize>, out: &mut TraceResult) {
     #[cfg(target_arch = "x86_64")]
     if std::arch::is_x86_feature_detected!("fma") {
         // SAFETY: the CPU supports FMA (checked just above).
-        return unsafe { solve_range_fma(work, range) };
+        return unsafe { solve_range_fma(work, range, out) };
     }
-    solve_range_impl(work, range)
+    solve_range_impl(work, range, out)
 }
 
 #[cfg(target_arch = "x86_64")]
 #[target_feature(enable = "fma")]
-fn solve_range_fma(work: &Work<'_>, range: std::ops::Range<usize>) -> TraceResult {
-    solve_range_impl(work, range)
+fn solve_range_fma(work: &Work<'_>, range: std::ops::Range<usize>, out: &mut TraceResult) {
+    solve_range_impl(work, range, out)
 }
 
 #[inline(always)]
-fn solve_range_impl(work: &Work<'_>, range: std::ops::Range<usize>) -> TraceResult {
-    let mut out = TraceResult::default();
+fn solve_range_impl(work: &Work<'_>, range: std::ops::Range<usize>, out: &mut TraceResult) {
     let mut buffer = [Vec3::ZERO; 8];
     let mut heap = Vec::new();
     let mut crossings = Vec::new();
@@ -469,7 +478,6 @@ fn solve_range_impl(work: &Work<'_>, range: std::ops::Range<usize>) -> TraceResu
         out.paths
             .extend(found(c, &outcome, points).map(|p| p.with_found_crossings(&crossings)));
     }
-    out
 }
 
 /// The found path of a valid outcome: the specular batch's ([`crate::batch::found_path`])

@@ -491,14 +491,16 @@ pub fn trace(
         }
     }
     // The diffracted paths come with their crossings: validation walked them.
-    parts.extend(diffraction::trace_set(
+    let mut out = TraceResult::concat(parts);
+    diffraction::trace_set(
         scene,
         ends,
         &candidates.diffracted,
         solver,
         parallel,
-    ));
-    Ok(TraceResult::concat(parts))
+        &mut out,
+    );
+    Ok(out)
 }
 
 #[cfg(test)]

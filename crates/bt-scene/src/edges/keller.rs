@@ -105,12 +105,19 @@ impl EdgeLine {
     #[inline(always)]
     pub fn keller_range(
         &self,
-        (a_distance, a_along): (Real, Real),
+        focus: (Real, Real),
         other: &EdgeLine,
-        (lo, hi): (Real, Real),
+        range: (Real, Real),
     ) -> Option<(Real, Real)> {
+        self.keller_reach(other, range).range(focus)
+    }
+
+    /// The part of [`Self::keller_range`] that depends on `other` and `range` alone, for one
+    /// stretch against several points `a` ([`KellerReach::range`]; the same interval, bit for
+    /// bit).
+    #[inline(always)]
+    pub fn keller_reach(&self, other: &EdgeLine, (lo, hi): (Real, Real)) -> KellerReach {
         let (p, q) = (other.point(lo), other.point(hi));
-        let (m0, m1) = (self.along(p) - a_along, self.along(q) - a_along);
         // The offset from the line is affine along `other`.
         let u = self.offset(p);
         let w = self.offset(q) - u;
@@ -120,8 +127,29 @@ impl EdgeLine {
         } else {
             0.0
         };
-        let d_lo = (u + s * w).length();
-        let d_hi = u.length().max((u + w).length());
+        KellerReach {
+            along: (self.along(p), self.along(q)),
+            distance: ((u + s * w).length(), u.length().max((u + w).length())),
+        }
+    }
+}
+
+/// A stretch of another line as [`EdgeLine::keller_range`] reads it, seen from this line: its
+/// ends' parameters on this line and the least and greatest distances of its points from
+/// this line (m).
+#[derive(Debug, Clone, Copy)]
+pub struct KellerReach {
+    along: (Real, Real),
+    distance: (Real, Real),
+}
+
+impl KellerReach {
+    /// [`EdgeLine::keller_range`] of the stretch and `a`, given by its distance from the line
+    /// and its parameter (m).
+    #[inline(always)]
+    pub fn range(&self, (a_distance, a_along): (Real, Real)) -> Option<(Real, Real)> {
+        let (m0, m1) = (self.along.0 - a_along, self.along.1 - a_along);
+        let (d_lo, d_hi) = self.distance;
         let (w_lo, w_hi) = (
             a_distance / (a_distance + d_hi),
             a_distance / (a_distance + d_lo),

@@ -17,7 +17,7 @@ use super::{Pairing, Reach};
 use crate::beamtree::{PAIR_TESTS_PER_CANDIDATE, TreeError};
 use crate::diffraction::DiffractedSet;
 use bt_geom::{Plane, Polygon, Real, Vec3};
-use bt_scene::edges::{EdgeLine, keller_pair};
+use bt_scene::edges::{EdgeLine, KellerReach, keller_pair};
 use bt_scene::{Edge, EdgeId, Scene, SurfaceId};
 
 /// Angular slack (rad) of the prefilters: far above round-off, far below any angle a valid
@@ -119,7 +119,7 @@ struct Far<'m> {
 /// normals of its two faces' planes (`e × t0` and `tn × e`), possibly mirrored through
 /// reflections (a mirror keeps every distance, so a point's distances from the mirrored
 /// planes are its mirror image's from the edge's own).
-#[derive(Clone, Copy)]
+#[derive(Debug, Clone, Copy)]
 struct Wedge {
     line: EdgeLine,
     normal0: Vec3,
@@ -314,18 +314,21 @@ pub(super) struct TxPart {
     near: Vec<Near>,
     groups: Vec<Group>,
     index: Toward,
+    /// Every edge's [`Wedge`], by edge index (the scene's alone, made once with the rest).
+    wedges: Vec<Wedge>,
 }
 
 impl TxPart {
     fn of(pairing: &Pairing<'_>, scene: &Scene, deepest: usize) -> Self {
         let near = pairing.near(scene, deepest);
         let groups = groups(&near);
-        let index = Toward::of(scene, &groups, pairing.margin);
+        let index = Toward::of(scene, &groups, pairing.margin, deepest);
         TxPart {
             margin: pairing.margin,
             near,
             groups,
             index,
+            wedges: scene.edges().all().iter().map(Wedge::of).collect(),
         }
     }
 }
@@ -338,8 +341,38 @@ struct Pairs<'a> {
     deepest: usize,
     /// Per far interval, per first edge: whether the interval leaves that edge's interior.
     seen: Vec<Option<bool>>,
+    /// Every edge's wedge ([`TxPart::wedges`]).
+    wedges: &'a [Wedge],
     before: Vec<SurfaceId>,
     after: Vec<SurfaceId>,
+}
+
+/// A group in a [`Toward`] list: its index into the groups and, in the lists per second
+/// edge, its interval (grown as [`Pairing::beyond`] reads it, [`widened`]) seen from that
+/// edge's line as the far intervals on it unfold it ([`EdgeLine::keller_reach`]): the part
+/// of `beyond`'s Keller range that the TX side and the scene give, the same bits as made
+/// there.
+#[derive(Debug, Clone, Copy)]
+struct Listed {
+    group: u32,
+    seen: Option<KellerReach>,
+}
+
+impl Listed {
+    /// Group `group` of `groups` seen from the (unfolded) second edge line `line`.
+    fn seen_from(line: &EdgeLine, groups: &[Group], group: u32) -> Self {
+        let span = &groups[group as usize].span;
+        Listed {
+            group,
+            seen: Some(line.keller_reach(&span.line, widened(span))),
+        }
+    }
+}
+
+/// A span's interval grown by [`APART_SLACK`] (m), as [`Pairing::beyond`] reads it.
+#[inline(always)]
+fn widened(span: &Span) -> (Real, Real) {
+    (span.t.0 - APART_SLACK, span.t.1 + APART_SLACK)
 }
 
 /// Per reflector, the groups of TX reaches whose diffracted rays may head into its box: a
@@ -349,27 +382,37 @@ struct Pairs<'a> {
 /// ([`cos_range_to_box`]) misses its incidence range pairs with no interval beyond that
 /// reflector, so the join never looks at those pairs. Likewise per second edge, for paths
 /// with no middle reflection: `D1 → D2` leaves `D1` towards the second edge's segment
-/// ([`heads_into`]).
+/// ([`heads_into`]), and per (reflector, second edge) for paths with that one middle
+/// reflection: the reflector's groups whose rays may head into the second edge's segment
+/// mirrored through it.
 /// Each list holds its groups by depth (ascending), so that a far interval takes the
-/// prefix whose depths fit.
+/// prefix whose depths fit; the lists per second edge hold with each group its interval seen
+/// from that edge's (unfolded) line ([`Listed`]).
 #[derive(Debug, Clone)]
 struct Toward {
-    /// Per surface id: the groups (indices) for a middle starting there.
-    groups: Vec<Vec<u32>>,
+    /// Per surface id: the groups for a middle starting there.
+    groups: Vec<Vec<Listed>>,
     /// Per surface id: a reflector's polygon box grown by the margin (m).
     boxes: Vec<(Vec3, Vec3)>,
     /// Per second edge: the groups for paths with no middle reflection, made when first
     /// asked for ([`Toward::straight`]).
-    straight: Vec<std::sync::OnceLock<Vec<u32>>>,
+    straight: Vec<std::sync::OnceLock<Vec<Listed>>>,
+    /// Per (surface id, second edge), at `surface · edges + edge`: the groups for a middle of
+    /// that one reflection, made when first asked for ([`Toward::across`]).
+    across: Vec<std::sync::OnceLock<Vec<Listed>>>,
     /// The margin (m).
     margin: Real,
+    /// The most reflections a path with two diffractions has room for.
+    deepest: usize,
 }
 
 impl Toward {
-    fn of(scene: &Scene, groups: &[Group], margin: Real) -> Self {
+    fn of(scene: &Scene, groups: &[Group], margin: Real, deepest: usize) -> Self {
         let by_depth = |mut list: Vec<u32>| {
             list.sort_by_key(|&g| (groups[g as usize].depth, g));
-            list
+            (list.into_iter())
+                .map(|group| Listed { group, seen: None })
+                .collect()
         };
         let mut by_surface = vec![Vec::new(); scene.surfaces().len()];
         let mut boxes = vec![(Vec3::ZERO, Vec3::ZERO); scene.surfaces().len()];
@@ -391,13 +434,15 @@ impl Toward {
             groups: by_surface,
             boxes,
             straight: vec![std::sync::OnceLock::new(); scene.edges().len()],
+            across: vec![std::sync::OnceLock::new(); scene.surfaces().len() * scene.edges().len()],
             margin,
+            deepest,
         }
     }
 
     /// The groups for paths with no middle reflection to edge `e2` of `scene` ([`heads_into`]
     /// its segment grown by the margin), by depth.
-    fn straight(&self, scene: &Scene, groups: &[Group], e2: usize) -> &[u32] {
+    fn straight(&self, scene: &Scene, groups: &[Group], e2: usize) -> &[Listed] {
         self.straight[e2].get_or_init(|| {
             let edge = &scene.edges().all()[e2];
             let line = EdgeLine::of(edge);
@@ -412,14 +457,48 @@ impl Toward {
                 })
                 .collect();
             list.sort_by_key(|&g| (groups[g as usize].depth, g));
-            list
+            (list.into_iter())
+                .map(|g| Listed::seen_from(&line, groups, g))
+                .collect()
+        })
+    }
+
+    /// The groups for paths with the one middle reflection `m` to edge `e2` of `scene`: those
+    /// of `m`'s list ([`Toward::groups`], by depth) with room for the middle (depth below
+    /// `deepest`), not [`surely_apart`] from the edge across `m`'s plane, that [`heads_into`]
+    /// the edge's segment,
+    /// grown by the margin, mirrored through `m`'s plane as [`Pairing::far`] unfolds it (the
+    /// far intervals on the edge behind `m` are parts of that segment, as for
+    /// [`Toward::straight`]).
+    fn across(&self, scene: &Scene, groups: &[Group], m: SurfaceId, e2: usize) -> &[Listed] {
+        let edges = scene.edges().all();
+        self.across[m.index() * edges.len() + e2].get_or_init(|| {
+            let edge = &edges[e2];
+            let line = EdgeLine::of(edge).mirrored(scene.surface(m).polygon.plane());
+            let whole = [
+                line.point(-self.margin),
+                line.point(edge.length + self.margin),
+            ];
+            // The second edge's real ends' side of the plane (the unfolded ends mirrored back).
+            let plane = scene.surface(m).polygon.plane();
+            let behind = whole.map(|p| -plane.signed_distance(p));
+            let list = &self.groups[m.index()];
+            let fit = list.partition_point(|l| groups[l.group as usize].depth < self.deepest);
+            (list[..fit].iter())
+                .filter(|l| {
+                    let span = &groups[l.group as usize].span;
+                    heads_into(span, whole)
+                        && !surely_apart(span.ends.map(|p| plane.signed_distance(p)), behind)
+                })
+                .map(|l| Listed::seen_from(&line, groups, l.group))
+                .collect()
         })
     }
 
     /// The groups that may pair with `far`, or `None` when none may: with one middle
     /// reflection, the ray arriving at the far interval from the reflector's box must obey
     /// Keller's law there too (cos β0 of `q − M` against the leaving range).
-    fn groups(&self, scene: &Scene, groups: &[Group], far: &Far<'_>) -> Option<&[u32]> {
+    fn groups(&self, scene: &Scene, groups: &[Group], far: &Far<'_>) -> Option<&[Listed]> {
         let Some(&m) = far.middle.first() else {
             return Some(self.straight(scene, groups, far.edge));
         };
@@ -429,13 +508,15 @@ impl Toward {
             if !overlap((-hi, -lo), far.leaving) {
                 return None;
             }
+            return Some(self.across(scene, groups, m, far.edge));
         }
         Some(&self.groups[m.index()])
     }
 }
 
 /// Whether rays from `span`'s interval to the segment `whole` (a second edge grown by the
-/// margin: every far interval on that edge, with no middle reflection, is a part of it) may
+/// margin, or that mirrored through one middle reflection: every far interval on that edge,
+/// with that middle, is a part of it, on the same line) may
 /// obey Keller's law at the first edge, with twice [`SLACK`]. When this fails, so does
 /// [`Pairing::may_pair`]'s first test for every far interval on the edge: a part's
 /// numerators lie between `whole`'s corners' and its lengths between the bounds taken here
@@ -468,6 +549,17 @@ fn heads_into(span: &Span, whole: [Vec3; 2]) -> bool {
     ];
     let at = cos_bounds(&along, (d_lo, d_hi));
     at.0 <= span.incidence.1 + 2.0 * SLACK && span.incidence.0 <= at.1 + 2.0 * SLACK
+}
+
+/// Whether the span with signed distances `first` from a middle reflection's plane and every
+/// part of the second edge's segment whose real ends have the signed distances `whole` lie
+/// strictly on opposite sides of it, as [`Pairing::may_pair`] tests a part (its ends'
+/// distances lie between the whole's up to round-off, far below [`NEAR`], which the whole's
+/// must exceed).
+fn surely_apart(first: [Real; 2], whole: [Real; 2]) -> bool {
+    let beyond = |x: [Real; 2], sign: Real| x.iter().all(|d| sign * d > NEAR);
+    let on = |x: [Real; 2], sign: Real| x.iter().all(|d| sign * d > 0.0);
+    (on(first, 1.0) && beyond(whole, -1.0)) || (on(first, -1.0) && beyond(whole, 1.0))
 }
 
 /// Length (m) below which [`heads_into`] takes two segments as close (and passes them).
@@ -544,13 +636,14 @@ impl Pairing<'_> {
             groups: &tx.groups,
             deepest,
             seen: Vec::new(),
+            wedges: &tx.wedges,
             before: Vec::new(),
             after: Vec::new(),
         };
         for (e2, on_edge) in self.from_rx.iter().enumerate() {
             for b in on_edge.iter().filter(|b| b.depth <= deepest) {
                 for middle in middles[..=deepest - b.depth].iter().flatten() {
-                    let far = self.far(scene, (e2, *b), middle);
+                    let far = self.far(scene, (e2, *b), middle, pairs.wedges[e2]);
                     let Some(first) = index.groups(scene, &tx.groups, &far) else {
                         continue;
                     };
@@ -561,14 +654,14 @@ impl Pairing<'_> {
         Ok(())
     }
 
-    /// The candidates of `far` with the groups `first` (indices into `pairs.groups`) whose
-    /// depths fit.
+    /// The candidates of `far` with the groups `first` (indices into `pairs.groups`, with
+    /// their intervals seen from `far`'s line when known) whose depths fit.
     #[inline(always)]
     fn pair_with(
         &self,
         scene: &Scene,
         far: &Far<'_>,
-        first: &[u32],
+        first: &[Listed],
         pairs: &mut Pairs<'_>,
         set: &mut DiffractedSet,
     ) -> Result<(), TreeError> {
@@ -577,22 +670,30 @@ impl Pairing<'_> {
         pairs.seen.resize(scene.edges().len(), None);
         // The lists hold their groups by depth: those that fit come first.
         let room = pairs.deepest - b.depth - far.middle.len();
-        let fit = first.partition_point(|&g| pairs.groups[g as usize].depth <= room);
-        for g in first[..fit].iter().map(|&g| &pairs.groups[g as usize]) {
-            if self.beyond(&g.span, far) || !self.may_pair(scene, (&g.span, far), &mut pairs.seen) {
+        let fit = first.partition_point(|l| pairs.groups[l.group as usize].depth <= room);
+        for listed in &first[..fit] {
+            let g = &pairs.groups[listed.group as usize];
+            let seen = (&mut pairs.seen[..], pairs.wedges);
+            if self.beyond(&g.span, far, listed.seen) || !self.may_pair(scene, (&g.span, far), seen)
+            {
                 continue;
             }
             // The members go straight to the Keller pair: their own prefilters, run again,
             // dropped no candidate on the living room that the pair keeps and cost more
             // than the pair's own first test ([`Pairing::apart`]).
+            // The first test of each member's `apart`, less its own point: one for the group.
+            let toward = g
+                .span
+                .line
+                .keller_reach(&far.wedge.line, self.grown(&far.reach));
             for a in &pairs.near[g.members.clone()] {
-                let Some(keller) = self.may_join(a, far) else {
+                let Some(keller) = self.may_join(a, far, toward) else {
                     continue;
                 };
                 let (before, after) = (&mut pairs.before, &mut pairs.after);
                 self.surfaces((a.reach.node, b.node), (before, after));
                 let edges = (EdgeId(a.span.edge as u32), EdgeId(far.edge as u32));
-                set.push_twice(before, edges, far.middle, after, keller);
+                set.push_twice(before, edges, far.middle, after, Some(keller));
                 self.check_budget(set)?;
             }
         }
@@ -663,9 +764,15 @@ impl Pairing<'_> {
         out
     }
 
-    /// RX reach `b` on edge `e2` with the `middle` reflections, unfolded ([`Far`]).
-    fn far<'m>(&self, scene: &Scene, (e2, b): (usize, Reach), middle: &'m [SurfaceId]) -> Far<'m> {
-        let mut wedge = Wedge::of(&scene.edges().all()[e2]);
+    /// RX reach `b` on edge `e2` (whose [`Wedge`] is `wedge`) with the `middle` reflections,
+    /// unfolded ([`Far`]).
+    fn far<'m>(
+        &self,
+        scene: &Scene,
+        (e2, b): (usize, Reach),
+        middle: &'m [SurfaceId],
+        mut wedge: Wedge,
+    ) -> Far<'m> {
         let mut image = b.image;
         for id in middle.iter().rev() {
             let plane = scene.surface(*id).polygon.plane();
@@ -701,13 +808,14 @@ impl Pairing<'_> {
     /// intervals overlap); across one middle reflection both points may lie on one side of
     /// its plane and the stretch may cross its window; the stretch between the edges leaves
     /// each into its exterior (the other interval is not wholly inside its interior wedge;
-    /// `seen` caches, per first edge, the test of `far`'s interval against it).
+    /// `seen` caches, per first edge, the test of `far`'s interval against it, `wedges` the
+    /// edges' wedges).
     #[inline(always)]
     fn may_pair(
         &self,
         scene: &Scene,
         (a, far): (&Span, &Far<'_>),
-        seen: &mut [Option<bool>],
+        (seen, wedges): (&mut [Option<bool>], &[Wedge]),
     ) -> bool {
         if far.middle.is_empty() && a.edge == far.edge {
             return false;
@@ -739,8 +847,7 @@ impl Pairing<'_> {
         }
         let inside = |wedge: &Wedge, ends: [Vec3; 2]| ends.iter().all(|p| wedge.deep_inside(*p));
         // The far interval against the first edge: one answer per edge for all its reaches.
-        let first_wedge = || Wedge::of(&scene.edges().all()[a.edge]);
-        if !*seen[a.edge].get_or_insert_with(|| !inside(&first_wedge(), far.ends)) {
+        if !*seen[a.edge].get_or_insert_with(|| !inside(&wedges[a.edge], far.ends)) {
             return false;
         }
         // The first edge's interval against the second edge's wedge, unfolded into this frame.
@@ -755,14 +862,21 @@ impl Pairing<'_> {
     /// the point `t2`, and `t2` at that of the point `t1` and the RX image. So if `t2` lies in
     /// its interval, `t1` lies in the range of Keller points over that interval
     /// ([`EdgeLine::keller_range`]), and in turn for `t2`: each interval shrinks to its
-    /// intersection with that range, and an empty one proves the pair outside.
+    /// intersection with that range, and an empty one proves the pair outside. `toward` is
+    /// the far reach (grown) seen from `a`'s line ([`EdgeLine::keller_reach`]), the first
+    /// range's part shared by a group's members.
     #[inline(always)]
-    fn apart(&self, a: &Near, far: &Far<'_>) -> bool {
+    fn apart(&self, a: &Near, far: &Far<'_>, toward: KellerReach) -> bool {
         let mut near = self.grown(&a.reach);
         let mut away = self.grown(&far.reach);
         let (first, second) = (&a.span.line, &far.wedge.line);
-        for _ in 0..APART_ROUNDS {
-            match shrink(&mut near, first.keller_range(a.focus, second, away)) {
+        for round in 0..APART_ROUNDS {
+            let range = if round == 0 {
+                toward.range(a.focus)
+            } else {
+                first.keller_range(a.focus, second, away)
+            };
+            match shrink(&mut near, range) {
                 Some(true) => return true,
                 Some(false) => {}
                 None => return false,
@@ -779,12 +893,12 @@ impl Pairing<'_> {
     /// Whether no reach of `span` (a group's) can pair with `far`: the second point of a pair
     /// is the Keller point of the first and the RX image, so it lies in the range of those
     /// over the span's interval ([`EdgeLine::keller_range`]); when that range misses the far
-    /// reach (grown as in [`Pairing::apart`]), so does every pair.
+    /// reach (grown as in [`Pairing::apart`]), so does every pair. `seen`: the span's
+    /// interval seen from `far`'s line ([`Listed`]), made here when not given.
     #[inline(always)]
-    fn beyond(&self, span: &Span, far: &Far<'_>) -> bool {
-        let near = (span.t.0 - APART_SLACK, span.t.1 + APART_SLACK);
-        let range = far.wedge.line.keller_range(far.focus, &span.line, near);
-        shrink(&mut self.grown(&far.reach), range) == Some(true)
+    fn beyond(&self, span: &Span, far: &Far<'_>, seen: Option<KellerReach>) -> bool {
+        let seen = seen.unwrap_or_else(|| far.wedge.line.keller_reach(&span.line, widened(span)));
+        shrink(&mut self.grown(&far.reach), seen.range(far.focus)) == Some(true)
     }
 
     /// `reach`'s interval grown by the margin and [`APART_SLACK`] (m), as [`Pairing::apart`]
@@ -798,10 +912,16 @@ impl Pairing<'_> {
     /// `Some` when the Keller pair of `a` and `far` lies in both reaches (within the margin),
     /// with the pair, or cannot be computed (`Some(None)`); `None` when it lies outside.
     /// The pair's inputs are the image method's for the candidate
-    /// ([`DiffractedSet::keller`]), so the solve reuses it.
+    /// ([`DiffractedSet::keller`]), so the solve reuses it. `toward` as for
+    /// [`Pairing::apart`].
     #[inline(always)]
-    fn may_join(&self, a: &Near, far: &Far<'_>) -> Option<Option<(Real, Real)>> {
-        if self.apart(a, far) {
+    fn may_join(
+        &self,
+        a: &Near,
+        far: &Far<'_>,
+        toward: KellerReach,
+    ) -> Option<Option<(Real, Real)>> {
+        if self.apart(a, far, toward) {
             return None;
         }
         let Some((t1, t2)) = keller_pair(a.reach.image, a.span.line, far.wedge.line, far.image)
