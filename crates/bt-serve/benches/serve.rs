@@ -8,7 +8,8 @@
 //! - `trace_many/kept-tree`: `Tracer::trace_each_then` with the full report of each receiver
 //!   into its thread's reused records (what Python's `trace_many` runs before its columns), 64
 //!   receivers per call, on a pool of one thread and of two: the ratio is the speed-up on two
-//!   cores.
+//!   cores; `trace_many/kept-tree-1000` the same with 1,000 receivers of the walk per call
+//!   (issue 30's workload: a Python `trace_many` over 1,000 nearby receivers).
 //!
 //! `cargo bench -p bt-serve --bench serve`
 
@@ -109,7 +110,6 @@ fn serve(c: &mut Criterion) {
 }
 
 fn trace_many(c: &mut Criterion) {
-    let receivers: Vec<Vec3> = walk(64).into_iter().map(Vec3::from_array).collect();
     let scene = bt_import::builtin_scene("living-room", Default::default())
         .expect("built-in scene")
         .expect("living room");
@@ -121,23 +121,28 @@ fn trace_many(c: &mut Criterion) {
     let tx = scene.tx_world().expect("the living room has a TX");
     let radio = RadioOptions::default();
     let mut group = c.benchmark_group("trace_many");
-    group.throughput(Throughput::Elements(receivers.len() as u64));
-    for threads in [1, 2] {
-        let pool = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .expect("pool");
-        let mut tracer = Tracer::new(scene.clone(), options);
-        let report = |moved: &bt_scene::Scene, t: bt_solve::pipeline::Traced| {
-            REPORTS.with_borrow_mut(|records| {
-                let paths = records.report(moved, &t.result.paths, &radio);
-                let paths = paths.expect("report");
-                (paths.len(), bt_beams::received_power_dbm(paths, 0.0))
-            })
-        };
-        group.bench_function(format!("kept-tree-{threads}-thread"), |b| {
-            b.iter(|| pool.install(|| black_box(tracer.trace_each_then(tx, &receivers, report))))
-        });
+    for (count, name) in [(64, "kept-tree"), (1000, "kept-tree-1000")] {
+        let receivers: Vec<Vec3> = walk(count).into_iter().map(Vec3::from_array).collect();
+        group.throughput(Throughput::Elements(receivers.len() as u64));
+        for threads in [1, 2] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .expect("pool");
+            let mut tracer = Tracer::new(scene.clone(), options);
+            let report = |moved: &bt_scene::Scene, t: bt_solve::pipeline::Traced| {
+                REPORTS.with_borrow_mut(|records| {
+                    let paths = records.report(moved, &t.result.paths, &radio);
+                    let paths = paths.expect("report");
+                    (paths.len(), bt_beams::received_power_dbm(paths, 0.0))
+                })
+            };
+            group.bench_function(format!("{name}-{threads}-thread"), |b| {
+                b.iter(|| {
+                    pool.install(|| black_box(tracer.trace_each_then(tx, &receivers, report)))
+                })
+            });
+        }
     }
     group.finish();
 }
