@@ -332,7 +332,9 @@ fn reflection_slice<'a>(c: DiffractedCandidate<'a>, k: usize) -> &'a [SurfaceId]
 
 /// Solve and validate `c` with `solver` (the image method or IPC; SBR does not diffract and
 /// gives `Missed`), the image method reading `keller` as [`solve_image`] does. `points` must
-/// have `c.order()` entries.
+/// have `c.order()` entries. IPC starts from [`ipc_start`]; when it converges to two
+/// consecutive points within the length tolerance (a spurious fixed point where an edge
+/// pierces a neighbouring reflection's plane), it runs again from the image method's points.
 #[inline(always)]
 pub fn solve_candidate(
     scene: &Scene,
@@ -370,10 +372,21 @@ fn solve_candidate_recording(
         crate::Solver::Ipc(options) => {
             ipc_start(scene, c, points);
             match solve_ipc(scene, ends, c, options, points) {
-                outcome @ IpcOutcome::Converged { .. } => CandidateOutcome::Solved {
-                    validity: validate_recording(scene, ends, c, points, crossings),
-                    ipc: Some(outcome),
-                },
+                outcome @ IpcOutcome::Converged { .. } => {
+                    if collapsed(scene, ends, points)
+                        && let Some(again) =
+                            ipc_from_image(scene, ends, c, (keller, options), (outcome, points))
+                    {
+                        return CandidateOutcome::Solved {
+                            validity: validate_recording(scene, ends, c, points, crossings),
+                            ipc: Some(again),
+                        };
+                    }
+                    CandidateOutcome::Solved {
+                        validity: validate_recording(scene, ends, c, points, crossings),
+                        ipc: Some(outcome),
+                    }
+                }
                 outcome @ IpcOutcome::NotConverged { .. } => {
                     CandidateOutcome::NotConverged(outcome)
                 }
@@ -381,6 +394,54 @@ fn solve_candidate_recording(
             }
         }
         crate::Solver::Sbr(_) => CandidateOutcome::Missed,
+    }
+}
+
+/// Whether two consecutive points of the path TX → `points` → RX lie within the scene's
+/// length tolerance of each other: a collapsed leg, which no valid path has.
+fn collapsed(scene: &Scene, ends: Endpoints, points: &[Vec3]) -> bool {
+    let tol = scene.length_tolerance();
+    let mut prev = ends.tx;
+    for &p in points.iter().chain(std::iter::once(&ends.rx)) {
+        if prev.distance(p) <= tol {
+            return true;
+        }
+        prev = p;
+    }
+    false
+}
+
+/// IPC's rounds again, from the image method's points of `c`, after a first run converged
+/// (`first`) to a collapsed leg in `points` ([`collapsed`]). An edge that pierces the plane
+/// of the reflection next to it has a spurious fixed point there: the reflection and the
+/// diffraction point both at the piercing point, each the other's neighbour (a path
+/// diffracting a millimetre from it drew IPC's centroid start there). Returns the second
+/// run's outcome, its rounds counted after the first's, with its points in `points` when it
+/// converged without a collapsed leg; else `None`, `points` as the first run left them.
+fn ipc_from_image(
+    scene: &Scene,
+    ends: Endpoints,
+    c: DiffractedCandidate<'_>,
+    (keller, options): (Option<Option<(Real, Real)>>, &IpcOptions),
+    (first, points): (IpcOutcome, &mut [Vec3]),
+) -> Option<IpcOutcome> {
+    let IpcOutcome::Converged { iterations, .. } = first else {
+        return None;
+    };
+    let mut again = points.to_vec();
+    solve_image(scene, ends, c, keller, &mut again).ok()?;
+    match solve_ipc(scene, ends, c, options, &mut again) {
+        IpcOutcome::Converged {
+            iterations: more,
+            residual,
+        } if !collapsed(scene, ends, &again) => {
+            points.copy_from_slice(&again);
+            Some(IpcOutcome::Converged {
+                iterations: iterations + more,
+                residual,
+            })
+        }
+        _ => None,
     }
 }
 
