@@ -373,18 +373,12 @@ fn solve_candidate_recording(
             ipc_start(scene, c, points);
             match solve_ipc(scene, ends, c, options, points) {
                 outcome @ IpcOutcome::Converged { .. } => {
-                    if collapsed(scene, ends, points)
-                        && let Some(again) =
-                            ipc_from_image(scene, ends, c, (keller, options), (outcome, points))
-                    {
-                        return CandidateOutcome::Solved {
-                            validity: validate_recording(scene, ends, c, points, crossings),
-                            ipc: Some(again),
-                        };
-                    }
+                    let again = collapsed(scene, ends, points).then(|| {
+                        ipc_from_image(scene, ends, c, (keller, options), (outcome, points))
+                    });
                     CandidateOutcome::Solved {
                         validity: validate_recording(scene, ends, c, points, crossings),
-                        ipc: Some(outcome),
+                        ipc: Some(again.flatten().unwrap_or(outcome)),
                     }
                 }
                 outcome @ IpcOutcome::NotConverged { .. } => {
