@@ -67,14 +67,17 @@ def test_moved_terminals_and_ipc_match_cli(cli_json):
     assert "iterations" in paths.columns
 
 
-def test_mesh_with_terminals_matches_cli(cli_json):
+@pytest.mark.parametrize("name", ["box-room.obj", "box-room-ascii.stl", "box-room-binary.stl"])
+def test_mesh_with_terminals_matches_cli(cli_json, name):
     tx, rx = [1.0, 1.0, 1.5], [3.0, 2.0, 1.2]
-    mesh = TESTDATA / "box-room.obj"
+    mesh = TESTDATA / name
     scene = beamtrace.load(mesh, tx=tx, rx=rx)
     paths = scene.trace(max_order=2, candidates="exhaustive")
     doc = cli_json(str(mesh), "--tx", vec(tx), "--rx", vec(rx), "--max-order", "2",
                    "--candidates", "exhaustive")
     assert_same_as_cli(paths, doc)
+    # The box as 12 triangles is 6 surfaces: 1 + 6 + 18 image sources up to order 2.
+    assert len(paths) == 25
 
 
 def test_bare_mesh_traces_with_terminals_per_call(cli_json):

@@ -159,6 +159,8 @@ pub enum Format {
     Obj,
     /// A PLY mesh (`.ply` declaring faces).
     PlyMesh,
+    /// An STL mesh, binary or ASCII (`.stl`).
+    Stl,
     /// A point cloud: `.pcd`, or `.ply` declaring no faces; planes are extracted.
     PointCloud,
     /// A Mitsuba 3 / Sionna RT scene (`.xml`) with PLY/OBJ shapes and radio bsdfs.
@@ -187,6 +189,7 @@ impl Format {
             "pcd" => Format::PointCloud,
             "ply" if crate::cloud::is_point_cloud(path) => Format::PointCloud,
             "ply" => Format::PlyMesh,
+            "stl" => Format::Stl,
             _ => return Err(ImportError::UnsupportedFormat { path: display }),
         })
     }
@@ -299,7 +302,7 @@ fn load_any(
             let loaded = Loaded::new(scene.without_duplicates(&display)?, Vec::new());
             (loaded, Some(read))
         }
-        Format::Obj | Format::PlyMesh => {
+        Format::Obj | Format::PlyMesh | Format::Stl => {
             let (import, read) =
                 crate::mesh::read_mesh_file(&path, &options.merge, options.max_file_bytes)?;
             let name = file_stem(&path, "mesh");

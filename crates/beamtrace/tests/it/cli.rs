@@ -139,6 +139,13 @@ fn meshes_import_and_trace_like_the_equivalent_scene() {
     for (x, y) in lengths(&obj).iter().zip(lengths(&a)) {
         assert!((x - y).abs() < 1e-9);
     }
+    // The same triangles as STL (float32 corners, exact for these integers): the ASCII file's
+    // `solid room` names the surfaces as the OBJ's `o room` does, so its paths are the OBJ's
+    // to the last bit; the binary file has no names, as the PLY files.
+    let stl = trace_json(&[&testdata("box-room-ascii.stl"), "--tx", tx, "--rx", rx]);
+    let stl_binary = trace_json(&[&testdata("box-room-binary.stl"), "--tx", tx, "--rx", rx]);
+    assert_eq!(without_timings(stl)["paths"], without_timings(obj)["paths"]);
+    assert_eq!(without_timings(stl_binary)["paths"], b["paths"]);
 }
 
 #[test]

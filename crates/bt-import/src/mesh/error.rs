@@ -51,8 +51,8 @@ pub enum MeshError {
         #[source]
         source: std::io::Error,
     },
-    /// The file extension is neither `.obj` nor `.ply` (case-insensitive).
-    #[error("{file}: unsupported mesh file extension {extension:?}: expected .obj or .ply")]
+    /// The file extension is none of `.obj`, `.ply` and `.stl` (case-insensitive).
+    #[error("{file}: unsupported mesh file extension {extension:?}: expected .obj, .ply or .stl")]
     UnsupportedExtension {
         /// File name as given.
         file: String,

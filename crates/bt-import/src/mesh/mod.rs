@@ -1,4 +1,4 @@
-//! Mesh files (Wavefront OBJ, PLY) to bounded planar polygon surfaces: the readers parse bytes
+//! Mesh files (Wavefront OBJ, PLY, STL) to bounded planar polygon surfaces: the readers parse bytes
 //! into a [`bt_mesh::RawMesh`] (polygon soup) and `bt-mesh` welds and merges it
 //! ([`bt_mesh::merge_mesh`]). [`read_mesh_path`] reads a file and picks the reader by
 //! extension; [`scene`] turns the surfaces into a [`bt_scene::Scene`].
@@ -10,6 +10,7 @@ mod error;
 mod obj;
 mod ply;
 pub mod scene;
+mod stl;
 
 use bt_geom::Vec3;
 use bt_mesh::{MergeOptions, MeshImport, RawMesh};
@@ -27,6 +28,8 @@ pub enum MeshFormat {
     Obj,
     /// PLY (ASCII, binary little or big endian).
     Ply,
+    /// STL (binary or ASCII; `stl`'s module docs).
+    Stl,
 }
 
 /// Reads a Wavefront OBJ mesh from bytes and merges its faces into planar surfaces.
@@ -50,6 +53,17 @@ pub fn read_ply(
     read_transformed(bytes, MeshFormat::Ply, file, opts, &|p| p)
 }
 
+/// Reads an STL mesh (binary or ASCII) from bytes and merges its faces into planar surfaces.
+/// `file` names the source in errors and warnings. STL has no materials: every surface gets
+/// the default one.
+pub fn read_stl(
+    bytes: &[u8],
+    file: Option<&str>,
+    opts: &MergeOptions,
+) -> Result<MeshImport, MeshError> {
+    read_transformed(bytes, MeshFormat::Stl, file, opts, &|p| p)
+}
+
 /// Checks `opts` and parses `bytes` as `format` into the polygon soup the merge starts from.
 fn parse(
     bytes: &[u8],
@@ -62,10 +76,11 @@ fn parse(
     match format {
         MeshFormat::Obj => obj::parse(bytes, file, opts.max_elements),
         MeshFormat::Ply => ply::parse(bytes, file, opts.max_elements),
+        MeshFormat::Stl => stl::parse(bytes, file, opts.max_elements),
     }
 }
 
-/// Reads a mesh from bytes like [`read_obj`] / [`read_ply`], but first maps every vertex
+/// Reads a mesh from bytes like [`read_obj`] / [`read_ply`] / [`read_stl`], but first maps every vertex
 /// through `to_world` (metres to metres), so that welding and the coplanar merge run in the
 /// world frame with their tolerances in world metres: the `to_world` transform of a shape in
 /// a Mitsuba scene. A vertex that the transform makes non-finite is an error.
@@ -91,7 +106,7 @@ pub fn read_transformed(
 }
 
 /// Reads the mesh file at `path` and merges its faces into planar surfaces, choosing the
-/// reader by extension (`.obj` or `.ply`, case-insensitive). Coordinates are in metres. A file
+/// reader by extension (`.obj`, `.ply` or `.stl`, case-insensitive). Coordinates are in metres. A file
 /// larger than `max_file_bytes` ([`crate::MAX_FILE_BYTES`]) is refused before it is read.
 pub fn read_mesh_path(
     path: &Path,
@@ -115,6 +130,7 @@ pub(crate) fn read_mesh_file(
     let format = match extension.as_str() {
         "obj" => MeshFormat::Obj,
         "ply" => MeshFormat::Ply,
+        "stl" => MeshFormat::Stl,
         _ => return Err(MeshError::UnsupportedExtension { file, extension }),
     };
     opts.validate()?;

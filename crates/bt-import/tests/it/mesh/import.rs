@@ -379,8 +379,8 @@ fn read_mesh_path_dispatches_on_extension() {
     assert_surfaces(&import, &box_expected(), TOL);
     let import = read_mesh_path(&dir.join("box_triangles.ply"), &opts(), MAX_BYTES).unwrap();
     assert_surfaces(&import, &box_expected(), 1e-6);
-    match read_mesh_path(&dir.join("room.stl"), &opts(), MAX_BYTES) {
-        Err(MeshError::UnsupportedExtension { extension, .. }) => assert_eq!(extension, "stl"),
+    match read_mesh_path(&dir.join("room.dae"), &opts(), MAX_BYTES) {
+        Err(MeshError::UnsupportedExtension { extension, .. }) => assert_eq!(extension, "dae"),
         other => panic!("unexpected {other:?}"),
     }
     match read_mesh_path(&dir.join("missing.obj"), &opts(), MAX_BYTES) {

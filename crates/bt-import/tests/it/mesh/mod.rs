@@ -5,3 +5,4 @@ mod common;
 mod import;
 mod robustness;
 mod rotation;
+mod stl;

@@ -1,7 +1,7 @@
 //! Properties: arbitrary input never panics, and whatever comes out is well formed.
 
 use crate::mesh::common::*;
-use bt_import::mesh::{read_obj, read_ply};
+use bt_import::mesh::{read_obj, read_ply, read_stl};
 use bt_mesh::MergeOptions;
 use glam::DVec3;
 use proptest::prelude::*;
@@ -48,6 +48,13 @@ proptest! {
     ) {
         let _ = read_obj(&body, None, &MergeOptions::default());
         let _ = read_ply(&body, None, &MergeOptions::default());
+        let _ = read_stl(&body, None, &MergeOptions::default());
+        // A binary STL whose size fits the count it claims.
+        let n = body.len() / 50;
+        let mut stl = vec![b' '; 80];
+        stl.extend_from_slice(&(n as u32).to_le_bytes());
+        stl.extend_from_slice(&body[..50 * n]);
+        let _ = read_stl(&stl, None, &MergeOptions::default());
         let format = if binary { "binary_little_endian" } else { "ascii" };
         let mut ply = format!(
             "ply\nformat {format} 1.0\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nelement face {count}\nproperty list uchar int vertex_indices\nend_header\n",
