@@ -67,7 +67,8 @@ def test_moved_terminals_and_ipc_match_cli(cli_json):
     assert "iterations" in paths.columns
 
 
-@pytest.mark.parametrize("name", ["box-room.obj", "box-room-ascii.stl", "box-room-binary.stl"])
+@pytest.mark.parametrize("name", ["box-room.obj", "box-room-ascii.stl", "box-room-binary.stl",
+                                  "box-room.glb"])
 def test_mesh_with_terminals_matches_cli(cli_json, name):
     tx, rx = [1.0, 1.0, 1.5], [3.0, 2.0, 1.2]
     mesh = TESTDATA / name

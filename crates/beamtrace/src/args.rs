@@ -40,7 +40,7 @@ pair was chosen for. docs/channel.md §7.";
 pub enum Command {
     /// Trace every specular path between TX and RX in a scene, and with --diffraction those
     /// that diffract once on an edge (JSON/TOML scene, Mitsuba/Sionna XML scene, OBJ, PLY
-    /// or STL mesh, point cloud, or builtin:NAME).
+    /// or STL mesh, glTF scene, point cloud, or builtin:NAME).
     #[command(after_help = TRACE_COLUMNS)]
     Trace(TraceArgs),
     /// Extract planar surfaces from a point cloud (PLY or PCD) into a scene file.
@@ -251,7 +251,7 @@ pub enum SceneCommand {
 /// Arguments that select and load a scene.
 #[derive(Debug, Args, Clone)]
 pub struct SceneArgs {
-    /// Scene file (.json, .toml, Mitsuba/Sionna .xml, .obj, .ply, .stl mesh, .ply/.pcd point cloud)
+    /// Scene file (.json, .toml, Mitsuba/Sionna .xml, .obj, .ply, .stl mesh, .gltf/.glb, .ply/.pcd point cloud)
     /// or builtin:NAME.
     pub scene: String,
     /// Transmitter position X,Y,Z in metres (overrides the scene's).

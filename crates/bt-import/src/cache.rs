@@ -93,7 +93,7 @@ impl LoadCache {
         let one_step = |path: &Path| {
             matches!(
                 Format::of(path),
-                Ok(Format::Obj | Format::PlyMesh | Format::Stl | Format::Xml)
+                Ok(Format::Obj | Format::PlyMesh | Format::Stl | Format::Gltf | Format::Xml)
             )
         };
         match Source::parse(source) {

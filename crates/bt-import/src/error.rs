@@ -27,7 +27,7 @@ pub enum ImportError {
     PointCloud(#[from] crate::cloud::CloudError),
     /// The extension is not one of the supported formats.
     #[error(
-        "{path}: unsupported scene format (expected .json, .toml, .xml, .obj, .ply, .stl, .pcd or builtin:NAME)"
+        "{path}: unsupported scene format (expected .json, .toml, .xml, .obj, .ply, .stl, .gltf, .glb, .pcd or builtin:NAME)"
     )]
     UnsupportedFormat {
         /// File path.

@@ -161,6 +161,8 @@ pub enum Format {
     PlyMesh,
     /// An STL mesh, binary or ASCII (`.stl`).
     Stl,
+    /// A glTF 2.0 scene (`.gltf` with its buffers, or `.glb`): its triangles as a mesh.
+    Gltf,
     /// A point cloud: `.pcd`, or `.ply` declaring no faces; planes are extracted.
     PointCloud,
     /// A Mitsuba 3 / Sionna RT scene (`.xml`) with PLY/OBJ shapes and radio bsdfs.
@@ -190,6 +192,7 @@ impl Format {
             "ply" if crate::cloud::is_point_cloud(path) => Format::PointCloud,
             "ply" => Format::PlyMesh,
             "stl" => Format::Stl,
+            "gltf" | "glb" => Format::Gltf,
             _ => return Err(ImportError::UnsupportedFormat { path: display }),
         })
     }
@@ -307,6 +310,14 @@ fn load_any(
                 crate::mesh::read_mesh_file(&path, &options.merge, options.max_file_bytes)?;
             let name = file_stem(&path, "mesh");
             (from_mesh(import, &name, &display, options)?, Some(read))
+        }
+        Format::Gltf => {
+            let (import, read, buffers) =
+                crate::mesh::read_gltf_file(&path, &options.merge, options.max_file_bytes)?;
+            let name = file_stem(&path, "gltf");
+            let mut loaded = from_mesh(import, &name, &display, options)?;
+            (loaded.sources, loaded.digests) = buffers.into_iter().unzip();
+            (loaded, Some(read))
         }
         Format::PointCloud => (
             crate::cloud::scene::load_cloud(&path, options, progress)?,

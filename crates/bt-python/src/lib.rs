@@ -49,7 +49,7 @@ fn terminals(tx: Option<[f64; 3]>, rx: Option<[f64; 3]>) -> Terminals {
     }
 }
 
-/// Load any source the CLI reads (`builtin:NAME`, JSON/TOML, OBJ/PLY/STL meshes, point clouds,
+/// Load any source the CLI reads (`builtin:NAME`, JSON/TOML, OBJ/PLY/STL meshes, glTF, point clouds,
 /// Mitsuba XML): the library's one loading entry, through the user's load cache when `cache`
 /// (as the CLI's `--cache`); beside the load, the cache's own warnings.
 fn load_scene(

@@ -144,8 +144,15 @@ fn meshes_import_and_trace_like_the_equivalent_scene() {
     // to the last bit; the binary file has no names, as the PLY files.
     let stl = trace_json(&[&testdata("box-room-ascii.stl"), "--tx", tx, "--rx", rx]);
     let stl_binary = trace_json(&[&testdata("box-room-binary.stl"), "--tx", tx, "--rx", rx]);
-    assert_eq!(without_timings(stl)["paths"], without_timings(obj)["paths"]);
+    assert_eq!(
+        without_timings(stl)["paths"],
+        without_timings(obj.clone())["paths"]
+    );
     assert_eq!(without_timings(stl_binary)["paths"], b["paths"]);
+    // As glTF (+Y up, turned to +Z up; the mesh 1 m off, put back by its node "room"'s
+    // translation): the OBJ's paths, names included.
+    let glb = trace_json(&[&testdata("box-room.glb"), "--tx", tx, "--rx", rx]);
+    assert_eq!(without_timings(glb)["paths"], without_timings(obj)["paths"]);
 }
 
 #[test]

@@ -7,6 +7,7 @@
 //! z up; no axis swap is applied).
 
 mod error;
+mod gltf;
 mod obj;
 mod ply;
 pub mod scene;
@@ -141,6 +142,38 @@ pub(crate) fn read_mesh_file(
     let import = read_transformed(&bytes, format, Some(&file), opts, &|p| p)?;
     Ok((import, crate::source::digest(&bytes)))
 }
+
+/// Reads the glTF 2.0 scene at `path` (`.gltf` with its buffers, or `.glb`; the `gltf`
+/// module's docs say what is read, and the +Y-up to +Z-up turn) and merges its triangles into
+/// planar surfaces. Returns the import, the SHA-256 of the scene file's bytes, and each
+/// external buffer file read with its SHA-256 (each file within `max_file_bytes`).
+pub(crate) fn read_gltf_file(
+    path: &Path,
+    opts: &MergeOptions,
+    max_file_bytes: u64,
+) -> Result<GltfRead, MeshError> {
+    let file = path.display().to_string();
+    opts.validate()?;
+    let bytes = crate::source::read_file(path, max_file_bytes).map_err(|source| MeshError::Io {
+        file: file.clone(),
+        source,
+    })?;
+    let doc = gltf::document(&bytes, &file, path.parent(), max_file_bytes)?;
+    let raw = gltf::parse(&doc, &file, opts.max_elements)?;
+    let import = bt_mesh::merge_mesh(&raw, opts, &file)?;
+    let buffers = (doc.files.iter())
+        .map(|(p, b)| (p.clone(), crate::source::digest(b)))
+        .collect();
+    Ok((import, crate::source::digest(&bytes), buffers))
+}
+
+/// What [`read_gltf_file`] returns: the import, the scene file's SHA-256, the buffer files
+/// read with theirs.
+pub(crate) type GltfRead = (
+    MeshImport,
+    crate::source::Digest,
+    Vec<(std::path::PathBuf, crate::source::Digest)>,
+);
 
 /// Returns the index of `name` in `table`, appending it when new. Linear search: files have a
 /// handful of objects and materials, and the reader caches the current one.

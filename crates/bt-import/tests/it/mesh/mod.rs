@@ -2,6 +2,7 @@
 
 #[macro_use]
 mod common;
+mod gltf;
 mod import;
 mod robustness;
 mod rotation;
