@@ -524,7 +524,7 @@ fn make_face(
 
 /// The faces without coincident duplicates: a face whose welded vertices are those of an
 /// earlier face, in the same cyclic order either way round, is dropped (counted in `counts`).
-/// Faces are sorted by length and the start of their canonical cycle, then index (no hashing,
+/// Faces are sorted by the start of their canonical cycle and length, then index (no hashing,
 /// no allocation per face); only faces agreeing there are compared in full, so each set of
 /// copies is one run led by its first face.
 fn drop_duplicates(mut faces: Faces, counts: &mut FaceCounts) -> Faces {
@@ -532,14 +532,15 @@ fn drop_duplicates(mut faces: Faces, counts: &mut FaceCounts) -> Faces {
         let vs = faces.vertices(i);
         (0..vs.len()).map(canonical_cycle(vs))
     };
-    let mut order: Vec<((usize, [u32; 3]), usize)> = (0..faces.len())
+    let order: Vec<((usize, [u32; 3]), usize)> = (0..faces.len())
         .map(|i| {
             let mut head = cycle(i);
             let mut next = || head.next().unwrap_or(u32::MAX);
             ((faces.vertices(i).len(), [next(), next(), next()]), i)
         })
         .collect();
-    order.sort_unstable();
+    // By least vertex first: each set of copies is still one run, in index order.
+    let order = crate::edges::bucket_sorted(order, |&((_, head), _)| head[0]);
     let mut duplicate = vec![false; faces.len()];
     for run in order
         .chunk_by(|a, b| a.0 == b.0)
@@ -609,8 +610,7 @@ fn grow_regions(faces: &Faces, points: &[Vec3], opts: &MergeOptions) -> Groups {
             let vs = faces.vertices(f);
             let n = vs.len();
             for i in 0..n {
-                let key = crate::edges::edge_key(vs[i], vs[(i + 1) % n]);
-                for other in edges.unsettled(key, |g| group_of[g].is_some()) {
+                for other in edges.unsettled(f, i, |g| group_of[g].is_some()) {
                     if group_of[other].is_some() || faces[other].key != faces[f].key {
                         continue;
                     }
