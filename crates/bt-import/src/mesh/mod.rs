@@ -98,7 +98,8 @@ pub fn read_mesh_path(
     opts: &MergeOptions,
     max_file_bytes: u64,
 ) -> Result<MeshImport, MeshError> {
-    Ok(read_mesh_file(path, opts, max_file_bytes)?.0)
+    let hashing = crate::source::Hashing::Off;
+    Ok(read_mesh_file(path, opts, max_file_bytes, hashing)?.0)
 }
 
 /// [`read_mesh_path`], with the SHA-256 of the bytes it parsed.
@@ -106,7 +107,8 @@ pub(crate) fn read_mesh_file(
     path: &Path,
     opts: &MergeOptions,
     max_file_bytes: u64,
-) -> Result<(MeshImport, crate::source::Digest), MeshError> {
+    hashing: crate::source::Hashing,
+) -> Result<(MeshImport, Option<crate::source::Digest>), MeshError> {
     let file = path.display().to_string();
     let extension = path
         .extension()
@@ -123,7 +125,7 @@ pub(crate) fn read_mesh_file(
         source,
     })?;
     let import = read_transformed(&bytes, format, Some(&file), opts, &|p| p)?;
-    Ok((import, crate::source::digest(&bytes)))
+    Ok((import, hashing.of(&bytes)))
 }
 
 /// Returns the index of `name` in `table`, appending it when new. Linear search: files have a
