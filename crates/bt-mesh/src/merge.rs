@@ -349,16 +349,32 @@ fn weld(positions: &[Vec3], tol: Real) -> (Vec<u32>, Vec<Vec3>) {
     (map, welded)
 }
 
-/// The welded vertices by cell, for [`weld`]: cubes of edge `2.5 tol`, so that the ball of
+/// The welded vertices by cell, for [`weld`]: cubes of edge `10 tol`, so that the ball of
 /// radius `tol` around a point, widened to `1.2 tol` for rounding, meets at most two cells
-/// per axis, eight in all. Each cell holds a chain of ids through `next` (no allocation per cell).
+/// per axis, and on average fewer than two in all (with cubes of `2.5 tol` it met eight
+/// almost always: the look-ups were most of welding). Each cell holds a chain of ids through
+/// `next` (no allocation per cell); welded vertices are more than `tol` apart, so in the
+/// meshes of cities and rooms a cell holds one or two.
 struct WeldGrid {
     tol: Real,
     cell: Real,
     /// The last id inserted into each cell.
-    head: KeyMap<[i64; 3], u32>,
+    head: KeyMap<Cell, u32>,
     /// Per welded id: the id inserted before it into its cell, or `u32::MAX`.
     next: Vec<u32>,
+}
+
+/// A [`WeldGrid`] cell, hashed as three integers (an `[i64; 3]` is hashed as 24 single
+/// bytes, each a round of the hasher).
+#[derive(Clone, Copy, PartialEq, Eq)]
+struct Cell([i64; 3]);
+
+impl std::hash::Hash for Cell {
+    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
+        for c in self.0 {
+            state.write_i64(c);
+        }
+    }
 }
 
 impl WeldGrid {
@@ -367,7 +383,7 @@ impl WeldGrid {
         head.reserve(capacity);
         WeldGrid {
             tol,
-            cell: 2.5 * tol,
+            cell: 10.0 * tol,
             head,
             next: Vec::with_capacity(capacity),
         }
@@ -380,7 +396,7 @@ impl WeldGrid {
 
     fn insert(&mut self, p: Vec3, id: u32) {
         let cell = self.cell_of(p);
-        let before = self.head.insert(cell, id).unwrap_or(u32::MAX);
+        let before = self.head.insert(Cell(cell), id).unwrap_or(u32::MAX);
         self.next.push(before);
     }
 
@@ -404,7 +420,8 @@ impl WeldGrid {
                     .into_iter()
                     .take(1 + usize::from(hi[2] != lo[2]))
                 {
-                    let mut id = self.head.get(&[x, y, z]).copied().unwrap_or(u32::MAX);
+                    let cell = Cell([x, y, z]);
+                    let mut id = self.head.get(&cell).copied().unwrap_or(u32::MAX);
                     while id != u32::MAX {
                         let d = welded[id as usize].distance(p);
                         if d <= self.tol && best.is_none_or(|(bd, bid)| (d, id) < (bd, bid)) {
