@@ -364,18 +364,9 @@ struct WeldGrid {
     next: Vec<u32>,
 }
 
-/// A [`WeldGrid`] cell, hashed as three integers (an `[i64; 3]` is hashed as 24 single
-/// bytes, each a round of the hasher).
-#[derive(Clone, Copy, PartialEq, Eq)]
-struct Cell([i64; 3]);
-
-impl std::hash::Hash for Cell {
-    fn hash<H: std::hash::Hasher>(&self, state: &mut H) {
-        for c in self.0 {
-            state.write_i64(c);
-        }
-    }
-}
+/// A [`WeldGrid`] cell: a tuple, hashed as three integers (an `[i64; 3]` is hashed as 24
+/// single bytes, each a round of the hasher).
+type Cell = (i64, i64, i64);
 
 impl WeldGrid {
     fn new(tol: Real, capacity: usize) -> Self {
@@ -390,13 +381,14 @@ impl WeldGrid {
     }
 
     /// The cell of `p` (`as` saturates, so absurd coordinates land in the outermost cell).
-    fn cell_of(&self, p: Vec3) -> [i64; 3] {
-        (p / self.cell).floor().to_array().map(|c| c as i64)
+    fn cell_of(&self, p: Vec3) -> Cell {
+        let [x, y, z] = (p / self.cell).floor().to_array().map(|c| c as i64);
+        (x, y, z)
     }
 
     fn insert(&mut self, p: Vec3, id: u32) {
         let cell = self.cell_of(p);
-        let before = self.head.insert(Cell(cell), id).unwrap_or(u32::MAX);
+        let before = self.head.insert(cell, id).unwrap_or(u32::MAX);
         self.next.push(before);
     }
 
@@ -408,20 +400,10 @@ impl WeldGrid {
         let reach = Vec3::splat(1.2 * self.tol);
         let (lo, hi) = (self.cell_of(p - reach), self.cell_of(p + reach));
         let mut best: Option<(Real, u32)> = None;
-        for x in [lo[0], hi[0]]
-            .into_iter()
-            .take(1 + usize::from(hi[0] != lo[0]))
-        {
-            for y in [lo[1], hi[1]]
-                .into_iter()
-                .take(1 + usize::from(hi[1] != lo[1]))
-            {
-                for z in [lo[2], hi[2]]
-                    .into_iter()
-                    .take(1 + usize::from(hi[2] != lo[2]))
-                {
-                    let cell = Cell([x, y, z]);
-                    let mut id = self.head.get(&cell).copied().unwrap_or(u32::MAX);
+        for x in [lo.0, hi.0].into_iter().take(1 + usize::from(hi.0 != lo.0)) {
+            for y in [lo.1, hi.1].into_iter().take(1 + usize::from(hi.1 != lo.1)) {
+                for z in [lo.2, hi.2].into_iter().take(1 + usize::from(hi.2 != lo.2)) {
+                    let mut id = self.head.get(&(x, y, z)).copied().unwrap_or(u32::MAX);
                     while id != u32::MAX {
                         let d = welded[id as usize].distance(p);
                         if d <= self.tol && best.is_none_or(|(bd, bid)| (d, id) < (bd, bid)) {
