@@ -68,7 +68,8 @@ pub fn load_scene(args: &SceneArgs) -> anyhow::Result<Loaded> {
     let (bar, mut progress) = crate::progress::extraction_progress();
     let loaded = match cache(args)? {
         Some(cache) => cache.load(&args.scene, &options, &mut progress),
-        None => bt_import::load_with_progress(&args.scene, &options, &mut progress).map(uncached),
+        // Without the cache, no file's SHA-256 is needed.
+        None => bt_import::load_without_digests(&args.scene, &options, &mut progress).map(uncached),
     };
     bar.finish_and_clear();
     let mut loaded = cache_warnings(loaded?);

@@ -45,6 +45,9 @@ pub fn run(args: &TraceArgs) -> anyhow::Result<ExitCode> {
     } else {
         output::print_table(&doc);
     }
+    // The process ends with this command: the scene and the beam tree are left to the exit
+    // instead of freed piece by piece on this thread (Munich: 17 M instructions).
+    std::mem::forget(tracer);
     Ok(ExitCode::SUCCESS)
 }
 

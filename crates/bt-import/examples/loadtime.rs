@@ -5,6 +5,8 @@
 //! directory), with the surface count and the entry's size. `--only fresh` or `--only hit`
 //! times one of the two (the other column shows `-`), for profiling one alone: with
 //! `--only hit` one load writes the entry first; with `--only fresh` nothing else runs.
+//! `--no-digests` makes the fresh loads `bt_import::load_without_digests`, as the CLI loads
+//! without `--cache`.
 
 use bt_import::LoadOptions;
 use bt_import::cache::LoadCache;
@@ -31,6 +33,17 @@ fn main() {
         runs = args.get(i + 1).and_then(|n| n.parse().ok()).unwrap_or(3);
         args.drain(i..(i + 2).min(args.len()));
     }
+    let digests = match args.iter().position(|a| a == "--no-digests") {
+        Some(i) => {
+            args.remove(i);
+            false
+        }
+        None => true,
+    };
+    let fresh_load = |file: &str, options: &LoadOptions| match digests {
+        true => bt_import::load(file, options),
+        false => bt_import::load_without_digests(file, options, &mut |_| {}),
+    };
     let mut only = None;
     if let Some(i) = args.iter().position(|a| a == "--only") {
         only = args.get(i + 1).cloned();
@@ -51,9 +64,9 @@ fn main() {
         let mut surfaces = 0;
         let mut fresh = None;
         if do_fresh {
-            drop(bt_import::load(file, &options).expect("loads")); // warm-up, untimed
+            drop(fresh_load(file, &options).expect("loads")); // warm-up, untimed
             fresh = Some(best(runs, || {
-                let loaded = bt_import::load(file, &options).expect("loads");
+                let loaded = fresh_load(file, &options).expect("loads");
                 surfaces = loaded.scene.surfaces().len();
                 loaded
             }));

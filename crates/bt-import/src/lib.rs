@@ -29,5 +29,5 @@ pub use error::ImportError;
 pub use scene_file::{parse_json, parse_toml, write_description};
 pub use source::{
     Digest, Format, LoadOptions, LoadProgress, Loaded, MAX_FILE_BYTES, Source, load, load_dynamic,
-    load_with_progress,
+    load_with_progress, load_without_digests,
 };

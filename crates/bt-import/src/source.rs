@@ -93,8 +93,9 @@ pub struct Loaded<S = Scene> {
     /// same run must not replace (`bt_output::refuse_input`).
     pub sources: Vec<PathBuf>,
     /// The SHA-256 of each of [`Loaded::sources`] as the load read it (the bytes it parsed),
-    /// in the same order; empty when the format does not record them (point clouds). What the
-    /// load cache ([`crate::cache`]) keys and checks its entries by.
+    /// in the same order; empty when the format does not record them (point clouds) or the
+    /// load took none ([`load_without_digests`]). What the load cache ([`crate::cache`]) keys
+    /// and checks its entries by.
     pub digests: Vec<Digest>,
 }
 
@@ -105,6 +106,23 @@ pub type Digest = [u8; 32];
 pub(crate) fn digest(bytes: &[u8]) -> Digest {
     use sha2::Digest as _;
     sha2::Sha256::digest(bytes).into()
+}
+
+/// Whether a load records [`Loaded::digests`]: they serve the load cache only, and hashing
+/// every file read is a tenth of a city's load (San Francisco's 25 MB).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Hashing {
+    /// Take the SHA-256 of every file read.
+    On,
+    /// Take none ([`Loaded::digests`] stays empty).
+    Off,
+}
+
+impl Hashing {
+    /// The SHA-256 of `bytes` when on.
+    pub(crate) fn of(self, bytes: &[u8]) -> Option<Digest> {
+        (self == Hashing::On).then(|| digest(bytes))
+    }
 }
 
 impl<S> Loaded<S> {
@@ -270,8 +288,28 @@ pub fn load_with_progress(
     options: &LoadOptions,
     progress: &mut dyn FnMut(LoadProgress),
 ) -> Result<Loaded, ImportError> {
+    load_hashing(source, options, progress, Hashing::On)
+}
+
+/// [`load_with_progress`] without [`Loaded::digests`] (left empty; the scene, warnings and
+/// files read are the same): the SHA-256 of every file read serves only the load cache
+/// ([`crate::cache`]), so a load that will not be stored there need not take it.
+pub fn load_without_digests(
+    source: &str,
+    options: &LoadOptions,
+    progress: &mut dyn FnMut(LoadProgress),
+) -> Result<Loaded, ImportError> {
+    load_hashing(source, options, progress, Hashing::Off)
+}
+
+fn load_hashing(
+    source: &str,
+    options: &LoadOptions,
+    progress: &mut dyn FnMut(LoadProgress),
+    hashing: Hashing,
+) -> Result<Loaded, ImportError> {
     options.check()?;
-    let mut loaded = load_any(source, options, progress)?;
+    let mut loaded = load_any(source, options, progress, hashing)?;
     if let Some(radio) = options.radio {
         loaded.scene = loaded.scene.with_radio_material(radio)?;
     }
@@ -282,6 +320,7 @@ fn load_any(
     source: &str,
     options: &LoadOptions,
     progress: &mut dyn FnMut(LoadProgress),
+    hashing: Hashing,
 ) -> Result<Loaded, ImportError> {
     let path = match Source::parse(source) {
         Source::Builtin(name) => {
@@ -300,33 +339,34 @@ fn load_any(
     let display = path.display().to_string();
     let (mut loaded, read) = match Format::of(&path)? {
         format @ (Format::Json | Format::Toml) => {
-            let (desc, read) = read_description(&path, format, options.max_file_bytes)?;
+            let (desc, read) = read_description(&path, format, options.max_file_bytes, hashing)?;
             let scene = Scene::from_description(&desc, &display, options.terminals)?;
             let loaded = Loaded::new(scene.without_duplicates(&display)?, Vec::new());
-            (loaded, Some(read))
+            (loaded, read)
         }
         Format::Obj | Format::PlyMesh | Format::Stl => {
-            let (import, read) =
-                crate::mesh::read_mesh_file(&path, &options.merge, options.max_file_bytes)?;
+            let (import, read) = crate::mesh::read_mesh_file(
+                &path,
+                &options.merge,
+                options.max_file_bytes,
+                hashing,
+            )?;
             let name = file_stem(&path, "mesh");
-            (from_mesh(import, &name, &display, options)?, Some(read))
+            (from_mesh(import, &name, &display, options)?, read)
         }
         Format::Gltf => {
-            let (import, read, buffers) =
-                crate::mesh::read_gltf_file(&path, &options.merge, options.max_file_bytes)?;
+            let limits = (&options.merge, options.max_file_bytes);
+            let (import, read, buffers) = crate::mesh::read_gltf_file(&path, limits, hashing)?;
             let name = file_stem(&path, "gltf");
             let mut loaded = from_mesh(import, &name, &display, options)?;
-            (loaded.sources, loaded.digests) = buffers.into_iter().unzip();
-            (loaded, Some(read))
+            (loaded.sources, loaded.digests) = buffers;
+            (loaded, read)
         }
         Format::PointCloud => (
             crate::cloud::scene::load_cloud(&path, options, progress)?,
             None,
         ),
-        Format::Xml => {
-            let (loaded, read) = crate::xml::load_xml_read(&path, options)?;
-            (loaded, Some(read))
-        }
+        Format::Xml => crate::xml::load_xml_read(&path, options, hashing)?,
     };
     loaded.sources.insert(0, path);
     match read {
@@ -355,7 +395,8 @@ pub fn load_dynamic(
         Source::Builtin(name) => (Some(builtin_description(&name)?), Vec::new()),
         Source::File(path) => match Format::of(&path)? {
             format @ (Format::Json | Format::Toml) => {
-                let (desc, _) = read_description(&path, format, options.max_file_bytes)?;
+                let (desc, _) =
+                    read_description(&path, format, options.max_file_bytes, Hashing::Off)?;
                 (Some(desc), vec![path])
             }
             _ => (None, Vec::new()),
@@ -387,19 +428,21 @@ fn builtin_description(name: &str) -> Result<SceneDescription, ImportError> {
     parse_json(json, &format!("builtin:{name}"))
 }
 
-/// The description in the scene file `path` and the SHA-256 of the bytes it was parsed from.
+/// The description in the scene file `path` and the SHA-256 of the bytes it was parsed from
+/// (with `hashing` on).
 fn read_description(
     path: &Path,
     format: Format,
     max_bytes: u64,
-) -> Result<(SceneDescription, Digest), ImportError> {
+    hashing: Hashing,
+) -> Result<(SceneDescription, Option<Digest>), ImportError> {
     let display = path.display().to_string();
     let io = |source| ImportError::Io {
         path: display.clone(),
         source,
     };
     let bytes = read_file(path, max_bytes).map_err(io)?;
-    let read = digest(&bytes);
+    let read = hashing.of(&bytes);
     let text = String::from_utf8(bytes).map_err(|_| {
         io(std::io::Error::new(
             std::io::ErrorKind::InvalidData,

@@ -349,17 +349,24 @@ fn weld(positions: &[Vec3], tol: Real) -> (Vec<u32>, Vec<Vec3>) {
     (map, welded)
 }
 
-/// The welded vertices by cell, for [`weld`]: cubes of edge `2.5 tol`, so that the ball of
+/// The welded vertices by cell, for [`weld`]: cubes of edge `10 tol`, so that the ball of
 /// radius `tol` around a point, widened to `1.2 tol` for rounding, meets at most two cells
-/// per axis, eight in all. Each cell holds a chain of ids through `next` (no allocation per cell).
+/// per axis, and on average fewer than two in all (with cubes of `2.5 tol` it met eight
+/// almost always: the look-ups were most of welding). Each cell holds a chain of ids through
+/// `next` (no allocation per cell); welded vertices are more than `tol` apart, so in the
+/// meshes of cities and rooms a cell holds one or two.
 struct WeldGrid {
     tol: Real,
     cell: Real,
     /// The last id inserted into each cell.
-    head: KeyMap<[i64; 3], u32>,
+    head: KeyMap<Cell, u32>,
     /// Per welded id: the id inserted before it into its cell, or `u32::MAX`.
     next: Vec<u32>,
 }
+
+/// A [`WeldGrid`] cell: a tuple, hashed as three integers (an `[i64; 3]` is hashed as 24
+/// single bytes, each a round of the hasher).
+type Cell = (i64, i64, i64);
 
 impl WeldGrid {
     fn new(tol: Real, capacity: usize) -> Self {
@@ -367,15 +374,16 @@ impl WeldGrid {
         head.reserve(capacity);
         WeldGrid {
             tol,
-            cell: 2.5 * tol,
+            cell: 10.0 * tol,
             head,
             next: Vec::with_capacity(capacity),
         }
     }
 
     /// The cell of `p` (`as` saturates, so absurd coordinates land in the outermost cell).
-    fn cell_of(&self, p: Vec3) -> [i64; 3] {
-        (p / self.cell).floor().to_array().map(|c| c as i64)
+    fn cell_of(&self, p: Vec3) -> Cell {
+        let [x, y, z] = (p / self.cell).floor().to_array().map(|c| c as i64);
+        (x, y, z)
     }
 
     fn insert(&mut self, p: Vec3, id: u32) {
@@ -392,19 +400,10 @@ impl WeldGrid {
         let reach = Vec3::splat(1.2 * self.tol);
         let (lo, hi) = (self.cell_of(p - reach), self.cell_of(p + reach));
         let mut best: Option<(Real, u32)> = None;
-        for x in [lo[0], hi[0]]
-            .into_iter()
-            .take(1 + usize::from(hi[0] != lo[0]))
-        {
-            for y in [lo[1], hi[1]]
-                .into_iter()
-                .take(1 + usize::from(hi[1] != lo[1]))
-            {
-                for z in [lo[2], hi[2]]
-                    .into_iter()
-                    .take(1 + usize::from(hi[2] != lo[2]))
-                {
-                    let mut id = self.head.get(&[x, y, z]).copied().unwrap_or(u32::MAX);
+        for x in [lo.0, hi.0].into_iter().take(1 + usize::from(hi.0 != lo.0)) {
+            for y in [lo.1, hi.1].into_iter().take(1 + usize::from(hi.1 != lo.1)) {
+                for z in [lo.2, hi.2].into_iter().take(1 + usize::from(hi.2 != lo.2)) {
+                    let mut id = self.head.get(&(x, y, z)).copied().unwrap_or(u32::MAX);
                     while id != u32::MAX {
                         let d = welded[id as usize].distance(p);
                         if d <= self.tol && best.is_none_or(|(bd, bid)| (d, id) < (bd, bid)) {
@@ -524,7 +523,7 @@ fn make_face(
 
 /// The faces without coincident duplicates: a face whose welded vertices are those of an
 /// earlier face, in the same cyclic order either way round, is dropped (counted in `counts`).
-/// Faces are sorted by length and the start of their canonical cycle, then index (no hashing,
+/// Faces are sorted by the start of their canonical cycle and length, then index (no hashing,
 /// no allocation per face); only faces agreeing there are compared in full, so each set of
 /// copies is one run led by its first face.
 fn drop_duplicates(mut faces: Faces, counts: &mut FaceCounts) -> Faces {
@@ -532,14 +531,15 @@ fn drop_duplicates(mut faces: Faces, counts: &mut FaceCounts) -> Faces {
         let vs = faces.vertices(i);
         (0..vs.len()).map(canonical_cycle(vs))
     };
-    let mut order: Vec<((usize, [u32; 3]), usize)> = (0..faces.len())
+    let order: Vec<((usize, [u32; 3]), usize)> = (0..faces.len())
         .map(|i| {
             let mut head = cycle(i);
             let mut next = || head.next().unwrap_or(u32::MAX);
             ((faces.vertices(i).len(), [next(), next(), next()]), i)
         })
         .collect();
-    order.sort_unstable();
+    // By least vertex first: each set of copies is still one run, in index order.
+    let order = crate::edges::bucket_sorted(order, |&((_, head), _)| head[0]);
     let mut duplicate = vec![false; faces.len()];
     for run in order
         .chunk_by(|a, b| a.0 == b.0)
@@ -609,8 +609,7 @@ fn grow_regions(faces: &Faces, points: &[Vec3], opts: &MergeOptions) -> Groups {
             let vs = faces.vertices(f);
             let n = vs.len();
             for i in 0..n {
-                let key = crate::edges::edge_key(vs[i], vs[(i + 1) % n]);
-                for other in edges.unsettled(key, |g| group_of[g].is_some()) {
+                for other in edges.unsettled(f, i, |g| group_of[g].is_some()) {
                     if group_of[other].is_some() || faces[other].key != faces[f].key {
                         continue;
                     }

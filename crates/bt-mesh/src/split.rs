@@ -15,7 +15,7 @@
 use bt_geom::{Real, Vec3};
 use std::collections::{HashMap, HashSet, VecDeque};
 
-use crate::edges::{EdgeTable, edge_key};
+use crate::edges::EdgeTable;
 use crate::merge::{Faces, Group};
 use crate::outline::{Frame, Outline, area_matches, outline};
 
@@ -249,8 +249,7 @@ impl<'a> Grower<'a> {
             self.in_piece[f] = true;
             order.push(f);
             for i in 0..vs.len() {
-                let key = edge_key(vs[i], vs[(i + 1) % vs.len()]);
-                let across = self.edges.unsettled(key, |g| done[g]);
+                let across = self.edges.unsettled(f, i, |g| done[g]);
                 let in_piece = &self.in_piece;
                 self.queue.extend(
                     across

@@ -9,23 +9,32 @@
 //! answer is "unknown" and nothing is warned about.
 
 use crate::surface::{Surface, SurfaceId};
+use bt_geom::hash::KeyMap;
 use bt_geom::{Real, Vec3};
 
 /// Surfaces (by id) of each closed shell of at least 4 surfaces, in order of their first id.
 pub(crate) fn closed_shells(surfaces: &[Surface]) -> Vec<Vec<SurfaceId>> {
-    let key = |p: Vec3| (p + Vec3::ZERO).to_array().map(Real::to_bits); // -0.0 as +0.0
-    // Every edge as (its ends in order, its surface), sorted: the owners of one edge are then
-    // neighbours, in surface order (a sort, not a map: a city has 100,000 edges).
-    let mut edges: Vec<([u64; 3], [u64; 3], u32)> = Vec::new();
+    // Each distinct point (exact coordinates, -0.0 as +0.0) numbered as first met; keyed by
+    // a tuple, hashed as three integers (an array is hashed byte by byte).
+    let mut ids: KeyMap<(u64, u64, u64), u32> = KeyMap::default();
+    let mut id = |p: Vec3| {
+        let next = ids.len() as u32;
+        let [x, y, z] = (p + Vec3::ZERO).to_array().map(Real::to_bits);
+        *ids.entry((x, y, z)).or_insert(next)
+    };
+    // Every edge as (its ends' numbers in order, its surface), sorted: the owners of one edge
+    // are then neighbours, in surface order (a sort, not a map: a city has 100,000 edges). The
+    // edges' order between them does not matter: what follows groups and counts owners.
+    let mut edges: Vec<(u64, u32)> = Vec::new();
     for (i, s) in surfaces.iter().enumerate() {
         let v = s.polygon.vertices();
         for k in 0..v.len() {
-            let (a, b) = (key(v[k]), key(v[(k + 1) % v.len()]));
-            edges.push((a.min(b), a.max(b), i as u32));
+            let (a, b) = (id(v[k]), id(v[(k + 1) % v.len()]));
+            edges.push(((u64::from(a.min(b)) << 32) | u64::from(a.max(b)), i as u32));
         }
     }
     edges.sort_unstable();
-    let owners = || edges.chunk_by(|x, y| (x.0, x.1) == (y.0, y.1));
+    let owners = || edges.chunk_by(|x, y| x.0 == y.0);
     let mut parent: Vec<usize> = (0..surfaces.len()).collect();
     fn root(parent: &mut [usize], mut i: usize) -> usize {
         while parent[i] != i {
@@ -37,17 +46,17 @@ pub(crate) fn closed_shells(surfaces: &[Surface]) -> Vec<Vec<SurfaceId>> {
     for owners in owners() {
         for w in owners.windows(2) {
             let (a, b) = (
-                root(&mut parent, w[0].2 as usize),
-                root(&mut parent, w[1].2 as usize),
+                root(&mut parent, w[0].1 as usize),
+                root(&mut parent, w[1].1 as usize),
             );
             parent[a.max(b)] = a.min(b);
         }
     }
     let mut open = vec![false; surfaces.len()];
     for owners in owners() {
-        let r = root(&mut parent, owners[0].2 as usize);
+        let r = root(&mut parent, owners[0].1 as usize);
         // an edge used once (a border) or by more than two faces (a fin) breaks watertightness
-        let two_distinct = owners.len() == 2 && owners[0].2 != owners[1].2;
+        let two_distinct = owners.len() == 2 && owners[0].1 != owners[1].1;
         open[r] |= !two_distinct;
     }
     // By root, the smallest id of its group (unions keep the smaller root): groups in order

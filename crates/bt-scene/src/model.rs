@@ -241,9 +241,10 @@ impl Scene {
     /// reflecting there is found twice, with two losses. A warning for imported geometry (a
     /// scene file refuses every overlapping pair).
     pub fn coplanar_conflicts(&self) -> Vec<(SurfaceId, SurfaceId)> {
-        crate::validate::coplanar_overlaps(&self.surfaces, &self.bvh, self.length_tolerance())
+        let tol = self.length_tolerance();
+        let differ = |a: &Surface, b: &Surface| a.material != b.material;
+        crate::validate::coplanar_overlaps(&self.surfaces, &self.bvh, tol, differ)
             .into_iter()
-            .filter(|&(i, j)| self.surfaces[i].material != self.surfaces[j].material)
             .map(|(i, j)| (SurfaceId(i as u32), SurfaceId(j as u32)))
             .collect()
     }
@@ -253,7 +254,7 @@ impl Scene {
     /// ([`bt_geom::Polygon::coincides`]). Every path reflecting there is found twice.
     pub fn duplicates(&self) -> Vec<(SurfaceId, SurfaceId)> {
         let tol = self.length_tolerance();
-        crate::validate::coplanar_overlaps(&self.surfaces, &self.bvh, tol)
+        crate::validate::coplanar_overlaps(&self.surfaces, &self.bvh, tol, |_, _| true)
             .into_iter()
             .filter(|&(i, j)| (self.surfaces[i].polygon).coincides(&self.surfaces[j].polygon, tol))
             .map(|(i, j)| (SurfaceId(i as u32), SurfaceId(j as u32)))

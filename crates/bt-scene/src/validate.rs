@@ -158,8 +158,14 @@ impl Scene {
 /// Pairs `(i, j)`, `i < j`, of reflectors in one plane whose interiors overlap
 /// ([`Polygon::overlaps_coplanar`] at `tol`, metres): a path reflecting there is found once per
 /// surface. Only pairs whose boxes meet are compared, through `bvh`, the BVH over the
-/// surfaces' polygons (the scene's: a city mesh has 20,000 surfaces, 200 million pairs).
-pub(crate) fn coplanar_overlaps(surfaces: &[Surface], bvh: &Bvh, tol: Real) -> Vec<(usize, usize)> {
+/// surfaces' polygons (the scene's: a city mesh has 20,000 surfaces, 200 million pairs), and
+/// only pairs `wanted` by the caller (tested first: it is cheaper than the overlap).
+pub(crate) fn coplanar_overlaps(
+    surfaces: &[Surface],
+    bvh: &Bvh,
+    tol: Real,
+    wanted: impl Fn(&Surface, &Surface) -> bool + Sync,
+) -> Vec<(usize, usize)> {
     let polygons: Vec<&Polygon> = surfaces.iter().map(|s| &s.polygon).collect();
     let reflector = |i: usize| surfaces[i].kind == SurfaceKind::Reflector;
     // Each reflector's partners on all cores; sorted, so the same on any number of threads.
@@ -174,7 +180,11 @@ pub(crate) fn coplanar_overlaps(surfaces: &[Surface], bvh: &Bvh, tol: Real) -> V
                 |min, max| (lo - max).max_element() <= tol && (min - hi).max_element() <= tol,
                 |j| {
                     let j = j as usize;
-                    if j > i && reflector(j) && a.overlaps_coplanar(polygons[j], tol) {
+                    if j > i
+                        && reflector(j)
+                        && wanted(&surfaces[i], &surfaces[j])
+                        && a.overlaps_coplanar(polygons[j], tol)
+                    {
                         pairs.push((i, j));
                     }
                 },

@@ -114,7 +114,8 @@ pub fn read_mesh_path(
     opts: &MergeOptions,
     max_file_bytes: u64,
 ) -> Result<MeshImport, MeshError> {
-    Ok(read_mesh_file(path, opts, max_file_bytes)?.0)
+    let hashing = crate::source::Hashing::Off;
+    Ok(read_mesh_file(path, opts, max_file_bytes, hashing)?.0)
 }
 
 /// [`read_mesh_path`], with the SHA-256 of the bytes it parsed.
@@ -122,7 +123,8 @@ pub(crate) fn read_mesh_file(
     path: &Path,
     opts: &MergeOptions,
     max_file_bytes: u64,
-) -> Result<(MeshImport, crate::source::Digest), MeshError> {
+    hashing: crate::source::Hashing,
+) -> Result<(MeshImport, Option<crate::source::Digest>), MeshError> {
     let file = path.display().to_string();
     let extension = path
         .extension()
@@ -140,17 +142,18 @@ pub(crate) fn read_mesh_file(
         source,
     })?;
     let import = read_transformed(&bytes, format, Some(&file), opts, &|p| p)?;
-    Ok((import, crate::source::digest(&bytes)))
+    Ok((import, hashing.of(&bytes)))
 }
 
 /// Reads the glTF 2.0 scene at `path` (`.gltf` with its buffers, or `.glb`; the `gltf`
 /// module's docs say what is read, and the +Y-up to +Z-up turn) and merges its triangles into
-/// planar surfaces. Returns the import, the SHA-256 of the scene file's bytes, and each
-/// external buffer file read with its SHA-256 (each file within `max_file_bytes`).
+/// planar surfaces, each file within `max_file_bytes`. Returns the import, the SHA-256 of the
+/// scene file's bytes, and the external buffer files read with theirs (no digests with
+/// `hashing` off).
 pub(crate) fn read_gltf_file(
     path: &Path,
-    opts: &MergeOptions,
-    max_file_bytes: u64,
+    (opts, max_file_bytes): (&MergeOptions, u64),
+    hashing: crate::source::Hashing,
 ) -> Result<GltfRead, MeshError> {
     let file = path.display().to_string();
     opts.validate()?;
@@ -161,18 +164,19 @@ pub(crate) fn read_gltf_file(
     let doc = gltf::document(&bytes, &file, path.parent(), max_file_bytes)?;
     let raw = gltf::parse(&doc, &file, opts.max_elements)?;
     let import = bt_mesh::merge_mesh(&raw, opts, &file)?;
-    let buffers = (doc.files.iter())
-        .map(|(p, b)| (p.clone(), crate::source::digest(b)))
+    let buffers = doc.files.iter().map(|(p, _)| p.clone()).collect();
+    let digests = (doc.files.iter())
+        .filter_map(|(_, b)| hashing.of(b))
         .collect();
-    Ok((import, crate::source::digest(&bytes), buffers))
+    Ok((import, hashing.of(&bytes), (buffers, digests)))
 }
 
 /// What [`read_gltf_file`] returns: the import, the scene file's SHA-256, the buffer files
-/// read with theirs.
+/// read and their SHA-256s.
 pub(crate) type GltfRead = (
     MeshImport,
-    crate::source::Digest,
-    Vec<(std::path::PathBuf, crate::source::Digest)>,
+    Option<crate::source::Digest>,
+    (Vec<std::path::PathBuf>, Vec<crate::source::Digest>),
 );
 
 /// Returns the index of `name` in `table`, appending it when new. Linear search: files have a

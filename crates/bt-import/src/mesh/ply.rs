@@ -19,6 +19,17 @@ use crate::formats::{
 
 /// Parses PLY bytes into a validated polygon soup; refuses a header declaring more than `max_elements` vertices or faces.
 pub(crate) fn parse(bytes: &[u8], file: &str, max_elements: u64) -> Result<RawMesh, MeshError> {
+    parse_with(bytes, file, max_elements, true)
+}
+
+/// [`parse`], with the [`Fast`] readings of binary elements when `fast` (the same result and
+/// errors either way).
+fn parse_with(
+    bytes: &[u8],
+    file: &str,
+    max_elements: u64,
+    fast: bool,
+) -> Result<RawMesh, MeshError> {
     let header = parse_header(bytes, file)?;
     let body = &bytes[header.body_start..];
     check_counts(&header, body.len() as u64, file)?;
@@ -46,7 +57,13 @@ pub(crate) fn parse(bytes: &[u8], file: &str, max_elements: u64) -> Result<RawMe
     let mut face: Vec<u32> = Vec::new();
     for (e, element) in header.elements.iter().enumerate() {
         let indices = (e == layout.face_element).then_some(layout.index_slot);
+        let fast = fast.then(|| Fast::of(&header, &layout, e)).flatten();
         for index in 0..element.count {
+            if let Some(fast) = &fast
+                && reader.fast_entry(fast, layout.vertex_count, &mut mesh, &mut face)
+            {
+                continue;
+            }
             reader.skip_space();
             // Where the entry starts, built only for an error (a `String` per vertex and face
             // was most of a city's small allocations).
@@ -160,6 +177,57 @@ impl Layout {
             xyz[k] = value;
         }
         Ok(Vec3::from_array(xyz))
+    }
+}
+
+/// A binary element read without the general per-property reader: a vertex element of
+/// scalars only (fixed records, `x`, `y`, `z` at fixed offsets), or a face element holding
+/// nothing but its index list (San Francisco's terrain: 96,641 vertices, 192,000 faces).
+/// An entry that could end in an error (data too short, a coordinate not finite, a list
+/// shorter than three or an index out of range) is left to the general reader, so the
+/// errors are the same.
+enum Fast {
+    Vertex {
+        /// Bytes of one entry.
+        record: usize,
+        /// Offset in the entry and type of `x`, `y`, `z`.
+        xyz: [(usize, Scalar); 3],
+    },
+    Face {
+        count: Scalar,
+        item: Scalar,
+    },
+}
+
+impl Fast {
+    /// The fast reading of element `e`, if it has one.
+    fn of(header: &Header, layout: &Layout, e: usize) -> Option<Fast> {
+        let properties = &header.elements[e].properties;
+        if header.format == Format::Ascii {
+            return None;
+        }
+        if e == layout.vertex_element {
+            let mut offsets = Vec::with_capacity(properties.len());
+            let mut record = 0;
+            for property in properties {
+                let Kind::Scalar(s) = property.kind else {
+                    return None;
+                };
+                offsets.push((record, s));
+                record += s.size();
+            }
+            let xyz = layout.xyz_slots.map(|slot| offsets[slot]);
+            return Some(Fast::Vertex { record, xyz });
+        }
+        match properties.as_slice() {
+            [only] if e == layout.face_element => match only.kind {
+                Kind::List { count, item } if count.is_integer() => {
+                    Some(Fast::Face { count, item })
+                }
+                _ => None,
+            },
+            _ => None,
+        }
     }
 }
 
@@ -338,6 +406,59 @@ impl Reader<'_> {
         Ok(())
     }
 
+    /// One entry read the [`Fast`] way into `mesh` (`face`: scratch), or `false` with nothing
+    /// read when the general reader must take it.
+    fn fast_entry(
+        &mut self,
+        fast: &Fast,
+        vertex_count: u64,
+        mesh: &mut RawMesh,
+        face: &mut Vec<u32>,
+    ) -> bool {
+        let big = self.format.is_big_endian();
+        let rest = &self.bytes[self.pos..];
+        match *fast {
+            Fast::Vertex { record, xyz } => {
+                let Some(raw) = rest.get(..record) else {
+                    return false;
+                };
+                let p = xyz.map(|(at, s)| s.decode(&raw[at..], big));
+                if !p.iter().all(|v| v.is_finite()) {
+                    return false;
+                }
+                mesh.positions.push(Vec3::from_array(p));
+                self.pos += record;
+            }
+            Fast::Face { count, item } => {
+                let Some(raw) = rest.get(..count.size()) else {
+                    return false;
+                };
+                let n = count.decode(raw, big);
+                if n < 3.0 {
+                    return false;
+                }
+                let (n, size) = (n as usize, item.size());
+                let end = n
+                    .checked_mul(size)
+                    .and_then(|b| b.checked_add(count.size()));
+                let Some(list) = end.and_then(|end| rest.get(count.size()..end)) else {
+                    return false;
+                };
+                face.clear();
+                for k in 0..n {
+                    let v = item.decode(&list[k * size..], big);
+                    if !(v >= 0.0 && v < vertex_count as Real) {
+                        return false;
+                    }
+                    face.push(v as u32);
+                }
+                mesh.push_face(face, None, None);
+                self.pos += count.size() + n * size;
+            }
+        }
+        true
+    }
+
     /// One scalar of type `ty` as f64 (exact for every PLY integer type).
     fn read(&mut self, ty: Scalar, property: &str, at: At<'_>) -> Result<Real, MeshError> {
         let truncated = || MeshError::Truncated {
@@ -387,6 +508,129 @@ impl Reader<'_> {
                 self.pos += size;
                 Ok(ty.decode(raw, self.format.is_big_endian()))
             }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// A binary PLY of `vertices` (x, y, z among extra properties, in the given types) and
+    /// `faces` (an index list of the given count and item types, maybe beside a flag), cut
+    /// short by `cut` bytes.
+    #[allow(clippy::too_many_arguments)]
+    fn binary_ply(
+        big: bool,
+        xyz: Scalar,
+        extra: bool,
+        count: Scalar,
+        item: Scalar,
+        flag: bool,
+        vertices: &[[f64; 3]],
+        faces: &[Vec<u32>],
+        cut: usize,
+    ) -> Vec<u8> {
+        let name = |s: Scalar| match s {
+            Scalar::U8 => "uchar",
+            Scalar::U16 => "ushort",
+            Scalar::I32 => "int",
+            Scalar::U32 => "uint",
+            Scalar::F32 => "float",
+            _ => "double",
+        };
+        let encoding = if big { "big" } else { "little" };
+        let mut head = format!("ply\nformat binary_{encoding}_endian 1.0\n");
+        head += &format!("element vertex {}\n", vertices.len());
+        if extra {
+            head += "property uchar red\n";
+        }
+        for axis in ["z", "x", "y"] {
+            head += &format!("property {} {axis}\n", name(xyz));
+        }
+        head += &format!("element face {}\n", faces.len());
+        if flag {
+            head += "property uchar flag\n";
+        }
+        head += &format!(
+            "property list {} {} vertex_indices\n",
+            name(count),
+            name(item)
+        );
+        head += "end_header\n";
+        let mut body = head.into_bytes();
+        let put = |body: &mut Vec<u8>, s: Scalar, v: f64| {
+            let bytes: Vec<u8> = match s {
+                Scalar::U8 => vec![v as u8],
+                Scalar::U16 if big => (v as u16).to_be_bytes().to_vec(),
+                Scalar::U16 => (v as u16).to_le_bytes().to_vec(),
+                Scalar::I32 if big => (v as i32).to_be_bytes().to_vec(),
+                Scalar::I32 => (v as i32).to_le_bytes().to_vec(),
+                Scalar::U32 if big => (v as u32).to_be_bytes().to_vec(),
+                Scalar::U32 => (v as u32).to_le_bytes().to_vec(),
+                Scalar::F32 if big => (v as f32).to_be_bytes().to_vec(),
+                Scalar::F32 => (v as f32).to_le_bytes().to_vec(),
+                _ if big => v.to_be_bytes().to_vec(),
+                _ => v.to_le_bytes().to_vec(),
+            };
+            body.extend(bytes);
+        };
+        for v in vertices {
+            if extra {
+                put(&mut body, Scalar::U8, 7.0);
+            }
+            for k in [2, 0, 1] {
+                put(&mut body, xyz, v[k]);
+            }
+        }
+        for f in faces {
+            if flag {
+                put(&mut body, Scalar::U8, 1.0);
+            }
+            put(&mut body, count, f.len() as f64);
+            for &i in f {
+                put(&mut body, item, f64::from(i));
+            }
+        }
+        body.truncate(body.len().saturating_sub(cut));
+        body
+    }
+
+    fn scalar(options: &'static [Scalar]) -> impl Strategy<Value = Scalar> {
+        proptest::sample::select(options)
+    }
+
+    proptest! {
+        /// The fast readings give what the general reader gives: the same soup, or the same
+        /// error (data cut short, coordinates not finite, short faces, indices out of range).
+        #[test]
+        fn fast_binary_reading_matches_the_general_reader(
+            big in any::<bool>(),
+            xyz in scalar(&[Scalar::F32, Scalar::F64, Scalar::I32]),
+            extra in any::<bool>(),
+            count in scalar(&[Scalar::U8, Scalar::U16, Scalar::I32, Scalar::U32]),
+            item in scalar(&[Scalar::I32, Scalar::U32, Scalar::U16]),
+            flag in any::<bool>(),
+            vertices in proptest::collection::vec(
+                proptest::array::uniform3(prop_oneof![
+                    20 => -1e3f64..1e3,
+                    1 => Just(f64::NAN),
+                    1 => Just(f64::INFINITY),
+                ]),
+                1..8,
+            ),
+            faces in proptest::collection::vec(proptest::collection::vec(0u32..9, 0..6), 0..8),
+            cut in prop_oneof![4 => Just(0usize), 1 => 0usize..12],
+        ) {
+            let bytes = binary_ply(big, xyz, extra, count, item, flag, &vertices, &faces, cut);
+            let show = |r: Result<RawMesh, MeshError>| match r {
+                Ok(mesh) => format!("{mesh:?}"),
+                Err(e) => format!("error: {e}"),
+            };
+            let fast = show(parse_with(&bytes, "t.ply", 1000, true));
+            let general = show(parse_with(&bytes, "t.ply", 1000, false));
+            prop_assert_eq!(fast, general);
         }
     }
 }

@@ -17,7 +17,7 @@ mod transform;
 
 pub use parse::{SIONNA_DEFAULT_THICKNESS_M, parse_xml, parse_xml_with};
 
-use crate::source::file_stem;
+use crate::source::{Digest, Hashing, file_stem};
 use crate::{ImportError, LoadOptions, Loaded};
 use bt_channel::{ItuMaterial, RadioModel};
 use bt_geom::Real;
@@ -133,19 +133,20 @@ pub struct XmlShape {
 /// The XML has no transmitter or receiver: without `options.terminals` the scene is bare
 /// geometry, traced with terminals given per trace.
 pub fn load_xml(path: &Path, options: &LoadOptions) -> Result<Loaded, ImportError> {
-    Ok(load_xml_read(path, options)?.0)
+    Ok(load_xml_read(path, options, Hashing::On)?.0)
 }
 
 /// [`load_xml`], with the SHA-256 of the XML's bytes as parsed ([`Loaded::digests`] holds the
-/// meshes').
+/// meshes'), with `hashing` on; with it off, no digest at all.
 pub(crate) fn load_xml_read(
     path: &Path,
     options: &LoadOptions,
-) -> Result<(Loaded, crate::source::Digest), ImportError> {
+    hashing: Hashing,
+) -> Result<(Loaded, Option<Digest>), ImportError> {
     let display = path.display().to_string();
     let limit = MAX_XML_BYTES.min(options.max_file_bytes);
     let text = read_bounded(path, None, limit, &display)?;
-    let read = crate::source::digest(&text);
+    let read = hashing.of(&text);
     let text = String::from_utf8(text).map_err(|e| ImportError::Parse {
         path: display.clone(),
         message: format!("not UTF-8 text: {e}"),
@@ -163,58 +164,85 @@ pub(crate) fn load_xml_read(
         xml: &display,
         folder,
         options,
+        hashing,
         bytes_left: MAX_MESH_TOTAL_BYTES,
         elements: SceneElements::default(),
         // Sized for one file per shape (as in Sionna's cities), not grown and rehashed.
         meshes: Vec::with_capacity(xml.shapes.len()),
         seen: std::collections::HashSet::with_capacity(xml.shapes.len()),
     };
-    for round in xml.shapes.chunks(SHAPES_PER_ROUND) {
+    let (found, refused) = reading.find(&xml.shapes);
+    for round in rounds(&found, ROUND_BYTES, |(_, (_, metadata))| metadata.len()) {
         reading.round(round, &mut desc, &mut warnings)?;
     }
+    if let Some(refused) = refused {
+        return Err(refused);
+    }
     let scene = Scene::from_owned_description(desc, &display, options.terminals)?;
-    let (sources, digests) = reading.meshes.into_iter().unzip();
+    let (sources, digests): (Vec<_>, Vec<_>) = reading.meshes.into_iter().unzip();
     let loaded = Loaded {
         sources,
-        digests,
+        // All or none: every mesh's with hashing on, else empty.
+        digests: (digests.into_iter().collect::<Option<_>>()).unwrap_or_default(),
         ..Loaded::new(scene, warnings)
     };
     Ok((loaded, read))
 }
 
-/// Shapes whose meshes are read and merged in parallel at a time. The budgets are charged in
-/// document order after each round, so a refused scene costs at most one round of extra work,
-/// and whatever the thread count the first problem in document order is the one reported.
-const SHAPES_PER_ROUND: usize = 256;
+/// Bytes of mesh files read and merged in parallel at a time (a round; at least one file).
+/// The element budget is charged in document order after each round, so a refused scene
+/// costs at most one round of extra work, and whatever the thread count the first problem in
+/// document order is the one reported. Sionna's cities (7-10 MB of meshes) are one round, so
+/// a large mesh (San Francisco's terrain: 192,000 triangles) is merged beside all the others
+/// instead of alone at the end of its round.
+const ROUND_BYTES: u64 = 64 << 20;
+
+/// A shape whose mesh file was found within the byte budgets, with that file and its
+/// metadata.
+type Found<'s> = (&'s XmlShape, (PathBuf, std::fs::Metadata));
+
+/// `items` in rounds of consecutive items of at most `limit` bytes in all by `size` (a larger
+/// item is a round alone).
+fn rounds<T>(items: &[T], limit: u64, size: impl Fn(&T) -> u64) -> impl Iterator<Item = &[T]> {
+    let mut rest = items;
+    std::iter::from_fn(move || {
+        let mut bytes = 0u64;
+        let end = (0..rest.len())
+            .find(|&n| {
+                bytes = bytes.saturating_add(size(&rest[n]));
+                n > 0 && bytes > limit
+            })
+            .unwrap_or(rest.len());
+        let (round, tail) = rest.split_at(end);
+        rest = tail;
+        (!round.is_empty()).then_some(round)
+    })
+}
 
 /// The state of reading one XML scene's meshes: budgets left and the files read.
 struct Reading<'a> {
     xml: &'a str,
     folder: &'a Path,
     options: &'a LoadOptions,
+    /// Whether the meshes' SHA-256s are taken.
+    hashing: Hashing,
     /// Of [`MAX_MESH_TOTAL_BYTES`].
     bytes_left: u64,
     elements: SceneElements,
-    /// Every mesh file read, once each, in document order, with the SHA-256 of its bytes.
-    meshes: Vec<(PathBuf, crate::source::Digest)>,
+    /// Every mesh file read, once each, in document order, with the SHA-256 of its bytes
+    /// (with hashing on).
+    meshes: Vec<(PathBuf, Option<Digest>)>,
     // A set beside `meshes`: comparing paths walks their components, and with one file per
     // shape (Sionna's cities: 2,367) `meshes.contains` was 40 % of the load.
     seen: std::collections::HashSet<PathBuf>,
 }
 
 impl Reading<'_> {
-    /// Read and merge the meshes of `shapes` (one round) and append their surfaces to `desc`,
-    /// as a shape-by-shape loop would: the files are found and their sizes charged in order
-    /// (stopping at the first refusal, before any of it is read), the meshes read and merged
-    /// on all cores (order kept), then charged and appended in order.
-    fn round(
-        &mut self,
-        shapes: &[XmlShape],
-        desc: &mut SceneDescription,
-        warnings: &mut Vec<String>,
-    ) -> Result<(), ImportError> {
+    /// The shapes whose mesh files are found within the byte budgets, in document order, up
+    /// to the first that is not (its error beside them): the files are looked up (`stat`) on
+    /// all cores and their sizes charged in order, before any is read.
+    fn find<'s>(&mut self, shapes: &'s [XmlShape]) -> (Vec<Found<'s>>, Option<ImportError>) {
         use rayon::prelude::*;
-        // The files are looked up (`stat`) on all cores; their sizes are charged in order.
         let stated: Vec<_> = (shapes.par_iter())
             .map(|shape| {
                 let file = resolve(self.folder, &shape.filename)?;
@@ -223,33 +251,49 @@ impl Reading<'_> {
             })
             .collect();
         let mut found = Vec::with_capacity(shapes.len());
-        let mut refused = None;
         for (shape, stated) in shapes.iter().zip(stated) {
             match find_shape(shape, stated, self.xml, self.options, &mut self.bytes_left) {
                 Ok(file) => found.push((shape, file)),
-                Err(e) => {
-                    refused = Some(e);
-                    break;
-                }
+                Err(e) => return (found, Some(e)),
             }
         }
+        (found, None)
+    }
+
+    /// Read and merge the meshes of `found` (one round) and append their surfaces to `desc`,
+    /// as a shape-by-shape loop would: the meshes are read and merged on all cores, the
+    /// largest files first (so that a large mesh is not merged alone at the end), then
+    /// charged and appended in document order.
+    fn round(
+        &mut self,
+        found: &[Found<'_>],
+        desc: &mut SceneDescription,
+        warnings: &mut Vec<String>,
+    ) -> Result<(), ImportError> {
+        use rayon::prelude::*;
+        let mut largest_first: Vec<usize> = (0..found.len()).collect();
+        largest_first.sort_by_key(|&k| std::cmp::Reverse(found[k].1.1.len()));
         // Each mesh is read, merged and turned into scene surfaces on the worker threads.
-        let imports: Vec<Result<_, ImportError>> = (found.par_iter())
-            .map(|(shape, (file, metadata))| {
-                let (import, read) = read_shape(shape, file, metadata, self.options)?;
-                Ok((shape_surfaces(shape, import, self.xml, self.options), read))
+        let mut merged: Vec<(usize, Result<_, ImportError>)> = (largest_first.par_iter())
+            .map(|&k| {
+                let (shape, (file, metadata)) = &found[k];
+                let import = read_shape(shape, file, metadata, self.options, self.hashing);
+                let surfaces =
+                    |(import, read)| (shape_surfaces(shape, import, self.xml, self.options), read);
+                (k, import.map(surfaces))
             })
             .collect();
-        for ((shape, (file, _)), import) in found.into_iter().zip(imports) {
+        merged.sort_unstable_by_key(|&(k, _)| k);
+        for ((shape, (file, _)), (_, import)) in found.iter().zip(merged) {
             let (added, read) = import?;
             (self.elements).charge(&added, shape, self.xml, self.options.merge.max_elements)?;
             if self.seen.insert(file.clone()) {
-                self.meshes.push((file, read));
+                self.meshes.push((file.clone(), read));
             }
             desc.surfaces.extend(added.surfaces);
             warnings.extend(added.warnings);
         }
-        refused.map_or(Ok(()), Err)
+        Ok(())
     }
 }
 
@@ -460,13 +504,14 @@ fn find_shape(
 }
 
 /// Read `shape`'s mesh `file` (found by [`find_shape`], with its `metadata`) and merge it
-/// through its transform; the mesh and the SHA-256 of the bytes read.
+/// through its transform; the mesh and the SHA-256 of the bytes read (with `hashing` on).
 fn read_shape(
     shape: &XmlShape,
     file: &Path,
     metadata: &std::fs::Metadata,
     options: &LoadOptions,
-) -> Result<(bt_mesh::MeshImport, crate::source::Digest), ImportError> {
+    hashing: Hashing,
+) -> Result<(bt_mesh::MeshImport, Option<Digest>), ImportError> {
     let shown = file.display().to_string();
     let bytes = read_bounded(file, Some(metadata), options.max_file_bytes, &shown)?;
     let format = match shape.kind {
@@ -478,7 +523,7 @@ fn read_shape(
         crate::mesh::read_transformed(&bytes, format, Some(&shown), &options.merge, &|p| {
             to_world.transform_point3(p)
         })?;
-    Ok((import, crate::source::digest(&bytes)))
+    Ok((import, hashing.of(&bytes)))
 }
 
 /// `name` under `folder`: relative, plain components only (no `..`, no root, no drive).

@@ -484,7 +484,7 @@ fn on_threads<T: Send>(threads: usize, f: impl FnOnce() -> T + Send) -> T {
 
 #[test]
 fn meshes_merged_in_parallel_give_the_scene_of_one_thread() {
-    // Etoile: 565 shapes, three rounds of SHAPES_PER_ROUND.
+    // Etoile: 565 shapes, merged largest first on all cores.
     let xml = Path::new(env!("CARGO_MANIFEST_DIR"))
         .join("../../testdata/scenes/sionna-rt/etoile/etoile.xml");
     let load = || load_xml(&xml, &LoadOptions::default()).unwrap();
@@ -499,7 +499,7 @@ fn meshes_merged_in_parallel_give_the_scene_of_one_thread() {
 
 #[test]
 fn the_first_problem_in_document_order_is_reported_whatever_the_threads() {
-    // 300 shapes (two rounds); shape 5 reads a broken mesh, shapes 7 and 290 name missing
+    // 300 shapes; shape 5 reads a broken mesh, shapes 7 and 290 name missing
     // files: the broken mesh comes first in the document, so it is the error, though the
     // missing files are found before any mesh is read.
     let shapes: String = (0..300)
@@ -538,4 +538,16 @@ fn the_first_problem_in_document_order_is_reported_whatever_the_threads() {
         assert!(e.contains("line 9") && e.contains("\"s7\""), "{e}");
     }
     std::fs::remove_dir_all(dir).ok();
+}
+
+#[test]
+fn rounds_hold_at_most_their_bytes_and_a_larger_file_alone() {
+    let lengths = |sizes: &[u64]| -> Vec<Vec<u64>> {
+        rounds(sizes, 10, |&s| s).map(<[u64]>::to_vec).collect()
+    };
+    assert_eq!(lengths(&[]), Vec::<Vec<u64>>::new());
+    assert_eq!(lengths(&[3, 3, 4, 1]), [vec![3, 3, 4], vec![1]]);
+    assert_eq!(lengths(&[25, 2, 30]), [vec![25], vec![2], vec![30]]);
+    assert_eq!(lengths(&[0, 0, 10, 0]), [vec![0, 0, 10, 0]]);
+    assert_eq!(lengths(&[u64::MAX, 1]), [vec![u64::MAX], vec![1]]);
 }

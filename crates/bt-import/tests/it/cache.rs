@@ -228,3 +228,24 @@ fn every_material_field_survives_the_cache() {
     assert!(cached.scene.penetrable(bt_scene::SurfaceId(1)));
     std::fs::remove_dir_all(dir).ok();
 }
+
+#[test]
+fn a_load_without_digests_is_the_same_load_without_them() {
+    let scenes = Path::new(env!("CARGO_MANIFEST_DIR")).join("../../testdata/scenes");
+    let sources = [
+        sionna("etoile").join("etoile.xml"),
+        scenes.join("box-room-binary.ply"),
+        scenes.join("box-room.obj"),
+        scenes.join("one-wall.json"),
+    ];
+    let options = LoadOptions::default();
+    for source in sources {
+        let source = source.display().to_string();
+        let hashed = bt_import::load(&source, &options).unwrap();
+        let bare = bt_import::load_without_digests(&source, &options, &mut |_| {}).unwrap();
+        assert_eq!(hashed.digests.len(), hashed.sources.len(), "{source}");
+        assert!(bare.digests.is_empty(), "{source}");
+        let digests = hashed.digests.clone();
+        assert_same(&hashed, &Loaded { digests, ..bare });
+    }
+}
