@@ -16,6 +16,9 @@ use rayon::prelude::*;
 const CHUNK_PARENTS: usize = 32;
 /// The root's children per chunk at depth 1.
 const CHUNK_CHILDREN: usize = 512;
+/// Rounds of chunks grown at once ([`BeamTree::in_rounds`]): 2,048 parents at depth 2 and
+/// beyond, 32,768 children of the root at depth 1.
+const ROUNDS_PER_BATCH: usize = 8;
 
 /// What one chunk grows.
 #[derive(Clone, Copy)]
@@ -85,7 +88,12 @@ impl BeamTree {
     /// `grow` each chunk of `work` (of level `depth`, which has `parents` parents) and `merge`
     /// its result into the tree, in order, a round of chunks at a time: the node budget is
     /// checked and progress reported each round (about [`PROGRESS_EVERY`] parents; at depth 1
-    /// the root is done only when the level is).
+    /// the root is done only when the level is). The chunks of [`ROUNDS_PER_BATCH`] rounds
+    /// are grown at once before their rounds are reported, merged and checked in order: the
+    /// cores wait for each other once a batch instead of once a round (a round is a few
+    /// chunks, so at its end one core often idles while the other grows the last). The
+    /// reports, the tree and the budget's verdict are those of growing round by round; only
+    /// the chunks of the batch after a round that exceeds the budget are grown in vain.
     fn in_rounds<W: Sync, R: Send>(
         &mut self,
         prep: &Prepared<'_>,
@@ -95,18 +103,23 @@ impl BeamTree {
         mut merge: impl FnMut(&mut Self, R),
     ) -> Result<(), TreeError> {
         let per_round = (PROGRESS_EVERY / CHUNK_PARENTS).max(2);
-        for (r, round) in work.chunks(per_round).enumerate() {
-            let done = if depth == 1 {
-                0
-            } else {
-                r * per_round * CHUNK_PARENTS
-            };
-            self.report(prep, depth, (done, parents), progress);
+        let mut r = 0;
+        for batch in work.chunks(per_round * ROUNDS_PER_BATCH) {
             let tree = &*self;
-            for part in in_order(prep, round, |w| grow(tree, w)) {
-                merge(self, part);
+            let mut grown = in_order(prep, batch, |w| grow(tree, w)).into_iter();
+            while grown.len() > 0 {
+                let done = if depth == 1 {
+                    0
+                } else {
+                    r * per_round * CHUNK_PARENTS
+                };
+                self.report(prep, depth, (done, parents), progress);
+                for part in grown.by_ref().take(per_round) {
+                    merge(self, part);
+                }
+                self.check_budget(prep, depth)?;
+                r += 1;
             }
-            self.check_budget(prep, depth)?;
         }
         Ok(())
     }
