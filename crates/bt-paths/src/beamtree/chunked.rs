@@ -213,13 +213,14 @@ impl BeamTree {
     }
 }
 
-/// `f` of each chunk of [`CHUNK_CHILDREN`] `items`, in order (see [`in_order`]).
+/// `f` of each chunk of `size` `items` ([`CHUNK_CHILDREN`] when `None`), in order (see
+/// [`in_order`]).
 pub(super) fn map_chunks<R: Send>(
     prep: &Prepared<'_>,
-    items: &[u32],
+    (items, size): (&[u32], Option<usize>),
     f: impl Fn(&[u32]) -> R + Sync,
 ) -> Vec<R> {
-    let chunks: Vec<&[u32]> = items.chunks(CHUNK_CHILDREN).collect();
+    let chunks: Vec<&[u32]> = items.chunks(size.unwrap_or(CHUNK_CHILDREN)).collect();
     in_order(prep, &chunks, |c| f(c))
 }
 
