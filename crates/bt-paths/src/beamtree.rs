@@ -1579,9 +1579,9 @@ fn worth_rx_visibility(prep: &Prepared<'_>, tree: &BeamTree) -> bool {
 /// reflection from TX). Blockers are `false`.
 fn rx_visibility(prep: &Prepared<'_>, rx: Vec3, stats: &mut TreeStats) -> RxVisible {
     let mut visible = vec![false; prep.planes.len()];
-    for (part, seen) in
-        chunked::map_chunks(prep, &prep.reflectors, |chunk| rx_sees(prep, rx, chunk))
-    {
+    for (part, seen) in chunked::map_chunks(prep, (&prep.reflectors, None), |chunk| {
+        rx_sees(prep, rx, chunk)
+    }) {
         stats.absorb(&part);
         for s in seen {
             visible[s as usize] = true;

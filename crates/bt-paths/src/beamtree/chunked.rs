@@ -16,6 +16,9 @@ use rayon::prelude::*;
 const CHUNK_PARENTS: usize = 32;
 /// The root's children per chunk at depth 1.
 const CHUNK_CHILDREN: usize = 512;
+/// Rounds of chunks grown at once ([`BeamTree::in_rounds`]): 2,048 parents at depth 2 and
+/// beyond, 32,768 children of the root at depth 1.
+const ROUNDS_PER_BATCH: usize = 8;
 
 /// What one chunk grows.
 #[derive(Clone, Copy)]
@@ -85,7 +88,12 @@ impl BeamTree {
     /// `grow` each chunk of `work` (of level `depth`, which has `parents` parents) and `merge`
     /// its result into the tree, in order, a round of chunks at a time: the node budget is
     /// checked and progress reported each round (about [`PROGRESS_EVERY`] parents; at depth 1
-    /// the root is done only when the level is).
+    /// the root is done only when the level is). The chunks of [`ROUNDS_PER_BATCH`] rounds
+    /// are grown at once before their rounds are reported, merged and checked in order: the
+    /// cores wait for each other once a batch instead of once a round (a round is a few
+    /// chunks, so at its end one core often idles while the other grows the last). The
+    /// reports, the tree and the budget's verdict are those of growing round by round; only
+    /// the chunks of the batch after a round that exceeds the budget are grown in vain.
     fn in_rounds<W: Sync, R: Send>(
         &mut self,
         prep: &Prepared<'_>,
@@ -95,18 +103,23 @@ impl BeamTree {
         mut merge: impl FnMut(&mut Self, R),
     ) -> Result<(), TreeError> {
         let per_round = (PROGRESS_EVERY / CHUNK_PARENTS).max(2);
-        for (r, round) in work.chunks(per_round).enumerate() {
-            let done = if depth == 1 {
-                0
-            } else {
-                r * per_round * CHUNK_PARENTS
-            };
-            self.report(prep, depth, (done, parents), progress);
+        let mut r = 0;
+        for batch in work.chunks(per_round * ROUNDS_PER_BATCH) {
             let tree = &*self;
-            for part in in_order(prep, round, |w| grow(tree, w)) {
-                merge(self, part);
+            let mut grown = in_order(prep, batch, |w| grow(tree, w)).into_iter();
+            while grown.len() > 0 {
+                let done = if depth == 1 {
+                    0
+                } else {
+                    r * per_round * CHUNK_PARENTS
+                };
+                self.report(prep, depth, (done, parents), progress);
+                for part in grown.by_ref().take(per_round) {
+                    merge(self, part);
+                }
+                self.check_budget(prep, depth)?;
+                r += 1;
             }
-            self.check_budget(prep, depth)?;
         }
         Ok(())
     }
@@ -200,13 +213,14 @@ impl BeamTree {
     }
 }
 
-/// `f` of each chunk of [`CHUNK_CHILDREN`] `items`, in order (see [`in_order`]).
+/// `f` of each chunk of `size` `items` ([`CHUNK_CHILDREN`] when `None`), in order (see
+/// [`in_order`]).
 pub(super) fn map_chunks<R: Send>(
     prep: &Prepared<'_>,
-    items: &[u32],
+    (items, size): (&[u32], Option<usize>),
     f: impl Fn(&[u32]) -> R + Sync,
 ) -> Vec<R> {
-    let chunks: Vec<&[u32]> = items.chunks(CHUNK_CHILDREN).collect();
+    let chunks: Vec<&[u32]> = items.chunks(size.unwrap_or(CHUNK_CHILDREN)).collect();
     in_order(prep, &chunks, |c| f(c))
 }
 
@@ -220,5 +234,98 @@ fn in_order<T: Sync, R: Send>(
     match prep.options.parallel && items.len() > 1 {
         true => items.par_iter().map(&f).collect(),
         false => items.iter().map(f).collect(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{BeamTree, BuildProgress, Culling, TreeError, TreeOptions};
+    use super::*;
+
+    /// Parents of one batch of rounds ([`ROUNDS_PER_BATCH`]) at depth 2 and beyond.
+    const BATCH_PARENTS: usize =
+        (PROGRESS_EVERY / CHUNK_PARENTS) * CHUNK_PARENTS * ROUNDS_PER_BATCH;
+
+    /// A scene whose tree at order 4 has several batches of parents at depth 3, and the
+    /// options (one thread) that grow it in chunks: culled as it is built (the scene's 80
+    /// surfaces are not all reflectors, so it would not be by default).
+    fn batched() -> (bt_scene::Scene, TreeOptions) {
+        let options = TreeOptions {
+            culling: Culling::Always,
+            ..TreeOptions::new(4)
+        };
+        (bt_testkit::random_scene(3, 80), options)
+    }
+
+    /// The kept tree of a scene, its RX's candidates, and the progress reports of its build.
+    fn grown(
+        scene: &bt_scene::Scene,
+        options: TreeOptions,
+    ) -> (BeamTree, Vec<Vec<u32>>, Vec<BuildProgress>) {
+        let mut reports = Vec::new();
+        let tree = BeamTree::build_with_progress(scene, options, &mut |p| reports.push(p)).unwrap();
+        let set = tree.candidates(scene.rx().unwrap());
+        let listing = set
+            .iter()
+            .map(|s| s.iter().map(|id| id.0).collect())
+            .collect();
+        (tree, listing, reports)
+    }
+
+    /// A level of several batches of parents grown on all cores is the level grown on one
+    /// thread (the batches are appended in order), and both report progress every
+    /// [`PROGRESS_EVERY`] parents, as rounds grown one at a time did.
+    #[test]
+    fn levels_of_several_batches_grow_as_on_one_thread() {
+        let (scene, one) = batched();
+        let (a, walk_a, reports_a) = grown(&scene, one);
+        let (b, walk_b, reports_b) = grown(
+            &scene,
+            TreeOptions {
+                parallel: true,
+                ..one
+            },
+        );
+        let parents = a.stats().nodes_per_depth[2] as usize;
+        assert!(parents > 2 * BATCH_PARENTS, "{parents} parents at depth 3");
+        assert_eq!(a.stats(), b.stats());
+        assert!(walk_a == walk_b, "the walks differ");
+        assert_eq!(reports_a, reports_b);
+        let done: Vec<usize> = (reports_a.iter())
+            .filter(|p| p.depth == 4)
+            .map(|p| p.parents_done)
+            .collect();
+        let expected: Vec<usize> = (0..parents).step_by(PROGRESS_EVERY).collect();
+        assert_eq!(done, expected);
+    }
+
+    /// A budget exceeded in the middle of a level of several batches stops the build on one
+    /// thread and on all at the end of the round that exceeds it, as rounds grown one at a
+    /// time did: with the nodes the next round's progress report counts.
+    #[test]
+    fn the_budget_stops_a_batched_level_after_the_round_that_exceeds_it() {
+        let (scene, options) = batched();
+        let (full, _, reports) = grown(&scene, options);
+        // The nodes after each round of depth 4, the last one's being the whole tree's.
+        let mut after: Vec<u64> = (reports.iter())
+            .filter(|p| p.depth == 4 && p.parents_done > 0)
+            .map(|p| p.nodes)
+            .collect();
+        after.push(full.len() as u64);
+        let budget = after[after.len() / 2] - 1;
+        let expected = after[after.len() / 2];
+        for parallel in [false, true] {
+            let options = TreeOptions {
+                max_nodes: budget,
+                parallel,
+                ..options
+            };
+            match BeamTree::build(&scene, options) {
+                Err(TreeError::Budget { nodes, depth, .. }) => {
+                    assert_eq!((nodes, depth), (expected, 4), "parallel: {parallel}");
+                }
+                other => panic!("{:?}", other.map(|t| t.len())),
+            }
+        }
     }
 }
