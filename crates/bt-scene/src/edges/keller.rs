@@ -194,13 +194,19 @@ pub fn keller_pair(a: Vec3, first: EdgeLine, second: EdgeLine, b: Vec3) -> Optio
 
 /// [`keller_pair`] solved from `a`'s end, the path not through the lines' crossing.
 fn keller_pair_from(a: Vec3, first: EdgeLine, second: EdgeLine, b: Vec3) -> Option<(Real, Real)> {
+    // The ends' distances from their lines and parameters, made once for every closed form
+    // below (each [`EdgeLine::keller`] of an end, the same bits).
+    let (a_on, b_on) = (focus(&first, a), focus(&second, b));
+    // `b`'s Keller point on `second` from `p` (the closed form with its two points swapped
+    // back, so the same operations as `second.keller(p, b)`).
+    let to_b = |p: Vec3| keller_of(focus(&second, p), b_on);
     let round = |t2: Real| {
-        let t1 = first.keller(a, second.point(t2))?;
-        Some((t1, second.keller(first.point(t1), b)?))
+        let t1 = keller_of(a_on, focus(&first, second.point(t2)))?;
+        Some((t1, to_b(first.point(t1))?))
     };
     let local = |t: (Real, Real)| local(a, (first, second), b, t);
-    let t1 = first.keller(a, b)?;
-    let (mut t1, mut t2) = round(second.keller(first.point(t1), b)?)?;
+    let t1 = keller_of(a_on, focus(&first, b))?;
+    let (mut t1, mut t2) = round(to_b(first.point(t1))?)?;
     let mut here = local((t1, t2));
     let mut polished = 0;
     for done in 1..=MAX_ROUNDS {
@@ -232,6 +238,19 @@ fn keller_pair_from(a: Vec3, first: EdgeLine, second: EdgeLine, b: Vec3) -> Opti
         }
     }
     None
+}
+
+/// A point's distance from `line` and its parameter on it (m).
+#[inline(always)]
+fn focus(line: &EdgeLine, p: Vec3) -> (Real, Real) {
+    (line.distance(p), line.along(p))
+}
+
+/// [`EdgeLine::keller`] from both points' [`focus`]es: the same operations, so the same bits.
+#[inline(always)]
+fn keller_of((da, ta): (Real, Real), (db, tb): (Real, Real)) -> Option<Real> {
+    let sum = da + db;
+    (sum > 0.0 && sum.is_finite()).then(|| (db * ta + da * tb) / sum)
 }
 
 /// Lines closer than this (m) cross, for [`shortest_at_crossing`].
