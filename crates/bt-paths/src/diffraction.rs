@@ -139,6 +139,24 @@ impl Default for DiffractedSet {
 }
 
 impl DiffractedSet {
+    /// An empty set with room for `candidates` candidates of `reflections` reflections in
+    /// all (a generator that knows its last set's size grows none of its arrays).
+    pub(crate) fn with_capacity(candidates: usize, reflections: usize) -> Self {
+        let mut offsets = Vec::with_capacity(candidates + 1);
+        offsets.push(0);
+        DiffractedSet {
+            ids: Vec::with_capacity(reflections),
+            offsets,
+            edges: Vec::with_capacity(candidates),
+            positions: Vec::with_capacity(candidates),
+            seconds: Vec::with_capacity(candidates),
+            keller: Vec::with_capacity(candidates),
+        }
+    }
+    /// The number of reflections of all candidates together.
+    pub(crate) fn reflection_count(&self) -> usize {
+        self.ids.len()
+    }
     /// Number of candidates.
     pub fn len(&self) -> usize {
         self.edges.len()
@@ -204,24 +222,28 @@ impl DiffractedSet {
     }
     /// Put the candidates in the canonical order and drop repeats.
     pub fn canonicalise(&mut self) {
-        let fields: Vec<[u64; KEY_FIELDS]> = (0..self.len()).map(|i| self.key_fields(i)).collect();
-        let widths: [u32; KEY_FIELDS] = std::array::from_fn(|f| {
-            let most = fields.iter().map(|k| k[f]).max().unwrap_or(0);
-            u64::BITS - most.leading_zeros()
-        });
+        // The fields are made twice (for their widths, then for the keys) rather than kept:
+        // an array of them per candidate cost more in fresh memory than making them again.
+        let mut most = [0u64; KEY_FIELDS];
+        for i in 0..self.len() {
+            for (m, v) in most.iter_mut().zip(self.key_fields(i)) {
+                *m |= v;
+            }
+        }
+        let widths: [u32; KEY_FIELDS] = most.map(|m| u64::BITS - m.leading_zeros());
         // One integer holds the fields (and orders as they do) when their widths fit 64 bits:
         // a smaller sort; otherwise two 128-bit integers with room for any field.
         let order = if widths.iter().sum::<u32>() <= u64::BITS {
-            let packed = fields.iter().enumerate().map(|(i, k)| {
-                let key = (k.iter().zip(widths))
+            let packed = (0..self.len()).map(|i| {
+                let key = (self.key_fields(i).iter().zip(widths))
                     .fold(0u64, |key, (&v, w)| key.checked_shl(w).unwrap_or(0) | v);
                 (key, i as u32)
             });
             self.canonical_order(packed.collect())
         } else {
             // Widths: order and position 8 bits, an edge 32, a reflection 33, the second 41.
-            let packed = fields.iter().enumerate().map(|(i, k)| {
-                let k = k.map(u128::from);
+            let packed = (0..self.len()).map(|i| {
+                let k = self.key_fields(i).map(u128::from);
                 let first = (k[0] << 120) | (k[1] << 112) | (k[2] << 80) | (k[3] << 40) | k[4];
                 let next = (k[5] << 88) | (k[6] << 48) | (k[7] << 41) | k[8];
                 ((first, next), i as u32)

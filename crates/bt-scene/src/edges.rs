@@ -17,7 +17,10 @@
 
 mod keller;
 
-pub use keller::{EdgeLine, KELLER_PAIR_TOL, KELLER_RESIDUAL, KellerReach, keller_pair};
+pub use keller::{
+    EdgeLine, KELLER_PAIR_TOL, KELLER_RESIDUAL, KellerPair, KellerReach, keller_pair,
+    keller_pair_settled,
+};
 
 use crate::surface::{Surface, SurfaceId, SurfaceKind};
 use bt_geom::{Bvh, Plane, Real, Vec3, bvh::Occluder};

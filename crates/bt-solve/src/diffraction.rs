@@ -459,6 +459,9 @@ pub fn trace_set(
         solver,
     };
     if !(parallel && set.len() >= 2 * CHUNK) {
+        // Room for every candidate's path at once: the vector is not grown and copied
+        // again (the pages its last paths would not reach are never touched).
+        out.paths.reserve(set.len());
         solve_range(&work, 0..set.len(), out);
         return;
     }

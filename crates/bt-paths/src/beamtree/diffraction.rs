@@ -360,6 +360,43 @@ pub struct DiffractionSide {
     tx: Vec3,
     /// The two-diffraction join's TX part, made by the first join that needs it.
     twice: std::sync::OnceLock<twice::TxPart>,
+    /// The size of the last join's set before [`DiffractedSet::canonicalise`].
+    last: LastSize,
+}
+
+/// The candidates and reflections of the last set a join made with a [`DiffractionSide`]:
+/// the next join (the next RX, often close by) reserves that much at once instead of
+/// growing its arrays (a hint only: any size works).
+#[derive(Debug, Default)]
+struct LastSize {
+    candidates: std::sync::atomic::AtomicUsize,
+    reflections: std::sync::atomic::AtomicUsize,
+}
+
+impl LastSize {
+    fn get(&self) -> (usize, usize) {
+        use std::sync::atomic::Ordering::Relaxed;
+        (
+            self.candidates.load(Relaxed),
+            self.reflections.load(Relaxed),
+        )
+    }
+
+    fn set(&self, set: &DiffractedSet) {
+        use std::sync::atomic::Ordering::Relaxed;
+        self.candidates.store(set.len(), Relaxed);
+        self.reflections.store(set.reflection_count(), Relaxed);
+    }
+}
+
+impl Clone for LastSize {
+    fn clone(&self) -> Self {
+        let (candidates, reflections) = self.get();
+        LastSize {
+            candidates: candidates.into(),
+            reflections: reflections.into(),
+        }
+    }
 }
 
 impl DiffractionSide {
@@ -384,6 +421,7 @@ impl DiffractionSide {
             tol: tx.tol,
             tx: tx.tx,
             twice: std::sync::OnceLock::new(),
+            last: LastSize::default(),
         }
     }
 }
@@ -397,7 +435,8 @@ pub fn join(
     rx: &BeamTree,
     budget: u64,
 ) -> Result<DiffractedSet, TreeError> {
-    let mut set = DiffractedSet::default();
+    let (candidates, reflections) = side.last.get();
+    let mut set = DiffractedSet::with_capacity(candidates, reflections);
     let max_order = side.max_order;
     if max_order == 0 {
         return Ok(set);
@@ -436,6 +475,7 @@ pub fn join(
     if twice {
         pairing.twice(scene, &mut set)?;
     }
+    side.last.set(&set);
     set.canonicalise();
     Ok(set)
 }

@@ -172,12 +172,45 @@ impl KellerReach {
 /// fails: a path and its reverse get the same parameters, bit for bit, and a start that
 /// stalls (a short middle leg near the lines' crossing) gets a second chance.
 pub fn keller_pair(a: Vec3, first: EdgeLine, second: EdgeLine, b: Vec3) -> Option<(Real, Real)> {
+    keller_pair_settled(a, first, second, b).map(|pair| pair.at)
+}
+
+/// The parameters of [`keller_pair`] and the Keller residual where its solve stopped.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct KellerPair {
+    /// (t1 on the first line, t2 on the second), metres: [`keller_pair`]'s, bit for bit.
+    pub at: (Real, Real),
+    /// The larger of |cos β_in − cos β_out| at the two points, at `at` (at most
+    /// [`KELLER_RESIDUAL`] unless the solve stopped on its round cap; infinite when a leg had
+    /// no length there, NaN when the residual could not be made).
+    pub residual: Real,
+}
+
+/// [`keller_pair`] with the residual where its solve stopped ([`KellerPair`]).
+pub fn keller_pair_settled(
+    a: Vec3,
+    first: EdgeLine,
+    second: EdgeLine,
+    b: Vec3,
+) -> Option<KellerPair> {
     // The same test from either end (the crossing's subgradient condition is symmetric).
     if shortest_at_crossing(a, (first, second), b) {
         return None;
     }
     let forward = || keller_pair_from(a, first, second, b);
-    let backward = || keller_pair_from(b, second, first, a).map(|(t2, t1)| (t1, t2));
+    let backward = || {
+        keller_pair_from(b, second, first, a).map(
+            |KellerPair {
+                 at: (t2, t1),
+                 residual,
+             }| {
+                KellerPair {
+                    at: (t1, t2),
+                    residual,
+                }
+            },
+        )
+    };
     let key = |v: Vec3| [v.x, v.y, v.z];
     let from_b = key(b)
         .iter()
@@ -193,14 +226,20 @@ pub fn keller_pair(a: Vec3, first: EdgeLine, second: EdgeLine, b: Vec3) -> Optio
 }
 
 /// [`keller_pair`] solved from `a`'s end, the path not through the lines' crossing.
-fn keller_pair_from(a: Vec3, first: EdgeLine, second: EdgeLine, b: Vec3) -> Option<(Real, Real)> {
+fn keller_pair_from(a: Vec3, first: EdgeLine, second: EdgeLine, b: Vec3) -> Option<KellerPair> {
+    // The ends' distances from their lines and parameters, made once for every closed form
+    // below (each [`EdgeLine::keller`] of an end, the same bits).
+    let (a_on, b_on) = (focus(&first, a), focus(&second, b));
+    // `b`'s Keller point on `second` from `p` (the closed form with its two points swapped
+    // back, so the same operations as `second.keller(p, b)`).
+    let to_b = |p: Vec3| keller_of(focus(&second, p), b_on);
     let round = |t2: Real| {
-        let t1 = first.keller(a, second.point(t2))?;
-        Some((t1, second.keller(first.point(t1), b)?))
+        let t1 = keller_of(a_on, focus(&first, second.point(t2)))?;
+        Some((t1, to_b(first.point(t1))?))
     };
     let local = |t: (Real, Real)| local(a, (first, second), b, t);
-    let t1 = first.keller(a, b)?;
-    let (mut t1, mut t2) = round(second.keller(first.point(t1), b)?)?;
+    let t1 = keller_of(a_on, focus(&first, b))?;
+    let (mut t1, mut t2) = round(to_b(first.point(t1))?)?;
     let mut here = local((t1, t2));
     let mut polished = 0;
     for done in 1..=MAX_ROUNDS {
@@ -226,12 +265,28 @@ fn keller_pair_from(a: Vec3, first: EdgeLine, second: EdgeLine, b: Vec3) -> Opti
             let residual = here.step.map_or(0.0, |s| s.residual);
             let settled = residual <= KELLER_RESIDUAL || residual.is_nan();
             if settled || polished == POLISH_ROUNDS || done == MAX_ROUNDS {
-                return Some((t1, t2));
+                return Some(KellerPair {
+                    at: (t1, t2),
+                    residual: here.step.map_or(Real::INFINITY, |s| s.residual),
+                });
             }
             polished += 1;
         }
     }
     None
+}
+
+/// A point's distance from `line` and its parameter on it (m).
+#[inline(always)]
+fn focus(line: &EdgeLine, p: Vec3) -> (Real, Real) {
+    (line.distance(p), line.along(p))
+}
+
+/// [`EdgeLine::keller`] from both points' [`focus`]es: the same operations, so the same bits.
+#[inline(always)]
+fn keller_of((da, ta): (Real, Real), (db, tb): (Real, Real)) -> Option<Real> {
+    let sum = da + db;
+    (sum > 0.0 && sum.is_finite()).then(|| (db * ta + da * tb) / sum)
 }
 
 /// Lines closer than this (m) cross, for [`shortest_at_crossing`].
@@ -369,6 +424,10 @@ mod tests {
             let Some((t1, t2)) = keller_pair(a, first, second, b) else {
                 panic!("case {case}: no solution");
             };
+            // The settled pair is the same, with the residual where the solve stopped.
+            let settled = keller_pair_settled(a, first, second, b).unwrap();
+            assert_eq!(settled.at, (t1, t2), "case {case}");
+            assert!(settled.residual < 1e-9, "case {case}: {}", settled.residual);
             let (p, q) = (first.point(t1), second.point(t2));
             let cos = |from: Vec3, to: Vec3, e: Vec3| (to - from).normalize().dot(e);
             assert!(

@@ -17,7 +17,7 @@ use super::{Pairing, Reach};
 use crate::beamtree::{PAIR_TESTS_PER_CANDIDATE, TreeError};
 use crate::diffraction::DiffractedSet;
 use bt_geom::{Plane, Polygon, Real, Vec3};
-use bt_scene::edges::{EdgeLine, KellerReach, keller_pair};
+use bt_scene::edges::{EdgeLine, KellerReach, keller_pair_settled};
 use bt_scene::{Edge, EdgeId, Scene, SurfaceId};
 
 /// Angular slack (rad) of the prefilters: far above round-off, far below any angle a valid
@@ -581,6 +581,19 @@ fn shrink(into: &mut (Real, Real), by: Option<(Real, Real)>) -> Option<bool> {
     Some(into.0 > into.1)
 }
 
+/// Whether a Keller pair inside both reaches (within the margin), solved to `residual`,
+/// proves that [`Pairing::obeys_keller`] holds for its group and far interval: its points
+/// lie on the intervals the test reads (the span's and the far interval's, both grown by
+/// the margin as the inside test is), so the test's conservative cos β0 ranges hold the
+/// diffracted rays' cosines there and the incidence and leaving ranges the incident
+/// rays' (each monotone along its edge, so held between its ends' values). Those differ by
+/// at most the residual at each point, so with a residual of at most half of [`SLACK`]
+/// the ranges overlap, the other half far above the tests' round-off.
+#[inline(always)]
+fn vouches(residual: Real) -> bool {
+    residual <= 0.5 * SLACK
+}
+
 /// Whether the ranges overlap, up to [`SLACK`].
 fn overlap(a: (Real, Real), b: (Real, Real)) -> bool {
     a.0 <= b.1 + SLACK && b.0 <= a.1 + SLACK
@@ -686,10 +699,17 @@ impl Pairing<'_> {
                 .span
                 .line
                 .keller_reach(&far.wedge.line, self.grown(&far.reach));
+            // The group's Keller-law test ([`Pairing::obeys_keller`]), made at its first
+            // candidate whose pair does not vouch for it ([`vouches`]): when it fails, the
+            // group has none (and no pair that vouches).
+            let mut keller_law = None;
             for a in &pairs.near[g.members.clone()] {
-                let Some(keller) = self.may_join(a, far, toward) else {
+                let Some((keller, vouched)) = self.may_join(a, far, toward) else {
                     continue;
                 };
+                if !vouched && !*keller_law.get_or_insert_with(|| self.obeys_keller(&g.span, far)) {
+                    break;
+                }
                 let (before, after) = (&mut pairs.before, &mut pairs.after);
                 self.surfaces((a.reach.node, b.node), (before, after));
                 let edges = (EdgeId(a.span.edge as u32), EdgeId(far.edge as u32));
@@ -803,13 +823,12 @@ impl Pairing<'_> {
     }
 
     /// Necessary conditions of a valid path through `a`'s and `far`'s intervals, each
-    /// conservative, the most selective first: two edges in a row differ; Keller's law may
-    /// hold at both points (the cos β0 ranges of the incident and diffracted rays over the
-    /// intervals overlap); across one middle reflection both points may lie on one side of
-    /// its plane and the stretch may cross its window; the stretch between the edges leaves
-    /// each into its exterior (the other interval is not wholly inside its interior wedge;
-    /// `seen` caches, per first edge, the test of `far`'s interval against it, `wedges` the
-    /// edges' wedges).
+    /// conservative: two edges in a row differ; across one middle reflection both points may
+    /// lie on one side of its plane and the stretch may cross its window; the stretch between
+    /// the edges leaves each into its exterior (the other interval is not wholly inside its
+    /// interior wedge; `seen` caches, per first edge, the test of `far`'s interval against
+    /// it, `wedges` the edges' wedges). The join also asks [`Pairing::obeys_keller`] of a
+    /// group, but only once one of its members has a candidate.
     #[inline(always)]
     fn may_pair(
         &self,
@@ -818,12 +837,6 @@ impl Pairing<'_> {
         (seen, wedges): (&mut [Option<bool>], &[Wedge]),
     ) -> bool {
         if far.middle.is_empty() && a.edge == far.edge {
-            return false;
-        }
-        // Keller's law at both points first: the most selective test.
-        let directions = [a.line.direction, far.wedge.line.direction];
-        let [at_first, at_second] = cos_ranges(a.ends, far.ends, directions);
-        if !(overlap(at_first, a.incidence) && overlap(at_second, far.leaving)) {
             return false;
         }
         if let (Some((plane, second)), [m]) = (&far.across, far.middle) {
@@ -855,6 +868,20 @@ impl Pairing<'_> {
             return false;
         }
         true
+    }
+
+    /// Whether Keller's law may hold at both points of a path through `a`'s and `far`'s
+    /// intervals: the cos β0 ranges of the incident and diffracted rays over the intervals
+    /// overlap (conservative). After the per-edge and per-reflector lists ([`Toward`], whose
+    /// [`heads_into`] is this test's first half against a whole second edge) and
+    /// [`Pairing::beyond`] it fails for few groups (under 4 % in the living room), so the
+    /// join makes it only for a group with a candidate, and drops the group's candidates
+    /// when it fails: the candidates this test made first would have given.
+    #[inline(always)]
+    fn obeys_keller(&self, a: &Span, far: &Far<'_>) -> bool {
+        let directions = [a.line.direction, far.wedge.line.direction];
+        let [at_first, at_second] = cos_ranges(a.ends, far.ends, directions);
+        overlap(at_first, a.incidence) && overlap(at_second, far.leaving)
     }
 
     /// Whether the Keller pair of `a` and `far` surely lies outside their reaches (grown by
@@ -913,24 +940,26 @@ impl Pairing<'_> {
     /// with the pair, or cannot be computed (`Some(None)`); `None` when it lies outside.
     /// The pair's inputs are the image method's for the candidate
     /// ([`DiffractedSet::keller`]), so the solve reuses it. `toward` as for
-    /// [`Pairing::apart`].
+    /// [`Pairing::apart`]. With the pair, whether it vouches for the group's Keller-law
+    /// test ([`vouches`]).
     #[inline(always)]
     fn may_join(
         &self,
         a: &Near,
         far: &Far<'_>,
         toward: KellerReach,
-    ) -> Option<Option<(Real, Real)>> {
+    ) -> Option<(Option<(Real, Real)>, bool)> {
         if self.apart(a, far, toward) {
             return None;
         }
-        let Some((t1, t2)) = keller_pair(a.reach.image, a.span.line, far.wedge.line, far.image)
+        let Some(pair) = keller_pair_settled(a.reach.image, a.span.line, far.wedge.line, far.image)
         else {
-            return Some(None);
+            return Some((None, false));
         };
+        let (t1, t2) = pair.at;
         let m = self.margin;
         let (a, b) = (&a.reach, &far.reach);
         let inside = t1 >= a.lo - m && t1 <= a.hi + m && t2 >= b.lo - m && t2 <= b.hi + m;
-        inside.then_some(Some((t1, t2)))
+        inside.then_some((Some((t1, t2)), vouches(pair.residual)))
     }
 }
