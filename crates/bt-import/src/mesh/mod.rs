@@ -1,10 +1,10 @@
-//! Mesh files (Wavefront OBJ, PLY, STL) to bounded planar polygon surfaces: the readers parse bytes
-//! into a [`bt_mesh::RawMesh`] (polygon soup) and `bt-mesh` welds and merges it
+//! Mesh files (Wavefront OBJ, PLY, STL, glTF 2.0) to bounded planar polygon surfaces: the
+//! readers parse bytes into a [`bt_mesh::RawMesh`] (polygon soup) and `bt-mesh` welds and merges it
 //! ([`bt_mesh::merge_mesh`]). [`read_mesh_path`] reads a file and picks the reader by
 //! extension; [`scene`] turns the surfaces into a [`bt_scene::Scene`].
 //!
 //! Units and frame: coordinates are taken as metres in the file's own frame (beamtrace uses
-//! z up; no axis swap is applied).
+//! z up; no axis swap is applied), except glTF's +Y up, turned to z up (`gltf` module).
 
 mod error;
 mod gltf;
