@@ -31,9 +31,20 @@ const MAX_DEPTH: usize = 64;
 /// A parsed glTF document and the bytes of its buffers, in the document's order.
 pub(crate) struct Document {
     gltf: gltf::Gltf,
-    buffers: Vec<Vec<u8>>,
-    /// The external files read for buffers (relative to the scene's folder).
-    pub(crate) files: Vec<(PathBuf, Vec<u8>)>,
+    /// Per buffer, its bytes; `None`: the GLB's binary chunk (`gltf.blob`, not copied).
+    buffers: Vec<Option<Vec<u8>>>,
+    /// The external files read for buffers (in the scene's folder), in the document's order.
+    pub(crate) files: Vec<PathBuf>,
+    /// Their SHA-256s, with hashing on (else empty).
+    pub(crate) digests: Vec<crate::source::Digest>,
+}
+
+impl Document {
+    /// The bytes of buffer `index` (a GLB chunk's presence was checked by [`document`]).
+    fn buffer(&self, index: usize) -> &[u8] {
+        let own = self.buffers[index].as_deref();
+        own.or(self.gltf.blob.as_deref()).unwrap_or_default()
+    }
 }
 
 fn syntax(file: &str, position: Position, detail: String) -> MeshError {
@@ -52,12 +63,12 @@ fn unsupported(file: &str, detail: String) -> MeshError {
 }
 
 /// Parse `bytes` (a `.gltf` or `.glb` file named `file`, in `folder`) and read its buffers,
-/// each file within `max_file_bytes`.
+/// each file within `max_file_bytes`, hashing the files read with `hashing` on.
 pub(crate) fn document(
     bytes: &[u8],
-    file: &str,
-    folder: Option<&Path>,
+    (file, folder): (&str, Option<&Path>),
     max_file_bytes: u64,
+    hashing: crate::source::Hashing,
 ) -> Result<Document, MeshError> {
     let gltf = gltf::Gltf::from_slice(bytes).map_err(|e| match e {
         gltf::Error::Deserialize(json) => syntax(
@@ -71,21 +82,27 @@ pub(crate) fn document(
             format!("not a valid glTF file: {other}"),
         ),
     })?;
-    let (mut buffers, mut files) = (Vec::new(), Vec::new());
+    let (mut buffers, mut files, mut digests) = (Vec::new(), Vec::new(), Vec::new());
     for buffer in gltf.buffers() {
         let data = match buffer.source() {
-            gltf::buffer::Source::Bin => gltf.blob.clone().ok_or_else(|| {
-                unsupported(
-                    file,
-                    format!("buffer {} has no GLB binary chunk", buffer.index()),
-                )
-            })?,
+            gltf::buffer::Source::Bin => None,
             gltf::buffer::Source::Uri(uri) => {
-                let data = uri_bytes(uri, file, folder, max_file_bytes, &mut files)?;
-                data.unwrap_or_else(|| files.last().map(|(_, b)| b.clone()).unwrap_or_default())
+                let (data, read) = uri_bytes(uri, file, folder, max_file_bytes)?;
+                if let Some(path) = read {
+                    digests.extend(hashing.of(&data));
+                    files.push(path);
+                }
+                Some(data)
             }
         };
-        if data.len() < buffer.length() {
+        let found = match &data {
+            Some(data) => data.len(),
+            None => (gltf.blob.as_ref()).map(Vec::len).ok_or_else(|| {
+                let detail = format!("buffer {} has no GLB binary chunk", buffer.index());
+                unsupported(file, detail)
+            })?,
+        };
+        if found < buffer.length() {
             return Err(MeshError::Truncated {
                 file: file.to_owned(),
                 position: Position::Element {
@@ -93,7 +110,7 @@ pub(crate) fn document(
                     index: buffer.index() as u64,
                     line: None,
                 },
-                detail: format!("{} bytes declared, {} found", buffer.length(), data.len()),
+                detail: format!("{} bytes declared, {found} found", buffer.length()),
             });
         }
         buffers.push(data);
@@ -102,18 +119,18 @@ pub(crate) fn document(
         gltf,
         buffers,
         files,
+        digests,
     })
 }
 
-/// A buffer's bytes from a `data:` URI (`Some`), or read from the relative file it names,
-/// appended to `files` (`None`: the bytes are `files`' last).
+/// A buffer's bytes from a `data:` URI, or read from the relative file it names (then also
+/// that file's path).
 fn uri_bytes(
     uri: &str,
     file: &str,
     folder: Option<&Path>,
     max_file_bytes: u64,
-    files: &mut Vec<(PathBuf, Vec<u8>)>,
-) -> Result<Option<Vec<u8>>, MeshError> {
+) -> Result<(Vec<u8>, Option<PathBuf>), MeshError> {
     if let Some(data) = uri.strip_prefix("data:") {
         let Some((_, encoded)) = data.split_once(";base64,") else {
             return Err(unsupported(
@@ -125,7 +142,7 @@ fn uri_bytes(
         let decoded = base64::engine::general_purpose::STANDARD
             .decode(encoded)
             .map_err(|e| syntax(file, Position::Line(1), format!("data: URI: {e}")))?;
-        return Ok(Some(decoded));
+        return Ok((decoded, None));
     }
     let relative = PathBuf::from(percent_decoded(uri, file)?);
     let confined = relative
@@ -141,13 +158,8 @@ fn uri_bytes(
         ));
     }
     let path = folder.map_or(relative.clone(), |f| f.join(&relative));
-    let bytes =
-        crate::source::read_file(&path, max_file_bytes).map_err(|source| MeshError::Io {
-            file: path.display().to_string(),
-            source,
-        })?;
-    files.push((path, bytes));
-    Ok(None)
+    let bytes = super::read_bytes(&path, max_file_bytes)?;
+    Ok((bytes, Some(path)))
 }
 
 /// `uri` with its `%XX` escapes decoded.
@@ -379,7 +391,7 @@ impl Walk<'_> {
             ));
         }
         let view = accessor.view().ok_or_else(|| bad("no buffer view"))?;
-        let buffer = &self.doc.buffers[view.buffer().index()];
+        let buffer = self.doc.buffer(view.buffer().index());
         let stride = view.stride().unwrap_or(element_bytes);
         let view_end = view.offset().checked_add(view.length());
         let view_bytes = view_end

@@ -137,10 +137,7 @@ pub(crate) fn read_mesh_file(
         _ => return Err(MeshError::UnsupportedExtension { file, extension }),
     };
     opts.validate()?;
-    let bytes = crate::source::read_file(path, max_file_bytes).map_err(|source| MeshError::Io {
-        file: file.clone(),
-        source,
-    })?;
+    let bytes = read_bytes(path, max_file_bytes)?;
     let import = read_transformed(&bytes, format, Some(&file), opts, &|p| p)?;
     Ok((import, hashing.of(&bytes)))
 }
@@ -157,18 +154,20 @@ pub(crate) fn read_gltf_file(
 ) -> Result<GltfRead, MeshError> {
     let file = path.display().to_string();
     opts.validate()?;
-    let bytes = crate::source::read_file(path, max_file_bytes).map_err(|source| MeshError::Io {
-        file: file.clone(),
-        source,
-    })?;
-    let doc = gltf::document(&bytes, &file, path.parent(), max_file_bytes)?;
+    let bytes = read_bytes(path, max_file_bytes)?;
+    let doc = gltf::document(&bytes, (&file, path.parent()), max_file_bytes, hashing)?;
     let raw = gltf::parse(&doc, &file, opts.max_elements)?;
     let import = bt_mesh::merge_mesh(&raw, opts, &file)?;
-    let buffers = doc.files.iter().map(|(p, _)| p.clone()).collect();
-    let digests = (doc.files.iter())
-        .filter_map(|(_, b)| hashing.of(b))
-        .collect();
-    Ok((import, hashing.of(&bytes), (buffers, digests)))
+    Ok((import, hashing.of(&bytes), (doc.files, doc.digests)))
+}
+
+/// The bytes of the mesh file `path` ([`crate::source::read_file`]: a regular file within
+/// `max_file_bytes`), an I/O error naming it otherwise.
+fn read_bytes(path: &Path, max_file_bytes: u64) -> Result<Vec<u8>, MeshError> {
+    crate::source::read_file(path, max_file_bytes).map_err(|source| MeshError::Io {
+        file: path.display().to_string(),
+        source,
+    })
 }
 
 /// What [`read_gltf_file`] returns: the import, the scene file's SHA-256, the buffer files

@@ -47,24 +47,26 @@ pub(crate) fn parse(bytes: &[u8], file: &str, max_elements: u64) -> Result<RawMe
 
 /// The triangle count of a binary STL: `Some` when the size is exactly what the count needs.
 fn binary_count(bytes: &[u8]) -> Option<u64> {
+    let (count, needed) = claimed(bytes)?;
+    (needed == bytes.len() as u64).then_some(count)
+}
+
+/// The triangle count the bytes at a binary STL's count field claim, and the file size (bytes)
+/// it needs; `None` for a file shorter than the header.
+fn claimed(bytes: &[u8]) -> Option<(u64, u64)> {
     let count = bytes.get(80..BINARY_HEADER)?;
     let count = u64::from(u32::from_le_bytes(count.try_into().ok()?));
-    let needed = BINARY_HEADER as u64 + BINARY_TRIANGLE as u64 * count;
-    (needed == bytes.len() as u64).then_some(count)
+    Some((count, BINARY_HEADER as u64 + BINARY_TRIANGLE as u64 * count))
 }
 
 /// Why `bytes` is not a binary STL, for messages: its size against what its count needs.
 fn binary_mismatch(bytes: &[u8]) -> String {
-    match bytes.get(80..BINARY_HEADER) {
-        Some(count) => {
-            let count = u32::from_le_bytes([count[0], count[1], count[2], count[3]]);
-            let needed = BINARY_HEADER as u64 + BINARY_TRIANGLE as u64 * u64::from(count);
-            format!(
-                "as a binary STL its count of {count} triangles needs {needed} bytes, but the \
-                 file has {}",
-                bytes.len()
-            )
-        }
+    match claimed(bytes) {
+        Some((count, needed)) => format!(
+            "as a binary STL its count of {count} triangles needs {needed} bytes, but the file \
+             has {}",
+            bytes.len()
+        ),
         None => format!(
             "it has {} bytes, fewer than a binary STL's header of {BINARY_HEADER}",
             bytes.len()
