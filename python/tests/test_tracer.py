@@ -48,6 +48,22 @@ def test_updates_answer_what_serve_answers():
     assert got[3]["tx"] == [3.0, 3.5, 2.0], "the transmitter stays where the last update put it"
 
 
+def test_a_partner_thread_changes_no_answer():
+    """``partner_spin_us`` (serve's ``--partner-spin-us``) splits a lone receiver's report
+    over two threads; 0 answers on one: the same answers, and the same as serve's with
+    ``--partner-spin-us 0``."""
+    walk = [{"rx": [0.6 + 0.2 * k, 1.0 + 0.1 * (k % 7), 1.1]} for k in range(20)]
+    one = beamtrace.Tracer("builtin:living-room-dynamic", partner_spin_us=0)
+    two = beamtrace.Tracer("builtin:living-room-dynamic", partner_spin_us=5000)
+    expected = serve(walk, "--partner-spin-us", "0")
+    for r, e in zip(walk, expected):
+        alone, split = one.update(**r), two.update(**r)
+        assert without_times(split) == without_times(alone) == without_times(e)
+    assert sum(len(e["paths"]) for e in expected) > 20 * 16, "answers with paths to split"
+    with pytest.raises(ValueError, match="partner_spin_us"):
+        beamtrace.Tracer("builtin:living-room", partner_spin_us=-1)
+
+
 def test_one_receiver_is_the_trace_of_the_scene():
     scene = beamtrace.load("builtin:living-room")
     tracer = beamtrace.Tracer(scene)

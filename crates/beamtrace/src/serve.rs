@@ -25,7 +25,8 @@ pub fn run(args: &ServeArgs) -> anyhow::Result<ExitCode> {
     };
     let max_connections = usize::try_from(args.max_connections).context("--max-connections")?;
     stop::install();
-    let mut server = Server::new(dynamic, options, radio, limits);
+    let spin = std::time::Duration::from_micros(args.partner_spin_us);
+    let mut server = Server::new(dynamic, options, radio, limits).with_partner(spin);
     if args.arrays.tx_array.is_some() || args.arrays.rx_array.is_some() {
         let beams = crate::channel::beam_options(&args.arrays, &radio, args.top)?;
         server = server.with_beams(beams);

@@ -7,6 +7,7 @@ use crate::{PathReport, RadioOptions, ReportError, Scratch, describe_into, gain,
 use bt_geom::Real;
 use bt_scene::Scene;
 use bt_solve::FoundPath;
+use bt_solve::partner::Partner;
 use std::cmp::Ordering;
 
 /// Records a report beyond the current one's keeps for the next (a few times a room's paths):
@@ -28,7 +29,13 @@ pub struct Records {
     responses: Option<(bt_scene::RadioKey, gain::Known)>,
     /// The buffers each path is described with, kept too.
     scratch: Scratch,
+    /// The partner's half of a split report ([`Records::report_with`]): its surfaces'
+    /// responses and buffers, kept as the caller's are.
+    second: (Option<(bt_scene::RadioKey, gain::Known)>, Scratch),
 }
+
+/// Paths a report splits over a [`Partner`] from: below, the offer costs more than the half.
+const SPLIT_FROM: usize = 8;
 
 /// A path's first keys in the ranking ([`rank_order`]) and its index among the paths: its
 /// order, its length as [`f64::total_cmp`] orders it ([`total_order_bits`]), then the index,
@@ -49,12 +56,81 @@ impl Records {
         paths: &[FoundPath],
         radio: &RadioOptions,
     ) -> Result<&[PathReport], ReportError> {
-        let known = match self.responses.take() {
-            Some((key, known)) if key.matches(scene) => known,
-            _ => Vec::new(),
-        };
-        let mut responses = gain::Responses::with_known(scene, known);
+        self.report_halves(scene, paths, radio, None, |_| (), |_| ())?;
+        Ok(self.paths())
+    }
+
+    /// [`Records::report`] in two halves of the ranked records, the second on `partner`
+    /// ([`Partner::join`]) when there is one and enough paths: each half is described and
+    /// ranked, then handed to its own closure on the same thread (`mine` the first half's
+    /// records, `theirs` the second's, empty without a partner), which may write them out
+    /// while they are in that core's cache. The records are those of [`Records::report`]
+    /// ([`Records::paths`] after the call): the halves split between runs of paths of the same
+    /// order and length, the only records the ranking compares.
+    pub fn report_halves<A, B, RA, RB>(
+        &mut self,
+        scene: &Scene,
+        paths: &[FoundPath],
+        radio: &RadioOptions,
+        partner: Option<&Partner>,
+        mine: A,
+        theirs: B,
+    ) -> Result<(RA, RB), ReportError>
+    where
+        A: FnOnce(&[PathReport]) -> RA,
+        B: FnOnce(&[PathReport]) -> RB + Send,
+        RB: Send,
+    {
+        let mut responses = gain::Responses::with_known(scene, known(&mut self.responses, scene));
+        self.rank_keys(scene, paths)?;
+        let n = paths.len();
+        let partner = partner.filter(|_| n >= SPLIT_FROM);
+        let k = partner.map_or(n, |_| halfway(&self.keys));
+        let (keys, their_keys) = self.keys.split_at(k);
+        let (records, their_records) = self.records[..n].split_at_mut(k);
+        let (their_known, their_scratch) = &mut self.second;
         let scratch = &mut self.scratch;
+        let first = |responses: &mut gain::Responses<'_>| {
+            describe_ranked(responses, scratch, keys, records, paths, radio)?;
+            rank_ties(keys, records, 0);
+            Ok(mine(records))
+        };
+        let second = || {
+            let known = known(their_known, scene);
+            let mut responses = gain::Responses::with_known(scene, known);
+            let keys = their_keys;
+            describe_ranked(
+                &mut responses,
+                their_scratch,
+                keys,
+                their_records,
+                paths,
+                radio,
+            )?;
+            *their_known = Some((scene.radio_key(), responses.into_known()));
+            rank_ties(keys, their_records, k);
+            Ok(theirs(their_records))
+        };
+        let (a, b) = match partner {
+            Some(partner) => partner.join(|| first(&mut responses), second),
+            None => (first(&mut responses), second()),
+        };
+        let (a, b): (Result<RA, ReportError>, Result<RB, ReportError>) = (a, b);
+        let (a, b) = match (a, b) {
+            (Ok(a), Ok(b)) => (a, b),
+            // The error a report in the paths' order meets first.
+            (Err(e), _) | (_, Err(e)) => {
+                return Err(first_error(&mut responses, paths, radio).unwrap_or(e));
+            }
+        };
+        self.responses = Some((scene.radio_key(), responses.into_known()));
+        self.len = n;
+        self.records.truncate(self.len + SPARE_RECORDS);
+        Ok((a, b))
+    }
+
+    /// The ranking's keys of `paths` in `keys`, sorted, and records enough for them.
+    fn rank_keys(&mut self, scene: &Scene, paths: &[FoundPath]) -> Result<(), ReportError> {
         self.len = 0;
         self.keys.clear();
         if !paths.is_empty() {
@@ -69,18 +145,7 @@ impl Records {
         if self.records.len() < paths.len() {
             self.records.resize_with(paths.len(), PathReport::blank);
         }
-        for (&(_, _, index), record) in self.keys.iter().zip(&mut self.records) {
-            let described = describe_into(&mut responses, scratch, &paths[index], radio, record);
-            if let Err(e) = described {
-                // The error a report in the paths' order meets first.
-                return Err(first_error(&mut responses, paths, radio).unwrap_or(e));
-            }
-        }
-        self.responses = Some((scene.radio_key(), responses.into_known()));
-        self.len = paths.len();
-        self.records.truncate(self.len + SPARE_RECORDS);
-        self.rank_ties();
-        Ok(self.paths())
+        Ok(())
     }
 
     /// The last report's records, ranked.
@@ -93,28 +158,76 @@ impl Records {
         self.records.truncate(self.len);
         self.records
     }
+}
 
-    /// Finish the ranking of records placed by their order and length (`keys`, aligned with
-    /// them): each run of records of the same order and length sorted by [`rank_order`]
-    /// (stable, so equal records keep the paths' order), and the records numbered from 1.
-    fn rank_ties(&mut self) {
-        let records = &mut self.records[..self.len];
-        let mut start = 0;
-        while start < records.len() {
-            let first = &self.keys[start];
-            let run = self.keys[start..]
-                .iter()
-                .take_while(|k| (k.0, k.1) == (first.0, first.1))
-                .count();
-            if run > 1 {
-                records[start..start + run].sort_by(rank_order);
-            }
-            start += run;
+/// Finish the ranking of records placed by their order and length (`keys`, aligned with
+/// them): each run of records of the same order and length sorted by [`rank_order`] (stable,
+/// so equal records keep the paths' order), and the records numbered from `before + 1` (the
+/// records ranked before them: a second half's, [`Records::report_halves`]).
+fn rank_ties(keys: &[RankKey], records: &mut [PathReport], before: usize) {
+    let mut start = 0;
+    while start < records.len() {
+        let first = &keys[start];
+        let run = keys[start..]
+            .iter()
+            .take_while(|k| (k.0, k.1) == (first.0, first.1))
+            .count();
+        if run > 1 {
+            records[start..start + run].sort_by(rank_order);
         }
-        for (i, r) in records.iter_mut().enumerate() {
-            r.rank = i + 1;
-        }
+        start += run;
     }
+    for (i, r) in records.iter_mut().enumerate() {
+        r.rank = before + i + 1;
+    }
+}
+
+/// The surfaces' responses kept in `kept` when they were looked up in a scene of `scene`'s
+/// radio key (taken out of `kept`), else none.
+fn known(kept: &mut Option<(bt_scene::RadioKey, gain::Known)>, scene: &Scene) -> gain::Known {
+    match kept.take() {
+        Some((key, known)) if key.matches(scene) => known,
+        _ => Vec::new(),
+    }
+}
+
+/// Where ranked `keys` split into the caller's and the partner's half
+/// ([`Records::report_halves`]): a path's description costs about one unit, and one more for
+/// each interaction (its order, the keys' first field); the caller takes [`MINE`] of the work
+/// (the partner starts later and on colder caches), and the split falls between runs of
+/// the same order and length.
+fn halfway(keys: &[RankKey]) -> usize {
+    let total: usize = keys.iter().map(|k| k.0 + 1).sum();
+    let mut sum = 0;
+    let mut k = keys
+        .iter()
+        .position(|k| {
+            sum += k.0 + 1;
+            sum as f64 >= MINE * total as f64
+        })
+        .map_or(keys.len(), |i| i + 1);
+    while k > 0 && k < keys.len() && (keys[k].0, keys[k].1) == (keys[k - 1].0, keys[k - 1].1) {
+        k += 1;
+    }
+    k
+}
+
+/// The caller's share of a split report's work ([`halfway`]).
+const MINE: f64 = 0.55;
+
+/// Describe the paths of `keys` (ranked, [`RankKey`]) into `records`, one each, in order.
+fn describe_ranked(
+    responses: &mut gain::Responses<'_>,
+    scratch: &mut Scratch,
+    keys: &[RankKey],
+    records: &mut [PathReport],
+    paths: &[FoundPath],
+    radio: &RadioOptions,
+) -> Result<(), ReportError> {
+    for (&(_, _, index), record) in keys.iter().zip(records) {
+        describe_into(responses, scratch, &paths[index], radio, record)?;
+    }
+    Ok(())
 }
 
 /// `x`'s bits as a signed integer whose order is [`f64::total_cmp`]'s (its own definition):
@@ -197,7 +310,8 @@ mod tests {
         let mut tracer = Tracer::new(scene.clone(), settings.trace_options(&scene).unwrap());
         let radio = RadioOptions::default();
         let mut records = Records::default();
-        let mut ties = 0;
+        let partner = Partner::new(std::time::Duration::from_millis(5)).unwrap();
+        let (mut ties, mut split_ties) = (0, 0);
         for rx in [[1.0, 1.0, 1.0], [2.3, 2.1, 0.72], [4.1, 3.3, 1.9]].map(Vec3::from_array) {
             let found = tracer.trace(tx, rx).unwrap().result.paths;
             let moved = tracer.scene().with_terminals(tx, rx).unwrap();
@@ -216,15 +330,36 @@ mod tests {
             let mut interleaved = paths.clone();
             interleaved.sort_by_key(|p| p.surfaces.len() % 2);
             for paths in [found, paths, reversed, interleaved] {
+                let expected = reference(&moved, &paths, &radio);
                 let ranked = records.report(&moved, &paths, &radio).unwrap();
-                assert_eq!(
-                    ranked,
-                    reference(&moved, &paths, &radio).as_slice(),
-                    "at {rx}"
+                assert_eq!(ranked, expected.as_slice(), "at {rx}");
+                // In halves, the second on a partner: the same records, and each closure
+                // is handed its half of them, in order.
+                let (first, second) = records
+                    .report_halves(
+                        &moved,
+                        &paths,
+                        &radio,
+                        Some(&partner),
+                        |a| a.to_vec(),
+                        |b| b.to_vec(),
+                    )
+                    .unwrap();
+                assert_eq!(records.paths(), expected.as_slice(), "halves at {rx}");
+                assert_eq!([first.as_slice(), &second].concat(), expected, "at {rx}");
+                assert!(
+                    !first.is_empty() && !second.is_empty(),
+                    "{} paths",
+                    paths.len()
+                );
+                split_ties += usize::from(
+                    first.last().map(|r| (r.order, r.length_m))
+                        == second.first().map(|r| (r.order, r.length_m)),
                 );
             }
         }
         assert!(ties > 10, "{ties} paths moved to a parallel surface");
+        assert_eq!(split_ties, 0, "a run of ties split between the halves");
     }
 
     /// Another surface of `scene` parallel to `path`'s first reflection's (the same normal,

@@ -537,6 +537,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
         bt_import::cloud::DEFAULT_MAX_POINTS,
     )?;
     m.add("DEFAULT_MAX_BEAM_PAIRS", bt_channel::MAX_BEAM_PAIRS.limit)?;
+    m.add("PARTNER_SPIN_US", bt_serve::PARTNER_SPIN_US)?;
     m.add_class::<PyScene>()?;
     m.add_class::<tracer::PyTracer>()?;
     m.add_function(wrap_pyfunction!(load, m)?)?;

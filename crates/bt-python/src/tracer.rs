@@ -22,7 +22,7 @@ impl PyTracer {
     /// overriding its terminals, and trace under `keywords` (the trace keywords of
     /// `Scene.trace`).
     #[new]
-    #[pyo3(signature = (source, keywords, tx, rx, beams=None))]
+    #[pyo3(signature = (source, keywords, tx, rx, beams=None, partner_spin_us=bt_serve::PARTNER_SPIN_US))]
     fn new(
         py: Python<'_>,
         source: String,
@@ -30,6 +30,7 @@ impl PyTracer {
         tx: Option<[f64; 3]>,
         rx: Option<[f64; 3]>,
         beams: Option<BeamKeywords>,
+        partner_spin_us: u64,
     ) -> PyResult<Self> {
         let options = LoadOptions {
             terminals: terminals(tx, rx),
@@ -41,7 +42,9 @@ impl PyTracer {
             .trace_options(dynamic.step(0))
             .map_err(PyValueError::new_err)?;
         let radio = keywords.radio().map_err(PyValueError::new_err)?;
-        let mut server = Server::new(dynamic, trace_options, radio, Limits::default());
+        let spin = std::time::Duration::from_micros(partner_spin_us);
+        let mut server =
+            Server::new(dynamic, trace_options, radio, Limits::default()).with_partner(spin);
         if let Some(beams) = beams {
             server = server.with_beams(beams.options(&radio)?);
         }

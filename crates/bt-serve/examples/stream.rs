@@ -6,7 +6,8 @@
 //! request, the mean paths and stage times of an answer (docs/performance.md). With
 //! `STREAM_TAIL=1` it also prints what the slowest 1 % of the answers are made of and the
 //! answers by their number of paths; with `STREAM_ONE=1` it runs the first mode alone, and `STREAM_OUT=FILE`
-//! writes that mode's answers to FILE, one a line. `STREAM_SAME=1` sends the walk's first
+//! writes that mode's answers to FILE, one a line; `STREAM_PARTNER_US=N` is serve's
+//! `--partner-spin-us` (default as serve's). `STREAM_SAME=1` sends the walk's first
 //! receiver every time: the same work each answer, so that the spread of `latency_us` is the
 //! machine's, not the data's.
 //!
@@ -204,12 +205,15 @@ fn server(max_order: usize) -> Result<Server, Box<dyn std::error::Error>> {
         ..SolveSettings::default()
     };
     let options = settings.trace_options(dynamic.step(0))?;
-    Ok(Server::new(
-        dynamic,
-        options,
-        RadioOptions::default(),
-        Limits::default(),
-    ))
+    let server = Server::new(dynamic, options, RadioOptions::default(), Limits::default());
+    // `STREAM_PARTNER_US=N`: serve's `--partner-spin-us` (0: every answer on one thread).
+    let spin = match std::env::var("STREAM_PARTNER_US") {
+        Ok(v) => v
+            .parse()
+            .map_err(|e| format!("STREAM_PARTNER_US ({v:?}): {e}"))?,
+        Err(_) => bt_serve::PARTNER_SPIN_US,
+    };
+    Ok(server.with_partner(std::time::Duration::from_micros(spin)))
 }
 
 /// Streams `lines` through a fresh server; the wall time of the whole stream and each

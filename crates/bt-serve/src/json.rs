@@ -14,16 +14,15 @@ use bt_beams::{Direction, InteractionKind, PathReport};
 use serde_json::ser::{CompactFormatter, Formatter};
 use std::io;
 
-/// `paths` as serde_json writes `Vec<PathReport>`: `[record, ...]`.
-pub(crate) fn write_paths(out: &mut Vec<u8>, paths: &[PathReport]) -> io::Result<()> {
-    out.push(b'[');
+/// `paths`' records separated by commas: inside brackets, the bytes serde_json writes for
+/// `Vec<PathReport>`.
+pub(crate) fn write_records(out: &mut Vec<u8>, paths: &[PathReport]) -> io::Result<()> {
     for (k, path) in paths.iter().enumerate() {
         if k > 0 {
             out.push(b',');
         }
         write_path(out, path)?;
     }
-    out.push(b']');
     Ok(())
 }
 
@@ -261,8 +260,9 @@ mod tests {
     use rand_chacha::ChaCha8Rng;
 
     fn mine(paths: &[PathReport]) -> String {
-        let mut out = Vec::new();
-        write_paths(&mut out, paths).unwrap();
+        let mut out = vec![b'['];
+        write_records(&mut out, paths).unwrap();
+        out.push(b']');
         String::from_utf8(out).unwrap()
     }
 

@@ -37,6 +37,11 @@ pub const MAX_RECEIVERS: usize = 1024;
 /// room), so the number bounds the memory.
 pub const MAX_CONNECTIONS: usize = 16;
 
+/// How long, µs, the partner of a lone receiver's answer spins for the next one before it
+/// sleeps (`serve --partner-spin-us`, [`Server::with_partner`]): requests that follow each
+/// other within it get their report and JSON split over two cores.
+pub const PARTNER_SPIN_US: u64 = 1000;
+
 /// The bounds every request is checked against before any work.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct Limits {

@@ -10,11 +10,12 @@ use bt_geom::Vec3;
 use bt_scene::dynamic::{DynamicScene, Pose};
 use bt_scene::{SceneError, Terminals};
 use bt_solve::Tracer;
+use bt_solve::partner::Partner;
 use bt_solve::pipeline::{TraceError, TraceOptions, Traced};
 use serde::Serialize;
 use serde_json::Value;
 use std::io::Write;
-use std::sync::Mutex;
+use std::sync::{Arc, Mutex};
 use std::time::{Duration, Instant};
 
 /// A long-lived tracer answering requests: one [`Tracer`] for the whole life of the server
@@ -34,6 +35,9 @@ pub struct Server {
     pub(crate) held: Vec<Pose>,
     /// Beam answers, when the server sweeps arrays.
     beams: Option<BeamOptions>,
+    /// The thread that takes half of a lone receiver's report and JSON
+    /// ([`Server::with_partner`]); clones of the server share it.
+    partner: Option<Arc<Partner>>,
 }
 
 /// What a request may leave out and take from the previous one.
@@ -124,7 +128,21 @@ impl Server {
             initial,
             held: poses,
             beams: None,
+            partner: None,
         }
+    }
+
+    /// The server splitting a lone receiver's report and JSON over a second core
+    /// ([`Partner`]), whose thread spins for `window` after each answer before it sleeps (a
+    /// stream of requests keeps it awake, at the price of that core); no partner when
+    /// `window` is zero, or on one core.
+    pub fn with_partner(self, window: Duration) -> Self {
+        let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
+        let partner = match window.is_zero() || cores < 2 {
+            true => None,
+            false => Partner::new(window).map(Arc::new),
+        };
+        Server { partner, ..self }
     }
 
     /// The server answering with a beam sweep too ([`BeamOptions`]).
@@ -320,6 +338,7 @@ impl Server {
             radio: &self.radio,
             beams: self.beams.as_ref(),
             head,
+            partner: self.partner.as_deref().filter(|_| positions.len() == 1),
         };
         let traced = self.tracer.trace_each_then(tx, positions, |scene, traced| {
             reporter.trace_answer(scene, &traced)
@@ -388,6 +407,7 @@ impl Server {
             radio: &self.radio,
             beams: self.beams.as_ref(),
             head,
+            partner: None,
         };
         let first = serialise(&Answer {
             head,
@@ -419,6 +439,8 @@ struct Reporter<'a> {
     beams: Option<&'a BeamOptions>,
     /// What opens each answer ([`Answer::head`]).
     head: Option<&'a [u8]>,
+    /// Who takes half of the report and of the JSON ([`Server::with_partner`]).
+    partner: Option<&'a Partner>,
 }
 
 impl Reporter<'_> {
@@ -428,17 +450,35 @@ impl Reporter<'_> {
     fn trace_answer(&self, scene: &bt_scene::Scene, traced: &Traced) -> Outcome {
         REPORTS.with_borrow_mut(|records| {
             let t0 = Instant::now();
-            let paths = records.report(scene, &traced.result.paths, self.radio)?;
             let [tx, rx] = bt_beams::terminals_world(scene)?;
+            let found = &traced.result.paths;
+            let mut bytes = open_answer(self.head, tx, rx, found.len())?;
+            let (mine, theirs) = records.report_halves(
+                scene,
+                found,
+                self.radio,
+                self.partner,
+                |first| json::write_records(&mut bytes, first),
+                |second| match second.is_empty() {
+                    true => Ok(None),
+                    false => {
+                        let mut theirs = answer_buffer();
+                        json::write_records(&mut theirs, second).map(|()| Some(theirs))
+                    }
+                },
+            )?;
+            mine.map_err(io_error)?;
+            if let Some(theirs) = theirs.map_err(io_error)? {
+                if bytes.last() != Some(&b'[') {
+                    bytes.push(b',');
+                }
+                bytes.extend_from_slice(&theirs);
+                give_back(theirs);
+            }
+            let paths = records.paths();
             let stats = Stats::of(traced, paths, self.radio, [Duration::ZERO, t0.elapsed()]);
-            serialise(&Answer {
-                head: self.head,
-                tx,
-                rx,
-                beams: self.beams_of(paths, scene.frequency_hz())?,
-                paths,
-                stats: AnswerStats::Trace(stats),
-            })
+            let beams = self.beams_of(paths, scene.frequency_hz())?;
+            close_answer(bytes, &AnswerStats::Trace(stats), beams.as_ref())
         })
     }
 
@@ -522,29 +562,46 @@ fn give_back(mut bytes: Vec<u8>) {
 /// for a typical answer up front: the bytes serde_json writes for [`Answer`], its path records
 /// written by hand ([`crate::json`]).
 fn serialise(answer: &Answer<'_>) -> Outcome {
+    let mut bytes = open_answer(answer.head, answer.tx, answer.rx, answer.paths.len())?;
+    json::write_records(&mut bytes, answer.paths).map_err(io_error)?;
+    close_answer(bytes, &answer.stats, answer.beams.as_ref())
+}
+
+/// An answer's JSON up to its path records: `{"tx":..,"rx":..,"paths":[` (opened by `head`
+/// when given, [`Answer::head`]), in a spare buffer with room for `paths` records.
+fn open_answer(head: Option<&[u8]>, tx: [f64; 3], rx: [f64; 3], paths: usize) -> Outcome {
     let mut bytes = answer_buffer();
-    bytes.reserve(1024 + 1024 * answer.paths.len());
-    let io = |e: std::io::Error| ServeError::Json(serde_json::Error::io(e));
-    match answer.head {
+    bytes.reserve(1024 + 1024 * paths);
+    match head {
         Some(head) => {
             bytes.extend_from_slice(head);
             bytes.extend_from_slice(b",\"tx\":");
         }
         None => bytes.extend_from_slice(b"{\"tx\":"),
     }
-    json::write_reals(&mut bytes, &answer.tx).map_err(io)?;
+    json::write_reals(&mut bytes, &tx).map_err(io_error)?;
     bytes.extend_from_slice(b",\"rx\":");
-    json::write_reals(&mut bytes, &answer.rx).map_err(io)?;
-    bytes.extend_from_slice(b",\"paths\":");
-    json::write_paths(&mut bytes, answer.paths).map_err(io)?;
-    bytes.extend_from_slice(b",\"stats\":");
-    serde_json::to_writer(&mut bytes, &answer.stats)?;
-    if let Some(beams) = &answer.beams {
+    json::write_reals(&mut bytes, &rx).map_err(io_error)?;
+    bytes.extend_from_slice(b",\"paths\":[");
+    Ok(bytes)
+}
+
+/// The rest of an answer opened by [`open_answer`] whose records `bytes` holds: the list's
+/// end, `stats`, `beams` when there are some, and the closing brace.
+fn close_answer(mut bytes: Vec<u8>, stats: &AnswerStats, beams: Option<&BeamsAnswer>) -> Outcome {
+    bytes.extend_from_slice(b"],\"stats\":");
+    serde_json::to_writer(&mut bytes, stats)?;
+    if let Some(beams) = beams {
         bytes.extend_from_slice(b",\"beams\":");
         serde_json::to_writer(&mut bytes, beams)?;
     }
     bytes.push(b'}');
     Ok(bytes)
+}
+
+/// A JSON writer's I/O error (into memory: none in practice) as the serve error.
+fn io_error(e: std::io::Error) -> ServeError {
+    ServeError::Json(serde_json::Error::io(e))
 }
 
 /// `{"id":ID`, the opening of the reply to the request of id `id`, into `out`.
@@ -679,6 +736,7 @@ mod tests {
             radio: &radio,
             beams: sweep.as_ref(),
             head: None,
+            partner: None,
         };
         let tx = scene.tx_world().unwrap();
         let mut tracer = Tracer::new(scene, options);

@@ -20,6 +20,7 @@ pub mod image;
 pub mod ipc;
 mod lanes;
 mod newton;
+pub mod partner;
 pub mod pipeline;
 pub mod sbr;
 pub mod settings;

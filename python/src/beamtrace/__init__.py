@@ -417,6 +417,10 @@ class Tracer:
     beams`` over the answer's paths, its ``best`` pair and the first ``top`` pairs, with
     ``tx_spacing``/``rx_spacing`` (wavelengths), ``ranking`` ("power" or "paper") and the
     ``max_beam_pairs`` budget.
+
+    ``partner_spin_us`` is ``serve --partner-spin-us``: how long (µs) a second thread spins
+    after each update for the next one, to take half of a lone receiver's report; 0 answers
+    every update on one thread (the same answers either way).
     """
 
     def __init__(
@@ -431,6 +435,7 @@ class Tracer:
         ranking: str = "power",
         top: int = 5,
         max_beam_pairs: int = _native.DEFAULT_MAX_BEAM_PAIRS,
+        partner_spin_us: int = _native.PARTNER_SPIN_US,
         **options: Any,
     ) -> None:
         rx = None
@@ -453,8 +458,11 @@ class Tracer:
                 "top": int(top),
                 "max_beam_pairs": int(max_beam_pairs),
             }
+        spin = int(partner_spin_us)
+        if not 0 <= spin <= 1_000_000:
+            raise ValueError(f"partner_spin_us: {spin} is outside 0..=1000000")
         self._native = _native.Tracer(
-            source, keywords, _point(tx, "tx"), _point(rx, "rx"), beams
+            source, keywords, _point(tx, "tx"), _point(rx, "rx"), beams, spin
         )
 
     def update(

@@ -17,6 +17,7 @@ DEFAULT_MAX_XML_SUBSTITUTION: int
 DEFAULT_MAX_MESH_ELEMENTS: int
 DEFAULT_MAX_CLOUD_POINTS: int
 DEFAULT_MAX_BEAM_PAIRS: int
+PARTNER_SPIN_US: int
 
 class BeamtraceError(Exception): ...
 
@@ -58,6 +59,7 @@ class Tracer:
         tx: _Point,
         rx: _Point,
         beams: Optional[Dict[str, Any]] = None,
+        partner_spin_us: int = ...,
     ) -> None: ...
     def answer(self, line: str) -> str: ...
 

@@ -77,3 +77,45 @@ fn a_stream_answered_in_batches_is_the_stream_answered_one_by_one() {
         assert_eq!(a, b, "answer {i} (request {})", lines[i]);
     }
 }
+
+/// A server with a partner thread (half of each lone receiver's report and JSON on a second
+/// core) answers a walk of single receivers, lists and a moved TX with the very bytes of a
+/// server without one, each request answered alone.
+#[test]
+fn answers_split_over_a_partner_are_the_answers_of_one_thread() {
+    let mut lines = Vec::new();
+    for i in 0..60 {
+        let x = 0.6 + 0.08 * f64::from(i);
+        let y = 1.0 + 0.05 * f64::from(i % 17);
+        lines.push(json!({"id": i, "rx": [x, y, 1.1]}).to_string());
+        match i {
+            20 => lines.push(json!({"id": "list", "rx": [[1, 1, 1], [2, 2, 1]]}).to_string()),
+            40 => lines.push(json!({"id": "tx", "tx": [3, 3, 2]}).to_string()),
+            _ => {}
+        }
+    }
+    let settings = SolveSettings {
+        max_order: 3,
+        ..SolveSettings::default()
+    };
+    let answers = |spin_us: u64| -> Vec<String> {
+        let server = server("builtin:living-room", settings, Limits::default());
+        let mut server = server.with_partner(std::time::Duration::from_micros(spin_us));
+        let mut out = Vec::new();
+        (lines.iter())
+            .map(|line| {
+                server.answer_line(line.as_bytes(), &mut out);
+                steady(std::str::from_utf8(&out).expect("UTF-8"))
+            })
+            .collect()
+    };
+    let (alone, split) = (answers(0), answers(5_000));
+    let paths = |l: &String| l.matches("\"rank\"").count();
+    assert!(
+        alone.iter().filter(|l| paths(l) >= 16).count() > 50,
+        "answers with paths to split"
+    );
+    for (i, (a, b)) in alone.iter().zip(&split).enumerate() {
+        assert_eq!(a, b, "answer {i} (request {})", lines[i]);
+    }
+}
