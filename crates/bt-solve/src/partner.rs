@@ -155,7 +155,9 @@ impl Partner {
         let erased: *const (dyn Half + 'static) = unsafe { std::mem::transmute(erased) };
         // SAFETY: `state` is `EMPTY` and this caller holds `busy` (`Shared`'s protocol).
         unsafe { *self.shared.job.get() = Some(erased) };
-        self.shared.state.store(OFFERED, Ordering::Release);
+        // SeqCst with the load of `parked` below and the partner's own pair: either the
+        // partner sees the offer before it parks, or this sees that it parked.
+        self.shared.state.store(OFFERED, Ordering::SeqCst);
         if self.shared.parked.load(Ordering::SeqCst) {
             self.handle.unpark();
         }
