@@ -608,6 +608,32 @@ impl BeamTree {
         rx: Vec3,
         nodes: impl IntoIterator<Item = usize>,
     ) -> CandidateSet {
+        let hits = nodes
+            .into_iter()
+            .filter(|&i| self.nodes[i].live && self.holds(i, rx));
+        self.candidates_of(hits)
+    }
+
+    /// Nodes of the tree in the order [`BeamTree::candidates`] tests them (by depth, then
+    /// index): [`BeamTree::holding`] takes ranges of it.
+    pub fn walk_len(&self) -> usize {
+        self.levels.iter().map(|&(lo, hi)| hi - lo).sum()
+    }
+
+    /// The live nodes at positions `part` of the walk ([`BeamTree::walk_len`]) whose beams
+    /// hold `rx`, in walk order, appended to `hits`: a part of [`BeamTree::candidates`]'s
+    /// tests, so that parts may be tested on different threads and their hits given, in
+    /// order, to [`BeamTree::candidates_of`].
+    pub fn holding(&self, rx: Vec3, part: std::ops::Range<usize>, hits: &mut Vec<usize>) {
+        let walk = self.levels.iter().flat_map(|&(lo, hi)| lo..hi);
+        let nodes = walk.skip(part.start).take(part.len());
+        hits.extend(nodes.filter(|&i| self.nodes[i].live && self.holds(i, rx)));
+    }
+
+    /// The candidate set of `hits`, the live nodes holding a receiver in walk order
+    /// ([`BeamTree::holding`]): line of sight and each node's sequence, as
+    /// [`BeamTree::candidates`] gives it.
+    pub fn candidates_of(&self, hits: impl IntoIterator<Item = usize>) -> CandidateSet {
         let mut set = CandidateSet::with_starts();
         set.reserve(
             RESERVED_CANDIDATES,
@@ -617,11 +643,9 @@ impl BeamTree {
         set.push_with_starts(&[], &[]);
         let mut seq = Vec::with_capacity(self.max_order);
         let mut starts = Vec::with_capacity(self.max_order);
-        for i in nodes {
-            if self.nodes[i].live && self.holds(i, rx) {
-                self.prefix(i as u32, &mut seq, &mut starts);
-                push(&mut set, &seq, &starts);
-            }
+        for i in hits {
+            self.prefix(i as u32, &mut seq, &mut starts);
+            push(&mut set, &seq, &starts);
         }
         set.stats = self.candidate_stats(set.len() as u64);
         set.tree = Some(self.stats.clone());

@@ -35,9 +35,6 @@ pub struct Server {
     pub(crate) held: Vec<Pose>,
     /// Beam answers, when the server sweeps arrays.
     beams: Option<BeamOptions>,
-    /// The thread that takes half of a lone receiver's report and JSON
-    /// ([`Server::with_partner`]); clones of the server share it.
-    partner: Option<Arc<Partner>>,
 }
 
 /// What a request may leave out and take from the previous one.
@@ -128,21 +125,21 @@ impl Server {
             initial,
             held: poses,
             beams: None,
-            partner: None,
         }
     }
 
-    /// The server splitting a lone receiver's report and JSON over a second core
+    /// The server splitting a lone receiver's walk of the kept tree, report and JSON over a second core
     /// ([`Partner`]), whose thread spins for `window` after each answer before it sleeps (a
     /// stream of requests keeps it awake, at the price of that core); no partner when
     /// `window` is zero, or on one core.
-    pub fn with_partner(self, window: Duration) -> Self {
+    pub fn with_partner(mut self, window: Duration) -> Self {
         let cores = std::thread::available_parallelism().map_or(1, |n| n.get());
         let partner = match window.is_zero() || cores < 2 {
             true => None,
             false => Partner::new(window).map(Arc::new),
         };
-        Server { partner, ..self }
+        self.tracer.set_partner(partner);
+        self
     }
 
     /// The server answering with a beam sweep too ([`BeamOptions`]).
@@ -334,11 +331,12 @@ impl Server {
         field: &Field<'_>,
         head: Option<&[u8]>,
     ) -> Result<Vec<Outcome>, ServeError> {
+        let partner = self.tracer.partner().filter(|_| positions.len() == 1);
         let reporter = Reporter {
             radio: &self.radio,
             beams: self.beams.as_ref(),
             head,
-            partner: self.partner.as_deref().filter(|_| positions.len() == 1),
+            partner: partner.as_deref(),
         };
         let traced = self.tracer.trace_each_then(tx, positions, |scene, traced| {
             reporter.trace_answer(scene, &traced)

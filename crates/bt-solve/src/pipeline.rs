@@ -5,6 +5,7 @@
 //! dispatch live here, in one place. [`candidates`] stays public for the accelerator's host and
 //! the studies, which solve the candidate set their own way.
 
+use crate::partner::Partner;
 use crate::{Solver, TraceResult};
 use bt_geom::Vec3;
 use bt_paths::beamtree::{
@@ -405,6 +406,9 @@ pub(crate) fn solve_set(
     })
 }
 
+/// Nodes of a kept tree from which a lone receiver's walk is split over a [`Partner`].
+const SPLIT_WALK: usize = 256;
+
 /// Receivers from which a many-receiver trace narrows the kept tree's nodes for boxes of
 /// receivers ([`BeamTree::receiver_nodes`]) before walking it for each.
 const BATCHED_RECEIVERS: usize = 16;
@@ -422,8 +426,11 @@ pub(crate) fn trace_each_receiver<T: Send>(
     receivers: &[Vec3],
     options: &TraceOptions,
     (tree, cache): (Option<&KeptTx>, &mut TreeCache),
+    partner: Option<&Partner>,
     then: &(impl Fn(&Scene, Traced) -> T + Sync),
 ) -> Vec<Result<T, TraceError>> {
+    // A lone receiver's walk may take the partner; receivers in parallel use the cores.
+    let partner = partner.filter(|_| receivers.len() == 1);
     let inner = TraceOptions {
         parallel: false,
         ..*options
@@ -451,7 +458,7 @@ pub(crate) fn trace_each_receiver<T: Send>(
             Some(kept) if moved.length_tolerance() <= kept.tree.tolerance() => {
                 let t0 = Instant::now();
                 let among = nodes.as_ref().map(|n| n.of(k));
-                let set = kept.candidates(&moved, among, &inner)?;
+                let set = kept.candidates(&moved, among, &inner, partner)?;
                 solve_set(&moved, set, &inner, t0.elapsed())?
             }
             // Receivers traced in parallel cannot share one cache (`tree` is built in beam-tree
@@ -504,16 +511,29 @@ impl KeptTx {
     /// The candidates of `scene`'s RX (`scene` has this tree's TX): a walk of the tree (of
     /// the nodes `among`, when given: a superset of those holding RX from
     /// [`BeamTree::receiver_nodes`]), and the diffracted ones joined with a tree grown from RX.
+    /// With a `partner`, the walk's second half of the nodes is tested on it.
     fn candidates(
         &self,
         scene: &Scene,
         among: Option<&[u32]>,
         options: &TraceOptions,
+        partner: Option<&Partner>,
     ) -> Result<CandidateSet, TraceError> {
         let rx = scene.terminals()?.rx;
-        let mut set = match among {
-            Some(nodes) => (self.tree).candidates_among(rx, nodes.iter().map(|&i| i as usize)),
-            None => self.tree.candidates(rx),
+        let tree = &self.tree;
+        let walk = tree.walk_len();
+        let mut set = match (among, partner) {
+            (Some(nodes), _) => tree.candidates_among(rx, nodes.iter().map(|&i| i as usize)),
+            (None, Some(partner)) if walk >= SPLIT_WALK => {
+                let (mut first, mut second) = (Vec::new(), Vec::new());
+                let k = walk / 2;
+                partner.join(
+                    || tree.holding(rx, 0..k, &mut first),
+                    || tree.holding(rx, k..walk, &mut second),
+                );
+                tree.candidates_of(first.into_iter().chain(second))
+            }
+            (None, _) => tree.candidates(rx),
         };
         if let Some(side) = &self.side {
             let tree_options = solver_tree_options(options);

@@ -5,6 +5,7 @@
 //! Every cache is a field: nothing lives in a thread-local that a caller cannot see or reset.
 //! A cache only saves work; a fresh `Tracer` gives bit-identical results.
 
+use crate::partner::Partner;
 use crate::pipeline::{
     BuildProgress, KeptTx, TraceError, TraceOptions, Traced, trace_each_receiver, trace_scene_in,
     walks_one_tree,
@@ -13,6 +14,7 @@ use crate::steps::{Incremental, StepTrace, trace_scratch};
 use bt_geom::Vec3;
 use bt_paths::beamtree::TreeCache;
 use bt_scene::Scene;
+use std::sync::Arc;
 
 /// Traces one scene (as its options see it, [`TraceOptions::scene_of`]): one TX–RX pair ([`Tracer::trace`]), one TX to many receivers with one beam
 /// tree ([`Tracer::trace_many`]), or the next time step of a dynamic scene, incrementally
@@ -39,6 +41,9 @@ pub struct Tracer {
     previous: Incremental,
     /// Index of the next time step.
     next_step: usize,
+    /// The thread that takes half of a lone receiver's walk of the kept tree
+    /// ([`Tracer::set_partner`]); clones share it.
+    partner: Option<Arc<Partner>>,
 }
 
 impl Tracer {
@@ -51,6 +56,7 @@ impl Tracer {
             kept: None,
             previous: Incremental::default(),
             next_step: 0,
+            partner: None,
         }
     }
 
@@ -127,6 +133,17 @@ impl Tracer {
         self.trace_each_then(tx, receivers, |_, traced| traced)
     }
 
+    /// A lone receiver's walk of the kept tree split over `partner` from now on
+    /// ([`Partner::join`]; `None`: on the calling thread): the same candidates.
+    pub fn set_partner(&mut self, partner: Option<Arc<Partner>>) {
+        self.partner = partner;
+    }
+
+    /// The partner of [`Tracer::set_partner`], if any.
+    pub fn partner(&self) -> Option<Arc<Partner>> {
+        self.partner.clone()
+    }
+
     /// [`Tracer::trace_each`], with `then` applied to each receiver's trace, beside the scene
     /// it was traced in (the scene with `tx` and that receiver), in the task that traced it:
     /// a caller that reports each receiver does so on the thread that traced it, in parallel
@@ -156,6 +173,7 @@ impl Tracer {
                 receivers,
                 &options,
                 (tree.as_ref(), cache),
+                self.partner.as_deref(),
                 &then,
             ));
         }
@@ -168,6 +186,7 @@ impl Tracer {
             receivers,
             &options,
             (tree, &mut self.cache),
+            self.partner.as_deref(),
             &then,
         ))
     }

@@ -559,7 +559,8 @@ proptest! {
     /// give each receiver exactly the candidates, in order, of a walk over every node: clusters
     /// of receivers (small boxes, tight against the beams' planes), scattered ones (large
     /// boxes), receivers on the beams' boundary planes themselves (the surfaces' vertices)
-    /// and one with a non-finite coordinate.
+    /// and one with a non-finite coordinate. The walk cut in two parts
+    /// ([`BeamTree::holding`]) gives the same candidates too.
     #[test]
     fn receiver_boxes_keep_every_candidate_of_a_full_walk(
         seed in 0u64..1_000_000, n in 1usize..9, order in 1usize..4, spread in 0.0f64..1.0,
@@ -580,9 +581,18 @@ proptest! {
         receivers.extend(scene.surfaces().iter().flat_map(|s| s.polygon.vertices().iter().copied()));
         receivers.push(Vec3::new(f64::NAN, centre.y, centre.z));
         let nodes = tree.receiver_nodes(&receivers);
+        let walk = tree.walk_len();
         for (k, &rx) in receivers.iter().enumerate() {
+            let full = listing(&tree.candidates(rx));
             let among = tree.candidates_among(rx, nodes.of(k).iter().map(|&i| i as usize));
-            prop_assert_eq!(listing(&among), listing(&tree.candidates(rx)), "receiver {}", k);
+            prop_assert_eq!(listing(&among), full.clone(), "receiver {}", k);
+            // The walk in two parts (serve's partner): the same candidates, in order.
+            let cut = (k * 7919) % (walk + 1);
+            let (mut first, mut second) = (Vec::new(), Vec::new());
+            tree.holding(rx, 0..cut, &mut first);
+            tree.holding(rx, cut..walk, &mut second);
+            let parts = tree.candidates_of(first.into_iter().chain(second));
+            prop_assert_eq!(listing(&parts), full, "receiver {} cut at {} of {}", k, cut, walk);
         }
     }
 }
