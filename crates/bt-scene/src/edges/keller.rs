@@ -508,6 +508,8 @@ mod tests {
             if shortest_at_crossing(a, (first, second), b) {
                 seen[0] += 1;
                 assert_eq!(keller_pair(a, first, second, b), None, "case {case}");
+                let why = keller_pair_checked(a, first, second, b);
+                assert_eq!(why, Err(NoKellerPair::Crossing), "case {case}");
                 for (e1, e2) in [(1e-4, 0.0), (0.0, 1e-4), (1e-4, 1e-4), (1e-4, -1e-4)] {
                     for sign in [1.0, -1.0] {
                         let moved = length(s1 + sign * e1, s2 + sign * e2);
