@@ -213,11 +213,20 @@ fn validate_recording(
     if points.iter().any(|p| !p.is_finite()) {
         return Validity::NonFinite;
     }
-    let vertex = |k: usize| match k {
-        0 => ends.tx,
-        k if k == n + 1 => ends.rx,
-        k => points[k - 1],
+    // TX, the points and RX in one array (a short path's on the stack): vertex k is
+    // `all[k]`, without asking which of the three it is at each call.
+    let (mut stack, mut heap) = ([Vec3::ZERO; 10], Vec::new());
+    let all: &mut [Vec3] = if n + 2 <= stack.len() {
+        &mut stack[..n + 2]
+    } else {
+        heap.resize(n + 2, Vec3::ZERO);
+        &mut heap
     };
+    all[0] = ends.tx;
+    all[1..=n].copy_from_slice(points);
+    all[n + 1] = ends.rx;
+    let all: &[Vec3] = all;
+    let vertex = |k: usize| all[k];
     for (k, e) in c.edges() {
         let edge = scene.edges().get(e);
         let t = edge.parameter(points[k]);
