@@ -222,15 +222,7 @@ impl DiffractedSet {
     }
     /// Put the candidates in the canonical order and drop repeats.
     pub fn canonicalise(&mut self) {
-        // The fields are made twice (for their widths, then for the keys) rather than kept:
-        // an array of them per candidate cost more in fresh memory than making them again.
-        let mut most = [0u64; KEY_FIELDS];
-        for i in 0..self.len() {
-            for (m, v) in most.iter_mut().zip(self.key_fields(i)) {
-                *m |= v;
-            }
-        }
-        let widths: [u32; KEY_FIELDS] = most.map(|m| u64::BITS - m.leading_zeros());
+        let widths = self.key_widths();
         // One integer holds the fields (and orders as they do) when their widths fit 64 bits:
         // a smaller sort; otherwise two 128-bit integers with room for any field.
         let order = if widths.iter().sum::<u32>() <= u64::BITS {
@@ -274,23 +266,57 @@ impl DiffractedSet {
         *self = sorted;
     }
 
+    /// Bits enough for each of [`Self::key_fields`]' fields of every candidate, from the
+    /// largest ids, positions and lengths in the arrays (no key made). Any widths that hold
+    /// the fields pack them into integers ordering as the fields do (in one integer or, past
+    /// 64 bits, in two), so the order and the repeats dropped are those exact widths give.
+    fn key_widths(&self) -> [u32; KEY_FIELDS] {
+        fn most(values: impl Iterator<Item = u64>) -> u64 {
+            values.max().unwrap_or(0)
+        }
+        let bits = |m: u64| u64::BITS - m.leading_zeros();
+        let ids = most(self.ids.iter().map(|s| u64::from(s.0) + 1));
+        let longest = most(self.offsets.windows(2).map(|w| u64::from(w[1] - w[0])));
+        let edges = most(self.edges.iter().map(|e| u64::from(e.0)));
+        let positions = most(self.positions.iter().map(|&p| u64::from(p)));
+        let seconds = most((self.seconds.iter().flatten()).map(|(e, q)| {
+            // The field [`Self::key_fields`] makes (or 0, for a long candidate).
+            1 + ((u64::from(e.0) << 8) | u64::from(*q))
+        }));
+        let id = bits(ids);
+        [
+            bits(longest + 2),
+            bits(positions),
+            bits(edges),
+            id,
+            id,
+            id,
+            id,
+            1,
+            bits(seconds),
+        ]
+    }
+
     /// The sort key of candidate `i`, field by field, most significant first: its order,
     /// position and edge, its first four reflections (each id + 1, 0 when absent), whether
     /// more follow, and its second diffraction (0 with none or with more than four
     /// reflections, else 1 + (edge << 8 | reflections between)). Together they decide alone
     /// up to four reflections; longer lists only on ties ([`Self::canonical_order`]).
+    #[inline(always)]
     fn key_fields(&self, i: usize) -> [u64; KEY_FIELDS] {
-        let c = self.get(i);
-        let id = |k: usize| c.reflections.get(k).map_or(0, |s| u64::from(s.0) + 1);
-        let long = c.reflections.len() > 4;
-        let second = match c.second {
-            Some((edge, q)) if !long => 1 + ((u64::from(edge.0) << 8) | q as u64),
+        // Read from the arrays (what [`Self::get`] gives, without making the candidate).
+        let reflections = &self.ids[self.offsets[i] as usize..self.offsets[i + 1] as usize];
+        let id = |k: usize| reflections.get(k).map_or(0, |s| u64::from(s.0) + 1);
+        let long = reflections.len() > 4;
+        let diffractions = 1 + usize::from(self.seconds[i].is_some());
+        let second = match self.seconds[i] {
+            Some((edge, q)) if !long => 1 + ((u64::from(edge.0) << 8) | u64::from(q)),
             _ => 0,
         };
         [
-            c.order() as u64,
-            c.position as u64,
-            u64::from(c.edge.0),
+            (reflections.len() + diffractions) as u64,
+            u64::from(self.positions[i]),
+            u64::from(self.edges[i].0),
             id(0),
             id(1),
             id(2),

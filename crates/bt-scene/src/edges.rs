@@ -18,8 +18,8 @@
 mod keller;
 
 pub use keller::{
-    EdgeLine, KELLER_PAIR_TOL, KELLER_RESIDUAL, KellerPair, KellerReach, keller_pair,
-    keller_pair_settled,
+    EdgeLine, KELLER_PAIR_TOL, KELLER_RESIDUAL, KellerPair, KellerReach, NoKellerPair, keller_pair,
+    keller_pair_checked, keller_pair_settled,
 };
 
 use crate::surface::{Surface, SurfaceId, SurfaceKind};
@@ -70,6 +70,11 @@ pub struct Edge {
     /// Unit vector `tn = cos(nπ)·t0 + sin(nπ)·y0`: ⊥ `e`, in face n, from the edge into face n
     /// (kept so that the exterior tests need no trigonometry).
     pub tn: Vec3,
+    /// `y0 = e × t0` (unit): face 0's normal on the exterior's side, kept for
+    /// [`Edge::about`] (made once: the same bits as made there at each call before).
+    pub y0: Vec3,
+    /// `tn × e` (unit): face n's normal on the exterior's side, kept as `y0` is.
+    pub yn: Vec3,
     /// Every reflector touching the edge (face 0 and face n among them), ascending: a path
     /// leaving the edge starts on all of them.
     pub touching: Vec<SurfaceId>,
@@ -104,8 +109,7 @@ impl Edge {
     #[inline]
     pub fn angle(&self, p: Vec3) -> Real {
         let v = self.perpendicular(p);
-        let y0 = self.direction.cross(self.t0);
-        let phi = v.dot(y0).atan2(v.dot(self.t0));
+        let phi = v.dot(self.y0).atan2(v.dot(self.t0));
         if phi < 0.0 { phi + 2.0 * PI } else { phi }
     }
 
@@ -125,11 +129,11 @@ impl Edge {
     #[inline]
     pub fn about(&self, p: Vec3) -> About {
         let v = p - self.start;
-        let (sin0, cos0) = (v.dot(self.direction.cross(self.t0)), v.dot(self.t0));
+        let (sin0, cos0) = (v.dot(self.y0), v.dot(self.t0));
         About {
             sin0,
             cos0,
-            sin_n: v.dot(self.tn.cross(self.direction)),
+            sin_n: v.dot(self.yn),
             cos_n: v.dot(self.tn),
             r: (sin0 * sin0 + cos0 * cos0).sqrt(),
         }
@@ -453,6 +457,7 @@ impl Around {
         let mut touching: Vec<SurfaceId> = here.iter().map(|h| h.surface).collect();
         touching.sort();
         touching.dedup();
+        let tn = face_direction(e, t0, gap);
         Some(Edge {
             start: s.a + from * e,
             end: s.a + to * e,
@@ -468,7 +473,9 @@ impl Around {
             // A free edge's gap is a whole turn; rounding may make it a hair more (two
             // coplanar faces on one side of the edge): n stays in UTD's [1, 2].
             n: (gap / PI).min(2.0),
-            tn: face_direction(e, t0, gap),
+            tn,
+            y0: e.cross(t0),
+            yn: tn.cross(e),
             touching,
         })
     }

@@ -213,11 +213,20 @@ fn validate_recording(
     if points.iter().any(|p| !p.is_finite()) {
         return Validity::NonFinite;
     }
-    let vertex = |k: usize| match k {
-        0 => ends.tx,
-        k if k == n + 1 => ends.rx,
-        k => points[k - 1],
+    // TX, the points and RX in one array (a short path's on the stack): vertex k is
+    // `all[k]`, without asking which of the three it is at each call.
+    let (mut stack, mut heap) = ([Vec3::ZERO; 10], Vec::new());
+    let all: &mut [Vec3] = if n + 2 <= stack.len() {
+        &mut stack[..n + 2]
+    } else {
+        heap.resize(n + 2, Vec3::ZERO);
+        &mut heap
     };
+    all[0] = ends.tx;
+    all[1..=n].copy_from_slice(points);
+    all[n + 1] = ends.rx;
+    let all: &[Vec3] = all;
+    let vertex = |k: usize| all[k];
     for (k, e) in c.edges() {
         let edge = scene.edges().get(e);
         let t = edge.parameter(points[k]);
@@ -225,11 +234,14 @@ fn validate_recording(
             return Validity::OffEdge { index: k };
         }
     }
+    // The reflections with their points' indices, in path order: the r-th reflection is
+    // point r plus the diffractions before it (the same pairs as [`DiffractedCandidate::site`]
+    // gives, without asking each point).
+    let (p, second) = (c.position, c.second.map(|(_, q)| c.position + q));
     let reflections = || {
-        (0..n).filter_map(move |k| match c.site(k) {
-            Site::Reflection(id) => Some((k, id)),
-            Site::Diffraction(_) => None,
-        })
+        let before =
+            move |r: usize| usize::from(r >= p) + usize::from(second.is_some_and(|s| r >= s));
+        (c.reflections.iter().enumerate()).map(move |(r, &id)| (r + before(r), id))
     };
     for (k, id) in reflections() {
         if let Some(verdict) = validate::reflection_point(scene, id, points[k], tol, k) {
@@ -292,16 +304,27 @@ fn blocked(
     crossings: &mut Crossings,
 ) -> Validity {
     let tol = scene.length_tolerance();
+    // Vertex k (0 = TX) lies on: nothing for the terminals, its edge's surfaces for a
+    // diffraction point, its surface for a reflection (the j-th point's reflection is
+    // `reflections[j − the diffractions before j]`). Worked out once for the candidate, not
+    // from [`DiffractedCandidate::site`] at each call.
+    let p = c.position;
+    let first: &[SurfaceId] = &scene.edges().get(c.edge).touching;
+    let (d2, second): (usize, &[SurfaceId]) = match c.second {
+        Some((edge, q)) => (p + q + 1, &scene.edges().get(edge).touching),
+        None => (usize::MAX, &[]),
+    };
     let on = |k: usize| -> &[SurfaceId] {
-        // Vertex k (0 = TX) lies on: nothing for the terminals, its edge's surfaces for a
-        // diffraction point.
         match k {
             0 => &[],
             k if k == n + 1 => &[],
-            k => match c.site(k - 1) {
-                Site::Diffraction(e) => &scene.edges().get(e).touching,
-                Site::Reflection(_) => reflection_slice(c, k - 1),
-            },
+            k if k - 1 == p => first,
+            k if k - 1 == d2 => second,
+            k => {
+                let j = k - 1;
+                let r = j - usize::from(j > p) - usize::from(j > d2);
+                std::slice::from_ref(&c.reflections[r])
+            }
         }
     };
     let through = validate::may_cross(scene, n);
@@ -321,13 +344,6 @@ fn blocked(
         return validate::crossing_budget_recording(scene, path, n, |c| crossings.push(c));
     }
     Validity::Valid
-}
-
-/// The one-surface slice of reflection point `k` of `c` (borrowed from its reflections).
-#[inline(always)]
-fn reflection_slice<'a>(c: DiffractedCandidate<'a>, k: usize) -> &'a [SurfaceId] {
-    let skipped = c.edges().filter(|&(index, _)| index < k).count();
-    std::slice::from_ref(&c.reflections[k - skipped])
 }
 
 /// Solve and validate `c` with `solver` (the image method or IPC; SBR does not diffract and

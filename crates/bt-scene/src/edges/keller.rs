@@ -193,9 +193,32 @@ pub fn keller_pair_settled(
     second: EdgeLine,
     b: Vec3,
 ) -> Option<KellerPair> {
+    keller_pair_checked(a, first, second, b).ok()
+}
+
+/// Why [`keller_pair_checked`] gives no pair.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum NoKellerPair {
+    /// The lines cross and the shortest path runs through their crossing, both points
+    /// there: the length is convex, so it has no other stationary point (another would be
+    /// a minimum too, and the strictly convex length has one), and no path over both lines
+    /// obeys Keller's law with a middle leg of positive length.
+    Crossing,
+    /// The solve did not settle from either end, or a point fell on its neighbour.
+    Unsettled,
+}
+
+/// [`keller_pair_settled`], telling why there is no pair ([`NoKellerPair`]): the same pair,
+/// bit for bit, when there is one.
+pub fn keller_pair_checked(
+    a: Vec3,
+    first: EdgeLine,
+    second: EdgeLine,
+    b: Vec3,
+) -> Result<KellerPair, NoKellerPair> {
     // The same test from either end (the crossing's subgradient condition is symmetric).
     if shortest_at_crossing(a, (first, second), b) {
-        return None;
+        return Err(NoKellerPair::Crossing);
     }
     let forward = || keller_pair_from(a, first, second, b);
     let backward = || {
@@ -218,11 +241,12 @@ pub fn keller_pair_settled(
         .map(|(x, y)| x.total_cmp(&y))
         .find(|o| o.is_ne())
         == Some(std::cmp::Ordering::Less);
-    if from_b {
+    let pair = if from_b {
         backward().or_else(forward)
     } else {
         forward().or_else(backward)
-    }
+    };
+    pair.ok_or(NoKellerPair::Unsettled)
 }
 
 /// [`keller_pair`] solved from `a`'s end, the path not through the lines' crossing.
@@ -484,6 +508,8 @@ mod tests {
             if shortest_at_crossing(a, (first, second), b) {
                 seen[0] += 1;
                 assert_eq!(keller_pair(a, first, second, b), None, "case {case}");
+                let why = keller_pair_checked(a, first, second, b);
+                assert_eq!(why, Err(NoKellerPair::Crossing), "case {case}");
                 for (e1, e2) in [(1e-4, 0.0), (0.0, 1e-4), (1e-4, 1e-4), (1e-4, -1e-4)] {
                     for sign in [1.0, -1.0] {
                         let moved = length(s1 + sign * e1, s2 + sign * e2);

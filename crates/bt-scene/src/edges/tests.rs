@@ -188,6 +188,7 @@ fn the_exterior_test_agrees_with_the_angle_definition() {
     for gap_deg in [185.0_f64, 225.0, 270.0, 300.0, 360.0] {
         let gap = gap_deg.to_radians();
         let (e, t0) = (Vec3::Z, Vec3::X);
+        let tn = face_direction(e, t0, gap);
         let edge = Edge {
             start: Vec3::ZERO,
             end: Vec3::Z,
@@ -197,7 +198,9 @@ fn the_exterior_test_agrees_with_the_angle_definition() {
             face_n: SurfaceId(1),
             t0,
             n: gap / PI,
-            tn: face_direction(e, t0, gap),
+            tn,
+            y0: e.cross(t0),
+            yn: tn.cross(e),
             touching: vec![],
         };
         let mut checked = 0;

@@ -17,7 +17,7 @@ use super::{Pairing, Reach};
 use crate::beamtree::{PAIR_TESTS_PER_CANDIDATE, TreeError};
 use crate::diffraction::DiffractedSet;
 use bt_geom::{Plane, Polygon, Real, Vec3};
-use bt_scene::edges::{EdgeLine, KellerReach, keller_pair_settled};
+use bt_scene::edges::{EdgeLine, KellerReach, NoKellerPair, keller_pair_checked};
 use bt_scene::{Edge, EdgeId, Scene, SurfaceId};
 
 /// Angular slack (rad) of the prefilters: far above round-off, far below any angle a valid
@@ -937,7 +937,8 @@ impl Pairing<'_> {
     }
 
     /// `Some` when the Keller pair of `a` and `far` lies in both reaches (within the margin),
-    /// with the pair, or cannot be computed (`Some(None)`); `None` when it lies outside.
+    /// with the pair, or its solve did not settle (`Some(None)`); `None` when it lies outside
+    /// or there is none, the shortest path through the lines' crossing.
     /// The pair's inputs are the image method's for the candidate
     /// ([`DiffractedSet::keller`]), so the solve reuses it. `toward` as for
     /// [`Pairing::apart`]. With the pair, whether it vouches for the group's Keller-law
@@ -952,9 +953,13 @@ impl Pairing<'_> {
         if self.apart(a, far, toward) {
             return None;
         }
-        let Some(pair) = keller_pair_settled(a.reach.image, a.span.line, far.wedge.line, far.image)
-        else {
-            return Some((None, false));
+        let pair = match keller_pair_checked(a.reach.image, a.span.line, far.wedge.line, far.image)
+        {
+            Ok(pair) => pair,
+            // No path over both edges at all ([`NoKellerPair::Crossing`]): the image method
+            // would count the candidate degenerate, and IPC could only meet the crossing.
+            Err(NoKellerPair::Crossing) => return None,
+            Err(NoKellerPair::Unsettled) => return Some((None, false)),
         };
         let (t1, t2) = pair.at;
         let m = self.margin;
