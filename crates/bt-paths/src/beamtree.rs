@@ -1687,14 +1687,16 @@ pub fn candidates_and_diffracted_in(
     if defer {
         let mut visible = rx_visibility(&prep, rx, &mut tree.stats);
         // The join reads the reach lists (and the probes then read them too).
-        let join = join::pays(options.max_order);
+        let parents = tree.levels.last().copied().unwrap_or_default();
+        let join = join::pays(&prep, options.max_order, parents.1 - parents.0);
         if join || reach::Reach::pays(&prep, &visible.ids) {
             visible.reach = Some(reach::Reach::of(&prep, &visible.ids, &rx_mirrored));
         }
         prep.rx_visible = Some(visible);
         let reach = prep.rx_visible.as_ref().and_then(|v| v.reach.as_ref());
-        let joined =
-            (reach.filter(|_| join)).map(|reach| join::Joined::of(&prep, &rx_mirrored, reach));
+        let area = join::apex_box(&tree, parents);
+        let joined = (reach.filter(|_| join))
+            .map(|reach| join::Joined::of(&prep, &rx_mirrored, reach, area));
         let probe = (rx, rx_mirrored.clone());
         let level = (Some(&probe), joined.as_ref());
         tree.grow_level_chunked(&prep, options.max_order - 1, level, progress)?;

@@ -11,9 +11,11 @@
 //! `s`'s plane: RX's depth-1 node on `s`, or its depth-2 node `(t, s)` (the part of `s`'s
 //! grown hull inside `t`'s mirror beam, [`super::reach`]). The join builds these cones once
 //! per reflector `s` (`t` from the reach lists), grouped by the side of `s`'s plane their apex
-//! lies on; a child `s` of a parent (found by the parent's box test as before) is then clipped
-//! and probed only when the parent's apex lies in one of `s`'s cones: a few dot products
-//! instead of a clip and a probe for each of the pairs no cone holds.
+//! lies on, each group with a box around its cones inside the parents' apexes' box; a child
+//! `s` of a parent (found by the parent's box test as before) is then clipped and probed only
+//! when the parent's apex lies in a group's box and in one of its cones: a few compares and
+//! dot products instead of a clip and a probe for each of the pairs no cone holds. Used from
+//! [`JOIN_FROM`] parents in large scenes, always in small ones ([`pays`]).
 //!
 //! Margins: `p`'s region is `s`'s hull grown by half the reach lists' margin (a
 //! well-conditioned node's window, relaxed by the probe's one tolerance, lies within a
@@ -23,10 +25,11 @@
 //! `s`'s plane joins every parent. A node whose beam is not well defined (a sliver window far
 //! from its apex, whose side planes rounding orients at random, or a sharp corner) can still
 //! pass the probe outside these cones: such nodes give candidates only by rounding, and the
-//! trace's paths do not depend on them (docs/beam-tree.md, "RX-side join").
+//! trace's paths do not depend on them (docs/beam-tree.md, "The deferred level's pairs from
+//! RX's side").
 
 use super::reach::Reach;
-use super::{Mirrored, Prepared, chunked, flip};
+use super::{BeamTree, LINEAR_SCAN, Mirrored, Prepared, chunked, flip};
 use bt_geom::{Plane, Real, Vec3, convex};
 use bt_scene::SurfaceId;
 
@@ -41,54 +44,88 @@ const MAX_NORMAL_ERROR: Real = 1e-10;
 /// Per reflector `s`, the cones that a parent's apex must lie in for the node `(parent, s)`
 /// to pass the probe (see the module).
 pub(super) struct Joined {
-    /// Per surface: its cones in `cones`, those whose apex lies on the positive side of its
-    /// plane first (`lo..mid`), then the others (`mid..hi`); `None`: every parent joins it.
-    spans: Vec<Option<(u32, u32, u32)>>,
-    /// Per cone, its planes' range in `planes`.
-    cones: Vec<(u32, u32)>,
-    planes: Vec<Plane>,
+    /// Per surface: its cones ([`Span`]), those whose apex lies on the positive side of its
+    /// plane first, then the others, and a box around each group's cones inside the
+    /// parents' apexes' box; `None`: every parent joins it.
+    spans: Vec<Option<Span>>,
+    /// The cones of each task of [`Joined::of`], where they were made (no copy).
+    parts: Vec<Part>,
     margin: Real,
 }
 
-/// Whether the deferred level of a trace to `max_order` uses the join: at order 3 (its
-/// parents are the first level's nodes, a city's few thousand).
-pub(super) fn pays(max_order: usize) -> bool {
-    max_order == 3
+/// The cones of some reflectors: per cone, its side planes' range in `planes`.
+#[derive(Default)]
+struct Part {
+    cones: Vec<(u32, u32)>,
+    planes: Vec<Plane>,
 }
 
-/// The cones of one reflector: every parent joins it (`None`), or its cones' side planes one
-/// after another, where each cone ends, and how many cones (the first) have their apex on
-/// the positive side of its plane.
-type SurfaceCones = Option<(Vec<Plane>, Vec<u32>, usize)>;
+/// One reflector's cones in [`Part::cones`] of part `part`, and a box (min, max) around each of its two
+/// groups' cones within the parents' apexes' box (empty for an empty group), read first:
+/// most parents' apexes lie outside it (one cache line instead of the cones' planes).
+#[derive(Clone, Copy)]
+struct Span {
+    part: u32,
+    cones: (u32, u32, u32),
+    bounds: [(Vec3, Vec3); 2],
+}
+
+/// A box holding nothing (the identity of [`union`]).
+const EMPTY: (Vec3, Vec3) = (Vec3::splat(Real::INFINITY), Vec3::splat(Real::NEG_INFINITY));
+
+/// The box around two boxes.
+fn union(a: (Vec3, Vec3), b: (Vec3, Vec3)) -> (Vec3, Vec3) {
+    (a.0.min(b.0), a.1.max(b.1))
+}
+
+/// The box (min, max; m) around the apexes of the nodes `tree.nodes[lo..hi]`.
+pub(super) fn apex_box(tree: &BeamTree, (lo, hi): (usize, usize)) -> (Vec3, Vec3) {
+    (tree.nodes[lo..hi].iter()).fold(EMPTY, |b, n| union(b, (n.image, n.image)))
+}
+
+/// From this many parents, a large scene's deferred level uses the join: its cones cost
+/// about the same whatever the number of parents, the tries they spare grow with it
+/// (order 3, one thread, CPU time of the whole trace: Florence's 9,139 parents −6 %, San
+/// Francisco's 12,822 −6 %; Munich's 3,460 +2 %, Etoile's 3,057 +4 %).
+const JOIN_FROM: usize = 8_192;
+
+/// Whether the deferred level of a trace to `max_order` with `parents` parents uses the
+/// join: at order 3 (its parents are the first level's nodes), in large scenes from
+/// [`JOIN_FROM`] parents, always in small ones (so that the property tests exercise it).
+pub(super) fn pays(prep: &Prepared<'_>, max_order: usize, parents: usize) -> bool {
+    max_order == 3 && (prep.reflectors.len() <= LINEAR_SCAN || parents >= JOIN_FROM)
+}
 
 impl Joined {
-    /// The cones of every reflector for the RX of `mirrored`, whose reach lists are `reach`.
-    pub(super) fn of(prep: &Prepared<'_>, mirrored: &Mirrored, reach: &Reach) -> Joined {
-        let side = RxSide::new(prep, mirrored, reach);
+    /// The cones of every reflector for the RX of `mirrored`, whose reach lists are `reach`,
+    /// and the parents whose apexes lie in the box `area` (min, max; m).
+    pub(super) fn of(
+        prep: &Prepared<'_>,
+        mirrored: &Mirrored,
+        reach: &Reach,
+        area: (Vec3, Vec3),
+    ) -> Joined {
+        let side = RxSide::new(prep, (mirrored, reach), area);
         let mut joined = Joined {
             spans: vec![None; prep.planes.len()],
-            cones: Vec::new(),
-            planes: Vec::new(),
+            parts: Vec::new(),
             margin: side.margin,
         };
         let parts = chunked::map_chunks(prep, (&prep.reflectors, Some(CHUNK)), |chunk| {
-            let mut q = Query::default();
-            let cones = chunk.iter().map(|&s| (s, side.cones_of(prep, s, &mut q)));
-            cones.collect::<Vec<(u32, SurfaceCones)>>()
-        });
-        for (s, cones) in parts.into_iter().flatten() {
-            let Some((planes, ends, positive)) = cones else {
-                continue;
-            };
-            let (base, lo) = (joined.planes.len() as u32, joined.cones.len() as u32);
-            joined.planes.extend_from_slice(&planes);
-            let mut start = base;
-            for end in ends {
-                joined.cones.push((start, base + end));
-                start = base + end;
+            let (mut q, mut part, mut spans) = (Query::default(), Part::default(), Vec::new());
+            for &s in chunk {
+                if let Some(span) = side.cones_of(prep, s, &mut q, &mut part) {
+                    spans.push((s, span));
+                }
             }
-            let mid = lo + positive as u32;
-            joined.spans[s as usize] = Some((lo, mid, joined.cones.len() as u32));
+            (part, spans)
+        });
+        for (part, spans) in parts {
+            for (s, span) in spans {
+                let part = joined.parts.len() as u32;
+                joined.spans[s as usize] = Some(Span { part, ..span });
+            }
+            joined.parts.push(part);
         }
         joined
     }
@@ -96,18 +133,31 @@ impl Joined {
     /// Whether the node of reflector `s` under a parent with apex `apex` may pass the probe:
     /// the apex lies in one of `s`'s cones (within the margin).
     pub(super) fn joins(&self, prep: &Prepared<'_>, s: u32, apex: Vec3) -> bool {
-        let Some((lo, mid, hi)) = self.spans[s as usize] else {
+        let Some(Span {
+            part,
+            cones,
+            bounds,
+        }) = self.spans[s as usize]
+        else {
             return true;
         };
+        let part = &self.parts[part as usize];
+        let (lo, mid, hi) = cones;
+        let held = |(min, max): (Vec3, Vec3)| apex.cmpge(min).all() && apex.cmple(max).all();
+        let [positive, negative] = bounds.map(held);
+        if !positive && !negative {
+            return false;
+        }
         let d = prep.plane(s).signed_distance_unfused(apex);
         // A cone lies beyond the plane from its apex: a parent's apex on the negative side
         // can only lie in the cones from the positive side, and the reverse.
         let inside = |k: u32| {
-            let (a, b) = self.cones[k as usize];
-            (self.planes[a as usize..b as usize].iter())
+            let (a, b) = part.cones[k as usize];
+            (part.planes[a as usize..b as usize].iter())
                 .all(|pl| pl.signed_distance_unfused(apex) >= -self.margin)
         };
-        (d <= self.margin && (lo..mid).any(inside)) || (d >= -self.margin && (mid..hi).any(inside))
+        (positive && d <= self.margin && (lo..mid).any(inside))
+            || (negative && d >= -self.margin && (mid..hi).any(inside))
     }
 }
 
@@ -119,6 +169,8 @@ struct RxSide<'a> {
     /// or not visible).
     beams: Vec<Vec<Plane>>,
     margin: Real,
+    /// The parents' apexes' box (min, max), grown by the margin.
+    area: (Vec3, Vec3),
 }
 
 /// Scratch of one task of [`Joined::of`].
@@ -127,10 +179,16 @@ struct Query {
     window: Vec<Vec3>,
     tmp: Vec<Vec3>,
     ts: Vec<u32>,
+    /// The cones whose apex lies on the negative side, before they join the part.
+    negative: Part,
 }
 
 impl<'a> RxSide<'a> {
-    fn new(prep: &Prepared<'_>, mirrored: &'a Mirrored, reach: &'a Reach) -> Self {
+    fn new(
+        prep: &Prepared<'_>,
+        (mirrored, reach): (&'a Mirrored, &'a Reach),
+        area: (Vec3, Vec3),
+    ) -> Self {
         let margin = reach.margin();
         let mut beams = vec![Vec::new(); prep.planes.len()];
         if let Some(visible) = prep.rx_visible.as_ref() {
@@ -142,16 +200,36 @@ impl<'a> RxSide<'a> {
                 }
             }
         }
+        let grow = Vec3::splat(margin);
         RxSide {
             mirrored,
             reach,
             beams,
             margin,
+            area: (area.0 - grow, area.1 + grow),
         }
     }
 
-    /// The cones of reflector `s` ([`SurfaceCones`]).
-    fn cones_of(&self, prep: &Prepared<'_>, s: u32, q: &mut Query) -> SurfaceCones {
+    /// Append the cones of reflector `s` to `part` and return their span (its part left
+    /// unset), or `None` (and `part` as it was) when every parent joins `s`.
+    fn cones_of(
+        &self,
+        prep: &Prepared<'_>,
+        s: u32,
+        q: &mut Query,
+        part: &mut Part,
+    ) -> Option<Span> {
+        let (cones, planes) = (part.cones.len(), part.planes.len());
+        let span = self.fill(prep, s, q, part);
+        if span.is_none() {
+            part.cones.truncate(cones);
+            part.planes.truncate(planes);
+        }
+        span
+    }
+
+    /// [`RxSide::cones_of`], leaving `part` to the caller when it fails.
+    fn fill(&self, prep: &Prepared<'_>, s: u32, q: &mut Query, part: &mut Part) -> Option<Span> {
         let plane = *prep.plane(s);
         let polygon = &prep.scene.surface(SurfaceId(s)).polygon;
         let hull = convex::grown_hull(polygon, 0.5 * self.margin);
@@ -159,13 +237,19 @@ impl<'a> RxSide<'a> {
             // No window to bound the cones by.
             return None;
         }
-        // Per side of the plane the cone's apex lies on: side planes and cone ends.
-        let mut sides: [(Vec<Plane>, Vec<u32>); 2] = Default::default();
+        let lo = part.cones.len() as u32;
+        q.negative.cones.clear();
+        q.negative.planes.clear();
+        let mut bounds = [EMPTY; 2];
+        let negative = &mut q.negative;
         let mut push = |apex: Vec3, window: &[Vec3]| {
             let h = plane.signed_distance_unfused(apex);
-            let (planes, ends) = &mut sides[usize::from(h < 0.0)];
-            cone(&plane, apex, window, self.margin, planes)?;
-            ends.push(planes.len() as u32);
+            let into = if h < 0.0 { &mut *negative } else { &mut *part };
+            let first = into.planes.len() as u32;
+            cone(&plane, apex, window, self.margin, &mut into.planes)?;
+            into.cones.push((first, into.planes.len() as u32));
+            let b = &mut bounds[usize::from(h < 0.0)];
+            *b = union(*b, self.cone_box((&plane, h), apex, window));
             Some(())
         };
         // RX in the node's beam: RX's depth-1 node on `s`.
@@ -197,11 +281,55 @@ impl<'a> RxSide<'a> {
                 }
             }
         }
-        let [(mut planes, mut ends), (negative, negative_ends)] = sides;
-        let (positive, shift) = (ends.len(), planes.len() as u32);
-        planes.extend(negative);
-        ends.extend(negative_ends.into_iter().map(|e| e + shift));
-        Some((planes, ends, positive))
+        let mid = part.cones.len() as u32;
+        let shift = part.planes.len() as u32;
+        part.planes.extend_from_slice(&q.negative.planes);
+        (part.cones).extend(
+            q.negative
+                .cones
+                .iter()
+                .map(|&(a, b)| (a + shift, b + shift)),
+        );
+        Some(Span {
+            part: 0,
+            cones: (lo, mid, part.cones.len() as u32),
+            bounds,
+        })
+    }
+
+    /// A box around the part inside [`RxSide::area`] of the cone from `apex` (at signed
+    /// distance `h` from `plane`, beyond the margin) through `window`, grown by the margin:
+    /// a point of the cone is `apex + λ·(v − apex)` for a point `v` of the window and
+    /// `λ ≥ 1`, and `λ = 1 + (its distance beyond the plane) / |h|`, at most `Λ` inside the
+    /// area; so the part lies in the hull of the window and its copy scaled by `Λ` from the
+    /// apex.
+    fn cone_box(&self, (plane, h): (&Plane, Real), apex: Vec3, window: &[Vec3]) -> (Vec3, Vec3) {
+        let (lo, hi) = self.area;
+        let away = if h > 0.0 { -1.0 } else { 1.0 };
+        let corners = (0..8).map(|k| {
+            let pick = |bit: u32, a: Real, b: Real| if k & bit == 0 { a } else { b };
+            Vec3::new(
+                pick(1, lo.x, hi.x),
+                pick(2, lo.y, hi.y),
+                pick(4, lo.z, hi.z),
+            )
+        });
+        let beyond = corners
+            .map(|c| away * plane.signed_distance_unfused(c))
+            .fold(0.0, Real::max);
+        let scale = 1.0 + (beyond + self.margin) / h.abs();
+        let mut b = EMPTY;
+        for &v in window {
+            let far = apex + scale * (v - apex);
+            b = union(b, (v.min(far), v.max(far)));
+        }
+        let grow = Vec3::splat(self.margin);
+        let (min, max) = ((b.0 - grow).max(lo), (b.1 + grow).min(hi));
+        if min.cmple(max).all() {
+            (min, max)
+        } else {
+            EMPTY
+        }
     }
 }
 
@@ -291,7 +419,7 @@ mod tests {
         visible.reach = Some(Reach::of(&prep, &visible.ids, &m));
         prep.rx_visible = Some(visible);
         let reach = prep.rx_visible.as_ref().and_then(|v| v.reach.as_ref());
-        let joined = Joined::of(&prep, &m, reach.unwrap());
+        let joined = Joined::of(&prep, &m, reach.unwrap(), apex_box(&tree, tree.levels[0]));
         let (mut probe, mut part) = (Probe::new(rx, m.clone()), tree.part());
         let (mut children, mut window, mut tmp) = (Vec::new(), Vec::new(), Vec::new());
         let mut counts = [0u64; 4];
