@@ -31,6 +31,7 @@ mod diffraction;
 
 use crate::diffraction::Diffracting;
 mod chunked;
+mod join;
 mod reach;
 mod rebuild;
 mod receivers;
@@ -705,7 +706,7 @@ impl BeamTree {
             // Nodes are culled as they are built, so no parent changes: chunks of parents
             // can grow apart.
             return match leaf {
-                None => self.grow_level_chunked(prep, depth, None, progress),
+                None => self.grow_level_chunked(prep, depth, (None, None), progress),
                 Some(leaf) => self.grow_leaves_chunked(prep, depth, leaf, progress),
             };
         }
@@ -1709,12 +1710,20 @@ pub fn candidates_and_diffracted_in(
     let rx_mirrored = mirrored(&prep, rx);
     if defer {
         let mut visible = rx_visibility(&prep, rx, &mut tree.stats);
-        if reach::Reach::pays(&prep, &visible.ids) {
+        // The join reads the reach lists (and the probes then read them too).
+        let parents = tree.levels.last().copied().unwrap_or_default();
+        let join = join::pays(&prep, options.max_order, parents.1 - parents.0);
+        if join || reach::Reach::pays(&prep, &visible.ids) {
             visible.reach = Some(reach::Reach::of(&prep, &visible.ids, &rx_mirrored));
         }
         prep.rx_visible = Some(visible);
+        let reach = prep.rx_visible.as_ref().and_then(|v| v.reach.as_ref());
+        let area = join::apex_box(&tree, parents);
+        let joined = (reach.filter(|_| join))
+            .map(|reach| join::Joined::of(&prep, &rx_mirrored, reach, area));
         let probe = (rx, rx_mirrored.clone());
-        tree.grow_level_chunked(&prep, options.max_order - 1, Some(&probe), progress)?;
+        let level = (Some(&probe), joined.as_ref());
+        tree.grow_level_chunked(&prep, options.max_order - 1, level, progress)?;
     }
     // The materialised levels' candidates first, then the last level's, tested against RX
     // without being materialised, straight into the same set.

@@ -5,6 +5,7 @@
 //! are independent and run on all cores when [`TreeOptions::parallel`] says so; fixed chunk
 //! bounds make the tree the same on any number of threads.
 
+use super::join::Joined;
 use super::{
     BeamTree, Leaf, Mirrored, Node, PROGRESS_EVERY, Prepared, Probe, Progress, ROOT, Scratch,
     TreeError, TreeStats,
@@ -33,12 +34,13 @@ impl BeamTree {
     /// Grow materialised level `depth` chunk by chunk (see the module), checking the node
     /// budget and reporting progress after each round of chunks. With `probe` (RX and its
     /// mirror images), only the nodes that can end or lead to a candidate for that RX are
-    /// culled and kept ([`Probe`]).
+    /// culled and kept ([`Probe`]); with `joined` too, each parent tries only the children
+    /// the RX-side join pairs it with ([`Joined`]) (all of them still count as tested).
     pub(super) fn grow_level_chunked(
         &mut self,
         prep: &Prepared<'_>,
         depth: usize,
-        probe: Option<&(bt_geom::Vec3, Mirrored)>,
+        (probe, joined): (Option<&(bt_geom::Vec3, Mirrored)>, Option<&Joined>),
         progress: Progress<'_>,
     ) -> Result<(), TreeError> {
         let start = self.nodes.len();
@@ -51,7 +53,7 @@ impl BeamTree {
             prep,
             (depth, parents.len(), &work),
             progress,
-            |tree, w| tree.grow_chunk(prep, *w, probe),
+            |tree, w| tree.grow_chunk(prep, *w, (probe, joined)),
             BeamTree::absorb,
         )?;
         self.end_level(start, true);
@@ -153,7 +155,7 @@ impl BeamTree {
         &self,
         prep: &Prepared<'_>,
         work: Work<'_>,
-        probe: Option<&(bt_geom::Vec3, Mirrored)>,
+        (probe, joined): (Option<&(bt_geom::Vec3, Mirrored)>, Option<&Joined>),
     ) -> BeamTree {
         let mut part = self.part();
         let mut scratch = Scratch::default();
@@ -172,6 +174,9 @@ impl BeamTree {
                     let parent = self.parent_ref(prep, p);
                     self.child_candidates(prep, &parent, false, &mut children);
                     part.stats.tested += children.len() as u64;
+                    if let Some(joined) = joined {
+                        children.retain(|&s| joined.joins(prep, s, parent.apex));
+                    }
                     for &s in &children {
                         part.child_probed(prep, &parent, s, &mut scratch, probe.as_mut());
                     }
@@ -182,7 +187,7 @@ impl BeamTree {
     }
 
     /// An empty tree of the same build, to grow a chunk's nodes in.
-    fn part(&self) -> BeamTree {
+    pub(super) fn part(&self) -> BeamTree {
         BeamTree {
             max_order: self.max_order,
             tol: self.tol,

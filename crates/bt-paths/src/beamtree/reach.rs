@@ -109,6 +109,22 @@ impl Reach {
             .copied()
     }
 
+    /// The reflectors of `s`'s list `side` (0: those whose grown hull reaches the positive
+    /// side of `s`'s plane, used by a node whose apex lies on its negative side; 1: the
+    /// reverse) and those tried by every probe.
+    pub(super) fn list(&self, s: u32, side: usize) -> impl Iterator<Item = u32> + '_ {
+        let k = 2 * s as usize + side;
+        let (lo, hi) = (self.offsets[k], self.offsets[k + 1]);
+        (self.always.iter())
+            .chain(&self.items[lo as usize..hi as usize])
+            .copied()
+    }
+
+    /// How far (m) a box may lie beyond a plane of a mirror beam and still be in its list.
+    pub(super) fn margin(&self) -> Real {
+        self.margin
+    }
+
     /// Whether the lists answer for the node on surface `s` with apex `apex` (m), window
     /// `window` and beam `planes` (its near plane first): whether the point `p` of any passing
     /// leaf test (module docs) surely lies within half the margin of `s`'s box and within a
