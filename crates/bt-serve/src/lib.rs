@@ -39,7 +39,7 @@ pub const MAX_CONNECTIONS: usize = 16;
 
 /// How long, µs, the partner of a lone receiver's answer spins for the next one before it
 /// sleeps (`serve --partner-spin-us`, [`Server::with_partner`]): requests that follow each
-/// other within it get their report and JSON split over two cores.
+/// other within it get their tree walk, report and JSON split over two cores.
 pub const PARTNER_SPIN_US: u64 = 1000;
 
 /// The bounds every request is checked against before any work.

@@ -419,7 +419,7 @@ class Tracer:
     ``max_beam_pairs`` budget.
 
     ``partner_spin_us`` is ``serve --partner-spin-us``: how long (µs) a second thread spins
-    after each update for the next one, to take half of a lone receiver's report; 0 answers
+    after each update for the next one, to take half of a lone receiver's tree walk and report; 0 answers
     every update on one thread (the same answers either way).
     """
 
