@@ -1312,8 +1312,9 @@ fn push_range<T: Copy>(arena: &mut Vec<T>, items: &[T]) -> (u32, u32) {
 
 /// The beam of rays from `apex` through the convex `window` lying in `plane`, appended to the
 /// arena `out`: the near plane (oriented away from the apex) and one side plane per edge
-/// (oriented inward); returns their range in `out`. Side planes that degenerate (apex on the
-/// edge's line) are left out, which only widens the beam.
+/// (oriented inward); returns their range in `out`. Side planes that rounding could have
+/// turned or flipped ([`side_plane`]: the apex on or near an edge's line, a short edge far
+/// from the apex, a window thinner than the rounding) are left out, which only widens the beam.
 fn beam_planes(plane: &Plane, apex: Vec3, window: &[Vec3], out: &mut Vec<Plane>) -> (u32, u32) {
     let lo = out.len() as u32;
     let near = if plane.signed_distance_unfused(apex) > 0.0 {
@@ -1322,24 +1323,66 @@ fn beam_planes(plane: &Plane, apex: Vec3, window: &[Vec3], out: &mut Vec<Plane>)
         *plane
     };
     out.push(near);
-    let inner = convex::vertex_mean(window);
-    // One square root per edge: the degeneracy test compares squares.
-    let mut a = window[0] - apex;
-    let mut a2 = a.length_squared();
-    for &v in window[1..].iter().chain(&window[..1]) {
-        let b = v - apex;
-        let b2 = b.length_squared();
-        let normal = a.cross(b);
-        if spans_a_plane(normal.length_squared(), a2 * b2) {
-            // `from_point_normal` normalises (one square root and one division per edge).
-            out.push(orient_towards(
-                Plane::from_point_normal(apex, normal),
-                inner,
-            ));
-        }
-        (a, a2) = (b, b2);
+    let inner = Inner::of(apex, window);
+    let mut w = window[window.len() - 1];
+    for &v in window {
+        out.extend(side_plane(apex, (w, v), &inner));
+        w = v;
     }
     (lo, out.len() as u32)
+}
+
+/// A side plane is kept only when its normal's rounding (about `ε / sin θ` radians, `θ` the
+/// angle between the edge and the ray from the apex to it, [`side_plane`]) is below this:
+/// then it moves a point at distance `r` from the apex by at most `1e-10 · r`, a tenth of the
+/// tree's margin (one length tolerance, `1e-9` of the scene's extent) for points within the
+/// scene's extent.
+pub(super) const MAX_NORMAL_ERROR: Real = 1e-10;
+
+/// A point inside a window that orients its side planes ([`side_plane`]): the window's
+/// vertex mean, its distance from the apex and the rounding of a plane's offset there.
+pub(super) struct Inner {
+    point: Vec3,
+    reach: Real,
+    rounding: Real,
+}
+
+impl Inner {
+    /// The vertex mean of `window` as seen from `apex`.
+    pub(super) fn of(apex: Vec3, window: &[Vec3]) -> Self {
+        let point = convex::vertex_mean(window);
+        Inner {
+            point,
+            reach: (point - apex).length(),
+            rounding: 1e-12 * (apex.length() + point.length()),
+        }
+    }
+}
+
+/// The plane through `apex` and the window edge from `w` to `v`, oriented so that the
+/// window's inner point lies on its non-negative side, or `None` when rounding could decide
+/// it. Its normal is `(w − apex) × (v − w)`: the edge vector is exact for nearby vertices
+/// (Sterbenz), so a short edge far from the apex keeps its plane through its own ends (the
+/// cross product of the two rays `(w − apex) × (v − apex)`, nearly parallel, lost about
+/// `ε·R² / e` metres at the window for an edge of length `e` at distance `R`: 5 µm for 1 nm at
+/// 5 m, beyond the margin, and a path just inside the edge was lost). Left out when the
+/// normal's relative error (about `1.2e-16·|a|·|e| / |a × e|`) is above
+/// [`MAX_NORMAL_ERROR`] (the apex near the edge's line), or when the inner point lies within
+/// 16 times the error it reaches of the plane (a window thinner than the rounding: the
+/// orientation would be a coin toss). Leaving a plane out only widens a beam or cone. Shared
+/// by the beams ([`beam_planes`]) and the join's cones ([`join`]).
+pub(super) fn side_plane(apex: Vec3, (w, v): (Vec3, Vec3), inner: &Inner) -> Option<Plane> {
+    let (a, e) = (w - apex, v - w);
+    let normal = a.cross(e);
+    let (len, ae) = (normal.length(), a.length() * e.length());
+    let error = 1.2e-16 * ae / len;
+    if !(len > 0.0 && error <= MAX_NORMAL_ERROR) {
+        return None;
+    }
+    let side = Plane::from_point_normal(apex, normal);
+    let d = side.signed_distance_unfused(inner.point);
+    let undecided = 16.0 * (error * inner.reach + inner.rounding);
+    (d.abs() > undecided).then(|| if d < 0.0 { flip(side) } else { side })
 }
 
 /// Put `ids` (distinct, each below `n`, as a BVH walk finds them) in increasing order. A long

@@ -29,17 +29,12 @@
 //! RX's side").
 
 use super::reach::Reach;
-use super::{BeamTree, LINEAR_SCAN, Mirrored, Prepared, chunked, flip};
+use super::{BeamTree, Inner, LINEAR_SCAN, Mirrored, Prepared, chunked, side_plane};
 use bt_geom::{Plane, Real, Vec3, convex};
 use bt_scene::SurfaceId;
 
 /// Reflectors per parallel task of [`Joined::of`].
 const CHUNK: usize = 64;
-
-/// A cone's side plane is kept only when its normal's rounding (about `ε·|a|·|b| / |a × b|`
-/// radians for the edge's vectors `a`, `b` from the apex) is below this: then it moves a
-/// point a few kilometres away by far less than the margin.
-const MAX_NORMAL_ERROR: Real = 1e-10;
 
 /// Per reflector `s`, the cones that a parent's apex must lie in for the node `(parent, s)`
 /// to pass the probe (see the module).
@@ -336,9 +331,8 @@ impl<'a> RxSide<'a> {
 /// The side planes of the cone of rays from `apex` through the convex `window` lying in
 /// `plane`, appended to `out` (the cone also lies beyond the plane from the apex: the caller
 /// tests that side). A side plane per window edge, kept only when rounding cannot have
-/// turned or flipped it (its normal's relative error below [`MAX_NORMAL_ERROR`], and the
-/// window's vertex mean inside it by far more than that error reaches); leaving a plane out
-/// only widens the cone. `None` (the whole space) for an apex within `margin` of the plane.
+/// turned or flipped it ([`side_plane`], the rule of the beams); leaving a plane out only
+/// widens the cone. `None` (the whole space) for an apex within `margin` of the plane.
 fn cone(
     plane: &Plane,
     apex: Vec3,
@@ -350,23 +344,11 @@ fn cone(
     if h.is_nan() || h.abs() <= margin {
         return None;
     }
-    let inner = convex::vertex_mean(window);
-    let reach = (inner - apex).length();
-    let rounding = 1e-12 * (apex.length() + inner.length());
-    let mut a = window[window.len() - 1] - apex;
+    let inner = Inner::of(apex, window);
+    let mut w = window[window.len() - 1];
     for &v in window {
-        let b = v - apex;
-        let normal = a.cross(b);
-        let (len, ab) = (normal.length(), a.length() * b.length());
-        let error = 1.2e-16 * ab / len;
-        if len > 0.0 && error <= MAX_NORMAL_ERROR {
-            let side = Plane::from_point_normal(apex, normal);
-            let d = side.signed_distance_unfused(inner);
-            if d.abs() > 16.0 * (error * reach + rounding) {
-                out.push(if d < 0.0 { flip(side) } else { side });
-            }
-        }
-        a = b;
+        out.extend(side_plane(apex, (w, v), &inner));
+        w = v;
     }
     Some(())
 }
