@@ -1312,9 +1312,9 @@ fn push_range<T: Copy>(arena: &mut Vec<T>, items: &[T]) -> (u32, u32) {
 
 /// The beam of rays from `apex` through the convex `window` lying in `plane`, appended to the
 /// arena `out`: the near plane (oriented away from the apex) and one side plane per edge
-/// (oriented inward); returns their range in `out`. Side planes that rounding could have
-/// turned or flipped ([`side_plane`]: the apex on or near an edge's line, a short edge far
-/// from the apex, a window thinner than the rounding) are left out, which only widens the beam.
+/// (oriented inward, [`Facing`]); returns their range in `out`. Side planes that rounding
+/// could have turned ([`side_plane`]: the apex on or near an edge's line) are left out, which
+/// only widens the beam.
 fn beam_planes(plane: &Plane, apex: Vec3, window: &[Vec3], out: &mut Vec<Plane>) -> (u32, u32) {
     let lo = out.len() as u32;
     let near = if plane.signed_distance_unfused(apex) > 0.0 {
@@ -1323,10 +1323,10 @@ fn beam_planes(plane: &Plane, apex: Vec3, window: &[Vec3], out: &mut Vec<Plane>)
         *plane
     };
     out.push(near);
-    let inner = Inner::of(apex, window);
+    let facing = Facing::of(plane, apex);
     let mut w = window[window.len() - 1];
     for &v in window {
-        out.extend(side_plane(apex, (w, v), &inner));
+        out.extend(side_plane(apex, (w, v), &facing));
         w = v;
     }
     (lo, out.len() as u32)
@@ -1339,50 +1339,47 @@ fn beam_planes(plane: &Plane, apex: Vec3, window: &[Vec3], out: &mut Vec<Plane>)
 /// scene's extent.
 pub(super) const MAX_NORMAL_ERROR: Real = 1e-10;
 
-/// A point inside a window that orients its side planes ([`side_plane`]): the window's
-/// vertex mean, its distance from the apex and the rounding of a plane's offset there.
-pub(super) struct Inner {
-    point: Vec3,
-    reach: Real,
-    rounding: Real,
+/// Which way a window's side planes face ([`side_plane`]): windows are convex hulls
+/// counter-clockwise in their polygon's frame (about its plane's normal), clipped in order,
+/// so an edge's plane `(w − apex) × (v − w)` faces inward exactly when the apex lies on the
+/// negative side of the window's plane. This reads one signed distance, which the tree keeps
+/// beyond a tolerance (a child whose plane passes within one of the apex is never built),
+/// instead of a point inside the window: for a window thinner than the rounding, the vertex
+/// mean left the orientation to chance, and a sliver clipped from a window could get a wider
+/// beam than the window's.
+pub(super) struct Facing {
+    outward: bool,
 }
 
-impl Inner {
-    /// The vertex mean of `window` as seen from `apex`.
-    pub(super) fn of(apex: Vec3, window: &[Vec3]) -> Self {
-        let point = convex::vertex_mean(window);
-        Inner {
-            point,
-            reach: (point - apex).length(),
-            rounding: 1e-12 * (apex.length() + point.length()),
+impl Facing {
+    /// The facing of a window lying in `plane`, seen from `apex`.
+    pub(super) fn of(plane: &Plane, apex: Vec3) -> Self {
+        Facing {
+            outward: plane.signed_distance_unfused(apex) > 0.0,
         }
     }
 }
 
-/// The plane through `apex` and the window edge from `w` to `v`, oriented so that the
-/// window's inner point lies on its non-negative side, or `None` when rounding could decide
-/// it. Its normal is `(w − apex) × (v − w)`: the edge vector is exact for nearby vertices
-/// (Sterbenz), so a short edge far from the apex keeps its plane through its own ends (the
-/// cross product of the two rays `(w − apex) × (v − apex)`, nearly parallel, lost about
-/// `ε·R² / e` metres at the window for an edge of length `e` at distance `R`: 5 µm for 1 nm at
-/// 5 m, beyond the margin, and a path just inside the edge was lost). Left out when the
-/// normal's relative error (about `1.2e-16·|a|·|e| / |a × e|`) is above
-/// [`MAX_NORMAL_ERROR`] (the apex near the edge's line), or when the inner point lies within
-/// 16 times the error it reaches of the plane (a window thinner than the rounding: the
-/// orientation would be a coin toss). Leaving a plane out only widens a beam or cone. Shared
-/// by the beams ([`beam_planes`]) and the join's cones ([`join`]).
-pub(super) fn side_plane(apex: Vec3, (w, v): (Vec3, Vec3), inner: &Inner) -> Option<Plane> {
+/// The plane through `apex` and the window edge from `w` to `v` (the window's edges in
+/// order), facing the window's inside ([`Facing`]), or `None` when rounding could have
+/// turned it by more than [`MAX_NORMAL_ERROR`] (its relative error, about
+/// `1.2e-16·|a|·|e| / |a × e|`, large when the apex lies near the edge's line). Its normal is
+/// `(w − apex) × (v − w)`: the edge vector is exact for nearby vertices (Sterbenz), so a short
+/// edge far from the apex keeps its plane through its own ends. The cross product of the two
+/// rays, `(w − apex) × (v − apex)`, nearly parallel, moved it by about `ε·R² / e` at the
+/// window for an edge of length `e` at distance `R` (5 µm for 1 nm at 5 m, beyond the
+/// margin: a path just inside the edge was lost). Leaving a plane out only widens a beam or
+/// cone. Shared by the beams ([`beam_planes`]) and the join's cones ([`join`]).
+pub(super) fn side_plane(apex: Vec3, (w, v): (Vec3, Vec3), facing: &Facing) -> Option<Plane> {
     let (a, e) = (w - apex, v - w);
     let normal = a.cross(e);
     let (len, ae) = (normal.length(), a.length() * e.length());
-    let error = 1.2e-16 * ae / len;
-    if !(len > 0.0 && error <= MAX_NORMAL_ERROR) {
+    // The error's bound, false for NaN and for a zero normal.
+    if !(len > 0.0 && 1.2e-16 * ae <= MAX_NORMAL_ERROR * len) {
         return None;
     }
     let side = Plane::from_point_normal(apex, normal);
-    let d = side.signed_distance_unfused(inner.point);
-    let undecided = 16.0 * (error * inner.reach + inner.rounding);
-    (d.abs() > undecided).then(|| if d < 0.0 { flip(side) } else { side })
+    Some(if facing.outward { flip(side) } else { side })
 }
 
 /// Put `ids` (distinct, each below `n`, as a BVH walk finds them) in increasing order. A long

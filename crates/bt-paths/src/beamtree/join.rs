@@ -29,7 +29,7 @@
 //! RX's side").
 
 use super::reach::Reach;
-use super::{BeamTree, Inner, LINEAR_SCAN, Mirrored, Prepared, chunked, side_plane};
+use super::{BeamTree, Facing, LINEAR_SCAN, Mirrored, Prepared, chunked, side_plane};
 use bt_geom::{Plane, Real, Vec3, convex};
 use bt_scene::SurfaceId;
 
@@ -331,8 +331,8 @@ impl<'a> RxSide<'a> {
 /// The side planes of the cone of rays from `apex` through the convex `window` lying in
 /// `plane`, appended to `out` (the cone also lies beyond the plane from the apex: the caller
 /// tests that side). A side plane per window edge, kept only when rounding cannot have
-/// turned or flipped it ([`side_plane`], the rule of the beams); leaving a plane out only
-/// widens the cone. `None` (the whole space) for an apex within `margin` of the plane.
+/// turned it ([`side_plane`], the rule of the beams; facing the window's inside by the
+/// apex's side of the plane); leaving a plane out only widens the cone. `None` (the whole space) for an apex within `margin` of the plane.
 fn cone(
     plane: &Plane,
     apex: Vec3,
@@ -344,10 +344,10 @@ fn cone(
     if h.is_nan() || h.abs() <= margin {
         return None;
     }
-    let inner = Inner::of(apex, window);
+    let facing = Facing::of(plane, apex);
     let mut w = window[window.len() - 1];
     for &v in window {
-        out.extend(side_plane(apex, (w, v), &inner));
+        out.extend(side_plane(apex, (w, v), &facing));
         w = v;
     }
     Some(())
