@@ -23,7 +23,7 @@
 //! whole margin; a cone's side plane is left out (widening the cone) when rounding could
 //! orient it wrongly, every plane test keeps the margin, and an apex within the margin of
 //! `s`'s plane joins every parent. A node whose beam is not well defined (a sliver window far
-//! from its apex, whose side planes rounding orients at random, or a sharp corner) can still
+//! from its apex, or a sharp corner) can still
 //! pass the probe outside these cones: such nodes give candidates only by rounding, and the
 //! trace's paths do not depend on them (docs/beam-tree.md, "The deferred level's pairs from
 //! RX's side").
