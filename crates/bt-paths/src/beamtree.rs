@@ -1312,8 +1312,9 @@ fn push_range<T: Copy>(arena: &mut Vec<T>, items: &[T]) -> (u32, u32) {
 
 /// The beam of rays from `apex` through the convex `window` lying in `plane`, appended to the
 /// arena `out`: the near plane (oriented away from the apex) and one side plane per edge
-/// (oriented inward); returns their range in `out`. Side planes that degenerate (apex on the
-/// edge's line) are left out, which only widens the beam.
+/// (oriented inward, [`Facing`]); returns their range in `out`. Side planes that rounding
+/// could have turned ([`side_plane`]: the apex on or near an edge's line) are left out, which
+/// only widens the beam.
 fn beam_planes(plane: &Plane, apex: Vec3, window: &[Vec3], out: &mut Vec<Plane>) -> (u32, u32) {
     let lo = out.len() as u32;
     let near = if plane.signed_distance_unfused(apex) > 0.0 {
@@ -1322,24 +1323,63 @@ fn beam_planes(plane: &Plane, apex: Vec3, window: &[Vec3], out: &mut Vec<Plane>)
         *plane
     };
     out.push(near);
-    let inner = convex::vertex_mean(window);
-    // One square root per edge: the degeneracy test compares squares.
-    let mut a = window[0] - apex;
-    let mut a2 = a.length_squared();
-    for &v in window[1..].iter().chain(&window[..1]) {
-        let b = v - apex;
-        let b2 = b.length_squared();
-        let normal = a.cross(b);
-        if spans_a_plane(normal.length_squared(), a2 * b2) {
-            // `from_point_normal` normalises (one square root and one division per edge).
-            out.push(orient_towards(
-                Plane::from_point_normal(apex, normal),
-                inner,
-            ));
-        }
-        (a, a2) = (b, b2);
+    let facing = Facing::of(plane, apex);
+    let mut w = window[window.len() - 1];
+    for &v in window {
+        out.extend(side_plane(apex, (w, v), &facing));
+        w = v;
     }
     (lo, out.len() as u32)
+}
+
+/// A side plane is kept only when its normal's rounding (about `ε / sin θ` radians, `θ` the
+/// angle between the edge and the ray from the apex to it, [`side_plane`]) is below this:
+/// then it moves a point at distance `r` from the apex by at most `1e-10 · r`, a tenth of the
+/// tree's margin (one length tolerance, `1e-9` of the scene's extent) for points within the
+/// scene's extent.
+pub(super) const MAX_NORMAL_ERROR: Real = 1e-10;
+
+/// Which way a window's side planes face ([`side_plane`]): windows are convex hulls
+/// counter-clockwise in their polygon's frame (about its plane's normal), clipped in order,
+/// so an edge's plane `(w − apex) × (v − w)` faces inward exactly when the apex lies on the
+/// negative side of the window's plane. This reads one signed distance, which the tree keeps
+/// beyond a tolerance (a child whose plane passes within one of the apex is never built),
+/// instead of a point inside the window: for a window thinner than the rounding, the vertex
+/// mean left the orientation to chance, and a sliver clipped from a window could get a wider
+/// beam than the window's.
+pub(super) struct Facing {
+    outward: bool,
+}
+
+impl Facing {
+    /// The facing of a window lying in `plane`, seen from `apex`.
+    pub(super) fn of(plane: &Plane, apex: Vec3) -> Self {
+        Facing {
+            outward: plane.signed_distance_unfused(apex) > 0.0,
+        }
+    }
+}
+
+/// The plane through `apex` and the window edge from `w` to `v` (the window's edges in
+/// order), facing the window's inside ([`Facing`]), or `None` when rounding could have
+/// turned it by more than [`MAX_NORMAL_ERROR`] (its relative error, about
+/// `1.2e-16·|a|·|e| / |a × e|`, large when the apex lies near the edge's line). Its normal is
+/// `(w − apex) × (v − w)`: the edge vector is exact for nearby vertices (Sterbenz), so a short
+/// edge far from the apex keeps its plane through its own ends. The cross product of the two
+/// rays, `(w − apex) × (v − apex)`, nearly parallel, moved it by about `ε·R² / e` at the
+/// window for an edge of length `e` at distance `R` (5 µm for 1 nm at 5 m, beyond the
+/// margin: a path just inside the edge was lost). Leaving a plane out only widens a beam or
+/// cone. Shared by the beams ([`beam_planes`]) and the join's cones ([`join`]).
+pub(super) fn side_plane(apex: Vec3, (w, v): (Vec3, Vec3), facing: &Facing) -> Option<Plane> {
+    let (a, e) = (w - apex, v - w);
+    let normal = a.cross(e);
+    let (len, ae) = (normal.length(), a.length() * e.length());
+    // The error's bound, false for NaN and for a zero normal.
+    if !(len > 0.0 && 1.2e-16 * ae <= MAX_NORMAL_ERROR * len) {
+        return None;
+    }
+    let side = Plane::from_point_normal(apex, normal);
+    Some(if facing.outward { flip(side) } else { side })
 }
 
 /// Put `ids` (distinct, each below `n`, as a BVH walk finds them) in increasing order. A long

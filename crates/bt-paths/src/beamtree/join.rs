@@ -23,23 +23,18 @@
 //! whole margin; a cone's side plane is left out (widening the cone) when rounding could
 //! orient it wrongly, every plane test keeps the margin, and an apex within the margin of
 //! `s`'s plane joins every parent. A node whose beam is not well defined (a sliver window far
-//! from its apex, whose side planes rounding orients at random, or a sharp corner) can still
+//! from its apex, or a sharp corner) can still
 //! pass the probe outside these cones: such nodes give candidates only by rounding, and the
 //! trace's paths do not depend on them (docs/beam-tree.md, "The deferred level's pairs from
 //! RX's side").
 
 use super::reach::Reach;
-use super::{BeamTree, LINEAR_SCAN, Mirrored, Prepared, chunked, flip};
+use super::{BeamTree, Facing, LINEAR_SCAN, Mirrored, Prepared, chunked, side_plane};
 use bt_geom::{Plane, Real, Vec3, convex};
 use bt_scene::SurfaceId;
 
 /// Reflectors per parallel task of [`Joined::of`].
 const CHUNK: usize = 64;
-
-/// A cone's side plane is kept only when its normal's rounding (about `ε·|a|·|b| / |a × b|`
-/// radians for the edge's vectors `a`, `b` from the apex) is below this: then it moves a
-/// point a few kilometres away by far less than the margin.
-const MAX_NORMAL_ERROR: Real = 1e-10;
 
 /// Per reflector `s`, the cones that a parent's apex must lie in for the node `(parent, s)`
 /// to pass the probe (see the module).
@@ -336,9 +331,8 @@ impl<'a> RxSide<'a> {
 /// The side planes of the cone of rays from `apex` through the convex `window` lying in
 /// `plane`, appended to `out` (the cone also lies beyond the plane from the apex: the caller
 /// tests that side). A side plane per window edge, kept only when rounding cannot have
-/// turned or flipped it (its normal's relative error below [`MAX_NORMAL_ERROR`], and the
-/// window's vertex mean inside it by far more than that error reaches); leaving a plane out
-/// only widens the cone. `None` (the whole space) for an apex within `margin` of the plane.
+/// turned it ([`side_plane`], the rule of the beams; facing the window's inside by the
+/// apex's side of the plane); leaving a plane out only widens the cone. `None` (the whole space) for an apex within `margin` of the plane.
 fn cone(
     plane: &Plane,
     apex: Vec3,
@@ -350,23 +344,11 @@ fn cone(
     if h.is_nan() || h.abs() <= margin {
         return None;
     }
-    let inner = convex::vertex_mean(window);
-    let reach = (inner - apex).length();
-    let rounding = 1e-12 * (apex.length() + inner.length());
-    let mut a = window[window.len() - 1] - apex;
+    let facing = Facing::of(plane, apex);
+    let mut w = window[window.len() - 1];
     for &v in window {
-        let b = v - apex;
-        let normal = a.cross(b);
-        let (len, ab) = (normal.length(), a.length() * b.length());
-        let error = 1.2e-16 * ab / len;
-        if len > 0.0 && error <= MAX_NORMAL_ERROR {
-            let side = Plane::from_point_normal(apex, normal);
-            let d = side.signed_distance_unfused(inner);
-            if d.abs() > 16.0 * (error * reach + rounding) {
-                out.push(if d < 0.0 { flip(side) } else { side });
-            }
-        }
-        a = b;
+        out.extend(side_plane(apex, (w, v), &facing));
+        w = v;
     }
     Some(())
 }
