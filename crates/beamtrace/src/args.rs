@@ -508,8 +508,8 @@ pub struct ServeArgs {
     #[arg(long, default_value_t = 5)]
     pub top: usize,
     /// Microseconds a second thread spins after each answer waiting for the next one, to
-    /// take half of a lone receiver's tree walk, report and JSON (lower latency for a busy stream, at
-    /// the price of that core while it spins); 0: every answer on one thread.
+    /// take half of a lone receiver's tree walk, report and JSON (lower latency for a busy
+    /// stream, at the price of that core while it spins); 0: every answer on one thread.
     #[arg(long, default_value_t = bt_serve::PARTNER_SPIN_US,
           value_parser = clap::value_parser!(u64).range(0..=1_000_000))]
     pub partner_spin_us: u64,

@@ -29,7 +29,7 @@ pub struct Records {
     responses: Option<(bt_scene::RadioKey, gain::Known)>,
     /// The buffers each path is described with, kept too.
     scratch: Scratch,
-    /// The partner's half of a split report ([`Records::report_with`]): its surfaces'
+    /// The partner's half of a split report ([`Records::report_halves`]): its surfaces'
     /// responses and buffers, kept as the caller's are.
     second: (Option<(bt_scene::RadioKey, gain::Known)>, Scratch),
 }
@@ -115,7 +115,6 @@ impl Records {
             Some(partner) => partner.join(|| first(&mut responses), second),
             None => (first(&mut responses), second()),
         };
-        let (a, b): (Result<RA, ReportError>, Result<RB, ReportError>) = (a, b);
         let (a, b) = match (a, b) {
             (Ok(a), Ok(b)) => (a, b),
             // The error a report in the paths' order meets first.

@@ -128,8 +128,8 @@ impl Server {
         }
     }
 
-    /// The server splitting a lone receiver's walk of the kept tree, report and JSON over a second core
-    /// ([`Partner`]), whose thread spins for `window` after each answer before it sleeps (a
+    /// The server splitting a lone receiver's walk of the kept tree, report and JSON over a
+    /// second core ([`Partner`]), whose thread spins for `window` after each answer before it sleeps (a
     /// stream of requests keeps it awake, at the price of that core); no partner when
     /// `window` is zero, or on one core.
     pub fn with_partner(mut self, window: Duration) -> Self {
