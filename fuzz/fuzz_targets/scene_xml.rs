@@ -16,6 +16,12 @@ fuzz_target!(|data: &[u8]| {
         // Affine (last row 0 0 0 1): the 4×4 determinant is that of the linear part.
         assert!(shape.to_world.is_finite(), "{shape:?}");
         assert!(shape.to_world.determinant() != 0.0, "{shape:?}");
-        assert!(!shape.filename.is_empty(), "{shape:?}");
+        // A mesh has a non-empty file name, a primitive (rectangle, cube) none.
+        let primitive = matches!(shape.kind, bt_import::xml::MeshKind::Primitive(_));
+        assert_eq!(
+            shape.filename.as_deref().map(str::is_empty),
+            (!primitive).then_some(false),
+            "{shape:?}"
+        );
     }
 });

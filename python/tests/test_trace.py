@@ -251,3 +251,24 @@ def test_point_cloud_matches_cli(cli, cli_json, tmp_path):
                        cli_json(str(cloud), "--tx", vec(tx), "--rx", vec(rx), "--max-order", "2"))
     with pytest.raises(beamtrace.BeamtraceError, match="max-cloud-points"):
         beamtrace.load(cloud, max_cloud_points=100)
+
+
+def test_mitsuba_rectangles_and_cubes_reflect_where_the_image_method_says(cli_json):
+    # Mitsuba's primitives: the ground is the rectangle [-1, 1]^2 scaled by 10, the block's
+    # south face the cube [-1, 1]^3 scaled by (3, 1, 2) and moved to (0, 5, 2): y = 4.
+    scene_file = TESTDATA / "mitsuba-primitives.xml"
+    tx, rx = [-5.0, -3.0, 2.0], [5.0, -3.0, 1.5]
+    paths = beamtrace.load(scene_file).trace(tx, rx, max_order=1)
+    assert_same_as_cli(paths, cli_json(str(scene_file), "--tx", vec(tx), "--rx", vec(rx),
+                                       "--max-order", "1"))
+    by_surfaces = {tuple(s): i for i, s in enumerate(paths.surfaces)}
+    # Images of RX in z = 0 and in y = 4; the reflection points where TX's rays to them cross.
+    for surface, image, point in [
+        ("ground.face_0", [5.0, -3.0, -1.5], [-5.0 + 10.0 * 2.0 / 3.5, -3.0, 0.0]),
+        ("block.face_2", [5.0, 11.0, 1.5], [0.0, 4.0, 1.75]),
+    ]:
+        i = by_surfaces[(surface,)]
+        assert paths.length_m[i] == pytest.approx(np.linalg.norm(np.subtract(image, tx)),
+                                                  rel=1e-12)
+        np.testing.assert_allclose(paths.points[i][0], point, rtol=0, atol=1e-12)
+    assert len(paths) == 3

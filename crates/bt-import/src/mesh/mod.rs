@@ -92,8 +92,18 @@ pub fn read_transformed(
     opts: &MergeOptions,
     to_world: &dyn Fn(Vec3) -> Vec3,
 ) -> Result<MeshImport, MeshError> {
-    let mut raw = parse(bytes, format, file, opts)?;
-    let file = file.unwrap_or(UNNAMED);
+    let raw = parse(bytes, format, file, opts)?;
+    merge_transformed(raw, file.unwrap_or(UNNAMED), opts, to_world)
+}
+
+/// Maps every vertex of `raw` through `to_world` (metres to metres) and merges it
+/// ([`read_transformed`] after its parse); `file` names the source in warnings and errors.
+pub(crate) fn merge_transformed(
+    mut raw: bt_mesh::RawMesh,
+    file: &str,
+    opts: &MergeOptions,
+    to_world: &dyn Fn(Vec3) -> Vec3,
+) -> Result<MeshImport, MeshError> {
     for (vertex, p) in raw.positions.iter_mut().enumerate() {
         *p = to_world(*p);
         if !p.is_finite() {

@@ -13,6 +13,7 @@
 //! per file.
 
 mod parse;
+mod primitive;
 mod transform;
 
 pub use parse::{SIONNA_DEFAULT_THICKNESS_M, parse_xml, parse_xml_with};
@@ -102,24 +103,36 @@ pub enum XmlRadio {
     },
 }
 
-/// Mesh formats a `<shape>` may load.
+/// What a `<shape>` is: a mesh file or one of Mitsuba's planar primitives.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum MeshKind {
     /// `<shape type="ply">`.
     Ply,
     /// `<shape type="obj">`.
     Obj,
+    /// `<shape type="rectangle">` or `<shape type="cube">`: no file.
+    Primitive(Primitive),
 }
 
-/// One `<shape type="ply|obj">`.
+/// Mitsuba's planar primitive shapes, in their object frame (metres before `to_world`).
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Primitive {
+    /// `<shape type="rectangle">`: the square `[-1, 1]²` in the plane `z = 0`, normal `+z`.
+    Rectangle,
+    /// `<shape type="cube">`: the cube `[-1, 1]³`, six faces with outward normals.
+    Cube,
+}
+
+/// One `<shape type="ply|obj|rectangle|cube">`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct XmlShape {
     /// The `id` attribute, or `shape-<k>`; prefixes its surfaces' names.
     pub name: String,
     /// Mesh format.
     pub kind: MeshKind,
-    /// The `filename` property as written (relative to the XML's folder).
-    pub filename: String,
+    /// The `filename` property as written (relative to the XML's folder); `None` for the
+    /// primitives (rectangle, cube), which have none.
+    pub filename: Option<String>,
     /// The bsdf id it refers to (or defines inline) and where; `None`: material `default`.
     pub bsdf: Option<(String, XmlPos)>,
     /// `to_world`, metres to metres (identity when absent).
@@ -172,7 +185,7 @@ pub(crate) fn load_xml_read(
         seen: std::collections::HashSet::with_capacity(xml.shapes.len()),
     };
     let (found, refused) = reading.find(&xml.shapes);
-    for round in rounds(&found, ROUND_BYTES, |(_, (_, metadata))| metadata.len()) {
+    for round in rounds(&found, ROUND_BYTES, file_bytes) {
         reading.round(round, &mut desc, &mut warnings)?;
     }
     if let Some(refused) = refused {
@@ -197,9 +210,16 @@ pub(crate) fn load_xml_read(
 /// instead of alone at the end of its round.
 const ROUND_BYTES: u64 = 64 << 20;
 
-/// A shape whose mesh file was found within the byte budgets, with that file and its
-/// metadata.
-type Found<'s> = (&'s XmlShape, (PathBuf, std::fs::Metadata));
+/// A shape with where its polygons come from.
+type Found<'s> = (&'s XmlShape, Source);
+
+/// Where a shape's polygons come from.
+enum Source {
+    /// Its mesh file, found within the byte budgets, and the file's metadata.
+    File(PathBuf, std::fs::Metadata),
+    /// A primitive: no file.
+    Primitive(Primitive),
+}
 
 /// `items` in rounds of consecutive items of at most `limit` bytes in all by `size` (a larger
 /// item is a round alone).
@@ -217,6 +237,14 @@ fn rounds<T>(items: &[T], limit: u64, size: impl Fn(&T) -> u64) -> impl Iterator
         rest = tail;
         (!round.is_empty()).then_some(round)
     })
+}
+
+/// The bytes of a found shape's mesh file (none for a primitive).
+fn file_bytes((_, source): &Found<'_>) -> u64 {
+    match source {
+        Source::File(_, metadata) => metadata.len(),
+        Source::Primitive(_) => 0,
+    }
 }
 
 /// The state of reading one XML scene's meshes: budgets left and the files read.
@@ -243,17 +271,29 @@ impl Reading<'_> {
     /// all cores and their sizes charged in order, before any is read.
     fn find<'s>(&mut self, shapes: &'s [XmlShape]) -> (Vec<Found<'s>>, Option<ImportError>) {
         use rayon::prelude::*;
-        let stated: Vec<_> = (shapes.par_iter())
+        let stated: Vec<Result<Stated, Primitive>> = (shapes.par_iter())
             .map(|shape| {
-                let file = resolve(self.folder, &shape.filename)?;
-                let metadata = std::fs::metadata(&file);
-                Ok((file, metadata))
+                if let MeshKind::Primitive(primitive) = shape.kind {
+                    return Err(primitive);
+                }
+                let name = shape.filename.as_deref().unwrap_or_default();
+                Ok(resolve(self.folder, name).map(|file| {
+                    let metadata = std::fs::metadata(&file);
+                    (file, metadata)
+                }))
             })
             .collect();
         let mut found = Vec::with_capacity(shapes.len());
         for (shape, stated) in shapes.iter().zip(stated) {
+            let stated = match stated {
+                Ok(stated) => stated,
+                Err(primitive) => {
+                    found.push((shape, Source::Primitive(primitive)));
+                    continue;
+                }
+            };
             match find_shape(shape, stated, self.xml, self.options, &mut self.bytes_left) {
-                Ok(file) => found.push((shape, file)),
+                Ok((file, metadata)) => found.push((shape, Source::File(file, metadata))),
                 Err(e) => return (found, Some(e)),
             }
         }
@@ -272,22 +312,32 @@ impl Reading<'_> {
     ) -> Result<(), ImportError> {
         use rayon::prelude::*;
         let mut largest_first: Vec<usize> = (0..found.len()).collect();
-        largest_first.sort_by_key(|&k| std::cmp::Reverse(found[k].1.1.len()));
+        largest_first.sort_by_key(|&k| std::cmp::Reverse(file_bytes(&found[k])));
         // Each mesh is read, merged and turned into scene surfaces on the worker threads.
         let mut merged: Vec<(usize, Result<_, ImportError>)> = (largest_first.par_iter())
             .map(|&k| {
-                let (shape, (file, metadata)) = &found[k];
-                let import = read_shape(shape, file, metadata, self.options, self.hashing);
+                let (shape, source) = &found[k];
+                let import = match source {
+                    Source::File(file, metadata) => {
+                        read_shape(shape, file, metadata, self.options, self.hashing)
+                    }
+                    Source::Primitive(primitive) => {
+                        merge_primitive(shape, *primitive, self.xml, self.options)
+                            .map(|import| (import, None))
+                    }
+                };
                 let surfaces =
                     |(import, read)| (shape_surfaces(shape, import, self.xml, self.options), read);
                 (k, import.map(surfaces))
             })
             .collect();
         merged.sort_unstable_by_key(|&(k, _)| k);
-        for ((shape, (file, _)), (_, import)) in found.iter().zip(merged) {
+        for ((shape, source), (_, import)) in found.iter().zip(merged) {
             let (added, read) = import?;
             (self.elements).charge(&added, shape, self.xml, self.options.merge.max_elements)?;
-            if self.seen.insert(file.clone()) {
+            if let Source::File(file, _) = source
+                && self.seen.insert(file.clone())
+            {
                 self.meshes.push((file.clone(), read));
             }
             desc.surfaces.extend(added.surfaces);
@@ -473,7 +523,7 @@ fn find_shape(
         at(format!(
             "<shape id=\"{}\"> filename \"{}\": {why}",
             bt_scene::name::shown(&shape.name),
-            bt_scene::name::shown(&shape.filename)
+            bt_scene::name::shown(shape.filename.as_deref().unwrap_or_default())
         ))
     })?;
     let shown = file.display().to_string();
@@ -516,7 +566,8 @@ fn read_shape(
     let bytes = read_bounded(file, Some(metadata), options.max_file_bytes, &shown)?;
     let format = match shape.kind {
         MeshKind::Ply => crate::mesh::MeshFormat::Ply,
-        MeshKind::Obj => crate::mesh::MeshFormat::Obj,
+        // A primitive has no file to reach here with (`Reading::find`).
+        MeshKind::Obj | MeshKind::Primitive(_) => crate::mesh::MeshFormat::Obj,
     };
     let to_world = shape.to_world;
     let import =
@@ -524,6 +575,26 @@ fn read_shape(
             to_world.transform_point3(p)
         })?;
     Ok((import, hashing.of(&bytes)))
+}
+
+/// The primitive `shape` (rectangle, cube) mapped through its transform and merged, named in
+/// warnings by the XML file `xml` and the shape's line.
+fn merge_primitive(
+    shape: &XmlShape,
+    primitive: Primitive,
+    xml: &str,
+    options: &LoadOptions,
+) -> Result<bt_mesh::MeshImport, ImportError> {
+    let raw = primitive::mesh(primitive);
+    let label = format!(
+        "{xml}: line {}: <shape id=\"{}\">",
+        shape.at.line, shape.name
+    );
+    let to_world = shape.to_world;
+    let import = crate::mesh::merge_transformed(raw, &label, &options.merge, &|p| {
+        to_world.transform_point3(p)
+    })?;
+    Ok(import)
 }
 
 /// `name` under `folder`: relative, plain components only (no `..`, no root, no drive).

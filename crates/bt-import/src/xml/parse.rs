@@ -3,8 +3,8 @@
 
 use super::transform::parse_transform;
 use super::{
-    MAX_XML_BSDFS, MAX_XML_NODES, MAX_XML_SHAPES, MAX_XML_SUBSTITUTION, MeshKind, XmlBsdf, XmlPos,
-    XmlRadio, XmlScene, XmlShape,
+    MAX_XML_BSDFS, MAX_XML_NODES, MAX_XML_SHAPES, MAX_XML_SUBSTITUTION, MeshKind, Primitive,
+    XmlBsdf, XmlPos, XmlRadio, XmlScene, XmlShape,
 };
 use crate::ImportError;
 use bt_geom::Real;
@@ -386,11 +386,13 @@ fn parse_shape(
     let kind = match ctx.required(node, "type")?.as_ref() {
         "ply" => MeshKind::Ply,
         "obj" => MeshKind::Obj,
+        "rectangle" => MeshKind::Primitive(Primitive::Rectangle),
+        "cube" => MeshKind::Primitive(Primitive::Cube),
         other => {
             return Err(ctx.error(
                 node,
                 format!(
-                    "<shape type=\"{}\"> is not supported (only ply and obj meshes)",
+                    "<shape type=\"{}\"> is not supported (only ply and obj meshes, rectangle and cube)",
                     bt_scene::name::shown(other)
                 ),
             ));
@@ -403,21 +405,20 @@ fn parse_shape(
     let mut shape = XmlShape {
         name,
         kind,
-        filename: String::new(),
+        filename: None,
         bsdf: None,
         to_world: DMat4::IDENTITY,
         at: ctx.pos(node),
     };
-    let mut filename = None;
     for child in elements(node) {
-        shape_child(ctx, scene, &mut shape, &mut filename, child)?;
+        shape_child(ctx, scene, &mut shape, child)?;
     }
-    shape.filename = filename.ok_or_else(|| {
-        ctx.error(
+    if !matches!(kind, MeshKind::Primitive(_)) && shape.filename.is_none() {
+        return Err(ctx.error(
             node,
             "<shape> needs <string name=\"filename\" value=\"...\"/>",
-        )
-    })?;
+        ));
+    }
     Ok(shape)
 }
 
@@ -425,16 +426,21 @@ fn shape_child(
     ctx: &mut Ctx<'_>,
     scene: &mut XmlScene,
     shape: &mut XmlShape,
-    filename: &mut Option<String>,
     child: Node<'_, '_>,
 ) -> Result<(), ImportError> {
     match tag(child) {
         "string" if ctx.required(child, "name")? == "filename" => {
+            if let MeshKind::Primitive(_) = shape.kind {
+                return Err(ctx.error(
+                    child,
+                    "a <shape type=\"rectangle\"> or <shape type=\"cube\"> has no filename",
+                ));
+            }
             let value = ctx.required(child, "value")?;
             if value.is_empty() {
                 return Err(ctx.error(child, "<string name=\"filename\"> is empty"));
             }
-            *filename = Some(value.into_owned());
+            shape.filename = Some(value.into_owned());
         }
         "boolean" => {
             let name = ctx.required(child, "name")?;

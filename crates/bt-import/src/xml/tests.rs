@@ -551,3 +551,90 @@ fn rounds_hold_at_most_their_bytes_and_a_larger_file_alone() {
     assert_eq!(lengths(&[0, 0, 10, 0]), [vec![0, 0, 10, 0]]);
     assert_eq!(lengths(&[u64::MAX, 1]), [vec![u64::MAX], vec![1]]);
 }
+
+#[test]
+fn rectangles_and_cubes_are_mitsubas_squares_and_cubes_through_their_transform() {
+    // A 4 m × 6 m floor at z = 0.5 (scale 2 × 3, then up), and a 2 m cube turned 90° about z
+    // and moved to (10, 0, 1): Mitsuba's rectangle is [-1, 1]² at z = 0, its cube [-1, 1]³.
+    let xml = r#"<scene>
+        <bsdf type="itu-radio-material" id="stone"><string name="type" value="marble"/></bsdf>
+        <shape type="rectangle" id="floor"><ref id="stone"/><boolean name="flip_normals" value="true"/>
+            <transform name="to_world"><scale x="2" y="3"/><translate z="0.5"/></transform></shape>
+        <shape type="cube" id="box"><ref id="stone"/>
+            <transform name="to_world"><rotate z="1" angle="90"/><translate x="10" z="1"/></transform></shape>
+    </scene>"#;
+    let dir = scratch("primitives", &[("s.xml", xml)]);
+    let loaded = load_xml(&dir.join("s.xml"), &LoadOptions::default()).unwrap();
+    let surfaces = loaded.scene.surfaces();
+    assert_eq!(surfaces.len(), 7);
+    let floor = &surfaces[0];
+    assert_eq!(
+        (floor.name.as_str(), floor.material.as_str()),
+        ("floor.face_0", "stone")
+    );
+    let corners: Vec<Vec3> = floor.polygon.vertices().to_vec();
+    for expected in [(-2.0, -3.0), (2.0, -3.0), (2.0, 3.0), (-2.0, 3.0)] {
+        let p = Vec3::new(expected.0, expected.1, 0.5);
+        assert!(
+            corners.iter().any(|&c| close(c, p)),
+            "{p} not in {corners:?}"
+        );
+    }
+    assert!((floor.polygon.area() - 24.0).abs() < 1e-12);
+    // The cube: six 4 m² faces, every corner at x = 9 or 11, |y| = 1, z = 0 or 2.
+    let faces = &surfaces[1..];
+    assert!(faces.iter().all(|f| f.name.starts_with("box.")));
+    assert!(faces.iter().all(|f| (f.polygon.area() - 4.0).abs() < 1e-12));
+    for c in faces.iter().flat_map(|f| f.polygon.vertices()) {
+        let near = |v: f64, a: f64| (v - a).abs() < 1e-12;
+        assert!(
+            (near(c.x, 9.0) || near(c.x, 11.0)) && near(c.y.abs(), 1.0),
+            "{c}"
+        );
+        assert!(near(c.z, 0.0) || near(c.z, 2.0), "{c}");
+    }
+    // No file is read for either, and neither is a source of the scene.
+    assert!(loaded.sources.is_empty());
+    std::fs::remove_dir_all(dir).ok();
+}
+
+#[test]
+fn a_primitive_takes_no_filename_and_a_mesh_needs_one() {
+    assert_errors_mention(&[
+        (
+            "<scene><shape type=\"rectangle\">\n<string name=\"filename\" value=\"a.ply\"/></shape></scene>",
+            &["line 2", "has no filename"],
+        ),
+        (
+            "<scene>\n<shape type=\"cube\" id=\"c\"><string name=\"filename\" value=\"a.ply\"/></shape></scene>",
+            &["line 2", "has no filename"],
+        ),
+        (
+            "<scene>\n<shape type=\"obj\"/></scene>",
+            &["line 2", "needs <string name=\"filename\""],
+        ),
+        (
+            "<scene><shape type=\"disk\"/></scene>",
+            &[
+                "<shape type=\"disk\"> is not supported",
+                "rectangle and cube",
+            ],
+        ),
+    ]);
+    let kinds: Vec<MeshKind> = parse_xml(
+        "<scene><shape type=\"rectangle\"/><shape type=\"cube\"/></scene>",
+        "t.xml",
+    )
+    .unwrap()
+    .shapes
+    .iter()
+    .map(|s| s.kind)
+    .collect();
+    assert_eq!(
+        kinds,
+        [
+            MeshKind::Primitive(Primitive::Rectangle),
+            MeshKind::Primitive(Primitive::Cube)
+        ]
+    );
+}

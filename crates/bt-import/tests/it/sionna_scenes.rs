@@ -83,7 +83,10 @@ fn check_scene(path: &Path) -> Vec<String> {
     let folder = path.parent().unwrap();
     let (mut mesh_total, mut loaded_total, mut worst) = (0.0, 0.0, 0.0f64);
     for shape in &xml.shapes {
-        let mesh = mesh_area(&folder.join(&shape.filename), shape.to_world);
+        let mesh = mesh_area(
+            &folder.join(shape.filename.as_deref().unwrap()),
+            shape.to_world,
+        );
         let got = loaded_area.get(shape.name.as_str()).copied().unwrap_or(0.0);
         mesh_total += mesh;
         loaded_total += got;
