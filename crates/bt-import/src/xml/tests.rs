@@ -53,7 +53,19 @@ fn unsupported_elements_are_named_with_their_line() {
         ),
         (
             "<scene><shape type=\"ply\"><string name=\"filename\" value=\"a.ply\"/><transform name=\"to_world\">\n<lookat origin=\"0 0 0\" target=\"1 0 0\"/></transform></shape></scene>",
-            &["line 2", "<lookat>"],
+            &["line 2", "<lookat>", "up"],
+        ),
+        (
+            "<scene><shape type=\"ply\"><string name=\"filename\" value=\"a.ply\"/><transform name=\"to_world\">\n<lookat origin=\"0 0 0\" target=\"1 0 0\" up=\"2, 0, 0\"/></transform></shape></scene>",
+            &["line 2", "<lookat> needs a target apart from the origin"],
+        ),
+        (
+            "<scene><shape type=\"ply\"><string name=\"filename\" value=\"a.ply\"/><transform name=\"to_world\">\n<lookat origin=\"1 1 1\" target=\"1 1 1\" up=\"0 0 1\"/></transform></shape></scene>",
+            &["line 2", "<lookat> needs a target apart from the origin"],
+        ),
+        (
+            "<scene><shape type=\"ply\"><string name=\"filename\" value=\"a.ply\"/><transform name=\"to_world\">\n<lookat origin=\"1 1\" target=\"1 1 1\" up=\"0 0 1\"/></transform></shape></scene>",
+            &["line 2", "origin= needs 3 numbers, got 2"],
         ),
         ("<mitsuba/>", &["expected <scene>"]),
         (
@@ -637,4 +649,24 @@ fn a_primitive_takes_no_filename_and_a_mesh_needs_one() {
             MeshKind::Primitive(Primitive::Cube)
         ]
     );
+}
+
+#[test]
+fn lookat_turns_z_towards_the_target_as_mitsuba_does() {
+    // Towards +x with +z up: the object's x goes to +y (up × dir), its y to +z, its z to +x,
+    // its origin to (1, 2, 3); then a translation listed after it moves the result.
+    let m =
+        one_shape(r#"<lookat origin="1, 2, 3" target="5, 2, 3" up="0, 0, 7"/><translate x="10"/>"#);
+    for (local, world) in [
+        (Vec3::ZERO, Vec3::new(11.0, 2.0, 3.0)),
+        (Vec3::X, Vec3::new(11.0, 3.0, 3.0)),
+        (Vec3::Y, Vec3::new(11.0, 2.0, 4.0)),
+        (Vec3::Z, Vec3::new(12.0, 2.0, 3.0)),
+    ] {
+        assert!(
+            close(m.transform_point3(local), world),
+            "{local} -> {}",
+            m.transform_point3(local)
+        );
+    }
 }

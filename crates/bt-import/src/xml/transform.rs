@@ -1,4 +1,4 @@
-//! `<transform name="to_world">`: translate, rotate, scale and matrix, composed in document
+//! `<transform name="to_world">`: translate, rotate, scale, matrix and lookat, composed in document
 //! order as Mitsuba does (each operation multiplies from the left: the first listed acts first).
 
 use super::parse::{Ctx, elements, parse_number, tag};
@@ -20,10 +20,11 @@ pub(super) fn parse_transform(ctx: &Ctx<'_>, node: Node<'_, '_>) -> Result<DMat4
             "scale" => DMat4::from_scale(vector(ctx, op, 1.0)?),
             "rotate" => rotation(ctx, op)?,
             "matrix" => matrix(ctx, op)?,
+            "lookat" => look_at(ctx, op)?,
             other => {
                 return Err(ctx.error(
                     op,
-                    format!("unsupported element <{other}> in <transform> (translate, rotate, scale, matrix)"),
+                    format!("unsupported element <{other}> in <transform> (translate, rotate, scale, matrix, lookat)"),
                 ));
             }
         };
@@ -103,6 +104,38 @@ fn matrix(ctx: &Ctx<'_>, op: Node<'_, '_>) -> Result<DMat4, ImportError> {
         ));
     }
     Ok(m)
+}
+
+/// `<lookat origin="x, y, z" target="x, y, z" up="x, y, z"/>`, as Mitsuba builds it: the
+/// object frame's `+z` turned towards `target`, its `+y` as near `up` as that allows (its `+x`
+/// is `up × z`), and its origin moved to `origin` (metres).
+fn look_at(ctx: &Ctx<'_>, op: Node<'_, '_>) -> Result<DMat4, ImportError> {
+    let point = |name: &str| -> Result<Vec3, ImportError> {
+        let text = ctx.required(op, name)?;
+        match numbers(ctx, op, &text)?.as_slice() {
+            [x, y, z] => Ok(Vec3::new(*x, *y, *z)),
+            v => Err(ctx.error(
+                op,
+                format!("<lookat> {name}= needs 3 numbers, got {}", v.len()),
+            )),
+        }
+    };
+    let (origin, target, up) = (point("origin")?, point("target")?, point("up")?);
+    let dir = (target - origin).normalize_or_zero();
+    let left = up.cross(dir).normalize_or_zero();
+    if dir == Vec3::ZERO || left == Vec3::ZERO {
+        return Err(ctx.error(
+            op,
+            "<lookat> needs a target apart from the origin and an up not along target - origin",
+        ));
+    }
+    let new_up = dir.cross(left);
+    Ok(DMat4::from_cols(
+        left.extend(0.0),
+        new_up.extend(0.0),
+        dir.extend(0.0),
+        origin.extend(1.0),
+    ))
 }
 
 fn numbers(ctx: &Ctx<'_>, op: Node<'_, '_>, text: &str) -> Result<Vec<Real>, ImportError> {
