@@ -63,7 +63,8 @@ fn unsupported(file: &str, detail: String) -> MeshError {
 }
 
 /// Parse `bytes` (a `.gltf` or `.glb` file named `file`, in `folder`) and read its buffers,
-/// each file within `max_file_bytes`, hashing the files read with `hashing` on.
+/// each file within `max_file_bytes`, hashing the files read with `hashing` on. Without a
+/// folder no file is read: a buffer must be a `data:` URI or the GLB binary chunk.
 pub(crate) fn document(
     bytes: &[u8],
     (file, folder): (&str, Option<&Path>),
@@ -157,7 +158,16 @@ fn uri_bytes(
             ),
         ));
     }
-    let path = folder.map_or(relative.clone(), |f| f.join(&relative));
+    let Some(folder) = folder else {
+        return Err(unsupported(
+            file,
+            format!(
+                "buffer URI \"{}\": glTF read from bytes has no folder (only data: URIs and the GLB chunk)",
+                bt_scene::name::shown(uri)
+            ),
+        ));
+    };
+    let path = folder.join(&relative);
     let bytes = super::read_bytes(&path, max_file_bytes)?;
     Ok((bytes, Some(path)))
 }

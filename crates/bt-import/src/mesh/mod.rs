@@ -65,6 +65,21 @@ pub fn read_stl(
     read_transformed(bytes, MeshFormat::Stl, file, opts, &|p| p)
 }
 
+/// Reads a glTF 2.0 scene from bytes (`.glb`, or `.gltf` JSON) and merges its triangles into
+/// planar surfaces, as a `.gltf`/`.glb` scene file loads but reading no file: every buffer must be the
+/// GLB binary chunk or a `data:` URI. `file` names the source in errors and warnings.
+pub fn read_gltf(
+    bytes: &[u8],
+    file: Option<&str>,
+    opts: &MergeOptions,
+) -> Result<MeshImport, MeshError> {
+    let file = file.unwrap_or(UNNAMED);
+    opts.validate()?;
+    let doc = gltf::document(bytes, (file, None), u64::MAX, crate::source::Hashing::Off)?;
+    let raw = gltf::parse(&doc, file, opts.max_elements)?;
+    Ok(bt_mesh::merge_mesh(&raw, opts, file)?)
+}
+
 /// Checks `opts` and parses `bytes` as `format` into the polygon soup the merge starts from.
 fn parse(
     bytes: &[u8],

@@ -244,3 +244,33 @@ proptest::proptest! {
         let _ = std::fs::remove_dir_all(&dir);
     }
 }
+
+#[test]
+fn gltf_from_bytes_reads_no_file_and_gives_the_files_surfaces() {
+    // The embedded document through `read_gltf` gives the surfaces the file load gives.
+    let (mut doc, bytes) = square(4, &[0, 1, 2, 0, 2, 3], None);
+    doc["buffers"][0]["uri"] = json!(format!(
+        "data:application/octet-stream;base64,{}",
+        base64(&bytes)
+    ));
+    let text = serde_json::to_vec(&doc).unwrap();
+    let dir = scratch("bytes");
+    let loaded = load_doc(&dir, "embedded.gltf", &doc).unwrap();
+    let import = bt_import::mesh::read_gltf(&text, None, &MergeOptions::default()).unwrap();
+    assert_eq!(import.surfaces.len(), 1);
+    let from_file = &loaded.scene.surfaces()[0];
+    let mut got = import.surfaces[0].vertices.clone();
+    let mut want = from_file.polygon.vertices().to_vec();
+    let key = |v: &bt_geom::Vec3| v.to_array().map(f64::to_bits);
+    got.sort_by_key(key);
+    want.sort_by_key(key);
+    assert_eq!(got, want);
+    // A buffer in a file is refused before any file is looked for: there is no folder.
+    let (doc, _) = square(4, &[0, 1, 2, 0, 2, 3], Some("floor.bin".into()));
+    let text = serde_json::to_vec(&doc).unwrap();
+    let e = bt_import::mesh::read_gltf(&text, Some("x.gltf"), &MergeOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(e.contains("x.gltf") && e.contains("has no folder"), "{e}");
+    std::fs::remove_dir_all(dir).ok();
+}
