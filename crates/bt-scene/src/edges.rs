@@ -18,8 +18,8 @@
 mod keller;
 
 pub use keller::{
-    EdgeLine, KELLER_PAIR_TOL, KELLER_RESIDUAL, KellerPair, KellerReach, NoKellerPair, keller_pair,
-    keller_pair_checked, keller_pair_settled,
+    EdgeLine, KELLER_PAIR_TOL, KELLER_RESIDUAL, KellerPair, KellerReach, LinePair, NoKellerPair,
+    keller_pair, keller_pair_checked, keller_pair_settled,
 };
 
 use crate::surface::{Surface, SurfaceId, SurfaceKind};

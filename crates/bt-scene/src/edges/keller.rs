@@ -216,44 +216,85 @@ pub fn keller_pair_checked(
     second: EdgeLine,
     b: Vec3,
 ) -> Result<KellerPair, NoKellerPair> {
-    // The same test from either end (the crossing's subgradient condition is symmetric).
-    if shortest_at_crossing(a, (first, second), b) {
-        return Err(NoKellerPair::Crossing);
-    }
-    let forward = || keller_pair_from(a, first, second, b);
-    let backward = || {
-        keller_pair_from(b, second, first, a).map(
-            |KellerPair {
-                 at: (t2, t1),
-                 residual,
-             }| {
-                KellerPair {
-                    at: (t1, t2),
-                    residual,
-                }
-            },
-        )
-    };
-    let key = |v: Vec3| [v.x, v.y, v.z];
-    let from_b = key(b)
-        .iter()
-        .zip(key(a))
-        .map(|(x, y)| x.total_cmp(&y))
-        .find(|o| o.is_ne())
-        == Some(std::cmp::Ordering::Less);
-    let pair = if from_b {
-        backward().or_else(forward)
-    } else {
-        forward().or_else(backward)
-    };
-    pair.ok_or(NoKellerPair::Unsettled)
+    let lines = LinePair::new(first, second);
+    lines.keller_pair((a, focus(&first, a)), (b, focus(&second, b)))
 }
 
-/// [`keller_pair`] solved from `a`'s end, the path not through the lines' crossing.
-fn keller_pair_from(a: Vec3, first: EdgeLine, second: EdgeLine, b: Vec3) -> Option<KellerPair> {
-    // The ends' distances from their lines and parameters, made once for every closed form
-    // below (each [`EdgeLine::keller`] of an end, the same bits).
-    let (a_on, b_on) = (focus(&first, a), focus(&second, b));
+/// Two edge lines of [`keller_pair_checked`] (first, second) and their crossing, when they
+/// cross: what its solve makes of the lines alone, made once for one pair of lines against
+/// many ends ([`LinePair::keller_pair`]).
+#[derive(Debug, Clone, Copy)]
+pub struct LinePair {
+    lines: (EdgeLine, EdgeLine),
+    /// The crossing (the middle of the lines' closest points), `d1·d2` and `1 − (d1·d2)²`,
+    /// when the lines are not parallel and pass within a nanometre of each other.
+    crossing: Option<(Vec3, Real, Real)>,
+}
+
+impl LinePair {
+    /// The pair `first`, `second`.
+    #[inline(always)]
+    pub fn new(first: EdgeLine, second: EdgeLine) -> Self {
+        LinePair {
+            lines: (first, second),
+            crossing: crossing(first, second),
+        }
+    }
+
+    /// [`keller_pair_checked`] of `a` and `b` on these lines, each end given with its
+    /// distance from its line and its parameter on it (`a` on the first line, `b` on the
+    /// second: [`EdgeLine::distance`], [`EdgeLine::along`]): the same result, bit for bit.
+    #[inline(always)]
+    pub fn keller_pair(
+        &self,
+        (a, a_on): (Vec3, (Real, Real)),
+        (b, b_on): (Vec3, (Real, Real)),
+    ) -> Result<KellerPair, NoKellerPair> {
+        let (first, second) = self.lines;
+        // The same test from either end (the crossing's subgradient condition is symmetric).
+        if self
+            .crossing
+            .is_some_and(|c| through_crossing(a, self.lines, b, c))
+        {
+            return Err(NoKellerPair::Crossing);
+        }
+        let forward = || keller_pair_from((a, a_on), (first, second), (b, b_on));
+        let backward = || {
+            keller_pair_from((b, b_on), (second, first), (a, a_on)).map(
+                |KellerPair {
+                     at: (t2, t1),
+                     residual,
+                 }| {
+                    KellerPair {
+                        at: (t1, t2),
+                        residual,
+                    }
+                },
+            )
+        };
+        let key = |v: Vec3| [v.x, v.y, v.z];
+        let from_b = key(b)
+            .iter()
+            .zip(key(a))
+            .map(|(x, y)| x.total_cmp(&y))
+            .find(|o| o.is_ne())
+            == Some(std::cmp::Ordering::Less);
+        let pair = if from_b {
+            backward().or_else(forward)
+        } else {
+            forward().or_else(backward)
+        };
+        pair.ok_or(NoKellerPair::Unsettled)
+    }
+}
+
+/// [`keller_pair`] solved from `a`'s end, the path not through the lines' crossing, each end
+/// with its distance from its line and its parameter ([`focus`]).
+fn keller_pair_from(
+    (a, a_on): (Vec3, (Real, Real)),
+    (first, second): (EdgeLine, EdgeLine),
+    (b, b_on): (Vec3, (Real, Real)),
+) -> Option<KellerPair> {
     // `b`'s Keller point on `second` from `p` (the closed form with its two points swapped
     // back, so the same operations as `second.keller(p, b)`).
     let to_b = |p: Vec3| keller_of(focus(&second, p), b_on);
@@ -322,12 +363,20 @@ const CROSSING_M: Real = 1e-9;
 /// crossing `C` is the minimum when zero is a subgradient there: some `w`, |w| ≤ 1 (the middle
 /// leg's), with `d1·w = d1·u1` and `d2·w = d2·u3` (`u1`, `u3` the unit legs from `a` to `C` and
 /// from `C` to `b`); the shortest such `w` lies in the lines' plane.
-fn shortest_at_crossing(a: Vec3, (first, second): (EdgeLine, EdgeLine), b: Vec3) -> bool {
+#[cfg(test)]
+fn shortest_at_crossing(a: Vec3, lines: (EdgeLine, EdgeLine), b: Vec3) -> bool {
+    crossing(lines.0, lines.1).is_some_and(|c| through_crossing(a, lines, b, c))
+}
+
+/// The lines' part of [`shortest_at_crossing`]: their crossing, `c = d1·d2` and
+/// `det = 1 − c²`, or `None` when they are (nearly) parallel or do not cross.
+#[inline(always)]
+fn crossing(first: EdgeLine, second: EdgeLine) -> Option<(Vec3, Real, Real)> {
     let (d1, d2) = (first.direction, second.direction);
     let c = d1.dot(d2);
     let det = 1.0 - c * c;
     if det <= 1e-12 {
-        return false;
+        return None;
     }
     let w0 = first.start - second.start;
     let (d, e) = (d1.dot(w0), d2.dot(w0));
@@ -335,10 +384,18 @@ fn shortest_at_crossing(a: Vec3, (first, second): (EdgeLine, EdgeLine), b: Vec3)
         first.point((c * e - d) / det),
         second.point((e - c * d) / det),
     );
-    if p.distance(q) > CROSSING_M {
-        return false;
-    }
-    let corner = 0.5 * (p + q);
+    (p.distance(q) <= CROSSING_M).then(|| (0.5 * (p + q), c, det))
+}
+
+/// The ends' part of [`shortest_at_crossing`], the lines crossing at `corner`.
+#[inline(always)]
+fn through_crossing(
+    a: Vec3,
+    (first, second): (EdgeLine, EdgeLine),
+    b: Vec3,
+    (corner, c, det): (Vec3, Real, Real),
+) -> bool {
+    let (d1, d2) = (first.direction, second.direction);
     let (v1, v3) = (corner - a, b - corner);
     if v1.length() <= CROSSING_M || v3.length() <= CROSSING_M {
         return false;

@@ -17,7 +17,7 @@ use super::{Pairing, Reach};
 use crate::beamtree::{PAIR_TESTS_PER_CANDIDATE, TreeError};
 use crate::diffraction::DiffractedSet;
 use bt_geom::{Plane, Polygon, Real, Vec3};
-use bt_scene::edges::{EdgeLine, KellerReach, NoKellerPair, keller_pair_checked};
+use bt_scene::edges::{EdgeLine, KellerReach, LinePair, NoKellerPair};
 use bt_scene::{Edge, EdgeId, Scene, SurfaceId};
 
 /// Angular slack (rad) of the prefilters: far above round-off, far below any angle a valid
@@ -703,8 +703,11 @@ impl Pairing<'_> {
             // candidate whose pair does not vouch for it ([`vouches`]): when it fails, the
             // group has none (and no pair that vouches).
             let mut keller_law = None;
+            // The two edge lines' part of the Keller pairs' solves, made for the group's
+            // first pair (the members share the group's edge line).
+            let mut lines = None;
             for a in &pairs.near[g.members.clone()] {
-                let Some((keller, vouched)) = self.may_join(a, far, toward) else {
+                let Some((keller, vouched)) = self.may_join(a, far, (toward, &mut lines)) else {
                     continue;
                 };
                 if !vouched && !*keller_law.get_or_insert_with(|| self.obeys_keller(&g.span, far)) {
@@ -941,20 +944,24 @@ impl Pairing<'_> {
     /// or there is none, the shortest path through the lines' crossing.
     /// The pair's inputs are the image method's for the candidate
     /// ([`DiffractedSet::keller`]), so the solve reuses it. `toward` as for
-    /// [`Pairing::apart`]. With the pair, whether it vouches for the group's Keller-law
-    /// test ([`vouches`]).
+    /// [`Pairing::apart`]; `lines`, the two edge lines' part of the solve
+    /// ([`LinePair`]), made here when not yet made. The ends' distances and parameters
+    /// are the ones `a` and `far` keep (`focus`: [`EdgeLine::distance`] and
+    /// [`EdgeLine::along`] of the same points on the same lines, so the same bits as
+    /// [`bt_scene::edges::keller_pair_checked`] makes). With the pair, whether it vouches
+    /// for the group's Keller-law test ([`vouches`]).
     #[inline(always)]
     fn may_join(
         &self,
         a: &Near,
         far: &Far<'_>,
-        toward: KellerReach,
+        (toward, lines): (KellerReach, &mut Option<LinePair>),
     ) -> Option<(Option<(Real, Real)>, bool)> {
         if self.apart(a, far, toward) {
             return None;
         }
-        let pair = match keller_pair_checked(a.reach.image, a.span.line, far.wedge.line, far.image)
-        {
+        let lines = lines.get_or_insert_with(|| LinePair::new(a.span.line, far.wedge.line));
+        let pair = match lines.keller_pair((a.reach.image, a.focus), (far.image, far.focus)) {
             Ok(pair) => pair,
             // No path over both edges at all ([`NoKellerPair::Crossing`]): the image method
             // would count the candidate degenerate, and IPC could only meet the crossing.
