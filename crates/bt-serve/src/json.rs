@@ -184,6 +184,12 @@ fn write_real(out: &mut Vec<u8>, v: f64) -> io::Result<()> {
 /// formatter gives it, without its shortest-digits search.
 #[inline]
 fn write_integral_or_real(out: &mut Vec<u8>, v: f64) -> io::Result<()> {
+    // +0.0 (a path's diffraction and transmission losses, most often) as `write_real` writes
+    // it, without the integer's digits.
+    if v.to_bits() == 0 {
+        out.extend_from_slice(b"0.0");
+        return Ok(());
+    }
     // `as` saturates (and takes NaN to 0): only an integral, finite value comes back equal.
     let i = v as i64;
     if i as f64 != v || i.unsigned_abs() >= INTEGRAL_BELOW {
@@ -444,6 +450,8 @@ mod tests {
         }
         let bound = INTEGRAL_BELOW as f64;
         values.extend([
+            0.0,
+            -0.0,
             bound,
             bound.next_down(),
             -bound.next_down(),
