@@ -317,6 +317,22 @@ CASES = [
             "lane 4.5 m from them. Mostly reached over roof edges and by reflections."
         ),
     ),
+    dict(
+        name="primitives-d2",
+        scene="mitsuba-primitives",
+        xml="testdata/scenes/mitsuba-primitives.xml",
+        tx=[-5.0, -3.0, 2.0],
+        rx=[[5.0, -3.0, 1.5], [6.0, 2.0, 3.0], [-2.0, 1.0, 1.0]],
+        max_depth=2,
+        diffraction=False,
+        why=(
+            "Mitsuba's primitives, not meshes: a ground rectangle ([-1, 1]^2 scaled by 10) "
+            "and a block (the cube [-1, 1]^3 scaled by 3, 1, 2, at (0, 5, 2)), a scene of "
+            "ours that Sionna loads through Mitsuba. Specular only: RX0 in front of the "
+            "block's south face, RX1 beside its east face (x = 3), RX2 close to the south "
+            "face; reflections on the ground, the faces and both."
+        ),
+    ),
 ]
 
 # --------------------------------------------------------------------------
@@ -341,9 +357,11 @@ def import_sionna():
     return dr, mi, rt
 
 
-def load(scene_name):
+def load(case):
+    """The case's scene: Sionna's own under ``SCENES``, or the repository file ``case["xml"]``."""
     dr, mi, rt = import_sionna()
-    xml = SCENES / scene_name / f"{scene_name}.xml"
+    name = case["scene"]
+    xml = REPO / case["xml"] if "xml" in case else SCENES / name / f"{name}.xml"
     scene = rt.load_scene(str(xml), merge_shapes=False)
     return scene, xml
 
@@ -559,7 +577,7 @@ def run_case(case, timing=True):
     dr, mi, rt = import_sionna()
     from sionna.rt import PathSolver, PlanarArray, Receiver, Transmitter
 
-    scene, xml = load(case["scene"])
+    scene, xml = load(case)
     freq = case.get("frequency", FREQ)
     scene.frequency = freq
     scene.tx_array = PlanarArray(num_rows=1, num_cols=1, pattern="iso", polarization="V")

@@ -6,7 +6,9 @@
 //! docs/sionna-diffraction-notes.md, docs/channel.md §8); with Sionna's coefficient and
 //! Sionna's diffracted leg (`bt_channel::path_gain_sionna_rt22`), every diffracted gain where
 //! Sionna's wedge is ours is Sionna's within 0.1 dB. With Sionna's refraction (its thin slab),
-//! every path it finds through walls is one of ours under `--transmission`, with its gain.
+//! every path it finds through walls is one of ours under `--transmission`, with its gain. On
+//! a scene of Mitsuba's rectangle and cube (ours, loaded by Sionna through Mitsuba), every
+//! specular path is ours with its gain.
 
 use bt_beams::{InteractionKind, PathReport, RadioOptions};
 use bt_channel::DiffractionCoefficient;
@@ -558,22 +560,30 @@ fn with_the_unfolded_leg_only_paths_reflecting_after_the_edge_differ() {
     assert!(grown.iter().all(|p| p.diff_db > 2.0 && p.diff_db < 9.0));
 }
 
-/// Sionna RT's refraction on the street canyon (`canyon-refraction-d2`: every material an ITU
-/// slab 0.1 m thick, no diffraction, `max_depth` 2): every path Sionna finds, through walls or
-/// not, is one of ours traced with transmission (same kinds in order, points within 1 cm), with
-/// its gain within 0.05 dB; and we find at least as many (Sionna samples its rays).
-#[test]
-fn sionnas_refracted_paths_are_ours_with_their_gains() {
-    let (doc, scene) = reference("canyon-refraction-d2");
+/// What [`sionnas_paths_are_ours`] counted: Sionna's paths, those through a surface, ours, and
+/// the largest gain difference (dB).
+struct Tally {
+    theirs: usize,
+    crossing: usize,
+    ours: usize,
+    worst_db: Real,
+}
+
+/// Every path Sionna finds in reference `case` (specular, no diffraction) is one of ours
+/// traced with `trace` (same kinds in order, points within 1 cm), with its gain within
+/// 0.05 dB.
+fn sionnas_paths_are_ours(case: &str, trace: impl Fn(usize) -> TraceOptions) -> Tally {
+    let (doc, scene) = reference(case);
     let max_depth = doc["max_depth"].as_u64().unwrap() as usize;
-    let trace = TraceOptions {
-        transmission: true,
-        ..TraceOptions::new(max_depth)
-    };
     let radio = RadioOptions::default().for_order(max_depth);
-    let mut tracer = Tracer::new(scene, trace);
+    let mut tracer = Tracer::new(scene, trace(max_depth));
     let tx = vec3(&doc["tx"]["position"]);
-    let (mut crossing, mut worst, mut ours_total, mut theirs_total) = (0, 0.0 as Real, 0, 0);
+    let mut tally = Tally {
+        theirs: 0,
+        crossing: 0,
+        ours: 0,
+        worst_db: 0.0,
+    };
     for receiver in doc["receivers"].as_array().unwrap() {
         let rx = vec3(&receiver["position"]);
         let (_, ours) = described(&mut tracer, (tx, rx), &radio);
@@ -582,27 +592,53 @@ fn sionnas_refracted_paths_are_ours_with_their_gains() {
             let e = expected(path);
             let Some((p, _)) = matching(&ours, &e, 0.01) else {
                 panic!(
-                    "rx {rx}: Sionna's {:?} at {:?} not found",
+                    "{case} rx {rx}: Sionna's {:?} at {:?} not found",
                     e.kinds, e.vertices
                 );
             };
             let diff = p.gain_db.unwrap() - e.gain_db;
-            crossing += usize::from(e.kinds.contains(&InteractionKind::Transmission));
-            worst = worst.max(diff.abs());
+            tally.crossing += usize::from(e.kinds.contains(&InteractionKind::Transmission));
+            tally.worst_db = tally.worst_db.max(diff.abs());
             assert!(
                 diff.abs() <= 0.05,
-                "rx {rx}: {:?} ours {:.4} dB, Sionna {:.4} dB",
+                "{case} rx {rx}: {:?} ours {:.4} dB, Sionna {:.4} dB",
                 e.kinds,
                 p.gain_db.unwrap(),
                 e.gain_db
             );
         }
-        ours_total += ours.len();
-        theirs_total += theirs.len();
+        tally.ours += ours.len();
+        tally.theirs += theirs.len();
     }
     eprintln!(
-        "canyon-refraction-d2: Sionna {theirs_total} paths ({crossing} through walls), ours \
-         {ours_total}; worst gain difference {worst:.4} dB"
+        "{case}: Sionna {} paths ({} through walls), ours {}; worst gain difference {:.4} dB",
+        tally.theirs, tally.crossing, tally.ours, tally.worst_db
     );
-    assert!(crossing > 0 && ours_total >= theirs_total);
+    tally
+}
+
+/// Sionna RT's refraction on the street canyon (`canyon-refraction-d2`: every material an ITU
+/// slab 0.1 m thick, no diffraction, `max_depth` 2): every path Sionna finds, through walls or
+/// not, is one of ours traced with transmission, with its gain within 0.05 dB; and we find at
+/// least as many (Sionna samples its rays).
+#[test]
+fn sionnas_refracted_paths_are_ours_with_their_gains() {
+    let tally = sionnas_paths_are_ours("canyon-refraction-d2", |max_depth| TraceOptions {
+        transmission: true,
+        ..TraceOptions::new(max_depth)
+    });
+    assert!(tally.crossing > 0 && tally.ours >= tally.theirs);
+}
+
+/// Mitsuba's rectangle and cube as Sionna loads them through Mitsuba (`primitives-d2`, our
+/// scene `testdata/scenes/mitsuba-primitives.xml`): Sionna's specular paths are ours, gains
+/// within 0.05 dB, so the primitives' extents and transforms are Mitsuba's.
+#[test]
+fn sionnas_paths_off_mitsubas_rectangle_and_cube_are_ours() {
+    let tally = sionnas_paths_are_ours("primitives-d2", TraceOptions::new);
+    assert!(
+        tally.theirs >= 8 && tally.ours >= tally.theirs,
+        "{}",
+        tally.theirs
+    );
 }
