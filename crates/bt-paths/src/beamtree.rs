@@ -1382,6 +1382,29 @@ pub(super) fn side_plane(apex: Vec3, (w, v): (Vec3, Vec3), facing: &Facing) -> O
     Some(if facing.outward { flip(side) } else { side })
 }
 
+/// A counting sort of `(key, value)` pairs (each key below `keys`) by key: the start of each
+/// key's run (one more entry than keys, the last the number of pairs) and the values in key
+/// order, each key's in the order `pairs` gives them (it is walked twice).
+fn by_key<I: Iterator<Item = (u32, u32)>>(
+    keys: usize,
+    pairs: impl Fn() -> I,
+) -> (Vec<u32>, Vec<u32>) {
+    let mut starts = vec![0u32; keys + 1];
+    for (k, _) in pairs() {
+        starts[k as usize + 1] += 1;
+    }
+    for i in 0..keys {
+        starts[i + 1] += starts[i];
+    }
+    let mut next = starts.clone();
+    let mut values = vec![0u32; starts[keys] as usize];
+    for (k, v) in pairs() {
+        values[next[k as usize] as usize] = v;
+        next[k as usize] += 1;
+    }
+    (starts, values)
+}
+
 /// Put `ids` (distinct, each below `n`, as a BVH walk finds them) in increasing order. A long
 /// list goes through a bit set of `n` bits (a parent's few hundred children of a city's
 /// 18,000 surfaces: a tenth of a sort's instructions), a short one is sorted.
@@ -1758,9 +1781,8 @@ pub fn candidates_and_diffracted_in(
         }
         prep.rx_visible = Some(visible);
         let reach = prep.rx_visible.as_ref().and_then(|v| v.reach.as_ref());
-        let area = join::apex_box(&tree, parents);
         let joined = (reach.filter(|_| join))
-            .map(|reach| join::Joined::of(&prep, &rx_mirrored, reach, area));
+            .map(|reach| join::Pairs::of(&tree, &prep, (&rx_mirrored, reach), parents));
         let probe = (rx, rx_mirrored.clone());
         let level = (Some(&probe), joined.as_ref());
         tree.grow_level_chunked(&prep, options.max_order - 1, level, progress)?;

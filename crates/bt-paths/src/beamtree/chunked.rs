@@ -5,7 +5,7 @@
 //! are independent and run on all cores when [`TreeOptions::parallel`] says so; fixed chunk
 //! bounds make the tree the same on any number of threads.
 
-use super::join::Joined;
+use super::join::Pairs;
 use super::{
     BeamTree, Leaf, Mirrored, Node, PROGRESS_EVERY, Prepared, Probe, Progress, ROOT, Scratch,
     TreeError, TreeStats,
@@ -14,7 +14,7 @@ use crate::CandidateSet;
 use rayon::prelude::*;
 
 /// Parents per chunk (a few milliseconds of a city's second level).
-const CHUNK_PARENTS: usize = 32;
+pub(super) const CHUNK_PARENTS: usize = 32;
 /// The root's children per chunk at depth 1.
 const CHUNK_CHILDREN: usize = 512;
 /// Rounds of chunks grown at once ([`BeamTree::in_rounds`]): 2,048 parents at depth 2 and
@@ -35,12 +35,12 @@ impl BeamTree {
     /// budget and reporting progress after each round of chunks. With `probe` (RX and its
     /// mirror images), only the nodes that can end or lead to a candidate for that RX are
     /// culled and kept ([`Probe`]); with `joined` too, each parent tries only the children
-    /// the RX-side join pairs it with ([`Joined`]) (all of them still count as tested).
+    /// the RX-side join pairs it with ([`Pairs`]) (all of them still count as tested).
     pub(super) fn grow_level_chunked(
         &mut self,
         prep: &Prepared<'_>,
         depth: usize,
-        (probe, joined): (Option<&(bt_geom::Vec3, Mirrored)>, Option<&Joined>),
+        (probe, joined): (Option<&(bt_geom::Vec3, Mirrored)>, Option<&Pairs>),
         progress: Progress<'_>,
     ) -> Result<(), TreeError> {
         let start = self.nodes.len();
@@ -155,7 +155,7 @@ impl BeamTree {
         &self,
         prep: &Prepared<'_>,
         work: Work<'_>,
-        (probe, joined): (Option<&(bt_geom::Vec3, Mirrored)>, Option<&Joined>),
+        (probe, joined): (Option<&(bt_geom::Vec3, Mirrored)>, Option<&Pairs>),
     ) -> BeamTree {
         let mut part = self.part();
         let mut scratch = Scratch::default();
@@ -172,12 +172,19 @@ impl BeamTree {
                 let mut children = Vec::new();
                 for &p in parents {
                     let parent = self.parent_ref(prep, p);
-                    self.child_candidates(prep, &parent, false, &mut children);
-                    part.stats.tested += children.len() as u64;
-                    if let Some(joined) = joined {
-                        children.retain(|&s| joined.joins(prep, s, parent.apex));
-                    }
-                    for &s in &children {
+                    let children = match joined {
+                        Some(pairs) => {
+                            let (kept, tried) = pairs.of_parent(p);
+                            part.stats.tested += tried;
+                            kept
+                        }
+                        None => {
+                            self.child_candidates(prep, &parent, false, &mut children);
+                            part.stats.tested += children.len() as u64;
+                            &children[..]
+                        }
+                    };
+                    for &s in children {
                         part.child_probed(prep, &parent, s, &mut scratch, probe.as_mut());
                     }
                 }

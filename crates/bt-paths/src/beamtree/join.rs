@@ -9,13 +9,17 @@
 //! `I` through `p` to `J'`, RX mirrored through `s` (or through `t` and then `s`), with `p`
 //! between them. So `I` lies in the *cone* of rays from `J'` through `p`'s region, beyond
 //! `s`'s plane: RX's depth-1 node on `s`, or its depth-2 node `(t, s)` (the part of `s`'s
-//! grown hull inside `t`'s mirror beam, [`super::reach`]). The join builds these cones once
-//! per reflector `s` (`t` from the reach lists), grouped by the side of `s`'s plane their apex
-//! lies on, each group with a box around its cones inside the parents' apexes' box; a child
-//! `s` of a parent (found by the parent's box test as before) is then clipped and probed only
-//! when the parent's apex lies in a group's box and in one of its cones: a few compares and
-//! dot products instead of a clip and a probe for each of the pairs no cone holds. Used from
-//! [`JOIN_FROM`] parents in large scenes, always in small ones ([`pays`]).
+//! grown hull inside `t`'s mirror beam, [`super::reach`]). Before the level, each parent's
+//! box test finds its children `s` as before ([`BeamTree::child_candidates`]); the tries are
+//! then gathered per reflector `s`, whose cones (`t` from the reach lists) are built, grouped
+//! by the side of `s`'s plane their apex lies on, each group with a box around its cones
+//! inside the parents' apexes' box, and tested against the apexes of all of `s`'s tries at
+//! once: each cone's planes are read while they are in the cache, once per reflector instead
+//! of once per try. A child `s` of a parent is then clipped and probed only when the parent's
+//! apex lies in a group's box and in one of its cones: a few compares and dot products
+//! instead of a clip and a probe for each of the pairs no cone holds. Used from [`JOIN_FROM`]
+//! parents in large scenes, always in small ones ([`pays`]); in large scenes a reflector with
+//! few tries for its cones keeps them all ([`TRIES_PER_CONE`]).
 //!
 //! Margins: `p`'s region is `s`'s hull grown by half the reach lists' margin (a
 //! well-conditioned node's window, relaxed by the probe's one tolerance, lies within a
@@ -33,36 +37,20 @@ use super::{BeamTree, Facing, LINEAR_SCAN, Mirrored, Prepared, chunked, side_pla
 use bt_geom::{Plane, Real, Vec3, convex};
 use bt_scene::SurfaceId;
 
-/// Reflectors per parallel task of [`Joined::of`].
+/// Reflectors per parallel task of [`Pairs::of`]'s joins.
 const CHUNK: usize = 64;
 
-/// Per reflector `s`, the cones that a parent's apex must lie in for the node `(parent, s)`
-/// to pass the probe (see the module).
-pub(super) struct Joined {
-    /// Per surface: its cones ([`Span`]), those whose apex lies on the positive side of its
-    /// plane first, then the others, and a box around each group's cones inside the
-    /// parents' apexes' box; `None`: every parent joins it.
-    spans: Vec<Option<Span>>,
-    /// The cones of each task of [`Joined::of`], where they were made (no copy).
-    parts: Vec<Part>,
-    margin: Real,
-}
-
-/// The cones of some reflectors: per cone, its side planes' range in `planes`.
-#[derive(Default)]
-struct Part {
-    cones: Vec<(u32, u32)>,
-    planes: Vec<Plane>,
-}
-
-/// One reflector's cones in [`Part::cones`] of part `part`, and a box (min, max) around each of its two
-/// groups' cones within the parents' apexes' box (empty for an empty group), read first:
-/// most parents' apexes lie outside it (one cache line instead of the cones' planes).
-#[derive(Clone, Copy)]
-struct Span {
-    part: u32,
-    cones: (u32, u32, u32),
-    bounds: [(Vec3, Vec3); 2],
+/// The deferred level's (parent, reflector) pairs the join keeps: per parent, in the order of
+/// the level, the reflectors (ascending) found by its box test ([`BeamTree::child_candidates`])
+/// whose cones hold its apex (see the module).
+pub(super) struct Pairs {
+    /// The level's first parent (node index).
+    first: u32,
+    /// Per parent: its range in `children` (one more entry than parents).
+    starts: Vec<u32>,
+    children: Vec<u32>,
+    /// Per parent: the reflectors its box test found (all of them count as tested).
+    tried: Vec<u32>,
 }
 
 /// A box holding nothing (the identity of [`union`]).
@@ -78,11 +66,19 @@ pub(super) fn apex_box(tree: &BeamTree, (lo, hi): (usize, usize)) -> (Vec3, Vec3
     (tree.nodes[lo..hi].iter()).fold(EMPTY, |b, n| union(b, (n.image, n.image)))
 }
 
-/// From this many parents, a large scene's deferred level uses the join: its cones cost
-/// about the same whatever the number of parents, the tries they spare grow with it
-/// (order 3, one thread, CPU time of the whole trace: Florence's 9,139 parents −6 %, San
-/// Francisco's 12,822 −6 %; Munich's 3,460 +2 %, Etoile's 3,057 +4 %).
-const JOIN_FROM: usize = 8_192;
+/// From this many parents, a large scene's deferred level uses the join: its fixed costs (the
+/// mirror beams of the reflectors RX sees, the cones of reflectors with few tries) are
+/// spread over more tries. Order 3, one thread, CPU time of the whole trace against the old
+/// path: Etoile's 3,057 parents −16 %, Munich's 3,460 −16 %; Munich with TX in the street
+/// (`--tx 45,90,1.5 --rx 8.5,21,27`): 723 parents +1-4 %.
+const JOIN_FROM: usize = 2_048;
+
+/// A large scene's reflector `s` gets its cones only when it has more tries than a third of
+/// its reach lists' entries (about its cones): a cone costs about as much as the clip of a
+/// try it could spare, so a reflector with fewer tries lets them all through (Munich with
+/// TX in the street, 723 parents: 2,835 → 2,744 M instructions, the old path's 2,727 M;
+/// the cities' counts do not move).
+const TRIES_PER_CONE: usize = 3;
 
 /// Whether the deferred level of a trace to `max_order` with `parents` parents uses the
 /// join: at order 3 (its parents are the first level's nodes), in large scenes from
@@ -91,68 +87,117 @@ pub(super) fn pays(prep: &Prepared<'_>, max_order: usize, parents: usize) -> boo
     max_order == 3 && (prep.reflectors.len() <= LINEAR_SCAN || parents >= JOIN_FROM)
 }
 
-impl Joined {
-    /// The cones of every reflector for the RX of `mirrored`, whose reach lists are `reach`,
-    /// and the parents whose apexes lie in the box `area` (min, max; m).
+impl Pairs {
+    /// The pairs of the parents `tree.nodes[lo..hi]` for the RX of `mirrored`, whose reach
+    /// lists are `reach`. Each parent's box test runs first (on all cores, in chunks); the
+    /// tries are then gathered per reflector, whose cones are built and tested against all
+    /// of its tries' apexes at once (each cone's planes read once per reflector, not once
+    /// per try), and the pairs kept are handed back per parent.
     pub(super) fn of(
+        tree: &BeamTree,
         prep: &Prepared<'_>,
-        mirrored: &Mirrored,
-        reach: &Reach,
-        area: (Vec3, Vec3),
-    ) -> Joined {
-        let side = RxSide::new(prep, (mirrored, reach), area);
-        let mut joined = Joined {
-            spans: vec![None; prep.planes.len()],
-            parts: Vec::new(),
-            margin: side.margin,
-        };
-        let parts = chunked::map_chunks(prep, (&prep.reflectors, Some(CHUNK)), |chunk| {
-            let (mut q, mut part, mut spans) = (Query::default(), Part::default(), Vec::new());
+        (mirrored, reach): (&Mirrored, &Reach),
+        (lo, hi): (usize, usize),
+    ) -> Pairs {
+        let positions: Vec<u32> = (0..(hi - lo) as u32).collect();
+        let found = chunked::map_chunks(prep, (&positions, Some(chunked::CHUNK_PARENTS)), |ps| {
+            let (mut children, mut all, mut tried) = (Vec::new(), Vec::new(), Vec::new());
+            for &i in ps {
+                let parent = tree.parent_ref(prep, lo as u32 + i);
+                tree.child_candidates(prep, &parent, false, &mut children);
+                all.extend_from_slice(&children);
+                tried.push(children.len() as u32);
+            }
+            (all, tried)
+        });
+        let tries = Tries::of(prep.planes.len(), &found);
+        let tried: Vec<u32> = found.into_iter().flat_map(|(_, t)| t).collect();
+        let apexes: Vec<Vec3> = tree.nodes[lo..hi].iter().map(|n| n.image).collect();
+        let side = RxSide::new(prep, (mirrored, reach), apex_box(tree, (lo, hi)));
+        let kept = chunked::map_chunks(prep, (&prep.reflectors, Some(CHUNK)), |chunk| {
+            let (mut q, mut out) = (Query::default(), Vec::new());
             for &s in chunk {
-                if let Some(span) = side.cones_of(prep, s, &mut q, &mut part) {
-                    spans.push((s, span));
+                let of_s = tries.of_surface(s);
+                if !of_s.is_empty() {
+                    side.join_surface(prep, (s, of_s), &apexes, &mut q, &mut out);
                 }
             }
-            (part, spans)
+            out
         });
-        for (part, spans) in parts {
-            for (s, span) in spans {
-                let part = joined.parts.len() as u32;
-                joined.spans[s as usize] = Some(Span { part, ..span });
-            }
-            joined.parts.push(part);
-        }
-        joined
+        Pairs::by_parent(lo as u32, tried, &kept)
     }
 
-    /// Whether the node of reflector `s` under a parent with apex `apex` may pass the probe:
-    /// the apex lies in one of `s`'s cones (within the margin).
-    pub(super) fn joins(&self, prep: &Prepared<'_>, s: u32, apex: Vec3) -> bool {
-        let Some(Span {
-            part,
-            cones,
-            bounds,
-        }) = self.spans[s as usize]
-        else {
-            return true;
-        };
-        let part = &self.parts[part as usize];
-        let (lo, mid, hi) = cones;
-        let held = |(min, max): (Vec3, Vec3)| apex.cmpge(min).all() && apex.cmple(max).all();
-        let [positive, negative] = bounds.map(held);
-        if !positive && !negative {
-            return false;
+    /// The pairs `kept` (per task, (parent's position, reflector), reflectors ascending)
+    /// per parent, each parent's reflectors ascending.
+    fn by_parent(first: u32, tried: Vec<u32>, kept: &[Vec<(u32, u32)>]) -> Pairs {
+        let (starts, children) = super::by_key(tried.len(), || kept.iter().flatten().copied());
+        Pairs {
+            first,
+            starts,
+            children,
+            tried,
         }
-        let d = prep.plane(s).signed_distance_unfused(apex);
-        // A cone lies beyond the plane from its apex: a parent's apex on the negative side
-        // can only lie in the cones from the positive side, and the reverse.
-        let inside = |k: u32| {
-            let (a, b) = part.cones[k as usize];
-            (part.planes[a as usize..b as usize].iter())
-                .all(|pl| pl.signed_distance_unfused(apex) >= -self.margin)
+    }
+
+    /// The reflectors the join keeps for parent `p` (a node of the level), ascending, and
+    /// the number its box test found.
+    pub(super) fn of_parent(&self, p: u32) -> (&[u32], u64) {
+        let i = (p - self.first) as usize;
+        let (a, b) = (self.starts[i] as usize, self.starts[i + 1] as usize);
+        (&self.children[a..b], u64::from(self.tried[i]))
+    }
+}
+
+/// Per reflector, the parents (positions in the level, ascending) whose box test found it.
+struct Tries {
+    starts: Vec<u32>,
+    parents: Vec<u32>,
+}
+
+impl Tries {
+    /// The tries of `found` (per chunk of parents in order: their reflectors, and how many
+    /// each parent found) over `surfaces` surfaces.
+    fn of(surfaces: usize, found: &[(Vec<u32>, Vec<u32>)]) -> Tries {
+        let firsts = found.iter().scan(0, |first, (_, tried)| {
+            let this = *first;
+            *first += tried.len() as u32;
+            Some(this)
+        });
+        let pairs = || {
+            (found.iter().zip(firsts.clone())).flat_map(|((all, tried), first)| {
+                let ends = tried.iter().scan(0, |end, &n| {
+                    *end += n as usize;
+                    Some(*end)
+                });
+                (ends.enumerate()).flat_map(move |(k, end)| {
+                    let parent = first + k as u32;
+                    all[end - tried[k] as usize..end]
+                        .iter()
+                        .map(move |&s| (s, parent))
+                })
+            })
         };
-        (positive && d <= self.margin && (lo..mid).any(inside))
-            || (negative && d >= -self.margin && (mid..hi).any(inside))
+        let (starts, parents) = super::by_key(surfaces, pairs);
+        Tries { starts, parents }
+    }
+
+    /// The tries of reflector `s`.
+    fn of_surface(&self, s: u32) -> &[u32] {
+        &self.parents[self.starts[s as usize] as usize..self.starts[s as usize + 1] as usize]
+    }
+}
+
+/// The cones of one reflector: per cone, its side planes' range in `planes`.
+#[derive(Default)]
+struct Cones {
+    cones: Vec<(u32, u32)>,
+    planes: Vec<Plane>,
+}
+
+impl Cones {
+    fn clear(&mut self) {
+        self.cones.clear();
+        self.planes.clear();
     }
 }
 
@@ -168,14 +213,18 @@ struct RxSide<'a> {
     area: (Vec3, Vec3),
 }
 
-/// Scratch of one task of [`Joined::of`].
+/// Scratch of one task of [`Pairs::of`]'s joins.
 #[derive(Default)]
 struct Query {
     window: Vec<Vec3>,
     tmp: Vec<Vec3>,
     ts: Vec<u32>,
-    /// The cones whose apex lies on the negative side, before they join the part.
-    negative: Part,
+    /// The reflector's cones whose apex lies on the positive side of its plane, and the others.
+    groups: [Cones; 2],
+    /// Per try: whether it joins.
+    joined: Vec<bool>,
+    /// The tries still to test against a group's cones: apex and index.
+    pending: Vec<(Vec3, u32)>,
 }
 
 impl<'a> RxSide<'a> {
@@ -205,26 +254,66 @@ impl<'a> RxSide<'a> {
         }
     }
 
-    /// Append the cones of reflector `s` to `part` and return their span (its part left
-    /// unset), or `None` (and `part` as it was) when every parent joins `s`.
-    fn cones_of(
+    /// Append to `out` the tries `tries` of reflector `s` (parents' positions; their apexes
+    /// in `apexes`) whose apex lies in one of `s`'s cones (within the margin), as (position,
+    /// `s`), in the order of `tries`; all of them when every parent joins `s`.
+    fn join_surface(
         &self,
         prep: &Prepared<'_>,
-        s: u32,
+        (s, tries): (u32, &[u32]),
+        apexes: &[Vec3],
         q: &mut Query,
-        part: &mut Part,
-    ) -> Option<Span> {
-        let (cones, planes) = (part.cones.len(), part.planes.len());
-        let span = self.fill(prep, s, q, part);
-        if span.is_none() {
-            part.cones.truncate(cones);
-            part.planes.truncate(planes);
+        out: &mut Vec<(u32, u32)>,
+    ) {
+        let worth = prep.reflectors.len() <= LINEAR_SCAN
+            || tries.len() * TRIES_PER_CONE > self.reach.lists_len(s);
+        let Some(bounds) = worth.then(|| self.cones(prep, s, q)).flatten() else {
+            out.extend(tries.iter().map(|&i| (i, s)));
+            return;
+        };
+        let plane = prep.plane(s);
+        q.joined.clear();
+        q.joined.resize(tries.len(), false);
+        for (g, &(min, max)) in bounds.iter().enumerate() {
+            // A cone lies beyond the plane from its apex: a parent's apex on the negative side
+            // can only lie in the cones from the positive side (group 0), and the reverse.
+            q.pending.clear();
+            for (k, &i) in tries.iter().enumerate() {
+                let apex = apexes[i as usize];
+                let d = plane.signed_distance_unfused(apex);
+                let side = if g == 0 {
+                    d <= self.margin
+                } else {
+                    d >= -self.margin
+                };
+                let held = apex.cmpge(min).all() && apex.cmple(max).all();
+                if held && side && !q.joined[k] {
+                    q.pending.push((apex, k as u32));
+                }
+            }
+            let group = &q.groups[g];
+            for &(a, b) in &group.cones {
+                if q.pending.is_empty() {
+                    break;
+                }
+                let planes = &group.planes[a as usize..b as usize];
+                let joined = &mut q.joined;
+                q.pending.retain(|&(apex, k)| {
+                    let inside =
+                        (planes.iter()).all(|pl| pl.signed_distance_unfused(apex) >= -self.margin);
+                    joined[k as usize] |= inside;
+                    !inside
+                });
+            }
         }
-        span
+        let kept = tries.iter().zip(&q.joined).filter(|&(_, &j)| j);
+        out.extend(kept.map(|(&i, _)| (i, s)));
     }
 
-    /// [`RxSide::cones_of`], leaving `part` to the caller when it fails.
-    fn fill(&self, prep: &Prepared<'_>, s: u32, q: &mut Query, part: &mut Part) -> Option<Span> {
+    /// The cones of reflector `s` in `q.groups` (those whose apex lies on the positive side
+    /// of its plane, then the others) and a box around each group's cones within the
+    /// parents' apexes' box (empty for an empty group), or `None` when every parent joins `s`.
+    fn cones(&self, prep: &Prepared<'_>, s: u32, q: &mut Query) -> Option<[(Vec3, Vec3); 2]> {
         let plane = *prep.plane(s);
         let polygon = &prep.scene.surface(SurfaceId(s)).polygon;
         let hull = convex::grown_hull(polygon, 0.5 * self.margin);
@@ -232,19 +321,17 @@ impl<'a> RxSide<'a> {
             // No window to bound the cones by.
             return None;
         }
-        let lo = part.cones.len() as u32;
-        q.negative.cones.clear();
-        q.negative.planes.clear();
+        q.groups.iter_mut().for_each(Cones::clear);
         let mut bounds = [EMPTY; 2];
-        let negative = &mut q.negative;
+        let groups = &mut q.groups;
         let mut push = |apex: Vec3, window: &[Vec3]| {
             let h = plane.signed_distance_unfused(apex);
-            let into = if h < 0.0 { &mut *negative } else { &mut *part };
+            let g = usize::from(h < 0.0);
+            let into = &mut groups[g];
             let first = into.planes.len() as u32;
             cone(&plane, apex, window, self.margin, &mut into.planes)?;
             into.cones.push((first, into.planes.len() as u32));
-            let b = &mut bounds[usize::from(h < 0.0)];
-            *b = union(*b, self.cone_box((&plane, h), apex, window));
+            bounds[g] = union(bounds[g], self.cone_box((&plane, h), apex, window));
             Some(())
         };
         // RX in the node's beam: RX's depth-1 node on `s`.
@@ -276,20 +363,7 @@ impl<'a> RxSide<'a> {
                 }
             }
         }
-        let mid = part.cones.len() as u32;
-        let shift = part.planes.len() as u32;
-        part.planes.extend_from_slice(&q.negative.planes);
-        (part.cones).extend(
-            q.negative
-                .cones
-                .iter()
-                .map(|&(a, b)| (a + shift, b + shift)),
-        );
-        Some(Span {
-            part: 0,
-            cones: (lo, mid, part.cones.len() as u32),
-            bounds,
-        })
+        Some(bounds)
     }
 
     /// A box around the part inside [`RxSide::area`] of the cone from `apex` (at signed
@@ -401,17 +475,20 @@ mod tests {
         visible.reach = Some(Reach::of(&prep, &visible.ids, &m));
         prep.rx_visible = Some(visible);
         let reach = prep.rx_visible.as_ref().and_then(|v| v.reach.as_ref());
-        let joined = Joined::of(&prep, &m, reach.unwrap(), apex_box(&tree, tree.levels[0]));
+        let pairs = Pairs::of(&tree, &prep, (&m, reach.unwrap()), tree.levels[0]);
         let (mut probe, mut part) = (Probe::new(rx, m.clone()), tree.part());
         let (mut children, mut window, mut tmp) = (Vec::new(), Vec::new(), Vec::new());
         let mut counts = [0u64; 4];
         for c in tree.levels[0].0 as u32..tree.levels[0].1 as u32 {
             let parent = tree.parent_ref(&prep, c);
             tree.child_candidates(&prep, &parent, false, &mut children);
+            let (kept, tried) = pairs.of_parent(c);
+            assert_eq!(tried, children.len() as u64);
+            assert!(kept.iter().all(|s| children.contains(s)));
             for &s in &children {
                 let before = (part.nodes.len(), part.stats.occluded);
                 part.child_probed(&prep, &parent, s, &mut scratch, Some(&mut probe));
-                let joins = joined.joins(&prep, s, parent.apex);
+                let joins = kept.binary_search(&s).is_ok();
                 counts[3] += 1;
                 counts[2] += u64::from(joins);
                 if before == (part.nodes.len(), part.stats.occluded) {

@@ -68,20 +68,7 @@ impl Reach {
             always.extend(flat);
         }
         // A counting sort by reached reflector and side: each list keeps `c` ascending.
-        let n = 2 * prep.planes.len();
-        let mut offsets = vec![0u32; n + 1];
-        for &(s, _) in &pairs {
-            offsets[s as usize + 1] += 1;
-        }
-        for i in 0..n {
-            offsets[i + 1] += offsets[i];
-        }
-        let mut next = offsets.clone();
-        let mut items = vec![0u32; pairs.len()];
-        for &(s, c) in &pairs {
-            items[next[s as usize] as usize] = c;
-            next[s as usize] += 1;
-        }
+        let (offsets, items) = super::by_key(2 * prep.planes.len(), || pairs.iter().copied());
         Reach {
             offsets,
             items,
@@ -118,6 +105,12 @@ impl Reach {
         (self.always.iter())
             .chain(&self.items[lo as usize..hi as usize])
             .copied()
+    }
+
+    /// The length of both of surface `s`'s lists ([`Reach::list`]).
+    pub(super) fn lists_len(&self, s: u32) -> usize {
+        let k = 2 * s as usize;
+        2 * self.always.len() + (self.offsets[k + 2] - self.offsets[k]) as usize
     }
 
     /// How far (m) a box may lie beyond a plane of a mirror beam and still be in its list.
