@@ -98,7 +98,10 @@ impl<'a> Responses<'a> {
         Ok(ends)
     }
 
-    /// Surface `id`'s response and its material's reflection loss (dB).
+    /// Surface `id`'s response and its material's reflection loss (dB). Inlined: its slot's
+    /// hit (almost every call, twice an interaction) costs a few instructions, the look-up
+    /// ([`Responses::look_up`]) is a call of its own.
+    #[inline]
     pub(crate) fn get(&mut self, id: SurfaceId) -> (SurfaceResponse, Real) {
         let slot = usize::from(self.slots[id.index() % SLOTS]);
         if let Some(&(kept, response, loss_db)) = slot.checked_sub(1).map(|k| &self.known[k])
@@ -106,6 +109,13 @@ impl<'a> Responses<'a> {
         {
             return (response, loss_db);
         }
+        self.look_up(id)
+    }
+
+    /// [`Responses::get`] past its slot: among the surfaces kept, else looked up in the scene
+    /// and kept.
+    #[inline(never)]
+    fn look_up(&mut self, id: SurfaceId) -> (SurfaceResponse, Real) {
         if let Some(&(_, response, loss_db)) = self.known.iter().find(|k| k.0 == id) {
             return (response, loss_db);
         }

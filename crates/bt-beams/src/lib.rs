@@ -347,14 +347,20 @@ fn interaction_names(scene: &Scene, interactions: &[Interaction], names: &mut Ve
 }
 
 /// The path's vertices TX → points → RX (the terminals `ends`, local frame) into `vertices`
-/// (cleared first), and its unfolded length (m).
-fn vertices(ends: bt_scene::Endpoints, path: &FoundPath, vertices: &mut Vec<Vec3>) -> Real {
+/// (cleared first), and its unfolded length (m): `length_m` when given (the caller's
+/// [`unfolded_length`] of the same path), else computed.
+fn vertices(
+    ends: bt_scene::Endpoints,
+    path: &FoundPath,
+    vertices: &mut Vec<Vec3>,
+    length_m: Option<Real>,
+) -> Real {
     let bt_scene::Endpoints { tx, rx } = ends;
     vertices.clear();
     vertices.push(tx);
     vertices.extend_from_slice(&path.points);
     vertices.push(rx);
-    unfolded_length(tx, &path.points, rx)
+    length_m.unwrap_or_else(|| unfolded_length(tx, &path.points, rx))
 }
 
 /// The length (m) of the polyline `tx` → `points` → `rx`: its legs summed from TX, the one
@@ -389,22 +395,32 @@ pub fn describe(
 ) -> Result<PathReport, ReportError> {
     let responses = &mut gain::Responses::new(scene);
     let mut record = PathReport::blank();
-    describe_into(responses, &mut Scratch::default(), path, radio, &mut record)?;
+    describe_into(
+        responses,
+        &mut Scratch::default(),
+        path,
+        radio,
+        &mut record,
+        None,
+    )?;
     Ok(record)
 }
 
 /// [`describe`] into `record`, whose vectors and names are reused (cleared and refilled, so a
 /// record of a previous report costs no allocation), with the surfaces' responses looked up
-/// once for all the paths of a report.
+/// once for all the paths of a report. `length_m` is the path's [`unfolded_length`] when the
+/// caller has it (the ranking computes it first, [`Records`]): the same bits, not made twice.
 pub(crate) fn describe_into(
     responses: &mut gain::Responses<'_>,
     scratch: &mut Scratch,
     path: &FoundPath,
     radio: &RadioOptions,
     record: &mut PathReport,
+    length_m: Option<Real>,
 ) -> Result<(), ReportError> {
     let scene = responses.scene();
-    let length_m = vertices(responses.terminals()?, path, &mut scratch.vertices);
+    let ends = responses.terminals()?;
+    let length_m = vertices(ends, path, &mut scratch.vertices, length_m);
     let vertices = &scratch.vertices;
     path.interactions_into(&mut scratch.interactions);
     let interactions = &scratch.interactions;
