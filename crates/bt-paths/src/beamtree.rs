@@ -1323,6 +1323,10 @@ fn beam_planes(plane: &Plane, apex: Vec3, window: &[Vec3], out: &mut Vec<Plane>)
         *plane
     };
     out.push(near);
+    debug_assert!(
+        counter_clockwise(plane, window),
+        "a beam's window runs clockwise about its plane: its side planes would face out"
+    );
     let facing = Facing::of(plane, apex);
     let mut w = window[window.len() - 1];
     for &v in window {
@@ -1330,6 +1334,17 @@ fn beam_planes(plane: &Plane, apex: Vec3, window: &[Vec3], out: &mut Vec<Plane>)
         w = v;
     }
     (lo, out.len() as u32)
+}
+
+/// Whether `window` runs counter-clockwise about `plane`'s normal, as [`Facing`] assumes:
+/// its Newell area vector does not point against the normal, beyond the rounding of a window
+/// too thin to have an orientation (a relative 1e-9 of its squared size).
+pub(super) fn counter_clockwise(plane: &Plane, window: &[Vec3]) -> bool {
+    let twice_area = bt_geom::poly2::newell(window).dot(plane.normal);
+    let size2 = (window.iter().zip(window.iter().skip(1)))
+        .map(|(a, b)| a.distance_squared(*b))
+        .sum::<Real>();
+    twice_area >= -1e-9 * size2
 }
 
 /// A side plane is kept only when its normal's rounding (about `ε / sin θ` radians, `θ` the

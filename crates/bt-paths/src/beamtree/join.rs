@@ -418,6 +418,10 @@ fn cone(
     if h.is_nan() || h.abs() <= margin {
         return None;
     }
+    debug_assert!(
+        super::counter_clockwise(plane, window),
+        "a cone's window runs clockwise about its plane: its side planes would face out"
+    );
     let facing = Facing::of(plane, apex);
     let mut w = window[window.len() - 1];
     for &v in window {
