@@ -1323,9 +1323,18 @@ fn beam_planes(plane: &Plane, apex: Vec3, window: &[Vec3], out: &mut Vec<Plane>)
         *plane
     };
     out.push(near);
+    side_planes(plane, apex, window, out);
+    (lo, out.len() as u32)
+}
+
+/// The side planes of the rays from `apex` through the convex `window` lying in `plane`,
+/// one per window edge, appended to `out`: each facing the window's inside ([`Facing`]) and
+/// kept only when rounding cannot have turned it ([`side_plane`]). Shared by the beams
+/// ([`beam_planes`]) and the join's cones ([`join`]).
+pub(super) fn side_planes(plane: &Plane, apex: Vec3, window: &[Vec3], out: &mut Vec<Plane>) {
     debug_assert!(
         counter_clockwise(plane, window),
-        "a beam's window runs clockwise about its plane: its side planes would face out"
+        "a window runs clockwise about its plane: its side planes would face out"
     );
     let facing = Facing::of(plane, apex);
     let mut w = window[window.len() - 1];
@@ -1333,13 +1342,12 @@ fn beam_planes(plane: &Plane, apex: Vec3, window: &[Vec3], out: &mut Vec<Plane>)
         out.extend(side_plane(apex, (w, v), &facing));
         w = v;
     }
-    (lo, out.len() as u32)
 }
 
 /// Whether `window` runs counter-clockwise about `plane`'s normal, as [`Facing`] assumes:
 /// its Newell area vector does not point against the normal, beyond the rounding of a window
 /// too thin to have an orientation (a relative 1e-9 of its squared size).
-pub(super) fn counter_clockwise(plane: &Plane, window: &[Vec3]) -> bool {
+fn counter_clockwise(plane: &Plane, window: &[Vec3]) -> bool {
     let twice_area = bt_geom::poly2::newell(window).dot(plane.normal);
     let size2 = (window.iter().zip(window.iter().skip(1)))
         .map(|(a, b)| a.distance_squared(*b))
@@ -1362,13 +1370,13 @@ pub(super) const MAX_NORMAL_ERROR: Real = 1e-10;
 /// instead of a point inside the window: for a window thinner than the rounding, the vertex
 /// mean left the orientation to chance, and a sliver clipped from a window could get a wider
 /// beam than the window's.
-pub(super) struct Facing {
+struct Facing {
     outward: bool,
 }
 
 impl Facing {
     /// The facing of a window lying in `plane`, seen from `apex`.
-    pub(super) fn of(plane: &Plane, apex: Vec3) -> Self {
+    fn of(plane: &Plane, apex: Vec3) -> Self {
         Facing {
             outward: plane.signed_distance_unfused(apex) > 0.0,
         }
@@ -1385,7 +1393,7 @@ impl Facing {
 /// window for an edge of length `e` at distance `R` (5 µm for 1 nm at 5 m, beyond the
 /// margin: a path just inside the edge was lost). Leaving a plane out only widens a beam or
 /// cone. Shared by the beams ([`beam_planes`]) and the join's cones ([`join`]).
-pub(super) fn side_plane(apex: Vec3, (w, v): (Vec3, Vec3), facing: &Facing) -> Option<Plane> {
+fn side_plane(apex: Vec3, (w, v): (Vec3, Vec3), facing: &Facing) -> Option<Plane> {
     let (a, e) = (w - apex, v - w);
     let normal = a.cross(e);
     let (len, ae) = (normal.length(), a.length() * e.length());

@@ -33,7 +33,7 @@
 //! RX's side").
 
 use super::reach::Reach;
-use super::{BeamTree, Facing, LINEAR_SCAN, Mirrored, Prepared, chunked, side_plane};
+use super::{BeamTree, LINEAR_SCAN, Mirrored, Prepared, chunked, side_planes};
 use bt_geom::{Plane, Real, Vec3, convex};
 use bt_scene::SurfaceId;
 
@@ -404,9 +404,8 @@ impl<'a> RxSide<'a> {
 
 /// The side planes of the cone of rays from `apex` through the convex `window` lying in
 /// `plane`, appended to `out` (the cone also lies beyond the plane from the apex: the caller
-/// tests that side). A side plane per window edge, kept only when rounding cannot have
-/// turned it ([`side_plane`], the rule of the beams; facing the window's inside by the
-/// apex's side of the plane); leaving a plane out only widens the cone. `None` (the whole space) for an apex within `margin` of the plane.
+/// tests that side): the beams' side planes ([`side_planes`]); leaving a plane out only
+/// widens the cone. `None` (the whole space) for an apex within `margin` of the plane.
 fn cone(
     plane: &Plane,
     apex: Vec3,
@@ -418,16 +417,7 @@ fn cone(
     if h.is_nan() || h.abs() <= margin {
         return None;
     }
-    debug_assert!(
-        super::counter_clockwise(plane, window),
-        "a cone's window runs clockwise about its plane: its side planes would face out"
-    );
-    let facing = Facing::of(plane, apex);
-    let mut w = window[window.len() - 1];
-    for &v in window {
-        out.extend(side_plane(apex, (w, v), &facing));
-        w = v;
-    }
+    side_planes(plane, apex, window, out);
     Some(())
 }
 
