@@ -73,11 +73,29 @@ pub fn read_gltf(
     file: Option<&str>,
     opts: &MergeOptions,
 ) -> Result<MeshImport, MeshError> {
-    let file = file.unwrap_or(UNNAMED);
     opts.validate()?;
-    let doc = gltf::document(bytes, (file, None), u64::MAX, crate::source::Hashing::Off)?;
+    let hashing = crate::source::Hashing::Off;
+    let (import, _) = merge_gltf(
+        bytes,
+        (file.unwrap_or(UNNAMED), None),
+        (opts, u64::MAX),
+        hashing,
+    )?;
+    Ok(import)
+}
+
+/// The glTF document of `bytes` (named `file`, its buffers read from `folder`, each within
+/// `max_file_bytes`; none without a folder) merged into planar surfaces with `opts` (checked
+/// by the caller), and the document (its buffer files and their SHA-256s with `hashing` on).
+fn merge_gltf(
+    bytes: &[u8],
+    (file, folder): (&str, Option<&Path>),
+    (opts, max_file_bytes): (&MergeOptions, u64),
+    hashing: crate::source::Hashing,
+) -> Result<(MeshImport, gltf::Document), MeshError> {
+    let doc = gltf::document(bytes, (file, folder), max_file_bytes, hashing)?;
     let raw = gltf::parse(&doc, file, opts.max_elements)?;
-    Ok(bt_mesh::merge_mesh(&raw, opts, file)?)
+    Ok((bt_mesh::merge_mesh(&raw, opts, file)?, doc))
 }
 
 /// Checks `opts` and parses `bytes` as `format` into the polygon soup the merge starts from.
@@ -180,9 +198,12 @@ pub(crate) fn read_gltf_file(
     let file = path.display().to_string();
     opts.validate()?;
     let bytes = read_bytes(path, max_file_bytes)?;
-    let doc = gltf::document(&bytes, (&file, path.parent()), max_file_bytes, hashing)?;
-    let raw = gltf::parse(&doc, &file, opts.max_elements)?;
-    let import = bt_mesh::merge_mesh(&raw, opts, &file)?;
+    let (import, doc) = merge_gltf(
+        &bytes,
+        (&file, path.parent()),
+        (opts, max_file_bytes),
+        hashing,
+    )?;
     Ok((import, hashing.of(&bytes), (doc.files, doc.digests)))
 }
 

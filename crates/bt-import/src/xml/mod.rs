@@ -18,6 +18,7 @@ mod transform;
 
 pub use parse::{SIONNA_DEFAULT_THICKNESS_M, parse_xml, parse_xml_with};
 
+use crate::mesh::MeshFormat;
 use crate::source::{Digest, Hashing, file_stem};
 use crate::{ImportError, LoadOptions, Loaded};
 use bt_channel::{ItuMaterial, RadioModel};
@@ -215,8 +216,8 @@ type Found<'s> = (&'s XmlShape, Source);
 
 /// Where a shape's polygons come from.
 enum Source {
-    /// Its mesh file, found within the byte budgets, and the file's metadata.
-    File(PathBuf, std::fs::Metadata),
+    /// Its mesh file in `format`, found within the byte budgets, and the file's metadata.
+    File(PathBuf, std::fs::Metadata, MeshFormat),
     /// A primitive: no file.
     Primitive(Primitive),
 }
@@ -242,7 +243,7 @@ fn rounds<T>(items: &[T], limit: u64, size: impl Fn(&T) -> u64) -> impl Iterator
 /// The bytes of a found shape's mesh file (none for a primitive).
 fn file_bytes((_, source): &Found<'_>) -> u64 {
     match source {
-        Source::File(_, metadata) => metadata.len(),
+        Source::File(_, metadata, _) => metadata.len(),
         Source::Primitive(_) => 0,
     }
 }
@@ -271,21 +272,24 @@ impl Reading<'_> {
     /// all cores and their sizes charged in order, before any is read.
     fn find<'s>(&mut self, shapes: &'s [XmlShape]) -> (Vec<Found<'s>>, Option<ImportError>) {
         use rayon::prelude::*;
-        let stated: Vec<Result<Stated, Primitive>> = (shapes.par_iter())
+        let stated: Vec<Result<(Stated, MeshFormat), Primitive>> = (shapes.par_iter())
             .map(|shape| {
-                if let MeshKind::Primitive(primitive) = shape.kind {
-                    return Err(primitive);
-                }
+                let format = match shape.kind {
+                    MeshKind::Ply => MeshFormat::Ply,
+                    MeshKind::Obj => MeshFormat::Obj,
+                    MeshKind::Primitive(primitive) => return Err(primitive),
+                };
                 let name = shape.filename.as_deref().unwrap_or_default();
-                Ok(resolve(self.folder, name).map(|file| {
+                let stated = resolve(self.folder, name).map(|file| {
                     let metadata = std::fs::metadata(&file);
                     (file, metadata)
-                }))
+                });
+                Ok((stated, format))
             })
             .collect();
         let mut found = Vec::with_capacity(shapes.len());
         for (shape, stated) in shapes.iter().zip(stated) {
-            let stated = match stated {
+            let (stated, format) = match stated {
                 Ok(stated) => stated,
                 Err(primitive) => {
                     found.push((shape, Source::Primitive(primitive)));
@@ -293,7 +297,7 @@ impl Reading<'_> {
                 }
             };
             match find_shape(shape, stated, self.xml, self.options, &mut self.bytes_left) {
-                Ok((file, metadata)) => found.push((shape, Source::File(file, metadata))),
+                Ok((file, metadata)) => found.push((shape, Source::File(file, metadata, format))),
                 Err(e) => return (found, Some(e)),
             }
         }
@@ -318,8 +322,9 @@ impl Reading<'_> {
             .map(|&k| {
                 let (shape, source) = &found[k];
                 let import = match source {
-                    Source::File(file, metadata) => {
-                        read_shape(shape, file, metadata, self.options, self.hashing)
+                    Source::File(file, metadata, format) => {
+                        let options = (self.options, self.hashing);
+                        read_shape(shape, (file, metadata, *format), options)
                     }
                     Source::Primitive(primitive) => {
                         merge_primitive(shape, *primitive, self.xml, self.options)
@@ -335,7 +340,7 @@ impl Reading<'_> {
         for ((shape, source), (_, import)) in found.iter().zip(merged) {
             let (added, read) = import?;
             (self.elements).charge(&added, shape, self.xml, self.options.merge.max_elements)?;
-            if let Source::File(file, _) = source
+            if let Source::File(file, ..) = source
                 && self.seen.insert(file.clone())
             {
                 self.meshes.push((file.clone(), read));
@@ -553,22 +558,16 @@ fn find_shape(
     Ok((file, metadata))
 }
 
-/// Read `shape`'s mesh `file` (found by [`find_shape`], with its `metadata`) and merge it
-/// through its transform; the mesh and the SHA-256 of the bytes read (with `hashing` on).
+/// Read `shape`'s mesh `file` (found by [`find_shape`], with its `metadata`, in `format`) and
+/// merge it through its transform; the mesh and the SHA-256 of the bytes read (with `hashing`
+/// on).
 fn read_shape(
     shape: &XmlShape,
-    file: &Path,
-    metadata: &std::fs::Metadata,
-    options: &LoadOptions,
-    hashing: Hashing,
+    (file, metadata, format): (&Path, &std::fs::Metadata, MeshFormat),
+    (options, hashing): (&LoadOptions, Hashing),
 ) -> Result<(bt_mesh::MeshImport, Option<Digest>), ImportError> {
     let shown = file.display().to_string();
     let bytes = read_bounded(file, Some(metadata), options.max_file_bytes, &shown)?;
-    let format = match shape.kind {
-        MeshKind::Ply => crate::mesh::MeshFormat::Ply,
-        // A primitive has no file to reach here with (`Reading::find`).
-        MeshKind::Obj | MeshKind::Primitive(_) => crate::mesh::MeshFormat::Obj,
-    };
     let to_world = shape.to_world;
     let import =
         crate::mesh::read_transformed(&bytes, format, Some(&shown), &options.merge, &|p| {
@@ -588,7 +587,8 @@ fn merge_primitive(
     let raw = primitive::mesh(primitive);
     let label = format!(
         "{xml}: line {}: <shape id=\"{}\">",
-        shape.at.line, shape.name
+        shape.at.line,
+        bt_scene::name::shown(&shape.name)
     );
     let to_world = shape.to_world;
     let import = crate::mesh::merge_transformed(raw, &label, &options.merge, &|p| {
