@@ -6,6 +6,7 @@
 
 use crate::hints::{self, Hints};
 use crate::ipc::IpcOptions;
+use crate::partner::Partner;
 use crate::{
     CandidateOutcome, FoundPath, Inline, IpcOutcome, Solver, Validity, ipc_verdict, lanes,
     solve_candidate_from, solve_candidate_in,
@@ -19,6 +20,13 @@ use rayon::prelude::*;
 const CHUNK: usize = 128;
 /// Below this many candidates a batch runs on the calling thread.
 const PARALLEL_FROM: usize = 256;
+/// From this many candidates a batch with a [`Partner`] (and not `parallel`) is split in two
+/// halves, the second on the partner: below it, the hand-over (about a microsecond) would
+/// take most of what the half saves. The halves' accumulators are allocated (and later freed)
+/// by the calling thread: memory of one thread freed by the other makes glibc's allocator
+/// lock the other's arena, and two threads allocating meanwhile then wait on each other
+/// (a concurrent solve took 1.5 times as long; docs/performance.md).
+const SPLIT_FROM: usize = 32;
 /// Maximum order handled with stack buffers; longer sequences use heap buffers.
 const STACK_ORDER: usize = 8;
 
@@ -61,6 +69,9 @@ pub(crate) struct Batch<'a> {
     pub(crate) solver: &'a Solver,
     /// Whether to use rayon's pool for large batches.
     pub(crate) parallel: bool,
+    /// Without `parallel`: a partner thread that takes the second half of a batch of at
+    /// least [`SPLIT_FROM`] candidates (a lone receiver's answer, `beamtrace serve`).
+    pub(crate) partner: Option<&'a Partner>,
     /// Whether the fold only counts a blocked candidate (not which segment, not by what):
     /// then the image method's and SBR's paths are validated with the thread's hints first
     /// ([`crate::hints`], [`crate::validate::validate_hinted`]: the same kind of verdict,
@@ -71,15 +82,17 @@ pub(crate) struct Batch<'a> {
 /// Solve the candidates of `todo`. IPC starts from `warm(i)` when it gives points for candidate
 /// `i`, else from the set's start points, else from the centroids. `each(acc, i, seq,
 /// outcome, points)` folds every candidate's result, in `todo` order within a chunk, into its chunk's
-/// accumulator (`R::default()` to begin); the accumulators come back in chunk order.
-pub(crate) fn solve_batch<'w, R, W, F>(
+/// accumulator (`init(n)` to begin, for a chunk of `n` candidates); the accumulators come back
+/// in chunk order.
+pub(crate) fn solve_batch<'w, R, I, W, F>(
     batch: &Batch<'_>,
     todo: Todo<'_>,
-    warm: W,
+    (init, warm): (I, W),
     each: F,
 ) -> Vec<R>
 where
-    R: Default + Send,
+    R: Send,
+    I: Fn(usize) -> R + Sync,
     W: Fn(usize) -> Option<&'w [Vec3]> + Sync,
     F: Fn(&mut R, usize, &[SurfaceId], &CandidateOutcome, &[Vec3]) + Sync,
 {
@@ -90,12 +103,28 @@ where
         warm: &warm,
         each: &each,
     };
+    if let (false, Some(partner)) = (batch.parallel, batch.partner)
+        && total >= SPLIT_FROM
+    {
+        let half = total / 2;
+        // Both accumulators are made here, so that the partner's is this thread's memory,
+        // freed by this thread (see `SPLIT_FROM`).
+        let (first, second) = (init(half), init(total - half));
+        let (first, second) = partner.join(
+            || chunk.run(0..half, first),
+            || chunk.run(half..total, second),
+        );
+        return vec![first, second];
+    }
     if !batch.parallel || total < PARALLEL_FROM {
-        return vec![chunk.run(0..total)];
+        return vec![chunk.run(0..total, init(total))];
     }
     (0..total.div_ceil(CHUNK))
         .into_par_iter()
-        .map(|c| chunk.run(c * CHUNK..((c + 1) * CHUNK).min(total)))
+        .map(|c| {
+            let range = c * CHUNK..((c + 1) * CHUNK).min(total);
+            chunk.run(range.clone(), init(range.len()))
+        })
         .collect()
 }
 
@@ -121,29 +150,29 @@ where
     /// contracts a separate multiply and add, so both versions give bit-identical results.
     /// The solvers and validation are `inline(always)` down to the BVH walk so that they are
     /// compiled into the FMA version.
-    fn run<R: Default>(&self, range: std::ops::Range<usize>) -> R
+    fn run<R>(&self, range: std::ops::Range<usize>, acc: R) -> R
     where
         F: Fn(&mut R, usize, &[SurfaceId], &CandidateOutcome, &[Vec3]),
     {
         #[cfg(target_arch = "x86_64")]
         if std::arch::is_x86_feature_detected!("fma") {
             // SAFETY: the CPU supports FMA (checked just above).
-            return unsafe { self.run_fma(range) };
+            return unsafe { self.run_fma(range, acc) };
         }
-        self.run_impl(range)
+        self.run_impl(range, acc)
     }
 
     #[cfg(target_arch = "x86_64")]
     #[target_feature(enable = "fma")]
-    fn run_fma<R: Default>(&self, range: std::ops::Range<usize>) -> R
+    fn run_fma<R>(&self, range: std::ops::Range<usize>, acc: R) -> R
     where
         F: Fn(&mut R, usize, &[SurfaceId], &CandidateOutcome, &[Vec3]),
     {
-        self.run_impl(range)
+        self.run_impl(range, acc)
     }
 
     #[inline(always)]
-    fn run_impl<R: Default>(&self, range: std::ops::Range<usize>) -> R
+    fn run_impl<R>(&self, range: std::ops::Range<usize>, mut acc: R) -> R
     where
         F: Fn(&mut R, usize, &[SurfaceId], &CandidateOutcome, &[Vec3]),
     {
@@ -155,9 +184,8 @@ where
             ..
         } = *self.batch;
         if let Solver::Ipc(options) = solver {
-            return self.run_ipc(range, options);
+            return self.run_ipc(range, options, acc);
         }
-        let mut acc = R::default();
         let mut stack_points = [Vec3::ZERO; STACK_ORDER];
         let mut stack_scratch = [Vec3::ZERO; STACK_ORDER];
         let mut heap_points = Vec::new();
@@ -204,7 +232,7 @@ where
     /// folded in `todo` order at the end, so the accumulator sees exactly what the one-by-one
     /// loop gives.
     #[inline(always)]
-    fn run_ipc<R: Default>(&self, range: std::ops::Range<usize>, options: &IpcOptions) -> R
+    fn run_ipc<R>(&self, range: std::ops::Range<usize>, options: &IpcOptions, mut acc: R) -> R
     where
         F: Fn(&mut R, usize, &[SurfaceId], &CandidateOutcome, &[Vec3]),
     {
@@ -262,7 +290,6 @@ where
                 outcomes[k] = Some(outcome);
             }
         }
-        let mut acc = R::default();
         for (k, outcome) in outcomes.iter().enumerate() {
             let outcome = outcome
                 .as_ref()

@@ -309,6 +309,14 @@ pub struct TraceResult {
 }
 
 impl TraceResult {
+    /// No paths yet, with room for the paths of `candidates` candidates.
+    pub(crate) fn with_room(candidates: usize) -> TraceResult {
+        TraceResult {
+            paths: Vec::with_capacity(candidates),
+            counts: OutcomeCounts::default(),
+        }
+    }
+
     /// The results of consecutive parts as one, in order: the paths moved once into a
     /// vector of their total length (a path holds its lists inline, so it is worth not
     /// moving twice), or, when a single part has paths (a trace on one thread: a room's),
@@ -468,6 +476,18 @@ pub fn trace(
     solver: &Solver,
     parallel: bool,
 ) -> Result<TraceResult, SceneError> {
+    trace_on(scene, candidates, solver, parallel, None)
+}
+
+/// [`trace`], its specular candidates split over `partner` (when not `parallel`): a lone
+/// receiver's solve on two cores, the same result.
+pub(crate) fn trace_on(
+    scene: &Scene,
+    candidates: &CandidateSet,
+    solver: &Solver,
+    parallel: bool,
+    partner: Option<&partner::Partner>,
+) -> Result<TraceResult, SceneError> {
     let ends = scene.terminals()?;
     if let Solver::Sbr(options) = solver {
         let max_order = candidates.iter().map(<[SurfaceId]>::len).max().unwrap_or(0);
@@ -481,9 +501,11 @@ pub fn trace(
         candidates,
         solver,
         parallel,
+        partner,
         counts_blocked: true,
     };
-    let mut parts = solve_batch(&batch, Todo::All, |_| None, keep_valid);
+    let room = |n| TraceResult::with_room(n);
+    let mut parts = solve_batch(&batch, Todo::All, (room, |_| None), keep_valid);
     if scene.transmits() {
         for part in &mut parts {
             part.paths = (std::mem::take(&mut part.paths).into_iter())

@@ -382,7 +382,7 @@ pub(crate) fn trace_scene_in(
         progress,
     )?;
     let t1 = Instant::now();
-    solve_set(scene, set, options, t1 - t0)
+    solve_set(scene, set, options, t1 - t0, None)
 }
 
 /// Solve a generated candidate set (the second half of [`trace_scene_in`]).
@@ -391,9 +391,10 @@ pub(crate) fn solve_set(
     set: CandidateSet,
     options: &TraceOptions,
     generation: Duration,
+    partner: Option<&Partner>,
 ) -> Result<Traced, TraceError> {
     let t1 = Instant::now();
-    let result = crate::trace(scene, &set, &options.solver, options.parallel)?;
+    let result = crate::trace_on(scene, &set, &options.solver, options.parallel, partner)?;
     let t2 = Instant::now();
     Ok(Traced {
         candidates: set.stats,
@@ -408,6 +409,14 @@ pub(crate) fn solve_set(
 
 /// Nodes of a kept tree from which a lone receiver's walk is split over a [`Partner`].
 const SPLIT_WALK: usize = 256;
+
+thread_local! {
+    /// The two halves' hits of a split walk ([`KeptTx::candidates`]), kept from answer to
+    /// answer by the serving thread: the partner fills the second in place, so no buffer is
+    /// allocated on one thread and freed on the other (glibc's allocator then locks the
+    /// other thread's arena, a few microseconds an answer when both threads allocate).
+    static WALK_HITS: std::cell::RefCell<[Vec<usize>; 2]> = std::cell::RefCell::default();
+}
 
 /// Receivers from which a many-receiver trace narrows the kept tree's nodes for boxes of
 /// receivers ([`BeamTree::receiver_nodes`]) before walking it for each.
@@ -459,7 +468,7 @@ pub(crate) fn trace_each_receiver<T: Send>(
                 let t0 = Instant::now();
                 let among = nodes.as_ref().map(|n| n.of(k));
                 let set = kept.candidates(&moved, among, &inner, partner)?;
-                solve_set(&moved, set, &inner, t0.elapsed())?
+                solve_set(&moved, set, &inner, t0.elapsed(), partner)?
             }
             // Receivers traced in parallel cannot share one cache (`tree` is built in beam-tree
             // mode, so this is a receiver that grows the scene, or another mode: no tree).
@@ -524,15 +533,17 @@ impl KeptTx {
         let walk = tree.walk_len();
         let mut set = match (among, partner) {
             (Some(nodes), _) => tree.candidates_among(rx, nodes.iter().map(|&i| i as usize)),
-            (None, Some(partner)) if walk >= SPLIT_WALK => {
-                let (mut first, mut second) = (Vec::new(), Vec::new());
+            (None, Some(partner)) if walk >= SPLIT_WALK => WALK_HITS.with_borrow_mut(|hits| {
+                let [first, second] = hits;
+                first.clear();
+                second.clear();
                 let k = walk / 2;
                 partner.join(
-                    || tree.holding(rx, 0..k, &mut first),
-                    || tree.holding(rx, k..walk, &mut second),
+                    || tree.holding(rx, 0..k, first),
+                    || tree.holding(rx, k..walk, second),
                 );
-                tree.candidates_of(first.into_iter().chain(second))
-            }
+                tree.candidates_of(first.iter().chain(second.iter()).copied())
+            }),
             (None, _) => tree.candidates(rx),
         };
         if let Some(side) = &self.side {

@@ -315,9 +315,15 @@ impl Incremental {
             candidates: &candidates,
             solver: &options.solver,
             parallel: options.parallel,
+            partner: None,
             counts_blocked: false,
         };
-        let (records, points) = concat(solve_batch(&batch, Todo::All, |_| None, keep_all));
+        let (records, points) = concat(solve_batch(
+            &batch,
+            Todo::All,
+            (no_room, |_| None),
+            keep_all,
+        ));
         let records: Vec<Record> = records
             .into_iter()
             .map(|(outcome, start, _)| Record { outcome, start })
@@ -518,9 +524,15 @@ fn solve_planned(
         candidates,
         solver: &options.solver,
         parallel: options.parallel,
+        partner: None,
         counts_blocked: false,
     };
-    let (records, points) = concat(solve_batch(&batch, Todo::Only(&todo), warm, keep_all));
+    let (records, points) = concat(solve_batch(
+        &batch,
+        Todo::Only(&todo),
+        (no_room, warm),
+        keep_all,
+    ));
     let outcomes = records
         .into_iter()
         .map(|(outcome, _, i)| (outcome, is_ipc && warm(i).is_some()))
@@ -543,6 +555,11 @@ fn keep_all(
 ) {
     acc.0.push((*outcome, acc.1.len() as u32, i));
     acc.1.extend_from_slice(points);
+}
+
+/// An empty [`keep_all`] accumulator, whatever the chunk's size.
+fn no_room(_: usize) -> Solved {
+    Solved::default()
 }
 
 /// The chunks of [`keep_all`] joined in order, with point offsets into the joined points.

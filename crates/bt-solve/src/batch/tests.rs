@@ -10,20 +10,36 @@ use bt_testkit::random_scene;
 
 type Solved = Vec<(usize, CandidateOutcome, Vec<Vec3>)>;
 
-/// Every candidate's outcome and points through the batch (`parallel` as given).
-fn batched(scene: &Scene, set: &CandidateSet, solver: &Solver, parallel: bool) -> Solved {
+/// How a batch spreads its candidates: on the calling thread, over rayon's pool, or in two
+/// halves with a partner thread.
+#[derive(Clone, Copy, Debug)]
+enum Spread {
+    Serial,
+    Parallel,
+    Partner,
+}
+
+/// A partner that spins long enough to take every half of a test.
+fn partner() -> crate::partner::Partner {
+    crate::partner::Partner::new(std::time::Duration::from_secs(1)).expect("a partner thread")
+}
+
+/// Every candidate's outcome and points through the batch, spread as `spread` says.
+fn batched(scene: &Scene, set: &CandidateSet, solver: &Solver, spread: Spread) -> Solved {
+    let partner = matches!(spread, Spread::Partner).then(partner);
     let batch = Batch {
         scene,
         ends: scene.terminals().unwrap(),
         candidates: set,
         solver,
-        parallel,
+        parallel: matches!(spread, Spread::Parallel),
+        partner: partner.as_ref(),
         counts_blocked: false,
     };
     let keep = |acc: &mut Solved, i: usize, _: &[SurfaceId], o: &CandidateOutcome, p: &[Vec3]| {
         acc.push((i, *o, p.to_vec()))
     };
-    solve_batch(&batch, Todo::All, |_| None, keep)
+    solve_batch(&batch, Todo::All, (|_| Solved::new(), |_| None), keep)
         .into_iter()
         .flatten()
         .collect()
@@ -96,9 +112,8 @@ fn lanes_equal_one_by_one_on_the_living_room() {
     let mut kinds = std::collections::BTreeMap::new();
     for solver in solvers(&scene) {
         let reference = one_by_one(&scene, &set, &solver);
-        for parallel in [false, true] {
-            for (k, n) in
-                assert_bitwise_equal(&batched(&scene, &set, &solver, parallel), &reference)
+        for spread in [Spread::Serial, Spread::Parallel, Spread::Partner] {
+            for (k, n) in assert_bitwise_equal(&batched(&scene, &set, &solver, spread), &reference)
             {
                 *kinds.entry(k).or_insert(0) += n;
             }
@@ -121,7 +136,7 @@ fn lanes_equal_one_by_one_where_ipc_degenerates() {
     let mut degenerate = 0;
     for solver in solvers(&scene) {
         let kinds = assert_bitwise_equal(
-            &batched(&scene, &set, &solver, false),
+            &batched(&scene, &set, &solver, Spread::Serial),
             &one_by_one(&scene, &set, &solver),
         );
         degenerate += kinds.get("Degenerate").copied().unwrap_or(0);
@@ -136,7 +151,7 @@ fn lanes_equal_one_by_one_on_random_scenes() {
         let set = enumerate(&scene, 3, &AllVisible).unwrap();
         for solver in solvers(&scene) {
             assert_bitwise_equal(
-                &batched(&scene, &set, &solver, false),
+                &batched(&scene, &set, &solver, Spread::Serial),
                 &one_by_one(&scene, &set, &solver),
             );
         }
