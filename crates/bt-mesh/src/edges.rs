@@ -23,6 +23,7 @@ pub(crate) struct EdgeTable {
 
 impl EdgeTable {
     /// The table of `faces`, each given by its vertex cycle; faces are numbered in order.
+    #[inline(never)]
     pub fn new<'a>(faces: impl IntoIterator<Item = &'a [u32]>) -> Self {
         let faces = faces.into_iter();
         // Room for triangles; larger faces grow it. Each pair carries where it was made (its

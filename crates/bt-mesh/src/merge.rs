@@ -85,6 +85,17 @@ impl Faces {
     }
 
     /// Appends the face with vertex ids `ids` and plane `plane`, from file face `source`.
+    /// Appends the faces of `other` after its own, in order.
+    fn append(&mut self, other: Faces) {
+        let offset = self.ids.len();
+        self.ids.extend_from_slice(&other.ids);
+        self.list.extend(other.list.into_iter().map(|face| Face {
+            start: face.start + offset,
+            end: face.end + offset,
+            ..face
+        }));
+    }
+
     fn push(&mut self, ids: &[u32], source: usize, key: (Option<u32>, Option<u32>), plane: Plane) {
         let start = self.ids.len();
         self.ids.extend_from_slice(ids);
@@ -177,14 +188,41 @@ struct FaceCounts {
 /// to pay for handing it to other threads (most meshes of a city hold a few groups).
 const PARALLEL_GROUPS: usize = 64;
 
+/// Where a large mesh's merge is cut into work for all cores. The pieces are joined in order,
+/// so the result is that of one piece whatever the sizes (a test merges with tiny ones).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Parallel {
+    /// File faces per run of [`planar_faces`] (one run up to this many), and faces per run
+    /// of [`drop_duplicates`]' cycle heads.
+    pub faces: usize,
+}
+
+impl Parallel {
+    /// The sizes a merge uses: a run is large enough that handing it to another thread pays
+    /// (most meshes of a city are one run; San Francisco's terrain of 192,000 triangles is 47).
+    pub const DEFAULT: Parallel = Parallel { faces: 4096 };
+}
+
 /// Runs the whole merge. `opts` must be validated.
 pub(crate) fn merge(mesh: &RawMesh, opts: &MergeOptions, file: &str) -> Merged {
+    merge_with(mesh, opts, file, Parallel::DEFAULT)
+}
+
+/// [`merge`], cut into parallel work as `parallel` says.
+pub(crate) fn merge_with(
+    mesh: &RawMesh,
+    opts: &MergeOptions,
+    file: &str,
+    parallel: Parallel,
+) -> Merged {
+    // The stages are never inlined (each runs once a mesh), so that a profile shows each.
     let extent = bounding_diagonal(&mesh.positions);
     let zero_length = opts.weld_tol_m.max(tol::REL_ZERO_LENGTH * extent.max(1.0));
     let (weld_map, points) = weld(&mesh.positions, opts.weld_tol_m);
     let mut counts = FaceCounts::default();
-    let faces = planar_faces(mesh, &weld_map, &points, opts, zero_length, &mut counts);
-    let faces = drop_duplicates(faces, &mut counts);
+    let welded = (weld_map.as_slice(), points.as_slice());
+    let faces = planar_faces(mesh, welded, opts, zero_length, &mut counts, parallel);
+    let faces = drop_duplicates(faces, &mut counts, parallel);
     let groups = grow_regions(&faces, &points, opts);
 
     // Each group is outlined on its own: on all cores when there are many (a large mesh, say
@@ -317,6 +355,7 @@ fn bounding_diagonal(points: &[Vec3]) -> Real {
 /// Maps every position to a welded vertex id; returns the map and the welded positions (the
 /// first position of each cluster). A position joins the nearest earlier welded vertex within
 /// `tol` (the lowest id among equally near ones); `tol == 0` welds exact duplicates only.
+#[inline(never)]
 fn weld(positions: &[Vec3], tol: Real) -> (Vec<u32>, Vec<Vec3>) {
     let mut map = Vec::with_capacity(positions.len());
     let mut welded: Vec<Vec3> = Vec::new();
@@ -419,19 +458,61 @@ impl WeldGrid {
 }
 
 /// Builds the planar, simple faces, counting in `counts` the faces dropped as degenerate and
-/// the polygon faces split into fan triangles (not planar, or not simple).
+/// the polygon faces split into fan triangles (not planar, or not simple). Faces are
+/// independent: a large mesh is cut into runs of `parallel.faces` faces made on all cores and
+/// joined in order, the same faces as one run.
+#[inline(never)]
 fn planar_faces(
     mesh: &RawMesh,
-    weld_map: &[u32],
-    points: &[Vec3],
+    welded: (&[u32], &[Vec3]),
     opts: &MergeOptions,
     zero_length: Real,
     counts: &mut FaceCounts,
+    parallel: Parallel,
 ) -> Faces {
-    let mut faces = Faces::with_capacity(mesh.face_count(), mesh.indices.len());
+    let n = mesh.face_count();
+    let run = |range: std::ops::Range<usize>, counts: &mut FaceCounts| {
+        planar_run(mesh, welded, opts, zero_length, range, counts)
+    };
+    if n <= parallel.faces {
+        return run(0..n, counts);
+    }
+    let runs: Vec<(Faces, FaceCounts)> = (0..n.div_ceil(parallel.faces))
+        .into_par_iter()
+        .map(|r| {
+            let mut counts = FaceCounts::default();
+            let start = r * parallel.faces;
+            let faces = run(start..(start + parallel.faces).min(n), &mut counts);
+            (faces, counts)
+        })
+        .collect();
+    let mut faces = Faces::with_capacity(
+        runs.iter().map(|(f, _)| f.list.len()).sum(),
+        runs.iter().map(|(f, _)| f.ids.len()).sum(),
+    );
+    for (run, run_counts) in runs {
+        faces.append(run);
+        counts.degenerate += run_counts.degenerate;
+        counts.non_planar += run_counts.non_planar;
+        counts.non_simple += run_counts.non_simple;
+    }
+    faces
+}
+
+/// [`planar_faces`] of the file faces `range`, in order.
+fn planar_run(
+    mesh: &RawMesh,
+    (weld_map, points): (&[u32], &[Vec3]),
+    opts: &MergeOptions,
+    zero_length: Real,
+    range: std::ops::Range<usize>,
+    counts: &mut FaceCounts,
+) -> Faces {
+    let indices = mesh.face_start[range.end] - mesh.face_start[range.start];
+    let mut faces = Faces::with_capacity(range.len(), indices);
     let mut ids: Vec<u32> = Vec::new();
     let mut scratch: Vec<Vec3> = Vec::new();
-    for f in 0..mesh.face_count() {
+    for f in range {
         ids.clear();
         for &i in mesh.face(f) {
             let id = weld_map[i as usize];
@@ -525,19 +606,27 @@ fn make_face(
 /// earlier face, in the same cyclic order either way round, is dropped (counted in `counts`).
 /// Faces are sorted by the start of their canonical cycle and length, then index (no hashing,
 /// no allocation per face); only faces agreeing there are compared in full, so each set of
-/// copies is one run led by its first face.
-fn drop_duplicates(mut faces: Faces, counts: &mut FaceCounts) -> Faces {
+/// copies is one run led by its first face. A large mesh's heads are taken on all cores, in
+/// runs of `parallel.faces`.
+#[inline(never)]
+fn drop_duplicates(mut faces: Faces, counts: &mut FaceCounts, parallel: Parallel) -> Faces {
     let cycle = |i: usize| {
         let vs = faces.vertices(i);
         (0..vs.len()).map(canonical_cycle(vs))
     };
-    let order: Vec<((usize, [u32; 3]), usize)> = (0..faces.len())
-        .map(|i| {
-            let mut head = cycle(i);
-            let mut next = || head.next().unwrap_or(u32::MAX);
-            ((faces.vertices(i).len(), [next(), next(), next()]), i)
-        })
-        .collect();
+    let head = |i: usize| {
+        let mut head = cycle(i);
+        let mut next = || head.next().unwrap_or(u32::MAX);
+        ((faces.vertices(i).len(), [next(), next(), next()]), i)
+    };
+    let order: Vec<((usize, [u32; 3]), usize)> = match faces.len() > parallel.faces {
+        true => (0..faces.len())
+            .into_par_iter()
+            .with_min_len(parallel.faces)
+            .map(head)
+            .collect(),
+        false => (0..faces.len()).map(head).collect(),
+    };
     // By least vertex first: each set of copies is still one run, in index order.
     let order = crate::edges::bucket_sorted(order, |&((_, head), _)| head[0]);
     let mut duplicate = vec![false; faces.len()];
@@ -582,6 +671,7 @@ fn canonical_cycle(vs: &[u32]) -> impl Fn(usize) -> u32 + '_ {
 
 /// The groups of coplanar, edge-connected faces with the same name and material, in the
 /// order of their first face.
+#[inline(never)]
 fn grow_regions(faces: &Faces, points: &[Vec3], opts: &MergeOptions) -> Groups {
     let cos_tol = opts.angle_tol_deg.to_radians().cos();
     let mut edges = EdgeTable::new(faces.all_vertices());
