@@ -192,8 +192,9 @@ const PARALLEL_GROUPS: usize = 64;
 /// so the result is that of one piece whatever the sizes (a test merges with tiny ones).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Parallel {
-    /// File faces per run of [`planar_faces`] (one run up to this many), and faces per run
-    /// of [`drop_duplicates`]' cycle heads.
+    /// File faces per run of [`planar_faces`] (one run up to this many), faces per run of
+    /// [`drop_duplicates`]' cycle heads, and the least faces of a run of grown groups
+    /// outlined apart ([`grow_and_outline`], for meshes of more faces).
     pub faces: usize,
 }
 
@@ -223,33 +224,12 @@ pub(crate) fn merge_with(
     let welded = (weld_map.as_slice(), points.as_slice());
     let faces = planar_faces(mesh, welded, opts, zero_length, &mut counts, parallel);
     let faces = drop_duplicates(faces, &mut counts, parallel);
-    let groups = grow_regions(&faces, &points, opts);
-
-    // Each group is outlined on its own: on all cores when there are many (a large mesh, say
-    // a church of 12,000 faces, would otherwise keep one core busy while the other waits).
-    let outline_group = |scratch: &mut crate::trace::Scratch, g: usize| {
-        let group = groups.get(g);
-        let frame = Frame::of_faces(&faces, group.faces);
-        let whole =
-            crate::trace::whole_outlines(&faces, group, &frame, &points, zero_length, scratch);
-        match whole {
-            Some(outlines) => (frame, outlines, 0),
-            None => {
-                let split = crate::split::split_group(&faces, group, &frame, &points, zero_length);
-                (frame, split.outlines, split.unusable)
-            }
-        }
-    };
-    let outlined: Vec<(Frame, Vec<Outline>, usize)> = if groups.len() >= PARALLEL_GROUPS {
-        (0..groups.len())
-            .into_par_iter()
-            .map_init(crate::trace::Scratch::default, outline_group)
-            .collect()
+    let (groups, outlined) = if faces.len() > parallel.faces {
+        grow_and_outline(&faces, &points, opts, zero_length, parallel)
     } else {
-        let mut scratch = crate::trace::Scratch::default();
-        (0..groups.len())
-            .map(|g| outline_group(&mut scratch, g))
-            .collect()
+        let groups = grow_regions(&faces, &points, opts, |_| {});
+        let outlined = outline_groups(&faces, &groups, &points, zero_length);
+        (groups, outlined)
     };
     let mut surfaces = Vec::with_capacity(outlined.iter().map(|(_, o, _)| o.len()).sum());
     let mut name_counts: HashMap<String, usize> = HashMap::new();
@@ -294,6 +274,106 @@ pub(crate) fn merge_with(
         surfaces,
         warnings: warnings(file, &counts),
     }
+}
+
+/// A group's outlines as [`merge_with`] makes them: its frame, its outlines and the number
+/// of its faces too thin to be a polygon (dropped).
+type Outlined = (Frame, Vec<Outline>, usize);
+
+/// Outlines `group` in its own plane: the whole traced boundary, else simple pieces.
+fn outline_group(
+    faces: &Faces,
+    group: Group<'_>,
+    points: &[Vec3],
+    zero_length: Real,
+    scratch: &mut crate::trace::Scratch,
+) -> Outlined {
+    let frame = Frame::of_faces(faces, group.faces);
+    let whole = crate::trace::whole_outlines(faces, group, &frame, points, zero_length, scratch);
+    match whole {
+        Some(outlines) => (frame, outlines, 0),
+        None => {
+            let split = crate::split::split_group(faces, group, &frame, points, zero_length);
+            (frame, split.outlines, split.unusable)
+        }
+    }
+}
+
+/// Every group outlined on its own, in order: on all cores when there are many (a large
+/// mesh, say a church of 12,000 faces, would otherwise keep one core busy while the other
+/// waits).
+fn outline_groups(
+    faces: &Faces,
+    groups: &Groups,
+    points: &[Vec3],
+    zero_length: Real,
+) -> Vec<Outlined> {
+    let outline = |scratch: &mut crate::trace::Scratch, g: usize| {
+        outline_group(faces, groups.get(g), points, zero_length, scratch)
+    };
+    if groups.len() >= PARALLEL_GROUPS {
+        (0..groups.len())
+            .into_par_iter()
+            .map_init(crate::trace::Scratch::default, outline)
+            .collect()
+    } else {
+        let mut scratch = crate::trace::Scratch::default();
+        (0..groups.len())
+            .map(|g| outline(&mut scratch, g))
+            .collect()
+    }
+}
+
+/// The groups of a large mesh, and their outlines in order, made while they grow: growing is
+/// one pass in file order, and a group is final once grown, so each run of finished groups
+/// of at least `parallel.faces` faces is outlined on another core while the next grow (San
+/// Francisco's terrain outlined its 2,004 groups only after growing all of them).
+fn grow_and_outline(
+    faces: &Faces,
+    points: &[Vec3],
+    opts: &MergeOptions,
+    zero_length: Real,
+    parallel: Parallel,
+) -> (Groups, Vec<Outlined>) {
+    let done: std::sync::Mutex<Vec<(usize, Vec<Outlined>)>> = Default::default();
+    let groups = rayon::scope(|scope| {
+        // The first group not yet handed out.
+        let mut next: usize = 0;
+        let mut hand_out = |groups: &Groups, last: bool| {
+            let start = next.checked_sub(1).map_or(0, |p| groups.ends[p].0);
+            let ready = groups.members.len() - start;
+            if groups.len() == next || (!last && ready < parallel.faces) {
+                return;
+            }
+            let run = Groups {
+                members: groups.members[start..].to_vec(),
+                ends: (groups.ends[next..].iter())
+                    .map(|&(end, sources)| (end - start, sources))
+                    .collect(),
+            };
+            let (first, done) = (next, &done);
+            next = groups.len();
+            scope.spawn(move |_| {
+                let mut scratch = crate::trace::Scratch::default();
+                let outlined = (run.iter())
+                    .map(|group| outline_group(faces, group, points, zero_length, &mut scratch))
+                    .collect();
+                let mut done = done
+                    .lock()
+                    .unwrap_or_else(std::sync::PoisonError::into_inner);
+                done.push((first, outlined));
+            });
+        };
+        let groups = grow_regions(faces, points, opts, |groups| hand_out(groups, false));
+        hand_out(&groups, true);
+        groups
+    });
+    let mut done = done
+        .into_inner()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    done.sort_unstable_by_key(|&(first, _)| first);
+    let outlined = done.into_iter().flat_map(|(_, outlined)| outlined);
+    (groups, outlined.collect())
 }
 
 /// `<base>_<counter>`, written without the formatting machinery (`format!` was a tenth of
@@ -683,9 +763,14 @@ fn canonical_cycle(vs: &[u32]) -> impl Fn(usize) -> u32 + '_ {
 }
 
 /// The groups of coplanar, edge-connected faces with the same name and material, in the
-/// order of their first face.
+/// order of their first face; `grown` sees the groups so far each time one is complete.
 #[inline(never)]
-fn grow_regions(faces: &Faces, points: &[Vec3], opts: &MergeOptions) -> Groups {
+fn grow_regions(
+    faces: &Faces,
+    points: &[Vec3],
+    opts: &MergeOptions,
+    mut grown: impl FnMut(&Groups),
+) -> Groups {
     let cos_tol = opts.angle_tol_deg.to_radians().cos();
     let mut edges = EdgeTable::new(faces.all_vertices());
     let mut group_of: Vec<Option<u32>> = vec![None; faces.len()];
@@ -743,6 +828,7 @@ fn grow_regions(faces: &Faces, points: &[Vec3], opts: &MergeOptions) -> Groups {
                 .filter(|w| faces[w[0]].source != faces[w[1]].source)
                 .count();
         groups.ends.push((groups.members.len(), source_faces));
+        grown(&groups);
     }
     groups
 }
