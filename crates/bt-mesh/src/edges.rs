@@ -27,21 +27,24 @@ impl EdgeTable {
     pub fn new<'a>(faces: impl IntoIterator<Item = &'a [u32]>) -> Self {
         let faces = faces.into_iter();
         // Room for triangles; larger faces grow it. Each pair carries where it was made (its
-        // face edge), which tells that face edge its run once sorted.
-        let mut made: Vec<(u64, u32, u32)> = Vec::with_capacity(3 * faces.size_hint().0);
+        // face edge), which tells that face edge its run once sorted. The triple (key, face,
+        // face edge) is packed in one integer, `key << 64 | face << 32 | face edge`: it sorts
+        // as the triple, in fewer instructions than a tuple compared field by field.
+        let mut made: Vec<u128> = Vec::with_capacity(3 * faces.size_hint().0);
         let mut firsts = Vec::with_capacity(faces.size_hint().0);
         for (f, vs) in faces.enumerate() {
             firsts.push(made.len() as u32);
             for i in 0..vs.len() {
                 let key = edge_key(vs[i], vs[(i + 1) % vs.len()]);
-                made.push((key, f as u32, made.len() as u32));
+                made.push(u128::from(key) << 64 | (f as u128) << 32 | made.len() as u128);
             }
         }
-        let made = bucket_sorted(made, |&(key, _, _)| (key >> 32) as u32);
+        let made = bucket_sorted(made, |&x| (x >> 96) as u32);
         let mut entries: Vec<(u64, u32)> = Vec::with_capacity(made.len());
         let mut runs = vec![0; made.len()];
         let mut run = 0;
-        for &(key, f, at) in &made {
+        for &x in &made {
+            let (key, f, at) = ((x >> 64) as u64, (x >> 32) as u32, x as u32);
             match entries.last() {
                 Some(&(last, _)) if last == key => {}
                 _ => run = entries.len() as u32,
