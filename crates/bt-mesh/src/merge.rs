@@ -85,17 +85,6 @@ impl Faces {
     }
 
     /// Appends the face with vertex ids `ids` and plane `plane`, from file face `source`.
-    /// Appends the faces of `other` after its own, in order.
-    fn append(&mut self, other: Faces) {
-        let offset = self.ids.len();
-        self.ids.extend_from_slice(&other.ids);
-        self.list.extend(other.list.into_iter().map(|face| Face {
-            start: face.start + offset,
-            end: face.end + offset,
-            ..face
-        }));
-    }
-
     fn push(&mut self, ids: &[u32], source: usize, key: (Option<u32>, Option<u32>), plane: Plane) {
         let start = self.ids.len();
         self.ids.extend_from_slice(ids);
@@ -192,9 +181,8 @@ const PARALLEL_GROUPS: usize = 64;
 /// so the result is that of one piece whatever the sizes (a test merges with tiny ones).
 #[derive(Clone, Copy, Debug)]
 pub(crate) struct Parallel {
-    /// File faces per run of [`planar_faces`] (one run up to this many), faces per run of
-    /// [`drop_duplicates`]' cycle heads, and the least faces of a run of grown groups
-    /// outlined apart ([`grow_and_outline`], for meshes of more faces).
+    /// Faces per run of [`drop_duplicates`]' cycle heads, and the least faces of a run of
+    /// grown groups outlined apart ([`grow_and_outline`], for meshes of more faces).
     pub faces: usize,
 }
 
@@ -222,7 +210,7 @@ pub(crate) fn merge_with(
     let (weld_map, points) = weld(&mesh.positions, opts.weld_tol_m);
     let mut counts = FaceCounts::default();
     let welded = (weld_map.as_slice(), points.as_slice());
-    let faces = planar_faces(mesh, welded, opts, zero_length, &mut counts, parallel);
+    let faces = planar_faces(mesh, welded, opts, zero_length, &mut counts);
     let faces = drop_duplicates(faces, &mut counts, parallel);
     let (groups, outlined) = if faces.len() > parallel.faces {
         grow_and_outline(&faces, &points, opts, zero_length, parallel)
@@ -551,61 +539,21 @@ fn floor_i64(x: Real) -> i64 {
 }
 
 /// Builds the planar, simple faces, counting in `counts` the faces dropped as degenerate and
-/// the polygon faces split into fan triangles (not planar, or not simple). Faces are
-/// independent: a large mesh is cut into runs of `parallel.faces` faces made on all cores and
-/// joined in order, the same faces as one run.
+/// the polygon faces split into fan triangles (not planar, or not simple). One pass on one
+/// core: made in runs on all cores and joined, the faces cost more than they saved (the runs'
+/// lists are a second copy of every face, fresh pages included).
 #[inline(never)]
 fn planar_faces(
-    mesh: &RawMesh,
-    welded: (&[u32], &[Vec3]),
-    opts: &MergeOptions,
-    zero_length: Real,
-    counts: &mut FaceCounts,
-    parallel: Parallel,
-) -> Faces {
-    let n = mesh.face_count();
-    let run = |range: std::ops::Range<usize>, counts: &mut FaceCounts| {
-        planar_run(mesh, welded, opts, zero_length, range, counts)
-    };
-    if n <= parallel.faces {
-        return run(0..n, counts);
-    }
-    let runs: Vec<(Faces, FaceCounts)> = (0..n.div_ceil(parallel.faces))
-        .into_par_iter()
-        .map(|r| {
-            let mut counts = FaceCounts::default();
-            let start = r * parallel.faces;
-            let faces = run(start..(start + parallel.faces).min(n), &mut counts);
-            (faces, counts)
-        })
-        .collect();
-    let mut faces = Faces::with_capacity(
-        runs.iter().map(|(f, _)| f.list.len()).sum(),
-        runs.iter().map(|(f, _)| f.ids.len()).sum(),
-    );
-    for (run, run_counts) in runs {
-        faces.append(run);
-        counts.degenerate += run_counts.degenerate;
-        counts.non_planar += run_counts.non_planar;
-        counts.non_simple += run_counts.non_simple;
-    }
-    faces
-}
-
-/// [`planar_faces`] of the file faces `range`, in order.
-fn planar_run(
     mesh: &RawMesh,
     (weld_map, points): (&[u32], &[Vec3]),
     opts: &MergeOptions,
     zero_length: Real,
-    range: std::ops::Range<usize>,
     counts: &mut FaceCounts,
 ) -> Faces {
-    let indices = mesh.face_start[range.end] - mesh.face_start[range.start];
-    let mut faces = Faces::with_capacity(range.len(), indices);
+    let mut faces = Faces::with_capacity(mesh.face_count(), mesh.indices.len());
     let mut ids: Vec<u32> = Vec::new();
     let mut scratch: Vec<Vec3> = Vec::new();
-    for f in range {
+    for f in 0..mesh.face_count() {
         ids.clear();
         for &i in mesh.face(f) {
             let id = weld_map[i as usize];
