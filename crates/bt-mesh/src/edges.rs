@@ -23,24 +23,28 @@ pub(crate) struct EdgeTable {
 
 impl EdgeTable {
     /// The table of `faces`, each given by its vertex cycle; faces are numbered in order.
+    #[inline(never)]
     pub fn new<'a>(faces: impl IntoIterator<Item = &'a [u32]>) -> Self {
         let faces = faces.into_iter();
         // Room for triangles; larger faces grow it. Each pair carries where it was made (its
-        // face edge), which tells that face edge its run once sorted.
-        let mut made: Vec<(u64, u32, u32)> = Vec::with_capacity(3 * faces.size_hint().0);
+        // face edge), which tells that face edge its run once sorted. The triple (key, face,
+        // face edge) is packed in one integer, `key << 64 | face << 32 | face edge`: it sorts
+        // as the triple, in fewer instructions than a tuple compared field by field.
+        let mut made: Vec<u128> = Vec::with_capacity(3 * faces.size_hint().0);
         let mut firsts = Vec::with_capacity(faces.size_hint().0);
         for (f, vs) in faces.enumerate() {
             firsts.push(made.len() as u32);
             for i in 0..vs.len() {
                 let key = edge_key(vs[i], vs[(i + 1) % vs.len()]);
-                made.push((key, f as u32, made.len() as u32));
+                made.push(u128::from(key) << 64 | (f as u128) << 32 | made.len() as u128);
             }
         }
-        let made = bucket_sorted(made, |&(key, _, _)| (key >> 32) as u32);
+        let made = bucket_sorted(made, |&x| (x >> 96) as u32);
         let mut entries: Vec<(u64, u32)> = Vec::with_capacity(made.len());
         let mut runs = vec![0; made.len()];
         let mut run = 0;
-        for &(key, f, at) in &made {
+        for &x in &made {
+            let (key, f, at) = ((x >> 64) as u64, (x >> 32) as u32, x as u32);
             match entries.last() {
                 Some(&(last, _)) if last == key => {}
                 _ => run = entries.len() as u32,
@@ -90,9 +94,24 @@ impl EdgeTable {
 /// with few items per bucket (a mesh's edges by their lower vertex, its faces by their least
 /// vertex) sorts in linear time plus many tiny sorts; a sparse range of buckets falls back to
 /// one sort.
-pub(crate) fn bucket_sorted<T: Copy + Ord>(
+pub(crate) fn bucket_sorted<T: Copy + Ord + Send>(
+    items: Vec<T>,
+    bucket: impl Fn(&T) -> u32,
+) -> Vec<T> {
+    bucket_sorted_in(items, bucket, PARALLEL_ITEMS)
+}
+
+/// Items of [`bucket_sorted`] per piece of buckets sorted on another core: the buckets of a
+/// large list (San Francisco's terrain: 576,000 face edges in 96,000 buckets) are sorted in
+/// pieces of whole buckets of about this many items, on all cores.
+const PARALLEL_ITEMS: usize = 1 << 15;
+
+/// [`bucket_sorted`], sorting the buckets in pieces of about `piece` items on all cores (the
+/// same result for any `piece`).
+fn bucket_sorted_in<T: Copy + Ord + Send>(
     mut items: Vec<T>,
     bucket: impl Fn(&T) -> u32,
+    piece: usize,
 ) -> Vec<T> {
     let Some((lo, hi)) = (items.iter().map(&bucket)).fold(None, |range, b| match range {
         None => Some((b, b)),
@@ -120,12 +139,34 @@ pub(crate) fn bucket_sorted<T: Copy + Ord>(
         sorted[next[b]] = *t;
         next[b] += 1;
     }
-    for b in 0..buckets {
-        let run = &mut sorted[ends[b]..ends[b + 1]];
-        if run.len() > 1 {
-            run.sort_unstable();
+    let sort_runs = |(rest, ends): (&mut [T], &[usize])| {
+        let mut rest = rest;
+        for w in ends.windows(2) {
+            let (run, tail) = std::mem::take(&mut rest).split_at_mut(w[1] - w[0]);
+            if run.len() > 1 {
+                run.sort_unstable();
+            }
+            rest = tail;
         }
+    };
+    if sorted.len() <= piece {
+        sort_runs((&mut sorted, &ends));
+        return sorted;
     }
+    // Pieces of whole buckets: each its items and its buckets' ends (one shared with the next).
+    let mut pieces = Vec::new();
+    let (mut rest, mut first) = (sorted.as_mut_slice(), 0);
+    while first < buckets {
+        let start = ends[first];
+        let last = (first + 1..=buckets)
+            .find(|&b| ends[b] - start >= piece)
+            .unwrap_or(buckets);
+        let (items, tail) = std::mem::take(&mut rest).split_at_mut(ends[last] - start);
+        pieces.push((items, &ends[first..=last]));
+        (rest, first) = (tail, last);
+    }
+    use rayon::prelude::*;
+    pieces.into_par_iter().for_each(sort_runs);
     sorted
 }
 
@@ -147,6 +188,10 @@ mod tests {
             sorted.sort_unstable();
             let bucketed = bucket_sorted(items.clone(), |&(key, _, _)| (key >> 32) as u32);
             proptest::prop_assert_eq!(&bucketed, &sorted);
+            for piece in [1, 2, 5, 64] {
+                let pieces = bucket_sorted_in(items.clone(), |&(key, _, _)| (key >> 32) as u32, piece);
+                proptest::prop_assert_eq!(&pieces, &sorted);
+            }
             let by_face = bucket_sorted(items, |&(_, f, _)| f);
             let mut runs: Vec<_> = by_face.chunk_by(|a, b| a == b).map(|r| r[0]).collect();
             let count = runs.len();

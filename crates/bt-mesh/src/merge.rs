@@ -177,41 +177,47 @@ struct FaceCounts {
 /// to pay for handing it to other threads (most meshes of a city hold a few groups).
 const PARALLEL_GROUPS: usize = 64;
 
+/// Where a large mesh's merge is cut into work for all cores. The pieces are joined in order,
+/// so the result is that of one piece whatever the sizes (a test merges with tiny ones).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Parallel {
+    /// Faces per run of [`drop_duplicates`]' cycle heads, and the least faces of a run of
+    /// grown groups outlined apart ([`grow_and_outline`], for meshes of more faces).
+    pub faces: usize,
+}
+
+impl Parallel {
+    /// The sizes a merge uses: a run is large enough that handing it to another thread pays
+    /// (most meshes of a city are one run; San Francisco's terrain of 192,000 triangles is 47).
+    pub const DEFAULT: Parallel = Parallel { faces: 4096 };
+}
+
 /// Runs the whole merge. `opts` must be validated.
 pub(crate) fn merge(mesh: &RawMesh, opts: &MergeOptions, file: &str) -> Merged {
+    merge_with(mesh, opts, file, Parallel::DEFAULT)
+}
+
+/// [`merge`], cut into parallel work as `parallel` says.
+pub(crate) fn merge_with(
+    mesh: &RawMesh,
+    opts: &MergeOptions,
+    file: &str,
+    parallel: Parallel,
+) -> Merged {
+    // The stages are never inlined (each runs once a mesh), so that a profile shows each.
     let extent = bounding_diagonal(&mesh.positions);
     let zero_length = opts.weld_tol_m.max(tol::REL_ZERO_LENGTH * extent.max(1.0));
     let (weld_map, points) = weld(&mesh.positions, opts.weld_tol_m);
     let mut counts = FaceCounts::default();
-    let faces = planar_faces(mesh, &weld_map, &points, opts, zero_length, &mut counts);
-    let faces = drop_duplicates(faces, &mut counts);
-    let groups = grow_regions(&faces, &points, opts);
-
-    // Each group is outlined on its own: on all cores when there are many (a large mesh, say
-    // a church of 12,000 faces, would otherwise keep one core busy while the other waits).
-    let outline_group = |scratch: &mut crate::trace::Scratch, g: usize| {
-        let group = groups.get(g);
-        let frame = Frame::of_faces(&faces, group.faces);
-        let whole =
-            crate::trace::whole_outlines(&faces, group, &frame, &points, zero_length, scratch);
-        match whole {
-            Some(outlines) => (frame, outlines, 0),
-            None => {
-                let split = crate::split::split_group(&faces, group, &frame, &points, zero_length);
-                (frame, split.outlines, split.unusable)
-            }
-        }
-    };
-    let outlined: Vec<(Frame, Vec<Outline>, usize)> = if groups.len() >= PARALLEL_GROUPS {
-        (0..groups.len())
-            .into_par_iter()
-            .map_init(crate::trace::Scratch::default, outline_group)
-            .collect()
+    let welded = (weld_map.as_slice(), points.as_slice());
+    let faces = planar_faces(mesh, welded, opts, zero_length, &mut counts);
+    let faces = drop_duplicates(faces, &mut counts, parallel);
+    let (groups, outlined) = if faces.len() > parallel.faces {
+        grow_and_outline(&faces, &points, opts, zero_length, parallel)
     } else {
-        let mut scratch = crate::trace::Scratch::default();
-        (0..groups.len())
-            .map(|g| outline_group(&mut scratch, g))
-            .collect()
+        let groups = grow_regions(&faces, &points, opts, |_| {});
+        let outlined = outline_groups(&faces, &groups, &points, zero_length);
+        (groups, outlined)
     };
     let mut surfaces = Vec::with_capacity(outlined.iter().map(|(_, o, _)| o.len()).sum());
     let mut name_counts: HashMap<String, usize> = HashMap::new();
@@ -256,6 +262,106 @@ pub(crate) fn merge(mesh: &RawMesh, opts: &MergeOptions, file: &str) -> Merged {
         surfaces,
         warnings: warnings(file, &counts),
     }
+}
+
+/// A group's outlines as [`merge_with`] makes them: its frame, its outlines and the number
+/// of its faces too thin to be a polygon (dropped).
+type Outlined = (Frame, Vec<Outline>, usize);
+
+/// Outlines `group` in its own plane: the whole traced boundary, else simple pieces.
+fn outline_group(
+    faces: &Faces,
+    group: Group<'_>,
+    points: &[Vec3],
+    zero_length: Real,
+    scratch: &mut crate::trace::Scratch,
+) -> Outlined {
+    let frame = Frame::of_faces(faces, group.faces);
+    let whole = crate::trace::whole_outlines(faces, group, &frame, points, zero_length, scratch);
+    match whole {
+        Some(outlines) => (frame, outlines, 0),
+        None => {
+            let split = crate::split::split_group(faces, group, &frame, points, zero_length);
+            (frame, split.outlines, split.unusable)
+        }
+    }
+}
+
+/// Every group outlined on its own, in order: on all cores when there are many (a large
+/// mesh, say a church of 12,000 faces, would otherwise keep one core busy while the other
+/// waits).
+fn outline_groups(
+    faces: &Faces,
+    groups: &Groups,
+    points: &[Vec3],
+    zero_length: Real,
+) -> Vec<Outlined> {
+    let outline = |scratch: &mut crate::trace::Scratch, g: usize| {
+        outline_group(faces, groups.get(g), points, zero_length, scratch)
+    };
+    if groups.len() >= PARALLEL_GROUPS {
+        (0..groups.len())
+            .into_par_iter()
+            .map_init(crate::trace::Scratch::default, outline)
+            .collect()
+    } else {
+        let mut scratch = crate::trace::Scratch::default();
+        (0..groups.len())
+            .map(|g| outline(&mut scratch, g))
+            .collect()
+    }
+}
+
+/// The groups of a large mesh, and their outlines in order, made while they grow: growing is
+/// one pass in file order, and a group is final once grown, so each run of finished groups
+/// of at least `parallel.faces` faces is outlined on another core while the next grow (San
+/// Francisco's terrain outlined its 2,004 groups only after growing all of them).
+fn grow_and_outline(
+    faces: &Faces,
+    points: &[Vec3],
+    opts: &MergeOptions,
+    zero_length: Real,
+    parallel: Parallel,
+) -> (Groups, Vec<Outlined>) {
+    let done: std::sync::Mutex<Vec<(usize, Vec<Outlined>)>> = Default::default();
+    let groups = rayon::scope(|scope| {
+        // The first group not yet handed out.
+        let mut next: usize = 0;
+        let mut hand_out = |groups: &Groups, last: bool| {
+            let start = next.checked_sub(1).map_or(0, |p| groups.ends[p].0);
+            let ready = groups.members.len() - start;
+            if groups.len() == next || (!last && ready < parallel.faces) {
+                return;
+            }
+            let run = Groups {
+                members: groups.members[start..].to_vec(),
+                ends: (groups.ends[next..].iter())
+                    .map(|&(end, sources)| (end - start, sources))
+                    .collect(),
+            };
+            let (first, done) = (next, &done);
+            next = groups.len();
+            scope.spawn(move |_| {
+                let mut scratch = crate::trace::Scratch::default();
+                let outlined = (run.iter())
+                    .map(|group| outline_group(faces, group, points, zero_length, &mut scratch))
+                    .collect();
+                let mut done = done
+                    .lock()
+                    .unwrap_or_else(std::sync::PoisonError::into_inner);
+                done.push((first, outlined));
+            });
+        };
+        let groups = grow_regions(faces, points, opts, |groups| hand_out(groups, false));
+        hand_out(&groups, true);
+        groups
+    });
+    let mut done = done
+        .into_inner()
+        .unwrap_or_else(std::sync::PoisonError::into_inner);
+    done.sort_unstable_by_key(|&(first, _)| first);
+    let outlined = done.into_iter().flat_map(|(_, outlined)| outlined);
+    (groups, outlined.collect())
 }
 
 /// `<base>_<counter>`, written without the formatting machinery (`format!` was a tenth of
@@ -317,6 +423,7 @@ fn bounding_diagonal(points: &[Vec3]) -> Real {
 /// Maps every position to a welded vertex id; returns the map and the welded positions (the
 /// first position of each cluster). A position joins the nearest earlier welded vertex within
 /// `tol` (the lowest id among equally near ones); `tol == 0` welds exact duplicates only.
+#[inline(never)]
 fn weld(positions: &[Vec3], tol: Real) -> (Vec<u32>, Vec<Vec3>) {
     let mut map = Vec::with_capacity(positions.len());
     let mut welded: Vec<Vec3> = Vec::new();
@@ -382,7 +489,7 @@ impl WeldGrid {
 
     /// The cell of `p` (`as` saturates, so absurd coordinates land in the outermost cell).
     fn cell_of(&self, p: Vec3) -> Cell {
-        let [x, y, z] = (p / self.cell).floor().to_array().map(|c| c as i64);
+        let [x, y, z] = (p / self.cell).to_array().map(floor_i64);
         (x, y, z)
     }
 
@@ -418,12 +525,27 @@ impl WeldGrid {
     }
 }
 
+/// `x.floor() as i64` (saturating, NaN to 0) without the call to the C library's `floor`
+/// that `f64::floor` is on a target without SSE4.1 (a tenth of welding): the truncation,
+/// less one when it rounded up. Exact: a truncation above `x` is at most one too high, and
+/// it is the integer `x` itself from 2^52 on.
+fn floor_i64(x: Real) -> i64 {
+    let t = x as i64;
+    if t as Real > x {
+        t.saturating_sub(1)
+    } else {
+        t
+    }
+}
+
 /// Builds the planar, simple faces, counting in `counts` the faces dropped as degenerate and
-/// the polygon faces split into fan triangles (not planar, or not simple).
+/// the polygon faces split into fan triangles (not planar, or not simple). One pass on one
+/// core: made in runs on all cores and joined, the faces cost more than they saved (the runs'
+/// lists are a second copy of every face, fresh pages included).
+#[inline(never)]
 fn planar_faces(
     mesh: &RawMesh,
-    weld_map: &[u32],
-    points: &[Vec3],
+    (weld_map, points): (&[u32], &[Vec3]),
     opts: &MergeOptions,
     zero_length: Real,
     counts: &mut FaceCounts,
@@ -525,19 +647,27 @@ fn make_face(
 /// earlier face, in the same cyclic order either way round, is dropped (counted in `counts`).
 /// Faces are sorted by the start of their canonical cycle and length, then index (no hashing,
 /// no allocation per face); only faces agreeing there are compared in full, so each set of
-/// copies is one run led by its first face.
-fn drop_duplicates(mut faces: Faces, counts: &mut FaceCounts) -> Faces {
+/// copies is one run led by its first face. A large mesh's heads are taken on all cores, in
+/// runs of `parallel.faces`.
+#[inline(never)]
+fn drop_duplicates(mut faces: Faces, counts: &mut FaceCounts, parallel: Parallel) -> Faces {
     let cycle = |i: usize| {
         let vs = faces.vertices(i);
         (0..vs.len()).map(canonical_cycle(vs))
     };
-    let order: Vec<((usize, [u32; 3]), usize)> = (0..faces.len())
-        .map(|i| {
-            let mut head = cycle(i);
-            let mut next = || head.next().unwrap_or(u32::MAX);
-            ((faces.vertices(i).len(), [next(), next(), next()]), i)
-        })
-        .collect();
+    let head = |i: usize| {
+        let mut head = cycle(i);
+        let mut next = || head.next().unwrap_or(u32::MAX);
+        ((faces.vertices(i).len(), [next(), next(), next()]), i)
+    };
+    let order: Vec<((usize, [u32; 3]), usize)> = match faces.len() > parallel.faces {
+        true => (0..faces.len())
+            .into_par_iter()
+            .with_min_len(parallel.faces)
+            .map(head)
+            .collect(),
+        false => (0..faces.len()).map(head).collect(),
+    };
     // By least vertex first: each set of copies is still one run, in index order.
     let order = crate::edges::bucket_sorted(order, |&((_, head), _)| head[0]);
     let mut duplicate = vec![false; faces.len()];
@@ -581,8 +711,14 @@ fn canonical_cycle(vs: &[u32]) -> impl Fn(usize) -> u32 + '_ {
 }
 
 /// The groups of coplanar, edge-connected faces with the same name and material, in the
-/// order of their first face.
-fn grow_regions(faces: &Faces, points: &[Vec3], opts: &MergeOptions) -> Groups {
+/// order of their first face; `grown` sees the groups so far each time one is complete.
+#[inline(never)]
+fn grow_regions(
+    faces: &Faces,
+    points: &[Vec3],
+    opts: &MergeOptions,
+    mut grown: impl FnMut(&Groups),
+) -> Groups {
     let cos_tol = opts.angle_tol_deg.to_radians().cos();
     let mut edges = EdgeTable::new(faces.all_vertices());
     let mut group_of: Vec<Option<u32>> = vec![None; faces.len()];
@@ -640,6 +776,7 @@ fn grow_regions(faces: &Faces, points: &[Vec3], opts: &MergeOptions) -> Groups {
                 .filter(|w| faces[w[0]].source != faces[w[1]].source)
                 .count();
         groups.ends.push((groups.members.len(), source_faces));
+        grown(&groups);
     }
     groups
 }
@@ -706,6 +843,47 @@ mod tests {
                 })
                 .collect();
             proptest::prop_assert_eq!(weld(&positions, tol), weld_by_scan(&positions, tol));
+        }
+    }
+
+    #[test]
+    fn floor_i64_is_floor_then_as() {
+        let edges = [
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            -1.0,
+            1.0 - Real::EPSILON / 2.0,
+            -1.0 + Real::EPSILON / 2.0,
+            4503599627370495.5,
+            -4503599627370495.5,
+            9007199254740993.0,
+            9.223372036854775e18,
+            -9.223372036854775e18,
+            9.3e18,
+            -9.3e18,
+            Real::MAX,
+            Real::MIN,
+            Real::INFINITY,
+            Real::NEG_INFINITY,
+            Real::NAN,
+            Real::MIN_POSITIVE,
+            -Real::MIN_POSITIVE,
+        ];
+        for x in edges {
+            assert_eq!(floor_i64(x), x.floor() as i64, "{x}");
+        }
+    }
+
+    proptest::proptest! {
+        /// Any bits at all: the cheap floor is `floor` then `as`.
+        #[test]
+        fn floor_i64_agrees_on_any_bits(bits in proptest::num::u64::ANY, scale in -70i32..70) {
+            let x = Real::from_bits(bits);
+            proptest::prop_assert_eq!(floor_i64(x), x.floor() as i64);
+            let y = (bits as i64 as Real) * (2.0 as Real).powi(scale) / 3.0;
+            proptest::prop_assert_eq!(floor_i64(y), y.floor() as i64);
         }
     }
 

@@ -428,3 +428,36 @@ proptest! {
         assert_same_cover(&mesh, &import, &samples(-0.5, 4.5));
     }
 }
+
+/// The merge of `mesh` cut into parallel work as `parallel` says, as text that shows every
+/// bit of the surfaces (`Debug` prints an `f64` as the shortest text that reads back to it)
+/// and the warnings in order.
+fn merged_text(mesh: &RawMesh, parallel: crate::merge::Parallel) -> String {
+    let merged = crate::merge::merge_with(mesh, &MergeOptions::default(), "test.ply", parallel);
+    format!("{:?}\n{:?}", merged.surfaces, merged.warnings)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(256))]
+
+    /// Polygon soups of triangles to hexagons over a wobbly grid (non-planar and self-touching
+    /// polygons split into fans, degenerate faces, duplicates in either winding): the merge cut
+    /// into tiny pieces of parallel work gives the merge in one piece, to the bit.
+    #[test]
+    fn parallel_pieces_merge_as_one(
+        picks in prop::collection::vec(prop::collection::vec(0u32..36, 3..7), 1..60),
+        wobble in prop_oneof![Just(0.0), 1e-4f64..0.2],
+        faces in 1usize..5,
+    ) {
+        let points: Vec<[Real; 3]> = (0..36u32)
+            .map(|k| {
+                let (i, j) = (Real::from(k % 6), Real::from(k / 6));
+                [i, j, wobble * Real::from((k * 7) % 5)]
+            })
+            .collect();
+        let mesh = raw(&points, &picks);
+        let serial = crate::merge::Parallel { faces: usize::MAX };
+        let tiny = crate::merge::Parallel { faces };
+        prop_assert_eq!(merged_text(&mesh, tiny), merged_text(&mesh, serial));
+    }
+}

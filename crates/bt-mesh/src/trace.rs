@@ -20,14 +20,15 @@ use crate::outline::{Frame, Outline, area_matches, outline};
 pub(crate) struct Scratch {
     /// The group's half-edges in face order: (undirected edge key, from, to).
     half: Vec<(u64, u32, u32)>,
-    /// The half-edges' keys with their positions in `half`, sorted.
-    keyed: Vec<(u64, u32)>,
+    /// The half-edges' keys with their positions in `half`, sorted: `key << 32 | position`
+    /// (one integer sorts in fewer instructions than a pair compared field by field).
+    keyed: Vec<u128>,
     /// Per half-edge: on the boundary; then per boundary edge: traced.
     flags: Vec<bool>,
     /// The boundary edges (from, to) in face order.
     boundary: Vec<(u32, u32)>,
-    /// The boundary edges by start vertex: (from, position in `boundary`), sorted.
-    outgoing: Vec<(u32, usize)>,
+    /// The boundary edges by start vertex, sorted: `from << 32 | position in boundary`.
+    outgoing: Vec<u64>,
 }
 
 /// The outlines of a plain group, in the order of their first boundary edge; `None` when the
@@ -75,13 +76,15 @@ fn boundary_edges(faces: &Faces, group: Group<'_>, scratch: &mut Scratch) {
         }
     }
     keyed.clear();
-    keyed.extend((half.iter().enumerate()).map(|(h, &(key, _, _))| (key, h as u32)));
+    keyed.extend(
+        (half.iter().enumerate()).map(|(h, &(key, _, _))| u128::from(key) << 32 | h as u128),
+    );
     keyed.sort_unstable();
     flags.clear();
     flags.resize(half.len(), false);
-    for run in keyed.chunk_by(|x, y| x.0 == y.0) {
-        if let [(_, h)] = run {
-            flags[*h as usize] = true;
+    for run in keyed.chunk_by(|x, y| x >> 32 == y >> 32) {
+        if let [h] = run {
+            flags[*h as u32 as usize] = true;
         }
     }
     boundary.clear();
@@ -112,12 +115,13 @@ fn closed_loops(
     // The boundary edges by start vertex (in edge order for each): a sorted list, no
     // allocation per vertex.
     outgoing.clear();
-    outgoing.extend((boundary.iter().enumerate()).map(|(h, &(a, _))| (a, h)));
+    outgoing
+        .extend((boundary.iter().enumerate()).map(|(h, &(a, _))| u64::from(a) << 32 | h as u64));
     outgoing.sort_unstable();
     let leaving = |at: u32| {
-        let start = outgoing.partition_point(|&(a, _)| a < at);
-        let end = start + outgoing[start..].partition_point(|&(a, _)| a == at);
-        outgoing[start..end].iter().map(|&(_, h)| h)
+        let start = outgoing.partition_point(|&x| x >> 32 < u64::from(at));
+        let end = start + outgoing[start..].partition_point(|&x| x >> 32 == u64::from(at));
+        outgoing[start..end].iter().map(|&x| x as u32 as usize)
     };
     let mut loops = Vec::new();
     used.clear();

@@ -89,6 +89,7 @@ impl Scalar {
 
     /// Decodes one value from the first `self.size()` bytes of `b` (panics if `b` is shorter:
     /// callers slice the record after checking its length).
+    #[inline(always)]
     pub fn decode(self, b: &[u8], big_endian: bool) -> f64 {
         macro_rules! get {
             ($t:ty, $n:expr) => {{

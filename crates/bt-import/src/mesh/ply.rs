@@ -60,7 +60,7 @@ fn parse_with(
         let fast = fast.then(|| Fast::of(&header, &layout, e)).flatten();
         for index in 0..element.count {
             if let Some(fast) = &fast
-                && reader.fast_entry(fast, layout.vertex_count, &mut mesh, &mut face)
+                && reader.fast_entry(fast, layout.vertex_count, &mut mesh)
             {
                 continue;
             }
@@ -406,15 +406,9 @@ impl Reader<'_> {
         Ok(())
     }
 
-    /// One entry read the [`Fast`] way into `mesh` (`face`: scratch), or `false` with nothing
+    /// One entry read the [`Fast`] way into `mesh`, or `false` with nothing
     /// read when the general reader must take it.
-    fn fast_entry(
-        &mut self,
-        fast: &Fast,
-        vertex_count: u64,
-        mesh: &mut RawMesh,
-        face: &mut Vec<u32>,
-    ) -> bool {
+    fn fast_entry(&mut self, fast: &Fast, vertex_count: u64, mesh: &mut RawMesh) -> bool {
         let big = self.format.is_big_endian();
         let rest = &self.bytes[self.pos..];
         match *fast {
@@ -444,15 +438,20 @@ impl Reader<'_> {
                 let Some(list) = end.and_then(|end| rest.get(count.size()..end)) else {
                     return false;
                 };
-                face.clear();
+                // Straight into the mesh's index list (taken back if an index is out of
+                // range), as `push_face` would append them.
+                let start = mesh.indices.len();
                 for k in 0..n {
                     let v = item.decode(&list[k * size..], big);
                     if !(v >= 0.0 && v < vertex_count as Real) {
+                        mesh.indices.truncate(start);
                         return false;
                     }
-                    face.push(v as u32);
+                    mesh.indices.push(v as u32);
                 }
-                mesh.push_face(face, None, None);
+                mesh.face_start.push(mesh.indices.len());
+                mesh.face_name.push(None);
+                mesh.face_material.push(None);
                 self.pos += count.size() + n * size;
             }
         }

@@ -670,3 +670,17 @@ fn lookat_turns_z_towards_the_target_as_mitsuba_does() {
         );
     }
 }
+
+#[cfg(unix)]
+#[test]
+fn a_path_is_shown_as_display_shows_it() {
+    use std::os::unix::ffi::OsStrExt;
+    let odd = std::ffi::OsStr::from_bytes(b"meshes/caf\xe9 \xff.ply");
+    for path in [
+        Path::new("meshes/Terrain.ply"),
+        Path::new("m/ä b.ply"),
+        Path::new(odd),
+    ] {
+        assert_eq!(shown_path(path), path.display().to_string());
+    }
+}
