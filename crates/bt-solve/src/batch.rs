@@ -106,7 +106,7 @@ where
     if let (false, Some(partner)) = (batch.parallel, batch.partner)
         && total >= SPLIT_FROM
     {
-        let half = total / 2;
+        let half = balanced_half(batch.candidates, todo, total);
         // Both accumulators are made here, so that the partner's is this thread's memory,
         // freed by this thread (see `SPLIT_FROM`).
         let (first, second) = (init(half), init(total - half));
@@ -126,6 +126,23 @@ where
             chunk.run(range.clone(), init(range.len()))
         })
         .collect()
+}
+
+/// Where the candidates of `todo` (`total` of them) split into a batch's two halves: the
+/// first position where the work before it, a candidate costing its order plus one (its
+/// segments to validate), reaches half of the whole (the image method's cost grows with the
+/// order, and a set's candidates come by order, so half the count left the partner the
+/// longer half).
+fn balanced_half(candidates: &CandidateSet, todo: Todo<'_>, total: usize) -> usize {
+    let weight = |k: usize| candidates.get(todo.index(k)).len() + 1;
+    let whole: usize = (0..total).map(weight).sum();
+    let mut sum = 0;
+    (0..total)
+        .position(|k| {
+            sum += weight(k);
+            2 * sum >= whole
+        })
+        .map_or(total / 2, |k| k + 1)
 }
 
 /// What every chunk of a batch shares.
