@@ -309,13 +309,18 @@ pub struct TraceResult {
 }
 
 impl TraceResult {
-    /// No paths yet, with room for the paths of `candidates` candidates.
+    /// No paths yet, with room for the paths of `candidates` candidates, up to
+    /// [`TraceResult::MAX_ROOM`] (a large batch's paths, a few of its candidates, grow as
+    /// they come instead of taking memory for every candidate up front).
     pub(crate) fn with_room(candidates: usize) -> TraceResult {
         TraceResult {
-            paths: Vec::with_capacity(candidates),
+            paths: Vec::with_capacity(candidates.min(Self::MAX_ROOM)),
             counts: OutcomeCounts::default(),
         }
     }
+
+    /// The most paths [`TraceResult::with_room`] makes room for (about 1 MB).
+    const MAX_ROOM: usize = 4096;
 
     /// The results of consecutive parts as one, in order: the paths moved once into a
     /// vector of their total length (a path holds its lists inline, so it is worth not
