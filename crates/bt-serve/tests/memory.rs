@@ -4,42 +4,15 @@
 //! Its own test binary (not a module of `tests/it`): the counting allocator sees every thread
 //! of the process, so no other test may run beside it.
 
-use bt_beams::RadioOptions;
+#[path = "support/counting.rs"]
+mod counting;
+
 use bt_serve::{Limits, Server};
-use bt_solve::settings::SolveSettings;
-use std::alloc::{GlobalAlloc, Layout, System};
-use std::sync::atomic::{AtomicIsize, Ordering};
-
-/// The system allocator, counting the bytes live.
-struct Counting;
-
-static LIVE: AtomicIsize = AtomicIsize::new(0);
-
-// SAFETY: every call is forwarded to the system allocator with the caller's arguments; the
-// counter only adds and subtracts the sizes.
-unsafe impl GlobalAlloc for Counting {
-    unsafe fn alloc(&self, layout: Layout) -> *mut u8 {
-        LIVE.fetch_add(layout.size() as isize, Ordering::Relaxed);
-        // SAFETY: the caller's layout, as `GlobalAlloc::alloc` requires.
-        unsafe { System.alloc(layout) }
-    }
-    unsafe fn dealloc(&self, ptr: *mut u8, layout: Layout) {
-        LIVE.fetch_sub(layout.size() as isize, Ordering::Relaxed);
-        // SAFETY: `ptr` was allocated by `System` with `layout` (every allocation goes there).
-        unsafe { System.dealloc(ptr, layout) }
-    }
-    unsafe fn realloc(&self, ptr: *mut u8, layout: Layout, new_size: usize) -> *mut u8 {
-        LIVE.fetch_add(
-            new_size as isize - layout.size() as isize,
-            Ordering::Relaxed,
-        );
-        // SAFETY: as `GlobalAlloc::realloc` requires, forwarded unchanged.
-        unsafe { System.realloc(ptr, layout, new_size) }
-    }
-}
+use counting::LIVE;
+use std::sync::atomic::Ordering;
 
 #[global_allocator]
-static ALLOCATOR: Counting = Counting;
+static ALLOCATOR: counting::Counting = counting::Counting;
 
 /// Request `i` of a stream that does everything a client does: receiver moves, lists, a TX
 /// moving back and forth, bad lines, a line over its budget.
@@ -74,20 +47,11 @@ fn stream(server: &mut Server, range: std::ops::Range<usize>) -> (u64, usize) {
 
 #[test]
 fn memory_stays_flat_over_a_long_stream() {
-    let options = bt_import::LoadOptions::default();
-    let dynamic = bt_import::load_dynamic("builtin:living-room", &options, &mut |_| {})
-        .unwrap()
-        .scene;
-    let settings = SolveSettings {
-        max_order: 2,
-        ..SolveSettings::default()
-    };
-    let options = settings.trace_options(dynamic.step(0)).unwrap();
     let limits = Limits {
         max_line_bytes: 4096,
         ..Limits::default()
     };
-    let mut server = Server::new(dynamic, options, RadioOptions::default(), limits);
+    let mut server = counting::living_room(2, limits);
     let (answered, sent) = stream(&mut server, 0..200);
     assert_eq!(answered as usize, sent);
     let warm = LIVE.load(Ordering::Relaxed);
