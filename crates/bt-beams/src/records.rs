@@ -228,9 +228,8 @@ fn known(kept: &mut Option<(bt_scene::RadioKey, gain::Known)>, scene: &Scene) ->
 
 /// Where ranked `keys` split into the caller's and the partner's half
 /// ([`Records::report_halves`]): a path's description costs about one unit, and one more for
-/// each interaction (its order, [`key_order`]); the caller takes [`MINE`] of the work
-/// (the partner starts later and on colder caches), and the split falls between runs of
-/// the same order and length.
+/// each interaction (its order, [`key_order`]); the caller takes [`MINE`] of the work, and the
+/// split falls between runs of the same order and length.
 fn halfway(keys: &[RankKey]) -> usize {
     let total: usize = keys.iter().map(|&k| key_order(k) + 1).sum();
     let mut sum = 0;
@@ -247,8 +246,12 @@ fn halfway(keys: &[RankKey]) -> usize {
     k
 }
 
-/// The caller's share of a split report's work ([`halfway`]).
-const MINE: f64 = 0.55;
+/// The caller's share of a split report's work ([`halfway`]): half. Both halves describe and
+/// write a path at the same rate since the partner's buffers are the serving thread's (timed
+/// per half over 3,000 answers: 0.73 and 0.75 µs a unit at 0.55, where the caller's half was
+/// the longer by 6 µs); the earlier 0.55 made up for a partner slowed by the allocator
+/// (docs/performance.md, session 9).
+const MINE: f64 = 0.5;
 
 /// Describe the paths of `keys` (ranked, [`RankKey`]) into `records`, one each, in order.
 fn describe_ranked(
