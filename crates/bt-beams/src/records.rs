@@ -247,10 +247,10 @@ fn halfway(keys: &[RankKey]) -> usize {
 }
 
 /// The caller's share of a split report's work ([`halfway`]): half. Both halves describe and
-/// write a path at the same rate since the partner's buffers are the serving thread's (timed
-/// per half over 3,000 answers: 0.73 and 0.75 µs a unit at 0.55, where the caller's half was
-/// the longer by 6 µs); the earlier 0.55 made up for a partner slowed by the allocator
-/// (docs/performance.md, session 9).
+/// write a path equally fast since the partner's buffers are the serving thread's: timed per
+/// half over 3,000 serve answers at 0.55, the caller took 40-43 µs and the partner 32-34 µs,
+/// the same time per percent of the work, so the answer waited on the caller. The earlier
+/// 0.55 made up for a partner slowed by the allocator (docs/performance.md, session 9).
 const MINE: f64 = 0.5;
 
 /// Describe the paths of `keys` (ranked, [`RankKey`]) into `records`, one each, in order.
