@@ -38,9 +38,10 @@ pair was chosen for. docs/channel.md §7.";
 
 #[derive(Debug, Subcommand)]
 pub enum Command {
-    /// Trace every specular path between TX and RX in a scene, and with --diffraction those
-    /// that diffract once on an edge (JSON/TOML scene, Mitsuba/Sionna XML scene, OBJ, PLY
-    /// or STL mesh, glTF scene, point cloud, or builtin:NAME).
+    /// Trace every specular path between TX and RX in a scene, with --diffraction or
+    /// --max-diffractions 2 those that diffract on edges, and with --transmission those that
+    /// cross walls (JSON/TOML scene, Mitsuba/Sionna XML scene, OBJ, PLY or STL mesh, glTF
+    /// scene, point cloud, or builtin:NAME).
     #[command(after_help = TRACE_COLUMNS)]
     Trace(TraceArgs),
     /// Extract planar surfaces from a point cloud (PLY or PCD) into a scene file.
