@@ -17,8 +17,7 @@ static ALLOCATOR: counting::Counting = counting::Counting;
 /// Request `i` of a stream that does everything a client does: receiver moves, lists, a TX
 /// moving back and forth, bad lines, a line over its budget.
 fn request(i: usize) -> String {
-    let t = i as f64;
-    let (x, y) = (3.0 + 2.0 * (t * 0.37).sin(), 2.2 + 1.5 * (t * 0.23).cos());
+    let (x, y) = counting::walk_xy(i);
     match i % 10 {
         3 => format!("{{\"id\": {i}, \"rx\": [[{x}, {y}, 1.1], [{y}, 2.0, 0.9]]}}"),
         5 => format!(
@@ -32,7 +31,7 @@ fn request(i: usize) -> String {
             "{{\"id\": {i}, \"rx\": [{x}, {y}, 1.0]}}{}",
             " ".repeat(5000)
         ),
-        _ => format!("{{\"id\": {i}, \"rx\": [{x}, {y}, 1.2]}}"),
+        _ => counting::move_request(i),
     }
 }
 

@@ -17,13 +17,6 @@ use std::sync::atomic::Ordering;
 #[global_allocator]
 static ALLOCATOR: counting::Counting = counting::Counting;
 
-/// Request `i` of a walk of one receiver through the living room.
-fn request(i: usize) -> String {
-    let t = i as f64;
-    let (x, y) = (3.0 + 2.0 * (t * 0.37).sin(), 2.2 + 1.5 * (t * 0.23).cos());
-    format!("{{\"id\": {i}, \"rx\": [{x}, {y}, 1.2]}}")
-}
-
 #[test]
 fn the_partner_allocates_nothing_once_warm() {
     MARKED.with(|m| m.set(true));
@@ -32,7 +25,7 @@ fn the_partner_allocates_nothing_once_warm() {
     let mut server = server.with_partner(std::time::Duration::from_secs(1));
     let mut out = Vec::new();
     let mut answer = |i: usize| {
-        server.answer_line(request(i).as_bytes(), &mut out);
+        server.answer_line(counting::move_request(i).as_bytes(), &mut out);
         assert!(out.starts_with(b"{\"id\":"), "request {i}: {out:?}");
     };
     (0..100).for_each(&mut answer);

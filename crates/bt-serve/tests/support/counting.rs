@@ -1,6 +1,7 @@
 //! What the allocation tests share (`tests/memory.rs`, `tests/partner.rs`, each its own test
 //! binary: a global allocator sees every thread of the process, so no other test may run
-//! beside it): the system allocator, counting, and the living room's server.
+//! beside it): the system allocator, counting, the living room's server and a receiver's
+//! walk through it.
 
 use bt_beams::RadioOptions;
 use bt_serve::{Limits, Server};
@@ -70,4 +71,17 @@ pub fn living_room(max_order: usize, limits: Limits) -> Server {
     };
     let options = settings.trace_options(dynamic.step(0)).unwrap();
     Server::new(dynamic, options, RadioOptions::default(), limits)
+}
+
+/// Where request `i` of a walk through the living room puts the receiver in the plan (x, y,
+/// metres, the scene's frame).
+pub fn walk_xy(i: usize) -> (f64, f64) {
+    let t = i as f64;
+    (3.0 + 2.0 * (t * 0.37).sin(), 2.2 + 1.5 * (t * 0.23).cos())
+}
+
+/// Request `i` of that walk: the receiver moved to its point, 1.2 m up.
+pub fn move_request(i: usize) -> String {
+    let (x, y) = walk_xy(i);
+    format!("{{\"id\": {i}, \"rx\": [{x}, {y}, 1.2]}}")
 }
