@@ -7,7 +7,7 @@ use crate::{PathReport, RadioOptions, ReportError, Scratch, describe_into, gain,
 use bt_geom::Real;
 use bt_scene::Scene;
 use bt_solve::FoundPath;
-use bt_solve::partner::Partner;
+use bt_solve::partner::{Partner, half_of_work};
 use std::cmp::Ordering;
 
 /// Records a report beyond the current one's keeps for the next (a few times a room's paths):
@@ -227,31 +227,20 @@ fn known(kept: &mut Option<(bt_scene::RadioKey, gain::Known)>, scene: &Scene) ->
 }
 
 /// Where ranked `keys` split into the caller's and the partner's half
-/// ([`Records::report_halves`]): a path's description costs about one unit, and one more for
-/// each interaction (its order, [`key_order`]); the caller takes [`MINE`] of the work, and the
-/// split falls between runs of the same order and length.
+/// ([`Records::report_halves`]): half of the work ([`bt_solve::partner::half_of_work`]), a
+/// path's description costing about one unit and one more for each interaction (its order,
+/// [`key_order`]), moved on to fall between runs of the same order and length. The caller
+/// once took 55 % of the work, to make up for a partner slowed by the allocator; timed per
+/// half over 3,000 serve answers after that was mended, the caller's 55 % took 40-43 µs and
+/// the partner's 45 % 32-34 µs, the same time per percent of the work (docs/performance.md,
+/// session 9).
 fn halfway(keys: &[RankKey]) -> usize {
-    let total: usize = keys.iter().map(|&k| key_order(k) + 1).sum();
-    let mut sum = 0;
-    let mut k = keys
-        .iter()
-        .position(|&k| {
-            sum += key_order(k) + 1;
-            sum as f64 >= MINE * total as f64
-        })
-        .map_or(keys.len(), |i| i + 1);
+    let mut k = half_of_work(keys.len(), |i| key_order(keys[i]) + 1);
     while k > 0 && k < keys.len() && key_run(keys[k]) == key_run(keys[k - 1]) {
         k += 1;
     }
     k
 }
-
-/// The caller's share of a split report's work ([`halfway`]): half. Both halves describe and
-/// write a path equally fast since the partner's buffers are the serving thread's: timed per
-/// half over 3,000 serve answers at 0.55, the caller took 40-43 µs and the partner 32-34 µs,
-/// the same time per percent of the work, so the answer waited on the caller. The earlier
-/// 0.55 made up for a partner slowed by the allocator (docs/performance.md, session 9).
-const MINE: f64 = 0.5;
 
 /// Describe the paths of `keys` (ranked, [`RankKey`]) into `records`, one each, in order.
 fn describe_ranked(

@@ -128,21 +128,12 @@ where
         .collect()
 }
 
-/// Where the candidates of `todo` (`total` of them) split into a batch's two halves: the
-/// first position where the work before it, a candidate costing its order plus one (its
-/// segments to validate), reaches half of the whole (the image method's cost grows with the
-/// order, and a set's candidates come by order, so half the count left the partner the
-/// longer half).
+/// Where the candidates of `todo` (`total` of them) split into a batch's two halves
+/// ([`crate::partner::half_of_work`]): a candidate costs its order plus one (its segments to
+/// validate); the image method's cost grows with the order, and a set's candidates come by
+/// order, so half the count left the partner the longer half.
 fn balanced_half(candidates: &CandidateSet, todo: Todo<'_>, total: usize) -> usize {
-    let weight = |k: usize| candidates.get(todo.index(k)).len() + 1;
-    let whole: usize = (0..total).map(weight).sum();
-    let mut sum = 0;
-    (0..total)
-        .position(|k| {
-            sum += weight(k);
-            2 * sum >= whole
-        })
-        .map_or(total / 2, |k| k + 1)
+    crate::partner::half_of_work(total, |k| candidates.get(todo.index(k)).len() + 1)
 }
 
 /// What every chunk of a batch shares.

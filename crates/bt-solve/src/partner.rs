@@ -194,6 +194,23 @@ impl Drop for Partner {
     }
 }
 
+/// Where `n` pieces of work split into a [`Partner::join`]'s two halves: the first count `k`
+/// of pieces whose work (`weight(i)` each, in any unit) reaches half of the whole: the
+/// caller's half `0..k` holds at least half, and less than half without its last piece; 0
+/// when `n` is 0. Both
+/// threads work at the same rate once the halves' buffers are the caller's (timed for the
+/// serve report's halves: docs/performance.md, session 9).
+pub fn half_of_work(n: usize, weight: impl Fn(usize) -> usize) -> usize {
+    let whole: usize = (0..n).map(&weight).sum();
+    let mut sum = 0;
+    (0..n)
+        .position(|i| {
+            sum += weight(i);
+            2 * sum >= whole
+        })
+        .map_or(n, |i| i + 1)
+}
+
 /// The partner: take each half on offer and run it; spin for the window after the last one,
 /// then park until an offer wakes it.
 fn partner_loop(shared: &Shared) {
@@ -232,6 +249,18 @@ fn partner_loop(shared: &Shared) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn half_of_work_is_where_the_work_before_reaches_half() {
+        let split = |w: &[usize]| half_of_work(w.len(), |i| w[i]);
+        assert_eq!(split(&[]), 0);
+        assert_eq!(split(&[1, 1, 1, 1]), 2);
+        assert_eq!(split(&[1, 1, 1, 1, 1]), 3);
+        assert_eq!(split(&[3, 1, 1, 1]), 1);
+        assert_eq!(split(&[1, 2, 3, 4]), 3);
+        // A piece heavier than all the others: the caller takes it and everything before.
+        assert_eq!(split(&[1, 1, 1, 5]), 4);
+    }
 
     /// Both halves run, each exactly once, whether the partner takes the second or not, and
     /// the second sees and fills borrowed memory.
