@@ -78,8 +78,12 @@ def main():
         parser.error("--moves must be at least 1 and --period-us at least 0")
     command = [args.binary, "serve", "builtin:living-room", "--max-order", str(args.max_order),
                *args.serve_args]
-    server = subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
-                              bufsize=1 << 20)
+    try:
+        server = subprocess.Popen(command, stdin=subprocess.PIPE, stdout=subprocess.PIPE,
+                                  bufsize=1 << 20)
+    except OSError as e:
+        sys.exit(f"--binary {args.binary}: cannot start it ({e.strerror}); "
+                 "build it with `cargo build --release -p beamtrace`")
     period = args.period_us * 1e-6
     latencies, errors = [], 0
     next_start = time.perf_counter()
