@@ -87,7 +87,7 @@ pub struct Direction {
 impl Direction {
     /// Direction of the (non-zero) vector `v`.
     pub fn of(v: Vec3) -> Self {
-        let h = v.x.hypot(v.y);
+        let h = bt_geom::real::hypot(v.x, v.y);
         let azimuth = if h == 0.0 {
             0.0
         } else {

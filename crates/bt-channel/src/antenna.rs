@@ -4,6 +4,7 @@
 //! 2 and 3GPP TR 38.901 §7.3.2 model 2), rotated into the world frame. `docs/channel.md`.
 
 use crate::ChannelError;
+use bt_geom::real::hypot;
 use bt_geom::{Real, Vec3};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::FRAC_PI_4;
@@ -160,12 +161,12 @@ fn basis_of(st: Real, ct: Real, sp: Real, cp: Real) -> (Vec3, Vec3) {
 /// cos θ = z/|v|, (cos φ, sin φ) = (x, y)/ρ with ρ = √(x² + y²). On the z axis, where φ is
 /// undefined, the basis of [`spherical`]'s φ (atan2 of the signed zeros).
 fn basis_towards(v: Vec3) -> (Vec3, Vec3) {
-    let rho = v.x.hypot(v.y);
+    let rho = hypot(v.x, v.y);
     if rho == 0.0 {
         let (theta, phi) = spherical(v.normalize_or_zero());
         return spherical_basis(theta, phi);
     }
-    let length = rho.hypot(v.z);
+    let length = hypot(rho, v.z);
     basis_of(rho / length, v.z / length, v.y / rho, v.x / rho)
 }
 

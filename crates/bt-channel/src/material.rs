@@ -392,7 +392,7 @@ impl RadioMaterial {
     /// infinite when nothing reflects.
     pub fn normal_loss_db(&self, frequency_hz: Real) -> Result<Real, ChannelError> {
         let r = self.reflection(frequency_hz, 1.0)?;
-        Ok(-20.0 * r.te.norm().log10())
+        Ok(-20.0 * modulus(r.te).log10())
     }
 }
 
@@ -418,7 +418,7 @@ fn transmitted_cos(eta: Complex64, cos: Real) -> Complex64 {
 /// the larger part and Im z/(2t) the other, so neither cancels. `Complex64::sqrt` goes
 /// through polar form (an `atan2` and a `sincos` more).
 fn principal_sqrt(z: Complex64) -> Complex64 {
-    let m = z.norm();
+    let m = modulus(z);
     if m == 0.0 {
         return Complex64::new(0.0, z.im);
     }
@@ -428,6 +428,12 @@ fn principal_sqrt(z: Complex64) -> Complex64 {
         true => Complex64::new(t, z.im.signum() * other),
         false => Complex64::new(other, t.copysign(z.im)),
     }
+}
+
+/// |z|, with [`bt_geom::real::hypot`] (`Complex64::norm` calls the C library's).
+#[inline(always)]
+fn modulus(z: Complex64) -> Real {
+    bt_geom::real::hypot(z.re, z.im)
 }
 
 /// Whether `den` is too small to divide by: |den| ≤ [`tol::COEFFICIENT_DENOMINATOR`], compared

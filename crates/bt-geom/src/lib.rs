@@ -11,6 +11,7 @@ pub mod hash;
 pub mod plane;
 pub mod poly2;
 pub mod polygon;
+pub mod real;
 pub mod tol;
 
 #[cfg(test)]

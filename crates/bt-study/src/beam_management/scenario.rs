@@ -72,7 +72,7 @@ fn facing(from: Vec3, to: Vec3) -> Orientation {
     let d = to - from;
     let yaw = d.y.atan2(d.x);
     // Orientation's pitch tilts boresight down for positive angles.
-    let pitch = (-d.z).atan2(d.x.hypot(d.y));
+    let pitch = (-d.z).atan2(bt_geom::real::hypot(d.x, d.y));
     Orientation {
         yaw,
         pitch,

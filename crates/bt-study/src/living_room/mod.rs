@@ -282,7 +282,7 @@ fn angles(d: &Directions) -> RayAngles {
     let az_el = |v: Vec3| {
         (
             v.y.atan2(v.x).to_degrees(),
-            v.z.atan2(v.x.hypot(v.y)).to_degrees(),
+            v.z.atan2(bt_geom::real::hypot(v.x, v.y)).to_degrees(),
         )
     };
     let (tx_az, tx_el) = az_el(d.departure);
