@@ -7,44 +7,19 @@ in turn. Prints the best and the median of each build per city and the ratio of 
 
     python3 tools/ab_cities.py OLD_BINARY NEW_BINARY [--rounds 7] [--scene munich ...]
 
-The cities are Sionna RT's Munich, Etoile and Florence from testdata/scenes/sionna-rt, and its
-San Francisco from an installed `sionna-rt` wheel when one is found (`--sionna-scenes DIR`),
-with the terminals of issue 29 (`--max-order 3 --frequency 3.5e9 --json`, output discarded).
+The cities are `cities.CASES` (those of `city_speed.py`): Munich, Florence and Etoile from
+testdata/scenes/sionna-rt, and San Francisco when an installed sionna-rt wheel has it (run with
+that venv's Python), traced as `city_speed.py` traces them (output discarded).
 """
 
 import argparse
-import glob
 import os
 import statistics
 import subprocess
 import sys
 import time
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-TESTDATA = os.path.join(ROOT, "testdata", "scenes", "sionna-rt")
-CITIES = {
-    "etoile": ("{t}/etoile/etoile.xml", "0,0,30", "20,5,1.5"),
-    "munich": ("{t}/munich/munich.xml", "8.5,21,27", "45,90,1.5"),
-    "florence": ("{t}/florence/florence.xml", "5,-55,60", "0,-150,1.5"),
-    "san_francisco": (
-        "{s}/san_francisco/san_francisco.xml",
-        "185.4021453857422,-86.6235580444336,45.3857421875",
-        "-12.491729736328125,41.86780548095703,14.31640625",
-    ),
-}
-
-
-def sionna_scenes():
-    """The scenes folder of an installed sionna-rt wheel, or None."""
-    found = glob.glob("/work/sionna-venv/lib/python3*/site-packages/sionna/rt/scenes")
-    return found[0] if found else None
-
-
-def command(binary, city, sionna):
-    path, tx, rx = CITIES[city]
-    scene = path.format(t=TESTDATA, s=sionna or "")
-    return [binary, "trace", scene, "--tx", tx, "--rx", rx, "--max-order", "3",
-            "--frequency", "3.5e9", "--json"]
+from cities import CASES, find_xml, trace_command
 
 
 def run(cmd):
@@ -63,10 +38,8 @@ def main(argv=None):
     ap.add_argument("old", help="the first build's beamtrace binary")
     ap.add_argument("new", help="the second build's beamtrace binary")
     ap.add_argument("--rounds", type=int, default=7, help="alternating rounds (default 7)")
-    ap.add_argument("--scene", action="append", choices=sorted(CITIES),
-                    help="a city to run (repeatable; default: all found)")
-    ap.add_argument("--sionna-scenes", default=sionna_scenes(),
-                    help="sionna-rt's scenes folder, for San Francisco")
+    ap.add_argument("--scene", action="append", choices=[c[0] for c in CASES],
+                    help="a city to run (repeatable; default: every one whose scene is found)")
     args = ap.parse_args(argv)
     for binary in (args.old, args.new):
         if not os.access(binary, os.X_OK):
@@ -74,18 +47,23 @@ def main(argv=None):
                      "`cargo build --release -p beamtrace`)")
     if args.rounds < 1:
         sys.exit("--rounds: at least 1")
-    cities = args.scene or [c for c in CITIES if c != "san_francisco" or args.sionna_scenes]
-    if "san_francisco" in cities and not args.sionna_scenes:
-        sys.exit("san_francisco needs --sionna-scenes (pip install sionna-rt in a venv)")
-    times = {(b, c): [] for b in (args.old, args.new) for c in cities}
+    wanted = args.scene or [c[0] for c in CASES]
+    cases = [(name, find_xml(name), tx, rx) for name, tx, rx in CASES if name in wanted]
+    for name, xml, _, _ in cases:
+        if xml is None and args.scene:
+            sys.exit(f"{name}: scene not found (San Francisco needs an installed sionna-rt: "
+                     "run this script with that venv's Python)")
+    cases = [c for c in cases if c[1] is not None]
+    names = [c[0] for c in cases]
+    times = {(b, c): [] for b in (args.old, args.new) for c in names}
     for r in range(args.rounds):
-        for city in cities:
+        for city, xml, tx, rx in cases:
             for binary in (args.old, args.new):
-                times[(binary, city)].append(run(command(binary, city, args.sionna_scenes)))
+                times[(binary, city)].append(run(trace_command(binary, xml, tx, rx)))
         print(f"round {r + 1}/{args.rounds} done", file=sys.stderr, flush=True)
     print("| city | old, best (median) | new, best (median) | new / old, best |")
     print("|---|---:|---:|---:|")
-    for city in cities:
+    for city in names:
         old, new = times[(args.old, city)], times[(args.new, city)]
         print(f"| {city} | {min(old) * 1e3:.1f} ms ({statistics.median(old) * 1e3:.1f}) "
               f"| {min(new) * 1e3:.1f} ms ({statistics.median(new) * 1e3:.1f}) "

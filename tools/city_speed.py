@@ -43,35 +43,21 @@ from pathlib import Path
 # The reference script's paths, its DRJIT_LIBLLVM_PATH setting, seed and Sionna importer.
 import sionna_reference as ref  # noqa: E402
 
-REPO = ref.REPO
-SCENES = ref.SCENES
-# (scene, TX, RX) in the scene's frame, metres: a roof or mast TX and a street receiver.
-CASES = [
-    ("munich", (8.5, 21.0, 27.0), (45.0, 90.0, 1.5)),
-    ("florence", (5.0, -55.0, 60.0), (0.0, -150.0, 1.5)),
-    ("etoile", (0.0, 0.0, 30.0), (20.0, 5.0, 1.5)),
-    # Not committed to testdata/: taken from the installed sionna-rt wheel (an unseen city).
-    ("san_francisco", (185.4021453857422, -86.6235580444336, 45.3857421875),
-     (-12.491729736328125, 41.86780548095703, 14.31640625)),
-]
-FREQUENCY_HZ = 3.5e9
+from cities import (  # noqa: E402
+    CASES, FREQUENCY_HZ, MAX_DEPTH, REPO, SCENES, find_xml, trace_command,
+)
+
 SAMPLES = 10**6
-MAX_DEPTH = 3
 # Seconds of rest before a scene's beamtrace runs, for Sionna's threads to go idle.
 SETTLE_S = 2.0
 
 
 def scene_xml(name):
-    """The scene's XML: the committed copy, else the one shipped in the sionna-rt wheel."""
-    xml = SCENES / name / f"{name}.xml"
-    if xml.is_file():
-        return xml
-    import importlib.util
-
-    spec = importlib.util.find_spec("sionna.rt.scenes")
-    if spec is None or not spec.submodule_search_locations:
+    """The scene's XML (``cities.find_xml``), or exit naming where it was looked for."""
+    xml = find_xml(name)
+    if xml is None:
         sys.exit(f"scene {name}: not in {SCENES} and sionna-rt is not installed")
-    return Path(list(spec.submodule_search_locations)[0]) / name / f"{name}.xml"
+    return xml
 
 
 def sionna_setup(name, tx, rx):
@@ -117,12 +103,7 @@ def timed(f):
 
 def beamtrace_call(binary, name, tx, rx):
     """One whole ``beamtrace trace`` process; its path records' count."""
-    xml = scene_xml(name)
-    args = [
-        str(binary), "trace", str(xml),
-        "--tx=" + ",".join(map(repr, tx)), "--rx=" + ",".join(map(repr, rx)),
-        "--max-order", str(MAX_DEPTH), "--frequency", repr(FREQUENCY_HZ), "--json",
-    ]
+    args = trace_command(binary, scene_xml(name), tx, rx)
     done = subprocess.run(args, capture_output=True, check=False)
     if done.returncode != 0:
         sys.exit(f"{' '.join(args)} failed: {done.stderr.decode(errors='replace')}")
