@@ -99,7 +99,7 @@ impl Bvh {
         let mut nodes = Vec::with_capacity(2 * items.len().max(1));
         if !items.is_empty() {
             let centres: Vec<Vec3> = boxes.iter().map(|(lo, hi)| *lo + *hi).collect();
-            let boxes = Built {
+            let built = Built {
                 boxes: &boxes,
                 centres: &centres,
                 leaf_size: if items.len() > SCAN_UP_TO {
@@ -108,7 +108,7 @@ impl Bvh {
                     LEAF_SIZE
                 },
             };
-            build_node(&boxes, &mut order, 0, items.len(), &mut nodes);
+            build_node(&built, &mut order, 0, items.len(), &mut nodes);
         }
         // Padded to whole groups (the padding's bits are masked off in `scan`).
         let scan = (boxes.len() <= SCAN_UP_TO).then(|| {
@@ -621,7 +621,7 @@ mod tests {
 
     proptest::proptest! {
         /// Whatever the split (surface-area heuristic, or the median where centres coincide),
-        /// every item is in exactly one leaf, every node's box holds its items' boxes, and a
+        /// every item is in exactly one leaf, every leaf's box holds its items' boxes, and a
         /// box query offers every item a test of every box finds (and others of the same
         /// leaves, which the callers' exact tests then refuse).
         #[test]

@@ -197,9 +197,8 @@ impl Drop for Partner {
 /// Where `n` pieces of work split into a [`Partner::join`]'s two halves: the first count `k`
 /// of pieces whose work (`weight(i)` each, in any unit) reaches half of the whole: the
 /// caller's half `0..k` holds at least half, and less than half without its last piece; 0
-/// when `n` is 0. Both
-/// threads work at the same rate once the halves' buffers are the caller's (timed for the
-/// serve report's halves: docs/performance.md, session 9).
+/// when `n` is 0. Both threads work at the same rate once the halves' buffers are the
+/// caller's (timed for the serve report's halves: docs/performance.md, session 9).
 pub fn half_of_work(n: usize, weight: impl Fn(usize) -> usize) -> usize {
     let whole: usize = (0..n).map(&weight).sum();
     let mut sum = 0;
