@@ -87,7 +87,8 @@ pub struct Direction {
 impl Direction {
     /// Direction of the (non-zero) vector `v`.
     pub fn of(v: Vec3) -> Self {
-        let h = bt_geom::real::hypot(v.x, v.y);
+        // The elevation's `atan2` waits for it.
+        let h = bt_geom::real::root_sum_squares(v.x, v.y);
         let azimuth = if h == 0.0 {
             0.0
         } else {

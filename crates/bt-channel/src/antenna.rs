@@ -4,7 +4,6 @@
 //! 2 and 3GPP TR 38.901 §7.3.2 model 2), rotated into the world frame. `docs/channel.md`.
 
 use crate::ChannelError;
-use bt_geom::real::hypot;
 use bt_geom::{Real, Vec3};
 use serde::{Deserialize, Serialize};
 use std::f64::consts::FRAC_PI_4;
@@ -157,16 +156,20 @@ fn basis_of(st: Real, ct: Real, sp: Real, cp: Real) -> (Vec3, Vec3) {
     (Vec3::new(ct * cp, ct * sp, -st), Vec3::new(-sp, cp, 0.0))
 }
 
-/// θ̂ and φ̂ towards the direction `v` (any length), without trigonometry: sin θ = ρ/|v|,
-/// cos θ = z/|v|, (cos φ, sin φ) = (x, y)/ρ with ρ = √(x² + y²). On the z axis, where φ is
-/// undefined, the basis of [`spherical`]'s φ (atan2 of the signed zeros).
+/// θ̂ and φ̂ towards the direction `v` (a unit vector, or near one), without trigonometry:
+/// sin θ = ρ/|v|, cos θ = z/|v|, (cos φ, sin φ) = (x, y)/ρ with ρ = √(x² + y²). The two roots
+/// are taken side by side from the squares, not one from the other as `hypot` would: on a
+/// path's gain they were a chain of two roots and five divisions that the CPU waited for
+/// (docs/performance.md); for a unit vector the squares neither overflow nor lose precision.
+/// Within 1.5e-154 of the z axis (ρ² below the normal range) and on it, where φ is
+/// undefined, the basis of [`spherical`]'s angles (atan2 of the components).
 fn basis_towards(v: Vec3) -> (Vec3, Vec3) {
-    let rho = hypot(v.x, v.y);
-    if rho == 0.0 {
+    let rho2 = v.x * v.x + v.y * v.y;
+    if rho2 < Real::MIN_POSITIVE {
         let (theta, phi) = spherical(v.normalize_or_zero());
         return spherical_basis(theta, phi);
     }
-    let length = hypot(rho, v.z);
+    let (rho, length) = (rho2.sqrt(), (rho2 + v.z * v.z).sqrt());
     basis_of(rho / length, v.z / length, v.y / rho, v.x / rho)
 }
 

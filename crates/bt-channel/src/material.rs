@@ -418,7 +418,8 @@ fn transmitted_cos(eta: Complex64, cos: Real) -> Complex64 {
 /// the larger part and Im z/(2t) the other, so neither cancels. `Complex64::sqrt` goes
 /// through polar form (an `atan2` and a `sincos` more).
 fn principal_sqrt(z: Complex64) -> Complex64 {
-    let m = modulus(z);
+    // On every reflection's chain of roots and divisions (docs/performance.md).
+    let m = bt_geom::real::root_sum_squares(z.re, z.im);
     if m == 0.0 {
         return Complex64::new(0.0, z.im);
     }
