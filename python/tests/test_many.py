@@ -50,6 +50,25 @@ def test_trace_many_single_thread_is_identical():
         assert_equal(x, y)
 
 
+@pytest.mark.parametrize("enabled", [True, False])
+def test_trace_many_leaves_the_garbage_collector_as_it_found_it(enabled):
+    # trace_many pauses the cyclic collector while it builds its result.
+    import gc
+
+    scene = beamtrace.load("builtin:living-room")
+    was = gc.isenabled()
+    try:
+        (gc.enable if enabled else gc.disable)()
+        many = scene.trace_many(scene.tx, receivers(), max_order=1)
+        assert len(many) == len(receivers())
+        assert gc.isenabled() == enabled
+        with pytest.raises(ValueError):
+            scene.trace_many(scene.tx, np.zeros((2, 2)), max_order=1)
+        assert gc.isenabled() == enabled
+    finally:
+        (gc.enable if was else gc.disable)()
+
+
 def test_trace_many_accepts_no_receivers():
     scene = beamtrace.load("builtin:living-room")
     assert scene.trace_many(None, np.zeros((0, 3))) == []
