@@ -21,6 +21,7 @@ use crate::run::{
 };
 use crate::{StudyConfig, StudyError, StudySolver};
 use bt_accel as fpga;
+use bt_beams::Direction;
 use bt_geom::{Real, Vec3};
 use bt_hls::{CLOCK_HZ, PlanOptions, ScheduleKind};
 use bt_scene::dynamic::DynamicScene;
@@ -278,20 +279,15 @@ pub fn drawn_steps(steps: usize) -> Vec<usize> {
     }
 }
 
+/// The departure's and arrival's azimuth and elevation, as every report gives them
+/// ([`bt_beams::Direction::of`]).
 fn angles(d: &Directions) -> RayAngles {
-    let az_el = |v: Vec3| {
-        (
-            v.y.atan2(v.x).to_degrees(),
-            v.z.atan2(bt_geom::real::hypot(v.x, v.y)).to_degrees(),
-        )
-    };
-    let (tx_az, tx_el) = az_el(d.departure);
-    let (rx_az, rx_el) = az_el(d.arrival);
+    let (tx, rx) = (Direction::of(d.departure), Direction::of(d.arrival));
     RayAngles {
-        tx_azimuth_deg: tx_az,
-        tx_elevation_deg: tx_el,
-        rx_azimuth_deg: rx_az,
-        rx_elevation_deg: rx_el,
+        tx_azimuth_deg: tx.azimuth,
+        tx_elevation_deg: tx.elevation,
+        rx_azimuth_deg: rx.azimuth,
+        rx_elevation_deg: rx.elevation,
     }
 }
 
