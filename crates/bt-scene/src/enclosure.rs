@@ -16,7 +16,12 @@ use bt_geom::{Real, Vec3};
 pub(crate) fn closed_shells(surfaces: &[Surface]) -> Vec<Vec<SurfaceId>> {
     // Each distinct point (exact coordinates, -0.0 as +0.0) numbered as first met; keyed by
     // a tuple, hashed as three integers (an array is hashed byte by byte).
+    // Sized once for every corner (distinct points are fewer): grown by doubling, the map
+    // and the edges touched fresh memory at each step (a city's load paid ~15 % of its page
+    // faults here, docs/performance.md).
+    let corners: usize = surfaces.iter().map(|s| s.polygon.vertices().len()).sum();
     let mut ids: KeyMap<(u64, u64, u64), u32> = KeyMap::default();
+    ids.reserve(corners);
     let mut id = |p: Vec3| {
         let next = ids.len() as u32;
         let [x, y, z] = (p + Vec3::ZERO).to_array().map(Real::to_bits);
@@ -25,7 +30,7 @@ pub(crate) fn closed_shells(surfaces: &[Surface]) -> Vec<Vec<SurfaceId>> {
     // Every edge as (its ends' numbers in order, its surface), sorted: the owners of one edge
     // are then neighbours, in surface order (a sort, not a map: a city has 100,000 edges). The
     // edges' order between them does not matter: what follows groups and counts owners.
-    let mut edges: Vec<(u64, u32)> = Vec::new();
+    let mut edges: Vec<(u64, u32)> = Vec::with_capacity(corners);
     for (i, s) in surfaces.iter().enumerate() {
         let v = s.polygon.vertices();
         for k in 0..v.len() {
