@@ -26,7 +26,7 @@ use bt_beams::PathReport;
 use numpy::ndarray::Array2;
 use numpy::{Complex64, IntoPyArray, PyArray1};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList};
+use pyo3::types::{PyDict, PyList, PyString};
 use std::sync::OnceLock;
 
 /// How the values of one field become a column.
@@ -141,7 +141,11 @@ pub fn names() -> PyResult<Vec<&'static str>> {
 
 /// The paths as a dictionary of column name → NumPy array (or list of arrays / of names).
 pub fn to_dict<'py>(py: Python<'py>, paths: &[PathReport]) -> PyResult<Bound<'py, PyDict>> {
-    dict_of(py, present(paths).map_err(crate::error)?)
+    dict_of(
+        py,
+        present(paths).map_err(crate::error)?,
+        &mut Texts::default(),
+    )
 }
 
 /// The columns of some paths before they become arrays ([`cells_of`]): plain Rust values, made
@@ -153,19 +157,43 @@ pub fn cells_of(paths: &[PathReport]) -> Result<Cells, String> {
     present(paths).map(Cells)
 }
 
-/// The dictionary of column name → array of [`Cells`] (the GIL's part of [`to_dict`]).
-pub fn cells_dict<'py>(py: Python<'py>, cells: Cells) -> PyResult<Bound<'py, PyDict>> {
-    dict_of(py, cells.0)
+/// The dictionary of column name → array of [`Cells`] (the GIL's part of [`to_dict`]), its
+/// names and kinds taken from `texts` (one cache for the dictionaries of one call).
+pub fn cells_dict<'py>(
+    py: Python<'py>,
+    cells: Cells,
+    texts: &mut Texts<'py>,
+) -> PyResult<Bound<'py, PyDict>> {
+    dict_of(py, cells.0, texts)
+}
+
+/// The Python strings made for the text columns (surface names, interaction kinds), by text:
+/// a receiver's paths name the same few surfaces and kinds hundreds of times, and each
+/// string is made once per call and shared (strings are immutable, so sharing is invisible).
+#[derive(Default)]
+pub struct Texts<'py>(std::collections::HashMap<String, Bound<'py, PyString>>);
+
+impl<'py> Texts<'py> {
+    /// The string `text`, made on first use.
+    fn get(&mut self, py: Python<'py>, text: &str) -> Bound<'py, PyString> {
+        if let Some(made) = self.0.get(text) {
+            return made.clone();
+        }
+        let made = PyString::new(py, text);
+        self.0.insert(text.to_owned(), made.clone());
+        made
+    }
 }
 
 /// The dictionary of column name → array of each column's values.
 fn dict_of<'py>(
     py: Python<'py>,
     columns: Vec<(Column, Vec<Value>)>,
+    texts: &mut Texts<'py>,
 ) -> PyResult<Bound<'py, PyDict>> {
     let dict = PyDict::new(py);
     for (column, cells) in columns {
-        let value = column_value(py, column.shape, &cells).ok_or_else(|| {
+        let value = column_value(py, column.shape, &cells, texts).ok_or_else(|| {
             let name = column.name;
             crate::error(format!(
                 "a path's {name} differs in shape from the example's"
@@ -209,6 +237,7 @@ fn column_value<'py>(
     py: Python<'py>,
     shape: Shape,
     cells: &[Value],
+    texts: &mut Texts<'py>,
 ) -> Option<PyResult<Bound<'py, PyAny>>> {
     Some(Ok(match shape {
         Shape::Int => PyArray1::from_vec(py, collect(cells, int)?).into_any(),
@@ -216,8 +245,19 @@ fn column_value<'py>(
         Shape::Complex => PyArray1::from_vec(py, collect(cells, complex)?).into_any(),
         Shape::Row(width) => rows(cells, width)?.into_pyarray(py).into_any(),
         Shape::Texts => {
-            let texts = collect(cells, |v| collect(items(v)?, text))?;
-            return Some(PyList::new(py, texts).map(Bound::into_any));
+            let mut lists = Vec::with_capacity(cells.len());
+            for cell in cells {
+                let strings: Option<Vec<_>> = (items(cell)?.iter())
+                    .map(|t| Some(texts.get(py, text(t)?)))
+                    .collect();
+                lists.push(PyList::new(py, strings?));
+            }
+            let lists = lists.into_iter().collect::<PyResult<Vec<_>>>();
+            return Some(
+                lists
+                    .and_then(|lists| PyList::new(py, lists))
+                    .map(Bound::into_any),
+            );
         }
         Shape::Reals => {
             let arrays = collect(cells, |v| collect(items(v)?, real))?;
@@ -260,9 +300,9 @@ fn complex(value: &Value) -> Option<Complex64> {
     }
 }
 
-fn text(value: &Value) -> Option<String> {
+fn text(value: &Value) -> Option<&str> {
     match value {
-        Value::Text(s) => Some(s.clone()),
+        Value::Text(s) => Some(s),
         _ => None,
     }
 }

@@ -308,10 +308,11 @@ impl PyScene {
         // Thousands of new lists and arrays: without the pause, Python's cyclic collector
         // ran again and again over the growing result (a third of the call's time).
         let _paused = GcPause::new(py)?;
+        let mut texts = columns::Texts::default();
         let dicts = reports
             .into_iter()
             .map(|cells| match cells {
-                Some(cells) => Ok(Some(columns::cells_dict(py, cells)?)),
+                Some(cells) => Ok(Some(columns::cells_dict(py, cells, &mut texts)?)),
                 None => Ok(None),
             })
             .collect::<PyResult<Vec<_>>>()?;
