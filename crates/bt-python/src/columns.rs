@@ -24,7 +24,7 @@
 use crate::record::{Value, to_value};
 use bt_beams::PathReport;
 use numpy::ndarray::Array2;
-use numpy::{Complex64, IntoPyArray, PyArray1};
+use numpy::{Complex64, IntoPyArray, PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString};
 use std::sync::OnceLock;
@@ -261,12 +261,14 @@ fn column_value<'py>(
         }
         Shape::Reals => {
             let arrays = collect(cells, |v| collect(items(v)?, real))?;
-            let arrays = arrays.into_iter().map(|a| PyArray1::from_vec(py, a));
+            // Copied into arrays NumPy allocates: one object each, where an array over a
+            // Rust vector is two (the array and the owner of its memory).
+            let arrays = arrays.iter().map(|a| PyArray1::from_slice(py, a));
             return Some(PyList::new(py, arrays).map(Bound::into_any));
         }
         Shape::Rows(width) => {
             let arrays = collect(cells, |v| rows(items(v)?, width))?;
-            let arrays = arrays.into_iter().map(|a| a.into_pyarray(py));
+            let arrays = arrays.iter().map(|a| PyArray2::from_array(py, a));
             return Some(PyList::new(py, arrays).map(Bound::into_any));
         }
     }))
