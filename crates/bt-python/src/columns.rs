@@ -24,7 +24,7 @@
 use crate::record::{Value, to_value};
 use bt_beams::PathReport;
 use numpy::ndarray::Array2;
-use numpy::{Complex64, IntoPyArray, PyArray1, PyArray2};
+use numpy::{Complex64, PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString};
 use std::sync::OnceLock;
@@ -240,10 +240,12 @@ fn column_value<'py>(
     texts: &mut Texts<'py>,
 ) -> Option<PyResult<Bound<'py, PyAny>>> {
     Some(Ok(match shape {
-        Shape::Int => PyArray1::from_vec(py, collect(cells, int)?).into_any(),
-        Shape::Real => PyArray1::from_vec(py, collect(cells, real)?).into_any(),
-        Shape::Complex => PyArray1::from_vec(py, collect(cells, complex)?).into_any(),
-        Shape::Row(width) => rows(cells, width)?.into_pyarray(py).into_any(),
+        // Every array is copied into memory NumPy allocates: one Python object, where an
+        // array over a Rust vector is two (the array and the owner of its memory).
+        Shape::Int => PyArray1::from_slice(py, &collect(cells, int)?).into_any(),
+        Shape::Real => PyArray1::from_slice(py, &collect(cells, real)?).into_any(),
+        Shape::Complex => PyArray1::from_slice(py, &collect(cells, complex)?).into_any(),
+        Shape::Row(width) => PyArray2::from_array(py, &rows(cells, width)?).into_any(),
         Shape::Texts => {
             let mut lists = Vec::with_capacity(cells.len());
             for cell in cells {
