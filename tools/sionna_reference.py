@@ -113,8 +113,9 @@ import sys
 import time
 from pathlib import Path
 
-REPO = Path(__file__).resolve().parents[1]
-SCENES = REPO / "testdata" / "scenes" / "sionna-rt"
+# The repository and Sionna RT's committed scenes, named once for every tool.
+from cities import REPO, SCENES  # noqa: E402
+
 OUT = REPO / "testdata" / "sionna-reference"
 
 _LLVM = "/usr/lib/x86_64-linux-gnu/libLLVM.so.19.1"

@@ -263,8 +263,6 @@ fn column_value<'py>(
         }
         Shape::Reals => {
             let arrays = collect(cells, |v| collect(items(v)?, real))?;
-            // Copied into arrays NumPy allocates: one object each, where an array over a
-            // Rust vector is two (the array and the owner of its memory).
             let arrays = arrays.iter().map(|a| PyArray1::from_slice(py, a));
             return Some(PyList::new(py, arrays).map(Bound::into_any));
         }
