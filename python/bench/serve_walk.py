@@ -9,17 +9,22 @@ import random
 import sys
 
 
-def main() -> None:
-    count = int(sys.argv[1]) if len(sys.argv) > 1 else 10000
+def walk(count: int):
+    """The walk's receivers, [x, y, z] in metres, in order."""
     rng = random.Random(30)
     p = [2.3, 2.1, 0.72]
     bounds = [(0.3, 5.7), (0.3, 4.2), (0.3, 2.4)]
-    out = sys.stdout
-    for i in range(count):
+    for _ in range(count):
         for k, (lo, hi) in enumerate(bounds):
             p[k] = round(min(max(p[k] + rng.uniform(-0.2, 0.2), lo), hi) * 1000) / 1000
-        out.write('{"id": %d, "rx": [%s, %s, %s]}\n' % (i, p[0], p[1], p[2]))
+        yield list(p)
 
+
+def main() -> None:
+    count = int(sys.argv[1]) if len(sys.argv) > 1 else 10000
+    out = sys.stdout
+    for i, p in enumerate(walk(count)):
+        out.write('{"id": %d, "rx": [%s, %s, %s]}\n' % (i, p[0], p[1], p[2]))
 
 if __name__ == "__main__":
     main()

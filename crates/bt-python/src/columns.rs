@@ -22,12 +22,16 @@
 //! `null` field (`gain_db`) is written back as `null` and its column is always there.
 
 use crate::record::{Value, to_value};
+use crate::sink::{Buffer, Fields, Record, Texts};
 use bt_beams::PathReport;
 use numpy::ndarray::Array2;
 use numpy::{Complex64, PyArray1, PyArray2};
 use pyo3::prelude::*;
 use pyo3::types::{PyDict, PyList, PyString};
-use std::sync::OnceLock;
+use rayon::prelude::*;
+use serde::Serialize;
+use std::ops::Range;
+use std::sync::{Mutex, OnceLock, PoisonError};
 
 /// How the values of one field become a column.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -139,199 +143,391 @@ pub fn names() -> PyResult<Vec<&'static str>> {
     Ok(columns.iter().map(|c| c.name).collect())
 }
 
-/// The paths as a dictionary of column name → NumPy array (or list of arrays / of names).
-pub fn to_dict<'py>(py: Python<'py>, paths: &[PathReport]) -> PyResult<Bound<'py, PyDict>> {
-    dict_of(
-        py,
-        present(paths).map_err(crate::error)?,
-        &mut Texts::default(),
-    )
-}
-
-/// The columns of some paths before they become arrays ([`cells_of`]): plain Rust values, made
-/// without the GIL (in parallel, by `trace_many`).
-pub struct Cells(Vec<(Column, Vec<Value>)>);
-
-/// The columns of `paths` as [`Cells`]; the error names a field the example does not write.
-pub fn cells_of(paths: &[PathReport]) -> Result<Cells, String> {
-    present(paths).map(Cells)
-}
-
-/// The dictionary of column name → array of [`Cells`] (the GIL's part of [`to_dict`]), its
-/// names and kinds taken from `texts` (one cache for the dictionaries of one call).
-pub fn cells_dict<'py>(
-    py: Python<'py>,
-    cells: Cells,
-    texts: &mut Texts<'py>,
-) -> PyResult<Bound<'py, PyDict>> {
-    dict_of(py, cells.0, texts)
-}
-
-/// The Python strings made for the text columns (surface names, interaction kinds), by text:
-/// a receiver's paths name the same few surfaces and kinds hundreds of times, and each
-/// string is made once per call and shared (strings are immutable, so sharing is invisible).
-#[derive(Default)]
-pub struct Texts<'py>(std::collections::HashMap<String, Bound<'py, PyString>>);
-
-impl<'py> Texts<'py> {
-    /// The string `text`, made on first use.
-    fn get(&mut self, py: Python<'py>, text: &str) -> Bound<'py, PyString> {
-        if let Some(made) = self.0.get(text) {
-            return made.clone();
-        }
-        let made = PyString::new(py, text);
-        self.0.insert(text.to_owned(), made.clone());
-        made
-    }
-}
-
-/// The dictionary of column name → array of each column's values.
-fn dict_of<'py>(
-    py: Python<'py>,
-    columns: Vec<(Column, Vec<Value>)>,
-    texts: &mut Texts<'py>,
-) -> PyResult<Bound<'py, PyDict>> {
-    let dict = PyDict::new(py);
-    for (column, cells) in columns {
-        let value = column_value(py, column.shape, &cells, texts).ok_or_else(|| {
-            let name = column.name;
-            crate::error(format!(
-                "a path's {name} differs in shape from the example's"
-            ))
-        })??;
-        dict.set_item(column.name, value)?;
-    }
-    Ok(dict)
-}
-
-/// The columns of `paths`, each with one value per path, in order: an optional column when
-/// every path has it and there is a path, the others always.
-fn present(paths: &[PathReport]) -> Result<Vec<(Column, Vec<Value>)>, String> {
-    let columns = table_of_example()?;
-    let mut cells: Vec<Vec<Value>> = vec![Vec::with_capacity(paths.len()); columns.len()];
-    for path in paths {
-        let mut fields = fields_of(path)?.into_iter().peekable();
-        for (column, cells) in columns.iter().zip(&mut cells) {
-            if let Some((_, value)) = fields.next_if(|(name, _)| *name == column.name) {
-                cells.push(value);
-            }
-        }
-        if let Some((name, _)) = fields.next() {
-            return Err(format!(
-                "path field {name} is not written by PathReport::example()"
-            ));
-        }
-    }
+/// The columns whose values are per interaction (aligned with `points`): flat in a
+/// [`Batch`], split at its interaction offsets into one list or array per path.
+pub fn per_interaction() -> PyResult<Vec<&'static str>> {
+    let columns = table_of_example().map_err(crate::error)?;
     Ok(columns
         .iter()
-        .zip(cells)
-        .filter(|(column, cells)| {
-            cells.len() == paths.len() && !(paths.is_empty() && column.optional)
-        })
-        .map(|(column, cells)| (*column, cells))
+        .filter(|c| c.shape.ragged())
+        .map(|c| c.name)
         .collect())
 }
 
-/// One column's array (or list); `None` when a value does not have the column's shape.
-fn column_value<'py>(
-    py: Python<'py>,
-    shape: Shape,
-    cells: &[Value],
-    texts: &mut Texts<'py>,
-) -> Option<PyResult<Bound<'py, PyAny>>> {
-    Some(Ok(match shape {
-        // Every array is copied into memory NumPy allocates: one Python object, where an
-        // array over a Rust vector is two (the array and the owner of its memory).
-        Shape::Int => PyArray1::from_slice(py, &collect(cells, int)?).into_any(),
-        Shape::Real => PyArray1::from_slice(py, &collect(cells, real)?).into_any(),
-        Shape::Complex => PyArray1::from_slice(py, &collect(cells, complex)?).into_any(),
-        Shape::Row(width) => PyArray2::from_array(py, &rows(cells, width)?).into_any(),
-        Shape::Texts => {
-            let mut lists = Vec::with_capacity(cells.len());
-            for cell in cells {
-                let strings: Option<Vec<_>> = (items(cell)?.iter())
-                    .map(|t| Some(texts.get(py, text(t)?)))
-                    .collect();
-                lists.push(PyList::new(py, strings?));
+/// The columns the document may leave out (IPC's), present in a [`Batch`] only when every
+/// path has them, and in one receiver's paths only when it has a path.
+pub fn optional() -> PyResult<Vec<&'static str>> {
+    let columns = table_of_example().map_err(crate::error)?;
+    Ok(columns
+        .iter()
+        .filter(|c| c.optional)
+        .map(|c| c.name)
+        .collect())
+}
+
+impl Shape {
+    /// Whether a path has one value per interaction (a list), not one value.
+    fn ragged(self) -> bool {
+        matches!(self, Shape::Texts | Shape::Reals | Shape::Rows(_))
+    }
+
+    /// The leaves (integers, reals, texts) a path's value writes, for `k` interactions.
+    fn leaves(self, k: usize) -> (usize, usize, usize) {
+        match self {
+            Shape::Int => (1, 0, 0),
+            Shape::Real => (0, 1, 0),
+            Shape::Complex => (0, 2, 0),
+            Shape::Row(width) => (0, width, 0),
+            Shape::Texts => (0, 0, k),
+            Shape::Reals => (0, k, 0),
+            Shape::Rows(width) => (0, k * width, 0),
+        }
+    }
+
+    /// The number of interactions a ragged value with these leaves holds (`None`: it is not
+    /// a whole number of this shape's items).
+    fn items(self, (ints, reals, texts): (usize, usize, usize)) -> Option<usize> {
+        let k = match self {
+            Shape::Texts => texts,
+            Shape::Reals => reals,
+            Shape::Rows(width) if reals % width == 0 => reals / width,
+            _ => return None,
+        };
+        (self.leaves(k) == (ints, reals, texts)).then_some(k)
+    }
+}
+
+/// The paths of many receivers as flat columns: every path's fields appended to one buffer
+/// per column, with the paths of each receiver and the interactions of each path as offsets
+/// (one set of arrays for the whole call, as Sionna RT's tensors are indexed by receiver,
+/// instead of a dictionary of arrays per receiver). Filled without the GIL ([`Shards`] fill
+/// one per thread); [`Batch::into_dict`] makes the arrays under it.
+#[derive(Debug)]
+pub struct Batch {
+    columns: &'static [Column],
+    names: Vec<&'static str>,
+    buffers: Vec<Buffer>,
+    /// How many paths wrote each column.
+    written: Vec<usize>,
+    texts: Texts,
+    /// Receiver i's paths are rows `path_offsets[i]..path_offsets[i + 1]`.
+    path_offsets: Vec<i64>,
+    /// Path j's interactions are rows `interaction_offsets[j]..interaction_offsets[j + 1]`
+    /// of the per-interaction columns.
+    interaction_offsets: Vec<i64>,
+    /// Whether each receiver was traced (false: skipped on error, no paths).
+    traced: Vec<bool>,
+    /// Scratch of [`Batch::push_path`]: each column's leaf counts and writers before a record.
+    before: Vec<((usize, usize, usize), usize)>,
+}
+
+impl Batch {
+    /// No receiver yet; the error names a field of the example with no column shape.
+    pub fn new() -> Result<Batch, String> {
+        let columns = table_of_example()?;
+        Ok(Batch {
+            columns,
+            names: columns.iter().map(|c| c.name).collect(),
+            buffers: columns.iter().map(|_| Buffer::default()).collect(),
+            written: vec![0; columns.len()],
+            texts: Texts::default(),
+            path_offsets: vec![0],
+            interaction_offsets: vec![0],
+            traced: Vec::new(),
+            before: Vec::with_capacity(columns.len()),
+        })
+    }
+
+    /// A batch of one receiver with `paths`.
+    pub fn of(paths: &[PathReport]) -> Result<Batch, String> {
+        let mut batch = Batch::new()?;
+        batch.push(paths)?;
+        Ok(batch)
+    }
+
+    fn paths(&self) -> usize {
+        self.interaction_offsets.len() - 1
+    }
+
+    /// Appends a receiver with `paths`; the error names a field whose value does not have its
+    /// column's shape, or a field the example does not write.
+    pub fn push(&mut self, paths: &[PathReport]) -> Result<(), String> {
+        for (column, buffer) in self.columns.iter().zip(&mut self.buffers) {
+            let (ints, reals, texts) = column.shape.leaves(0);
+            buffer.ints.reserve(ints * paths.len());
+            buffer.reals.reserve(reals * paths.len());
+            buffer.texts.reserve(texts * paths.len());
+        }
+        for path in paths {
+            self.push_path(path)?;
+        }
+        self.path_offsets.push(self.paths() as i64);
+        self.traced.push(true);
+        Ok(())
+    }
+
+    /// Appends a receiver that was not traced: no paths.
+    pub fn push_untraced(&mut self) {
+        self.path_offsets.push(self.paths() as i64);
+        self.traced.push(false);
+    }
+
+    fn push_path(&mut self, path: &PathReport) -> Result<(), String> {
+        // Each column's leaves and writers before the record, to check what it added.
+        self.before.clear();
+        (self.before).extend(
+            self.buffers
+                .iter()
+                .zip(&self.written)
+                .map(|(b, &w)| (b.counts(), w)),
+        );
+        let fields = Fields {
+            names: &self.names,
+            buffers: &mut self.buffers,
+            written: &mut self.written,
+            texts: &mut self.texts,
+            next: 0,
+        };
+        path.serialize(Record(fields)).map_err(|e| e.to_string())?;
+        let mut interactions = None;
+        for (c, column) in self.columns.iter().enumerate() {
+            let (b, written) = self.before[c];
+            if self.written[c] == written {
+                continue;
             }
-            let lists = lists.into_iter().collect::<PyResult<Vec<_>>>();
-            return Some(
-                lists
-                    .and_then(|lists| PyList::new(py, lists))
-                    .map(Bound::into_any),
+            let a = self.buffers[c].counts();
+            let delta = (a.0 - b.0, a.1 - b.1, a.2 - b.2);
+            let name = column.name;
+            let k = match column.shape.ragged() {
+                true => column.shape.items(delta),
+                false => (column.shape.leaves(0) == delta).then_some(0),
+            };
+            let Some(k) = k else {
+                return Err(format!(
+                    "a path's {name} differs in shape from the example's"
+                ));
+            };
+            if column.shape.ragged() && *interactions.get_or_insert(k) != k {
+                return Err(format!(
+                    "a path's {name} is not aligned with its other lists"
+                ));
+            }
+        }
+        let end = self.interaction_offsets[self.paths()] + interactions.unwrap_or(0) as i64;
+        self.interaction_offsets.push(end);
+        Ok(())
+    }
+
+    /// Appends a receiver whose paths are `paths` of `shard`.
+    fn append_rows(&mut self, shard: &Batch, paths: Range<usize>) {
+        let at = |j: usize| shard.interaction_offsets[j];
+        let mut end = self.interaction_offsets[self.paths()];
+        for j in paths {
+            end += at(j + 1) - at(j);
+            self.interaction_offsets.push(end);
+        }
+        self.path_offsets.push(self.paths() as i64);
+        self.traced.push(true);
+    }
+
+    /// The dictionary of column name → array: each column present when every path wrote it
+    /// (an optional one also needs a path), flat over all receivers; beside them
+    /// `path_offsets` (m + 1,), `interaction_offsets` (n + 1,), `receiver` (n,) and `traced`
+    /// (m,).
+    pub fn into_dict(self, py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
+        let dict = PyDict::new(py);
+        let n = self.paths();
+        let strings: Vec<_> = (self.texts.list.iter())
+            .map(|t| PyString::new(py, t))
+            .collect();
+        for ((column, buffer), written) in self.columns.iter().zip(self.buffers).zip(self.written) {
+            if written != n || (n == 0 && column.optional) {
+                continue;
+            }
+            dict.set_item(
+                column.name,
+                column_array(py, column.shape, buffer, &strings)?,
+            )?;
+        }
+        let receiver = (self.path_offsets.windows(2).enumerate())
+            .flat_map(|(i, w)| std::iter::repeat_n(i as i64, (w[1] - w[0]) as usize));
+        dict.set_item("receiver", PyArray1::from_iter(py, receiver))?;
+        dict.set_item("path_offsets", PyArray1::from_vec(py, self.path_offsets))?;
+        dict.set_item(
+            "interaction_offsets",
+            PyArray1::from_vec(py, self.interaction_offsets),
+        )?;
+        dict.set_item("traced", PyArray1::from_vec(py, self.traced))?;
+        Ok(dict)
+    }
+}
+
+/// Where a receiver's paths are in the shard that reported them ([`Shards::push`]).
+#[derive(Debug, Clone)]
+pub struct Rows {
+    shard: usize,
+    paths: Range<usize>,
+}
+
+/// One [`Batch`] per thread of a many-receiver call: each task appends its receiver's paths to
+/// its thread's batch (growing, so no allocation per receiver), and [`Shards::gather`] copies
+/// them into one batch in receiver order.
+pub struct Shards(Vec<Mutex<Batch>>);
+
+impl Shards {
+    /// One empty batch per thread of the current rayon pool, and one for other threads.
+    pub fn new() -> Result<Shards, String> {
+        let count = rayon::current_num_threads() + 1;
+        let shards = (0..count).map(|_| Batch::new().map(Mutex::new));
+        Ok(Shards(shards.collect::<Result<_, _>>()?))
+    }
+
+    /// Appends a receiver with `paths` to the calling thread's shard ([`Batch::push`]'s
+    /// errors); where they are.
+    pub fn push(&self, paths: &[PathReport]) -> Result<Rows, String> {
+        let others = self.0.len() - 1;
+        let shard = rayon::current_thread_index().map_or(others, |i| i % others.max(1));
+        let mut batch = self.0[shard].lock().unwrap_or_else(PoisonError::into_inner);
+        let start = batch.paths();
+        batch.push(paths)?;
+        Ok(Rows {
+            shard,
+            paths: start..batch.paths(),
+        })
+    }
+
+    /// The receivers `rows` (`None`: not traced), in order, in one batch. Each column is
+    /// sized once and filled by its own task, on all cores when `parallel`: 1,000 receivers
+    /// of the living room at order 3 make ~14 MB of columns, whose fresh pages fault in as
+    /// they are written.
+    pub fn gather(self, rows: &[Option<Rows>], parallel: bool) -> Result<Batch, String> {
+        let shards: Vec<Batch> = (self.0.into_iter())
+            .map(|m| m.into_inner().unwrap_or_else(PoisonError::into_inner))
+            .collect();
+        let mut all = Batch::new()?;
+        let mut codes = Vec::with_capacity(shards.len());
+        for shard in &shards {
+            let texts = shard.texts.list.iter().map(|text| all.texts.code(text));
+            codes.push(
+                texts
+                    .collect::<Result<Vec<u32>, _>>()
+                    .map_err(|e| e.to_string())?,
             );
         }
-        Shape::Reals => {
-            let arrays = collect(cells, |v| collect(items(v)?, real))?;
-            let arrays = arrays.iter().map(|a| PyArray1::from_slice(py, a));
-            return Some(PyList::new(py, arrays).map(Bound::into_any));
+        for row in rows {
+            match row {
+                Some(row) => all.append_rows(&shards[row.shard], row.paths.clone()),
+                None => all.push_untraced(),
+            }
         }
-        Shape::Rows(width) => {
-            let arrays = collect(cells, |v| rows(items(v)?, width))?;
-            let arrays = arrays.iter().map(|a| PyArray2::from_array(py, a));
-            return Some(PyList::new(py, arrays).map(Bound::into_any));
+        // A column is there when every path wrote it: every path of every shard.
+        let n = all.paths();
+        for (c, written) in all.written.iter_mut().enumerate() {
+            let complete = shards.iter().all(|s| s.written[c] == s.paths());
+            *written = if complete { n } else { 0 };
         }
-    }))
-}
-
-/// `f` of every value, or `None` when one has another shape.
-fn collect<T>(cells: &[Value], f: impl Fn(&Value) -> Option<T>) -> Option<Vec<T>> {
-    cells.iter().map(f).collect()
-}
-
-fn int(value: &Value) -> Option<i64> {
-    match value {
-        Value::Int(i) => Some(*i),
-        _ => None,
-    }
-}
-
-/// A real; `null` (a path carrying no power has no dB) as −inf.
-fn real(value: &Value) -> Option<f64> {
-    match value {
-        Value::Real(x) => Some(*x),
-        Value::Null => Some(f64::NEG_INFINITY),
-        _ => None,
-    }
-}
-
-fn complex(value: &Value) -> Option<Complex64> {
-    match value {
-        Value::Complex(re, im) => Some(Complex64::new(*re, *im)),
-        _ => None,
-    }
-}
-
-fn text(value: &Value) -> Option<&str> {
-    match value {
-        Value::Text(s) => Some(s),
-        _ => None,
-    }
-}
-
-fn items(value: &Value) -> Option<&[Value]> {
-    match value {
-        Value::Seq(items) => Some(items),
-        _ => None,
-    }
-}
-
-/// Rows of `width` reals (each a struct of reals or a list of reals) as an array (k, width).
-fn rows(cells: &[Value], width: usize) -> Option<Array2<f64>> {
-    let mut flat = Vec::with_capacity(cells.len() * width);
-    for cell in cells {
-        let start = flat.len();
-        match cell {
-            Value::Struct(fields) => flat.extend(fields.iter().map(|(_, v)| real(v))),
-            Value::Seq(items) => flat.extend(items.iter().map(real)),
-            _ => return None,
+        let rows: Vec<&Rows> = rows.iter().flatten().collect();
+        let (columns, written) = (all.columns, &all.written);
+        let copy = |(c, buffer): (usize, &mut Buffer)| {
+            if written[c] == n {
+                *buffer = gathered(columns[c].shape, c, &shards, &rows, &codes);
+            }
+        };
+        match parallel {
+            true => all.buffers.par_iter_mut().enumerate().for_each(copy),
+            false => all.buffers.iter_mut().enumerate().for_each(copy),
         }
-        if flat.len() - start != width {
-            return None;
-        }
+        Ok(all)
     }
-    let flat = flat.into_iter().collect::<Option<Vec<f64>>>()?;
-    Array2::from_shape_vec((cells.len(), width), flat).ok()
+}
+
+/// Column `c` (of `shape`) of `rows`, in order, their texts coded as `codes` says for each
+/// shard.
+fn gathered(
+    shape: Shape,
+    c: usize,
+    shards: &[Batch],
+    rows: &[&Rows],
+    codes: &[Vec<u32>],
+) -> Buffer {
+    // The leaves of a path (fixed shapes) or of an interaction (per-interaction columns).
+    let (ints, reals, texts) = shape.leaves(shape.ragged() as usize);
+    let units = |row: &Rows| {
+        let shard = &shards[row.shard];
+        match shape.ragged() {
+            true => {
+                let at = |j: usize| shard.interaction_offsets[j] as usize;
+                at(row.paths.start)..at(row.paths.end)
+            }
+            false => row.paths.clone(),
+        }
+    };
+    let part = |row: &&Rows, width: usize| {
+        let units = units(row);
+        (
+            &shards[row.shard].buffers[c],
+            units.start * width..units.end * width,
+        )
+    };
+    let ints = rows
+        .iter()
+        .map(|row| part(row, ints))
+        .map(|(b, r)| b.ints[r].iter().copied());
+    let reals = rows
+        .iter()
+        .map(|row| part(row, reals))
+        .map(|(b, r)| b.reals[r].iter().copied());
+    let texts = rows.iter().map(|row| {
+        let (buffer, range) = part(row, texts);
+        let codes = &codes[row.shard];
+        buffer.texts[range].iter().map(move |&t| codes[t as usize])
+    });
+    Buffer {
+        ints: joined(ints),
+        reals: joined(reals),
+        texts: joined(texts),
+    }
+}
+
+/// The items of `pieces`, in order, in one vector sized once.
+fn joined<T, I>(pieces: impl Iterator<Item = I> + Clone) -> Vec<T>
+where
+    I: ExactSizeIterator<Item = T>,
+{
+    let mut all = Vec::with_capacity(pieces.clone().map(|p| p.len()).sum());
+    for piece in pieces {
+        all.extend(piece);
+    }
+    all
+}
+
+/// One column's array (a list of shared strings for texts).
+fn column_array<'py>(
+    py: Python<'py>,
+    shape: Shape,
+    buffer: Buffer,
+    strings: &[Bound<'py, PyString>],
+) -> PyResult<Bound<'py, PyAny>> {
+    let rows = |reals: Vec<f64>, width: usize| {
+        let rows = reals.len() / width;
+        let array = Array2::from_shape_vec((rows, width), reals);
+        array.map_err(|e| crate::error(format!("column rows: {e}")))
+    };
+    Ok(match shape {
+        Shape::Int => PyArray1::from_vec(py, buffer.ints).into_any(),
+        Shape::Real | Shape::Reals => PyArray1::from_vec(py, buffer.reals).into_any(),
+        Shape::Complex => {
+            let pairs = buffer.reals.chunks_exact(2);
+            PyArray1::from_iter(py, pairs.map(|p| Complex64::new(p[0], p[1]))).into_any()
+        }
+        Shape::Row(width) | Shape::Rows(width) => {
+            PyArray2::from_owned_array(py, rows(buffer.reals, width)?).into_any()
+        }
+        Shape::Texts => {
+            let items = buffer.texts.iter().map(|&t| strings[t as usize].clone());
+            PyList::new(py, items)?.into_any()
+        }
+    })
 }
 
 #[cfg(test)]
@@ -361,19 +557,30 @@ mod tests {
         assert_eq!(names.len(), example_json().as_object().unwrap().len());
     }
 
+    /// The names of the columns a batch of one receiver with `paths` presents.
+    fn present(paths: &[PathReport]) -> Vec<&'static str> {
+        let batch = Batch::of(paths).unwrap();
+        let n = batch.paths();
+        (batch.columns.iter().zip(&batch.written))
+            .filter(|(c, written)| **written == n && !(n == 0 && c.optional))
+            .map(|(c, _)| c.name)
+            .collect()
+    }
+
     #[test]
     fn no_path_gives_the_columns_every_path_has_empty() {
         let columns = table_of_example().unwrap();
-        let present = present(&[]).unwrap();
-        let always: Vec<Column> = columns.iter().filter(|c| !c.optional).copied().collect();
-        assert_eq!(present.iter().map(|(c, _)| *c).collect::<Vec<_>>(), always);
-        assert!(present.iter().all(|(_, cells)| cells.is_empty()));
+        let always: Vec<&str> = columns
+            .iter()
+            .filter(|c| !c.optional)
+            .map(|c| c.name)
+            .collect();
+        assert_eq!(present(&[]), always);
         // IPC's columns are optional; a field written as null is not.
         assert!(always.len() < columns.len());
         assert!(
-            always
-                .iter()
-                .any(|c| c.shape == Shape::Real && may_read_without(c.name))
+            (columns.iter())
+                .any(|c| !c.optional && c.shape == Shape::Real && may_read_without(c.name))
         );
     }
 
@@ -387,32 +594,73 @@ mod tests {
     fn an_optional_column_needs_every_path() {
         let example = PathReport::example();
         for column in table_of_example().unwrap().iter().filter(|c| c.optional) {
-            let names = |paths: &[PathReport]| -> Vec<&str> {
-                present(paths)
-                    .unwrap()
-                    .iter()
-                    .map(|(c, _)| c.name)
-                    .collect()
-            };
-            assert!(names(std::slice::from_ref(&example)).contains(&column.name));
+            assert!(present(std::slice::from_ref(&example)).contains(&column.name));
             let lacking = without(column.name);
-            assert!(!names(&[example.clone(), lacking.clone()]).contains(&column.name));
-            assert!(!names(&[lacking]).contains(&column.name));
+            assert!(!present(&[example.clone(), lacking.clone()]).contains(&column.name));
+            assert!(!present(&[lacking]).contains(&column.name));
         }
     }
 
-    #[test]
-    fn null_is_minus_infinity_in_real_columns() {
-        assert_eq!(real(&Value::Null), Some(f64::NEG_INFINITY));
-        assert_eq!(int(&Value::Null), None);
+    /// The example with `n` interactions (its first repeated), and `rank`.
+    fn with_interactions(n: usize, rank: usize) -> PathReport {
+        let mut path = PathReport::example();
+        let k = path.points.len();
+        assert!(k > 0);
+        for _ in k..n {
+            path.interactions.push(path.interactions[0]);
+            path.surfaces.push(path.surfaces[0].clone());
+            path.points.push(path.points[0]);
+            path.incidence_deg.push(None);
+        }
+        path.interactions.truncate(n);
+        path.surfaces.truncate(n);
+        path.points.truncate(n);
+        path.incidence_deg.truncate(n);
+        path.order = n;
+        path.rank = rank;
+        path
     }
 
     #[test]
-    fn rows_keep_their_width_when_there_are_none() {
-        let row = |a: f64| Value::Seq(vec![Value::Real(a), Value::Real(a + 1.0)]);
-        let a = rows(&[row(1.0), row(3.0)], 2).unwrap();
-        assert_eq!((a.shape(), a[[1, 0]]), (&[2, 2][..], 3.0));
-        assert_eq!(rows(&[], 3).unwrap().shape(), &[0, 3]);
-        assert!(rows(&[row(1.0)], 3).is_none());
+    fn batches_append_with_offsets_texts_and_nulls() {
+        // Two shards (as two threads fill them), gathered in receiver order.
+        let shards = Shards((0..2).map(|_| Mutex::new(Batch::new().unwrap())).collect());
+        let on = |shard: usize, paths: &[PathReport]| {
+            let mut batch = shards.0[shard].lock().unwrap();
+            let start = batch.paths();
+            batch.push(paths).unwrap();
+            Some(Rows {
+                shard,
+                paths: start..batch.paths(),
+            })
+        };
+        let last = on(1, &[with_interactions(3, 7)]);
+        let first = on(0, &[with_interactions(2, 1), with_interactions(0, 2)]);
+        let batch = shards.gather(&[first, None, last], true).unwrap();
+        assert_eq!(batch.path_offsets, [0, 2, 2, 3]);
+        assert_eq!(batch.interaction_offsets, [0, 2, 2, 5]);
+        assert_eq!(batch.traced, [true, false, true]);
+        assert_eq!(batch.written, vec![3; batch.columns.len()]);
+        let column = |name| {
+            let c = batch.names.iter().position(|n| *n == name).unwrap();
+            (&batch.buffers[c], batch.columns[c].shape)
+        };
+        assert_eq!(column("rank").0.ints, [1, 2, 7]);
+        let (points, shape) = column("points");
+        assert_eq!((points.reals.len(), shape), (5 * 3, Shape::Rows(3)));
+        // The texts of both batches share one table, and null is −inf.
+        let surfaces = &column("surfaces").0.texts;
+        assert_eq!(surfaces.len(), 5);
+        assert!(surfaces.iter().all(|&t| t == surfaces[0]));
+        assert_eq!(batch.texts.list.len(), 1 + 1, "{:?}", batch.texts.list);
+        assert_eq!(column("incidence_deg").0.reals[1], f64::NEG_INFINITY);
+    }
+
+    #[test]
+    fn a_path_whose_lists_disagree_is_an_error() {
+        let mut path = with_interactions(2, 1);
+        path.surfaces.pop();
+        let error = Batch::of(&[path]).unwrap_err();
+        assert!(error.contains("not aligned"), "{error}");
     }
 }

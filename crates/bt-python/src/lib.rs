@@ -11,6 +11,7 @@
 mod columns;
 mod options;
 mod record;
+mod sink;
 mod tracer;
 
 use bt_geom::Vec3;
@@ -23,7 +24,7 @@ use options::TraceKeywords;
 use pyo3::create_exception;
 use pyo3::exceptions::{PyException, PyValueError};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList, PyModule};
+use pyo3::types::{PyDict, PyModule};
 use std::sync::{Arc, Mutex};
 
 create_exception!(
@@ -226,7 +227,8 @@ impl PyScene {
         keywords: TraceKeywords,
     ) -> PyResult<Bound<'py, PyDict>> {
         let (_, paths) = self.reported(py, tx, rx, &keywords)?;
-        columns::to_dict(py, &paths)
+        let batch = py.detach(|| columns::Batch::of(&paths)).map_err(error)?;
+        batch.into_dict(py)
     }
 
     /// The viewer's page (`beamtrace view`: one offline HTML document, three.js inside) of the
@@ -249,7 +251,8 @@ impl PyScene {
     }
 
     /// Trace one TX to each row of `receivers` (m × 3, metres) in parallel without the GIL;
-    /// returns one column dict per receiver, in order.
+    /// returns the columns of all their paths as one flat dict (`columns::Batch`), receivers in
+    /// order, a receiver that failed untraced when `skip_errors`.
     fn trace_many<'py>(
         &self,
         py: Python<'py>,
@@ -257,10 +260,10 @@ impl PyScene {
         receivers: PyReadonlyArray2<'py, f64>,
         keywords: TraceKeywords,
         skip_errors: bool,
-    ) -> PyResult<Bound<'py, PyList>> {
+    ) -> PyResult<Bound<'py, PyDict>> {
         let receivers = receivers_of(&receivers)?;
         if receivers.is_empty() {
-            return Ok(PyList::empty(py));
+            return columns::Batch::new().map_err(error)?.into_dict(py);
         }
         // The scene with the TX and the first receiver it accepts (each receiver gets its own
         // outcome below); when it accepts none, the first one's error.
@@ -280,12 +283,14 @@ impl PyScene {
         let radio = keywords.radio().map_err(PyValueError::new_err)?;
         let tx = scene.to_world(scene.terminals().map_err(error)?.tx);
         let reports = py.detach(|| {
-            // Each receiver reported, and its columns gathered, in the task that traced it (in
-            // parallel when asked); only the arrays are made under the GIL.
+            // Each receiver reported, and its columns appended to its thread's shard, in the
+            // task that traced it (in parallel when asked); the shards are gathered in
+            // receiver order, and only the arrays are made under the GIL.
+            let shards = columns::Shards::new().map_err(|e| (None, Failure::Report(e)))?;
             let report = |moved: &Scene, t: Traced| {
                 REPORTS.with_borrow_mut(|records| {
                     let paths = records.report(moved, &t.result.paths, &radio);
-                    columns::cells_of(paths.map_err(|e| e.to_string())?)
+                    shards.push(paths.map_err(|e| e.to_string())?)
                 })
             };
             let reported = self
@@ -293,7 +298,8 @@ impl PyScene {
                     t.trace_each_then(tx, &receivers, report)
                 })
                 .map_err(|e| (None, Failure::Trace(e)))?;
-            first_failure(reported, skip_errors)
+            let rows = first_failure(reported, skip_errors)?;
+            (shards.gather(&rows, options.parallel)).map_err(|e| (None, Failure::Report(e)))
         });
         let reports = reports.map_err(|(index, e)| {
             let at = |message: String| match index {
@@ -305,46 +311,7 @@ impl PyScene {
                 Failure::Report(message) => error(at(format!("{}: {message}", scene.name()))),
             }
         })?;
-        // Thousands of new lists and arrays: without the pause, Python's cyclic collector
-        // ran again and again over the growing result (a third of the call's time).
-        let _paused = GcPause::new(py)?;
-        let mut texts = columns::Texts::default();
-        let dicts = reports
-            .into_iter()
-            .map(|cells| match cells {
-                Some(cells) => Ok(Some(columns::cells_dict(py, cells, &mut texts)?)),
-                None => Ok(None),
-            })
-            .collect::<PyResult<Vec<_>>>()?;
-        PyList::new(py, dicts)
-    }
-}
-
-/// Python's cyclic garbage collector disabled while this lives (when it was enabled), for
-/// code that makes many containers none of which can be garbage: the result of a call. The
-/// objects made are only acyclic lists, arrays and dicts, which reference counting frees.
-struct GcPause<'py> {
-    gc: Option<Bound<'py, PyModule>>,
-}
-
-impl<'py> GcPause<'py> {
-    fn new(py: Python<'py>) -> PyResult<Self> {
-        let gc = py.import("gc")?;
-        if !gc.call_method0("isenabled")?.is_truthy()? {
-            return Ok(GcPause { gc: None });
-        }
-        gc.call_method0("disable")?;
-        Ok(GcPause { gc: Some(gc) })
-    }
-}
-
-impl Drop for GcPause<'_> {
-    fn drop(&mut self) {
-        if let Some(gc) = &self.gc {
-            // Enabling cannot fail; were it to, the collector would stay off, which only
-            // delays collection.
-            let _ = gc.call_method0("enable");
-        }
+        reports.into_dict(py)
     }
 }
 
@@ -377,8 +344,8 @@ enum Failure {
     Report(String),
 }
 
-/// One receiver's paths as columns, before they become arrays.
-type Report = columns::Cells;
+/// Where one receiver's paths are among the columns of its thread's shard.
+type Report = columns::Rows;
 
 /// Why a many-receiver call failed: the receiver's index (none: the call as a whole).
 type Failed = (Option<usize>, Failure);
@@ -545,6 +512,8 @@ fn study_beam_management(
 fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("BeamtraceError", m.py().get_type::<BeamtraceError>())?;
     m.add("PATH_COLUMNS", columns::names()?)?;
+    m.add("PER_INTERACTION_COLUMNS", columns::per_interaction()?)?;
+    m.add("OPTIONAL_PATH_COLUMNS", columns::optional()?)?;
     m.add(
         "DEFAULT_MAX_CANDIDATES",
         bt_solve::pipeline::DEFAULT_MAX_CANDIDATES,

@@ -29,7 +29,7 @@ pub enum Value {
 
 /// What the model does not hold (maps, enums, booleans, bytes, unit), as serde's message.
 #[derive(Debug)]
-pub struct Unsupported(String);
+pub struct Unsupported(pub String);
 
 impl fmt::Display for Unsupported {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
@@ -50,9 +50,58 @@ pub fn to_value<T: Serialize + ?Sized>(value: &T) -> Result<Value> {
     value.serialize(ValueSerializer)
 }
 
-fn unsupported(what: &str) -> Unsupported {
+/// The error for a value of kind `what`, which has no column shape.
+pub fn unsupported(what: &str) -> Unsupported {
     Unsupported(format!("{what} has no column shape"))
 }
+
+/// The `serialize_*` methods of the kinds no column holds (enum variants with data, tuple
+/// structs, maps), each an [`unsupported`] error.
+macro_rules! no_compound_kinds {
+    () => {
+        fn serialize_newtype_variant<T: serde::Serialize + ?Sized>(
+            self,
+            name: &'static str,
+            _: u32,
+            _: &'static str,
+            _: &T,
+        ) -> std::result::Result<Self::Ok, Self::Error> {
+            Err($crate::record::unsupported(name))
+        }
+        fn serialize_tuple_struct(
+            self,
+            name: &'static str,
+            _: usize,
+        ) -> std::result::Result<Self::SerializeTupleStruct, Self::Error> {
+            Err($crate::record::unsupported(name))
+        }
+        fn serialize_tuple_variant(
+            self,
+            name: &'static str,
+            _: u32,
+            _: &'static str,
+            _: usize,
+        ) -> std::result::Result<Self::SerializeTupleVariant, Self::Error> {
+            Err($crate::record::unsupported(name))
+        }
+        fn serialize_map(
+            self,
+            _: Option<usize>,
+        ) -> std::result::Result<Self::SerializeMap, Self::Error> {
+            Err($crate::record::unsupported("a map"))
+        }
+        fn serialize_struct_variant(
+            self,
+            name: &'static str,
+            _: u32,
+            _: &'static str,
+            _: usize,
+        ) -> std::result::Result<Self::SerializeStructVariant, Self::Error> {
+            Err($crate::record::unsupported(name))
+        }
+    };
+}
+pub(crate) use no_compound_kinds;
 
 struct ValueSerializer;
 
@@ -156,51 +205,15 @@ impl ser::Serializer for ValueSerializer {
             _ => Err(unsupported("a complex that is not a pair of reals")),
         }
     }
-    fn serialize_newtype_variant<T: Serialize + ?Sized>(
-        self,
-        name: &'static str,
-        _: u32,
-        _: &'static str,
-        _: &T,
-    ) -> Result<Value> {
-        Err(unsupported(name))
-    }
     fn serialize_seq(self, len: Option<usize>) -> Result<SeqValues> {
         Ok(SeqValues(Vec::with_capacity(len.unwrap_or(0))))
     }
     fn serialize_tuple(self, len: usize) -> Result<SeqValues> {
         Ok(SeqValues(Vec::with_capacity(len)))
     }
-    fn serialize_tuple_struct(
-        self,
-        name: &'static str,
-        _: usize,
-    ) -> Result<Self::SerializeTupleStruct> {
-        Err(unsupported(name))
-    }
-    fn serialize_tuple_variant(
-        self,
-        name: &'static str,
-        _: u32,
-        _: &'static str,
-        _: usize,
-    ) -> Result<Self::SerializeTupleVariant> {
-        Err(unsupported(name))
-    }
-    fn serialize_map(self, _: Option<usize>) -> Result<Self::SerializeMap> {
-        Err(unsupported("a map"))
-    }
+    no_compound_kinds!();
     fn serialize_struct(self, _: &'static str, len: usize) -> Result<StructValues> {
         Ok(StructValues(Vec::with_capacity(len)))
-    }
-    fn serialize_struct_variant(
-        self,
-        name: &'static str,
-        _: u32,
-        _: &'static str,
-        _: usize,
-    ) -> Result<Self::SerializeStructVariant> {
-        Err(unsupported(name))
     }
 }
 

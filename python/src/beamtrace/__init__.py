@@ -104,7 +104,27 @@ class Paths:
         self._columns = dict(columns)
         self.__dict__.update(self._columns)
 
+    @classmethod
+    def _of_receiver(cls, batch: Dict[str, Any], i: int) -> "Paths":
+        """Receiver ``i``'s paths of a flat batch, made on first use of a column (a
+        many-receiver call builds one batch; most callers read a few receivers' columns)."""
+        paths = cls.__new__(cls)
+        paths.__dict__["_receiver"] = (batch, i)
+        return paths
+
+    def __getattr__(self, name: str) -> Any:
+        # Reached only for a name not set yet: the columns of a receiver of a batch.
+        receiver = self.__dict__.pop("_receiver", None)
+        if receiver is None:
+            raise AttributeError(f"'Paths' object has no attribute {name!r}")
+        self.__init__(_receiver_columns(*receiver))  # type: ignore[misc]
+        return getattr(self, name)
+
     def __len__(self) -> int:
+        receiver = self.__dict__.get("_receiver")
+        if receiver is not None:
+            batch, i = receiver
+            return int(batch["path_offsets"][i + 1] - batch["path_offsets"][i])
         return len(self._columns["order"])
 
     def __getitem__(self, i: int) -> "Path":
@@ -147,6 +167,31 @@ class Paths:
 
     def __setstate__(self, state: Dict[str, Any]) -> None:
         self.__init__(state)  # type: ignore[misc]
+
+
+def _receiver_columns(batch: Dict[str, Any], i: int) -> Dict[str, Any]:
+    """Receiver ``i``'s columns of a flat batch (``Scene.trace_many(..., flat=True)``): views
+    of its rows, the per-interaction columns split into one array (or list) per path; IPC's
+    optional columns left out when it has no path, as ``Scene.trace`` leaves them."""
+    p0, p1 = int(batch["path_offsets"][i]), int(batch["path_offsets"][i + 1])
+    bounds = batch["interaction_offsets"][p0 : p1 + 1]
+    i0 = int(bounds[0])
+    cuts = bounds[1:-1] - i0
+    columns: Dict[str, Any] = {}
+    for name in _native.PATH_COLUMNS:
+        if name not in batch or (p0 == p1 and name in _native.OPTIONAL_PATH_COLUMNS):
+            continue
+        column = batch[name]
+        if name not in _native.PER_INTERACTION_COLUMNS:
+            columns[name] = column[p0:p1]
+        elif p0 == p1:
+            columns[name] = []
+        elif isinstance(column, list):
+            edges = [i0, *(bounds[1:-1].tolist()), int(bounds[-1])]
+            columns[name] = [column[a:b] for a, b in zip(edges, edges[1:])]
+        else:
+            columns[name] = np.split(column[i0 : int(bounds[-1])], cuts)
+    return columns
 
 
 class Path:
@@ -293,12 +338,12 @@ class Scene:
         node pairs × surfaces, with ``candidates="wvrn"``), ``ValueError`` on a bad option or when
         a terminal is neither given nor in the scene (meshes, XML and point clouds have none).
         """
-        columns = self._native.trace(
+        batch = self._native.trace(
             _point(tx, "tx"),
             _point(rx, "rx"),
             _options(locals()),
         )
-        return Paths(columns)
+        return Paths(_receiver_columns(batch, 0))
 
     def trace_many(
         self,
@@ -332,7 +377,8 @@ class Scene:
         rx_orientation: Point = (0.0, 0.0, 0.0),
         tx_power_dbm: float = 0.0,
         on_error: str = "raise",
-    ) -> List[Optional[Paths]]:
+        flat: bool = False,
+    ) -> Any:
         """Trace one ``tx`` to every row of ``rx`` (an (m, 3) array, metres): one
         :class:`Paths` per receiver, in order, equal to calling :meth:`trace` for each.
 
@@ -341,18 +387,33 @@ class Scene:
         :class:`BeamtraceError` naming the first such receiver's index and position; with
         ``on_error="skip"`` its entry is ``None`` and the others are traced, as the CLI's
         ``sweep`` marks such grid points.
+
+        All receivers' columns are built in one set of arrays; a receiver's :class:`Paths`
+        makes its own columns (views of its rows) when one is first read. With ``flat=True``
+        the call returns that set instead, one dict for all receivers (as Sionna RT's path
+        tensors are indexed by receiver): every column of :class:`Paths` over the ``n`` paths
+        of all receivers in receiver order, the per-interaction ones (``interactions``,
+        ``surfaces``, ``points``, ``incidence_deg``) flat over all interactions; beside them
+        ``receiver`` (n,) each path's receiver index, ``path_offsets`` (m + 1,) (receiver
+        ``i``'s paths are rows ``path_offsets[i]:path_offsets[i + 1]``),
+        ``interaction_offsets`` (n + 1,) (path ``j``'s interactions are rows
+        ``interaction_offsets[j]:interaction_offsets[j + 1]``) and ``traced`` (m,) (False
+        where ``on_error="skip"`` skipped a receiver: it has no paths).
         """
         if on_error not in ("raise", "skip"):
             raise ValueError(f'on_error must be "raise" or "skip", got {on_error!r}')
         arguments = dict(locals())
-        del arguments["on_error"]
-        results = self._native.trace_many(
+        del arguments["on_error"], arguments["flat"]
+        batch = self._native.trace_many(
             _point(tx, "tx"),
             _receivers(rx),
             _options(arguments),
             on_error == "skip",
         )
-        return [None if c is None else Paths(c) for c in results]
+        if flat:
+            return batch
+        traced = batch["traced"].tolist()
+        return [Paths._of_receiver(batch, i) if t else None for i, t in enumerate(traced)]
 
     def view(
         self, tx: Optional[Point] = None, rx: Optional[Point] = None, **options: Any

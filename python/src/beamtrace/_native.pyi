@@ -6,6 +6,8 @@ import numpy as np
 import numpy.typing as npt
 
 PATH_COLUMNS: List[str]
+PER_INTERACTION_COLUMNS: List[str]
+OPTIONAL_PATH_COLUMNS: List[str]
 """Every column a trace can give, in the order of ``beamtrace trace --json``'s path objects
 (derived from the report record; ``iterations``/``residual_m`` only for IPC)."""
 DEFAULT_MAX_CANDIDATES: int
@@ -47,7 +49,7 @@ class Scene:
         receivers: npt.NDArray[np.float64],
         keywords: Dict[str, Any],
         skip_errors: bool,
-    ) -> List[Optional[Dict[str, Any]]]: ...
+    ) -> Dict[str, Any]: ...
     def view(self, tx: _Point, rx: _Point, keywords: Dict[str, Any]) -> str: ...
     def to_bytes(self) -> bytes: ...
 
