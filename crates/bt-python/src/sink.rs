@@ -28,6 +28,20 @@ impl Buffer {
     pub fn counts(&self) -> (usize, usize, usize) {
         (self.ints.len(), self.reals.len(), self.texts.len())
     }
+
+    /// No leaf, the memory kept.
+    pub fn clear(&mut self) {
+        self.ints.clear();
+        self.reals.clear();
+        self.texts.clear();
+    }
+
+    /// The bytes it holds (its capacity).
+    pub fn bytes(&self) -> usize {
+        self.ints.capacity() * size_of::<i64>()
+            + self.reals.capacity() * size_of::<f64>()
+            + self.texts.capacity() * size_of::<u32>()
+    }
 }
 
 /// The distinct texts of a batch, each stored once and referred to by index.
@@ -41,6 +55,13 @@ pub struct Texts {
 }
 
 impl Texts {
+    /// No text.
+    pub fn clear(&mut self) {
+        self.list.clear();
+        self.index.clear();
+        self.statics.clear();
+    }
+
     /// The index of `text`, added on first use.
     pub fn code(&mut self, text: &str) -> Result<u32> {
         if let Some(&code) = self.index.get(text) {
