@@ -79,13 +79,15 @@ def test_flat_columns_are_the_receivers_paths_end_to_end(solver):
         values = [p.to_dict()[key] for p in traced]
         if key in beamtrace._native.PER_INTERACTION_COLUMNS:
             items = [item for v in values for per_path in v for item in per_path]
-            if isinstance(flat[key], list):
-                assert flat[key] == items, key
+            if key in beamtrace._native.TEXT_COLUMNS:
+                assert flat[key].dtype == np.uint32
+                assert [flat["texts"][t] for t in flat[key]] == items, key
             else:
                 assert np.array_equal(flat[key], np.array(items).reshape(flat[key].shape)), key
         else:
             assert np.array_equal(flat[key], np.concatenate(values)), key
-    for name in ("receiver", "path_offsets", "interaction_offsets", "traced"):
+    assert len(set(flat["texts"])) == len(flat["texts"])
+    for name in ("texts", "receiver", "path_offsets", "interaction_offsets", "traced"):
         assert name not in beamtrace._native.PATH_COLUMNS
 
 

@@ -27,7 +27,7 @@ use bt_beams::PathReport;
 use numpy::ndarray::Array2;
 use numpy::{Complex64, PyArray1, PyArray2};
 use pyo3::prelude::*;
-use pyo3::types::{PyDict, PyList, PyString};
+use pyo3::types::{PyDict, PyList};
 use rayon::prelude::*;
 use serde::Serialize;
 use std::ops::Range;
@@ -141,6 +141,16 @@ fn width<'a>(mut values: impl ExactSizeIterator<Item = &'a Value>) -> Option<usi
 pub fn names() -> PyResult<Vec<&'static str>> {
     let columns = table_of_example().map_err(crate::error)?;
     Ok(columns.iter().map(|c| c.name).collect())
+}
+
+/// The columns of texts (interaction kinds, surface names): indices into a [`Batch`]'s texts.
+pub fn texts() -> PyResult<Vec<&'static str>> {
+    let columns = table_of_example().map_err(crate::error)?;
+    Ok(columns
+        .iter()
+        .filter(|c| c.shape == Shape::Texts)
+        .map(|c| c.name)
+        .collect())
 }
 
 /// The columns whose values are per interaction (aligned with `points`): flat in a
@@ -371,24 +381,20 @@ impl Batch {
     }
 
     /// The dictionary of column name → array: each column present when every path wrote it
-    /// (an optional one also needs a path), flat over all receivers; beside them
-    /// `path_offsets` (m + 1,), `interaction_offsets` (n + 1,), `receiver` (n,) and `traced`
-    /// (m,).
+    /// (an optional one also needs a path), flat over all receivers, a text column as
+    /// `uint32` indices into `texts` (the distinct texts, a list of `str`: as Sionna RT gives
+    /// interaction types and objects as integers); beside them `path_offsets` (m + 1,),
+    /// `interaction_offsets` (n + 1,), `receiver` (n,) and `traced` (m,).
     pub fn into_dict(self, py: Python<'_>) -> PyResult<Bound<'_, PyDict>> {
         let dict = PyDict::new(py);
         let n = self.paths();
-        let strings: Vec<_> = (self.texts.list.iter())
-            .map(|t| PyString::new(py, t))
-            .collect();
         for ((column, buffer), written) in self.columns.iter().zip(self.buffers).zip(self.written) {
             if written != n || (n == 0 && column.optional) {
                 continue;
             }
-            dict.set_item(
-                column.name,
-                column_array(py, column.shape, buffer, &strings)?,
-            )?;
+            dict.set_item(column.name, column_array(py, column.shape, buffer)?)?;
         }
+        dict.set_item("texts", PyList::new(py, &self.texts.list)?)?;
         let receiver = (self.path_offsets.windows(2).enumerate())
             .flat_map(|(i, w)| std::iter::repeat_n(i as i64, (w[1] - w[0]) as usize));
         dict.set_item("receiver", PyArray1::from_iter(py, receiver))?;
@@ -555,13 +561,8 @@ where
     all
 }
 
-/// One column's array (a list of shared strings for texts).
-fn column_array<'py>(
-    py: Python<'py>,
-    shape: Shape,
-    buffer: Buffer,
-    strings: &[Bound<'py, PyString>],
-) -> PyResult<Bound<'py, PyAny>> {
+/// One column's array (texts as their indices).
+fn column_array(py: Python<'_>, shape: Shape, buffer: Buffer) -> PyResult<Bound<'_, PyAny>> {
     let rows = |reals: Vec<f64>, width: usize| {
         let rows = reals.len() / width;
         let array = Array2::from_shape_vec((rows, width), reals);
@@ -577,10 +578,7 @@ fn column_array<'py>(
         Shape::Row(width) | Shape::Rows(width) => {
             PyArray2::from_owned_array(py, rows(buffer.reals, width)?).into_any()
         }
-        Shape::Texts => {
-            let items = buffer.texts.iter().map(|&t| strings[t as usize].clone());
-            PyList::new(py, items)?.into_any()
-        }
+        Shape::Texts => PyArray1::from_vec(py, buffer.texts).into_any(),
     })
 }
 

@@ -533,6 +533,7 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add("PATH_COLUMNS", columns::names()?)?;
     m.add("PER_INTERACTION_COLUMNS", columns::per_interaction()?)?;
     m.add("OPTIONAL_PATH_COLUMNS", columns::optional()?)?;
+    m.add("TEXT_COLUMNS", columns::texts()?)?;
     m.add(
         "DEFAULT_MAX_CANDIDATES",
         bt_solve::pipeline::DEFAULT_MAX_CANDIDATES,

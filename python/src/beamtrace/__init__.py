@@ -186,9 +186,11 @@ def _receiver_columns(batch: Dict[str, Any], i: int) -> Dict[str, Any]:
             columns[name] = column[p0:p1]
         elif p0 == p1:
             columns[name] = []
-        elif isinstance(column, list):
-            edges = [i0, *(bounds[1:-1].tolist()), int(bounds[-1])]
-            columns[name] = [column[a:b] for a, b in zip(edges, edges[1:])]
+        elif name in _native.TEXT_COLUMNS:
+            texts = batch["texts"]
+            items = [texts[t] for t in column[i0 : int(bounds[-1])].tolist()]
+            edges = [0, *cuts.tolist(), len(items)]
+            columns[name] = [items[a:b] for a, b in zip(edges, edges[1:])]
         else:
             columns[name] = np.split(column[i0 : int(bounds[-1])], cuts)
     return columns
@@ -393,7 +395,9 @@ class Scene:
         the call returns that set instead, one dict for all receivers (as Sionna RT's path
         tensors are indexed by receiver): every column of :class:`Paths` over the ``n`` paths
         of all receivers in receiver order, the per-interaction ones (``interactions``,
-        ``surfaces``, ``points``, ``incidence_deg``) flat over all interactions; beside them
+        ``surfaces``, ``points``, ``incidence_deg``) flat over all interactions, the texts
+        (``interactions``, ``surfaces``) as ``uint32`` indices into ``texts`` (a list of the
+        distinct texts: ``np.array(flat["texts"])[flat["surfaces"]]`` names them); beside them
         ``receiver`` (n,) each path's receiver index, ``path_offsets`` (m + 1,) (receiver
         ``i``'s paths are rows ``path_offsets[i]:path_offsets[i + 1]``),
         ``interaction_offsets`` (n + 1,) (path ``j``'s interactions are rows

@@ -8,6 +8,7 @@ import numpy.typing as npt
 PATH_COLUMNS: List[str]
 PER_INTERACTION_COLUMNS: List[str]
 OPTIONAL_PATH_COLUMNS: List[str]
+TEXT_COLUMNS: List[str]
 """Every column a trace can give, in the order of ``beamtrace trace --json``'s path objects
 (derived from the report record; ``iterations``/``residual_m`` only for IPC)."""
 DEFAULT_MAX_CANDIDATES: int
