@@ -458,7 +458,7 @@ pub(crate) fn trace_each_receiver<T: Send>(
         .filter(|_| receivers.len() >= BATCHED_RECEIVERS)
         .map(|kept| {
             let local: Vec<Vec3> = receivers.iter().map(|&rx| base.to_local(rx)).collect();
-            kept.tree.receiver_nodes(&local)
+            kept.tree.receiver_nodes(&local, options.parallel)
         });
     let one = |(k, rx): (usize, &Vec3)| -> Result<T, TraceError> {
         let moved = base.with_receiver(*rx)?;

@@ -11,6 +11,9 @@ use bt_geom::{Real, Vec3};
 /// Receivers per box below which a box is not halved again.
 const LEAF_RECEIVERS: usize = 4;
 
+/// Receivers per half from which the two halves of a box are narrowed in parallel.
+const PARALLEL_RECEIVERS: usize = 32;
+
 /// For each receiver, the tree's live nodes whose beams may hold it, in node order
 /// ([`BeamTree::receiver_nodes`]).
 #[derive(Debug, Clone, Default)]
@@ -32,8 +35,9 @@ impl ReceiverNodes {
 impl BeamTree {
     /// The live nodes whose beams may hold each of `receivers` (metres, the tree's frame): a
     /// superset of the nodes that hold it, in node order. Receivers with a non-finite
-    /// coordinate get every live node.
-    pub fn receiver_nodes(&self, receivers: &[Vec3]) -> ReceiverNodes {
+    /// coordinate get every live node. The halves of a large box are narrowed side by side
+    /// on rayon's pool when `parallel`; the answer is the same.
+    pub fn receiver_nodes(&self, receivers: &[Vec3], parallel: bool) -> ReceiverNodes {
         let live: Vec<u32> = (self.levels.iter().flat_map(|&(lo, hi)| lo..hi))
             .filter(|&i| self.nodes[i].live)
             .map(|i| i as u32)
@@ -46,18 +50,32 @@ impl BeamTree {
         let mut ids: Vec<u32> = (0..receivers.len() as u32)
             .filter(|&k| receivers[k as usize].is_finite())
             .collect();
-        self.split_box(receivers, &mut ids, live, &mut out);
+        let mut boxes = Vec::new();
+        self.split_box(receivers, &mut ids, live, parallel, &mut boxes);
+        // The boxes cover `ids` in order, each a run of them.
+        let mut at = 0;
+        for (count, nodes) in boxes {
+            let list = out.lists.len() as u32;
+            for &k in &ids[at..at + count] {
+                out.list_of[k as usize] = list;
+            }
+            out.lists.push(nodes);
+            at += count;
+        }
         out
     }
 
     /// Narrows `nodes` to those whose beams may meet the box of the receivers `ids` (finite),
-    /// then halves the box along its longest side, down to [`LEAF_RECEIVERS`].
+    /// then halves the box along its longest side, down to [`LEAF_RECEIVERS`]; appends each
+    /// final box to `boxes`, in the order of `ids` (reordered in place): how many receivers
+    /// it has and its nodes.
     fn split_box(
         &self,
         receivers: &[Vec3],
         ids: &mut [u32],
         nodes: Vec<u32>,
-        out: &mut ReceiverNodes,
+        parallel: bool,
+        boxes: &mut Vec<(usize, Vec<u32>)>,
     ) {
         let Some((lo, hi)) = (ids.iter().map(|&k| receivers[k as usize]))
             .map(|p| (p, p))
@@ -69,11 +87,7 @@ impl BeamTree {
             .filter(|&i| self.may_hold_box(i as usize, lo, hi))
             .collect();
         if ids.len() <= LEAF_RECEIVERS || nodes.is_empty() {
-            let list = out.lists.len() as u32;
-            for &k in ids.iter() {
-                out.list_of[k as usize] = list;
-            }
-            out.lists.push(nodes);
+            boxes.push((ids.len(), nodes));
             return;
         }
         let axis = (hi - lo).max_position();
@@ -82,8 +96,18 @@ impl BeamTree {
             receivers[a as usize][axis].total_cmp(&receivers[b as usize][axis])
         });
         let (first, second) = ids.split_at_mut(half);
-        self.split_box(receivers, first, nodes.clone(), out);
-        self.split_box(receivers, second, nodes, out);
+        if parallel && first.len() >= PARALLEL_RECEIVERS {
+            let copy = nodes.clone();
+            let mut later = Vec::new();
+            rayon::join(
+                || self.split_box(receivers, first, copy, parallel, boxes),
+                || self.split_box(receivers, second, nodes, parallel, &mut later),
+            );
+            boxes.append(&mut later);
+        } else {
+            self.split_box(receivers, first, nodes.clone(), parallel, boxes);
+            self.split_box(receivers, second, nodes, parallel, boxes);
+        }
     }
 
     /// Whether some point of the box `lo..hi` may lie in node `i`'s beam as

@@ -580,7 +580,12 @@ proptest! {
             .collect();
         receivers.extend(scene.surfaces().iter().flat_map(|s| s.polygon.vertices().iter().copied()));
         receivers.push(Vec3::new(f64::NAN, centre.y, centre.z));
-        let nodes = tree.receiver_nodes(&receivers);
+        let nodes = tree.receiver_nodes(&receivers, false);
+        // Narrowed on all cores, the same lists for every receiver.
+        let parallel = tree.receiver_nodes(&receivers, true);
+        for k in 0..receivers.len() {
+            prop_assert_eq!(parallel.of(k), nodes.of(k), "receiver {}", k);
+        }
         let walk = tree.walk_len();
         for (k, &rx) in receivers.iter().enumerate() {
             let full = listing(&tree.candidates(rx));
