@@ -174,9 +174,10 @@ def _receiver_columns(batch: Dict[str, Any], i: int) -> Dict[str, Any]:
     of its rows, the per-interaction columns split into one array (or list) per path; IPC's
     optional columns left out when it has no path, as ``Scene.trace`` leaves them."""
     p0, p1 = int(batch["path_offsets"][i]), int(batch["path_offsets"][i + 1])
-    bounds = batch["interaction_offsets"][p0 : p1 + 1]
-    i0 = int(bounds[0])
-    cuts = bounds[1:-1] - i0
+    bounds = batch["interaction_offsets"][p0 : p1 + 1].tolist()
+    i0, i1 = bounds[0], bounds[-1]
+    # Each path's interactions, as slice bounds within the receiver's.
+    spans = [(a - i0, b - i0) for a, b in zip(bounds, bounds[1:])]
     columns: Dict[str, Any] = {}
     for name in _native.PATH_COLUMNS:
         if name not in batch or (p0 == p1 and name in _native.OPTIONAL_PATH_COLUMNS):
@@ -184,15 +185,12 @@ def _receiver_columns(batch: Dict[str, Any], i: int) -> Dict[str, Any]:
         column = batch[name]
         if name not in _native.PER_INTERACTION_COLUMNS:
             columns[name] = column[p0:p1]
-        elif p0 == p1:
-            columns[name] = []
-        elif name in _native.TEXT_COLUMNS:
+            continue
+        part = column[i0:i1]
+        if name in _native.TEXT_COLUMNS:
             texts = batch["texts"]
-            items = [texts[t] for t in column[i0 : int(bounds[-1])].tolist()]
-            edges = [0, *cuts.tolist(), len(items)]
-            columns[name] = [items[a:b] for a, b in zip(edges, edges[1:])]
-        else:
-            columns[name] = np.split(column[i0 : int(bounds[-1])], cuts)
+            part = [texts[t] for t in part.tolist()]
+        columns[name] = [part[a:b] for a, b in spans]
     return columns
 
 
