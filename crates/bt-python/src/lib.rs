@@ -77,8 +77,8 @@ struct PyScene {
     /// The scene's tracer, kept between calls for its caches (a stream of traces of one
     /// scene reuses the beam tree's hulls and arenas).
     tracer: Mutex<Tracer>,
-    /// The column shards of the last `trace_many`, kept for their memory (see
-    /// [`KEPT_SHARD_BYTES`]).
+    /// The column shards of the last `trace_many`, emptied and kept for their memory (up to
+    /// [`KEPT_SHARD_BYTES`] each).
     shards: Mutex<Option<columns::Shards>>,
 }
 
@@ -293,13 +293,12 @@ impl PyScene {
             // Each receiver reported, and its columns appended to its thread's shard, in the
             // task that traced it (in parallel when asked); the shards are gathered in
             // receiver order, and only the arrays are made under the GIL.
-            // The last call's shards, unless another thread holds them.
+            // The last call's shards (emptied), unless another thread holds them.
             let kept = self.shards.try_lock().ok().and_then(|mut kept| kept.take());
             let mut shards = match kept {
-                Some(mut kept) => kept.clear(KEPT_SHARD_BYTES).map(|_| kept),
-                None => columns::Shards::new(),
-            }
-            .map_err(|e| (None, Failure::Report(e)))?;
+                Some(kept) => kept,
+                None => columns::Shards::new().map_err(|e| (None, Failure::Report(e)))?,
+            };
             let report = |moved: &Scene, t: Traced| {
                 REPORTS.with_borrow_mut(|records| {
                     let paths = records.report(moved, &t.result.paths, &radio);
@@ -313,7 +312,9 @@ impl PyScene {
                 .map_err(|e| (None, Failure::Trace(e)))?;
             let rows = first_failure(reported, skip_errors)?;
             let gathered = shards.gather(&rows, options.parallel);
-            if let Ok(mut kept) = self.shards.try_lock() {
+            // Kept emptied, and only up to the bound, so that a large call's memory goes now.
+            if let (Ok(()), Ok(mut kept)) = (shards.clear(KEPT_SHARD_BYTES), self.shards.try_lock())
+            {
                 *kept = Some(shards);
             }
             gathered.map_err(|e| (None, Failure::Report(e)))
