@@ -2,12 +2,15 @@
 //! are the keys of `beamtrace trace --json`'s path objects, in the same order, so a new field
 //! of the record is a new column without an edit here.
 //!
-//! Each record is serialized into a typed value model ([`crate::record`]) and every field
-//! becomes a column by the *shape* of its value: an integer → `int64` (n,); a real →
-//! `float64` (n,), with −inf where the document has `null` (`gain_db` of a path carrying no
-//! power); a struct of k reals (a direction) → `float64` (n, k) in field order; the complex
-//! newtype → `complex128` (n,); a list of strings → n lists of `str`; a list of reals → n
-//! `float64` (k,) arrays; a list of rows of w reals (points) → n `float64` (k, w) arrays.
+//! The shape of each field comes from its value in one example record, serialized into a
+//! typed value model ([`crate::record`]); the records themselves are serialized straight
+//! into flat column buffers ([`crate::sink`], [`Batch`]). By shape: an integer → `int64`
+//! (n,); a real → `float64` (n,), with −inf where the document has `null` (`gain_db` of a
+//! path carrying no power); a struct of k reals (a direction) → `float64` (n, k) in field
+//! order; the complex newtype → `complex128` (n,). A list per path (one item per
+//! interaction) is flat over all interactions, cut per path at the interaction offsets: a
+//! list of strings → `uint32` indices into the batch's texts; a list of reals → `float64`
+//! (N,); a list of rows of w reals (points) → `float64` (N, w).
 //!
 //! The shapes must not depend on the paths at hand (a line of sight has no points, yet its
 //! `points` is a (0, 3) array; no path at all still gives every column, empty), so they come
@@ -137,42 +140,32 @@ fn width<'a>(mut values: impl ExactSizeIterator<Item = &'a Value>) -> Option<usi
     (n > 0 && values.all(|v| matches!(v, Value::Real(_)))).then_some(n)
 }
 
-/// Every column name `to_dict` can produce, in the order of the JSON path objects.
-pub fn names() -> PyResult<Vec<&'static str>> {
+/// The names of the columns that `keep`, in the order of the JSON path objects.
+fn names_where(keep: impl Fn(&Column) -> bool) -> PyResult<Vec<&'static str>> {
     let columns = table_of_example().map_err(crate::error)?;
-    Ok(columns.iter().map(|c| c.name).collect())
+    Ok(columns.iter().filter(|c| keep(c)).map(|c| c.name).collect())
+}
+
+/// Every column name a [`Batch`] can hold, in the order of the JSON path objects.
+pub fn names() -> PyResult<Vec<&'static str>> {
+    names_where(|_| true)
 }
 
 /// The columns of texts (interaction kinds, surface names): indices into a [`Batch`]'s texts.
 pub fn texts() -> PyResult<Vec<&'static str>> {
-    let columns = table_of_example().map_err(crate::error)?;
-    Ok(columns
-        .iter()
-        .filter(|c| c.shape == Shape::Texts)
-        .map(|c| c.name)
-        .collect())
+    names_where(|c| c.shape == Shape::Texts)
 }
 
 /// The columns whose values are per interaction (aligned with `points`): flat in a
 /// [`Batch`], split at its interaction offsets into one list or array per path.
 pub fn per_interaction() -> PyResult<Vec<&'static str>> {
-    let columns = table_of_example().map_err(crate::error)?;
-    Ok(columns
-        .iter()
-        .filter(|c| c.shape.ragged())
-        .map(|c| c.name)
-        .collect())
+    names_where(|c| c.shape.ragged())
 }
 
 /// The columns the document may leave out (IPC's), present in a [`Batch`] only when every
 /// path has them, and in one receiver's paths only when it has a path.
 pub fn optional() -> PyResult<Vec<&'static str>> {
-    let columns = table_of_example().map_err(crate::error)?;
-    Ok(columns
-        .iter()
-        .filter(|c| c.optional)
-        .map(|c| c.name)
-        .collect())
+    names_where(|c| c.optional)
 }
 
 impl Shape {
@@ -192,6 +185,12 @@ impl Shape {
             Shape::Reals => (0, k, 0),
             Shape::Rows(width) => (0, k * width, 0),
         }
+    }
+
+    /// The leaves of one unit of a column: a path's (one value) or, for a per-interaction
+    /// column, an interaction's.
+    fn per_unit(self) -> (usize, usize, usize) {
+        self.leaves(self.ragged() as usize)
     }
 
     /// The number of interactions a ragged value with these leaves holds (`None`: it is not
@@ -351,7 +350,7 @@ impl Batch {
             }
             let a = self.buffers[c].counts();
             let added = (a.0 - ints, a.1 - reals, a.2 - texts);
-            let per = column.shape.leaves(column.shape.ragged() as usize);
+            let per = column.shape.per_unit();
             let units = if column.shape.ragged() {
                 interactions
             } else {
@@ -510,8 +509,7 @@ fn gathered(
     rows: &[&Rows],
     codes: &[Vec<u32>],
 ) -> Buffer {
-    // The leaves of a path (fixed shapes) or of an interaction (per-interaction columns).
-    let (ints, reals, texts) = shape.leaves(shape.ragged() as usize);
+    let (ints, reals, texts) = shape.per_unit();
     let units = |row: &Rows| {
         let shard = &shards[row.shard];
         match shape.ragged() {
