@@ -360,6 +360,32 @@ impl<'a> Prepared<'a> {
         })
     }
 
+    /// The surfaces whose boxes the segment `a -> q` touches (grown by the tolerance) among
+    /// those that may occlude, each at most once and in no particular order: the scene's
+    /// BVH, or with penetrable surfaces the opaque ones' ([`Opaque`]). Callers still test
+    /// [`Prepared::is_occluder`].
+    fn visit_opaque(&self, (a, q): (Vec3, Vec3), mut visit: impl FnMut(u32)) {
+        match self.opaque() {
+            None => self.scene.bvh().visit_segment(a, q, self.tol, visit),
+            Some(o) => o
+                .bvh
+                .visit_segment(a, q, self.tol, |i| visit(o.ids[i as usize])),
+        }
+    }
+
+    /// [`Opaque`]'s index of the scene, made on first use.
+    fn opaque(&self) -> Option<&Opaque> {
+        self.shapes
+            .opaque
+            .get_or_init(|| Opaque::of(self.scene))
+            .as_ref()
+    }
+
+    /// Whether no surface of the scene can occlude (every one penetrable).
+    fn nothing_occludes(&self) -> bool {
+        self.opaque().is_some_and(|o| o.ids.is_empty())
+    }
+
     /// Whether surface `s` may occlude: convex and opaque (a penetrable surface,
     /// [`Scene::penetrable`], lets every beam through).
     fn is_occluder(&self, s: u32) -> bool {
@@ -405,7 +431,8 @@ impl std::fmt::Debug for TreeCache {
 }
 
 /// Per-surface shapes derived from the geometry alone: each reflector's convex hull grown by
-/// `margin` (m) and each surface's convexity, computed on first use. A [`TreeCache`] keeps the
+/// `margin` (m), each surface's convexity and the index of the opaque surfaces
+/// ([`Opaque`]), computed on first use. A [`TreeCache`] keeps the
 /// last build's for its next one of the same geometry, so that hulls are not rebuilt every
 /// trace. Unlike the [`Arenas`], they are kept whatever their size: they grow with the scene,
 /// not with a tree.
@@ -415,6 +442,37 @@ struct Shapes {
     margin: Real,
     hulls: Vec<OnceLock<Vec<Vec3>>>,
     convex: Vec<OnceLock<bool>>,
+    opaque: OnceLock<Option<Opaque>>,
+}
+
+/// Where occlusion's walks ([`occlude`]) look for occluders in a scene with penetrable
+/// surfaces, which never occlude: a BVH over the opaque surfaces only (item `i` is surface
+/// `ids[i]`), so that a walk does not visit every wall a beam passes through. With none
+/// opaque (transmission everywhere), nothing occludes and no walk is made.
+struct Opaque {
+    ids: Vec<u32>,
+    bvh: bt_geom::bvh::Bvh,
+}
+
+impl Opaque {
+    /// The index of `scene`'s opaque surfaces, or `None` when every surface is opaque (the
+    /// scene's own BVH then serves).
+    fn of(scene: &Scene) -> Option<Opaque> {
+        if !scene.transmits() {
+            return None;
+        }
+        let ids: Vec<u32> = (0..scene.surfaces().len() as u32)
+            .filter(|&s| !scene.penetrable(SurfaceId(s)))
+            .collect();
+        let polygons: Vec<&bt_geom::Polygon> = ids
+            .iter()
+            .map(|&s| &scene.surface(SurfaceId(s)).polygon)
+            .collect();
+        Some(Opaque {
+            bvh: bt_geom::bvh::Bvh::build(&polygons),
+            ids,
+        })
+    }
 }
 
 impl Shapes {
@@ -434,6 +492,7 @@ impl Shapes {
             margin,
             hulls: (0..n).map(|_| OnceLock::new()).collect(),
             convex: (0..n).map(|_| OnceLock::new()).collect(),
+            opaque: OnceLock::new(),
         }
     }
 }
@@ -1470,18 +1529,12 @@ fn occlude(
     scratch: &mut Scratch,
     stats: &mut TreeStats,
 ) -> bool {
+    if prep.nothing_occludes() {
+        return false;
+    }
     let scene = prep.scene;
-    let start_plane = parent.surface.map(|p| *prep.plane(p));
-    // Start points of the rays through the window's vertices, on the parent's plane (or TX).
     let mut starts = std::mem::take(&mut scratch.starts);
-    starts.clear();
-    starts.extend(scratch.a.iter().map(|&q| match &start_plane {
-        None => parent.apex,
-        Some(pl) => match pl.line_parameter(parent.apex, q) {
-            Some(t) => parent.apex + t * (q - parent.apex),
-            None => q,
-        },
-    }));
+    ray_starts(prep, parent, &scratch.a, &mut starts);
     let margin = COVER * prep.tol;
     if let Some(o) = scratch
         .last_cover
@@ -1516,7 +1569,7 @@ fn occlude(
         let (a, q) = (starts[k], window_rays[k]);
         // The walk gathers, then the segment tests run in a build with FMA.
         reached.clear();
-        scene.bvh().visit_segment(a, q, prep.tol, |item| {
+        prep.visit_opaque((a, q), |item| {
             if Some(item) != parent.surface
                 && item != s
                 && prep.is_occluder(item)
@@ -1560,6 +1613,20 @@ fn occlude(
     scratch.starts = starts;
     scratch.rays = window_rays;
     covered
+}
+
+/// Into `starts` (cleared first): the start points of the rays from `parent`'s apex through
+/// the `window`'s vertices, on the parent's plane (or the apex itself at the root).
+fn ray_starts(prep: &Prepared<'_>, parent: &Parent<'_>, window: &[Vec3], starts: &mut Vec<Vec3>) {
+    let start_plane = parent.surface.map(|p| *prep.plane(p));
+    starts.clear();
+    starts.extend(window.iter().map(|&q| match &start_plane {
+        None => parent.apex,
+        Some(pl) => match pl.line_parameter(parent.apex, q) {
+            Some(t) => parent.apex + t * (q - parent.apex),
+            None => q,
+        },
+    }));
 }
 
 /// The surfaces of `reached` (in order) that the segment `a -> q` crosses
@@ -1900,4 +1967,67 @@ pub fn diffracted_with(
     };
     let rx = BeamTree::build_in(&swapped, depth, cache, &mut |_| {})?;
     diffraction::join(scene, tx, &rx, options.max_nodes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::prelude::*;
+
+    /// The occluders (convex, opaque) that the segment `a -> q` crosses, among `ids`.
+    fn crossed(
+        prep: &Prepared<'_>,
+        ids: impl Iterator<Item = u32>,
+        (a, q): (Vec3, Vec3),
+    ) -> Vec<u32> {
+        let mut out: Vec<u32> = ids
+            .filter(|&s| prep.is_occluder(s))
+            .filter(|&s| {
+                prep.scene
+                    .surface(SurfaceId(s))
+                    .polygon
+                    .blocks_segment(a, q, 0.0, 0.0)
+            })
+            .collect();
+        out.sort_unstable();
+        out.dedup();
+        out
+    }
+
+    proptest! {
+        #![proptest_config(ProptestConfig {
+            cases: 256,
+            rng_seed: proptest::test_runner::RngSeed::Fixed(0x0b5c_0001),
+            ..ProptestConfig::default()
+        })]
+
+        /// With penetrable surfaces, occlusion's walks search the index of the opaque ones
+        /// ([`Opaque`]): along any segment they find exactly the occluders that a scan of
+        /// every surface finds crossing it (so culling removes and clips the same windows as
+        /// with the scene's BVH), and no walk at all only when every surface is penetrable.
+        #[test]
+        fn occlusion_walks_find_every_crossed_occluder(
+            seed in 0u64..1_000_000, n in 1usize..9, everywhere in any::<bool>(),
+            ends in proptest::array::uniform6(0.0..1.0f64),
+        ) {
+            let Some(scene) = bt_testkit::nasty_penetrable_scene(seed, n, 0) else {
+                return Ok(());
+            };
+            let scene = scene.with_transmission(everywhere, 3);
+            let mut cache = TreeCache::default();
+            let prep = Prepared::new(&scene, TreeOptions::new(3), &mut cache).unwrap();
+            let (lo, hi) = scene.bvh().bounds().unwrap();
+            let at = |f: &[f64]| lo + Vec3::new(f[0], f[1], f[2]) * (hi - lo);
+            let segment = (at(&ends[..3]), at(&ends[3..]));
+            let n_surfaces = scene.surfaces().len() as u32;
+            let mut walked = Vec::new();
+            prep.visit_opaque(segment, |s| walked.push(s));
+            prop_assert_eq!(
+                crossed(&prep, walked.into_iter(), segment),
+                crossed(&prep, 0..n_surfaces, segment)
+            );
+            let every_one_penetrable = (0..n_surfaces).all(|s| scene.penetrable(SurfaceId(s)));
+            prop_assert_eq!(prep.nothing_occludes(), every_one_penetrable);
+        }
+    }
 }

@@ -144,15 +144,19 @@ proptest! {
 
     /// Every culling policy of the beam tree (the default rarely culls in rooms this small):
     /// penetrable surfaces never cover a window, so forced culling loses no crossing path,
-    /// specular or diffracted (the RX tree of the diffraction join culls the same way).
+    /// specular or diffracted (the RX tree of the diffraction join culls the same way), with
+    /// transmission everywhere (blockers and half-spaces stay opaque) or per material. The
+    /// occlusion walks then search the opaque surfaces' own index: one that left an opaque
+    /// surface out would lose no path but keep blocked candidates, and one that held a
+    /// penetrable one would lose paths, so both are compared against enumeration.
     #[test]
     fn every_culling_policy_keeps_the_crossing_paths(
         seed in 0u64..1_000_000, n in 1usize..7, terminals in 0u8..3, order in 1usize..4,
-        policy in 0usize..2, diffract in any::<bool>(),
+        policy in 0usize..2, diffract in any::<bool>(), everywhere in any::<bool>(),
     ) {
         let Some(scene) = nasty_penetrable_scene(seed, n, terminals) else { return Ok(()) };
         let culling = [Culling::Always, Culling::Auto { min_work: 0 }][policy];
-        let reference = options(order, CandidateMode::Exhaustive, true, diffract);
+        let reference = options(order, CandidateMode::Exhaustive, everywhere, diffract);
         let exhaustive = paths(&scene, &reference);
         let traced = seen(&scene, &reference);
         let set = bt_paths::beamtree::candidates_and_diffracted_in(
