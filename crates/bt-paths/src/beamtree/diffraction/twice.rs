@@ -19,6 +19,8 @@ use crate::diffraction::DiffractedSet;
 use bt_geom::{Plane, Polygon, Real, Vec3};
 use bt_scene::edges::{EdgeLine, KellerReach, LinePair, NoKellerPair};
 use bt_scene::{Edge, EdgeId, Scene, SurfaceId};
+use rustc_hash::FxHashMap;
+use std::sync::{Arc, Mutex, OnceLock};
 
 /// Angular slack (rad) of the prefilters: far above round-off, far below any angle a valid
 /// path could need.
@@ -322,7 +324,7 @@ impl TxPart {
     fn of(pairing: &Pairing<'_>, scene: &Scene, deepest: usize) -> Self {
         let near = pairing.near(scene, deepest);
         let groups = groups(&near);
-        let index = Toward::of(scene, &groups, pairing.margin, deepest);
+        let index = Toward::of(scene, pairing.margin, deepest);
         TxPart {
             margin: pairing.margin,
             near,
@@ -390,54 +392,90 @@ fn widened(span: &Span) -> (Real, Real) {
 /// from that edge's (unfolded) line ([`Listed`]).
 #[derive(Debug, Clone)]
 struct Toward {
-    /// Per surface id: the groups for a middle starting there.
-    groups: Vec<Vec<Listed>>,
+    /// Per surface id: the groups for a middle starting there, made when first asked for
+    /// ([`Toward::starting_at`]).
+    groups: Vec<OnceLock<Vec<Listed>>>,
     /// Per surface id: a reflector's polygon box grown by the margin (m).
     boxes: Vec<(Vec3, Vec3)>,
     /// Per second edge: the groups for paths with no middle reflection, made when first
     /// asked for ([`Toward::straight`]).
-    straight: Vec<std::sync::OnceLock<Vec<Listed>>>,
-    /// Per (surface id, second edge), at `surface · edges + edge`: the groups for a middle of
-    /// that one reflection, made when first asked for ([`Toward::across`]).
-    across: Vec<std::sync::OnceLock<Vec<Listed>>>,
+    straight: Vec<OnceLock<Vec<Listed>>>,
+    /// Per (surface id, second edge) asked for: the groups for a middle of that one
+    /// reflection, made when first asked for ([`Toward::across`]). A map, not a table of
+    /// every pair: a city has ~10⁹ pairs (a table of empty slots was 10-20 GB).
+    across: Across,
     /// The margin (m).
     margin: Real,
     /// The most reflections a path with two diffractions has room for.
     deepest: usize,
 }
 
+/// [`Toward::across`]'s lists by (surface id, second edge), shared with the callers (the
+/// lock is held only to look up or insert).
+#[derive(Debug, Default)]
+struct Across(Mutex<FxHashMap<(u32, u32), Shared>>);
+
+/// A list of [`Across`], shared.
+type Shared = Arc<[Listed]>;
+
+impl Clone for Across {
+    fn clone(&self) -> Self {
+        let map = self.0.lock().unwrap_or_else(|e| e.into_inner());
+        Across(Mutex::new(map.clone()))
+    }
+}
+
+/// A list of groups that the join reads: borrowed from a [`Toward`] or shared with its map.
+enum Lists<'a> {
+    Borrowed(&'a [Listed]),
+    Shared(Arc<[Listed]>),
+}
+
+impl std::ops::Deref for Lists<'_> {
+    type Target = [Listed];
+
+    fn deref(&self) -> &[Listed] {
+        match self {
+            Lists::Borrowed(list) => list,
+            Lists::Shared(list) => list,
+        }
+    }
+}
+
 impl Toward {
-    fn of(scene: &Scene, groups: &[Group], margin: Real, deepest: usize) -> Self {
-        let by_depth = |mut list: Vec<u32>| {
+    fn of(scene: &Scene, margin: Real, deepest: usize) -> Self {
+        let mut boxes = vec![(Vec3::ZERO, Vec3::ZERO); scene.surfaces().len()];
+        for m in scene.reflectors() {
+            let (lo, hi) = scene.surface(m).polygon.bounds();
+            boxes[m.index()] = (lo - Vec3::splat(margin), hi + Vec3::splat(margin));
+        }
+        Toward {
+            groups: vec![OnceLock::new(); scene.surfaces().len()],
+            boxes,
+            straight: vec![OnceLock::new(); scene.edges().len()],
+            across: Across::default(),
+            margin,
+            deepest,
+        }
+    }
+
+    /// The groups whose diffracted rays may head into reflector `m`'s box (see the type), by
+    /// depth.
+    fn starting_at(&self, groups: &[Group], m: SurfaceId) -> &[Listed] {
+        self.groups[m.index()].get_or_init(|| {
+            let bounds = self.boxes[m.index()];
+            let mut list: Vec<u32> = (0..groups.len() as u32)
+                .filter(|&g| {
+                    let span = &groups[g as usize].span;
+                    let range = cos_range_to_box(span.ends, bounds, span.line.direction);
+                    overlap(range, span.incidence)
+                })
+                .collect();
             list.sort_by_key(|&g| (groups[g as usize].depth, g));
             (list.into_iter())
                 .map(|group| Listed { group, seen: None })
                 .collect()
-        };
-        let mut by_surface = vec![Vec::new(); scene.surfaces().len()];
-        let mut boxes = vec![(Vec3::ZERO, Vec3::ZERO); scene.surfaces().len()];
-        for m in scene.reflectors() {
-            let (lo, hi) = scene.surface(m).polygon.bounds();
-            let bounds = (lo - Vec3::splat(margin), hi + Vec3::splat(margin));
-            boxes[m.index()] = bounds;
-            by_surface[m.index()] = by_depth(
-                (0..groups.len() as u32)
-                    .filter(|&g| {
-                        let span = &groups[g as usize].span;
-                        let range = cos_range_to_box(span.ends, bounds, span.line.direction);
-                        overlap(range, span.incidence)
-                    })
-                    .collect(),
-            );
-        }
-        Toward {
-            groups: by_surface,
-            boxes,
-            straight: vec![std::sync::OnceLock::new(); scene.edges().len()],
-            across: vec![std::sync::OnceLock::new(); scene.surfaces().len() * scene.edges().len()],
-            margin,
-            deepest,
-        }
+        })
     }
 
     /// The groups for paths with no middle reflection to edge `e2` of `scene` ([`heads_into`]
@@ -470,37 +508,51 @@ impl Toward {
     /// grown by the margin, mirrored through `m`'s plane as [`Pairing::far`] unfolds it (the
     /// far intervals on the edge behind `m` are parts of that segment, as for
     /// [`Toward::straight`]).
-    fn across(&self, scene: &Scene, groups: &[Group], m: SurfaceId, e2: usize) -> &[Listed] {
-        let edges = scene.edges().all();
-        self.across[m.index() * edges.len() + e2].get_or_init(|| {
-            let edge = &edges[e2];
-            let line = EdgeLine::of(edge).mirrored(scene.surface(m).polygon.plane());
-            let whole = [
-                line.point(-self.margin),
-                line.point(edge.length + self.margin),
-            ];
-            // The second edge's real ends' side of the plane (the unfolded ends mirrored back).
-            let plane = scene.surface(m).polygon.plane();
-            let behind = whole.map(|p| -plane.signed_distance(p));
-            let list = &self.groups[m.index()];
-            let fit = list.partition_point(|l| groups[l.group as usize].depth < self.deepest);
-            (list[..fit].iter())
-                .filter(|l| {
-                    let span = &groups[l.group as usize].span;
-                    heads_into(span, whole)
-                        && !surely_apart(span.ends.map(|p| plane.signed_distance(p)), behind)
-                })
-                .map(|l| Listed::seen_from(&line, groups, l.group))
-                .collect()
-        })
+    fn across(&self, scene: &Scene, groups: &[Group], m: SurfaceId, e2: usize) -> Arc<[Listed]> {
+        let key = (m.0, e2 as u32);
+        let lock = || self.across.0.lock().unwrap_or_else(|e| e.into_inner());
+        if let Some(list) = lock().get(&key) {
+            return list.clone();
+        }
+        let list = self.across_anew(scene, groups, m, e2);
+        lock().entry(key).or_insert(list).clone()
+    }
+
+    /// [`Toward::across`]'s list, made.
+    fn across_anew(
+        &self,
+        scene: &Scene,
+        groups: &[Group],
+        m: SurfaceId,
+        e2: usize,
+    ) -> Arc<[Listed]> {
+        let edge = &scene.edges().all()[e2];
+        let line = EdgeLine::of(edge).mirrored(scene.surface(m).polygon.plane());
+        let whole = [
+            line.point(-self.margin),
+            line.point(edge.length + self.margin),
+        ];
+        // The second edge's real ends' side of the plane (the unfolded ends mirrored back).
+        let plane = scene.surface(m).polygon.plane();
+        let behind = whole.map(|p| -plane.signed_distance(p));
+        let list = self.starting_at(groups, m);
+        let fit = list.partition_point(|l| groups[l.group as usize].depth < self.deepest);
+        (list[..fit].iter())
+            .filter(|l| {
+                let span = &groups[l.group as usize].span;
+                heads_into(span, whole)
+                    && !surely_apart(span.ends.map(|p| plane.signed_distance(p)), behind)
+            })
+            .map(|l| Listed::seen_from(&line, groups, l.group))
+            .collect()
     }
 
     /// The groups that may pair with `far`, or `None` when none may: with one middle
     /// reflection, the ray arriving at the far interval from the reflector's box must obey
     /// Keller's law there too (cos β0 of `q − M` against the leaving range).
-    fn groups(&self, scene: &Scene, groups: &[Group], far: &Far<'_>) -> Option<&[Listed]> {
+    fn groups(&self, scene: &Scene, groups: &[Group], far: &Far<'_>) -> Option<Lists<'_>> {
         let Some(&m) = far.middle.first() else {
-            return Some(self.straight(scene, groups, far.edge));
+            return Some(Lists::Borrowed(self.straight(scene, groups, far.edge)));
         };
         if far.middle.len() == 1 {
             let direction = far.wedge.line.direction;
@@ -508,9 +560,9 @@ impl Toward {
             if !overlap((-hi, -lo), far.leaving) {
                 return None;
             }
-            return Some(self.across(scene, groups, m, far.edge));
+            return Some(Lists::Shared(self.across(scene, groups, m, far.edge)));
         }
-        Some(&self.groups[m.index()])
+        Some(Lists::Borrowed(self.starting_at(groups, m)))
     }
 }
 
@@ -660,7 +712,7 @@ impl Pairing<'_> {
                     let Some(first) = index.groups(scene, &tx.groups, &far) else {
                         continue;
                     };
-                    self.pair_with(scene, &far, first, &mut pairs, set)?;
+                    self.pair_with(scene, &far, &first, &mut pairs, set)?;
                 }
             }
         }
