@@ -71,11 +71,32 @@ struct Focus {
     shortcut: bool,
 }
 
+/// Nodes per task of [`BeamTree::reaches`] (tens of microseconds of a city's edges each).
+const REACH_CHUNK: usize = 256;
+/// Tasks of [`BeamTree::reaches`] run at once before their reaches are appended in order (it
+/// bounds the reaches held twice, in the tasks' lists and the edges').
+const REACH_BATCH: usize = 64;
+
+/// What every node's reaches read at one depth of [`BeamTree::reaches`].
+struct ReachLevel<'a> {
+    edges: &'a bt_scene::edges::Edges,
+    depth: usize,
+    limit: &'a [usize],
+    /// Per edge, the surfaces whose planes hold it ([`plane_holds_edge`]).
+    in_plane: &'a [Vec<u32>],
+    sectors: &'a [Sector],
+    /// At the root-only depth, TX's half of each edge's Keller point and the margin.
+    focus: Option<(Vec<Focus>, Real)>,
+    eps: Real,
+}
+
 impl BeamTree {
     /// The nodes (the root included) whose image lies in an edge's exterior and whose beam
     /// reaches the edge, per edge, each edge's in ascending depth: on edge `e` the nodes of
     /// depth below `limit[e]` (none when 0). At `root_only`'s depth, only the nodes whose
-    /// Keller point with TX lies on the edge (within the margin).
+    /// Keller point with TX lies on the edge (within the margin). Each level's nodes are
+    /// split into fixed chunks, on all cores when the tree's options say so, and their
+    /// reaches appended in node order: the same lists on any number of threads.
     fn reaches(
         &self,
         scene: &Scene,
@@ -90,7 +111,6 @@ impl BeamTree {
             .map(|edge| plane_holds_edge(scene, edge))
             .collect();
         let sectors: Vec<Sector> = edges.all().iter().map(Sector::of).collect();
-        let eps = EPS * self.tol;
         let mut out: Vec<Vec<Reach>> = vec![Vec::new(); edges.len()];
         for (e, edge) in edges.all().iter().enumerate() {
             if limit[e] > 0 && in_sector(edge, self.tx) && !hidden_from(scene, self.tx, edge) {
@@ -105,36 +125,73 @@ impl BeamTree {
         }
         for (d, &(lo, hi)) in self.levels.iter().enumerate().take(max_depth) {
             let depth = d + 1;
-            // At the root-only depth, TX's half of each edge's Keller point.
-            let focus = root_only
-                .filter(|r| r.depth == depth)
-                .map(|r| (focus(scene, r.tx, r.margin), r.margin));
-            for i in (lo..hi).filter(|&i| self.nodes[i].live) {
-                let node = &self.nodes[i];
-                let planes = &self.planes[node.planes.0 as usize..node.planes.1 as usize];
-                let test = |min, max| box_meets_halfspaces(min, max, planes, eps);
-                edges.bvh().visit(test, |e| {
-                    let edge = &edges.all()[e as usize];
-                    if depth >= limit[e as usize]
-                        || in_plane[e as usize].contains(&node.surface)
-                        || focus.as_ref().is_some_and(|(focus, margin)| {
-                            !on_edge(edge, focus[e as usize], node.image, *margin)
-                        })
-                        || !sectors[e as usize].holds(edge, node.image)
-                    {
-                        return;
+            let level = ReachLevel {
+                edges,
+                depth,
+                limit,
+                in_plane: &in_plane,
+                sectors: &sectors,
+                focus: root_only
+                    .filter(|r| r.depth == depth)
+                    .map(|r| (focus(scene, r.tx, r.margin), r.margin)),
+                eps: EPS * self.tol,
+            };
+            let chunks: Vec<std::ops::Range<usize>> = (lo..hi)
+                .step_by(REACH_CHUNK)
+                .map(|a| a..(a + REACH_CHUNK).min(hi))
+                .collect();
+            for batch in chunks.chunks(REACH_BATCH) {
+                let of = |r: &std::ops::Range<usize>| self.reaches_of(r.clone(), &level);
+                let parts: Vec<Vec<(u32, Reach)>> = match self.options.parallel && batch.len() > 1 {
+                    true => {
+                        use rayon::prelude::*;
+                        batch.par_iter().map(of).collect()
                     }
-                    if let Some((lo, hi)) = clip(edge, planes, eps) {
-                        out[e as usize].push(Reach {
-                            node: i as u32,
-                            depth,
-                            image: node.image,
-                            lo,
-                            hi,
-                        });
-                    }
-                });
+                    false => batch.iter().map(of).collect(),
+                };
+                for (e, reach) in parts.into_iter().flatten() {
+                    out[e as usize].push(reach);
+                }
             }
+        }
+        out
+    }
+
+    /// The reaches of the live nodes `nodes` (all of `level`'s depth) as (edge, reach), in
+    /// node order.
+    fn reaches_of(
+        &self,
+        nodes: std::ops::Range<usize>,
+        level: &ReachLevel<'_>,
+    ) -> Vec<(u32, Reach)> {
+        let mut out = Vec::new();
+        let (edges, depth) = (level.edges, level.depth);
+        for i in nodes.filter(|&i| self.nodes[i].live) {
+            let node = &self.nodes[i];
+            let planes = &self.planes[node.planes.0 as usize..node.planes.1 as usize];
+            let test = |min, max| box_meets_halfspaces(min, max, planes, level.eps);
+            edges.bvh().visit(test, |e| {
+                let edge = &edges.all()[e as usize];
+                if depth >= level.limit[e as usize]
+                    || level.in_plane[e as usize].contains(&node.surface)
+                    || level.focus.as_ref().is_some_and(|(focus, margin)| {
+                        !on_edge(edge, focus[e as usize], node.image, *margin)
+                    })
+                    || !level.sectors[e as usize].holds(edge, node.image)
+                {
+                    return;
+                }
+                if let Some((lo, hi)) = clip(edge, planes, level.eps) {
+                    let reach = Reach {
+                        node: i as u32,
+                        depth,
+                        image: node.image,
+                        lo,
+                        hi,
+                    };
+                    out.push((e, reach));
+                }
+            });
         }
         out
     }

@@ -310,3 +310,40 @@ fn edges_a_wall_hides_from_tx_start_no_candidate_and_lose_no_path() {
         assert_eq!(listing(&tree), listing(&reference), "order {order}");
     }
 }
+
+/// The reaches of both trees are found in chunks of nodes on all cores: the diffracted
+/// candidates (one and two diffractions) are those found on one thread, in a city whose
+/// levels span many chunks (19,300 nodes at depth 2 with one diffraction at order 3).
+#[test]
+fn diffracted_candidates_on_all_cores_are_those_on_one() {
+    let scene = bt_import::builtin_scene("city", bt_scene::Terminals::default())
+        .unwrap()
+        .unwrap();
+    for (order, max_diffractions) in [(3, 1), (2, 2)] {
+        let [one, all] = [false, true].map(|parallel| {
+            bt_paths::beamtree::candidates_and_diffracted_in(
+                &scene,
+                bt_paths::beamtree::TreeOptions {
+                    parallel,
+                    ..bt_paths::beamtree::TreeOptions::new(order)
+                },
+                Some(bt_paths::diffraction::Diffracting {
+                    min_edge_length: 0.0,
+                    max_diffractions,
+                }),
+                &mut bt_paths::beamtree::TreeCache::default(),
+                &mut |_| {},
+            )
+            .unwrap()
+        });
+        assert!(
+            one.diffracted.len() > 1000,
+            "order {order}: a real workload"
+        );
+        assert!(
+            one.diffracted == all.diffracted,
+            "order {order}, {max_diffractions} diffractions: the sets differ"
+        );
+        assert_eq!(one.tree, all.tree, "order {order}");
+    }
+}
