@@ -106,7 +106,7 @@ pub enum StudyCommand {
 #[derive(Debug, Args, Clone)]
 pub struct StudyBeamManagementArgs {
     /// Output directory (created if missing).
-    #[arg(long)]
+    #[arg(short = 'o', long, visible_alias = "output")]
     pub out: PathBuf,
     /// Scenario: `living-room` (the dynamic living room, a UE walking a loop), `city` (a
     /// street of the built-in city) or a scene file (a street through its TX and RX);
@@ -166,7 +166,7 @@ pub struct StudyBeamManagementArgs {
 #[derive(Debug, Args, Clone)]
 pub struct StudyLivingRoomArgs {
     /// Output directory (created if missing).
-    #[arg(long)]
+    #[arg(short = 'o', long, visible_alias = "output")]
     pub out: PathBuf,
     /// The dynamic scene whose time steps are traced (a scene file with steps, or builtin:NAME).
     #[arg(long, default_value = "builtin:living-room-dynamic")]
@@ -227,7 +227,7 @@ pub struct Study2dArgs {
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
     /// Output directory (created if missing).
-    #[arg(long)]
+    #[arg(short = 'o', long, visible_alias = "output")]
     pub out: PathBuf,
     /// SBR angular step, degrees (the paper: 1).
     #[arg(long, default_value_t = 1.0, value_parser = numbers::sbr_step_deg)]
@@ -462,7 +462,7 @@ pub struct TraceArgs {
     pub json: bool,
     /// Write the JSON document to this file instead of the terminal (which gets one line
     /// saying where it went).
-    #[arg(long)]
+    #[arg(short = 'o', long, visible_alias = "output")]
     pub out: Option<PathBuf>,
     /// Trace every time step of a dynamic scene (static scenes have one step).
     #[arg(long)]
@@ -622,7 +622,7 @@ pub struct SweepArgs {
     #[command(flatten)]
     pub solve: SolveArgs,
     /// Output directory (created if missing): coverage.csv, coverage.svg, coverage.png.
-    #[arg(long)]
+    #[arg(short = 'o', long, visible_alias = "output")]
     pub out: PathBuf,
     /// Budget: refuse grids with more points than this (checked before any work).
     #[arg(long, default_value_t = bt_coverage::DEFAULT_MAX_POINTS)]
@@ -668,7 +668,7 @@ pub struct ViewArgs {
     #[arg(long)]
     pub paths: Option<PathBuf>,
     /// HTML file to write.
-    #[arg(short = 'o', long = "output")]
+    #[arg(short = 'o', long = "output", visible_alias = "out")]
     pub output: PathBuf,
     #[command(flatten)]
     pub coefficient: CoefficientArgs,
@@ -754,7 +754,7 @@ pub struct WvrnArgs {
     #[arg(long)]
     pub dot: bool,
     /// Write the output to this file instead of stdout.
-    #[arg(short = 'o', long)]
+    #[arg(short = 'o', long, visible_alias = "output")]
     pub out: Option<PathBuf>,
     /// Dynamic scenes: the time step to export (0-based).
     #[arg(long, default_value_t = 0)]
@@ -850,7 +850,7 @@ pub struct ChannelArgs {
     #[command(flatten)]
     pub paths: PathArgs,
     /// Channel impulse response CSV to write (one tap per path, by delay).
-    #[arg(long)]
+    #[arg(short = 'o', long, visible_alias = "output")]
     pub out: PathBuf,
     /// Also write the frequency response at the subcarriers to this CSV.
     #[arg(long)]
@@ -917,7 +917,7 @@ pub struct BeamsArgs {
     #[arg(long)]
     pub json: bool,
     /// Write the JSON to this file.
-    #[arg(long)]
+    #[arg(short = 'o', long, visible_alias = "output")]
     pub out: Option<PathBuf>,
 }
 
@@ -981,7 +981,7 @@ pub struct ExtractArgs {
     /// Point cloud: .ply (ASCII or binary) or .pcd (ASCII or binary), metres, z up.
     pub cloud: PathBuf,
     /// Scene file to write: .json or .toml (by extension; other extensions are refused).
-    #[arg(short = 'o', long = "output")]
+    #[arg(short = 'o', long = "output", visible_alias = "out")]
     pub output: PathBuf,
     /// Also write the extraction report (JSON) here.
     #[arg(long)]
@@ -1014,7 +1014,7 @@ pub struct SampleArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
     /// Point cloud to write (.ply binary little-endian, or .pcd ASCII).
-    #[arg(short = 'o', long = "output")]
+    #[arg(short = 'o', long = "output", visible_alias = "out")]
     pub output: PathBuf,
     /// Points per square metre of surface.
     #[arg(long, default_value_t = 2000.0, value_parser = numbers::positive)]
@@ -1106,7 +1106,7 @@ pub struct HlsGenArgs {
     #[command(flatten)]
     pub scene: SceneArgs,
     /// Output directory.
-    #[arg(short = 'o', long = "output")]
+    #[arg(short = 'o', long = "output", visible_alias = "out")]
     pub output: PathBuf,
     /// Highest reflection order of the candidate paths.
     #[arg(long, default_value_t = 3)]
@@ -1188,6 +1188,33 @@ pub fn with_default_subcommands(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// Clap's own checks of every command (names, short flags and aliases unique per
+    /// command), and every file a command writes named by `-o`, `--out` and `--output` alike.
+    #[test]
+    fn every_output_takes_o_out_and_output() {
+        use clap::CommandFactory;
+        let cli = Cli::command();
+        cli.clone().debug_assert();
+        fn walk(cmd: &clap::Command, path: &str, found: &mut Vec<String>) {
+            for arg in cmd.get_arguments() {
+                let long = arg.get_long().unwrap_or_default();
+                if long == "out" || long == "output" {
+                    let aliases = arg.get_visible_aliases().unwrap_or_default();
+                    let other = if long == "out" { "output" } else { "out" };
+                    assert!(aliases.contains(&other), "{path} --{long}: no --{other}");
+                    assert_eq!(arg.get_short(), Some('o'), "{path} --{long}: no -o");
+                    found.push(path.to_string());
+                }
+            }
+            for sub in cmd.get_subcommands() {
+                walk(sub, &format!("{path} {}", sub.get_name()), found);
+            }
+        }
+        let mut found = Vec::new();
+        walk(&cli, "beamtrace", &mut found);
+        assert!(found.len() >= 10, "outputs found: {found:?}");
+    }
 
     #[test]
     fn scene_defaults_are_the_command_lines() {
