@@ -452,6 +452,12 @@ fn print_summary(s: &HlsSummary, dir: &Path) {
         f.missed,
         f.spurious
     );
+    if f.reference == bt_accel::Reference::StepCandidates {
+        println!(
+            "  (the reference traced the step's own candidates: enumerating every sequence \
+             would exceed --max-candidates)"
+        );
+    }
     if s.rtl_written {
         println!(
             "wrote {}/rtl, tb, vectors, platform.json, work.json, report.md, summary.json",

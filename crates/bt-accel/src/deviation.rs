@@ -3,15 +3,32 @@
 
 use bt_geom::Vec3;
 use bt_hls::PathResult;
-use bt_paths::AllVisible;
+use bt_paths::{AllVisible, CandidateSet};
 use bt_scene::{Endpoints, Scene};
 use serde::Serialize;
 
 use crate::bridge::{HostRejection, StepInput, host_accepts};
 
+/// The candidates the f64 reference of [`fixed_deviation`] traces with the image method.
+#[derive(Debug, Clone, Copy, Serialize, Default, PartialEq, Eq)]
+#[serde(rename_all = "kebab-case")]
+pub enum Reference {
+    /// Every sequence up to the order (blind enumeration): independent of the generator
+    /// that gave the step its candidates.
+    #[default]
+    Exhaustive,
+    /// The step's own candidates, when blind enumeration would exceed the candidate budget
+    /// (a city holds ~10⁸ sequences at order 2, ~10¹² at order 3). The beam tree gives every
+    /// path blind enumeration gives (property-tested), so the points and angles compare as
+    /// before; `missed` then counts only the paths the host check rejects.
+    StepCandidates,
+}
+
 /// Fixed-point model vs the f64 reference (image method over every candidate of the order).
 #[derive(Debug, Clone, Serialize, Default, PartialEq)]
 pub struct FixedDeviation {
+    /// Which candidates the reference traced.
+    pub reference: Reference,
     /// Exact paths the accelerator computed (found among its candidates).
     pub valid_paths_compared: usize,
     /// Largest distance between a fixed-point point and the exact one, millimetres.
@@ -39,18 +56,30 @@ pub struct FixedDeviation {
 
 /// Compare one step's accelerator results (`results[p]` of `step.sequences[p]`) with the
 /// image method over every sequence up to `max_order` (exhaustive enumeration, validated):
-/// the reference is independent of the candidate generator the step used. A scene without
-/// both terminals fails ([`bt_scene::SceneError::MissingTerminal`]).
+/// the reference is independent of the candidate generator the step used. When those
+/// sequences number more than `budget` (`--max-candidates`), the reference traces the step's
+/// own candidates `own` instead ([`Reference::StepCandidates`]): enumerating a city's took
+/// gigabytes. A scene without both terminals fails
+/// ([`bt_scene::SceneError::MissingTerminal`]).
 pub fn fixed_deviation(
     scene: &Scene,
-    step: &StepInput,
+    (step, own): (&StepInput, &CandidateSet),
     results: &[PathResult],
-    max_order: usize,
+    (max_order, budget): (usize, u64),
 ) -> Result<FixedDeviation, bt_scene::SceneError> {
     let ends = scene.terminals()?;
-    let candidates = bt_paths::enumerate(scene, max_order, &AllVisible)?;
-    let reference = bt_solve::trace(scene, &candidates, &bt_solve::Solver::Image, true)?;
+    let within = bt_solve::pipeline::exhaustive_budget(scene, max_order, budget).is_ok();
+    let enumerated;
+    let (candidates, which) = match within {
+        true => {
+            enumerated = bt_paths::enumerate(scene, max_order, &AllVisible)?;
+            (&enumerated, Reference::Exhaustive)
+        }
+        false => (own, Reference::StepCandidates),
+    };
+    let reference = bt_solve::trace(scene, candidates, &bt_solve::Solver::Image, true)?;
     let mut err = FixedDeviation {
+        reference: which,
         left_bounds: results.iter().filter(|r| r.left_bounds).count(),
         ..FixedDeviation::default()
     };

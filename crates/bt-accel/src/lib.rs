@@ -16,5 +16,5 @@ pub use bridge::{
     HostRejection, REFLECTION_TOLERANCE_DEG, StepInput, hls_input, host_accepts,
     reflection_error_deg, static_reflectors, step_input, warm_start,
 };
-pub use deviation::{FixedDeviation, fixed_deviation};
+pub use deviation::{FixedDeviation, Reference, fixed_deviation};
 pub use step::{AccelError, PlannedStep, StepOptions, plan_step};

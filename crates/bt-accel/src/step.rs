@@ -172,7 +172,8 @@ pub fn plan_step(
     bt_hls::predict_dispatch(&mut plan, &rounds, columns, step.input.pe_latency())
         .map_err(hardware)?;
     let t3 = Instant::now();
-    let fixed = fixed_deviation(scene, &step, &results, trace.max_order)
+    let budget = (trace.max_order, trace.max_candidates);
+    let fixed = fixed_deviation(scene, (&step, &candidates), &results, budget)
         .map_err(|e| candidates_failed(e.into()))?;
     Ok(PlannedStep {
         index,

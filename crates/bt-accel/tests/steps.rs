@@ -271,3 +271,28 @@ fn one_copy_takes_every_cold_step_of_the_living_room_under_a_millisecond() {
         assert!(p.plan.predicted_cycles < plain.plan.predicted_cycles);
     }
 }
+
+/// Beyond the candidate budget, the fixed-point comparison traces the step's own candidates
+/// instead of every sequence (a city's took gigabytes): the beam tree holds every path
+/// enumeration holds, so the comparison's figures are those of the exhaustive reference.
+#[test]
+fn the_reference_beyond_the_budget_is_the_steps_candidates_with_the_same_figures() {
+    let scene = living_room();
+    let steps = scene.scenes();
+    let planes = static_reflectors(steps);
+    let reflectors = steps[0].reflectors().count() as u64;
+    let enumerated = bt_solve::pipeline::exhaustive_count(reflectors, 2);
+    let within = options(2, false);
+    let mut beyond = options(2, false);
+    beyond.trace.max_candidates = enumerated - 1;
+    let a = plan_step(&steps[0], &planes, 0, &within, None).unwrap();
+    let b = plan_step(&steps[0], &planes, 0, &beyond, None).unwrap();
+    assert_eq!(a.fixed.reference, bt_accel::Reference::Exhaustive);
+    assert_eq!(b.fixed.reference, bt_accel::Reference::StepCandidates);
+    assert!(a.fixed.valid_paths_compared > 5, "{:?}", a.fixed);
+    let same = bt_accel::FixedDeviation {
+        reference: a.fixed.reference,
+        ..b.fixed.clone()
+    };
+    assert_eq!(same, a.fixed);
+}
