@@ -243,7 +243,16 @@ fn in_order<T: Sync, R: Send>(
     items: &[T],
     f: impl Fn(&T) -> R + Sync,
 ) -> Vec<R> {
-    match prep.options.parallel && items.len() > 1 {
+    in_order_if(prep.options.parallel, items, f)
+}
+
+/// `f` of each of `items`, in order; on all cores when `parallel` and there is more than one.
+pub(super) fn in_order_if<T: Sync, R: Send>(
+    parallel: bool,
+    items: &[T],
+    f: impl Fn(&T) -> R + Sync,
+) -> Vec<R> {
+    match parallel && items.len() > 1 {
         true => items.par_iter().map(&f).collect(),
         false => items.iter().map(f).collect(),
     }

@@ -141,14 +141,9 @@ impl BeamTree {
                 .map(|a| a..(a + REACH_CHUNK).min(hi))
                 .collect();
             for batch in chunks.chunks(REACH_BATCH) {
-                let of = |r: &std::ops::Range<usize>| self.reaches_of(r.clone(), &level);
-                let parts: Vec<Vec<(u32, Reach)>> = match self.options.parallel && batch.len() > 1 {
-                    true => {
-                        use rayon::prelude::*;
-                        batch.par_iter().map(of).collect()
-                    }
-                    false => batch.iter().map(of).collect(),
-                };
+                let parts = super::chunked::in_order_if(self.options.parallel, batch, |r| {
+                    self.reaches_of(r.clone(), &level)
+                });
                 for (e, reach) in parts.into_iter().flatten() {
                     out[e as usize].push(reach);
                 }
