@@ -24,6 +24,7 @@ pub use keller::{
 
 use crate::surface::{Surface, SurfaceId, SurfaceKind};
 use bt_geom::{Bvh, Plane, Real, Vec3, bvh::Occluder};
+use rayon::prelude::*;
 use std::f64::consts::PI;
 
 /// Index of an edge in [`Edges`].
@@ -191,11 +192,23 @@ impl Edges {
                 .map(|s| Grown(s.polygon.bounds(), tol))
                 .collect::<Vec<_>>(),
         );
-        let mut edges = Vec::new();
-        for (i, segment) in segments.iter().enumerate() {
-            let around = Around::gather(i, &segments, &segment_bvh, surfaces, &polygon_bvh, tol);
-            around.edges(segment, tol, &mut edges);
-        }
+        // Each segment's edges depend on the segments and surfaces alone: chunks of them on
+        // all cores, appended in segment order (the same edges on any number of threads).
+        let starts: Vec<usize> = (0..segments.len()).step_by(SEGMENTS_PER_TASK).collect();
+        let parts: Vec<Vec<Edge>> = starts
+            .par_iter()
+            .map(|&start| {
+                let mut part = Vec::new();
+                let end = (start + SEGMENTS_PER_TASK).min(segments.len());
+                for (i, segment) in segments.iter().enumerate().take(end).skip(start) {
+                    let around =
+                        Around::gather(i, &segments, &segment_bvh, surfaces, &polygon_bvh, tol);
+                    around.edges(segment, tol, &mut part);
+                }
+                part
+            })
+            .collect();
+        let edges: Vec<Edge> = parts.concat();
         let boxes: Vec<Grown> = edges
             .iter()
             .map(|e| Grown((e.start.min(e.end), e.start.max(e.end)), 0.0))
@@ -206,6 +219,9 @@ impl Edges {
         }
     }
 }
+
+/// Boundary segments per task of [`Edges::build`] (a few milliseconds of a city's).
+const SEGMENTS_PER_TASK: usize = 4096;
 
 /// A box grown by a margin (m) on every side.
 struct Grown((Vec3, Vec3), Real);

@@ -224,3 +224,35 @@ fn the_exterior_test_agrees_with_the_angle_definition() {
         assert!(checked > 19_000);
     }
 }
+
+/// The edges are found in chunks of boundary segments on all cores: the same edges, in the
+/// same order, as on one thread, for a row of cubes with many chunks' segments (some cubes
+/// touching their neighbours, so that wedges span two cubes' faces).
+#[test]
+fn edges_found_on_all_cores_are_those_found_on_one() {
+    let surfaces: Vec<Surface> = (0..400)
+        .flat_map(|k| {
+            let x = k as Real * if k % 3 == 0 { 1.0 } else { 1.5 };
+            cube().into_iter().map(move |mut s| {
+                let moved = s.polygon.vertices().iter().map(|v| *v + Vec3::new(x, 0.0, 0.0));
+                s.polygon = Polygon::new(moved.collect()).unwrap();
+                s.name = format!("{}-{k}", s.name);
+                s
+            })
+        })
+        .collect();
+    let sides: usize = surfaces.iter().map(|s| s.polygon.vertices().len()).sum();
+    assert!(sides > 2 * SEGMENTS_PER_TASK, "{sides} sides: more than two tasks");
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap()
+        .install(|| Edges::build(&surfaces));
+    let all = rayon::ThreadPoolBuilder::new()
+        .num_threads(2)
+        .build()
+        .unwrap()
+        .install(|| Edges::build(&surfaces));
+    assert!(one.len() > 3000, "{} edges", one.len());
+    assert_eq!(one.all(), all.all());
+}
