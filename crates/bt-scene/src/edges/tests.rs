@@ -234,7 +234,11 @@ fn edges_found_on_all_cores_are_those_found_on_one() {
         .flat_map(|k| {
             let x = k as Real * if k % 3 == 0 { 1.0 } else { 1.5 };
             cube().into_iter().map(move |mut s| {
-                let moved = s.polygon.vertices().iter().map(|v| *v + Vec3::new(x, 0.0, 0.0));
+                let moved = s
+                    .polygon
+                    .vertices()
+                    .iter()
+                    .map(|v| *v + Vec3::new(x, 0.0, 0.0));
                 s.polygon = Polygon::new(moved.collect()).unwrap();
                 s.name = format!("{}-{k}", s.name);
                 s
@@ -242,7 +246,10 @@ fn edges_found_on_all_cores_are_those_found_on_one() {
         })
         .collect();
     let sides: usize = surfaces.iter().map(|s| s.polygon.vertices().len()).sum();
-    assert!(sides > 2 * SEGMENTS_PER_TASK, "{sides} sides: more than two tasks");
+    assert!(
+        sides > 2 * SEGMENTS_PER_TASK,
+        "{sides} sides: more than two tasks"
+    );
     let one = rayon::ThreadPoolBuilder::new()
         .num_threads(1)
         .build()
