@@ -428,7 +428,7 @@ impl Clone for Across {
 /// A list of groups that the join reads: borrowed from a [`Toward`] or shared with its map.
 enum Lists<'a> {
     Borrowed(&'a [Listed]),
-    Shared(Arc<[Listed]>),
+    Shared(Shared),
 }
 
 impl std::ops::Deref for Lists<'_> {
@@ -508,7 +508,7 @@ impl Toward {
     /// grown by the margin, mirrored through `m`'s plane as [`Pairing::far`] unfolds it (the
     /// far intervals on the edge behind `m` are parts of that segment, as for
     /// [`Toward::straight`]).
-    fn across(&self, scene: &Scene, groups: &[Group], m: SurfaceId, e2: usize) -> Arc<[Listed]> {
+    fn across(&self, scene: &Scene, groups: &[Group], m: SurfaceId, e2: usize) -> Shared {
         let key = (m.0, e2 as u32);
         let lock = || self.across.0.lock().unwrap_or_else(|e| e.into_inner());
         if let Some(list) = lock().get(&key) {
@@ -519,13 +519,7 @@ impl Toward {
     }
 
     /// [`Toward::across`]'s list, made.
-    fn across_anew(
-        &self,
-        scene: &Scene,
-        groups: &[Group],
-        m: SurfaceId,
-        e2: usize,
-    ) -> Arc<[Listed]> {
+    fn across_anew(&self, scene: &Scene, groups: &[Group], m: SurfaceId, e2: usize) -> Shared {
         let edge = &scene.edges().all()[e2];
         let line = EdgeLine::of(edge).mirrored(scene.surface(m).polygon.plane());
         let whole = [
