@@ -464,12 +464,8 @@ impl Opaque {
         let ids: Vec<u32> = (0..scene.surfaces().len() as u32)
             .filter(|&s| !scene.penetrable(SurfaceId(s)))
             .collect();
-        let polygons: Vec<&bt_geom::Polygon> = ids
-            .iter()
-            .map(|&s| &scene.surface(SurfaceId(s)).polygon)
-            .collect();
         Some(Opaque {
-            bvh: bt_geom::bvh::Bvh::build(&polygons),
+            bvh: bvh_over(scene, &ids),
             ids,
         })
     }
@@ -1771,16 +1767,22 @@ fn rx_visibility(prep: &Prepared<'_>, rx: Vec3, stats: &mut TreeStats) -> RxVisi
         .copied()
         .filter(|&s| visible[s as usize])
         .collect();
-    let polygons: Vec<&bt_geom::Polygon> = ids
-        .iter()
-        .map(|&s| &prep.scene.surface(SurfaceId(s)).polygon)
-        .collect();
     RxVisible {
         visible,
-        bvh: bt_geom::bvh::Bvh::build(&polygons),
+        bvh: bvh_over(prep.scene, &ids),
         ids,
         reach: None,
     }
+}
+
+/// A BVH over the polygons of `scene`'s surfaces `ids` (item `i` is surface `ids[i]`): the
+/// reflectors RX sees ([`rx_visibility`]), the opaque surfaces ([`Opaque`]).
+fn bvh_over(scene: &Scene, ids: &[u32]) -> bt_geom::bvh::Bvh {
+    let polygons: Vec<&bt_geom::Polygon> = ids
+        .iter()
+        .map(|&s| &scene.surface(SurfaceId(s)).polygon)
+        .collect();
+    bt_geom::bvh::Bvh::build(&polygons)
 }
 
 /// The reflectors of `chunk` that RX sees (see [`rx_visibility`]), and the occlusion tests'
