@@ -1053,14 +1053,15 @@ impl BeamTree {
     }
 
     /// [`BeamTree::child`]; with `probe`, the child is tested for occlusion and pushed only
-    /// when it can end or lead to a candidate ([`Probe::ends_a_candidate`]).
+    /// when it can end or lead to a candidate ([`Probe::ends_a_candidate`], trying only the
+    /// leaves given with it, when given).
     fn child_probed(
         &mut self,
         prep: &Prepared<'_>,
         parent: &Parent<'_>,
         s: u32,
         scratch: &mut Scratch,
-        probe: Option<&mut Probe>,
+        probe: Option<(&mut Probe, Option<&[u32]>)>,
     ) {
         let plane = *prep.plane(s);
         if plane.signed_distance_unfused(parent.apex).abs() <= prep.tol {
@@ -1082,8 +1083,8 @@ impl BeamTree {
             return;
         }
         let image = plane.mirror(parent.apex);
-        if let Some(probe) = probe
-            && !probe.ends_a_candidate(self, prep, (s, image), &scratch.a)
+        if let Some((probe, only)) = probe
+            && !probe.ends_a_candidate(self, prep, (s, image), &scratch.a, only)
         {
             return;
         }
@@ -1260,13 +1261,16 @@ impl Probe {
     /// in the beam of one of its children ([`LeafTest::hit`]); counts the children tested in
     /// `tree`'s statistics. Occlusion culling only shrinks a window, and the beam of a smaller
     /// window lies inside the larger's: a node for which this is false holds no candidate and
-    /// has no child that does, culled or not.
+    /// has no child that does, culled or not. With `only` (the leaves whose cones hold the
+    /// parent's apex, [`join::Joined`]), a node whose reach lists answer tries those leaves
+    /// instead of its list: the others cannot pass when its beam is well defined.
     fn ends_a_candidate(
         &mut self,
         tree: &mut BeamTree,
         prep: &Prepared<'_>,
         (s, image): (u32, Vec3),
         window: &[Vec3],
+        only: Option<&[u32]>,
     ) -> bool {
         self.planes.clear();
         beam_planes(prep.plane(s), image, window, &mut self.planes);
@@ -1288,6 +1292,10 @@ impl Probe {
         let mut tested = 0;
         let reach = prep.rx_visible.as_ref().and_then(|v| v.reach.as_ref());
         if let Some(reach) = reach.filter(|r| r.answers(prep, (s, image), window, &self.planes)) {
+            if let Some(only) = only {
+                tree.stats.tested += only.len() as u64;
+                return only.iter().any(|&c| self.test.hit(prep, &node, c));
+            }
             // Only the reflectors whose mirror beam reaches `s` can pass.
             let found = reach.of_surface(prep, s, image).any(|c| {
                 tested += u64::from(c != s);

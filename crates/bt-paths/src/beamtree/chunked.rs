@@ -165,27 +165,28 @@ impl BeamTree {
                 let parent = self.parent_ref(prep, ROOT);
                 part.stats.tested += children.len() as u64;
                 for &s in children {
-                    part.child_probed(prep, &parent, s, &mut scratch, probe.as_mut());
+                    let probing = probe.as_mut().map(|p| (p, None));
+                    part.child_probed(prep, &parent, s, &mut scratch, probing);
                 }
             }
             Work::Parents(parents) => {
                 let mut children = Vec::new();
                 for &p in parents {
                     let parent = self.parent_ref(prep, p);
-                    let children = match joined {
-                        Some(pairs) => {
-                            let (kept, tried) = pairs.of_parent(p);
-                            part.stats.tested += tried;
-                            kept
+                    if let Some(pairs) = joined {
+                        let (kept, tried) = pairs.of_parent(p);
+                        part.stats.tested += tried;
+                        for child in kept {
+                            let probing = probe.as_mut().map(|p| (p, pairs.leaves(child)));
+                            part.child_probed(prep, &parent, child.s, &mut scratch, probing);
                         }
-                        None => {
-                            self.child_candidates(prep, &parent, false, &mut children);
-                            part.stats.tested += children.len() as u64;
-                            &children[..]
-                        }
-                    };
-                    for &s in children {
-                        part.child_probed(prep, &parent, s, &mut scratch, probe.as_mut());
+                        continue;
+                    }
+                    self.child_candidates(prep, &parent, false, &mut children);
+                    part.stats.tested += children.len() as u64;
+                    for &s in &children {
+                        let probing = probe.as_mut().map(|p| (p, None));
+                        part.child_probed(prep, &parent, s, &mut scratch, probing);
                     }
                 }
             }
