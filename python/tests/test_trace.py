@@ -119,6 +119,21 @@ def test_diffraction_coefficient_matches_cli(cli_json):
     assert many[0].gain.tolist() == sionna.gain.tolist()
 
 
+def test_thickness_alone_matches_cli(cli_json):
+    """load(thickness=) alone is --thickness alone: the scene's half-space materials (the two
+    rooms' concrete shell) become slabs, so a receiver outside is reached through the shell,
+    with the CLI's every field."""
+    two_rooms = str(REPO / "examples" / "two-rooms.json")
+    outside = [9.0, 1.0, 1.2]
+    scene = beamtrace.load(two_rooms, thickness=0.1)
+    paths = scene.trace(rx=outside, max_order=2, transmission=True)
+    assert len(paths) > 0
+    assert all(names[-1] == "shell.east" for names in paths.surfaces)
+    assert_same_as_cli(paths, cli_json(two_rooms, "--max-order", "2", "--rx", vec(outside),
+                                       "--transmission", "--thickness", "0.1"))
+    assert len(beamtrace.load(two_rooms).trace(rx=outside, max_order=2, transmission=True)) == 0
+
+
 def test_transmission_matches_cli(cli_json):
     # Through the partition (plasterboard) with transmission=True, as `--transmission`; the
     # curtain's material opens it either way.
@@ -185,8 +200,8 @@ def test_radio_load_options_match_cli(cli_json, material, thickness, frequency):
 def test_radio_load_options_are_checked():
     with pytest.raises(ValueError, match="expected itu:NAME"):
         beamtrace.load("builtin:living-room", material="concrete")
-    with pytest.raises(ValueError, match="thickness= needs material="):
-        beamtrace.load("builtin:living-room", thickness=0.2)
+    with pytest.raises(ValueError, match="thickness= must be a finite number"):
+        beamtrace.load("builtin:living-room", thickness=-0.2)
     with pytest.raises(beamtrace.BeamtraceError, match="frequency"):
         beamtrace.load("builtin:living-room", frequency=-1.0)
 

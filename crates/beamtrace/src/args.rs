@@ -320,12 +320,19 @@ pub struct MaterialArgs {
     /// custom:EPS_R,SIGMA (relative permittivity, conductivity in S/m).
     #[arg(long, value_parser = parse_material)]
     pub material: Option<String>,
-    /// With --material: slab thickness in metres (default: a half-space).
-    #[arg(long, requires = "material", allow_hyphen_values = true, value_parser = numbers::length_m)]
+    /// Slab thickness in metres: of --material; without it, of every material the scene
+    /// leaves a half-space (so that --transmission crosses it; slabs keep their own).
+    #[arg(long, allow_hyphen_values = true, value_parser = numbers::length_m)]
     pub thickness: Option<f64>,
 }
 
 impl MaterialArgs {
+    /// `--thickness` alone (without `--material`): the slab thickness of every half-space
+    /// material, m.
+    pub fn thickness_alone(&self) -> Option<f64> {
+        self.thickness.filter(|_| self.material.is_none())
+    }
+
     /// The radio material `--material`/`--thickness` select, checked.
     pub fn radio(&self) -> anyhow::Result<Option<bt_channel::RadioMaterial>> {
         let Some(spec) = &self.material else {

@@ -8,8 +8,9 @@ use bt_scene::dynamic::DynamicScene;
 use bt_scene::{Scene, Terminal, Terminals, Vec3};
 
 /// The load options the scene arguments select: `--material`/`--thickness` give every
-/// material of any source that radio model; `--frequency` is the carrier of sources that carry
-/// none (meshes, point clouds, XML scenes).
+/// material of any source that radio model (`--thickness` alone: that slab thickness to each
+/// half-space material); `--frequency` is the carrier of sources that carry none (meshes,
+/// point clouds, XML scenes).
 pub fn load_options(args: &SceneArgs) -> anyhow::Result<LoadOptions> {
     Ok(LoadOptions {
         terminals: Terminals {
@@ -35,6 +36,7 @@ pub fn load_options(args: &SceneArgs) -> anyhow::Result<LoadOptions> {
             .frequency
             .unwrap_or(bt_scene::DEFAULT_FREQUENCY_HZ),
         radio: args.material.radio()?,
+        thickness: args.material.thickness_alone(),
         ..LoadOptions::default()
     })
 }

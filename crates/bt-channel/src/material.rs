@@ -295,6 +295,16 @@ impl RadioMaterial {
         })
     }
 
+    /// The same material as a slab of `thickness` metres (CLI `--thickness` without
+    /// `--material`): a finite number ≥ 0.
+    pub fn with_thickness(self, thickness: Real) -> Result<RadioMaterial, ChannelError> {
+        check_thickness(Some(thickness))?;
+        Ok(RadioMaterial {
+            thickness: Some(thickness),
+            ..self
+        })
+    }
+
     /// εr' and σ (S/m) at `frequency_hz`.
     pub fn properties(&self, frequency_hz: Real) -> Result<(Real, Real), ChannelError> {
         match self.model {

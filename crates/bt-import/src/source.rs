@@ -31,6 +31,9 @@ pub struct LoadOptions {
     /// A radio material for every surface (CLI `--material itu:NAME --thickness M`), replacing
     /// the radio model of every material of the loaded scene, whatever its format.
     pub radio: Option<bt_channel::RadioMaterial>,
+    /// Without `radio`: the slab thickness (m) of every material the scene leaves a
+    /// half-space (CLI `--thickness` alone), so that `--transmission` crosses them too.
+    pub thickness: Option<Real>,
     /// Budget: the largest input file read, bytes (CLI `--max-file-bytes`): scene files, meshes
     /// (also those of an XML scene), point clouds. Checked against the file's size before it
     /// is read ([`MAX_FILE_BYTES`]).
@@ -74,6 +77,7 @@ impl Default for LoadOptions {
             extract: bt_pointcloud::ExtractParams::default(),
             cloud: crate::cloud::ReadOptions::default(),
             radio: None,
+            thickness: None,
             max_file_bytes: MAX_FILE_BYTES.limit,
             max_xml_substitution: crate::xml::MAX_XML_SUBSTITUTION.limit,
         }
@@ -282,7 +286,8 @@ pub fn load(source: &str, options: &LoadOptions) -> Result<Loaded, ImportError> 
 }
 
 /// [`load`], reporting the progress of point-cloud plane extraction to `progress`.
-/// `options.radio`, when set, replaces the radio model of every material, whatever the format.
+/// `options.radio`, when set, replaces the radio model of every material, whatever the format;
+/// otherwise `options.thickness` makes each half-space material a slab.
 pub fn load_with_progress(
     source: &str,
     options: &LoadOptions,
@@ -312,6 +317,8 @@ fn load_hashing(
     let mut loaded = load_any(source, options, progress, hashing)?;
     if let Some(radio) = options.radio {
         loaded.scene = loaded.scene.with_radio_material(radio)?;
+    } else if let Some(thickness) = options.thickness {
+        loaded.scene = loaded.scene.with_half_spaces_as_slabs(thickness)?;
     }
     Ok(loaded)
 }
@@ -410,6 +417,8 @@ pub fn load_dynamic(
             }
             if let Some(radio) = options.radio {
                 scene = scene.with_radio_material(radio)?;
+            } else if let Some(thickness) = options.thickness {
+                scene = scene.with_half_spaces_as_slabs(thickness)?;
             }
             Ok(Loaded {
                 sources,

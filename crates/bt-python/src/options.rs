@@ -112,8 +112,9 @@ pub struct LoadBudgets {
 }
 
 /// `load`'s `material=` and `thickness=` (the CLI's `--material`, `--thickness`): the radio
-/// material of every surface, or none; a thickness without a material is a `ValueError`, as
-/// the CLI requires `--material` with `--thickness`.
+/// material of every surface, or none; a `thickness=` alone is left to
+/// [`bt_import::LoadOptions::thickness`] (every half-space material's slab thickness), checked here as
+/// the CLI checks it.
 pub fn radio_material(
     material: Option<&str>,
     thickness: Option<f64>,
@@ -121,9 +122,10 @@ pub fn radio_material(
     let value_error = |e: String| pyo3::exceptions::PyValueError::new_err(e);
     match (material, thickness) {
         (None, None) => Ok(None),
-        (None, Some(_)) => Err(value_error(
-            "thickness= needs material= (the slab's material)".into(),
-        )),
+        (None, Some(t)) if !(t.is_finite() && t >= 0.0) => Err(value_error(format!(
+            "thickness= must be a finite number of metres >= 0, got {t}"
+        ))),
+        (None, Some(_)) => Ok(None),
         (Some(spec), thickness) => bt_beams::RadioMaterial::from_spec(spec, thickness)
             .map(Some)
             .map_err(|e| value_error(e.to_string())),

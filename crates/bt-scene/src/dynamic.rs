@@ -217,6 +217,12 @@ impl DynamicScene {
         self.map_steps(|s| s.with_radio_material(radio))
     }
 
+    /// A copy whose half-space materials are slabs of `thickness` metres at every step (CLI
+    /// `--thickness` alone), see [`Scene::with_half_spaces_as_slabs`].
+    pub fn with_half_spaces_as_slabs(&self, thickness: bt_geom::Real) -> Result<Self, SceneError> {
+        self.map_steps(|s| s.with_half_spaces_as_slabs(thickness))
+    }
+
     /// A copy with carrier `frequency_hz` at every step (CLI `--frequency`), see
     /// [`Scene::with_frequency`].
     pub fn with_frequency(&self, frequency_hz: Real) -> Result<Self, SceneError> {

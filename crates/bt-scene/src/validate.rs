@@ -800,9 +800,41 @@ impl Scene {
         &self,
         radio: bt_channel::RadioMaterial,
     ) -> Result<Scene, crate::SceneError> {
+        self.with_radio_models(|_| Ok(Some(radio)))
+    }
+
+    /// A copy in which every material whose radio model is a half-space (no thickness)
+    /// is a slab of `thickness` metres instead (CLI `--thickness` without `--material`, so
+    /// that `--transmission` can cross it; a finite number ≥ 0), checked at the scene's
+    /// frequency. Slabs keep their own thickness; materials without a radio model (a
+    /// constant `reflection_loss_db` alone) stay as they are.
+    pub fn with_half_spaces_as_slabs(&self, thickness: Real) -> Result<Scene, crate::SceneError> {
+        let invalid = |e: bt_channel::ChannelError| crate::SceneError::Invalid {
+            source_name: self.name.clone(),
+            problems: vec![Problem {
+                location: "--thickness".into(),
+                message: e.to_string(),
+            }],
+        };
+        self.with_radio_models(|radio| match radio {
+            Some(r) if r.thickness.is_none() => {
+                r.with_thickness(thickness).map(Some).map_err(invalid)
+            }
+            other => Ok(other),
+        })
+    }
+
+    /// A copy in which each material's radio model is `f` of its own, checked at the scene's
+    /// frequency, with the penetrable surfaces they give.
+    fn with_radio_models(
+        &self,
+        f: impl Fn(
+            Option<bt_channel::RadioMaterial>,
+        ) -> Result<Option<bt_channel::RadioMaterial>, crate::SceneError>,
+    ) -> Result<Scene, crate::SceneError> {
         let mut scene = self.clone();
         for m in Arc::make_mut(&mut scene.materials).values_mut() {
-            m.radio = Some(radio);
+            m.radio = f(m.radio)?;
         }
         // Which surfaces waves cross depends on the materials: a new mask, and with it a new
         // `geometry_key` when there are penetrable surfaces.

@@ -672,7 +672,9 @@ def load(
     ``material`` and ``thickness`` (m) are ``--frequency``, ``--material`` and ``--thickness``:
     the carrier (replacing a scene file's), and every surface's radio material spelled
     ``"itu:NAME"`` (e.g. ``"itu:concrete"``) or ``"custom:EPS_R,SIGMA"``, a slab of
-    ``thickness`` metres or a half-space; a bad value is a ``ValueError``. Raises :class:`BeamtraceError`
+    ``thickness`` metres or a half-space; ``thickness`` alone makes every material the scene
+    leaves a half-space a slab of that thickness (so that ``transmission=True`` crosses it;
+    slabs keep their own); a bad value is a ``ValueError``. Raises :class:`BeamtraceError`
     with the CLI's message (naming the file, line or field) when the scene cannot be read or is
     invalid.
     """

@@ -98,6 +98,52 @@ fn a_thickness_makes_a_half_space_a_slab() {
     }
 }
 
+/// `--thickness` alone makes the half-space materials slabs and keeps the slabs' own
+/// thicknesses: the document equals that of the same scene whose file gives its half-space
+/// (the concrete shell) that thickness, and the shell now lets a receiver outside be reached.
+#[test]
+fn a_thickness_alone_makes_the_half_spaces_slabs() {
+    let outside = ["--rx", "9,1,1.2", "--transmission", "--json"];
+    let mut alone =
+        beamtrace_in_repo(&[&["trace", TWO_ROOMS, "--thickness", "0.1"], &outside[..]].concat());
+    let mut scene: Value =
+        serde_json::from_str(&std::fs::read_to_string(example()).unwrap()).unwrap();
+    // The built-in concrete (a 6 dB ITU concrete half-space), as a 0.1 m slab.
+    scene["materials"]["concrete"] =
+        serde_json::json!({ "itu": "concrete", "thickness": 0.1, "reflection_loss_db": 6.0 });
+    let twin = scratch("thickness-twin").join("two-rooms.json");
+    std::fs::write(&twin, serde_json::to_string(&scene).unwrap()).unwrap();
+    let mut given = run_json(&[&["trace", twin.to_str().unwrap()], &outside[..]].concat());
+    assert!(!alone["paths"].as_array().unwrap().is_empty(), "{alone}");
+    for doc in [&mut alone, &mut given] {
+        doc["stats"].as_object_mut().unwrap().remove("time_s");
+        doc.as_object_mut().unwrap().remove("scene");
+    }
+    assert_eq!(alone, given);
+    // The partition (12.5 mm plasterboard) kept its own thickness: with 0.1 m its loss differs.
+    let thick = [
+        &["trace", TWO_ROOMS, "--transmission", "--thickness", "0.1"],
+        &["--json"][..],
+    ]
+    .concat();
+    let plain = beamtrace_in_repo(&["trace", TWO_ROOMS, "--transmission", "--json"]);
+    let with_thickness = beamtrace_in_repo(&thick);
+    let losses = |doc: &Value| -> Vec<String> {
+        (doc["paths"].as_array().unwrap().iter())
+            .filter(|p| {
+                p["surfaces"]
+                    .as_array()
+                    .unwrap()
+                    .iter()
+                    .any(|s| s == "partition")
+            })
+            .map(|p| p["transmission_loss_db"].to_string())
+            .collect()
+    };
+    assert!(!losses(&plain).is_empty());
+    assert_eq!(losses(&with_thickness), losses(&plain));
+}
+
 fn beamtrace_in_repo(args: &[&str]) -> Value {
     serde_json::from_slice(&run_ok_in(&repo(), args).stdout).expect("valid JSON")
 }
