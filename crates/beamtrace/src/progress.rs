@@ -118,21 +118,28 @@ impl Deferred {
 }
 
 /// A bar for the beam tree's build, drawn once the build has run for half a second (a room's
-/// tree takes a millisecond; a city's at order 3 takes seconds): depth, parents of the level
-/// done, nodes so far.
+/// tree takes a millisecond; a city's at order 3 takes seconds): what is built (TX's tree;
+/// with diffraction, the edges its nodes reach, RX's tree and its reaches), depth, parents
+/// (or nodes) of the level done, nodes so far.
 pub fn tree_progress() -> (ProgressBar, impl FnMut(bt_solve::pipeline::BuildProgress)) {
     let deferred = Deferred::new(
-        "{spinner} beam tree {msg} {bar:30} {pos}/{len} parents [{elapsed_precise}, ETA {eta}]",
+        "{spinner} {msg} {bar:30} {pos}/{len} [{elapsed_precise}, ETA {eta}]",
         Duration::from_millis(500),
-        "beam tree",
+        "trace",
     );
     let bar = deferred.bar();
     let callback = move |p: bt_solve::pipeline::BuildProgress| {
+        use bt_solve::pipeline::BuildStage;
         let feed = deferred.show_after();
         feed.set_length(p.parents as u64);
         feed.set_position(p.parents_done as u64);
+        let (what, of) = match p.stage {
+            BuildStage::Tree => ("beam tree", "parents"),
+            BuildStage::RxTree => ("RX's beam tree (diffraction)", "parents"),
+            BuildStage::Reaches => ("edges each node reaches (diffraction)", "nodes"),
+        };
         feed.set_message(format!(
-            "depth {}/{}, {} nodes,",
+            "{what}: {of} of depth {}/{}, {} nodes so far",
             p.depth, p.max_order, p.nodes
         ));
     };

@@ -153,9 +153,13 @@ pub enum TreeError {
 }
 
 /// Where a build stands, reported to a progress callback at each level's start and every
-/// [`PROGRESS_EVERY`] parents: large trees (cities, high orders) take seconds.
+/// [`PROGRESS_EVERY`] parents: large trees (cities, high orders) take seconds. With
+/// diffraction, a trace then reports the TX tree's reaches on the edges, the tree grown from
+/// RX and its reaches ([`BuildStage`]).
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub struct BuildProgress {
+    /// What is being built.
+    pub stage: BuildStage,
     /// Depth being built (1 = first reflection).
     pub depth: usize,
     /// The order asked for.
@@ -166,6 +170,18 @@ pub struct BuildProgress {
     pub parents: usize,
     /// Nodes materialised so far (all levels).
     pub nodes: u64,
+}
+
+/// What a [`BuildProgress`] reports on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum BuildStage {
+    /// The beam tree from TX: `parents_done` of the `parents` of level `depth`.
+    Tree,
+    /// With diffraction, the tree grown from RX (the same fields).
+    RxTree,
+    /// With diffraction, the part of each edge each node's beam reaches, TX's tree and then
+    /// RX's: `parents_done` of the `parents` nodes of depth `depth` done.
+    Reaches,
 }
 
 /// Parents between two progress reports.
@@ -798,6 +814,7 @@ impl BeamTree {
         progress: Progress<'_>,
     ) {
         progress(BuildProgress {
+            stage: BuildStage::Tree,
             depth,
             max_order: prep.options.max_order,
             parents_done: done.min(parents),
@@ -1905,7 +1922,8 @@ pub fn candidates_and_diffracted_in(
     }
     set.stats = tree.candidate_stats(set.len() as u64);
     set.tree = Some(tree.stats.clone());
-    let side = diffraction.map(|diffracting| KeptSide::take(cache, scene, &tree, diffracting));
+    let side = diffraction
+        .map(|diffracting| KeptSide::take(cache, scene, (&tree, diffracting), &mut *progress));
     Arenas {
         nodes: tree.nodes,
         verts: tree.verts,
@@ -1914,7 +1932,7 @@ pub fn candidates_and_diffracted_in(
     .give_back(cache);
     prep.keep_in(cache);
     if let Some(side) = side {
-        set.diffracted = diffracted_with(scene, &side.side, options, cache)?;
+        set.diffracted = diffracted_reporting(scene, &side.side, (options, cache), progress)?;
         set.stats.diffracted = set.diffracted.len() as u64;
         cache.side = Some(side);
     }
@@ -1934,8 +1952,14 @@ struct KeptSide {
 }
 
 impl KeptSide {
-    /// `cache`'s kept side when it was built for `tx`'s tree in `scene`, or a new one.
-    fn take(cache: &mut TreeCache, scene: &Scene, tx: &BeamTree, diffracting: Diffracting) -> Self {
+    /// `cache`'s kept side when it was built for `tx`'s tree in `scene`, or a new one (its
+    /// reaches reported to `progress`).
+    fn take(
+        cache: &mut TreeCache,
+        scene: &Scene,
+        (tx, diffracting): (&BeamTree, Diffracting),
+        progress: Progress<'_>,
+    ) -> Self {
         let same = |k: &KeptSide| {
             k.geometry.matches(scene)
                 && k.tx == tx.tx
@@ -1950,7 +1974,12 @@ impl KeptSide {
                 tx: tx.tx,
                 options: tx.options,
                 diffracting,
-                side: DiffractionSide::of(scene, tx, tx.options.max_order, diffracting),
+                side: DiffractionSide::reporting(
+                    scene,
+                    (tx, tx.options.max_order),
+                    diffracting,
+                    progress,
+                ),
             },
         }
     }
@@ -1968,6 +1997,20 @@ pub fn diffracted_with(
     if options.max_order == 0 {
         return Ok(Default::default());
     }
+    diffracted_reporting(scene, tx, (options, cache), &mut |_| {})
+}
+
+/// [`diffracted_with`], reporting the RX tree's build ([`BuildStage::RxTree`]) and its
+/// reaches to `progress`.
+fn diffracted_reporting(
+    scene: &Scene,
+    tx: &DiffractionSide,
+    (options, cache): (TreeOptions, &mut TreeCache),
+    progress: Progress<'_>,
+) -> Result<crate::diffraction::DiffractedSet, TreeError> {
+    if options.max_order == 0 {
+        return Ok(Default::default());
+    }
     let ends = scene.terminals()?;
     let swapped = scene.with_terminals(scene.to_world(ends.rx), scene.to_world(ends.tx))?;
     let depth = TreeOptions {
@@ -1975,14 +2018,56 @@ pub fn diffracted_with(
         starts: false,
         ..options
     };
-    let rx = BeamTree::build_in(&swapped, depth, cache, &mut |_| {})?;
-    diffraction::join(scene, tx, &rx, options.max_nodes)
+    let rx = BeamTree::build_in(&swapped, depth, cache, &mut |p| {
+        progress(BuildProgress {
+            stage: BuildStage::RxTree,
+            ..p
+        })
+    })?;
+    diffraction::join_reporting(scene, tx, (&rx, options.max_nodes), progress)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    /// A trace with diffraction reports each stage of its work to the progress callback, in
+    /// order: TX's tree, the edges its nodes reach, RX's tree and the edges its nodes reach;
+    /// each depth's reaches end with all of its nodes done.
+    #[test]
+    fn a_diffracting_trace_reports_every_stage() {
+        let scene = bt_testkit::random_scene(3, 40);
+        let diffracting = Diffracting {
+            min_edge_length: 0.0,
+            max_diffractions: 1,
+        };
+        let mut reports = Vec::new();
+        let mut cache = TreeCache::default();
+        let options = TreeOptions::new(3);
+        let diffraction = Some(diffracting);
+        candidates_and_diffracted_in(&scene, options, diffraction, &mut cache, &mut |p| {
+            reports.push(p)
+        })
+        .unwrap();
+        let mut stages: Vec<BuildStage> = reports.iter().map(|p| p.stage).collect();
+        stages.dedup();
+        use BuildStage::*;
+        assert_eq!(stages, [Tree, Reaches, RxTree, Reaches], "{reports:?}");
+        let reaches = reports.iter().filter(|p| p.stage == Reaches);
+        let ends = reaches.clone().filter(|p| p.parents_done == p.parents);
+        let depths = |it: &mut dyn Iterator<Item = &BuildProgress>| {
+            let mut d: Vec<usize> = it.map(|p| p.depth).collect();
+            d.dedup();
+            d
+        };
+        assert!(!depths(&mut reaches.clone()).is_empty());
+        assert_eq!(
+            depths(&mut reaches.clone()).len(),
+            depths(&mut ends.clone()).len()
+        );
+        assert!(reaches.clone().all(|p| p.parents_done <= p.parents));
+    }
 
     /// The occluders (convex, opaque) that the segment `a -> q` crosses, among `ids`.
     fn crossed(

@@ -11,7 +11,7 @@ use bt_geom::Vec3;
 use bt_paths::beamtree::{
     BeamTree, DiffractionSide, TreeCache, TreeOptions, TreeStats, diffracted_with,
 };
-pub use bt_paths::beamtree::{BuildProgress, Progress};
+pub use bt_paths::beamtree::{BuildProgress, BuildStage, Progress};
 use bt_paths::diffraction::Diffracting;
 use bt_paths::{AllVisible, CandidateSet, CandidateStats};
 use bt_scene::{Scene, SceneError};

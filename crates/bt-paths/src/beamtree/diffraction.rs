@@ -22,7 +22,7 @@
 
 mod twice;
 
-use super::{BeamTree, EPS, GROW, ROOT, TreeError};
+use super::{BeamTree, BuildProgress, BuildStage, EPS, GROW, Progress, ROOT, TreeError};
 use crate::diffraction::{DiffractedSet, Diffracting};
 use bt_geom::bvh::box_meets_halfspaces;
 use bt_geom::{Plane, Real, Vec3};
@@ -100,8 +100,8 @@ impl BeamTree {
     fn reaches(
         &self,
         scene: &Scene,
-        limit: &[usize],
-        root_only: Option<RootOnly>,
+        (limit, root_only): (&[usize], Option<RootOnly>),
+        progress: Progress<'_>,
     ) -> Vec<Vec<Reach>> {
         let max_depth = limit.iter().max().map_or(0, |m| m.saturating_sub(1));
         let edges = scene.edges();
@@ -141,6 +141,7 @@ impl BeamTree {
                 .map(|a| a..(a + REACH_CHUNK).min(hi))
                 .collect();
             for batch in chunks.chunks(REACH_BATCH) {
+                self.report_reaches((depth, batch[0].start - lo, hi - lo), progress);
                 let parts = super::chunked::in_order_if(self.options.parallel, batch, |r| {
                     self.reaches_of(r.clone(), &level)
                 });
@@ -148,8 +149,21 @@ impl BeamTree {
                     out[e as usize].push(reach);
                 }
             }
+            self.report_reaches((depth, hi - lo, hi - lo), progress);
         }
         out
+    }
+
+    /// Report `done` of the `nodes` nodes of depth `depth` whose reaches are found.
+    fn report_reaches(&self, (depth, done, nodes): (usize, usize, usize), progress: Progress<'_>) {
+        progress(BuildProgress {
+            stage: BuildStage::Reaches,
+            depth,
+            max_order: self.max_order,
+            parents_done: done,
+            parents: nodes,
+            nodes: self.nodes.len() as u64,
+        });
     }
 
     /// The reaches of the live nodes `nodes` (all of `level`'s depth) as (edge, reach), in
@@ -455,6 +469,16 @@ impl DiffractionSide {
     /// The side of `tx` (materialised to depth `max_order − 1` at least) for paths of up to
     /// `max_order` interactions, as `diffracting` says.
     pub fn of(scene: &Scene, tx: &BeamTree, max_order: usize, diffracting: Diffracting) -> Self {
+        Self::reporting(scene, (tx, max_order), diffracting, &mut |_| {})
+    }
+
+    /// [`DiffractionSide::of`], reporting the reaches ([`BuildStage::Reaches`]) to `progress`.
+    pub(crate) fn reporting(
+        scene: &Scene,
+        (tx, max_order): (&BeamTree, usize),
+        diffracting: Diffracting,
+        progress: Progress<'_>,
+    ) -> Self {
         let mut usable = vec![false; scene.edges().len()];
         for e in crate::diffraction::usable_edges(scene, diffracting.min_edge_length) {
             usable[e.index()] = true;
@@ -463,7 +487,7 @@ impl DiffractionSide {
             .iter()
             .map(|&u| if u { max_order } else { 0 })
             .collect();
-        let reaches = tx.reaches(scene, &limit, None);
+        let reaches = tx.reaches(scene, (&limit, None), progress);
         DiffractionSide {
             reaches,
             max_order,
@@ -486,6 +510,16 @@ pub fn join(
     side: &DiffractionSide,
     rx: &BeamTree,
     budget: u64,
+) -> Result<DiffractedSet, TreeError> {
+    join_reporting(scene, side, (rx, budget), &mut |_| {})
+}
+
+/// [`join`], reporting the RX tree's reaches ([`BuildStage::Reaches`]) to `progress`.
+pub(crate) fn join_reporting(
+    scene: &Scene,
+    side: &DiffractionSide,
+    (rx, budget): (&BeamTree, u64),
+    progress: Progress<'_>,
 ) -> Result<DiffractedSet, TreeError> {
     let (candidates, reflections) = side.last.get();
     let mut set = DiffractedSet::with_capacity(candidates, reflections);
@@ -515,7 +549,8 @@ pub fn join(
         tx: side.tx,
         margin,
     };
-    let from_rx = rx.reaches(scene, &limit, (max_order >= 2).then_some(root_only));
+    let root_only = (max_order >= 2).then_some(root_only);
+    let from_rx = rx.reaches(scene, (&limit, root_only), progress);
     let pairing = Pairing {
         side,
         rx,
