@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import beamtrace
-from conftest import _cli_path
+from conftest import REPO, _cli_path
 
 
 def serve(requests, *args):
@@ -71,6 +71,32 @@ def test_one_receiver_is_the_trace_of_the_scene():
     paths = scene.trace(rx=[1.0, 2.0, 1.2])
     assert answer["tx"] == list(scene.tx)
     assert [p["length_m"] for p in answer["paths"]] == list(paths.length_m)
+    assert [p["surfaces"] for p in answer["paths"]] == paths.surfaces
+
+
+@pytest.mark.parametrize(
+    "source, load_options, rx, trace_options",
+    [
+        ("builtin:living-room", {"frequency": 3.5e9, "material": "itu:glass", "thickness": 0.01},
+         [1.0, 2.0, 1.2], {"max_order": 2}),
+        ("examples/two-rooms.json", {"thickness": 0.1}, [9.0, 1.0, 1.2],
+         {"max_order": 2, "transmission": True}),
+        ("testdata/scenes/box-room.obj", {"min_reflector_area": 4.0, "frequency": 3.5e9},
+         [4.0, 3.0, 1.2], {"max_order": 2}),
+    ],
+)
+def test_a_tracer_of_a_loaded_scene_loads_it_as_load_did(source, load_options, rx,
+                                                          trace_options):
+    """Tracer(scene) reloads the scene with the options load was given (the carrier, radio
+    material, thickness and mesh options): its answers are the scene's own traces, gain for
+    gain (it lost them all once, silently)."""
+    tx = [1.0, 1.0, 1.5] if source.endswith(".obj") else None
+    path = source if source.startswith("builtin:") else str(REPO / source)
+    scene = beamtrace.load(path, tx=tx, rx=rx, **load_options)
+    paths = scene.trace(**trace_options)
+    assert len(paths) > 0
+    answer = beamtrace.Tracer(scene, **trace_options).update(rx=rx)
+    assert [p["gain_db"] for p in answer["paths"]] == list(paths.gain_db)
     assert [p["surfaces"] for p in answer["paths"]] == paths.surfaces
 
 

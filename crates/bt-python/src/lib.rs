@@ -71,6 +71,9 @@ struct PyScene {
     scene: Arc<Scene>,
     /// What `load` was given (file path or `builtin:NAME`): messages name it, as the CLI's do.
     source: String,
+    /// How `load` read it: its load options and the carrier it set (`frequency=`), so that a
+    /// `Tracer` of this scene reloads the same scene; `None` for an unpickled scene.
+    loaded_with: Option<(LoadOptions, Option<f64>)>,
     warnings: Vec<String>,
     /// The load cache's own warnings (a damaged entry replaced), for Python's `warnings`.
     cache_warnings: Vec<String>,
@@ -451,6 +454,7 @@ fn load(
         shards: Mutex::default(),
         scene: Arc::new(loaded.scene),
         source,
+        loaded_with: Some((options, frequency)),
         warnings: loaded.warnings,
         cache_warnings,
     })
@@ -470,6 +474,7 @@ fn scene_from_bytes(source: String, data: &[u8]) -> PyResult<PyScene> {
         shards: Mutex::default(),
         scene: Arc::new(scene),
         source,
+        loaded_with: None,
         warnings: Vec::new(),
         cache_warnings: Vec::new(),
     })

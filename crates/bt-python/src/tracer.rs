@@ -20,9 +20,12 @@ pub struct PyTracer {
 impl PyTracer {
     /// Load `source` with its time steps and objects (`builtin:NAME` or a file), `tx`/`rx`
     /// overriding its terminals, and trace under `keywords` (the trace keywords of
-    /// `Scene.trace`).
+    /// `Scene.trace`). With `scene` (the `Scene` that `load` read from `source`), the load
+    /// takes the same options (mesh, radio material, thickness, carrier) as it did.
     #[new]
-    #[pyo3(signature = (source, keywords, tx, rx, beams=None, partner_spin_us=bt_serve::PARTNER_SPIN_US))]
+    #[pyo3(signature = (source, keywords, tx, rx, beams=None, partner_spin_us=bt_serve::PARTNER_SPIN_US, scene=None))]
+    // One argument per Python keyword: pyo3 maps them by name.
+    #[allow(clippy::too_many_arguments)]
     fn new(
         py: Python<'_>,
         source: String,
@@ -31,13 +34,21 @@ impl PyTracer {
         rx: Option<[f64; 3]>,
         beams: Option<BeamKeywords>,
         partner_spin_us: u64,
+        scene: Option<PyRef<'_, crate::PyScene>>,
     ) -> PyResult<Self> {
+        let (loaded_with, frequency) = scene
+            .and_then(|s| s.loaded_with.clone())
+            .unwrap_or_default();
         let options = LoadOptions {
             terminals: terminals(tx, rx),
-            ..LoadOptions::default()
+            ..loaded_with
         };
         let loaded = py.detach(|| bt_import::load_dynamic(&source, &options, &mut |_| {}));
-        let dynamic = loaded.map_err(error)?.scene;
+        let mut dynamic = loaded.map_err(error)?.scene;
+        // As `load(frequency=)`: the carrier replaces a scene file's own.
+        if let Some(f) = frequency {
+            dynamic = dynamic.with_frequency(f).map_err(error)?;
+        }
         let trace_options = keywords
             .trace_options(dynamic.step(0))
             .map_err(PyValueError::new_err)?;

@@ -470,8 +470,9 @@ class Tracer:
     >>> tracer.update(objects={"person": {"offset": [0.5, 1.5, 0.0]}})
 
     ``scene`` is a source (``builtin:NAME`` or a scene file, loaded with its time steps and
-    moving objects) or a :class:`Scene` (reloaded from its :attr:`Scene.source`, with its TX
-    and RX). ``tx`` overrides the scene's transmitter. ``options`` are :meth:`Scene.trace`'s
+    moving objects) or a :class:`Scene` (reloaded from its :attr:`Scene.source` with the
+    options :func:`load` was given: mesh options, ``material``, ``thickness``, ``frequency``;
+    with its TX and RX). ``tx`` overrides the scene's transmitter. ``options`` are :meth:`Scene.trace`'s
     keywords with its defaults (``max_order=3``, ``solver``, ``diffraction``, ...); an unknown
     one raises ``TypeError``, a bad value ``ValueError``, here.
 
@@ -501,9 +502,9 @@ class Tracer:
         partner_spin_us: int = _native.PARTNER_SPIN_US,
         **options: Any,
     ) -> None:
-        rx = None
+        rx, native_scene = None, None
         if isinstance(scene, Scene):
-            source = scene.source
+            source, native_scene = scene.source, scene._native
             tx = scene.tx if tx is None else tx
             rx = scene.rx
         else:
@@ -525,7 +526,7 @@ class Tracer:
         if not 0 <= spin <= 1_000_000:
             raise ValueError(f"partner_spin_us: {spin} is outside 0..=1000000")
         self._native = _native.Tracer(
-            source, keywords, _point(tx, "tx"), _point(rx, "rx"), beams, spin
+            source, keywords, _point(tx, "tx"), _point(rx, "rx"), beams, spin, native_scene
         )
 
     def update(

@@ -63,6 +63,7 @@ class Tracer:
         rx: _Point,
         beams: Optional[Dict[str, Any]] = None,
         partner_spin_us: int = ...,
+        scene: Optional[Scene] = None,
     ) -> None: ...
     def answer(self, line: str) -> str: ...
 
