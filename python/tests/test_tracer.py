@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import pickle
 import subprocess
 
 import numpy as np
@@ -98,6 +99,24 @@ def test_a_tracer_of_a_loaded_scene_loads_it_as_load_did(source, load_options, r
     answer = beamtrace.Tracer(scene, **trace_options).update(rx=rx)
     assert [p["gain_db"] for p in answer["paths"]] == list(paths.gain_db)
     assert [p["surfaces"] for p in answer["paths"]] == paths.surfaces
+
+
+def test_a_tracer_of_an_unpickled_scene_traces_that_scene():
+    """A Scene sent through pickle (to a Ray worker, say) keeps its materials and carrier but
+    not the options load was given: its Tracer traces the scene itself, not a reload of its
+    source with default options."""
+    scene = beamtrace.load("builtin:living-room", frequency=3.5e9, material="itu:glass",
+                           thickness=0.01)
+    copy = pickle.loads(pickle.dumps(scene))
+    rx = [1.0, 2.0, 1.2]
+    paths = copy.trace(rx=rx, max_order=2)
+    assert list(paths.gain_db) == list(scene.trace(rx=rx, max_order=2).gain_db)
+    answer = beamtrace.Tracer(copy, max_order=2).update(rx=rx)
+    assert [p["gain_db"] for p in answer["paths"]] == list(paths.gain_db)
+    moved = beamtrace.Tracer(copy, tx=[5.0, 1.0, 2.0], max_order=2).update(rx=rx)
+    assert moved["tx"] == [5.0, 1.0, 2.0]
+    assert [p["gain_db"] for p in moved["paths"]] == list(
+        copy.trace(tx=[5.0, 1.0, 2.0], rx=rx, max_order=2).gain_db)
 
 
 def test_several_receivers_give_one_entry_each_and_a_bad_one_fails_alone():

@@ -10,6 +10,49 @@ use pyo3::exceptions::PyValueError;
 use pyo3::prelude::*;
 use std::sync::Mutex;
 
+/// `source` loaded with its time steps and objects, as `load` read it when `loaded_with`
+/// (its options and `frequency=`) is given, with `tx`/`rx` overriding its terminals.
+fn reload(
+    py: Python<'_>,
+    source: &str,
+    loaded_with: Option<(LoadOptions, Option<f64>)>,
+    (tx, rx): (Option<[f64; 3]>, Option<[f64; 3]>),
+) -> PyResult<bt_scene::dynamic::DynamicScene> {
+    let (loaded_with, frequency) = loaded_with.unwrap_or_default();
+    let options = LoadOptions {
+        terminals: terminals(tx, rx),
+        ..loaded_with
+    };
+    let loaded = py.detach(|| bt_import::load_dynamic(source, &options, &mut |_| {}));
+    let dynamic = loaded.map_err(error)?.scene;
+    // As `load(frequency=)`: the carrier replaces a scene file's own.
+    match frequency {
+        Some(f) => dynamic.with_frequency(f).map_err(error),
+        None => Ok(dynamic),
+    }
+}
+
+/// An unpickled `scene` (its load options are not in the pickle) as the tracer's scene, with
+/// `tx`/`rx` overriding its terminals: the scene itself, which a reload of its source with
+/// default options need not equal. `None` (reload it) for a scene loaded in this process, or
+/// when a terminal is neither given nor in the scene (a bare mesh moved by updates).
+fn unpickled(
+    scene: &crate::PyScene,
+    tx: Option<[f64; 3]>,
+    rx: Option<[f64; 3]>,
+) -> Option<PyResult<bt_scene::Scene>> {
+    if scene.loaded_with.is_some() {
+        return None;
+    }
+    if tx.is_none() && rx.is_none() {
+        return Some(Ok((*scene.scene).clone()));
+    }
+    let has =
+        |given: Option<[f64; 3]>, own: Option<bt_scene::Vec3>| given.is_some() || own.is_some();
+    (has(tx, scene.scene.tx_world()) && has(rx, scene.scene.rx_world()))
+        .then(|| scene.moved(tx, rx))
+}
+
 /// A scene kept loaded with one tracer, answering the requests of `beamtrace serve`.
 #[pyclass(frozen, module = "beamtrace._native", name = "Tracer")]
 pub struct PyTracer {
@@ -36,19 +79,15 @@ impl PyTracer {
         partner_spin_us: u64,
         scene: Option<PyRef<'_, crate::PyScene>>,
     ) -> PyResult<Self> {
-        let (loaded_with, frequency) = scene
-            .and_then(|s| s.loaded_with.clone())
-            .unwrap_or_default();
-        let options = LoadOptions {
-            terminals: terminals(tx, rx),
-            ..loaded_with
+        let dynamic = match scene.as_deref().and_then(|s| unpickled(s, tx, rx)) {
+            Some(scene) => bt_scene::dynamic::DynamicScene::from_static(scene?),
+            None => reload(
+                py,
+                &source,
+                scene.and_then(|s| s.loaded_with.clone()),
+                (tx, rx),
+            )?,
         };
-        let loaded = py.detach(|| bt_import::load_dynamic(&source, &options, &mut |_| {}));
-        let mut dynamic = loaded.map_err(error)?.scene;
-        // As `load(frequency=)`: the carrier replaces a scene file's own.
-        if let Some(f) = frequency {
-            dynamic = dynamic.with_frequency(f).map_err(error)?;
-        }
         let trace_options = keywords
             .trace_options(dynamic.step(0))
             .map_err(PyValueError::new_err)?;

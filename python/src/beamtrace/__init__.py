@@ -472,7 +472,8 @@ class Tracer:
     ``scene`` is a source (``builtin:NAME`` or a scene file, loaded with its time steps and
     moving objects) or a :class:`Scene` (reloaded from its :attr:`Scene.source` with the
     options :func:`load` was given: mesh options, ``material``, ``thickness``, ``frequency``;
-    with its TX and RX). ``tx`` overrides the scene's transmitter. ``options`` are :meth:`Scene.trace`'s
+    with its TX and RX; an unpickled :class:`Scene`, whose pickle keeps no load options, is
+    traced as it is, as one step without moving objects). ``tx`` overrides the scene's transmitter. ``options`` are :meth:`Scene.trace`'s
     keywords with its defaults (``max_order=3``, ``solver``, ``diffraction``, ...); an unknown
     one raises ``TypeError``, a bad value ``ValueError``, here.
 
