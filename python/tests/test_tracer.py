@@ -119,6 +119,20 @@ def test_a_tracer_of_an_unpickled_scene_traces_that_scene():
         copy.trace(tx=[5.0, 1.0, 2.0], rx=rx, max_order=2).gain_db)
 
 
+def test_a_tracer_takes_loads_keywords_with_a_source():
+    """Tracer(source, material=, thickness=, frequency=, min_reflector_area=, ...) loads the
+    source with them, as serve's flags of those names: the answers of
+    Tracer(load(source, ...)); with a Scene they are a TypeError."""
+    load_options = {"frequency": 3.5e9, "material": "itu:glass", "thickness": 0.01}
+    rx = [1.0, 2.0, 1.2]
+    given = beamtrace.Tracer("builtin:living-room", max_order=2, **load_options).update(rx=rx)
+    loaded = beamtrace.load("builtin:living-room", **load_options)
+    assert [p["gain_db"] for p in given["paths"]] == list(loaded.trace(rx=rx, max_order=2).gain_db)
+    assert given["paths"] != beamtrace.Tracer("builtin:living-room", max_order=2).update(rx=rx)["paths"]
+    with pytest.raises(TypeError, match="material: load options of a source"):
+        beamtrace.Tracer(loaded, material="itu:glass")
+
+
 def test_several_receivers_give_one_entry_each_and_a_bad_one_fails_alone():
     tracer = beamtrace.Tracer("builtin:living-room", max_order=1)
     answer = tracer.update(rx=np.array([[1.0, 1.0, 1.0], [3.0, 0.0, 1.0], [2.0, 3.0, 1.5]]))

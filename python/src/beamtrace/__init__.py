@@ -473,7 +473,10 @@ class Tracer:
     moving objects) or a :class:`Scene` (reloaded from its :attr:`Scene.source` with the
     options :func:`load` was given: mesh options, ``material``, ``thickness``, ``frequency``;
     with its TX and RX; an unpickled :class:`Scene`, whose pickle keeps no load options, is
-    traced as it is, as one step without moving objects). ``tx`` overrides the scene's transmitter. ``options`` are :meth:`Scene.trace`'s
+    traced as it is, as one step without moving objects). With a source, ``options`` may also
+    hold :func:`load`'s keywords (``material``, ``thickness``, ``frequency``, the mesh options
+    and budgets, ``cache``: ``serve``'s flags of the same names); the source is then loaded
+    with them. ``tx`` overrides the scene's transmitter. ``options`` are :meth:`Scene.trace`'s
     keywords with its defaults (``max_order=3``, ``solver``, ``diffraction``, ...); an unknown
     one raises ``TypeError``, a bad value ``ValueError``, here.
 
@@ -504,6 +507,14 @@ class Tracer:
         **options: Any,
     ) -> None:
         rx, native_scene = None, None
+        loading = _load_keywords(options)
+        if loading and isinstance(scene, Scene):
+            raise TypeError(
+                f"{', '.join(sorted(loading))}: load options of a source; this Scene is "
+                "loaded already (give them to beamtrace.load)"
+            )
+        if loading:
+            scene = load(scene, tx=tx, **loading)
         if isinstance(scene, Scene):
             source, native_scene = scene.source, scene._native
             tx = scene.tx if tx is None else tx
@@ -566,6 +577,13 @@ class Tracer:
         if "error" in answer:
             raise BeamtraceError(answer["error"])
         return answer
+
+
+def _load_keywords(options: Dict[str, Any]) -> Dict[str, Any]:
+    """The keywords of :func:`load` (but the source and terminals) among ``options``, taken
+    out of them."""
+    names = set(inspect.signature(load).parameters) - {"source", "tx", "rx"}
+    return {name: options.pop(name) for name in sorted(names & set(options))}
 
 
 def _trace_keywords(options: Dict[str, Any]) -> Dict[str, Any]:
