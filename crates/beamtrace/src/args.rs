@@ -327,12 +327,6 @@ pub struct MaterialArgs {
 }
 
 impl MaterialArgs {
-    /// `--thickness` alone (without `--material`): the slab thickness of every half-space
-    /// material, m.
-    pub fn thickness_alone(&self) -> Option<f64> {
-        self.thickness.filter(|_| self.material.is_none())
-    }
-
     /// The radio material `--material`/`--thickness` select, checked.
     pub fn radio(&self) -> anyhow::Result<Option<bt_channel::RadioMaterial>> {
         let Some(spec) = &self.material else {

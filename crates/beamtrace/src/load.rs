@@ -36,7 +36,8 @@ pub fn load_options(args: &SceneArgs) -> anyhow::Result<LoadOptions> {
             .frequency
             .unwrap_or(bt_scene::DEFAULT_FREQUENCY_HZ),
         radio: args.material.radio()?,
-        thickness: args.material.thickness_alone(),
+        // Used only without --material (whose slab it is then, in `radio`).
+        thickness: args.material.thickness,
         ..LoadOptions::default()
     })
 }

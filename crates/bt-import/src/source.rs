@@ -31,8 +31,9 @@ pub struct LoadOptions {
     /// A radio material for every surface (CLI `--material itu:NAME --thickness M`), replacing
     /// the radio model of every material of the loaded scene, whatever its format.
     pub radio: Option<bt_channel::RadioMaterial>,
-    /// Without `radio`: the slab thickness (m) of every material the scene leaves a
-    /// half-space (CLI `--thickness` alone), so that `--transmission` crosses them too.
+    /// The slab thickness (m) of every material the scene leaves a half-space (CLI
+    /// `--thickness`), so that `--transmission` crosses them too; ignored with `radio`
+    /// (`--material`), whose own thickness it then is.
     pub thickness: Option<Real>,
     /// Budget: the largest input file read, bytes (CLI `--max-file-bytes`): scene files, meshes
     /// (also those of an XML scene), point clouds. Checked against the file's size before it

@@ -1994,9 +1994,6 @@ pub fn diffracted_with(
     options: TreeOptions,
     cache: &mut TreeCache,
 ) -> Result<crate::diffraction::DiffractedSet, TreeError> {
-    if options.max_order == 0 {
-        return Ok(Default::default());
-    }
     diffracted_reporting(scene, tx, (options, cache), &mut |_| {})
 }
 

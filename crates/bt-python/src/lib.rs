@@ -436,7 +436,8 @@ fn load(
         max_file_bytes: budgets.max_file_bytes,
         max_xml_substitution: budgets.max_xml_substitution,
         frequency_hz: frequency.unwrap_or(bt_scene::DEFAULT_FREQUENCY_HZ),
-        thickness: thickness.filter(|_| material.is_none()),
+        // Used only without `material` (whose slab it is then, in `radio`).
+        thickness,
         radio,
         ..defaults
     };
