@@ -9,6 +9,7 @@ pub mod convex;
 pub mod count;
 pub mod hash;
 pub mod plane;
+pub mod points;
 pub mod poly2;
 pub mod polygon;
 pub mod real;
@@ -20,6 +21,7 @@ mod fixtures;
 pub use bvh::{Bvh, Occluder};
 pub use count::{AtLeast, Budget, Count, OverBudget};
 pub use plane::{Plane, Side};
+pub use points::Points;
 pub use polygon::{Polygon, PolygonError};
 
 /// The one scalar type of the project (metres, seconds, radians unless a name says otherwise).

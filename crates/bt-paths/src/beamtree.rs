@@ -1481,7 +1481,13 @@ fn side_plane(apex: Vec3, (w, v): (Vec3, Vec3), facing: &Facing) -> Option<Plane
     if !(len > 0.0 && 1.2e-16 * ae <= MAX_NORMAL_ERROR * len) {
         return None;
     }
-    let side = Plane::from_point_normal(apex, normal);
+    // `Plane::from_point_normal`'s normalisation (`normalize`: times the length's
+    // reciprocal), with the length already at hand: the same bits.
+    let unit = normal * len.recip();
+    let side = Plane {
+        normal: unit,
+        offset: unit.dot(apex),
+    };
     Some(if facing.outward { flip(side) } else { side })
 }
 

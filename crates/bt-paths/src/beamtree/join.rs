@@ -36,7 +36,7 @@
 
 use super::reach::Reach;
 use super::{BeamTree, LINEAR_SCAN, Mirrored, Prepared, chunked, side_planes};
-use bt_geom::{Plane, Real, Vec3, convex};
+use bt_geom::{Plane, Points, Real, Vec3, convex};
 use bt_scene::SurfaceId;
 
 /// Reflectors per parallel task of [`Pairs::of`]'s joins.
@@ -269,8 +269,10 @@ struct Query {
     groups: [Cones; 2],
     /// Per try: whether it joins.
     joined: Vec<bool>,
-    /// The tries to test against a group's cones: apex and index.
-    pending: Vec<(Vec3, u32)>,
+    /// The tries to test against a group's cones: apexes, tagged with their index.
+    pending: Points,
+    /// Per pending try: whether the cone at hand holds its apex.
+    inside: Vec<bool>,
     /// (try, leaf) of each leaf's cone that holds the try's apex.
     hits: Vec<(u32, u32)>,
 }
@@ -365,7 +367,7 @@ impl<'a> RxSide<'a> {
                 };
                 let held = apex.cmpge(min).all() && apex.cmple(max).all();
                 if held && side {
-                    q.pending.push((apex, k as u32));
+                    q.pending.push(apex, k as u32);
                 }
             }
             let group = &q.groups[g];
@@ -374,14 +376,15 @@ impl<'a> RxSide<'a> {
             }
             for &(a, b, leaf) in &group.cones {
                 let planes = &group.planes[a as usize..b as usize];
-                for &(apex, k) in &q.pending {
-                    let inside =
-                        (planes.iter()).all(|pl| pl.signed_distance_unfused(apex) >= -self.margin);
-                    if inside {
-                        q.joined[k as usize] = true;
-                        if leaf != NO_LEAF {
-                            q.hits.push((k, leaf));
-                        }
+                if !q.pending.inside_all(planes, self.margin, &mut q.inside) {
+                    continue;
+                }
+                for (&k, _) in
+                    (q.pending.tags().iter().zip(&q.inside)).filter(|(_, inside)| **inside)
+                {
+                    q.joined[k as usize] = true;
+                    if leaf != NO_LEAF {
+                        q.hits.push((k, leaf));
                     }
                 }
             }
@@ -401,6 +404,7 @@ impl<'a> RxSide<'a> {
         }
         q.groups.iter_mut().for_each(Cones::clear);
         let mut bounds = [EMPTY; 2];
+        let beyond = self.beyond(&plane);
         let groups = &mut q.groups;
         let mut push = |apex: Vec3, window: &[Vec3], leaf: u32| {
             let h = plane.signed_distance_unfused(apex);
@@ -409,7 +413,7 @@ impl<'a> RxSide<'a> {
             let first = into.planes.len() as u32;
             cone(&plane, apex, window, self.margin, &mut into.planes)?;
             into.cones.push((first, into.planes.len() as u32, leaf));
-            bounds[g] = union(bounds[g], self.cone_box((&plane, h), apex, window));
+            bounds[g] = union(bounds[g], self.cone_box((beyond, h), apex, window));
             Some(())
         };
         // RX in the node's beam: RX's depth-1 node on `s`.
@@ -444,26 +448,42 @@ impl<'a> RxSide<'a> {
         Some(bounds)
     }
 
-    /// A box around the part inside [`RxSide::area`] of the cone from `apex` (at signed
-    /// distance `h` from `plane`, beyond the margin) through `window`, grown by the margin:
-    /// a point of the cone is `apex + λ·(v − apex)` for a point `v` of the window and
-    /// `λ ≥ 1`, and `λ = 1 + (its distance beyond the plane) / |h|`, at most `Λ` inside the
-    /// area; so the part lies in the hull of the window and its copy scaled by `Λ` from the
-    /// apex.
-    fn cone_box(&self, (plane, h): (&Plane, Real), apex: Vec3, window: &[Vec3]) -> (Vec3, Vec3) {
+    /// How far beyond `plane` the farthest corner of [`RxSide::area`] lies (m, at least 0),
+    /// seen from an apex on each side: `[0]` for an apex on the positive side, `[1]` for one
+    /// on the negative side ([`RxSide::cone_box`]).
+    fn beyond(&self, plane: &Plane) -> [Real; 2] {
         let (lo, hi) = self.area;
-        let away = if h > 0.0 { -1.0 } else { 1.0 };
-        let corners = (0..8).map(|k| {
-            let pick = |bit: u32, a: Real, b: Real| if k & bit == 0 { a } else { b };
-            Vec3::new(
-                pick(1, lo.x, hi.x),
-                pick(2, lo.y, hi.y),
-                pick(4, lo.z, hi.z),
-            )
-        });
-        let beyond = corners
-            .map(|c| away * plane.signed_distance_unfused(c))
-            .fold(0.0, Real::max);
+        let corners = || {
+            (0..8).map(move |k| {
+                let pick = |bit: u32, a: Real, b: Real| if k & bit == 0 { a } else { b };
+                Vec3::new(
+                    pick(1, lo.x, hi.x),
+                    pick(2, lo.y, hi.y),
+                    pick(4, lo.z, hi.z),
+                )
+            })
+        };
+        [-1.0, 1.0].map(|away: Real| {
+            corners()
+                .map(|c| away * plane.signed_distance_unfused(c))
+                .fold(0.0, Real::max)
+        })
+    }
+
+    /// A box around the part inside [`RxSide::area`] of the cone from `apex` (at signed
+    /// distance `h` from the plane, beyond the margin) through `window`, grown by the margin;
+    /// `beyond` is [`RxSide::beyond`] of the plane. A point of the cone is
+    /// `apex + λ·(v − apex)` for a point `v` of the window and `λ ≥ 1`, and
+    /// `λ = 1 + (its distance beyond the plane) / |h|`, at most `Λ` inside the area; so the
+    /// part lies in the hull of the window and its copy scaled by `Λ` from the apex.
+    fn cone_box(
+        &self,
+        (beyond, h): ([Real; 2], Real),
+        apex: Vec3,
+        window: &[Vec3],
+    ) -> (Vec3, Vec3) {
+        let (lo, hi) = self.area;
+        let beyond = beyond[usize::from(h <= 0.0)];
         let scale = 1.0 + (beyond + self.margin) / h.abs();
         let mut b = EMPTY;
         for &v in window {
