@@ -27,7 +27,15 @@ pub enum Side {
 impl Plane {
     /// Plane through `point` with unit normal `normal` (normalised here; must be non-zero).
     pub fn from_point_normal(point: Vec3, normal: Vec3) -> Self {
-        let normal = normal.normalize();
+        Self::from_point_normal_of_length(point, normal, normal.length())
+    }
+
+    /// [`Plane::from_point_normal`] for a `normal` whose length `length` (its `length()`) the
+    /// caller already has: the same normalisation (`normalize`: times the length's
+    /// reciprocal), so the same bits, without a second square root.
+    #[inline]
+    pub fn from_point_normal_of_length(point: Vec3, normal: Vec3, length: Real) -> Self {
+        let normal = normal * length.recip();
         Self {
             normal,
             offset: normal.dot(point),

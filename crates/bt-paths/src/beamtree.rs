@@ -376,6 +376,13 @@ impl<'a> Prepared<'a> {
         })
     }
 
+    /// Occluder `s`'s edges as [`shadow`] reads them, moved inward by the cover margin.
+    fn shadow_edges(&self, s: u32) -> &[ShadowEdge] {
+        self.shapes.shadow_edges[s as usize].get_or_init(|| {
+            shadow_edges(&self.scene.surface(SurfaceId(s)).polygon, COVER * self.tol)
+        })
+    }
+
     /// The surfaces whose boxes the segment `a -> q` touches (grown by the tolerance) among
     /// those that may occlude, each at most once and in no particular order: the scene's
     /// BVH, or with penetrable surfaces the opaque ones' ([`Opaque`]). Callers still test
@@ -458,6 +465,8 @@ struct Shapes {
     margin: Real,
     hulls: Vec<OnceLock<Vec<Vec3>>>,
     convex: Vec<OnceLock<bool>>,
+    /// Per occluder, its edges as [`shadow`] reads them ([`shadow_edges`]), made on first use.
+    shadow_edges: Vec<OnceLock<Box<[ShadowEdge]>>>,
     opaque: OnceLock<Option<Opaque>>,
 }
 
@@ -504,6 +513,7 @@ impl Shapes {
             margin,
             hulls: (0..n).map(|_| OnceLock::new()).collect(),
             convex: (0..n).map(|_| OnceLock::new()).collect(),
+            shadow_edges: (0..n).map(|_| OnceLock::new()).collect(),
             opaque: OnceLock::new(),
         }
     }
@@ -1481,13 +1491,7 @@ fn side_plane(apex: Vec3, (w, v): (Vec3, Vec3), facing: &Facing) -> Option<Plane
     if !(len > 0.0 && 1.2e-16 * ae <= MAX_NORMAL_ERROR * len) {
         return None;
     }
-    // `Plane::from_point_normal`'s normalisation (`normalize`: times the length's
-    // reciprocal), with the length already at hand: the same bits.
-    let unit = normal * len.recip();
-    let side = Plane {
-        normal: unit,
-        offset: unit.dot(apex),
-    };
+    let side = Plane::from_point_normal_of_length(apex, normal, len);
     Some(if facing.outward { flip(side) } else { side })
 }
 
@@ -1570,7 +1574,7 @@ fn occlude(
         let polygon = &scene.surface(SurfaceId(o)).polygon;
         if between(polygon.plane(), &starts, &scratch.a, margin)
             && matches!(
-                shadow(polygon, parent.apex, &scratch.a, margin),
+                shadow(prep.shadow_edges(o), parent.apex, &scratch.a),
                 Shadow::Covers
             )
         {
@@ -1613,7 +1617,7 @@ fn occlude(
             if !between(polygon.plane(), &starts, &scratch.a, margin) {
                 continue;
             }
-            match shadow(polygon, parent.apex, &scratch.a, margin) {
+            match shadow(prep.shadow_edges(o), parent.apex, &scratch.a) {
                 Shadow::Covers => {
                     stats.occluders.push(o);
                     scratch.last_cover = Some(o);
@@ -1725,28 +1729,44 @@ enum Shadow {
     None,
 }
 
-/// The shadow of the convex `occluder` from `apex` on the window's vertices. Each occluder edge,
-/// moved inward by `margin` in the occluder's plane, spans a plane with the apex.
-fn shadow(occluder: &bt_geom::Polygon, apex: Vec3, window: &[Vec3], margin: Real) -> Shadow {
+/// An occluder's edge as [`shadow`] reads it: its start moved inward by the cover margin in
+/// the occluder's plane, its direction (start to end, m) and the inward unit normal.
+type ShadowEdge = (Vec3, Vec3, Vec3);
+
+/// The [`ShadowEdge`]s of the convex `occluder`, its edges moved inward by `margin` (m): what
+/// [`shadow`] needs of the occluder alone, made once per occluder and trace.
+fn shadow_edges(occluder: &bt_geom::Polygon, margin: Real) -> Box<[ShadowEdge]> {
     let v = occluder.vertices();
     let n = v.len();
     let normal = occluder.plane().normal;
+    (0..n)
+        .map(|i| {
+            let (a, b) = (v[i], v[if i + 1 == n { 0 } else { i + 1 }]);
+            let dir = b - a;
+            let mut inward = normal.cross(dir).normalize_or_zero();
+            if (occluder.centroid() - a).dot(inward) < 0.0 {
+                inward = -inward;
+            }
+            (a + margin * inward, dir, inward)
+        })
+        .collect()
+}
+
+/// The shadow from `apex` on the window's vertices of a convex occluder, given by its
+/// [`shadow_edges`]: each edge, moved inward, spans a plane with the apex.
+fn shadow(edges: &[ShadowEdge], apex: Vec3, window: &[Vec3]) -> Shadow {
     let mut open: Option<Plane> = None;
-    for i in 0..n {
-        let (a, b) = (v[i], v[if i + 1 == n { 0 } else { i + 1 }]);
-        let dir = b - a;
-        let mut inward = normal.cross(dir).normalize_or_zero();
-        if (occluder.centroid() - a).dot(inward) < 0.0 {
-            inward = -inward;
-        }
-        let moved = a + margin * inward;
+    for &(moved, dir, inward) in edges {
         let pn = (moved - apex).cross(dir);
-        let scale2 = (moved - apex).length_squared() * dir.length_squared();
-        if !spans_a_plane(pn.length_squared(), scale2) {
+        let (len2, scale2) = (
+            pn.length_squared(),
+            (moved - apex).length_squared() * dir.length_squared(),
+        );
+        if !spans_a_plane(len2, scale2) {
             return Shadow::None;
         }
-        // `from_point_normal` normalises.
-        let plane = orient_towards(Plane::from_point_normal(apex, pn), moved + inward);
+        let plane = Plane::from_point_normal_of_length(apex, pn, len2.sqrt());
+        let plane = orient_towards(plane, moved + inward);
         if window
             .iter()
             .all(|q| plane.signed_distance_unfused(*q) > 0.0)
