@@ -301,6 +301,9 @@ struct Prepared<'a> {
     tol: Real,
     /// Each surface's plane, contiguous (the leaf test reads one per child).
     planes: Vec<Plane>,
+    /// Each surface's box `(min, max)` (its polygon's bounds, m), contiguous: the reach
+    /// lists' and small scenes' box tests read one per surface a walk reaches.
+    boxes: Vec<(Vec3, Vec3)>,
     /// Hulls and convexity, from and back to the caller's [`TreeCache`].
     shapes: Shapes,
     reflectors: Vec<u32>,
@@ -346,6 +349,7 @@ impl<'a> Prepared<'a> {
         let tol = scene.length_tolerance();
         Ok(Prepared {
             planes: surfaces.iter().map(|s| *s.polygon.plane()).collect(),
+            boxes: surfaces.iter().map(|s| s.polygon.bounds()).collect(),
             shapes: Shapes::take(&mut cache.shapes, scene, GROW * tol),
             is_reflector: surfaces
                 .iter()
@@ -1042,7 +1046,7 @@ impl BeamTree {
         }
         if prep.reflectors.len() <= LINEAR_SCAN {
             out.extend(prep.reflectors.iter().copied().filter(|&s| {
-                let (lo, hi) = prep.scene.surface(SurfaceId(s)).polygon.bounds();
+                let (lo, hi) = prep.boxes[s as usize];
                 Some(s) != parent.surface
                     && may_end(s)
                     && (leaf_level || box_meets_halfspaces(lo, hi, parent.planes, eps))
