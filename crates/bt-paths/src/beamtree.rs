@@ -301,9 +301,6 @@ struct Prepared<'a> {
     tol: Real,
     /// Each surface's plane, contiguous (the leaf test reads one per child).
     planes: Vec<Plane>,
-    /// Each surface's box `(min, max)` (its polygon's bounds, m), contiguous: the reach
-    /// lists' and small scenes' box tests read one per surface a walk reaches.
-    boxes: Vec<(Vec3, Vec3)>,
     /// Hulls and convexity, from and back to the caller's [`TreeCache`].
     shapes: Shapes,
     reflectors: Vec<u32>,
@@ -349,7 +346,6 @@ impl<'a> Prepared<'a> {
         let tol = scene.length_tolerance();
         Ok(Prepared {
             planes: surfaces.iter().map(|s| *s.polygon.plane()).collect(),
-            boxes: surfaces.iter().map(|s| s.polygon.bounds()).collect(),
             shapes: Shapes::take(&mut cache.shapes, scene, GROW * tol),
             is_reflector: surfaces
                 .iter()
@@ -457,9 +453,10 @@ impl std::fmt::Debug for TreeCache {
     }
 }
 
-/// Per-surface shapes derived from the geometry alone: each reflector's convex hull grown by
-/// `margin` (m), each surface's convexity and the index of the opaque surfaces
-/// ([`Opaque`]), computed on first use. A [`TreeCache`] keeps the
+/// Per-surface shapes derived from the geometry alone: each surface's box, and, computed on
+/// first use, each reflector's convex hull grown by `margin` (m), each surface's convexity,
+/// each occluder's shadow edges and the index of the opaque surfaces ([`Opaque`]). A
+/// [`TreeCache`] keeps the
 /// last build's for its next one of the same geometry, so that hulls are not rebuilt every
 /// trace. Unlike the [`Arenas`], they are kept whatever their size: they grow with the scene,
 /// not with a tree.
@@ -467,6 +464,9 @@ impl std::fmt::Debug for TreeCache {
 struct Shapes {
     geometry: Option<bt_scene::GeometryKey>,
     margin: Real,
+    /// Each surface's box `(min, max)` (its polygon's bounds, m), contiguous: the reach
+    /// lists' and small scenes' box tests read one per surface a walk reaches.
+    boxes: Vec<(Vec3, Vec3)>,
     hulls: Vec<OnceLock<Vec<Vec3>>>,
     convex: Vec<OnceLock<bool>>,
     /// Per occluder, its edges as [`shadow`] reads them ([`shadow_edges`]), made on first use.
@@ -515,6 +515,9 @@ impl Shapes {
         Shapes {
             geometry: Some(scene.geometry_key()),
             margin,
+            boxes: (scene.surfaces().iter())
+                .map(|s| s.polygon.bounds())
+                .collect(),
             hulls: (0..n).map(|_| OnceLock::new()).collect(),
             convex: (0..n).map(|_| OnceLock::new()).collect(),
             shadow_edges: (0..n).map(|_| OnceLock::new()).collect(),
@@ -1046,7 +1049,7 @@ impl BeamTree {
         }
         if prep.reflectors.len() <= LINEAR_SCAN {
             out.extend(prep.reflectors.iter().copied().filter(|&s| {
-                let (lo, hi) = prep.boxes[s as usize];
+                let (lo, hi) = prep.shapes.boxes[s as usize];
                 Some(s) != parent.surface
                     && may_end(s)
                     && (leaf_level || box_meets_halfspaces(lo, hi, parent.planes, eps))

@@ -201,7 +201,7 @@ fn reached(
             |lo, hi| box_meets_halfspaces(lo, hi, &planes, margin),
             |s| {
                 if s != c && prep.is_reflector[s as usize] {
-                    let (lo, hi) = prep.boxes[s as usize];
+                    let (lo, hi) = prep.shapes.boxes[s as usize];
                     let hull = prep.hull(s);
                     let near = |p: &Plane| {
                         hull.iter()
